@@ -1,0 +1,77 @@
+//! Compiles every GLSL stage in `glsl/` to SPIR-V in OUT_DIR, with `glsl/shared/` as the include
+//! directory and the constants of `src/constants.rs` injected as macros.
+use std::path::{Path, PathBuf};
+
+#[allow(dead_code)]
+mod constants {
+    include!("src/constants.rs");
+}
+
+fn main() {
+    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
+    let glsl = Path::new("glsl");
+    println!("cargo:rerun-if-changed=src/constants.rs");
+    println!("cargo:rerun-if-changed=glsl");
+
+    let mut shared: Vec<PathBuf> = std::fs::read_dir(glsl.join("shared"))
+        .expect("glsl/shared exists")
+        .map(|e| e.unwrap().path())
+        .collect();
+    shared.sort();
+    for p in &shared {
+        println!("cargo:rerun-if-changed={}", p.display());
+    }
+
+    let mut stages: Vec<PathBuf> = std::fs::read_dir(glsl)
+        .expect("glsl exists")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .collect();
+    stages.sort();
+
+    let compiler = shaderc::Compiler::new().expect("shaderc compiler");
+    let mut failed = Vec::new();
+    for path in &stages {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        let kind = match ext {
+            "comp" => shaderc::ShaderKind::Compute,
+            "vert" => shaderc::ShaderKind::Vertex,
+            "frag" => shaderc::ShaderKind::Fragment,
+            _ => continue,
+        };
+        let source = std::fs::read_to_string(path).unwrap();
+        let mut opts = shaderc::CompileOptions::new().unwrap();
+        opts.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
+        opts.set_optimization_level(shaderc::OptimizationLevel::Performance);
+        opts.set_generate_debug_info();
+        for (name, value) in constants::GLSL_DEFINES {
+            opts.add_macro_definition(name, Some(&value.to_string()));
+        }
+        let shared_dir = glsl.join("shared");
+        opts.set_include_callback(move |name, _ty, _from, _depth| {
+            let p = shared_dir.join(name);
+            std::fs::read_to_string(&p)
+                .map(|content| shaderc::ResolvedInclude {
+                    resolved_name: p.display().to_string(),
+                    content,
+                })
+                .map_err(|e| format!("cannot include {}: {e}", p.display()))
+        });
+        let file = path.display().to_string();
+        match compiler.compile_into_spirv(&source, kind, &file, "main", Some(&opts)) {
+            Ok(art) => {
+                let name = path.file_name().unwrap().to_str().unwrap();
+                std::fs::write(out.join(format!("{name}.spv")), art.as_binary_u8()).unwrap();
+            }
+            // shaderc's message already carries "file:line: error: ...".
+            Err(e) => failed.push(e.to_string()),
+        }
+    }
+    if !failed.is_empty() {
+        for f in &failed {
+            eprintln!("{f}");
+        }
+        panic!("GLSL compilation failed:\n{}", failed.join("\n"));
+    }
+}

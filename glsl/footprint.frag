@@ -1,0 +1,26 @@
+#version 450
+// Footprint stage, fragment half: weight of the pre-integrated kernel at this pixel's point on the
+// quad, as optical depth. Per-splat mode emits premultiplied colour and alpha = 1 - exp(-tau) for
+// over/under blending; sheet mode emits (rgb * tau, tau) for additive summation. Mirror: cpu::footprint.
+#include "types.glsl"
+#include "footprint_table.glsl"
+
+layout(binding = 5) uniform sampler2D table;
+layout(push_constant) uniform Push {
+    uint sheet_mode;
+} pc;
+
+layout(location = 0) in vec2 in_uv;
+layout(location = 1) flat in vec4 in_emit;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    float tau = in_emit.a * sample_table(table, in_uv);
+    if (tau <= 0.0) discard;
+    if (pc.sheet_mode != 0u) {
+        out_color = vec4(in_emit.rgb * tau, tau);
+    } else {
+        float a = 1.0 - exp(-tau);
+        out_color = vec4(in_emit.rgb * a, a);
+    }
+}

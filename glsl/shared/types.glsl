@@ -1,0 +1,36 @@
+// GPU structs and constants shared by every stage.
+// Keep in sync with src/gpu_types.rs (sizes are asserted there).
+#ifndef VOXSPLAT_TYPES_GLSL
+#define VOXSPLAT_TYPES_GLSL
+
+// One extracted (non-empty) voxel; camera independent. 32 bytes.
+struct Splat {
+    uvec4 ijk;    // grid index i, j, k; w: unused
+    vec4 color;   // straight rgb; a: opacity of one voxel-length of material, in [0, 1)
+};
+
+// Output of splat_params, input of the footprint stage. 64 bytes.
+struct SplatParams {
+    vec4 center;  // world-space centre; w: 1 if drawn, 0 if culled
+    vec4 axis_u;  // world-space half-extent vector of the footprint quad; w: energy scale
+    vec4 axis_v;  // second half-extent vector, perpendicular to axis_u and to the eye ray; w: unused
+    vec4 emit;    // rgb colour; a: optical depth at the kernel centre per unit footprint (tau)
+};
+
+// Per-frame uniforms (std140, vec4-only so the Rust mirror is plain repr(C)). 192 bytes.
+struct Frame {
+    mat4 view_proj;   // world -> clip (Vulkan: y down, depth 0..1)
+    vec4 eye;         // world eye position; w: 1 perspective, 0 orthographic
+    vec4 forward;     // unit view direction; w: near distance
+    vec4 right;       // unit camera right; w: far distance
+    vec4 up;          // unit camera up; w: unused
+    vec4 origin;      // world position of voxel (0,0,0); w: footprint radius in voxels
+    vec4 spacing;     // voxel spacing xyz; w: world footprint radius
+    uvec4 dims;       // nx, ny, nz; w: splat count
+    uvec4 split;      // PBTF: voxels per axis on the low side of the eye; w: 1 = back-to-front
+};
+
+#define KERNEL_GAUSSIAN 0u
+#define KERNEL_CUBIC 1u
+
+#endif

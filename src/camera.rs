@@ -1,0 +1,133 @@
+//! Perspective and orthographic cameras. World space is right-handed; eye space is the rigid
+//! transform looking down -z (section 3.3.1); clip space follows Vulkan (y down, depth 0..1), so
+//! image row 0 is the top of the picture.
+use crate::error::{Error, Result};
+use crate::volume::Grid;
+use glam::{Mat4, Vec3, Vec4};
+
+/// Largest image side accepted.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Vertical field of view in degrees, in (0, 180).
+    Perspective { fov_y_deg: f32 },
+    /// World-space height of the view.
+    Orthographic { height: f32 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub projection: Projection,
+    pub near: f32,
+    pub far: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Camera {
+    /// A three-quarter perspective view that frames `grid` at the given image size.
+    pub fn framing(grid: &Grid, width: u32, height: u32) -> Self {
+        let center = grid.center();
+        let radius = 0.5 * grid.diagonal().max(1.0);
+        let fov = 35.0f32;
+        let dist = radius / (0.5 * fov.to_radians()).sin() * 1.05;
+        let dir = Vec3::new(0.55, 0.45, 1.0).normalize();
+        Self {
+            eye: center + dir * dist,
+            target: center,
+            up: Vec3::Y,
+            projection: Projection::Perspective { fov_y_deg: fov },
+            near: (dist - radius * 1.5).max(dist * 0.01),
+            far: dist + radius * 1.5,
+            width,
+            height,
+        }
+    }
+
+    /// Check every value; a camera that passes always yields finite matrices.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: &str| Err(Error::InvalidCamera(m.to_string()));
+        if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
+            return bad("eye, target and up must be finite");
+        }
+        if self.width == 0 || self.height == 0 {
+            return bad("image size must be at least 1x1");
+        }
+        if self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
+            return Err(Error::InvalidCamera(format!("image sides must be at most {MAX_IMAGE_SIDE}")));
+        }
+        let view = self.target - self.eye;
+        if view.length() < 1e-6 * (1.0 + self.eye.length()) {
+            return bad("eye and target coincide");
+        }
+        if self.up.length() < 1e-12 || view.normalize().cross(self.up.normalize()).length() < 1e-4 {
+            return bad("up is zero or parallel to the view direction");
+        }
+        if !(self.near.is_finite() && self.far.is_finite()) || self.far <= self.near {
+            return bad("near and far must be finite with far > near");
+        }
+        match self.projection {
+            Projection::Perspective { fov_y_deg } => {
+                if !(fov_y_deg.is_finite() && fov_y_deg > 0.0 && fov_y_deg < 180.0) {
+                    return bad("field of view must be in (0, 180) degrees");
+                }
+                if self.near <= 0.0 {
+                    return bad("perspective near distance must be positive");
+                }
+            }
+            Projection::Orthographic { height } => {
+                if !(height.is_finite() && height > 0.0) {
+                    return bad("orthographic view height must be positive");
+                }
+            }
+        }
+        Ok(())
+    }
+
+    pub fn is_perspective(&self) -> bool {
+        matches!(self.projection, Projection::Perspective { .. })
+    }
+
+    pub fn forward(&self) -> Vec3 {
+        (self.target - self.eye).normalize()
+    }
+
+    pub fn right(&self) -> Vec3 {
+        self.forward().cross(self.up).normalize()
+    }
+
+    pub fn true_up(&self) -> Vec3 {
+        self.right().cross(self.forward())
+    }
+
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    pub fn view(&self) -> Mat4 {
+        Mat4::look_at_rh(self.eye, self.target, self.up)
+    }
+
+    /// Projection with Vulkan's downward y.
+    pub fn proj(&self) -> Mat4 {
+        let mut p = match self.projection {
+            Projection::Perspective { fov_y_deg } => {
+                Mat4::perspective_rh(fov_y_deg.to_radians(), self.aspect(), self.near, self.far)
+            }
+            Projection::Orthographic { height } => {
+                let (h, w) = (0.5 * height, 0.5 * height * self.aspect());
+                Mat4::orthographic_rh(-w, w, -h, h, self.near, self.far)
+            }
+        };
+        p.y_axis = Vec4::new(p.y_axis.x, -p.y_axis.y, p.y_axis.z, p.y_axis.w);
+        p
+    }
+
+    pub fn view_proj(&self) -> Mat4 {
+        self.proj() * self.view()
+    }
+}

@@ -1,0 +1,21 @@
+// Shared by the library and build.rs (which injects each one into every GLSL stage as a macro),
+// so the workgroup sizes and table sizes have a single source of truth.
+
+/// Invocations per workgroup for the 1D compute stages (order, splat_params).
+pub const WORKGROUP_SIZE: u32 = 256;
+/// Invocations of the single-workgroup prefix sum in `order_scan`.
+pub const SCAN_WORKGROUP_SIZE: u32 = 256;
+/// Side of the square composite tile (`composite.comp` runs TILE×TILE invocations).
+pub const COMPOSITE_TILE: u32 = 8;
+/// Texels per side of the pre-integrated footprint table.
+pub const FOOTPRINT_TABLE_SIZE: u32 = 64;
+/// Workgroups per dispatch row: larger 1D dispatches spill into y so they stay under the 65535 limit.
+pub const MAX_GROUPS_X: u32 = 32768;
+
+/// Macros injected into GLSL (name, value).
+pub const GLSL_DEFINES: &[(&str, u32)] = &[
+    ("WORKGROUP_SIZE", WORKGROUP_SIZE),
+    ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
+    ("COMPOSITE_TILE", COMPOSITE_TILE),
+    ("FOOTPRINT_TABLE_SIZE", FOOTPRINT_TABLE_SIZE),
+];

@@ -1,0 +1,25 @@
+//! CPU mirrors of the GPU stages, one function per stage with the stage's name, written loop for
+//! loop like the shaders and reading the same `#[repr(C)]` structs.
+pub mod composite;
+pub mod footprint;
+pub mod order;
+pub mod splat_params;
+
+pub use composite::composite;
+pub use footprint::{footprint, sample_table};
+pub use order::{order_count, order_scan, order_scatter};
+pub use splat_params::splat_params;
+
+/// An RGBA32F image, row 0 at the top. Colour is premultiplied by alpha.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageF32 {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 4]>,
+}
+
+impl ImageF32 {
+    pub fn new(width: u32, height: u32) -> Self {
+        Self { width, height, pixels: vec![[0.0; 4]; width as usize * height as usize] }
+    }
+}

@@ -1,0 +1,32 @@
+//! Mirror of `splat_params.comp`.
+use crate::gpu_types::{Frame, Splat, SplatParams};
+use glam::Vec3;
+
+pub const MAX_OPACITY: f32 = 0.999;
+/// Splats closer than this many radii to the near or far plane are culled (the quad's corners
+/// must stay in front of the eye; 1.5 > sqrt 2).
+pub const CULL_RADII: f32 = 1.5;
+
+pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams]) {
+    let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+    let (eye, forward, right, origin, spacing) =
+        (v3(frame.eye), v3(frame.forward), v3(frame.right), v3(frame.origin), v3(frame.spacing));
+    let radius = frame.spacing[3];
+    for (s, sp) in splats.iter().enumerate().take(frame.dims[3] as usize) {
+        let ijk = Vec3::new(sp.ijk[0] as f32, sp.ijk[1] as f32, sp.ijk[2] as f32);
+        let center = origin + ijk * spacing;
+        let depth = (center - eye).dot(forward);
+        let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
+        let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
+        let u = (right - right.dot(w) * w).normalize();
+        let v = w.cross(u);
+        let opacity = sp.color[3].clamp(0.0, MAX_OPACITY);
+        let tau = -(1.0 - opacity).ln();
+        params[s] = SplatParams {
+            center: [center.x, center.y, center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
+            axis_u: [u.x * radius, u.y * radius, u.z * radius, 1.0],
+            axis_v: [v.x * radius, v.y * radius, v.z * radius, 0.0],
+            emit: [sp.color[0], sp.color[1], sp.color[2], tau],
+        };
+    }
+}

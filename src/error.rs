@@ -1,0 +1,47 @@
+use ash::vk;
+
+/// Everything that can go wrong, split by concern so callers can tell their input from the device.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A bad argument: NaN, zero size, unknown name, out-of-range value.
+    #[error("invalid argument: {0}")]
+    InvalidArgument(String),
+    /// The camera cannot form a view (eye at target, up parallel to the view, bad angles).
+    #[error("invalid camera: {0}")]
+    InvalidCamera(String),
+    /// The scene exceeds a configured limit.
+    #[error("scene too large: {0}")]
+    TooLarge(String),
+    /// No usable Vulkan device or a missing feature / layer.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+    /// Device or host memory ran out.
+    #[error("out of memory while allocating {0}")]
+    OutOfMemory(String),
+    /// A Vulkan call failed.
+    #[error("Vulkan call {call} failed: {result}")]
+    Vulkan { call: &'static str, result: vk::Result },
+    /// The Vulkan loader could not be opened.
+    #[error("cannot load Vulkan: {0}")]
+    Loader(String),
+    /// Reading or writing a file.
+    #[error("I/O error on {path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    /// Encoding an output image.
+    #[error("cannot write image {path}: {message}")]
+    Image { path: String, message: String },
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    pub(crate) fn vk(call: &'static str) -> impl FnOnce(vk::Result) -> Error {
+        move |result| match result {
+            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+                Error::OutOfMemory(call.to_string())
+            }
+            result => Error::Vulkan { call, result },
+        }
+    }
+}

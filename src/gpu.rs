@@ -1,0 +1,399 @@
+//! The stage list executed on Vulkan through the safe `vk` layer.
+use crate::camera::Camera;
+use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE};
+use crate::cpu::ImageF32;
+use crate::error::{Error, Result};
+use crate::gpu_types::{CompositePush, FootprintPush, Frame, SplatParams};
+use crate::kernel::Kernel;
+use crate::order::{self, Direction, OrderKind};
+use crate::pipeline::{groups_1d, make_frame, sheet_plan, Composite, Prepared, RenderOptions, Rendered, StageTime};
+use crate::vk::{
+    Bind, Blend, Buffer, BufferUsageFlags as BU, Context, DescriptorSet, Format, Framebuffer, Image, ImageLayout as IL,
+    ImageUsageFlags as IU, Layout, Memory, Pipeline, RenderPass, Sampler, ShaderStageFlags as SS, Slot, Stage, Timer,
+};
+use std::sync::Arc;
+
+macro_rules! spirv {
+    ($name:literal) => {
+        include_bytes!(concat!(env!("OUT_DIR"), "/", $name, ".spv"))
+    };
+}
+
+const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
+
+struct Stages {
+    order_layout: Layout,
+    order_count: Pipeline,
+    order_scan: Pipeline,
+    order_scatter: Pipeline,
+    params_layout: Layout,
+    splat_params: Pipeline,
+    footprint_layout: Layout,
+    target_pass: RenderPass,
+    sheet_pass: RenderPass,
+    over: Pipeline,
+    under: Pipeline,
+    add: Pipeline,
+    composite_layout: Layout,
+    composite: Pipeline,
+}
+
+struct SceneGpu {
+    n: u32,
+    rows: u32,
+    _splats: Buffer,
+    _row_start: Buffer,
+    _row_split: Buffer,
+    _segments: Buffer,
+    order: Buffer,
+    _params: Buffer,
+    _draw: [Buffer; 3],
+    _ranks: Buffer,
+    order_set: DescriptorSet,
+    params_set: DescriptorSet,
+    /// Footprint sets: 0 = visibility order, 1..=3 = slice-grouped lists of axes x, y, z.
+    footprint_sets: Vec<DescriptorSet>,
+}
+
+struct TargetGpu {
+    width: u32,
+    height: u32,
+    layers: u32,
+    color: Image,
+    color_fb: Framebuffer,
+    _sums: Image,
+    sums_fb: Framebuffer,
+    accum: Image,
+    composite_set: DescriptorSet,
+    readback: Buffer,
+}
+
+pub struct GpuPipeline {
+    stages: Stages,
+    frame: Buffer,
+    table: Image,
+    sampler: Sampler,
+    kernel: Option<Kernel>,
+    scene: Option<SceneGpu>,
+    target: Option<TargetGpu>,
+    timer: Timer,
+    ctx: Arc<Context>,
+}
+
+fn storage(ctx: &Arc<Context>, name: &str, data: &[u8]) -> Result<Buffer> {
+    Buffer::with_data(ctx, name, data, BU::STORAGE_BUFFER)
+}
+
+impl GpuPipeline {
+    pub fn new(ctx: Arc<Context>) -> Result<Self> {
+        let compute = SS::COMPUTE;
+        let order_layout = Layout::new(
+            &ctx,
+            &[Slot::Uniform, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage],
+            compute,
+            0,
+        )?;
+        let params_layout = Layout::new(&ctx, &[Slot::Uniform, Slot::Storage, Slot::Storage], compute, 0)?;
+        let footprint_layout = Layout::new(
+            &ctx,
+            &[Slot::Uniform, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Texture],
+            SS::VERTEX | SS::FRAGMENT,
+            std::mem::size_of::<FootprintPush>() as u32,
+        )?;
+        let composite_layout = Layout::new(
+            &ctx,
+            &[Slot::StorageImage, Slot::StorageImage],
+            compute,
+            std::mem::size_of::<CompositePush>() as u32,
+        )?;
+        let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
+        let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
+        let (vert, frag) = (spirv!("footprint.vert"), spirv!("footprint.frag"));
+        let stages = Stages {
+            order_count: Pipeline::compute(&ctx, &order_layout, spirv!("order_count.comp"))?,
+            order_scan: Pipeline::compute(&ctx, &order_layout, spirv!("order_scan.comp"))?,
+            order_scatter: Pipeline::compute(&ctx, &order_layout, spirv!("order_scatter.comp"))?,
+            splat_params: Pipeline::compute(&ctx, &params_layout, spirv!("splat_params.comp"))?,
+            over: Pipeline::graphics(&ctx, &footprint_layout, &target_pass, vert, frag, Blend::Over)?,
+            under: Pipeline::graphics(&ctx, &footprint_layout, &target_pass, vert, frag, Blend::Under)?,
+            add: Pipeline::graphics(&ctx, &footprint_layout, &sheet_pass, vert, frag, Blend::Add)?,
+            composite: Pipeline::compute(&ctx, &composite_layout, spirv!("composite.comp"))?,
+            order_layout,
+            params_layout,
+            footprint_layout,
+            composite_layout,
+            target_pass,
+            sheet_pass,
+        };
+        let frame = Buffer::new(&ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::UNIFORM_BUFFER, Memory::Upload)?;
+        let n = FOOTPRINT_TABLE_SIZE;
+        let table = Image::new(&ctx, "footprint table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
+        let sampler = Sampler::nearest(&ctx)?;
+        let timer = Timer::new(&ctx, 16)?;
+        Ok(Self { stages, frame, table, sampler, kernel: None, scene: None, target: None, timer, ctx })
+    }
+
+    pub fn context(&self) -> &Arc<Context> {
+        &self.ctx
+    }
+
+    fn upload_table(&mut self, kernel: Kernel) -> Result<()> {
+        if self.kernel == Some(kernel) {
+            return Ok(());
+        }
+        let data = kernel.footprint_table();
+        let staging = Buffer::with_data(&self.ctx, "table staging", bytemuck::cast_slice(&data), BU::TRANSFER_SRC)?;
+        let table = &self.table;
+        self.ctx.submit(|rec| {
+            rec.transition(table, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::Graphics, Stage::Transfer);
+            rec.copy_buffer_to_image(&staging, table);
+            rec.transition(table, IL::TRANSFER_DST_OPTIMAL, IL::SHADER_READ_ONLY_OPTIMAL, Stage::Transfer, Stage::Graphics);
+            Ok(())
+        })?;
+        self.kernel = Some(kernel);
+        // Footprint sets reference the table image itself, not its contents: no rebinding needed.
+        Ok(())
+    }
+
+    /// Upload a scene's splats, rows and slice lists; descriptor sets are rebuilt.
+    pub fn set_scene(&mut self, prep: &Prepared) -> Result<()> {
+        self.ctx.wait_idle();
+        self.scene = None;
+        let ctx = &self.ctx;
+        let set = &prep.set;
+        let n = set.len() as u32;
+        let rows = (set.row_start().len() - 1) as u32;
+        let splats = storage(ctx, "splats", bytemuck::cast_slice(set.splats()))?;
+        let row_start = storage(ctx, "row_start", bytemuck::cast_slice(set.row_start()))?;
+        let row_split = Buffer::new(ctx, "row_split", rows as u64 * 4, BU::STORAGE_BUFFER, Memory::Device)?;
+        let segments = Buffer::new(ctx, "segments", rows as u64 * 8, BU::STORAGE_BUFFER, Memory::Device)?;
+        let order = Buffer::new(ctx, "order", n as u64 * 4, BU::STORAGE_BUFFER, Memory::Upload)?;
+        let params = Buffer::new(
+            ctx,
+            "params",
+            n as u64 * std::mem::size_of::<SplatParams>() as u64,
+            BU::STORAGE_BUFFER,
+            Memory::Device,
+        )?;
+        let draw = [
+            storage(ctx, "slices x", bytemuck::cast_slice(&prep.slices[0].1))?,
+            storage(ctx, "slices y", bytemuck::cast_slice(&prep.slices[1].1))?,
+            storage(ctx, "slices z", bytemuck::cast_slice(&prep.slices[2].1))?,
+        ];
+        let ranks = storage(ctx, "sheet ranks", bytemuck::cast_slice(&prep.ranks))?;
+        let st = &self.stages;
+        let order_set = st.order_layout.bind(&[
+            Bind::Buffer(&self.frame),
+            Bind::Buffer(&splats),
+            Bind::Buffer(&row_start),
+            Bind::Buffer(&row_split),
+            Bind::Buffer(&segments),
+            Bind::Buffer(&order),
+        ])?;
+        let params_set =
+            st.params_layout.bind(&[Bind::Buffer(&self.frame), Bind::Buffer(&splats), Bind::Buffer(&params)])?;
+        let mut footprint_sets = Vec::new();
+        for list in [&order, &draw[0], &draw[1], &draw[2]] {
+            footprint_sets.push(st.footprint_layout.bind(&[
+                Bind::Buffer(&self.frame),
+                Bind::Buffer(&params),
+                Bind::Buffer(list),
+                Bind::Buffer(&splats),
+                Bind::Buffer(&ranks),
+                Bind::Texture(&self.table, &self.sampler),
+            ])?);
+        }
+        self.scene = Some(SceneGpu {
+            n,
+            rows,
+            _splats: splats,
+            _row_start: row_start,
+            _row_split: row_split,
+            _segments: segments,
+            order,
+            _params: params,
+            _draw: draw,
+            _ranks: ranks,
+            order_set,
+            params_set,
+            footprint_sets,
+        });
+        Ok(())
+    }
+
+    fn ensure_target(&mut self, width: u32, height: u32, layers: u32) -> Result<()> {
+        if let Some(t) = &self.target {
+            if t.width == width && t.height == height && t.layers == layers {
+                return Ok(());
+            }
+        }
+        self.ctx.wait_idle();
+        self.target = None;
+        let ctx = &self.ctx;
+        let color = Image::new(ctx, "color", (width, height, 1), COLOR_FORMAT, IU::COLOR_ATTACHMENT | IU::TRANSFER_SRC, false)?;
+        let color_fb = Framebuffer::new(ctx, &self.stages.target_pass, &color)?;
+        let sums = Image::new(ctx, "sheet sums", (width, height, layers), COLOR_FORMAT, IU::COLOR_ATTACHMENT | IU::STORAGE, true)?;
+        let sums_fb = Framebuffer::new(ctx, &self.stages.sheet_pass, &sums)?;
+        let accum = Image::new(
+            ctx,
+            "accumulation",
+            (width, height, 1),
+            COLOR_FORMAT,
+            IU::STORAGE | IU::TRANSFER_SRC | IU::TRANSFER_DST,
+            false,
+        )?;
+        let composite_set = self.stages.composite_layout.bind(&[Bind::Image(&sums), Bind::Image(&accum)])?;
+        let readback = Buffer::new(ctx, "readback", width as u64 * height as u64 * 16, BU::TRANSFER_DST, Memory::Readback)?;
+        self.target =
+            Some(TargetGpu { width, height, layers, color, color_fb, _sums: sums, sums_fb, accum, composite_set, readback });
+        Ok(())
+    }
+
+    /// Run the GPU PBTF order stage alone and read the draw sequence back.
+    pub fn order(&mut self, prep: &Prepared, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
+        camera.validate()?;
+        let split = order::pbtf_split(&prep.set, camera);
+        let frame = make_frame(&prep.set, camera, Kernel::Gaussian, split, direction == Direction::BackToFront);
+        self.frame.write(bytemuck::bytes_of(&frame))?;
+        let scene = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        let st = &self.stages;
+        self.ctx.submit(|rec| {
+            record_order(rec, st, scene);
+            Ok(())
+        })?;
+        let bytes = scene.order.read()?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&bytes[..scene.n as usize * 4]).to_vec())
+    }
+
+    pub fn render(&mut self, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Rendered> {
+        camera.validate()?;
+        let (max_side, max_layers) = self.ctx.image_limits();
+        if camera.width > max_side || camera.height > max_side {
+            return Err(Error::InvalidArgument(format!(
+                "image {}x{} exceeds the device's limit of {max_side} per side",
+                camera.width, camera.height
+            )));
+        }
+        self.upload_table(opts.kernel)?;
+        let (w, h) = (camera.width, camera.height);
+        let direction = opts.direction();
+        let btf = direction == Direction::BackToFront;
+        let layers = opts.batch_layers(w, h).min(max_layers.max(1));
+        let (axis, batches) = if opts.composite == Composite::Sheet {
+            sheet_plan(prep, camera, direction, layers)
+        } else {
+            (0, Vec::new())
+        };
+        // Allocate only as many layers as the largest batch needs.
+        let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
+        self.ensure_target(w, h, layers)?;
+        let split = order::pbtf_split(&prep.set, camera);
+        let frame = make_frame(&prep.set, camera, opts.kernel, split, btf);
+        self.frame.write(bytemuck::bytes_of(&frame))?;
+        let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;
+        if opts.composite == Composite::Splat && !gpu_order {
+            let cpu_order = order::visibility_order(&prep.set, camera, opts.order, direction);
+            scene.order.write(bytemuck::cast_slice(&cpu_order))?;
+        }
+        let needed = 3 + 2 * batches.len() as u32;
+        if self.timer.capacity < needed {
+            self.timer = Timer::new(&self.ctx, needed)?;
+        }
+        let (st, scene, target, timer) = (&self.stages, self.scene.as_ref().expect("set above"), self.target.as_ref().expect("ensured"), &self.timer);
+        let n = scene.n;
+        let stamps = self.ctx.submit(|rec| {
+            rec.reset_timer(timer);
+            rec.timestamp(timer, 0);
+            if gpu_order {
+                record_order(rec, st, scene);
+            }
+            rec.timestamp(timer, 1);
+            if n > 0 {
+                rec.dispatch(&st.splat_params, &st.params_layout, &scene.params_set, &[], groups_1d(n));
+            }
+            rec.barrier(Stage::Compute, Stage::Graphics);
+            rec.timestamp(timer, 2);
+            match opts.composite {
+                Composite::Splat => {
+                    rec.begin_pass(&st.target_pass, &target.color_fb);
+                    if n > 0 {
+                        let pipe = if btf { &st.over } else { &st.under };
+                        let push = FootprintPush::default();
+                        rec.draw_quads(pipe, &st.footprint_layout, &scene.footprint_sets[0], bytemuck::bytes_of(&push), 0, n);
+                    }
+                    rec.end_pass();
+                    rec.timestamp(timer, 3);
+                    rec.copy_image_to_buffer(&target.color, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
+                    Ok(4)
+                }
+                Composite::Sheet => {
+                    rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Transfer);
+                    rec.clear_image(&target.accum, IL::GENERAL, [0.0; 4]);
+                    rec.barrier(Stage::Transfer, Stage::Compute);
+                    let mut q = 3;
+                    for b in &batches {
+                        rec.begin_pass(&st.sheet_pass, &target.sums_fb);
+                        rec.draw_quads(
+                            &st.add,
+                            &st.footprint_layout,
+                            &scene.footprint_sets[1 + axis],
+                            bytemuck::bytes_of(&b.push),
+                            b.first_instance,
+                            b.instances,
+                        );
+                        rec.end_pass();
+                        rec.timestamp(timer, q);
+                        let push = CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
+                        let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
+                        rec.dispatch(&st.composite, &st.composite_layout, &target.composite_set, bytemuck::bytes_of(&push), groups);
+                        rec.barrier(Stage::Compute, Stage::Compute);
+                        rec.timestamp(timer, q + 1);
+                        q += 2;
+                    }
+                    rec.transition(&target.accum, IL::GENERAL, IL::TRANSFER_SRC_OPTIMAL, Stage::Compute, Stage::Transfer);
+                    rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
+                    Ok(q)
+                }
+            }
+        })?;
+        let mut timings = Vec::new();
+        if let Some(ms) = timer.read_ms(stamps)? {
+            timings.push(StageTime { stage: "order", ms: ms[0] });
+            timings.push(StageTime { stage: "splat_params", ms: ms[1] });
+            match opts.composite {
+                Composite::Splat => timings.push(StageTime { stage: "footprint", ms: ms[2] }),
+                Composite::Sheet => {
+                    // ms[2 + 2b] is batch b's raster (after the gap from params), ms[3 + 2b] its composite.
+                    let raster: f64 = ms.iter().skip(2).step_by(2).sum();
+                    let comp: f64 = ms.iter().skip(3).step_by(2).sum();
+                    timings.push(StageTime { stage: "footprint", ms: raster });
+                    timings.push(StageTime { stage: "composite", ms: comp });
+                }
+            }
+        }
+        let bytes = target.readback.read()?;
+        let floats: &[f32] = bytemuck::cast_slice(&bytes[..(w * h * 16) as usize]);
+        let pixels = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        Ok(Rendered { image: ImageF32 { width: w, height: h, pixels }, timings })
+    }
+}
+
+fn record_order(rec: &crate::vk::Recorder<'_>, st: &Stages, scene: &SceneGpu) {
+    if scene.n == 0 {
+        return;
+    }
+    rec.dispatch(&st.order_count, &st.order_layout, &scene.order_set, &[], groups_1d(scene.rows));
+    rec.barrier(Stage::Compute, Stage::Compute);
+    rec.dispatch(&st.order_scan, &st.order_layout, &scene.order_set, &[], [1, 1, 1]);
+    rec.barrier(Stage::Compute, Stage::Compute);
+    rec.dispatch(&st.order_scatter, &st.order_layout, &scene.order_set, &[], groups_1d(scene.n));
+    rec.barrier(Stage::Compute, Stage::Graphics);
+}
+
+impl Drop for GpuPipeline {
+    fn drop(&mut self) {
+        // Resources free themselves; make sure the GPU is done with them first.
+        self.ctx.wait_idle();
+    }
+}

@@ -1,0 +1,69 @@
+//! `#[repr(C)]` mirrors of the structs in `glsl/shared/types.glsl`. Keep in sync with that header;
+//! the size asserts catch drift.
+use bytemuck::{Pod, Zeroable};
+
+/// One extracted (non-empty) voxel.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Splat {
+    /// Grid index i, j, k; the fourth lane is unused.
+    pub ijk: [u32; 4],
+    /// Straight RGB and the opacity of one voxel-length of material.
+    pub color: [f32; 4],
+}
+
+/// Output of `splat_params`, input of `footprint`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SplatParams {
+    /// World centre; w = 1 if drawn, 0 if culled.
+    pub center: [f32; 4],
+    /// Half-extent vector of the quad; w = energy scale.
+    pub axis_u: [f32; 4],
+    /// Second half-extent vector; w unused.
+    pub axis_v: [f32; 4],
+    /// RGB colour; a = optical depth of the voxel (tau).
+    pub emit: [f32; 4],
+}
+
+/// Per-frame uniforms (std140, vec4 members only).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Frame {
+    pub view_proj: [[f32; 4]; 4],
+    pub eye: [f32; 4],
+    pub forward: [f32; 4],
+    pub right: [f32; 4],
+    pub up: [f32; 4],
+    pub origin: [f32; 4],
+    pub spacing: [f32; 4],
+    pub dims: [u32; 4],
+    pub split: [u32; 4],
+}
+
+/// Push constants of `footprint.vert` / `footprint.frag`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FootprintPush {
+    pub sheet_mode: u32,
+    pub axis: u32,
+    pub rank_offset: u32,
+    pub rank_base: u32,
+    pub rank_dir: i32,
+}
+
+/// Push constants of `composite.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CompositePush {
+    pub layers: u32,
+    pub back_to_front: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<Splat>() == 32);
+const _: () = assert!(std::mem::size_of::<SplatParams>() == 64);
+const _: () = assert!(std::mem::size_of::<Frame>() == 192);
+const _: () = assert!(std::mem::size_of::<FootprintPush>() == 20);
+const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);

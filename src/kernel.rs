@@ -1,0 +1,100 @@
+//! Reconstruction kernels (section 1.2.3), pre-integrated along the view direction into the 2D
+//! footprint table that `footprint.frag` reads as a texture.
+//!
+//! Units: distances are in voxel spacings. The table covers uv in [-1, 1]^2 = [-R, R]^2 and holds
+//! the footprint f(rho) = integral of h(sqrt(rho^2 + z^2)) dz, normalised so that the table's own
+//! discrete integral is exactly 1 voxel^2. A sheet of unit-spaced splats therefore sums to ~1, and
+//! a voxel of optical depth tau contributes tau * f to the pixels its footprint covers.
+use crate::constants::FOOTPRINT_TABLE_SIZE;
+use crate::error::{Error, Result};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Kernel {
+    /// Westover's Gaussian, sigma = 0.6 voxel, truncated at radius 2.
+    #[default]
+    Gaussian,
+    /// The Crawfis–Max piecewise-cubic radial kernel shape, radius 1.6 voxel: h(r) = 1 - 3x^2 + 2x^3
+    /// with x = r / 1.6 (zero value and slope at the edge). Crawfis and Max optimised their cubic's
+    /// coefficients numerically; this is the Hermite cubic with the same support, not their exact fit.
+    Cubic,
+}
+
+pub const GAUSSIAN_SIGMA: f64 = 0.6;
+
+impl std::str::FromStr for Kernel {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "gaussian" => Ok(Self::Gaussian),
+            "cubic" => Ok(Self::Cubic),
+            _ => Err(Error::InvalidArgument(format!("unknown kernel '{s}' (gaussian, cubic)"))),
+        }
+    }
+}
+
+impl Kernel {
+    /// Support radius in voxel spacings.
+    pub fn radius(self) -> f32 {
+        match self {
+            Kernel::Gaussian => 2.0,
+            Kernel::Cubic => 1.6,
+        }
+    }
+
+    /// The 3D radial profile (unnormalised).
+    pub fn profile(self, r: f64) -> f64 {
+        let rr = self.radius() as f64;
+        if r >= rr {
+            return 0.0;
+        }
+        match self {
+            Kernel::Gaussian => (-(r * r) / (2.0 * GAUSSIAN_SIGMA * GAUSSIAN_SIGMA)).exp(),
+            Kernel::Cubic => {
+                let x = r / rr;
+                1.0 - 3.0 * x * x + 2.0 * x * x * x
+            }
+        }
+    }
+
+    /// The profile integrated along the view ray at distance `rho` from the centre.
+    pub fn integrated(self, rho: f64) -> f64 {
+        let rr = self.radius() as f64;
+        if rho >= rr {
+            return 0.0;
+        }
+        let half = (rr * rr - rho * rho).sqrt();
+        let n = 256;
+        let h = 2.0 * half / n as f64;
+        // Simpson's rule over [-half, half].
+        let mut sum = 0.0;
+        for i in 0..=n {
+            let z = -half + i as f64 * h;
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            sum += w * self.profile((rho * rho + z * z).sqrt());
+        }
+        sum * h / 3.0
+    }
+
+    /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2.
+    pub fn footprint_table(self) -> Vec<f32> {
+        let n = FOOTPRINT_TABLE_SIZE as usize;
+        let rr = self.radius() as f64;
+        let mut t = vec![0.0f64; n * n];
+        for y in 0..n {
+            for x in 0..n {
+                let u = ((x as f64 + 0.5) / n as f64 * 2.0 - 1.0) * rr;
+                let v = ((y as f64 + 0.5) / n as f64 * 2.0 - 1.0) * rr;
+                t[y * n + x] = self.integrated((u * u + v * v).sqrt());
+            }
+        }
+        let texel_area = (2.0 * rr / n as f64).powi(2);
+        let total: f64 = t.iter().sum::<f64>() * texel_area;
+        t.iter().map(|v| (v / total) as f32).collect()
+    }
+}

@@ -1,0 +1,162 @@
+//! voxsplat renders discrete objects (volume rasters) by splatting on Vulkan, following J. E. Swan's
+//! 1997 dissertation: PBTF visibility order computed on the GPU without a sort, eye-facing
+//! footprints drawn instanced, per-splat compositing or Westover's sheet summation buffer — and a
+//! CPU mirror of every GPU stage that computes the same frame.
+//!
+//! ```no_run
+//! use voxsplat::{scene, Camera, Renderer, RendererOptions, RenderOptions};
+//! let set = scene::build("cube60")?;
+//! let camera = Camera::framing(set.grid(), 512, 512);
+//! let mut renderer = Renderer::new(&RendererOptions::default())?;
+//! renderer.set_scene(set)?;
+//! let frame = renderer.render(&camera, &RenderOptions::default())?;
+//! voxsplat::output::write_image(&frame.image, "cube.png".as_ref())?;
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
+#![deny(unsafe_code)]
+
+pub mod camera;
+pub mod constants;
+pub mod cpu;
+mod error;
+mod gpu;
+pub mod gpu_types;
+pub mod kernel;
+pub mod order;
+pub mod output;
+pub mod pipeline;
+pub mod scene;
+#[allow(unsafe_code)]
+pub mod vk;
+pub mod volume;
+
+pub use camera::{Camera, Projection};
+pub use error::{Error, Result};
+pub use kernel::Kernel;
+pub use order::{Direction, OrderKind};
+pub use pipeline::{Composite, RenderOptions, Rendered, StageTime};
+pub use volume::{Grid, SplatSet, Volume};
+
+use pipeline::Prepared;
+use std::sync::Arc;
+
+/// Where the frame is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Backend {
+    #[default]
+    Gpu,
+    /// The CPU mirrors, stage by stage.
+    Cpu,
+}
+
+/// How to create a [`Renderer`].
+#[derive(Clone, Debug, Default)]
+#[non_exhaustive]
+pub struct RendererOptions {
+    pub backend: Backend,
+    /// Khronos validation with synchronization validation; messages are counted, see
+    /// [`Renderer::validation_messages`].
+    pub validation: bool,
+    /// Pick the Vulkan device whose name contains this text.
+    pub device_name: Option<String>,
+}
+
+/// A scene on a backend. `Send`: one renderer per thread.
+pub struct Renderer {
+    gpu: Option<gpu::GpuPipeline>,
+    scene: Option<Prepared>,
+}
+
+impl Renderer {
+    pub fn new(options: &RendererOptions) -> Result<Self> {
+        let gpu = match options.backend {
+            Backend::Gpu => {
+                let ctx = vk::Context::new(&vk::ContextOptions {
+                    validation: options.validation,
+                    device_name: options.device_name.clone(),
+                })?;
+                Some(gpu::GpuPipeline::new(ctx)?)
+            }
+            Backend::Cpu => None,
+        };
+        Ok(Self { gpu, scene: None })
+    }
+
+    /// A renderer on a host program's Vulkan device (see [`vk::Context::from_host`]).
+    pub fn with_context(ctx: Arc<vk::Context>) -> Result<Self> {
+        Ok(Self { gpu: Some(gpu::GpuPipeline::new(ctx)?), scene: None })
+    }
+
+    /// The Vulkan device's name, or "cpu".
+    pub fn device_name(&self) -> String {
+        self.gpu.as_ref().map(|g| g.context().device_name().to_string()).unwrap_or_else(|| "cpu".into())
+    }
+
+    pub fn backend(&self) -> Backend {
+        if self.gpu.is_some() {
+            Backend::Gpu
+        } else {
+            Backend::Cpu
+        }
+    }
+
+    pub fn set_scene(&mut self, set: SplatSet) -> Result<()> {
+        let prep = Prepared::new(set);
+        if let Some(g) = &mut self.gpu {
+            g.set_scene(&prep)?;
+        }
+        self.scene = Some(prep);
+        Ok(())
+    }
+
+    pub fn scene(&self) -> Option<&SplatSet> {
+        self.scene.as_ref().map(|p| &p.set)
+    }
+
+    pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
+        let prep = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        match &mut self.gpu {
+            Some(g) => g.render(prep, camera, options),
+            None => pipeline::render_cpu(prep, camera, options),
+        }
+    }
+
+    /// The PBTF draw sequence as the backend computes it (the GPU order stage, or its CPU mirror).
+    pub fn pbtf_order(&mut self, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
+        camera.validate()?;
+        let prep = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        match &mut self.gpu {
+            Some(g) => g.order(prep, camera, direction),
+            None => Ok(cpu_pbtf_order(prep, camera, direction)),
+        }
+    }
+
+    /// Validation messages counted so far (always 0 without validation or on the CPU).
+    pub fn validation_count(&self) -> u64 {
+        self.gpu.as_ref().map(|g| g.context().validation_count()).unwrap_or(0)
+    }
+
+    pub fn validation_messages(&self) -> Vec<String> {
+        self.gpu.as_ref().map(|g| g.context().validation_messages()).unwrap_or_default()
+    }
+
+    /// The Vulkan context, for hosts that share it or tests that probe it.
+    pub fn context(&self) -> Option<&Arc<vk::Context>> {
+        self.gpu.as_ref().map(|g| g.context())
+    }
+}
+
+/// The three order stages' CPU mirrors run in sequence.
+fn cpu_pbtf_order(prep: &Prepared, camera: &Camera, direction: Direction) -> Vec<u32> {
+    let set = &prep.set;
+    let split = order::pbtf_split(set, camera);
+    let frame = pipeline::make_frame(set, camera, Kernel::Gaussian, split, direction == Direction::BackToFront);
+    let rows = set.row_start().len() - 1;
+    let mut row_split = vec![0u32; rows];
+    let mut segments = vec![0u32; 2 * rows];
+    let mut out = vec![0u32; set.len()];
+    cpu::order_count(&frame, set.splats(), set.row_start(), &mut row_split, &mut segments);
+    cpu::order_scan(&frame, &mut segments);
+    cpu::order_scatter(&frame, set.splats(), set.row_start(), &row_split, &segments, &mut out);
+    out
+}

@@ -1,0 +1,237 @@
+//! Visibility orders for rectilinear grids (chapter 2): BTF (Fig. 2.1), WBTF (Fig. 2.3), PBTF
+//! (section 2.3), and a reference order by exact distance to the eye; plus a validator.
+//!
+//! Orders are computed front to back and reversed for back to front. All of them return indices
+//! into [`SplatSet::splats`].
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::volume::SplatSet;
+use glam::DVec3;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum OrderKind {
+    /// Frieder et al.: one traversal direction per axis, z outermost.
+    Btf,
+    /// Westover: BTF with the axis most perpendicular to the view plane outermost.
+    Wbtf,
+    /// Swan's perspective back-to-front order: split at the eye, traverse outward.
+    #[default]
+    Pbtf,
+    /// Reference: sorted by exact distance to the eye (to the view plane in orthographic views).
+    Sorted,
+}
+
+impl std::str::FromStr for OrderKind {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "btf" => Ok(Self::Btf),
+            "wbtf" => Ok(Self::Wbtf),
+            "pbtf" => Ok(Self::Pbtf),
+            "sorted" => Ok(Self::Sorted),
+            _ => Err(Error::InvalidArgument(format!("unknown order '{s}' (btf, wbtf, pbtf, sorted)"))),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    FrontToBack,
+    BackToFront,
+}
+
+/// Where the viewer is, in grid index coordinates: a point (perspective) or a direction at
+/// infinity (orthographic).
+#[derive(Clone, Copy, Debug)]
+pub enum Viewer {
+    Eye(DVec3),
+    Toward(DVec3),
+}
+
+impl Viewer {
+    pub fn of(set: &SplatSet, camera: &Camera) -> Self {
+        let g = set.grid();
+        let o = DVec3::from(g.origin.map(f64::from));
+        let s = DVec3::from(g.spacing.map(f64::from));
+        if camera.is_perspective() {
+            Viewer::Eye((camera.eye.as_dvec3() - o) / s)
+        } else {
+            // Index space scales each axis: directions scale by 1/spacing too.
+            Viewer::Toward(camera.forward().as_dvec3() / s)
+        }
+    }
+
+    /// Which of two 6-neighbours along `axis` (at `lo` and `lo + 1`) is in front: `Some(true)` for
+    /// the lower one, `Some(false)` for the upper one, `None` when the separating grid plane holds
+    /// the eye (either order is correct).
+    pub fn lower_in_front(&self, axis: usize, lo: u32) -> Option<bool> {
+        match *self {
+            Viewer::Eye(e) => {
+                let mid = lo as f64 + 0.5;
+                let e = e[axis];
+                if e < mid {
+                    Some(true)
+                } else if e > mid {
+                    Some(false)
+                } else {
+                    None
+                }
+            }
+            Viewer::Toward(d) => {
+                if d[axis] > 0.0 {
+                    Some(true)
+                } else if d[axis] < 0.0 {
+                    Some(false)
+                } else {
+                    None
+                }
+            }
+        }
+    }
+}
+
+/// Voxels per axis on the eye's low side: indices `< split[a]` are visited downward from
+/// `split[a] - 1`, the others upward. The split sits at the grid plane nearest the eye, so every
+/// pair of 6-neighbours is ordered by the plane between them.
+pub fn pbtf_split(set: &SplatSet, camera: &Camera) -> [u32; 3] {
+    let dims = set.grid().dims;
+    match Viewer::of(set, camera) {
+        Viewer::Eye(e) => [0, 1, 2].map(|a| {
+            let s = (e[a] + 0.5).floor() + 1.0;
+            s.clamp(0.0, dims[a] as f64) as u32
+        }),
+        Viewer::Toward(d) => [0, 1, 2].map(|a| if d[a] < 0.0 { dims[a] } else { 0 }),
+    }
+}
+
+/// The pure-Rust PBTF order, front to back: octants one after another, and inside each octant rows
+/// (k outer, j inner) and voxels (i) visited outward from the eye.
+pub fn pbtf(set: &SplatSet, split: [u32; 3]) -> Vec<u32> {
+    let [_, ny, nz] = set.grid().dims;
+    let mut out = Vec::with_capacity(set.len());
+    let outward = |n: u32, s: u32, side: u32| -> Vec<u32> {
+        if side == 0 {
+            (0..s).rev().collect()
+        } else {
+            (s..n).collect()
+        }
+    };
+    for octant in 0..8u32 {
+        let (si, sj, sk) = (octant & 1, (octant >> 1) & 1, (octant >> 2) & 1);
+        for k in outward(nz, split[2], sk) {
+            for j in outward(ny, split[1], sj) {
+                let r = set.row_index(j, k);
+                let (s, e) = (set.row_start()[r] as usize, set.row_start()[r + 1] as usize);
+                let row = &set.splats()[s..e];
+                let low = row.partition_point(|sp| sp.ijk[0] < split[0]);
+                if si == 0 {
+                    out.extend((s..s + low).rev().map(|x| x as u32));
+                } else {
+                    out.extend((s + low..e).map(|x| x as u32));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Order by a per-splat key, ascending (a comparison sort: fine for the CPU reference orders).
+fn by_key<K: PartialOrd>(set: &SplatSet, key: impl Fn(usize) -> K) -> Vec<u32> {
+    let keys: Vec<K> = (0..set.len()).map(key).collect();
+    let mut idx: Vec<u32> = (0..set.len() as u32).collect();
+    idx.sort_by(|&a, &b| keys[a as usize].partial_cmp(&keys[b as usize]).unwrap_or(std::cmp::Ordering::Equal).then(a.cmp(&b)));
+    idx
+}
+
+/// BTF-family orders: loop nesting `axes` (outermost first), each axis traversed in the direction
+/// of the view vector (front to back).
+fn nested(set: &SplatSet, camera: &Camera, axes: [usize; 3]) -> Vec<u32> {
+    let f = camera.forward();
+    let dims = set.grid().dims;
+    let rank = |a: usize, v: u32| -> u64 {
+        if f[a] >= 0.0 {
+            v as u64
+        } else {
+            (dims[a] - 1 - v) as u64
+        }
+    };
+    let (d1, d2) = (dims[axes[1]] as u64, dims[axes[2]] as u64);
+    by_key(set, |s| {
+        let ijk = set.splats()[s].ijk;
+        (rank(axes[0], ijk[axes[0]]) * d1 + rank(axes[1], ijk[axes[1]])) * d2 + rank(axes[2], ijk[axes[2]])
+    })
+}
+
+/// Westover's axis permutation: most perpendicular to the view plane outermost.
+pub fn wbtf_axes(camera: &Camera) -> [usize; 3] {
+    let f = camera.forward().abs();
+    let mut axes = [0usize, 1, 2];
+    axes.sort_by(|&a, &b| f[b].partial_cmp(&f[a]).unwrap_or(std::cmp::Ordering::Equal));
+    axes
+}
+
+/// The draw sequence of `kind` in `direction`.
+pub fn visibility_order(set: &SplatSet, camera: &Camera, kind: OrderKind, direction: Direction) -> Vec<u32> {
+    let mut order = match kind {
+        OrderKind::Pbtf => pbtf(set, pbtf_split(set, camera)),
+        OrderKind::Btf => nested(set, camera, [2, 1, 0]),
+        OrderKind::Wbtf => nested(set, camera, wbtf_axes(camera)),
+        OrderKind::Sorted => {
+            let g = *set.grid();
+            let eye = camera.eye.as_dvec3();
+            let fwd = camera.forward().as_dvec3();
+            let persp = camera.is_perspective();
+            by_key(set, |s| {
+                let ijk = set.splats()[s].ijk;
+                let p = g.position([ijk[0], ijk[1], ijk[2]]).as_dvec3();
+                if persp {
+                    (p - eye).length()
+                } else {
+                    (p - eye).dot(fwd)
+                }
+            })
+        }
+    };
+    if direction == Direction::BackToFront {
+        order.reverse();
+    }
+    order
+}
+
+/// Pairs of 6-neighbour splats drawn in the wrong order with respect to the grid plane between
+/// them and the eye. `order` must be a permutation of the splats.
+pub fn count_violations(set: &SplatSet, camera: &Camera, order: &[u32], direction: Direction) -> Result<u64> {
+    if order.len() != set.len() {
+        return Err(Error::InvalidArgument(format!("order has {} entries for {} splats", order.len(), set.len())));
+    }
+    let mut pos = vec![u32::MAX; set.len()];
+    for (p, &s) in order.iter().enumerate() {
+        let slot = pos
+            .get_mut(s as usize)
+            .ok_or_else(|| Error::InvalidArgument(format!("order names splat {s} of {}", set.len())))?;
+        if *slot != u32::MAX {
+            return Err(Error::InvalidArgument(format!("order names splat {s} twice")));
+        }
+        *slot = p as u32;
+    }
+    let viewer = Viewer::of(set, camera);
+    let mut violations = 0u64;
+    for (s, sp) in set.splats().iter().enumerate() {
+        let [i, j, k, _] = sp.ijk;
+        for axis in 0..3 {
+            let n = match axis {
+                0 => set.find(i + 1, j, k),
+                1 => set.find(i, j + 1, k),
+                _ => set.find(i, j, k + 1),
+            };
+            let Some(t) = n else { continue };
+            let Some(lower_front) = viewer.lower_in_front(axis, sp.ijk[axis]) else { continue };
+            let lower_first = pos[s] < pos[t];
+            let want_lower_first = lower_front == (direction == Direction::FrontToBack);
+            if lower_first != want_lower_first {
+                violations += 1;
+            }
+        }
+    }
+    Ok(violations)
+}

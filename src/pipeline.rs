@@ -1,0 +1,283 @@
+//! The named stage list and its execution, on the GPU or on the CPU mirrors:
+//!
+//! | stage          | GPU                          | CPU mirror              |
+//! |----------------|------------------------------|-------------------------|
+//! | order          | `order_{count,scan,scatter}.comp` | `cpu::order_*`     |
+//! | splat_params   | `splat_params.comp`          | `cpu::splat_params`     |
+//! | footprint      | `footprint.vert/.frag`       | `cpu::footprint`        |
+//! | composite      | `composite.comp`             | `cpu::composite`        |
+use crate::camera::Camera;
+use crate::constants::{MAX_GROUPS_X, WORKGROUP_SIZE};
+use crate::cpu::{self, footprint::Blend, ImageF32};
+use crate::error::{Error, Result};
+use crate::gpu_types::{CompositePush, FootprintPush, Frame};
+use crate::kernel::Kernel;
+use crate::order::{self, Direction, OrderKind};
+use crate::volume::SplatSet;
+use glam::Vec3;
+use std::time::Instant;
+
+/// How splats become pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Composite {
+    /// Every footprint is composited (over / under) in visibility order.
+    #[default]
+    Splat,
+    /// Westover's sheet summation buffer: splats summed per sheet, sheets composited in order.
+    Sheet,
+}
+
+impl std::str::FromStr for Composite {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "splat" => Ok(Self::Splat),
+            "sheet" => Ok(Self::Sheet),
+            _ => Err(Error::InvalidArgument(format!("unknown compositing '{s}' (splat, sheet)"))),
+        }
+    }
+}
+
+/// Per-frame choices. `Default` gives PBTF, per-splat back-to-front compositing, the Gaussian.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RenderOptions {
+    pub order: OrderKind,
+    pub composite: Composite,
+    pub kernel: Kernel,
+    /// `None`: back to front for per-splat compositing, front to back for sheets.
+    pub direction: Option<Direction>,
+    /// Memory allowed for one batch of sheet summation layers (RGBA32F each).
+    pub sheet_budget_bytes: u64,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            order: OrderKind::Pbtf,
+            composite: Composite::Splat,
+            kernel: Kernel::Gaussian,
+            direction: None,
+            sheet_budget_bytes: 256 << 20,
+        }
+    }
+}
+
+/// Most summation layers in one batch, whatever the budget.
+pub const MAX_BATCH_LAYERS: u32 = 256;
+
+impl RenderOptions {
+    pub fn direction(&self) -> Direction {
+        self.direction.unwrap_or(match self.composite {
+            Composite::Splat => Direction::BackToFront,
+            Composite::Sheet => Direction::FrontToBack,
+        })
+    }
+
+    /// Layers per batch for an image of this size.
+    pub fn batch_layers(&self, width: u32, height: u32) -> u32 {
+        let layer = width as u64 * height as u64 * 16;
+        (self.sheet_budget_bytes / layer.max(1)).clamp(1, MAX_BATCH_LAYERS as u64) as u32
+    }
+}
+
+/// One named stage's time in milliseconds (GPU timestamps, or wall time on the CPU path).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageTime {
+    pub stage: &'static str,
+    pub ms: f64,
+}
+
+/// A rendered frame: premultiplied RGBA32F, row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    pub image: ImageF32,
+    pub timings: Vec<StageTime>,
+}
+
+/// A scene ready to draw: the splat rows plus, per axis, the splats grouped by slice and each
+/// slice's rank among non-empty slices (what the sheet batches index).
+pub struct Prepared {
+    pub set: SplatSet,
+    pub slices: [(Vec<u32>, Vec<u32>); 3],
+    pub ranks: Vec<u32>,
+    pub rank_offsets: [u32; 3],
+}
+
+impl Prepared {
+    pub fn new(set: SplatSet) -> Self {
+        let slices = [0, 1, 2].map(|a| set.slices(a));
+        let mut ranks = Vec::new();
+        let mut rank_offsets = [0; 3];
+        for a in 0..3 {
+            rank_offsets[a] = ranks.len() as u32;
+            ranks.extend(SplatSet::sheet_ranks(&slices[a].0));
+        }
+        Self { set, slices, ranks, rank_offsets }
+    }
+}
+
+/// The per-frame uniforms shared by every stage.
+pub fn make_frame(set: &SplatSet, camera: &Camera, kernel: Kernel, split: [u32; 3], back_to_front: bool) -> Frame {
+    let g = set.grid();
+    let radius_vox = kernel.radius();
+    let f = camera.forward();
+    let r = camera.right();
+    let u = camera.true_up();
+    let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
+    Frame {
+        view_proj: camera.view_proj().to_cols_array_2d(),
+        eye: v4(camera.eye, if camera.is_perspective() { 1.0 } else { 0.0 }),
+        forward: v4(f, camera.near),
+        right: v4(r, camera.far),
+        up: v4(u, 0.0),
+        origin: [g.origin[0], g.origin[1], g.origin[2], radius_vox],
+        spacing: [g.spacing[0], g.spacing[1], g.spacing[2], radius_vox * g.kernel_spacing()],
+        dims: [g.dims[0], g.dims[1], g.dims[2], set.len() as u32],
+        split: [split[0], split[1], split[2], back_to_front as u32],
+    }
+}
+
+/// One batch of sheets drawn into summation layers and composited together.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Batch {
+    pub first_instance: u32,
+    pub instances: u32,
+    pub layers: u32,
+    pub push: FootprintPush,
+}
+
+/// The sheet axis (the grid axis most perpendicular to the view plane) and its batches in visiting
+/// order. Empty sheets are skipped; a batch never straddles the eye's plane, so its splats are one
+/// contiguous run of the slice-grouped draw list.
+pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_layers: u32) -> (usize, Vec<Batch>) {
+    let f = camera.forward().abs();
+    let axis = if f.x >= f.y && f.x >= f.z {
+        0
+    } else if f.y >= f.z {
+        1
+    } else {
+        2
+    };
+    let split = order::pbtf_split(&prep.set, camera)[axis];
+    let n = prep.set.grid().dims[axis];
+    let offsets = &prep.slices[axis].0;
+    let nonempty = |s: &u32| offsets[*s as usize + 1] > offsets[*s as usize];
+    let low: Vec<u32> = (0..split).rev().filter(nonempty).collect();
+    let high: Vec<u32> = (split..n).filter(nonempty).collect();
+    let mut sides = vec![low, high];
+    if direction == Direction::BackToFront {
+        sides.reverse();
+        for s in &mut sides {
+            s.reverse();
+        }
+    }
+    let rank_of = |s: u32| prep.ranks[(prep.rank_offsets[axis] + s) as usize];
+    let mut batches = Vec::new();
+    for side in &sides {
+        for chunk in side.chunks(max_layers.max(1) as usize) {
+            let (first, last) = (chunk[0], chunk[chunk.len() - 1]);
+            let (lo, hi) = (first.min(last), first.max(last));
+            let start = offsets[lo as usize];
+            let end = offsets[hi as usize + 1];
+            batches.push(Batch {
+                first_instance: start,
+                instances: end - start,
+                layers: chunk.len() as u32,
+                push: FootprintPush {
+                    sheet_mode: 1,
+                    axis: axis as u32,
+                    rank_offset: prep.rank_offsets[axis],
+                    rank_base: rank_of(first),
+                    rank_dir: if last >= first { 1 } else { -1 },
+                },
+            });
+        }
+    }
+    (axis, batches)
+}
+
+/// Workgroup counts for `n` invocations of a 1D stage (spilling into y past `MAX_GROUPS_X`).
+pub fn groups_1d(n: u32) -> [u32; 3] {
+    let g = n.div_ceil(WORKGROUP_SIZE).max(1);
+    [g.min(MAX_GROUPS_X), g.div_ceil(MAX_GROUPS_X), 1]
+}
+
+/// The whole frame on the CPU mirrors, stage by stage.
+pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Rendered> {
+    camera.validate()?;
+    let set = &prep.set;
+    let direction = opts.direction();
+    let btf = direction == Direction::BackToFront;
+    let split = order::pbtf_split(set, camera);
+    let frame = make_frame(set, camera, opts.kernel, split, btf);
+    let n = set.len();
+    let mut timings = Vec::new();
+    let mut t = Instant::now();
+    let mut lap = |stage: &'static str, timings: &mut Vec<StageTime>| {
+        timings.push(StageTime { stage, ms: t.elapsed().as_secs_f64() * 1e3 });
+        t = Instant::now();
+    };
+
+    let mut draw = vec![0u32; n];
+    if opts.composite == Composite::Splat {
+        if opts.order == OrderKind::Pbtf {
+            let rows = set.row_start().len() - 1;
+            let mut row_split = vec![0u32; rows];
+            let mut segments = vec![0u32; 2 * rows];
+            cpu::order_count(&frame, set.splats(), set.row_start(), &mut row_split, &mut segments);
+            cpu::order_scan(&frame, &mut segments);
+            cpu::order_scatter(&frame, set.splats(), set.row_start(), &row_split, &segments, &mut draw);
+        } else {
+            draw = order::visibility_order(set, camera, opts.order, direction);
+        }
+        lap("order", &mut timings);
+    }
+    let mut params = vec![Default::default(); n];
+    cpu::splat_params(&frame, set.splats(), &mut params);
+    lap("splat_params", &mut timings);
+
+    let table = opts.kernel.footprint_table();
+    let (w, h) = (camera.width, camera.height);
+    let mut image = ImageF32::new(w, h);
+    match opts.composite {
+        Composite::Splat => {
+            let inputs = cpu::footprint::FootprintInputs {
+                frame: &frame,
+                params: &params,
+                draw_list: &draw,
+                splats: set.splats(),
+                sheet_rank: &prep.ranks,
+                table: &table,
+            };
+            let blend = if btf { Blend::Over } else { Blend::Under };
+            cpu::footprint(&inputs, &FootprintPush::default(), blend, 0, n as u32, std::slice::from_mut(&mut image));
+            lap("footprint", &mut timings);
+        }
+        Composite::Sheet => {
+            let (axis, batches) = sheet_plan(prep, camera, direction, opts.batch_layers(w, h));
+            let inputs = cpu::footprint::FootprintInputs {
+                frame: &frame,
+                params: &params,
+                draw_list: &prep.slices[axis].1,
+                splats: set.splats(),
+                sheet_rank: &prep.ranks,
+                table: &table,
+            };
+            let (mut raster_ms, mut comp_ms) = (0.0, 0.0);
+            for b in &batches {
+                let t0 = Instant::now();
+                let mut layers = vec![ImageF32::new(w, h); b.layers as usize];
+                cpu::footprint(&inputs, &b.push, Blend::Add, b.first_instance, b.instances, &mut layers);
+                let t1 = Instant::now();
+                let push = CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
+                cpu::composite(&push, &layers, &mut image);
+                raster_ms += (t1 - t0).as_secs_f64() * 1e3;
+                comp_ms += t1.elapsed().as_secs_f64() * 1e3;
+            }
+            timings.push(StageTime { stage: "footprint", ms: raster_ms });
+            timings.push(StageTime { stage: "composite", ms: comp_ms });
+        }
+    }
+    Ok(Rendered { image, timings })
+}

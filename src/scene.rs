@@ -1,0 +1,50 @@
+//! Built-in scenes reproducing the dissertation's test objects, listed by name.
+use crate::error::{Error, Result};
+use crate::volume::{Grid, SplatSet};
+
+/// Opacity of one voxel-length of the built-in materials.
+pub const SCENE_OPACITY: f32 = 0.95;
+const RED: [f32; 3] = [0.85, 0.1, 0.1];
+const WHITE: [f32; 3] = [0.95, 0.95, 0.95];
+const BLACK: [f32; 3] = [0.08, 0.08, 0.08];
+
+/// (name, description) of every built-in scene.
+pub const SCENES: &[(&str, &str)] = &[
+    ("cube40", "hollow 40^3 cube, one voxel thick, alternating 10^3 red/white sub-cubes (Figs 1.13-1.15, 1.17)"),
+    ("cube60", "hollow 60^3 cube, one voxel thick, alternating 10^3 red/white sub-cubes (Figs 1.16, 2.25-2.27)"),
+    ("cube40-attenuated", "cube40 with opacity 0.3: semi-transparent splats (Fig. 1.14)"),
+    ("plane", "single-sheet 498x398x1 checkerboard of 10x10 black/white squares (Fig. 3.6)"),
+    ("empty", "an 8^3 grid with no non-empty voxel"),
+];
+
+fn hollow_cube(n: u32, opacity: f32) -> Result<SplatSet> {
+    let grid = Grid::centered([n, n, n], [1.0; 3])?;
+    SplatSet::from_fn(grid, |i, j, k| {
+        let shell = [i, j, k].iter().any(|&c| c == 0 || c == n - 1);
+        shell.then(|| {
+            let c = if (i / 10 + j / 10 + k / 10) % 2 == 0 { RED } else { WHITE };
+            [c[0], c[1], c[2], opacity]
+        })
+    })
+}
+
+/// Build a scene by name.
+pub fn build(name: &str) -> Result<SplatSet> {
+    match name {
+        "cube40" => hollow_cube(40, SCENE_OPACITY),
+        "cube60" => hollow_cube(60, SCENE_OPACITY),
+        "cube40-attenuated" => hollow_cube(40, 0.3),
+        "plane" => {
+            let grid = Grid::centered([498, 398, 1], [1.0; 3])?;
+            SplatSet::from_fn(grid, |i, j, _| {
+                let c = if (i / 10 + j / 10) % 2 == 0 { BLACK } else { WHITE };
+                Some([c[0], c[1], c[2], SCENE_OPACITY])
+            })
+        }
+        "empty" => SplatSet::from_fn(Grid::centered([8, 8, 8], [1.0; 3])?, |_, _, _| None),
+        other => Err(Error::InvalidArgument(format!(
+            "unknown scene '{other}'; built-in scenes: {}",
+            SCENES.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
+        ))),
+    }
+}

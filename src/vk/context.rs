@@ -1,0 +1,395 @@
+//! Instance, device, queue and allocator: created headless, or adopted from a host program.
+use super::debug::{callback, DebugState};
+use crate::error::{Error, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::CStr;
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// Options for [`Context::new`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Enable `VK_LAYER_KHRONOS_validation` with synchronization validation; messages are counted.
+    pub validation: bool,
+    /// Pick the device whose name contains this string (case-insensitive).
+    pub device_name: Option<String>,
+}
+
+struct Debug {
+    loader: ash::ext::debug_utils::Instance,
+    messenger: vk::DebugUtilsMessengerEXT,
+}
+
+/// The Vulkan objects every resource needs. Resources hold an `Arc<Context>` so it outlives them.
+pub struct Context {
+    _entry: ash::Entry,
+    pub(crate) instance: ash::Instance,
+    pub(crate) physical: vk::PhysicalDevice,
+    pub(crate) device: ash::Device,
+    pub(crate) queue: Mutex<vk::Queue>,
+    pub(crate) queue_family: u32,
+    pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
+    debug: Option<Debug>,
+    debug_state: Box<DebugState>,
+    owned: bool,
+    /// Nanoseconds per timestamp tick; `None` when the queue has no timestamps.
+    pub(crate) timestamp_period: Option<f64>,
+    device_name: String,
+    device_type: vk::PhysicalDeviceType,
+}
+
+fn device_rank(t: vk::PhysicalDeviceType) -> u32 {
+    match t {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 4,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 3,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 1,
+        _ => 0,
+    }
+}
+
+impl Context {
+    /// A headless context on the best device: discrete > integrated > virtual > CPU.
+    pub fn new(options: &ContextOptions) -> Result<Arc<Self>> {
+        // SAFETY: loading the system Vulkan loader; it stays alive as long as `_entry`.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
+        let debug_state = Box::<DebugState>::default();
+
+        let mut layers = Vec::new();
+        let mut extensions = Vec::new();
+        if options.validation {
+            // SAFETY: plain enumeration.
+            let available = unsafe { entry.enumerate_instance_layer_properties() }
+                .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
+            let found = available
+                .iter()
+                .any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
+            if !found {
+                return Err(Error::Unsupported(
+                    "validation requested but VK_LAYER_KHRONOS_validation is not installed \
+                     (Debian: apt-get install vulkan-validationlayers)"
+                        .into(),
+                ));
+            }
+            layers.push(VALIDATION_LAYER.as_ptr());
+            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"voxsplat")
+            .engine_name(c"voxsplat")
+            .api_version(vk::make_api_version(0, 1, 2, 0));
+        let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
+        let user_data = &*debug_state as *const DebugState as *mut std::ffi::c_void;
+        let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(callback))
+            .user_data(user_data);
+        let mut info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions);
+        if options.validation {
+            info = info.push_next(&mut features).push_next(&mut messenger_info);
+        }
+        // SAFETY: all pointers in `info` outlive the call.
+        let instance = unsafe { entry.create_instance(&info, None) }.map_err(Error::vk("vkCreateInstance"))?;
+
+        let debug = if options.validation {
+            let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            // The chained copy above only covers instance creation; the messenger itself needs a
+            // create info with an empty pNext.
+            let own_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(messenger_info.message_severity)
+                .message_type(messenger_info.message_type)
+                .pfn_user_callback(Some(callback))
+                .user_data(user_data);
+            // SAFETY: `debug_state` is boxed and outlives the messenger (destroyed in Drop first).
+            match unsafe { loader.create_debug_utils_messenger(&own_info, None) } {
+                Ok(messenger) => Some(Debug { loader, messenger }),
+                Err(e) => {
+                    // SAFETY: nothing else was created from this instance.
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(Error::vk("vkCreateDebugUtilsMessengerEXT")(e));
+                }
+            }
+        } else {
+            None
+        };
+
+        let picked = Self::pick_device(&instance, options);
+        let (physical, queue_family) = match picked {
+            Ok(p) => p,
+            Err(e) => {
+                // SAFETY: tear down what we created, in reverse order.
+                unsafe {
+                    if let Some(d) = &debug {
+                        d.loader.destroy_debug_utils_messenger(d.messenger, None);
+                    }
+                    instance.destroy_instance(None);
+                }
+                return Err(e);
+            }
+        };
+
+        let priorities = [1.0f32];
+        let queues = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true);
+        let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queues).push_next(&mut f12);
+        // SAFETY: `physical` came from this instance; features were checked in pick_device.
+        let device = match unsafe { instance.create_device(physical, &device_info, None) } {
+            Ok(d) => d,
+            Err(e) => {
+                // SAFETY: reverse-order teardown of what exists.
+                unsafe {
+                    if let Some(d) = &debug {
+                        d.loader.destroy_debug_utils_messenger(d.messenger, None);
+                    }
+                    instance.destroy_instance(None);
+                }
+                return Err(Error::vk("vkCreateDevice")(e));
+            }
+        };
+        // SAFETY: queue family and index were requested above.
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        Self::finish(entry, instance, physical, device, queue, queue_family, debug, debug_state, true)
+    }
+
+    /// Adopt a host program's instance, device and queue. The host keeps ownership (nothing is
+    /// destroyed here), must have enabled Vulkan 1.2 `shaderOutputLayer`, and must not use `queue`
+    /// from another thread while voxsplat submits to it.
+    pub fn from_host(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        physical: vk::PhysicalDevice,
+        device: ash::Device,
+        queue: vk::Queue,
+        queue_family: u32,
+    ) -> Result<Arc<Self>> {
+        Self::finish(
+            entry,
+            instance,
+            physical,
+            device,
+            queue,
+            queue_family,
+            None,
+            Box::default(),
+            false,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn finish(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        physical: vk::PhysicalDevice,
+        device: ash::Device,
+        queue: vk::Queue,
+        queue_family: u32,
+        debug: Option<Debug>,
+        debug_state: Box<DebugState>,
+        owned: bool,
+    ) -> Result<Arc<Self>> {
+        // SAFETY: plain queries on a valid physical device.
+        let (props, families) = unsafe {
+            (
+                instance.get_physical_device_properties(physical),
+                instance.get_physical_device_queue_family_properties(physical),
+            )
+        };
+        let ts_bits = families.get(queue_family as usize).map(|f| f.timestamp_valid_bits).unwrap_or(0);
+        let timestamp_period = (ts_bits > 0 && props.limits.timestamp_period > 0.0)
+            .then_some(props.limits.timestamp_period as f64);
+        let device_name = props
+            .device_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        });
+        let allocator = match allocator {
+            Ok(a) => a,
+            Err(e) => {
+                if owned {
+                    // SAFETY: reverse-order teardown of what we own.
+                    unsafe {
+                        device.destroy_device(None);
+                        if let Some(d) = &debug {
+                            d.loader.destroy_debug_utils_messenger(d.messenger, None);
+                        }
+                        instance.destroy_instance(None);
+                    }
+                }
+                return Err(Error::Unsupported(format!("gpu-allocator: {e}")));
+            }
+        };
+        Ok(Arc::new(Self {
+            _entry: entry,
+            instance,
+            physical,
+            device,
+            queue: Mutex::new(queue),
+            queue_family,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            debug,
+            debug_state,
+            owned,
+            timestamp_period,
+            device_name,
+            device_type: props.device_type,
+        }))
+    }
+
+    fn pick_device(instance: &ash::Instance, options: &ContextOptions) -> Result<(vk::PhysicalDevice, u32)> {
+        // SAFETY: plain enumeration and queries.
+        let devices = unsafe { instance.enumerate_physical_devices() }
+            .map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
+        let mut best: Option<(u32, vk::PhysicalDevice, u32)> = None;
+        let mut rejected = Vec::new();
+        for pd in devices {
+            // SAFETY: `pd` is a valid handle from this instance.
+            let props = unsafe { instance.get_physical_device_properties(pd) };
+            let name = props
+                .device_name_as_c_str()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            if let Some(want) = &options.device_name {
+                if !name.to_lowercase().contains(&want.to_lowercase()) {
+                    continue;
+                }
+            }
+            if vk::api_version_major(props.api_version) == 1 && vk::api_version_minor(props.api_version) < 2 {
+                rejected.push(format!("{name}: Vulkan 1.2 required"));
+                continue;
+            }
+            let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+            let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12);
+            // SAFETY: valid handle; the chain lives on the stack for the call.
+            unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+            if f12.shader_output_layer == vk::FALSE {
+                rejected.push(format!("{name}: shaderOutputLayer missing"));
+                continue;
+            }
+            // SAFETY: valid handle.
+            let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+            let want = vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE;
+            let Some(family) = families.iter().position(|f| f.queue_flags.contains(want)) else {
+                rejected.push(format!("{name}: no graphics+compute queue"));
+                continue;
+            };
+            let rank = device_rank(props.device_type);
+            if best.map(|b| rank > b.0).unwrap_or(true) {
+                best = Some((rank, pd, family as u32));
+            }
+        }
+        best.map(|(_, pd, f)| (pd, f)).ok_or_else(|| {
+            Error::Unsupported(format!(
+                "no suitable Vulkan device{}{}",
+                if rejected.is_empty() { "" } else { ": " },
+                rejected.join("; ")
+            ))
+        })
+    }
+
+    /// The device's name as the driver reports it.
+    pub fn device_name(&self) -> &str {
+        &self.device_name
+    }
+
+    /// Largest 2D image / framebuffer side and array layer count the device accepts.
+    pub fn image_limits(&self) -> (u32, u32) {
+        // SAFETY: plain query on a valid physical device.
+        let l = unsafe { self.instance.get_physical_device_properties(self.physical) }.limits;
+        (
+            l.max_image_dimension2_d.min(l.max_framebuffer_width).min(l.max_framebuffer_height),
+            l.max_image_array_layers.min(l.max_framebuffer_layers),
+        )
+    }
+
+    /// True for a CPU implementation such as lavapipe.
+    pub fn is_cpu_device(&self) -> bool {
+        self.device_type == vk::PhysicalDeviceType::CPU
+    }
+
+    /// Validation messages seen so far (0 when validation is off).
+    pub fn validation_count(&self) -> u64 {
+        self.debug_state.count()
+    }
+
+    /// The first validation messages seen (up to 64).
+    pub fn validation_messages(&self) -> Vec<String> {
+        self.debug_state.messages()
+    }
+
+    /// gpu-allocator's view of live allocations: (allocation count, bytes).
+    pub fn allocation_report(&self) -> (usize, u64) {
+        match self.allocator.lock() {
+            Ok(a) => {
+                let r = a.generate_report();
+                (r.allocations.len(), r.total_allocated_bytes)
+            }
+            Err(_) => (0, 0),
+        }
+    }
+
+    pub(crate) fn wait_idle(&self) {
+        // SAFETY: the device is valid until Drop.
+        let _ = unsafe { self.device.device_wait_idle() };
+    }
+
+    /// Test-only: makes an invalid call (a zero-sized buffer) so tests can prove the validation
+    /// counter is live. Returns whether the call itself failed.
+    #[doc(hidden)]
+    pub fn provoke_validation_error(&self) -> bool {
+        let info = vk::BufferCreateInfo::default()
+            .size(0)
+            .usage(vk::BufferUsageFlags::STORAGE_BUFFER)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: deliberately invalid size; the layer reports it. lavapipe still returns a handle,
+        // which we destroy at once.
+        match unsafe { self.device.create_buffer(&info, None) } {
+            Ok(b) => {
+                // SAFETY: the buffer is unused.
+                unsafe { self.device.destroy_buffer(b, None) };
+                false
+            }
+            Err(_) => true,
+        }
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        self.wait_idle();
+        // SAFETY: all resources hold an Arc<Context>, so none is alive now; the allocator goes
+        // before the device (gpu-allocator's teardown order), then the messenger, then the instance.
+        unsafe {
+            ManuallyDrop::drop(&mut self.allocator);
+            if self.owned {
+                self.device.destroy_device(None);
+                if let Some(d) = &self.debug {
+                    d.loader.destroy_debug_utils_messenger(d.messenger, None);
+                }
+                self.instance.destroy_instance(None);
+            }
+        }
+    }
+}

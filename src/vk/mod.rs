@@ -1,0 +1,16 @@
+//! The thin ash layer: the only place with `unsafe`. One file per Vulkan concern.
+mod buffer;
+mod context;
+mod debug;
+mod image;
+mod pipeline;
+mod submit;
+mod timer;
+
+pub use buffer::{Buffer, Memory};
+pub use context::{Context, ContextOptions};
+pub use image::{Image, Sampler};
+pub use pipeline::{Bind, Blend, DescriptorSet, Framebuffer, Layout, Pipeline, RenderPass, Slot};
+pub use submit::{Recorder, Stage};
+pub use timer::Timer;
+pub use ash::vk::{BufferUsageFlags, Format, ImageLayout, ImageUsageFlags, ShaderStageFlags};

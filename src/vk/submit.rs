@@ -1,0 +1,252 @@
+//! One-shot command recording and submission with a fence. `Recorder` is the safe face of a
+//! command buffer: every command the pipeline records goes through it.
+use super::{Buffer, Context, DescriptorSet, Framebuffer, Image, Layout, Pipeline, RenderPass, Timer};
+use crate::error::{Error, Result};
+use ash::vk;
+
+pub struct Recorder<'a> {
+    ctx: &'a Context,
+    cmd: vk::CommandBuffer,
+}
+
+/// Pipeline stages a barrier connects (a small vocabulary is all the pipeline needs).
+#[derive(Clone, Copy, Debug)]
+pub enum Stage {
+    Compute,
+    Transfer,
+    Graphics,
+    Host,
+    All,
+}
+
+impl Stage {
+    fn flags(self) -> (vk::PipelineStageFlags, vk::AccessFlags, vk::AccessFlags) {
+        use vk::AccessFlags as A;
+        use vk::PipelineStageFlags as P;
+        match self {
+            Stage::Compute => (P::COMPUTE_SHADER, A::SHADER_WRITE, A::SHADER_READ | A::SHADER_WRITE),
+            Stage::Transfer => (P::TRANSFER, A::TRANSFER_WRITE, A::TRANSFER_READ | A::TRANSFER_WRITE),
+            Stage::Graphics => (
+                P::VERTEX_SHADER | P::FRAGMENT_SHADER | P::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                A::SHADER_READ | A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
+            ),
+            Stage::Host => (P::HOST, A::HOST_WRITE, A::HOST_READ),
+            Stage::All => (P::ALL_COMMANDS, A::MEMORY_WRITE, A::MEMORY_READ | A::MEMORY_WRITE),
+        }
+    }
+}
+
+impl Recorder<'_> {
+    /// Make all writes of `src` visible to `dst`.
+    pub fn barrier(&self, src: Stage, dst: Stage) {
+        let (s, sa, _) = src.flags();
+        let (d, _, da) = dst.flags();
+        let mb = [vk::MemoryBarrier::default().src_access_mask(sa).dst_access_mask(da)];
+        // SAFETY: recording into a command buffer in the recording state.
+        unsafe {
+            self.ctx.device.cmd_pipeline_barrier(self.cmd, s, d, vk::DependencyFlags::empty(), &mb, &[], &[])
+        };
+    }
+
+    /// Transition all layers of `image`, ordering `src` work before `dst` work.
+    pub fn transition(&self, image: &Image, from: vk::ImageLayout, to: vk::ImageLayout, src: Stage, dst: Stage) {
+        let (s, sa, _) = src.flags();
+        let (d, _, da) = dst.flags();
+        let b = [vk::ImageMemoryBarrier::default()
+            .old_layout(from)
+            .new_layout(to)
+            .src_access_mask(sa)
+            .dst_access_mask(da)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(image.raw)
+            .subresource_range(image.range())];
+        // SAFETY: recording state; image alive for the submission.
+        unsafe { self.ctx.device.cmd_pipeline_barrier(self.cmd, s, d, vk::DependencyFlags::empty(), &[], &[], &b) };
+    }
+
+    pub fn clear_image(&self, image: &Image, layout: vk::ImageLayout, color: [f32; 4]) {
+        let value = vk::ClearColorValue { float32: color };
+        // SAFETY: image is in `layout` (GENERAL or TRANSFER_DST) per the caller's transitions.
+        unsafe { self.ctx.device.cmd_clear_color_image(self.cmd, image.raw, layout, &value, &[image.range()]) };
+    }
+
+    pub fn copy_buffer_to_image(&self, buffer: &Buffer, image: &Image) {
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 })];
+        // SAFETY: image in TRANSFER_DST_OPTIMAL; buffer holds width*height texels.
+        unsafe {
+            self.ctx.device.cmd_copy_buffer_to_image(
+                self.cmd,
+                buffer.raw,
+                image.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+            )
+        };
+    }
+
+    pub fn copy_image_to_buffer(&self, image: &Image, layout: vk::ImageLayout, buffer: &Buffer) {
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 })];
+        // SAFETY: image in `layout` (GENERAL or TRANSFER_SRC); buffer large enough (checked by caller).
+        unsafe { self.ctx.device.cmd_copy_image_to_buffer(self.cmd, image.raw, layout, buffer.raw, &region) };
+    }
+
+    fn bind(&self, pipeline: &Pipeline, layout: &Layout, set: &DescriptorSet, push: &[u8]) {
+        // SAFETY: pipeline, layout and set are compatible (built from the same Layout).
+        unsafe {
+            self.ctx.device.cmd_bind_pipeline(self.cmd, pipeline.bind_point, pipeline.raw);
+            self.ctx.device.cmd_bind_descriptor_sets(
+                self.cmd,
+                pipeline.bind_point,
+                layout.pipeline_layout,
+                0,
+                &[set.raw],
+                &[],
+            );
+            if !push.is_empty() {
+                self.ctx.device.cmd_push_constants(self.cmd, layout.pipeline_layout, layout.push_stages, 0, push);
+            }
+        }
+    }
+
+    pub fn dispatch(&self, pipeline: &Pipeline, layout: &Layout, set: &DescriptorSet, push: &[u8], groups: [u32; 3]) {
+        self.bind(pipeline, layout, set, push);
+        // SAFETY: compute pipeline bound above.
+        unsafe { self.ctx.device.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]) };
+    }
+
+    pub fn begin_pass(&self, pass: &RenderPass, fb: &Framebuffer) {
+        let clear = [vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } }];
+        let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: fb.width, height: fb.height } };
+        let info = vk::RenderPassBeginInfo::default()
+            .render_pass(pass.raw)
+            .framebuffer(fb.raw)
+            .render_area(area)
+            .clear_values(&clear);
+        let viewport = [vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: fb.width as f32,
+            height: fb.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        }];
+        // SAFETY: framebuffer built for this pass.
+        unsafe {
+            self.ctx.device.cmd_begin_render_pass(self.cmd, &info, vk::SubpassContents::INLINE);
+            self.ctx.device.cmd_set_viewport(self.cmd, 0, &viewport);
+            self.ctx.device.cmd_set_scissor(self.cmd, 0, &[area]);
+        }
+    }
+
+    /// Instanced quads: 4 strip vertices per instance.
+    pub fn draw_quads(
+        &self,
+        pipeline: &Pipeline,
+        layout: &Layout,
+        set: &DescriptorSet,
+        push: &[u8],
+        first_instance: u32,
+        instances: u32,
+    ) {
+        self.bind(pipeline, layout, set, push);
+        // SAFETY: inside a render pass with a graphics pipeline bound.
+        unsafe { self.ctx.device.cmd_draw(self.cmd, 4, instances, 0, first_instance) };
+    }
+
+    pub fn end_pass(&self) {
+        // SAFETY: matches begin_pass.
+        unsafe { self.ctx.device.cmd_end_render_pass(self.cmd) };
+    }
+
+    pub fn timestamp(&self, timer: &Timer, index: u32) {
+        if let Some(pool) = timer.pool {
+            if index < timer.capacity {
+                // SAFETY: query index within the pool, reset at the start of the recording.
+                unsafe {
+                    self.ctx.device.cmd_write_timestamp(self.cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, index)
+                };
+            }
+        }
+    }
+
+    pub fn reset_timer(&self, timer: &Timer) {
+        if let Some(pool) = timer.pool {
+            // SAFETY: outside a render pass.
+            unsafe { self.ctx.device.cmd_reset_query_pool(self.cmd, pool, 0, timer.capacity) };
+        }
+    }
+}
+
+impl Context {
+    /// Record with `f`, submit, and wait on a fence. Everything `f` referenced must live until
+    /// this returns, which the borrow of the recorder guarantees for resources passed by reference.
+    pub fn submit<T>(&self, f: impl FnOnce(&Recorder<'_>) -> Result<T>) -> Result<T> {
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(self.queue_family)
+            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        // SAFETY: valid device; the pool is destroyed below on every path.
+        let pool = unsafe { self.device.create_command_pool(&pool_info, None) }
+            .map_err(Error::vk("vkCreateCommandPool"))?;
+        let result = self.submit_in(pool, f);
+        // SAFETY: submit_in waited on its fence (or never submitted) before returning.
+        unsafe { self.device.destroy_command_pool(pool, None) };
+        result
+    }
+
+    fn submit_in<T>(&self, pool: vk::CommandPool, f: impl FnOnce(&Recorder<'_>) -> Result<T>) -> Result<T> {
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        // SAFETY: pool from this device.
+        let cmd = unsafe { self.device.allocate_command_buffers(&alloc) }
+            .map_err(Error::vk("vkAllocateCommandBuffers"))?[0];
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: fresh command buffer.
+        unsafe { self.device.begin_command_buffer(cmd, &begin) }.map_err(Error::vk("vkBeginCommandBuffer"))?;
+        let rec = Recorder { ctx: self, cmd };
+        // Earlier submissions on this queue touched the same resources: order them first.
+        rec.barrier(Stage::All, Stage::All);
+        let value = f(&rec)?;
+        rec.barrier(Stage::All, Stage::Host);
+        // SAFETY: recording state.
+        unsafe { self.device.end_command_buffer(cmd) }.map_err(Error::vk("vkEndCommandBuffer"))?;
+        // SAFETY: fence destroyed below.
+        let fence = unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) }
+            .map_err(Error::vk("vkCreateFence"))?;
+        let cmds = [cmd];
+        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        let submitted = {
+            let queue = self.queue.lock().map_err(|_| Error::Unsupported("queue lock poisoned".into()))?;
+            // SAFETY: the queue is externally synchronised by the mutex.
+            unsafe { self.device.queue_submit(*queue, &submit, fence) }.map_err(Error::vk("vkQueueSubmit"))
+        };
+        let waited = submitted.and_then(|_| {
+            // SAFETY: fence from this device.
+            unsafe { self.device.wait_for_fences(&[fence], true, u64::MAX) }.map_err(Error::vk("vkWaitForFences"))
+        });
+        if waited.is_err() {
+            // Device lost or similar: make sure nothing is still running before the pool goes.
+            self.wait_idle();
+        }
+        // SAFETY: the fence has signalled or the device is idle/lost.
+        unsafe { self.device.destroy_fence(fence, None) };
+        waited.map(|_| value)
+    }
+}

@@ -1,0 +1,204 @@
+//! Volume rasters and their sparse extraction into splat rows (section 1.2.5): only non-empty
+//! voxels are stored, each keeping its grid index.
+use crate::error::{Error, Result};
+use crate::gpu_types::Splat;
+use glam::Vec3;
+
+/// Most splats a scene may hold (32 bytes each on the GPU, plus order and parameters).
+pub const MAX_SPLATS: usize = 1 << 26;
+/// Most rows (ny * nz) of the row table.
+pub const MAX_ROWS: u64 = 1 << 26;
+/// Largest extent of one axis.
+pub const MAX_DIM: u32 = 1 << 16;
+
+/// A rectilinear grid: dimensions, voxel spacing, and the world position of voxel (0, 0, 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    pub dims: [u32; 3],
+    pub spacing: [f32; 3],
+    pub origin: [f32; 3],
+}
+
+impl Grid {
+    /// A grid centred on the world origin.
+    pub fn centered(dims: [u32; 3], spacing: [f32; 3]) -> Result<Self> {
+        let origin = [0, 1, 2].map(|a| -((dims[a].max(1) - 1) as f32) * 0.5 * spacing[a]);
+        let g = Self { dims, spacing, origin };
+        g.validate()?;
+        Ok(g)
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if self.dims.iter().any(|&d| d == 0 || d > MAX_DIM) {
+            return Err(Error::InvalidArgument(format!("grid dimensions {:?} must be in 1..={MAX_DIM}", self.dims)));
+        }
+        if self.spacing.iter().any(|s| !s.is_finite() || *s <= 0.0) {
+            return Err(Error::InvalidArgument(format!("voxel spacing {:?} must be finite and positive", self.spacing)));
+        }
+        if self.origin.iter().any(|o| !o.is_finite()) {
+            return Err(Error::InvalidArgument("grid origin must be finite".into()));
+        }
+        let rows = self.dims[1] as u64 * self.dims[2] as u64;
+        if rows > MAX_ROWS {
+            return Err(Error::TooLarge(format!("{rows} rows exceed the limit of {MAX_ROWS}")));
+        }
+        Ok(())
+    }
+
+    pub fn position(&self, ijk: [u32; 3]) -> Vec3 {
+        Vec3::from(self.origin) + Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) * Vec3::from(self.spacing)
+    }
+
+    pub fn center(&self) -> Vec3 {
+        self.position([0, 0, 0]).lerp(self.position([self.dims[0] - 1, self.dims[1] - 1, self.dims[2] - 1]), 0.5)
+    }
+
+    /// Length of the grid's diagonal (corner voxel centres).
+    pub fn diagonal(&self) -> f32 {
+        (self.position([self.dims[0] - 1, self.dims[1] - 1, self.dims[2] - 1]) - self.position([0, 0, 0])).length()
+    }
+
+    /// The spacing the footprint kernel is scaled by (the largest, so anisotropic grids have no holes).
+    pub fn kernel_spacing(&self) -> f32 {
+        self.spacing.iter().cloned().fold(0.0, f32::max)
+    }
+}
+
+/// The extracted voxels of a grid as rows along i: row (j, k) holds its voxels sorted by i.
+#[derive(Clone, Debug)]
+pub struct SplatSet {
+    grid: Grid,
+    row_start: Vec<u32>,
+    splats: Vec<Splat>,
+}
+
+impl SplatSet {
+    /// Visit every cell in (k, j, i) order and keep those for which `voxel` returns a colour
+    /// (straight RGB, opacity). Memory is proportional to the kept voxels plus one entry per row.
+    pub fn from_fn(grid: Grid, mut voxel: impl FnMut(u32, u32, u32) -> Option<[f32; 4]>) -> Result<Self> {
+        grid.validate()?;
+        let [nx, ny, nz] = grid.dims;
+        let mut row_start = Vec::with_capacity((ny as usize) * (nz as usize) + 1);
+        let mut splats = Vec::new();
+        for k in 0..nz {
+            for j in 0..ny {
+                row_start.push(splats.len() as u32);
+                for i in 0..nx {
+                    if let Some(c) = voxel(i, j, k) {
+                        if c.iter().any(|v| !v.is_finite()) {
+                            return Err(Error::InvalidArgument(format!("voxel ({i},{j},{k}) has a non-finite colour")));
+                        }
+                        if c[3] <= 0.0 {
+                            continue;
+                        }
+                        if splats.len() >= MAX_SPLATS {
+                            return Err(Error::TooLarge(format!("more than {MAX_SPLATS} non-empty voxels")));
+                        }
+                        splats.push(Splat { ijk: [i, j, k, 0], color: c });
+                    }
+                }
+            }
+        }
+        row_start.push(splats.len() as u32);
+        Ok(Self { grid, row_start, splats })
+    }
+
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+    pub fn splats(&self) -> &[Splat] {
+        &self.splats
+    }
+    pub fn row_start(&self) -> &[u32] {
+        &self.row_start
+    }
+    pub fn len(&self) -> usize {
+        self.splats.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.splats.is_empty()
+    }
+
+    pub fn row_index(&self, j: u32, k: u32) -> usize {
+        (j + self.grid.dims[1] * k) as usize
+    }
+
+    /// Index of the splat at (i, j, k), if that voxel was extracted.
+    pub fn find(&self, i: u32, j: u32, k: u32) -> Option<usize> {
+        let [nx, ny, nz] = self.grid.dims;
+        if i >= nx || j >= ny || k >= nz {
+            return None;
+        }
+        let r = self.row_index(j, k);
+        let (s, e) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
+        self.splats[s..e].binary_search_by_key(&i, |sp| sp.ijk[0]).ok().map(|x| s + x)
+    }
+
+    /// Splat indices grouped by slice along `axis` (a counting sort): `(offsets, list)` where
+    /// slice `s` holds `list[offsets[s]..offsets[s + 1]]`.
+    pub fn slices(&self, axis: usize) -> (Vec<u32>, Vec<u32>) {
+        let n = self.grid.dims[axis] as usize;
+        let mut offsets = vec![0u32; n + 1];
+        for sp in &self.splats {
+            offsets[sp.ijk[axis] as usize + 1] += 1;
+        }
+        for s in 0..n {
+            offsets[s + 1] += offsets[s];
+        }
+        let mut fill = offsets.clone();
+        let mut list = vec![0u32; self.splats.len()];
+        for (idx, sp) in self.splats.iter().enumerate() {
+            let s = sp.ijk[axis] as usize;
+            list[fill[s] as usize] = idx as u32;
+            fill[s] += 1;
+        }
+        (offsets, list)
+    }
+
+    /// Rank of each slice along `axis` among the non-empty slices (empty slices get the rank of
+    /// the next non-empty one; they are never drawn).
+    pub fn sheet_ranks(offsets: &[u32]) -> Vec<u32> {
+        let mut rank = 0;
+        let mut out = Vec::with_capacity(offsets.len().saturating_sub(1));
+        for w in offsets.windows(2) {
+            out.push(rank);
+            if w[1] > w[0] {
+                rank += 1;
+            }
+        }
+        out
+    }
+}
+
+/// A dense volume raster: density and RGBA per voxel. Loaders produce these; rendering uses the
+/// sparse [`SplatSet`] extracted from it.
+#[derive(Clone, Debug)]
+pub struct Volume {
+    pub grid: Grid,
+    pub density: Vec<f32>,
+    pub rgba: Vec<[f32; 4]>,
+}
+
+impl Volume {
+    pub fn new(grid: Grid, density: Vec<f32>, rgba: Vec<[f32; 4]>) -> Result<Self> {
+        grid.validate()?;
+        let n = grid.dims.iter().map(|&d| d as u64).product::<u64>();
+        if density.len() as u64 != n || rgba.len() as u64 != n {
+            return Err(Error::InvalidArgument(format!(
+                "volume of {n} voxels given {} densities and {} colours",
+                density.len(),
+                rgba.len()
+            )));
+        }
+        Ok(Self { grid, density, rgba })
+    }
+
+    /// Keep the voxels whose density exceeds `threshold`.
+    pub fn extract(&self, threshold: f32) -> Result<SplatSet> {
+        let [nx, ny, _] = self.grid.dims;
+        SplatSet::from_fn(self.grid, |i, j, k| {
+            let idx = i as usize + nx as usize * (j as usize + ny as usize * k as usize);
+            (self.density[idx] > threshold).then_some(self.rgba[idx])
+        })
+    }
+}
