@@ -35,13 +35,18 @@ pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
     }
 }
 
-/// Mean and max absolute difference per channel between two images' 8-bit straight-alpha
-/// encodings, in units of 1/255.
+/// Premultiplied RGBA8 pixels (what a compositor would blend).
+pub fn to_premultiplied_rgba8(img: &ImageF32) -> Vec<u8> {
+    img.pixels.iter().flat_map(|p| p.map(|v| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)).collect()
+}
+
+/// Mean and max absolute difference per channel between two images' 8-bit premultiplied
+/// encodings, in units of 1/255. (Straight alpha would amplify noise in nearly transparent pixels.)
 pub fn diff_rgba8(a: &ImageF32, b: &ImageF32) -> Result<(f64, u8)> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err(Error::InvalidArgument("images differ in size".into()));
     }
-    let (x, y) = (to_rgba8(a), to_rgba8(b));
+    let (x, y) = (to_premultiplied_rgba8(a), to_premultiplied_rgba8(b));
     let mut sum = 0u64;
     let mut max = 0u8;
     for (p, q) in x.iter().zip(&y) {

@@ -1,0 +1,120 @@
+#![allow(dead_code)]
+use glam::Vec3;
+use voxsplat::{Backend, Camera, Grid, Projection, Renderer, RendererOptions, SplatSet};
+
+/// A GPU renderer with validation on (every GPU test asks for it).
+pub fn gpu() -> Renderer {
+    let mut o = RendererOptions::default();
+    o.backend = Backend::Gpu;
+    o.validation = true;
+    Renderer::new(&o).expect("a Vulkan device with the validation layer (run scripts/setup.sh)")
+}
+
+pub fn cpu() -> Renderer {
+    let mut o = RendererOptions::default();
+    o.backend = Backend::Cpu;
+    Renderer::new(&o).expect("cpu renderer")
+}
+
+/// Fails the test on any validation message, printing them.
+pub fn assert_clean(r: &Renderer) {
+    let n = r.validation_count();
+    if n > 0 {
+        for m in r.validation_messages() {
+            eprintln!("{m}");
+        }
+    }
+    assert_eq!(n, 0, "validation messages");
+}
+
+/// splitmix64: seeded, dependency-free randomness.
+pub struct Rng(pub u64);
+impl Rng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
+        z ^ (z >> 31)
+    }
+    pub fn f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f32()
+    }
+    pub fn dir(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0));
+            if v.length() > 0.1 && v.length() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+/// A random sparse volume with holes in its rows, to exercise the row logic.
+pub fn random_sparse(seed: u64, dims: [u32; 3], fill: f32) -> SplatSet {
+    let mut rng = Rng(seed);
+    let grid = Grid::centered(dims, [1.0, 1.5, 0.75]).unwrap();
+    SplatSet::from_fn(grid, |i, j, k| {
+        (rng.f32() < fill).then(|| [(i % 3) as f32 / 2.0, (j % 2) as f32, (k % 5) as f32 / 4.0, 0.8])
+    })
+    .unwrap()
+}
+
+/// Which kind of viewpoint a random camera is.
+#[derive(Clone, Copy, Debug)]
+pub enum ViewKind {
+    Outside,
+    Inside,
+    OnGridPlane,
+    Orthographic,
+}
+
+/// A random camera of `kind` around `grid`.
+pub fn random_camera(rng: &mut Rng, grid: &Grid, kind: ViewKind) -> Camera {
+    let c = grid.center();
+    let r = 0.5 * grid.diagonal().max(1.0);
+    let lo = Vec3::from(grid.origin);
+    let hi = grid.position([grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1]);
+    let sp = Vec3::from(grid.spacing);
+    let eye = match kind {
+        ViewKind::Outside | ViewKind::Orthographic => c + rng.dir() * r * rng.range(1.05, 3.0),
+        ViewKind::Inside => Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z)),
+        ViewKind::OnGridPlane => {
+            // Snap some coordinates to a voxel plane or to a midplane between voxels, inside or
+            // just outside the grid.
+            let mut e = c + rng.dir() * r * rng.range(0.0, 2.0);
+            for a in 0..3 {
+                if rng.f32() < 0.7 {
+                    let idx = ((e[a] - lo[a]) / sp[a]).round();
+                    let half = if rng.f32() < 0.5 { 0.0 } else { 0.5 };
+                    e[a] = lo[a] + (idx + half) * sp[a];
+                }
+            }
+            e
+        }
+    };
+    let mut target = c + rng.dir() * r * 0.3;
+    if (target - eye).length() < 1e-3 {
+        target = eye + Vec3::X;
+    }
+    let fwd = (target - eye).normalize();
+    let up = if fwd.cross(Vec3::Y).length() > 0.1 { Vec3::Y } else { Vec3::Z };
+    let projection = match kind {
+        ViewKind::Orthographic => Projection::Orthographic { height: 2.0 * r },
+        _ => Projection::Perspective { fov_y_deg: rng.range(20.0, 90.0) },
+    };
+    let d = (c - eye).length();
+    Camera {
+        eye,
+        target,
+        up,
+        projection,
+        near: if matches!(kind, ViewKind::Orthographic) { -4.0 * r } else { 0.05 },
+        far: d + 4.0 * r,
+        width: 64,
+        height: 64,
+    }
+}

@@ -1,0 +1,120 @@
+//! Visibility orders on the CPU: PBTF is free of violations everywhere; BTF and WBTF fail on the
+//! close perspective view of Figs 2.25-2.26; the CPU mirror of the GPU order stages equals the
+//! pure-Rust PBTF.
+mod common;
+use common::{random_camera, random_sparse, Rng, ViewKind};
+use glam::Vec3;
+use voxsplat::order::{count_violations, pbtf, pbtf_split, visibility_order};
+use voxsplat::{scene, Camera, Direction, OrderKind, Projection, SplatSet};
+
+fn is_permutation(order: &[u32], n: usize) -> bool {
+    let mut seen = vec![false; n];
+    order.len() == n && order.iter().all(|&s| (s as usize) < n && !std::mem::replace(&mut seen[s as usize], true))
+}
+
+#[test]
+fn pbtf_has_no_violations_on_1000_random_viewpoints() {
+    let sets: Vec<SplatSet> = vec![scene::build("cube40").unwrap(), random_sparse(7, [13, 9, 11], 0.6)];
+    let mut rng = Rng(0x5EED);
+    let kinds = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic];
+    let mut checked = 0;
+    let mut total_pairs_violated_by_btf = 0;
+    for v in 0..1000 {
+        let set = &sets[v % 2];
+        let kind = kinds[v % 4];
+        let cam = random_camera(&mut rng, set.grid(), kind);
+        for dir in [Direction::FrontToBack, Direction::BackToFront] {
+            let order = visibility_order(set, &cam, OrderKind::Pbtf, dir);
+            assert!(is_permutation(&order, set.len()));
+            let n = count_violations(set, &cam, &order, dir).unwrap();
+            assert_eq!(n, 0, "PBTF violations {n} for {kind:?} camera {cam:?} {dir:?}");
+        }
+        // The reference order agrees with the validator too.
+        let sorted = visibility_order(set, &cam, OrderKind::Sorted, Direction::FrontToBack);
+        assert_eq!(count_violations(set, &cam, &sorted, Direction::FrontToBack).unwrap(), 0, "{kind:?} {cam:?}");
+        let btf = visibility_order(set, &cam, OrderKind::Btf, Direction::FrontToBack);
+        total_pairs_violated_by_btf += count_violations(set, &cam, &btf, Direction::FrontToBack).unwrap();
+        checked += 1;
+    }
+    assert_eq!(checked, 1000);
+    // The same viewpoints break BTF, so the validator is not vacuous.
+    assert!(total_pairs_violated_by_btf > 0);
+}
+
+/// A close, off-axis perspective view of the 60^3 cube whose eye projects inside the grid on two
+/// axes, as in Figs 2.25-2.27.
+fn close_view(set: &SplatSet) -> Camera {
+    let c = set.grid().center();
+    Camera {
+        eye: c + Vec3::new(12.0, 20.0, 75.0),
+        target: c,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 60.0 },
+        near: 0.5,
+        far: 300.0,
+        width: 256,
+        height: 256,
+    }
+}
+
+#[test]
+fn btf_and_wbtf_fail_where_pbtf_does_not() {
+    let set = scene::build("cube60").unwrap();
+    let cam = close_view(&set);
+    let count = |k| {
+        let o = visibility_order(&set, &cam, k, Direction::BackToFront);
+        count_violations(&set, &cam, &o, Direction::BackToFront).unwrap()
+    };
+    let (btf, wbtf, pbtf_v, sorted) =
+        (count(OrderKind::Btf), count(OrderKind::Wbtf), count(OrderKind::Pbtf), count(OrderKind::Sorted));
+    eprintln!("violations: btf {btf}, wbtf {wbtf}, pbtf {pbtf_v}, sorted {sorted}");
+    assert!(btf > 0, "BTF should fail on this view");
+    assert!(wbtf > 0, "WBTF should fail on this view");
+    assert_eq!(pbtf_v, 0);
+    assert_eq!(sorted, 0);
+    // The orthographic view from the same direction is fine for all of them (Frieder, Westover).
+    let mut ortho = cam;
+    ortho.projection = Projection::Orthographic { height: 90.0 };
+    ortho.near = -200.0;
+    for k in [OrderKind::Btf, OrderKind::Wbtf, OrderKind::Pbtf] {
+        let o = visibility_order(&set, &ortho, k, Direction::BackToFront);
+        assert_eq!(count_violations(&set, &ortho, &o, Direction::BackToFront).unwrap(), 0, "{k:?} orthographic");
+    }
+}
+
+#[test]
+fn cpu_mirror_of_gpu_order_equals_pure_rust_pbtf() {
+    let mut rng = Rng(42);
+    let sets = [scene::build("cube40").unwrap(), random_sparse(3, [17, 5, 8], 0.4), scene::build("plane").unwrap()];
+    let mut r = common::cpu();
+    for (si, set) in sets.iter().enumerate() {
+        r.set_scene(set.clone()).unwrap();
+        for v in 0..60 {
+            let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
+            let cam = random_camera(&mut rng, set.grid(), kind);
+            let want = pbtf(set, pbtf_split(set, &cam));
+            let got = r.pbtf_order(&cam, Direction::FrontToBack).unwrap();
+            assert_eq!(got, want, "set {si} {kind:?}");
+            let mut back = r.pbtf_order(&cam, Direction::BackToFront).unwrap();
+            back.reverse();
+            assert_eq!(back, want);
+        }
+    }
+}
+
+#[test]
+fn split_handles_eye_on_planes_and_outside() {
+    let set = random_sparse(1, [10, 10, 10], 1.0);
+    let g = *set.grid();
+    let mut cam = Camera::framing(&g, 8, 8);
+    // Eye exactly on voxel 4's plane in x, on the midplane 6.5 in y, beyond the grid in z.
+    cam.eye = Vec3::new(
+        g.origin[0] + 4.0 * g.spacing[0],
+        g.origin[1] + 6.5 * g.spacing[1],
+        g.origin[2] + 20.0 * g.spacing[2],
+    );
+    let split = pbtf_split(&set, &cam);
+    assert_eq!(split[0], 5, "voxel 4 on the eye's plane goes to the low side");
+    assert_eq!(split[1], 8, "eye on the 6.5 midplane");
+    assert_eq!(split[2], 10, "eye beyond the grid: everything on the low side");
+}
