@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs what voxsplat needs on Debian 12 beyond Rust: lavapipe (Mesa's CPU Vulkan driver), the
+# Vulkan loader, the Khronos validation layers, and the static shaderc/glslang/SPIRV-Tools libraries
+# that build.rs links through .cargo/config.toml. Idempotent: does nothing when all are present.
+set -euo pipefail
+pkgs=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}" >&2
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust first (https://rustup.rs)" >&2; exit 1; }

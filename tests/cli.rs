@@ -1,0 +1,105 @@
+//! The command-line contract: listed scenes, rendered files, order dumps, and clear errors (never
+//! a panic) for bad input.
+use std::process::{Command, Output};
+
+fn voxsplat(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_voxsplat")).args(args).output().expect("run voxsplat")
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("voxsplat-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn scenes_are_listed() {
+    let out = voxsplat(&["scenes"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for name in ["cube40", "cube60", "plane", "empty"] {
+        assert!(text.lines().any(|l| l.starts_with(name)), "{name} missing from:\n{text}");
+    }
+}
+
+#[test]
+fn render_writes_png_and_exr() {
+    for (ext, extra) in [("png", vec!["--cpu"]), ("exr", vec!["--validation", "--composite", "sheet", "--kernel", "cubic"])] {
+        let path = tmp(&format!("cube.{ext}"));
+        let p = path.to_str().unwrap();
+        let mut args = vec!["render", "--scene", "cube40", "--size", "96x64", "--out", p];
+        args.extend(extra);
+        let out = voxsplat(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let bytes = std::fs::read(&path).unwrap();
+        match ext {
+            "png" => {
+                let img = image::load_from_memory(&bytes).unwrap().to_rgba8();
+                assert_eq!(img.dimensions(), (96, 64));
+                assert!(img.pixels().any(|px| px[3] > 200), "the cube is drawn");
+                assert!(img.pixels().any(|px| px[3] == 0), "the background is transparent");
+            }
+            _ => assert_eq!(&bytes[..4], &[0x76, 0x2f, 0x31, 0x01], "EXR magic"),
+        }
+    }
+}
+
+#[test]
+fn order_dump_and_check() {
+    let path = tmp("order.csv");
+    let out = voxsplat(&[
+        "order", "--scene", "cube40", "--eye", "5,8,45", "--target", "0,0,0", "--order", "pbtf", "--dump",
+        path.to_str().unwrap(), "--check", "--validation",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.lines().last(), Some("violations: 0"));
+    let csv = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 40 * 40 * 40 - 38 * 38 * 38);
+    let fields: Vec<f32> = lines[0].split(',').map(|f| f.parse().unwrap()).collect();
+    assert_eq!(fields.len(), 6);
+    // x = i - 19.5 for the centred 40^3 grid.
+    assert_eq!(fields[3], fields[0] - 19.5);
+    // Back to front: the first splat is farther from the eye than the last.
+    let dist = |l: &str| {
+        let f: Vec<f32> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        ((f[3] - 5.0).powi(2) + (f[4] - 8.0).powi(2) + (f[5] - 45.0).powi(2)).sqrt()
+    };
+    assert!(dist(lines[0]) > dist(lines[lines.len() - 1]));
+
+    let out = voxsplat(&["order", "--scene", "cube40", "--eye", "5,8,45", "--target", "0,0,0", "--order", "btf", "--check"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let last = stdout.lines().last().unwrap();
+    let n: u64 = last.strip_prefix("violations: ").unwrap().parse().unwrap();
+    assert!(n > 0, "BTF breaks on this close perspective view");
+}
+
+#[test]
+fn bad_arguments_fail_cleanly() {
+    let cases: &[&[&str]] = &[
+        &["render", "--scene", "nosuch", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--eye", "nan,0,0", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--eye", "1,2", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--eye", "0,0,0", "--target", "0,0,0", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--size", "0x10", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--size", "100000x10", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--fov", "180", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--fov", "-5", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--ortho", "0", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--up", "0,0,0", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--order", "zigzag", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--out", "x.bmp", "--cpu"],
+        &["render", "--scene", "cube40", "--near", "10", "--far", "5", "--out", "x.png"],
+        &["order", "--scene", "cube40", "--dump", "/nonexistent-dir/x.csv", "--cpu"],
+        &["frobnicate"],
+    ];
+    for args in cases {
+        let out = voxsplat(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+        assert!(stderr.contains("error"), "{args:?}: no message: {stderr}");
+    }
+}

@@ -1,0 +1,144 @@
+//! Kernels, cameras, scenes and the sheet plan.
+mod common;
+use glam::Vec3;
+use voxsplat::constants::{FOOTPRINT_TABLE_SIZE, MAX_GROUPS_X, WORKGROUP_SIZE};
+use voxsplat::order::Direction;
+use voxsplat::pipeline::{groups_1d, sheet_plan, Prepared};
+use voxsplat::{scene, Camera, Error, Grid, Kernel, Projection, SplatSet, Volume};
+
+#[test]
+fn footprint_tables_integrate_to_one_and_vanish_at_the_radius() {
+    for k in [Kernel::Gaussian, Kernel::Cubic] {
+        let t = k.footprint_table();
+        let n = FOOTPRINT_TABLE_SIZE as usize;
+        let texel = (2.0 * k.radius() as f64 / n as f64).powi(2);
+        let integral: f64 = t.iter().map(|&v| v as f64).sum::<f64>() * texel;
+        assert!((integral - 1.0).abs() < 1e-5, "{k:?} integral {integral}");
+        // Corners lie outside the radius.
+        assert_eq!(t[0], 0.0);
+        // Peak at the centre, monotone outward along a row.
+        let mid = n / 2;
+        let row = &t[mid * n..(mid + 1) * n];
+        assert!(row[mid] >= row[mid + 5] && row[mid + 5] >= row[mid + 10]);
+        // A unit-spaced sheet of footprints sums to about 1 (partition of unity for the plane).
+        let r = k.radius() as f64;
+        let mut sum = 0.0;
+        for dx in -3..=3 {
+            for dy in -3..=3 {
+                let (u, v) = ((0.3 + dx as f64) / r, (0.2 + dy as f64) / r);
+                if u.abs() <= 1.0 && v.abs() <= 1.0 {
+                    sum += voxsplat::cpu::sample_table(&t, u as f32, v as f32) as f64;
+                }
+            }
+        }
+        assert!((sum - 1.0).abs() < 0.1, "{k:?} sheet sum {sum}");
+    }
+    // Gaussian pre-integration matches the closed form 1/(2 pi s^2) exp(-rho^2 / 2 s^2).
+    let s = voxsplat::kernel::GAUSSIAN_SIGMA;
+    let g = Kernel::Gaussian;
+    let ratio = g.integrated(0.8) / g.integrated(0.0);
+    assert!((ratio - (-(0.64) / (2.0 * s * s)).exp()).abs() < 2e-3, "{ratio}");
+}
+
+#[test]
+fn camera_rejects_bad_values() {
+    let set = scene::build("cube40").unwrap();
+    let good = Camera::framing(set.grid(), 64, 64);
+    good.validate().unwrap();
+    let bad: Vec<Camera> = vec![
+        Camera { eye: Vec3::new(f32::NAN, 0.0, 0.0), ..good },
+        Camera { target: good.eye, ..good },
+        Camera { up: good.target - good.eye, ..good },
+        Camera { up: Vec3::ZERO, ..good },
+        Camera { width: 0, ..good },
+        Camera { height: 1 << 20, ..good },
+        Camera { projection: Projection::Perspective { fov_y_deg: 0.0 }, ..good },
+        Camera { projection: Projection::Perspective { fov_y_deg: 180.0 }, ..good },
+        Camera { projection: Projection::Orthographic { height: -1.0 }, ..good },
+        Camera { near: 5.0, far: 5.0, ..good },
+        Camera { near: 0.0, ..good },
+        Camera { far: f32::INFINITY, ..good },
+    ];
+    for c in bad {
+        assert!(matches!(c.validate(), Err(Error::InvalidCamera(_))), "{c:?} accepted");
+    }
+}
+
+#[test]
+fn dispatch_groups_spill_into_y_past_the_row_limit() {
+    assert_eq!(groups_1d(0), [1, 1, 1]);
+    assert_eq!(groups_1d(1), [1, 1, 1]);
+    assert_eq!(groups_1d(WORKGROUP_SIZE + 1), [2, 1, 1]);
+    let big = MAX_GROUPS_X * WORKGROUP_SIZE * 3 + 5;
+    let g = groups_1d(big);
+    assert_eq!(g, [MAX_GROUPS_X, 4, 1]);
+    assert!(g[0] <= 65535 && g[1] <= 65535);
+    assert!((g[0] as u64 * g[1] as u64 * WORKGROUP_SIZE as u64) >= big as u64);
+}
+
+#[test]
+fn sheet_plan_covers_every_splat_once_within_the_budget() {
+    let mut rng = common::Rng(11);
+    for set in [scene::build("cube40").unwrap(), common::random_sparse(8, [9, 14, 6], 0.3)] {
+        let prep = Prepared::new(set.clone());
+        for v in 0..40 {
+            let kind = [common::ViewKind::Outside, common::ViewKind::Inside, common::ViewKind::Orthographic][v % 3];
+            let cam = common::random_camera(&mut rng, set.grid(), kind);
+            for dir in [Direction::FrontToBack, Direction::BackToFront] {
+                let max_layers = 1 + (v as u32 % 5);
+                let (axis, batches) = sheet_plan(&prep, &cam, dir, max_layers);
+                let mut seen = vec![0u32; set.len()];
+                for b in &batches {
+                    assert!(b.layers >= 1 && b.layers <= max_layers);
+                    for inst in b.first_instance..b.first_instance + b.instances {
+                        let s = prep.slices[axis].1[inst as usize] as usize;
+                        seen[s] += 1;
+                        // Layer arithmetic of footprint.vert lands inside the batch.
+                        let rank = prep.ranks[(b.push.rank_offset + set.splats()[s].ijk[axis]) as usize];
+                        let layer = if b.push.rank_dir > 0 { rank as i64 - b.push.rank_base as i64 } else { b.push.rank_base as i64 - rank as i64 };
+                        assert!(layer >= 0 && layer < b.layers as i64, "layer {layer} of {}", b.layers);
+                    }
+                }
+                assert!(seen.iter().all(|&c| c == 1), "every splat drawn exactly once");
+            }
+        }
+    }
+}
+
+#[test]
+fn extraction_keeps_only_non_empty_voxels_with_their_index() {
+    let grid = Grid::centered([4, 3, 2], [1.0, 2.0, 0.5]).unwrap();
+    let n = 24;
+    let density: Vec<f32> = (0..n).map(|i| if i % 5 == 0 { 1.0 } else { 0.0 }).collect();
+    let rgba = vec![[1.0, 0.5, 0.25, 0.5]; n];
+    let vol = Volume::new(grid, density, rgba).unwrap();
+    let set = vol.extract(0.5).unwrap();
+    assert_eq!(set.len(), 5);
+    for sp in set.splats() {
+        let idx = sp.ijk[0] + 4 * (sp.ijk[1] + 3 * sp.ijk[2]);
+        assert_eq!(idx % 5, 0);
+        assert_eq!(set.find(sp.ijk[0], sp.ijk[1], sp.ijk[2]).map(|i| set.splats()[i].ijk), Some(sp.ijk));
+    }
+    assert_eq!(set.row_start().len(), 3 * 2 + 1);
+    assert!(Volume::new(grid, vec![0.0; 3], vec![[0.0; 4]; 3]).is_err());
+    assert!(Grid::centered([0, 1, 1], [1.0; 3]).is_err());
+    assert!(Grid::centered([1, 1, 1], [f32::NAN, 1.0, 1.0]).is_err());
+    assert!(SplatSet::from_fn(grid, |_, _, _| Some([f32::NAN, 0.0, 0.0, 1.0])).is_err());
+}
+
+#[test]
+fn built_in_scenes_match_the_dissertation() {
+    let c60 = scene::build("cube60").unwrap();
+    assert_eq!(c60.grid().dims, [60, 60, 60]);
+    assert_eq!(c60.len(), 60 * 60 * 60 - 58 * 58 * 58);
+    let plane = scene::build("plane").unwrap();
+    assert_eq!(plane.grid().dims, [498, 398, 1]);
+    assert_eq!(plane.len(), 498 * 398);
+    // 10x10 squares alternate.
+    let a = plane.splats()[plane.find(0, 0, 0).unwrap()].color;
+    let b = plane.splats()[plane.find(10, 0, 0).unwrap()].color;
+    let c = plane.splats()[plane.find(9, 9, 0).unwrap()].color;
+    assert_ne!(a, b);
+    assert_eq!(a, c);
+    assert!(matches!(scene::build("nope"), Err(Error::InvalidArgument(_))));
+}
