@@ -359,7 +359,9 @@ impl GpuPipeline {
         })?;
         let mut timings = Vec::new();
         if let Some(ms) = timer.read_ms(stamps)? {
-            timings.push(StageTime { stage: "order", ms: ms[0] });
+            if gpu_order {
+                timings.push(StageTime { stage: "order", ms: ms[0] });
+            }
             timings.push(StageTime { stage: "splat_params", ms: ms[1] });
             match opts.composite {
                 Composite::Splat => timings.push(StageTime { stage: "footprint", ms: ms[2] }),

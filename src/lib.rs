@@ -15,6 +15,7 @@
 //! ```
 #![deny(unsafe_code)]
 
+pub mod bench;
 pub mod camera;
 pub mod constants;
 pub mod cpu;

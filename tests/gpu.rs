@@ -121,3 +121,25 @@ fn validation_counter_reports_a_deliberate_error() {
     assert!(gpu.validation_count() > 0, "a zero-sized buffer must be reported");
     assert!(gpu.validation_messages().iter().any(|m| m.contains("00912") || m.contains("size")));
 }
+
+#[test]
+fn renderer_on_an_adopted_host_device_matches_an_owning_one() {
+    let mut owner = common::gpu();
+    let set = scene::build("cube40").unwrap();
+    let cam = Camera::framing(set.grid(), 96, 80);
+    owner.set_scene(set.clone()).unwrap();
+    let want = owner.render(&cam, &RenderOptions::default()).unwrap().image;
+    {
+        // The "host" here is the owning renderer's context; the adopted one must not destroy it.
+        let host = owner.context().unwrap().handles();
+        let ctx = voxsplat::vk::Context::from_host(host).unwrap();
+        let mut guest = voxsplat::Renderer::with_context(ctx).unwrap();
+        guest.set_scene(set).unwrap();
+        let got = guest.render(&cam, &RenderOptions::default()).unwrap().image;
+        assert_eq!(diff_rgba8(&got, &want).unwrap().1, 0);
+    }
+    // The owner still works after the guest is gone.
+    let again = owner.render(&cam, &RenderOptions::default()).unwrap().image;
+    assert_eq!(again.pixels, want.pixels);
+    assert_clean(&owner);
+}

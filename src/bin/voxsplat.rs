@@ -24,6 +24,18 @@ enum Command {
     Render(RenderArgs),
     /// Write or check a visibility order (back to front).
     Order(OrderArgs),
+    /// Time the benchmark cases (cube60 and the plane at 512x512): per-stage medians.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Measured frames per case (after 2 warm-up frames).
+    #[arg(long, default_value_t = 9)]
+    frames: usize,
+    /// Time the CPU mirrors instead of the GPU.
+    #[arg(long)]
+    cpu: bool,
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
@@ -66,25 +78,25 @@ struct SceneArgs {
     #[arg(long, default_value = "cube60")]
     scene: String,
     /// Eye position (default: a three-quarter view framing the scene).
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
     /// Look-at point (default: the scene's centre).
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     target: Option<Vec3>,
     /// Up vector.
-    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0")]
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0", allow_hyphen_values = true)]
     up: Vec3,
     /// Vertical field of view in degrees (perspective).
-    #[arg(long, value_parser = parse_finite, conflicts_with = "ortho")]
+    #[arg(long, value_parser = parse_finite, conflicts_with = "ortho", allow_hyphen_values = true)]
     fov: Option<f32>,
     /// Orthographic projection with this view height (world units).
-    #[arg(long, value_parser = parse_finite)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     ortho: Option<f32>,
     /// Near plane distance (default: fitted to the scene).
-    #[arg(long, value_parser = parse_finite)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     near: Option<f32>,
     /// Far plane distance (default: fitted to the scene).
-    #[arg(long, value_parser = parse_finite)]
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
     far: Option<f32>,
     /// Image size.
     #[arg(long, value_parser = parse_size, default_value = "512x512")]
@@ -214,6 +226,23 @@ fn run(cli: Cli) -> Result<()> {
                     println!("{:<14} {:>9.3} ms", t.stage, t.ms);
                 }
             }
+            Ok(())
+        }
+        Command::Bench(a) => {
+            if a.frames == 0 {
+                return Err(Error::InvalidArgument("--frames must be positive".into()));
+            }
+            let mut opts = RendererOptions::default();
+            opts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
+            let mut r = Renderer::new(&opts)?;
+            println!("device: {}", r.device_name());
+            let mut rows = Vec::new();
+            let cases = voxsplat::bench::default_cases();
+            for (i, case) in cases.iter().enumerate() {
+                eprintln!("[{}/{}] {}", i + 1, cases.len(), case.label());
+                rows.push(voxsplat::bench::measure(&mut r, case, 2, a.frames)?);
+            }
+            print!("{}", voxsplat::bench::table(&rows));
             Ok(())
         }
         Command::Order(a) => {

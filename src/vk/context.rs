@@ -23,6 +23,17 @@ struct Debug {
     messenger: vk::DebugUtilsMessengerEXT,
 }
 
+/// A host program's Vulkan objects, handed to [`Context::from_host`].
+#[derive(Clone)]
+pub struct HostHandles {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+}
+
 /// The Vulkan objects every resource needs. Resources hold an `Arc<Context>` so it outlives them.
 pub struct Context {
     _entry: ash::Entry,
@@ -168,27 +179,34 @@ impl Context {
     }
 
     /// Adopt a host program's instance, device and queue. The host keeps ownership (nothing is
-    /// destroyed here), must have enabled Vulkan 1.2 `shaderOutputLayer`, and must not use `queue`
-    /// from another thread while voxsplat submits to it.
-    pub fn from_host(
-        entry: ash::Entry,
-        instance: ash::Instance,
-        physical: vk::PhysicalDevice,
-        device: ash::Device,
-        queue: vk::Queue,
-        queue_family: u32,
-    ) -> Result<Arc<Self>> {
+    /// destroyed here) and must keep them alive longer than every renderer built on this context.
+    /// The device needs Vulkan 1.2 `shaderOutputLayer` enabled and a graphics+compute queue; the
+    /// host must not use `queue` from another thread while voxsplat submits to it.
+    pub fn from_host(host: HostHandles) -> Result<Arc<Self>> {
         Self::finish(
-            entry,
-            instance,
-            physical,
-            device,
-            queue,
-            queue_family,
+            host.entry,
+            host.instance,
+            host.physical,
+            host.device,
+            host.queue,
+            host.queue_family,
             None,
             Box::default(),
             false,
         )
+    }
+
+    /// This context's Vulkan objects, for a host that wants to share them (for example to draw
+    /// voxsplat's output into its own frame).
+    pub fn handles(&self) -> HostHandles {
+        HostHandles {
+            entry: self._entry.clone(),
+            instance: self.instance.clone(),
+            physical: self.physical,
+            device: self.device.clone(),
+            queue: self.queue.lock().map(|q| *q).unwrap_or_default(),
+            queue_family: self.queue_family,
+        }
     }
 
     #[allow(clippy::too_many_arguments)]
