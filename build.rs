@@ -13,20 +13,15 @@ fn main() {
     println!("cargo:rerun-if-changed=src/constants.rs");
     println!("cargo:rerun-if-changed=glsl");
 
-    let mut shared: Vec<PathBuf> = std::fs::read_dir(glsl.join("shared"))
-        .expect("glsl/shared exists")
-        .map(|e| e.unwrap().path())
-        .collect();
+    let mut shared: Vec<PathBuf> =
+        std::fs::read_dir(glsl.join("shared")).expect("glsl/shared exists").map(|e| e.unwrap().path()).collect();
     shared.sort();
     for p in &shared {
         println!("cargo:rerun-if-changed={}", p.display());
     }
 
-    let mut stages: Vec<PathBuf> = std::fs::read_dir(glsl)
-        .expect("glsl exists")
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_file())
-        .collect();
+    let mut stages: Vec<PathBuf> =
+        std::fs::read_dir(glsl).expect("glsl exists").map(|e| e.unwrap().path()).filter(|p| p.is_file()).collect();
     stages.sort();
 
     let compiler = shaderc::Compiler::new().expect("shaderc compiler");
@@ -52,10 +47,7 @@ fn main() {
         opts.set_include_callback(move |name, _ty, _from, _depth| {
             let p = shared_dir.join(name);
             std::fs::read_to_string(&p)
-                .map(|content| shaderc::ResolvedInclude {
-                    resolved_name: p.display().to_string(),
-                    content,
-                })
+                .map(|content| shaderc::ResolvedInclude { resolved_name: p.display().to_string(), content })
                 .map_err(|e| format!("cannot include {}: {e}", p.display()))
         });
         let file = path.display().to_string();

@@ -19,11 +19,8 @@ pub struct Case {
 
 impl Case {
     pub fn label(&self) -> String {
-        format!(
-            "{} {:?} {:?} {:?} {}x{}",
-            self.scene, self.order, self.composite, self.kernel, self.width, self.height
-        )
-        .to_lowercase()
+        format!("{} {:?} {:?} {:?} {}x{}", self.scene, self.order, self.composite, self.kernel, self.width, self.height)
+            .to_lowercase()
     }
 }
 
@@ -32,7 +29,14 @@ pub fn default_cases() -> Vec<Case> {
     let mut v = Vec::new();
     for scene in ["cube60", "plane"] {
         for composite in [Composite::Splat, Composite::Sheet] {
-            v.push(Case { scene, composite, kernel: Kernel::Gaussian, order: OrderKind::Pbtf, width: 512, height: 512 });
+            v.push(Case {
+                scene,
+                composite,
+                kernel: Kernel::Gaussian,
+                order: OrderKind::Pbtf,
+                width: 512,
+                height: 512,
+            });
         }
     }
     v
@@ -65,10 +69,8 @@ pub fn measure(renderer: &mut Renderer, case: &Case, warmup: usize, frames: usiz
     let splats = set.len();
     let camera = Camera::framing(set.grid(), case.width, case.height);
     renderer.set_scene(set)?;
-    let mut opts = RenderOptions::default();
-    opts.composite = case.composite;
-    opts.kernel = case.kernel;
-    opts.order = case.order;
+    let opts =
+        RenderOptions { composite: case.composite, kernel: case.kernel, order: case.order, ..Default::default() };
     let mut walls = Vec::new();
     let mut per_stage: Vec<(&'static str, Vec<f64>)> = Vec::new();
     let mut totals = Vec::new();

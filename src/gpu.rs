@@ -125,9 +125,11 @@ impl GpuPipeline {
             target_pass,
             sheet_pass,
         };
-        let frame = Buffer::new(&ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::UNIFORM_BUFFER, Memory::Upload)?;
+        let frame =
+            Buffer::new(&ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::UNIFORM_BUFFER, Memory::Upload)?;
         let n = FOOTPRINT_TABLE_SIZE;
-        let table = Image::new(&ctx, "footprint table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
+        let table =
+            Image::new(&ctx, "footprint table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
         let sampler = Sampler::nearest(&ctx)?;
         let timer = Timer::new(&ctx, 16)?;
         Ok(Self { stages, frame, table, sampler, kernel: None, scene: None, target: None, timer, ctx })
@@ -147,7 +149,13 @@ impl GpuPipeline {
         self.ctx.submit(|rec| {
             rec.transition(table, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::Graphics, Stage::Transfer);
             rec.copy_buffer_to_image(&staging, table);
-            rec.transition(table, IL::TRANSFER_DST_OPTIMAL, IL::SHADER_READ_ONLY_OPTIMAL, Stage::Transfer, Stage::Graphics);
+            rec.transition(
+                table,
+                IL::TRANSFER_DST_OPTIMAL,
+                IL::SHADER_READ_ONLY_OPTIMAL,
+                Stage::Transfer,
+                Stage::Graphics,
+            );
             Ok(())
         })?;
         self.kernel = Some(kernel);
@@ -230,9 +238,17 @@ impl GpuPipeline {
         self.ctx.wait_idle();
         self.target = None;
         let ctx = &self.ctx;
-        let color = Image::new(ctx, "color", (width, height, 1), COLOR_FORMAT, IU::COLOR_ATTACHMENT | IU::TRANSFER_SRC, false)?;
+        let color =
+            Image::new(ctx, "color", (width, height, 1), COLOR_FORMAT, IU::COLOR_ATTACHMENT | IU::TRANSFER_SRC, false)?;
         let color_fb = Framebuffer::new(ctx, &self.stages.target_pass, &color)?;
-        let sums = Image::new(ctx, "sheet sums", (width, height, layers), COLOR_FORMAT, IU::COLOR_ATTACHMENT | IU::STORAGE, true)?;
+        let sums = Image::new(
+            ctx,
+            "sheet sums",
+            (width, height, layers),
+            COLOR_FORMAT,
+            IU::COLOR_ATTACHMENT | IU::STORAGE,
+            true,
+        )?;
         let sums_fb = Framebuffer::new(ctx, &self.stages.sheet_pass, &sums)?;
         let accum = Image::new(
             ctx,
@@ -243,9 +259,20 @@ impl GpuPipeline {
             false,
         )?;
         let composite_set = self.stages.composite_layout.bind(&[Bind::Image(&sums), Bind::Image(&accum)])?;
-        let readback = Buffer::new(ctx, "readback", width as u64 * height as u64 * 16, BU::TRANSFER_DST, Memory::Readback)?;
-        self.target =
-            Some(TargetGpu { width, height, layers, color, color_fb, _sums: sums, sums_fb, accum, composite_set, readback });
+        let readback =
+            Buffer::new(ctx, "readback", width as u64 * height as u64 * 16, BU::TRANSFER_DST, Memory::Readback)?;
+        self.target = Some(TargetGpu {
+            width,
+            height,
+            layers,
+            color,
+            color_fb,
+            _sums: sums,
+            sums_fb,
+            accum,
+            composite_set,
+            readback,
+        });
         Ok(())
     }
 
@@ -300,7 +327,12 @@ impl GpuPipeline {
         if self.timer.capacity < needed {
             self.timer = Timer::new(&self.ctx, needed)?;
         }
-        let (st, scene, target, timer) = (&self.stages, self.scene.as_ref().expect("set above"), self.target.as_ref().expect("ensured"), &self.timer);
+        let (st, scene, target, timer) = (
+            &self.stages,
+            self.scene.as_ref().expect("set above"),
+            self.target.as_ref().expect("ensured"),
+            &self.timer,
+        );
         let n = scene.n;
         let stamps = self.ctx.submit(|rec| {
             rec.reset_timer(timer);
@@ -320,7 +352,14 @@ impl GpuPipeline {
                     if n > 0 {
                         let pipe = if btf { &st.over } else { &st.under };
                         let push = FootprintPush::default();
-                        rec.draw_quads(pipe, &st.footprint_layout, &scene.footprint_sets[0], bytemuck::bytes_of(&push), 0, n);
+                        rec.draw_quads(
+                            pipe,
+                            &st.footprint_layout,
+                            &scene.footprint_sets[0],
+                            bytemuck::bytes_of(&push),
+                            0,
+                            n,
+                        );
                     }
                     rec.end_pass();
                     rec.timestamp(timer, 3);
@@ -346,12 +385,24 @@ impl GpuPipeline {
                         rec.timestamp(timer, q);
                         let push = CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
                         let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
-                        rec.dispatch(&st.composite, &st.composite_layout, &target.composite_set, bytemuck::bytes_of(&push), groups);
+                        rec.dispatch(
+                            &st.composite,
+                            &st.composite_layout,
+                            &target.composite_set,
+                            bytemuck::bytes_of(&push),
+                            groups,
+                        );
                         rec.barrier(Stage::Compute, Stage::Compute);
                         rec.timestamp(timer, q + 1);
                         q += 2;
                     }
-                    rec.transition(&target.accum, IL::GENERAL, IL::TRANSFER_SRC_OPTIMAL, Stage::Compute, Stage::Transfer);
+                    rec.transition(
+                        &target.accum,
+                        IL::GENERAL,
+                        IL::TRANSFER_SRC_OPTIMAL,
+                        Stage::Compute,
+                        Stage::Transfer,
+                    );
                     rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
                     Ok(q)
                 }

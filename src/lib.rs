@@ -115,7 +115,8 @@ impl Renderer {
     }
 
     pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
-        let prep = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         match &mut self.gpu {
             Some(g) => g.render(prep, camera, options),
             None => pipeline::render_cpu(prep, camera, options),
@@ -125,7 +126,8 @@ impl Renderer {
     /// The PBTF draw sequence as the backend computes it (the GPU order stage, or its CPU mirror).
     pub fn pbtf_order(&mut self, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
         camera.validate()?;
-        let prep = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         match &mut self.gpu {
             Some(g) => g.order(prep, camera, direction),
             None => Ok(cpu_pbtf_order(prep, camera, direction)),

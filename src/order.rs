@@ -139,7 +139,9 @@ pub fn pbtf(set: &SplatSet, split: [u32; 3]) -> Vec<u32> {
 fn by_key<K: PartialOrd>(set: &SplatSet, key: impl Fn(usize) -> K) -> Vec<u32> {
     let keys: Vec<K> = (0..set.len()).map(key).collect();
     let mut idx: Vec<u32> = (0..set.len() as u32).collect();
-    idx.sort_by(|&a, &b| keys[a as usize].partial_cmp(&keys[b as usize]).unwrap_or(std::cmp::Ordering::Equal).then(a.cmp(&b)));
+    idx.sort_by(|&a, &b| {
+        keys[a as usize].partial_cmp(&keys[b as usize]).unwrap_or(std::cmp::Ordering::Equal).then(a.cmp(&b))
+    });
     idx
 }
 

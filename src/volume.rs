@@ -33,7 +33,10 @@ impl Grid {
             return Err(Error::InvalidArgument(format!("grid dimensions {:?} must be in 1..={MAX_DIM}", self.dims)));
         }
         if self.spacing.iter().any(|s| !s.is_finite() || *s <= 0.0) {
-            return Err(Error::InvalidArgument(format!("voxel spacing {:?} must be finite and positive", self.spacing)));
+            return Err(Error::InvalidArgument(format!(
+                "voxel spacing {:?} must be finite and positive",
+                self.spacing
+            )));
         }
         if self.origin.iter().any(|o| !o.is_finite()) {
             return Err(Error::InvalidArgument("grid origin must be finite".into()));

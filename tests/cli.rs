@@ -24,7 +24,9 @@ fn scenes_are_listed() {
 
 #[test]
 fn render_writes_png_and_exr() {
-    for (ext, extra) in [("png", vec!["--cpu"]), ("exr", vec!["--validation", "--composite", "sheet", "--kernel", "cubic"])] {
+    for (ext, extra) in
+        [("png", vec!["--cpu"]), ("exr", vec!["--validation", "--composite", "sheet", "--kernel", "cubic"])]
+    {
         let path = tmp(&format!("cube.{ext}"));
         let p = path.to_str().unwrap();
         let mut args = vec!["render", "--scene", "cube40", "--size", "96x64", "--out", p];
@@ -48,8 +50,19 @@ fn render_writes_png_and_exr() {
 fn order_dump_and_check() {
     let path = tmp("order.csv");
     let out = voxsplat(&[
-        "order", "--scene", "cube40", "--eye", "5,8,45", "--target", "0,0,0", "--order", "pbtf", "--dump",
-        path.to_str().unwrap(), "--check", "--validation",
+        "order",
+        "--scene",
+        "cube40",
+        "--eye",
+        "5,8,45",
+        "--target",
+        "0,0,0",
+        "--order",
+        "pbtf",
+        "--dump",
+        path.to_str().unwrap(),
+        "--check",
+        "--validation",
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -68,7 +81,8 @@ fn order_dump_and_check() {
     };
     assert!(dist(lines[0]) > dist(lines[lines.len() - 1]));
 
-    let out = voxsplat(&["order", "--scene", "cube40", "--eye", "5,8,45", "--target", "0,0,0", "--order", "btf", "--check"]);
+    let out =
+        voxsplat(&["order", "--scene", "cube40", "--eye", "5,8,45", "--target", "0,0,0", "--order", "btf", "--check"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let last = stdout.lines().last().unwrap();
     let n: u64 = last.strip_prefix("violations: ").unwrap().parse().unwrap();

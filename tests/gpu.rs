@@ -13,6 +13,20 @@ fn options(composite: Composite, kernel: Kernel) -> RenderOptions {
     o
 }
 
+/// On a mismatch, write the GPU image, the CPU image and their difference for inspection.
+fn save_failure(tag: &str, gpu: &voxsplat::cpu::ImageF32, cpu: &voxsplat::cpu::ImageF32) {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("mirror-failures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut diff = gpu.clone();
+    for (d, c) in diff.pixels.iter_mut().zip(&cpu.pixels) {
+        *d = [0, 1, 2, 3].map(|i| if i == 3 { 1.0 } else { ((d[i] - c[i]).abs() * 8.0).min(1.0) });
+    }
+    for (suffix, img) in [("gpu", gpu), ("cpu", cpu), ("diff", &diff)] {
+        voxsplat::output::write_image(img, &dir.join(format!("{tag}-{suffix}.png"))).unwrap();
+    }
+    eprintln!("wrote {}/{tag}-*.png", dir.display());
+}
+
 #[test]
 fn gpu_matches_cpu_mirror_for_both_compositing_modes_and_kernels() {
     let mut gpu = common::gpu();
@@ -38,7 +52,8 @@ fn gpu_matches_cpu_mirror_for_both_compositing_modes_and_kernels() {
         height: 160,
     };
     let framing = |g: &voxsplat::Grid| Camera::framing(g, 192, 160);
-    let cases: [(&str, &dyn Fn(&voxsplat::Grid) -> Camera); 4] =
+    type CameraFor<'a> = &'a dyn Fn(&voxsplat::Grid) -> Camera;
+    let cases: [(&str, CameraFor); 4] =
         [("cube60", &framing), ("cube40-attenuated", &framing), ("plane", &plane_ortho), ("plane", &plane_grazing)];
     for (name, camera) in cases {
         let set = scene::build(name).unwrap();
@@ -55,7 +70,12 @@ fn gpu_matches_cpu_mirror_for_both_compositing_modes_and_kernels() {
                     let g = gpu.render(&cam, &o).unwrap();
                     let c = cpu.render(&cam, &o).unwrap();
                     let (mean, max) = diff_rgba8(&g.image, &c.image).unwrap();
-                    eprintln!("{name} {composite:?} {kernel:?} {direction:?}: mean |diff| {mean:.4}/255, max {max}/255");
+                    if mean > 1.0 {
+                        save_failure(&format!("{name}-{composite:?}-{kernel:?}-{direction:?}"), &g.image, &c.image);
+                    }
+                    eprintln!(
+                        "{name} {composite:?} {kernel:?} {direction:?}: mean |diff| {mean:.4}/255, max {max}/255"
+                    );
                     assert!(mean <= 1.0, "{name} {composite:?} {kernel:?} {direction:?}: mean {mean}");
                     let covered = g.image.pixels.iter().filter(|p| p[3] > 0.5).count();
                     assert!(covered > 192 * 160 / 10, "the object covers the frame ({covered} px)");
@@ -102,7 +122,11 @@ fn empty_scene_and_splats_behind_the_eye_render_transparent() {
     // Looking away from the cube: every splat is behind the eye.
     let set = scene::build("cube40").unwrap();
     let c = set.grid().center();
-    let away = Camera { eye: c + Vec3::new(0.0, 0.0, 60.0), target: c + Vec3::new(0.0, 0.0, 120.0), ..Camera::framing(set.grid(), 64, 48) };
+    let away = Camera {
+        eye: c + Vec3::new(0.0, 0.0, 60.0),
+        target: c + Vec3::new(0.0, 0.0, 120.0),
+        ..Camera::framing(set.grid(), 64, 48)
+    };
     for r in [&mut gpu, &mut cpu] {
         r.set_scene(set.clone()).unwrap();
         for composite in [Composite::Splat, Composite::Sheet] {

@@ -95,7 +95,11 @@ fn sheet_plan_covers_every_splat_once_within_the_budget() {
                         seen[s] += 1;
                         // Layer arithmetic of footprint.vert lands inside the batch.
                         let rank = prep.ranks[(b.push.rank_offset + set.splats()[s].ijk[axis]) as usize];
-                        let layer = if b.push.rank_dir > 0 { rank as i64 - b.push.rank_base as i64 } else { b.push.rank_base as i64 - rank as i64 };
+                        let layer = if b.push.rank_dir > 0 {
+                            rank as i64 - b.push.rank_base as i64
+                        } else {
+                            b.push.rank_base as i64 - rank as i64
+                        };
                         assert!(layer >= 0 && layer < b.layers as i64, "layer {layer} of {}", b.layers);
                     }
                 }
@@ -141,4 +145,11 @@ fn built_in_scenes_match_the_dissertation() {
     assert_ne!(a, b);
     assert_eq!(a, c);
     assert!(matches!(scene::build("nope"), Err(Error::InvalidArgument(_))));
+}
+
+#[test]
+fn renderer_is_send() {
+    fn send<T: Send>() {}
+    send::<voxsplat::Renderer>();
+    send::<voxsplat::SplatSet>();
 }

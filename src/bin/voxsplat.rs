@@ -209,7 +209,10 @@ fn run(cli: Cli) -> Result<()> {
             opts.order = a.scene.order.parse::<OrderKind>()?;
             opts.composite = a.composite.parse::<Composite>()?;
             opts.kernel = a.kernel.parse::<Kernel>()?;
-            opts.direction = a.direction.as_deref().map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
+            opts.direction =
+                a.direction
+                    .as_deref()
+                    .map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
             if a.sheet_budget_mib == 0 {
                 return Err(Error::InvalidArgument("--sheet-budget-mib must be positive".into()));
             }

@@ -18,7 +18,12 @@ pub fn composite(push: &CompositePush, sums: &[ImageF32], accum: &mut ImageF32) 
                 let k = a / t;
                 let rgb = [v[0] * k, v[1] * k, v[2] * k];
                 if push.back_to_front != 0 {
-                    acc = [rgb[0] + (1.0 - a) * acc[0], rgb[1] + (1.0 - a) * acc[1], rgb[2] + (1.0 - a) * acc[2], a + (1.0 - a) * acc[3]];
+                    acc = [
+                        rgb[0] + (1.0 - a) * acc[0],
+                        rgb[1] + (1.0 - a) * acc[1],
+                        rgb[2] + (1.0 - a) * acc[2],
+                        a + (1.0 - a) * acc[3],
+                    ];
                 } else {
                     let r = 1.0 - acc[3];
                     acc = [acc[0] + r * rgb[0], acc[1] + r * rgb[1], acc[2] + r * rgb[2], acc[3] + r * a];

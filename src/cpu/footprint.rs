@@ -71,7 +71,15 @@ pub fn footprint(
     }
 }
 
-fn raster_quad(p: &SplatParams, sheet: bool, blend: Blend, vp: Mat4, inv: &DMat4, table: &[f32], target: &mut ImageF32) {
+fn raster_quad(
+    p: &SplatParams,
+    sheet: bool,
+    blend: Blend,
+    vp: Mat4,
+    inv: &DMat4,
+    table: &[f32],
+    target: &mut ImageF32,
+) {
     let v3 = |v: [f32; 4]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
     let (c, au, av) = (v3(p.center), v3(p.axis_u), v3(p.axis_v));
     let (w, h) = (target.width as f64, target.height as f64);

@@ -32,10 +32,7 @@ impl Buffer {
     /// A buffer of at least `size` bytes (zero is rounded up to 16: Vulkan forbids empty buffers).
     pub fn new(ctx: &Arc<Context>, name: &str, size: u64, usage: vk::BufferUsageFlags, memory: Memory) -> Result<Self> {
         let size = size.max(16);
-        let info = vk::BufferCreateInfo::default()
-            .size(size)
-            .usage(usage)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device and create info.
         let raw = unsafe { ctx.device.create_buffer(&info, None) }.map_err(Error::vk("vkCreateBuffer"))?;
         // SAFETY: `raw` was just created on this device.

@@ -75,9 +75,8 @@ impl Context {
             // SAFETY: plain enumeration.
             let available = unsafe { entry.enumerate_instance_layer_properties() }
                 .map_err(Error::vk("vkEnumerateInstanceLayerProperties"))?;
-            let found = available
-                .iter()
-                .any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
+            let found =
+                available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
             if !found {
                 return Err(Error::Unsupported(
                     "validation requested but VK_LAYER_KHRONOS_validation is not installed \
@@ -154,9 +153,8 @@ impl Context {
         };
 
         let priorities = [1.0f32];
-        let queues = [vk::DeviceQueueCreateInfo::default()
-            .queue_family_index(queue_family)
-            .queue_priorities(&priorities)];
+        let queues =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true);
         let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queues).push_next(&mut f12);
         // SAFETY: `physical` came from this instance; features were checked in pick_device.
@@ -229,12 +227,9 @@ impl Context {
             )
         };
         let ts_bits = families.get(queue_family as usize).map(|f| f.timestamp_valid_bits).unwrap_or(0);
-        let timestamp_period = (ts_bits > 0 && props.limits.timestamp_period > 0.0)
-            .then_some(props.limits.timestamp_period as f64);
-        let device_name = props
-            .device_name_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let timestamp_period =
+            (ts_bits > 0 && props.limits.timestamp_period > 0.0).then_some(props.limits.timestamp_period as f64);
+        let device_name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -278,17 +273,14 @@ impl Context {
 
     fn pick_device(instance: &ash::Instance, options: &ContextOptions) -> Result<(vk::PhysicalDevice, u32)> {
         // SAFETY: plain enumeration and queries.
-        let devices = unsafe { instance.enumerate_physical_devices() }
-            .map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
+        let devices =
+            unsafe { instance.enumerate_physical_devices() }.map_err(Error::vk("vkEnumeratePhysicalDevices"))?;
         let mut best: Option<(u32, vk::PhysicalDevice, u32)> = None;
         let mut rejected = Vec::new();
         for pd in devices {
             // SAFETY: `pd` is a valid handle from this instance.
             let props = unsafe { instance.get_physical_device_properties(pd) };
-            let name = props
-                .device_name_as_c_str()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
+            let name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             if let Some(want) = &options.device_name {
                 if !name.to_lowercase().contains(&want.to_lowercase()) {
                     continue;

@@ -29,9 +29,9 @@ pub(crate) unsafe extern "system" fn callback(
     data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
     user: *mut c_void,
 ) -> vk::Bool32 {
-    let counted = ty.intersects(
-        vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
-    ) || severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR);
+    let counted = ty
+        .intersects(vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE)
+        || severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR);
     if !counted || user.is_null() {
         return vk::FALSE;
     }

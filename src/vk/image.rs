@@ -80,7 +80,8 @@ impl Image {
             .format(format)
             .subresource_range(Self::range_of(layers));
         // SAFETY: bound image, matching format.
-        image.view = unsafe { ctx.device.create_image_view(&view_info, None) }.map_err(Error::vk("vkCreateImageView"))?;
+        image.view =
+            unsafe { ctx.device.create_image_view(&view_info, None) }.map_err(Error::vk("vkCreateImageView"))?;
         Ok(image)
     }
 

@@ -7,11 +7,11 @@ mod pipeline;
 mod submit;
 mod timer;
 
+pub use ash;
+pub use ash::vk::{BufferUsageFlags, Format, ImageLayout, ImageUsageFlags, ShaderStageFlags};
 pub use buffer::{Buffer, Memory};
 pub use context::{Context, ContextOptions, HostHandles};
 pub use image::{Image, Sampler};
 pub use pipeline::{Bind, Blend, DescriptorSet, Framebuffer, Layout, Pipeline, RenderPass, Slot};
 pub use submit::{Recorder, Stage};
 pub use timer::Timer;
-pub use ash;
-pub use ash::vk::{BufferUsageFlags, Format, ImageLayout, ImageUsageFlags, ShaderStageFlags};

@@ -44,9 +44,7 @@ impl Recorder<'_> {
         let (d, _, da) = dst.flags();
         let mb = [vk::MemoryBarrier::default().src_access_mask(sa).dst_access_mask(da)];
         // SAFETY: recording into a command buffer in the recording state.
-        unsafe {
-            self.ctx.device.cmd_pipeline_barrier(self.cmd, s, d, vk::DependencyFlags::empty(), &mb, &[], &[])
-        };
+        unsafe { self.ctx.device.cmd_pipeline_barrier(self.cmd, s, d, vk::DependencyFlags::empty(), &mb, &[], &[]) };
     }
 
     /// Transition all layers of `image`, ordering `src` work before `dst` work.
@@ -132,7 +130,10 @@ impl Recorder<'_> {
 
     pub fn begin_pass(&self, pass: &RenderPass, fb: &Framebuffer) {
         let clear = [vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } }];
-        let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: fb.width, height: fb.height } };
+        let area = vk::Rect2D {
+            offset: vk::Offset2D { x: 0, y: 0 },
+            extent: vk::Extent2D { width: fb.width, height: fb.height },
+        };
         let info = vk::RenderPassBeginInfo::default()
             .render_pass(pass.raw)
             .framebuffer(fb.raw)
@@ -201,8 +202,8 @@ impl Context {
             .queue_family_index(self.queue_family)
             .flags(vk::CommandPoolCreateFlags::TRANSIENT);
         // SAFETY: valid device; the pool is destroyed below on every path.
-        let pool = unsafe { self.device.create_command_pool(&pool_info, None) }
-            .map_err(Error::vk("vkCreateCommandPool"))?;
+        let pool =
+            unsafe { self.device.create_command_pool(&pool_info, None) }.map_err(Error::vk("vkCreateCommandPool"))?;
         let result = self.submit_in(pool, f);
         // SAFETY: submit_in waited on its fence (or never submitted) before returning.
         unsafe { self.device.destroy_command_pool(pool, None) };
@@ -215,8 +216,8 @@ impl Context {
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
         // SAFETY: pool from this device.
-        let cmd = unsafe { self.device.allocate_command_buffers(&alloc) }
-            .map_err(Error::vk("vkAllocateCommandBuffers"))?[0];
+        let cmd =
+            unsafe { self.device.allocate_command_buffers(&alloc) }.map_err(Error::vk("vkAllocateCommandBuffers"))?[0];
         let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: fresh command buffer.
         unsafe { self.device.begin_command_buffer(cmd, &begin) }.map_err(Error::vk("vkBeginCommandBuffer"))?;

@@ -33,7 +33,12 @@ impl Timer {
         let mut ticks = vec![0u64; count as usize];
         // SAFETY: the queries were written by a submission that has completed (its fence waited).
         unsafe {
-            self.ctx.device.get_query_pool_results(pool, 0, &mut ticks, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT)
+            self.ctx.device.get_query_pool_results(
+                pool,
+                0,
+                &mut ticks,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
         }
         .map_err(Error::vk("vkGetQueryPoolResults"))?;
         Ok(Some(ticks.windows(2).map(|w| w[1].saturating_sub(w[0]) as f64 * period * 1e-6).collect()))
