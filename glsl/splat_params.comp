@@ -33,5 +33,8 @@ void main() {
     p.axis_u = vec4(u * radius, 1.0);
     p.axis_v = vec4(v * radius, 0.0);
     p.emit = vec4(sp.color.rgb, tau);
+    float dist = length(center - frame.eye.xyz);
+    float pixels = frame.eye.w > 0.5 ? radius * frame.up.w / max(depth, 1e-6) : radius * frame.up.w;
+    p.screen = vec4(depth, dist, pixels, 0.0);
     params[s] = p;
 }

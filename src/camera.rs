@@ -130,4 +130,37 @@ impl Camera {
     pub fn view_proj(&self) -> Mat4 {
         self.proj() * self.view()
     }
+
+    /// D/p of section 3.3.4: the eye-to-view-plane distance over a pixel's extent, i.e. pixels per
+    /// world unit at unit depth. Orthographic: pixels per world unit everywhere.
+    pub fn pixels_per_unit(&self) -> f32 {
+        match self.projection {
+            Projection::Perspective { fov_y_deg } => 0.5 * self.height as f32 / (0.5 * fov_y_deg.to_radians()).tan(),
+            Projection::Orthographic { height } => self.height as f32 / height,
+        }
+    }
+
+    /// World to eye space as in section 3.3.1: a rigid transform with the eye at the origin looking
+    /// down +z (x right, y up).
+    pub fn world_to_eye(&self, p: Vec3) -> Vec3 {
+        let d = p - self.eye;
+        Vec3::new(d.dot(self.right()), d.dot(self.true_up()), d.dot(self.forward()))
+    }
+
+    /// Eye to perspective space, Eqs 3.3-3.5 with D = near, F = far and h = half the view-plane
+    /// height at the near plane: x_p, y_p in [-1, 1] across the view (x scaled by the aspect),
+    /// z_p in [0, 1] from near to far (Vulkan depth). Orthographic views map linearly.
+    pub fn eye_to_perspective(&self, e: Vec3) -> Vec3 {
+        let (d, f) = (self.near, self.far);
+        match self.projection {
+            Projection::Perspective { fov_y_deg } => {
+                let h = d * (0.5 * fov_y_deg.to_radians()).tan();
+                Vec3::new(d / (h * self.aspect()) * e.x / e.z, d / h * e.y / e.z, f * (1.0 - d / e.z) / (f - d))
+            }
+            Projection::Orthographic { height } => {
+                let h = 0.5 * height;
+                Vec3::new(e.x / (h * self.aspect()), e.y / h, (e.z - d) / (f - d))
+            }
+        }
+    }
 }

@@ -46,7 +46,7 @@ struct SceneGpu {
     _row_split: Buffer,
     _segments: Buffer,
     order: Buffer,
-    _params: Buffer,
+    params: Buffer,
     _draw: [Buffer; 3],
     _ranks: Buffer,
     order_set: DescriptorSet,
@@ -180,7 +180,7 @@ impl GpuPipeline {
             ctx,
             "params",
             n as u64 * std::mem::size_of::<SplatParams>() as u64,
-            BU::STORAGE_BUFFER,
+            BU::STORAGE_BUFFER | BU::TRANSFER_SRC,
             Memory::Device,
         )?;
         let draw = [
@@ -219,7 +219,7 @@ impl GpuPipeline {
             _row_split: row_split,
             _segments: segments,
             order,
-            _params: params,
+            params,
             _draw: draw,
             _ranks: ranks,
             order_set,
@@ -290,6 +290,27 @@ impl GpuPipeline {
         })?;
         let bytes = scene.order.read()?;
         Ok(bytemuck::cast_slice::<u8, u32>(&bytes[..scene.n as usize * 4]).to_vec())
+    }
+
+    /// Run the splat_params stage alone and read its output back (for comparison with the mirror).
+    pub fn splat_params(&mut self, prep: &Prepared, camera: &Camera, kernel: Kernel) -> Result<Vec<SplatParams>> {
+        camera.validate()?;
+        let split = order::pbtf_split(&prep.set, camera);
+        let frame = make_frame(&prep.set, camera, kernel, split, true);
+        self.frame.write(bytemuck::bytes_of(&frame))?;
+        let scene = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        let bytes = scene.n as u64 * std::mem::size_of::<SplatParams>() as u64;
+        let readback = Buffer::new(&self.ctx, "params readback", bytes, BU::TRANSFER_DST, Memory::Readback)?;
+        let st = &self.stages;
+        self.ctx.submit(|rec| {
+            if scene.n > 0 {
+                rec.dispatch(&st.splat_params, &st.params_layout, &scene.params_set, &[], groups_1d(scene.n));
+                rec.barrier(Stage::Compute, Stage::Transfer);
+                rec.copy_buffer(&scene.params, &readback, bytes);
+            }
+            Ok(())
+        })?;
+        Ok(bytemuck::cast_slice::<u8, SplatParams>(&readback.read()?[..bytes as usize]).to_vec())
     }
 
     pub fn render(&mut self, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Rendered> {

@@ -24,6 +24,8 @@ pub struct SplatParams {
     pub axis_v: [f32; 4],
     /// RGB colour; a = optical depth of the voxel (tau).
     pub emit: [f32; 4],
+    /// Eye-space depth z_e, eye distance d, footprint radius in pixels; w unused.
+    pub screen: [f32; 4],
 }
 
 /// Per-frame uniforms (std140, vec4 members only).
@@ -63,7 +65,7 @@ pub struct CompositePush {
 }
 
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
-const _: () = assert!(std::mem::size_of::<SplatParams>() == 64);
+const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 192);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 20);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);

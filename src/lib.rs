@@ -134,6 +134,23 @@ impl Renderer {
         }
     }
 
+    /// The splat_params stage's output for this camera (GPU stage, or its CPU mirror).
+    pub fn splat_params(&mut self, camera: &Camera, kernel: Kernel) -> Result<Vec<gpu_types::SplatParams>> {
+        camera.validate()?;
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        match &mut self.gpu {
+            Some(g) => g.splat_params(prep, camera, kernel),
+            None => {
+                let set = &prep.set;
+                let frame = pipeline::make_frame(set, camera, kernel, order::pbtf_split(set, camera), true);
+                let mut out = vec![gpu_types::SplatParams::default(); set.len()];
+                cpu::splat_params(&frame, set.splats(), &mut out);
+                Ok(out)
+            }
+        }
+    }
+
     /// Validation messages counted so far (always 0 without validation or on the CPU).
     pub fn validation_count(&self) -> u64 {
         self.gpu.as_ref().map(|g| g.context().validation_count()).unwrap_or(0)

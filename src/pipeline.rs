@@ -130,7 +130,7 @@ pub fn make_frame(set: &SplatSet, camera: &Camera, kernel: Kernel, split: [u32; 
         eye: v4(camera.eye, if camera.is_perspective() { 1.0 } else { 0.0 }),
         forward: v4(f, camera.near),
         right: v4(r, camera.far),
-        up: v4(u, 0.0),
+        up: v4(u, camera.pixels_per_unit()),
         origin: [g.origin[0], g.origin[1], g.origin[2], radius_vox],
         spacing: [g.spacing[0], g.spacing[1], g.spacing[2], radius_vox * g.kernel_spacing()],
         dims: [g.dims[0], g.dims[1], g.dims[2], set.len() as u32],

@@ -167,3 +167,44 @@ fn renderer_on_an_adopted_host_device_matches_an_owning_one() {
     assert_eq!(again.pixels, want.pixels);
     assert_clean(&owner);
 }
+
+#[test]
+fn splat_params_stage_matches_its_mirror() {
+    let mut gpu = common::gpu();
+    let mut cpu = common::cpu();
+    let mut rng = Rng(5);
+    let set = random_sparse(21, [30, 20, 25], 0.3);
+    gpu.set_scene(set.clone()).unwrap();
+    cpu.set_scene(set.clone()).unwrap();
+    for v in 0..8 {
+        let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
+        let cam = random_camera(&mut rng, set.grid(), kind);
+        for kernel in [Kernel::Gaussian, Kernel::Cubic] {
+            let g = gpu.splat_params(&cam, kernel).unwrap();
+            let c = cpu.splat_params(&cam, kernel).unwrap();
+            assert_eq!(g.len(), set.len());
+            let mut culled = 0;
+            for (a, b) in g.iter().zip(&c) {
+                assert_eq!(a.center[3], b.center[3], "culling differs");
+                culled += (a.center[3] == 0.0) as usize;
+                let fields = [
+                    (a.center, b.center),
+                    (a.axis_u, b.axis_u),
+                    (a.axis_v, b.axis_v),
+                    (a.emit, b.emit),
+                    (a.screen, b.screen),
+                ];
+                for (x, y) in fields {
+                    for i in 0..4 {
+                        let tol = 1e-4 * (1.0 + y[i].abs());
+                        assert!((x[i] - y[i]).abs() <= tol, "{kind:?}: gpu {x:?} cpu {y:?}");
+                    }
+                }
+            }
+            if matches!(kind, ViewKind::Outside | ViewKind::Orthographic) {
+                assert!(culled < set.len(), "something is visible");
+            }
+        }
+    }
+    assert_clean(&gpu);
+}

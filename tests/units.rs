@@ -153,3 +153,39 @@ fn renderer_is_send() {
     send::<voxsplat::Renderer>();
     send::<voxsplat::SplatSet>();
 }
+
+#[test]
+fn eye_and_perspective_spaces_agree_with_the_clip_transform() {
+    let set = scene::build("cube40").unwrap();
+    let mut rng = common::Rng(3);
+    for v in 0..20 {
+        let kind = if v % 2 == 0 { common::ViewKind::Outside } else { common::ViewKind::Orthographic };
+        let mut cam = common::random_camera(&mut rng, set.grid(), kind);
+        cam.width = 160;
+        cam.height = 90;
+        for _ in 0..20 {
+            let p = set.grid().center() + rng.dir() * rng.range(0.0, 20.0);
+            let e = cam.world_to_eye(p);
+            // Rigid: distances are preserved.
+            assert!(((p - cam.eye).length() - e.length()).abs() < 1e-3);
+            if e.z <= cam.near {
+                continue;
+            }
+            let pp = cam.eye_to_perspective(e);
+            let clip = cam.view_proj() * p.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            // Clip space has Vulkan's downward y; perspective space points y up.
+            assert!(
+                (pp.x - ndc.x).abs() < 1e-3 && (pp.y + ndc.y).abs() < 1e-3 && (pp.z - ndc.z).abs() < 1e-3,
+                "{pp} {ndc}"
+            );
+        }
+    }
+    // D/p: a world unit at distance z covers pixels_per_unit / z pixels.
+    let cam = Camera {
+        projection: Projection::Perspective { fov_y_deg: 90.0 },
+        height: 200,
+        ..Camera::framing(set.grid(), 200, 200)
+    };
+    assert!((cam.pixels_per_unit() - 100.0).abs() < 1e-3);
+}

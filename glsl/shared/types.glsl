@@ -9,12 +9,14 @@ struct Splat {
     vec4 color;   // straight rgb; a: opacity of one voxel-length of material, in [0, 1)
 };
 
-// Output of splat_params, input of the footprint stage. 64 bytes.
+// Output of splat_params, input of the footprint stage. 80 bytes.
 struct SplatParams {
     vec4 center;  // world-space centre; w: 1 if drawn, 0 if culled
     vec4 axis_u;  // world-space half-extent vector of the footprint quad; w: energy scale
     vec4 axis_v;  // second half-extent vector, perpendicular to axis_u and to the eye ray; w: unused
-    vec4 emit;    // rgb colour; a: optical depth at the kernel centre per unit footprint (tau)
+    vec4 emit;    // rgb colour; a: optical depth of the voxel (tau)
+    vec4 screen;  // eye-space depth z_e (section 3.3.1, +z forward), eye distance d,
+                  // footprint radius in pixels, unused
 };
 
 // Per-frame uniforms (std140, vec4-only so the Rust mirror is plain repr(C)). 192 bytes.
@@ -23,7 +25,7 @@ struct Frame {
     vec4 eye;         // world eye position; w: 1 perspective, 0 orthographic
     vec4 forward;     // unit view direction; w: near distance
     vec4 right;       // unit camera right; w: far distance
-    vec4 up;          // unit camera up; w: unused
+    vec4 up;          // unit camera up; w: D/p, pixels per world unit at unit depth (ortho: per unit)
     vec4 origin;      // world position of voxel (0,0,0); w: footprint radius in voxels
     vec4 spacing;     // voxel spacing xyz; w: world footprint radius
     uvec4 dims;       // nx, ny, nz; w: splat count

@@ -27,6 +27,12 @@ pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams])
             axis_u: [u.x * radius, u.y * radius, u.z * radius, 1.0],
             axis_v: [v.x * radius, v.y * radius, v.z * radius, 0.0],
             emit: [sp.color[0], sp.color[1], sp.color[2], tau],
+            screen: [
+                depth,
+                (center - eye).length(),
+                if frame.eye[3] > 0.5 { radius * frame.up[3] / depth.max(1e-6) } else { radius * frame.up[3] },
+                0.0,
+            ],
         };
     }
 }

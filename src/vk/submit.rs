@@ -91,6 +91,16 @@ impl Recorder<'_> {
         };
     }
 
+    pub fn copy_buffer(&self, src: &Buffer, dst: &Buffer, bytes: u64) {
+        let size = bytes.min(src.size()).min(dst.size());
+        if size == 0 {
+            return;
+        }
+        let region = [vk::BufferCopy { src_offset: 0, dst_offset: 0, size }];
+        // SAFETY: both buffers alive for the submission; size within both.
+        unsafe { self.ctx.device.cmd_copy_buffer(self.cmd, src.raw, dst.raw, &region) };
+    }
+
     pub fn copy_image_to_buffer(&self, image: &Image, layout: vk::ImageLayout, buffer: &Buffer) {
         let region = [vk::BufferImageCopy::default()
             .image_subresource(vk::ImageSubresourceLayers {
