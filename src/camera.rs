@@ -7,6 +7,8 @@ use glam::{Mat4, Vec3, Vec4};
 
 /// Largest image side accepted.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Most pixels accepted (8192^2: 1 GiB per RGBA32F image).
+pub const MAX_PIXELS: u64 = 8192 * 8192;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
@@ -59,6 +61,9 @@ impl Camera {
         }
         if self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
             return Err(Error::InvalidCamera(format!("image sides must be at most {MAX_IMAGE_SIDE}")));
+        }
+        if self.width as u64 * self.height as u64 > MAX_PIXELS {
+            return Err(Error::InvalidCamera(format!("image has more than {MAX_PIXELS} pixels")));
         }
         let view = self.target - self.eye;
         if view.length() < 1e-6 * (1.0 + self.eye.length()) {

@@ -118,3 +118,43 @@ fn split_handles_eye_on_planes_and_outside() {
     assert_eq!(split[1], 8, "eye on the 6.5 midplane");
     assert_eq!(split[2], 10, "eye beyond the grid: everything on the low side");
 }
+
+/// Every case of Table 2.3 (each eye coordinate below, inside or above the grid), with the eye
+/// also exactly on the first and last voxel planes, on a voxel plane inside, and on a midplane.
+#[test]
+fn pbtf_is_correct_in_every_case_of_table_2_3() {
+    let set = random_sparse(17, [9, 8, 7], 0.7);
+    let g = *set.grid();
+    let mut cases = 0;
+    let positions = |a: usize| {
+        let n = g.dims[a] as f32;
+        [-6.0, 0.0, 2.0, 3.5, n - 1.0, n + 5.0].map(|idx| g.origin[a] + idx * g.spacing[a])
+    };
+    let (px, py, pz) = (positions(0), positions(1), positions(2));
+    for &x in &px {
+        for &y in &py {
+            for &z in &pz {
+                let eye = Vec3::new(x, y, z);
+                let target = if (g.center() - eye).length() > 1e-3 { g.center() } else { g.center() + Vec3::X };
+                let up = if (target - eye).normalize().cross(Vec3::Y).length() > 0.1 { Vec3::Y } else { Vec3::Z };
+                let cam = Camera {
+                    eye,
+                    target,
+                    up,
+                    projection: Projection::Perspective { fov_y_deg: 60.0 },
+                    near: 0.01,
+                    far: 100.0,
+                    width: 8,
+                    height: 8,
+                };
+                for dir in [Direction::FrontToBack, Direction::BackToFront] {
+                    let o = visibility_order(&set, &cam, OrderKind::Pbtf, dir);
+                    assert!(is_permutation(&o, set.len()));
+                    assert_eq!(count_violations(&set, &cam, &o, dir).unwrap(), 0, "eye {eye}");
+                }
+                cases += 1;
+            }
+        }
+    }
+    assert_eq!(cases, 216);
+}
