@@ -1,32 +1,23 @@
-use glam::Vec3;
 use voxsplat::*;
 fn main() {
-    let set = scene::build("cube60").unwrap();
-    let mut r = Renderer::new(&RendererOptions::default()).unwrap();
-    r.set_scene(set.clone()).unwrap();
-    for (eye, tgt) in [
-        ([20.0, 10.0, 60.0], [-40.0, 0.0, 0.0]),
-        ([15.0, 20.0, 50.0], [-50.0, 0.0, -10.0]),
-        ([10.0, 10.0, 45.0], [-60.0, 0.0, -10.0]),
-        ([20.0, 40.0, 50.0], [-40.0, -10.0, -10.0]),
-    ] {
-        let cam = Camera {
-            eye: Vec3::from(eye),
-            target: Vec3::from(tgt),
-            up: Vec3::Y,
-            projection: Projection::Perspective { fov_y_deg: 75.0 },
-            near: 0.5,
-            far: 300.0,
-            width: 200,
-            height: 200,
-        };
-        let mut img = |k| {
-            let mut ro = RenderOptions::default();
-            ro.order = k;
-            r.render(&cam, &ro).unwrap().image
-        };
-        let (b, w, p, s) = (img(OrderKind::Btf), img(OrderKind::Wbtf), img(OrderKind::Pbtf), img(OrderKind::Sorted));
-        let d = |x: &cpu::ImageF32| output::diff_rgba8(x, &s).unwrap().0;
-        println!("{eye:?} {tgt:?}: btf {:.2} wbtf {:.2} pbtf {:.2}", d(&b), d(&w), d(&p));
+    for name in ["cube60", "plane", "cube40-attenuated"] {
+        let set = scene::build(name).unwrap();
+        let cam = Camera::framing(set.grid(), 128, 128);
+        let t0 = std::time::Instant::now();
+        let truth = truth::volumetric_summation(&set, &cam, &truth::TruthOptions::default()).unwrap();
+        let tt = t0.elapsed().as_secs_f64();
+        let mut r = Renderer::new(&RendererOptions::default()).unwrap();
+        r.set_scene(set.clone()).unwrap();
+        for comp in [Composite::Splat, Composite::Sheet] {
+            let mut o = RenderOptions::default();
+            o.composite = comp;
+            let img = r.render(&cam, &o).unwrap().image;
+            let m = metrics::compare(&img, &truth).unwrap();
+            println!(
+                "{name} {comp:?}: psnr {:.2} ssim {:.4} max {:.3} (truth {tt:.2}s)",
+                m.psnr, m.ssim_luma, m.max_abs
+            );
+        }
+        output::write_image(&truth, format!("out/truth-{name}.png").as_ref()).unwrap();
     }
 }

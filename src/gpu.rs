@@ -1,12 +1,14 @@
 //! The stage list executed on Vulkan through the safe `vk` layer.
 use crate::camera::Camera;
 use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE};
+use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, Frame, SplatParams};
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
 use crate::pipeline::{groups_1d, make_frame, sheet_plan, Composite, Prepared, RenderOptions, Rendered, StageTime};
+use crate::truth::DenseField;
 use crate::vk::{
     Bind, Blend, Buffer, BufferUsageFlags as BU, Context, DescriptorSet, Format, Framebuffer, Image, ImageLayout as IL,
     ImageUsageFlags as IU, Layout, Memory, Pipeline, RenderPass, Sampler, ShaderStageFlags as SS, Slot, Stage, Timer,
@@ -36,6 +38,8 @@ struct Stages {
     add: Pipeline,
     composite_layout: Layout,
     composite: Pipeline,
+    raycast_layout: Layout,
+    raycast: Pipeline,
 }
 
 struct SceneGpu {
@@ -50,6 +54,8 @@ struct SceneGpu {
     _draw: [Buffer; 3],
     _ranks: Buffer,
     order_set: DescriptorSet,
+    /// The ray caster's 3D texture of (colour * tau, tau), built on first use.
+    field: Option<Image>,
     params_set: DescriptorSet,
     /// Footprint sets: 0 = visibility order, 1..=3 = slice-grouped lists of axes x, y, z.
     footprint_sets: Vec<DescriptorSet>,
@@ -106,6 +112,7 @@ impl GpuPipeline {
             compute,
             std::mem::size_of::<CompositePush>() as u32,
         )?;
+        let raycast_layout = Layout::new(&ctx, &[Slot::Uniform, Slot::Texture, Slot::StorageImage], compute, 0)?;
         let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
         let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
         let (vert, frag) = (spirv!("footprint.vert"), spirv!("footprint.frag"));
@@ -118,6 +125,8 @@ impl GpuPipeline {
             under: Pipeline::graphics(&ctx, &footprint_layout, &target_pass, vert, frag, Blend::Under)?,
             add: Pipeline::graphics(&ctx, &footprint_layout, &sheet_pass, vert, frag, Blend::Add)?,
             composite: Pipeline::compute(&ctx, &composite_layout, spirv!("composite.comp"))?,
+            raycast: Pipeline::compute(&ctx, &raycast_layout, spirv!("raycast.comp"))?,
+            raycast_layout,
             order_layout,
             params_layout,
             footprint_layout,
@@ -223,6 +232,7 @@ impl GpuPipeline {
             _draw: draw,
             _ranks: ranks,
             order_set,
+            field: None,
             params_set,
             footprint_sets,
         });
@@ -290,6 +300,66 @@ impl GpuPipeline {
         })?;
         let bytes = scene.order.read()?;
         Ok(bytemuck::cast_slice::<u8, u32>(&bytes[..scene.n as usize * 4]).to_vec())
+    }
+
+    /// The GPU ray caster (`raycast.comp`), uploading the dense field on first use.
+    pub fn raycast(&mut self, prep: &Prepared, camera: &Camera, opts: &RaycastOptions) -> Result<Rendered> {
+        camera.validate()?;
+        self.ensure_target(camera.width, camera.height, self.target.as_ref().map(|t| t.layers).unwrap_or(1))?;
+        let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        if scene.field.is_none() {
+            let dense = DenseField::new(&prep.set)?;
+            let [nx, ny, nz] = dense.dims;
+            let image = Image::new_3d(
+                &self.ctx,
+                "raycast field",
+                (nx, ny, nz),
+                Format::R32G32B32A32_SFLOAT,
+                IU::SAMPLED | IU::TRANSFER_DST,
+            )?;
+            let staging =
+                Buffer::with_data(&self.ctx, "field staging", bytemuck::cast_slice(&dense.values), BU::TRANSFER_SRC)?;
+            self.ctx.submit(|rec| {
+                rec.transition(&image, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::Compute, Stage::Transfer);
+                rec.copy_buffer_to_image(&staging, &image);
+                rec.transition(
+                    &image,
+                    IL::TRANSFER_DST_OPTIMAL,
+                    IL::SHADER_READ_ONLY_OPTIMAL,
+                    Stage::Transfer,
+                    Stage::Compute,
+                );
+                Ok(())
+            })?;
+            scene.field = Some(image);
+        }
+        let params = raycast_params(&prep.set, camera, opts);
+        let ubo = Buffer::with_data(&self.ctx, "raycast params", bytemuck::bytes_of(&params), BU::UNIFORM_BUFFER)?;
+        let (st, scene, target, timer) =
+            (&self.stages, self.scene.as_ref().expect("set"), self.target.as_ref().expect("ensured"), &self.timer);
+        let field = scene.field.as_ref().expect("built above");
+        let set = st.raycast_layout.bind(&[
+            Bind::Buffer(&ubo),
+            Bind::Texture(field, &self.sampler),
+            Bind::Image(&target.accum),
+        ])?;
+        let (w, h) = (camera.width, camera.height);
+        self.ctx.submit(|rec| {
+            rec.reset_timer(timer);
+            rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
+            rec.timestamp(timer, 0);
+            let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
+            rec.dispatch(&st.raycast, &st.raycast_layout, &set, &[], groups);
+            rec.timestamp(timer, 1);
+            rec.transition(&target.accum, IL::GENERAL, IL::TRANSFER_SRC_OPTIMAL, Stage::Compute, Stage::Transfer);
+            rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
+            Ok(())
+        })?;
+        let mut timings = Vec::new();
+        if let Some(ms) = timer.read_ms(2)? {
+            timings.push(StageTime { stage: "raycast", ms: ms[0] });
+        }
+        Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })
     }
 
     /// Run the splat_params stage alone and read its output back (for comparison with the mirror).
@@ -446,11 +516,15 @@ impl GpuPipeline {
                 }
             }
         }
-        let bytes = target.readback.read()?;
-        let floats: &[f32] = bytemuck::cast_slice(&bytes[..(w * h * 16) as usize]);
-        let pixels = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-        Ok(Rendered { image: ImageF32 { width: w, height: h, pixels }, timings })
+        Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })
     }
+}
+
+fn read_image(readback: &Buffer, w: u32, h: u32) -> Result<ImageF32> {
+    let bytes = readback.read()?;
+    let floats: &[f32] = bytemuck::cast_slice(&bytes[..(w * h * 16) as usize]);
+    let pixels = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+    Ok(ImageF32 { width: w, height: h, pixels })
 }
 
 fn record_order(rec: &crate::vk::Recorder<'_>, st: &Stages, scene: &SceneGpu) {

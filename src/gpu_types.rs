@@ -43,6 +43,19 @@ pub struct Frame {
     pub split: [u32; 4],
 }
 
+/// Uniforms of `raycast.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RaycastParams {
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub box_min: [f32; 4],
+    pub box_max: [f32; 4],
+    pub origin: [f32; 4],
+    pub inv_spacing: [f32; 4],
+    pub dims: [u32; 4],
+    pub image: [u32; 4],
+}
+
 /// Push constants of `footprint.vert` / `footprint.frag`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -68,4 +81,5 @@ const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 192);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 20);
+const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);

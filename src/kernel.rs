@@ -81,6 +81,31 @@ impl Kernel {
         sum * h / 3.0
     }
 
+    /// The 3D kernel normalised so that its integral over space is 1 voxel^3.
+    pub fn normalized(self, r: f64) -> f64 {
+        self.profile(r) / self.volume_integral()
+    }
+
+    /// Integral of the 3D profile over its ball (Simpson, 1024 intervals in r).
+    pub fn volume_integral(self) -> f64 {
+        let rr = self.radius() as f64;
+        let n = 1024;
+        let h = rr / n as f64;
+        let mut sum = 0.0;
+        for i in 0..=n {
+            let r = i as f64 * h;
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            sum += w * self.profile(r) * 4.0 * std::f64::consts::PI * r * r;
+        }
+        sum * h / 3.0
+    }
+
     /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2.
     pub fn footprint_table(self) -> Vec<f32> {
         let n = FOOTPRINT_TABLE_SIZE as usize;

@@ -23,10 +23,12 @@ mod error;
 mod gpu;
 pub mod gpu_types;
 pub mod kernel;
+pub mod metrics;
 pub mod order;
 pub mod output;
 pub mod pipeline;
 pub mod scene;
+pub mod truth;
 #[allow(unsafe_code)]
 pub mod vk;
 pub mod volume;
@@ -131,6 +133,29 @@ impl Renderer {
         match &mut self.gpu {
             Some(g) => g.order(prep, camera, direction),
             None => Ok(cpu_pbtf_order(prep, camera, direction)),
+        }
+    }
+
+    /// The ray caster: `raycast.comp` on the GPU, or its CPU mirror.
+    pub fn raycast(&mut self, camera: &Camera, options: &cpu::raycast::RaycastOptions) -> Result<Rendered> {
+        camera.validate()?;
+        if !(options.step.is_finite() && options.step > 0.0) {
+            return Err(Error::InvalidArgument("ray caster step must be positive".into()));
+        }
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        match &mut self.gpu {
+            Some(g) => g.raycast(prep, camera, options),
+            None => {
+                let t = std::time::Instant::now();
+                let field = truth::DenseField::new(&prep.set)?;
+                let rc = cpu::raycast::raycast_params(&prep.set, camera, options);
+                let image = cpu::raycast(&rc, &field, None);
+                Ok(Rendered {
+                    image,
+                    timings: vec![StageTime { stage: "raycast", ms: t.elapsed().as_secs_f64() * 1e3 }],
+                })
+            }
         }
     }
 

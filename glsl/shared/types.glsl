@@ -32,6 +32,17 @@ struct Frame {
     uvec4 split;      // PBTF: voxels per axis on the low side of the eye; w: 1 = back-to-front
 };
 
+// Uniforms of the ray caster. 160 bytes.
+struct RaycastParams {
+    mat4 inv_view_proj;  // clip -> world
+    vec4 box_min;        // world box sampled (voxel centres widened by one spacing); w: step length
+    vec4 box_max;        // w: transmittance below which a ray stops (early ray termination)
+    vec4 origin;         // world position of voxel (0,0,0); w: 1 / kernel spacing (sigma = tau * w)
+    vec4 inv_spacing;    // 1 / voxel spacing; w: unused
+    uvec4 dims;          // nx, ny, nz; w: most steps per ray
+    uvec4 image;         // width, height; zw: unused
+};
+
 #define KERNEL_GAUSSIAN 0u
 #define KERNEL_CUBIC 1u
 

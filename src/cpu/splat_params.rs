@@ -7,6 +7,11 @@ pub const MAX_OPACITY: f32 = 0.999;
 /// must stay in front of the eye; 1.5 > sqrt 2).
 pub const CULL_RADII: f32 = 1.5;
 
+/// tau = -ln(1 - alpha) of one voxel-length of material, alpha clamped to `MAX_OPACITY`.
+pub fn optical_depth(opacity: f32) -> f32 {
+    -(1.0 - opacity.clamp(0.0, MAX_OPACITY)).ln()
+}
+
 pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams]) {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right, origin, spacing) =
@@ -20,8 +25,7 @@ pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams])
         let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
         let u = (right - right.dot(w) * w).normalize();
         let v = w.cross(u);
-        let opacity = sp.color[3].clamp(0.0, MAX_OPACITY);
-        let tau = -(1.0 - opacity).ln();
+        let tau = optical_depth(sp.color[3]);
         params[s] = SplatParams {
             center: [center.x, center.y, center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
             axis_u: [u.x * radius, u.y * radius, u.z * radius, 1.0],

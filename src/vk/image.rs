@@ -14,6 +14,7 @@ pub struct Image {
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) layers: u32,
+    pub(crate) depth: u32,
 }
 
 impl Image {
@@ -26,10 +27,35 @@ impl Image {
         usage: vk::ImageUsageFlags,
         array: bool,
     ) -> Result<Self> {
+        Self::create(ctx, name, (width, height, 1), layers, format, usage, array, false)
+    }
+
+    /// A device-local 3D image (one layer).
+    pub fn new_3d(
+        ctx: &Arc<Context>,
+        name: &str,
+        extent: (u32, u32, u32),
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self> {
+        Self::create(ctx, name, extent, 1, format, usage, false, true)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn create(
+        ctx: &Arc<Context>,
+        name: &str,
+        (width, height, depth): (u32, u32, u32),
+        layers: u32,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        array: bool,
+        three_d: bool,
+    ) -> Result<Self> {
         let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
+            .image_type(if three_d { vk::ImageType::TYPE_3D } else { vk::ImageType::TYPE_2D })
             .format(format)
-            .extent(vk::Extent3D { width, height, depth: 1 })
+            .extent(vk::Extent3D { width, height, depth })
             .mip_levels(1)
             .array_layers(layers)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -69,6 +95,7 @@ impl Image {
             width,
             height,
             layers,
+            depth,
         };
         let alloc = image.allocation.as_ref().expect("just set");
         // SAFETY: memory from the allocator for these requirements.
@@ -76,7 +103,13 @@ impl Image {
             .map_err(Error::vk("vkBindImageMemory"))?;
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
-            .view_type(if array || layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D })
+            .view_type(if three_d {
+                vk::ImageViewType::TYPE_3D
+            } else if array || layers > 1 {
+                vk::ImageViewType::TYPE_2D_ARRAY
+            } else {
+                vk::ImageViewType::TYPE_2D
+            })
             .format(format)
             .subresource_range(Self::range_of(layers));
         // SAFETY: bound image, matching format.

@@ -78,8 +78,8 @@ impl Recorder<'_> {
                 base_array_layer: 0,
                 layer_count: 1,
             })
-            .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 })];
-        // SAFETY: image in TRANSFER_DST_OPTIMAL; buffer holds width*height texels.
+            .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: image.depth })];
+        // SAFETY: image in TRANSFER_DST_OPTIMAL; buffer holds width*height*depth texels.
         unsafe {
             self.ctx.device.cmd_copy_buffer_to_image(
                 self.cmd,

@@ -1,0 +1,125 @@
+//! Mirror of `raycast.comp`, in the shader's f32 arithmetic, with an optional per-pixel jitter of
+//! the first sample (CPU only) for supersampled references.
+use super::ImageF32;
+use crate::camera::Camera;
+use crate::gpu_types::RaycastParams;
+use crate::truth::DenseField;
+use crate::volume::SplatSet;
+use glam::{Mat4, Vec3, Vec4};
+use rayon::prelude::*;
+
+/// Ray caster settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RaycastOptions {
+    /// Step length in voxel spacings.
+    pub step: f32,
+    /// Transmittance below which a ray stops.
+    pub min_transmittance: f32,
+    /// Most samples per ray.
+    pub max_steps: u32,
+}
+
+impl Default for RaycastOptions {
+    fn default() -> Self {
+        Self { step: 0.5, min_transmittance: 1e-3, max_steps: 1 << 16 }
+    }
+}
+
+/// The uniforms shared by the GPU stage and this mirror.
+pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) -> RaycastParams {
+    let g = set.grid();
+    let o = Vec3::from(g.origin);
+    let s = Vec3::from(g.spacing);
+    let last = g.position([g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1]);
+    let (lo, hi) = (o - s, last + s);
+    let step = opts.step * s.min_element();
+    RaycastParams {
+        inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
+        box_min: [lo.x, lo.y, lo.z, step],
+        box_max: [hi.x, hi.y, hi.z, opts.min_transmittance],
+        origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
+        inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
+        dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
+        image: [camera.width, camera.height, 0, 0],
+    }
+}
+
+/// Mirror of `trilinear` in `glsl/shared/trilinear.glsl`.
+pub fn trilinear(field: &DenseField, u: Vec3) -> [f32; 4] {
+    let b = u.floor();
+    let f = u - b;
+    let (i, j, k) = (b.x as i64, b.y as i64, b.z as i64);
+    let lerp = |p: [f32; 4], q: [f32; 4], t: f32| [0, 1, 2, 3].map(|c| p[c] + (q[c] - p[c]) * t);
+    let x00 = lerp(field.at(i, j, k), field.at(i + 1, j, k), f.x);
+    let x10 = lerp(field.at(i, j + 1, k), field.at(i + 1, j + 1, k), f.x);
+    let x01 = lerp(field.at(i, j, k + 1), field.at(i + 1, j, k + 1), f.x);
+    let x11 = lerp(field.at(i, j + 1, k + 1), field.at(i + 1, j + 1, k + 1), f.x);
+    lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
+}
+
+/// `jitter`: `Some(seed)` offsets each pixel's samples by a hashed fraction of a step.
+pub fn raycast(rc: &RaycastParams, field: &DenseField, jitter: Option<u64>) -> ImageF32 {
+    let (w, h) = (rc.image[0], rc.image[1]);
+    let inv = Mat4::from_cols_array_2d(&rc.inv_view_proj);
+    let (lo, hi) = (Vec3::from_slice(&rc.box_min[..3]), Vec3::from_slice(&rc.box_max[..3]));
+    let origin = Vec3::from_slice(&rc.origin[..3]);
+    let inv_spacing = Vec3::from_slice(&rc.inv_spacing[..3]);
+    let mut pixels = vec![[0.0f32; 4]; (w * h) as usize];
+    pixels.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            let ndc = Vec3::new((x as f32 + 0.5) / w as f32 * 2.0 - 1.0, (y as f32 + 0.5) / h as f32 * 2.0 - 1.0, 0.0);
+            let a4 = inv * Vec4::new(ndc.x, ndc.y, 0.0, 1.0);
+            let b4 = inv * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
+            let a = a4.truncate() / a4.w;
+            let d = b4.truncate() / b4.w - a;
+            let len = d.length();
+            let dir = d / len;
+            let (mut t0, mut t1) = (0.0f32, len);
+            for ax in 0..3 {
+                if dir[ax].abs() < 1e-30 {
+                    if a[ax] < lo[ax] || a[ax] > hi[ax] {
+                        t1 = -1.0;
+                    }
+                    continue;
+                }
+                let p = (lo[ax] - a[ax]) / dir[ax];
+                let q = (hi[ax] - a[ax]) / dir[ax];
+                t0 = t0.max(p.min(q));
+                t1 = t1.min(p.max(q));
+            }
+            let (mut col, mut trans) = ([0.0f32; 3], 1.0f32);
+            if t1 > t0 {
+                let step = rc.box_min[3];
+                let n = (((t1 - t0) / step).ceil() as u32).min(rc.dims[3]);
+                let offset = match jitter {
+                    Some(seed) => hash01(seed, x as u64, y as u64),
+                    None => 0.5,
+                };
+                for s in 0..n {
+                    let p = a + dir * (t0 + (s as f32 + offset) * step);
+                    let v = trilinear(field, (p - origin) * inv_spacing);
+                    if v[3] <= 0.0 {
+                        continue;
+                    }
+                    let alpha = 1.0 - (-v[3] * rc.origin[3] * step).exp();
+                    for c in 0..3 {
+                        col[c] += trans * alpha * (v[c] / v[3]);
+                    }
+                    trans *= 1.0 - alpha;
+                    if trans < rc.box_max[3] {
+                        break;
+                    }
+                }
+            }
+            *px = [col[0], col[1], col[2], 1.0 - trans];
+        }
+    });
+    ImageF32 { width: w, height: h, pixels }
+}
+
+fn hash01(seed: u64, x: u64, y: u64) -> f32 {
+    let mut z = seed ^ x.wrapping_mul(0x9E3779B97F4A7C15) ^ y.wrapping_mul(0xC2B2AE3D27D4EB4F);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
+    ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+}

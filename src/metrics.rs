@@ -1,0 +1,138 @@
+//! Image and animation error metrics, used by tests, the bench and `voxsplat compare`. All work on
+//! premultiplied RGBA with values clamped to [0, 1].
+use crate::cpu::ImageF32;
+use crate::error::{Error, Result};
+
+/// How far one image is from a reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageMetrics {
+    /// Root mean square error over all RGBA channels.
+    pub rmse: f64,
+    /// 20 log10(1 / rmse) in dB; infinite for identical images.
+    pub psnr: f64,
+    /// Largest absolute channel difference.
+    pub max_abs: f64,
+    /// Structural similarity of the luminance (colour composited over black).
+    pub ssim_luma: f64,
+    /// Structural similarity of the alpha channel.
+    pub ssim_alpha: f64,
+}
+
+fn clamp01(v: f32) -> f64 {
+    (v as f64).clamp(0.0, 1.0)
+}
+
+/// Compare `img` against the reference `truth`.
+pub fn compare(img: &ImageF32, truth: &ImageF32) -> Result<ImageMetrics> {
+    if (img.width, img.height) != (truth.width, truth.height) {
+        return Err(Error::InvalidArgument(format!(
+            "images differ in size: {}x{} and {}x{}",
+            img.width, img.height, truth.width, truth.height
+        )));
+    }
+    let (mut se, mut max_abs) = (0.0f64, 0.0f64);
+    for (a, b) in img.pixels.iter().zip(&truth.pixels) {
+        for c in 0..4 {
+            let d = clamp01(a[c]) - clamp01(b[c]);
+            se += d * d;
+            max_abs = max_abs.max(d.abs());
+        }
+    }
+    let n = (img.pixels.len() * 4).max(1) as f64;
+    let rmse = (se / n).sqrt();
+    let psnr = if rmse > 0.0 { 20.0 * (1.0 / rmse).log10() } else { f64::INFINITY };
+    let luma = |im: &ImageF32| -> Vec<f64> {
+        im.pixels.iter().map(|p| 0.2126 * clamp01(p[0]) + 0.7152 * clamp01(p[1]) + 0.0722 * clamp01(p[2])).collect()
+    };
+    let alpha = |im: &ImageF32| -> Vec<f64> { im.pixels.iter().map(|p| clamp01(p[3])).collect() };
+    let (w, h) = (img.width as usize, img.height as usize);
+    Ok(ImageMetrics {
+        rmse,
+        psnr,
+        max_abs,
+        ssim_luma: ssim(&luma(img), &luma(truth), w, h),
+        ssim_alpha: ssim(&alpha(img), &alpha(truth), w, h),
+    })
+}
+
+/// Separable Gaussian blur (sigma 1.5, 11 taps, edges clamped), the SSIM window of Wang et al.
+fn blur(v: &[f64], w: usize, h: usize) -> Vec<f64> {
+    let taps: Vec<f64> = (-5i32..=5).map(|i| (-(i * i) as f64 / (2.0 * 1.5 * 1.5)).exp()).collect();
+    let norm: f64 = taps.iter().sum();
+    let mut tmp = vec![0.0; v.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let mut s = 0.0;
+            for (k, t) in taps.iter().enumerate() {
+                let xx = (x as i64 + k as i64 - 5).clamp(0, w as i64 - 1) as usize;
+                s += t * v[y * w + xx];
+            }
+            tmp[y * w + x] = s / norm;
+        }
+    }
+    let mut out = vec![0.0; v.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let mut s = 0.0;
+            for (k, t) in taps.iter().enumerate() {
+                let yy = (y as i64 + k as i64 - 5).clamp(0, h as i64 - 1) as usize;
+                s += t * tmp[yy * w + x];
+            }
+            out[y * w + x] = s / norm;
+        }
+    }
+    out
+}
+
+/// Mean SSIM with constants for a dynamic range of 1.
+pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize) -> f64 {
+    if a.is_empty() {
+        return 1.0;
+    }
+    let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));
+    let prod = |x: &[f64], y: &[f64]| -> Vec<f64> { x.iter().zip(y).map(|(p, q)| p * q).collect() };
+    let (ma, mb) = (blur(a, w, h), blur(b, w, h));
+    let (aa, bb, ab) = (blur(&prod(a, a), w, h), blur(&prod(b, b), w, h), blur(&prod(a, b), w, h));
+    let mut sum = 0.0;
+    for i in 0..a.len() {
+        let (va, vb, cov) = (aa[i] - ma[i] * ma[i], bb[i] - mb[i] * mb[i], ab[i] - ma[i] * mb[i]);
+        sum +=
+            ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2)) / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2));
+    }
+    sum / a.len() as f64
+}
+
+/// Frame-to-frame change of an animation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Temporal {
+    /// Mean RMSE between consecutive frames.
+    pub mean_change: f64,
+    /// Largest RMSE between consecutive frames.
+    pub max_change: f64,
+    /// Largest consecutive change divided by the median one: 1 for a steady animation, large when
+    /// one step jumps (a pop). Defined in docs/MODEL.md.
+    pub popping: f64,
+}
+
+pub fn temporal(frames: &[ImageF32]) -> Result<Temporal> {
+    if frames.len() < 3 {
+        return Err(Error::InvalidArgument("temporal metrics need at least 3 frames".into()));
+    }
+    let mut changes = Vec::with_capacity(frames.len() - 1);
+    for w in frames.windows(2) {
+        changes.push(compare(&w[1], &w[0])?.rmse);
+    }
+    let mean_change = changes.iter().sum::<f64>() / changes.len() as f64;
+    let max_change = changes.iter().cloned().fold(0.0, f64::max);
+    let mut sorted = changes.clone();
+    sorted.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+    let median = sorted[sorted.len() / 2];
+    let popping = if median > 0.0 {
+        max_change / median
+    } else if max_change > 0.0 {
+        f64::INFINITY
+    } else {
+        1.0
+    };
+    Ok(Temporal { mean_change, max_change, popping })
+}
