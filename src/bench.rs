@@ -1,123 +1,710 @@
-//! Benchmark bodies shared by `benches/render.rs` and `voxsplat bench`: per-stage GPU times from
-//! timestamp queries (wall times on the CPU backend), medians over frames after warm-up.
+//! Benchmark bodies shared by `benches/render.rs` and `voxsplat bench`: the method matrix (time
+//! from GPU timestamps, error against the truth), the roofline, and scaling; CSV, SVG charts and
+//! docs/RESULTS.md. Medians over frames after warm-up.
 use crate::camera::Camera;
-use crate::error::Result;
-use crate::pipeline::{Composite, RenderOptions};
-use crate::{scene, Kernel, OrderKind, Renderer};
+use crate::cpu::raycast::RaycastOptions;
+use crate::cpu::ImageF32;
+use crate::error::{Error, Result};
+use crate::metrics::{compare, ImageMetrics};
+use crate::order::{count_violations, visibility_order};
+use crate::pipeline::{Composite, RenderOptions, Rendered};
+use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
+use crate::volume::{Grid, SplatSet};
+use crate::{scene, Direction, Kernel, OrderKind, Renderer};
+use std::fmt::Write as _;
+use std::path::Path;
 use std::time::Instant;
+
+/// One rendering method of the matrix.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Method {
+    Splat { order: OrderKind, composite: Composite, kernel: Kernel },
+    Raycast { step: f32 },
+}
+
+impl Method {
+    pub fn label(&self) -> String {
+        match self {
+            Method::Splat { order, composite: Composite::Splat, kernel } => format!("{order:?} splat {kernel:?}"),
+            Method::Splat { composite: Composite::Sheet, kernel, .. } => format!("sheet {kernel:?}"),
+            Method::Raycast { step } => format!("raycast {step}"),
+        }
+        .to_lowercase()
+    }
+
+    fn reconstruction(&self) -> Reconstruction {
+        match self {
+            Method::Splat { kernel, .. } => Reconstruction::Kernel(*kernel),
+            Method::Raycast { .. } => Reconstruction::Trilinear,
+        }
+    }
+}
+
+/// What `run_matrix` covers.
+#[derive(Clone, Debug)]
+pub struct MatrixOptions {
+    pub scenes: Vec<&'static str>,
+    pub methods: Vec<Method>,
+    pub width: u32,
+    pub height: u32,
+    pub warmup: usize,
+    pub frames: usize,
+}
+
+impl MatrixOptions {
+    /// The full matrix: three scenes at 512x512, every order and kernel, sheets, three ray steps.
+    pub fn full() -> Self {
+        let mut methods = Vec::new();
+        for kernel in [Kernel::Gaussian, Kernel::Cubic] {
+            for order in [OrderKind::Btf, OrderKind::Wbtf, OrderKind::Pbtf, OrderKind::Sorted] {
+                methods.push(Method::Splat { order, composite: Composite::Splat, kernel });
+            }
+            methods.push(Method::Splat { order: OrderKind::Pbtf, composite: Composite::Sheet, kernel });
+        }
+        for step in [1.0, 0.5, 0.25] {
+            methods.push(Method::Raycast { step });
+        }
+        Self {
+            scenes: vec!["cube60", "cube40-attenuated", "plane"],
+            methods,
+            width: 512,
+            height: 512,
+            warmup: 2,
+            frames: 7,
+        }
+    }
+
+    /// A small matrix CI can afford.
+    pub fn quick() -> Self {
+        let g = Kernel::Gaussian;
+        Self {
+            scenes: vec!["cube40", "plane"],
+            methods: vec![
+                Method::Splat { order: OrderKind::Btf, composite: Composite::Splat, kernel: g },
+                Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: g },
+                Method::Splat { order: OrderKind::Pbtf, composite: Composite::Sheet, kernel: g },
+                Method::Raycast { step: 1.0 },
+                Method::Raycast { step: 0.5 },
+            ],
+            width: 128,
+            height: 128,
+            warmup: 1,
+            frames: 5,
+        }
+    }
+}
 
 /// One measured configuration.
 #[derive(Clone, Debug)]
-pub struct Case {
-    pub scene: &'static str,
-    pub composite: Composite,
-    pub kernel: Kernel,
-    pub order: OrderKind,
+pub struct Row {
+    pub scene: String,
+    pub method: String,
     pub width: u32,
     pub height: u32,
-}
-
-impl Case {
-    pub fn label(&self) -> String {
-        format!("{} {:?} {:?} {:?} {}x{}", self.scene, self.order, self.composite, self.kernel, self.width, self.height)
-            .to_lowercase()
-    }
-}
-
-/// The cases of `docs/RESULTS.md`: cube60 and the plane at 512x512, both compositing modes.
-pub fn default_cases() -> Vec<Case> {
-    let mut v = Vec::new();
-    for scene in ["cube60", "plane"] {
-        for composite in [Composite::Splat, Composite::Sheet] {
-            v.push(Case {
-                scene,
-                composite,
-                kernel: Kernel::Gaussian,
-                order: OrderKind::Pbtf,
-                width: 512,
-                height: 512,
-            });
-        }
-    }
-    v
-}
-
-#[derive(Clone, Debug)]
-pub struct Measurement {
-    pub label: String,
     pub splats: usize,
-    /// Median wall time of a whole frame (submit to readback).
+    /// Median of the summed stage times (GPU timestamps; plus CPU order time where the order is
+    /// computed on the CPU).
+    pub time_ms: f64,
     pub wall_ms: f64,
-    /// Median per named stage.
+    /// Median per stage.
     pub stages: Vec<(&'static str, f64)>,
-    /// Splats divided by the median of the summed stage times.
-    pub splats_per_second: f64,
+    pub metrics: ImageMetrics,
+    pub violations: Option<u64>,
 }
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
     if v.is_empty() {
-        0.0
+        f64::NAN
     } else {
         v[v.len() / 2]
     }
 }
 
-/// Render `case` `warmup + frames` times and take medians over the last `frames`.
-pub fn measure(renderer: &mut Renderer, case: &Case, warmup: usize, frames: usize) -> Result<Measurement> {
-    let set = scene::build(case.scene)?;
-    let splats = set.len();
-    let camera = Camera::framing(set.grid(), case.width, case.height);
-    renderer.set_scene(set)?;
-    let opts =
-        RenderOptions { composite: case.composite, kernel: case.kernel, order: case.order, ..Default::default() };
+/// The camera every benchmark uses for a scene.
+pub fn bench_camera(grid: &Grid, width: u32, height: u32) -> Camera {
+    Camera::framing(grid, width, height)
+}
+
+fn render_method(r: &mut Renderer, m: &Method, camera: &Camera) -> Result<Rendered> {
+    match m {
+        Method::Splat { order, composite, kernel } => {
+            let o = RenderOptions { order: *order, composite: *composite, kernel: *kernel, ..Default::default() };
+            r.render(camera, &o)
+        }
+        Method::Raycast { step } => r.raycast(camera, &RaycastOptions { step: *step, ..Default::default() }),
+    }
+}
+
+/// Medians of a timed method and its last image.
+pub struct Timed {
+    /// Median of the summed stage times.
+    pub time_ms: f64,
+    /// Median wall time of a whole frame.
+    pub wall_ms: f64,
+    pub stages: Vec<(&'static str, f64)>,
+    pub image: ImageF32,
+}
+
+/// Time `frames` renders after `warmup`.
+pub fn time_method(r: &mut Renderer, m: &Method, camera: &Camera, warmup: usize, frames: usize) -> Result<Timed> {
+    let mut totals = Vec::new();
     let mut walls = Vec::new();
     let mut per_stage: Vec<(&'static str, Vec<f64>)> = Vec::new();
-    let mut totals = Vec::new();
-    for f in 0..warmup + frames {
+    let mut last = None;
+    for f in 0..warmup + frames.max(1) {
         let t = Instant::now();
-        let r = renderer.render(&camera, &opts)?;
+        let out = render_method(r, m, camera)?;
         let wall = t.elapsed().as_secs_f64() * 1e3;
-        if f < warmup {
-            continue;
-        }
-        walls.push(wall);
-        totals.push(r.timings.iter().map(|s| s.ms).sum::<f64>());
-        for s in r.timings {
-            match per_stage.iter_mut().find(|(n, _)| *n == s.stage) {
-                Some((_, v)) => v.push(s.ms),
-                None => per_stage.push((s.stage, vec![s.ms])),
+        if f >= warmup {
+            walls.push(wall);
+            totals.push(out.timings.iter().map(|s| s.ms).sum::<f64>());
+            for s in &out.timings {
+                match per_stage.iter_mut().find(|(n, _)| *n == s.stage) {
+                    Some((_, v)) => v.push(s.ms),
+                    None => per_stage.push((s.stage, vec![s.ms])),
+                }
             }
         }
+        last = Some(out.image);
     }
-    let total = median(&mut totals);
-    Ok(Measurement {
-        label: case.label(),
-        splats,
+    let stages = per_stage.into_iter().map(|(n, mut v)| (n, median(&mut v))).collect();
+    Ok(Timed {
+        time_ms: median(&mut totals),
         wall_ms: median(&mut walls),
-        stages: per_stage.into_iter().map(|(n, mut v)| (n, median(&mut v))).collect(),
-        splats_per_second: if total > 0.0 { splats as f64 / (total * 1e-3) } else { 0.0 },
+        stages,
+        image: last.expect("at least one frame"),
     })
 }
 
-/// A markdown table of measurements.
-pub fn table(ms: &[Measurement]) -> String {
+/// Run the matrix; `progress(done, total, label)` is called before each configuration.
+pub fn run_matrix(
+    r: &mut Renderer,
+    opts: &MatrixOptions,
+    mut progress: impl FnMut(usize, usize, &str),
+) -> Result<Vec<Row>> {
+    let total = opts.scenes.len() * opts.methods.len();
+    let mut rows = Vec::new();
+    let mut done = 0;
+    for &name in &opts.scenes {
+        let set = scene::build(name)?;
+        let camera = bench_camera(set.grid(), opts.width, opts.height);
+        r.set_scene(set.clone())?;
+        let mut truths: Vec<(Reconstruction, ImageF32)> = Vec::new();
+        for m in &opts.methods {
+            progress(done, total, &format!("{name}: {}", m.label()));
+            done += 1;
+            let rec = m.reconstruction();
+            if !truths.iter().any(|(k, _)| *k == rec) {
+                let t =
+                    volumetric_summation(&set, &camera, &TruthOptions { reconstruction: rec, ..Default::default() })?;
+                truths.push((rec, t));
+            }
+            let truth = &truths.iter().find(|(k, _)| *k == rec).expect("computed").1;
+            let Timed { time_ms, wall_ms, stages, image } = time_method(r, m, &camera, opts.warmup, opts.frames)?;
+            let violations = match m {
+                Method::Splat { order, composite: Composite::Splat, .. } => {
+                    let o = visibility_order(&set, &camera, *order, Direction::BackToFront);
+                    Some(count_violations(&set, &camera, &o, Direction::BackToFront)?)
+                }
+                _ => None,
+            };
+            rows.push(Row {
+                scene: name.to_string(),
+                method: m.label(),
+                width: opts.width,
+                height: opts.height,
+                splats: set.len(),
+                time_ms,
+                wall_ms,
+                stages,
+                metrics: compare(&image, truth)?,
+                violations,
+            });
+        }
+    }
+    progress(done, total, "done");
+    Ok(rows)
+}
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
+    move |e| Error::Io { path: path.display().to_string(), source: e }
+}
+
+pub fn write_csv(rows: &[Row], path: &Path) -> Result<()> {
     let mut s = String::from(
-        "| case | splats | order ms | splat_params ms | footprint ms | composite ms | wall ms | splats/s |\n|---|---:|---:|---:|---:|---:|---:|---:|\n",
+        "scene,method,width,height,splats,time_ms,wall_ms,order_ms,splat_params_ms,footprint_ms,composite_ms,raycast_ms,rmse,psnr_db,ssim_luma,ssim_alpha,max_abs,violations\n",
     );
-    for m in ms {
-        let st = |n: &str| m.stages.iter().find(|(k, _)| *k == n).map(|(_, v)| format!("{v:.2}")).unwrap_or("-".into());
-        s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} M |\n",
-            m.label,
-            m.splats,
-            st("order"),
+    for r in rows {
+        let st = |n: &str| r.stages.iter().find(|(k, _)| *k == n).map(|(_, v)| format!("{v:.4}")).unwrap_or_default();
+        let order = if st("order").is_empty() { st("order_cpu") } else { st("order") };
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{:.4},{:.4},{},{},{},{},{},{:.6e},{:.3},{:.6},{:.6},{:.6},{}",
+            r.scene,
+            r.method,
+            r.width,
+            r.height,
+            r.splats,
+            r.time_ms,
+            r.wall_ms,
+            order,
             st("splat_params"),
             st("footprint"),
             st("composite"),
-            m.wall_ms,
-            m.splats_per_second / 1e6
+            st("raycast"),
+            r.metrics.rmse,
+            r.metrics.psnr,
+            r.metrics.ssim_luma,
+            r.metrics.ssim_alpha,
+            r.metrics.max_abs,
+            r.violations.map(|v| v.to_string()).unwrap_or_default()
         );
     }
-    s
+    std::fs::write(path, s).map_err(io_err(path))
+}
+
+/// Indices of the points on the Pareto front (no other point is both faster and more accurate),
+/// sorted by time.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
+    let mut idx: Vec<usize> =
+        (0..points.len()).filter(|&i| points[i].0.is_finite() && points[i].1.is_finite()).collect();
+    idx.sort_by(|&a, &b| points[a].0.partial_cmp(&points[b].0).unwrap_or(std::cmp::Ordering::Equal));
+    let mut best = f64::INFINITY;
+    let mut front = Vec::new();
+    for i in idx {
+        if points[i].1 < best {
+            best = points[i].1;
+            front.push(i);
+        }
+    }
+    front
+}
+
+fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Image { path: path.display().to_string(), message: e.to_string() }
+}
+
+/// Time (log x) against error (y) for one scene, one labelled point per method, Pareto front drawn.
+pub fn chart_svg(rows: &[Row], scene: &str, path: &Path) -> Result<()> {
+    use plotters::prelude::*;
+    let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
+    let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.time_ms.max(1e-3), r.metrics.rmse)).collect();
+    let (xmin, xmax) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let ymax = pts.iter().fold(0.0f64, |a, p| a.max(p.1));
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{scene}: time vs error (RMSE against the truth)"), ("sans-serif", 20))
+        .margin(16)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((xmin * 0.7..xmax * 1.4).log_scale(), 0.0..ymax * 1.15 + 1e-6)
+        .map_err(|e| plot_err(path, e))?;
+    chart.configure_mesh().x_desc("time per frame, ms (log)").y_desc("RMSE").draw().map_err(|e| plot_err(path, e))?;
+    let front: Vec<(f64, f64)> = pareto_front(&pts).into_iter().map(|i| pts[i]).collect();
+    chart.draw_series(LineSeries::new(front, RED.stroke_width(2))).map_err(|e| plot_err(path, e))?;
+    chart
+        .draw_series(rows.iter().zip(&pts).map(|(r, &(x, y))| {
+            EmptyElement::at((x, y))
+                + Circle::new((0, 0), 4, BLUE.filled())
+                + Text::new(r.method.clone(), (6, -12), ("sans-serif", 12))
+        }))
+        .map_err(|e| plot_err(path, e))?;
+    root.present().map_err(|e| plot_err(path, e))?;
+    Ok(())
+}
+
+/// One point of the roofline.
+#[derive(Clone, Debug)]
+pub struct RooflinePoint {
+    pub size_px: u32,
+    pub quads: u32,
+    pub ms: f64,
+    pub fragments_per_s: f64,
+    pub quads_per_s: f64,
+}
+
+/// The compositing roofline at a layer count.
+#[derive(Clone, Debug)]
+pub struct CompositeRoofline {
+    pub layers: u32,
+    pub roofline_ms: f64,
+    pub composite_ms: f64,
+    pub roofline_bytes_per_s: f64,
+}
+
+/// Best-case raster rate of additive quads of each size, and the compositing roofline.
+pub fn roofline(
+    r: &mut Renderer,
+    width: u32,
+    height: u32,
+    sizes: &[u32],
+    fragments: u64,
+    frames: usize,
+) -> Result<(Vec<RooflinePoint>, CompositeRoofline)> {
+    let mut pts = Vec::new();
+    for &size in sizes {
+        let quads = (fragments / (size as u64 * size as u64)).max(1) as u32;
+        let _ = r.roofline_quads(width, height, size, quads)?;
+        let mut t: Vec<f64> =
+            (0..frames.max(1)).map(|_| r.roofline_quads(width, height, size, quads)).collect::<Result<_>>()?;
+        let ms = median(&mut t);
+        let frags = quads as f64 * (size * size) as f64;
+        pts.push(RooflinePoint {
+            size_px: size,
+            quads,
+            ms,
+            fragments_per_s: frags / (ms * 1e-3),
+            quads_per_s: quads as f64 / (ms * 1e-3),
+        });
+    }
+    let layers = 32;
+    let _ = r.roofline_composite(width, height, layers)?;
+    let mut a = Vec::new();
+    let mut b = Vec::new();
+    for _ in 0..frames.max(1) {
+        let (x, y) = r.roofline_composite(width, height, layers)?;
+        a.push(x);
+        b.push(y);
+    }
+    let (roofline_ms, composite_ms) = (median(&mut a), median(&mut b));
+    let bytes = (layers as f64 + 2.0) * width as f64 * height as f64 * 16.0;
+    Ok((
+        pts,
+        CompositeRoofline { layers, roofline_ms, composite_ms, roofline_bytes_per_s: bytes / (roofline_ms * 1e-3) },
+    ))
+}
+
+/// Fragments the footprint pass of a frame touches: the quads' pixel areas (clipped to the image).
+pub fn footprint_fragments(set: &SplatSet, camera: &Camera, kernel: Kernel) -> Result<(f64, f64)> {
+    let mut r = Renderer::new(&crate::RendererOptions { backend: crate::Backend::Cpu, ..Default::default() })?;
+    r.set_scene(set.clone())?;
+    let params = r.splat_params(camera, kernel)?;
+    let cap = camera.width as f64 * camera.height as f64;
+    let mut total = 0.0;
+    let mut sizes = Vec::new();
+    for p in params.iter().filter(|p| p.center[3] != 0.0) {
+        let side = 2.0 * p.screen[2] as f64;
+        total += (side * side).min(cap);
+        sizes.push(side);
+    }
+    Ok((total, median(&mut sizes)))
+}
+
+/// A dense cube of side `n` with a colour gradient and low opacity: n^3 splats.
+pub fn synthetic_cube(n: u32) -> Result<SplatSet> {
+    let grid = Grid::centered([n, n, n], [1.0; 3])?;
+    let f = 1.0 / n as f32;
+    SplatSet::from_fn(grid, |i, j, k| Some([i as f32 * f, j as f32 * f, k as f32 * f, 0.02]))
+}
+
+/// One scaling measurement.
+#[derive(Clone, Debug)]
+pub struct ScalePoint {
+    pub what: &'static str,
+    pub splats: usize,
+    pub width: u32,
+    pub time_ms: f64,
+    pub order_ms: f64,
+    pub gpu_bytes: u64,
+}
+
+/// Time against splat count (dense cubes of the given sides) and against image side (cube60).
+pub fn scaling(
+    r: &mut Renderer,
+    cube_sides: &[u32],
+    image_sides: &[u32],
+    frames: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<ScalePoint>> {
+    let mut out = Vec::new();
+    let m = Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: Kernel::Gaussian };
+    let gpu_bytes = |r: &Renderer| r.context().map(|c| c.allocation_report().1).unwrap_or(0);
+    for &n in cube_sides {
+        progress(&format!("scaling: {}^3 splats", n));
+        let set = synthetic_cube(n)?;
+        let splats = set.len();
+        let camera = bench_camera(set.grid(), 512, 512);
+        r.set_scene(set)?;
+        let t = time_method(r, &m, &camera, 1, frames)?;
+        let order_ms = t.stages.iter().find(|s| s.0 == "order").map(|s| s.1).unwrap_or(f64::NAN);
+        out.push(ScalePoint {
+            what: "splats",
+            splats,
+            width: 512,
+            time_ms: t.time_ms,
+            order_ms,
+            gpu_bytes: gpu_bytes(r),
+        });
+    }
+    let set = scene::build("cube60")?;
+    let splats = set.len();
+    let grid = *set.grid();
+    r.set_scene(set)?;
+    for &side in image_sides {
+        progress(&format!("scaling: {side}^2 image"));
+        let camera = bench_camera(&grid, side, side);
+        let t = time_method(r, &m, &camera, 1, frames)?;
+        let order_ms = t.stages.iter().find(|s| s.0 == "order").map(|s| s.1).unwrap_or(f64::NAN);
+        out.push(ScalePoint {
+            what: "image",
+            splats,
+            width: side,
+            time_ms: t.time_ms,
+            order_ms,
+            gpu_bytes: gpu_bytes(r),
+        });
+    }
+    Ok(out)
+}
+
+pub fn write_scaling_csv(points: &[ScalePoint], path: &Path) -> Result<()> {
+    let mut s = String::from("series,splats,image_side,time_ms,order_ms,gpu_bytes,gpu_bytes_per_splat\n");
+    for p in points {
+        let _ = writeln!(
+            s,
+            "{},{},{},{:.4},{:.4},{},{:.1}",
+            p.what,
+            p.splats,
+            p.width,
+            p.time_ms,
+            p.order_ms,
+            p.gpu_bytes,
+            p.gpu_bytes as f64 / p.splats.max(1) as f64
+        );
+    }
+    std::fs::write(path, s).map_err(io_err(path))
+}
+
+/// Log-log time against size for both scaling series.
+pub fn scaling_svg(points: &[ScalePoint], path: &Path) -> Result<()> {
+    use plotters::prelude::*;
+    let root = SVGBackend::new(path, (900, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    let halves = root.split_evenly((1, 2));
+    for (area, what) in halves.iter().zip(["splats", "image"]) {
+        let pts: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.what == what)
+            .map(|p| (if what == "splats" { p.splats as f64 } else { (p.width as f64).powi(2) }, p.time_ms.max(1e-3)))
+            .collect();
+        if pts.is_empty() {
+            continue;
+        }
+        let (x0, x1) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+        let (y0, y1) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        let mut chart = ChartBuilder::on(area)
+            .caption(
+                if what == "splats" { "time vs splats (PBTF, 512^2)" } else { "time vs pixels (cube60)" },
+                ("sans-serif", 16),
+            )
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d((x0 * 0.7..x1 * 1.4).log_scale(), (y0 * 0.7..y1 * 1.4).log_scale())
+            .map_err(|e| plot_err(path, e))?;
+        chart
+            .configure_mesh()
+            .x_desc(if what == "splats" { "splats" } else { "pixels" })
+            .y_desc("ms per frame")
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
+        chart.draw_series(LineSeries::new(pts.clone(), BLUE.stroke_width(2))).map_err(|e| plot_err(path, e))?;
+        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLUE.filled()))).map_err(|e| plot_err(path, e))?;
+    }
+    root.present().map_err(|e| plot_err(path, e))?;
+    Ok(())
+}
+
+/// Everything `results_markdown` reports.
+pub struct Report<'a> {
+    pub device: String,
+    pub commit: String,
+    pub command: String,
+    pub rows: &'a [Row],
+    pub roofline: Option<&'a (Vec<RooflinePoint>, CompositeRoofline)>,
+    pub scaling: &'a [ScalePoint],
+    /// Relative path from the markdown file to the charts.
+    pub chart_dir: String,
+    pub notes: Option<String>,
+}
+
+fn row<'a>(rows: &'a [Row], scene: &str, method: &str) -> Option<&'a Row> {
+    rows.iter().find(|r| r.scene == scene && r.method == method)
+}
+
+fn stage(r: &Row, name: &str) -> Option<f64> {
+    r.stages.iter().find(|s| s.0 == name).map(|s| s.1)
+}
+
+/// docs/RESULTS.md: device, commit, the table, the charts, and each target with its measured ratio.
+pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Results\n");
+    let _ = writeln!(
+        s,
+        "Generated by `{}` at commit `{}` on **{}**. Times are medians after warm-up of each stage's \
+         GPU time: timestamp queries on a GPU; on a CPU device (lavapipe) each stage is its own \
+         submission timed fence to fence on the host, because lavapipe takes a timestamp when its \
+         rasterizer next flushes, not when compute work ends. BTF/WBTF/sorted orders are computed on the \
+         host and their time is included. Errors are against the volumetric-summation truth with each \
+         method's own reconstruction kernel (docs/MODEL.md). Absolute times on shared machines are \
+         noise: read the ratios.\n",
+        rep.command, rep.commit, rep.device
+    );
+    let mut scenes: Vec<&str> = rep.rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    let _ = writeln!(s, "## Speed against accuracy\n");
+    for sc in &scenes {
+        let _ = writeln!(s, "![{sc}]({}/chart-{sc}.svg)\n", rep.chart_dir);
+    }
+    let _ = writeln!(
+        s,
+        "| scene | method | splats | ms | order ms | params ms | footprint ms | composite ms | RMSE | PSNR dB | SSIM luma | violations |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "-".into());
+    for r in rep.rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.2} | {} | {} | {} | {} | {:.4} | {:.2} | {:.4} | {} |",
+            r.scene,
+            r.method,
+            r.splats,
+            r.time_ms,
+            f(stage(r, "order").or(stage(r, "order_cpu"))),
+            f(stage(r, "splat_params")),
+            f(stage(r, "footprint").or(stage(r, "raycast"))),
+            f(stage(r, "composite")),
+            r.metrics.rmse,
+            r.metrics.psnr,
+            r.metrics.ssim_luma,
+            r.violations.map(|v| v.to_string()).unwrap_or_else(|| "-".into())
+        );
+    }
+
+    let _ = writeln!(s, "\n## Targets\n");
+    // 1. Order stage share and linearity.
+    let mut shares = Vec::new();
+    for r in rep.rows.iter().filter(|r| r.method == "pbtf splat gaussian") {
+        if let Some(o) = stage(r, "order") {
+            shares.push(format!("{} {:.1} %", r.scene, 100.0 * o / r.time_ms));
+        }
+    }
+    let per_splat: Vec<String> = rep
+        .scaling
+        .iter()
+        .filter(|p| p.what == "splats" && p.order_ms.is_finite())
+        .map(|p| format!("{} splats: {:.1} ns/splat", p.splats, p.order_ms * 1e6 / p.splats as f64))
+        .collect();
+    let _ = writeln!(
+        s,
+        "- **GPU order stage ≤ 5 % of a frame, linear time.** Share of the PBTF per-splat frame: {}. \
+         Order time per splat across the scaling series: {}.",
+        if shares.is_empty() { "not measured".into() } else { shares.join(", ") },
+        if per_splat.is_empty() { "not measured".into() } else { per_splat.join("; ") }
+    );
+    // 2. Splat pass against the roofline.
+    if let Some((pts, comp)) = rep.roofline {
+        let mut lines = Vec::new();
+        for sc in &scenes {
+            let Some(r) = row(rep.rows, sc, "pbtf splat gaussian") else { continue };
+            let (Some(fp), Ok(set)) = (stage(r, "footprint"), scene::build(sc)) else { continue };
+            let cam = bench_camera(set.grid(), r.width, r.height);
+            let (frags, side) = footprint_fragments(&set, &cam, Kernel::Gaussian)?;
+            let rate = frags / (fp * 1e-3);
+            let best = pts.iter().min_by(|a, b| {
+                (a.size_px as f64 - side)
+                    .abs()
+                    .partial_cmp(&(b.size_px as f64 - side).abs())
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            });
+            if let Some(b) = best {
+                lines.push(format!(
+                    "{sc}: median footprint {side:.1} px, {:.1} Mfrag/s = {:.0} % of the {} px roofline ({:.1} Mfrag/s)",
+                    rate / 1e6,
+                    100.0 * rate / b.fragments_per_s,
+                    b.size_px,
+                    b.fragments_per_s / 1e6
+                ));
+            }
+        }
+        let _ = writeln!(s, "- **Splat pass ≥ 60 % of the roofline's fragment rate.** {}.", lines.join("; "));
+        let _ = writeln!(
+            s,
+            "- Compositing: `composite.comp` over {} layers takes {:.2} ms against {:.2} ms for the read-once roofline \
+             ({:.2} GB/s): {:.0} % of the roofline's rate.",
+            comp.layers,
+            comp.composite_ms,
+            comp.roofline_ms,
+            comp.roofline_bytes_per_s / 1e9,
+            100.0 * comp.roofline_ms / comp.composite_ms
+        );
+        let _ = writeln!(s, "\n| footprint px | quads | ms | M quads/s | M frag/s |\n|---:|---:|---:|---:|---:|");
+        for p in pts {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.2} | {:.2} | {:.1} |",
+                p.size_px,
+                p.quads,
+                p.ms,
+                p.quads_per_s / 1e6,
+                p.fragments_per_s / 1e6
+            );
+        }
+        let _ = writeln!(s);
+    }
+    // 3. Sheet buffer against the ray caster.
+    for sc in &scenes {
+        let Some(sheet) = row(rep.rows, sc, "sheet gaussian") else { continue };
+        let casts: Vec<&Row> = rep.rows.iter().filter(|r| r.scene == *sc && r.method.starts_with("raycast")).collect();
+        if casts.is_empty() {
+            continue;
+        }
+        let reaching: Vec<&&Row> = casts.iter().filter(|r| r.metrics.rmse <= sheet.metrics.rmse).collect();
+        let verdict = match reaching
+            .iter()
+            .min_by(|a, b| a.time_ms.partial_cmp(&b.time_ms).unwrap_or(std::cmp::Ordering::Equal))
+        {
+            Some(c) => {
+                let ratio = sheet.time_ms / c.time_ms;
+                format!(
+                    "the fastest ray caster at least as accurate ({}, RMSE {:.4}) takes {:.2} ms; the sheet buffer (RMSE {:.4}) takes {:.2}× its time: target {}",
+                    c.method, c.metrics.rmse, c.time_ms, sheet.metrics.rmse, ratio, if ratio <= 1.0 / 3.0 { "met" } else { "missed" }
+                )
+            }
+            None => {
+                let best = casts
+                    .iter()
+                    .min_by(|a, b| a.metrics.rmse.partial_cmp(&b.metrics.rmse).unwrap_or(std::cmp::Ordering::Equal))
+                    .expect("non-empty");
+                format!(
+                    "no ray-caster step measured is as accurate as the sheet buffer (RMSE {:.4}; best ray caster {} at {:.4}); sheet time / that ray caster's = {:.2}",
+                    sheet.metrics.rmse, best.method, best.metrics.rmse, sheet.time_ms / best.time_ms
+                )
+            }
+        };
+        let _ = writeln!(s, "- **Sheet buffer vs ray caster, {sc}:** {verdict}.");
+    }
+    if !rep.scaling.is_empty() {
+        let _ = writeln!(s, "\n## Scaling\n\n![scaling]({}/scaling.svg)\n", rep.chart_dir);
+        let _ = writeln!(s, "| series | splats | image | ms | order ms | GPU bytes | bytes/splat |\n|---|---:|---:|---:|---:|---:|---:|");
+        for p in rep.scaling {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {}² | {:.2} | {:.3} | {} | {:.0} |",
+                p.what,
+                p.splats,
+                p.width,
+                p.time_ms,
+                p.order_ms,
+                p.gpu_bytes,
+                p.gpu_bytes as f64 / p.splats.max(1) as f64
+            );
+        }
+    }
+    if let Some(n) = &rep.notes {
+        let _ = writeln!(s, "\n{n}");
+    }
+    Ok(s)
 }

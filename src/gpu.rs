@@ -11,9 +11,11 @@ use crate::pipeline::{groups_1d, make_frame, sheet_plan, Composite, Prepared, Re
 use crate::truth::DenseField;
 use crate::vk::{
     Bind, Blend, Buffer, BufferUsageFlags as BU, Context, DescriptorSet, Format, Framebuffer, Image, ImageLayout as IL,
-    ImageUsageFlags as IU, Layout, Memory, Pipeline, RenderPass, Sampler, ShaderStageFlags as SS, Slot, Stage, Timer,
+    ImageUsageFlags as IU, Layout, Memory, Pipeline, Recorder, RenderPass, Sampler, ShaderStageFlags as SS, Slot,
+    Stage, Timer,
 };
 use std::sync::Arc;
+use std::time::Instant;
 
 macro_rules! spirv {
     ($name:literal) => {
@@ -40,6 +42,9 @@ struct Stages {
     composite: Pipeline,
     raycast_layout: Layout,
     raycast: Pipeline,
+    roofline_layout: Layout,
+    roofline_quads: Pipeline,
+    roofline_composite: Pipeline,
 }
 
 struct SceneGpu {
@@ -113,6 +118,7 @@ impl GpuPipeline {
             std::mem::size_of::<CompositePush>() as u32,
         )?;
         let raycast_layout = Layout::new(&ctx, &[Slot::Uniform, Slot::Texture, Slot::StorageImage], compute, 0)?;
+        let roofline_layout = Layout::new(&ctx, &[Slot::Uniform], SS::VERTEX | SS::FRAGMENT, 16)?;
         let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
         let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
         let (vert, frag) = (spirv!("footprint.vert"), spirv!("footprint.frag"));
@@ -127,6 +133,16 @@ impl GpuPipeline {
             composite: Pipeline::compute(&ctx, &composite_layout, spirv!("composite.comp"))?,
             raycast: Pipeline::compute(&ctx, &raycast_layout, spirv!("raycast.comp"))?,
             raycast_layout,
+            roofline_quads: Pipeline::graphics(
+                &ctx,
+                &roofline_layout,
+                &target_pass,
+                spirv!("roofline.vert"),
+                spirv!("roofline.frag"),
+                Blend::Add,
+            )?,
+            roofline_composite: Pipeline::compute(&ctx, &composite_layout, spirv!("roofline.comp"))?,
+            roofline_layout,
             order_layout,
             params_layout,
             footprint_layout,
@@ -335,8 +351,8 @@ impl GpuPipeline {
         }
         let params = raycast_params(&prep.set, camera, opts);
         let ubo = Buffer::with_data(&self.ctx, "raycast params", bytemuck::bytes_of(&params), BU::UNIFORM_BUFFER)?;
-        let (st, scene, target, timer) =
-            (&self.stages, self.scene.as_ref().expect("set"), self.target.as_ref().expect("ensured"), &self.timer);
+        let (st, scene, target) =
+            (&self.stages, self.scene.as_ref().expect("set"), self.target.as_ref().expect("ensured"));
         let field = scene.field.as_ref().expect("built above");
         let set = st.raycast_layout.bind(&[
             Bind::Buffer(&ubo),
@@ -344,22 +360,94 @@ impl GpuPipeline {
             Bind::Image(&target.accum),
         ])?;
         let (w, h) = (camera.width, camera.height);
-        self.ctx.submit(|rec| {
-            rec.reset_timer(timer);
-            rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
-            rec.timestamp(timer, 0);
-            let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
-            rec.dispatch(&st.raycast, &st.raycast_layout, &set, &[], groups);
-            rec.timestamp(timer, 1);
-            rec.transition(&target.accum, IL::GENERAL, IL::TRANSFER_SRC_OPTIMAL, Stage::Compute, Stage::Transfer);
-            rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
-            Ok(())
-        })?;
-        let mut timings = Vec::new();
-        if let Some(ms) = timer.read_ms(2)? {
-            timings.push(StageTime { stage: "raycast", ms: ms[0] });
-        }
+        let steps: Vec<Step<'_>> = vec![
+            (
+                UNTIMED,
+                Box::new(|rec| rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute)),
+            ),
+            (
+                "raycast",
+                Box::new(|rec| {
+                    let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
+                    rec.dispatch(&st.raycast, &st.raycast_layout, &set, &[], groups);
+                    rec.barrier(Stage::Compute, Stage::Compute);
+                }),
+            ),
+            (
+                UNTIMED,
+                Box::new(|rec| {
+                    rec.transition(
+                        &target.accum,
+                        IL::GENERAL,
+                        IL::TRANSFER_SRC_OPTIMAL,
+                        Stage::Compute,
+                        Stage::Transfer,
+                    );
+                    rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
+                }),
+            ),
+        ];
+        let timings = execute(&self.ctx, &mut self.timer, &steps)?;
+        drop(steps);
         Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })
+    }
+
+    /// GPU milliseconds for `instances` additive `size`-pixel quads into a `width`x`height` RGBA32F
+    /// target with the cheapest shaders (the raster roofline).
+    pub fn roofline_quads(&mut self, width: u32, height: u32, size: u32, instances: u32) -> Result<f64> {
+        self.ensure_target(width, height, self.target.as_ref().map(|t| t.layers).unwrap_or(1))?;
+        let set = self.stages.roofline_layout.bind(&[Bind::Buffer(&self.frame)])?;
+        let push: [u32; 4] = [(width / size).max(1), size, width, height];
+        let (st, target) = (&self.stages, self.target.as_ref().expect("ensured"));
+        let steps: Vec<Step<'_>> = vec![(
+            "roofline",
+            Box::new(|rec| {
+                rec.begin_pass(&st.target_pass, &target.color_fb);
+                rec.draw_quads(&st.roofline_quads, &st.roofline_layout, &set, bytemuck::bytes_of(&push), 0, instances);
+                rec.end_pass();
+            }),
+        )];
+        let t = execute(&self.ctx, &mut self.timer, &steps)?;
+        Ok(t.first().map(|s| s.ms).unwrap_or(f64::NAN))
+    }
+
+    /// GPU milliseconds of the compositing roofline (`roofline.comp`: read `layers` summation
+    /// layers, write the accumulation image) and of `composite.comp` on the same data.
+    pub fn roofline_composite(&mut self, width: u32, height: u32, layers: u32) -> Result<(f64, f64)> {
+        self.ensure_target(width, height, layers)?;
+        let (st, target) = (&self.stages, self.target.as_ref().expect("ensured"));
+        let push = CompositePush { layers, back_to_front: 0, width, height };
+        let groups = [width.div_ceil(COMPOSITE_TILE), height.div_ceil(COMPOSITE_TILE), 1];
+        let bytes = bytemuck::bytes_of(&push);
+        let set = &target.composite_set;
+        let steps: Vec<Step<'_>> = vec![
+            (
+                UNTIMED,
+                Box::new(|rec| {
+                    // An empty sheet pass clears the layers and leaves them in GENERAL.
+                    rec.begin_pass(&st.sheet_pass, &target.sums_fb);
+                    rec.end_pass();
+                    rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
+                }),
+            ),
+            (
+                "roofline",
+                Box::new(|rec| {
+                    rec.dispatch(&st.roofline_composite, &st.composite_layout, set, bytes, groups);
+                    rec.barrier(Stage::Compute, Stage::Compute);
+                }),
+            ),
+            (
+                "composite",
+                Box::new(|rec| {
+                    rec.dispatch(&st.composite, &st.composite_layout, set, bytes, groups);
+                    rec.barrier(Stage::Compute, Stage::Compute);
+                }),
+            ),
+        ];
+        let t = execute(&self.ctx, &mut self.timer, &steps)?;
+        let get = |n: &str| t.iter().find(|s| s.stage == n).map(|s| s.ms).unwrap_or(f64::NAN);
+        Ok((get("roofline"), get("composite")))
     }
 
     /// Run the splat_params stage alone and read its output back (for comparison with the mirror).
@@ -410,114 +498,156 @@ impl GpuPipeline {
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;
+        let mut cpu_order_ms = None;
         if opts.composite == Composite::Splat && !gpu_order {
+            let t = std::time::Instant::now();
             let cpu_order = order::visibility_order(&prep.set, camera, opts.order, direction);
             scene.order.write(bytemuck::cast_slice(&cpu_order))?;
+            cpu_order_ms = Some(t.elapsed().as_secs_f64() * 1e3);
         }
-        let needed = 3 + 2 * batches.len() as u32;
-        if self.timer.capacity < needed {
-            self.timer = Timer::new(&self.ctx, needed)?;
-        }
-        let (st, scene, target, timer) = (
-            &self.stages,
-            self.scene.as_ref().expect("set above"),
-            self.target.as_ref().expect("ensured"),
-            &self.timer,
-        );
+        let (st, scene, target) =
+            (&self.stages, self.scene.as_ref().expect("set above"), self.target.as_ref().expect("ensured"));
         let n = scene.n;
-        let stamps = self.ctx.submit(|rec| {
-            rec.reset_timer(timer);
-            rec.timestamp(timer, 0);
-            if gpu_order {
-                record_order(rec, st, scene);
-            }
-            rec.timestamp(timer, 1);
-            if n > 0 {
-                rec.dispatch(&st.splat_params, &st.params_layout, &scene.params_set, &[], groups_1d(n));
-            }
-            rec.barrier(Stage::Compute, Stage::Graphics);
-            rec.timestamp(timer, 2);
-            match opts.composite {
-                Composite::Splat => {
-                    rec.begin_pass(&st.target_pass, &target.color_fb);
-                    if n > 0 {
-                        let pipe = if btf { &st.over } else { &st.under };
-                        let push = FootprintPush::default();
-                        rec.draw_quads(
-                            pipe,
-                            &st.footprint_layout,
-                            &scene.footprint_sets[0],
-                            bytemuck::bytes_of(&push),
-                            0,
-                            n,
-                        );
-                    }
-                    rec.end_pass();
-                    rec.timestamp(timer, 3);
-                    rec.copy_image_to_buffer(&target.color, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
-                    Ok(4)
-                }
-                Composite::Sheet => {
-                    rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Transfer);
-                    rec.clear_image(&target.accum, IL::GENERAL, [0.0; 4]);
-                    rec.barrier(Stage::Transfer, Stage::Compute);
-                    let mut q = 3;
-                    for b in &batches {
-                        rec.begin_pass(&st.sheet_pass, &target.sums_fb);
-                        rec.draw_quads(
-                            &st.add,
-                            &st.footprint_layout,
-                            &scene.footprint_sets[1 + axis],
-                            bytemuck::bytes_of(&b.push),
-                            b.first_instance,
-                            b.instances,
-                        );
+        let mut steps: Vec<Step<'_>> = Vec::new();
+        if gpu_order && n > 0 {
+            steps.push(("order", Box::new(|rec| record_order(rec, st, scene))));
+        }
+        if n > 0 {
+            steps.push((
+                "splat_params",
+                Box::new(|rec| {
+                    rec.dispatch(&st.splat_params, &st.params_layout, &scene.params_set, &[], groups_1d(n));
+                    rec.barrier(Stage::Compute, Stage::Graphics);
+                }),
+            ));
+        }
+        match opts.composite {
+            Composite::Splat => {
+                steps.push((
+                    "footprint",
+                    Box::new(move |rec| {
+                        rec.begin_pass(&st.target_pass, &target.color_fb);
+                        if n > 0 {
+                            let pipe = if btf { &st.over } else { &st.under };
+                            let push = FootprintPush::default();
+                            let set = &scene.footprint_sets[0];
+                            rec.draw_quads(pipe, &st.footprint_layout, set, bytemuck::bytes_of(&push), 0, n);
+                        }
                         rec.end_pass();
-                        rec.timestamp(timer, q);
-                        let push = CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
-                        let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
-                        rec.dispatch(
-                            &st.composite,
-                            &st.composite_layout,
-                            &target.composite_set,
-                            bytemuck::bytes_of(&push),
-                            groups,
+                    }),
+                ));
+                steps.push((
+                    UNTIMED,
+                    Box::new(|rec| rec.copy_image_to_buffer(&target.color, IL::TRANSFER_SRC_OPTIMAL, &target.readback)),
+                ));
+            }
+            Composite::Sheet => {
+                steps.push((
+                    UNTIMED,
+                    Box::new(|rec| {
+                        rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Transfer);
+                        rec.clear_image(&target.accum, IL::GENERAL, [0.0; 4]);
+                        rec.barrier(Stage::Transfer, Stage::Compute);
+                    }),
+                ));
+                for b in &batches {
+                    steps.push((
+                        "footprint",
+                        Box::new(move |rec| {
+                            rec.begin_pass(&st.sheet_pass, &target.sums_fb);
+                            let set = &scene.footprint_sets[1 + axis];
+                            let push = bytemuck::bytes_of(&b.push);
+                            rec.draw_quads(&st.add, &st.footprint_layout, set, push, b.first_instance, b.instances);
+                            rec.end_pass();
+                        }),
+                    ));
+                    steps.push((
+                        "composite",
+                        Box::new(move |rec| {
+                            let push =
+                                CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
+                            let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
+                            let set = &target.composite_set;
+                            rec.dispatch(&st.composite, &st.composite_layout, set, bytemuck::bytes_of(&push), groups);
+                            rec.barrier(Stage::Compute, Stage::Compute);
+                        }),
+                    ));
+                }
+                steps.push((
+                    UNTIMED,
+                    Box::new(|rec| {
+                        rec.transition(
+                            &target.accum,
+                            IL::GENERAL,
+                            IL::TRANSFER_SRC_OPTIMAL,
+                            Stage::Compute,
+                            Stage::Transfer,
                         );
-                        rec.barrier(Stage::Compute, Stage::Compute);
-                        rec.timestamp(timer, q + 1);
-                        q += 2;
-                    }
-                    rec.transition(
-                        &target.accum,
-                        IL::GENERAL,
-                        IL::TRANSFER_SRC_OPTIMAL,
-                        Stage::Compute,
-                        Stage::Transfer,
-                    );
-                    rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
-                    Ok(q)
-                }
-            }
-        })?;
-        let mut timings = Vec::new();
-        if let Some(ms) = timer.read_ms(stamps)? {
-            if gpu_order {
-                timings.push(StageTime { stage: "order", ms: ms[0] });
-            }
-            timings.push(StageTime { stage: "splat_params", ms: ms[1] });
-            match opts.composite {
-                Composite::Splat => timings.push(StageTime { stage: "footprint", ms: ms[2] }),
-                Composite::Sheet => {
-                    // ms[2 + 2b] is batch b's raster (after the gap from params), ms[3 + 2b] its composite.
-                    let raster: f64 = ms.iter().skip(2).step_by(2).sum();
-                    let comp: f64 = ms.iter().skip(3).step_by(2).sum();
-                    timings.push(StageTime { stage: "footprint", ms: raster });
-                    timings.push(StageTime { stage: "composite", ms: comp });
-                }
+                        rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
+                    }),
+                ));
             }
         }
+        let mut timings = execute(&self.ctx, &mut self.timer, &steps)?;
+        drop(steps);
+        if let Some(ms) = cpu_order_ms {
+            timings.insert(0, StageTime { stage: "order_cpu", ms });
+        }
+        let target = self.target.as_ref().expect("ensured");
         Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })
     }
+}
+
+/// A named piece of GPU work; `UNTIMED` steps (layout transitions, copies) are not reported.
+type Step<'a> = (&'static str, Box<dyn Fn(&Recorder<'_>) + 'a>);
+const UNTIMED: &str = "";
+
+/// Run `steps` and time each named stage (summed over steps of the same name, in first-seen
+/// order). On a GPU: one submission with a timestamp after every step. On a CPU device (lavapipe)
+/// timestamps are taken when the rasterizer next flushes, not when compute work ends, so there each
+/// step is its own submission timed on the host (fence to fence, so submission overhead is
+/// included).
+fn execute(ctx: &Arc<Context>, timer: &mut Timer, steps: &[Step<'_>]) -> Result<Vec<StageTime>> {
+    let mut per_step = vec![0.0f64; steps.len()];
+    if ctx.is_cpu_device() || ctx.timestamp_period.is_none() {
+        for (i, (_, f)) in steps.iter().enumerate() {
+            let t = Instant::now();
+            ctx.submit(|rec| {
+                f(rec);
+                Ok(())
+            })?;
+            per_step[i] = t.elapsed().as_secs_f64() * 1e3;
+        }
+    } else {
+        let needed = steps.len() as u32 + 1;
+        if timer.capacity < needed {
+            *timer = Timer::new(ctx, needed.next_power_of_two())?;
+        }
+        let timer = &*timer;
+        ctx.submit(|rec| {
+            rec.reset_timer(timer);
+            rec.timestamp(timer, 0);
+            for (i, (_, f)) in steps.iter().enumerate() {
+                f(rec);
+                rec.timestamp(timer, i as u32 + 1);
+            }
+            Ok(())
+        })?;
+        if let Some(ms) = timer.read_ms(needed)? {
+            per_step.copy_from_slice(&ms);
+        }
+    }
+    let mut out: Vec<StageTime> = Vec::new();
+    for ((name, _), ms) in steps.iter().zip(per_step) {
+        if name.is_empty() {
+            continue;
+        }
+        match out.iter_mut().find(|t| t.stage == *name) {
+            Some(t) => t.ms += ms,
+            None => out.push(StageTime { stage: name, ms }),
+        }
+    }
+    Ok(out)
 }
 
 fn read_image(readback: &Buffer, w: u32, h: u32) -> Result<ImageF32> {

@@ -185,6 +185,22 @@ impl Renderer {
         self.gpu.as_ref().map(|g| g.context().validation_messages()).unwrap_or_default()
     }
 
+    /// GPU roofline of the raster pass: milliseconds for `instances` additive `size`-pixel quads.
+    pub fn roofline_quads(&mut self, width: u32, height: u32, size: u32, instances: u32) -> Result<f64> {
+        match &mut self.gpu {
+            Some(g) => g.roofline_quads(width, height, size.max(1), instances),
+            None => Err(Error::Unsupported("the roofline needs a GPU backend".into())),
+        }
+    }
+
+    /// GPU roofline of the compositing pass: (roofline ms, composite.comp ms) over `layers` layers.
+    pub fn roofline_composite(&mut self, width: u32, height: u32, layers: u32) -> Result<(f64, f64)> {
+        match &mut self.gpu {
+            Some(g) => g.roofline_composite(width, height, layers.max(1)),
+            None => Err(Error::Unsupported("the roofline needs a GPU backend".into())),
+        }
+    }
+
     /// The Vulkan context, for hosts that share it or tests that probe it.
     pub fn context(&self) -> Option<&Arc<vk::Context>> {
         self.gpu.as_ref().map(|g| g.context())

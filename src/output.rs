@@ -35,6 +35,51 @@ pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
     }
 }
 
+/// Read a PNG (straight alpha, 8 or 16 bit) or an EXR (premultiplied) as a premultiplied float
+/// image. Sizes are checked against `MAX_PIXELS` from the header before any pixel is decoded.
+pub fn read_image(path: &Path) -> Result<ImageF32> {
+    use crate::camera::MAX_PIXELS;
+    let name = path.display().to_string();
+    let bad = |message: String| Error::Image { path: name.clone(), message };
+    let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("png") => {
+            let mut reader = image::ImageReader::open(path)
+                .map_err(|e| Error::Io { path: name.clone(), source: e })?
+                .with_guessed_format()
+                .map_err(|e| Error::Io { path: name.clone(), source: e })?;
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(crate::camera::MAX_IMAGE_SIDE);
+            limits.max_image_height = Some(crate::camera::MAX_IMAGE_SIDE);
+            limits.max_alloc = Some(MAX_PIXELS * 16);
+            reader.limits(limits);
+            let img = reader.decode().map_err(|e| bad(e.to_string()))?.to_rgba32f();
+            let (width, height) = img.dimensions();
+            let pixels = img.pixels().map(|p| [p[0] * p[3], p[1] * p[3], p[2] * p[3], p[3]]).collect();
+            Ok(ImageF32 { width, height, pixels })
+        }
+        Some("exr") => {
+            let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| bad(e.to_string()))?;
+            let header = meta.headers.first().ok_or_else(|| bad("no layer".into()))?;
+            let size = header.layer_size;
+            if size.0 as u64 * size.1 as u64 > MAX_PIXELS {
+                return Err(bad(format!("{}x{} exceeds the pixel limit", size.0, size.1)));
+            }
+            let image = exr::prelude::read_first_rgba_layer_from_file(
+                path,
+                |res, _| ImageF32::new(res.width() as u32, res.height() as u32),
+                |img: &mut ImageF32, pos, (r, g, b, a): (f32, f32, f32, f32)| {
+                    let w = img.width as usize;
+                    img.pixels[pos.y() * w + pos.x()] = [r, g, b, a];
+                },
+            )
+            .map_err(|e| bad(e.to_string()))?;
+            Ok(image.layer_data.channel_data.pixels)
+        }
+        _ => Err(Error::InvalidArgument(format!("'{name}' must end in .png or .exr"))),
+    }
+}
+
 /// Premultiplied RGBA8 pixels (what a compositor would blend).
 pub fn to_premultiplied_rgba8(img: &ImageF32) -> Vec<u8> {
     img.pixels.iter().flat_map(|p| p.map(|v| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)).collect()

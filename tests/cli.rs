@@ -117,3 +117,75 @@ fn bad_arguments_fail_cleanly() {
         assert!(stderr.contains("error"), "{args:?}: no message: {stderr}");
     }
 }
+
+#[test]
+fn quick_bench_writes_valid_csv_and_svg() {
+    let dir = tmp("bench");
+    let results = dir.join("RESULTS.md");
+    let out =
+        voxsplat(&["bench", "--quick", "--out-dir", dir.to_str().unwrap(), "--results", results.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = std::fs::read_to_string(dir.join("matrix.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 2 * 5, "two scenes x five methods");
+    for r in &rows {
+        assert_eq!(r.len(), header.len());
+        let t: f64 = r[col("time_ms")].parse().unwrap();
+        let rmse: f64 = r[col("rmse")].parse().unwrap();
+        assert!(t > 0.0 && t.is_finite(), "{r:?}");
+        assert!((0.0..1.0).contains(&rmse), "{r:?}");
+    }
+    // The smaller ray-caster step is more accurate.
+    let rm = |scene: &str, m: &str| -> f64 {
+        rows.iter().find(|r| r[0] == scene && r[1] == m).unwrap()[col("rmse")].parse().unwrap()
+    };
+    assert!(rm("cube40", "raycast 0.5") < rm("cube40", "raycast 1"));
+    for svg in ["chart-cube40.svg", "chart-plane.svg", "scaling.svg"] {
+        let text = std::fs::read_to_string(dir.join(svg)).unwrap();
+        assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"), "{svg}");
+    }
+    assert!(std::fs::read_to_string(dir.join("chart-plane.svg")).unwrap().contains("sheet gaussian"));
+    let scaling = std::fs::read_to_string(dir.join("scaling.csv")).unwrap();
+    assert_eq!(scaling.lines().count(), 1 + 2 + 2);
+    let md = std::fs::read_to_string(&results).unwrap();
+    assert!(md.contains("## Targets") && md.contains("chart-cube40.svg"));
+}
+
+#[test]
+fn compare_prints_metrics_and_rejects_bad_files() {
+    let a = tmp("cmp-a.png");
+    let b = tmp("cmp-b.exr");
+    for (p, comp) in [(&a, "splat"), (&b, "sheet")] {
+        let out = voxsplat(&[
+            "render",
+            "--scene",
+            "cube40",
+            "--size",
+            "48x40",
+            "--cpu",
+            "--composite",
+            comp,
+            "--out",
+            p.to_str().unwrap(),
+        ]);
+        assert!(out.status.success());
+    }
+    let out = voxsplat(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for key in ["rmse:", "psnr:", "max_abs:", "ssim_luma:", "ssim_alpha:"] {
+        assert!(text.contains(key), "{text}");
+    }
+    let same = voxsplat(&["compare", a.to_str().unwrap(), a.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&same.stdout).contains("rmse:       0.000000"));
+    let junk = tmp("junk.png");
+    std::fs::write(&junk, b"not a png").unwrap();
+    for args in [[a.to_str().unwrap(), junk.to_str().unwrap()], [a.to_str().unwrap(), "/nonexistent.exr"]] {
+        let out = voxsplat(&["compare", args[0], args[1]]);
+        assert_eq!(out.status.code(), Some(2));
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    }
+}

@@ -24,18 +24,34 @@ enum Command {
     Render(RenderArgs),
     /// Write or check a visibility order (back to front).
     Order(OrderArgs),
+    /// Print error metrics of image A against reference B (PNG or EXR).
+    Compare {
+        /// The image to score.
+        a: PathBuf,
+        /// The reference.
+        b: PathBuf,
+    },
     /// Time the benchmark cases (cube60 and the plane at 512x512): per-stage medians.
     Bench(BenchArgs),
 }
 
 #[derive(Args)]
 struct BenchArgs {
-    /// Measured frames per case (after 2 warm-up frames).
-    #[arg(long, default_value_t = 9)]
-    frames: usize,
-    /// Time the CPU mirrors instead of the GPU.
+    /// A small matrix (two scenes at 128x128) that CI can afford.
     #[arg(long)]
-    cpu: bool,
+    quick: bool,
+    /// Measured frames per configuration (at least 5; after warm-up).
+    #[arg(long)]
+    frames: Option<usize>,
+    /// Where the CSV files and SVG charts go.
+    #[arg(long, default_value = "bench-out")]
+    out_dir: PathBuf,
+    /// Also write the results page (e.g. docs/RESULTS.md), linking the charts in --out-dir.
+    #[arg(long)]
+    results: Option<PathBuf>,
+    /// Skip the scaling series.
+    #[arg(long)]
+    no_scaling: bool,
 }
 
 fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
@@ -231,23 +247,17 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Bench(a) => {
-            if a.frames == 0 {
-                return Err(Error::InvalidArgument("--frames must be positive".into()));
-            }
-            let mut opts = RendererOptions::default();
-            opts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
-            let mut r = Renderer::new(&opts)?;
-            println!("device: {}", r.device_name());
-            let mut rows = Vec::new();
-            let cases = voxsplat::bench::default_cases();
-            for (i, case) in cases.iter().enumerate() {
-                eprintln!("[{}/{}] {}", i + 1, cases.len(), case.label());
-                rows.push(voxsplat::bench::measure(&mut r, case, 2, a.frames)?);
-            }
-            print!("{}", voxsplat::bench::table(&rows));
+        Command::Compare { a, b } => {
+            let (x, y) = (voxsplat::output::read_image(&a)?, voxsplat::output::read_image(&b)?);
+            let m = voxsplat::metrics::compare(&x, &y)?;
+            println!("rmse:       {:.6}", m.rmse);
+            println!("psnr:       {:.2} dB", m.psnr);
+            println!("max_abs:    {:.6}", m.max_abs);
+            println!("ssim_luma:  {:.5}", m.ssim_luma);
+            println!("ssim_alpha: {:.5}", m.ssim_alpha);
             Ok(())
         }
+        Command::Bench(a) => bench(a),
         Command::Order(a) => {
             let set = scene::build(&a.scene.scene)?;
             let cam = camera_of(&a.scene, set.grid())?;
@@ -279,6 +289,91 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
     }
+}
+
+fn bench(a: BenchArgs) -> Result<()> {
+    use voxsplat::bench::*;
+    let mut m = if a.quick { MatrixOptions::quick() } else { MatrixOptions::full() };
+    if let Some(f) = a.frames {
+        if f < 5 {
+            return Err(Error::InvalidArgument("--frames must be at least 5".into()));
+        }
+        m.frames = f;
+    }
+    let io = |p: &std::path::Path| {
+        let p = p.display().to_string();
+        move |e| Error::Io { path: p, source: e }
+    };
+    std::fs::create_dir_all(&a.out_dir).map_err(io(&a.out_dir))?;
+    let mut r = Renderer::new(&RendererOptions::default())?;
+    let device = r.device_name();
+    eprintln!("device: {device}");
+    let bar = indicatif::ProgressBar::new((m.scenes.len() * m.methods.len()) as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let rows = run_matrix(&mut r, &m, |done, _, label| {
+        bar.set_position(done as u64);
+        bar.set_message(label.to_string());
+    })?;
+    bar.finish_and_clear();
+    write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    for sc in &scenes {
+        chart_svg(&rows, sc, &a.out_dir.join(format!("chart-{sc}.svg")))?;
+    }
+    eprintln!("roofline...");
+    let (w, h) = (m.width.max(256), m.height.max(256));
+    let sizes: &[u32] = if a.quick { &[3, 7] } else { &[3, 7, 15, 31] };
+    let frags = if a.quick { 1 << 20 } else { 8 << 20 };
+    let roof = roofline(&mut r, w, h, sizes, frags, 5)?;
+    let scale = if a.no_scaling {
+        Vec::new()
+    } else {
+        let (cubes, images): (&[u32], &[u32]) =
+            if a.quick { (&[22, 46], &[128, 256]) } else { (&[22, 46, 100, 215], &[128, 256, 512, 1024, 2048]) };
+        let s = scaling(&mut r, cubes, images, 5, |msg| eprintln!("{msg}"))?;
+        write_scaling_csv(&s, &a.out_dir.join("scaling.csv"))?;
+        scaling_svg(&s, &a.out_dir.join("scaling.svg"))?;
+        s
+    };
+    if let Some(path) = &a.results {
+        let commit = std::process::Command::new("git")
+            .args(["rev-parse", "--short", "HEAD"])
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+            .unwrap_or_else(|| "unknown".into());
+        let base = path.parent().unwrap_or(std::path::Path::new("."));
+        let chart_dir = pathdiff(&a.out_dir, base);
+        let notes_path = base.join("results-notes.md");
+        let notes = std::fs::read_to_string(&notes_path).ok();
+        let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+        let md = results_markdown(&Report {
+            device,
+            commit,
+            command: format!("voxsplat {cmd}"),
+            rows: &rows,
+            roofline: Some(&roof),
+            scaling: &scale,
+            chart_dir,
+            notes,
+        })?;
+        std::fs::write(path, md).map_err(io(path))?;
+        eprintln!("wrote {}", path.display());
+    }
+    print!("{}", std::fs::read_to_string(a.out_dir.join("matrix.csv")).map_err(io(&a.out_dir))?);
+    Ok(())
+}
+
+/// `target` relative to `base` when it lies below it, else as given.
+fn pathdiff(target: &std::path::Path, base: &std::path::Path) -> String {
+    let t = std::fs::canonicalize(target).unwrap_or_else(|_| target.to_path_buf());
+    let b = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
+    t.strip_prefix(&b).map(|p| p.display().to_string()).unwrap_or_else(|_| target.display().to_string())
 }
 
 fn main() -> ExitCode {
