@@ -144,6 +144,12 @@ struct RenderArgs {
     /// Memory budget for one batch of sheet summation layers, in MiB.
     #[arg(long, default_value_t = 256)]
     sheet_budget_mib: u64,
+    /// Render with the ray caster at this step (in voxel spacings) instead of splatting.
+    #[arg(long, value_parser = parse_finite, conflicts_with = "truth")]
+    raycast: Option<f32>,
+    /// Render the volumetric-summation truth (CPU, f64) with --kernel's reconstruction.
+    #[arg(long)]
+    truth: bool,
     /// Print per-stage times.
     #[arg(long)]
     timings: bool,
@@ -234,12 +240,30 @@ fn run(cli: Cli) -> Result<()> {
             }
             opts.sheet_budget_bytes = a.sheet_budget_mib << 20;
             let splats = set.len();
-            let mut r = renderer_of(&a.scene)?;
-            r.set_scene(set)?;
-            let frame = r.render(&cam, &opts)?;
+            let frame = if a.truth {
+                let t = std::time::Instant::now();
+                let opts = voxsplat::truth::TruthOptions {
+                    reconstruction: voxsplat::truth::Reconstruction::Kernel(opts.kernel),
+                    ..Default::default()
+                };
+                let image = voxsplat::truth::volumetric_summation(&set, &cam, &opts)?;
+                let ms = t.elapsed().as_secs_f64() * 1e3;
+                voxsplat::Rendered { image, timings: vec![voxsplat::StageTime { stage: "truth", ms }] }
+            } else {
+                let mut r = renderer_of(&a.scene)?;
+                r.set_scene(set)?;
+                let f = match a.raycast {
+                    Some(step) => {
+                        let o = voxsplat::cpu::raycast::RaycastOptions { step, ..Default::default() };
+                        r.raycast(&cam, &o)?
+                    }
+                    None => r.render(&cam, &opts)?,
+                };
+                report_validation(&r)?;
+                f
+            };
             voxsplat::output::write_image(&frame.image, &a.out)?;
-            report_validation(&r)?;
-            eprintln!("{} splats on {} -> {}", splats, r.device_name(), a.out.display());
+            eprintln!("{} splats -> {}", splats, a.out.display());
             if a.timings {
                 for t in &frame.timings {
                     println!("{:<14} {:>9.3} ms", t.stage, t.ms);
