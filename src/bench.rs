@@ -380,7 +380,7 @@ pub fn roofline(
 pub fn footprint_fragments(set: &SplatSet, camera: &Camera, kernel: Kernel) -> Result<(f64, f64)> {
     let mut r = Renderer::new(&crate::RendererOptions { backend: crate::Backend::Cpu, ..Default::default() })?;
     r.set_scene(set.clone())?;
-    let params = r.splat_params(camera, kernel)?;
+    let params = r.splat_params(camera, kernel, crate::Antialias::None)?;
     let cap = camera.width as f64 * camera.height as f64;
     let mut total = 0.0;
     let mut sizes = Vec::new();

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, Frame, SplatParams};
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
-use crate::pipeline::{groups_1d, make_frame, sheet_plan, Composite, Prepared, RenderOptions, Rendered, StageTime};
+use crate::pipeline::{groups_1d, Antialias, make_frame, sheet_plan, Composite, Prepared, RenderOptions, Rendered, StageTime};
 use crate::truth::DenseField;
 use crate::vk::{
     Bind, Blend, Buffer, BufferUsageFlags as BU, Context, DescriptorSet, Format, Framebuffer, Image, ImageLayout as IL,
@@ -306,7 +306,7 @@ impl GpuPipeline {
     pub fn order(&mut self, prep: &Prepared, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
         camera.validate()?;
         let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, Kernel::Gaussian, split, direction == Direction::BackToFront);
+        let frame = make_frame(&prep.set, camera, Kernel::Gaussian, Antialias::None, split, direction == Direction::BackToFront);
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let st = &self.stages;
@@ -451,10 +451,16 @@ impl GpuPipeline {
     }
 
     /// Run the splat_params stage alone and read its output back (for comparison with the mirror).
-    pub fn splat_params(&mut self, prep: &Prepared, camera: &Camera, kernel: Kernel) -> Result<Vec<SplatParams>> {
+    pub fn splat_params(
+        &mut self,
+        prep: &Prepared,
+        camera: &Camera,
+        kernel: Kernel,
+        antialias: Antialias,
+    ) -> Result<Vec<SplatParams>> {
         camera.validate()?;
         let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, kernel, split, true);
+        let frame = make_frame(&prep.set, camera, kernel, antialias, split, true);
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let bytes = scene.n as u64 * std::mem::size_of::<SplatParams>() as u64;
@@ -494,7 +500,7 @@ impl GpuPipeline {
         let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
         self.ensure_target(w, h, layers)?;
         let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, opts.kernel, split, btf);
+        let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, split, btf);
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;

@@ -41,6 +41,8 @@ pub struct Frame {
     pub spacing: [f32; 4],
     pub dims: [u32; 4],
     pub split: [u32; 4],
+    /// Anti-aliasing: mode (0 none, 1 Swan, 2 EWA), footprint std in voxels, EWA low-pass std in pixels.
+    pub aa: [f32; 4],
 }
 
 /// Uniforms of `raycast.comp`.
@@ -79,7 +81,7 @@ pub struct CompositePush {
 
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
-const _: () = assert!(std::mem::size_of::<Frame>() == 192);
+const _: () = assert!(std::mem::size_of::<Frame>() == 208);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 20);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);

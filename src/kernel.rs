@@ -106,6 +106,27 @@ impl Kernel {
         sum * h / 3.0
     }
 
+    /// Standard deviation (voxels) of the 2D footprint along one screen axis; the EWA low-pass adds
+    /// its variance to this one.
+    pub fn footprint_sigma(self) -> f64 {
+        match self {
+            Kernel::Gaussian => GAUSSIAN_SIGMA,
+            Kernel::Cubic => {
+                let rr = self.radius() as f64;
+                let n = 400;
+                let (mut m0, mut m2) = (0.0, 0.0);
+                for i in 0..n {
+                    let rho = (i as f64 + 0.5) / n as f64 * rr;
+                    let f = self.integrated(rho) * rho;
+                    m0 += f;
+                    m2 += f * rho * rho;
+                }
+                // For a radial density, E[x^2] = E[rho^2] / 2.
+                (m2 / m0 / 2.0).sqrt()
+            }
+        }
+    }
+
     /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2.
     pub fn footprint_table(self) -> Vec<f32> {
         let n = FOOTPRINT_TABLE_SIZE as usize;

@@ -37,7 +37,7 @@ pub use camera::{Camera, Projection};
 pub use error::{Error, Result};
 pub use kernel::Kernel;
 pub use order::{Direction, OrderKind};
-pub use pipeline::{Composite, RenderOptions, Rendered, StageTime};
+pub use pipeline::{Antialias, Composite, RenderOptions, Rendered, StageTime};
 pub use volume::{Grid, SplatSet, Volume};
 
 use pipeline::Prepared;
@@ -160,15 +160,20 @@ impl Renderer {
     }
 
     /// The splat_params stage's output for this camera (GPU stage, or its CPU mirror).
-    pub fn splat_params(&mut self, camera: &Camera, kernel: Kernel) -> Result<Vec<gpu_types::SplatParams>> {
+    pub fn splat_params(
+        &mut self,
+        camera: &Camera,
+        kernel: Kernel,
+        antialias: Antialias,
+    ) -> Result<Vec<gpu_types::SplatParams>> {
         camera.validate()?;
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         match &mut self.gpu {
-            Some(g) => g.splat_params(prep, camera, kernel),
+            Some(g) => g.splat_params(prep, camera, kernel, antialias),
             None => {
                 let set = &prep.set;
-                let frame = pipeline::make_frame(set, camera, kernel, order::pbtf_split(set, camera), true);
+                let frame = pipeline::make_frame(set, camera, kernel, antialias, order::pbtf_split(set, camera), true);
                 let mut out = vec![gpu_types::SplatParams::default(); set.len()];
                 cpu::splat_params(&frame, set.splats(), &mut out);
                 Ok(out)
@@ -211,7 +216,8 @@ impl Renderer {
 fn cpu_pbtf_order(prep: &Prepared, camera: &Camera, direction: Direction) -> Vec<u32> {
     let set = &prep.set;
     let split = order::pbtf_split(set, camera);
-    let frame = pipeline::make_frame(set, camera, Kernel::Gaussian, split, direction == Direction::BackToFront);
+    let frame =
+        pipeline::make_frame(set, camera, Kernel::Gaussian, Antialias::None, split, direction == Direction::BackToFront);
     let rows = set.row_start().len() - 1;
     let mut row_split = vec![0u32; rows];
     let mut segments = vec![0u32; 2 * rows];

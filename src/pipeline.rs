@@ -38,6 +38,44 @@ impl std::str::FromStr for Composite {
     }
 }
 
+/// Anti-aliasing of distant splats (chapter 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Antialias {
+    /// Footprints keep their world size at every distance.
+    #[default]
+    None,
+    /// Swan's method: beyond k = s·D/p a splat's radius grows by d/k and its energy by (k/d)².
+    Swan,
+    /// EWA-style screen-space low-pass (Zwicker et al. 2001): the footprint convolved with a
+    /// Gaussian of `EWA_LOWPASS_PX` pixels standard deviation, energy preserved.
+    Ewa,
+}
+
+/// Standard deviation, in pixels, of the EWA low-pass filter.
+pub const EWA_LOWPASS_PX: f32 = 0.5;
+
+impl Antialias {
+    fn code(self) -> f32 {
+        match self {
+            Antialias::None => 0.0,
+            Antialias::Swan => 1.0,
+            Antialias::Ewa => 2.0,
+        }
+    }
+}
+
+impl std::str::FromStr for Antialias {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "none" => Ok(Self::None),
+            "swan" => Ok(Self::Swan),
+            "ewa" => Ok(Self::Ewa),
+            _ => Err(Error::InvalidArgument(format!("unknown anti-aliasing '{s}' (none, swan, ewa)"))),
+        }
+    }
+}
+
 /// Per-frame choices. `Default` gives PBTF, per-splat back-to-front compositing, the Gaussian.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
@@ -45,6 +83,7 @@ pub struct RenderOptions {
     pub order: OrderKind,
     pub composite: Composite,
     pub kernel: Kernel,
+    pub antialias: Antialias,
     /// `None`: back to front for per-splat compositing, front to back for sheets.
     pub direction: Option<Direction>,
     /// Memory allowed for one batch of sheet summation layers (RGBA32F each).
@@ -57,6 +96,7 @@ impl Default for RenderOptions {
             order: OrderKind::Pbtf,
             composite: Composite::Splat,
             kernel: Kernel::Gaussian,
+            antialias: Antialias::None,
             direction: None,
             sheet_budget_bytes: 256 << 20,
         }
@@ -118,7 +158,14 @@ impl Prepared {
 }
 
 /// The per-frame uniforms shared by every stage.
-pub fn make_frame(set: &SplatSet, camera: &Camera, kernel: Kernel, split: [u32; 3], back_to_front: bool) -> Frame {
+pub fn make_frame(
+    set: &SplatSet,
+    camera: &Camera,
+    kernel: Kernel,
+    antialias: Antialias,
+    split: [u32; 3],
+    back_to_front: bool,
+) -> Frame {
     let g = set.grid();
     let radius_vox = kernel.radius();
     let f = camera.forward();
@@ -135,6 +182,7 @@ pub fn make_frame(set: &SplatSet, camera: &Camera, kernel: Kernel, split: [u32; 
         spacing: [g.spacing[0], g.spacing[1], g.spacing[2], radius_vox * g.kernel_spacing()],
         dims: [g.dims[0], g.dims[1], g.dims[2], set.len() as u32],
         split: [split[0], split[1], split[2], back_to_front as u32],
+        aa: [antialias.code(), kernel.footprint_sigma() as f32, EWA_LOWPASS_PX, 0.0],
     }
 }
 
@@ -210,7 +258,7 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
     let direction = opts.direction();
     let btf = direction == Direction::BackToFront;
     let split = order::pbtf_split(set, camera);
-    let frame = make_frame(set, camera, opts.kernel, split, btf);
+    let frame = make_frame(set, camera, opts.kernel, opts.antialias, split, btf);
     let n = set.len();
     let mut timings = Vec::new();
     let mut t = Instant::now();

@@ -4,7 +4,7 @@ mod common;
 use common::{assert_clean, random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
 use voxsplat::output::diff_rgba8;
-use voxsplat::{scene, Camera, Composite, Direction, Kernel, OrderKind, RenderOptions};
+use voxsplat::{scene, Antialias, Camera, Composite, Direction, Kernel, OrderKind, RenderOptions};
 
 fn options(composite: Composite, kernel: Kernel) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -65,6 +65,13 @@ fn gpu_matches_cpu_mirror_for_both_compositing_modes_and_kernels() {
                 for direction in [Direction::BackToFront, Direction::FrontToBack] {
                     let mut o = options(composite, kernel);
                     o.direction = Some(direction);
+                    // Every anti-aliasing mode through both compositing paths.
+                    o.antialias = match (kernel, direction) {
+                        (Kernel::Gaussian, Direction::BackToFront) => Antialias::None,
+                        (Kernel::Gaussian, Direction::FrontToBack) => Antialias::Swan,
+                        (Kernel::Cubic, Direction::BackToFront) => Antialias::Ewa,
+                        (Kernel::Cubic, Direction::FrontToBack) => Antialias::Swan,
+                    };
                     // Small batches so several batches and the layer arithmetic are exercised.
                     o.sheet_budget_bytes = 192 * 160 * 16 * 7;
                     let g = gpu.render(&cam, &o).unwrap();
@@ -74,7 +81,8 @@ fn gpu_matches_cpu_mirror_for_both_compositing_modes_and_kernels() {
                         save_failure(&format!("{name}-{composite:?}-{kernel:?}-{direction:?}"), &g.image, &c.image);
                     }
                     eprintln!(
-                        "{name} {composite:?} {kernel:?} {direction:?}: mean |diff| {mean:.4}/255, max {max}/255"
+                        "{name} {composite:?} {kernel:?} {direction:?} {:?}: mean |diff| {mean:.4}/255, max {max}/255",
+                        o.antialias
                     );
                     assert!(mean <= 1.0, "{name} {composite:?} {kernel:?} {direction:?}: mean {mean}");
                     let covered = g.image.pixels.iter().filter(|p| p[3] > 0.5).count();
@@ -179,9 +187,13 @@ fn splat_params_stage_matches_its_mirror() {
     for v in 0..8 {
         let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
         let cam = random_camera(&mut rng, set.grid(), kind);
-        for kernel in [Kernel::Gaussian, Kernel::Cubic] {
-            let g = gpu.splat_params(&cam, kernel).unwrap();
-            let c = cpu.splat_params(&cam, kernel).unwrap();
+        for (kernel, aa) in [
+            (Kernel::Gaussian, Antialias::None),
+            (Kernel::Cubic, Antialias::Swan),
+            (Kernel::Gaussian, Antialias::Ewa),
+        ] {
+            let g = gpu.splat_params(&cam, kernel, aa).unwrap();
+            let c = cpu.splat_params(&cam, kernel, aa).unwrap();
             assert_eq!(g.len(), set.len());
             let mut culled = 0;
             for (a, b) in g.iter().zip(&c) {

@@ -16,10 +16,10 @@ struct SplatParams {
     vec4 axis_v;  // second half-extent vector, perpendicular to axis_u and to the eye ray; w: unused
     vec4 emit;    // rgb colour; a: optical depth of the voxel (tau)
     vec4 screen;  // eye-space depth z_e (section 3.3.1, +z forward), eye distance d,
-                  // footprint radius in pixels, unused
+                  // footprint radius in pixels, anti-aliasing radius scale
 };
 
-// Per-frame uniforms (std140, vec4-only so the Rust mirror is plain repr(C)). 192 bytes.
+// Per-frame uniforms (std140, vec4-only so the Rust mirror is plain repr(C)). 208 bytes.
 struct Frame {
     mat4 view_proj;   // world -> clip (Vulkan: y down, depth 0..1)
     vec4 eye;         // world eye position; w: 1 perspective, 0 orthographic
@@ -30,7 +30,13 @@ struct Frame {
     vec4 spacing;     // voxel spacing xyz; w: world footprint radius
     uvec4 dims;       // nx, ny, nz; w: splat count
     uvec4 split;      // PBTF: voxels per axis on the low side of the eye; w: 1 = back-to-front
+    vec4 aa;          // x: anti-aliasing mode (AA_*); y: footprint standard deviation in voxels;
+                      // z: EWA low-pass standard deviation in pixels; w: unused
 };
+
+#define AA_NONE 0.0
+#define AA_SWAN 1.0
+#define AA_EWA 2.0
 
 // Uniforms of the ray caster. 160 bytes.
 struct RaycastParams {

@@ -12,15 +12,28 @@ pub fn optical_depth(opacity: f32) -> f32 {
     -(1.0 - opacity.clamp(0.0, MAX_OPACITY)).ln()
 }
 
+pub const AA_NONE: f32 = 0.0;
+pub const AA_SWAN: f32 = 1.0;
+pub const AA_EWA: f32 = 2.0;
+
 pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams]) {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right, origin, spacing) =
         (v3(frame.eye), v3(frame.forward), v3(frame.right), v3(frame.origin), v3(frame.spacing));
-    let radius = frame.spacing[3];
     for (s, sp) in splats.iter().enumerate().take(frame.dims[3] as usize) {
         let ijk = Vec3::new(sp.ijk[0] as f32, sp.ijk[1] as f32, sp.ijk[2] as f32);
         let center = origin + ijk * spacing;
         let depth = (center - eye).dot(forward);
+        let voxel = frame.spacing[3] / frame.origin[3];
+        let ppv = if frame.eye[3] > 0.5 { voxel * frame.up[3] / depth.max(1e-6) } else { voxel * frame.up[3] };
+        let mut scale = 1.0f32;
+        if frame.aa[0] == AA_SWAN {
+            scale = (1.0 / ppv).max(1.0);
+        } else if frame.aa[0] == AA_EWA {
+            let lp = frame.aa[2] / (frame.aa[1] * ppv);
+            scale = (1.0 + lp * lp).sqrt();
+        }
+        let radius = frame.spacing[3] * scale;
         let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
         let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
         let u = (right - right.dot(w) * w).normalize();
@@ -28,14 +41,14 @@ pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams])
         let tau = optical_depth(sp.color[3]);
         params[s] = SplatParams {
             center: [center.x, center.y, center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
-            axis_u: [u.x * radius, u.y * radius, u.z * radius, 1.0],
+            axis_u: [u.x * radius, u.y * radius, u.z * radius, 1.0 / (scale * scale)],
             axis_v: [v.x * radius, v.y * radius, v.z * radius, 0.0],
             emit: [sp.color[0], sp.color[1], sp.color[2], tau],
             screen: [
                 depth,
                 (center - eye).length(),
                 if frame.eye[3] > 0.5 { radius * frame.up[3] / depth.max(1e-6) } else { radius * frame.up[3] },
-                0.0,
+                scale,
             ],
         };
     }
