@@ -7,7 +7,7 @@ use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
 use crate::metrics::{compare, ImageMetrics};
 use crate::order::{count_violations, visibility_order};
-use crate::pipeline::{Composite, RenderOptions, Rendered};
+use crate::pipeline::{Antialias, Composite, RenderOptions, Rendered};
 use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use crate::volume::{Grid, SplatSet};
 use crate::{scene, Direction, Kernel, OrderKind, Renderer};
@@ -18,15 +18,31 @@ use std::time::Instant;
 /// One rendering method of the matrix.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Method {
-    Splat { order: OrderKind, composite: Composite, kernel: Kernel },
+    Splat { order: OrderKind, composite: Composite, kernel: Kernel, aa: Antialias },
     Raycast { step: f32 },
+}
+
+fn aa_suffix(aa: Antialias) -> String {
+    match aa {
+        Antialias::None => String::new(),
+        other => format!(" aa={other:?}"),
+    }
+}
+
+/// Plain splats (no anti-aliasing).
+pub fn splat(order: OrderKind, composite: Composite, kernel: Kernel) -> Method {
+    Method::Splat { order, composite, kernel, aa: Antialias::None }
 }
 
 impl Method {
     pub fn label(&self) -> String {
         match self {
-            Method::Splat { order, composite: Composite::Splat, kernel } => format!("{order:?} splat {kernel:?}"),
-            Method::Splat { composite: Composite::Sheet, kernel, .. } => format!("sheet {kernel:?}"),
+            Method::Splat { order, composite: Composite::Splat, kernel, aa } => {
+                format!("{order:?} splat {kernel:?}{}", aa_suffix(*aa))
+            }
+            Method::Splat { composite: Composite::Sheet, kernel, aa, .. } => {
+                format!("sheet {kernel:?}{}", aa_suffix(*aa))
+            }
             Method::Raycast { step } => format!("raycast {step}"),
         }
         .to_lowercase()
@@ -57,9 +73,9 @@ impl MatrixOptions {
         let mut methods = Vec::new();
         for kernel in [Kernel::Gaussian, Kernel::Cubic] {
             for order in [OrderKind::Btf, OrderKind::Wbtf, OrderKind::Pbtf, OrderKind::Sorted] {
-                methods.push(Method::Splat { order, composite: Composite::Splat, kernel });
+                methods.push(splat(order, Composite::Splat, kernel));
             }
-            methods.push(Method::Splat { order: OrderKind::Pbtf, composite: Composite::Sheet, kernel });
+            methods.push(splat(OrderKind::Pbtf, Composite::Sheet, kernel));
         }
         for step in [1.0, 0.5, 0.25] {
             methods.push(Method::Raycast { step });
@@ -80,9 +96,9 @@ impl MatrixOptions {
         Self {
             scenes: vec!["cube40", "plane"],
             methods: vec![
-                Method::Splat { order: OrderKind::Btf, composite: Composite::Splat, kernel: g },
-                Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: g },
-                Method::Splat { order: OrderKind::Pbtf, composite: Composite::Sheet, kernel: g },
+                splat(OrderKind::Btf, Composite::Splat, g),
+                splat(OrderKind::Pbtf, Composite::Splat, g),
+                splat(OrderKind::Pbtf, Composite::Sheet, g),
                 Method::Raycast { step: 1.0 },
                 Method::Raycast { step: 0.5 },
             ],
@@ -128,8 +144,14 @@ pub fn bench_camera(grid: &Grid, width: u32, height: u32) -> Camera {
 
 fn render_method(r: &mut Renderer, m: &Method, camera: &Camera) -> Result<Rendered> {
     match m {
-        Method::Splat { order, composite, kernel } => {
-            let o = RenderOptions { order: *order, composite: *composite, kernel: *kernel, ..Default::default() };
+        Method::Splat { order, composite, kernel, aa } => {
+            let o = RenderOptions {
+                order: *order,
+                composite: *composite,
+                kernel: *kernel,
+                antialias: *aa,
+                ..Default::default()
+            };
             r.render(camera, &o)
         }
         Method::Raycast { step } => r.raycast(camera, &RaycastOptions { step: *step, ..Default::default() }),
@@ -419,7 +441,7 @@ pub fn scaling(
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<ScalePoint>> {
     let mut out = Vec::new();
-    let m = Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: Kernel::Gaussian };
+    let m = splat(OrderKind::Pbtf, Composite::Splat, Kernel::Gaussian);
     let gpu_bytes = |r: &Renderer| r.context().map(|c| c.allocation_report().1).unwrap_or(0);
     for &n in cube_sides {
         progress(&format!("scaling: {}^3 splats", n));
@@ -528,6 +550,8 @@ pub struct Report<'a> {
     /// Relative path from the markdown file to the charts.
     pub chart_dir: String,
     pub notes: Option<String>,
+    /// The anti-aliasing section, already rendered.
+    pub antialias: Option<String>,
 }
 
 fn row<'a>(rows: &'a [Row], scene: &str, method: &str) -> Option<&'a Row> {
@@ -686,6 +710,9 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
         };
         let _ = writeln!(s, "- **Sheet buffer vs ray caster, {sc}:** {verdict}.");
     }
+    if let Some(aa) = &rep.antialias {
+        let _ = writeln!(s, "\n{aa}");
+    }
     if !rep.scaling.is_empty() {
         let _ = writeln!(s, "\n## Scaling\n\n![scaling]({}/scaling.svg)\n", rep.chart_dir);
         let _ = writeln!(s, "| series | splats | image | ms | order ms | GPU bytes | bytes/splat |\n|---|---:|---:|---:|---:|---:|---:|");
@@ -707,4 +734,132 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
         let _ = writeln!(s, "\n{n}");
     }
     Ok(s)
+}
+
+/// One anti-aliasing mode on the grazing checkerboard view (chapter 3).
+#[derive(Clone, Debug)]
+pub struct AaRow {
+    pub mode: Antialias,
+    pub time_ms: f64,
+    pub rmse_before: f64,
+    pub rmse_beyond: f64,
+    pub pixels_beyond: usize,
+    /// Mean frame-to-frame RMSE over the beyond-k pixels along the dolly (see docs/MODEL.md).
+    pub shimmer: f64,
+    pub metrics: ImageMetrics,
+}
+
+/// The plane at the grazing view: error against a `factor`× supersampled truth before and beyond
+/// k, shimmer along a `dolly` frame camera dolly, and time, for every anti-aliasing mode.
+pub fn antialias_study(
+    r: &mut Renderer,
+    size: u32,
+    factor: u32,
+    dolly: usize,
+    frames: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<AaRow>> {
+    let set = scene::build("plane")?;
+    let camera = Camera::grazing(set.grid(), size, size);
+    progress("anti-aliasing: supersampled truth");
+    let truth = crate::truth::supersampled(&set, &camera, factor, &TruthOptions::default())?;
+    let regions = crate::aa::k_regions(&set, &camera);
+    r.set_scene(set.clone())?;
+    let mut rows = Vec::new();
+    for mode in [Antialias::None, Antialias::Swan, Antialias::Ewa] {
+        progress(&format!("anti-aliasing: {mode:?}"));
+        let m =
+            Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: Kernel::Gaussian, aa: mode };
+        let t = time_method(r, &m, &camera, 1, frames)?;
+        let before = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
+        let beyond = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
+        // Dolly: the camera moves forward half a voxel per frame, parallel to the sheet.
+        let step = glam::Vec3::new(0.0, 0.5 * set.grid().spacing[1], 0.0);
+        let mut prev: Option<(ImageF32, Vec<u8>)> = None;
+        let mut changes = Vec::new();
+        for f in 0..dolly {
+            let cam = Camera { eye: camera.eye + step * f as f32, target: camera.target + step * f as f32, ..camera };
+            let img = render_method(r, &m, &cam)?.image;
+            let reg = crate::aa::k_regions(&set, &cam);
+            if let Some((pimg, preg)) = &prev {
+                if let Some(c) = crate::metrics::rmse_masked(&img, pimg, |i| reg[i] == 2 && preg[i] == 2) {
+                    changes.push(c);
+                }
+            }
+            prev = Some((img, reg));
+        }
+        rows.push(AaRow {
+            mode,
+            time_ms: t.time_ms,
+            rmse_before: before,
+            rmse_beyond: beyond,
+            pixels_beyond: regions.iter().filter(|&&x| x == 2).count(),
+            shimmer: if changes.is_empty() { f64::NAN } else { changes.iter().sum::<f64>() / changes.len() as f64 },
+            metrics: compare(&t.image, &truth)?,
+        });
+    }
+    Ok(rows)
+}
+
+/// Chart rows for the anti-aliasing modes (scene "plane-grazing").
+pub fn antialias_rows(rows: &[AaRow], size: u32) -> Vec<Row> {
+    rows.iter()
+        .map(|r| Row {
+            scene: "plane-grazing".into(),
+            method: format!("pbtf splat gaussian aa={:?}", r.mode).to_lowercase(),
+            width: size,
+            height: size,
+            splats: 498 * 398,
+            time_ms: r.time_ms,
+            wall_ms: r.time_ms,
+            stages: Vec::new(),
+            metrics: r.metrics,
+            violations: None,
+        })
+        .collect()
+}
+
+/// The anti-aliasing section of RESULTS.md, with the chapter-3 targets.
+pub fn antialias_markdown(rows: &[AaRow], size: u32, factor: u32, dolly: usize) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "## Anti-aliasing (chapter 3)\n\nThe checkerboard plane, grazing view (`--view grazing`), {size}², PBTF per-splat, Gaussian; \
+         error against the truth supersampled {factor}×{factor} and box-filtered; shimmer = mean frame-to-frame RMSE over the \
+         beyond-k pixels along a {dolly}-frame dolly (half a voxel per frame).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| aa | ms | PSNR before k | PSNR beyond k | beyond-k pixels | shimmer | whole-frame PSNR |\n|---|---:|---:|---:|---:|---:|---:|"
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {:?} | {:.2} | {:.2} | {:.2} | {} | {:.5} | {:.2} |",
+            r.mode,
+            r.time_ms,
+            crate::metrics::psnr(r.rmse_before),
+            crate::metrics::psnr(r.rmse_beyond),
+            r.pixels_beyond,
+            r.shimmer,
+            r.metrics.psnr
+        );
+    }
+    let find = |m: Antialias| rows.iter().find(|r| r.mode == m);
+    if let Some(none) = find(Antialias::None) {
+        for m in [Antialias::Swan, Antialias::Ewa] {
+            let Some(x) = find(m) else { continue };
+            let db = crate::metrics::psnr(x.rmse_beyond) - crate::metrics::psnr(none.rmse_beyond);
+            let sh = x.shimmer / none.shimmer;
+            let tr = x.time_ms / none.time_ms;
+            let met = db >= 6.0 && sh <= 0.5 && tr < 1.5;
+            let _ = writeln!(
+                s,
+                "\n- **{m:?} vs none beyond k:** {db:+.2} dB, shimmer × {sh:.2}, time × {tr:.2} (target: ≥ +6 dB, ≤ × 0.5, < × 1.5{}): {}.",
+                if m == Antialias::Ewa { ", applied to Swan; EWA measured beside it" } else { "" },
+                if met { "met" } else { "missed" }
+            );
+        }
+    }
+    s
 }

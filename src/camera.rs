@@ -145,6 +145,34 @@ impl Camera {
         }
     }
 
+    /// k = s·D/p of Eq. 3.8: the eye distance beyond which a voxel spacing `s` covers less than a
+    /// pixel. Orthographic views have no k: every splat lies before or beyond it at once, according
+    /// to `s * pixels_per_unit()` (pixels per voxel) being above or below 1.
+    pub fn k(&self, voxel_spacing: f32) -> Option<f32> {
+        self.is_perspective().then(|| voxel_spacing * self.pixels_per_unit())
+    }
+
+    /// A grazing perspective view across a single-sheet grid such as the checkerboard plane
+    /// (Fig. 3.6): the eye low above the near edge, the far part of the sheet beyond k.
+    pub fn grazing(grid: &Grid, width: u32, height: u32) -> Self {
+        let c = grid.center();
+        let half_y = 0.5 * (grid.dims[1].max(2) - 1) as f32 * grid.spacing[1];
+        // 12 voxels above the sheet, 5 before its near edge, pitched 25 degrees down with an 80
+        // degree field: the sheet fills the frame below a horizon in its upper part.
+        let eye = c + Vec3::new(0.0, -half_y - 5.0, 12.0);
+        let target = eye + Vec3::new(0.0, 100.0, -46.6);
+        Self {
+            eye,
+            target,
+            up: Vec3::Z,
+            projection: Projection::Perspective { fov_y_deg: 80.0 },
+            near: 1.0,
+            far: 4.0 * (half_y + 100.0),
+            width,
+            height,
+        }
+    }
+
     /// World to eye space as in section 3.3.1: a rigid transform with the eye at the origin looking
     /// down +z (x right, y up).
     pub fn world_to_eye(&self, p: Vec3) -> Vec3 {

@@ -7,7 +7,9 @@ use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, Frame, SplatParams};
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
-use crate::pipeline::{groups_1d, Antialias, make_frame, sheet_plan, Composite, Prepared, RenderOptions, Rendered, StageTime};
+use crate::pipeline::{
+    groups_1d, make_frame, sheet_plan, Antialias, Composite, Prepared, RenderOptions, Rendered, StageTime,
+};
 use crate::truth::DenseField;
 use crate::vk::{
     Bind, Blend, Buffer, BufferUsageFlags as BU, Context, DescriptorSet, Format, Framebuffer, Image, ImageLayout as IL,
@@ -306,7 +308,14 @@ impl GpuPipeline {
     pub fn order(&mut self, prep: &Prepared, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
         camera.validate()?;
         let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, Kernel::Gaussian, Antialias::None, split, direction == Direction::BackToFront);
+        let frame = make_frame(
+            &prep.set,
+            camera,
+            Kernel::Gaussian,
+            Antialias::None,
+            split,
+            direction == Direction::BackToFront,
+        );
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let st = &self.stages;

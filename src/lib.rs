@@ -15,6 +15,7 @@
 //! ```
 #![deny(unsafe_code)]
 
+pub mod aa;
 pub mod bench;
 pub mod camera;
 pub mod constants;
@@ -216,8 +217,14 @@ impl Renderer {
 fn cpu_pbtf_order(prep: &Prepared, camera: &Camera, direction: Direction) -> Vec<u32> {
     let set = &prep.set;
     let split = order::pbtf_split(set, camera);
-    let frame =
-        pipeline::make_frame(set, camera, Kernel::Gaussian, Antialias::None, split, direction == Direction::BackToFront);
+    let frame = pipeline::make_frame(
+        set,
+        camera,
+        Kernel::Gaussian,
+        Antialias::None,
+        split,
+        direction == Direction::BackToFront,
+    );
     let rows = set.row_start().len() - 1;
     let mut row_split = vec![0u32; rows];
     let mut segments = vec![0u32; 2 * rows];

@@ -102,6 +102,30 @@ pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize) -> f64 {
     sum / a.len() as f64
 }
 
+/// RMSE over the pixels where `keep(pixel index)` holds; `None` when no pixel is kept.
+pub fn rmse_masked(img: &ImageF32, truth: &ImageF32, keep: impl Fn(usize) -> bool) -> Option<f64> {
+    let (mut se, mut n) = (0.0f64, 0usize);
+    for (i, (a, b)) in img.pixels.iter().zip(&truth.pixels).enumerate() {
+        if keep(i) {
+            for c in 0..4 {
+                let d = clamp01(a[c]) - clamp01(b[c]);
+                se += d * d;
+            }
+            n += 4;
+        }
+    }
+    (n > 0).then(|| (se / n as f64).sqrt())
+}
+
+/// PSNR in dB of an RMSE (dynamic range 1).
+pub fn psnr(rmse: f64) -> f64 {
+    if rmse > 0.0 {
+        20.0 * (1.0 / rmse).log10()
+    } else {
+        f64::INFINITY
+    }
+}
+
 /// Frame-to-frame change of an animation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Temporal {

@@ -14,6 +14,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("cube60", "hollow 60^3 cube, one voxel thick, alternating 10^3 red/white sub-cubes (Figs 1.16, 2.25-2.27)"),
     ("cube40-attenuated", "cube40 with opacity 0.3: semi-transparent splats (Fig. 1.14)"),
     ("plane", "single-sheet 498x398x1 checkerboard of 10x10 black/white squares (Fig. 3.6)"),
+    ("stripes128", "dense 128^3 ball with 3-voxel colour stripes, semi-transparent: finer than the pixels in small views (Fig. 3.8)"),
     ("empty", "an 8^3 grid with no non-empty voxel"),
 ];
 
@@ -39,6 +40,17 @@ pub fn build(name: &str) -> Result<SplatSet> {
             SplatSet::from_fn(grid, |i, j, _| {
                 let c = if (i / 10 + j / 10) % 2 == 0 { BLACK } else { WHITE };
                 Some([c[0], c[1], c[2], SCENE_OPACITY])
+            })
+        }
+        "stripes128" => {
+            let grid = Grid::centered([128, 128, 128], [1.0; 3])?;
+            SplatSet::from_fn(grid, |i, j, k| {
+                let d = [i, j, k].map(|c| c as f32 - 63.5);
+                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                (r2 < 60.0 * 60.0).then(|| {
+                    let c = if (i / 3 + j / 3) % 2 == 0 { RED } else { WHITE };
+                    [c[0], c[1], c[2], 0.04]
+                })
             })
         }
         "empty" => SplatSet::from_fn(Grid::centered([8, 8, 8], [1.0; 3])?, |_, _, _| None),

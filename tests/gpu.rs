@@ -187,11 +187,9 @@ fn splat_params_stage_matches_its_mirror() {
     for v in 0..8 {
         let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
         let cam = random_camera(&mut rng, set.grid(), kind);
-        for (kernel, aa) in [
-            (Kernel::Gaussian, Antialias::None),
-            (Kernel::Cubic, Antialias::Swan),
-            (Kernel::Gaussian, Antialias::Ewa),
-        ] {
+        for (kernel, aa) in
+            [(Kernel::Gaussian, Antialias::None), (Kernel::Cubic, Antialias::Swan), (Kernel::Gaussian, Antialias::Ewa)]
+        {
             let g = gpu.splat_params(&cam, kernel, aa).unwrap();
             let c = cpu.splat_params(&cam, kernel, aa).unwrap();
             assert_eq!(g.len(), set.len());

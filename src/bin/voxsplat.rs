@@ -117,6 +117,9 @@ struct SceneArgs {
     /// Image size.
     #[arg(long, value_parser = parse_size, default_value = "512x512")]
     size: (u32, u32),
+    /// Preset view: a three-quarter framing, or a grazing view across a single-sheet scene (Fig. 3.6).
+    #[arg(long, default_value = "framing", value_parser = ["framing", "grazing"])]
+    view: String,
     /// Visibility order.
     #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted"])]
     order: String,
@@ -138,6 +141,12 @@ struct RenderArgs {
     /// Reconstruction kernel.
     #[arg(long, default_value = "gaussian", value_parser = ["gaussian", "cubic"])]
     kernel: String,
+    /// Anti-aliasing of distant splats (chapter 3): none, Swan's d/k scaling, or an EWA low-pass.
+    #[arg(long, default_value = "none", value_parser = ["none", "swan", "ewa"])]
+    aa: String,
+    /// Draw the line where eye distance equals k (single-sheet scenes such as `plane`).
+    #[arg(long)]
+    k_line: bool,
     /// Traversal direction (default: back to front for splats, front to back for sheets).
     #[arg(long, value_parser = ["ftb", "btf"])]
     direction: Option<String>,
@@ -172,7 +181,8 @@ struct OrderArgs {
 
 fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     let (w, h) = a.size;
-    let mut cam = Camera::framing(grid, w, h);
+    let grazing = a.view == "grazing";
+    let mut cam = if grazing { Camera::grazing(grid, w, h) } else { Camera::framing(grid, w, h) };
     let fitted_eye = cam.eye;
     if let Some(t) = a.target {
         cam.target = t;
@@ -182,7 +192,9 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     } else if a.target.is_some() {
         cam.eye = cam.target + (fitted_eye - grid.center());
     }
-    cam.up = a.up;
+    if !grazing || a.eye.is_some() {
+        cam.up = a.up;
+    }
     if let Some(fov) = a.fov {
         cam.projection = Projection::Perspective { fov_y_deg: fov };
     }
@@ -192,8 +204,9 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     // Fit near/far to the scene's bounding sphere seen from this eye unless given.
     let d = (grid.center() - cam.eye).length();
     let r = 0.5 * grid.diagonal() + 4.0 * grid.kernel_spacing();
-    cam.near = a.near.unwrap_or(if cam.is_perspective() { (d - r).max(1e-3 * d.max(1.0)) } else { d - r - 1.0 });
-    cam.far = a.far.unwrap_or(d + r + 1.0);
+    let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d.max(1.0)) } else { d - r - 1.0 };
+    cam.near = a.near.unwrap_or(if grazing { cam.near } else { fit_near });
+    cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + r + 1.0 });
     cam.validate()?;
     Ok(cam)
 }
@@ -231,6 +244,7 @@ fn run(cli: Cli) -> Result<()> {
             opts.order = a.scene.order.parse::<OrderKind>()?;
             opts.composite = a.composite.parse::<Composite>()?;
             opts.kernel = a.kernel.parse::<Kernel>()?;
+            opts.antialias = a.aa.parse::<voxsplat::Antialias>()?;
             opts.direction =
                 a.direction
                     .as_deref()
@@ -240,6 +254,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             opts.sheet_budget_bytes = a.sheet_budget_mib << 20;
             let splats = set.len();
+            let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
             let frame = if a.truth {
                 let t = std::time::Instant::now();
                 let opts = voxsplat::truth::TruthOptions {
@@ -262,7 +277,17 @@ fn run(cli: Cli) -> Result<()> {
                 report_validation(&r)?;
                 f
             };
-            voxsplat::output::write_image(&frame.image, &a.out)?;
+            let mut image = frame.image;
+            if a.k_line {
+                let regions = voxsplat::aa::k_regions(&set_for_k, &cam);
+                if regions.iter().all(|&r| r == 0) {
+                    return Err(Error::InvalidArgument(
+                        "--k-line needs a single-sheet scene in view (e.g. plane)".into(),
+                    ));
+                }
+                voxsplat::aa::draw_k_line(&mut image, &regions);
+            }
+            voxsplat::output::write_image(&image, &a.out)?;
             eprintln!("{} splats -> {}", splats, a.out.display());
             if a.timings {
                 for t in &frame.timings {
@@ -337,11 +362,14 @@ fn bench(a: BenchArgs) -> Result<()> {
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let rows = run_matrix(&mut r, &m, |done, _, label| {
+    let mut rows = run_matrix(&mut r, &m, |done, _, label| {
         bar.set_position(done as u64);
         bar.set_message(label.to_string());
     })?;
     bar.finish_and_clear();
+    let (aa_size, aa_factor, aa_dolly) = if a.quick { (96, 4, 8) } else { (256, 8, 60) };
+    let aa = antialias_study(&mut r, aa_size, aa_factor, aa_dolly, m.frames, |msg| eprintln!("{msg}"))?;
+    rows.extend(antialias_rows(&aa, aa_size));
     write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -385,6 +413,7 @@ fn bench(a: BenchArgs) -> Result<()> {
             scaling: &scale,
             chart_dir,
             notes,
+            antialias: Some(antialias_markdown(&aa, aa_size, aa_factor, aa_dolly)),
         })?;
         std::fs::write(path, md).map_err(io(path))?;
         eprintln!("wrote {}", path.display());
