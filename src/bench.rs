@@ -775,26 +775,21 @@ pub fn antialias_study(
         let beyond = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
         // Dolly: the camera moves forward half a voxel per frame, parallel to the sheet.
         let step = glam::Vec3::new(0.0, 0.5 * set.grid().spacing[1], 0.0);
-        let mut prev: Option<(ImageF32, Vec<u8>)> = None;
-        let mut changes = Vec::new();
+        let mut frames_img = Vec::with_capacity(dolly);
+        let mut regions_f = Vec::with_capacity(dolly);
         for f in 0..dolly {
             let cam = Camera { eye: camera.eye + step * f as f32, target: camera.target + step * f as f32, ..camera };
-            let img = render_method(r, &m, &cam)?.image;
-            let reg = crate::aa::k_regions(&set, &cam);
-            if let Some((pimg, preg)) = &prev {
-                if let Some(c) = crate::metrics::rmse_masked(&img, pimg, |i| reg[i] == 2 && preg[i] == 2) {
-                    changes.push(c);
-                }
-            }
-            prev = Some((img, reg));
+            frames_img.push(render_method(r, &m, &cam)?.image);
+            regions_f.push(crate::aa::k_regions(&set, &cam));
         }
+        let shimmer = crate::metrics::shimmer(&frames_img, |t, i| regions_f[t][i] == 2).unwrap_or(f64::NAN);
         rows.push(AaRow {
             mode,
             time_ms: t.time_ms,
             rmse_before: before,
             rmse_beyond: beyond,
             pixels_beyond: regions.iter().filter(|&&x| x == 2).count(),
-            shimmer: if changes.is_empty() { f64::NAN } else { changes.iter().sum::<f64>() / changes.len() as f64 },
+            shimmer,
             metrics: compare(&t.image, &truth)?,
         });
     }

@@ -117,6 +117,16 @@ pub fn rmse_masked(img: &ImageF32, truth: &ImageF32, keep: impl Fn(usize) -> boo
     (n > 0).then(|| (se / n as f64).sqrt())
 }
 
+/// Shimmer of an animation: the mean over consecutive frames of their RMSE over the pixels where
+/// `keep(frame, pixel)` holds in both frames (for anti-aliasing: the pixels beyond k). `None` when
+/// no pair shares a kept pixel.
+pub fn shimmer(frames: &[ImageF32], keep: impl Fn(usize, usize) -> bool) -> Option<f64> {
+    let changes: Vec<f64> = (1..frames.len())
+        .filter_map(|t| rmse_masked(&frames[t], &frames[t - 1], |i| keep(t, i) && keep(t - 1, i)))
+        .collect();
+    (!changes.is_empty()).then(|| changes.iter().sum::<f64>() / changes.len() as f64)
+}
+
 /// PSNR in dB of an RMSE (dynamic range 1).
 pub fn psnr(rmse: f64) -> f64 {
     if rmse > 0.0 {

@@ -146,4 +146,8 @@ fn metrics_on_known_pairs() {
     assert!((t.max_change - 0.1).abs() < 1e-6);
     assert!((t.popping - 10.0).abs() < 1e-3, "{}", t.popping);
     assert!(temporal(&frames[..2]).is_err());
+    // Shimmer over kept pixels only: keeping nothing gives None; keeping all gives the mean change.
+    assert!(voxsplat::metrics::shimmer(&frames, |_, _| false).is_none());
+    let mean = voxsplat::metrics::shimmer(&frames, |_, _| true).unwrap();
+    assert!((mean - t.mean_change).abs() < 1e-12);
 }
