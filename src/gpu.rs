@@ -382,19 +382,7 @@ impl GpuPipeline {
                     rec.barrier(Stage::Compute, Stage::Compute);
                 }),
             ),
-            (
-                UNTIMED,
-                Box::new(|rec| {
-                    rec.transition(
-                        &target.accum,
-                        IL::GENERAL,
-                        IL::TRANSFER_SRC_OPTIMAL,
-                        Stage::Compute,
-                        Stage::Transfer,
-                    );
-                    rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
-                }),
-            ),
+            (UNTIMED, Box::new(|rec| read_back_accum(rec, target))),
         ];
         let timings = execute(&self.ctx, &mut self.timer, &steps)?;
         drop(steps);
@@ -588,19 +576,7 @@ impl GpuPipeline {
                         }),
                     ));
                 }
-                steps.push((
-                    UNTIMED,
-                    Box::new(|rec| {
-                        rec.transition(
-                            &target.accum,
-                            IL::GENERAL,
-                            IL::TRANSFER_SRC_OPTIMAL,
-                            Stage::Compute,
-                            Stage::Transfer,
-                        );
-                        rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
-                    }),
-                ));
+                steps.push((UNTIMED, Box::new(|rec| read_back_accum(rec, target))));
             }
         }
         let mut timings = execute(&self.ctx, &mut self.timer, &steps)?;
@@ -663,6 +639,12 @@ fn execute(ctx: &Arc<Context>, timer: &mut Timer, steps: &[Step<'_>]) -> Result<
         }
     }
     Ok(out)
+}
+
+/// Copy the accumulation image (written by compute, in GENERAL) to the readback buffer.
+fn read_back_accum(rec: &Recorder<'_>, target: &TargetGpu) {
+    rec.transition(&target.accum, IL::GENERAL, IL::TRANSFER_SRC_OPTIMAL, Stage::Compute, Stage::Transfer);
+    rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, &target.readback);
 }
 
 fn read_image(readback: &Buffer, w: u32, h: u32) -> Result<ImageF32> {

@@ -21,6 +21,16 @@ pub enum Kernel {
 
 pub const GAUSSIAN_SIGMA: f64 = 0.6;
 
+/// Simpson's rule over [a, b] with `n` (even) intervals.
+fn simpson(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
+    let h = (b - a) / n as f64;
+    let mut sum = f(a) + f(b);
+    for i in 1..n {
+        sum += if i % 2 == 1 { 4.0 } else { 2.0 } * f(a + i as f64 * h);
+    }
+    sum * h / 3.0
+}
+
 impl std::str::FromStr for Kernel {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
@@ -63,22 +73,7 @@ impl Kernel {
             return 0.0;
         }
         let half = (rr * rr - rho * rho).sqrt();
-        let n = 256;
-        let h = 2.0 * half / n as f64;
-        // Simpson's rule over [-half, half].
-        let mut sum = 0.0;
-        for i in 0..=n {
-            let z = -half + i as f64 * h;
-            let w = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            sum += w * self.profile((rho * rho + z * z).sqrt());
-        }
-        sum * h / 3.0
+        simpson(-half, half, 256, |z| self.profile((rho * rho + z * z).sqrt()))
     }
 
     /// The 3D kernel normalised so that its integral over space is 1 voxel^3.
@@ -89,21 +84,7 @@ impl Kernel {
     /// Integral of the 3D profile over its ball (Simpson, 1024 intervals in r).
     pub fn volume_integral(self) -> f64 {
         let rr = self.radius() as f64;
-        let n = 1024;
-        let h = rr / n as f64;
-        let mut sum = 0.0;
-        for i in 0..=n {
-            let r = i as f64 * h;
-            let w = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            sum += w * self.profile(r) * 4.0 * std::f64::consts::PI * r * r;
-        }
-        sum * h / 3.0
+        simpson(0.0, rr, 1024, |r| self.profile(r) * 4.0 * std::f64::consts::PI * r * r)
     }
 
     /// Standard deviation (voxels) of the 2D footprint along one screen axis; the EWA low-pass adds
