@@ -12,10 +12,13 @@ layout(push_constant) uniform Push {
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) flat in vec4 in_emit;
+layout(location = 2) flat in float in_stretch;
 layout(location = 0) out vec4 out_color;
 
 void main() {
-    float tau = in_emit.a * sample_table(table, in_uv);
+    // Distance beyond the motion segment along u (radius units); the kernel profile across it.
+    float along = max(abs(in_uv.x) * (1.0 + in_stretch) - in_stretch, 0.0);
+    float tau = in_emit.a * sample_table(table, vec2(along, in_uv.y));
     if (tau <= 0.0) discard;
     if (pc.sheet_mode != 0u) {
         out_color = vec4(in_emit.rgb * tau, tau);

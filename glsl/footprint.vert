@@ -20,6 +20,7 @@ layout(push_constant) uniform Push {
 
 layout(location = 0) out vec2 out_uv;
 layout(location = 1) flat out vec4 out_emit;
+layout(location = 2) flat out float out_stretch;
 
 const vec2 CORNERS[4] = vec2[](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
 
@@ -29,6 +30,7 @@ void main() {
     vec2 c = CORNERS[gl_VertexIndex];
     out_uv = c;
     out_emit = vec4(p.emit.rgb, p.emit.a * p.axis_u.w);
+    out_stretch = p.axis_v.w;
     if (p.center.w == 0.0) {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: culled
     } else {

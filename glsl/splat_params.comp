@@ -36,12 +36,33 @@ void main() {
     vec3 w = frame.eye.w > 0.5 ? normalize(center - frame.eye.xyz) : forward;
     vec3 u = normalize(frame.right.xyz - dot(frame.right.xyz, w) * w);
     vec3 v = cross(w, u);
+    // Chapter 4: stretch the footprint back along the projected path from t_{i-1} (Fig. 4.3), in
+    // the plane facing the eye ray at t_i (Fig. 4.4), when the path exceeds delta pixels.
+    float stretch = 0.0;
+    vec3 quad_center = center;
+    float energy = 1.0 / (scale * scale);
+    if (frame.blur.x > 0.0 && visible) {
+        vec3 prev = (frame.motion * vec4(center, 1.0)).xyz;
+        vec4 c1 = frame.view_proj * vec4(center, 1.0);
+        vec4 c0 = frame.view_proj * vec4(prev, 1.0);
+        vec2 moved = (c1.xy / c1.w - c0.xy / c0.w) * 0.5 * frame.blur.zw;
+        vec3 d = center - prev;
+        vec3 dp = d - dot(d, w) * w;
+        float len = length(dp);
+        if (c0.w > 0.0 && length(moved) > frame.blur.x && len > 1e-6 * radius) {
+            u = dp / len;
+            v = cross(w, u);
+            stretch = 0.5 * len / radius;
+            quad_center = center - 0.5 * dp;
+            energy /= 1.0 + 2.0 * stretch * frame.blur.y;   // Eq. 4.2 with effective area and width
+        }
+    }
     float opacity = clamp(sp.color.a, 0.0, MAX_OPACITY);
     float tau = -log(1.0 - opacity);
     SplatParams p;
-    p.center = vec4(center, visible && tau > 0.0 ? 1.0 : 0.0);
-    p.axis_u = vec4(u * radius, 1.0 / (scale * scale));   // Eq. 3.13: energy x (k/d)^2
-    p.axis_v = vec4(v * radius, 0.0);
+    p.center = vec4(quad_center, visible && tau > 0.0 ? 1.0 : 0.0);
+    p.axis_u = vec4(u * radius * (1.0 + stretch), energy);   // Eq. 3.13: energy x (k/d)^2
+    p.axis_v = vec4(v * radius, stretch);
     p.emit = vec4(sp.color.rgb, tau);
     float dist = length(center - frame.eye.xyz);
     float pixels = frame.eye.w > 0.5 ? radius * frame.up.w / max(depth, 1e-6) : radius * frame.up.w;

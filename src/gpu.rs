@@ -313,6 +313,7 @@ impl GpuPipeline {
             camera,
             Kernel::Gaussian,
             Antialias::None,
+            None,
             split,
             direction == Direction::BackToFront,
         );
@@ -457,7 +458,7 @@ impl GpuPipeline {
     ) -> Result<Vec<SplatParams>> {
         camera.validate()?;
         let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, kernel, antialias, split, true);
+        let frame = make_frame(&prep.set, camera, kernel, antialias, None, split, true);
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let bytes = scene.n as u64 * std::mem::size_of::<SplatParams>() as u64;
@@ -497,7 +498,7 @@ impl GpuPipeline {
         let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
         self.ensure_target(w, h, layers)?;
         let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, split, btf);
+        let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;

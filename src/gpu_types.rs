@@ -20,7 +20,7 @@ pub struct SplatParams {
     pub center: [f32; 4],
     /// Half-extent vector of the quad; w = energy scale.
     pub axis_u: [f32; 4],
-    /// Second half-extent vector; w unused.
+    /// Second half-extent vector; w = motion stretch (half blur length / radius).
     pub axis_v: [f32; 4],
     /// RGB colour; a = optical depth of the voxel (tau).
     pub emit: [f32; 4],
@@ -43,6 +43,10 @@ pub struct Frame {
     pub split: [u32; 4],
     /// Anti-aliasing: mode (0 none, 1 Swan, 2 EWA), footprint std in voxels, EWA low-pass std in pixels.
     pub aa: [f32; 4],
+    /// Grid point -> its position at t_{i-1} relative to the eye at t_i (identity when still).
+    pub motion: [[f32; 4]; 4],
+    /// Motion blur: delta in pixels (0 = off), G (across-line integral over area), image width, height.
+    pub blur: [f32; 4],
 }
 
 /// Uniforms of `raycast.comp`.
@@ -81,7 +85,7 @@ pub struct CompositePush {
 
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
-const _: () = assert!(std::mem::size_of::<Frame>() == 208);
+const _: () = assert!(std::mem::size_of::<Frame>() == 288);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 20);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);

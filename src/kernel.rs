@@ -108,6 +108,17 @@ impl Kernel {
         }
     }
 
+    /// G of the motion-blurred footprint: its integral along a line across the centre over its
+    /// integral over the whole disc, in units of the radius. A footprint stretched by a length l
+    /// (radius units) gains l·G of its energy, so Eq. 4.2's A1 / (A1 + l·w), with A1 and w the
+    /// footprint's effective area and width (integral over peak), is 1 / (1 + l·G).
+    pub fn motion_g(self) -> f64 {
+        let rr = self.radius() as f64;
+        let line = simpson(-rr, rr, 512, |b| self.integrated(b.abs()));
+        let area = simpson(0.0, rr, 512, |r| self.integrated(r) * 2.0 * std::f64::consts::PI * r);
+        line / area * rr
+    }
+
     /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2.
     pub fn footprint_table(self) -> Vec<f32> {
         let n = FOOTPRINT_TABLE_SIZE as usize;

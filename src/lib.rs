@@ -16,6 +16,7 @@
 #![deny(unsafe_code)]
 
 pub mod aa;
+pub mod animate;
 pub mod bench;
 pub mod camera;
 pub mod constants;
@@ -174,7 +175,8 @@ impl Renderer {
             Some(g) => g.splat_params(prep, camera, kernel, antialias),
             None => {
                 let set = &prep.set;
-                let frame = pipeline::make_frame(set, camera, kernel, antialias, order::pbtf_split(set, camera), true);
+                let frame =
+                    pipeline::make_frame(set, camera, kernel, antialias, None, order::pbtf_split(set, camera), true);
                 let mut out = vec![gpu_types::SplatParams::default(); set.len()];
                 cpu::splat_params(&frame, set.splats(), &mut out);
                 Ok(out)
@@ -222,6 +224,7 @@ fn cpu_pbtf_order(prep: &Prepared, camera: &Camera, direction: Direction) -> Vec
         camera,
         Kernel::Gaussian,
         Antialias::None,
+        None,
         split,
         direction == Direction::BackToFront,
     );

@@ -35,6 +35,27 @@ pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
     }
 }
 
+/// An animated GIF of premultiplied frames over a dark background, `delay_ms` per frame.
+pub fn write_gif(frames: &[ImageF32], path: &Path, delay_ms: u32) -> Result<()> {
+    use image::codecs::gif::{GifEncoder, Repeat};
+    let name = path.display().to_string();
+    let file = std::fs::File::create(path).map_err(|e| Error::Io { path: name.clone(), source: e })?;
+    let mut enc = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
+    enc.set_repeat(Repeat::Infinite).map_err(|e| Error::Image { path: name.clone(), message: e.to_string() })?;
+    let bg = [0.12f32, 0.12, 0.16];
+    for f in frames {
+        let mut rgba = image::RgbaImage::new(f.width, f.height);
+        for (px, p) in rgba.pixels_mut().zip(&f.pixels) {
+            let a = p[3].clamp(0.0, 1.0);
+            let c = |i: usize| ((p[i] + bg[i] * (1.0 - a)).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+            *px = image::Rgba([c(0), c(1), c(2), 255]);
+        }
+        let frame = image::Frame::from_parts(rgba, 0, 0, image::Delay::from_numer_denom_ms(delay_ms, 1));
+        enc.encode_frame(frame).map_err(|e| Error::Image { path: name.clone(), message: e.to_string() })?;
+    }
+    Ok(())
+}
+
 /// Read a PNG (straight alpha, 8 or 16 bit) or an EXR (premultiplied) as a premultiplied float
 /// image. Sizes are checked against `MAX_PIXELS` from the header before any pixel is decoded.
 pub fn read_image(path: &Path) -> Result<ImageF32> {

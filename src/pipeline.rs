@@ -78,6 +78,17 @@ impl std::str::FromStr for Antialias {
     }
 }
 
+/// Motion blur of one frame (chapter 4): where every grid point was at the previous time step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// Maps a grid point (the scene's own coordinates, as drawn this frame) to its position at
+    /// t_{i-1} relative to the eye at t_i: `(V_i M_i)^-1 V_{i-1} M_{i-1}` for object transforms M and
+    /// view transforms V.
+    pub previous: glam::Mat4,
+    /// Splats whose projected path is at most this many pixels are drawn unblurred (delta).
+    pub delta_px: f32,
+}
+
 /// Per-frame choices. `Default` gives PBTF, per-splat back-to-front compositing, the Gaussian.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
@@ -86,6 +97,8 @@ pub struct RenderOptions {
     pub composite: Composite,
     pub kernel: Kernel,
     pub antialias: Antialias,
+    /// Motion-blurred splats (chapter 4); `None` draws the frame still.
+    pub motion: Option<Motion>,
     /// `None`: back to front for per-splat compositing, front to back for sheets.
     pub direction: Option<Direction>,
     /// Memory allowed for one batch of sheet summation layers (RGBA32F each).
@@ -99,6 +112,7 @@ impl Default for RenderOptions {
             composite: Composite::Splat,
             kernel: Kernel::Gaussian,
             antialias: Antialias::None,
+            motion: None,
             direction: None,
             sheet_budget_bytes: 256 << 20,
         }
@@ -165,6 +179,7 @@ pub fn make_frame(
     camera: &Camera,
     kernel: Kernel,
     antialias: Antialias,
+    motion: Option<&Motion>,
     split: [u32; 3],
     back_to_front: bool,
 ) -> Frame {
@@ -185,6 +200,13 @@ pub fn make_frame(
         dims: [g.dims[0], g.dims[1], g.dims[2], set.len() as u32],
         split: [split[0], split[1], split[2], back_to_front as u32],
         aa: [antialias.code(), kernel.footprint_sigma() as f32, EWA_LOWPASS_PX, 0.0],
+        motion: motion.map(|m| m.previous).unwrap_or(glam::Mat4::IDENTITY).to_cols_array_2d(),
+        blur: [
+            motion.map(|m| m.delta_px.max(1e-6)).unwrap_or(0.0),
+            kernel.motion_g() as f32,
+            camera.width as f32,
+            camera.height as f32,
+        ],
     }
 }
 
@@ -260,7 +282,7 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
     let direction = opts.direction();
     let btf = direction == Direction::BackToFront;
     let split = order::pbtf_split(set, camera);
-    let frame = make_frame(set, camera, opts.kernel, opts.antialias, split, btf);
+    let frame = make_frame(set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
     let n = set.len();
     let mut timings = Vec::new();
     let mut t = Instant::now();

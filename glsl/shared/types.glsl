@@ -13,13 +13,14 @@ struct Splat {
 struct SplatParams {
     vec4 center;  // world-space centre; w: 1 if drawn, 0 if culled
     vec4 axis_u;  // world-space half-extent vector of the footprint quad; w: energy scale
-    vec4 axis_v;  // second half-extent vector, perpendicular to axis_u and to the eye ray; w: unused
+    vec4 axis_v;  // second half-extent vector, perpendicular to axis_u and to the eye ray;
+                  // w: motion stretch (half the blur length over the radius; 0 = not blurred)
     vec4 emit;    // rgb colour; a: optical depth of the voxel (tau)
     vec4 screen;  // eye-space depth z_e (section 3.3.1, +z forward), eye distance d,
                   // footprint radius in pixels, anti-aliasing radius scale
 };
 
-// Per-frame uniforms (std140, vec4-only so the Rust mirror is plain repr(C)). 208 bytes.
+// Per-frame uniforms (std140, vec4-only so the Rust mirror is plain repr(C)). 288 bytes.
 struct Frame {
     mat4 view_proj;   // world -> clip (Vulkan: y down, depth 0..1)
     vec4 eye;         // world eye position; w: 1 perspective, 0 orthographic
@@ -32,6 +33,9 @@ struct Frame {
     uvec4 split;      // PBTF: voxels per axis on the low side of the eye; w: 1 = back-to-front
     vec4 aa;          // x: anti-aliasing mode (AA_*); y: footprint standard deviation in voxels;
                       // z: EWA low-pass standard deviation in pixels; w: unused
+    mat4 motion;      // chapter 4: grid point -> where it was at t_{i-1}, relative to the eye at t_i
+    vec4 blur;        // x: delta in pixels (0 = no motion blur); y: G, the footprint's across-line
+                      // integral over its area (radius units); z, w: image width and height
 };
 
 #define AA_NONE 0.0

@@ -24,6 +24,8 @@ enum Command {
     Render(RenderArgs),
     /// Write or check a visibility order (back to front).
     Order(OrderArgs),
+    /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
+    Animate(AnimateArgs),
     /// Print error metrics of image A against reference B (PNG or EXR).
     Compare {
         /// The image to score.
@@ -168,6 +170,31 @@ struct RenderArgs {
 }
 
 #[derive(Args)]
+struct AnimateArgs {
+    /// A built-in animation (rotating-box) or a TOML file.
+    #[arg(long, default_value = "rotating-box")]
+    anim: String,
+    /// none, splat (motion-blurred splats) or accum:N (N sub-frames averaged).
+    #[arg(long, default_value = "splat")]
+    blur: String,
+    /// Per-splat compositing or sheet summation.
+    #[arg(long, default_value = "splat", value_parser = ["splat", "sheet"])]
+    composite: String,
+    /// Visibility order.
+    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted"])]
+    order: String,
+    /// Frame files: png or exr.
+    #[arg(long, default_value = "png", value_parser = ["png", "exr"])]
+    format: String,
+    /// Where the frames and anim.gif go.
+    #[arg(long, default_value = "anim-out")]
+    out_dir: PathBuf,
+    /// Run on the CPU mirrors.
+    #[arg(long)]
+    cpu: bool,
+}
+
+#[derive(Args)]
 struct OrderArgs {
     #[command(flatten)]
     scene: SceneArgs,
@@ -296,6 +323,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        Command::Animate(a) => animate(a),
         Command::Compare { a, b } => {
             let (x, y) = (voxsplat::output::read_image(&a)?, voxsplat::output::read_image(&b)?);
             let m = voxsplat::metrics::compare(&x, &y)?;
@@ -338,6 +366,40 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
     }
+}
+
+fn animate(a: AnimateArgs) -> Result<()> {
+    use voxsplat::animate::{render_frame, Animation, Blur};
+    let anim = if a.anim.ends_with(".toml") {
+        let text = std::fs::read_to_string(&a.anim).map_err(|e| Error::Io { path: a.anim.clone(), source: e })?;
+        Animation::from_toml(&text)?
+    } else {
+        Animation::builtin(&a.anim)?
+    };
+    let blur: Blur = a.blur.parse()?;
+    let set = scene::build(&anim.scene)?;
+    let grid = *set.grid();
+    let mut opts = RenderOptions::default();
+    opts.composite = a.composite.parse::<Composite>()?;
+    opts.order = a.order.parse::<OrderKind>()?;
+    let mut ropts = RendererOptions::default();
+    ropts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
+    let mut r = Renderer::new(&ropts)?;
+    r.set_scene(set)?;
+    std::fs::create_dir_all(&a.out_dir).map_err(|e| Error::Io { path: a.out_dir.display().to_string(), source: e })?;
+    let bar = indicatif::ProgressBar::new(anim.frames as u64);
+    let mut gif_frames = Vec::new();
+    for i in 0..anim.frames {
+        let img = render_frame(&mut r, &anim, &grid, i, blur, &opts)?;
+        voxsplat::output::write_image(&img, &a.out_dir.join(format!("frame{i:04}.{}", a.format)))?;
+        gif_frames.push(img);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let gif = a.out_dir.join("anim.gif");
+    voxsplat::output::write_gif(&gif_frames, &gif, 1000 / 12)?;
+    eprintln!("{} frames -> {}", anim.frames, a.out_dir.display());
+    Ok(())
 }
 
 fn bench(a: BenchArgs) -> Result<()> {

@@ -120,7 +120,9 @@ fn raster_quad(
             if u.abs() > 1.0 || v.abs() > 1.0 {
                 continue;
             }
-            let tau = p.emit[3] * energy * sample_table(table, u as f32, v as f32);
+            let stretch = p.axis_v[3];
+            let along = ((u.abs() as f32) * (1.0 + stretch) - stretch).max(0.0);
+            let tau = p.emit[3] * energy * sample_table(table, along, v as f32);
             if tau <= 0.0 {
                 continue;
             }

@@ -1,6 +1,6 @@
 //! Mirror of `splat_params.comp`.
 use crate::gpu_types::{Frame, Splat, SplatParams};
-use glam::Vec3;
+use glam::{Mat4, Vec2, Vec3};
 
 pub const MAX_OPACITY: f32 = 0.999;
 /// Splats closer than this many radii to the near or far plane are culled (the quad's corners
@@ -36,13 +36,41 @@ pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams])
         let radius = frame.spacing[3] * scale;
         let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
         let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
-        let u = (right - right.dot(w) * w).normalize();
-        let v = w.cross(u);
+        let mut u = (right - right.dot(w) * w).normalize();
+        let mut v = w.cross(u);
+        let mut stretch = 0.0f32;
+        let mut quad_center = center;
+        let mut energy = 1.0 / (scale * scale);
+        if frame.blur[0] > 0.0 && visible {
+            let m = Mat4::from_cols_array_2d(&frame.motion);
+            let vp = Mat4::from_cols_array_2d(&frame.view_proj);
+            let prev = (m * center.extend(1.0)).truncate();
+            let c1 = vp * center.extend(1.0);
+            let c0 = vp * prev.extend(1.0);
+            let moved = (c1.truncate().truncate() / c1.w - c0.truncate().truncate() / c0.w)
+                * 0.5
+                * Vec2::new(frame.blur[2], frame.blur[3]);
+            let d = center - prev;
+            let dp = d - d.dot(w) * w;
+            let len = dp.length();
+            if c0.w > 0.0 && moved.length() > frame.blur[0] && len > 1e-6 * radius {
+                u = dp / len;
+                v = w.cross(u);
+                stretch = 0.5 * len / radius;
+                quad_center = center - 0.5 * dp;
+                energy /= 1.0 + 2.0 * stretch * frame.blur[1];
+            }
+        }
         let tau = optical_depth(sp.color[3]);
         params[s] = SplatParams {
-            center: [center.x, center.y, center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
-            axis_u: [u.x * radius, u.y * radius, u.z * radius, 1.0 / (scale * scale)],
-            axis_v: [v.x * radius, v.y * radius, v.z * radius, 0.0],
+            center: [quad_center.x, quad_center.y, quad_center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
+            axis_u: [
+                u.x * radius * (1.0 + stretch),
+                u.y * radius * (1.0 + stretch),
+                u.z * radius * (1.0 + stretch),
+                energy,
+            ],
+            axis_v: [v.x * radius, v.y * radius, v.z * radius, stretch],
             emit: [sp.color[0], sp.color[1], sp.color[2], tau],
             screen: [
                 depth,

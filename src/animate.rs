@@ -1,0 +1,298 @@
+//! Animations (chapter 4): a scene, a camera, and object-transform keyframes, from a small TOML
+//! file or built in; frames rendered still, with motion-blurred splats, or with an accumulation
+//! buffer of N sub-frames over the shutter interval.
+use crate::camera::{Camera, Projection};
+use crate::cpu::ImageF32;
+use crate::error::{Error, Result};
+use crate::pipeline::{Motion, RenderOptions};
+use crate::volume::Grid;
+use crate::Renderer;
+use glam::{Mat4, Quat, Vec3};
+use serde::Deserialize;
+
+/// Largest frame count and accumulation sub-frame count accepted.
+pub const MAX_FRAMES: u32 = 100_000;
+pub const MAX_SUBFRAMES: u32 = 1024;
+/// Default delta of chapter 4: paths shorter than this many pixels are not blurred.
+pub const DEFAULT_DELTA_PX: f32 = 0.5;
+
+/// One keyframe of the object's rigid transform: a rotation about the grid's centre, then a
+/// translation.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Keyframe {
+    pub frame: f32,
+    /// Axis (x, y, z) and angle in degrees.
+    #[serde(default = "no_rotation")]
+    pub rotate: [f32; 4],
+    #[serde(default)]
+    pub translate: [f32; 3],
+}
+
+fn no_rotation() -> [f32; 4] {
+    [0.0, 1.0, 0.0, 0.0]
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraFile {
+    eye: [f32; 3],
+    target: [f32; 3],
+    #[serde(default = "default_up")]
+    up: [f32; 3],
+    fov: Option<f32>,
+    ortho: Option<f32>,
+    near: Option<f32>,
+    far: Option<f32>,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AnimationFile {
+    scene: String,
+    frames: u32,
+    #[serde(default = "one")]
+    shutter: f32,
+    #[serde(default = "default_size")]
+    size: [u32; 2],
+    camera: CameraFile,
+    keyframe: Vec<Keyframe>,
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+fn default_size() -> [u32; 2] {
+    [256, 256]
+}
+
+/// A rigid-body animation of one scene seen by a fixed camera.
+#[derive(Clone, Debug)]
+pub struct Animation {
+    pub scene: String,
+    pub frames: u32,
+    /// Fraction of the frame interval the shutter is open (the blur covers [t - shutter, t]).
+    pub shutter: f32,
+    /// The world camera.
+    pub camera: Camera,
+    pub keyframes: Vec<Keyframe>,
+}
+
+/// Built-in animations: (name, description).
+pub const ANIMATIONS: &[(&str, &str)] =
+    &[("rotating-box", "the 60^3 hollow cube turning 6 degrees a frame about y, orthographic (Fig. 4.5)")];
+
+impl Animation {
+    pub fn builtin(name: &str) -> Result<Self> {
+        match name {
+            "rotating-box" => Self::from_toml(
+                r#"
+                scene = "cube60"
+                frames = 24
+                size = [256, 256]
+                [camera]
+                eye = [0.0, 45.0, 120.0]
+                target = [0.0, 0.0, 0.0]
+                ortho = 110.0
+                [[keyframe]]
+                frame = 0
+                rotate = [0.0, 1.0, 0.0, 0.0]
+                [[keyframe]]
+                frame = 24
+                rotate = [0.0, 1.0, 0.0, 144.0]
+                "#,
+            ),
+            other => Err(Error::InvalidArgument(format!(
+                "unknown animation '{other}'; built in: {}",
+                ANIMATIONS.iter().map(|a| a.0).collect::<Vec<_>>().join(", ")
+            ))),
+        }
+    }
+
+    /// Parse and check an animation file.
+    pub fn from_toml(text: &str) -> Result<Self> {
+        let f: AnimationFile =
+            toml::from_str(text).map_err(|e| Error::InvalidArgument(format!("animation file: {e}")))?;
+        if f.frames == 0 || f.frames > MAX_FRAMES {
+            return Err(Error::InvalidArgument(format!("frames must be in 1..={MAX_FRAMES}")));
+        }
+        if !(f.shutter.is_finite() && f.shutter > 0.0 && f.shutter <= 1.0) {
+            return Err(Error::InvalidArgument("shutter must be in (0, 1]".into()));
+        }
+        if f.keyframe.is_empty() {
+            return Err(Error::InvalidArgument("an animation needs at least one [[keyframe]]".into()));
+        }
+        for k in &f.keyframe {
+            let finite = k.frame.is_finite()
+                && k.rotate.iter().all(|v| v.is_finite())
+                && k.translate.iter().all(|v| v.is_finite());
+            if !finite {
+                return Err(Error::InvalidArgument("keyframe values must be finite".into()));
+            }
+            if k.rotate[3] != 0.0 && Vec3::from_slice(&k.rotate[..3]).length() < 1e-6 {
+                return Err(Error::InvalidArgument("a keyframe rotates about a zero axis".into()));
+            }
+        }
+        let mut keyframes = f.keyframe;
+        keyframes.sort_by(|a, b| a.frame.partial_cmp(&b.frame).unwrap_or(std::cmp::Ordering::Equal));
+        let c = f.camera;
+        let projection = match (c.fov, c.ortho) {
+            (Some(_), Some(_)) => return Err(Error::InvalidArgument("camera: give fov or ortho, not both".into())),
+            (_, Some(h)) => Projection::Orthographic { height: h },
+            (fov, None) => Projection::Perspective { fov_y_deg: fov.unwrap_or(40.0) },
+        };
+        let eye = Vec3::from(c.eye);
+        let dist = (Vec3::from(c.target) - eye).length();
+        let ortho = matches!(projection, Projection::Orthographic { .. });
+        let camera = Camera {
+            eye,
+            target: Vec3::from(c.target),
+            up: Vec3::from(c.up),
+            projection,
+            near: c.near.unwrap_or(if ortho { -4.0 * dist } else { 0.05 * dist }),
+            far: c.far.unwrap_or(4.0 * dist.max(1.0)),
+            width: f.size[0],
+            height: f.size[1],
+        };
+        camera.validate()?;
+        Ok(Self { scene: f.scene, frames: f.frames, shutter: f.shutter, camera, keyframes })
+    }
+
+    /// The object's transform at time `t` (in frames): rotation about the grid centre, slerped
+    /// between keyframes, and linearly interpolated translation.
+    pub fn model(&self, grid: &Grid, t: f32) -> Mat4 {
+        let rot = |k: &Keyframe| {
+            let axis = Vec3::from_slice(&k.rotate[..3]);
+            if k.rotate[3] == 0.0 || axis.length() < 1e-6 {
+                Quat::IDENTITY
+            } else {
+                Quat::from_axis_angle(axis.normalize(), k.rotate[3].to_radians())
+            }
+        };
+        let ks = &self.keyframes;
+        let (q, tr) = match ks.iter().position(|k| k.frame > t) {
+            Some(0) => (rot(&ks[0]), Vec3::from(ks[0].translate)),
+            None => (rot(&ks[ks.len() - 1]), Vec3::from(ks[ks.len() - 1].translate)),
+            Some(i) => {
+                let (a, b) = (&ks[i - 1], &ks[i]);
+                let s = ((t - a.frame) / (b.frame - a.frame).max(1e-9)).clamp(0.0, 1.0);
+                // Angles up to 180 degrees apart slerp the short way, which is the intended path
+                // between keyframes given that far apart.
+                let qa = rot(a);
+                let qb = rot(b);
+                let q = if (b.rotate[3] - a.rotate[3]).abs() < 180.0 && a.rotate[..3] == b.rotate[..3] {
+                    Quat::from_axis_angle(
+                        Vec3::from_slice(&a.rotate[..3]).try_normalize().unwrap_or(Vec3::Y),
+                        (a.rotate[3] + (b.rotate[3] - a.rotate[3]) * s).to_radians(),
+                    )
+                } else {
+                    qa.slerp(qb, s)
+                };
+                (q, Vec3::from(a.translate).lerp(Vec3::from(b.translate), s))
+            }
+        };
+        let c = grid.center();
+        Mat4::from_translation(tr + c) * Mat4::from_quat(q) * Mat4::from_translation(-c)
+    }
+
+    /// The camera expressed in the grid's own coordinates at time `t`: drawing the still grid with
+    /// it gives the picture of the moving grid seen by the world camera.
+    pub fn object_camera(&self, grid: &Grid, t: f32) -> Camera {
+        let inv = self.model(grid, t).inverse();
+        let c = &self.camera;
+        Camera {
+            eye: inv.transform_point3(c.eye),
+            target: inv.transform_point3(c.target),
+            up: inv.transform_vector3(c.up),
+            ..*c
+        }
+    }
+
+    /// Chapter 4's motion from `t0` to `t1`: grid point -> its position at `t0` relative to the
+    /// eye at `t1`, in the object coordinates of `t1`.
+    pub fn motion(&self, grid: &Grid, t0: f32, t1: f32) -> Mat4 {
+        let v = self.camera.view();
+        (v * self.model(grid, t1)).inverse() * (v * self.model(grid, t0))
+    }
+}
+
+/// How a frame's motion is rendered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blur {
+    None,
+    /// Motion-blurred splats.
+    Splat,
+    /// N sub-frames over the shutter interval, averaged.
+    Accum(u32),
+}
+
+impl std::str::FromStr for Blur {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "none" => Ok(Blur::None),
+            "splat" => Ok(Blur::Splat),
+            _ => {
+                let n = s
+                    .strip_prefix("accum:")
+                    .and_then(|n| n.parse::<u32>().ok())
+                    .filter(|n| (1..=MAX_SUBFRAMES).contains(n))
+                    .ok_or_else(|| {
+                        Error::InvalidArgument(format!(
+                            "blur '{s}': use none, splat or accum:N with N in 1..={MAX_SUBFRAMES}"
+                        ))
+                    })?;
+                Ok(Blur::Accum(n))
+            }
+        }
+    }
+}
+
+/// Render frame `i` (the renderer must hold the animation's scene).
+pub fn render_frame(
+    r: &mut Renderer,
+    anim: &Animation,
+    grid: &Grid,
+    i: u32,
+    blur: Blur,
+    base: &RenderOptions,
+) -> Result<ImageF32> {
+    let t = i as f32;
+    match blur {
+        Blur::None => Ok(r.render(&anim.object_camera(grid, t), base)?.image),
+        Blur::Splat => {
+            let mut o = base.clone();
+            o.motion = Some(Motion { previous: anim.motion(grid, t - anim.shutter, t), delta_px: DEFAULT_DELTA_PX });
+            Ok(r.render(&anim.object_camera(grid, t), &o)?.image)
+        }
+        Blur::Accum(n) => {
+            let mut acc: Option<ImageF32> = None;
+            for k in 0..n {
+                // The last sub-frame is exactly t_i, so N = 1 is the still frame.
+                let tk = if k + 1 == n { t } else { t - anim.shutter + (k + 1) as f32 / n as f32 * anim.shutter };
+                let img = r.render(&anim.object_camera(grid, tk), base)?.image;
+                match &mut acc {
+                    None => acc = Some(img),
+                    Some(a) => {
+                        for (p, q) in a.pixels.iter_mut().zip(&img.pixels) {
+                            for c in 0..4 {
+                                p[c] += q[c];
+                            }
+                        }
+                    }
+                }
+            }
+            let mut a = acc.expect("n >= 1");
+            let inv = 1.0 / n as f32;
+            for p in &mut a.pixels {
+                *p = p.map(|v| v * inv);
+            }
+            Ok(a)
+        }
+    }
+}
