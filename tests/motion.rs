@@ -1,0 +1,170 @@
+//! Chapter 4: motion-blurred splats against the accumulation buffer.
+mod common;
+use common::assert_clean;
+use glam::{Mat4, Vec3};
+use voxsplat::animate::{render_frame, Animation, Blur};
+use voxsplat::output::diff_rgba8;
+use voxsplat::pipeline::Motion;
+use voxsplat::{Antialias, Camera, Composite, Grid, Kernel, Projection, RenderOptions, SplatSet};
+
+fn one_voxel() -> SplatSet {
+    let grid = Grid::centered([1, 1, 1], [1.0; 3]).unwrap();
+    SplatSet::from_fn(grid, |_, _, _| Some([1.0, 1.0, 1.0, 0.01])).unwrap()
+}
+
+/// Orthographic, 4 pixels per voxel, looking down -z.
+fn ortho() -> Camera {
+    Camera {
+        eye: Vec3::new(0.13, 0.07, 50.0),
+        target: Vec3::new(0.13, 0.07, 0.0),
+        up: Vec3::Y,
+        projection: Projection::Orthographic { height: 32.0 },
+        near: 1.0,
+        far: 100.0,
+        width: 128,
+        height: 128,
+    }
+}
+
+fn sheet_with(motion: Option<Motion>) -> RenderOptions {
+    let mut o = RenderOptions::default();
+    o.composite = Composite::Sheet;
+    o.motion = motion;
+    o
+}
+
+/// Per-pixel optical depth T of a single splat drawn into a sheet (alpha = 1 - e^-T).
+fn optical_depths(r: &mut voxsplat::Renderer, cam: &Camera, o: &RenderOptions) -> Vec<f64> {
+    r.render(cam, o).unwrap().image.pixels.iter().map(|p| -(1.0 - p[3] as f64).ln()).collect()
+}
+
+#[test]
+fn a_moving_splat_keeps_its_energy_over_area_a1_plus_lw() {
+    let mut r = common::cpu();
+    r.set_scene(one_voxel()).unwrap();
+    let cam = ortho();
+    let still = optical_depths(&mut r, &cam, &sheet_with(None));
+    let e1: f64 = still.iter().sum();
+    let peak1 = still.iter().cloned().fold(0.0, f64::max);
+    let a1 = e1 / peak1; // effective area in pixels
+    let g = Kernel::Gaussian.motion_g();
+    let radius_px = Kernel::Gaussian.radius() as f64 * 4.0;
+    for l_vox in [2.0f32, 5.0, 9.0] {
+        // The voxel was l voxels to the left at t_{i-1}: l * 4 pixels of motion.
+        let m = Motion { previous: Mat4::from_translation(Vec3::new(-l_vox, 0.0, 0.0)), delta_px: 0.5 };
+        let moved = optical_depths(&mut r, &cam, &sheet_with(Some(m)));
+        let e2: f64 = moved.iter().sum();
+        let peak2 = moved.iter().cloned().fold(0.0, f64::max);
+        let l_px = l_vox as f64 * 4.0;
+        // Effective width w = line integral across / peak = G * A1 / radius.
+        let want_area = a1 + l_px * (g * a1 / radius_px);
+        let area = e2 / peak2;
+        eprintln!("l = {l_px} px: energy {e2:.5e} vs {e1:.5e}, area {area:.1} vs {want_area:.1}");
+        assert!((e2 - e1).abs() < 0.01 * e1, "energy {e2} vs {e1}");
+        assert!((area - want_area).abs() < 0.01 * want_area, "area {area} vs {want_area}");
+    }
+}
+
+#[test]
+fn no_blur_below_delta_or_along_the_eye_axis() {
+    let mut r = common::cpu();
+    r.set_scene(one_voxel()).unwrap();
+    let cam = ortho();
+    let still = r.render(&cam, &sheet_with(None)).unwrap().image;
+    for (shift, delta) in [(Vec3::new(0.1, 0.0, 0.0), 0.5), (Vec3::new(0.0, 0.0, 7.0), 0.5), (Vec3::new(3.0, 0.0, 0.0), 20.0)] {
+        let m = Motion { previous: Mat4::from_translation(shift), delta_px: delta };
+        let mut o = sheet_with(Some(m));
+        o.antialias = Antialias::None;
+        let moved = r.render(&cam, &o).unwrap().image;
+        assert_eq!(moved.pixels, still.pixels, "shift {shift} with delta {delta} px must not blur");
+    }
+    // Just above delta it does blur.
+    let m = Motion { previous: Mat4::from_translation(Vec3::new(3.0, 0.0, 0.0)), delta_px: 0.5 };
+    assert_ne!(r.render(&cam, &sheet_with(Some(m))).unwrap().image.pixels, still.pixels);
+}
+
+#[test]
+fn accumulation_with_one_subframe_is_the_still_frame() {
+    let anim = Animation::builtin("rotating-box").unwrap();
+    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let grid = *set.grid();
+    let mut anim = anim;
+    anim.camera.width = 64;
+    anim.camera.height = 64;
+    let mut r = common::cpu();
+    r.set_scene(set).unwrap();
+    let o = RenderOptions::default();
+    let still = render_frame(&mut r, &anim, &grid, 7, Blur::None, &o).unwrap();
+    let acc1 = render_frame(&mut r, &anim, &grid, 7, Blur::Accum(1), &o).unwrap();
+    assert_eq!(still.pixels, acc1.pixels);
+    let acc4 = render_frame(&mut r, &anim, &grid, 7, Blur::Accum(4), &o).unwrap();
+    assert_ne!(still.pixels, acc4.pixels);
+}
+
+#[test]
+fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
+    let mut anim = Animation::builtin("rotating-box").unwrap();
+    anim.camera.width = 128;
+    anim.camera.height = 128;
+    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let grid = *set.grid();
+    let mut gpu = common::gpu();
+    let mut cpu = common::cpu();
+    gpu.set_scene(set.clone()).unwrap();
+    cpu.set_scene(set).unwrap();
+    for composite in [Composite::Splat, Composite::Sheet] {
+        let mut o = RenderOptions::default();
+        o.composite = composite;
+        let g = render_frame(&mut gpu, &anim, &grid, 9, Blur::Splat, &o).unwrap();
+        let c = render_frame(&mut cpu, &anim, &grid, 9, Blur::Splat, &o).unwrap();
+        let (mean, max) = diff_rgba8(&g, &c).unwrap();
+        eprintln!("{composite:?} blurred: mean |diff| {mean:.4}/255, max {max}/255");
+        assert!(mean <= 1.0);
+        // Blurred splats are closer to a 16-sub-frame accumulation than the still frame is.
+        let truth = render_frame(&mut gpu, &anim, &grid, 9, Blur::Accum(16), &o).unwrap();
+        let still = render_frame(&mut gpu, &anim, &grid, 9, Blur::None, &o).unwrap();
+        let e_blur = voxsplat::metrics::compare(&g, &truth).unwrap().rmse;
+        let e_still = voxsplat::metrics::compare(&still, &truth).unwrap().rmse;
+        eprintln!("{composite:?}: rmse to accum:16: blurred {e_blur:.4}, still {e_still:.4}");
+        assert!(e_blur < e_still);
+    }
+    assert_clean(&gpu);
+}
+
+#[test]
+fn animation_files_are_checked() {
+    let good = r#"
+        scene = "cube40"
+        frames = 10
+        [camera]
+        eye = [0.0, 0.0, 100.0]
+        target = [0.0, 0.0, 0.0]
+        fov = 30.0
+        [[keyframe]]
+        frame = 0
+        [[keyframe]]
+        frame = 10
+        rotate = [1.0, 0.0, 0.0, 90.0]
+        translate = [5.0, 0.0, 0.0]
+    "#;
+    let a = Animation::from_toml(good).unwrap();
+    let grid = *voxsplat::scene::build("cube40").unwrap().grid();
+    // Halfway: 45 degrees about x and half the translation.
+    let m = a.model(&grid, 5.0);
+    let p = m.transform_point3(grid.center() + Vec3::Y);
+    let want = grid.center() + Vec3::new(2.5, 45f32.to_radians().cos(), 45f32.to_radians().sin());
+    assert!((p - want).length() < 1e-4, "{p} vs {want}");
+    for bad in [
+        good.replace("frames = 10", "frames = 0"),
+        good.replace("fov = 30.0", "fov = 30.0\northo = 5.0"),
+        good.replace("rotate = [1.0, 0.0, 0.0, 90.0]", "rotate = [0.0, 0.0, 0.0, 90.0]"),
+        good.replace("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, 100.0]"),
+        good.replace("frame = 10", "frame = nan"),
+        "scene = 3".to_string(),
+        good.replace("scene", "sceen"),
+    ] {
+        assert!(Animation::from_toml(&bad).is_err(), "accepted:\n{bad}");
+    }
+    assert!("accum:0".parse::<Blur>().is_err() && "accum:x".parse::<Blur>().is_err());
+    assert_eq!("accum:5".parse::<Blur>().unwrap(), Blur::Accum(5));
+}
