@@ -262,20 +262,42 @@ pub fn render_frame(
     blur: Blur,
     base: &RenderOptions,
 ) -> Result<ImageF32> {
+    Ok(render_frame_timed(r, anim, grid, i, blur, base)?.0)
+}
+
+/// [`render_frame`] and the summed stage time of every render it took, in milliseconds.
+pub fn render_frame_timed(
+    r: &mut Renderer,
+    anim: &Animation,
+    grid: &Grid,
+    i: u32,
+    blur: Blur,
+    base: &RenderOptions,
+) -> Result<(ImageF32, f64)> {
     let t = i as f32;
+    let ms = |f: &crate::Rendered| f.timings.iter().map(|s| s.ms).sum::<f64>();
     match blur {
-        Blur::None => Ok(r.render(&anim.object_camera(grid, t), base)?.image),
+        Blur::None => {
+            let f = r.render(&anim.object_camera(grid, t), base)?;
+            let m = ms(&f);
+            Ok((f.image, m))
+        }
         Blur::Splat => {
             let mut o = base.clone();
             o.motion = Some(Motion { previous: anim.motion(grid, t - anim.shutter, t), delta_px: DEFAULT_DELTA_PX });
-            Ok(r.render(&anim.object_camera(grid, t), &o)?.image)
+            let f = r.render(&anim.object_camera(grid, t), &o)?;
+            let m = ms(&f);
+            Ok((f.image, m))
         }
         Blur::Accum(n) => {
             let mut acc: Option<ImageF32> = None;
+            let mut total = 0.0;
             for k in 0..n {
                 // The last sub-frame is exactly t_i, so N = 1 is the still frame.
                 let tk = if k + 1 == n { t } else { t - anim.shutter + (k + 1) as f32 / n as f32 * anim.shutter };
-                let img = r.render(&anim.object_camera(grid, tk), base)?.image;
+                let f = r.render(&anim.object_camera(grid, tk), base)?;
+                total += ms(&f);
+                let img = f.image;
                 match &mut acc {
                     None => acc = Some(img),
                     Some(a) => {
@@ -292,7 +314,7 @@ pub fn render_frame(
             for p in &mut a.pixels {
                 *p = p.map(|v| v * inv);
             }
-            Ok(a)
+            Ok((a, total))
         }
     }
 }

@@ -130,7 +130,11 @@ fn quick_bench_writes_valid_csv_and_svg() {
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows.len(), 2 * 5 + 3, "two scenes x five methods, and three anti-aliasing modes");
+    assert_eq!(
+        rows.len(),
+        2 * 5 + 3 + 4,
+        "two scenes x five methods, three anti-aliasing modes, four motion-blur methods"
+    );
     for r in &rows {
         assert_eq!(r.len(), header.len());
         let t: f64 = r[col("time_ms")].parse().unwrap();
@@ -143,7 +147,9 @@ fn quick_bench_writes_valid_csv_and_svg() {
         rows.iter().find(|r| r[0] == scene && r[1] == m).unwrap()[col("rmse")].parse().unwrap()
     };
     assert!(rm("cube40", "raycast 0.5") < rm("cube40", "raycast 1"));
-    for svg in ["chart-cube40.svg", "chart-plane.svg", "chart-plane-grazing.svg", "scaling.svg"] {
+    for svg in
+        ["chart-cube40.svg", "chart-plane.svg", "chart-plane-grazing.svg", "chart-rotating-box.svg", "scaling.svg"]
+    {
         let text = std::fs::read_to_string(dir.join(svg)).unwrap();
         assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"), "{svg}");
     }
@@ -153,6 +159,7 @@ fn quick_bench_writes_valid_csv_and_svg() {
     let md = std::fs::read_to_string(&results).unwrap();
     assert!(md.contains("## Targets") && md.contains("chart-cube40.svg"));
     assert!(md.contains("## Anti-aliasing") && md.contains("Swan vs none beyond k"));
+    assert!(md.contains("## Motion blur") && md.contains("accumulation"));
 }
 
 #[test]

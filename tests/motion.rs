@@ -71,7 +71,9 @@ fn no_blur_below_delta_or_along_the_eye_axis() {
     r.set_scene(one_voxel()).unwrap();
     let cam = ortho();
     let still = r.render(&cam, &sheet_with(None)).unwrap().image;
-    for (shift, delta) in [(Vec3::new(0.1, 0.0, 0.0), 0.5), (Vec3::new(0.0, 0.0, 7.0), 0.5), (Vec3::new(3.0, 0.0, 0.0), 20.0)] {
+    for (shift, delta) in
+        [(Vec3::new(0.1, 0.0, 0.0), 0.5), (Vec3::new(0.0, 0.0, 7.0), 0.5), (Vec3::new(3.0, 0.0, 0.0), 20.0)]
+    {
         let m = Motion { previous: Mat4::from_translation(shift), delta_px: delta };
         let mut o = sheet_with(Some(m));
         o.antialias = Antialias::None;

@@ -432,6 +432,10 @@ fn bench(a: BenchArgs) -> Result<()> {
     let (aa_size, aa_factor, aa_dolly) = if a.quick { (96, 4, 8) } else { (256, 8, 60) };
     let aa = antialias_study(&mut r, aa_size, aa_factor, aa_dolly, m.frames, |msg| eprintln!("{msg}"))?;
     rows.extend(antialias_rows(&aa, aa_size));
+    eprintln!("motion blur...");
+    let (mb_size, mb_frame) = if a.quick { (96, 9) } else { (256, 12) };
+    let mb = motion_study(&mut r, mb_size, mb_frame, m.frames)?;
+    rows.extend(motion_rows(&mb, mb_size));
     write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -475,7 +479,11 @@ fn bench(a: BenchArgs) -> Result<()> {
             scaling: &scale,
             chart_dir,
             notes,
-            antialias: Some(antialias_markdown(&aa, aa_size, aa_factor, aa_dolly)),
+            antialias: Some(format!(
+                "{}\n{}",
+                antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
+                motion_markdown(&mb, mb_size, mb_frame)
+            )),
         })?;
         std::fs::write(path, md).map_err(io(path))?;
         eprintln!("wrote {}", path.display());
