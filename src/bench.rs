@@ -554,6 +554,15 @@ pub struct Report<'a> {
     pub antialias: Option<String>,
 }
 
+/// A relative link to `file` in `dir` ("" = beside the page).
+fn link(dir: &str, file: &str) -> String {
+    if dir.is_empty() {
+        file.to_string()
+    } else {
+        format!("{dir}/{file}")
+    }
+}
+
 fn row<'a>(rows: &'a [Row], scene: &str, method: &str) -> Option<&'a Row> {
     rows.iter().find(|r| r.scene == scene && r.method == method)
 }
@@ -581,7 +590,7 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
     scenes.dedup();
     let _ = writeln!(s, "## Speed against accuracy\n");
     for sc in &scenes {
-        let _ = writeln!(s, "![{sc}]({}/chart-{sc}.svg)\n", rep.chart_dir);
+        let _ = writeln!(s, "![{sc}]({})\n", link(&rep.chart_dir, &format!("chart-{sc}.svg")));
     }
     let _ = writeln!(
         s,
@@ -714,7 +723,7 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
         let _ = writeln!(s, "\n{aa}");
     }
     if !rep.scaling.is_empty() {
-        let _ = writeln!(s, "\n## Scaling\n\n![scaling]({}/scaling.svg)\n", rep.chart_dir);
+        let _ = writeln!(s, "\n## Scaling\n\n![scaling]({})\n", link(&rep.chart_dir, "scaling.svg"));
         let _ = writeln!(s, "| series | splats | image | ms | order ms | GPU bytes | bytes/splat |\n|---|---:|---:|---:|---:|---:|---:|");
         for p in rep.scaling {
             let _ = writeln!(
@@ -865,6 +874,10 @@ pub struct MotionRow {
     pub method: String,
     pub time_ms: f64,
     pub metrics: ImageMetrics,
+    /// RMSE over the silhouette (truth alpha in (0.05, 0.95)) and over the interior (alpha ≥ 0.95).
+    pub rmse_edge: f64,
+    pub rmse_interior: f64,
+    pub image: ImageF32,
 }
 
 /// The rotating box at one frame: still, blurred splats (per-splat and sheet), and 5-sub-frame
@@ -896,14 +909,33 @@ pub fn motion_study(r: &mut Renderer, size: u32, frame: u32, frames: usize) -> R
             last = Some(img);
         }
         let img = last.expect("one frame");
-        rows.push(MotionRow { method: name.into(), time_ms: median(&mut times), metrics: compare(&img, &truth)? });
+        let alpha = |i: usize| truth.pixels[i][3];
+        let rmse_edge = crate::metrics::rmse_masked(&img, &truth, |i| alpha(i) > 0.05 && alpha(i) < 0.95);
+        let rmse_interior = crate::metrics::rmse_masked(&img, &truth, |i| alpha(i) >= 0.95);
+        rows.push(MotionRow {
+            method: name.into(),
+            time_ms: median(&mut times),
+            metrics: compare(&img, &truth)?,
+            rmse_edge: rmse_edge.unwrap_or(f64::NAN),
+            rmse_interior: rmse_interior.unwrap_or(f64::NAN),
+            image: img,
+        });
     }
+    rows.push(MotionRow {
+        method: "accum:64 (truth)".into(),
+        time_ms: f64::NAN,
+        metrics: compare(&truth, &truth)?,
+        rmse_edge: 0.0,
+        rmse_interior: 0.0,
+        image: truth,
+    });
     Ok(rows)
 }
 
 /// Chart rows for the motion study (scene "rotating-box").
 pub fn motion_rows(rows: &[MotionRow], size: u32) -> Vec<Row> {
     rows.iter()
+        .filter(|m| m.time_ms.is_finite())
         .map(|m| Row {
             scene: "rotating-box".into(),
             method: m.method.clone(),
@@ -919,20 +951,59 @@ pub fn motion_rows(rows: &[MotionRow], size: u32) -> Vec<Row> {
         .collect()
 }
 
+/// Write each method's frame and, for the blurred splats, the error against the truth (×4) as
+/// `motion-*.png` in `dir`; returns (label, file name) pairs.
+pub fn write_motion_images(rows: &[MotionRow], dir: &Path) -> Result<Vec<(String, String)>> {
+    let mut out = Vec::new();
+    let truth = rows.iter().find(|r| r.method.starts_with("accum:64")).map(|r| &r.image);
+    for r in rows {
+        let name = format!(
+            "motion-{}.png",
+            r.method.split([' ', '(', ')', ':']).filter(|s| !s.is_empty()).collect::<Vec<_>>().join("-")
+        );
+        crate::output::write_image(&r.image, &dir.join(&name))?;
+        out.push((r.method.clone(), name));
+    }
+    if let (Some(t), Some(b)) = (truth, rows.iter().find(|r| r.method == "blurred splats")) {
+        let mut err = t.clone();
+        for (e, (p, q)) in err.pixels.iter_mut().zip(b.image.pixels.iter().zip(&t.pixels)) {
+            let d = (0..4).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max);
+            *e = [(4.0 * d).min(1.0), (4.0 * d).min(1.0) * 0.5, 0.0, 1.0];
+        }
+        crate::output::write_image(&err, &dir.join("motion-error-blurred-splats.png"))?;
+        out.push(("error of blurred splats ×4".into(), "motion-error-blurred-splats.png".into()));
+    }
+    Ok(out)
+}
+
 /// The motion-blur section of RESULTS.md with the chapter-4 targets.
-pub fn motion_markdown(rows: &[MotionRow], size: u32, frame: u32) -> String {
+pub fn motion_markdown(
+    rows: &[MotionRow],
+    size: u32,
+    frame: u32,
+    images: &[(String, String)],
+    chart_dir: &str,
+) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
         "## Motion blur (chapter 4)\n\nThe rotating 60³ box (`voxsplat animate --anim rotating-box`), frame {frame}, {size}², \
-         orthographic, 6° per frame; error against 64-sub-frame accumulation.\n\n| method | ms | RMSE | PSNR dB | SSIM luma |\n|---|---:|---:|---:|---:|"
+         orthographic, 6° per frame; error against 64-sub-frame accumulation, over the whole frame, the \
+         silhouette (truth alpha in (0.05, 0.95)) and the interior (alpha ≥ 0.95).\n\n\
+         | method | ms | RMSE | PSNR dB | SSIM luma | RMSE silhouette | RMSE interior |\n|---|---:|---:|---:|---:|---:|---:|"
     );
-    for r in rows {
+    for r in rows.iter().filter(|r| r.time_ms.is_finite()) {
         let _ = writeln!(
             s,
-            "| {} | {:.2} | {:.4} | {:.2} | {:.4} |",
-            r.method, r.time_ms, r.metrics.rmse, r.metrics.psnr, r.metrics.ssim_luma
+            "| {} | {:.2} | {:.4} | {:.2} | {:.4} | {:.4} | {:.4} |",
+            r.method, r.time_ms, r.metrics.rmse, r.metrics.psnr, r.metrics.ssim_luma, r.rmse_edge, r.rmse_interior
         );
+    }
+    if !images.is_empty() {
+        let heads: Vec<&str> = images.iter().map(|i| i.0.as_str()).collect();
+        let _ = writeln!(s, "\n| {} |\n|{}", heads.join(" | "), "---|".repeat(images.len()));
+        let cells: Vec<String> = images.iter().map(|i| format!("![]({})", link(chart_dir, &i.1))).collect();
+        let _ = writeln!(s, "| {} |", cells.join(" | "));
     }
     let get = |n: &str| rows.iter().find(|r| r.method == n);
     if let (Some(still), Some(acc)) = (get("still"), get("accum:5")) {

@@ -436,6 +436,7 @@ fn bench(a: BenchArgs) -> Result<()> {
     let (mb_size, mb_frame) = if a.quick { (96, 9) } else { (256, 12) };
     let mb = motion_study(&mut r, mb_size, mb_frame, m.frames)?;
     rows.extend(motion_rows(&mb, mb_size));
+    let mb_images = write_motion_images(&mb, &a.out_dir)?;
     write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -470,6 +471,11 @@ fn bench(a: BenchArgs) -> Result<()> {
         let notes_path = base.join("results-notes.md");
         let notes = std::fs::read_to_string(&notes_path).ok();
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+        let motion_md = format!(
+            "{}\n{}",
+            antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
+            motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir)
+        );
         let md = results_markdown(&Report {
             device,
             commit,
@@ -479,11 +485,7 @@ fn bench(a: BenchArgs) -> Result<()> {
             scaling: &scale,
             chart_dir,
             notes,
-            antialias: Some(format!(
-                "{}\n{}",
-                antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
-                motion_markdown(&mb, mb_size, mb_frame)
-            )),
+            antialias: Some(motion_md),
         })?;
         std::fs::write(path, md).map_err(io(path))?;
         eprintln!("wrote {}", path.display());
