@@ -27,6 +27,12 @@ pub struct Keyframe {
     pub rotate: [f32; 4],
     #[serde(default)]
     pub translate: [f32; 3],
+    /// Camera path: the eye and look-at point at this keyframe (both or neither); frames between
+    /// camera keyframes interpolate linearly, and frames outside them hold the nearest.
+    #[serde(default)]
+    pub eye: Option<[f32; 3]>,
+    #[serde(default)]
+    pub target: Option<[f32; 3]>,
 }
 
 fn no_rotation() -> [f32; 4] {
@@ -128,7 +134,12 @@ impl Animation {
             return Err(Error::InvalidArgument("an animation needs at least one [[keyframe]]".into()));
         }
         for k in &f.keyframe {
-            let finite = k.frame.is_finite()
+            if k.eye.is_some() != k.target.is_some() {
+                return Err(Error::InvalidArgument("a camera keyframe needs both eye and target".into()));
+            }
+            let cam_finite = k.eye.iter().chain(k.target.iter()).flatten().all(|v| v.is_finite());
+            let finite = cam_finite
+                && k.frame.is_finite()
                 && k.rotate.iter().all(|v| v.is_finite())
                 && k.translate.iter().all(|v| v.is_finite());
             if !finite {
@@ -160,7 +171,28 @@ impl Animation {
             height: f.size[1],
         };
         camera.validate()?;
-        Ok(Self { scene: f.scene, frames: f.frames, shutter: f.shutter, camera, keyframes })
+        let anim = Self { scene: f.scene, frames: f.frames, shutter: f.shutter, camera, keyframes };
+        for k in anim.keyframes.iter().filter(|k| k.eye.is_some()) {
+            anim.camera_at(k.frame).validate()?;
+        }
+        Ok(anim)
+    }
+
+    /// The world camera at time `t`: the [camera] table, moved along the keyframes' camera path.
+    pub fn camera_at(&self, t: f32) -> Camera {
+        let path: Vec<(f32, Vec3, Vec3)> =
+            self.keyframes.iter().filter_map(|k| Some((k.frame, Vec3::from(k.eye?), Vec3::from(k.target?)))).collect();
+        let (eye, target) = match path.iter().position(|p| p.0 > t) {
+            _ if path.is_empty() => (self.camera.eye, self.camera.target),
+            Some(0) => (path[0].1, path[0].2),
+            None => (path[path.len() - 1].1, path[path.len() - 1].2),
+            Some(i) => {
+                let (a, b) = (&path[i - 1], &path[i]);
+                let s = ((t - a.0) / (b.0 - a.0).max(1e-9)).clamp(0.0, 1.0);
+                (a.1.lerp(b.1, s), a.2.lerp(b.2, s))
+            }
+        };
+        Camera { eye, target, ..self.camera }
     }
 
     /// The object's transform at time `t` (in frames): rotation about the grid centre, slerped
@@ -204,7 +236,7 @@ impl Animation {
     /// it gives the picture of the moving grid seen by the world camera.
     pub fn object_camera(&self, grid: &Grid, t: f32) -> Camera {
         let inv = self.model(grid, t).inverse();
-        let c = &self.camera;
+        let c = &self.camera_at(t);
         Camera {
             eye: inv.transform_point3(c.eye),
             target: inv.transform_point3(c.target),
@@ -216,8 +248,8 @@ impl Animation {
     /// Chapter 4's motion from `t0` to `t1`: grid point -> its position at `t0` relative to the
     /// eye at `t1`, in the object coordinates of `t1`.
     pub fn motion(&self, grid: &Grid, t0: f32, t1: f32) -> Mat4 {
-        let v = self.camera.view();
-        (v * self.model(grid, t1)).inverse() * (v * self.model(grid, t0))
+        let (v0, v1) = (self.camera_at(t0).view(), self.camera_at(t1).view());
+        (v1 * self.model(grid, t1)).inverse() * (v0 * self.model(grid, t0))
     }
 }
 

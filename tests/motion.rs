@@ -168,5 +168,17 @@ fn animation_files_are_checked() {
         assert!(Animation::from_toml(&bad).is_err(), "accepted:\n{bad}");
     }
     assert!("accum:0".parse::<Blur>().is_err() && "accum:x".parse::<Blur>().is_err());
+    // A camera path: the eye moves from z = 100 to z = 80 between frames 0 and 10.
+    let path = good
+        .replace("frame = 10\n", "frame = 10\n        eye = [0.0, 0.0, 80.0]\n        target = [0.0, 0.0, 0.0]\n")
+        .replace("frame = 0\n", "frame = 0\n        eye = [0.0, 0.0, 100.0]\n        target = [0.0, 0.0, 0.0]\n");
+    let a = Animation::from_toml(&path).unwrap();
+    assert!((a.camera_at(5.0).eye.z - 90.0).abs() < 1e-4);
+    // A camera dolly along the view axis alone projects to no motion: nothing blurs.
+    let still_grid = *voxsplat::scene::build("cube40").unwrap().grid();
+    let m = a.motion(&still_grid, 4.0, 5.0);
+    let o = a.object_camera(&still_grid, 5.0);
+    assert!(m.is_finite() && o.validate().is_ok());
+    assert!(Animation::from_toml(&good.replace("frame = 0\n", "frame = 0\n        eye = [1.0, 2.0, 3.0]\n")).is_err());
     assert_eq!("accum:5".parse::<Blur>().unwrap(), Blur::Accum(5));
 }
