@@ -173,6 +173,30 @@ impl Camera {
         }
     }
 
+    /// A perspective fly-over of a terrain grid (z up): the eye beyond the southern (low y) edge,
+    /// above the highest level, looking north and down across the terrain (Figs 5.1-5.3).
+    pub fn flyover(grid: &Grid, width: u32, height: u32) -> Self {
+        let c = grid.center();
+        let ext = Vec3::new(
+            grid.dims[0] as f32 * grid.spacing[0],
+            grid.dims[1] as f32 * grid.spacing[1],
+            grid.dims[2] as f32 * grid.spacing[2],
+        );
+        let eye = c + Vec3::new(0.1 * ext.x, -0.75 * ext.y, 0.5 * ext.z + 0.25 * ext.y);
+        let target = c + Vec3::new(0.0, 0.15 * ext.y, -0.2 * ext.z);
+        let d = (target - eye).length();
+        Self {
+            eye,
+            target,
+            up: Vec3::Z,
+            projection: Projection::Perspective { fov_y_deg: 55.0 },
+            near: 0.01 * d,
+            far: 4.0 * (d + ext.length()),
+            width,
+            height,
+        }
+    }
+
     /// World to eye space as in section 3.3.1: a rigid transform with the eye at the origin looking
     /// down +z (x right, y up).
     pub fn world_to_eye(&self, p: Vec3) -> Vec3 {

@@ -16,6 +16,9 @@ pub const SCENES: &[(&str, &str)] = &[
     ("plane", "single-sheet 498x398x1 checkerboard of 10x10 black/white squares (Fig. 3.6)"),
     ("stripes128", "dense 128^3 ball with 3-voxel colour stripes, semi-transparent: finer than the pixels in small views (Fig. 3.8)"),
     ("empty", "an 8^3 grid with no non-empty voxel"),
+    ("bonsai", "data: CT of a bonsai, 256^3 NIfTI (shared/data/bonsai), 'bonsai' transfer function"),
+    ("stent", "data: CT of a stented aorta, 128x128x256 NRRD (shared/data/stent), 'ct' transfer function"),
+    ("rmnp", "data: Rocky Mountain NP elevation, 152x187 GeoTIFF with Landsat colour (shared/data/rmnp), x3 relief"),
 ];
 
 fn hollow_cube(n: u32, opacity: f32) -> Result<SplatSet> {
@@ -54,6 +57,23 @@ pub fn build(name: &str) -> Result<SplatSet> {
             })
         }
         "empty" => SplatSet::from_fn(Grid::centered([8, 8, 8], [1.0; 3])?, |_, _, _| None),
+        "bonsai" | "stent" => {
+            let dir = crate::loaders::data_dir();
+            let (file, tf) =
+                if name == "bonsai" { ("bonsai/bonsai.nii.gz", "bonsai") } else { ("stent/stent.nrrd", "ct") };
+            let vol = crate::loaders::load_volume(&dir.join(file), &Default::default())?;
+            crate::classify::classify(&vol, &crate::classify::TransferFunction::preset(tf)?, None)
+        }
+        "rmnp" => {
+            let dir = crate::loaders::data_dir().join("rmnp");
+            let heights = crate::loaders::load_heights(&dir.join("rmnp-dem.tif"))?;
+            let color = image::open(dir.join("rmnp-rgb.png"))
+                .map_err(|e| Error::InvalidArgument(format!("rmnp-rgb.png: {e}")))?
+                .to_rgba8();
+            let opts =
+                crate::terrain::TerrainOptions { cell: 233.0, vscale: 3.0, color: Some(color), ..Default::default() };
+            crate::terrain::terrain_splats(&heights, &opts)
+        }
         other => Err(Error::InvalidArgument(format!(
             "unknown scene '{other}'; built-in scenes: {}",
             SCENES.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")

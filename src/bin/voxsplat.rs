@@ -24,6 +24,19 @@ enum Command {
     Render(RenderArgs),
     /// Write or check a visibility order (back to front).
     Order(OrderArgs),
+    /// Describe a volume or height file: dims, spacing, value range, splats at the default
+    /// classification and GPU bytes per splat.
+    Info {
+        /// The file (.nrrd/.nhdr, .nii/.nii.gz, .npy, .tif, .png; raw with --dims and --dtype).
+        file: PathBuf,
+        #[arg(long, value_parser = parse_dims)]
+        dims: Option<[u32; 3]>,
+        #[arg(long, value_parser = ["u8", "u16", "i16", "f32"])]
+        dtype: Option<String>,
+        /// Transfer function for the splat count.
+        #[arg(long, default_value = "ramp")]
+        tf: String,
+    },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
     Animate(AnimateArgs),
     /// Print error metrics of image A against reference B (PNG or EXR).
@@ -81,6 +94,21 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+fn parse_dims(s: &str) -> std::result::Result<[u32; 3], String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if v.len() != 3 {
+        return Err(format!("expected X,Y,Z, got '{s}'"));
+    }
+    let mut d = [0u32; 3];
+    for (o, p) in d.iter_mut().zip(v) {
+        *o = p.trim().parse().map_err(|_| format!("'{p}' is not a dimension"))?;
+        if *o == 0 {
+            return Err("dimensions must be positive".into());
+        }
+    }
+    Ok(d)
+}
+
 fn parse_finite(s: &str) -> std::result::Result<f32, String> {
     let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
     if v.is_finite() {
@@ -119,9 +147,43 @@ struct SceneArgs {
     /// Image size.
     #[arg(long, value_parser = parse_size, default_value = "512x512")]
     size: (u32, u32),
-    /// Preset view: a three-quarter framing, or a grazing view across a single-sheet scene (Fig. 3.6).
-    #[arg(long, default_value = "framing", value_parser = ["framing", "grazing"])]
+    /// Preset view: auto (fly-over for terrain, framing otherwise), a three-quarter framing, a
+    /// grazing view across a single-sheet scene (Fig. 3.6), or a terrain fly-over (Figs 5.1-5.3).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover"])]
     view: String,
+    /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, or raw with --dims and --dtype).
+    #[arg(long, conflicts_with = "terrain")]
+    volume: Option<PathBuf>,
+    /// Raw volume dimensions.
+    #[arg(long, value_parser = parse_dims)]
+    dims: Option<[u32; 3]>,
+    /// Raw sample type.
+    #[arg(long, value_parser = ["u8", "u16", "i16", "f32"])]
+    dtype: Option<String>,
+    /// Raw data is big-endian.
+    #[arg(long)]
+    big_endian: bool,
+    /// Voxel spacing (overrides the file's).
+    #[arg(long, value_parser = parse_vec3)]
+    spacing: Option<Vec3>,
+    /// Transfer function: a preset (ramp, ct, bonsai) or a TOML file.
+    #[arg(long, default_value = "ramp")]
+    tf: String,
+    /// Phong shading with a headlight, applied to the voxels before splatting.
+    #[arg(long)]
+    shade: bool,
+    /// Render a height grid (16-bit PNG, GeoTIFF, or 2D .npy) as voxel columns.
+    #[arg(long)]
+    terrain: Option<PathBuf>,
+    /// Colour image for --terrain (default: hypsometric ramp with hillshade).
+    #[arg(long, requires = "terrain")]
+    color: Option<PathBuf>,
+    /// Vertical exaggeration for --terrain.
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    vscale: f32,
+    /// Horizontal cell size of --terrain, in height units.
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    cell: f32,
     /// Visibility order.
     #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted"])]
     order: String,
@@ -208,8 +270,17 @@ struct OrderArgs {
 
 fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     let (w, h) = a.size;
-    let grazing = a.view == "grazing";
-    let mut cam = if grazing { Camera::grazing(grid, w, h) } else { Camera::framing(grid, w, h) };
+    let view = match a.view.as_str() {
+        "auto" if a.terrain.is_some() || a.scene == "rmnp" => "flyover",
+        "auto" => "framing",
+        v => v,
+    };
+    let grazing = view == "grazing" || view == "flyover";
+    let mut cam = match view {
+        "grazing" => Camera::grazing(grid, w, h),
+        "flyover" => Camera::flyover(grid, w, h),
+        _ => Camera::framing(grid, w, h),
+    };
     let fitted_eye = cam.eye;
     if let Some(t) = a.target {
         cam.target = t;
@@ -236,6 +307,54 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + r + 1.0 });
     cam.validate()?;
     Ok(cam)
+}
+
+/// The splats named by --volume, --terrain or --scene, with a one-line report of what was loaded.
+fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
+    let set = if let Some(path) = &a.volume {
+        let hints = voxsplat::loaders::VolumeHints {
+            dims: a.dims,
+            dtype: a.dtype.as_deref().map(str::parse).transpose()?,
+            big_endian: a.big_endian,
+            spacing: a.spacing.map(|v| v.to_array()),
+        };
+        let vol = voxsplat::loaders::load_volume(path, &hints)?;
+        let tf = if a.tf.ends_with(".toml") {
+            let text = std::fs::read_to_string(&a.tf).map_err(|e| Error::Io { path: a.tf.clone(), source: e })?;
+            voxsplat::classify::TransferFunction::from_toml(&text)?
+        } else {
+            voxsplat::classify::TransferFunction::preset(&a.tf)?
+        };
+        let shading = a.shade.then(|| {
+            let g = voxsplat::Grid::centered(vol.dims, vol.spacing).ok();
+            let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
+            voxsplat::classify::Shading::headlight(-dir)
+        });
+        voxsplat::classify::classify(&vol, &tf, shading)?
+    } else if let Some(path) = &a.terrain {
+        let heights = voxsplat::loaders::load_heights(path)?;
+        let color = match &a.color {
+            Some(c) => Some(
+                image::open(c)
+                    .map_err(|e| Error::Image { path: c.display().to_string(), message: e.to_string() })?
+                    .to_rgba8(),
+            ),
+            None => None,
+        };
+        let opts = voxsplat::terrain::TerrainOptions { cell: a.cell, vscale: a.vscale, color, ..Default::default() };
+        voxsplat::terrain::terrain_splats(&heights, &opts)?
+    } else {
+        scene::build(&a.scene)?
+    };
+    eprintln!(
+        "{} splats, {:.0} bytes per splat on the GPU ({} x {} x {} grid)",
+        set.len(),
+        voxsplat::gpu_bytes_per_splat(&set),
+        set.grid().dims[0],
+        set.grid().dims[1],
+        set.grid().dims[2]
+    );
+    Ok(set)
 }
 
 fn renderer_of(a: &SceneArgs) -> Result<Renderer> {
@@ -265,7 +384,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Render(a) => {
-            let set = scene::build(&a.scene.scene)?;
+            let set = load_scene(&a.scene)?;
             let cam = camera_of(&a.scene, set.grid())?;
             let mut opts = RenderOptions::default();
             opts.order = a.scene.order.parse::<OrderKind>()?;
@@ -324,6 +443,30 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Animate(a) => animate(a),
+        Command::Info { file, dims, dtype, tf } => {
+            let name = file.display().to_string().to_ascii_lowercase();
+            let set = if name.ends_with(".tif") || name.ends_with(".tiff") || name.ends_with(".png") {
+                let h = voxsplat::loaders::load_heights(&file)?;
+                let (lo, hi) =
+                    h.heights.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+                println!("height grid: {} x {} cells, heights {lo} .. {hi}", h.width, h.rows);
+                voxsplat::terrain::terrain_splats(&h, &Default::default())?
+            } else {
+                let hints = voxsplat::loaders::VolumeHints {
+                    dims,
+                    dtype: dtype.as_deref().map(str::parse).transpose()?,
+                    ..Default::default()
+                };
+                let v = voxsplat::loaders::load_volume(&file, &hints)?;
+                let (lo, hi) =
+                    v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+                println!("volume: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
+                voxsplat::classify::classify(&v, &voxsplat::classify::TransferFunction::preset(&tf)?, None)?
+            };
+            println!("splats: {}", set.len());
+            println!("bytes per splat: {:.0}", voxsplat::gpu_bytes_per_splat(&set));
+            Ok(())
+        }
         Command::Compare { a, b } => {
             let (x, y) = (voxsplat::output::read_image(&a)?, voxsplat::output::read_image(&b)?);
             let m = voxsplat::metrics::compare(&x, &y)?;
@@ -336,7 +479,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Bench(a) => bench(a),
         Command::Order(a) => {
-            let set = scene::build(&a.scene.scene)?;
+            let set = load_scene(&a.scene)?;
             let cam = camera_of(&a.scene, set.grid())?;
             let kind = a.scene.order.parse::<OrderKind>()?;
             let seq = if kind == OrderKind::Pbtf && !a.scene.cpu {

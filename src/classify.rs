@@ -1,0 +1,188 @@
+//! Classification (section 1.2.5): a transfer function t = F(∇, ρ) maps each voxel's density (and
+//! optionally its gradient magnitude) to colour and opacity; voxels with zero opacity are not
+//! extracted. Optional Phong shading with a headlight is applied to the voxels before splatting,
+//! as in the seed (docs/MODEL.md).
+use crate::error::{Error, Result};
+use crate::loaders::ScalarVolume;
+use crate::volume::{Grid, SplatSet};
+use glam::Vec3;
+use serde::Deserialize;
+
+/// Piecewise-linear colour and opacity over density normalised to [0, 1].
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransferFunction {
+    /// (density in [0, 1], [r, g, b, opacity]) control points, in increasing density.
+    pub points: Vec<(f32, [f32; 4])>,
+    /// Opacity × (|∇ρ| / max |∇ρ|)^gradient_weight; 0 disables the weighting.
+    #[serde(default)]
+    pub gradient_weight: f32,
+    /// Densities mapped to 0 and 1 (default: the data's minimum and maximum).
+    #[serde(default)]
+    pub range: Option<(f32, f32)>,
+}
+
+/// Named transfer functions: (name, description).
+pub const TF_PRESETS: &[(&str, &str)] = &[
+    ("ramp", "grey ramp, opacity rising from a tenth of the range"),
+    ("ct", "CT: soft tissue faint red, contrast and bone opaque white"),
+    ("bonsai", "the bonsai CT: foliage green, trunk and pot brown"),
+];
+
+impl TransferFunction {
+    pub fn preset(name: &str) -> Result<Self> {
+        let p = |points: Vec<(f32, [f32; 4])>| Self { points, gradient_weight: 0.0, range: None };
+        match name {
+            "ramp" => Ok(p(vec![(0.1, [0.0, 0.0, 0.0, 0.0]), (1.0, [1.0, 1.0, 1.0, 0.6])])),
+            "ct" => Ok(p(vec![
+                (0.0, [0.0, 0.0, 0.0, 0.0]),
+                (0.12, [0.0, 0.0, 0.0, 0.0]),
+                (0.2, [0.8, 0.3, 0.2, 0.03]),
+                (0.45, [1.0, 0.9, 0.8, 0.6]),
+                (1.0, [1.0, 1.0, 1.0, 0.95]),
+            ])),
+            "bonsai" => Ok(p(vec![
+                (0.0, [0.0, 0.0, 0.0, 0.0]),
+                (0.15, [0.0, 0.0, 0.0, 0.0]),
+                (0.25, [0.25, 0.6, 0.15, 0.35]),
+                (0.45, [0.3, 0.55, 0.15, 0.6]),
+                (0.6, [0.55, 0.35, 0.15, 0.9]),
+                (1.0, [0.7, 0.5, 0.3, 0.95]),
+            ])),
+            other => Err(Error::InvalidArgument(format!(
+                "unknown transfer function '{other}' ({})",
+                TF_PRESETS.iter().map(|t| t.0).collect::<Vec<_>>().join(", ")
+            ))),
+        }
+    }
+
+    /// Parse and check a TOML transfer function (`points = [[0.2, [1, 0, 0, 0.5]], ...]`).
+    pub fn from_toml(text: &str) -> Result<Self> {
+        let tf: Self = toml::from_str(text).map_err(|e| Error::InvalidArgument(format!("transfer function: {e}")))?;
+        tf.validate()?;
+        Ok(tf)
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: &str| Err(Error::InvalidArgument(format!("transfer function: {m}")));
+        if self.points.is_empty() || self.points.len() > 4096 {
+            return bad("needs 1 to 4096 points");
+        }
+        for w in self.points.windows(2) {
+            if w[1].0.partial_cmp(&w[0].0).is_none_or(|o| o == std::cmp::Ordering::Less) {
+                return bad("densities must increase");
+            }
+        }
+        for (d, c) in &self.points {
+            if !d.is_finite() || c.iter().any(|v| !v.is_finite() || *v < 0.0) || c[3] > 1.0 {
+                return bad("values must be finite, non-negative, opacity at most 1");
+            }
+        }
+        if !(self.gradient_weight.is_finite() && self.gradient_weight >= 0.0) {
+            return bad("gradient_weight must be non-negative");
+        }
+        if let Some((a, b)) = self.range {
+            if !(a.is_finite() && b.is_finite() && b > a) {
+                return bad("range must be finite and increasing");
+            }
+        }
+        Ok(())
+    }
+
+    pub fn eval(&self, d: f32) -> [f32; 4] {
+        let pts = &self.points;
+        if d <= pts[0].0 {
+            return pts[0].1;
+        }
+        for w in pts.windows(2) {
+            if d <= w[1].0 {
+                let s = if w[1].0 > w[0].0 { (d - w[0].0) / (w[1].0 - w[0].0) } else { 1.0 };
+                return [0, 1, 2, 3].map(|c| w[0].1[c] + (w[1].1[c] - w[0].1[c]) * s);
+            }
+        }
+        pts[pts.len() - 1].1
+    }
+}
+
+/// Phong shading with a headlight, applied per voxel before splatting.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shading {
+    /// Direction the light travels (the view direction, for a headlight), in grid coordinates.
+    pub light: Vec3,
+    pub ambient: f32,
+    pub diffuse: f32,
+    pub specular: f32,
+    pub shininess: f32,
+}
+
+impl Shading {
+    pub fn headlight(view_dir: Vec3) -> Self {
+        Self { light: view_dir.normalize_or_zero(), ambient: 0.3, diffuse: 0.7, specular: 0.25, shininess: 20.0 }
+    }
+}
+
+/// Classify a loaded volume into splats. Gradients by central differences on the grid.
+pub fn classify(vol: &ScalarVolume, tf: &TransferFunction, shading: Option<Shading>) -> Result<SplatSet> {
+    tf.validate()?;
+    let [nx, ny, nz] = vol.dims;
+    let grid = Grid::centered(vol.dims, vol.spacing)?;
+    let (lo, hi) = tf.range.unwrap_or_else(|| {
+        vol.values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)))
+    });
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let at = |i: i64, j: i64, k: i64| -> f32 {
+        let (i, j, k) = (i.clamp(0, nx as i64 - 1), j.clamp(0, ny as i64 - 1), k.clamp(0, nz as i64 - 1));
+        let v = vol.values[(i + nx as i64 * (j + ny as i64 * k)) as usize];
+        if v.is_finite() {
+            (v - lo) / span
+        } else {
+            0.0
+        }
+    };
+    let grad = |i: u32, j: u32, k: u32| -> Vec3 {
+        let (i, j, k) = (i as i64, j as i64, k as i64);
+        Vec3::new(
+            (at(i + 1, j, k) - at(i - 1, j, k)) / (2.0 * vol.spacing[0]),
+            (at(i, j + 1, k) - at(i, j - 1, k)) / (2.0 * vol.spacing[1]),
+            (at(i, j, k + 1) - at(i, j, k - 1)) / (2.0 * vol.spacing[2]),
+        )
+    };
+    let gmax = if tf.gradient_weight > 0.0 || shading.is_some() {
+        let mut m = 0.0f32;
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    m = m.max(grad(i, j, k).length());
+                }
+            }
+        }
+        m.max(1e-12)
+    } else {
+        1.0
+    };
+    SplatSet::from_fn(grid, |i, j, k| {
+        let mut c = tf.eval(at(i as i64, j as i64, k as i64));
+        if c[3] <= 0.0 {
+            return None;
+        }
+        if tf.gradient_weight > 0.0 || shading.is_some() {
+            let g = grad(i, j, k);
+            if tf.gradient_weight > 0.0 {
+                c[3] *= (g.length() / gmax).powf(tf.gradient_weight);
+            }
+            if let Some(s) = shading {
+                let n = g.normalize_or_zero();
+                let ndl = n.dot(-s.light).abs();
+                let lit = s.ambient + s.diffuse * ndl;
+                let spec = s.specular * ndl.powf(s.shininess);
+                for ch in c.iter_mut().take(3) {
+                    *ch = (*ch * lit + spec).min(1.0);
+                }
+            }
+        }
+        (c[3] > 0.0).then_some(c)
+    })
+}

@@ -1,0 +1,424 @@
+//! Volume and height-grid loaders. Every size that comes from a header is checked against
+//! `MAX_VOXELS` and against the bytes actually present before anything is allocated from it;
+//! malformed input gives `Error::InvalidFile`-style typed errors (`Error::InvalidArgument` with the
+//! file's name), never a panic.
+use crate::error::{Error, Result};
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
+pub const MAX_VOXELS: u64 = 1 << 28;
+/// Most bytes a compressed stream may inflate to.
+pub const MAX_INFLATED: u64 = MAX_VOXELS * 8 + (1 << 20);
+
+/// Sample types of raw and NRRD data.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DType {
+    U8,
+    U16,
+    I16,
+    F32,
+}
+
+impl DType {
+    pub fn size(self) -> usize {
+        match self {
+            DType::U8 => 1,
+            DType::U16 | DType::I16 => 2,
+            DType::F32 => 4,
+        }
+    }
+}
+
+impl std::str::FromStr for DType {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "u8" | "uint8" | "uchar" | "unsigned char" | "uint8_t" => Ok(DType::U8),
+            "u16" | "uint16" | "ushort" | "unsigned short" | "uint16_t" => Ok(DType::U16),
+            "i16" | "int16" | "short" | "signed short" | "int16_t" => Ok(DType::I16),
+            "f32" | "float" | "float32" => Ok(DType::F32),
+            other => Err(Error::InvalidArgument(format!("unsupported sample type '{other}' (u8, u16, i16, f32)"))),
+        }
+    }
+}
+
+/// A dense scalar volume as loaded: x fastest, then y, then z.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalarVolume {
+    pub dims: [u32; 3],
+    pub spacing: [f32; 3],
+    pub values: Vec<f32>,
+}
+
+fn bad(path: &str, msg: impl std::fmt::Display) -> Error {
+    Error::InvalidArgument(format!("{path}: {msg}"))
+}
+
+/// Checked voxel count of `dims`.
+pub fn voxel_count(dims: &[u64], what: &str) -> Result<u64> {
+    let mut n: u64 = 1;
+    for &d in dims {
+        if d == 0 {
+            return Err(bad(what, "a dimension is zero"));
+        }
+        n = n.checked_mul(d).ok_or_else(|| bad(what, "dimensions overflow"))?;
+        if n > MAX_VOXELS {
+            return Err(Error::TooLarge(format!("{what}: more than {MAX_VOXELS} voxels")));
+        }
+    }
+    Ok(n)
+}
+
+/// Decode `n` samples of `dtype` from `bytes` (which must hold exactly enough).
+pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) -> Result<Vec<f32>> {
+    let need = n.checked_mul(dtype.size() as u64).ok_or_else(|| bad(what, "size overflows"))?;
+    if (bytes.len() as u64) < need {
+        return Err(bad(what, format!("data is truncated: {} bytes for {need}", bytes.len())));
+    }
+    let b = &bytes[..need as usize];
+    let v = match dtype {
+        DType::U8 => b.iter().map(|&x| x as f32).collect(),
+        DType::U16 => b
+            .chunks_exact(2)
+            .map(
+                |c| if big_endian { u16::from_be_bytes([c[0], c[1]]) } else { u16::from_le_bytes([c[0], c[1]]) } as f32,
+            )
+            .collect(),
+        DType::I16 => b
+            .chunks_exact(2)
+            .map(
+                |c| if big_endian { i16::from_be_bytes([c[0], c[1]]) } else { i16::from_le_bytes([c[0], c[1]]) } as f32,
+            )
+            .collect(),
+        DType::F32 => b
+            .chunks_exact(4)
+            .map(|c| {
+                let a = [c[0], c[1], c[2], c[3]];
+                if big_endian {
+                    f32::from_be_bytes(a)
+                } else {
+                    f32::from_le_bytes(a)
+                }
+            })
+            .collect(),
+    };
+    Ok(v)
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| Error::Io { path: path.display().to_string(), source: e })
+}
+
+/// Inflate gzip data, refusing to produce more than `limit` bytes.
+pub fn gunzip(bytes: &[u8], limit: u64, what: &str) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    flate2::read::MultiGzDecoder::new(bytes)
+        .take(limit + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| bad(what, format!("gzip: {e}")))?;
+    if out.len() as u64 > limit {
+        return Err(Error::TooLarge(format!("{what}: inflates beyond {limit} bytes")));
+    }
+    Ok(out)
+}
+
+fn is_gzip(bytes: &[u8]) -> bool {
+    bytes.len() >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b
+}
+
+/// A raw volume: `dims`, `dtype`, byte order and spacing given by the caller.
+pub fn raw_from_bytes(
+    bytes: &[u8],
+    dims: [u32; 3],
+    dtype: DType,
+    big_endian: bool,
+    spacing: [f32; 3],
+    what: &str,
+) -> Result<ScalarVolume> {
+    let n = voxel_count(&dims.map(u64::from), what)?;
+    let need = n * dtype.size() as u64;
+    if bytes.len() as u64 != need {
+        return Err(bad(what, format!("has {} bytes; {dims:?} of {dtype:?} needs {need}", bytes.len())));
+    }
+    check_spacing(spacing, what)?;
+    Ok(ScalarVolume { dims, spacing, values: decode(bytes, n, dtype, big_endian, what)? })
+}
+
+fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
+    if s.iter().all(|v| v.is_finite() && *v > 0.0) {
+        Ok(())
+    } else {
+        Err(bad(what, format!("spacing {s:?} must be finite and positive")))
+    }
+}
+
+/// NRRD with an attached or detached header, raw or gzip encoding. `dir` resolves detached data
+/// files.
+pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<ScalarVolume> {
+    if !bytes.starts_with(b"NRRD000") {
+        return Err(bad(what, "not an NRRD file (no NRRD000x magic)"));
+    }
+    // The header ends at the first blank line.
+    let end = bytes
+        .windows(2)
+        .position(|w| w == b"\n\n")
+        .map(|p| (p + 1, p + 2))
+        .or_else(|| bytes.windows(4).position(|w| w == b"\r\n\r\n").map(|p| (p + 2, p + 4)));
+    let (hdr_end, data_start) = match end {
+        Some(e) => e,
+        None => (bytes.len(), bytes.len()),
+    };
+    if hdr_end > 1 << 20 {
+        return Err(bad(what, "header longer than 1 MiB"));
+    }
+    let header = std::str::from_utf8(&bytes[..hdr_end]).map_err(|_| bad(what, "header is not text"))?;
+    let (mut dtype, mut dims, mut enc, mut endian_big, mut spacing, mut data_file) =
+        (None, None, None, false, [1.0f32; 3], None::<String>);
+    let mut dimension = None;
+    for line in header.lines().skip(1) {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let Some((key, value)) = line.split_once(':') else { continue };
+        let value = value.trim_start_matches('=').trim();
+        match key.trim() {
+            "type" => dtype = Some(value.parse::<DType>().map_err(|e| bad(what, e))?),
+            "dimension" => dimension = Some(value.parse::<u32>().map_err(|_| bad(what, "bad dimension"))?),
+            "sizes" => {
+                let v: std::result::Result<Vec<u64>, _> = value.split_whitespace().map(|t| t.parse::<u64>()).collect();
+                dims = Some(v.map_err(|_| bad(what, "bad sizes"))?);
+            }
+            "encoding" => enc = Some(value.to_string()),
+            "endian" => endian_big = value == "big",
+            "spacings" => {
+                let v: Vec<f32> = value.split_whitespace().filter_map(|t| t.parse().ok()).collect();
+                for (i, s) in v.iter().take(3).enumerate() {
+                    spacing[i] = *s;
+                }
+            }
+            "data file" | "datafile" => data_file = Some(value.to_string()),
+            _ => {}
+        }
+    }
+    let dtype = dtype.ok_or_else(|| bad(what, "no type field"))?;
+    let sizes = dims.ok_or_else(|| bad(what, "no sizes field"))?;
+    if sizes.is_empty() || sizes.len() > 3 || dimension.map(|d| d as usize != sizes.len()).unwrap_or(false) {
+        return Err(bad(what, "only 1 to 3 dimensional NRRD scalar volumes are supported"));
+    }
+    let mut d3 = [1u64; 3];
+    d3[..sizes.len()].copy_from_slice(&sizes);
+    let n = voxel_count(&d3, what)?;
+    if d3.iter().any(|&d| d > crate::volume::MAX_DIM as u64) {
+        return Err(Error::TooLarge(format!("{what}: a dimension exceeds {}", crate::volume::MAX_DIM)));
+    }
+    check_spacing(spacing, what)?;
+    let need = n * dtype.size() as u64;
+    let payload: Vec<u8> = match &data_file {
+        Some(f) => {
+            let dir = dir.ok_or_else(|| bad(what, "detached data file without a directory"))?;
+            let p = dir.join(f);
+            let len = std::fs::metadata(&p).map_err(|e| Error::Io { path: p.display().to_string(), source: e })?.len();
+            if !enc.as_deref().unwrap_or("raw").starts_with("gz") && len < need {
+                return Err(bad(what, format!("data file {} has {len} bytes, needs {need}", p.display())));
+            }
+            read_file(&p)?
+        }
+        None => bytes[data_start.min(bytes.len())..].to_vec(),
+    };
+    let data = match enc.as_deref().unwrap_or("raw") {
+        "raw" => payload,
+        "gzip" | "gz" => gunzip(&payload, need, what)?,
+        other => return Err(bad(what, format!("unsupported encoding '{other}' (raw, gzip)"))),
+    };
+    let values = decode(&data, n, dtype, endian_big, what)?;
+    Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
+}
+
+/// NIfTI-1 (`.nii` or `.nii.gz`), through the `nifti` crate's header parser; the data is read
+/// from the checked byte range.
+pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
+    let data = if is_gzip(bytes) { gunzip(bytes, MAX_INFLATED, what)? } else { bytes.to_vec() };
+    if data.len() < 348 {
+        return Err(bad(what, "shorter than a NIfTI-1 header"));
+    }
+    let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&data[..]))
+        .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
+    let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
+    if dim.is_empty() || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
+        return Err(bad(what, "only 3D NIfTI volumes (or 4D with one frame) are supported"));
+    }
+    let mut d3 = [1u64; 3];
+    for (i, d) in dim.iter().take(3).enumerate() {
+        d3[i] = *d as u64;
+    }
+    let n = voxel_count(&d3, what)?;
+    let dtype = match header.data_type().map_err(|e| bad(what, format!("NIfTI type: {e}")))? {
+        nifti::NiftiType::Uint8 => DType::U8,
+        nifti::NiftiType::Uint16 => DType::U16,
+        nifti::NiftiType::Int16 => DType::I16,
+        nifti::NiftiType::Float32 => DType::F32,
+        other => return Err(bad(what, format!("unsupported NIfTI type {other:?}"))),
+    };
+    let off = header.vox_offset;
+    if !(off.is_finite() && off >= 348.0) || off as u64 > data.len() as u64 {
+        return Err(bad(what, format!("voxel offset {off} outside the file")));
+    }
+    let big = header.endianness == nifti::Endianness::Big;
+    let mut values = decode(&data[off as usize..], n, dtype, big, what)?;
+    let (slope, inter) = (header.scl_slope, header.scl_inter);
+    if slope.is_finite() && slope != 0.0 && (slope != 1.0 || inter != 0.0) && inter.is_finite() {
+        for v in &mut values {
+            *v = *v * slope + inter;
+        }
+    }
+    let mut spacing = [1.0f32; 3];
+    for (s, p) in spacing.iter_mut().zip(&header.pixdim[1..4]) {
+        if p.is_finite() && p.abs() > 0.0 {
+            *s = p.abs();
+        }
+    }
+    Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
+}
+
+/// `.npy` arrays of 2 or 3 dimensions (C order: the last axis is x), through `npyz`.
+pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> {
+    let npy = npyz::NpyFile::new(bytes).map_err(|e| bad(what, format!("npy: {e}")))?;
+    let shape = npy.shape().to_vec();
+    if shape.len() < 2 || shape.len() > 3 {
+        return Err(bad(what, format!("npy array of rank {} (2 or 3 expected)", shape.len())));
+    }
+    if npy.order() != npyz::Order::C {
+        return Err(bad(what, "Fortran-ordered npy arrays are not supported"));
+    }
+    let n = voxel_count(&shape, what)?;
+    let dtype = npy.dtype();
+    let npyz::DType::Plain(ts) = &dtype else { return Err(bad(what, "structured npy arrays are not supported")) };
+    let size = ts.size_field();
+    // The payload must be present before anything is allocated from the header's shape.
+    if (bytes.len() as u64) < n * size {
+        return Err(bad(what, "data is truncated"));
+    }
+    let values: Vec<f32> = match (ts.type_char(), size) {
+        (npyz::TypeChar::Uint, 1) => read_all::<u8>(npy, what)?.into_iter().map(f32::from).collect(),
+        (npyz::TypeChar::Uint, 2) => read_all::<u16>(npy, what)?.into_iter().map(f32::from).collect(),
+        (npyz::TypeChar::Int, 2) => read_all::<i16>(npy, what)?.into_iter().map(f32::from).collect(),
+        (npyz::TypeChar::Float, 4) => read_all::<f32>(npy, what)?,
+        (npyz::TypeChar::Float, 8) => read_all::<f64>(npy, what)?.into_iter().map(|v| v as f32).collect(),
+        (c, s) => return Err(bad(what, format!("unsupported npy type {c:?}{s}"))),
+    };
+    if values.len() as u64 != n {
+        return Err(bad(what, "data is truncated"));
+    }
+    Ok((shape, values))
+}
+
+fn read_all<T: npyz::Deserialize>(npy: npyz::NpyFile<&[u8]>, what: &str) -> Result<Vec<T>> {
+    npy.into_vec::<T>().map_err(|e| bad(what, format!("npy data: {e}")))
+}
+
+/// Options for volumes whose files do not say everything (raw data).
+#[derive(Clone, Debug, Default)]
+pub struct VolumeHints {
+    pub dims: Option<[u32; 3]>,
+    pub dtype: Option<DType>,
+    pub big_endian: bool,
+    pub spacing: Option<[f32; 3]>,
+}
+
+/// Load a volume by its extension: `.nrrd`/`.nhdr`, `.nii`/`.nii.gz`, `.npy`, anything else raw.
+pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
+    let what = path.display().to_string();
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+    let bytes = read_file(path)?;
+    let mut v = if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
+        nrrd_from_bytes(&bytes, path.parent(), &what)?
+    } else if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+        nifti_from_bytes(&bytes, &what)?
+    } else if name.ends_with(".npy") {
+        let (shape, values) = npy_from_bytes(&bytes, &what)?;
+        if shape.len() != 3 {
+            return Err(bad(&what, "a volume .npy must be 3D (z, y, x)"));
+        }
+        ScalarVolume { dims: [shape[2] as u32, shape[1] as u32, shape[0] as u32], spacing: [1.0; 3], values }
+    } else {
+        let dims = hints.dims.ok_or_else(|| bad(&what, "raw data needs --dims X,Y,Z"))?;
+        let dtype = hints.dtype.ok_or_else(|| bad(&what, "raw data needs --dtype"))?;
+        raw_from_bytes(&bytes, dims, dtype, hints.big_endian, hints.spacing.unwrap_or([1.0; 3]), &what)?
+    };
+    if let Some(s) = hints.spacing {
+        check_spacing(s, &what)?;
+        v.spacing = s;
+    }
+    Ok(v)
+}
+
+/// A height grid: `width` × `rows` heights, row 0 first (north for the DEMs here).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeightGrid {
+    pub width: u32,
+    pub rows: u32,
+    pub heights: Vec<f32>,
+}
+
+/// Load heights from a 16-bit (or 8-bit) PNG, a GeoTIFF / TIFF, or a 2D `.npy`.
+pub fn load_heights(path: &Path) -> Result<HeightGrid> {
+    let what = path.display().to_string();
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+    if name.ends_with(".npy") {
+        let bytes = read_file(path)?;
+        let (shape, heights) = npy_from_bytes(&bytes, &what)?;
+        if shape.len() != 2 {
+            return Err(bad(&what, "a height .npy must be 2D (rows, columns)"));
+        }
+        return Ok(HeightGrid { width: shape[1] as u32, rows: shape[0] as u32, heights });
+    }
+    if name.ends_with(".tif") || name.ends_with(".tiff") {
+        let bytes = read_file(path)?;
+        return tiff_heights(&bytes, &what);
+    }
+    let mut reader = image::ImageReader::open(path)
+        .map_err(|e| Error::Io { path: what.clone(), source: e })?
+        .with_guessed_format()
+        .map_err(|e| Error::Io { path: what.clone(), source: e })?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(MAX_VOXELS * 4);
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| bad(&what, e))?.to_luma16();
+    let (w, h) = img.dimensions();
+    Ok(HeightGrid { width: w, rows: h, heights: img.pixels().map(|p| p[0] as f32).collect() })
+}
+
+/// The first image of a TIFF as heights (u8, u16, i16, u32, f32), within `MAX_VOXELS`.
+pub fn tiff_heights(bytes: &[u8], what: &str) -> Result<HeightGrid> {
+    let mut limits = tiff::decoder::Limits::default();
+    limits.decoding_buffer_size = (MAX_VOXELS * 4) as usize;
+    limits.intermediate_buffer_size = (MAX_VOXELS * 4) as usize;
+    let mut dec = tiff::decoder::Decoder::new(std::io::Cursor::new(bytes))
+        .map_err(|e| bad(what, format!("tiff: {e}")))?
+        .with_limits(limits);
+    let (w, h) = dec.dimensions().map_err(|e| bad(what, format!("tiff: {e}")))?;
+    voxel_count(&[w as u64, h as u64], what)?;
+    use tiff::decoder::DecodingResult as D;
+    let heights: Vec<f32> = match dec.read_image().map_err(|e| bad(what, format!("tiff: {e}")))? {
+        D::U8(v) => v.into_iter().map(f32::from).collect(),
+        D::U16(v) => v.into_iter().map(f32::from).collect(),
+        D::I16(v) => v.into_iter().map(f32::from).collect(),
+        D::U32(v) => v.into_iter().map(|x| x as f32).collect(),
+        D::F32(v) => v,
+        D::F64(v) => v.into_iter().map(|x| x as f32).collect(),
+        _ => return Err(bad(what, "unsupported TIFF sample type")),
+    };
+    if heights.len() as u64 != w as u64 * h as u64 {
+        return Err(bad(what, "TIFF is not a single-channel height grid"));
+    }
+    Ok(HeightGrid { width: w, rows: h, heights })
+}
+
+/// Where the shared real datasets live: `$VOXSPLAT_DATA`, else `../shared/data` beside the crate.
+pub fn data_dir() -> PathBuf {
+    std::env::var_os("VOXSPLAT_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"))
+}

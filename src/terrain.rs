@@ -1,0 +1,119 @@
+//! Terrain as voxel columns (chapter 5): one splat at each height cell's surface, plus splats
+//! filling the vertical gap down to the lowest 4-neighbour so the surface has no holes from a
+//! grazing view.
+use crate::error::{Error, Result};
+use crate::loaders::HeightGrid;
+use crate::volume::{Grid, SplatSet};
+
+/// Most height levels a terrain may span.
+pub const MAX_LEVELS: u32 = 4096;
+
+#[derive(Clone, Debug)]
+pub struct TerrainOptions {
+    /// Horizontal size of one height cell, in height units (e.g. 233 for a 233 m DEM in metres).
+    pub cell: f32,
+    /// Vertical exaggeration.
+    pub vscale: f32,
+    /// Colour image covering the same extent (row 0 = the grid's row 0); `None`: hypsometric ramp.
+    pub color: Option<image::RgbaImage>,
+    pub opacity: f32,
+    /// Fill each column down to its lowest neighbour (on by default; off only to show the holes).
+    pub fill_gaps: bool,
+}
+
+impl Default for TerrainOptions {
+    fn default() -> Self {
+        Self { cell: 1.0, vscale: 1.0, color: None, opacity: 0.98, fill_gaps: true }
+    }
+}
+
+/// Green lowlands through brown to white peaks.
+fn hypsometric(t: f32) -> [f32; 3] {
+    let stops: [(f32, [f32; 3]); 5] = [
+        (0.0, [0.20, 0.45, 0.20]),
+        (0.35, [0.45, 0.55, 0.25]),
+        (0.6, [0.55, 0.42, 0.28]),
+        (0.85, [0.6, 0.55, 0.5]),
+        (1.0, [0.95, 0.95, 0.97]),
+    ];
+    for w in stops.windows(2) {
+        if t <= w[1].0 {
+            let s = ((t - w[0].0) / (w[1].0 - w[0].0)).clamp(0.0, 1.0);
+            return [0, 1, 2].map(|c| w[0].1[c] + (w[1].1[c] - w[0].1[c]) * s);
+        }
+    }
+    stops[4].1
+}
+
+/// Build the splat columns. Grid x = column, y = row counted from the last row (so +y points to
+/// row 0, north for the DEMs here), z = height level.
+pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet> {
+    let (w, rows) = (h.width, h.rows);
+    if w < 2 || rows < 2 || h.heights.len() as u64 != w as u64 * rows as u64 {
+        return Err(Error::InvalidArgument("a height grid needs at least 2x2 cells".into()));
+    }
+    if !(opts.cell.is_finite() && opts.cell > 0.0 && opts.vscale.is_finite() && opts.vscale > 0.0) {
+        return Err(Error::InvalidArgument("cell size and vertical scale must be positive".into()));
+    }
+    let finite: Vec<f32> = h.heights.iter().cloned().filter(|v| v.is_finite()).collect();
+    if finite.is_empty() {
+        return Err(Error::InvalidArgument("no finite height".into()));
+    }
+    let (hmin, hmax) = finite.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let level_of = |v: f32| -> u32 {
+        let v = if v.is_finite() { v } else { hmin };
+        ((v - hmin) / opts.cell * opts.vscale).round().max(0.0) as u32
+    };
+    let levels: Vec<u32> = h.heights.iter().map(|&v| level_of(v)).collect();
+    let nz = levels.iter().max().copied().unwrap_or(0) + 1;
+    if nz > MAX_LEVELS {
+        return Err(Error::TooLarge(format!("{nz} height levels exceed {MAX_LEVELS}: lower --vscale")));
+    }
+    let at = |x: i64, r: i64| -> u32 {
+        let (x, r) = (x.clamp(0, w as i64 - 1), r.clamp(0, rows as i64 - 1));
+        levels[(r * w as i64 + x) as usize]
+    };
+    let height = |x: i64, r: i64| -> f32 {
+        let (x, r) = (x.clamp(0, w as i64 - 1), r.clamp(0, rows as i64 - 1));
+        let v = h.heights[(r * w as i64 + x) as usize];
+        if v.is_finite() {
+            v
+        } else {
+            hmin
+        }
+    };
+    let grid = Grid::centered([w, rows, nz], [1.0; 3])?;
+    let span = (hmax - hmin).max(1e-6);
+    let color = opts.color.as_ref();
+    SplatSet::from_fn(grid, |i, j, k| {
+        let r = (rows - 1 - j) as i64;
+        let x = i as i64;
+        let top = at(x, r);
+        let lowest = [at(x - 1, r), at(x + 1, r), at(x, r - 1), at(x, r + 1)].into_iter().min().unwrap_or(top);
+        let bottom = if opts.fill_gaps { top.min(lowest + 1) } else { top };
+        if k > top || k < bottom {
+            return None;
+        }
+        let base = match color {
+            Some(img) => {
+                let (iw, ih) = img.dimensions();
+                let px = ((x as f32 + 0.5) / w as f32 * iw as f32) as u32;
+                let py = ((r as f32 + 0.5) / rows as f32 * ih as f32) as u32;
+                let p = img.get_pixel(px.min(iw - 1), py.min(ih - 1));
+                [p[0] as f32 / 255.0, p[1] as f32 / 255.0, p[2] as f32 / 255.0]
+            }
+            None => {
+                // Hillshade from the north-west, 45 degrees up.
+                let dzdx = (height(x + 1, r) - height(x - 1, r)) * opts.vscale / (2.0 * opts.cell);
+                let dzdy = (height(x, r - 1) - height(x, r + 1)) * opts.vscale / (2.0 * opts.cell);
+                let n = glam::Vec3::new(-dzdx, -dzdy, 1.0).normalize();
+                let l = glam::Vec3::new(-1.0, 1.0, 1.4).normalize();
+                let shade = 0.45 + 0.55 * n.dot(l).max(0.0);
+                hypsometric((height(x, r) - hmin) / span).map(|c| c * shade)
+            }
+        };
+        // Gap-filling splats below the surface are a little darker (cliff faces).
+        let dim = if k < top { 0.75 } else { 1.0 };
+        Some([base[0] * dim, base[1] * dim, base[2] * dim, opts.opacity])
+    })
+}
