@@ -239,10 +239,11 @@ pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<S
 /// NIfTI-1 (`.nii` or `.nii.gz`), through the `nifti` crate's header parser; the data is read
 /// from the checked byte range.
 pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
-    let data = if is_gzip(bytes) { gunzip(bytes, MAX_INFLATED, what)? } else { bytes.to_vec() };
-    if data.len() < 348 {
-        return Err(bad(what, "shorter than a NIfTI-1 header"));
-    }
+    // Compressed files are inflated in two steps: the header alone first, then exactly as much as
+    // the checked header says the data needs.
+    let head = if is_gzip(bytes) { gunzip_prefix(bytes, 348, what)? } else { bytes.to_vec() };
+    let need_total = nifti_size(&head, what)?;
+    let data = if is_gzip(bytes) { gunzip(bytes, need_total, what)? } else { head };
     let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&data[..]))
         .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
     let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
@@ -280,6 +281,65 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
         }
     }
     Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
+}
+
+/// The first `n` inflated bytes of a gzip stream (fewer if it is shorter).
+fn gunzip_prefix(bytes: &[u8], n: u64, what: &str) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    flate2::read::MultiGzDecoder::new(bytes)
+        .take(n)
+        .read_to_end(&mut out)
+        .map_err(|e| bad(what, format!("gzip: {e}")))?;
+    Ok(out)
+}
+
+/// Bytes a NIfTI-1 file needs (offset + data), from its checked header.
+fn nifti_size(head: &[u8], what: &str) -> Result<u64> {
+    if head.len() < 348 {
+        return Err(bad(what, "shorter than a NIfTI-1 header"));
+    }
+    let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&head[..348]))
+        .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
+    let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
+    let dims: Vec<u64> = dim.iter().map(|&d| d as u64).collect();
+    let n = voxel_count(&dims, what)?;
+    let size = (header.bitpix.max(8) as u64) / 8;
+    let off = header.vox_offset;
+    if !(off.is_finite() && (348.0..=1e7).contains(&off)) {
+        return Err(bad(what, format!("voxel offset {off} is not valid")));
+    }
+    Ok(off as u64 + n * size)
+}
+
+/// A raw volume described by a TOML sidecar next to it (`FILE.toml`, e.g. `head.raw.toml`):
+/// `dims = [x, y, z]`, `dtype = "u16"`, optional `endian = "big"` and `spacing = [sx, sy, sz]`.
+pub fn raw_sidecar(path: &Path) -> Option<PathBuf> {
+    let mut s = path.as_os_str().to_owned();
+    s.push(".toml");
+    let p = PathBuf::from(s);
+    p.exists().then_some(p)
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Sidecar {
+    dims: [u32; 3],
+    dtype: String,
+    #[serde(default)]
+    endian: Option<String>,
+    #[serde(default)]
+    spacing: Option<[f32; 3]>,
+}
+
+/// Parse a raw sidecar into hints.
+pub fn sidecar_hints(text: &str, what: &str) -> Result<VolumeHints> {
+    let s: Sidecar = toml::from_str(text).map_err(|e| bad(what, format!("sidecar: {e}")))?;
+    let big_endian = match s.endian.as_deref() {
+        None | Some("little") => false,
+        Some("big") => true,
+        Some(o) => return Err(bad(what, format!("endian '{o}' (little, big)"))),
+    };
+    Ok(VolumeHints { dims: Some(s.dims), dtype: Some(s.dtype.parse()?), big_endian, spacing: s.spacing })
 }
 
 /// `.npy` arrays of 2 or 3 dimensions (C order: the last axis is x), through `npyz`.
@@ -343,9 +403,20 @@ pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
         }
         ScalarVolume { dims: [shape[2] as u32, shape[1] as u32, shape[0] as u32], spacing: [1.0; 3], values }
     } else {
-        let dims = hints.dims.ok_or_else(|| bad(&what, "raw data needs --dims X,Y,Z"))?;
-        let dtype = hints.dtype.ok_or_else(|| bad(&what, "raw data needs --dtype"))?;
-        raw_from_bytes(&bytes, dims, dtype, hints.big_endian, hints.spacing.unwrap_or([1.0; 3]), &what)?
+        let side = match raw_sidecar(path) {
+            Some(p) => {
+                let text =
+                    std::fs::read_to_string(&p).map_err(|e| Error::Io { path: p.display().to_string(), source: e })?;
+                sidecar_hints(&text, &what)?
+            }
+            None => VolumeHints::default(),
+        };
+        let dims =
+            hints.dims.or(side.dims).ok_or_else(|| bad(&what, "raw data needs --dims X,Y,Z or a .toml sidecar"))?;
+        let dtype =
+            hints.dtype.or(side.dtype).ok_or_else(|| bad(&what, "raw data needs --dtype or a .toml sidecar"))?;
+        let big = hints.big_endian || side.big_endian;
+        raw_from_bytes(&bytes, dims, dtype, big, hints.spacing.or(side.spacing).unwrap_or([1.0; 3]), &what)?
     };
     if let Some(s) = hints.spacing {
         check_spacing(s, &what)?;

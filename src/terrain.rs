@@ -10,7 +10,8 @@ pub const MAX_LEVELS: u32 = 4096;
 
 #[derive(Clone, Debug)]
 pub struct TerrainOptions {
-    /// Horizontal size of one height cell, in height units (e.g. 233 for a 233 m DEM in metres).
+    /// Horizontal size of one height cell, in height units (e.g. 233 for a 233 m DEM in metres);
+    /// 0 picks one that makes the relief a sixth of the grid's width (before `vscale`).
     pub cell: f32,
     /// Vertical exaggeration.
     pub vscale: f32,
@@ -52,7 +53,7 @@ pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet>
     if w < 2 || rows < 2 || h.heights.len() as u64 != w as u64 * rows as u64 {
         return Err(Error::InvalidArgument("a height grid needs at least 2x2 cells".into()));
     }
-    if !(opts.cell.is_finite() && opts.cell > 0.0 && opts.vscale.is_finite() && opts.vscale > 0.0) {
+    if !(opts.cell.is_finite() && opts.cell >= 0.0 && opts.vscale.is_finite() && opts.vscale > 0.0) {
         return Err(Error::InvalidArgument("cell size and vertical scale must be positive".into()));
     }
     let finite: Vec<f32> = h.heights.iter().cloned().filter(|v| v.is_finite()).collect();
@@ -60,9 +61,10 @@ pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet>
         return Err(Error::InvalidArgument("no finite height".into()));
     }
     let (hmin, hmax) = finite.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let cell = if opts.cell > 0.0 { opts.cell } else { ((hmax - hmin) / (w.max(rows) as f32 / 6.0)).max(1e-6) };
     let level_of = |v: f32| -> u32 {
         let v = if v.is_finite() { v } else { hmin };
-        ((v - hmin) / opts.cell * opts.vscale).round().max(0.0) as u32
+        ((v - hmin) / cell * opts.vscale).round().max(0.0) as u32
     };
     let levels: Vec<u32> = h.heights.iter().map(|&v| level_of(v)).collect();
     let nz = levels.iter().max().copied().unwrap_or(0) + 1;
@@ -104,8 +106,8 @@ pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet>
             }
             None => {
                 // Hillshade from the north-west, 45 degrees up.
-                let dzdx = (height(x + 1, r) - height(x - 1, r)) * opts.vscale / (2.0 * opts.cell);
-                let dzdy = (height(x, r - 1) - height(x, r + 1)) * opts.vscale / (2.0 * opts.cell);
+                let dzdx = (height(x + 1, r) - height(x - 1, r)) * opts.vscale / (2.0 * cell);
+                let dzdy = (height(x, r - 1) - height(x, r + 1)) * opts.vscale / (2.0 * cell);
                 let n = glam::Vec3::new(-dzdx, -dzdy, 1.0).normalize();
                 let l = glam::Vec3::new(-1.0, 1.0, 1.4).normalize();
                 let shade = 0.45 + 0.55 * n.dot(l).max(0.0);

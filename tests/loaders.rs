@@ -102,6 +102,21 @@ fn every_format_round_trips() {
     let f32_data: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
     let (shape, got) = npy_from_bytes(&npy(&[4, 5, 7], "<f4", &f32_data), "npy").unwrap();
     assert_eq!((shape, got), (vec![4, 5, 7], v.clone()));
+    // Raw with a TOML sidecar, through load_volume.
+    std::fs::write(dir.join("vol.raw"), u16_bytes(&v, true)).unwrap();
+    std::fs::write(
+        dir.join("vol.raw.toml"),
+        "dims = [7, 5, 4]\ndtype = \"u16\"\nendian = \"big\"\nspacing = [1.0, 2.0, 0.5]\n",
+    )
+    .unwrap();
+    let r = voxsplat::loaders::load_volume(&dir.join("vol.raw"), &Default::default()).unwrap();
+    assert_eq!((r.dims, r.spacing, r.values.clone()), (DIMS, [1.0, 2.0, 0.5], v.clone()));
+    // 16-bit PNG heights.
+    let png =
+        image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(7, 5, |x, y| image::Luma([(x * 1000 + y) as u16]));
+    png.save(dir.join("h.png")).unwrap();
+    let hp = voxsplat::loaders::load_heights(&dir.join("h.png")).unwrap();
+    assert_eq!((hp.width, hp.rows, hp.heights[8]), (7, 5, 1001.0));
     let hv: Vec<u16> = (0..35).map(|i| (i * 100) as u16).collect();
     let t = tiff_heights(&tiff_u16(7, 5, &hv), "tif").unwrap();
     assert_eq!((t.width, t.rows, t.heights), (7, 5, hv.iter().map(|&x| x as f32).collect::<Vec<_>>()));

@@ -181,8 +181,8 @@ struct SceneArgs {
     /// Vertical exaggeration for --terrain.
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     vscale: f32,
-    /// Horizontal cell size of --terrain, in height units.
-    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    /// Horizontal cell size of --terrain, in height units (0: relief a sixth of the width).
+    #[arg(long, value_parser = parse_finite, default_value = "0")]
     cell: f32,
     /// Visibility order.
     #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted"])]
