@@ -20,6 +20,9 @@ pub struct TransferFunction {
     /// Densities mapped to 0 and 1 (default: the data's minimum and maximum).
     #[serde(default)]
     pub range: Option<(f32, f32)>,
+    /// Extraction threshold: voxels whose normalised density is below it are never extracted.
+    #[serde(default)]
+    pub threshold: f32,
 }
 
 /// Named transfer functions: (name, description).
@@ -31,7 +34,7 @@ pub const TF_PRESETS: &[(&str, &str)] = &[
 
 impl TransferFunction {
     pub fn preset(name: &str) -> Result<Self> {
-        let p = |points: Vec<(f32, [f32; 4])>| Self { points, gradient_weight: 0.0, range: None };
+        let p = |points: Vec<(f32, [f32; 4])>| Self { points, gradient_weight: 0.0, range: None, threshold: 0.0 };
         match name {
             "ramp" => Ok(p(vec![(0.1, [0.0, 0.0, 0.0, 0.0]), (1.0, [1.0, 1.0, 1.0, 0.6])])),
             "ct" => Ok(p(vec![
@@ -77,6 +80,9 @@ impl TransferFunction {
             if !d.is_finite() || c.iter().any(|v| !v.is_finite() || *v < 0.0) || c[3] > 1.0 {
                 return bad("values must be finite, non-negative, opacity at most 1");
             }
+        }
+        if !self.threshold.is_finite() {
+            return bad("threshold must be finite");
         }
         if !(self.gradient_weight.is_finite() && self.gradient_weight >= 0.0) {
             return bad("gradient_weight must be non-negative");
@@ -164,7 +170,11 @@ pub fn classify(vol: &ScalarVolume, tf: &TransferFunction, shading: Option<Shadi
         1.0
     };
     SplatSet::from_fn(grid, |i, j, k| {
-        let mut c = tf.eval(at(i as i64, j as i64, k as i64));
+        let d = at(i as i64, j as i64, k as i64);
+        if d < tf.threshold {
+            return None;
+        }
+        let mut c = tf.eval(d);
         if c[3] <= 0.0 {
             return None;
         }

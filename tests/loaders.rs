@@ -315,4 +315,11 @@ fn transfer_functions_are_checked() {
         assert!(TransferFunction::from_toml(bad).is_err(), "accepted {bad}");
     }
     assert!(TransferFunction::preset("nope").is_err());
+    // The extraction threshold removes voxels the ramp would keep.
+    let vol = voxsplat::loaders::ScalarVolume { dims: [4, 1, 1], spacing: [1.0; 3], values: vec![0.0, 1.0, 2.0, 3.0] };
+    let ramp =
+        TransferFunction::from_toml("points = [[0.0, [1.0, 1.0, 1.0, 0.0]], [1.0, [1.0, 1.0, 1.0, 1.0]]]").unwrap();
+    assert_eq!(voxsplat::classify::classify(&vol, &ramp, None).unwrap().len(), 3);
+    let cut = TransferFunction { threshold: 0.5, ..ramp };
+    assert_eq!(voxsplat::classify::classify(&vol, &cut, None).unwrap().len(), 2);
 }
