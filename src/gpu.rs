@@ -307,16 +307,7 @@ impl GpuPipeline {
     /// Run the GPU PBTF order stage alone and read the draw sequence back.
     pub fn order(&mut self, prep: &Prepared, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
         camera.validate()?;
-        let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(
-            &prep.set,
-            camera,
-            Kernel::Gaussian,
-            Antialias::None,
-            None,
-            split,
-            direction == Direction::BackToFront,
-        );
+        let frame = crate::pipeline::order_frame(&prep.set, camera, direction);
         self.frame.write(bytemuck::bytes_of(&frame))?;
         let scene = self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let st = &self.stages;

@@ -232,16 +232,7 @@ pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
 /// The three order stages' CPU mirrors run in sequence.
 fn cpu_pbtf_order(prep: &Prepared, camera: &Camera, direction: Direction) -> Vec<u32> {
     let set = &prep.set;
-    let split = order::pbtf_split(set, camera);
-    let frame = pipeline::make_frame(
-        set,
-        camera,
-        Kernel::Gaussian,
-        Antialias::None,
-        None,
-        split,
-        direction == Direction::BackToFront,
-    );
+    let frame = pipeline::order_frame(set, camera, direction);
     let rows = set.row_start().len() - 1;
     let mut row_split = vec![0u32; rows];
     let mut segments = vec![0u32; 2 * rows];

@@ -210,6 +210,12 @@ pub fn make_frame(
     }
 }
 
+/// The uniforms the order stage alone needs (no anti-aliasing or motion).
+pub fn order_frame(set: &SplatSet, camera: &Camera, direction: Direction) -> Frame {
+    let split = order::pbtf_split(set, camera);
+    make_frame(set, camera, Kernel::Gaussian, Antialias::None, None, split, direction == Direction::BackToFront)
+}
+
 /// One batch of sheets drawn into summation layers and composited together.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Batch {

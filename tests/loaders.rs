@@ -127,7 +127,8 @@ fn every_format_round_trips() {
 fn malformed_input_returns_errors() {
     let v = values();
     let f32_data: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
-    let formats: Vec<(&str, Vec<u8>, Box<dyn Fn(&[u8]) -> bool>)> = vec![
+    type Parser = Box<dyn Fn(&[u8]) -> bool>;
+    let formats: Vec<(&str, Vec<u8>, Parser)> = vec![
         (
             "raw",
             u16_bytes(&v, false),
