@@ -39,6 +39,17 @@ enum Command {
     },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
     Animate(AnimateArgs),
+    /// Render many frames with changing scenes, cameras and modes; report host memory and GPU
+    /// allocations per cycle (they must stay flat after warm-up).
+    Soak {
+        #[arg(long, default_value_t = 1000)]
+        frames: usize,
+        #[arg(long, default_value_t = 96)]
+        size: u32,
+        /// Enable the validation layer and count its messages.
+        #[arg(long)]
+        validation: bool,
+    },
     /// Print error metrics of image A against reference B (PNG or EXR).
     Compare {
         /// The image to score.
@@ -443,6 +454,26 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Animate(a) => animate(a),
+        Command::Soak { frames, size, validation } => {
+            if frames == 0 || size == 0 {
+                return Err(Error::InvalidArgument("--frames and --size must be positive".into()));
+            }
+            let mut ro = RendererOptions::default();
+            ro.validation = validation;
+            let mut r = Renderer::new(&ro)?;
+            let bar = indicatif::ProgressBar::new(frames as u64);
+            let rep = voxsplat::soak::soak(&mut r, frames, size, |_| bar.inc(1))?;
+            bar.finish_and_clear();
+            println!("frames: {}", rep.frames);
+            println!("cycle,rss_mib,gpu_allocations,gpu_bytes");
+            for (i, (rss, (n, b))) in rep.rss.iter().zip(&rep.gpu).enumerate() {
+                println!("{i},{:.1},{n},{b}", *rss as f64 / (1u64 << 20) as f64);
+            }
+            let drift = rep.rss.last().copied().unwrap_or(0) as f64 - rep.rss.get(1).copied().unwrap_or(0) as f64;
+            println!("rss drift after warm-up: {:.1} MiB", drift / (1u64 << 20) as f64);
+            println!("validation messages: {}", rep.validation_messages);
+            Ok(())
+        }
         Command::Info { file, dims, dtype, tf } => {
             let name = file.display().to_string().to_ascii_lowercase();
             let set = if name.ends_with(".tif") || name.ends_with(".tiff") || name.ends_with(".png") {

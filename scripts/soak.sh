@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# The 1,000-frame soak of docs/RELIABILITY.md (CI runs a 100-frame version as a test).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/setup.sh
+cargo run --release --quiet -- soak --frames "${1:-1000}" --validation

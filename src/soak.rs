@@ -1,0 +1,69 @@
+//! Long runs: render many frames with changing scenes, cameras and modes and watch host memory and
+//! GPU allocations (issue 7). The scene/mode sequence repeats every `CYCLE` frames, so after warm-up
+//! the allocator's report at the start of each cycle must not grow.
+use crate::camera::Camera;
+use crate::error::Result;
+use crate::pipeline::{Antialias, Composite, RenderOptions};
+use crate::{scene, Kernel, OrderKind, Renderer};
+
+/// Frames per repetition of the sequence.
+pub const CYCLE: usize = 12;
+
+/// What a soak run saw, sampled at the start of every cycle.
+#[derive(Clone, Debug, Default)]
+pub struct SoakReport {
+    pub frames: usize,
+    /// Host resident set size in bytes, per cycle.
+    pub rss: Vec<u64>,
+    /// (live allocations, bytes) from gpu-allocator, per cycle.
+    pub gpu: Vec<(usize, u64)>,
+    pub validation_messages: u64,
+}
+
+/// Resident set size of this process (Linux `/proc/self/statm`; 0 elsewhere).
+pub fn rss_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/statm")
+        .ok()
+        .and_then(|s| s.split_whitespace().nth(1).and_then(|p| p.parse::<u64>().ok()))
+        .map(|pages| pages * 4096)
+        .unwrap_or(0)
+}
+
+/// Render `frames` frames of the repeating sequence at `size`×`size`.
+pub fn soak(r: &mut Renderer, frames: usize, size: u32, mut progress: impl FnMut(usize)) -> Result<SoakReport> {
+    let scenes = ["cube40", "plane", "cube40-attenuated"];
+    let mut report = SoakReport { frames, ..Default::default() };
+    let mut current = "";
+    for f in 0..frames {
+        if f % CYCLE == 0 {
+            report.rss.push(rss_bytes());
+            report.gpu.push(r.context().map(|c| c.allocation_report()).unwrap_or((0, 0)));
+        }
+        let step = f % CYCLE;
+        let name = scenes[step / 4];
+        if name != current {
+            r.set_scene(scene::build(name)?)?;
+            current = name;
+        }
+        let set = r.scene().expect("set above");
+        let mut cam = Camera::framing(set.grid(), size, size);
+        // Orbit the camera a little each frame; alternate the image size to exercise reallocation.
+        let angle = step as f32 * 0.21;
+        let off = cam.eye - cam.target;
+        cam.eye = cam.target + glam::Quat::from_rotation_y(angle).mul_vec3(off);
+        if step % 2 == 1 {
+            cam.width = size + 8;
+        }
+        let opts = RenderOptions {
+            order: [OrderKind::Pbtf, OrderKind::Wbtf][step % 2],
+            composite: if step % 3 == 2 { Composite::Sheet } else { Composite::Splat },
+            kernel: if step % 4 < 2 { Kernel::Gaussian } else { Kernel::Cubic },
+            antialias: [Antialias::None, Antialias::Swan, Antialias::Ewa][step % 3],
+            ..Default::default()
+        };
+        r.render(&cam, &opts)?;
+        progress(f);
+    }
+    report.validation_messages = r.validation_count();
+    Ok(report)
+}
