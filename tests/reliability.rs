@@ -10,10 +10,13 @@ fn a_100_frame_soak_keeps_gpu_allocations_flat() {
     let rep = voxsplat::soak::soak(&mut r, 100, 64, |_| {}).unwrap();
     eprintln!("gpu per cycle {:?}", rep.gpu);
     eprintln!("rss per cycle (MiB) {:?}", rep.rss.iter().map(|b| b / (1 << 20)).collect::<Vec<_>>());
-    // After the first cycle (warm-up) every cycle starts in the same state.
+    // After the first cycle (warm-up) every cycle starts with the same live allocations. lavapipe's
+    // memory requirement for a re-created image can differ by an alignment step (32 bytes seen), so
+    // the byte total may move by that much but must not grow with the cycles.
     assert!(rep.gpu.len() >= 8);
     for g in &rep.gpu[2..] {
-        assert_eq!(*g, rep.gpu[1], "GPU allocations drift");
+        assert_eq!(g.0, rep.gpu[1].0, "the number of live GPU allocations drifts: {:?}", rep.gpu);
+        assert!(g.1.abs_diff(rep.gpu[1].1) <= 4096, "GPU bytes drift: {:?}", rep.gpu);
     }
     assert_eq!(rep.validation_messages, 0);
     common::assert_clean(&r);

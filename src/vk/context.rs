@@ -360,6 +360,16 @@ impl Context {
         }
     }
 
+    /// gpu-allocator's live allocations as (name, bytes), sorted: what a leak hunt compares.
+    pub fn allocation_details(&self) -> Vec<(String, u64)> {
+        let mut v: Vec<(String, u64)> = match self.allocator.lock() {
+            Ok(a) => a.generate_report().allocations.iter().map(|r| (r.name.clone(), r.size)).collect(),
+            Err(_) => Vec::new(),
+        };
+        v.sort();
+        v
+    }
+
     pub(crate) fn wait_idle(&self) {
         // SAFETY: the device is valid until Drop.
         let _ = unsafe { self.device.device_wait_idle() };
