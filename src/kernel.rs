@@ -119,8 +119,18 @@ impl Kernel {
         line / area * rr
     }
 
-    /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2.
+    /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2. Computed once
+    /// per kernel (a million profile evaluations) and shared.
     pub fn footprint_table(self) -> Vec<f32> {
+        static TABLES: [std::sync::OnceLock<Vec<f32>>; 2] = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+        let slot = match self {
+            Kernel::Gaussian => 0,
+            Kernel::Cubic => 1,
+        };
+        TABLES[slot].get_or_init(|| self.compute_footprint_table()).clone()
+    }
+
+    fn compute_footprint_table(self) -> Vec<f32> {
         let n = FOOTPRINT_TABLE_SIZE as usize;
         let rr = self.radius() as f64;
         let mut t = vec![0.0f64; n * n];
