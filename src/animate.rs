@@ -90,8 +90,13 @@ pub struct Animation {
 }
 
 /// Built-in animations: (name, description).
-pub const ANIMATIONS: &[(&str, &str)] =
-    &[("rotating-box", "the 60^3 hollow cube turning 6 degrees a frame about y, orthographic (Fig. 4.5)")];
+pub const ANIMATIONS: &[(&str, &str)] = &[
+    ("rotating-box", "the 60^3 hollow cube turning 6 degrees a frame about y, orthographic (Fig. 4.5)"),
+    (
+        "rotating-terrain",
+        "the rmnp terrain turning 3 degrees a frame about its vertical axis, perspective (Figs 5.4-5.6)",
+    ),
+];
 
 impl Animation {
     pub fn builtin(name: &str) -> Result<Self> {
@@ -111,6 +116,24 @@ impl Animation {
                 [[keyframe]]
                 frame = 24
                 rotate = [0.0, 1.0, 0.0, 144.0]
+                "#,
+            ),
+            "rotating-terrain" => Self::from_toml(
+                r#"
+                scene = "rmnp"
+                frames = 40
+                size = [256, 192]
+                [camera]
+                eye = [0.0, -190.0, 120.0]
+                target = [0.0, 0.0, 0.0]
+                up = [0.0, 0.0, 1.0]
+                fov = 45.0
+                [[keyframe]]
+                frame = 0
+                rotate = [0.0, 0.0, 1.0, 0.0]
+                [[keyframe]]
+                frame = 40
+                rotate = [0.0, 0.0, 1.0, 120.0]
                 "#,
             ),
             other => Err(Error::InvalidArgument(format!(

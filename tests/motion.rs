@@ -134,6 +134,22 @@ fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
 }
 
 #[test]
+fn the_rotating_terrain_animation_blurs_the_real_dem() {
+    let mut anim = Animation::builtin("rotating-terrain").unwrap();
+    anim.camera.width = 96;
+    anim.camera.height = 72;
+    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let grid = *set.grid();
+    let mut r = common::cpu();
+    r.set_scene(set).unwrap();
+    let o = RenderOptions::default();
+    let still = render_frame(&mut r, &anim, &grid, 10, Blur::None, &o).unwrap();
+    let blurred = render_frame(&mut r, &anim, &grid, 10, Blur::Splat, &o).unwrap();
+    assert!(still.pixels.iter().filter(|p| p[3] > 0.5).count() > 1000, "the terrain is in view");
+    assert_ne!(still.pixels, blurred.pixels);
+}
+
+#[test]
 fn animation_files_are_checked() {
     let good = r#"
         scene = "cube40"
