@@ -154,9 +154,9 @@ impl Renderer {
             Some(g) => g.raycast(prep, camera, options),
             None => {
                 let t = std::time::Instant::now();
-                let field = truth::DenseField::new(&prep.set)?;
+                let field = prep.dense_field()?;
                 let rc = cpu::raycast::raycast_params(&prep.set, camera, options);
-                let image = cpu::raycast(&rc, &field, None);
+                let image = cpu::raycast(&rc, field, None);
                 Ok(Rendered {
                     image,
                     timings: vec![StageTime { stage: "raycast", ms: t.elapsed().as_secs_f64() * 1e3 }],

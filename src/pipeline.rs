@@ -158,6 +158,9 @@ pub struct Prepared {
     pub slices: [(Vec<u32>, Vec<u32>); 3],
     pub ranks: Vec<u32>,
     pub rank_offsets: [u32; 3],
+    /// The CPU ray caster's dense (colour * tau, tau) field, built on first use and kept with the
+    /// scene (the GPU path uploads it to a 3D texture and drops the host copy).
+    field: std::sync::OnceLock<crate::truth::DenseField>,
 }
 
 impl Prepared {
@@ -169,7 +172,16 @@ impl Prepared {
             rank_offsets[a] = ranks.len() as u32;
             ranks.extend(SplatSet::sheet_ranks(&slices[a].0));
         }
-        Self { set, slices, ranks, rank_offsets }
+        Self { set, slices, ranks, rank_offsets, field: std::sync::OnceLock::new() }
+    }
+
+    /// The dense field for ray casting, built once per scene.
+    pub fn dense_field(&self) -> Result<&crate::truth::DenseField> {
+        if let Some(f) = self.field.get() {
+            return Ok(f);
+        }
+        let f = crate::truth::DenseField::new(&self.set)?;
+        Ok(self.field.get_or_init(|| f))
     }
 }
 
