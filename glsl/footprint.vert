@@ -4,7 +4,7 @@
 #extension GL_ARB_shader_viewport_layer_array : require
 #include "types.glsl"
 
-layout(std140, binding = 0) uniform FrameBlock { Frame frame; };
+layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 1) readonly buffer Params { SplatParams params[]; };
 layout(std430, binding = 2) readonly buffer DrawList { uint draw_list[]; };
 layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };

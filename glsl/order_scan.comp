@@ -4,7 +4,7 @@
 #include "types.glsl"
 
 layout(local_size_x = SCAN_WORKGROUP_SIZE) in;
-layout(std140, binding = 0) uniform FrameBlock { Frame frame; };
+layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 4) buffer Segments { uint segments[]; };
 
 shared uint partial[SCAN_WORKGROUP_SIZE];

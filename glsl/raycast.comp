@@ -6,7 +6,7 @@
 #include "trilinear.glsl"
 
 layout(local_size_x = COMPOSITE_TILE, local_size_y = COMPOSITE_TILE) in;
-layout(std140, binding = 0) uniform ParamsBlock { RaycastParams rc; };
+layout(std430, binding = 0) readonly buffer ParamsBlock { RaycastParams rc; };
 layout(binding = 1) uniform sampler3D field;
 layout(binding = 2, rgba32f) uniform writeonly image2D out_image;
 

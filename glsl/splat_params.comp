@@ -6,7 +6,7 @@
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "linear.glsl"
-layout(std140, binding = 0) uniform FrameBlock { Frame frame; };
+layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 1) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 2) writeonly buffer Params { SplatParams params[]; };
 

@@ -102,14 +102,14 @@ impl GpuPipeline {
         let compute = SS::COMPUTE;
         let order_layout = Layout::new(
             &ctx,
-            &[Slot::Uniform, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage],
+            &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage],
             compute,
             0,
         )?;
-        let params_layout = Layout::new(&ctx, &[Slot::Uniform, Slot::Storage, Slot::Storage], compute, 0)?;
+        let params_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Storage, Slot::Storage], compute, 0)?;
         let footprint_layout = Layout::new(
             &ctx,
-            &[Slot::Uniform, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Texture],
+            &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Texture],
             SS::VERTEX | SS::FRAGMENT,
             std::mem::size_of::<FootprintPush>() as u32,
         )?;
@@ -119,7 +119,7 @@ impl GpuPipeline {
             compute,
             std::mem::size_of::<CompositePush>() as u32,
         )?;
-        let raycast_layout = Layout::new(&ctx, &[Slot::Uniform, Slot::Texture, Slot::StorageImage], compute, 0)?;
+        let raycast_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Texture, Slot::StorageImage], compute, 0)?;
         let roofline_layout = Layout::new(&ctx, &[Slot::Uniform], SS::VERTEX | SS::FRAGMENT, 16)?;
         let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
         let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
@@ -153,7 +153,7 @@ impl GpuPipeline {
             sheet_pass,
         };
         let frame =
-            Buffer::new(&ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::UNIFORM_BUFFER, Memory::Upload)?;
+            Buffer::new(&ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::STORAGE_BUFFER, Memory::Upload)?;
         let n = FOOTPRINT_TABLE_SIZE;
         let table =
             Image::new(&ctx, "footprint table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
@@ -351,7 +351,7 @@ impl GpuPipeline {
             scene.field = Some(image);
         }
         let params = raycast_params(&prep.set, camera, opts);
-        let ubo = Buffer::with_data(&self.ctx, "raycast params", bytemuck::bytes_of(&params), BU::UNIFORM_BUFFER)?;
+        let ubo = Buffer::with_data(&self.ctx, "raycast params", bytemuck::bytes_of(&params), BU::STORAGE_BUFFER)?;
         let (st, scene, target) =
             (&self.stages, self.scene.as_ref().expect("set"), self.target.as_ref().expect("ensured"));
         let field = scene.field.as_ref().expect("built above");

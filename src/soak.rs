@@ -20,6 +20,29 @@ pub struct SoakReport {
     pub validation_messages: u64,
 }
 
+impl SoakReport {
+    /// Host memory growth after warm-up: the peak RSS of the later half of the cycles minus the
+    /// peak of the earlier half (the first cycle is warm-up). Peaks, not means, because the
+    /// allocator returns memory to the system now and then: a leak raises the peak, a returned
+    /// block only dips. Run with `MALLOC_MMAP_THRESHOLD_=131072` (as `scripts/soak.sh` and the
+    /// test do) so that large transient buffers are mapped and unmapped instead of fragmenting
+    /// the heap, which otherwise adds steps of several MiB that are not leaks.
+    pub fn rss_growth(&self) -> i64 {
+        let after = self.rss.get(2..).unwrap_or(&[]);
+        if after.len() < 2 {
+            return 0;
+        }
+        let (a, b) = after.split_at(after.len() / 2);
+        let peak = |x: &[u64]| x.iter().copied().max().unwrap_or(0) as i64;
+        peak(b) - peak(a)
+    }
+
+    /// Frames between the middles of the two halves that `rss_growth` compares.
+    pub fn growth_span_frames(&self) -> usize {
+        self.rss.len().saturating_sub(2) / 2 * CYCLE
+    }
+}
+
 /// Resident set size of this process (Linux `/proc/self/statm`; 0 elsewhere).
 pub fn rss_bytes() -> u64 {
     std::fs::read_to_string("/proc/self/statm")

@@ -20,7 +20,10 @@ struct SplatParams {
                   // footprint radius in pixels, anti-aliasing radius scale
 };
 
-// Per-frame uniforms (std140, vec4-only so the Rust mirror is plain repr(C)). 288 bytes.
+// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 288 bytes.
+// Bound as a readonly storage buffer, not a uniform buffer: Mesa 22.3's lavapipe inlines uniform
+// values that steer branches and recompiles the shader for every dispatch, keeping each variant until
+// the pipeline dies (+0.2-0.7 MB of host memory per frame; docs/RELIABILITY.md).
 struct Frame {
     mat4 view_proj;   // world -> clip (Vulkan: y down, depth 0..1)
     vec4 eye;         // world eye position; w: 1 perspective, 0 orthographic

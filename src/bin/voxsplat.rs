@@ -469,8 +469,8 @@ fn run(cli: Cli) -> Result<()> {
             for (i, (rss, (n, b))) in rep.rss.iter().zip(&rep.gpu).enumerate() {
                 println!("{i},{:.1},{n},{b}", *rss as f64 / (1u64 << 20) as f64);
             }
-            let drift = rep.rss.last().copied().unwrap_or(0) as f64 - rep.rss.get(1).copied().unwrap_or(0) as f64;
-            println!("rss drift after warm-up: {:.1} MiB", drift / (1u64 << 20) as f64);
+            let growth = rep.rss_growth() as f64 / (1u64 << 20) as f64;
+            println!("rss peak growth after warm-up: {growth:.1} MiB over {} frames", rep.growth_span_frames());
             println!("validation messages: {}", rep.validation_messages);
             Ok(())
         }
