@@ -19,6 +19,10 @@ pub enum Error {
     /// Device or host memory ran out.
     #[error("out of memory while allocating {0}")]
     OutOfMemory(String),
+    /// The device was lost (driver reset, hang or crash). Every later GPU call on this renderer
+    /// fails the same way; drop it and create a new one.
+    #[error("the Vulkan device was lost during {0}; drop this renderer and create a new one")]
+    DeviceLost(String),
     /// A Vulkan call failed.
     #[error("Vulkan call {call} failed: {result}")]
     Vulkan { call: &'static str, result: vk::Result },
@@ -41,6 +45,7 @@ impl Error {
             vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
                 Error::OutOfMemory(call.to_string())
             }
+            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost(call.to_string()),
             result => Error::Vulkan { call, result },
         }
     }

@@ -24,7 +24,7 @@ impl SoakReport {
     /// Host memory growth after warm-up: the peak RSS of the later half of the cycles minus the
     /// peak of the earlier half (the first cycle is warm-up). Peaks, not means, because the
     /// allocator returns memory to the system now and then: a leak raises the peak, a returned
-    /// block only dips. Run with `MALLOC_MMAP_THRESHOLD_=131072` (as `scripts/soak.sh` and the
+    /// block only dips. Run with `MALLOC_MMAP_THRESHOLD_=131072 MALLOC_ARENA_MAX=1` (as `scripts/soak.sh` and the
     /// test do) so that large transient buffers are mapped and unmapped instead of fragmenting
     /// the heap, which otherwise adds steps of several MiB that are not leaks.
     pub fn rss_growth(&self) -> i64 {

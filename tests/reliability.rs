@@ -30,6 +30,7 @@ fn a_120_frame_soak_keeps_host_memory_flat() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_voxsplat"))
         .args(["soak", "--frames", "120", "--size", "64", "--validation"])
         .env("MALLOC_MMAP_THRESHOLD_", "131072")
+        .env("MALLOC_ARENA_MAX", "1")
         .output()
         .expect("run voxsplat soak");
     let text = String::from_utf8_lossy(&out.stdout);
@@ -86,4 +87,46 @@ fn the_same_inputs_give_bit_identical_images_run_to_run() {
             }
         }
     }
+}
+
+/// Device loss (injected at the queue: a CPU device cannot be made to lose itself) reaches the
+/// caller as `DeviceLost`, stays lost for every later call without touching the device, and the
+/// renderer then drops cleanly.
+#[test]
+fn device_loss_is_an_error_that_sticks_and_the_renderer_drops_cleanly() {
+    let mut r = common::gpu();
+    r.set_scene(scene::build("cube40").unwrap()).unwrap();
+    let cam = Camera::framing(r.scene().unwrap().grid(), 48, 48);
+    r.render(&cam, &RenderOptions::default()).unwrap();
+    let ctx = r.context().expect("gpu").clone();
+    assert!(!ctx.is_lost());
+    ctx.inject_submit_fault(ash::vk::Result::ERROR_DEVICE_LOST);
+    let err = r.render(&cam, &RenderOptions::default()).unwrap_err();
+    assert!(matches!(err, voxsplat::Error::DeviceLost(_)), "{err}");
+    assert!(err.to_string().contains("create a new one"), "{err}");
+    assert!(ctx.is_lost());
+    let mut sheet = RenderOptions::default();
+    sheet.composite = Composite::Sheet;
+    assert!(matches!(r.render(&cam, &sheet), Err(voxsplat::Error::DeviceLost(_))));
+    let rc = voxsplat::cpu::raycast::RaycastOptions::default();
+    assert!(matches!(r.raycast(&cam, &rc), Err(voxsplat::Error::DeviceLost(_))));
+    common::assert_clean(&r);
+    drop(ctx);
+    drop(r);
+}
+
+/// Out-of-memory from a submission is an error, and transient: the next frame renders the same
+/// image as before.
+#[test]
+fn out_of_memory_at_submit_is_an_error_and_the_next_frame_renders() {
+    let mut r = common::gpu();
+    r.set_scene(scene::build("cube40").unwrap()).unwrap();
+    let cam = Camera::framing(r.scene().unwrap().grid(), 48, 48);
+    let before = r.render(&cam, &RenderOptions::default()).unwrap().image;
+    r.context().unwrap().inject_submit_fault(ash::vk::Result::ERROR_OUT_OF_DEVICE_MEMORY);
+    let err = r.render(&cam, &RenderOptions::default()).unwrap_err();
+    assert!(matches!(err, voxsplat::Error::OutOfMemory(_)), "{err}");
+    let after = r.render(&cam, &RenderOptions::default()).unwrap().image;
+    assert_eq!(before.pixels, after.pixels);
+    common::assert_clean(&r);
 }

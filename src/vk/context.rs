@@ -5,6 +5,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::CStr;
 use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -50,6 +51,10 @@ pub struct Context {
     pub(crate) timestamp_period: Option<f64>,
     device_name: String,
     device_type: vk::PhysicalDeviceType,
+    /// Set once a call reports VK_ERROR_DEVICE_LOST: later submissions fail fast.
+    pub(crate) lost: AtomicBool,
+    /// Test-only fault for the next submission (a raw `vk::Result`, 0 = none).
+    pub(crate) injected: AtomicI32,
 }
 
 fn device_rank(t: vk::PhysicalDeviceType) -> u32 {
@@ -268,6 +273,8 @@ impl Context {
             timestamp_period,
             device_name,
             device_type: props.device_type,
+            lost: AtomicBool::new(false),
+            injected: AtomicI32::new(0),
         }))
     }
 
@@ -373,6 +380,19 @@ impl Context {
     pub(crate) fn wait_idle(&self) {
         // SAFETY: the device is valid until Drop.
         let _ = unsafe { self.device.device_wait_idle() };
+    }
+
+    /// Whether the device has been reported lost.
+    pub fn is_lost(&self) -> bool {
+        self.lost.load(Ordering::Acquire)
+    }
+
+    /// Test-only: the next submission completes on the device but reports `result` (for example
+    /// `ERROR_DEVICE_LOST`, which a CPU device cannot be made to produce), so tests can follow the
+    /// error path from the queue up to the caller and through Drop.
+    #[doc(hidden)]
+    pub fn inject_submit_fault(&self, result: vk::Result) {
+        self.injected.store(result.as_raw(), Ordering::Release);
     }
 
     /// Test-only: makes an invalid call (a zero-sized buffer) so tests can prove the validation

@@ -3,6 +3,7 @@
 use super::{Buffer, Context, DescriptorSet, Framebuffer, Image, Layout, Pipeline, RenderPass, Timer};
 use crate::error::{Error, Result};
 use ash::vk;
+use std::sync::atomic::Ordering;
 
 pub struct Recorder<'a> {
     ctx: &'a Context,
@@ -208,6 +209,9 @@ impl Context {
     /// Record with `f`, submit, and wait on a fence. Everything `f` referenced must live until
     /// this returns, which the borrow of the recorder guarantees for resources passed by reference.
     pub fn submit<T>(&self, f: impl FnOnce(&Recorder<'_>) -> Result<T>) -> Result<T> {
+        if self.is_lost() {
+            return Err(Error::DeviceLost("a submission after the device was lost".into()));
+        }
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(self.queue_family)
             .flags(vk::CommandPoolCreateFlags::TRANSIENT);
@@ -252,6 +256,15 @@ impl Context {
             // SAFETY: fence from this device.
             unsafe { self.device.wait_for_fences(&[fence], true, u64::MAX) }.map_err(Error::vk("vkWaitForFences"))
         });
+        let injected = self.injected.swap(0, Ordering::AcqRel);
+        let waited = if injected != 0 && waited.is_ok() {
+            Err(Error::vk("vkWaitForFences")(vk::Result::from_raw(injected)))
+        } else {
+            waited
+        };
+        if matches!(waited, Err(Error::DeviceLost(_))) {
+            self.lost.store(true, Ordering::Release);
+        }
         if waited.is_err() {
             // Device lost or similar: make sure nothing is still running before the pool goes.
             self.wait_idle();
