@@ -1,6 +1,8 @@
 #version 450
 // Footprint stage, vertex half: one instanced quad per splat in draw-list order; in sheet mode each
-// splat goes to the layer of its sheet. Mirror: cpu::footprint.
+// splat goes to the layer of its sheet; in slab mode (image-aligned sheets) the draw list holds
+// (splat, slab) pairs and each pair goes to its slab's layer with the slab's faces relative to the
+// splat. Mirror: cpu::footprint.
 #extension GL_ARB_shader_viewport_layer_array : require
 #include "types.glsl"
 
@@ -11,22 +13,27 @@ layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 4) readonly buffer SheetRank { uint sheet_rank[]; };
 
 layout(push_constant) uniform Push {
-    uint sheet_mode;   // 0: per-splat compositing, 1: additive sheet summation
+    uint sheet_mode;   // SHEET_MODE_*
     uint axis;         // sheet axis
     uint rank_offset;  // start of this axis in sheet_rank
-    uint rank_base;    // rank of the batch's first sheet
+    uint rank_base;    // rank of the batch's first sheet (slab mode: its first slab)
     int rank_dir;      // +1 or -1: direction of the batch in rank space
+    float slab_z0;     // slab mode: eye-space depth of slab 0's near face
+    float slab_dz;     // slab mode: slab thickness (world units)
 } pc;
 
 layout(location = 0) out vec2 out_uv;
 layout(location = 1) flat out vec4 out_emit;
 layout(location = 2) flat out float out_stretch;
+layout(location = 3) flat out vec2 out_slab;
 
 const vec2 CORNERS[4] = vec2[](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
 
 void main() {
-    uint splat = draw_list[gl_InstanceIndex];
+    bool slab_mode = pc.sheet_mode == SHEET_MODE_SLAB;
+    uint splat = slab_mode ? draw_list[2 * gl_InstanceIndex] : draw_list[gl_InstanceIndex];
     SplatParams p = params[splat];
+    out_slab = vec2(0.0);
     vec2 c = CORNERS[gl_VertexIndex];
     out_uv = c;
     out_emit = vec4(p.emit.rgb, p.emit.a * p.axis_u.w);
@@ -37,7 +44,13 @@ void main() {
         vec3 pos = p.center.xyz + c.x * p.axis_u.xyz + c.y * p.axis_v.xyz;
         gl_Position = frame.view_proj * vec4(pos, 1.0);
     }
-    if (pc.sheet_mode != 0u) {
+    if (slab_mode) {
+        uint slab = draw_list[2 * gl_InstanceIndex + 1];
+        float radius = length(p.axis_v.xyz);
+        float near_face = pc.slab_z0 + float(slab) * pc.slab_dz - p.screen.x;
+        out_slab = vec2(near_face, near_face + pc.slab_dz) / radius;
+        gl_Layer = pc.rank_dir > 0 ? int(slab - pc.rank_base) : int(pc.rank_base - slab);
+    } else if (pc.sheet_mode == SHEET_MODE_AXIS) {
         uint rank = sheet_rank[pc.rank_offset + splats[splat].ijk[pc.axis]];
         gl_Layer = pc.rank_dir > 0 ? int(rank - pc.rank_base) : int(pc.rank_base - rank);
     } else {

@@ -43,6 +43,9 @@ impl Method {
             Method::Splat { composite: Composite::Sheet, kernel, aa, .. } => {
                 format!("sheet {kernel:?}{}", aa_suffix(*aa))
             }
+            Method::Splat { composite: Composite::Slab, kernel, aa, .. } => {
+                format!("slab {kernel:?}{}", aa_suffix(*aa))
+            }
             Method::Raycast { step } => format!("raycast {step}"),
         }
         .to_lowercase()
@@ -76,6 +79,7 @@ impl MatrixOptions {
                 methods.push(splat(order, Composite::Splat, kernel));
             }
             methods.push(splat(OrderKind::Pbtf, Composite::Sheet, kernel));
+            methods.push(splat(OrderKind::Pbtf, Composite::Slab, kernel));
         }
         for step in [1.0, 0.5, 0.25] {
             methods.push(Method::Raycast { step });
@@ -99,6 +103,7 @@ impl MatrixOptions {
                 splat(OrderKind::Btf, Composite::Splat, g),
                 splat(OrderKind::Pbtf, Composite::Splat, g),
                 splat(OrderKind::Pbtf, Composite::Sheet, g),
+                splat(OrderKind::Pbtf, Composite::Slab, g),
                 Method::Raycast { step: 1.0 },
                 Method::Raycast { step: 0.5 },
             ],

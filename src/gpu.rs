@@ -66,6 +66,8 @@ struct SceneGpu {
     params_set: DescriptorSet,
     /// Footprint sets: 0 = visibility order, 1..=3 = slice-grouped lists of axes x, y, z.
     footprint_sets: Vec<DescriptorSet>,
+    /// The image-aligned sheets' (splat, slab) pairs and their footprint set; grown on demand.
+    slab: Option<(Buffer, DescriptorSet)>,
 }
 
 struct TargetGpu {
@@ -85,6 +87,8 @@ pub struct GpuPipeline {
     stages: Stages,
     frame: Buffer,
     table: Image,
+    /// The kernel-slice table of the image-aligned sheets.
+    slices: Image,
     sampler: Sampler,
     kernel: Option<Kernel>,
     scene: Option<SceneGpu>,
@@ -109,7 +113,7 @@ impl GpuPipeline {
         let params_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Storage, Slot::Storage], compute, 0)?;
         let footprint_layout = Layout::new(
             &ctx,
-            &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Texture],
+            &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Texture, Slot::Texture],
             SS::VERTEX | SS::FRAGMENT,
             std::mem::size_of::<FootprintPush>() as u32,
         )?;
@@ -157,9 +161,11 @@ impl GpuPipeline {
         let n = FOOTPRINT_TABLE_SIZE;
         let table =
             Image::new(&ctx, "footprint table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
+        let slices =
+            Image::new(&ctx, "slice table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
         let sampler = Sampler::nearest(&ctx)?;
         let timer = Timer::new(&ctx, 16)?;
-        Ok(Self { stages, frame, table, sampler, kernel: None, scene: None, target: None, timer, ctx })
+        Ok(Self { stages, frame, table, slices, sampler, kernel: None, scene: None, target: None, timer, ctx })
     }
 
     pub fn context(&self) -> &Arc<Context> {
@@ -170,19 +176,24 @@ impl GpuPipeline {
         if self.kernel == Some(kernel) {
             return Ok(());
         }
-        let data = kernel.footprint_table();
-        let staging = Buffer::with_data(&self.ctx, "table staging", bytemuck::cast_slice(&data), BU::TRANSFER_SRC)?;
-        let table = &self.table;
+        let footprint = kernel.footprint_table();
+        let slice = kernel.slice_table();
+        let stage =
+            |name, data: &[f32]| Buffer::with_data(&self.ctx, name, bytemuck::cast_slice(data), BU::TRANSFER_SRC);
+        let staging = [stage("table staging", &footprint)?, stage("slice table staging", &slice)?];
+        let images = [&self.table, &self.slices];
         self.ctx.submit(|rec| {
-            rec.transition(table, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::Graphics, Stage::Transfer);
-            rec.copy_buffer_to_image(&staging, table);
-            rec.transition(
-                table,
-                IL::TRANSFER_DST_OPTIMAL,
-                IL::SHADER_READ_ONLY_OPTIMAL,
-                Stage::Transfer,
-                Stage::Graphics,
-            );
+            for (table, staging) in images.iter().zip(&staging) {
+                rec.transition(table, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::Graphics, Stage::Transfer);
+                rec.copy_buffer_to_image(staging, table);
+                rec.transition(
+                    table,
+                    IL::TRANSFER_DST_OPTIMAL,
+                    IL::SHADER_READ_ONLY_OPTIMAL,
+                    Stage::Transfer,
+                    Stage::Graphics,
+                );
+            }
             Ok(())
         })?;
         self.kernel = Some(kernel);
@@ -236,6 +247,7 @@ impl GpuPipeline {
                 Bind::Buffer(&splats),
                 Bind::Buffer(&ranks),
                 Bind::Texture(&self.table, &self.sampler),
+                Bind::Texture(&self.slices, &self.sampler),
             ])?);
         }
         self.scene = Some(SceneGpu {
@@ -253,8 +265,32 @@ impl GpuPipeline {
             field: None,
             params_set,
             footprint_sets,
+            slab: None,
         });
         Ok(())
+    }
+
+    /// Copy this frame's (splat, slab) pairs to the GPU, growing their buffer (and its footprint
+    /// set) to the next power of two when they do not fit.
+    fn upload_slab_pairs(&mut self, pairs: &[u32]) -> Result<()> {
+        let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        let bytes = std::mem::size_of_val(pairs) as u64;
+        if scene.slab.as_ref().is_none_or(|(b, _)| b.size() < bytes) {
+            scene.slab = None;
+            let buffer =
+                Buffer::new(&self.ctx, "slab pairs", bytes.next_power_of_two(), BU::STORAGE_BUFFER, Memory::Upload)?;
+            let set = self.stages.footprint_layout.bind(&[
+                Bind::Buffer(&self.frame),
+                Bind::Buffer(&scene.params),
+                Bind::Buffer(&buffer),
+                Bind::Buffer(&scene._splats),
+                Bind::Buffer(&scene._ranks),
+                Bind::Texture(&self.table, &self.sampler),
+                Bind::Texture(&self.slices, &self.sampler),
+            ])?;
+            scene.slab = Some((buffer, set));
+        }
+        scene.slab.as_mut().expect("ensured").0.write(bytemuck::cast_slice(pairs))
     }
 
     fn ensure_target(&mut self, width: u32, height: u32, layers: u32) -> Result<()> {
@@ -480,26 +516,37 @@ impl GpuPipeline {
         let direction = opts.direction();
         let btf = direction == Direction::BackToFront;
         let layers = opts.batch_layers(w, h).min(max_layers.max(1));
-        let (axis, batches) = if opts.composite == Composite::Sheet {
-            sheet_plan(prep, camera, direction, layers)
-        } else {
-            (0, Vec::new())
+        let split = order::pbtf_split(&prep.set, camera);
+        let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
+        let mut host_ms = None;
+        let mut slab_pairs = None;
+        let (axis, batches) = match opts.composite {
+            Composite::Sheet => sheet_plan(prep, camera, direction, layers),
+            Composite::Slab => {
+                let t = Instant::now();
+                let plan = crate::slab::slab_bins(&frame, prep.set.splats(), opts.slab_thickness, direction, layers)?;
+                host_ms = Some(("slab_bins", t));
+                slab_pairs = Some(plan.pairs);
+                (0, plan.batches)
+            }
+            Composite::Splat => (0, Vec::new()),
         };
         // Allocate only as many layers as the largest batch needs.
         let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
         self.ensure_target(w, h, layers)?;
-        let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
         self.frame.write(bytemuck::bytes_of(&frame))?;
+        if let Some(pairs) = &slab_pairs {
+            self.upload_slab_pairs(pairs)?;
+        }
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;
-        let mut cpu_order_ms = None;
         if opts.composite == Composite::Splat && !gpu_order {
-            let t = std::time::Instant::now();
+            let t = Instant::now();
             let cpu_order = order::visibility_order(&prep.set, camera, opts.order, direction);
             scene.order.write(bytemuck::cast_slice(&cpu_order))?;
-            cpu_order_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+            host_ms = Some(("order_cpu", t));
         }
+        let host_ms = host_ms.map(|(stage, t)| StageTime { stage, ms: t.elapsed().as_secs_f64() * 1e3 });
         let (st, scene, target) =
             (&self.stages, self.scene.as_ref().expect("set above"), self.target.as_ref().expect("ensured"));
         let n = scene.n;
@@ -536,7 +583,11 @@ impl GpuPipeline {
                     Box::new(|rec| rec.copy_image_to_buffer(&target.color, IL::TRANSFER_SRC_OPTIMAL, &target.readback)),
                 ));
             }
-            Composite::Sheet => {
+            Composite::Sheet | Composite::Slab => {
+                let set = match opts.composite {
+                    Composite::Slab => &scene.slab.as_ref().expect("uploaded above").1,
+                    _ => &scene.footprint_sets[1 + axis],
+                };
                 steps.push((
                     UNTIMED,
                     Box::new(|rec| {
@@ -550,7 +601,6 @@ impl GpuPipeline {
                         "footprint",
                         Box::new(move |rec| {
                             rec.begin_pass(&st.sheet_pass, &target.sums_fb);
-                            let set = &scene.footprint_sets[1 + axis];
                             let push = bytemuck::bytes_of(&b.push);
                             rec.draw_quads(&st.add, &st.footprint_layout, set, push, b.first_instance, b.instances);
                             rec.end_pass();
@@ -573,8 +623,8 @@ impl GpuPipeline {
         }
         let mut timings = execute(&self.ctx, &mut self.timer, &steps)?;
         drop(steps);
-        if let Some(ms) = cpu_order_ms {
-            timings.insert(0, StageTime { stage: "order_cpu", ms });
+        if let Some(t) = host_ms {
+            timings.insert(0, t);
         }
         let target = self.target.as_ref().expect("ensured");
         Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })

@@ -66,12 +66,20 @@ pub struct RaycastParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct FootprintPush {
+    /// `SHEET_MODE_*`.
     pub sheet_mode: u32,
     pub axis: u32,
     pub rank_offset: u32,
     pub rank_base: u32,
     pub rank_dir: i32,
+    pub slab_z0: f32,
+    pub slab_dz: f32,
 }
+
+/// `sheet_mode` values (glsl/shared/types.glsl).
+pub const SHEET_MODE_SPLAT: u32 = 0;
+pub const SHEET_MODE_AXIS: u32 = 1;
+pub const SHEET_MODE_SLAB: u32 = 2;
 
 /// Push constants of `composite.comp`.
 #[repr(C)]
@@ -86,6 +94,6 @@ pub struct CompositePush {
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 288);
-const _: () = assert!(std::mem::size_of::<FootprintPush>() == 20);
+const _: () = assert!(std::mem::size_of::<FootprintPush>() == 28);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);

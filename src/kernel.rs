@@ -131,6 +131,12 @@ impl Kernel {
     }
 
     fn compute_footprint_table(self) -> Vec<f32> {
+        let (t, total) = self.raw_footprint_table();
+        t.iter().map(|v| (v / total) as f32).collect()
+    }
+
+    /// Unnormalised footprint texels and their discrete integral (the normaliser both tables share).
+    fn raw_footprint_table(self) -> (Vec<f64>, f64) {
         let n = FOOTPRINT_TABLE_SIZE as usize;
         let rr = self.radius() as f64;
         let mut t = vec![0.0f64; n * n];
@@ -142,7 +148,42 @@ impl Kernel {
             }
         }
         let texel_area = (2.0 * rr / n as f64).powi(2);
-        let total: f64 = t.iter().sum::<f64>() * texel_area;
-        t.iter().map(|v| (v / total) as f32).collect()
+        let total = t.iter().sum::<f64>() * texel_area;
+        (t, total)
+    }
+
+    /// The pre-integrated kernel-slice table of the image-aligned sheet buffer (Mueller & Crawfis
+    /// 1998): texel (x, y) holds the kernel integrated along the view axis from -R up to z at
+    /// in-plane distance r, with r = x / (N-1) and z = 2y / (N-1) - 1 in radius units, so the first
+    /// row is exactly 0 and the last equals the footprint. A slab [za, zb] of a splat then weighs
+    /// S(r, zb) - S(r, za), and the slabs of one splat sum to its footprint. Same normaliser as
+    /// `footprint_table`; computed once per kernel.
+    pub fn slice_table(self) -> Vec<f32> {
+        static TABLES: [std::sync::OnceLock<Vec<f32>>; 2] = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+        let slot = match self {
+            Kernel::Gaussian => 0,
+            Kernel::Cubic => 1,
+        };
+        TABLES[slot].get_or_init(|| self.compute_slice_table()).clone()
+    }
+
+    fn compute_slice_table(self) -> Vec<f32> {
+        let n = FOOTPRINT_TABLE_SIZE as usize;
+        let rr = self.radius() as f64;
+        let (_, total) = self.raw_footprint_table();
+        let mut t = vec![0.0f32; n * n];
+        // Cumulative Simpson along z, 16 intervals per table row.
+        const SUB: usize = 16;
+        for x in 0..n {
+            let rho = x as f64 / (n - 1) as f64 * rr;
+            let mut acc = 0.0;
+            for y in 1..n {
+                let z0 = (2.0 * (y - 1) as f64 / (n - 1) as f64 - 1.0) * rr;
+                let z1 = (2.0 * y as f64 / (n - 1) as f64 - 1.0) * rr;
+                acc += simpson(z0, z1, SUB, |z| self.profile((rho * rho + z * z).sqrt()));
+                t[y * n + x] = (acc / total) as f32;
+            }
+        }
+        t
     }
 }

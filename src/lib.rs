@@ -32,6 +32,7 @@ pub mod order;
 pub mod output;
 pub mod pipeline;
 pub mod scene;
+pub mod slab;
 pub mod soak;
 pub mod terrain;
 pub mod truth;

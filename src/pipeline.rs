@@ -10,7 +10,7 @@ use crate::camera::Camera;
 use crate::constants::{MAX_GROUPS_X, WORKGROUP_SIZE};
 use crate::cpu::{self, footprint::Blend, ImageF32};
 use crate::error::{Error, Result};
-use crate::gpu_types::{CompositePush, FootprintPush, Frame};
+use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS};
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
 use crate::volume::SplatSet;
@@ -25,6 +25,9 @@ pub enum Composite {
     Splat,
     /// Westover's sheet summation buffer: splats summed per sheet, sheets composited in order.
     Sheet,
+    /// Image-aligned sheet buffer (Mueller & Crawfis 1998): slabs parallel to the image plane, each
+    /// splat's kernel sliced into the slabs it overlaps (`crate::slab`).
+    Slab,
 }
 
 impl std::str::FromStr for Composite {
@@ -33,7 +36,8 @@ impl std::str::FromStr for Composite {
         match s {
             "splat" => Ok(Self::Splat),
             "sheet" => Ok(Self::Sheet),
-            _ => Err(Error::InvalidArgument(format!("unknown compositing '{s}' (splat, sheet)"))),
+            "slab" => Ok(Self::Slab),
+            _ => Err(Error::InvalidArgument(format!("unknown compositing '{s}' (splat, sheet, slab)"))),
         }
     }
 }
@@ -103,6 +107,9 @@ pub struct RenderOptions {
     pub direction: Option<Direction>,
     /// Memory allowed for one batch of sheet summation layers (RGBA32F each).
     pub sheet_budget_bytes: u64,
+    /// Image-aligned slab thickness in voxel spacings (`Composite::Slab`): thinner is closer to the
+    /// volume integral and costs more primitives (about 2R/Δ + 1 per splat).
+    pub slab_thickness: f32,
 }
 
 impl Default for RenderOptions {
@@ -115,6 +122,7 @@ impl Default for RenderOptions {
             motion: None,
             direction: None,
             sheet_budget_bytes: 256 << 20,
+            slab_thickness: 1.0,
         }
     }
 }
@@ -126,7 +134,7 @@ impl RenderOptions {
     pub fn direction(&self) -> Direction {
         self.direction.unwrap_or(match self.composite {
             Composite::Splat => Direction::BackToFront,
-            Composite::Sheet => Direction::FrontToBack,
+            Composite::Sheet | Composite::Slab => Direction::FrontToBack,
         })
     }
 
@@ -275,11 +283,12 @@ pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_la
                 instances: end - start,
                 layers: chunk.len() as u32,
                 push: FootprintPush {
-                    sheet_mode: 1,
+                    sheet_mode: SHEET_MODE_AXIS,
                     axis: axis as u32,
                     rank_offset: prep.rank_offsets[axis],
                     rank_base: rank_of(first),
                     rank_dir: if last >= first { 1 } else { -1 },
+                    ..Default::default()
                 },
             });
         }
@@ -328,6 +337,7 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
     lap("splat_params", &mut timings);
 
     let table = opts.kernel.footprint_table();
+    let slice_table = opts.kernel.slice_table();
     let (w, h) = (camera.width, camera.height);
     let mut image = ImageF32::new(w, h);
     match opts.composite {
@@ -339,20 +349,35 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                 splats: set.splats(),
                 sheet_rank: &prep.ranks,
                 table: &table,
+                slice_table: &slice_table,
             };
             let blend = if btf { Blend::Over } else { Blend::Under };
             cpu::footprint(&inputs, &FootprintPush::default(), blend, 0, n as u32, std::slice::from_mut(&mut image));
             lap("footprint", &mut timings);
         }
-        Composite::Sheet => {
-            let (axis, batches) = sheet_plan(prep, camera, direction, opts.batch_layers(w, h));
+        Composite::Sheet | Composite::Slab => {
+            let (draw_list, batches) = if opts.composite == Composite::Sheet {
+                let (axis, batches) = sheet_plan(prep, camera, direction, opts.batch_layers(w, h));
+                (std::borrow::Cow::Borrowed(&prep.slices[axis].1[..]), batches)
+            } else {
+                let plan = crate::slab::slab_bins(
+                    &frame,
+                    set.splats(),
+                    opts.slab_thickness,
+                    direction,
+                    opts.batch_layers(w, h),
+                )?;
+                lap("slab_bins", &mut timings);
+                (std::borrow::Cow::Owned(plan.pairs), plan.batches)
+            };
             let inputs = cpu::footprint::FootprintInputs {
                 frame: &frame,
                 params: &params,
-                draw_list: &prep.slices[axis].1,
+                draw_list: &draw_list,
                 splats: set.splats(),
                 sheet_rank: &prep.ranks,
                 table: &table,
+                slice_table: &slice_table,
             };
             let (mut raster_ms, mut comp_ms) = (0.0, 0.0);
             for b in &batches {

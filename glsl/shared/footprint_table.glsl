@@ -16,3 +16,21 @@ float sample_table(sampler2D table, vec2 uv) {
     float bottom = c + (d - c) * w.x;
     return top + (bottom - top) * w.y;
 }
+
+// Lookup in the kernel-slice table (image-aligned sheets): r in [0, 1] is the in-plane distance
+// from the splat's centre and z in [-1, 1] the depth of a slab face relative to it, both in radius
+// units; texel centres sit on r = x / (N-1) and z = 2y / (N-1) - 1 so both ends are exact.
+// Mirror: sample_slice_table in src/cpu/footprint.rs.
+float sample_slice_table(sampler2D slices, float r, float z) {
+    float m = float(FOOTPRINT_TABLE_SIZE - 1);
+    vec2 t = vec2(clamp(r, 0.0, 1.0), clamp(z, -1.0, 1.0) * 0.5 + 0.5) * m;
+    ivec2 i0 = min(ivec2(floor(t)), ivec2(FOOTPRINT_TABLE_SIZE - 2));
+    vec2 w = t - vec2(i0);
+    float a = texelFetch(slices, ivec2(i0.x, i0.y), 0).r;
+    float b = texelFetch(slices, ivec2(i0.x + 1, i0.y), 0).r;
+    float c = texelFetch(slices, ivec2(i0.x, i0.y + 1), 0).r;
+    float d = texelFetch(slices, ivec2(i0.x + 1, i0.y + 1), 0).r;
+    float top = a + (b - a) * w.x;
+    float bottom = c + (d - c) * w.x;
+    return top + (bottom - top) * w.y;
+}

@@ -56,6 +56,10 @@ struct RaycastParams {
     uvec4 image;         // width, height; zw: unused
 };
 
+#define SHEET_MODE_SPLAT 0u  // per-splat over / under compositing
+#define SHEET_MODE_AXIS 1u   // axis-aligned sheet summation
+#define SHEET_MODE_SLAB 2u   // image-aligned sheets (slabs)
+
 #define KERNEL_GAUSSIAN 0u
 #define KERNEL_CUBIC 1u
 

@@ -210,9 +210,13 @@ struct SceneArgs {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// Per-splat compositing or Westover's sheet summation buffer.
-    #[arg(long, default_value = "splat", value_parser = ["splat", "sheet"])]
+    /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
+    /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
+    #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
     composite: String,
+    /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25).
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    slab_thickness: f32,
     /// Reconstruction kernel.
     #[arg(long, default_value = "gaussian", value_parser = ["gaussian", "cubic"])]
     kernel: String,
@@ -410,6 +414,7 @@ fn run(cli: Cli) -> Result<()> {
                 return Err(Error::InvalidArgument("--sheet-budget-mib must be positive".into()));
             }
             opts.sheet_budget_bytes = a.sheet_budget_mib << 20;
+            opts.slab_thickness = a.slab_thickness;
             let splats = set.len();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
             let frame = if a.truth {

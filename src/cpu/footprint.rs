@@ -3,7 +3,7 @@
 //! perspective-correct interpolation computes on the GPU), weight by the footprint table, blend.
 use super::ImageF32;
 use crate::constants::FOOTPRINT_TABLE_SIZE;
-use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams};
+use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB};
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec4};
 
 /// How a fragment combines with the attachment (premultiplied colour).
@@ -29,6 +29,19 @@ pub fn sample_table(table: &[f32], u: f32, v: f32) -> f32 {
     top + (bottom - top) * wy
 }
 
+/// Mirror of `sample_slice_table` in `glsl/shared/footprint_table.glsl`.
+pub fn sample_slice_table(table: &[f32], r: f32, z: f32) -> f32 {
+    let n = FOOTPRINT_TABLE_SIZE as usize;
+    let m = (n - 1) as f32;
+    let (tx, ty) = (r.clamp(0.0, 1.0) * m, (z.clamp(-1.0, 1.0) * 0.5 + 0.5) * m);
+    let (x0, y0) = ((tx.floor() as usize).min(n - 2), (ty.floor() as usize).min(n - 2));
+    let (wx, wy) = (tx - x0 as f32, ty - y0 as f32);
+    let at = |x: usize, y: usize| table[y * n + x];
+    let top = at(x0, y0) + (at(x0 + 1, y0) - at(x0, y0)) * wx;
+    let bottom = at(x0, y0 + 1) + (at(x0 + 1, y0 + 1) - at(x0, y0 + 1)) * wx;
+    top + (bottom - top) * wy
+}
+
 /// The draw call's inputs, as bound on the GPU.
 pub struct FootprintInputs<'a> {
     pub frame: &'a Frame,
@@ -37,6 +50,8 @@ pub struct FootprintInputs<'a> {
     pub splats: &'a [Splat],
     pub sheet_rank: &'a [u32],
     pub table: &'a [f32],
+    /// The kernel-slice table (slab mode).
+    pub slice_table: &'a [f32],
 }
 
 /// Draw `instances` quads starting at `first_instance` of the draw list into `layers`.
@@ -51,12 +66,26 @@ pub fn footprint(
     let vp = Mat4::from_cols_array_2d(&inputs.frame.view_proj);
     let inv = vp.as_dmat4().inverse();
     for inst in first_instance..first_instance + instances {
-        let splat = inputs.draw_list[inst as usize] as usize;
+        let slab_mode = push.sheet_mode == SHEET_MODE_SLAB;
+        let splat =
+            if slab_mode { inputs.draw_list[2 * inst as usize] } else { inputs.draw_list[inst as usize] } as usize;
         let p = &inputs.params[splat];
         if p.center[3] == 0.0 {
             continue;
         }
-        let layer = if push.sheet_mode != 0 {
+        let mut weight = Weight::Footprint(inputs.table);
+        let layer = if slab_mode {
+            let slab = inputs.draw_list[2 * inst as usize + 1];
+            let radius = glam::Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length();
+            let near_face = push.slab_z0 + slab as f32 * push.slab_dz - p.screen[0];
+            let faces = [near_face / radius, (near_face + push.slab_dz) / radius];
+            weight = Weight::Slice(inputs.slice_table, faces);
+            if push.rank_dir > 0 {
+                slab.wrapping_sub(push.rank_base)
+            } else {
+                push.rank_base.wrapping_sub(slab)
+            }
+        } else if push.sheet_mode == SHEET_MODE_AXIS {
             let rank = inputs.sheet_rank[(push.rank_offset + inputs.splats[splat].ijk[push.axis as usize]) as usize];
             if push.rank_dir > 0 {
                 rank.wrapping_sub(push.rank_base)
@@ -67,8 +96,16 @@ pub fn footprint(
             0
         } as usize;
         let Some(target) = layers.get_mut(layer) else { continue };
-        raster_quad(p, push.sheet_mode != 0, blend, vp, &inv, inputs.table, target);
+        raster_quad(p, push.sheet_mode != 0, blend, vp, &inv, weight, target);
     }
+}
+
+/// What a fragment weighs: the whole pre-integrated footprint, or the slice between two slab
+/// faces (radius units, relative to the splat's centre).
+#[derive(Clone, Copy)]
+enum Weight<'a> {
+    Footprint(&'a [f32]),
+    Slice(&'a [f32], [f32; 2]),
 }
 
 fn raster_quad(
@@ -77,7 +114,7 @@ fn raster_quad(
     blend: Blend,
     vp: Mat4,
     inv: &DMat4,
-    table: &[f32],
+    weight: Weight<'_>,
     target: &mut ImageF32,
 ) {
     let v3 = |v: [f32; 4]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
@@ -122,7 +159,14 @@ fn raster_quad(
             }
             let stretch = p.axis_v[3];
             let along = ((u.abs() as f32) * (1.0 + stretch) - stretch).max(0.0);
-            let tau = p.emit[3] * energy * sample_table(table, along, v as f32);
+            let w = match weight {
+                Weight::Footprint(table) => sample_table(table, along, v as f32),
+                Weight::Slice(table, [za, zb]) => {
+                    let r = (along * along + (v * v) as f32).sqrt();
+                    sample_slice_table(table, r, zb) - sample_slice_table(table, r, za)
+                }
+            };
+            let tau = p.emit[3] * energy * w;
             if tau <= 0.0 {
                 continue;
             }

@@ -16,6 +16,20 @@ pub const AA_NONE: f32 = 0.0;
 pub const AA_SWAN: f32 = 1.0;
 pub const AA_EWA: f32 = 2.0;
 
+/// The anti-aliasing radius scale at eye-space `depth` (1 before k; Eq. 3.9 or the EWA low-pass).
+pub fn footprint_scale(frame: &Frame, depth: f32) -> f32 {
+    let voxel = frame.spacing[3] / frame.origin[3];
+    let ppv = if frame.eye[3] > 0.5 { voxel * frame.up[3] / depth.max(1e-6) } else { voxel * frame.up[3] };
+    if frame.aa[0] == AA_SWAN {
+        (1.0 / ppv).max(1.0)
+    } else if frame.aa[0] == AA_EWA {
+        let lp = frame.aa[2] / (frame.aa[1] * ppv);
+        (1.0 + lp * lp).sqrt()
+    } else {
+        1.0
+    }
+}
+
 pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams]) {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right, origin, spacing) =
@@ -24,15 +38,7 @@ pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams])
         let ijk = Vec3::new(sp.ijk[0] as f32, sp.ijk[1] as f32, sp.ijk[2] as f32);
         let center = origin + ijk * spacing;
         let depth = (center - eye).dot(forward);
-        let voxel = frame.spacing[3] / frame.origin[3];
-        let ppv = if frame.eye[3] > 0.5 { voxel * frame.up[3] / depth.max(1e-6) } else { voxel * frame.up[3] };
-        let mut scale = 1.0f32;
-        if frame.aa[0] == AA_SWAN {
-            scale = (1.0 / ppv).max(1.0);
-        } else if frame.aa[0] == AA_EWA {
-            let lp = frame.aa[2] / (frame.aa[1] * ppv);
-            scale = (1.0 + lp * lp).sqrt();
-        }
+        let scale = footprint_scale(frame, depth);
         let radius = frame.spacing[3] * scale;
         let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
         let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
