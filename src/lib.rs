@@ -34,6 +34,7 @@ pub mod pipeline;
 pub mod scene;
 pub mod slab;
 pub mod soak;
+pub mod stability;
 pub mod terrain;
 pub mod truth;
 #[allow(unsafe_code)]

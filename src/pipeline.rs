@@ -245,18 +245,23 @@ pub struct Batch {
     pub push: FootprintPush,
 }
 
-/// The sheet axis (the grid axis most perpendicular to the view plane) and its batches in visiting
-/// order. Empty sheets are skipped; a batch never straddles the eye's plane, so its splats are one
-/// contiguous run of the slice-grouped draw list.
-pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_layers: u32) -> (usize, Vec<Batch>) {
+/// The grid axis most perpendicular to the view plane: the axis-aligned sheets' normal.
+pub fn sheet_axis(camera: &Camera) -> usize {
     let f = camera.forward().abs();
-    let axis = if f.x >= f.y && f.x >= f.z {
+    if f.x >= f.y && f.x >= f.z {
         0
     } else if f.y >= f.z {
         1
     } else {
         2
-    };
+    }
+}
+
+/// The sheet axis (the grid axis most perpendicular to the view plane) and its batches in visiting
+/// order. Empty sheets are skipped; a batch never straddles the eye's plane, so its splats are one
+/// contiguous run of the slice-grouped draw list.
+pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_layers: u32) -> (usize, Vec<Batch>) {
+    let axis = sheet_axis(camera);
     let split = order::pbtf_split(&prep.set, camera)[axis];
     let n = prep.set.grid().dims[axis];
     let offsets = &prep.slices[axis].0;

@@ -132,8 +132,8 @@ fn quick_bench_writes_valid_csv_and_svg() {
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(
         rows.len(),
-        2 * 5 + 3 + 4,
-        "two scenes x five methods, three anti-aliasing modes, four motion-blur methods"
+        2 * 6 + 3 + 4,
+        "two scenes x six methods, three anti-aliasing modes, four motion-blur methods"
     );
     for r in &rows {
         assert_eq!(r.len(), header.len());

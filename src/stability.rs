@@ -1,0 +1,361 @@
+//! Where methods fail (section 1.2.2.3; issue 8), reproduced as animations and views with numbers:
+//! (a) the axis-aligned sheet buffer's pop when its sheet axis switches (Figs 1.9, 1.16);
+//! (b) brightening against screen splat density in perspective (Fig. 1.17);
+//! (c) per-splat compositing's dependence on the order of overlapping splats (Figs 1.13, 1.14);
+//! (d) BTF/WBTF visibility errors in perspective (Figs 2.25, 2.26, 5.1).
+use crate::camera::{Camera, Projection};
+use crate::cpu::raycast::RaycastOptions;
+use crate::cpu::ImageF32;
+use crate::error::Result;
+use crate::metrics::{compare, temporal};
+use crate::order::{count_violations, visibility_order, Direction, OrderKind};
+use crate::pipeline::{sheet_axis, Composite, RenderOptions, Rendered};
+use crate::truth::{volumetric_summation, TruthOptions};
+use crate::volume::{Grid, SplatSet};
+use crate::{scene, Renderer};
+use glam::{Quat, Vec3};
+
+/// A renderer configuration compared by the studies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Variant {
+    /// Per-splat compositing in this visibility order.
+    Splat(OrderKind),
+    /// Westover's axis-aligned sheet buffer.
+    Sheet,
+    /// Image-aligned sheets of this thickness (voxel spacings).
+    Slab(f32),
+    /// The ray caster at this step (voxel spacings).
+    Raycast(f32),
+}
+
+impl Variant {
+    pub fn label(&self) -> String {
+        match self {
+            Variant::Splat(o) => format!("{} splat", format!("{o:?}").to_lowercase()),
+            Variant::Sheet => "axis-aligned sheet".into(),
+            Variant::Slab(t) => format!("image-aligned slab {t}"),
+            Variant::Raycast(s) => format!("raycast {s}"),
+        }
+    }
+
+    pub fn render(&self, r: &mut Renderer, camera: &Camera) -> Result<Rendered> {
+        let mut o = RenderOptions::default();
+        match *self {
+            Variant::Splat(order) => o.order = order,
+            Variant::Sheet => o.composite = Composite::Sheet,
+            Variant::Slab(t) => {
+                o.composite = Composite::Slab;
+                o.slab_thickness = t;
+            }
+            Variant::Raycast(step) => return r.raycast(camera, &RaycastOptions { step, ..Default::default() }),
+        }
+        r.render(camera, &o)
+    }
+
+    /// The variants every study compares.
+    pub fn all() -> Vec<Variant> {
+        vec![Variant::Splat(OrderKind::Pbtf), Variant::Sheet, Variant::Slab(1.0), Variant::Slab(0.5), Variant::Raycast(0.5)]
+    }
+}
+
+fn total_ms(r: &Rendered) -> f64 {
+    r.timings.iter().map(|s| s.ms).sum()
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// An orthographic turntable about the vertical axis through the grid's centre, 20° above the
+/// equator, `frames` steps of one degree centred on 45°: the sheet axis switches from z to x midway
+/// (Fig. 1.9). Returns the cameras and the step (i → i+1) across which the axis switches.
+pub fn axis_switch_cameras(grid: &Grid, size: u32, frames: usize) -> (Vec<Camera>, Option<usize>) {
+    let c = grid.center();
+    let dist = grid.diagonal() * 2.0;
+    let cams: Vec<Camera> = (0..frames)
+        .map(|i| {
+            let azimuth = (45.0 + (i as f32 - (frames as f32 - 1.0) / 2.0)).to_radians();
+            let dir = Quat::from_rotation_y(azimuth) * Quat::from_rotation_x(-20f32.to_radians()) * Vec3::Z;
+            Camera {
+                eye: c + dir * dist,
+                target: c,
+                up: Vec3::Y,
+                projection: Projection::Orthographic { height: grid.diagonal() * 1.05 },
+                near: dist - grid.diagonal(),
+                far: dist + grid.diagonal(),
+                width: size,
+                height: size,
+            }
+        })
+        .collect();
+    let switch = cams.windows(2).position(|w| sheet_axis(&w[0]) != sheet_axis(&w[1]));
+    (cams, switch)
+}
+
+/// (a) One variant through the axis switch.
+#[derive(Clone, Debug)]
+pub struct SwitchRow {
+    pub variant: String,
+    /// Frame change across the axis switch over the median frame change (1 = no pop).
+    pub switch_popping: f64,
+    /// Largest frame change over the median one, anywhere in the animation.
+    pub popping: f64,
+    pub median_change: f64,
+    /// Mean RMSE against the truth over the sampled frames.
+    pub rmse: f64,
+    /// Median frame time (sum of stage times).
+    pub time_ms: f64,
+}
+
+/// Render the turntable of `scene_name` with every variant; the truth is computed at `truth_frames`
+/// evenly spaced frames (including both sides of the switch).
+pub fn axis_switch_study(
+    r: &mut Renderer,
+    scene_name: &str,
+    size: u32,
+    frames: usize,
+    variants: &[Variant],
+    truth_frames: usize,
+) -> Result<Vec<SwitchRow>> {
+    let set = scene::build(scene_name)?;
+    let (cams, switch) = axis_switch_cameras(set.grid(), size, frames);
+    let switch = switch.unwrap_or(frames / 2);
+    let mut sample: Vec<usize> = (0..truth_frames.max(2)).map(|i| i * (frames - 1) / (truth_frames.max(2) - 1)).collect();
+    sample.extend([switch, switch + 1]);
+    sample.sort_unstable();
+    sample.dedup();
+    let truth: Vec<(usize, ImageF32)> = sample
+        .iter()
+        .map(|&i| Ok((i, volumetric_summation(&set, &cams[i], &TruthOptions::default())?)))
+        .collect::<Result<_>>()?;
+    r.set_scene(set)?;
+    let mut rows = Vec::new();
+    for v in variants {
+        v.render(r, &cams[0])?; // warm-up
+        let mut images = Vec::with_capacity(frames);
+        let mut times = Vec::with_capacity(frames);
+        for cam in &cams {
+            let out = v.render(r, cam)?;
+            times.push(total_ms(&out));
+            images.push(out.image);
+        }
+        let t = temporal(&images)?;
+        let mut changes = Vec::with_capacity(frames - 1);
+        for w in images.windows(2) {
+            changes.push(compare(&w[1], &w[0])?.rmse);
+        }
+        let median_change = median(changes.clone());
+        let rmse = truth.iter().map(|(i, t)| compare(&images[*i], t).map(|m| m.rmse)).sum::<Result<f64>>()?
+            / truth.len() as f64;
+        rows.push(SwitchRow {
+            variant: v.label(),
+            switch_popping: if median_change > 0.0 { changes[switch] / median_change } else { 1.0 },
+            popping: t.popping,
+            median_change,
+            rmse,
+            time_ms: median(times),
+        });
+    }
+    Ok(rows)
+}
+
+/// Projected splat centres per pixel, averaged over a `box_px`-wide square around each pixel.
+pub fn splat_density(set: &SplatSet, camera: &Camera, box_px: u32) -> Vec<f32> {
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let mut counts = vec![0.0f32; w * h];
+    let vp = camera.view_proj();
+    for sp in set.splats() {
+        let p = set.grid().position([sp.ijk[0], sp.ijk[1], sp.ijk[2]]);
+        let clip = vp * p.extend(1.0);
+        if clip.w <= 0.0 {
+            continue;
+        }
+        let (x, y) = ((clip.x / clip.w * 0.5 + 0.5) * w as f32, (clip.y / clip.w * 0.5 + 0.5) * h as f32);
+        if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
+            counts[y as usize * w + x as usize] += 1.0;
+        }
+    }
+    let r = (box_px / 2) as i64;
+    let mut out = vec![0.0f32; w * h];
+    for y in 0..h as i64 {
+        for x in 0..w as i64 {
+            let (mut sum, mut n) = (0.0, 0.0);
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (xx, yy) = (x + dx, y + dy);
+                    if xx >= 0 && yy >= 0 && xx < w as i64 && yy < h as i64 {
+                        sum += counts[yy as usize * w + xx as usize];
+                        n += 1.0;
+                    }
+                }
+            }
+            out[y as usize * w + x as usize] = sum / n;
+        }
+    }
+    out
+}
+
+/// Brightness (luma of the premultiplied colour) over the truth's, in the densest quarter of the
+/// object's pixels against the sparsest quarter, minus 1: 0 when brightness does not depend on how
+/// many splats crowd into a pixel. Pixels count where the truth is nearly opaque.
+pub fn brightening(img: &ImageF32, truth: &ImageF32, density: &[f32]) -> f64 {
+    let luma = |p: [f32; 4]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let mut px: Vec<(f32, f64)> = (0..truth.pixels.len())
+        .filter(|&i| truth.pixels[i][3] > 0.9 && luma(truth.pixels[i]) > 0.05 && density[i] > 0.0)
+        .map(|i| (density[i], luma(img.pixels[i]) / luma(truth.pixels[i])))
+        .collect();
+    if px.len() < 8 {
+        return f64::NAN;
+    }
+    px.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
+    let q = px.len() / 4;
+    let mean = |s: &[(f32, f64)]| s.iter().map(|p| p.1).sum::<f64>() / s.len() as f64;
+    mean(&px[px.len() - q..]) / mean(&px[..q]) - 1.0
+}
+
+/// The Fig. 1.17 view: the 40³ cube from below and in front, close, wide angle, so its bottom face
+/// narrows towards the back and packs ever more splats into each pixel.
+pub fn brightening_camera(grid: &Grid, size: u32) -> Camera {
+    let c = grid.center();
+    let s = grid.diagonal() / 3f32.sqrt();
+    Camera {
+        eye: c + Vec3::new(0.1 * s, -0.75 * s, 1.05 * s),
+        target: c + Vec3::new(0.0, -0.2 * s, 0.0),
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 70.0 },
+        near: 0.05 * s,
+        far: 4.0 * s,
+        width: size,
+        height: size,
+    }
+}
+
+/// (b) Brightening and error of one variant on the Fig. 1.17 view.
+#[derive(Clone, Debug)]
+pub struct BrightRow {
+    pub variant: String,
+    pub brightening: f64,
+    pub rmse: f64,
+    pub time_ms: f64,
+}
+
+pub fn brightening_study(r: &mut Renderer, size: u32, variants: &[Variant]) -> Result<Vec<BrightRow>> {
+    let set = scene::build("cube40")?;
+    let cam = brightening_camera(set.grid(), size);
+    let truth = volumetric_summation(&set, &cam, &TruthOptions::default())?;
+    let density = splat_density(&set, &cam, 5);
+    r.set_scene(set)?;
+    let mut rows = Vec::new();
+    for v in variants {
+        v.render(r, &cam)?;
+        let out = v.render(r, &cam)?;
+        rows.push(BrightRow {
+            variant: v.label(),
+            brightening: brightening(&out.image, &truth, &density),
+            rmse: compare(&out.image, &truth)?.rmse,
+            time_ms: total_ms(&out),
+        });
+    }
+    Ok(rows)
+}
+
+/// (c) How much per-splat compositing depends on the order of overlapping splats: RMSE between
+/// two valid visibility orders (PBTF and a depth sort) over a short rotation, for one scene.
+#[derive(Clone, Debug)]
+pub struct OverlapRow {
+    pub scene: String,
+    /// Mean RMSE between the PBTF and sorted-order images.
+    pub order_sensitivity: f64,
+    /// The same for the axis-aligned sheet buffer (orders only matter between sheets: 0 expected).
+    pub sheet_sensitivity: f64,
+    /// Mean alpha of the PBTF images (the attenuated cube is fainter overall).
+    pub mean_alpha: f64,
+}
+
+pub fn overlap_study(r: &mut Renderer, size: u32, frames: usize) -> Result<Vec<OverlapRow>> {
+    let mut rows = Vec::new();
+    for name in ["cube40", "cube40-attenuated"] {
+        let set = scene::build(name)?;
+        let base = Camera::framing(set.grid(), size, size);
+        r.set_scene(set)?;
+        let (mut sens, mut sheet, mut alpha) = (0.0, 0.0, 0.0);
+        for f in 0..frames {
+            let mut cam = base;
+            let off = cam.eye - cam.target;
+            cam.eye = cam.target + Quat::from_rotation_y((f as f32 * 3.0).to_radians()) * off;
+            let mut o = RenderOptions::default();
+            let pbtf = r.render(&cam, &o)?.image;
+            o.order = OrderKind::Sorted;
+            let sorted = r.render(&cam, &o)?.image;
+            sens += compare(&pbtf, &sorted)?.rmse;
+            o.composite = Composite::Sheet;
+            let s_sorted = r.render(&cam, &o)?.image;
+            o.order = OrderKind::Pbtf;
+            let s_pbtf = r.render(&cam, &o)?.image;
+            sheet += compare(&s_pbtf, &s_sorted)?.rmse;
+            alpha += pbtf.pixels.iter().map(|p| p[3] as f64).sum::<f64>() / pbtf.pixels.len() as f64;
+        }
+        let n = frames as f64;
+        rows.push(OverlapRow {
+            scene: name.into(),
+            order_sensitivity: sens / n,
+            sheet_sensitivity: sheet / n,
+            mean_alpha: alpha / n,
+        });
+    }
+    Ok(rows)
+}
+
+/// (d) Visibility errors of one order on one perspective view.
+#[derive(Clone, Debug)]
+pub struct VisibilityRow {
+    pub view: String,
+    pub order: String,
+    pub violations: u64,
+    /// RMSE against the same renderer with a depth-sorted order (the visibility reference).
+    pub rmse_vs_sorted: f64,
+}
+
+/// The close, off-axis perspective view of the 60³ cube of Figs 2.25–2.27 (the eye projects inside
+/// the grid on two axes).
+pub fn close_view(grid: &Grid, size: u32) -> Camera {
+    let c = grid.center();
+    Camera {
+        eye: c + Vec3::new(12.0, 20.0, 75.0),
+        target: c,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 60.0 },
+        near: 0.5,
+        far: 300.0,
+        width: size,
+        height: size,
+    }
+}
+
+pub fn visibility_study(r: &mut Renderer, size: u32) -> Result<Vec<VisibilityRow>> {
+    let mut rows = Vec::new();
+    for (view, name) in [("cube60 close (Figs 2.25-2.26)", "cube60"), ("rmnp fly-over (Fig. 5.1)", "rmnp")] {
+        let set = scene::build(name)?;
+        let cam = if name == "rmnp" { Camera::flyover(set.grid(), size, size) } else { close_view(set.grid(), size) };
+        let mut o = RenderOptions { order: OrderKind::Sorted, ..Default::default() };
+        let orders = [OrderKind::Btf, OrderKind::Wbtf, OrderKind::Pbtf];
+        let violations: Vec<u64> = orders
+            .iter()
+            .map(|&k| count_violations(&set, &cam, &visibility_order(&set, &cam, k, Direction::BackToFront), Direction::BackToFront))
+            .collect::<Result<_>>()?;
+        r.set_scene(set)?;
+        let reference = r.render(&cam, &o)?.image;
+        for (k, v) in orders.iter().zip(violations) {
+            o.order = *k;
+            let img = r.render(&cam, &o)?.image;
+            rows.push(VisibilityRow {
+                view: view.into(),
+                order: format!("{k:?}").to_lowercase(),
+                violations: v,
+                rmse_vs_sorted: compare(&img, &reference)?.rmse,
+            });
+        }
+    }
+    Ok(rows)
+}
