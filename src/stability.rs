@@ -10,7 +10,7 @@ use crate::error::Result;
 use crate::metrics::{compare, temporal};
 use crate::order::{count_violations, visibility_order, Direction, OrderKind};
 use crate::pipeline::{sheet_axis, Composite, RenderOptions, Rendered};
-use crate::truth::{volumetric_summation, TruthOptions};
+use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use crate::volume::{Grid, SplatSet};
 use crate::{scene, Renderer};
 use glam::{Quat, Vec3};
@@ -38,6 +38,14 @@ impl Variant {
         }
     }
 
+    /// The reconstruction its truth uses (splats: their kernel; the ray caster: trilinear).
+    pub fn reconstruction(&self) -> Reconstruction {
+        match self {
+            Variant::Raycast(_) => Reconstruction::Trilinear,
+            _ => Reconstruction::Kernel(crate::Kernel::Gaussian),
+        }
+    }
+
     pub fn render(&self, r: &mut Renderer, camera: &Camera) -> Result<Rendered> {
         let mut o = RenderOptions::default();
         match *self {
@@ -56,6 +64,22 @@ impl Variant {
     pub fn all() -> Vec<Variant> {
         vec![Variant::Splat(OrderKind::Pbtf), Variant::Sheet, Variant::Slab(1.0), Variant::Slab(0.5), Variant::Raycast(0.5)]
     }
+}
+
+/// Truth images of `set` from `camera`, one per reconstruction that `variants` need.
+fn truths(set: &SplatSet, camera: &Camera, variants: &[Variant]) -> Result<Vec<(Reconstruction, ImageF32)>> {
+    let mut out: Vec<(Reconstruction, ImageF32)> = Vec::new();
+    for v in variants {
+        let rec = v.reconstruction();
+        if !out.iter().any(|(r, _)| *r == rec) {
+            out.push((rec, volumetric_summation(set, camera, &TruthOptions { reconstruction: rec, ..Default::default() })?));
+        }
+    }
+    Ok(out)
+}
+
+fn truth_for<'a>(truths: &'a [(Reconstruction, ImageF32)], v: &Variant) -> &'a ImageF32 {
+    &truths.iter().find(|(r, _)| *r == v.reconstruction()).expect("computed for every variant").1
 }
 
 fn total_ms(r: &Rendered) -> f64 {
@@ -109,7 +133,7 @@ pub struct SwitchRow {
 }
 
 /// Render the turntable of `scene_name` with every variant; the truth is computed at `truth_frames`
-/// evenly spaced frames (including both sides of the switch).
+/// evenly spaced frames plus both sides of the switch (0: no truth, `rmse` is NaN).
 pub fn axis_switch_study(
     r: &mut Renderer,
     scene_name: &str,
@@ -121,14 +145,15 @@ pub fn axis_switch_study(
     let set = scene::build(scene_name)?;
     let (cams, switch) = axis_switch_cameras(set.grid(), size, frames);
     let switch = switch.unwrap_or(frames / 2);
-    let mut sample: Vec<usize> = (0..truth_frames.max(2)).map(|i| i * (frames - 1) / (truth_frames.max(2) - 1)).collect();
-    sample.extend([switch, switch + 1]);
-    sample.sort_unstable();
-    sample.dedup();
-    let truth: Vec<(usize, ImageF32)> = sample
-        .iter()
-        .map(|&i| Ok((i, volumetric_summation(&set, &cams[i], &TruthOptions::default())?)))
-        .collect::<Result<_>>()?;
+    let mut sample: Vec<usize> = Vec::new();
+    if truth_frames > 0 {
+        sample.extend((0..truth_frames.max(2)).map(|i| i * (frames - 1) / (truth_frames.max(2) - 1)));
+        sample.extend([switch, switch + 1]);
+        sample.sort_unstable();
+        sample.dedup();
+    }
+    let truth: Vec<(usize, Vec<(Reconstruction, ImageF32)>)> =
+        sample.iter().map(|&i| Ok((i, truths(&set, &cams[i], variants)?))).collect::<Result<_>>()?;
     r.set_scene(set)?;
     let mut rows = Vec::new();
     for v in variants {
@@ -146,7 +171,7 @@ pub fn axis_switch_study(
             changes.push(compare(&w[1], &w[0])?.rmse);
         }
         let median_change = median(changes.clone());
-        let rmse = truth.iter().map(|(i, t)| compare(&images[*i], t).map(|m| m.rmse)).sum::<Result<f64>>()?
+        let rmse = truth.iter().map(|(i, t)| compare(&images[*i], truth_for(t, v)).map(|m| m.rmse)).sum::<Result<f64>>()?
             / truth.len() as f64;
         rows.push(SwitchRow {
             variant: v.label(),
@@ -200,18 +225,26 @@ pub fn splat_density(set: &SplatSet, camera: &Camera, box_px: u32) -> Vec<f32> {
 /// object's pixels against the sparsest quarter, minus 1: 0 when brightness does not depend on how
 /// many splats crowd into a pixel. Pixels count where the truth is nearly opaque.
 pub fn brightening(img: &ImageF32, truth: &ImageF32, density: &[f32]) -> f64 {
+    brightening_and_density(img, truth, density).0
+}
+
+/// `brightening`, and the mean density of the densest quarter over that of the sparsest (how much
+/// the view crowds splats: the lever the brightening would pull on).
+pub fn brightening_and_density(img: &ImageF32, truth: &ImageF32, density: &[f32]) -> (f64, f64) {
     let luma = |p: [f32; 4]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
     let mut px: Vec<(f32, f64)> = (0..truth.pixels.len())
         .filter(|&i| truth.pixels[i][3] > 0.9 && luma(truth.pixels[i]) > 0.05 && density[i] > 0.0)
         .map(|i| (density[i], luma(img.pixels[i]) / luma(truth.pixels[i])))
         .collect();
     if px.len() < 8 {
-        return f64::NAN;
+        return (f64::NAN, f64::NAN);
     }
     px.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
     let q = px.len() / 4;
     let mean = |s: &[(f32, f64)]| s.iter().map(|p| p.1).sum::<f64>() / s.len() as f64;
-    mean(&px[px.len() - q..]) / mean(&px[..q]) - 1.0
+    let dens = |s: &[(f32, f64)]| s.iter().map(|p| p.0 as f64).sum::<f64>() / s.len() as f64;
+    let (dense, sparse) = (&px[px.len() - q..], &px[..q]);
+    (mean(dense) / mean(sparse) - 1.0, dens(dense) / dens(sparse))
 }
 
 /// The Fig. 1.17 view: the 40³ cube from below and in front, close, wide angle, so its bottom face
@@ -236,6 +269,8 @@ pub fn brightening_camera(grid: &Grid, size: u32) -> Camera {
 pub struct BrightRow {
     pub variant: String,
     pub brightening: f64,
+    /// Densest quarter's splats per pixel over the sparsest quarter's.
+    pub density_ratio: f64,
     pub rmse: f64,
     pub time_ms: f64,
 }
@@ -243,17 +278,20 @@ pub struct BrightRow {
 pub fn brightening_study(r: &mut Renderer, size: u32, variants: &[Variant]) -> Result<Vec<BrightRow>> {
     let set = scene::build("cube40")?;
     let cam = brightening_camera(set.grid(), size);
-    let truth = volumetric_summation(&set, &cam, &TruthOptions::default())?;
+    let truth = truths(&set, &cam, variants)?;
     let density = splat_density(&set, &cam, 5);
     r.set_scene(set)?;
     let mut rows = Vec::new();
     for v in variants {
         v.render(r, &cam)?;
         let out = v.render(r, &cam)?;
+        let t = truth_for(&truth, v);
+        let (brightening, density_ratio) = brightening_and_density(&out.image, t, &density);
         rows.push(BrightRow {
             variant: v.label(),
-            brightening: brightening(&out.image, &truth, &density),
-            rmse: compare(&out.image, &truth)?.rmse,
+            brightening,
+            density_ratio,
+            rmse: compare(&out.image, t)?.rmse,
             time_ms: total_ms(&out),
         });
     }
@@ -315,6 +353,8 @@ pub struct VisibilityRow {
     pub violations: u64,
     /// RMSE against the same renderer with a depth-sorted order (the visibility reference).
     pub rmse_vs_sorted: f64,
+    /// RMSE against the volumetric-summation truth.
+    pub rmse_vs_truth: f64,
 }
 
 /// The close, off-axis perspective view of the 60³ cube of Figs 2.25–2.27 (the eye projects inside
@@ -344,6 +384,7 @@ pub fn visibility_study(r: &mut Renderer, size: u32) -> Result<Vec<VisibilityRow
             .iter()
             .map(|&k| count_violations(&set, &cam, &visibility_order(&set, &cam, k, Direction::BackToFront), Direction::BackToFront))
             .collect::<Result<_>>()?;
+        let truth = volumetric_summation(&set, &cam, &TruthOptions::default())?;
         r.set_scene(set)?;
         let reference = r.render(&cam, &o)?.image;
         for (k, v) in orders.iter().zip(violations) {
@@ -354,6 +395,7 @@ pub fn visibility_study(r: &mut Renderer, size: u32) -> Result<Vec<VisibilityRow
                 order: format!("{k:?}").to_lowercase(),
                 violations: v,
                 rmse_vs_sorted: compare(&img, &reference)?.rmse,
+                rmse_vs_truth: compare(&img, &truth)?.rmse,
             });
         }
     }

@@ -28,7 +28,7 @@ fn save_failure(tag: &str, gpu: &voxsplat::cpu::ImageF32, cpu: &voxsplat::cpu::I
 }
 
 #[test]
-fn gpu_matches_cpu_mirror_for_both_compositing_modes_and_kernels() {
+fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
     let mut gpu = common::gpu();
     let mut cpu = common::cpu();
     let plane_ortho = |g: &voxsplat::Grid| Camera {
@@ -60,7 +60,7 @@ fn gpu_matches_cpu_mirror_for_both_compositing_modes_and_kernels() {
         let cam = camera(set.grid());
         gpu.set_scene(set.clone()).unwrap();
         cpu.set_scene(set).unwrap();
-        for composite in [Composite::Splat, Composite::Sheet] {
+        for composite in [Composite::Splat, Composite::Sheet, Composite::Slab] {
             for kernel in [Kernel::Gaussian, Kernel::Cubic] {
                 for direction in [Direction::BackToFront, Direction::FrontToBack] {
                     let mut o = options(composite, kernel);
