@@ -11,6 +11,7 @@ layout(std430, binding = 1) readonly buffer Params { SplatParams params[]; };
 layout(std430, binding = 2) readonly buffer DrawList { uint draw_list[]; };
 layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 4) readonly buffer SheetRank { uint sheet_rank[]; };
+layout(std430, binding = 7) readonly buffer Occlusion { float occlusion[]; };
 
 layout(push_constant) uniform Push {
     uint sheet_mode;   // SHEET_MODE_*
@@ -20,6 +21,8 @@ layout(push_constant) uniform Push {
     int rank_dir;      // +1 or -1: direction of the batch in rank space
     float slab_z0;     // slab mode: eye-space depth of slab 0's near face
     float slab_dz;     // slab mode: slab thickness (world units)
+    float occluded;    // front-to-back early termination: skip a splat whose every tile has at most
+                       // this transmittance left (0: off)
 } pc;
 
 layout(location = 0) out vec2 out_uv;
@@ -28,6 +31,34 @@ layout(location = 2) flat out float out_stretch;
 layout(location = 3) flat out vec2 out_slab;
 
 const vec2 CORNERS[4] = vec2[](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
+// Most tiles a footprint may span and still be tested (larger ones are always drawn).
+const int MAX_OCCLUSION_TILES = 16;
+
+// Whether the footprint quad lies wholly over tiles whose transmittance is at most pc.occluded.
+// Every vertex of the quad computes the same answer from the same four corners. Mirror:
+// cpu::footprint::occluded.
+bool occluded(SplatParams p) {
+    vec2 size = frame.blur.zw;
+    vec2 lo = vec2(1e30), hi = vec2(-1e30);
+    for (int k = 0; k < 4; ++k) {
+        vec3 q = p.center.xyz + CORNERS[k].x * p.axis_u.xyz + CORNERS[k].y * p.axis_v.xyz;
+        vec4 c = frame.view_proj * vec4(q, 1.0);
+        if (c.w <= 0.0) return false;
+        vec2 s = (c.xy / c.w * 0.5 + 0.5) * size;
+        lo = min(lo, s);
+        hi = max(hi, s);
+    }
+    ivec2 tiles = ivec2(ceil(size / float(COMPOSITE_TILE)));
+    ivec2 t0 = ivec2(floor(clamp(lo, vec2(0.0), size - 1.0) / float(COMPOSITE_TILE)));
+    ivec2 t1 = ivec2(floor(clamp(hi, vec2(0.0), size - 1.0) / float(COMPOSITE_TILE)));
+    if ((t1.x - t0.x + 1) * (t1.y - t0.y + 1) > MAX_OCCLUSION_TILES) return false;
+    for (int y = t0.y; y <= t1.y; ++y) {
+        for (int x = t0.x; x <= t1.x; ++x) {
+            if (occlusion[y * tiles.x + x] > pc.occluded) return false;
+        }
+    }
+    return true;
+}
 
 void main() {
     bool slab_mode = pc.sheet_mode == SHEET_MODE_SLAB;
@@ -38,7 +69,7 @@ void main() {
     out_uv = c;
     out_emit = vec4(p.emit.rgb, p.emit.a * p.axis_u.w);
     out_stretch = p.axis_v.w;
-    if (p.center.w == 0.0) {
+    if (p.center.w == 0.0 || (pc.occluded > 0.0 && occluded(p))) {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: culled
     } else {
         vec3 pos = p.center.xyz + c.x * p.axis_u.xyz + c.y * p.axis_v.xyz;

@@ -314,28 +314,34 @@ fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
 
 /// Time (log x) against error (y) for one scene, one labelled point per method, Pareto front drawn.
 pub fn chart_svg(rows: &[Row], scene: &str, path: &Path) -> Result<()> {
+    let points: Vec<(String, f64, f64)> =
+        rows.iter().filter(|r| r.scene == scene).map(|r| (r.method.clone(), r.time_ms, r.metrics.rmse)).collect();
+    scatter_svg(&points, &format!("{scene}: time vs error (RMSE against the truth)"), "RMSE", path)
+}
+
+/// Labelled points, time per frame (log x) against `y_desc`, with the Pareto front (lower is better).
+pub fn scatter_svg(points: &[(String, f64, f64)], title: &str, y_desc: &str, path: &Path) -> Result<()> {
     use plotters::prelude::*;
-    let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
-    let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.time_ms.max(1e-3), r.metrics.rmse)).collect();
+    let pts: Vec<(f64, f64)> = points.iter().map(|p| (p.1.max(1e-3), p.2)).collect();
     let (xmin, xmax) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let ymax = pts.iter().fold(0.0f64, |a, p| a.max(p.1));
+    let ymax = pts.iter().filter(|p| p.1.is_finite()).fold(0.0f64, |a, p| a.max(p.1));
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{scene}: time vs error (RMSE against the truth)"), ("sans-serif", 20))
+        .caption(title, ("sans-serif", 20))
         .margin(16)
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d((xmin * 0.7..xmax * 1.4).log_scale(), 0.0..ymax * 1.15 + 1e-6)
         .map_err(|e| plot_err(path, e))?;
-    chart.configure_mesh().x_desc("time per frame, ms (log)").y_desc("RMSE").draw().map_err(|e| plot_err(path, e))?;
+    chart.configure_mesh().x_desc("time per frame, ms (log)").y_desc(y_desc).draw().map_err(|e| plot_err(path, e))?;
     let front: Vec<(f64, f64)> = pareto_front(&pts).into_iter().map(|i| pts[i]).collect();
     chart.draw_series(LineSeries::new(front, RED.stroke_width(2))).map_err(|e| plot_err(path, e))?;
     chart
-        .draw_series(rows.iter().zip(&pts).map(|(r, &(x, y))| {
+        .draw_series(points.iter().zip(&pts).map(|(p, &(x, y))| {
             EmptyElement::at((x, y))
                 + Circle::new((0, 0), 4, BLUE.filled())
-                + Text::new(r.method.clone(), (6, -12), ("sans-serif", 12))
+                + Text::new(p.0.clone(), (6, -12), ("sans-serif", 12))
         }))
         .map_err(|e| plot_err(path, e))?;
     root.present().map_err(|e| plot_err(path, e))?;

@@ -52,22 +52,25 @@ struct Stages {
 struct SceneGpu {
     n: u32,
     rows: u32,
-    _splats: Buffer,
+    splats: Buffer,
     _row_start: Buffer,
     _row_split: Buffer,
     _segments: Buffer,
     order: Buffer,
     params: Buffer,
-    _draw: [Buffer; 3],
-    _ranks: Buffer,
+    /// Slice-grouped draw lists of axes x, y, z.
+    draw: [Buffer; 3],
+    ranks: Buffer,
     order_set: DescriptorSet,
     /// The ray caster's 3D texture of (colour * tau, tau), built on first use.
     field: Option<Image>,
     params_set: DescriptorSet,
-    /// Footprint sets: 0 = visibility order, 1..=3 = slice-grouped lists of axes x, y, z.
+    /// Footprint sets: 0 = visibility order, 1..=3 = slice-grouped lists of axes x, y, z, 4 = slab
+    /// pairs. They bind the target's occlusion map too, so they are built for a (scene, target,
+    /// pair buffer) and emptied when any of them is replaced.
     footprint_sets: Vec<DescriptorSet>,
-    /// The image-aligned sheets' (splat, slab) pairs and their footprint set; grown on demand.
-    slab: Option<(Buffer, DescriptorSet)>,
+    /// The image-aligned sheets' (splat, slab) pairs; grown on demand.
+    slab_pairs: Option<Buffer>,
 }
 
 struct TargetGpu {
@@ -79,6 +82,8 @@ struct TargetGpu {
     _sums: Image,
     sums_fb: Framebuffer,
     accum: Image,
+    /// Largest transmittance left per composite tile (front-to-back early termination).
+    occlusion: Buffer,
     composite_set: DescriptorSet,
     readback: Buffer,
 }
@@ -113,13 +118,22 @@ impl GpuPipeline {
         let params_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Storage, Slot::Storage], compute, 0)?;
         let footprint_layout = Layout::new(
             &ctx,
-            &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage, Slot::Texture, Slot::Texture],
+            &[
+                Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
+                Slot::Texture,
+                Slot::Texture,
+                Slot::Storage,
+            ],
             SS::VERTEX | SS::FRAGMENT,
             std::mem::size_of::<FootprintPush>() as u32,
         )?;
         let composite_layout = Layout::new(
             &ctx,
-            &[Slot::StorageImage, Slot::StorageImage],
+            &[Slot::StorageImage, Slot::StorageImage, Slot::Storage],
             compute,
             std::mem::size_of::<CompositePush>() as u32,
         )?;
@@ -238,59 +252,64 @@ impl GpuPipeline {
         ])?;
         let params_set =
             st.params_layout.bind(&[Bind::Buffer(&self.frame), Bind::Buffer(&splats), Bind::Buffer(&params)])?;
-        let mut footprint_sets = Vec::new();
-        for list in [&order, &draw[0], &draw[1], &draw[2]] {
-            footprint_sets.push(st.footprint_layout.bind(&[
-                Bind::Buffer(&self.frame),
-                Bind::Buffer(&params),
-                Bind::Buffer(list),
-                Bind::Buffer(&splats),
-                Bind::Buffer(&ranks),
-                Bind::Texture(&self.table, &self.sampler),
-                Bind::Texture(&self.slices, &self.sampler),
-            ])?);
-        }
         self.scene = Some(SceneGpu {
             n,
             rows,
-            _splats: splats,
+            splats,
             _row_start: row_start,
             _row_split: row_split,
             _segments: segments,
             order,
             params,
-            _draw: draw,
-            _ranks: ranks,
+            draw,
+            ranks,
             order_set,
             field: None,
             params_set,
-            footprint_sets,
-            slab: None,
+            footprint_sets: Vec::new(),
+            slab_pairs: None,
         });
         Ok(())
     }
 
-    /// Copy this frame's (splat, slab) pairs to the GPU, growing their buffer (and its footprint
-    /// set) to the next power of two when they do not fit.
+    /// Copy this frame's (splat, slab) pairs to the GPU, growing their buffer to the next power of
+    /// two when they do not fit.
     fn upload_slab_pairs(&mut self, pairs: &[u32]) -> Result<()> {
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let bytes = std::mem::size_of_val(pairs) as u64;
-        if scene.slab.as_ref().is_none_or(|(b, _)| b.size() < bytes) {
-            scene.slab = None;
-            let buffer =
-                Buffer::new(&self.ctx, "slab pairs", bytes.next_power_of_two(), BU::STORAGE_BUFFER, Memory::Upload)?;
-            let set = self.stages.footprint_layout.bind(&[
+        if scene.slab_pairs.as_ref().is_none_or(|b| b.size() < bytes) {
+            scene.footprint_sets.clear();
+            scene.slab_pairs = None;
+            let size = bytes.next_power_of_two();
+            scene.slab_pairs = Some(Buffer::new(&self.ctx, "slab pairs", size, BU::STORAGE_BUFFER, Memory::Upload)?);
+        }
+        scene.slab_pairs.as_mut().expect("ensured").write(bytemuck::cast_slice(pairs))
+    }
+
+    /// Build the footprint sets for the current scene and target if they are missing.
+    fn ensure_footprint_sets(&mut self) -> Result<()> {
+        let (Some(scene), Some(target)) = (self.scene.as_mut(), self.target.as_ref()) else {
+            return Err(Error::InvalidArgument("no scene set".into()));
+        };
+        if !scene.footprint_sets.is_empty() {
+            return Ok(());
+        }
+        let pairs = scene.slab_pairs.as_ref().unwrap_or(&scene.order);
+        let mut sets = Vec::with_capacity(5);
+        for list in [&scene.order, &scene.draw[0], &scene.draw[1], &scene.draw[2], pairs] {
+            sets.push(self.stages.footprint_layout.bind(&[
                 Bind::Buffer(&self.frame),
                 Bind::Buffer(&scene.params),
-                Bind::Buffer(&buffer),
-                Bind::Buffer(&scene._splats),
-                Bind::Buffer(&scene._ranks),
+                Bind::Buffer(list),
+                Bind::Buffer(&scene.splats),
+                Bind::Buffer(&scene.ranks),
                 Bind::Texture(&self.table, &self.sampler),
                 Bind::Texture(&self.slices, &self.sampler),
-            ])?;
-            scene.slab = Some((buffer, set));
+                Bind::Buffer(&target.occlusion),
+            ])?);
         }
-        scene.slab.as_mut().expect("ensured").0.write(bytemuck::cast_slice(pairs))
+        scene.footprint_sets = sets;
+        Ok(())
     }
 
     fn ensure_target(&mut self, width: u32, height: u32, layers: u32) -> Result<()> {
@@ -300,6 +319,9 @@ impl GpuPipeline {
             }
         }
         self.ctx.wait_idle();
+        if let Some(scene) = self.scene.as_mut() {
+            scene.footprint_sets.clear();
+        }
         self.target = None;
         let ctx = &self.ctx;
         let color =
@@ -322,7 +344,11 @@ impl GpuPipeline {
             IU::STORAGE | IU::TRANSFER_SRC | IU::TRANSFER_DST,
             false,
         )?;
-        let composite_set = self.stages.composite_layout.bind(&[Bind::Image(&sums), Bind::Image(&accum)])?;
+        let tiles = width.div_ceil(COMPOSITE_TILE) as u64 * height.div_ceil(COMPOSITE_TILE) as u64;
+        let occlusion =
+            Buffer::new(ctx, "occlusion", tiles * 4, BU::STORAGE_BUFFER | BU::TRANSFER_DST, Memory::Device)?;
+        let composite_set =
+            self.stages.composite_layout.bind(&[Bind::Image(&sums), Bind::Image(&accum), Bind::Buffer(&occlusion)])?;
         let readback =
             Buffer::new(ctx, "readback", width as u64 * height as u64 * 16, BU::TRANSFER_DST, Memory::Readback)?;
         self.target = Some(TargetGpu {
@@ -334,6 +360,7 @@ impl GpuPipeline {
             _sums: sums,
             sums_fb,
             accum,
+            occlusion,
             composite_set,
             readback,
         });
@@ -520,7 +547,7 @@ impl GpuPipeline {
         let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
         let mut host_ms = None;
         let mut slab_pairs = None;
-        let (axis, batches) = match opts.composite {
+        let (axis, mut batches) = match opts.composite {
             Composite::Sheet => sheet_plan(prep, camera, direction, layers),
             Composite::Slab => {
                 let t = Instant::now();
@@ -531,6 +558,7 @@ impl GpuPipeline {
             }
             Composite::Splat => (0, Vec::new()),
         };
+        opts.set_early_termination(&mut batches);
         // Allocate only as many layers as the largest batch needs.
         let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
         self.ensure_target(w, h, layers)?;
@@ -538,6 +566,7 @@ impl GpuPipeline {
         if let Some(pairs) = &slab_pairs {
             self.upload_slab_pairs(pairs)?;
         }
+        self.ensure_footprint_sets()?;
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;
         if opts.composite == Composite::Splat && !gpu_order {
@@ -585,7 +614,7 @@ impl GpuPipeline {
             }
             Composite::Sheet | Composite::Slab => {
                 let set = match opts.composite {
-                    Composite::Slab => &scene.slab.as_ref().expect("uploaded above").1,
+                    Composite::Slab => &scene.footprint_sets[4],
                     _ => &scene.footprint_sets[1 + axis],
                 };
                 steps.push((
@@ -593,7 +622,8 @@ impl GpuPipeline {
                     Box::new(|rec| {
                         rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Transfer);
                         rec.clear_image(&target.accum, IL::GENERAL, [0.0; 4]);
-                        rec.barrier(Stage::Transfer, Stage::Compute);
+                        rec.fill_buffer(&target.occlusion, 1.0f32.to_bits());
+                        rec.barrier(Stage::Transfer, Stage::All);
                     }),
                 ));
                 for b in &batches {
@@ -614,7 +644,8 @@ impl GpuPipeline {
                             let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
                             let set = &target.composite_set;
                             rec.dispatch(&st.composite, &st.composite_layout, set, bytemuck::bytes_of(&push), groups);
-                            rec.barrier(Stage::Compute, Stage::Compute);
+                            // The next batch's footprints read the occlusion map.
+                            rec.barrier(Stage::Compute, Stage::All);
                         }),
                     ));
                 }

@@ -74,6 +74,8 @@ pub struct FootprintPush {
     pub rank_dir: i32,
     pub slab_z0: f32,
     pub slab_dz: f32,
+    /// Early termination: skip footprints over tiles with at most this transmittance (0 = off).
+    pub occluded: f32,
 }
 
 /// `sheet_mode` values (glsl/shared/types.glsl).
@@ -94,6 +96,6 @@ pub struct CompositePush {
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 288);
-const _: () = assert!(std::mem::size_of::<FootprintPush>() == 28);
+const _: () = assert!(std::mem::size_of::<FootprintPush>() == 32);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);

@@ -125,6 +125,7 @@ impl Renderer {
     }
 
     pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
+        options.validate()?;
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         match &mut self.gpu {

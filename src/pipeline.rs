@@ -7,7 +7,7 @@
 //! | footprint      | `footprint.vert/.frag`       | `cpu::footprint`        |
 //! | composite      | `composite.comp`             | `cpu::composite`        |
 use crate::camera::Camera;
-use crate::constants::{MAX_GROUPS_X, WORKGROUP_SIZE};
+use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, WORKGROUP_SIZE};
 use crate::cpu::{self, footprint::Blend, ImageF32};
 use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS};
@@ -110,6 +110,12 @@ pub struct RenderOptions {
     /// Image-aligned slab thickness in voxel spacings (`Composite::Slab`): thinner is closer to the
     /// volume integral and costs more primitives (about 2R/Δ + 1 per splat).
     pub slab_thickness: f32,
+    /// Front-to-back early termination for the sheet modes (Mueller et al. 1999): after each batch,
+    /// footprints lying wholly over composite tiles whose remaining transmittance is at most this
+    /// are skipped. No pixel changes by more than this much. 0 (the default) turns it off; back to
+    /// front ignores it. It pays on opaque data (1.8x on `solid40`) and costs on translucent data,
+    /// where nothing is culled but batches are smaller (docs/RESULTS.md).
+    pub early_termination: f32,
 }
 
 impl Default for RenderOptions {
@@ -123,9 +129,16 @@ impl Default for RenderOptions {
             direction: None,
             sheet_budget_bytes: 256 << 20,
             slab_thickness: 1.0,
+            early_termination: 0.0,
         }
     }
 }
+
+/// Suggested transmittance threshold of front-to-back early termination: a quarter of an 8-bit step.
+pub const DEFAULT_EARLY_TERMINATION: f32 = 1.0 / 1024.0;
+
+/// Most summation layers in one batch when front-to-back early termination is on.
+pub const EARLY_TERMINATION_BATCH: u32 = 8;
 
 /// Most summation layers in one batch, whatever the budget.
 pub const MAX_BATCH_LAYERS: u32 = 256;
@@ -138,10 +151,38 @@ impl RenderOptions {
         })
     }
 
-    /// Layers per batch for an image of this size.
+    /// Reject values no frame can use.
+    pub fn validate(&self) -> Result<()> {
+        if !(0.0..1.0).contains(&self.early_termination) {
+            return Err(Error::InvalidArgument(format!(
+                "early-termination transmittance {} must be in [0, 1)",
+                self.early_termination
+            )));
+        }
+        if self.sheet_budget_bytes == 0 {
+            return Err(Error::InvalidArgument("the sheet budget must be positive".into()));
+        }
+        Ok(())
+    }
+
+    /// Put the early-termination threshold in the batches' push constants (front to back only).
+    pub fn set_early_termination(&self, batches: &mut [Batch]) {
+        let on = self.direction() == Direction::FrontToBack && self.early_termination > 0.0;
+        for b in batches {
+            b.push.occluded = if on { self.early_termination } else { 0.0 };
+        }
+    }
+
+    /// Layers per batch for an image of this size. With early termination on, batches hold at most
+    /// `EARLY_TERMINATION_BATCH` layers: the occlusion map only changes between batches.
     pub fn batch_layers(&self, width: u32, height: u32) -> u32 {
         let layer = width as u64 * height as u64 * 16;
-        (self.sheet_budget_bytes / layer.max(1)).clamp(1, MAX_BATCH_LAYERS as u64) as u32
+        let most = if self.direction() == Direction::FrontToBack && self.early_termination > 0.0 {
+            EARLY_TERMINATION_BATCH
+        } else {
+            MAX_BATCH_LAYERS
+        };
+        (self.sheet_budget_bytes / layer.max(1)).clamp(1, most as u64) as u32
     }
 }
 
@@ -355,6 +396,7 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                 sheet_rank: &prep.ranks,
                 table: &table,
                 slice_table: &slice_table,
+                occlusion: &[],
             };
             let blend = if btf { Blend::Over } else { Blend::Under };
             cpu::footprint(&inputs, &FootprintPush::default(), blend, 0, n as u32, std::slice::from_mut(&mut image));
@@ -375,23 +417,28 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                 lap("slab_bins", &mut timings);
                 (std::borrow::Cow::Owned(plan.pairs), plan.batches)
             };
-            let inputs = cpu::footprint::FootprintInputs {
-                frame: &frame,
-                params: &params,
-                draw_list: &draw_list,
-                splats: set.splats(),
-                sheet_rank: &prep.ranks,
-                table: &table,
-                slice_table: &slice_table,
-            };
+            let mut batches = batches;
+            opts.set_early_termination(&mut batches);
+            let tiles = w.div_ceil(COMPOSITE_TILE) as usize * h.div_ceil(COMPOSITE_TILE) as usize;
+            let mut occlusion = vec![1.0f32; tiles];
             let (mut raster_ms, mut comp_ms) = (0.0, 0.0);
             for b in &batches {
+                let inputs = cpu::footprint::FootprintInputs {
+                    frame: &frame,
+                    params: &params,
+                    draw_list: &draw_list,
+                    splats: set.splats(),
+                    sheet_rank: &prep.ranks,
+                    table: &table,
+                    slice_table: &slice_table,
+                    occlusion: &occlusion,
+                };
                 let t0 = Instant::now();
                 let mut layers = vec![ImageF32::new(w, h); b.layers as usize];
                 cpu::footprint(&inputs, &b.push, Blend::Add, b.first_instance, b.instances, &mut layers);
                 let t1 = Instant::now();
                 let push = CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
-                cpu::composite(&push, &layers, &mut image);
+                cpu::composite(&push, &layers, &mut image, &mut occlusion);
                 raster_ms += (t1 - t0).as_secs_f64() * 1e3;
                 comp_ms += t1.elapsed().as_secs_f64() * 1e3;
             }

@@ -13,6 +13,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("cube40", "hollow 40^3 cube, one voxel thick, alternating 10^3 red/white sub-cubes (Figs 1.13-1.15, 1.17)"),
     ("cube60", "hollow 60^3 cube, one voxel thick, alternating 10^3 red/white sub-cubes (Figs 1.16, 2.25-2.27)"),
     ("cube40-attenuated", "cube40 with opacity 0.3: semi-transparent splats (Fig. 1.14)"),
+    ("solid40", "filled 40^3 cube, opacity 0.95, the sub-cube texture: opaque data for early termination"),
     ("plane", "single-sheet 498x398x1 checkerboard of 10x10 black/white squares (Fig. 3.6)"),
     ("stripes128", "dense 128^3 ball with 3-voxel colour stripes, semi-transparent: finer than the pixels in small views (Fig. 3.8)"),
     ("empty", "an 8^3 grid with no non-empty voxel"),
@@ -22,9 +23,13 @@ pub const SCENES: &[(&str, &str)] = &[
 ];
 
 fn hollow_cube(n: u32, opacity: f32) -> Result<SplatSet> {
+    textured_cube(n, opacity, false)
+}
+
+fn textured_cube(n: u32, opacity: f32, solid: bool) -> Result<SplatSet> {
     let grid = Grid::centered([n, n, n], [1.0; 3])?;
     SplatSet::from_fn(grid, |i, j, k| {
-        let shell = [i, j, k].iter().any(|&c| c == 0 || c == n - 1);
+        let shell = solid || [i, j, k].iter().any(|&c| c == 0 || c == n - 1);
         shell.then(|| {
             let c = if (i / 10 + j / 10 + k / 10) % 2 == 0 { RED } else { WHITE };
             [c[0], c[1], c[2], opacity]
@@ -38,6 +43,7 @@ pub fn build(name: &str) -> Result<SplatSet> {
         "cube40" => hollow_cube(40, SCENE_OPACITY),
         "cube60" => hollow_cube(60, SCENE_OPACITY),
         "cube40-attenuated" => hollow_cube(40, 0.3),
+        "solid40" => textured_cube(40, SCENE_OPACITY, true),
         "plane" => {
             let grid = Grid::centered([498, 398, 1], [1.0; 3])?;
             SplatSet::from_fn(grid, |i, j, _| {

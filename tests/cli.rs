@@ -147,9 +147,15 @@ fn quick_bench_writes_valid_csv_and_svg() {
         rows.iter().find(|r| r[0] == scene && r[1] == m).unwrap()[col("rmse")].parse().unwrap()
     };
     assert!(rm("cube40", "raycast 0.5") < rm("cube40", "raycast 1"));
-    for svg in
-        ["chart-cube40.svg", "chart-plane.svg", "chart-plane-grazing.svg", "chart-rotating-box.svg", "scaling.svg"]
-    {
+    for svg in [
+        "chart-cube40.svg",
+        "chart-plane.svg",
+        "chart-plane-grazing.svg",
+        "chart-rotating-box.svg",
+        "scaling.svg",
+        "stability-popping.svg",
+        "stability-error.svg",
+    ] {
         let text = std::fs::read_to_string(dir.join(svg)).unwrap();
         assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"), "{svg}");
     }
@@ -160,6 +166,10 @@ fn quick_bench_writes_valid_csv_and_svg() {
     assert!(md.contains("## Targets") && md.contains("chart-cube40.svg"));
     assert!(md.contains("## Anti-aliasing") && md.contains("Swan vs none beyond k"));
     assert!(md.contains("## Motion blur") && md.contains("accumulation"));
+    assert!(md.contains("## Stability where methods fail") && md.contains("popping at the switch"));
+    let stab = std::fs::read_to_string(dir.join("stability.csv")).unwrap();
+    assert_eq!(stab.lines().count(), 1 + 5, "five variants through the axis switch");
+    assert!(stab.contains("image-aligned slab 1,") && stab.contains("axis-aligned sheet,"));
 }
 
 #[test]

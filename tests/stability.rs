@@ -183,3 +183,41 @@ fn btf_and_wbtf_visibility_errors_show_in_the_image() {
     }
     common::assert_clean(&r);
 }
+
+fn max_abs(a: &ImageF32, b: &ImageF32) -> f32 {
+    a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |i| (p[i] - q[i]).abs())).fold(0.0, f32::max)
+}
+
+/// Front-to-back early termination changes no pixel by more than its transmittance threshold, does
+/// cull something on opaque data, and the GPU matches the CPU mirror with it on.
+#[test]
+fn early_termination_stays_within_its_threshold_and_matches_the_mirror() {
+    let mut gpu = common::gpu();
+    let mut cpu = common::cpu();
+    let set = voxsplat::scene::build("solid40").unwrap();
+    let cam = Camera::framing(set.grid(), 96, 80);
+    gpu.set_scene(set.clone()).unwrap();
+    cpu.set_scene(set).unwrap();
+    for composite in [Composite::Sheet, Composite::Slab] {
+        let mut o = RenderOptions::default();
+        o.composite = composite;
+        let full = gpu.render(&cam, &o).unwrap().image;
+        for threshold in [1.0 / 1024.0, 0.3] {
+            o.early_termination = threshold;
+            let g = gpu.render(&cam, &o).unwrap().image;
+            let d = max_abs(&g, &full);
+            eprintln!("{composite:?} threshold {threshold}: max |change| {d}");
+            assert!(d <= threshold * 1.001 + 1e-6, "{composite:?}: {d} > {threshold}");
+            if threshold >= 0.3 {
+                assert!(d > 0.0, "{composite:?}: nothing was culled");
+            }
+            let c = cpu.render(&cam, &o).unwrap().image;
+            let (mean, max) = diff_rgba8(&g, &c).unwrap();
+            assert!(mean <= 1.0, "{composite:?} GPU vs mirror: mean {mean}/255, max {max}/255");
+        }
+    }
+    let mut bad = RenderOptions::default();
+    bad.early_termination = 1.0;
+    assert!(gpu.render(&cam, &bad).is_err());
+    common::assert_clean(&gpu);
+}

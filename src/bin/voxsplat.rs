@@ -214,6 +214,10 @@ struct RenderArgs {
     /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
     composite: String,
+    /// Front-to-back sheet modes: skip footprints over tiles whose remaining transmittance is at
+    /// most this (0 = off; 0.001 suits opaque data). No pixel changes by more than this.
+    #[arg(long, value_parser = parse_finite, default_value = "0")]
+    early_termination: f32,
     /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25).
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     slab_thickness: f32,
@@ -415,6 +419,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             opts.sheet_budget_bytes = a.sheet_budget_mib << 20;
             opts.slab_thickness = a.slab_thickness;
+            opts.early_termination = a.early_termination;
             let splats = set.len();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
             let frame = if a.truth {
@@ -616,6 +621,8 @@ fn bench(a: BenchArgs) -> Result<()> {
     let mb = motion_study(&mut r, mb_size, mb_frame, m.frames)?;
     rows.extend(motion_rows(&mb, mb_size));
     let mb_images = write_motion_images(&mb, &a.out_dir)?;
+    let stab = voxsplat::stability::run(&mut r, a.quick, |msg| eprintln!("{msg}"))?;
+    voxsplat::stability::write_outputs(&stab, &a.out_dir)?;
     write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -651,9 +658,10 @@ fn bench(a: BenchArgs) -> Result<()> {
         let notes = std::fs::read_to_string(&notes_path).ok();
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
         let motion_md = format!(
-            "{}\n{}",
+            "{}\n{}\n{}",
             antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
-            motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir)
+            motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
+            voxsplat::stability::markdown(&stab, &chart_dir)
         );
         let md = results_markdown(&Report {
             device,

@@ -1,9 +1,12 @@
 //! Mirror of `composite.comp`.
 use super::ImageF32;
+use crate::constants::COMPOSITE_TILE;
 use crate::gpu_types::CompositePush;
 use rayon::prelude::*;
 
-pub fn composite(push: &CompositePush, sums: &[ImageF32], accum: &mut ImageF32) {
+/// Composite the batch into `accum`, then write each tile's largest remaining transmittance into
+/// `occlusion` (row-major tiles of `COMPOSITE_TILE`² pixels).
+pub fn composite(push: &CompositePush, sums: &[ImageF32], accum: &mut ImageF32, occlusion: &mut [f32]) {
     let width = push.width as usize;
     accum.pixels.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
@@ -32,4 +35,11 @@ pub fn composite(push: &CompositePush, sums: &[ImageF32], accum: &mut ImageF32) 
             *px = acc;
         }
     });
+    let (tile, tiles_x) = (COMPOSITE_TILE as usize, push.width.div_ceil(COMPOSITE_TILE) as usize);
+    occlusion.iter_mut().for_each(|o| *o = 0.0);
+    for (i, p) in accum.pixels.iter().enumerate() {
+        let (x, y) = (i % width, i / width);
+        let o = &mut occlusion[(y / tile) * tiles_x + x / tile];
+        *o = o.max(1.0 - p[3]);
+    }
 }

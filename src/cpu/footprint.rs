@@ -52,6 +52,8 @@ pub struct FootprintInputs<'a> {
     pub table: &'a [f32],
     /// The kernel-slice table (slab mode).
     pub slice_table: &'a [f32],
+    /// Largest transmittance left per composite tile (early termination; empty when off).
+    pub occlusion: &'a [f32],
 }
 
 /// Draw `instances` quads starting at `first_instance` of the draw list into `layers`.
@@ -70,7 +72,7 @@ pub fn footprint(
         let splat =
             if slab_mode { inputs.draw_list[2 * inst as usize] } else { inputs.draw_list[inst as usize] } as usize;
         let p = &inputs.params[splat];
-        if p.center[3] == 0.0 {
+        if p.center[3] == 0.0 || (push.occluded > 0.0 && occluded(inputs, p, push.occluded)) {
             continue;
         }
         let mut weight = Weight::Footprint(inputs.table);
@@ -98,6 +100,40 @@ pub fn footprint(
         let Some(target) = layers.get_mut(layer) else { continue };
         raster_quad(p, push.sheet_mode != 0, blend, vp, &inv, weight, target);
     }
+}
+
+/// Mirror of `occluded` in `footprint.vert`: the quad lies wholly over tiles with at most
+/// `threshold` transmittance left (footprints over more than 16 tiles are always drawn).
+pub fn occluded(inputs: &FootprintInputs<'_>, p: &SplatParams, threshold: f32) -> bool {
+    let vp = Mat4::from_cols_array_2d(&inputs.frame.view_proj);
+    let size = glam::Vec2::new(inputs.frame.blur[2], inputs.frame.blur[3]);
+    let (mut lo, mut hi) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
+    let v3 = |v: [f32; 4]| glam::Vec3::new(v[0], v[1], v[2]);
+    for (cx, cy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+        let q = v3(p.center) + cx * v3(p.axis_u) + cy * v3(p.axis_v);
+        let c = vp * q.extend(1.0);
+        if c.w <= 0.0 {
+            return false;
+        }
+        let s = (glam::Vec2::new(c.x, c.y) / c.w * 0.5 + 0.5) * size;
+        lo = lo.min(s);
+        hi = hi.max(s);
+    }
+    let tile = crate::constants::COMPOSITE_TILE as f32;
+    let tiles_x = (size.x / tile).ceil() as i64;
+    let t = |v: glam::Vec2| (v.clamp(glam::Vec2::ZERO, size - 1.0) / tile).floor();
+    let (t0, t1) = (t(lo), t(hi));
+    if (t1.x - t0.x + 1.0) * (t1.y - t0.y + 1.0) > 16.0 {
+        return false;
+    }
+    for y in t0.y as i64..=t1.y as i64 {
+        for x in t0.x as i64..=t1.x as i64 {
+            if inputs.occlusion.get((y * tiles_x + x) as usize).is_none_or(|&o| o > threshold) {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// What a fragment weighs: the whole pre-integrated footprint, or the slice between two slab

@@ -92,6 +92,12 @@ impl Recorder<'_> {
         };
     }
 
+    /// Fill a whole buffer with one 32-bit pattern (e.g. the bits of 1.0f).
+    pub fn fill_buffer(&self, buffer: &Buffer, value: u32) {
+        // SAFETY: outside a render pass; the buffer was created with TRANSFER_DST.
+        unsafe { self.ctx.device.cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value) };
+    }
+
     pub fn copy_buffer(&self, src: &Buffer, dst: &Buffer, bytes: u64) {
         let size = bytes.min(src.size()).min(dst.size());
         if size == 0 {
