@@ -428,6 +428,7 @@ pub struct StabilityReport {
     pub bright: Vec<BrightRow>,
     pub overlap: Vec<OverlapRow>,
     pub visibility: Vec<VisibilityRow>,
+    pub early: Vec<EarlyRow>,
 }
 
 /// Run the four studies (`quick`: small images and few frames, for CI).
@@ -442,7 +443,9 @@ pub fn run(r: &mut Renderer, quick: bool, mut progress: impl FnMut(&str)) -> Res
     let overlap = overlap_study(r, size, if quick { 2 } else { 6 })?;
     progress("stability: BTF/WBTF visibility");
     let visibility = visibility_study(r, size)?;
-    Ok(StabilityReport { size, frames, switch, bright, overlap, visibility })
+    progress("stability: early termination");
+    let early = early_termination_study(r, size, if quick { 3 } else { 5 })?;
+    Ok(StabilityReport { size, frames, switch, bright, overlap, visibility, early })
 }
 
 /// `stability.csv` and the two charts (popping and error against time) into `dir`.
@@ -564,6 +567,7 @@ pub fn markdown(rep: &StabilityReport, chart_dir: &str) -> String {
             v.view, v.order, v.violations, v.rmse_vs_sorted, v.rmse_vs_truth
         );
     }
+    md += &early_markdown(&rep.early, rep.size);
     md
 }
 
