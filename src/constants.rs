@@ -9,6 +9,8 @@ pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 pub const COMPOSITE_TILE: u32 = 8;
 /// Texels per side of the pre-integrated footprint table.
 pub const FOOTPRINT_TABLE_SIZE: u32 = 64;
+/// Splats per invocation of the slab binning stages (one column of the slab x chunk count matrix).
+pub const SLAB_CHUNK: u32 = 1024;
 /// Workgroups per dispatch row: larger 1D dispatches spill into y so they stay under the 65535 limit.
 pub const MAX_GROUPS_X: u32 = 32768;
 
@@ -18,4 +20,5 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
     ("COMPOSITE_TILE", COMPOSITE_TILE),
     ("FOOTPRINT_TABLE_SIZE", FOOTPRINT_TABLE_SIZE),
+    ("SLAB_CHUNK", SLAB_CHUNK),
 ];

@@ -4,7 +4,7 @@ use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE};
 use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
-use crate::gpu_types::{CompositePush, FootprintPush, Frame, SplatParams};
+use crate::gpu_types::{CompositePush, FootprintPush, Frame, SlabPush, SplatParams};
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
 use crate::pipeline::{
@@ -42,6 +42,10 @@ struct Stages {
     add: Pipeline,
     composite_layout: Layout,
     composite: Pipeline,
+    slab_layout: Layout,
+    slab_count: Pipeline,
+    slab_scan: Pipeline,
+    slab_scatter: Pipeline,
     raycast_layout: Layout,
     raycast: Pipeline,
     roofline_layout: Layout,
@@ -69,8 +73,12 @@ struct SceneGpu {
     /// pairs. They bind the target's occlusion map too, so they are built for a (scene, target,
     /// pair buffer) and emptied when any of them is replaced.
     footprint_sets: Vec<DescriptorSet>,
-    /// The image-aligned sheets' (splat, slab) pairs; grown on demand.
+    /// The image-aligned sheets' binning: (splat, slab) pairs, the slab x chunk count matrix, each
+    /// slab's first pair (on the device and read back) and their set; grown on demand.
     slab_pairs: Option<Buffer>,
+    slab_counts: Option<Buffer>,
+    slab_start: Option<(Buffer, Buffer)>,
+    slab_set: Option<DescriptorSet>,
 }
 
 struct TargetGpu {
@@ -138,6 +146,12 @@ impl GpuPipeline {
             std::mem::size_of::<CompositePush>() as u32,
         )?;
         let raycast_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Texture, Slot::StorageImage], compute, 0)?;
+        let slab_layout = Layout::new(
+            &ctx,
+            &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage],
+            compute,
+            std::mem::size_of::<SlabPush>() as u32,
+        )?;
         let roofline_layout = Layout::new(&ctx, &[Slot::Uniform], SS::VERTEX | SS::FRAGMENT, 16)?;
         let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
         let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
@@ -151,6 +165,10 @@ impl GpuPipeline {
             under: Pipeline::graphics(&ctx, &footprint_layout, &target_pass, vert, frag, Blend::Under)?,
             add: Pipeline::graphics(&ctx, &footprint_layout, &sheet_pass, vert, frag, Blend::Add)?,
             composite: Pipeline::compute(&ctx, &composite_layout, spirv!("composite.comp"))?,
+            slab_count: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_count.comp"))?,
+            slab_scan: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_scan.comp"))?,
+            slab_scatter: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_scatter.comp"))?,
+            slab_layout,
             raycast: Pipeline::compute(&ctx, &raycast_layout, spirv!("raycast.comp"))?,
             raycast_layout,
             roofline_quads: Pipeline::graphics(
@@ -268,22 +286,117 @@ impl GpuPipeline {
             params_set,
             footprint_sets: Vec::new(),
             slab_pairs: None,
+            slab_counts: None,
+            slab_start: None,
+            slab_set: None,
         });
         Ok(())
     }
 
-    /// Copy this frame's (splat, slab) pairs to the GPU, growing their buffer to the next power of
-    /// two when they do not fit.
-    fn upload_slab_pairs(&mut self, pairs: &[u32]) -> Result<()> {
+    /// Run `splat_params` and the first two binning stages, read back each slab's first pair, and
+    /// size the pair buffer: (slab_start, stage times).
+    fn slab_prepass(&mut self, pc: &SlabPush) -> Result<(Vec<u32>, Vec<StageTime>)> {
+        let ctx = self.ctx.clone();
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
-        let bytes = std::mem::size_of_val(pairs) as u64;
-        if scene.slab_pairs.as_ref().is_none_or(|b| b.size() < bytes) {
-            scene.footprint_sets.clear();
-            scene.slab_pairs = None;
-            let size = bytes.next_power_of_two();
-            scene.slab_pairs = Some(Buffer::new(&self.ctx, "slab pairs", size, BU::STORAGE_BUFFER, Memory::Upload)?);
+        let grow = |slot: &mut Option<Buffer>, name: &str, bytes: u64, memory: Memory| -> Result<bool> {
+            if slot.as_ref().is_some_and(|b| b.size() >= bytes) {
+                return Ok(false);
+            }
+            *slot = None;
+            *slot = Some(Buffer::new(
+                &ctx,
+                name,
+                bytes.next_power_of_two(),
+                BU::STORAGE_BUFFER | BU::TRANSFER_SRC,
+                memory,
+            )?);
+            Ok(true)
+        };
+        let cells = pc.slabs as u64 * pc.chunks as u64 * 4;
+        let starts = (pc.slabs as u64 + 1) * 4;
+        let mut changed = grow(&mut scene.slab_counts, "slab counts", cells, Memory::Device)?;
+        if scene.slab_start.as_ref().is_none_or(|(b, _)| b.size() < starts) {
+            scene.slab_start = None;
+            let size = starts.next_power_of_two();
+            let dev = Buffer::new(&ctx, "slab starts", size, BU::STORAGE_BUFFER | BU::TRANSFER_SRC, Memory::Device)?;
+            let back = Buffer::new(&ctx, "slab starts readback", size, BU::TRANSFER_DST, Memory::Readback)?;
+            scene.slab_start = Some((dev, back));
+            changed = true;
         }
-        scene.slab_pairs.as_mut().expect("ensured").write(bytemuck::cast_slice(pairs))
+        if changed {
+            scene.slab_set = None;
+        }
+        self.ensure_slab_set()?;
+        let (st, scene) = (&self.stages, self.scene.as_ref().expect("checked above"));
+        let set = scene.slab_set.as_ref().expect("ensured");
+        let (dev, back) = scene.slab_start.as_ref().expect("ensured");
+        let push = bytemuck::bytes_of(pc);
+        let n = scene.n;
+        let steps: Vec<Step<'_>> = vec![
+            (
+                "splat_params",
+                Box::new(|rec| {
+                    rec.dispatch(&st.splat_params, &st.params_layout, &scene.params_set, &[], groups_1d(n));
+                    rec.barrier(Stage::Compute, Stage::Compute);
+                }),
+            ),
+            (
+                "slab_bins",
+                Box::new(move |rec| {
+                    rec.dispatch(&st.slab_count, &st.slab_layout, set, push, groups_1d(pc.chunks));
+                    rec.barrier(Stage::Compute, Stage::Compute);
+                    rec.dispatch(&st.slab_scan, &st.slab_layout, set, push, [1, 1, 1]);
+                    rec.barrier(Stage::Compute, Stage::Transfer);
+                    rec.copy_buffer(dev, back, starts);
+                }),
+            ),
+        ];
+        let timings = execute(&self.ctx, &mut self.timer, &steps)?;
+        drop(steps);
+        let slab_start = bytemuck::cast_slice::<u8, u32>(&back.read()?[..starts as usize]).to_vec();
+        let pairs = slab_start[pc.slabs as usize] as u64 * 8;
+        let scene = self.scene.as_mut().expect("checked above");
+        if grow(&mut scene.slab_pairs, "slab pairs", pairs, Memory::Device)? {
+            scene.slab_set = None;
+            scene.footprint_sets.clear();
+        }
+        self.ensure_slab_set()?;
+        Ok((slab_start, timings))
+    }
+
+    /// Run the binning for `frame` and read the pairs back.
+    pub fn slab_pairs(&mut self, frame: &Frame, pc: &SlabPush) -> Result<Vec<u32>> {
+        self.frame.write(bytemuck::bytes_of(frame))?;
+        let (starts, _) = self.slab_prepass(pc)?;
+        let bytes = starts[pc.slabs as usize] as u64 * 8;
+        let readback = Buffer::new(&self.ctx, "pairs readback", bytes, BU::TRANSFER_DST, Memory::Readback)?;
+        let (st, scene) = (&self.stages, self.scene.as_ref().expect("prepass checked"));
+        let (set, pairs) = (scene.slab_set.as_ref().expect("ensured"), scene.slab_pairs.as_ref().expect("grown"));
+        self.ctx.submit(|rec| {
+            rec.dispatch(&st.slab_scatter, &st.slab_layout, set, bytemuck::bytes_of(pc), groups_1d(pc.chunks));
+            rec.barrier(Stage::Compute, Stage::Transfer);
+            rec.copy_buffer(pairs, &readback, bytes.max(4));
+            Ok(())
+        })?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&readback.read()?[..bytes as usize]).to_vec())
+    }
+
+    fn ensure_slab_set(&mut self) -> Result<()> {
+        let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        if scene.slab_set.is_some() {
+            return Ok(());
+        }
+        let (Some(counts), Some((starts, _))) = (&scene.slab_counts, &scene.slab_start) else {
+            return Err(Error::InvalidArgument("slab buffers not allocated".into()));
+        };
+        let pairs = scene.slab_pairs.as_ref().unwrap_or(&scene.order);
+        scene.slab_set = Some(self.stages.slab_layout.bind(&[
+            Bind::Buffer(&scene.params),
+            Bind::Buffer(counts),
+            Bind::Buffer(pairs),
+            Bind::Buffer(starts),
+        ])?);
+        Ok(())
     }
 
     /// Build the footprint sets for the current scene and target if they are missing.
@@ -546,15 +659,23 @@ impl GpuPipeline {
         let split = order::pbtf_split(&prep.set, camera);
         let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
         let mut host_ms = None;
-        let mut slab_pairs = None;
+        let mut pre_timings = Vec::new();
+        let mut slab_pc = None;
+        self.frame.write(bytemuck::bytes_of(&frame))?;
         let (axis, mut batches) = match opts.composite {
             Composite::Sheet => sheet_plan(prep, camera, direction, layers),
             Composite::Slab => {
-                let t = Instant::now();
-                let plan = crate::slab::slab_bins(&frame, prep.set.splats(), opts.slab_thickness, direction, layers)?;
-                host_ms = Some(("slab_bins", t));
-                slab_pairs = Some(plan.pairs);
-                (0, plan.batches)
+                let pc = crate::slab::slab_geometry(
+                    &frame,
+                    prep.set.grid(),
+                    prep.set.len(),
+                    opts.slab_thickness,
+                    direction,
+                )?;
+                let (starts, t) = self.slab_prepass(&pc)?;
+                pre_timings = t;
+                slab_pc = Some(pc);
+                (0, crate::slab::slab_batches(&pc, &starts, layers)?)
             }
             Composite::Splat => (0, Vec::new()),
         };
@@ -562,10 +683,6 @@ impl GpuPipeline {
         // Allocate only as many layers as the largest batch needs.
         let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
         self.ensure_target(w, h, layers)?;
-        self.frame.write(bytemuck::bytes_of(&frame))?;
-        if let Some(pairs) = &slab_pairs {
-            self.upload_slab_pairs(pairs)?;
-        }
         self.ensure_footprint_sets()?;
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;
@@ -583,7 +700,16 @@ impl GpuPipeline {
         if gpu_order && n > 0 {
             steps.push(("order", Box::new(|rec| record_order(rec, st, scene))));
         }
-        if n > 0 {
+        if let (Some(pc), Some(set)) = (slab_pc.as_ref(), scene.slab_set.as_ref()) {
+            steps.push((
+                "slab_bins",
+                Box::new(move |rec| {
+                    let push = bytemuck::bytes_of(pc);
+                    rec.dispatch(&st.slab_scatter, &st.slab_layout, set, push, groups_1d(pc.chunks));
+                    rec.barrier(Stage::Compute, Stage::Graphics);
+                }),
+            ));
+        } else if n > 0 {
             steps.push((
                 "splat_params",
                 Box::new(|rec| {
@@ -657,6 +783,14 @@ impl GpuPipeline {
         if let Some(t) = host_ms {
             timings.insert(0, t);
         }
+        // The slab pre-pass ran first; a stage named in both lists is summed.
+        for t in timings {
+            match pre_timings.iter_mut().find(|p| p.stage == t.stage) {
+                Some(p) => p.ms += t.ms,
+                None => pre_timings.push(t),
+            }
+        }
+        let timings = pre_timings;
         let target = self.target.as_ref().expect("ensured");
         Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })
     }

@@ -83,6 +83,19 @@ pub const SHEET_MODE_SPLAT: u32 = 0;
 pub const SHEET_MODE_AXIS: u32 = 1;
 pub const SHEET_MODE_SLAB: u32 = 2;
 
+/// Push constants of the slab binning stages (`glsl/shared/slab.glsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SlabPush {
+    pub z0: f32,
+    pub dz: f32,
+    pub slabs: u32,
+    pub chunks: u32,
+    pub ftb: u32,
+    pub n: u32,
+    pub pad: [u32; 2],
+}
+
 /// Push constants of `composite.comp`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -99,3 +112,4 @@ const _: () = assert!(std::mem::size_of::<Frame>() == 288);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 32);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);
+const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -145,6 +145,36 @@ impl Renderer {
         }
     }
 
+    /// The image-aligned sheets' binning for this camera: the (splat, slab) pairs, interleaved, in
+    /// visiting order (GPU stages `splat_params`, `slab_count`, `slab_scan`, `slab_scatter`, or
+    /// their CPU mirrors), for comparison and inspection.
+    pub fn slab_pairs(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
+        camera.validate()?;
+        options.validate()?;
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let direction = options.direction();
+        let set = &prep.set;
+        let frame = pipeline::make_frame(
+            set,
+            camera,
+            options.kernel,
+            options.antialias,
+            options.motion.as_ref(),
+            order::pbtf_split(set, camera),
+            direction == Direction::BackToFront,
+        );
+        let pc = slab::slab_geometry(&frame, set.grid(), set.len(), options.slab_thickness, direction)?;
+        match &mut self.gpu {
+            Some(g) => g.slab_pairs(&frame, &pc),
+            None => {
+                let mut params = vec![gpu_types::SplatParams::default(); set.len()];
+                cpu::splat_params(&frame, set.splats(), &mut params);
+                Ok(slab::slab_bins_cpu(&pc, &params, u32::MAX)?.0)
+            }
+        }
+    }
+
     /// The ray caster: `raycast.comp` on the GPU, or its CPU mirror.
     pub fn raycast(&mut self, camera: &Camera, options: &cpu::raycast::RaycastOptions) -> Result<Rendered> {
         camera.validate()?;

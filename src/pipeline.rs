@@ -407,15 +407,10 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                 let (axis, batches) = sheet_plan(prep, camera, direction, opts.batch_layers(w, h));
                 (std::borrow::Cow::Borrowed(&prep.slices[axis].1[..]), batches)
             } else {
-                let plan = crate::slab::slab_bins(
-                    &frame,
-                    set.splats(),
-                    opts.slab_thickness,
-                    direction,
-                    opts.batch_layers(w, h),
-                )?;
+                let pc = crate::slab::slab_geometry(&frame, set.grid(), n, opts.slab_thickness, direction)?;
+                let (pairs, batches) = crate::slab::slab_bins_cpu(&pc, &params, opts.batch_layers(w, h))?;
                 lap("slab_bins", &mut timings);
-                (std::borrow::Cow::Owned(plan.pairs), plan.batches)
+                (std::borrow::Cow::Owned(pairs), batches)
             };
             let mut batches = batches;
             opts.set_early_termination(&mut batches);

@@ -9,110 +9,86 @@
 //! footprint quad stays eye-facing and a slab face is measured from the splat's centre along the
 //! view axis, the same for every pixel of the footprint (the perspective approximation).
 //!
-//! This module is the binning stage: a counting sort of (splat, slab) pairs by slab, in visiting
-//! order, so every batch of slabs is one contiguous run of instances. It runs on the host each frame
-//! (linear in the pairs; measured as `slab_bins` in the stage timings).
-use crate::cpu::splat_params::{footprint_scale, optical_depth};
+//! Binning is a stable counting sort of (splat, slab) pairs by slab, in visiting order, so every
+//! batch of slabs is one contiguous run of instances: three GPU stages after `splat_params`
+//! (`slab_count`, `slab_scan`, `slab_scatter`, mirrored in `cpu::slab`). The host only fixes the
+//! slab geometry from the grid's bounds (O(1)) and reads back the slabs' first pairs (one u32 per
+//! slab) to size the pair buffer and cut the batches.
+use crate::constants::SLAB_CHUNK;
+use crate::cpu::splat_params::footprint_scale;
 use crate::error::{Error, Result};
-use crate::gpu_types::{FootprintPush, Frame, Splat, SHEET_MODE_SLAB};
+use crate::gpu_types::{FootprintPush, Frame, SlabPush, SplatParams, SHEET_MODE_SLAB};
 use crate::order::Direction;
 use crate::pipeline::Batch;
+use crate::volume::Grid;
 use glam::Vec3;
 
 /// Thinnest slab allowed, in voxel spacings (pairs grow as 2R/Δ).
 pub const MIN_SLAB_THICKNESS: f32 = 0.25;
 /// Most (splat, slab) pairs in one frame (8 bytes each: 1 GiB).
 pub const MAX_SLAB_PAIRS: u64 = 1 << 27;
+/// Most cells of the slab x chunk count matrix (4 bytes each: 64 MiB).
+pub const MAX_SLAB_CELLS: u64 = 1 << 24;
 
-/// One frame's slabs: geometry, the pair list and its batches.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct SlabPlan {
-    /// Depth of slab 0's near face and the slab thickness, world units.
-    pub z0: f32,
-    pub dz: f32,
-    /// Slabs from the nearest to the farthest kernel extent.
-    pub slabs: u32,
-    /// (splat, slab) pairs, interleaved, grouped by slab in visiting order (stable in splat index).
-    pub pairs: Vec<u32>,
-    pub batches: Vec<Batch>,
-}
-
-/// Bin `splats` into slabs `thickness` voxel spacings thick, in `direction`'s visiting order, with
-/// at most `max_layers` slabs per batch. Mirror of nothing: it is the same code on both paths.
-pub fn slab_bins(
-    frame: &Frame,
-    splats: &[Splat],
-    thickness: f32,
-    direction: Direction,
-    max_layers: u32,
-) -> Result<SlabPlan> {
+/// Where the slabs lie for one frame, as the binning stages' push constants.
+pub fn slab_geometry(frame: &Frame, grid: &Grid, n: usize, thickness: f32, direction: Direction) -> Result<SlabPush> {
     if !(thickness.is_finite() && thickness >= MIN_SLAB_THICKNESS) {
         return Err(Error::InvalidArgument(format!(
             "slab thickness {thickness} must be at least {MIN_SLAB_THICKNESS} voxel spacings"
         )));
     }
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-    let (eye, forward, origin, spacing) = (v3(frame.eye), v3(frame.forward), v3(frame.origin), v3(frame.spacing));
-    let voxel = frame.spacing[3] / frame.origin[3];
-    let dz = thickness * voxel;
-    // Depth extents of the splats that can show (zero optical depth draws nothing).
-    let mut extents = Vec::with_capacity(splats.len());
+    let (eye, forward) = (v3(frame.eye), v3(frame.forward));
+    let dz = thickness * frame.spacing[3] / frame.origin[3];
+    // Depths of the grid's corner voxel centres bound every splat's.
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for (s, sp) in splats.iter().enumerate() {
-        if optical_depth(sp.color[3]) <= 0.0 {
-            continue;
-        }
-        let ijk = Vec3::new(sp.ijk[0] as f32, sp.ijk[1] as f32, sp.ijk[2] as f32);
-        let depth = (origin + ijk * spacing - eye).dot(forward);
-        // A hair wider than the shader's radius, so a rounding difference never drops a slice.
-        let radius = frame.spacing[3] * footprint_scale(frame, depth) * 1.0001;
-        extents.push((s as u32, depth - radius, depth + radius));
-        lo = lo.min(depth - radius);
-        hi = hi.max(depth + radius);
+    for c in 0..8u32 {
+        let ijk = [0, 1, 2].map(|a| if c >> a & 1 == 1 { grid.dims[a].saturating_sub(1) } else { 0 });
+        let d = (grid.position(ijk) - eye).dot(forward);
+        lo = lo.min(d);
+        hi = hi.max(d);
     }
-    if extents.is_empty() {
-        return Ok(SlabPlan { dz, ..Default::default() });
-    }
-    let slabs = ((hi - lo) / dz).floor() as u64 + 1;
-    let slab_of = |z: f32| (((z - lo) / dz).floor().max(0.0) as u64).min(slabs - 1);
-    let total: u64 = extents.iter().map(|&(_, a, b)| slab_of(b) - slab_of(a) + 1).sum();
-    if total > MAX_SLAB_PAIRS || slabs > u32::MAX as u64 {
+    // The footprint scale grows with depth; a hair wider, as in the shaders.
+    let scale = footprint_scale(frame, lo.max(1e-6)).max(footprint_scale(frame, hi.max(1e-6)));
+    let r = frame.spacing[3] * scale * 1.0001;
+    let (near, far) = (frame.forward[3], frame.right[3]);
+    let z0 = (lo - r).max(near);
+    let top = (hi + r).min(far);
+    let slabs = if top > z0 { ((top - z0) / dz).floor() as u64 + 1 } else { 1 };
+    let chunks = (n as u64).div_ceil(SLAB_CHUNK as u64).max(1);
+    if slabs * chunks > MAX_SLAB_CELLS {
         return Err(Error::TooLarge(format!(
-            "{total} splat-slab pairs over {slabs} slabs (limit {MAX_SLAB_PAIRS}): use thicker slabs"
+            "{slabs} slabs x {chunks} splat chunks exceed {MAX_SLAB_CELLS} binning cells: use thicker slabs"
         )));
     }
-    let slabs = slabs as usize;
-    // Visiting position of a slab: near to far front to back, far to near back to front.
-    let ftb = direction == Direction::FrontToBack;
-    let pos = |slab: usize| if ftb { slab } else { slabs - 1 - slab };
-    let mut offsets = vec![0u32; slabs + 1];
-    for &(_, a, b) in &extents {
-        for slab in slab_of(a)..=slab_of(b) {
-            offsets[pos(slab as usize) + 1] += 1;
-        }
+    Ok(SlabPush {
+        z0,
+        dz,
+        slabs: slabs as u32,
+        chunks: chunks as u32,
+        ftb: (direction == Direction::FrontToBack) as u32,
+        n: n as u32,
+        pad: [0; 2],
+    })
+}
+
+/// The batches of at most `max_layers` consecutive slabs in visiting order, from each slab's first
+/// pair (`slab_start`, slabs + 1 entries). Batches without a pair are dropped.
+pub fn slab_batches(pc: &SlabPush, slab_start: &[u32], max_layers: u32) -> Result<Vec<Batch>> {
+    let total = slab_start[pc.slabs as usize] as u64;
+    if total > MAX_SLAB_PAIRS {
+        return Err(Error::TooLarge(format!("{total} splat-slab pairs (limit {MAX_SLAB_PAIRS}): use thicker slabs")));
     }
-    for i in 0..slabs {
-        offsets[i + 1] += offsets[i];
-    }
-    let mut cursor = offsets.clone();
-    let mut pairs = vec![0u32; 2 * total as usize];
-    for &(s, a, b) in &extents {
-        for slab in slab_of(a)..=slab_of(b) {
-            let c = &mut cursor[pos(slab as usize)];
-            pairs[2 * *c as usize] = s;
-            pairs[2 * *c as usize + 1] = slab as u32;
-            *c += 1;
-        }
-    }
+    let slabs = pc.slabs as usize;
     let layers = max_layers.max(1) as usize;
     let mut batches = Vec::new();
     for start in (0..slabs).step_by(layers) {
         let end = (start + layers).min(slabs);
-        let (first, count) = (offsets[start], offsets[end] - offsets[start]);
+        let (first, count) = (slab_start[start], slab_start[end] - slab_start[start]);
         if count == 0 {
             continue;
         }
-        let base = if ftb { start } else { slabs - 1 - start } as u32;
+        let base = if pc.ftb != 0 { start } else { slabs - 1 - start } as u32;
         batches.push(Batch {
             first_instance: first,
             instances: count,
@@ -120,12 +96,24 @@ pub fn slab_bins(
             push: FootprintPush {
                 sheet_mode: SHEET_MODE_SLAB,
                 rank_base: base,
-                rank_dir: if ftb { 1 } else { -1 },
-                slab_z0: lo,
-                slab_dz: dz,
+                rank_dir: if pc.ftb != 0 { 1 } else { -1 },
+                slab_z0: pc.z0,
+                slab_dz: pc.dz,
                 ..Default::default()
             },
         });
     }
-    Ok(SlabPlan { z0: lo, dz, slabs: slabs as u32, pairs, batches })
+    Ok(batches)
+}
+
+/// The whole binning on the CPU mirrors: (pairs, batches).
+pub fn slab_bins_cpu(pc: &SlabPush, params: &[SplatParams], max_layers: u32) -> Result<(Vec<u32>, Vec<Batch>)> {
+    let mut counts = vec![0u32; (pc.slabs * pc.chunks) as usize];
+    let mut start = vec![0u32; pc.slabs as usize + 1];
+    crate::cpu::slab_count(pc, params, &mut counts);
+    crate::cpu::slab_scan(pc, &mut counts, &mut start);
+    let batches = slab_batches(pc, &start, max_layers)?;
+    let mut pairs = vec![0u32; 2 * start[pc.slabs as usize] as usize];
+    crate::cpu::slab_scatter(pc, params, &mut counts, &mut pairs);
+    Ok((pairs, batches))
 }

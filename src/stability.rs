@@ -592,7 +592,7 @@ pub fn early_termination_study(r: &mut Renderer, size: u32, frames: usize) -> Re
         r.set_scene(set)?;
         for composite in [Composite::Sheet, Composite::Slab] {
             let mut o = RenderOptions { composite, ..Default::default() };
-            let mut time = |o: &RenderOptions, r: &mut Renderer| -> Result<(f64, ImageF32)> {
+            let time = |o: &RenderOptions, r: &mut Renderer| -> Result<(f64, ImageF32)> {
                 r.render(&cam, o)?;
                 let mut t = Vec::new();
                 let mut last = None;

@@ -55,7 +55,7 @@ fn two_renderers_in_two_threads_render_identical_images() {
             let mut r = common::gpu();
             r.set_scene(set).unwrap();
             let mut out = Vec::new();
-            for composite in [Composite::Splat, Composite::Sheet] {
+            for composite in [Composite::Splat, Composite::Sheet, Composite::Slab] {
                 let mut o = RenderOptions::default();
                 o.composite = composite;
                 out.push(r.render(&cam, &o).unwrap().image);
@@ -78,7 +78,7 @@ fn the_same_inputs_give_bit_identical_images_run_to_run() {
     for gpu in [false, true] {
         let mut r = if gpu { common::gpu() } else { common::cpu() };
         r.set_scene(set.clone()).unwrap();
-        for composite in [Composite::Splat, Composite::Sheet] {
+        for composite in [Composite::Splat, Composite::Sheet, Composite::Slab] {
             let mut o = RenderOptions::default();
             o.composite = composite;
             let first = r.render(&cam, &o).unwrap().image;

@@ -64,7 +64,7 @@ pub fn random_sparse(seed: u64, dims: [u32; 3], fill: f32) -> SplatSet {
 }
 
 /// Which kind of viewpoint a random camera is.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ViewKind {
     Outside,
     Inside,
