@@ -8,6 +8,10 @@
 
 layout(binding = 5) uniform sampler2D table;
 layout(binding = 6) uniform sampler2D slices;
+// The mode is fixed per pipeline (a branch on the push constant made llvmpipe pay for both sides);
+// the push constant's sheet_mode carries the same value for the CPU mirror.
+layout(constant_id = 0) const uint SHEET_MODE = SHEET_MODE_SPLAT;
+
 layout(push_constant) uniform Push {
     uint sheet_mode;
 } pc;
@@ -22,7 +26,7 @@ void main() {
     // Distance beyond the motion segment along u (radius units); the kernel profile across it.
     float along = max(abs(in_uv.x) * (1.0 + in_stretch) - in_stretch, 0.0);
     float weight;
-    if (pc.sheet_mode == SHEET_MODE_SLAB) {
+    if (SHEET_MODE == SHEET_MODE_SLAB) {
         float r = length(vec2(along, in_uv.y));
         weight = sample_slice_table(slices, r, in_slab.y) - sample_slice_table(slices, r, in_slab.x);
     } else {
@@ -30,7 +34,7 @@ void main() {
     }
     float tau = in_emit.a * weight;
     if (tau <= 0.0) discard;
-    if (pc.sheet_mode != 0u) {
+    if (SHEET_MODE != SHEET_MODE_SPLAT) {
         out_color = vec4(in_emit.rgb * tau, tau);
     } else {
         float a = 1.0 - exp(-tau);

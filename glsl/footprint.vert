@@ -13,6 +13,10 @@ layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 4) readonly buffer SheetRank { uint sheet_rank[]; };
 layout(std430, binding = 7) readonly buffer Occlusion { float occlusion[]; };
 
+// The mode is fixed per pipeline (a branch on the push constant made llvmpipe pay for both sides);
+// the push constant's sheet_mode carries the same value for the CPU mirror.
+layout(constant_id = 0) const uint SHEET_MODE = SHEET_MODE_SPLAT;
+
 layout(push_constant) uniform Push {
     uint sheet_mode;   // SHEET_MODE_*
     uint axis;         // sheet axis
@@ -61,7 +65,7 @@ bool occluded(SplatParams p) {
 }
 
 void main() {
-    bool slab_mode = pc.sheet_mode == SHEET_MODE_SLAB;
+    bool slab_mode = SHEET_MODE == SHEET_MODE_SLAB;
     uint splat = slab_mode ? draw_list[2 * gl_InstanceIndex] : draw_list[gl_InstanceIndex];
     SplatParams p = params[splat];
     out_slab = vec2(0.0);
@@ -69,7 +73,7 @@ void main() {
     out_uv = c;
     out_emit = vec4(p.emit.rgb, p.emit.a * p.axis_u.w);
     out_stretch = p.axis_v.w;
-    if (p.center.w == 0.0 || (pc.occluded > 0.0 && occluded(p))) {
+    if (p.center.w == 0.0 || (SHEET_MODE != SHEET_MODE_SPLAT && pc.occluded > 0.0 && occluded(p))) {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: culled
     } else {
         vec3 pos = p.center.xyz + c.x * p.axis_u.xyz + c.y * p.axis_v.xyz;
@@ -81,7 +85,7 @@ void main() {
         float near_face = pc.slab_z0 + float(slab) * pc.slab_dz - p.screen.x;
         out_slab = vec2(near_face, near_face + pc.slab_dz) / radius;
         gl_Layer = pc.rank_dir > 0 ? int(slab - pc.rank_base) : int(pc.rank_base - slab);
-    } else if (pc.sheet_mode == SHEET_MODE_AXIS) {
+    } else if (SHEET_MODE == SHEET_MODE_AXIS) {
         uint rank = sheet_rank[pc.rank_offset + splats[splat].ijk[pc.axis]];
         gl_Layer = pc.rank_dir > 0 ? int(rank - pc.rank_base) : int(pc.rank_base - rank);
     } else {

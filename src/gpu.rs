@@ -4,7 +4,9 @@ use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE};
 use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
-use crate::gpu_types::{CompositePush, FootprintPush, Frame, SlabPush, SplatParams};
+use crate::gpu_types::{
+    CompositePush, FootprintPush, Frame, SlabPush, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB, SHEET_MODE_SPLAT,
+};
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
 use crate::pipeline::{
@@ -40,6 +42,7 @@ struct Stages {
     over: Pipeline,
     under: Pipeline,
     add: Pipeline,
+    add_slab: Pipeline,
     composite_layout: Layout,
     composite: Pipeline,
     slab_layout: Layout,
@@ -161,9 +164,34 @@ impl GpuPipeline {
             order_scan: Pipeline::compute(&ctx, &order_layout, spirv!("order_scan.comp"))?,
             order_scatter: Pipeline::compute(&ctx, &order_layout, spirv!("order_scatter.comp"))?,
             splat_params: Pipeline::compute(&ctx, &params_layout, spirv!("splat_params.comp"))?,
-            over: Pipeline::graphics(&ctx, &footprint_layout, &target_pass, vert, frag, Blend::Over)?,
-            under: Pipeline::graphics(&ctx, &footprint_layout, &target_pass, vert, frag, Blend::Under)?,
-            add: Pipeline::graphics(&ctx, &footprint_layout, &sheet_pass, vert, frag, Blend::Add)?,
+            over: Pipeline::graphics(
+                &ctx,
+                &footprint_layout,
+                &target_pass,
+                vert,
+                frag,
+                Blend::Over,
+                &[SHEET_MODE_SPLAT],
+            )?,
+            under: Pipeline::graphics(
+                &ctx,
+                &footprint_layout,
+                &target_pass,
+                vert,
+                frag,
+                Blend::Under,
+                &[SHEET_MODE_SPLAT],
+            )?,
+            add: Pipeline::graphics(&ctx, &footprint_layout, &sheet_pass, vert, frag, Blend::Add, &[SHEET_MODE_AXIS])?,
+            add_slab: Pipeline::graphics(
+                &ctx,
+                &footprint_layout,
+                &sheet_pass,
+                vert,
+                frag,
+                Blend::Add,
+                &[SHEET_MODE_SLAB],
+            )?,
             composite: Pipeline::compute(&ctx, &composite_layout, spirv!("composite.comp"))?,
             slab_count: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_count.comp"))?,
             slab_scan: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_scan.comp"))?,
@@ -178,6 +206,7 @@ impl GpuPipeline {
                 spirv!("roofline.vert"),
                 spirv!("roofline.frag"),
                 Blend::Add,
+                &[],
             )?,
             roofline_composite: Pipeline::compute(&ctx, &composite_layout, spirv!("roofline.comp"))?,
             roofline_layout,
@@ -758,7 +787,8 @@ impl GpuPipeline {
                         Box::new(move |rec| {
                             rec.begin_pass(&st.sheet_pass, &target.sums_fb);
                             let push = bytemuck::bytes_of(&b.push);
-                            rec.draw_quads(&st.add, &st.footprint_layout, set, push, b.first_instance, b.instances);
+                            let pipe = if b.push.sheet_mode == SHEET_MODE_SLAB { &st.add_slab } else { &st.add };
+                            rec.draw_quads(pipe, &st.footprint_layout, set, push, b.first_instance, b.instances);
                             rec.end_pass();
                         }),
                     ));

@@ -205,6 +205,8 @@ impl Pipeline {
     }
 
     /// Instanced triangle-strip quads (4 vertices, no vertex buffers) with the given blend.
+    /// `specialization[i]` sets `constant_id = i` in both stages: a mode fixed per pipeline costs
+    /// nothing at run time, where a branch on a push constant makes llvmpipe pay for both sides.
     pub fn graphics(
         ctx: &Arc<Context>,
         layout: &Layout,
@@ -212,6 +214,7 @@ impl Pipeline {
         vert: &[u8],
         frag: &[u8],
         blend: Blend,
+        specialization: &[u32],
     ) -> Result<Self> {
         let vm = shader_module(ctx, vert)?;
         let fm = match shader_module(ctx, frag) {
@@ -222,9 +225,22 @@ impl Pipeline {
                 return Err(e);
             }
         };
+        let entries: Vec<vk::SpecializationMapEntry> = (0..specialization.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let data: &[u8] = bytemuck::cast_slice(specialization);
+        let spec = vk::SpecializationInfo::default().map_entries(&entries).data(data);
         let stages = [
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vm).name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fm).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vm)
+                .name(c"main")
+                .specialization_info(&spec),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fm)
+                .name(c"main")
+                .specialization_info(&spec),
         ];
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
         let assembly =
