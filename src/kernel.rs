@@ -7,6 +7,7 @@
 //! a voxel of optical depth tau contributes tau * f to the pixels its footprint covers.
 use crate::constants::FOOTPRINT_TABLE_SIZE;
 use crate::error::{Error, Result};
+use std::sync::OnceLock;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Kernel {
@@ -20,6 +21,8 @@ pub enum Kernel {
 }
 
 pub const GAUSSIAN_SIGMA: f64 = 0.6;
+
+type KernelTables = [OnceLock<Vec<f32>>; 2];
 
 /// Simpson's rule over [a, b] with `n` (even) intervals.
 fn simpson(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
@@ -122,12 +125,17 @@ impl Kernel {
     /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2. Computed once
     /// per kernel (a million profile evaluations) and shared.
     pub fn footprint_table(self) -> Vec<f32> {
-        static TABLES: [std::sync::OnceLock<Vec<f32>>; 2] = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+        static TABLES: KernelTables = [OnceLock::new(), OnceLock::new()];
+        self.cached(&TABLES, Kernel::compute_footprint_table)
+    }
+
+    /// One table per kernel, computed on first use.
+    fn cached(self, tables: &'static KernelTables, compute: fn(Kernel) -> Vec<f32>) -> Vec<f32> {
         let slot = match self {
             Kernel::Gaussian => 0,
             Kernel::Cubic => 1,
         };
-        TABLES[slot].get_or_init(|| self.compute_footprint_table()).clone()
+        tables[slot].get_or_init(|| compute(self)).clone()
     }
 
     fn compute_footprint_table(self) -> Vec<f32> {
@@ -159,12 +167,8 @@ impl Kernel {
     /// S(r, zb) - S(r, za), and the slabs of one splat sum to its footprint. Same normaliser as
     /// `footprint_table`; computed once per kernel.
     pub fn slice_table(self) -> Vec<f32> {
-        static TABLES: [std::sync::OnceLock<Vec<f32>>; 2] = [std::sync::OnceLock::new(), std::sync::OnceLock::new()];
-        let slot = match self {
-            Kernel::Gaussian => 0,
-            Kernel::Cubic => 1,
-        };
-        TABLES[slot].get_or_init(|| self.compute_slice_table()).clone()
+        static TABLES: KernelTables = [OnceLock::new(), OnceLock::new()];
+        self.cached(&TABLES, Kernel::compute_slice_table)
     }
 
     fn compute_slice_table(self) -> Vec<f32> {

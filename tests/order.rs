@@ -41,20 +41,9 @@ fn pbtf_has_no_violations_on_1000_random_viewpoints() {
     assert!(total_pairs_violated_by_btf > 0);
 }
 
-/// A close, off-axis perspective view of the 60^3 cube whose eye projects inside the grid on two
-/// axes, as in Figs 2.25-2.27.
+/// The close, off-axis perspective view of Figs 2.25-2.27 (shared with the stability study).
 fn close_view(set: &SplatSet) -> Camera {
-    let c = set.grid().center();
-    Camera {
-        eye: c + Vec3::new(12.0, 20.0, 75.0),
-        target: c,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 60.0 },
-        near: 0.5,
-        far: 300.0,
-        width: 256,
-        height: 256,
-    }
+    voxsplat::stability::close_view(set.grid(), 256)
 }
 
 #[test]
