@@ -30,6 +30,7 @@ pub mod loaders;
 pub mod metrics;
 pub mod order;
 pub mod output;
+pub mod peer;
 pub mod pipeline;
 pub mod scene;
 pub mod slab;

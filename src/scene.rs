@@ -17,6 +17,8 @@ pub const SCENES: &[(&str, &str)] = &[
     ("plane", "single-sheet 498x398x1 checkerboard of 10x10 black/white squares (Fig. 3.6)"),
     ("stripes128", "dense 128^3 ball with 3-voxel colour stripes, semi-transparent: finer than the pixels in small views (Fig. 3.8)"),
     ("empty", "an 8^3 grid with no non-empty voxel"),
+    ("peer128", "the peers' synthetic 128^3 volume and transfer function (../shared/peers, issue 9)"),
+    ("peer256", "the same at 256^3"),
     ("bonsai", "data: CT of a bonsai, 256^3 NIfTI (shared/data/bonsai), 'bonsai' transfer function"),
     ("stent", "data: CT of a stented aorta, 128x128x256 NRRD (shared/data/stent), 'ct' transfer function"),
     ("rmnp", "data: Rocky Mountain NP elevation, 152x187 GeoTIFF with Landsat colour (shared/data/rmnp), x3 relief"),
@@ -63,6 +65,10 @@ pub fn build(name: &str) -> Result<SplatSet> {
             })
         }
         "empty" => SplatSet::from_fn(Grid::centered([8, 8, 8], [1.0; 3])?, |_, _, _| None),
+        "peer128" | "peer256" => {
+            let n = crate::peer::side_of(name).expect("matched above");
+            crate::classify::classify(&crate::peer::volume(n)?, &crate::peer::transfer_function(), None)
+        }
         "bonsai" | "stent" => {
             let dir = crate::loaders::data_dir();
             let (file, tf) =

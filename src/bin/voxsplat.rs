@@ -50,6 +50,25 @@ enum Command {
         #[arg(long)]
         validation: bool,
     },
+    /// Render the peers' scene (../shared/peers, issue 9) with every voxsplat mode: median frame
+    /// times as CSV on stdout, images into --out-dir; `scripts/peers.sh` runs it beside VTK.
+    Peer {
+        /// Volume side (the peers use 128 and 256).
+        #[arg(long, default_value_t = 128)]
+        n: u32,
+        #[arg(long, default_value_t = 512)]
+        size: u32,
+        #[arg(long, default_value_t = 2)]
+        warmup: usize,
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        #[arg(long, default_value = "peers-out")]
+        out_dir: PathBuf,
+        /// Also write the references: ray integration of the interpolated scalar (VTK's model) at
+        /// this step, and the pre-classified volumetric truth.
+        #[arg(long, value_parser = parse_finite)]
+        truth_step: Option<f32>,
+    },
     /// Print error metrics of image A against reference B (PNG or EXR).
     Compare {
         /// The image to score.
@@ -158,9 +177,10 @@ struct SceneArgs {
     /// Image size.
     #[arg(long, value_parser = parse_size, default_value = "512x512")]
     size: (u32, u32),
-    /// Preset view: auto (fly-over for terrain, framing otherwise), a three-quarter framing, a
-    /// grazing view across a single-sheet scene (Fig. 3.6), or a terrain fly-over (Figs 5.1-5.3).
-    #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover"])]
+    /// Preset view: auto (fly-over for terrain, VTK's camera for the peer scenes, framing otherwise),
+    /// a three-quarter framing, a grazing view across a single-sheet scene (Fig. 3.6), a terrain
+    /// fly-over (Figs 5.1-5.3), or the peers' VTK camera (issue 9).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover", "peer"])]
     view: String,
     /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, or raw with --dims and --dtype).
     #[arg(long, conflicts_with = "terrain")]
@@ -291,6 +311,7 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     let (w, h) = a.size;
     let view = match a.view.as_str() {
         "auto" if a.terrain.is_some() || a.scene == "rmnp" => "flyover",
+        "auto" if voxsplat::peer::side_of(&a.scene).is_some() && a.volume.is_none() => "peer",
         "auto" => "framing",
         v => v,
     };
@@ -298,6 +319,12 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     let mut cam = match view {
         "grazing" => Camera::grazing(grid, w, h),
         "flyover" => Camera::flyover(grid, w, h),
+        "peer" => {
+            if w != h {
+                return Err(Error::InvalidArgument("the peer view is square: use --size NxN".into()));
+            }
+            voxsplat::peer::camera(grid.dims[0], w)
+        }
         _ => Camera::framing(grid, w, h),
     };
     let fitted_eye = cam.eye;
@@ -464,6 +491,41 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Animate(a) => animate(a),
+        Command::Peer { n, size, warmup, frames, out_dir, truth_step } => {
+            if frames < 5 {
+                return Err(Error::InvalidArgument("--frames must be at least 5".into()));
+            }
+            std::fs::create_dir_all(&out_dir)
+                .map_err(|e| Error::Io { path: out_dir.display().to_string(), source: e })?;
+            let cam = voxsplat::peer::camera(n, size);
+            if let Some(step) = truth_step {
+                let t = std::time::Instant::now();
+                let vol = voxsplat::peer::volume(n)?;
+                let img = voxsplat::truth::ray_integrate_scalars(
+                    &vol,
+                    &voxsplat::peer::transfer_function(),
+                    &cam,
+                    step as f64,
+                )?;
+                voxsplat::output::write_image(&img, &out_dir.join(format!("truth-scalar-{n}.png")))?;
+                let set = voxsplat::classify::classify(&vol, &voxsplat::peer::transfer_function(), None)?;
+                let opts = voxsplat::truth::TruthOptions {
+                    reconstruction: voxsplat::truth::Reconstruction::Trilinear,
+                    ..Default::default()
+                };
+                let img = voxsplat::truth::volumetric_summation(&set, &cam, &opts)?;
+                voxsplat::output::write_image(&img, &out_dir.join(format!("truth-classified-{n}.png")))?;
+                eprintln!("references in {:.1} s", t.elapsed().as_secs_f64());
+            }
+            let mut r = Renderer::new(&RendererOptions::default())?;
+            println!("label,median_ms");
+            for run in voxsplat::peer::time_variants(&mut r, n, size, warmup, frames)? {
+                println!("{},{:.2}", run.label, run.median_ms);
+                let file = format!("voxsplat-{}-{n}.png", run.label.replace(' ', "-"));
+                voxsplat::output::write_image(&run.image, &out_dir.join(file))?;
+            }
+            Ok(())
+        }
         Command::Soak { frames, size, validation } => {
             if frames == 0 || size == 0 {
                 return Err(Error::InvalidArgument("--frames and --size must be positive".into()));
@@ -657,11 +719,14 @@ fn bench(a: BenchArgs) -> Result<()> {
         let notes_path = base.join("results-notes.md");
         let notes = std::fs::read_to_string(&notes_path).ok();
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+        // The peer comparison is its own run (scripts/peers.sh); its section is kept when present.
+        let peers_md = std::fs::read_to_string(a.out_dir.join("peers.md")).unwrap_or_default();
         let motion_md = format!(
-            "{}\n{}\n{}",
+            "{}\n{}\n{}\n{}",
             antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
             motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
-            voxsplat::stability::markdown(&stab, &chart_dir)
+            voxsplat::stability::markdown(&stab, &chart_dir),
+            peers_md
         );
         let md = results_markdown(&Report {
             device,
