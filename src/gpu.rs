@@ -69,8 +69,10 @@ struct SceneGpu {
     draw: [Buffer; 3],
     ranks: Buffer,
     order_set: DescriptorSet,
-    /// The ray caster's 3D texture of (colour * tau, tau), built on first use.
+    /// The ray caster's 3D texture of (colour * tau, tau), built on first use, and its brick
+    /// occupancy for empty-space skipping: (brick side, flags).
     field: Option<Image>,
+    bricks: Option<(u32, Buffer)>,
     params_set: DescriptorSet,
     /// Footprint sets: 0 = visibility order, 1..=3 = slice-grouped lists of axes x, y, z, 4 = slab
     /// pairs. They bind the target's occlusion map too, so they are built for a (scene, target,
@@ -148,7 +150,8 @@ impl GpuPipeline {
             compute,
             std::mem::size_of::<CompositePush>() as u32,
         )?;
-        let raycast_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Texture, Slot::StorageImage], compute, 0)?;
+        let raycast_layout =
+            Layout::new(&ctx, &[Slot::Storage, Slot::Texture, Slot::StorageImage, Slot::Storage], compute, 0)?;
         let slab_layout = Layout::new(
             &ctx,
             &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage],
@@ -312,6 +315,7 @@ impl GpuPipeline {
             ranks,
             order_set,
             field: None,
+            bricks: None,
             params_set,
             footprint_sets: Vec::new(),
             slab_pairs: None,
@@ -529,8 +533,15 @@ impl GpuPipeline {
         camera.validate()?;
         self.ensure_target(camera.width, camera.height, self.target.as_ref().map(|t| t.layers).unwrap_or(1))?;
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
-        if scene.field.is_none() {
-            let dense = DenseField::new(&prep.set)?;
+        let need_bricks = scene.bricks.as_ref().is_none_or(|(b, _)| *b != opts.brick);
+        // The dense field is built on the host only to upload it (and its bricks), then dropped.
+        let dense = if scene.field.is_none() || need_bricks { Some(DenseField::new(&prep.set)?) } else { None };
+        if let (true, Some(dense)) = (need_bricks, dense.as_ref()) {
+            let (_, occ) = crate::cpu::raycast::brick_occupancy(dense, opts.brick.max(1));
+            scene.bricks = None;
+            scene.bricks = Some((opts.brick, storage(&self.ctx, "raycast bricks", bytemuck::cast_slice(&occ))?));
+        }
+        if let (None, Some(dense)) = (scene.field.as_ref(), dense.as_ref()) {
             let [nx, ny, nz] = dense.dims;
             let image = Image::new_3d(
                 &self.ctx,
@@ -560,10 +571,12 @@ impl GpuPipeline {
         let (st, scene, target) =
             (&self.stages, self.scene.as_ref().expect("set"), self.target.as_ref().expect("ensured"));
         let field = scene.field.as_ref().expect("built above");
+        let bricks = &scene.bricks.as_ref().expect("built above").1;
         let set = st.raycast_layout.bind(&[
             Bind::Buffer(&ubo),
             Bind::Texture(field, &self.sampler),
             Bind::Image(&target.accum),
+            Bind::Buffer(bricks),
         ])?;
         let (w, h) = (camera.width, camera.height);
         let steps: Vec<Step<'_>> = vec![

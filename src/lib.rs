@@ -190,7 +190,8 @@ impl Renderer {
                 let t = std::time::Instant::now();
                 let field = prep.dense_field()?;
                 let rc = cpu::raycast::raycast_params(&prep.set, camera, options);
-                let image = cpu::raycast(&rc, field, None);
+                let (_, bricks) = cpu::raycast::brick_occupancy(field, options.brick.max(1));
+                let image = cpu::raycast(&rc, field, &bricks, None);
                 Ok(Rendered {
                     image,
                     timings: vec![StageTime { stage: "raycast", ms: t.elapsed().as_secs_f64() * 1e3 }],

@@ -17,11 +17,74 @@ pub struct RaycastOptions {
     pub min_transmittance: f32,
     /// Most samples per ray.
     pub max_steps: u32,
+    /// Empty-space skipping over bricks of this many voxels per side (0: off). Exact: only samples
+    /// that read nothing but empty voxels are skipped.
+    pub brick: u32,
+}
+
+/// Default brick side of the empty-space skipping.
+pub const DEFAULT_BRICK: u32 = 8;
+
+/// Which bricks of `brick`³ voxels hold a voxel with optical depth, looking one voxel beyond each
+/// face (the trilinear support of every sample inside the brick): (bricks per axis, flags).
+pub fn brick_occupancy(field: &DenseField, brick: u32) -> ([u32; 3], Vec<u32>) {
+    let b = brick.max(1) as i64;
+    let nb = field.dims.map(|d| (d as i64 + b - 1) / b);
+    let mut occ = vec![0u32; (nb[0] * nb[1] * nb[2]) as usize];
+    for k in 0..field.dims[2] as i64 {
+        for j in 0..field.dims[1] as i64 {
+            for i in 0..field.dims[0] as i64 {
+                if field.at(i, j, k)[3] <= 0.0 {
+                    continue;
+                }
+                // Mark every brick whose widened range [bB - 1, (b+1)B + 1] holds (i, j, k).
+                let range = |c: i64, n: i64| ((c - 1).div_euclid(b).max(0), ((c + 1).div_euclid(b)).min(n - 1));
+                let (rx, ry, rz) = (range(i, nb[0]), range(j, nb[1]), range(k, nb[2]));
+                for bz in rz.0..=rz.1 {
+                    for by in ry.0..=ry.1 {
+                        for bx in rx.0..=rx.1 {
+                            occ[((bz * nb[1] + by) * nb[0] + bx) as usize] = 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    (nb.map(|n| n as u32), occ)
+}
+
+/// Mirror of `skip_brick` in `raycast.comp`.
+#[allow(clippy::too_many_arguments)]
+fn skip_brick(rc: &RaycastParams, b: [i32; 3], nb: [i32; 3], a: Vec3, dir: Vec3, t0: f32, offset: f32, s: u32) -> u32 {
+    let bs = rc.image[2] as f32;
+    let size = Vec3::new(bs / rc.inv_spacing[0], bs / rc.inv_spacing[1], bs / rc.inv_spacing[2]);
+    let lo = Vec3::from_slice(&rc.origin[..3]) + Vec3::new(b[0] as f32, b[1] as f32, b[2] as f32) * size;
+    let hi = lo + size;
+    let mut t_exit = 3.4e38f32;
+    for ax in 0..3 {
+        if dir[ax] > 0.0 && b[ax] < nb[ax] - 1 {
+            t_exit = t_exit.min((hi[ax] - a[ax]) / dir[ax]);
+        }
+        if dir[ax] < 0.0 && b[ax] > 0 {
+            t_exit = t_exit.min((lo[ax] - a[ax]) / dir[ax]);
+        }
+    }
+    let step = rc.box_min[3];
+    let next = ((t_exit - 1e-3 * step - t0) / step - offset).ceil();
+    if next > (s + 1) as f32 {
+        if next < 4.0e9 {
+            next as u32
+        } else {
+            u32::MAX
+        }
+    } else {
+        s + 1
+    }
 }
 
 impl Default for RaycastOptions {
     fn default() -> Self {
-        Self { step: 0.5, min_transmittance: 1e-3, max_steps: 1 << 16 }
+        Self { step: 0.5, min_transmittance: 1e-3, max_steps: 1 << 16, brick: DEFAULT_BRICK }
     }
 }
 
@@ -40,7 +103,7 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
         origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
         inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
-        image: [camera.width, camera.height, 0, 0],
+        image: [camera.width, camera.height, opts.brick, 0],
     }
 }
 
@@ -58,7 +121,8 @@ pub fn trilinear(field: &DenseField, u: Vec3) -> [f32; 4] {
 }
 
 /// `jitter`: `Some(seed)` offsets each pixel's samples by a hashed fraction of a step.
-pub fn raycast(rc: &RaycastParams, field: &DenseField, jitter: Option<u64>) -> ImageF32 {
+/// `bricks`: `brick_occupancy(field, rc.image[2])` when skipping is on.
+pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: Option<u64>) -> ImageF32 {
     let (w, h) = (rc.image[0], rc.image[1]);
     let inv = Mat4::from_cols_array_2d(&rc.inv_view_proj);
     let (lo, hi) = (Vec3::from_slice(&rc.box_min[..3]), Vec3::from_slice(&rc.box_max[..3]));
@@ -95,9 +159,21 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, jitter: Option<u64>) -> I
                     Some(seed) => hash01(seed, x as u64, y as u64),
                     None => 0.5,
                 };
-                for s in 0..n {
+                let bs = rc.image[2];
+                let nb = [0, 1, 2].map(|ax| (rc.dims[ax] as i32 + bs as i32 - 1) / (bs as i32).max(1));
+                let mut s = 0u32;
+                while s < n {
                     let p = a + dir * (t0 + (s as f32 + offset) * step);
-                    let v = trilinear(field, (p - origin) * inv_spacing);
+                    let u = (p - origin) * inv_spacing;
+                    if bs > 0 {
+                        let b = [0, 1, 2].map(|ax| ((u[ax] / bs as f32).floor() as i32).clamp(0, nb[ax] - 1));
+                        if bricks[((b[2] * nb[1] + b[1]) * nb[0] + b[0]) as usize] == 0 {
+                            s = skip_brick(rc, b, nb, a, dir, t0, offset, s);
+                            continue;
+                        }
+                    }
+                    s += 1;
+                    let v = trilinear(field, u);
                     if v[3] <= 0.0 {
                         continue;
                     }
