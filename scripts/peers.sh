@@ -40,4 +40,4 @@ for n in $SIZES; do
   done
 done
 "$VENV/bin/python" scripts/peers_report.py "$OUT" docs/bench "$SIZES"
-echo "wrote docs/bench/peers.md"
+echo "wrote docs/bench/peers.md and its section of docs/RESULTS.md"

@@ -89,3 +89,20 @@ for n in sizes:
         md.append("No voxsplat mode reaches 40 dB against the truth here.")
     md.append("")
 open(os.path.join(docs, "peers.md"), "w").write("\n".join(md) + "\n")
+
+# Splice the section into docs/RESULTS.md (replacing an earlier one); `voxsplat bench --results`
+# includes docs/bench/peers.md the same way when it regenerates the page.
+results = os.path.join(os.path.dirname(os.path.abspath(docs)), "RESULTS.md")
+if os.path.exists(results):
+    page = open(results).read()
+    section = "\n".join(md) + "\n"
+    head = "## Side by side with the peers (issue 9)"
+    if head in page:
+        start = page.index(head)
+        nxt = page.find("\n## ", start + len(head))
+        page = page[:start] + section + (page[nxt + 1:] if nxt >= 0 else "")
+    else:
+        anchor = page.find("## Scaling")
+        anchor = anchor if anchor >= 0 else len(page)
+        page = page[:anchor] + section + "\n" + page[anchor:]
+    open(results, "w").write(page)

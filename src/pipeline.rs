@@ -113,7 +113,7 @@ pub struct RenderOptions {
     /// Front-to-back early termination for the sheet modes (Mueller et al. 1999): after each batch,
     /// footprints lying wholly over composite tiles whose remaining transmittance is at most this
     /// are skipped. No pixel changes by more than this much. 0 (the default) turns it off; back to
-    /// front ignores it. It pays on opaque data (1.8x on `solid40`) and costs on translucent data,
+    /// front ignores it. It pays on opaque data (1.2-1.8x on `solid40`) and costs on translucent data,
     /// where nothing is culled but batches are smaller (docs/RESULTS.md).
     pub early_termination: f32,
 }
