@@ -37,6 +37,19 @@ impl SoakReport {
         peak(b) - peak(a)
     }
 
+    /// The median change of host RSS from one cycle to the next after warm-up, in bytes: a leak
+    /// moves every cycle and shows here; a one-off step (a driver pool or allocator arena growing
+    /// once, seen as +10-30 MiB in one cycle on loaded machines) moves only one and does not.
+    pub fn rss_median_step(&self) -> i64 {
+        let after = self.rss.get(2..).unwrap_or(&[]);
+        let mut steps: Vec<i64> = after.windows(2).map(|w| w[1] as i64 - w[0] as i64).collect();
+        if steps.is_empty() {
+            return 0;
+        }
+        steps.sort_unstable();
+        steps[steps.len() / 2]
+    }
+
     /// Frames between the middles of the two halves that `rss_growth` compares.
     pub fn growth_span_frames(&self) -> usize {
         self.rss.len().saturating_sub(2) / 2 * CYCLE

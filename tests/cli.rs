@@ -207,3 +207,26 @@ fn compare_prints_metrics_and_rejects_bad_files() {
         assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     }
 }
+
+/// `voxsplat peer` times every mode on the peers' scene and writes their images; bad sizes are
+/// typed errors.
+#[test]
+fn peer_subcommand_times_every_mode() {
+    let dir = tmp("peer");
+    let d = dir.to_str().unwrap();
+    let out = voxsplat(&["peer", "--n", "24", "--size", "48", "--frames", "5", "--warmup", "1", "--out-dir", d]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 5, "splat, sheet, slab and two ray-caster steps: {csv}");
+    for r in rows {
+        let (label, ms) = r.rsplit_once(',').unwrap();
+        assert!(ms.parse::<f64>().unwrap() > 0.0, "{r}");
+        assert!(dir.join(format!("voxsplat-{}-24.png", label.replace(' ', "-"))).exists(), "{label}");
+    }
+    for args in [["peer", "--n", "1"], ["peer", "--frames", "2"]] {
+        let out = voxsplat(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("error"));
+    }
+}

@@ -24,7 +24,7 @@ fn a_100_frame_soak_keeps_gpu_allocations_flat() {
 /// Host memory must not grow after warm-up. In a child process so that the test harness's own
 /// allocations do not count and the allocator can be configured (see `SoakReport::rss_growth`).
 /// Before the frame constants moved from a uniform to a storage buffer, lavapipe grew by
-/// 0.2-0.7 MB per frame here, about 14 MiB between the halves this compares.
+/// 0.2-0.7 MB per frame here, about 5 MiB per cycle.
 #[test]
 fn a_120_frame_soak_keeps_host_memory_flat() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_voxsplat"))
@@ -36,13 +36,18 @@ fn a_120_frame_soak_keeps_host_memory_flat() {
     let text = String::from_utf8_lossy(&out.stdout);
     eprintln!("{text}{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success());
-    let growth: f64 = text
-        .lines()
-        .find_map(|l| l.strip_prefix("rss peak growth after warm-up: "))
-        .and_then(|l| l.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .expect("growth line");
-    assert!(growth < 4.0, "host RSS grew {growth} MiB after warm-up");
+    let figure = |prefix: &str| -> f64 {
+        text.lines()
+            .find_map(|l| l.strip_prefix(prefix))
+            .and_then(|l| l.split_whitespace().next())
+            .and_then(|v| v.parse().ok())
+            .expect(prefix)
+    };
+    // A leak moves every cycle: the old uniform-buffer leak measured ~5 MiB per 12-frame cycle here.
+    // One-off steps (driver pools, allocator arenas) move one cycle and leave the median alone.
+    let step = figure("rss median step per cycle after warm-up: ");
+    eprintln!("peak growth {} MiB", figure("rss peak growth after warm-up: "));
+    assert!(step < 1.0, "host RSS grows {step} MiB per cycle after warm-up");
     assert!(text.contains("validation messages: 0"));
 }
 

@@ -543,6 +543,11 @@ fn run(cli: Cli) -> Result<()> {
             }
             let growth = rep.rss_growth() as f64 / (1u64 << 20) as f64;
             println!("rss peak growth after warm-up: {growth:.1} MiB over {} frames", rep.growth_span_frames());
+            let step = rep.rss_median_step() as f64 / (1u64 << 20) as f64;
+            println!(
+                "rss median step per cycle after warm-up: {step:.2} MiB ({} frames per cycle)",
+                voxsplat::soak::CYCLE
+            );
             println!("validation messages: {}", rep.validation_messages);
             Ok(())
         }
