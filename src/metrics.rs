@@ -152,15 +152,21 @@ pub fn temporal(frames: &[ImageF32]) -> Result<Temporal> {
     if frames.len() < 3 {
         return Err(Error::InvalidArgument("temporal metrics need at least 3 frames".into()));
     }
-    let mut changes = Vec::with_capacity(frames.len() - 1);
-    for w in frames.windows(2) {
-        changes.push(compare(&w[1], &w[0])?.rmse);
-    }
-    let mean_change = changes.iter().sum::<f64>() / changes.len() as f64;
+    Ok(temporal_of(&frame_changes(frames)?))
+}
+
+/// RMSE between each frame and the next.
+pub fn frame_changes(frames: &[ImageF32]) -> Result<Vec<f64>> {
+    frames.windows(2).map(|w| compare(&w[1], &w[0]).map(|m| m.rmse)).collect()
+}
+
+/// `Temporal` from the frame-to-frame changes (at least one).
+pub fn temporal_of(changes: &[f64]) -> Temporal {
+    let mean_change = changes.iter().sum::<f64>() / changes.len().max(1) as f64;
     let max_change = changes.iter().cloned().fold(0.0, f64::max);
-    let mut sorted = changes.clone();
+    let mut sorted = changes.to_vec();
     sorted.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
-    let median = sorted[sorted.len() / 2];
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
     let popping = if median > 0.0 {
         max_change / median
     } else if max_change > 0.0 {
@@ -168,5 +174,5 @@ pub fn temporal(frames: &[ImageF32]) -> Result<Temporal> {
     } else {
         1.0
     };
-    Ok(Temporal { mean_change, max_change, popping })
+    Temporal { mean_change, max_change, popping }
 }

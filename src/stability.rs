@@ -7,7 +7,7 @@ use crate::camera::{Camera, Projection};
 use crate::cpu::raycast::RaycastOptions;
 use crate::cpu::ImageF32;
 use crate::error::Result;
-use crate::metrics::{compare, temporal};
+use crate::metrics::{compare, frame_changes, temporal_of};
 use crate::order::{count_violations, visibility_order, Direction, OrderKind};
 use crate::pipeline::{sheet_axis, Composite, RenderOptions, Rendered};
 use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
@@ -174,11 +174,8 @@ pub fn axis_switch_study(
             times.push(total_ms(&out));
             images.push(out.image);
         }
-        let t = temporal(&images)?;
-        let mut changes = Vec::with_capacity(frames - 1);
-        for w in images.windows(2) {
-            changes.push(compare(&w[1], &w[0])?.rmse);
-        }
+        let changes = frame_changes(&images)?;
+        let t = temporal_of(&changes);
         let median_change = median(changes.clone());
         let rmse =
             truth.iter().map(|(i, t)| compare(&images[*i], truth_for(t, v)).map(|m| m.rmse)).sum::<Result<f64>>()?
