@@ -133,7 +133,8 @@ pub struct Row {
     pub violations: Option<u64>,
 }
 
-fn median(v: &mut [f64]) -> f64 {
+/// The middle value (upper median); NaN when empty.
+pub(crate) fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
     if v.is_empty() {
         f64::NAN

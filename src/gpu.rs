@@ -10,7 +10,7 @@ use crate::gpu_types::{
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
 use crate::pipeline::{
-    groups_1d, make_frame, sheet_plan, Antialias, Composite, Prepared, RenderOptions, Rendered, StageTime,
+    frame_for, groups_1d, make_frame, sheet_plan, Antialias, Composite, Prepared, RenderOptions, Rendered, StageTime,
 };
 use crate::truth::DenseField;
 use crate::vk::{
@@ -698,8 +698,7 @@ impl GpuPipeline {
         let direction = opts.direction();
         let btf = direction == Direction::BackToFront;
         let layers = opts.batch_layers(w, h).min(max_layers.max(1));
-        let split = order::pbtf_split(&prep.set, camera);
-        let frame = make_frame(&prep.set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
+        let frame = frame_for(&prep.set, camera, opts);
         let mut host_ms = None;
         let mut pre_timings = Vec::new();
         let mut slab_pc = None;

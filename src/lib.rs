@@ -156,15 +156,7 @@ impl Renderer {
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         let direction = options.direction();
         let set = &prep.set;
-        let frame = pipeline::make_frame(
-            set,
-            camera,
-            options.kernel,
-            options.antialias,
-            options.motion.as_ref(),
-            order::pbtf_split(set, camera),
-            direction == Direction::BackToFront,
-        );
+        let frame = pipeline::frame_for(set, camera, options);
         let pc = slab::slab_geometry(&frame, set.grid(), set.len(), options.slab_thickness, direction)?;
         match &mut self.gpu {
             Some(g) => g.slab_pairs(&frame, &pc),

@@ -135,8 +135,7 @@ pub fn time_variants(r: &mut crate::Renderer, n: u32, size: u32, warmup: usize, 
         }
         // The kept image is from the unrotated camera, for scoring.
         let img = v.render(r, &base)?.image;
-        times.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
-        out.push(PeerRun { label: v.label(), median_ms: times[times.len() / 2], image: img });
+        out.push(PeerRun { label: v.label(), median_ms: crate::bench::median(&mut times), image: img });
     }
     Ok(out)
 }

@@ -271,6 +271,13 @@ pub fn make_frame(
     }
 }
 
+/// The per-frame constants for rendering `set` from `camera` with `opts`.
+pub fn frame_for(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> Frame {
+    let split = order::pbtf_split(set, camera);
+    let btf = opts.direction() == Direction::BackToFront;
+    make_frame(set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf)
+}
+
 /// The uniforms the order stage alone needs (no anti-aliasing or motion).
 pub fn order_frame(set: &SplatSet, camera: &Camera, direction: Direction) -> Frame {
     let split = order::pbtf_split(set, camera);
@@ -354,8 +361,7 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
     let set = &prep.set;
     let direction = opts.direction();
     let btf = direction == Direction::BackToFront;
-    let split = order::pbtf_split(set, camera);
-    let frame = make_frame(set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
+    let frame = frame_for(set, camera, opts);
     let n = set.len();
     let mut timings = Vec::new();
     let mut t = Instant::now();

@@ -3,6 +3,7 @@
 //! (b) brightening against screen splat density in perspective (Fig. 1.17);
 //! (c) per-splat compositing's dependence on the order of overlapping splats (Figs 1.13, 1.14);
 //! (d) BTF/WBTF visibility errors in perspective (Figs 2.25, 2.26, 5.1).
+use crate::bench::median;
 use crate::camera::{Camera, Projection};
 use crate::cpu::raycast::RaycastOptions;
 use crate::cpu::ImageF32;
@@ -95,11 +96,6 @@ fn total_ms(r: &Rendered) -> f64 {
     r.timings.iter().map(|s| s.ms).sum()
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
 /// An orthographic turntable about the vertical axis through the grid's centre, 20° above the
 /// equator, `frames` steps of one degree centred on 45°: the sheet axis switches from z to x midway
 /// (Fig. 1.9). Returns the cameras and the step (i → i+1) across which the axis switches.
@@ -176,7 +172,7 @@ pub fn axis_switch_study(
         }
         let changes = frame_changes(&images)?;
         let t = temporal_of(&changes);
-        let median_change = median(changes.clone());
+        let median_change = median(&mut changes.clone());
         let rmse =
             truth.iter().map(|(i, t)| compare(&images[*i], truth_for(t, v)).map(|m| m.rmse)).sum::<Result<f64>>()?
                 / truth.len() as f64;
@@ -186,7 +182,7 @@ pub fn axis_switch_study(
             popping: t.popping,
             median_change,
             rmse,
-            time_ms: median(times),
+            time_ms: median(&mut times),
         });
     }
     Ok(rows)
@@ -598,7 +594,7 @@ pub fn early_termination_study(r: &mut Renderer, size: u32, frames: usize) -> Re
                     t.push(total_ms(&out));
                     last = Some(out.image);
                 }
-                Ok((median(t), last.expect("one frame")))
+                Ok((median(&mut t), last.expect("one frame")))
             };
             let (off_ms, off) = time(&o, r)?;
             o.early_termination = crate::pipeline::DEFAULT_EARLY_TERMINATION;
