@@ -9,6 +9,10 @@ layout(local_size_x = COMPOSITE_TILE, local_size_y = COMPOSITE_TILE) in;
 layout(binding = 0, rgba32f) uniform readonly image2DArray sums;
 layout(binding = 1, rgba32f) uniform image2D accum;
 layout(std430, binding = 2) writeonly buffer Occlusion { float occlusion[]; };
+// The compute raster's layers: fixed-point (rgb * tau, tau), SUM_FIXED_SCALE per unit.
+layout(std430, binding = 3) readonly buffer SumsFixed { uint sums_fixed[]; };
+// 1: read the sums from sums_fixed (footprint_sum.comp), 0: from the sums image (the raster pass).
+layout(constant_id = 0) const uint SUMS_FIXED = 0u;
 layout(push_constant) uniform Push {
     uint layers;
     uint back_to_front;
@@ -25,7 +29,14 @@ void main() {
     if (inside) {
         vec4 acc = imageLoad(accum, ivec2(px));
         for (uint l = 0u; l < pc.layers; ++l) {
-            vec4 s = imageLoad(sums, ivec3(px, l));
+            vec4 s;
+            if (SUMS_FIXED != 0u) {
+                uint idx = 4u * ((l * pc.height + px.y) * pc.width + px.x);
+                uvec4 f = uvec4(sums_fixed[idx], sums_fixed[idx + 1u], sums_fixed[idx + 2u], sums_fixed[idx + 3u]);
+                s = vec4(f) / float(SUM_FIXED_SCALE);
+            } else {
+                s = imageLoad(sums, ivec3(px, l));
+            }
             float t = s.a;
             if (t <= 0.0) continue;
             float a = 1.0 - exp(-t);

@@ -134,7 +134,7 @@ pub struct Row {
 }
 
 /// The middle value (upper median); NaN when empty.
-pub(crate) fn median(v: &mut [f64]) -> f64 {
+pub fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
     if v.is_empty() {
         f64::NAN

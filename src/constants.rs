@@ -11,6 +11,18 @@ pub const COMPOSITE_TILE: u32 = 8;
 pub const FOOTPRINT_TABLE_SIZE: u32 = 64;
 /// Splats per invocation of the slab binning stages (one column of the slab x chunk count matrix).
 pub const SLAB_CHUNK: u32 = 1024;
+/// Side of the square screen tile of the compute rasteriser (`tile_composite.comp` runs
+/// TILE×TILE invocations, one per pixel).
+pub const RASTER_TILE: u32 = 16;
+/// Draw-list entries per invocation of the tile binning stages.
+pub const TILE_CHUNK: u32 = 1024;
+/// Invocations per workgroup of the tile binning stages: few chunks still fill several workgroups
+/// (llvmpipe runs one workgroup per thread).
+pub const TILE_BIN_WORKGROUP: u32 = 8;
+/// Fixed-point scale of the compute sheet summation (`footprint_sum.comp`): 2^20 per unit of
+/// optical depth, so a pixel's sum within one sheet may reach 4096 before the u32 wraps and each
+/// contribution is rounded to within 5e-7.
+pub const SUM_FIXED_SCALE: u32 = 1 << 20;
 /// Workgroups per dispatch row: larger 1D dispatches spill into y so they stay under the 65535 limit.
 pub const MAX_GROUPS_X: u32 = 32768;
 
@@ -21,4 +33,8 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("COMPOSITE_TILE", COMPOSITE_TILE),
     ("FOOTPRINT_TABLE_SIZE", FOOTPRINT_TABLE_SIZE),
     ("SLAB_CHUNK", SLAB_CHUNK),
+    ("RASTER_TILE", RASTER_TILE),
+    ("TILE_CHUNK", TILE_CHUNK),
+    ("TILE_BIN_WORKGROUP", TILE_BIN_WORKGROUP),
+    ("SUM_FIXED_SCALE", SUM_FIXED_SCALE),
 ];

@@ -1,6 +1,6 @@
 //! The stage list executed on Vulkan through the safe `vk` layer.
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE};
+use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, RASTER_TILE, TILE_BIN_WORKGROUP};
 use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
@@ -10,13 +10,15 @@ use crate::gpu_types::{
 use crate::kernel::Kernel;
 use crate::order::{self, Direction, OrderKind};
 use crate::pipeline::{
-    frame_for, groups_1d, make_frame, sheet_plan, Antialias, Composite, Prepared, RenderOptions, Rendered, StageTime,
+    frame_for, groups_1d, make_frame, sheet_plan, tile_push, Antialias, Composite, Prepared, RenderOptions, Rendered,
+    StageTime,
 };
+use crate::raster::Raster;
 use crate::truth::DenseField;
 use crate::vk::{
     Bind, Blend, Buffer, BufferUsageFlags as BU, Context, DescriptorSet, Format, Framebuffer, Image, ImageLayout as IL,
-    ImageUsageFlags as IU, Layout, Memory, Pipeline, Recorder, RenderPass, Sampler, ShaderStageFlags as SS, Slot,
-    Stage, Timer,
+    ImageUsageFlags as IU, Layout, Memory, Pipeline, Primitive, Recorder, RenderPass, Sampler, ShaderStageFlags as SS,
+    Slot, Stage, Timer,
 };
 use std::sync::Arc;
 use std::time::Instant;
@@ -43,8 +45,21 @@ struct Stages {
     under: Pipeline,
     add: Pipeline,
     add_slab: Pipeline,
+    /// The same four as point sprites.
+    over_points: Pipeline,
+    under_points: Pipeline,
+    add_points: Pipeline,
+    add_slab_points: Pipeline,
+    /// Compute raster: fixed-point sheet sums (axis, slab) and the tile compositor's stages.
+    sum_axis: Pipeline,
+    sum_slab: Pipeline,
+    tile_count: Pipeline,
+    tile_scan: Pipeline,
+    tile_scatter: Pipeline,
+    tile_composite: Pipeline,
     composite_layout: Layout,
     composite: Pipeline,
+    composite_fixed: Pipeline,
     slab_layout: Layout,
     slab_count: Pipeline,
     slab_scan: Pipeline,
@@ -84,6 +99,11 @@ struct SceneGpu {
     slab_counts: Option<Buffer>,
     slab_start: Option<(Buffer, Buffer)>,
     slab_set: Option<DescriptorSet>,
+    /// The compute tile compositor's binning: tile x chunk counts, each tile's first entry (on the
+    /// device and read back) and the entries; grown on demand.
+    tile_counts: Option<Buffer>,
+    tile_start: Option<(Buffer, Buffer)>,
+    tile_entries: Option<Buffer>,
 }
 
 struct TargetGpu {
@@ -92,11 +112,13 @@ struct TargetGpu {
     layers: u32,
     color: Image,
     color_fb: Framebuffer,
-    _sums: Image,
+    sums: Image,
     sums_fb: Framebuffer,
     accum: Image,
     /// Largest transmittance left per composite tile (front-to-back early termination).
     occlusion: Buffer,
+    /// The compute raster's fixed-point summation layers, allocated on first use.
+    fixed: Option<Buffer>,
     composite_set: DescriptorSet,
     readback: Buffer,
 }
@@ -115,6 +137,31 @@ pub struct GpuPipeline {
     ctx: Arc<Context>,
 }
 
+/// Replace the buffer in `slot` with a power-of-two-sized one when it holds fewer than `bytes`;
+/// true when it did (descriptor sets naming the old one must be rebuilt).
+fn grow(ctx: &Arc<Context>, slot: &mut Option<Buffer>, name: &str, bytes: u64, memory: Memory) -> Result<bool> {
+    if slot.as_ref().is_some_and(|b| b.size() >= bytes) {
+        return Ok(false);
+    }
+    *slot = None;
+    let usage = BU::STORAGE_BUFFER | BU::TRANSFER_SRC | BU::TRANSFER_DST;
+    *slot = Some(Buffer::new(ctx, name, bytes.max(4).next_power_of_two(), usage, memory)?);
+    Ok(true)
+}
+
+/// A device buffer and its host-readable copy, grown together (see `grow`).
+fn grow_readable(ctx: &Arc<Context>, slot: &mut Option<(Buffer, Buffer)>, name: &str, bytes: u64) -> Result<bool> {
+    if slot.as_ref().is_some_and(|(b, _)| b.size() >= bytes) {
+        return Ok(false);
+    }
+    *slot = None;
+    let size = bytes.max(4).next_power_of_two();
+    let dev = Buffer::new(ctx, name, size, BU::STORAGE_BUFFER | BU::TRANSFER_SRC, Memory::Device)?;
+    let back = Buffer::new(ctx, &format!("{name} readback"), size, BU::TRANSFER_DST, Memory::Readback)?;
+    *slot = Some((dev, back));
+    Ok(true)
+}
+
 fn storage(ctx: &Arc<Context>, name: &str, data: &[u8]) -> Result<Buffer> {
     Buffer::with_data(ctx, name, data, BU::STORAGE_BUFFER)
 }
@@ -129,6 +176,8 @@ impl GpuPipeline {
             0,
         )?;
         let params_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Storage, Slot::Storage], compute, 0)?;
+        // glsl/shared/footprint.glsl: 0-4 frame, params, draw list, splats, ranks; 5-6 tables;
+        // 7 occlusion; 8 fixed-point sums; 9-11 tile counts, starts, entries; 12 accumulation.
         let footprint_layout = Layout::new(
             &ctx,
             &[
@@ -140,13 +189,18 @@ impl GpuPipeline {
                 Slot::Texture,
                 Slot::Texture,
                 Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
+                Slot::StorageImage,
             ],
-            SS::VERTEX | SS::FRAGMENT,
+            SS::VERTEX | SS::FRAGMENT | SS::COMPUTE,
             std::mem::size_of::<FootprintPush>() as u32,
         )?;
         let composite_layout = Layout::new(
             &ctx,
-            &[Slot::StorageImage, Slot::StorageImage, Slot::Storage],
+            &[Slot::StorageImage, Slot::StorageImage, Slot::Storage, Slot::Storage],
             compute,
             std::mem::size_of::<CompositePush>() as u32,
         )?;
@@ -162,39 +216,40 @@ impl GpuPipeline {
         let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
         let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
         let (vert, frag) = (spirv!("footprint.vert"), spirv!("footprint.frag"));
+        let footprint_pipe = |blend, primitive, mode, pass: &RenderPass| {
+            let points = (primitive == Primitive::Points) as u32;
+            Pipeline::graphics(&ctx, &footprint_layout, pass, vert, frag, blend, primitive, &[mode, points])
+        };
         let stages = Stages {
             order_count: Pipeline::compute(&ctx, &order_layout, spirv!("order_count.comp"))?,
             order_scan: Pipeline::compute(&ctx, &order_layout, spirv!("order_scan.comp"))?,
             order_scatter: Pipeline::compute(&ctx, &order_layout, spirv!("order_scatter.comp"))?,
             splat_params: Pipeline::compute(&ctx, &params_layout, spirv!("splat_params.comp"))?,
-            over: Pipeline::graphics(
+            over: footprint_pipe(Blend::Over, Primitive::Quads, SHEET_MODE_SPLAT, &target_pass)?,
+            under: footprint_pipe(Blend::Under, Primitive::Quads, SHEET_MODE_SPLAT, &target_pass)?,
+            add: footprint_pipe(Blend::Add, Primitive::Quads, SHEET_MODE_AXIS, &sheet_pass)?,
+            add_slab: footprint_pipe(Blend::Add, Primitive::Quads, SHEET_MODE_SLAB, &sheet_pass)?,
+            over_points: footprint_pipe(Blend::Over, Primitive::Points, SHEET_MODE_SPLAT, &target_pass)?,
+            under_points: footprint_pipe(Blend::Under, Primitive::Points, SHEET_MODE_SPLAT, &target_pass)?,
+            add_points: footprint_pipe(Blend::Add, Primitive::Points, SHEET_MODE_AXIS, &sheet_pass)?,
+            add_slab_points: footprint_pipe(Blend::Add, Primitive::Points, SHEET_MODE_SLAB, &sheet_pass)?,
+            sum_axis: Pipeline::compute_specialized(
                 &ctx,
                 &footprint_layout,
-                &target_pass,
-                vert,
-                frag,
-                Blend::Over,
-                &[SHEET_MODE_SPLAT],
+                spirv!("footprint_sum.comp"),
+                &[SHEET_MODE_AXIS],
             )?,
-            under: Pipeline::graphics(
+            sum_slab: Pipeline::compute_specialized(
                 &ctx,
                 &footprint_layout,
-                &target_pass,
-                vert,
-                frag,
-                Blend::Under,
-                &[SHEET_MODE_SPLAT],
-            )?,
-            add: Pipeline::graphics(&ctx, &footprint_layout, &sheet_pass, vert, frag, Blend::Add, &[SHEET_MODE_AXIS])?,
-            add_slab: Pipeline::graphics(
-                &ctx,
-                &footprint_layout,
-                &sheet_pass,
-                vert,
-                frag,
-                Blend::Add,
+                spirv!("footprint_sum.comp"),
                 &[SHEET_MODE_SLAB],
             )?,
+            tile_count: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_count.comp"))?,
+            tile_scan: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scan.comp"))?,
+            tile_scatter: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp"))?,
+            tile_composite: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_composite.comp"))?,
+            composite_fixed: Pipeline::compute_specialized(&ctx, &composite_layout, spirv!("composite.comp"), &[1])?,
             composite: Pipeline::compute(&ctx, &composite_layout, spirv!("composite.comp"))?,
             slab_count: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_count.comp"))?,
             slab_scan: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_scan.comp"))?,
@@ -209,6 +264,7 @@ impl GpuPipeline {
                 spirv!("roofline.vert"),
                 spirv!("roofline.frag"),
                 Blend::Add,
+                Primitive::Quads,
                 &[],
             )?,
             roofline_composite: Pipeline::compute(&ctx, &composite_layout, spirv!("roofline.comp"))?,
@@ -322,6 +378,9 @@ impl GpuPipeline {
             slab_counts: None,
             slab_start: None,
             slab_set: None,
+            tile_counts: None,
+            tile_start: None,
+            tile_entries: None,
         });
         Ok(())
     }
@@ -331,31 +390,10 @@ impl GpuPipeline {
     fn slab_prepass(&mut self, pc: &SlabPush) -> Result<(Vec<u32>, Vec<StageTime>)> {
         let ctx = self.ctx.clone();
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
-        let grow = |slot: &mut Option<Buffer>, name: &str, bytes: u64, memory: Memory| -> Result<bool> {
-            if slot.as_ref().is_some_and(|b| b.size() >= bytes) {
-                return Ok(false);
-            }
-            *slot = None;
-            *slot = Some(Buffer::new(
-                &ctx,
-                name,
-                bytes.next_power_of_two(),
-                BU::STORAGE_BUFFER | BU::TRANSFER_SRC,
-                memory,
-            )?);
-            Ok(true)
-        };
         let cells = pc.slabs as u64 * pc.chunks as u64 * 4;
         let starts = (pc.slabs as u64 + 1) * 4;
-        let mut changed = grow(&mut scene.slab_counts, "slab counts", cells, Memory::Device)?;
-        if scene.slab_start.as_ref().is_none_or(|(b, _)| b.size() < starts) {
-            scene.slab_start = None;
-            let size = starts.next_power_of_two();
-            let dev = Buffer::new(&ctx, "slab starts", size, BU::STORAGE_BUFFER | BU::TRANSFER_SRC, Memory::Device)?;
-            let back = Buffer::new(&ctx, "slab starts readback", size, BU::TRANSFER_DST, Memory::Readback)?;
-            scene.slab_start = Some((dev, back));
-            changed = true;
-        }
+        let mut changed = grow(&ctx, &mut scene.slab_counts, "slab counts", cells, Memory::Device)?;
+        changed |= grow_readable(&ctx, &mut scene.slab_start, "slab starts", starts)?;
         if changed {
             scene.slab_set = None;
         }
@@ -389,12 +427,104 @@ impl GpuPipeline {
         let slab_start = bytemuck::cast_slice::<u8, u32>(&back.read()?[..starts as usize]).to_vec();
         let pairs = slab_start[pc.slabs as usize] as u64 * 8;
         let scene = self.scene.as_mut().expect("checked above");
-        if grow(&mut scene.slab_pairs, "slab pairs", pairs, Memory::Device)? {
+        if grow(&self.ctx, &mut scene.slab_pairs, "slab pairs", pairs, Memory::Device)? {
             scene.slab_set = None;
             scene.footprint_sets.clear();
         }
         self.ensure_slab_set()?;
         Ok((slab_start, timings))
+    }
+
+    /// Compute tile compositing, first half: the order (when on the GPU), `splat_params`, the tile
+    /// counts and their scan, then read back the total to size the entry list (checked against
+    /// `MAX_TILE_ENTRIES` before allocating).
+    fn tile_prepass(&mut self, frame: &Frame, push: &FootprintPush, gpu_order: bool) -> Result<Vec<StageTime>> {
+        let ctx = self.ctx.clone();
+        let (tx, ty) = crate::cpu::tile::tile_grid(frame);
+        let tiles = tx as u64 * ty as u64;
+        let cells = crate::raster::check_tile_cells(tiles, push.chunks)?;
+        let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        let mut changed = grow(&ctx, &mut scene.tile_counts, "tile counts", cells * 4, Memory::Device)?;
+        changed |= grow_readable(&ctx, &mut scene.tile_start, "tile starts", (tiles + 1) * 4)?;
+        if changed {
+            scene.footprint_sets.clear();
+        }
+        self.ensure_footprint_sets()?;
+        let (st, scene) = (&self.stages, self.scene.as_ref().expect("checked above"));
+        let (dev, back) = scene.tile_start.as_ref().expect("grown");
+        let set = &scene.footprint_sets[0];
+        let bytes = bytemuck::bytes_of(push);
+        let n = scene.n;
+        let mut steps: Vec<Step<'_>> = Vec::new();
+        if gpu_order && n > 0 {
+            steps.push(("order", Box::new(|rec| record_order(rec, st, scene))));
+        }
+        if n > 0 {
+            steps.push((
+                "splat_params",
+                Box::new(|rec| {
+                    rec.dispatch(&st.splat_params, &st.params_layout, &scene.params_set, &[], groups_1d(n));
+                    rec.barrier(Stage::Compute, Stage::Compute);
+                }),
+            ));
+        }
+        steps.push((
+            "tile_bins",
+            Box::new(move |rec| {
+                let groups = [push.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1];
+                rec.dispatch(&st.tile_count, &st.footprint_layout, set, bytes, groups);
+                rec.barrier(Stage::Compute, Stage::Compute);
+                rec.dispatch(&st.tile_scan, &st.footprint_layout, set, bytes, [1, 1, 1]);
+                rec.barrier(Stage::Compute, Stage::Transfer);
+                rec.copy_buffer(dev, back, (tiles + 1) * 4);
+            }),
+        ));
+        let timings = execute(&self.ctx, &mut self.timer, &steps)?;
+        drop(steps);
+        let total = bytemuck::cast_slice::<u8, u32>(&back.read()?[..(tiles as usize + 1) * 4])[tiles as usize] as u64;
+        crate::raster::check_tile_entries(total)?;
+        let scene = self.scene.as_mut().expect("checked above");
+        if grow(&self.ctx, &mut scene.tile_entries, "tile entries", total * 4, Memory::Device)? {
+            scene.footprint_sets.clear();
+        }
+        Ok(timings)
+    }
+
+    /// Run the tile binning of the compute tile compositor for this frame and read it back:
+    /// (each tile's first entry and the total, the entries).
+    pub fn tile_lists(&mut self, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<(Vec<u32>, Vec<u32>)> {
+        camera.validate()?;
+        let frame = frame_for(&prep.set, camera, opts);
+        self.frame.write(bytemuck::bytes_of(&frame))?;
+        let (w, h) = (camera.width, camera.height);
+        self.ensure_target(w, h, self.target.as_ref().map(|t| t.layers).unwrap_or(1))?;
+        let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
+        let gpu_order = opts.order == OrderKind::Pbtf;
+        if !gpu_order {
+            let cpu_order = order::visibility_order(&prep.set, camera, opts.order, opts.direction());
+            scene.order.write(bytemuck::cast_slice(&cpu_order))?;
+        }
+        let push = tile_push(opts, scene.n);
+        self.tile_prepass(&frame, &push, gpu_order)?;
+        self.ensure_footprint_sets()?;
+        let scene = self.scene.as_ref().expect("checked above");
+        let (tx, ty) = crate::cpu::tile::tile_grid(&frame);
+        let tiles = tx as usize * ty as usize;
+        let starts = bytemuck::cast_slice::<u8, u32>(&scene.tile_start.as_ref().expect("grown").1.read()?)[..tiles + 1]
+            .to_vec();
+        let bytes = starts[tiles] as u64 * 4;
+        let readback = Buffer::new(&self.ctx, "tile entries readback", bytes.max(4), BU::TRANSFER_DST, Memory::Readback)?;
+        let (st, entries) = (&self.stages, scene.tile_entries.as_ref().expect("grown"));
+        let set = &scene.footprint_sets[0];
+        self.ctx.submit(|rec| {
+            let groups = [push.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1];
+            rec.dispatch(&st.tile_scatter, &st.footprint_layout, set, bytemuck::bytes_of(&push), groups);
+            rec.barrier(Stage::Compute, Stage::Transfer);
+            rec.copy_buffer(entries, &readback, bytes);
+            Ok(())
+        })?;
+        let entries = bytemuck::cast_slice::<u8, u32>(&readback.read()?[..bytes as usize]).to_vec();
+        Ok((starts, entries))
     }
 
     /// Run the binning for `frame` and read the pairs back.
@@ -440,7 +570,13 @@ impl GpuPipeline {
         if !scene.footprint_sets.is_empty() {
             return Ok(());
         }
-        let pairs = scene.slab_pairs.as_ref().unwrap_or(&scene.order);
+        // Buffers not allocated yet are stood in for by one the stage in use never reads.
+        let stand_in = &scene.order;
+        let pairs = scene.slab_pairs.as_ref().unwrap_or(stand_in);
+        let fixed = target.fixed.as_ref().unwrap_or(stand_in);
+        let counts = scene.tile_counts.as_ref().unwrap_or(stand_in);
+        let starts = scene.tile_start.as_ref().map(|(b, _)| b).unwrap_or(stand_in);
+        let entries = scene.tile_entries.as_ref().unwrap_or(stand_in);
         let mut sets = Vec::with_capacity(5);
         for list in [&scene.order, &scene.draw[0], &scene.draw[1], &scene.draw[2], pairs] {
             sets.push(self.stages.footprint_layout.bind(&[
@@ -452,6 +588,11 @@ impl GpuPipeline {
                 Bind::Texture(&self.table, &self.sampler),
                 Bind::Texture(&self.slices, &self.sampler),
                 Bind::Buffer(&target.occlusion),
+                Bind::Buffer(fixed),
+                Bind::Buffer(counts),
+                Bind::Buffer(starts),
+                Bind::Buffer(entries),
+                Bind::Image(&target.accum),
             ])?);
         }
         scene.footprint_sets = sets;
@@ -493,8 +634,12 @@ impl GpuPipeline {
         let tiles = width.div_ceil(COMPOSITE_TILE) as u64 * height.div_ceil(COMPOSITE_TILE) as u64;
         let occlusion =
             Buffer::new(ctx, "occlusion", tiles * 4, BU::STORAGE_BUFFER | BU::TRANSFER_DST, Memory::Device)?;
-        let composite_set =
-            self.stages.composite_layout.bind(&[Bind::Image(&sums), Bind::Image(&accum), Bind::Buffer(&occlusion)])?;
+        let composite_set = self.stages.composite_layout.bind(&[
+            Bind::Image(&sums),
+            Bind::Image(&accum),
+            Bind::Buffer(&occlusion),
+            Bind::Buffer(&occlusion), // stands in for the fixed-point layers until they exist
+        ])?;
         let readback =
             Buffer::new(ctx, "readback", width as u64 * height as u64 * 16, BU::TRANSFER_DST, Memory::Readback)?;
         self.target = Some(TargetGpu {
@@ -503,13 +648,36 @@ impl GpuPipeline {
             layers,
             color,
             color_fb,
-            _sums: sums,
+            sums: sums,
             sums_fb,
             accum,
             occlusion,
+            fixed: None,
             composite_set,
             readback,
         });
+        Ok(())
+    }
+
+    /// Allocate the compute raster's fixed-point layers for the current target (as many as its
+    /// summation image) and rebind the sets that name them.
+    fn ensure_fixed_sums(&mut self) -> Result<()> {
+        let target = self.target.as_mut().ok_or_else(|| Error::InvalidArgument("no target".into()))?;
+        if target.fixed.is_some() {
+            return Ok(());
+        }
+        let bytes = target.width as u64 * target.height as u64 * target.layers as u64 * 16;
+        let fixed = Buffer::new(&self.ctx, "fixed-point sums", bytes, BU::STORAGE_BUFFER | BU::TRANSFER_DST, Memory::Device)?;
+        target.composite_set = self.stages.composite_layout.bind(&[
+            Bind::Image(&target.sums),
+            Bind::Image(&target.accum),
+            Bind::Buffer(&target.occlusion),
+            Bind::Buffer(&fixed),
+        ])?;
+        target.fixed = Some(fixed);
+        if let Some(scene) = self.scene.as_mut() {
+            scene.footprint_sets.clear();
+        }
         Ok(())
     }
 
@@ -596,7 +764,7 @@ impl GpuPipeline {
         ];
         let timings = execute(&self.ctx, &mut self.timer, &steps)?;
         drop(steps);
-        Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })
+        Ok(Rendered { image: read_image(&target.readback, w, h)?, timings, raster: None })
     }
 
     /// GPU milliseconds for `instances` additive `size`-pixel quads into a `width`x`height` RGBA32F
@@ -721,10 +889,15 @@ impl GpuPipeline {
             Composite::Splat => (0, Vec::new()),
         };
         opts.set_early_termination(&mut batches);
+        let points = opts.raster == Raster::Points;
+        let compute = opts.raster == Raster::Compute;
+        let tiles = compute && opts.composite == Composite::Splat;
         // Allocate only as many layers as the largest batch needs.
         let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
         self.ensure_target(w, h, layers)?;
-        self.ensure_footprint_sets()?;
+        if compute && !tiles {
+            self.ensure_fixed_sums()?;
+        }
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;
         if opts.composite == Composite::Splat && !gpu_order {
@@ -734,11 +907,16 @@ impl GpuPipeline {
             host_ms = Some(("order_cpu", t));
         }
         let host_ms = host_ms.map(|(stage, t)| StageTime { stage, ms: t.elapsed().as_secs_f64() * 1e3 });
+        let tile_pc = tile_push(opts, scene.n);
+        if tiles {
+            pre_timings = self.tile_prepass(&frame, &tile_pc, gpu_order)?;
+        }
+        self.ensure_footprint_sets()?;
         let (st, scene, target) =
             (&self.stages, self.scene.as_ref().expect("set above"), self.target.as_ref().expect("ensured"));
         let n = scene.n;
         let mut steps: Vec<Step<'_>> = Vec::new();
-        if gpu_order && n > 0 {
+        if gpu_order && n > 0 && !tiles {
             steps.push(("order", Box::new(|rec| record_order(rec, st, scene))));
         }
         if let (Some(pc), Some(set)) = (slab_pc.as_ref(), scene.slab_set.as_ref()) {
@@ -747,29 +925,60 @@ impl GpuPipeline {
                 Box::new(move |rec| {
                     let push = bytemuck::bytes_of(pc);
                     rec.dispatch(&st.slab_scatter, &st.slab_layout, set, push, groups_1d(pc.chunks));
-                    rec.barrier(Stage::Compute, Stage::Graphics);
+                    rec.barrier(Stage::Compute, Stage::All);
                 }),
             ));
-        } else if n > 0 {
+        } else if n > 0 && !tiles {
             steps.push((
                 "splat_params",
                 Box::new(|rec| {
                     rec.dispatch(&st.splat_params, &st.params_layout, &scene.params_set, &[], groups_1d(n));
-                    rec.barrier(Stage::Compute, Stage::Graphics);
+                    rec.barrier(Stage::Compute, Stage::All);
                 }),
             ));
         }
         match opts.composite {
+            Composite::Splat if tiles => {
+                let set = &scene.footprint_sets[0];
+                let push = bytemuck::bytes_of(&tile_pc);
+                steps.push((
+                    "tile_bins",
+                    Box::new(move |rec| {
+                        let groups = [tile_pc.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1];
+                        rec.dispatch(&st.tile_scatter, &st.footprint_layout, set, push, groups);
+                        rec.barrier(Stage::Compute, Stage::Compute);
+                    }),
+                ));
+                steps.push((
+                    UNTIMED,
+                    Box::new(|rec| rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute)),
+                ));
+                steps.push((
+                    "footprint",
+                    Box::new(move |rec| {
+                        let groups = [w.div_ceil(RASTER_TILE), h.div_ceil(RASTER_TILE), 1];
+                        rec.dispatch(&st.tile_composite, &st.footprint_layout, set, push, groups);
+                        rec.barrier(Stage::Compute, Stage::Compute);
+                    }),
+                ));
+                steps.push((UNTIMED, Box::new(|rec| read_back_accum(rec, target))));
+            }
             Composite::Splat => {
                 steps.push((
                     "footprint",
                     Box::new(move |rec| {
                         rec.begin_pass(&st.target_pass, &target.color_fb);
                         if n > 0 {
-                            let pipe = if btf { &st.over } else { &st.under };
                             let push = FootprintPush::default();
+                            let push = bytemuck::bytes_of(&push);
                             let set = &scene.footprint_sets[0];
-                            rec.draw_quads(pipe, &st.footprint_layout, set, bytemuck::bytes_of(&push), 0, n);
+                            let layout = &st.footprint_layout;
+                            match (points, btf) {
+                                (false, true) => rec.draw_quads(&st.over, layout, set, push, 0, n),
+                                (false, false) => rec.draw_quads(&st.under, layout, set, push, 0, n),
+                                (true, true) => rec.draw_points(&st.over_points, layout, set, push, 0, n),
+                                (true, false) => rec.draw_points(&st.under_points, layout, set, push, 0, n),
+                            }
                         }
                         rec.end_pass();
                     }),
@@ -790,17 +999,38 @@ impl GpuPipeline {
                         rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Transfer);
                         rec.clear_image(&target.accum, IL::GENERAL, [0.0; 4]);
                         rec.fill_buffer(&target.occlusion, 1.0f32.to_bits());
+                        if compute {
+                            // composite.comp's fixed-point variant still names the sums image.
+                            rec.transition(&target.sums, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
+                        }
                         rec.barrier(Stage::Transfer, Stage::All);
                     }),
                 ));
                 for b in &batches {
+                    let slab = b.push.sheet_mode == SHEET_MODE_SLAB;
                     steps.push((
                         "footprint",
                         Box::new(move |rec| {
+                            if let (true, Some(fixed)) = (compute, target.fixed.as_ref()) {
+                                rec.fill_buffer(fixed, 0);
+                                rec.barrier(Stage::Transfer, Stage::Compute);
+                                let push = FootprintPush { first: b.first_instance, count: b.instances, ..b.push };
+                                let pipe = if slab { &st.sum_slab } else { &st.sum_axis };
+                                let push = bytemuck::bytes_of(&push);
+                                rec.dispatch(pipe, &st.footprint_layout, set, push, groups_1d(b.instances));
+                                rec.barrier(Stage::Compute, Stage::Compute);
+                                return;
+                            }
                             rec.begin_pass(&st.sheet_pass, &target.sums_fb);
                             let push = bytemuck::bytes_of(&b.push);
-                            let pipe = if b.push.sheet_mode == SHEET_MODE_SLAB { &st.add_slab } else { &st.add };
-                            rec.draw_quads(pipe, &st.footprint_layout, set, push, b.first_instance, b.instances);
+                            let layout = &st.footprint_layout;
+                            let (first, count) = (b.first_instance, b.instances);
+                            match (points, slab) {
+                                (false, false) => rec.draw_quads(&st.add, layout, set, push, first, count),
+                                (false, true) => rec.draw_quads(&st.add_slab, layout, set, push, first, count),
+                                (true, false) => rec.draw_points(&st.add_points, layout, set, push, first, count),
+                                (true, true) => rec.draw_points(&st.add_slab_points, layout, set, push, first, count),
+                            }
                             rec.end_pass();
                         }),
                     ));
@@ -811,7 +1041,8 @@ impl GpuPipeline {
                                 CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
                             let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
                             let set = &target.composite_set;
-                            rec.dispatch(&st.composite, &st.composite_layout, set, bytemuck::bytes_of(&push), groups);
+                            let pipe = if compute { &st.composite_fixed } else { &st.composite };
+                            rec.dispatch(pipe, &st.composite_layout, set, bytemuck::bytes_of(&push), groups);
                             // The next batch's footprints read the occlusion map.
                             rec.barrier(Stage::Compute, Stage::All);
                         }),
@@ -834,7 +1065,7 @@ impl GpuPipeline {
         }
         let timings = pre_timings;
         let target = self.target.as_ref().expect("ensured");
-        Ok(Rendered { image: read_image(&target.readback, w, h)?, timings })
+        Ok(Rendered { image: read_image(&target.readback, w, h)?, timings, raster: None })
     }
 }
 

@@ -62,7 +62,8 @@ pub struct RaycastParams {
     pub image: [u32; 4],
 }
 
-/// Push constants of `footprint.vert` / `footprint.frag`.
+/// Push constants of the footprint stage in every raster variant (`footprint.vert` / `.frag`,
+/// `footprint_sum.comp`, `tile_*.comp`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct FootprintPush {
@@ -74,8 +75,16 @@ pub struct FootprintPush {
     pub rank_dir: i32,
     pub slab_z0: f32,
     pub slab_dz: f32,
-    /// Early termination: skip footprints over tiles with at most this transmittance (0 = off).
+    /// Early termination: skip footprints over tiles with at most this transmittance (0 = off);
+    /// the tile compositor stops a pixel once its transmittance is at most this.
     pub occluded: f32,
+    /// Compute raster: first draw-list entry of the batch and the entry count.
+    pub first: u32,
+    pub count: u32,
+    /// Tile binning: entry chunks of `TILE_CHUNK` (columns of the tile x chunk count matrix).
+    pub chunks: u32,
+    /// Tile compositing: 1 = the list runs back to front (over), 0 = front to back (under).
+    pub back_to_front: u32,
 }
 
 /// `sheet_mode` values (glsl/shared/types.glsl).
@@ -109,7 +118,7 @@ pub struct CompositePush {
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 288);
-const _: () = assert!(std::mem::size_of::<FootprintPush>() == 32);
+const _: () = assert!(std::mem::size_of::<FootprintPush>() == 48);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -32,6 +32,7 @@ pub mod order;
 pub mod output;
 pub mod peer;
 pub mod pipeline;
+pub mod raster;
 pub mod scene;
 pub mod slab;
 pub mod soak;
@@ -47,6 +48,7 @@ pub use error::{Error, Result};
 pub use kernel::Kernel;
 pub use order::{Direction, OrderKind};
 pub use pipeline::{Antialias, Composite, RenderOptions, Rendered, StageTime};
+pub use raster::{Raster, RasterChoice};
 pub use volume::{Grid, SplatSet, Volume};
 
 use pipeline::Prepared;
@@ -129,10 +131,54 @@ impl Renderer {
         options.validate()?;
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
-        match &mut self.gpu {
-            Some(g) => g.render(prep, camera, options),
-            None => pipeline::render_cpu(prep, camera, options),
+        camera.validate()?;
+        let device = match &self.gpu {
+            Some(g) => raster::Device { cpu: g.context().is_cpu_device(), point_size_max: g.context().point_size_max() },
+            None => raster::Device { cpu: true, point_size_max: f32::INFINITY },
+        };
+        let choice = raster::choose(&prep.set, camera, options, device)?;
+        let mut opts = options.clone();
+        opts.raster = choice.raster;
+        let mut out = match &mut self.gpu {
+            Some(g) => g.render(prep, camera, &opts),
+            None => pipeline::render_cpu(prep, camera, &opts),
+        }?;
+        out.raster = Some(choice);
+        Ok(out)
+    }
+
+    /// The compute tile compositor's binning for this frame (GPU stages or their CPU mirrors):
+    /// each screen tile's first entry plus the total, and the entries (splat indices, each tile's
+    /// run in draw-list order).
+    pub fn tile_lists(&mut self, camera: &Camera, options: &RenderOptions) -> Result<(Vec<u32>, Vec<u32>)> {
+        camera.validate()?;
+        options.validate()?;
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let mut opts = options.clone();
+        opts.raster = Raster::Compute;
+        opts.composite = Composite::Splat;
+        if let Some(g) = &mut self.gpu {
+            return g.tile_lists(prep, camera, &opts);
         }
+        let frame = pipeline::frame_for(&prep.set, camera, &opts);
+        let draw = match opts.order {
+            OrderKind::Pbtf => cpu_pbtf_order(prep, camera, opts.direction()),
+            kind => order::visibility_order(&prep.set, camera, kind, opts.direction()),
+        };
+        let mut params = vec![Default::default(); prep.set.len()];
+        cpu::splat_params(&frame, prep.set.splats(), &mut params);
+        let inputs = cpu::footprint::FootprintInputs {
+            frame: &frame,
+            params: &params,
+            draw_list: &draw,
+            splats: prep.set.splats(),
+            sheet_rank: &prep.ranks,
+            table: &[],
+            slice_table: &[],
+            occlusion: &[],
+        };
+        cpu::tile::tile_bins_cpu(&inputs, &pipeline::tile_push(&opts, prep.set.len() as u32))
     }
 
     /// The PBTF draw sequence as the backend computes it (the GPU order stage, or its CPU mirror).
@@ -187,6 +233,7 @@ impl Renderer {
                 Ok(Rendered {
                     image,
                     timings: vec![StageTime { stage: "raycast", ms: t.elapsed().as_secs_f64() * 1e3 }],
+                    raster: None,
                 })
             }
         }

@@ -7,11 +7,12 @@
 //! | footprint      | `footprint.vert/.frag`       | `cpu::footprint`        |
 //! | composite      | `composite.comp`             | `cpu::composite`        |
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, WORKGROUP_SIZE};
+use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, TILE_CHUNK, WORKGROUP_SIZE};
 use crate::cpu::{self, footprint::Blend, ImageF32};
 use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS};
 use crate::kernel::Kernel;
+use crate::raster::{Raster, RasterChoice};
 use crate::order::{self, Direction, OrderKind};
 use crate::volume::SplatSet;
 use glam::Vec3;
@@ -114,8 +115,12 @@ pub struct RenderOptions {
     /// footprints lying wholly over composite tiles whose remaining transmittance is at most this
     /// are skipped. No pixel changes by more than this much. 0 (the default) turns it off; back to
     /// front ignores it. It pays on opaque data (1.2-1.8x on `solid40`) and costs on translucent data,
-    /// where nothing is culled but batches are smaller (docs/RESULTS.md).
+    /// where nothing is culled but batches are smaller (docs/RESULTS.md). The compute tile
+    /// compositor (`Raster::Compute` with `Composite::Splat`) stops each pixel at this transmittance.
     pub early_termination: f32,
+    /// How the footprint stage rasterises (`crate::raster`); `Auto` picks per device and footprint
+    /// size, and `Rendered::raster` says what it picked.
+    pub raster: Raster,
 }
 
 impl Default for RenderOptions {
@@ -130,6 +135,7 @@ impl Default for RenderOptions {
             sheet_budget_bytes: 256 << 20,
             slab_thickness: 1.0,
             early_termination: 0.0,
+            raster: Raster::Auto,
         }
     }
 }
@@ -144,10 +150,14 @@ pub const EARLY_TERMINATION_BATCH: u32 = 8;
 pub const MAX_BATCH_LAYERS: u32 = 256;
 
 impl RenderOptions {
+    /// The visiting direction: as set, else back to front for per-splat compositing through the
+    /// graphics pipeline (the over operator needs no destination alpha) and front to back
+    /// otherwise (sheets, and the compute tile compositor, which can then stop early).
     pub fn direction(&self) -> Direction {
-        self.direction.unwrap_or(match self.composite {
-            Composite::Splat => Direction::BackToFront,
-            Composite::Sheet | Composite::Slab => Direction::FrontToBack,
+        self.direction.unwrap_or(match (self.composite, self.raster) {
+            (Composite::Splat, Raster::Compute) => Direction::FrontToBack,
+            (Composite::Splat, _) => Direction::BackToFront,
+            (Composite::Sheet | Composite::Slab, _) => Direction::FrontToBack,
         })
     }
 
@@ -198,6 +208,8 @@ pub struct StageTime {
 pub struct Rendered {
     pub image: ImageF32,
     pub timings: Vec<StageTime>,
+    /// The footprint stage's raster variant and why (`None` for the ray caster and the truth).
+    pub raster: Option<RasterChoice>,
 }
 
 /// A scene ready to draw: the splat rows plus, per axis, the splats grouped by slice and each
@@ -349,6 +361,18 @@ pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_la
     (axis, batches)
 }
 
+/// Push constants of the tile binning and compositing stages for a draw list of `n` entries.
+pub fn tile_push(opts: &RenderOptions, n: u32) -> FootprintPush {
+    let btf = opts.direction() == Direction::BackToFront;
+    FootprintPush {
+        count: n,
+        chunks: n.div_ceil(TILE_CHUNK).max(1),
+        back_to_front: btf as u32,
+        occluded: if btf { 0.0 } else { opts.early_termination },
+        ..Default::default()
+    }
+}
+
 /// Workgroup counts for `n` invocations of a 1D stage (spilling into y past `MAX_GROUPS_X`).
 pub fn groups_1d(n: u32) -> [u32; 3] {
     let g = n.div_ceil(WORKGROUP_SIZE).max(1);
@@ -392,6 +416,8 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
     let slice_table = opts.kernel.slice_table();
     let (w, h) = (camera.width, camera.height);
     let mut image = ImageF32::new(w, h);
+    let points = opts.raster == Raster::Points;
+    let compute = opts.raster == Raster::Compute;
     match opts.composite {
         Composite::Splat => {
             let inputs = cpu::footprint::FootprintInputs {
@@ -404,8 +430,16 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                 slice_table: &slice_table,
                 occlusion: &[],
             };
-            let blend = if btf { Blend::Over } else { Blend::Under };
-            cpu::footprint(&inputs, &FootprintPush::default(), blend, 0, n as u32, std::slice::from_mut(&mut image));
+            if compute {
+                let push = tile_push(opts, n as u32);
+                let (start, entries) = cpu::tile::tile_bins_cpu(&inputs, &push)?;
+                lap("tile_bins", &mut timings);
+                cpu::tile_composite(&inputs, &push, &start, &entries, &mut image);
+            } else {
+                let blend = if btf { Blend::Over } else { Blend::Under };
+                let push = FootprintPush::default();
+                cpu::footprint(&inputs, &push, blend, points, 0, n as u32, std::slice::from_mut(&mut image));
+            }
             lap("footprint", &mut timings);
         }
         Composite::Sheet | Composite::Slab => {
@@ -435,8 +469,16 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                     occlusion: &occlusion,
                 };
                 let t0 = Instant::now();
-                let mut layers = vec![ImageF32::new(w, h); b.layers as usize];
-                cpu::footprint(&inputs, &b.push, Blend::Add, b.first_instance, b.instances, &mut layers);
+                let layers = if compute {
+                    let mut sums = vec![0u32; b.layers as usize * w as usize * h as usize * 4];
+                    let push = FootprintPush { first: b.first_instance, count: b.instances, ..b.push };
+                    cpu::footprint_sum(&inputs, &push, &mut sums);
+                    (0..b.layers as usize).map(|l| cpu::footprint::fixed_layer(&sums, l, w, h)).collect()
+                } else {
+                    let mut layers = vec![ImageF32::new(w, h); b.layers as usize];
+                    cpu::footprint(&inputs, &b.push, Blend::Add, points, b.first_instance, b.instances, &mut layers);
+                    layers
+                };
                 let t1 = Instant::now();
                 let push = CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
                 cpu::composite(&push, &layers, &mut image, &mut occlusion);
@@ -447,5 +489,5 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
             timings.push(StageTime { stage: "composite", ms: comp_ms });
         }
     }
-    Ok(Rendered { image, timings })
+    Ok(Rendered { image, timings, raster: None })
 }

@@ -34,3 +34,15 @@ float sample_slice_table(sampler2D slices, float r, float z) {
     float bottom = c + (d - c) * w.x;
     return top + (bottom - top) * w.y;
 }
+
+// A footprint's weight at quad coordinates uv: the pre-integrated kernel across the motion segment
+// (stretch, radius units along u) or, for a slab, the kernel slice between its faces (radius units).
+// Mirror: the weight in src/cpu/footprint.rs (raster_quad).
+float footprint_weight(sampler2D table, sampler2D slices, bool slab, vec2 uv, float stretch, vec2 faces) {
+    float along = max(abs(uv.x) * (1.0 + stretch) - stretch, 0.0);
+    if (slab) {
+        float r = length(vec2(along, uv.y));
+        return sample_slice_table(slices, r, faces.y) - sample_slice_table(slices, r, faces.x);
+    }
+    return sample_table(table, vec2(along, uv.y));
+}

@@ -241,6 +241,11 @@ struct RenderArgs {
     /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25).
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     slab_thickness: f32,
+    /// How footprints become pixels: instanced quads (graphics), point sprites (points), compute
+    /// shaders (tile compositing / fixed-point sheet sums), or auto (compute for small footprints
+    /// on a CPU device, graphics otherwise; it prints what it picked).
+    #[arg(long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"])]
+    raster: String,
     /// Reconstruction kernel.
     #[arg(long, default_value = "gaussian", value_parser = ["gaussian", "cubic"])]
     kernel: String,
@@ -265,6 +270,10 @@ struct RenderArgs {
     /// Print per-stage times.
     #[arg(long)]
     timings: bool,
+    /// Render the frame this many times and report each stage's median (the first frames pay
+    /// one-off costs: allocation, shader compilation on some drivers).
+    #[arg(long, default_value_t = 1)]
+    repeat: u32,
     /// Output file, .png or .exr.
     #[arg(long)]
     out: PathBuf,
@@ -421,6 +430,17 @@ fn report_validation(r: &Renderer) -> Result<()> {
     Ok(())
 }
 
+/// The last frame with every stage's time replaced by its median over `frames`.
+fn median_timings(mut frames: Vec<voxsplat::Rendered>) -> voxsplat::Rendered {
+    let mut last = frames.pop().expect("at least one frame");
+    for t in &mut last.timings {
+        let mut v: Vec<f64> = frames.iter().flat_map(|f| f.timings.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
+        v.push(t.ms);
+        t.ms = voxsplat::bench::median(&mut v);
+    }
+    last
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Scenes => {
@@ -447,6 +467,7 @@ fn run(cli: Cli) -> Result<()> {
             opts.sheet_budget_bytes = a.sheet_budget_mib << 20;
             opts.slab_thickness = a.slab_thickness;
             opts.early_termination = a.early_termination;
+            opts.raster = a.raster.parse::<voxsplat::Raster>()?;
             let splats = set.len();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
             let frame = if a.truth {
@@ -457,7 +478,7 @@ fn run(cli: Cli) -> Result<()> {
                 };
                 let image = voxsplat::truth::volumetric_summation(&set, &cam, &opts)?;
                 let ms = t.elapsed().as_secs_f64() * 1e3;
-                voxsplat::Rendered { image, timings: vec![voxsplat::StageTime { stage: "truth", ms }] }
+                voxsplat::Rendered { image, timings: vec![voxsplat::StageTime { stage: "truth", ms }], raster: None }
             } else {
                 let mut r = renderer_of(&a.scene)?;
                 r.set_scene(set)?;
@@ -466,7 +487,13 @@ fn run(cli: Cli) -> Result<()> {
                         let o = voxsplat::cpu::raycast::RaycastOptions { step, ..Default::default() };
                         r.raycast(&cam, &o)?
                     }
-                    None => r.render(&cam, &opts)?,
+                    None => {
+                        let mut frames = Vec::new();
+                        for _ in 0..a.repeat.max(1) {
+                            frames.push(r.render(&cam, &opts)?);
+                        }
+                        median_timings(frames)
+                    }
                 };
                 report_validation(&r)?;
                 f
@@ -483,6 +510,9 @@ fn run(cli: Cli) -> Result<()> {
             }
             voxsplat::output::write_image(&image, &a.out)?;
             eprintln!("{} splats -> {}", splats, a.out.display());
+            if let Some(c) = &frame.raster {
+                eprintln!("raster: {} ({})", c.raster, c.reason);
+            }
             if a.timings {
                 for t in &frame.timings {
                     println!("{:<14} {:>9.3} ms", t.stage, t.ms);

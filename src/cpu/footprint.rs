@@ -1,10 +1,13 @@
-//! Mirror of `footprint.vert` + `footprint.frag` and the fixed-function blend: rasterise each
-//! splat's eye-facing quad by intersecting every covered pixel's ray with the quad's plane (what
-//! perspective-correct interpolation computes on the GPU), weight by the footprint table, blend.
+//! Mirrors of the footprint stage's raster variants. `footprint` mirrors `footprint.vert` +
+//! `footprint.frag` and the fixed-function blend: each splat's eye-facing quad is rasterised by
+//! intersecting every covered pixel's ray with the quad's plane (what perspective-correct
+//! interpolation computes on the GPU), or its point sprite by the point rule; weighted by the
+//! footprint table; blended. `footprint_sum` mirrors `footprint_sum.comp` (fixed-point sums through
+//! the projective map of `screen_quad`).
 use super::ImageF32;
-use crate::constants::FOOTPRINT_TABLE_SIZE;
+use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
 use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB};
-use glam::{DMat4, DVec3, DVec4, Mat4, Vec4};
+use glam::{DMat4, DVec3, DVec4, IVec4, Mat3, Mat4, Vec2, Vec3, Vec4};
 
 /// How a fragment combines with the attachment (premultiplied colour).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,50 +59,146 @@ pub struct FootprintInputs<'a> {
     pub occlusion: &'a [f32],
 }
 
-/// Draw `instances` quads starting at `first_instance` of the draw list into `layers`.
+/// Mirror of `entry_splat` + `entry_layer` in `glsl/shared/footprint.glsl`: draw-list entry `e`'s
+/// splat, its summation layer within the batch and how it is weighed; `None` when it is culled.
+fn entry<'a>(inputs: &FootprintInputs<'a>, push: &FootprintPush, e: u32) -> Option<(usize, usize, Weight<'a>)> {
+    let slab_mode = push.sheet_mode == SHEET_MODE_SLAB;
+    let splat = if slab_mode { inputs.draw_list[2 * e as usize] } else { inputs.draw_list[e as usize] } as usize;
+    let p = &inputs.params[splat];
+    if p.center[3] == 0.0 || (push.occluded > 0.0 && occluded(inputs, p, push.occluded)) {
+        return None;
+    }
+    let mut weight = Weight::Footprint(inputs.table);
+    let layer = if slab_mode {
+        let slab = inputs.draw_list[2 * e as usize + 1];
+        let radius = Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length();
+        let near_face = push.slab_z0 + slab as f32 * push.slab_dz - p.screen[0];
+        let faces = [near_face / radius, (near_face + push.slab_dz) / radius];
+        weight = Weight::Slice(inputs.slice_table, faces);
+        if push.rank_dir > 0 {
+            slab.wrapping_sub(push.rank_base)
+        } else {
+            push.rank_base.wrapping_sub(slab)
+        }
+    } else if push.sheet_mode == SHEET_MODE_AXIS {
+        let rank = inputs.sheet_rank[(push.rank_offset + inputs.splats[splat].ijk[push.axis as usize]) as usize];
+        if push.rank_dir > 0 {
+            rank.wrapping_sub(push.rank_base)
+        } else {
+            push.rank_base.wrapping_sub(rank)
+        }
+    } else {
+        0
+    } as usize;
+    Some((splat, layer, weight))
+}
+
+/// Draw `instances` draw-list entries starting at `first_instance` into `layers`, as instanced
+/// quads or, with `points`, as point sprites.
 pub fn footprint(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
     blend: Blend,
+    points: bool,
     first_instance: u32,
     instances: u32,
     layers: &mut [ImageF32],
 ) {
     let vp = Mat4::from_cols_array_2d(&inputs.frame.view_proj);
     let inv = vp.as_dmat4().inverse();
-    for inst in first_instance..first_instance + instances {
-        let slab_mode = push.sheet_mode == SHEET_MODE_SLAB;
-        let splat =
-            if slab_mode { inputs.draw_list[2 * inst as usize] } else { inputs.draw_list[inst as usize] } as usize;
-        let p = &inputs.params[splat];
-        if p.center[3] == 0.0 || (push.occluded > 0.0 && occluded(inputs, p, push.occluded)) {
-            continue;
-        }
-        let mut weight = Weight::Footprint(inputs.table);
-        let layer = if slab_mode {
-            let slab = inputs.draw_list[2 * inst as usize + 1];
-            let radius = glam::Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length();
-            let near_face = push.slab_z0 + slab as f32 * push.slab_dz - p.screen[0];
-            let faces = [near_face / radius, (near_face + push.slab_dz) / radius];
-            weight = Weight::Slice(inputs.slice_table, faces);
-            if push.rank_dir > 0 {
-                slab.wrapping_sub(push.rank_base)
-            } else {
-                push.rank_base.wrapping_sub(slab)
-            }
-        } else if push.sheet_mode == SHEET_MODE_AXIS {
-            let rank = inputs.sheet_rank[(push.rank_offset + inputs.splats[splat].ijk[push.axis as usize]) as usize];
-            if push.rank_dir > 0 {
-                rank.wrapping_sub(push.rank_base)
-            } else {
-                push.rank_base.wrapping_sub(rank)
-            }
-        } else {
-            0
-        } as usize;
+    for e in first_instance..first_instance + instances {
+        let Some((splat, layer, weight)) = entry(inputs, push, e) else { continue };
         let Some(target) = layers.get_mut(layer) else { continue };
-        raster_quad(p, push.sheet_mode != 0, blend, vp, &inv, weight, target);
+        let p = &inputs.params[splat];
+        if points {
+            raster_point(p, push.sheet_mode != 0, blend, vp, weight, target);
+        } else {
+            raster_quad(p, push.sheet_mode != 0, blend, vp, &inv, weight, target);
+        }
     }
+}
+
+/// Mirror of `screen_quad` in `glsl/shared/footprint.glsl`: the inverse projective map from pixel
+/// centres to quad coordinates and the inclusive pixel box; `None` when culled, behind the eye or
+/// off screen.
+pub fn screen_quad(frame: &Frame, p: &SplatParams) -> Option<(Mat3, IVec4)> {
+    if p.center[3] == 0.0 {
+        return None;
+    }
+    let vp = Mat4::from_cols_array_2d(&frame.view_proj);
+    let size = Vec2::new(frame.blur[2], frame.blur[3]);
+    let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+    let c0 = vp * v3(p.center).extend(1.0);
+    let cu = vp * v3(p.axis_u).extend(0.0);
+    let cv = vp * v3(p.axis_v).extend(0.0);
+    let m = |c: Vec4| Vec3::new((c.x + c.w) * 0.5 * size.x, (c.y + c.w) * 0.5 * size.y, c.w);
+    let (m0, mu, mv) = (m(c0), m(cu), m(cv));
+    let (mut lo, mut hi) = (Vec2::splat(1e30), Vec2::splat(-1e30));
+    for (cx, cy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+        let q = m0 + cx * mu + cy * mv;
+        if q.z <= 0.0 {
+            return None;
+        }
+        let s = Vec2::new(q.x, q.y) / q.z;
+        lo = lo.min(s);
+        hi = hi.max(s);
+    }
+    let a = (lo - 0.5).ceil().max(Vec2::ZERO);
+    let b = (hi - 0.5).floor().min(size - 1.0);
+    let bx = IVec4::new(a.x as i32, a.y as i32, b.x as i32, b.y as i32);
+    if bx.x > bx.z || bx.y > bx.w {
+        return None;
+    }
+    Some((Mat3::from_cols(mu, mv, m0).inverse(), bx))
+}
+
+/// Mirror of `quad_uv`: quad coordinates of pixel (x, y).
+pub fn quad_uv(inv: &Mat3, x: i32, y: i32) -> Vec2 {
+    let q = *inv * Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 1.0);
+    Vec2::new(q.x, q.y) / q.z
+}
+
+/// Mirror of `fixed_point` in `footprint_sum.comp`.
+fn fixed_point(v: f32) -> u32 {
+    (v.min(64.0) * SUM_FIXED_SCALE as f32 + 0.5) as u32
+}
+
+/// Mirror of `footprint_sum.comp`: add `push.count` entries from `push.first` to the fixed-point
+/// layers `sums` (layer-major rows of width x 4 channels), wrapping as the GPU's u32 atomics do.
+pub fn footprint_sum(inputs: &FootprintInputs<'_>, push: &FootprintPush, sums: &mut [u32]) {
+    let (width, height) = (inputs.frame.blur[2] as usize, inputs.frame.blur[3] as usize);
+    for e in push.first..push.first + push.count {
+        let Some((splat, layer, weight)) = entry(inputs, push, e) else { continue };
+        let p = &inputs.params[splat];
+        let Some((inv, bx)) = screen_quad(inputs.frame, p) else { continue };
+        let energy = p.emit[3] * p.axis_u[3];
+        for y in bx.y..=bx.w {
+            for x in bx.x..=bx.z {
+                let uv = quad_uv(&inv, x, y);
+                if uv.x.abs() > 1.0 || uv.y.abs() > 1.0 {
+                    continue;
+                }
+                let tau = energy * weight.at(uv.x, uv.y, p.axis_v[3]);
+                if tau <= 0.0 {
+                    continue;
+                }
+                let idx = 4 * ((layer * height + y as usize) * width + x as usize);
+                let Some(px) = sums.get_mut(idx..idx + 4) else { continue };
+                for (c, v) in px.iter_mut().zip([p.emit[0] * tau, p.emit[1] * tau, p.emit[2] * tau, tau]) {
+                    *c = c.wrapping_add(fixed_point(v));
+                }
+            }
+        }
+    }
+}
+
+/// Mirror of the fixed-point read in `composite.comp` (SUMS_FIXED): one layer as floats.
+pub fn fixed_layer(sums: &[u32], layer: usize, width: u32, height: u32) -> ImageF32 {
+    let n = width as usize * height as usize;
+    let s = SUM_FIXED_SCALE as f32;
+    let pixels =
+        sums[4 * layer * n..4 * (layer + 1) * n].chunks_exact(4).map(|c| [0, 1, 2, 3].map(|i| c[i] as f32 / s)).collect();
+    ImageF32 { width, height, pixels }
 }
 
 /// Mirror of `occluded` in `footprint.vert`: the quad lies wholly over tiles with at most
@@ -144,6 +243,77 @@ enum Weight<'a> {
     Slice(&'a [f32], [f32; 2]),
 }
 
+impl Weight<'_> {
+    /// Mirror of `footprint_weight` in `glsl/shared/footprint_table.glsl`.
+    fn at(self, u: f32, v: f32, stretch: f32) -> f32 {
+        let along = (u.abs() * (1.0 + stretch) - stretch).max(0.0);
+        match self {
+            Weight::Footprint(table) => sample_table(table, along, v),
+            Weight::Slice(table, [za, zb]) => {
+                let r = (along * along + v * v).sqrt();
+                sample_slice_table(table, r, zb) - sample_slice_table(table, r, za)
+            }
+        }
+    }
+}
+
+/// The whole footprint's weight at quad coordinates (u, v) with a motion stretch (the tile
+/// compositor's case).
+pub fn footprint_weight(table: &[f32], uv: Vec2, stretch: f32) -> f32 {
+    Weight::Footprint(table).at(uv.x, uv.y, stretch)
+}
+
+/// The fragment shader's output at quad coordinates (u, v), blended into `dst`.
+fn shade(p: &SplatParams, sheet: bool, blend: Blend, weight: Weight<'_>, u: f32, v: f32, dst: &mut [f32; 4]) {
+    let tau = p.emit[3] * p.axis_u[3] * weight.at(u, v, p.axis_v[3]);
+    if tau <= 0.0 {
+        return;
+    }
+    let src = if sheet {
+        [p.emit[0] * tau, p.emit[1] * tau, p.emit[2] * tau, tau]
+    } else {
+        let a = 1.0 - (-tau).exp();
+        [p.emit[0] * a, p.emit[1] * a, p.emit[2] * a, a]
+    };
+    match blend {
+        Blend::Over => {
+            let k = 1.0 - src[3];
+            *dst = [0, 1, 2, 3].map(|i| src[i] + k * dst[i]);
+        }
+        Blend::Under => {
+            let k = 1.0 - dst[3];
+            *dst = [0, 1, 2, 3].map(|i| k * src[i] + dst[i]);
+        }
+        Blend::Add => *dst = [0, 1, 2, 3].map(|i| src[i] + dst[i]),
+    }
+}
+
+/// A point sprite `2 * screen radius` pixels wide centred on the projected centre: the pixels whose
+/// centres fall inside it, with gl_PointCoord mapped to [-1, 1]².
+fn raster_point(p: &SplatParams, sheet: bool, blend: Blend, vp: Mat4, weight: Weight<'_>, target: &mut ImageF32) {
+    let clip = vp * Vec4::new(p.center[0], p.center[1], p.center[2], 1.0);
+    if clip.w <= 0.0 {
+        return;
+    }
+    let (w, h) = (target.width as f32, target.height as f32);
+    let (sx, sy) = ((clip.x / clip.w * 0.5 + 0.5) * w, (clip.y / clip.w * 0.5 + 0.5) * h);
+    let half = p.screen[2];
+    if half <= 0.0 {
+        return;
+    }
+    let x0 = (sx - half - 0.5).ceil().max(0.0) as i64;
+    let x1 = (sx + half - 0.5).floor().min(w - 1.0) as i64;
+    let y0 = (sy - half - 0.5).ceil().max(0.0) as i64;
+    let y1 = (sy + half - 0.5).floor().min(h - 1.0) as i64;
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let (u, v) = ((x as f32 + 0.5 - sx) / half, (y as f32 + 0.5 - sy) / half);
+            let dst = &mut target.pixels[(y as u32 * target.width + x as u32) as usize];
+            shade(p, sheet, blend, weight, u, v, dst);
+        }
+    }
+}
+
 fn raster_quad(
     p: &SplatParams,
     sheet: bool,
@@ -175,7 +345,6 @@ fn raster_quad(
     let y1 = (maxy - 0.5).floor().min(h - 1.0) as i64;
     let n = au.cross(av);
     let (uu, vv) = (au.length_squared(), av.length_squared());
-    let energy = p.axis_u[3];
     for y in y0..=y1 {
         for x in x0..=x1 {
             let ndc = DVec4::new((x as f64 + 0.5) / w * 2.0 - 1.0, (y as f64 + 0.5) / h * 2.0 - 1.0, 0.0, 1.0);
@@ -193,37 +362,8 @@ fn raster_quad(
             if u.abs() > 1.0 || v.abs() > 1.0 {
                 continue;
             }
-            let stretch = p.axis_v[3];
-            let along = ((u.abs() as f32) * (1.0 + stretch) - stretch).max(0.0);
-            let w = match weight {
-                Weight::Footprint(table) => sample_table(table, along, v as f32),
-                Weight::Slice(table, [za, zb]) => {
-                    let r = (along * along + (v * v) as f32).sqrt();
-                    sample_slice_table(table, r, zb) - sample_slice_table(table, r, za)
-                }
-            };
-            let tau = p.emit[3] * energy * w;
-            if tau <= 0.0 {
-                continue;
-            }
-            let src = if sheet {
-                [p.emit[0] * tau, p.emit[1] * tau, p.emit[2] * tau, tau]
-            } else {
-                let a = 1.0 - (-tau).exp();
-                [p.emit[0] * a, p.emit[1] * a, p.emit[2] * a, a]
-            };
             let dst = &mut target.pixels[(y as u32 * target.width + x as u32) as usize];
-            match blend {
-                Blend::Over => {
-                    let k = 1.0 - src[3];
-                    *dst = [0, 1, 2, 3].map(|i| src[i] + k * dst[i]);
-                }
-                Blend::Under => {
-                    let k = 1.0 - dst[3];
-                    *dst = [0, 1, 2, 3].map(|i| k * src[i] + dst[i]);
-                }
-                Blend::Add => *dst = [0, 1, 2, 3].map(|i| src[i] + dst[i]),
-            }
+            shade(p, sheet, blend, weight, u as f32, v as f32, dst);
         }
     }
 }

@@ -161,7 +161,12 @@ impl Context {
         let queues =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true);
-        let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queues).push_next(&mut f12);
+        // Point sprites wider than one pixel (`--raster points`) when the device has them.
+        // SAFETY: plain query on a valid physical device.
+        let supported = unsafe { instance.get_physical_device_features(physical) };
+        let core = vk::PhysicalDeviceFeatures::default().large_points(supported.large_points == vk::TRUE);
+        let device_info =
+            vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut f12);
         // SAFETY: `physical` came from this instance; features were checked in pick_device.
         let device = match unsafe { instance.create_device(physical, &device_info, None) } {
             Ok(d) => d,
@@ -339,6 +344,23 @@ impl Context {
             l.max_image_dimension2_d.min(l.max_framebuffer_width).min(l.max_framebuffer_height),
             l.max_image_array_layers.min(l.max_framebuffer_layers),
         )
+    }
+
+    /// Widest point sprite the device draws, in pixels (1 without the `largePoints` feature, which
+    /// a host-created device may not have enabled: then points wider than one pixel are refused).
+    pub fn point_size_max(&self) -> f32 {
+        // SAFETY: plain queries on a valid physical device.
+        let (features, props) = unsafe {
+            (
+                self.instance.get_physical_device_features(self.physical),
+                self.instance.get_physical_device_properties(self.physical),
+            )
+        };
+        if self.owned && features.large_points == vk::TRUE {
+            props.limits.point_size_range[1]
+        } else {
+            1.0
+        }
     }
 
     /// True for a CPU implementation such as lavapipe.

@@ -12,6 +12,6 @@ pub use ash::vk::{BufferUsageFlags, Format, ImageLayout, ImageUsageFlags, Shader
 pub use buffer::{Buffer, Memory};
 pub use context::{Context, ContextOptions, HostHandles};
 pub use image::{Image, Sampler};
-pub use pipeline::{Bind, Blend, DescriptorSet, Framebuffer, Layout, Pipeline, RenderPass, Slot};
+pub use pipeline::{Bind, Blend, DescriptorSet, Framebuffer, Layout, Pipeline, Primitive, RenderPass, Slot};
 pub use submit::{Recorder, Stage};
 pub use timer::Timer;

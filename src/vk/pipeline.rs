@@ -174,6 +174,19 @@ impl Drop for DescriptorSet {
     }
 }
 
+/// What a graphics pipeline draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Primitive {
+    /// Instanced 4-vertex triangle strips.
+    Quads,
+    /// One point sprite per vertex.
+    Points,
+}
+
+fn spec_entries(specialization: &[u32]) -> Vec<vk::SpecializationMapEntry> {
+    (0..specialization.len() as u32).map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 }).collect()
+}
+
 fn shader_module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
     let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
         .map_err(|e| Error::Unsupported(format!("bad SPIR-V: {e}")))?;
@@ -190,11 +203,19 @@ pub struct Pipeline {
 
 impl Pipeline {
     pub fn compute(ctx: &Arc<Context>, layout: &Layout, spirv: &[u8]) -> Result<Self> {
+        Self::compute_specialized(ctx, layout, spirv, &[])
+    }
+
+    /// A compute pipeline with `specialization[i]` as `constant_id = i` (see [`Pipeline::graphics`]).
+    pub fn compute_specialized(ctx: &Arc<Context>, layout: &Layout, spirv: &[u8], specialization: &[u32]) -> Result<Self> {
         let module = shader_module(ctx, spirv)?;
+        let entries = spec_entries(specialization);
+        let spec = vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(specialization));
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
-            .name(c"main");
+            .name(c"main")
+            .specialization_info(&spec);
         let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline_layout);
         // SAFETY: valid module and layout.
         let result = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
@@ -204,9 +225,11 @@ impl Pipeline {
         Ok(Self { ctx: ctx.clone(), raw, bind_point: vk::PipelineBindPoint::COMPUTE })
     }
 
-    /// Instanced triangle-strip quads (4 vertices, no vertex buffers) with the given blend.
-    /// `specialization[i]` sets `constant_id = i` in both stages: a mode fixed per pipeline costs
-    /// nothing at run time, where a branch on a push constant makes llvmpipe pay for both sides.
+    /// Instanced triangle-strip quads (4 vertices per instance) or a point list (one vertex per
+    /// point), no vertex buffers, with the given blend. `specialization[i]` sets `constant_id = i`
+    /// in both stages: a mode fixed per pipeline costs nothing at run time, where a branch on a push
+    /// constant makes llvmpipe pay for both sides.
+    #[allow(clippy::too_many_arguments)]
     pub fn graphics(
         ctx: &Arc<Context>,
         layout: &Layout,
@@ -214,6 +237,7 @@ impl Pipeline {
         vert: &[u8],
         frag: &[u8],
         blend: Blend,
+        primitive: Primitive,
         specialization: &[u32],
     ) -> Result<Self> {
         let vm = shader_module(ctx, vert)?;
@@ -225,9 +249,7 @@ impl Pipeline {
                 return Err(e);
             }
         };
-        let entries: Vec<vk::SpecializationMapEntry> = (0..specialization.len() as u32)
-            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
-            .collect();
+        let entries = spec_entries(specialization);
         let data: &[u8] = bytemuck::cast_slice(specialization);
         let spec = vk::SpecializationInfo::default().map_entries(&entries).data(data);
         let stages = [
@@ -244,7 +266,10 @@ impl Pipeline {
         ];
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
         let assembly =
-            vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_STRIP);
+            vk::PipelineInputAssemblyStateCreateInfo::default().topology(match primitive {
+                Primitive::Quads => vk::PrimitiveTopology::TRIANGLE_STRIP,
+                Primitive::Points => vk::PrimitiveTopology::POINT_LIST,
+            });
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)

@@ -187,6 +187,21 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_draw(self.cmd, 4, instances, 0, first_instance) };
     }
 
+    /// A point list: vertex `first + i` for i < `count` (the vertex index picks the draw-list entry).
+    pub fn draw_points(
+        &self,
+        pipeline: &Pipeline,
+        layout: &Layout,
+        set: &DescriptorSet,
+        push: &[u8],
+        first: u32,
+        count: u32,
+    ) {
+        self.bind(pipeline, layout, set, push);
+        // SAFETY: inside a render pass with a graphics pipeline bound.
+        unsafe { self.ctx.device.cmd_draw(self.cmd, count, 1, first, 0) };
+    }
+
     pub fn end_pass(&self) {
         // SAFETY: matches begin_pass.
         unsafe { self.ctx.device.cmd_end_render_pass(self.cmd) };

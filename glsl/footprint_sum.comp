@@ -1,0 +1,50 @@
+#version 450
+// Footprint stage in compute, sheet modes: one invocation per draw-list entry of the batch walks
+// its quad's pixel box, evaluates the footprint where the perspective-correct quad coordinates
+// fall inside the quad (the pixels the rasteriser would shade) and adds (rgb * tau, tau) to its
+// summation layer with fixed-point atomics: order-independent, so the sums are bit-identical run to
+// run (float atomics would round differently with every interleaving). composite.comp reads the
+// fixed-point layers directly (its SUMS_FIXED variant). Mirror: cpu::footprint_sum.
+#define FOOTPRINT_COMPUTE
+#include "footprint.glsl"
+
+layout(local_size_x = WORKGROUP_SIZE) in;
+#include "linear.glsl"
+layout(std430, binding = 8) buffer Sums { uint sums[]; };
+
+// One contribution in fixed point; clamped so no single add can wrap a pixel's sum.
+uint fixed_point(float v) {
+    return uint(min(v, 64.0) * float(SUM_FIXED_SCALE) + 0.5);
+}
+
+void main() {
+    uint i = linear_invocation();
+    if (i >= pc.count) return;
+    uint e = pc.first + i;
+    uint splat = entry_splat(e);
+    SplatParams p = params[splat];
+    if (p.center.w == 0.0 || (pc.occluded > 0.0 && occluded(p))) return;
+    vec2 faces;
+    int layer = entry_layer(e, splat, p, faces);
+    mat3 inv;
+    ivec4 box;
+    if (layer < 0 || !screen_quad(p, inv, box)) return;
+    uint width = uint(frame.blur.z);
+    uint base = uint(layer) * width * uint(frame.blur.w);
+    float energy = p.emit.a * p.axis_u.w;
+    bool slab = SHEET_MODE == SHEET_MODE_SLAB;
+    for (int y = box.y; y <= box.w; ++y) {
+        for (int x = box.x; x <= box.z; ++x) {
+            vec2 uv = quad_uv(inv, ivec2(x, y));
+            if (abs(uv.x) > 1.0 || abs(uv.y) > 1.0) continue;
+            float tau = energy * footprint_weight(table, slices, slab, uv, p.axis_v.w, faces);
+            if (tau <= 0.0) continue;
+            uint idx = 4u * (base + uint(y) * width + uint(x));
+            if (idx + 3u >= uint(sums.length())) continue;
+            atomicAdd(sums[idx], fixed_point(p.emit.r * tau));
+            atomicAdd(sums[idx + 1u], fixed_point(p.emit.g * tau));
+            atomicAdd(sums[idx + 2u], fixed_point(p.emit.b * tau));
+            atomicAdd(sums[idx + 3u], fixed_point(tau));
+        }
+    }
+}

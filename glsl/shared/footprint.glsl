@@ -1,0 +1,123 @@
+// The footprint stage's bindings, push constants and per-entry helpers, shared by its raster
+// variants: footprint.vert (quads and point sprites), footprint_sum.comp (compute sheet summation)
+// and tile_{count,scan,scatter,composite}.comp (compute per-splat compositing in screen tiles).
+// Mirrors: src/cpu/footprint.rs, src/cpu/tile.rs.
+#include "types.glsl"
+#include "footprint_table.glsl"
+
+layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
+layout(std430, binding = 1) readonly buffer Params { SplatParams params[]; };
+layout(std430, binding = 2) readonly buffer DrawList { uint draw_list[]; };
+layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };
+layout(std430, binding = 4) readonly buffer SheetRank { uint sheet_rank[]; };
+layout(binding = 5) uniform sampler2D table;
+layout(binding = 6) uniform sampler2D slices;
+layout(std430, binding = 7) readonly buffer Occlusion { float occlusion[]; };
+
+// The mode is fixed per pipeline (a branch on the push constant made llvmpipe pay for both sides);
+// the push constant's sheet_mode carries the same value for the CPU mirror.
+layout(constant_id = 0) const uint SHEET_MODE = SHEET_MODE_SPLAT;
+
+layout(push_constant) uniform Push {
+    uint sheet_mode;   // SHEET_MODE_*
+    uint axis;         // sheet axis
+    uint rank_offset;  // start of this axis in sheet_rank
+    uint rank_base;    // rank of the batch's first sheet (slab mode: its first slab)
+    int rank_dir;      // +1 or -1: direction of the batch in rank space
+    float slab_z0;     // slab mode: eye-space depth of slab 0's near face
+    float slab_dz;     // slab mode: slab thickness (world units)
+    float occluded;    // early termination: skip a splat whose every tile has at most this
+                       // transmittance left; the tile compositor stops a pixel there (0: off)
+    uint first;        // compute raster: the batch's first draw-list entry
+    uint count;        // compute raster: entries in the batch (tile binning: in the list)
+    uint chunks;       // tile binning: entry chunks of TILE_CHUNK
+    uint back_to_front;// tile compositing: 1 = the list runs back to front
+} pc;
+
+const vec2 CORNERS[4] = vec2[](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
+// Most tiles a footprint may span and still be tested (larger ones are always drawn).
+const int MAX_OCCLUSION_TILES = 16;
+
+// Whether the footprint quad lies wholly over composite tiles whose transmittance is at most
+// pc.occluded. Mirror: cpu::footprint::occluded.
+bool occluded(SplatParams p) {
+    vec2 size = frame.blur.zw;
+    vec2 lo = vec2(1e30), hi = vec2(-1e30);
+    for (int k = 0; k < 4; ++k) {
+        vec3 q = p.center.xyz + CORNERS[k].x * p.axis_u.xyz + CORNERS[k].y * p.axis_v.xyz;
+        vec4 c = frame.view_proj * vec4(q, 1.0);
+        if (c.w <= 0.0) return false;
+        vec2 s = (c.xy / c.w * 0.5 + 0.5) * size;
+        lo = min(lo, s);
+        hi = max(hi, s);
+    }
+    ivec2 tiles = ivec2(ceil(size / float(COMPOSITE_TILE)));
+    ivec2 t0 = ivec2(floor(clamp(lo, vec2(0.0), size - 1.0) / float(COMPOSITE_TILE)));
+    ivec2 t1 = ivec2(floor(clamp(hi, vec2(0.0), size - 1.0) / float(COMPOSITE_TILE)));
+    if ((t1.x - t0.x + 1) * (t1.y - t0.y + 1) > MAX_OCCLUSION_TILES) return false;
+    for (int y = t0.y; y <= t1.y; ++y) {
+        for (int x = t0.x; x <= t1.x; ++x) {
+            if (occlusion[y * tiles.x + x] > pc.occluded) return false;
+        }
+    }
+    return true;
+}
+
+// The splat of draw-list entry e (slab mode: the list holds (splat, slab) pairs).
+uint entry_splat(uint e) {
+    return SHEET_MODE == SHEET_MODE_SLAB ? draw_list[2u * e] : draw_list[e];
+}
+
+// The summation layer of entry e within its batch and, in slab mode, the slab's faces relative to
+// the splat's centre (radius units).
+int entry_layer(uint e, uint splat, SplatParams p, out vec2 faces) {
+    faces = vec2(0.0);
+    if (SHEET_MODE == SHEET_MODE_SLAB) {
+        uint slab = draw_list[2u * e + 1u];
+        float radius = length(p.axis_v.xyz);
+        float near_face = pc.slab_z0 + float(slab) * pc.slab_dz - p.screen.x;
+        faces = vec2(near_face, near_face + pc.slab_dz) / radius;
+        return pc.rank_dir > 0 ? int(slab - pc.rank_base) : int(pc.rank_base - slab);
+    } else if (SHEET_MODE == SHEET_MODE_AXIS) {
+        uint rank = sheet_rank[pc.rank_offset + splats[splat].ijk[pc.axis]];
+        return pc.rank_dir > 0 ? int(rank - pc.rank_base) : int(pc.rank_base - rank);
+    }
+    return 0;
+}
+
+// The footprint quad in pixels: `inv` maps a pixel centre (x, y, 1) to homogeneous quad
+// coordinates (u, v, 1) — the projective map that perspective-correct interpolation evaluates —
+// and `box` is the inclusive pixel range (x0, y0, x1, y1) of the quad's bounding box, clipped to
+// the image. False when the splat is culled, a corner lies behind the eye or the box is empty.
+// Mirror: cpu::footprint::screen_quad.
+bool screen_quad(SplatParams p, out mat3 inv, out ivec4 box) {
+    inv = mat3(1.0);
+    box = ivec4(0, 0, -1, -1);
+    if (p.center.w == 0.0) return false;
+    vec2 size = frame.blur.zw;
+    vec4 c0 = frame.view_proj * vec4(p.center.xyz, 1.0);
+    vec4 cu = frame.view_proj * vec4(p.axis_u.xyz, 0.0);
+    vec4 cv = frame.view_proj * vec4(p.axis_v.xyz, 0.0);
+    // Pixel = (X / W, Y / W) with X = (x + w) / 2 * width, Y = (y + w) / 2 * height.
+    vec3 m0 = vec3((c0.xy + c0.w) * 0.5 * size, c0.w);
+    vec3 mu = vec3((cu.xy + cu.w) * 0.5 * size, cu.w);
+    vec3 mv = vec3((cv.xy + cv.w) * 0.5 * size, cv.w);
+    vec2 lo = vec2(1e30), hi = vec2(-1e30);
+    for (int k = 0; k < 4; ++k) {
+        vec3 q = m0 + CORNERS[k].x * mu + CORNERS[k].y * mv;
+        if (q.z <= 0.0) return false;
+        vec2 s = q.xy / q.z;
+        lo = min(lo, s);
+        hi = max(hi, s);
+    }
+    box = ivec4(max(ceil(lo - 0.5), vec2(0.0)), min(floor(hi - 0.5), size - 1.0));
+    if (box.x > box.z || box.y > box.w) return false;
+    inv = inverse(mat3(mu, mv, m0));
+    return true;
+}
+
+// Quad coordinates of pixel (x, y) under `inv`.
+vec2 quad_uv(mat3 inv, ivec2 px) {
+    vec3 q = inv * vec3(vec2(px) + 0.5, 1.0);
+    return q.xy / q.z;
+}

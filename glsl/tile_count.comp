@@ -1,0 +1,25 @@
+#version 450
+// Compute per-splat compositing, binning pass 1 of 3: each invocation owns a chunk of TILE_CHUNK
+// draw-list entries and counts, serially and without atomics, how many of them each screen tile
+// receives (its column of the tile x chunk count matrix). Mirror: cpu::tile::tile_count.
+#define FOOTPRINT_COMPUTE
+#include "footprint.glsl"
+#include "tiles.glsl"
+
+layout(local_size_x = TILE_BIN_WORKGROUP) in;
+layout(std430, binding = 9) buffer Counts { uint counts[]; };
+
+void main() {
+    uint chunk = gl_GlobalInvocationID.x;
+    if (chunk >= pc.chunks) return;
+    uvec2 grid = tile_grid();
+    for (uint t = 0u; t < grid.x * grid.y; ++t) counts[t * pc.chunks + chunk] = 0u;
+    uvec2 range = chunk_entries(chunk);
+    for (uint e = range.x; e < range.y; ++e) {
+        uvec4 r;
+        if (!tile_range(params[draw_list[e]], r)) continue;
+        for (uint ty = r.y; ty <= r.w; ++ty) {
+            for (uint tx = r.x; tx <= r.z; ++tx) counts[(ty * grid.x + tx) * pc.chunks + chunk] += 1u;
+        }
+    }
+}

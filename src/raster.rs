@@ -1,0 +1,183 @@
+//! How the footprint stage turns splats into pixels, and the `auto` rule that picks one.
+//!
+//! | variant    | per-splat compositing (`Composite::Splat`)      | sheet modes (`Sheet`, `Slab`)          |
+//! |------------|-------------------------------------------------|----------------------------------------|
+//! | `graphics` | instanced eye-facing quads, over/under blending | quads, additive blending into layers   |
+//! | `points`   | one point sprite per splat (circular footprint) | point sprites, additive                |
+//! | `compute`  | tile binning + per-tile compositing (`tile_*`)  | fixed-point atomic sums (`footprint_sum`) |
+//!
+//! The graphics pass is the design and what a hardware rasteriser is built for. A CPU device
+//! (lavapipe) pays per primitive, not per pixel (../shared/peers/README.md), so there small
+//! footprints are cheaper in compute. Point sprites draw a screen-aligned square of the footprint's
+//! radius at its centre: exact in orthographic views, an approximation for perspective splats
+//! (docs/RESULTS.md measures it), and they cannot stretch along a motion path.
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::pipeline::{Composite, RenderOptions};
+use crate::volume::SplatSet;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Raster {
+    /// Instanced quads through the graphics pipeline.
+    Graphics,
+    /// Point sprites through the graphics pipeline (no motion blur).
+    Points,
+    /// Compute shaders: tile binning (per-splat) or fixed-point sums (sheets).
+    Compute,
+    /// Pick per device and footprint size (`choose`).
+    #[default]
+    Auto,
+}
+
+impl Raster {
+    pub fn name(self) -> &'static str {
+        match self {
+            Raster::Graphics => "graphics",
+            Raster::Points => "points",
+            Raster::Compute => "compute",
+            Raster::Auto => "auto",
+        }
+    }
+}
+
+impl std::str::FromStr for Raster {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "graphics" => Ok(Self::Graphics),
+            "points" => Ok(Self::Points),
+            "compute" => Ok(Self::Compute),
+            "auto" => Ok(Self::Auto),
+            _ => Err(Error::InvalidArgument(format!("unknown raster '{s}' (graphics, points, compute, auto)"))),
+        }
+    }
+}
+
+impl std::fmt::Display for Raster {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The variant a frame was drawn with and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RasterChoice {
+    pub raster: Raster,
+    pub reason: String,
+}
+
+/// What the device offers the choice.
+#[derive(Clone, Copy, Debug)]
+pub struct Device {
+    /// A CPU implementation (lavapipe) or the CPU mirrors: primitive-bound rasteriser.
+    pub cpu: bool,
+    /// Widest point sprite in pixels.
+    pub point_size_max: f32,
+}
+
+/// Footprint diameters in pixels, estimated from the grid's bounds (O(1), no pass over splats).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FootprintSize {
+    /// At the depth of the grid's centre.
+    pub typical_px: f32,
+    /// At the nearest grid corner's depth (the largest footprint).
+    pub max_px: f32,
+}
+
+/// Footprint diameter estimate for `set` seen from `camera` with `opts` (anti-aliasing widens far
+/// splats, which only matters for the typical size).
+pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> FootprintSize {
+    let frame = crate::pipeline::frame_for(set, camera, opts);
+    let g = set.grid();
+    let eye = camera.eye;
+    let forward = camera.forward();
+    let (mut near, mut sum) = (f32::INFINITY, 0.0);
+    for c in 0..8u32 {
+        let ijk = [0, 1, 2].map(|a| if c >> a & 1 == 1 { g.dims[a].saturating_sub(1) } else { 0 });
+        let d = (g.position(ijk) - eye).dot(forward);
+        near = near.min(d);
+        sum += d;
+    }
+    let centre = sum / 8.0;
+    let diameter = |depth: f32| {
+        let depth = depth.max(camera.near);
+        let scale = crate::cpu::splat_params::footprint_scale(&frame, depth);
+        let radius = frame.spacing[3] * scale;
+        let ppu = frame.up[3];
+        2.0 * if camera.is_perspective() { radius * ppu / depth } else { radius * ppu }
+    };
+    FootprintSize { typical_px: diameter(centre), max_px: diameter(near) }
+}
+
+/// Above this typical footprint diameter `auto` keeps the graphics pipeline on a CPU device for
+/// the sheet modes: one invocation walks a whole footprint, so wide ones serialise (measured in
+/// docs/RESULTS.md, "Raster variants").
+pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 24.0;
+/// Above this typical diameter `auto` keeps the graphics pipeline for per-splat compositing on a
+/// CPU device: tile lists grow with the tiles a footprint covers.
+pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 48.0;
+
+/// Resolve `opts.raster` for this frame; `Auto` becomes a concrete variant. Explicit choices are
+/// checked: points cannot stretch along a motion path nor exceed the device's point size.
+pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Device) -> Result<RasterChoice> {
+    let size = footprint_size(set, camera, opts);
+    match opts.raster {
+        Raster::Points => {
+            if opts.motion.is_some() {
+                return Err(Error::InvalidArgument(
+                    "point sprites cannot stretch along a motion path: use --raster graphics or compute".into(),
+                ));
+            }
+            if size.max_px > device.point_size_max {
+                return Err(Error::InvalidArgument(format!(
+                    "footprints up to {:.0} px exceed the device's widest point sprite ({:.0} px): use --raster \
+                     graphics or compute",
+                    size.max_px, device.point_size_max
+                )));
+            }
+            Ok(RasterChoice { raster: Raster::Points, reason: "requested".into() })
+        }
+        Raster::Graphics | Raster::Compute => Ok(RasterChoice { raster: opts.raster, reason: "requested".into() }),
+        Raster::Auto => {
+            let limit = match opts.composite {
+                Composite::Splat => AUTO_COMPUTE_TILES_MAX_PX,
+                Composite::Sheet | Composite::Slab => AUTO_COMPUTE_SUM_MAX_PX,
+            };
+            let (raster, why) = if !device.cpu {
+                (Raster::Graphics, "hardware rasteriser".to_string())
+            } else if size.typical_px <= limit {
+                (Raster::Compute, format!("CPU device, footprints ~{:.1} px <= {limit:.0} px", size.typical_px))
+            } else {
+                (Raster::Graphics, format!("CPU device, footprints ~{:.1} px > {limit:.0} px", size.typical_px))
+            };
+            Ok(RasterChoice { raster, reason: format!("auto: {why}") })
+        }
+    }
+}
+
+/// Most cells of the tile x chunk count matrix (4 bytes each: 64 MiB).
+pub const MAX_TILE_CELLS: u64 = 1 << 24;
+/// Most (tile, splat) entries in one frame (4 bytes each: 512 MiB).
+pub const MAX_TILE_ENTRIES: u64 = 1 << 27;
+
+/// The count matrix's cells, checked before it is allocated.
+pub fn check_tile_cells(tiles: u64, chunks: u32) -> Result<u64> {
+    let cells = tiles * chunks as u64;
+    if cells > MAX_TILE_CELLS {
+        return Err(Error::TooLarge(format!(
+            "{tiles} screen tiles x {chunks} splat chunks exceed {MAX_TILE_CELLS} binning cells: use a smaller \
+             image or --raster graphics"
+        )));
+    }
+    Ok(cells)
+}
+
+/// The tile lists' total length, checked before the list is allocated.
+pub fn check_tile_entries(total: u64) -> Result<()> {
+    if total > MAX_TILE_ENTRIES {
+        return Err(Error::TooLarge(format!(
+            "{total} (tile, splat) entries exceed {MAX_TILE_ENTRIES}: use a smaller image or --raster graphics"
+        )));
+    }
+    Ok(())
+}
