@@ -1,14 +1,14 @@
 #version 450
-// Footprint stage, fragment half: weight of the pre-integrated kernel at this pixel's point on the
+// Footprint stage, fragment half: weight of the pre-integrated kernel (radial table) at this pixel's point on the
 // quad (or point sprite), as optical depth. Per-splat mode emits premultiplied colour and
 // alpha = 1 - exp(-tau) for over/under blending; sheet mode emits (rgb * tau, tau) for additive
 // summation; slab mode weighs by the kernel slice between the slab's faces instead of the whole
 // footprint. Mirror: cpu::footprint.
 #include "types.glsl"
-#include "footprint_table.glsl"
 
-layout(binding = 5) uniform sampler2D table;
+layout(std430, binding = 5) readonly buffer Radial { float radial[]; };
 layout(binding = 6) uniform sampler2D slices;
+#include "footprint_table.glsl"
 // The modes are fixed per pipeline (a branch on the push constant made llvmpipe pay for both
 // sides); the push constant's sheet_mode carries the same value for the CPU mirror.
 layout(constant_id = 0) const uint SHEET_MODE = SHEET_MODE_SPLAT;
@@ -22,7 +22,7 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     vec2 uv = POINTS != 0u ? gl_PointCoord * 2.0 - 1.0 : in_uv;
-    float weight = footprint_weight(table, slices, SHEET_MODE == SHEET_MODE_SLAB, uv, in_stretch, in_slab);
+    float weight = footprint_weight(slices, SHEET_MODE == SHEET_MODE_SLAB, uv, in_stretch, in_slab);
     float tau = in_emit.a * weight;
     if (tau <= 0.0) discard;
     if (SHEET_MODE != SHEET_MODE_SPLAT) {

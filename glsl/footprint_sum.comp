@@ -37,7 +37,7 @@ void main() {
         for (int x = box.x; x <= box.z; ++x) {
             vec2 uv = quad_uv(inv, ivec2(x, y));
             if (abs(uv.x) > 1.0 || abs(uv.y) > 1.0) continue;
-            float tau = energy * footprint_weight(table, slices, slab, uv, p.axis_v.w, faces);
+            float tau = energy * footprint_weight(slices, slab, uv, p.axis_v.w, faces);
             if (tau <= 0.0) continue;
             uint idx = 4u * (base + uint(y) * width + uint(x));
             if (idx + 3u >= uint(sums.length())) continue;

@@ -1,13 +1,15 @@
 #version 450
 // Compute per-splat compositing, binning pass 1 of 3: each invocation owns a chunk of TILE_CHUNK
-// draw-list entries and counts, serially and without atomics, how many of them each screen tile
-// receives (its column of the tile x chunk count matrix). Mirror: cpu::tile::tile_count.
+// draw-list entries, records each one's footprint in screen space for the later stages and counts,
+// serially and without atomics, how many of them each screen tile receives (its column of the
+// tile x chunk count matrix). Mirror: cpu::tile::tile_count.
 #define FOOTPRINT_COMPUTE
 #include "footprint.glsl"
 #include "tiles.glsl"
 
 layout(local_size_x = TILE_BIN_WORKGROUP) in;
 layout(std430, binding = 9) buffer Counts { uint counts[]; };
+layout(std430, binding = 13) writeonly buffer Quads { ScreenQuad quads[]; };
 
 void main() {
     uint chunk = gl_GlobalInvocationID.x;
@@ -16,8 +18,11 @@ void main() {
     for (uint t = 0u; t < grid.x * grid.y; ++t) counts[t * pc.chunks + chunk] = 0u;
     uvec2 range = chunk_entries(chunk);
     for (uint e = range.x; e < range.y; ++e) {
+        uint splat = draw_list[e];
+        ScreenQuad q = screen_record(params[splat]);
+        quads[splat] = q;
         uvec4 r;
-        if (!tile_range(params[draw_list[e]], r)) continue;
+        if (!tile_range(q.box, r)) continue;
         for (uint ty = r.y; ty <= r.w; ++ty) {
             for (uint tx = r.x; tx <= r.z; ++tx) counts[(ty * grid.x + tx) * pc.chunks + chunk] += 1u;
         }

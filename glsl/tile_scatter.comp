@@ -11,6 +11,7 @@
 layout(local_size_x = TILE_BIN_WORKGROUP) in;
 layout(std430, binding = 9) buffer Counts { uint counts[]; };
 layout(std430, binding = 11) writeonly buffer TileEntries { uint tile_entries[]; };
+layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads[]; };
 
 void main() {
     uint chunk = gl_GlobalInvocationID.x;
@@ -20,7 +21,7 @@ void main() {
     for (uint e = range.x; e < range.y; ++e) {
         uint splat = draw_list[e];
         uvec4 r;
-        if (!tile_range(params[splat], r)) continue;
+        if (!tile_range(quads[splat].box, r)) continue;
         for (uint ty = r.y; ty <= r.w; ++ty) {
             for (uint tx = r.x; tx <= r.z; ++tx) {
                 uint cell = (ty * grid.x + tx) * pc.chunks + chunk;

@@ -9,11 +9,13 @@ pub const SCAN_WORKGROUP_SIZE: u32 = 256;
 pub const COMPOSITE_TILE: u32 = 8;
 /// Texels per side of the pre-integrated footprint table.
 pub const FOOTPRINT_TABLE_SIZE: u32 = 64;
+/// Intervals of the radial footprint table (in r², radius units) the footprint stage samples.
+pub const RADIAL_TABLE_SIZE: u32 = 256;
 /// Splats per invocation of the slab binning stages (one column of the slab x chunk count matrix).
 pub const SLAB_CHUNK: u32 = 1024;
 /// Side of the square screen tile of the compute rasteriser (`tile_composite.comp` runs
 /// TILE×TILE invocations, one per pixel).
-pub const RASTER_TILE: u32 = 16;
+pub const RASTER_TILE: u32 = 8;
 /// Draw-list entries per invocation of the tile binning stages.
 pub const TILE_CHUNK: u32 = 1024;
 /// Invocations per workgroup of the tile binning stages: few chunks still fill several workgroups
@@ -32,6 +34,7 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),
     ("COMPOSITE_TILE", COMPOSITE_TILE),
     ("FOOTPRINT_TABLE_SIZE", FOOTPRINT_TABLE_SIZE),
+    ("RADIAL_TABLE_SIZE", RADIAL_TABLE_SIZE),
     ("SLAB_CHUNK", SLAB_CHUNK),
     ("RASTER_TILE", RASTER_TILE),
     ("TILE_CHUNK", TILE_CHUNK),

@@ -1,6 +1,6 @@
 //! The stage list executed on Vulkan through the safe `vk` layer.
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, RASTER_TILE, TILE_BIN_WORKGROUP};
+use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, RADIAL_TABLE_SIZE, RASTER_TILE, TILE_BIN_WORKGROUP};
 use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
@@ -104,6 +104,7 @@ struct SceneGpu {
     tile_counts: Option<Buffer>,
     tile_start: Option<(Buffer, Buffer)>,
     tile_entries: Option<Buffer>,
+    tile_quads: Option<Buffer>,
 }
 
 struct TargetGpu {
@@ -126,7 +127,8 @@ struct TargetGpu {
 pub struct GpuPipeline {
     stages: Stages,
     frame: Buffer,
-    table: Image,
+    /// The radial footprint table (`Kernel::radial_table`).
+    radial: Buffer,
     /// The kernel-slice table of the image-aligned sheets.
     slices: Image,
     sampler: Sampler,
@@ -176,8 +178,10 @@ impl GpuPipeline {
             0,
         )?;
         let params_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Storage, Slot::Storage], compute, 0)?;
-        // glsl/shared/footprint.glsl: 0-4 frame, params, draw list, splats, ranks; 5-6 tables;
-        // 7 occlusion; 8 fixed-point sums; 9-11 tile counts, starts, entries; 12 accumulation.
+        // glsl/shared/footprint.glsl: 0-4 frame, params, draw list, splats, ranks; 5 radial table,
+        // 6 slice table;
+        // 7 occlusion; 8 fixed-point sums; 9-11 tile counts, starts, entries; 12 accumulation;
+        // 13 screen quads.
         let footprint_layout = Layout::new(
             &ctx,
             &[
@@ -186,7 +190,7 @@ impl GpuPipeline {
                 Slot::Storage,
                 Slot::Storage,
                 Slot::Storage,
-                Slot::Texture,
+                Slot::Storage,
                 Slot::Texture,
                 Slot::Storage,
                 Slot::Storage,
@@ -194,6 +198,7 @@ impl GpuPipeline {
                 Slot::Storage,
                 Slot::Storage,
                 Slot::StorageImage,
+                Slot::Storage,
             ],
             SS::VERTEX | SS::FRAGMENT | SS::COMPUTE,
             std::mem::size_of::<FootprintPush>() as u32,
@@ -279,13 +284,13 @@ impl GpuPipeline {
         let frame =
             Buffer::new(&ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::STORAGE_BUFFER, Memory::Upload)?;
         let n = FOOTPRINT_TABLE_SIZE;
-        let table =
-            Image::new(&ctx, "footprint table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
+        let radial_bytes = (RADIAL_TABLE_SIZE as u64 + 1) * 4;
+        let radial = Buffer::new(&ctx, "radial table", radial_bytes, BU::STORAGE_BUFFER, Memory::Upload)?;
         let slices =
             Image::new(&ctx, "slice table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
         let sampler = Sampler::nearest(&ctx)?;
         let timer = Timer::new(&ctx, 16)?;
-        Ok(Self { stages, frame, table, slices, sampler, kernel: None, scene: None, target: None, timer, ctx })
+        Ok(Self { stages, frame, radial, slices, sampler, kernel: None, scene: None, target: None, timer, ctx })
     }
 
     pub fn context(&self) -> &Arc<Context> {
@@ -296,28 +301,19 @@ impl GpuPipeline {
         if self.kernel == Some(kernel) {
             return Ok(());
         }
-        let footprint = kernel.footprint_table();
+        self.radial.write(bytemuck::cast_slice(&kernel.radial_table()))?;
         let slice = kernel.slice_table();
-        let stage =
-            |name, data: &[f32]| Buffer::with_data(&self.ctx, name, bytemuck::cast_slice(data), BU::TRANSFER_SRC);
-        let staging = [stage("table staging", &footprint)?, stage("slice table staging", &slice)?];
-        let images = [&self.table, &self.slices];
+        let staging =
+            Buffer::with_data(&self.ctx, "slice table staging", bytemuck::cast_slice(&slice), BU::TRANSFER_SRC)?;
+        let table = &self.slices;
         self.ctx.submit(|rec| {
-            for (table, staging) in images.iter().zip(&staging) {
-                rec.transition(table, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::Graphics, Stage::Transfer);
-                rec.copy_buffer_to_image(staging, table);
-                rec.transition(
-                    table,
-                    IL::TRANSFER_DST_OPTIMAL,
-                    IL::SHADER_READ_ONLY_OPTIMAL,
-                    Stage::Transfer,
-                    Stage::Graphics,
-                );
-            }
+            rec.transition(table, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::All, Stage::Transfer);
+            rec.copy_buffer_to_image(&staging, table);
+            rec.transition(table, IL::TRANSFER_DST_OPTIMAL, IL::SHADER_READ_ONLY_OPTIMAL, Stage::Transfer, Stage::All);
             Ok(())
         })?;
         self.kernel = Some(kernel);
-        // Footprint sets reference the table image itself, not its contents: no rebinding needed.
+        // Footprint sets reference the table objects themselves, not their contents: no rebinding.
         Ok(())
     }
 
@@ -381,6 +377,7 @@ impl GpuPipeline {
             tile_counts: None,
             tile_start: None,
             tile_entries: None,
+            tile_quads: None,
         });
         Ok(())
     }
@@ -446,6 +443,8 @@ impl GpuPipeline {
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let mut changed = grow(&ctx, &mut scene.tile_counts, "tile counts", cells * 4, Memory::Device)?;
         changed |= grow_readable(&ctx, &mut scene.tile_start, "tile starts", (tiles + 1) * 4)?;
+        let quad_bytes = scene.n as u64 * std::mem::size_of::<crate::gpu_types::ScreenQuad>() as u64;
+        changed |= grow(&ctx, &mut scene.tile_quads, "screen quads", quad_bytes, Memory::Device)?;
         if changed {
             scene.footprint_sets.clear();
         }
@@ -577,6 +576,7 @@ impl GpuPipeline {
         let counts = scene.tile_counts.as_ref().unwrap_or(stand_in);
         let starts = scene.tile_start.as_ref().map(|(b, _)| b).unwrap_or(stand_in);
         let entries = scene.tile_entries.as_ref().unwrap_or(stand_in);
+        let quads = scene.tile_quads.as_ref().unwrap_or(stand_in);
         let mut sets = Vec::with_capacity(5);
         for list in [&scene.order, &scene.draw[0], &scene.draw[1], &scene.draw[2], pairs] {
             sets.push(self.stages.footprint_layout.bind(&[
@@ -585,7 +585,7 @@ impl GpuPipeline {
                 Bind::Buffer(list),
                 Bind::Buffer(&scene.splats),
                 Bind::Buffer(&scene.ranks),
-                Bind::Texture(&self.table, &self.sampler),
+                Bind::Buffer(&self.radial),
                 Bind::Texture(&self.slices, &self.sampler),
                 Bind::Buffer(&target.occlusion),
                 Bind::Buffer(fixed),
@@ -593,6 +593,7 @@ impl GpuPipeline {
                 Bind::Buffer(starts),
                 Bind::Buffer(entries),
                 Bind::Image(&target.accum),
+                Bind::Buffer(quads),
             ])?);
         }
         scene.footprint_sets = sets;

@@ -28,6 +28,19 @@ pub struct SplatParams {
     pub screen: [f32; 4],
 }
 
+/// A footprint in screen space (`tile_count` writes one per splat for the later tile stages).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ScreenQuad {
+    /// Rows of the inverse projective map, pixel centre -> homogeneous quad coordinates;
+    /// `inv[0][3]` is the motion stretch.
+    pub inv: [[f32; 4]; 3],
+    /// Inclusive pixel box x0, y0, x1, y1 (empty when culled: x0 > x1).
+    pub bx: [i32; 4],
+    /// RGB; a: optical depth scale (tau x energy).
+    pub emit: [f32; 4],
+}
+
 /// Per-frame uniforms (std140, vec4 members only).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -117,6 +130,7 @@ pub struct CompositePush {
 
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
+const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 288);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 48);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);

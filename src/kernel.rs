@@ -129,6 +129,22 @@ impl Kernel {
         self.cached(&TABLES, Kernel::compute_footprint_table)
     }
 
+    /// The footprint as a function of s = r² in radius units (`RADIAL_TABLE_SIZE` + 1 samples at
+    /// s = i / N, linear in between, 0 from s = 1), in voxel^-2 with `footprint_table`'s normaliser.
+    /// A radially symmetric kernel's footprint depends on r alone, so the footprint stage samples
+    /// this (two loads, no sampler) rather than the 2D table (four texel fetches).
+    pub fn radial_table(self) -> Vec<f32> {
+        static TABLES: KernelTables = [OnceLock::new(), OnceLock::new()];
+        self.cached(&TABLES, Kernel::compute_radial_table)
+    }
+
+    fn compute_radial_table(self) -> Vec<f32> {
+        let n = crate::constants::RADIAL_TABLE_SIZE as usize;
+        let rr = self.radius() as f64;
+        let (_, total) = self.raw_footprint_table();
+        (0..=n).map(|i| (self.integrated((i as f64 / n as f64).sqrt() * rr) / total) as f32).collect()
+    }
+
     /// One table per kernel, computed on first use.
     fn cached(self, tables: &'static KernelTables, compute: fn(Kernel) -> Vec<f32>) -> Vec<f32> {
         let slot = match self {

@@ -178,7 +178,8 @@ impl Renderer {
             slice_table: &[],
             occlusion: &[],
         };
-        cpu::tile::tile_bins_cpu(&inputs, &pipeline::tile_push(&opts, prep.set.len() as u32))
+        let bins = cpu::tile::tile_bins_cpu(&inputs, &pipeline::tile_push(&opts, prep.set.len() as u32))?;
+        Ok((bins.start, bins.entries))
     }
 
     /// The PBTF draw sequence as the backend computes it (the GPU order stage, or its CPU mirror).

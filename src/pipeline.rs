@@ -412,7 +412,7 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
     cpu::splat_params(&frame, set.splats(), &mut params);
     lap("splat_params", &mut timings);
 
-    let table = opts.kernel.footprint_table();
+    let table = opts.kernel.radial_table();
     let slice_table = opts.kernel.slice_table();
     let (w, h) = (camera.width, camera.height);
     let mut image = ImageF32::new(w, h);
@@ -432,9 +432,9 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
             };
             if compute {
                 let push = tile_push(opts, n as u32);
-                let (start, entries) = cpu::tile::tile_bins_cpu(&inputs, &push)?;
+                let bins = cpu::tile::tile_bins_cpu(&inputs, &push)?;
                 lap("tile_bins", &mut timings);
-                cpu::tile_composite(&inputs, &push, &start, &entries, &mut image);
+                cpu::tile_composite(&inputs, &push, &bins.quads, &bins.start, &bins.entries, &mut image);
             } else {
                 let blend = if btf { Blend::Over } else { Blend::Under };
                 let push = FootprintPush::default();

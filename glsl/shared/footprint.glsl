@@ -3,15 +3,15 @@
 // and tile_{count,scan,scatter,composite}.comp (compute per-splat compositing in screen tiles).
 // Mirrors: src/cpu/footprint.rs, src/cpu/tile.rs.
 #include "types.glsl"
-#include "footprint_table.glsl"
 
 layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 1) readonly buffer Params { SplatParams params[]; };
 layout(std430, binding = 2) readonly buffer DrawList { uint draw_list[]; };
 layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 4) readonly buffer SheetRank { uint sheet_rank[]; };
-layout(binding = 5) uniform sampler2D table;
+layout(std430, binding = 5) readonly buffer Radial { float radial[]; };
 layout(binding = 6) uniform sampler2D slices;
+#include "footprint_table.glsl"
 layout(std430, binding = 7) readonly buffer Occlusion { float occlusion[]; };
 
 // The mode is fixed per pipeline (a branch on the push constant made llvmpipe pay for both sides);

@@ -35,14 +35,25 @@ float sample_slice_table(sampler2D slices, float r, float z) {
     return top + (bottom - top) * w.y;
 }
 
+// Lookup in the radial footprint table (Kernel::radial_table): s = r² in radius units, linear
+// between RADIAL_TABLE_SIZE + 1 samples. The includer declares the `radial` buffer.
+// Mirror: sample_radial in src/cpu/footprint.rs.
+float sample_radial(float s) {
+    float t = clamp(s, 0.0, 1.0) * float(RADIAL_TABLE_SIZE);
+    uint i = min(uint(t), RADIAL_TABLE_SIZE - 1u);
+    float a = radial[i];
+    return a + (radial[i + 1u] - a) * (t - float(i));
+}
+
 // A footprint's weight at quad coordinates uv: the pre-integrated kernel across the motion segment
 // (stretch, radius units along u) or, for a slab, the kernel slice between its faces (radius units).
-// Mirror: the weight in src/cpu/footprint.rs (raster_quad).
-float footprint_weight(sampler2D table, sampler2D slices, bool slab, vec2 uv, float stretch, vec2 faces) {
+// Mirror: Weight::at in src/cpu/footprint.rs.
+float footprint_weight(sampler2D slices, bool slab, vec2 uv, float stretch, vec2 faces) {
     float along = max(abs(uv.x) * (1.0 + stretch) - stretch, 0.0);
+    float s = along * along + uv.y * uv.y;
     if (slab) {
-        float r = length(vec2(along, uv.y));
+        float r = sqrt(s);
         return sample_slice_table(slices, r, faces.y) - sample_slice_table(slices, r, faces.x);
     }
-    return sample_table(table, vec2(along, uv.y));
+    return sample_radial(s);
 }

@@ -20,6 +20,15 @@ struct SplatParams {
                   // footprint radius in pixels, anti-aliasing radius scale
 };
 
+// A footprint in screen space, written by tile_count for the later tile stages. 80 bytes.
+struct ScreenQuad {
+    vec4 inv0;    // rows of the inverse projective map, pixel centre (x, y, 1) -> homogeneous
+    vec4 inv1;    // quad coordinates (u, v, 1); inv0.w: motion stretch
+    vec4 inv2;
+    ivec4 box;    // inclusive pixel box x0, y0, x1, y1 (empty when culled: x0 > x1)
+    vec4 emit;    // rgb; a: optical depth scale (tau x energy)
+};
+
 // Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 288 bytes.
 // Bound as a readonly storage buffer, not a uniform buffer: Mesa 22.3's lavapipe inlines uniform
 // values that steer branches and recompiles the shader for every dispatch, keeping each variant until

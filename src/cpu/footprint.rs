@@ -32,6 +32,16 @@ pub fn sample_table(table: &[f32], u: f32, v: f32) -> f32 {
     top + (bottom - top) * wy
 }
 
+/// Mirror of `sample_radial` in `glsl/shared/footprint_table.glsl`: the radial footprint table at
+/// s = r² (radius units).
+pub fn sample_radial(table: &[f32], s: f32) -> f32 {
+    let n = crate::constants::RADIAL_TABLE_SIZE;
+    let t = s.clamp(0.0, 1.0) * n as f32;
+    let i = (t as u32).min(n - 1);
+    let a = table[i as usize];
+    a + (table[i as usize + 1] - a) * (t - i as f32)
+}
+
 /// Mirror of `sample_slice_table` in `glsl/shared/footprint_table.glsl`.
 pub fn sample_slice_table(table: &[f32], r: f32, z: f32) -> f32 {
     let n = FOOTPRINT_TABLE_SIZE as usize;
@@ -52,6 +62,7 @@ pub struct FootprintInputs<'a> {
     pub draw_list: &'a [u32],
     pub splats: &'a [Splat],
     pub sheet_rank: &'a [u32],
+    /// The radial footprint table (`Kernel::radial_table`).
     pub table: &'a [f32],
     /// The kernel-slice table (slab mode).
     pub slice_table: &'a [f32],
@@ -247,10 +258,11 @@ impl Weight<'_> {
     /// Mirror of `footprint_weight` in `glsl/shared/footprint_table.glsl`.
     fn at(self, u: f32, v: f32, stretch: f32) -> f32 {
         let along = (u.abs() * (1.0 + stretch) - stretch).max(0.0);
+        let s = along * along + v * v;
         match self {
-            Weight::Footprint(table) => sample_table(table, along, v),
+            Weight::Footprint(table) => sample_radial(table, s),
             Weight::Slice(table, [za, zb]) => {
-                let r = (along * along + v * v).sqrt();
+                let r = s.sqrt();
                 sample_slice_table(table, r, zb) - sample_slice_table(table, r, za)
             }
         }

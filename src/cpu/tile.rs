@@ -2,31 +2,43 @@
 //! `tile_scatter.comp` (a stable counting sort of the draw list into screen tiles, so every tile's
 //! list keeps the PBTF order) and `tile_composite.comp` (each tile composites its list per pixel,
 //! front to back with early termination or back to front).
-use super::footprint::{quad_uv, screen_quad, FootprintInputs};
+use super::footprint::{footprint_weight, screen_quad, FootprintInputs};
 use super::ImageF32;
 use crate::constants::{RASTER_TILE, TILE_CHUNK};
 use crate::error::Result;
-use crate::gpu_types::{FootprintPush, Frame, SplatParams};
+use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams};
+use glam::{IVec4, Mat3, Vec2, Vec3};
+use rayon::prelude::*;
 
 /// Tiles across and down an image of the frame's size.
 pub fn tile_grid(frame: &Frame) -> (u32, u32) {
     ((frame.blur[2] as u32).div_ceil(RASTER_TILE), (frame.blur[3] as u32).div_ceil(RASTER_TILE))
 }
 
-/// Inclusive tile range (x0, y0, x1, y1) of a splat's footprint box; `None` when it covers no pixel.
-pub fn tile_range(frame: &Frame, p: &SplatParams) -> Option<[u32; 4]> {
-    let (_, b) = screen_quad(frame, p)?;
-    Some([b.x, b.y, b.z, b.w].map(|v| v as u32 / RASTER_TILE))
+/// Mirror of `screen_record` in `glsl/shared/tiles.glsl`.
+pub fn screen_record(frame: &Frame, p: &SplatParams) -> ScreenQuad {
+    let (inv, bx) = screen_quad(frame, p).unwrap_or((Mat3::IDENTITY, IVec4::new(0, 0, -1, -1)));
+    let row = |r: usize, w: f32| [inv.x_axis[r], inv.y_axis[r], inv.z_axis[r], w];
+    ScreenQuad {
+        inv: [row(0, p.axis_v[3]), row(1, 0.0), row(2, 0.0)],
+        bx: bx.to_array(),
+        emit: [p.emit[0], p.emit[1], p.emit[2], p.emit[3] * p.axis_u[3]],
+    }
+}
+
+/// Inclusive tile range (x0, y0, x1, y1) of a footprint box; `None` when the box is empty.
+pub fn tile_range(bx: [i32; 4]) -> Option<[u32; 4]> {
+    (bx[0] <= bx[2] && bx[1] <= bx[3]).then(|| bx.map(|v| v.max(0) as u32 / RASTER_TILE))
 }
 
 fn chunk_entries(push: &FootprintPush, chunk: u32) -> std::ops::Range<usize> {
     (chunk * TILE_CHUNK) as usize..((chunk + 1) * TILE_CHUNK).min(push.count) as usize
 }
 
-/// Calls `f(tile)` for every tile the entry's footprint overlaps, row by row.
-fn each_tile(frame: &Frame, p: &SplatParams, mut f: impl FnMut(usize)) {
+/// Calls `f(tile)` for every tile the footprint box overlaps, row by row.
+fn each_tile(frame: &Frame, bx: [i32; 4], mut f: impl FnMut(usize)) {
     let tiles_x = tile_grid(frame).0;
-    if let Some([x0, y0, x1, y1]) = tile_range(frame, p) {
+    if let Some([x0, y0, x1, y1]) = tile_range(bx) {
         for ty in y0..=y1 {
             for tx in x0..=x1 {
                 f((ty * tiles_x + tx) as usize);
@@ -35,7 +47,7 @@ fn each_tile(frame: &Frame, p: &SplatParams, mut f: impl FnMut(usize)) {
     }
 }
 
-pub fn tile_count(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mut [u32]) {
+pub fn tile_count(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mut [u32], quads: &mut [ScreenQuad]) {
     let (tx, ty) = tile_grid(inputs.frame);
     let chunks = push.chunks as usize;
     for chunk in 0..push.chunks {
@@ -43,8 +55,10 @@ pub fn tile_count(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &m
             counts[t * chunks + chunk as usize] = 0;
         }
         for e in chunk_entries(push, chunk) {
-            let p = &inputs.params[inputs.draw_list[e] as usize];
-            each_tile(inputs.frame, p, |t| counts[t * chunks + chunk as usize] += 1);
+            let splat = inputs.draw_list[e] as usize;
+            let q = screen_record(inputs.frame, &inputs.params[splat]);
+            quads[splat] = q;
+            each_tile(inputs.frame, q.bx, |t| counts[t * chunks + chunk as usize] += 1);
         }
     }
 }
@@ -65,12 +79,18 @@ pub fn tile_scan(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mu
     tile_start[tiles] = carry;
 }
 
-pub fn tile_scatter(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mut [u32], entries: &mut [u32]) {
+pub fn tile_scatter(
+    inputs: &FootprintInputs<'_>,
+    push: &FootprintPush,
+    quads: &[ScreenQuad],
+    counts: &mut [u32],
+    entries: &mut [u32],
+) {
     let chunks = push.chunks as usize;
     for chunk in 0..push.chunks {
         for e in chunk_entries(push, chunk) {
             let splat = inputs.draw_list[e];
-            each_tile(inputs.frame, &inputs.params[splat as usize], |t| {
+            each_tile(inputs.frame, quads[splat as usize].bx, |t| {
                 let cell = t * chunks + chunk as usize;
                 entries[counts[cell] as usize] = splat;
                 counts[cell] += 1;
@@ -79,44 +99,44 @@ pub fn tile_scatter(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: 
     }
 }
 
-/// Composite every tile's list into `image` (which it overwrites).
+/// Composite every tile's list into `image` (which it overwrites), pixel by pixel as each tile
+/// row does on the GPU.
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
+    quads: &[ScreenQuad],
     tile_start: &[u32],
     entries: &[u32],
     image: &mut ImageF32,
 ) {
-    let frame = inputs.frame;
-    let tiles_x = tile_grid(frame).0;
+    let tiles_x = tile_grid(inputs.frame).0;
     let btf = push.back_to_front != 0;
     let terminate = !btf && push.occluded > 0.0;
-    let quads: Vec<_> = entries.iter().map(|&s| screen_quad(frame, &inputs.params[s as usize])).collect();
     let width = image.width;
-    for (i, px) in image.pixels.iter_mut().enumerate() {
-        let (x, y) = (i as u32 % width, i as u32 / width);
-        let tile = ((y / RASTER_TILE) * tiles_x + x / RASTER_TILE) as usize;
+    image.pixels.par_iter_mut().enumerate().for_each(|(i, px)| {
+        let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
+        let tile = ((y as u32 / RASTER_TILE) * tiles_x + x as u32 / RASTER_TILE) as usize;
         let mut acc = [0.0f32; 4];
-        for k in tile_start[tile] as usize..tile_start[tile + 1] as usize {
+        for &splat in &entries[tile_start[tile] as usize..tile_start[tile + 1] as usize] {
             if terminate && 1.0 - acc[3] <= push.occluded {
                 break;
             }
-            let Some((inv, b)) = quads[k] else { continue };
-            let (xi, yi) = (x as i32, y as i32);
-            if xi < b.x || xi > b.z || yi < b.y || yi > b.w {
+            let q = &quads[splat as usize];
+            if x < q.bx[0] || x > q.bx[2] || y < q.bx[1] || y > q.bx[3] {
                 continue;
             }
-            let uv = quad_uv(&inv, xi, yi);
+            let p = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 1.0);
+            let row = |r: usize| Vec3::new(q.inv[r][0], q.inv[r][1], q.inv[r][2]).dot(p);
+            let uv = Vec2::new(row(0), row(1)) / row(2);
             if uv.x.abs() > 1.0 || uv.y.abs() > 1.0 {
                 continue;
             }
-            let p = &inputs.params[entries[k] as usize];
-            let tau = p.emit[3] * p.axis_u[3] * super::footprint::footprint_weight(inputs.table, uv, p.axis_v[3]);
+            let tau = q.emit[3] * footprint_weight(inputs.table, uv, q.inv[0][3]);
             if tau <= 0.0 {
                 continue;
             }
             let a = 1.0 - (-tau).exp();
-            let src = [p.emit[0] * a, p.emit[1] * a, p.emit[2] * a, a];
+            let src = [q.emit[0] * a, q.emit[1] * a, q.emit[2] * a, a];
             if btf {
                 acc = [0, 1, 2, 3].map(|c| src[c] + (1.0 - a) * acc[c]);
             } else {
@@ -125,21 +145,32 @@ pub fn tile_composite(
             }
         }
         *px = acc;
-    }
+    });
 }
 
 /// The whole binning on the CPU mirrors, sizes checked against the limits before allocating:
 /// (tile_start, entries).
-pub fn tile_bins_cpu(inputs: &FootprintInputs<'_>, push: &FootprintPush) -> Result<(Vec<u32>, Vec<u32>)> {
+pub fn tile_bins_cpu(inputs: &FootprintInputs<'_>, push: &FootprintPush) -> Result<TileBins> {
     let (tx, ty) = tile_grid(inputs.frame);
     let tiles = (tx * ty) as usize;
     let cells = crate::raster::check_tile_cells(tiles as u64, push.chunks)?;
     let mut counts = vec![0u32; cells as usize];
     let mut start = vec![0u32; tiles + 1];
-    tile_count(inputs, push, &mut counts);
+    let mut quads = vec![ScreenQuad::default(); inputs.params.len()];
+    tile_count(inputs, push, &mut counts, &mut quads);
     tile_scan(inputs, push, &mut counts, &mut start);
     crate::raster::check_tile_entries(start[tiles] as u64)?;
     let mut entries = vec![0u32; start[tiles] as usize];
-    tile_scatter(inputs, push, &mut counts, &mut entries);
-    Ok((start, entries))
+    tile_scatter(inputs, push, &quads, &mut counts, &mut entries);
+    Ok(TileBins { start, entries, quads })
+}
+
+/// The tile binning's output.
+pub struct TileBins {
+    /// Each tile's first entry, then the total.
+    pub start: Vec<u32>,
+    /// Splat indices, tile by tile, each run in draw-list order.
+    pub entries: Vec<u32>,
+    /// Every splat's footprint in screen space.
+    pub quads: Vec<ScreenQuad>,
 }
