@@ -37,12 +37,15 @@ void main() {
         if (terminate && subgroupAll(open == 0)) break;
         ScreenQuad q = quads[tile_entries[k]];
         bool row = y >= q.box.y && y <= q.box.w;
-        int xa = max(q.box.x, x0), xb = min(q.box.z, x_end);
-        for (int x = xa; x <= xb; ++x) {
-            vec4 a = acc[x - x0];
+        // A fixed trip count unrolls, so acc[] stays in registers (an indexed private array costs
+        // llvmpipe a gather and a scatter per access).
+        for (int i = 0; i < int(RASTER_TILE); ++i) {
+            int x = x0 + i;
+            vec4 a = acc[i];
             vec3 p = vec3(float(x) + 0.5, float(y) + 0.5, 1.0);
             vec2 uv = vec2(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p)) / dot(q.inv2.xyz, p);
-            bool live = row && abs(uv.x) <= 1.0 && abs(uv.y) <= 1.0 && (!terminate || 1.0 - a.a > pc.occluded);
+            bool live = row && x >= q.box.x && x <= q.box.z && abs(uv.x) <= 1.0 && abs(uv.y) <= 1.0 &&
+                        (!terminate || 1.0 - a.a > pc.occluded);
             if (live) {
                 float tau = q.emit.a * footprint_weight(slices, false, uv, q.inv0.w, vec2(0.0));
                 float alpha = 1.0 - exp(-tau);
@@ -53,11 +56,11 @@ void main() {
                     a += (1.0 - a.a) * src;
                     if (terminate && 1.0 - a.a <= pc.occluded) open -= 1;
                 }
-                acc[x - x0] = a;
+                acc[i] = a;
             }
         }
     }
-    if (y < int(size.y)) {
-        for (int x = x0; x <= x_end; ++x) imageStore(accum, ivec2(x, y), acc[x - x0]);
+    for (int i = 0; i < int(RASTER_TILE); ++i) {
+        if (y < int(size.y) && x0 + i <= x_end) imageStore(accum, ivec2(x0 + i, y), acc[i]);
     }
 }

@@ -1,5 +1,5 @@
 #version 450
-// Compute per-splat compositing, binning pass 1 of 3: each invocation owns a chunk of TILE_CHUNK
+// Compute per-splat compositing, binning pass 1 of 4 (the count matrix is zeroed before): each invocation owns a chunk of TILE_CHUNK
 // draw-list entries, records each one's footprint in screen space for the later stages and counts,
 // serially and without atomics, how many of them each screen tile receives (its column of the
 // tile x chunk count matrix). Mirror: cpu::tile::tile_count.
@@ -15,7 +15,6 @@ void main() {
     uint chunk = gl_GlobalInvocationID.x;
     if (chunk >= pc.chunks) return;
     uvec2 grid = tile_grid();
-    for (uint t = 0u; t < grid.x * grid.y; ++t) counts[t * pc.chunks + chunk] = 0u;
     uvec2 range = chunk_entries(chunk);
     for (uint e = range.x; e < range.y; ++e) {
         uint splat = draw_list[e];

@@ -1,5 +1,5 @@
 #version 450
-// Compute per-splat compositing, binning pass 3 of 3: each invocation walks its chunk again and
+// Compute per-splat compositing, binning pass 4 of 4: each invocation walks its chunk again and
 // writes each entry's splat at its own cursor of every tile it overlaps. Chunks are laid out in
 // list order inside every tile's run and each chunk is walked in list order, so every tile's list
 // keeps the draw list's (PBTF) order: a stable counting sort, no depth sort.
@@ -10,6 +10,7 @@
 
 layout(local_size_x = TILE_BIN_WORKGROUP) in;
 layout(std430, binding = 9) buffer Counts { uint counts[]; };
+layout(std430, binding = 10) readonly buffer TileStart { uint tile_start[]; };
 layout(std430, binding = 11) writeonly buffer TileEntries { uint tile_entries[]; };
 layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads[]; };
 
@@ -24,10 +25,11 @@ void main() {
         if (!tile_range(quads[splat].box, r)) continue;
         for (uint ty = r.y; ty <= r.w; ++ty) {
             for (uint tx = r.x; tx <= r.z; ++tx) {
-                uint cell = (ty * grid.x + tx) * pc.chunks + chunk;
+                uint tile = ty * grid.x + tx;
+                uint cell = tile * pc.chunks + chunk;
                 uint at = counts[cell];
                 counts[cell] = at + 1u;
-                tile_entries[at] = splat;
+                tile_entries[tile_start[tile] + at] = splat;
             }
         }
     }

@@ -55,6 +55,7 @@ struct Stages {
     sum_slab: Pipeline,
     tile_count: Pipeline,
     tile_scan: Pipeline,
+    tile_offsets: Pipeline,
     tile_scatter: Pipeline,
     tile_composite: Pipeline,
     composite_layout: Layout,
@@ -252,6 +253,7 @@ impl GpuPipeline {
             )?,
             tile_count: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_count.comp"))?,
             tile_scan: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scan.comp"))?,
+            tile_offsets: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_offsets.comp"))?,
             tile_scatter: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp"))?,
             tile_composite: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_composite.comp"))?,
             composite_fixed: Pipeline::compute_specialized(&ctx, &composite_layout, spirv!("composite.comp"), &[1])?,
@@ -467,13 +469,18 @@ impl GpuPipeline {
                 }),
             ));
         }
+        let counts = scene.tile_counts.as_ref().expect("grown");
         steps.push((
             "tile_bins",
             Box::new(move |rec| {
+                rec.fill_buffer(counts, 0);
+                rec.barrier(Stage::Transfer, Stage::Compute);
                 let groups = [push.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1];
                 rec.dispatch(&st.tile_count, &st.footprint_layout, set, bytes, groups);
                 rec.barrier(Stage::Compute, Stage::Compute);
-                rec.dispatch(&st.tile_scan, &st.footprint_layout, set, bytes, [1, 1, 1]);
+                rec.dispatch(&st.tile_scan, &st.footprint_layout, set, bytes, groups_1d(tiles as u32));
+                rec.barrier(Stage::Compute, Stage::Compute);
+                rec.dispatch(&st.tile_offsets, &st.footprint_layout, set, bytes, [1, 1, 1]);
                 rec.barrier(Stage::Compute, Stage::Transfer);
                 rec.copy_buffer(dev, back, (tiles + 1) * 4);
             }),
@@ -491,7 +498,12 @@ impl GpuPipeline {
 
     /// Run the tile binning of the compute tile compositor for this frame and read it back:
     /// (each tile's first entry and the total, the entries).
-    pub fn tile_lists(&mut self, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<(Vec<u32>, Vec<u32>)> {
+    pub fn tile_lists(
+        &mut self,
+        prep: &Prepared,
+        camera: &Camera,
+        opts: &RenderOptions,
+    ) -> Result<(Vec<u32>, Vec<u32>)> {
         camera.validate()?;
         let frame = frame_for(&prep.set, camera, opts);
         self.frame.write(bytemuck::bytes_of(&frame))?;
@@ -509,10 +521,11 @@ impl GpuPipeline {
         let scene = self.scene.as_ref().expect("checked above");
         let (tx, ty) = crate::cpu::tile::tile_grid(&frame);
         let tiles = tx as usize * ty as usize;
-        let starts = bytemuck::cast_slice::<u8, u32>(&scene.tile_start.as_ref().expect("grown").1.read()?)[..tiles + 1]
-            .to_vec();
+        let starts =
+            bytemuck::cast_slice::<u8, u32>(&scene.tile_start.as_ref().expect("grown").1.read()?)[..tiles + 1].to_vec();
         let bytes = starts[tiles] as u64 * 4;
-        let readback = Buffer::new(&self.ctx, "tile entries readback", bytes.max(4), BU::TRANSFER_DST, Memory::Readback)?;
+        let readback =
+            Buffer::new(&self.ctx, "tile entries readback", bytes.max(4), BU::TRANSFER_DST, Memory::Readback)?;
         let (st, entries) = (&self.stages, scene.tile_entries.as_ref().expect("grown"));
         let set = &scene.footprint_sets[0];
         self.ctx.submit(|rec| {
@@ -668,7 +681,8 @@ impl GpuPipeline {
             return Ok(());
         }
         let bytes = target.width as u64 * target.height as u64 * target.layers as u64 * 16;
-        let fixed = Buffer::new(&self.ctx, "fixed-point sums", bytes, BU::STORAGE_BUFFER | BU::TRANSFER_DST, Memory::Device)?;
+        let fixed =
+            Buffer::new(&self.ctx, "fixed-point sums", bytes, BU::STORAGE_BUFFER | BU::TRANSFER_DST, Memory::Device)?;
         target.composite_set = self.stages.composite_layout.bind(&[
             Bind::Image(&target.sums),
             Bind::Image(&target.accum),
@@ -952,7 +966,9 @@ impl GpuPipeline {
                 ));
                 steps.push((
                     UNTIMED,
-                    Box::new(|rec| rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute)),
+                    Box::new(|rec| {
+                        rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute)
+                    }),
                 ));
                 steps.push((
                     "footprint",

@@ -133,7 +133,9 @@ impl Renderer {
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         camera.validate()?;
         let device = match &self.gpu {
-            Some(g) => raster::Device { cpu: g.context().is_cpu_device(), point_size_max: g.context().point_size_max() },
+            Some(g) => {
+                raster::Device { cpu: g.context().is_cpu_device(), point_size_max: g.context().point_size_max() }
+            }
             None => raster::Device { cpu: true, point_size_max: f32::INFINITY },
         };
         let choice = raster::choose(&prep.set, camera, options, device)?;

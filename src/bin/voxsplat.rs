@@ -434,7 +434,8 @@ fn report_validation(r: &Renderer) -> Result<()> {
 fn median_timings(mut frames: Vec<voxsplat::Rendered>) -> voxsplat::Rendered {
     let mut last = frames.pop().expect("at least one frame");
     for t in &mut last.timings {
-        let mut v: Vec<f64> = frames.iter().flat_map(|f| f.timings.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
+        let mut v: Vec<f64> =
+            frames.iter().flat_map(|f| f.timings.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
         v.push(t.ms);
         t.ms = voxsplat::bench::median(&mut v);
     }

@@ -207,8 +207,10 @@ pub fn footprint_sum(inputs: &FootprintInputs<'_>, push: &FootprintPush, sums: &
 pub fn fixed_layer(sums: &[u32], layer: usize, width: u32, height: u32) -> ImageF32 {
     let n = width as usize * height as usize;
     let s = SUM_FIXED_SCALE as f32;
-    let pixels =
-        sums[4 * layer * n..4 * (layer + 1) * n].chunks_exact(4).map(|c| [0, 1, 2, 3].map(|i| c[i] as f32 / s)).collect();
+    let pixels = sums[4 * layer * n..4 * (layer + 1) * n]
+        .chunks_exact(4)
+        .map(|c| [0, 1, 2, 3].map(|i| c[i] as f32 / s))
+        .collect();
     ImageF32 { width, height, pixels }
 }
 

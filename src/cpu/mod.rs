@@ -14,7 +14,7 @@ pub use order::{order_count, order_scan, order_scatter};
 pub use raycast::raycast;
 pub use slab::{slab_count, slab_scan, slab_scatter};
 pub use splat_params::splat_params;
-pub use tile::{tile_composite, tile_count, tile_scan, tile_scatter};
+pub use tile::{tile_composite, tile_count, tile_offsets, tile_scan, tile_scatter};
 
 /// An RGBA32F image, row 0 at the top. Colour is premultiplied by alpha.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,5 +1,5 @@
 //! Mirrors of the compute per-splat compositing stages: `tile_count.comp`, `tile_scan.comp`,
-//! `tile_scatter.comp` (a stable counting sort of the draw list into screen tiles, so every tile's
+//! `tile_offsets.comp`, `tile_scatter.comp` (a stable counting sort of the draw list into screen tiles, so every tile's
 //! list keeps the PBTF order) and `tile_composite.comp` (each tile composites its list per pixel,
 //! front to back with early termination or back to front).
 use super::footprint::{footprint_weight, screen_quad, FootprintInputs};
@@ -47,13 +47,10 @@ fn each_tile(frame: &Frame, bx: [i32; 4], mut f: impl FnMut(usize)) {
     }
 }
 
+/// The count matrix arrives zeroed (the GPU fills it first).
 pub fn tile_count(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mut [u32], quads: &mut [ScreenQuad]) {
-    let (tx, ty) = tile_grid(inputs.frame);
     let chunks = push.chunks as usize;
     for chunk in 0..push.chunks {
-        for t in 0..(tx * ty) as usize {
-            counts[t * chunks + chunk as usize] = 0;
-        }
         for e in chunk_entries(push, chunk) {
             let splat = inputs.draw_list[e] as usize;
             let q = screen_record(inputs.frame, &inputs.params[splat]);
@@ -63,18 +60,30 @@ pub fn tile_count(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &m
     }
 }
 
-/// Exclusive prefix sum of the count matrix; `tile_start` gets each tile's first entry and the total.
+/// Each tile's row of the count matrix becomes offsets within the tile; `tile_start[t]` its total.
 pub fn tile_scan(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mut [u32], tile_start: &mut [u32]) {
+    let (tx, ty) = tile_grid(inputs.frame);
+    let chunks = push.chunks as usize;
+    for t in 0..(tx * ty) as usize {
+        let mut carry = 0u32;
+        for c in &mut counts[t * chunks..(t + 1) * chunks] {
+            let v = *c;
+            *c = carry;
+            carry += v;
+        }
+        tile_start[t] = carry;
+    }
+}
+
+/// Exclusive prefix sum of the tiles' totals; `tile_start[tiles]` gets the total.
+pub fn tile_offsets(inputs: &FootprintInputs<'_>, tile_start: &mut [u32]) {
     let (tx, ty) = tile_grid(inputs.frame);
     let tiles = (tx * ty) as usize;
     let mut carry = 0u32;
-    for c in counts.iter_mut().take(tiles * push.chunks as usize) {
-        let v = *c;
-        *c = carry;
-        carry += v;
-    }
-    for t in 0..tiles {
-        tile_start[t] = counts[t * push.chunks as usize];
+    for v in &mut tile_start[..tiles] {
+        let c = *v;
+        *v = carry;
+        carry += c;
     }
     tile_start[tiles] = carry;
 }
@@ -83,6 +92,7 @@ pub fn tile_scatter(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
     quads: &[ScreenQuad],
+    tile_start: &[u32],
     counts: &mut [u32],
     entries: &mut [u32],
 ) {
@@ -92,7 +102,7 @@ pub fn tile_scatter(
             let splat = inputs.draw_list[e];
             each_tile(inputs.frame, quads[splat as usize].bx, |t| {
                 let cell = t * chunks + chunk as usize;
-                entries[counts[cell] as usize] = splat;
+                entries[(tile_start[t] + counts[cell]) as usize] = splat;
                 counts[cell] += 1;
             });
         }
@@ -159,9 +169,10 @@ pub fn tile_bins_cpu(inputs: &FootprintInputs<'_>, push: &FootprintPush) -> Resu
     let mut quads = vec![ScreenQuad::default(); inputs.params.len()];
     tile_count(inputs, push, &mut counts, &mut quads);
     tile_scan(inputs, push, &mut counts, &mut start);
+    tile_offsets(inputs, &mut start);
     crate::raster::check_tile_entries(start[tiles] as u64)?;
     let mut entries = vec![0u32; start[tiles] as usize];
-    tile_scatter(inputs, push, &quads, &mut counts, &mut entries);
+    tile_scatter(inputs, push, &quads, &start, &mut counts, &mut entries);
     Ok(TileBins { start, entries, quads })
 }
 

@@ -184,7 +184,9 @@ pub enum Primitive {
 }
 
 fn spec_entries(specialization: &[u32]) -> Vec<vk::SpecializationMapEntry> {
-    (0..specialization.len() as u32).map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 }).collect()
+    (0..specialization.len() as u32)
+        .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+        .collect()
 }
 
 fn shader_module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
@@ -207,7 +209,12 @@ impl Pipeline {
     }
 
     /// A compute pipeline with `specialization[i]` as `constant_id = i` (see [`Pipeline::graphics`]).
-    pub fn compute_specialized(ctx: &Arc<Context>, layout: &Layout, spirv: &[u8], specialization: &[u32]) -> Result<Self> {
+    pub fn compute_specialized(
+        ctx: &Arc<Context>,
+        layout: &Layout,
+        spirv: &[u8],
+        specialization: &[u32],
+    ) -> Result<Self> {
         let module = shader_module(ctx, spirv)?;
         let entries = spec_entries(specialization);
         let spec = vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(specialization));
@@ -265,11 +272,10 @@ impl Pipeline {
                 .specialization_info(&spec),
         ];
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-        let assembly =
-            vk::PipelineInputAssemblyStateCreateInfo::default().topology(match primitive {
-                Primitive::Quads => vk::PrimitiveTopology::TRIANGLE_STRIP,
-                Primitive::Points => vk::PrimitiveTopology::POINT_LIST,
-            });
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(match primitive {
+            Primitive::Quads => vk::PrimitiveTopology::TRIANGLE_STRIP,
+            Primitive::Points => vk::PrimitiveTopology::POINT_LIST,
+        });
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
