@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::metrics::{compare, ImageMetrics};
 use crate::order::{count_violations, visibility_order};
 use crate::pipeline::{Antialias, Composite, RenderOptions, Rendered};
+use crate::raster::Raster;
 use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use crate::volume::{Grid, SplatSet};
 use crate::{scene, Direction, Kernel, OrderKind, Renderer};
@@ -18,7 +19,7 @@ use std::time::Instant;
 /// One rendering method of the matrix.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Method {
-    Splat { order: OrderKind, composite: Composite, kernel: Kernel, aa: Antialias },
+    Splat { order: OrderKind, composite: Composite, kernel: Kernel, aa: Antialias, raster: Raster },
     Raycast { step: f32 },
 }
 
@@ -29,22 +30,34 @@ fn aa_suffix(aa: Antialias) -> String {
     }
 }
 
-/// Plain splats (no anti-aliasing).
+/// Plain splats (no anti-aliasing) through the graphics pipeline.
 pub fn splat(order: OrderKind, composite: Composite, kernel: Kernel) -> Method {
-    Method::Splat { order, composite, kernel, aa: Antialias::None }
+    Method::Splat { order, composite, kernel, aa: Antialias::None, raster: Raster::Graphics }
+}
+
+/// PBTF splats with the Gaussian through a raster variant.
+pub fn rastered(composite: Composite, raster: Raster) -> Method {
+    Method::Splat { order: OrderKind::Pbtf, composite, kernel: Kernel::Gaussian, aa: Antialias::None, raster }
+}
+
+fn raster_suffix(raster: Raster) -> String {
+    match raster {
+        Raster::Graphics => String::new(),
+        other => format!(" {other}"),
+    }
 }
 
 impl Method {
     pub fn label(&self) -> String {
         match self {
-            Method::Splat { order, composite: Composite::Splat, kernel, aa } => {
-                format!("{order:?} splat {kernel:?}{}", aa_suffix(*aa))
+            Method::Splat { order, composite: Composite::Splat, kernel, aa, raster } => {
+                format!("{order:?} splat {kernel:?}{}{}", aa_suffix(*aa), raster_suffix(*raster))
             }
-            Method::Splat { composite: Composite::Sheet, kernel, aa, .. } => {
-                format!("sheet {kernel:?}{}", aa_suffix(*aa))
+            Method::Splat { composite: Composite::Sheet, kernel, aa, raster, .. } => {
+                format!("sheet {kernel:?}{}{}", aa_suffix(*aa), raster_suffix(*raster))
             }
-            Method::Splat { composite: Composite::Slab, kernel, aa, .. } => {
-                format!("slab {kernel:?}{}", aa_suffix(*aa))
+            Method::Splat { composite: Composite::Slab, kernel, aa, raster, .. } => {
+                format!("slab {kernel:?}{}{}", aa_suffix(*aa), raster_suffix(*raster))
             }
             Method::Raycast { step } => format!("raycast {step}"),
         }
@@ -81,6 +94,11 @@ impl MatrixOptions {
             methods.push(splat(OrderKind::Pbtf, Composite::Sheet, kernel));
             methods.push(splat(OrderKind::Pbtf, Composite::Slab, kernel));
         }
+        for composite in [Composite::Splat, Composite::Sheet, Composite::Slab] {
+            for raster in [Raster::Points, Raster::Compute] {
+                methods.push(rastered(composite, raster));
+            }
+        }
         for step in [1.0, 0.5, 0.25] {
             methods.push(Method::Raycast { step });
         }
@@ -104,6 +122,8 @@ impl MatrixOptions {
                 splat(OrderKind::Pbtf, Composite::Splat, g),
                 splat(OrderKind::Pbtf, Composite::Sheet, g),
                 splat(OrderKind::Pbtf, Composite::Slab, g),
+                rastered(Composite::Splat, Raster::Compute),
+                rastered(Composite::Sheet, Raster::Compute),
                 Method::Raycast { step: 1.0 },
                 Method::Raycast { step: 0.5 },
             ],
@@ -150,12 +170,13 @@ pub fn bench_camera(grid: &Grid, width: u32, height: u32) -> Camera {
 
 fn render_method(r: &mut Renderer, m: &Method, camera: &Camera) -> Result<Rendered> {
     match m {
-        Method::Splat { order, composite, kernel, aa } => {
+        Method::Splat { order, composite, kernel, aa, raster } => {
             let o = RenderOptions {
                 order: *order,
                 composite: *composite,
                 kernel: *kernel,
                 antialias: *aa,
+                raster: *raster,
                 ..Default::default()
             };
             r.render(camera, &o)
@@ -437,6 +458,8 @@ pub fn synthetic_cube(n: u32) -> Result<SplatSet> {
 #[derive(Clone, Debug)]
 pub struct ScalePoint {
     pub what: &'static str,
+    /// The footprint stage's raster variant (PBTF per-splat compositing).
+    pub raster: Raster,
     pub splats: usize,
     pub width: u32,
     pub time_ms: f64,
@@ -444,7 +467,11 @@ pub struct ScalePoint {
     pub gpu_bytes: u64,
 }
 
-/// Time against splat count (dense cubes of the given sides) and against image side (cube60).
+/// Every raster variant in the scaling curves.
+pub const SCALING_RASTERS: [Raster; 3] = [Raster::Graphics, Raster::Points, Raster::Compute];
+
+/// Time against splat count (dense cubes of the given sides) and against image side (cube60),
+/// PBTF per-splat compositing through every raster variant.
 pub fn scaling(
     r: &mut Renderer,
     cube_sides: &[u32],
@@ -453,24 +480,23 @@ pub fn scaling(
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<ScalePoint>> {
     let mut out = Vec::new();
-    let m = splat(OrderKind::Pbtf, Composite::Splat, Kernel::Gaussian);
     let gpu_bytes = |r: &Renderer| r.context().map(|c| c.allocation_report().1).unwrap_or(0);
+    let measure = |r: &mut Renderer, what, splats, camera: &Camera, out: &mut Vec<ScalePoint>| -> Result<()> {
+        for raster in SCALING_RASTERS {
+            let t = time_method(r, &rastered(Composite::Splat, raster), camera, 1, frames)?;
+            let order_ms = t.stages.iter().find(|s| s.0 == "order").map(|s| s.1).unwrap_or(f64::NAN);
+            let (time_ms, width, gpu_bytes) = (t.time_ms, camera.width, gpu_bytes(r));
+            out.push(ScalePoint { what, raster, splats, width, time_ms, order_ms, gpu_bytes });
+        }
+        Ok(())
+    };
     for &n in cube_sides {
         progress(&format!("scaling: {}^3 splats", n));
         let set = synthetic_cube(n)?;
         let splats = set.len();
         let camera = bench_camera(set.grid(), 512, 512);
         r.set_scene(set)?;
-        let t = time_method(r, &m, &camera, 1, frames)?;
-        let order_ms = t.stages.iter().find(|s| s.0 == "order").map(|s| s.1).unwrap_or(f64::NAN);
-        out.push(ScalePoint {
-            what: "splats",
-            splats,
-            width: 512,
-            time_ms: t.time_ms,
-            order_ms,
-            gpu_bytes: gpu_bytes(r),
-        });
+        measure(r, "splats", splats, &camera, &mut out)?;
     }
     let set = scene::build("cube60")?;
     let splats = set.len();
@@ -478,28 +504,19 @@ pub fn scaling(
     r.set_scene(set)?;
     for &side in image_sides {
         progress(&format!("scaling: {side}^2 image"));
-        let camera = bench_camera(&grid, side, side);
-        let t = time_method(r, &m, &camera, 1, frames)?;
-        let order_ms = t.stages.iter().find(|s| s.0 == "order").map(|s| s.1).unwrap_or(f64::NAN);
-        out.push(ScalePoint {
-            what: "image",
-            splats,
-            width: side,
-            time_ms: t.time_ms,
-            order_ms,
-            gpu_bytes: gpu_bytes(r),
-        });
+        measure(r, "image", splats, &bench_camera(&grid, side, side), &mut out)?;
     }
     Ok(out)
 }
 
 pub fn write_scaling_csv(points: &[ScalePoint], path: &Path) -> Result<()> {
-    let mut s = String::from("series,splats,image_side,time_ms,order_ms,gpu_bytes,gpu_bytes_per_splat\n");
+    let mut s = String::from("series,raster,splats,image_side,time_ms,order_ms,gpu_bytes,gpu_bytes_per_splat\n");
     for p in points {
         let _ = writeln!(
             s,
-            "{},{},{},{:.4},{:.4},{},{:.1}",
+            "{},{},{},{},{:.4},{:.4},{},{:.1}",
             p.what,
+            p.raster,
             p.splats,
             p.width,
             p.time_ms,
@@ -517,17 +534,24 @@ pub fn scaling_svg(points: &[ScalePoint], path: &Path) -> Result<()> {
     let root = SVGBackend::new(path, (900, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
     let halves = root.split_evenly((1, 2));
+    let colours = [BLUE, GREEN, RED];
     for (area, what) in halves.iter().zip(["splats", "image"]) {
-        let pts: Vec<(f64, f64)> = points
-            .iter()
-            .filter(|p| p.what == what)
-            .map(|p| (if what == "splats" { p.splats as f64 } else { (p.width as f64).powi(2) }, p.time_ms.max(1e-3)))
-            .collect();
-        if pts.is_empty() {
+        let series = |raster: Raster| -> Vec<(f64, f64)> {
+            points
+                .iter()
+                .filter(|p| p.what == what && p.raster == raster)
+                .map(|p| {
+                    let x = if what == "splats" { p.splats as f64 } else { (p.width as f64).powi(2) };
+                    (x, p.time_ms.max(1e-3))
+                })
+                .collect()
+        };
+        let all: Vec<(f64, f64)> = SCALING_RASTERS.iter().flat_map(|&r| series(r)).collect();
+        if all.is_empty() {
             continue;
         }
-        let (x0, x1) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
-        let (y0, y1) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        let (x0, x1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+        let (y0, y1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
         let mut chart = ChartBuilder::on(area)
             .caption(
                 if what == "splats" { "time vs splats (PBTF, 512^2)" } else { "time vs pixels (cube60)" },
@@ -544,8 +568,21 @@ pub fn scaling_svg(points: &[ScalePoint], path: &Path) -> Result<()> {
             .y_desc("ms per frame")
             .draw()
             .map_err(|e| plot_err(path, e))?;
-        chart.draw_series(LineSeries::new(pts.clone(), BLUE.stroke_width(2))).map_err(|e| plot_err(path, e))?;
-        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLUE.filled()))).map_err(|e| plot_err(path, e))?;
+        for (raster, colour) in SCALING_RASTERS.iter().zip(colours) {
+            let pts = series(*raster);
+            chart
+                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
+                .map_err(|e| plot_err(path, e))?
+                .label(raster.name())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled()))).map_err(|e| plot_err(path, e))?;
+        }
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
     }
     root.present().map_err(|e| plot_err(path, e))?;
     Ok(())
@@ -639,7 +676,7 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
     let per_splat: Vec<String> = rep
         .scaling
         .iter()
-        .filter(|p| p.what == "splats" && p.order_ms.is_finite())
+        .filter(|p| p.what == "splats" && p.raster == Raster::Graphics && p.order_ms.is_finite())
         .map(|p| format!("{} splats: {:.1} ns/splat", p.splats, p.order_ms * 1e6 / p.splats as f64))
         .collect();
     let _ = writeln!(
@@ -736,12 +773,16 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
     }
     if !rep.scaling.is_empty() {
         let _ = writeln!(s, "\n## Scaling\n\n![scaling]({})\n", link(&rep.chart_dir, "scaling.svg"));
-        let _ = writeln!(s, "| series | splats | image | ms | order ms | GPU bytes | bytes/splat |\n|---|---:|---:|---:|---:|---:|---:|");
+        let _ = writeln!(
+            s,
+            "| series | raster | splats | image | ms | order ms | GPU bytes | bytes/splat |\n|---|---|---:|---:|---:|---:|---:|---:|"
+        );
         for p in rep.scaling {
             let _ = writeln!(
                 s,
-                "| {} | {} | {}² | {:.2} | {:.3} | {} | {:.0} |",
+                "| {} | {} | {} | {}² | {:.2} | {:.3} | {} | {:.0} |",
                 p.what,
+                p.raster,
                 p.splats,
                 p.width,
                 p.time_ms,
@@ -790,7 +831,7 @@ pub fn antialias_study(
     for mode in [Antialias::None, Antialias::Swan, Antialias::Ewa] {
         progress(&format!("anti-aliasing: {mode:?}"));
         let m =
-            Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: Kernel::Gaussian, aa: mode };
+            Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: Kernel::Gaussian, aa: mode, raster: Raster::Graphics };
         let t = time_method(r, &m, &camera, 1, frames)?;
         let before = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
         let beyond = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);

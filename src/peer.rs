@@ -105,7 +105,14 @@ pub struct PeerRun {
 /// they are timed at 128³ only.
 pub fn variants(n: u32) -> Vec<crate::stability::Variant> {
     use crate::stability::Variant;
-    let mut v = vec![Variant::Splat(crate::OrderKind::Pbtf), Variant::Sheet];
+    use crate::{Composite, Raster};
+    let mut v = vec![
+        Variant::Splat(crate::OrderKind::Pbtf),
+        Variant::Rastered(Composite::Splat, Raster::Points),
+        Variant::Rastered(Composite::Splat, Raster::Compute),
+        Variant::Sheet,
+        Variant::Rastered(Composite::Sheet, Raster::Compute),
+    ];
     if n <= 128 {
         v.push(Variant::Slab(1.0));
     }

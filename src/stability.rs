@@ -3,6 +3,7 @@
 //! (b) brightening against screen splat density in perspective (Fig. 1.17);
 //! (c) per-splat compositing's dependence on the order of overlapping splats (Figs 1.13, 1.14);
 //! (d) BTF/WBTF visibility errors in perspective (Figs 2.25, 2.26, 5.1).
+use crate::raster::Raster;
 use crate::bench::median;
 use crate::camera::{Camera, Projection};
 use crate::cpu::raycast::RaycastOptions;
@@ -27,6 +28,9 @@ pub enum Variant {
     Slab(f32),
     /// The ray caster at this step (voxel spacings).
     Raycast(f32),
+    /// PBTF per-splat compositing, the axis-aligned sheet buffer or 1-voxel slabs through a raster
+    /// variant (the others draw instanced quads through the graphics pipeline).
+    Rastered(Composite, Raster),
 }
 
 impl Variant {
@@ -36,6 +40,11 @@ impl Variant {
             Variant::Sheet => "axis-aligned sheet".into(),
             Variant::Slab(t) => format!("image-aligned slab {t}"),
             Variant::Raycast(s) => format!("raycast {s}"),
+            Variant::Rastered(c, r) => match c {
+                Composite::Splat => format!("pbtf splat {r}"),
+                Composite::Sheet => format!("axis-aligned sheet {r}"),
+                Composite::Slab => format!("image-aligned slab 1 {r}"),
+            },
         }
     }
 
@@ -48,8 +57,12 @@ impl Variant {
     }
 
     pub fn render(&self, r: &mut Renderer, camera: &Camera) -> Result<Rendered> {
-        let mut o = RenderOptions::default();
+        let mut o = RenderOptions { raster: Raster::Graphics, ..Default::default() };
         match *self {
+            Variant::Rastered(composite, raster) => {
+                o.composite = composite;
+                o.raster = raster;
+            }
             Variant::Splat(order) => o.order = order,
             Variant::Sheet => o.composite = Composite::Sheet,
             Variant::Slab(t) => {
