@@ -604,7 +604,7 @@ pub struct Report<'a> {
 }
 
 /// A relative link to `file` in `dir` ("" = beside the page).
-fn link(dir: &str, file: &str) -> String {
+pub fn link(dir: &str, file: &str) -> String {
     if dir.is_empty() {
         file.to_string()
     } else {

@@ -33,6 +33,7 @@ pub mod output;
 pub mod peer;
 pub mod pipeline;
 pub mod raster;
+pub mod rates;
 pub mod scene;
 pub mod slab;
 pub mod soak;

@@ -132,8 +132,8 @@ fn quick_bench_writes_valid_csv_and_svg() {
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(
         rows.len(),
-        2 * 6 + 3 + 4,
-        "two scenes x six methods, three anti-aliasing modes, four motion-blur methods"
+        2 * 8 + 3 + 4,
+        "two scenes x eight methods, three anti-aliasing modes, four motion-blur methods"
     );
     for r in &rows {
         assert_eq!(r.len(), header.len());
@@ -153,17 +153,29 @@ fn quick_bench_writes_valid_csv_and_svg() {
         "chart-plane-grazing.svg",
         "chart-rotating-box.svg",
         "scaling.svg",
+        "rates.svg",
         "stability-popping.svg",
         "stability-error.svg",
     ] {
         let text = std::fs::read_to_string(dir.join(svg)).unwrap();
         assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"), "{svg}");
     }
-    assert!(std::fs::read_to_string(dir.join("chart-plane.svg")).unwrap().contains("sheet gaussian"));
+    let chart = std::fs::read_to_string(dir.join("chart-plane.svg")).unwrap();
+    assert!(chart.contains("sheet gaussian") && chart.contains("pbtf splat gaussian compute"));
     let scaling = std::fs::read_to_string(dir.join("scaling.csv")).unwrap();
-    assert_eq!(scaling.lines().count(), 1 + 2 + 2);
+    assert_eq!(scaling.lines().count(), 1 + 3 * (2 + 2), "three raster variants x four points");
+    // The raster sweep: six variants at two footprint sizes, every variant drawing the same picture.
+    let rates = std::fs::read_to_string(dir.join("rates.csv")).unwrap();
+    let rates: Vec<Vec<&str>> = rates.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rates.len(), 6 * 2);
+    for r in &rates {
+        let (per_s, rmse): (f64, f64) = (r[4].parse().unwrap(), r[5].parse().unwrap());
+        assert!(per_s > 0.0 && per_s.is_finite(), "{r:?}");
+        assert!(rmse < 0.02, "every variant close to the truth: {r:?}");
+    }
     let md = std::fs::read_to_string(&results).unwrap();
     assert!(md.contains("## Targets") && md.contains("chart-cube40.svg"));
+    assert!(md.contains("## Raster variants") && md.contains("rates.svg"));
     assert!(md.contains("## Anti-aliasing") && md.contains("Swan vs none beyond k"));
     assert!(md.contains("## Motion blur") && md.contains("accumulation"));
     assert!(md.contains("## Stability where methods fail") && md.contains("popping at the switch"));
@@ -218,7 +230,7 @@ fn peer_subcommand_times_every_mode() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert_eq!(rows.len(), 5, "splat, sheet, slab and two ray-caster steps: {csv}");
+    assert_eq!(rows.len(), 8, "splat (quads, points, compute), sheet (quads, compute), slab, two ray-caster steps: {csv}");
     for r in rows {
         let (label, ms) = r.rsplit_once(',').unwrap();
         assert!(ms.parse::<f64>().unwrap() > 0.0, "{r}");

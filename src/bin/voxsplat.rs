@@ -69,6 +69,19 @@ enum Command {
         #[arg(long, value_parser = parse_finite)]
         truth_step: Option<f32>,
     },
+    /// Splat rate of every raster variant against footprint size (the bench's raster sweep): a
+    /// sheet of N x N voxels head-on, footprints exactly S px wide; CSV on stdout.
+    Rates {
+        /// Voxels per side of the sheet.
+        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(4..=2048))]
+        n: u32,
+        /// Footprint quad sides in pixels, comma-separated.
+        #[arg(long, default_value = "3,5,7,11,15", value_delimiter = ',', value_parser = parse_finite)]
+        sizes: Vec<f32>,
+        /// Timed frames per variant (median; one warm-up first).
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+    },
     /// Print error metrics of image A against reference B (PNG or EXR).
     Compare {
         /// The image to score.
@@ -522,6 +535,16 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Animate(a) => animate(a),
+        Command::Rates { n, sizes, frames } => {
+            if frames < 1 {
+                return Err(Error::InvalidArgument("--frames must be at least 1".into()));
+            }
+            let mut r = Renderer::new(&RendererOptions::default())?;
+            eprintln!("device: {}", r.device_name());
+            let pts = voxsplat::rates::raster_rates(&mut r, n, &sizes, frames, |m| eprintln!("{m}"))?;
+            print!("{}", voxsplat::rates::rates_csv(&pts));
+            Ok(())
+        }
         Command::Peer { n, size, warmup, frames, out_dir, truth_step } => {
             if frames < 5 {
                 return Err(Error::InvalidArgument("--frames must be at least 5".into()));
@@ -732,6 +755,10 @@ fn bench(a: BenchArgs) -> Result<()> {
     let sizes: &[u32] = if a.quick { &[3, 7] } else { &[3, 7, 15, 31] };
     let frags = if a.quick { 1 << 20 } else { 8 << 20 };
     let roof = roofline(&mut r, w, h, sizes, frags, 5)?;
+    let (rate_n, rate_sizes): (u32, &[f32]) = if a.quick { (48, &[3.0, 7.0]) } else { (256, &[3.0, 5.0, 7.0, 11.0, 15.0]) };
+    let rates = voxsplat::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames, |msg| eprintln!("{msg}"))?;
+    voxsplat::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
+    voxsplat::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
     let scale = if a.no_scaling {
         Vec::new()
     } else {
@@ -757,8 +784,10 @@ fn bench(a: BenchArgs) -> Result<()> {
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
         // The peer comparison is its own run (scripts/peers.sh); its section is kept when present.
         let peers_md = std::fs::read_to_string(a.out_dir.join("peers.md")).unwrap_or_default();
+        let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
         let motion_md = format!(
-            "{}\n{}\n{}\n{}",
+            "{}\n{}\n{}\n{}\n{}",
+            voxsplat::rates::rates_markdown(&rates, &roof_rates, &voxsplat::bench::link(&chart_dir, "rates.svg")),
             antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
             motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
             voxsplat::stability::markdown(&stab, &chart_dir),
