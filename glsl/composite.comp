@@ -10,7 +10,7 @@ layout(binding = 0, rgba32f) uniform readonly image2DArray sums;
 layout(binding = 1, rgba32f) uniform image2D accum;
 layout(std430, binding = 2) writeonly buffer Occlusion { float occlusion[]; };
 // The compute raster's layers: fixed-point (rgb * tau, tau), SUM_FIXED_SCALE per unit.
-layout(std430, binding = 3) readonly buffer SumsFixed { uint sums_fixed[]; };
+layout(std430, binding = 3) readonly buffer SumsFixed { uvec4 sums_fixed[]; };
 // 1: read the sums from sums_fixed (footprint_sum.comp), 0: from the sums image (the raster pass).
 layout(constant_id = 0) const uint SUMS_FIXED = 0u;
 layout(push_constant) uniform Push {
@@ -31,9 +31,7 @@ void main() {
         for (uint l = 0u; l < pc.layers; ++l) {
             vec4 s;
             if (SUMS_FIXED != 0u) {
-                uint idx = 4u * ((l * pc.height + px.y) * pc.width + px.x);
-                uvec4 f = uvec4(sums_fixed[idx], sums_fixed[idx + 1u], sums_fixed[idx + 2u], sums_fixed[idx + 3u]);
-                s = vec4(f) / float(SUM_FIXED_SCALE);
+                s = vec4(sums_fixed[(l * pc.height + px.y) * pc.width + px.x]) / float(SUM_FIXED_SCALE);
             } else {
                 s = imageLoad(sums, ivec3(px, l));
             }

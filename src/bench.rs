@@ -575,7 +575,9 @@ pub fn scaling_svg(points: &[ScalePoint], path: &Path) -> Result<()> {
                 .map_err(|e| plot_err(path, e))?
                 .label(raster.name())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
-            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled()))).map_err(|e| plot_err(path, e))?;
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                .map_err(|e| plot_err(path, e))?;
         }
         chart
             .configure_series_labels()
@@ -830,8 +832,13 @@ pub fn antialias_study(
     let mut rows = Vec::new();
     for mode in [Antialias::None, Antialias::Swan, Antialias::Ewa] {
         progress(&format!("anti-aliasing: {mode:?}"));
-        let m =
-            Method::Splat { order: OrderKind::Pbtf, composite: Composite::Splat, kernel: Kernel::Gaussian, aa: mode, raster: Raster::Graphics };
+        let m = Method::Splat {
+            order: OrderKind::Pbtf,
+            composite: Composite::Splat,
+            kernel: Kernel::Gaussian,
+            aa: mode,
+            raster: Raster::Graphics,
+        };
         let t = time_method(r, &m, &camera, 1, frames)?;
         let before = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
         let beyond = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);

@@ -522,7 +522,7 @@ impl GpuPipeline {
         let (tx, ty) = crate::cpu::tile::tile_grid(&frame);
         let tiles = tx as usize * ty as usize;
         let starts =
-            bytemuck::cast_slice::<u8, u32>(&scene.tile_start.as_ref().expect("grown").1.read()?)[..tiles + 1].to_vec();
+            bytemuck::cast_slice::<u8, u32>(scene.tile_start.as_ref().expect("grown").1.read()?)[..tiles + 1].to_vec();
         let bytes = starts[tiles] as u64 * 4;
         let readback =
             Buffer::new(&self.ctx, "tile entries readback", bytes.max(4), BU::TRANSFER_DST, Memory::Readback)?;
@@ -662,7 +662,7 @@ impl GpuPipeline {
             layers,
             color,
             color_fb,
-            sums: sums,
+            sums,
             sums_fb,
             accum,
             occlusion,

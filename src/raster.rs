@@ -8,7 +8,8 @@
 //!
 //! The graphics pass is the design and what a hardware rasteriser is built for. A CPU device
 //! (lavapipe) pays per primitive, not per pixel (../shared/peers/README.md), so there small
-//! footprints are cheaper in compute. Point sprites draw a screen-aligned square of the footprint's
+//! footprints are cheaper in compute. `auto`: graphics on a hardware device; on a CPU device point
+//! sprites for orthographic views (exact there), compute for small footprints, graphics otherwise. Point sprites draw a screen-aligned square of the footprint's
 //! radius at its centre: exact in orthographic views, an approximation for perspective splats
 //! (docs/RESULTS.md measures it), and they cannot stretch along a motion path.
 use crate::camera::Camera;
@@ -109,13 +110,12 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
     FootprintSize { typical_px: diameter(centre), max_px: diameter(near) }
 }
 
-/// Above this typical footprint diameter `auto` keeps the graphics pipeline on a CPU device for
-/// the sheet modes: one invocation walks a whole footprint, so wide ones serialise (measured in
-/// docs/RESULTS.md, "Raster variants").
-pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 24.0;
-/// Above this typical diameter `auto` keeps the graphics pipeline for per-splat compositing on a
-/// CPU device: tile lists grow with the tiles a footprint covers.
-pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 48.0;
+/// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device, per-splat
+/// compositing (tile compositor) and sheet modes (fixed-point sums). Measured on lavapipe
+/// (`voxsplat rates`, docs/RESULTS.md): the tile compositor 2.2x the quads at 3 px, ~1.2-1.5x at
+/// 5-7 px, below 1x at 14 px in perspective; the sums 5.7x at 3 px, 2-2.9x at 5-7 px, ~1x from 11 px.
+pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 8.0;
+pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 
 /// Resolve `opts.raster` for this frame; `Auto` becomes a concrete variant. Explicit choices are
 /// checked: points cannot stretch along a motion path nor exceed the device's point size.
@@ -143,12 +143,17 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
                 Composite::Splat => AUTO_COMPUTE_TILES_MAX_PX,
                 Composite::Sheet | Composite::Slab => AUTO_COMPUTE_SUM_MAX_PX,
             };
+            let px = size.typical_px;
             let (raster, why) = if !device.cpu {
                 (Raster::Graphics, "hardware rasteriser".to_string())
-            } else if size.typical_px <= limit {
-                (Raster::Compute, format!("CPU device, footprints ~{:.1} px <= {limit:.0} px", size.typical_px))
+            } else if !camera.is_perspective() && opts.motion.is_none() && size.max_px <= device.point_size_max {
+                // Orthographic: a point sprite is the footprint exactly, and the fastest variant
+                // measured at every size.
+                (Raster::Points, "CPU device, orthographic view: point sprites are exact".to_string())
+            } else if px <= limit {
+                (Raster::Compute, format!("CPU device, footprints ~{px:.1} px <= {limit:.0} px"))
             } else {
-                (Raster::Graphics, format!("CPU device, footprints ~{:.1} px > {limit:.0} px", size.typical_px))
+                (Raster::Graphics, format!("CPU device, footprints ~{px:.1} px > {limit:.0} px"))
             };
             Ok(RasterChoice { raster, reason: format!("auto: {why}") })
         }

@@ -108,8 +108,7 @@ pub fn raster_rates(
         )?;
         for (composite, raster) in RATE_VARIANTS {
             let t = time_method(r, &rastered(composite, raster), &camera, 1, frames)?;
-            let before: f64 =
-                t.stages.iter().filter(|s| matches!(s.0, "order" | "splat_params")).map(|s| s.1).sum();
+            let before: f64 = t.stages.iter().filter(|s| matches!(s.0, "order" | "splat_params")).map(|s| s.1).sum();
             let raster_ms = t.time_ms - before;
             out.push(RatePoint {
                 composite,
@@ -160,8 +159,10 @@ pub fn rates_svg(points: &[RatePoint], path: &Path) -> Result<()> {
     };
     let root = SVGBackend::new(path, (760, 460)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let (x0, x1) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.size_px as f64), b.max(p.size_px as f64)));
-    let (y0, y1) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.splats_per_s), b.max(p.splats_per_s)));
+    let (x0, x1) =
+        points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.size_px as f64), b.max(p.size_px as f64)));
+    let (y0, y1) =
+        points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.splats_per_s), b.max(p.splats_per_s)));
     if !x0.is_finite() || !y0.is_finite() || y0 <= 0.0 {
         return Err(Error::InvalidArgument("no raster rates to chart".into()));
     }
@@ -212,7 +213,10 @@ pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str
          truth. Roofline: additive quads with the cheapest shaders (`roofline.vert/.frag`).\n",
         points.first().map(|p| p.splats).unwrap_or(0)
     );
-    let _ = writeln!(s, "| variant | px | ms | Msplats/s | RMSE | vs quads (same compositing) |\n|---|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "| variant | px | ms | Msplats/s | RMSE | vs quads (same compositing) |\n|---|---:|---:|---:|---:|---:|"
+    );
     for p in points {
         let quads = points
             .iter()
@@ -230,8 +234,7 @@ pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str
         );
     }
     if !roofline.is_empty() {
-        let cells: Vec<String> =
-            roofline.iter().map(|(px, q)| format!("{px} px: {:.2} M quads/s", q / 1e6)).collect();
+        let cells: Vec<String> = roofline.iter().map(|(px, q)| format!("{px} px: {:.2} M quads/s", q / 1e6)).collect();
         let _ = writeln!(s, "\nRaster roofline (this run): {}.", cells.join("; "));
     }
     // The target: compute at >= 2.5x the quads' splat rate for footprints of 7 px or less.

@@ -3,7 +3,6 @@
 //! (b) brightening against screen splat density in perspective (Fig. 1.17);
 //! (c) per-splat compositing's dependence on the order of overlapping splats (Figs 1.13, 1.14);
 //! (d) BTF/WBTF visibility errors in perspective (Figs 2.25, 2.26, 5.1).
-use crate::raster::Raster;
 use crate::bench::median;
 use crate::camera::{Camera, Projection};
 use crate::cpu::raycast::RaycastOptions;
@@ -12,6 +11,7 @@ use crate::error::Result;
 use crate::metrics::{compare, frame_changes, temporal_of};
 use crate::order::{count_violations, visibility_order, Direction, OrderKind};
 use crate::pipeline::{sheet_axis, Composite, RenderOptions, Rendered};
+use crate::raster::Raster;
 use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use crate::volume::{Grid, SplatSet};
 use crate::{scene, Renderer};

@@ -230,7 +230,11 @@ fn peer_subcommand_times_every_mode() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert_eq!(rows.len(), 8, "splat (quads, points, compute), sheet (quads, compute), slab, two ray-caster steps: {csv}");
+    assert_eq!(
+        rows.len(),
+        8,
+        "splat (quads, points, compute), sheet (quads, compute), slab, two ray-caster steps: {csv}"
+    );
     for r in rows {
         let (label, ms) = r.rsplit_once(',').unwrap();
         assert!(ms.parse::<f64>().unwrap() > 0.0, "{r}");

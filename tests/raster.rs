@@ -26,7 +26,7 @@ fn max_abs(a: &ImageF32, b: &ImageF32) -> f32 {
 fn close_up() -> (SplatSet, Camera) {
     let grid = Grid::centered([4, 3, 2], [1.0, 1.0, 1.0]).unwrap();
     let set = SplatSet::from_fn(grid, |i, j, k| {
-        ((i + j + k) % 2 == 0).then(|| [0.2 + 0.2 * i as f32, 0.3 * j as f32, 0.5 * k as f32 + 0.2, 0.6])
+        ((i + j + k) % 2 == 0).then_some([0.2 + 0.2 * i as f32, 0.3 * j as f32, 0.5 * k as f32 + 0.2, 0.6])
     })
     .unwrap();
     let cam = Camera {
@@ -220,7 +220,7 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
 }
 
 #[test]
-fn auto_picks_compute_for_small_footprints_on_a_cpu_device_and_says_so() {
+fn auto_picks_points_for_orthographic_views_compute_for_small_footprints_and_says_so() {
     let mut gpu = common::gpu();
     let set = scene::build("cube40").unwrap();
     gpu.set_scene(set.clone()).unwrap();
@@ -229,6 +229,13 @@ fn auto_picks_compute_for_small_footprints_on_a_cpu_device_and_says_so() {
     let choice = frame.raster.expect("a splatted frame reports its raster");
     assert_eq!(choice.raster, Raster::Compute);
     assert!(choice.reason.starts_with("auto: CPU device"), "{}", choice.reason);
+    let ortho = Camera { projection: Projection::Orthographic { height: 80.0 }, ..small };
+    let choice = gpu.render(&ortho, &opts(Composite::Sheet, Raster::Auto)).unwrap().raster.unwrap();
+    assert_eq!(choice.raster, Raster::Points, "orthographic: points are exact: {}", choice.reason);
+    let mut o = opts(Composite::Sheet, Raster::Auto);
+    o.motion = Some(voxsplat::pipeline::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
+    let choice = gpu.render(&ortho, &o).unwrap().raster.unwrap();
+    assert_eq!(choice.raster, Raster::Compute, "motion blur: never points: {}", choice.reason);
     let (set, cam) = close_up();
     gpu.set_scene(set).unwrap();
     let choice = gpu.render(&cam, &opts(Composite::Sheet, Raster::Auto)).unwrap().raster.unwrap();

@@ -755,7 +755,8 @@ fn bench(a: BenchArgs) -> Result<()> {
     let sizes: &[u32] = if a.quick { &[3, 7] } else { &[3, 7, 15, 31] };
     let frags = if a.quick { 1 << 20 } else { 8 << 20 };
     let roof = roofline(&mut r, w, h, sizes, frags, 5)?;
-    let (rate_n, rate_sizes): (u32, &[f32]) = if a.quick { (48, &[3.0, 7.0]) } else { (256, &[3.0, 5.0, 7.0, 11.0, 15.0]) };
+    let (rate_n, rate_sizes): (u32, &[f32]) =
+        if a.quick { (48, &[3.0, 7.0]) } else { (256, &[3.0, 5.0, 7.0, 11.0, 15.0]) };
     let rates = voxsplat::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames, |msg| eprintln!("{msg}"))?;
     voxsplat::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
     voxsplat::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
