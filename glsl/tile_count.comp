@@ -1,5 +1,5 @@
 #version 450
-// Compute per-splat compositing, binning pass 1 of 4 (the count matrix is zeroed before): each invocation owns a chunk of TILE_CHUNK
+// Compute per-splat compositing, binning pass 1 of 4 (the count matrix is zeroed before): each invocation owns a chunk of the
 // draw-list entries, records each one's footprint in screen space for the later stages and counts,
 // serially and without atomics, how many of them each screen tile receives (its column of the
 // tile x chunk count matrix). Mirror: cpu::tile::tile_count.

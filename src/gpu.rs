@@ -515,7 +515,7 @@ impl GpuPipeline {
             let cpu_order = order::visibility_order(&prep.set, camera, opts.order, opts.direction());
             scene.order.write(bytemuck::cast_slice(&cpu_order))?;
         }
-        let push = tile_push(opts, scene.n);
+        let push = tile_push(opts, scene.n, w, h);
         self.tile_prepass(&frame, &push, gpu_order)?;
         self.ensure_footprint_sets()?;
         let scene = self.scene.as_ref().expect("checked above");
@@ -922,7 +922,7 @@ impl GpuPipeline {
             host_ms = Some(("order_cpu", t));
         }
         let host_ms = host_ms.map(|(stage, t)| StageTime { stage, ms: t.elapsed().as_secs_f64() * 1e3 });
-        let tile_pc = tile_push(opts, scene.n);
+        let tile_pc = tile_push(opts, scene.n, w, h);
         if tiles {
             pre_timings = self.tile_prepass(&frame, &tile_pc, gpu_order)?;
         }

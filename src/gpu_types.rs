@@ -94,7 +94,8 @@ pub struct FootprintPush {
     /// Compute raster: first draw-list entry of the batch and the entry count.
     pub first: u32,
     pub count: u32,
-    /// Tile binning: entry chunks of `TILE_CHUNK` (columns of the tile x chunk count matrix).
+    /// Tile binning: chunks of the draw list (columns of the tile x chunk count matrix), each
+    /// `ceil(count / chunks)` entries.
     pub chunks: u32,
     /// Tile compositing: 1 = the list runs back to front (over), 0 = front to back (under).
     pub back_to_front: u32,

@@ -181,7 +181,10 @@ impl Renderer {
             slice_table: &[],
             occlusion: &[],
         };
-        let bins = cpu::tile::tile_bins_cpu(&inputs, &pipeline::tile_push(&opts, prep.set.len() as u32))?;
+        let bins = cpu::tile::tile_bins_cpu(
+            &inputs,
+            &pipeline::tile_push(&opts, prep.set.len() as u32, camera.width, camera.height),
+        )?;
         Ok((bins.start, bins.entries))
     }
 

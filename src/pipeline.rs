@@ -7,7 +7,7 @@
 //! | footprint      | `footprint.vert/.frag`       | `cpu::footprint`        |
 //! | composite      | `composite.comp`             | `cpu::composite`        |
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, TILE_CHUNK, WORKGROUP_SIZE};
+use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE, TILE_CHUNK, WORKGROUP_SIZE};
 use crate::cpu::{self, footprint::Blend, ImageF32};
 use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS};
@@ -361,12 +361,16 @@ pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_la
     (axis, batches)
 }
 
-/// Push constants of the tile binning and compositing stages for a draw list of `n` entries.
-pub fn tile_push(opts: &RenderOptions, n: u32) -> FootprintPush {
+/// Push constants of the tile binning and compositing stages for a draw list of `n` entries on a
+/// `width` x `height` image: chunks of `TILE_CHUNK` entries, fewer (and longer) where the count
+/// matrix would pass `raster::MAX_TILE_CELLS`.
+pub fn tile_push(opts: &RenderOptions, n: u32, width: u32, height: u32) -> FootprintPush {
     let btf = opts.direction() == Direction::BackToFront;
+    let tiles = (width.div_ceil(RASTER_TILE) as u64 * height.div_ceil(RASTER_TILE) as u64).max(1);
+    let most = (crate::raster::MAX_TILE_CELLS / tiles).max(1);
     FootprintPush {
         count: n,
-        chunks: n.div_ceil(TILE_CHUNK).max(1),
+        chunks: (n.div_ceil(TILE_CHUNK) as u64).clamp(1, most) as u32,
         back_to_front: btf as u32,
         occluded: if btf { 0.0 } else { opts.early_termination },
         ..Default::default()
@@ -431,7 +435,7 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                 occlusion: &[],
             };
             if compute {
-                let push = tile_push(opts, n as u32);
+                let push = tile_push(opts, n as u32, w, h);
                 let bins = cpu::tile::tile_bins_cpu(&inputs, &push)?;
                 lap("tile_bins", &mut timings);
                 cpu::tile_composite(&inputs, &push, &bins.quads, &bins.start, &bins.entries, &mut image);

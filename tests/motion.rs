@@ -5,7 +5,7 @@ use glam::{Mat4, Vec3};
 use voxsplat::animate::{render_frame, Animation, Blur};
 use voxsplat::output::diff_rgba8;
 use voxsplat::pipeline::Motion;
-use voxsplat::{Antialias, Camera, Composite, Grid, Kernel, Projection, RenderOptions, SplatSet};
+use voxsplat::{Antialias, Camera, Composite, Grid, Kernel, Projection, Raster, RenderOptions, SplatSet};
 
 fn one_voxel() -> SplatSet {
     let grid = Grid::centered([1, 1, 1], [1.0; 3]).unwrap();
@@ -26,10 +26,13 @@ fn ortho() -> Camera {
     }
 }
 
+/// One raster for still and blurred frames (`auto` would draw the still orthographic frame as point
+/// sprites, which cannot blur), so they compare bit for bit.
 fn sheet_with(motion: Option<Motion>) -> RenderOptions {
     let mut o = RenderOptions::default();
     o.composite = Composite::Sheet;
     o.motion = motion;
+    o.raster = Raster::Graphics;
     o
 }
 

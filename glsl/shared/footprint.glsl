@@ -30,7 +30,7 @@ layout(push_constant) uniform Push {
                        // transmittance left; the tile compositor stops a pixel there (0: off)
     uint first;        // compute raster: the batch's first draw-list entry
     uint count;        // compute raster: entries in the batch (tile binning: in the list)
-    uint chunks;       // tile binning: entry chunks of TILE_CHUNK
+    uint chunks;       // tile binning: draw-list chunks of ceil(count / chunks) entries
     uint back_to_front;// tile compositing: 1 = the list runs back to front
 } pc;
 

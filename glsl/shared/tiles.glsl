@@ -26,5 +26,6 @@ bool tile_range(ivec4 box, out uvec4 tiles) {
 
 // Entries [begin, end) of a binning chunk.
 uvec2 chunk_entries(uint chunk) {
-    return uvec2(chunk * TILE_CHUNK, min((chunk + 1u) * TILE_CHUNK, pc.count));
+    uint size = (pc.count + pc.chunks - 1u) / pc.chunks;
+    return uvec2(min(chunk * size, pc.count), min((chunk + 1u) * size, pc.count));
 }

@@ -4,7 +4,7 @@
 //! front to back with early termination or back to front).
 use super::footprint::{footprint_weight, screen_quad, FootprintInputs};
 use super::ImageF32;
-use crate::constants::{RASTER_TILE, TILE_CHUNK};
+use crate::constants::RASTER_TILE;
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams};
 use glam::{IVec4, Mat3, Vec2, Vec3};
@@ -32,7 +32,8 @@ pub fn tile_range(bx: [i32; 4]) -> Option<[u32; 4]> {
 }
 
 fn chunk_entries(push: &FootprintPush, chunk: u32) -> std::ops::Range<usize> {
-    (chunk * TILE_CHUNK) as usize..((chunk + 1) * TILE_CHUNK).min(push.count) as usize
+    let size = push.count.div_ceil(push.chunks.max(1));
+    (chunk * size).min(push.count) as usize..((chunk + 1) * size).min(push.count) as usize
 }
 
 /// Calls `f(tile)` for every tile the footprint box overlaps, row by row.
