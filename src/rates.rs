@@ -85,7 +85,13 @@ pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
     })
 }
 
-/// Time every variant of `RATE_VARIANTS` at each footprint size on an `n` x `n` sheet.
+/// Rounds of the sweep at each size: every variant is timed once per round, in turn, and each
+/// variant's time is the median over rounds, so a drift of the shared machine during a size lands
+/// on all variants alike.
+pub const RATE_ROUNDS: usize = 3;
+
+/// Time every variant of `RATE_VARIANTS` at each footprint size on an `n` x `n` sheet
+/// (`RATE_ROUNDS` interleaved rounds of `frames` frames after a warm-up).
 pub fn raster_rates(
     r: &mut Renderer,
     n: u32,
@@ -209,7 +215,8 @@ pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str
     let _ = writeln!(
         s,
         "One sheet of {} voxels, head-on and orthographic, footprint quads exactly N px wide; rate = splats \
-         over the median time of the stages after `splat_params`; RMSE against the volumetric-summation \
+         over the time of the stages after `splat_params` (median of {RATE_ROUNDS} rounds that take the \
+         variants in turn, each round the median of its frames); RMSE against the volumetric-summation \
          truth. Roofline: additive quads with the cheapest shaders (`roofline.vert/.frag`).\n",
         points.first().map(|p| p.splats).unwrap_or(0)
     );
