@@ -112,8 +112,8 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
 
 /// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device, per-splat
 /// compositing (tile compositor) and sheet modes (fixed-point sums). Measured on lavapipe
-/// (`voxsplat rates`, docs/RESULTS.md): the tile compositor 2.2x the quads at 3 px, ~1.2-1.5x at
-/// 5-7 px, below 1x at 14 px in perspective; the sums 5.7x at 3 px, 2-2.9x at 5-7 px, ~1x from 11 px.
+/// (`voxsplat rates`, docs/RESULTS.md): the tile compositor 1.9x the quads at 3 px, ~1.0x at 5-7 px,
+/// 0.9x at 14 px in perspective (the peer scene); the sums 3.2-3.6x at 3-7 px, 1.4-1.7x at 11-15 px.
 pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 8.0;
 pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 

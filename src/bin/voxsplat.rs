@@ -757,7 +757,8 @@ fn bench(a: BenchArgs) -> Result<()> {
     let roof = roofline(&mut r, w, h, sizes, frags, 5)?;
     let (rate_n, rate_sizes): (u32, &[f32]) =
         if a.quick { (48, &[3.0, 7.0]) } else { (256, &[3.0, 5.0, 7.0, 11.0, 15.0]) };
-    let rates = voxsplat::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames.clamp(3, 5), |msg| eprintln!("{msg}"))?;
+    let rates =
+        voxsplat::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames.clamp(3, 5), |msg| eprintln!("{msg}"))?;
     voxsplat::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
     voxsplat::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
     let scale = if a.no_scaling {
