@@ -475,8 +475,7 @@ impl GpuPipeline {
             Box::new(move |rec| {
                 rec.fill_buffer(counts, 0);
                 rec.barrier(Stage::Transfer, Stage::Compute);
-                let groups = [push.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1];
-                rec.dispatch(&st.tile_count, &st.footprint_layout, set, bytes, groups);
+                rec.dispatch(&st.tile_count, &st.footprint_layout, set, bytes, tile_chunk_groups(push));
                 rec.barrier(Stage::Compute, Stage::Compute);
                 rec.dispatch(&st.tile_scan, &st.footprint_layout, set, bytes, groups_1d(tiles as u32));
                 rec.barrier(Stage::Compute, Stage::Compute);
@@ -512,8 +511,7 @@ impl GpuPipeline {
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let gpu_order = opts.order == OrderKind::Pbtf;
         if !gpu_order {
-            let cpu_order = order::visibility_order(&prep.set, camera, opts.order, opts.direction());
-            scene.order.write(bytemuck::cast_slice(&cpu_order))?;
+            upload_host_order(scene, prep, camera, opts.order, opts.direction())?;
         }
         let push = tile_push(opts, scene.n, w, h);
         self.tile_prepass(&frame, &push, gpu_order)?;
@@ -529,8 +527,13 @@ impl GpuPipeline {
         let (st, entries) = (&self.stages, scene.tile_entries.as_ref().expect("grown"));
         let set = &scene.footprint_sets[0];
         self.ctx.submit(|rec| {
-            let groups = [push.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1];
-            rec.dispatch(&st.tile_scatter, &st.footprint_layout, set, bytemuck::bytes_of(&push), groups);
+            rec.dispatch(
+                &st.tile_scatter,
+                &st.footprint_layout,
+                set,
+                bytemuck::bytes_of(&push),
+                tile_chunk_groups(&push),
+            );
             rec.barrier(Stage::Compute, Stage::Transfer);
             rec.copy_buffer(entries, &readback, bytes);
             Ok(())
@@ -917,8 +920,7 @@ impl GpuPipeline {
         let gpu_order = opts.composite == Composite::Splat && opts.order == OrderKind::Pbtf;
         if opts.composite == Composite::Splat && !gpu_order {
             let t = Instant::now();
-            let cpu_order = order::visibility_order(&prep.set, camera, opts.order, direction);
-            scene.order.write(bytemuck::cast_slice(&cpu_order))?;
+            upload_host_order(scene, prep, camera, opts.order, direction)?;
             host_ms = Some(("order_cpu", t));
         }
         let host_ms = host_ms.map(|(stage, t)| StageTime { stage, ms: t.elapsed().as_secs_f64() * 1e3 });
@@ -959,8 +961,7 @@ impl GpuPipeline {
                 steps.push((
                     "tile_bins",
                     Box::new(move |rec| {
-                        let groups = [tile_pc.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1];
-                        rec.dispatch(&st.tile_scatter, &st.footprint_layout, set, push, groups);
+                        rec.dispatch(&st.tile_scatter, &st.footprint_layout, set, push, tile_chunk_groups(&tile_pc));
                         rec.barrier(Stage::Compute, Stage::Compute);
                     }),
                 ));
@@ -1149,6 +1150,22 @@ fn read_image(readback: &Buffer, w: u32, h: u32) -> Result<ImageF32> {
     let floats: &[f32] = bytemuck::cast_slice(&bytes[..(w * h * 16) as usize]);
     let pixels = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
     Ok(ImageF32 { width: w, height: h, pixels })
+}
+
+/// Upload a visibility order computed on the host (orders other than PBTF) as the draw list.
+fn upload_host_order(
+    scene: &mut SceneGpu,
+    prep: &Prepared,
+    camera: &Camera,
+    kind: OrderKind,
+    dir: Direction,
+) -> Result<()> {
+    scene.order.write(bytemuck::cast_slice(&order::visibility_order(&prep.set, camera, kind, dir)))
+}
+
+/// Workgroups of the tile binning passes that walk the draw list chunk by chunk.
+fn tile_chunk_groups(push: &FootprintPush) -> [u32; 3] {
+    [push.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1]
 }
 
 fn record_order(rec: &crate::vk::Recorder<'_>, st: &Stages, scene: &SceneGpu) {
