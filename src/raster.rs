@@ -8,10 +8,13 @@
 //!
 //! The graphics pass is the design and what a hardware rasteriser is built for. A CPU device
 //! (lavapipe) pays per primitive, not per pixel (../shared/peers/README.md), so there small
-//! footprints are cheaper in compute. `auto`: graphics on a hardware device; on a CPU device point
-//! sprites for orthographic views (exact there), compute for small footprints, graphics otherwise. Point sprites draw a screen-aligned square of the footprint's
-//! radius at its centre: exact in orthographic views, an approximation for perspective splats
-//! (docs/RESULTS.md measures it), and they cannot stretch along a motion path.
+//! footprints are cheaper in compute. `auto`: graphics on a hardware device; on a CPU device the
+//! fixed-point sums for sheet modes with small footprints, else point sprites where they fit
+//! (no motion blur, footprints within the device's point size), else compute for small footprints,
+//! else graphics. Point sprites draw a screen-aligned square of the footprint's radius at its
+//! centre: exact in orthographic views; for perspective splats they ignore the eye-facing quad's
+//! off-axis elongation, which measured no worse against the truth than the quads (docs/MODEL.md);
+//! they cannot stretch along a motion path.
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::pipeline::{Composite, RenderOptions};
@@ -111,9 +114,10 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
 }
 
 /// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device, per-splat
-/// compositing (tile compositor) and sheet modes (fixed-point sums). Measured on lavapipe
-/// (`voxsplat rates`, docs/RESULTS.md): the tile compositor 1.9x the quads at 3 px, ~1.0x at 5-7 px,
-/// 0.9x at 14 px in perspective (the peer scene); the sums 3.2-3.6x at 3-7 px, 1.4-1.7x at 11-15 px.
+/// compositing (tile compositor, where point sprites are not allowed: motion blur) and sheet modes
+/// (fixed-point sums). Measured on lavapipe (`voxsplat rates`, docs/RESULTS.md): the tile
+/// compositor 1.9x the quads at 3 px, ~1.0x at 5-7 px, 0.9x at 14 px in perspective (the peer
+/// scene); the sums 3.2-3.6x at 3-7 px, 1.4-1.7x at 11-15 px, ahead of point sprites up to 11 px.
 pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 8.0;
 pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 
@@ -144,12 +148,21 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
                 Composite::Sheet | Composite::Slab => AUTO_COMPUTE_SUM_MAX_PX,
             };
             let px = size.typical_px;
+            let points_fit = opts.motion.is_none() && size.max_px <= device.point_size_max;
+            let sheets = opts.composite != Composite::Splat;
+            // Point sprites: exact in orthographic views; in perspective as close to the truth as
+            // the eye-facing quads (docs/MODEL.md, "Raster variants"), and the fastest per-splat
+            // variant measured at every footprint size.
+            let view = if camera.is_perspective() { "perspective" } else { "orthographic" };
             let (raster, why) = if !device.cpu {
                 (Raster::Graphics, "hardware rasteriser".to_string())
-            } else if !camera.is_perspective() && opts.motion.is_none() && size.max_px <= device.point_size_max {
-                // Orthographic: a point sprite is the footprint exactly, and the fastest variant
-                // measured at every size.
-                (Raster::Points, "CPU device, orthographic view: point sprites are exact".to_string())
+            } else if sheets && px <= limit {
+                (Raster::Compute, format!("CPU device, footprints ~{px:.1} px <= {limit:.0} px: fixed-point sums"))
+            } else if points_fit {
+                (
+                    Raster::Points,
+                    format!("CPU device, {view} view, footprints up to {:.0} px: point sprites", size.max_px),
+                )
             } else if px <= limit {
                 (Raster::Compute, format!("CPU device, footprints ~{px:.1} px <= {limit:.0} px"))
             } else {

@@ -198,6 +198,32 @@ fn compute_raster_is_bit_identical_run_to_run() {
     assert_clean(&gpu);
 }
 
+/// Why `auto` takes point sprites in perspective views too: against the volumetric truth they
+/// score as well as the eye-facing quads they stand in for, from a narrow to a wide field of view
+/// (their difference from the quads is an order of magnitude below either one's error).
+#[test]
+fn points_in_perspective_are_as_close_to_the_truth_as_the_quads() {
+    use voxsplat::metrics::compare;
+    use voxsplat::truth::{volumetric_summation, TruthOptions};
+    let mut gpu = common::gpu();
+    let set = scene::build("cube40").unwrap();
+    gpu.set_scene(set.clone()).unwrap();
+    for fov in [20.0f32, 60.0] {
+        // The 35-degree framing's eye: at 20 degrees the cube overflows the view, at 60 it is small.
+        let mut cam = Camera::framing(set.grid(), 128, 128);
+        cam.projection = Projection::Perspective { fov_y_deg: fov };
+        let truth = volumetric_summation(&set, &cam, &TruthOptions::default()).unwrap();
+        let quads = gpu.render(&cam, &opts(Composite::Splat, Raster::Graphics)).unwrap().image;
+        let points = gpu.render(&cam, &opts(Composite::Splat, Raster::Points)).unwrap().image;
+        let (q, p) = (compare(&quads, &truth).unwrap().rmse, compare(&points, &truth).unwrap().rmse);
+        let between = compare(&points, &quads).unwrap().rmse;
+        eprintln!("fov {fov}: RMSE vs truth quads {q:.5} points {p:.5}; points vs quads {between:.5}");
+        assert!(p <= q * 1.05, "fov {fov}: points {p} against quads {q}");
+        assert!(between < 0.5 * q, "fov {fov}: points and quads differ by {between}, the error is {q}");
+    }
+    assert_clean(&gpu);
+}
+
 #[test]
 fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
     let mut gpu = common::gpu();
@@ -220,25 +246,42 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
 }
 
 #[test]
-fn auto_picks_points_for_orthographic_views_compute_for_small_footprints_and_says_so() {
-    let mut gpu = common::gpu();
+fn auto_rule_points_where_they_fit_sums_for_small_sheets_else_compute_or_graphics_and_says_so() {
+    use voxsplat::raster::{choose, Device};
     let set = scene::build("cube40").unwrap();
-    gpu.set_scene(set.clone()).unwrap();
     let small = Camera::framing(set.grid(), 96, 80);
+    let cpu = Device { cpu: true, point_size_max: 64.0 };
+    let wide_points = Device { cpu: true, point_size_max: 256.0 };
+    let pick = |set: &SplatSet, cam: &Camera, o: &RenderOptions, d: Device| choose(set, cam, o, d).unwrap();
+    let mut blurred = opts(Composite::Splat, Raster::Auto);
+    blurred.motion = Some(voxsplat::pipeline::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
+
+    let c = pick(&set, &small, &opts(Composite::Splat, Raster::Auto), cpu);
+    assert_eq!(c.raster, Raster::Points, "{}", c.reason);
+    assert!(c.reason.contains("perspective"), "{}", c.reason);
+    let ortho = Camera { projection: Projection::Orthographic { height: 80.0 }, ..small };
+    assert_eq!(pick(&set, &ortho, &opts(Composite::Splat, Raster::Auto), cpu).raster, Raster::Points);
+    let c = pick(&set, &small, &opts(Composite::Sheet, Raster::Auto), cpu);
+    assert_eq!(c.raster, Raster::Compute, "small sheet footprints: fixed-point sums: {}", c.reason);
+    let c = pick(&set, &small, &blurred, cpu);
+    assert_eq!(c.raster, Raster::Compute, "motion blur, small footprints: the tile compositor: {}", c.reason);
+    let hw = Device { cpu: false, point_size_max: 64.0 };
+    assert_eq!(pick(&set, &small, &opts(Composite::Splat, Raster::Auto), hw).raster, Raster::Graphics);
+
+    // Footprints 40-110 px: past a 64-px point size the quads; within a 256-px one point sprites,
+    // sheets included; never points with motion blur.
+    let (close, cam) = close_up();
+    assert_eq!(pick(&close, &cam, &opts(Composite::Splat, Raster::Auto), cpu).raster, Raster::Graphics);
+    assert_eq!(pick(&close, &cam, &opts(Composite::Sheet, Raster::Auto), cpu).raster, Raster::Graphics);
+    assert_eq!(pick(&close, &cam, &opts(Composite::Splat, Raster::Auto), wide_points).raster, Raster::Points);
+    assert_eq!(pick(&close, &cam, &opts(Composite::Sheet, Raster::Auto), wide_points).raster, Raster::Points);
+    assert_eq!(pick(&close, &cam, &blurred, wide_points).raster, Raster::Graphics);
+
+    // The renderer resolves auto per frame and reports what it drew.
+    let mut gpu = common::gpu();
+    gpu.set_scene(set).unwrap();
     let frame = gpu.render(&small, &opts(Composite::Splat, Raster::Auto)).unwrap();
     let choice = frame.raster.expect("a splatted frame reports its raster");
-    assert_eq!(choice.raster, Raster::Compute);
     assert!(choice.reason.starts_with("auto: CPU device"), "{}", choice.reason);
-    let ortho = Camera { projection: Projection::Orthographic { height: 80.0 }, ..small };
-    let choice = gpu.render(&ortho, &opts(Composite::Sheet, Raster::Auto)).unwrap().raster.unwrap();
-    assert_eq!(choice.raster, Raster::Points, "orthographic: points are exact: {}", choice.reason);
-    let mut o = opts(Composite::Sheet, Raster::Auto);
-    o.motion = Some(voxsplat::pipeline::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
-    let choice = gpu.render(&ortho, &o).unwrap().raster.unwrap();
-    assert_eq!(choice.raster, Raster::Compute, "motion blur: never points: {}", choice.reason);
-    let (set, cam) = close_up();
-    gpu.set_scene(set).unwrap();
-    let choice = gpu.render(&cam, &opts(Composite::Sheet, Raster::Auto)).unwrap().raster.unwrap();
-    assert_eq!(choice.raster, Raster::Graphics, "wide footprints stay on the raster pipeline: {}", choice.reason);
     assert_clean(&gpu);
 }
