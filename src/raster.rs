@@ -10,8 +10,8 @@
 //! (lavapipe) pays per primitive, not per pixel (../shared/peers/README.md), so there small
 //! footprints are cheaper in compute. `auto`: graphics on a hardware device; on a CPU device the
 //! fixed-point sums for sheet modes with small footprints, else point sprites where they fit
-//! (no motion blur, footprints within the device's point size), else compute for small footprints,
-//! else graphics. Point sprites draw a screen-aligned square of the footprint's radius at its
+//! (no motion blur, footprints from `AUTO_POINTS_MIN_PX` to the device's point size), else compute
+//! for small footprints, else graphics. Point sprites draw a screen-aligned square of the footprint's radius at its
 //! centre: exact in orthographic views; for perspective splats they ignore the eye-facing quad's
 //! off-axis elongation, which measured no worse against the truth than the quads (docs/MODEL.md);
 //! they cannot stretch along a motion path.
@@ -86,6 +86,8 @@ pub struct FootprintSize {
     pub typical_px: f32,
     /// At the nearest grid corner's depth (the largest footprint).
     pub max_px: f32,
+    /// At the farthest grid corner's depth (the smallest footprint).
+    pub min_px: f32,
 }
 
 /// Footprint diameter estimate for `set` seen from `camera` with `opts` (anti-aliasing widens far
@@ -95,11 +97,12 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
     let g = set.grid();
     let eye = camera.eye;
     let forward = camera.forward();
-    let (mut near, mut sum) = (f32::INFINITY, 0.0);
+    let (mut near, mut far, mut sum) = (f32::INFINITY, f32::NEG_INFINITY, 0.0);
     for c in 0..8u32 {
         let ijk = [0, 1, 2].map(|a| if c >> a & 1 == 1 { g.dims[a].saturating_sub(1) } else { 0 });
         let d = (g.position(ijk) - eye).dot(forward);
         near = near.min(d);
+        far = far.max(d);
         sum += d;
     }
     let centre = sum / 8.0;
@@ -110,7 +113,7 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
         let ppu = frame.up[3];
         2.0 * if camera.is_perspective() { radius * ppu / depth } else { radius * ppu }
     };
-    FootprintSize { typical_px: diameter(centre), max_px: diameter(near) }
+    FootprintSize { typical_px: diameter(centre), max_px: diameter(near), min_px: diameter(far) }
 }
 
 /// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device, per-splat
@@ -120,6 +123,12 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
 /// scene); the sums 3.2-3.6x at 3-7 px, 1.4-1.7x at 11-15 px, ahead of point sprites up to 11 px.
 pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 8.0;
 pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
+/// Narrowest footprint (px) for which `auto` draws point sprites. Below about a pixel the device
+/// clamps a sprite to its minimum point size and evaluates the footprint at the sprite's centre, so
+/// a sub-pixel splat lands on a whole pixel at its peak weight where a quad covers no pixel centre
+/// (bonsai at 96x72: 3.5/255 mean, 220/255 largest difference). Quads and compute sample the same
+/// pixel centres.
+pub const AUTO_POINTS_MIN_PX: f32 = 2.0;
 
 /// Resolve `opts.raster` for this frame; `Auto` becomes a concrete variant. Explicit choices are
 /// checked: points cannot stretch along a motion path nor exceed the device's point size.
@@ -148,7 +157,8 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
                 Composite::Sheet | Composite::Slab => AUTO_COMPUTE_SUM_MAX_PX,
             };
             let px = size.typical_px;
-            let points_fit = opts.motion.is_none() && size.max_px <= device.point_size_max;
+            let points_fit =
+                opts.motion.is_none() && size.max_px <= device.point_size_max && size.min_px >= AUTO_POINTS_MIN_PX;
             let sheets = opts.composite != Composite::Splat;
             // Point sprites: exact in orthographic views; in perspective as close to the truth as
             // the eye-facing quads (docs/MODEL.md, "Raster variants"), and the fastest per-splat

@@ -259,6 +259,11 @@ fn auto_rule_points_where_they_fit_sums_for_small_sheets_else_compute_or_graphic
     let c = pick(&set, &small, &opts(Composite::Splat, Raster::Auto), cpu);
     assert_eq!(c.raster, Raster::Points, "{}", c.reason);
     assert!(c.reason.contains("perspective"), "{}", c.reason);
+    // Sub-pixel footprints: the device would clamp a sprite to its smallest point; compute
+    // samples pixel centres as the quads do.
+    let tiny = Camera::framing(set.grid(), 24, 20);
+    let c = pick(&set, &tiny, &opts(Composite::Splat, Raster::Auto), cpu);
+    assert_eq!(c.raster, Raster::Compute, "{}", c.reason);
     let ortho = Camera { projection: Projection::Orthographic { height: 80.0 }, ..small };
     assert_eq!(pick(&set, &ortho, &opts(Composite::Splat, Raster::Auto), cpu).raster, Raster::Points);
     let c = pick(&set, &small, &opts(Composite::Sheet, Raster::Auto), cpu);
