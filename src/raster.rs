@@ -11,10 +11,10 @@
 //! footprints are cheaper in compute. `auto`: graphics on a hardware device; on a CPU device the
 //! fixed-point sums for sheet modes with small footprints, else point sprites where they fit
 //! (no motion blur, footprints from `AUTO_POINTS_MIN_PX` to the device's point size), else compute
-//! for small footprints, else graphics. Point sprites draw a screen-aligned square of the footprint's radius at its
-//! centre: exact in orthographic views; for perspective splats they ignore the eye-facing quad's
-//! off-axis elongation, which measured no worse against the truth than the quads (docs/MODEL.md);
-//! they cannot stretch along a motion path.
+//! for small footprints, else graphics. Point sprites draw a screen-aligned square of the
+//! footprint's radius at its centre: exact in orthographic views; for perspective splats they
+//! ignore the eye-facing quad's off-axis elongation, which measured no worse against the truth than
+//! the quads (docs/MODEL.md); they cannot stretch along a motion path.
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::pipeline::{Composite, RenderOptions};
