@@ -110,6 +110,7 @@ pub fn variants(n: u32) -> Vec<crate::stability::Variant> {
         Variant::Splat(crate::OrderKind::Pbtf),
         Variant::Rastered(Composite::Splat, Raster::Points),
         Variant::Rastered(Composite::Splat, Raster::Compute),
+        Variant::Kernel(crate::Kernel::Narrow, Raster::Points),
         Variant::Sheet,
         Variant::Rastered(Composite::Sheet, Raster::Compute),
     ];

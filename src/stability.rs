@@ -31,6 +31,8 @@ pub enum Variant {
     /// PBTF per-splat compositing, the axis-aligned sheet buffer or 1-voxel slabs through a raster
     /// variant (the others draw instanced quads through the graphics pipeline).
     Rastered(Composite, Raster),
+    /// PBTF per-splat compositing with another reconstruction kernel, through a raster variant.
+    Kernel(crate::Kernel, Raster),
 }
 
 impl Variant {
@@ -45,6 +47,7 @@ impl Variant {
                 Composite::Sheet => format!("axis-aligned sheet {r}"),
                 Composite::Slab => format!("image-aligned slab 1 {r}"),
             },
+            Variant::Kernel(k, r) => format!("pbtf splat {r} {}", k.name()),
         }
     }
 
@@ -52,6 +55,7 @@ impl Variant {
     pub fn reconstruction(&self) -> Reconstruction {
         match self {
             Variant::Raycast(_) => Reconstruction::Trilinear,
+            Variant::Kernel(k, _) => Reconstruction::Kernel(*k),
             _ => Reconstruction::Kernel(crate::Kernel::Gaussian),
         }
     }
@@ -61,6 +65,10 @@ impl Variant {
         match *self {
             Variant::Rastered(composite, raster) => {
                 o.composite = composite;
+                o.raster = raster;
+            }
+            Variant::Kernel(kernel, raster) => {
+                o.kernel = kernel;
                 o.raster = raster;
             }
             Variant::Splat(order) => o.order = order,

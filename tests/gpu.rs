@@ -63,7 +63,7 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
         gpu.set_scene(set.clone()).unwrap();
         cpu.set_scene(set).unwrap();
         for composite in [Composite::Splat, Composite::Sheet, Composite::Slab] {
-            for kernel in [Kernel::Gaussian, Kernel::Cubic] {
+            for kernel in [Kernel::Gaussian, Kernel::Cubic, Kernel::Narrow] {
                 for direction in [Direction::BackToFront, Direction::FrontToBack] {
                     let mut o = options(composite, kernel);
                     o.direction = Some(direction);
@@ -78,6 +78,8 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
                         (Kernel::Gaussian, Direction::FrontToBack) => Antialias::Swan,
                         (Kernel::Cubic, Direction::BackToFront) => Antialias::Ewa,
                         (Kernel::Cubic, Direction::FrontToBack) => Antialias::Swan,
+                        (Kernel::Narrow, Direction::BackToFront) => Antialias::None,
+                        (Kernel::Narrow, Direction::FrontToBack) => Antialias::Ewa,
                     };
                     // Small batches so several batches and the layer arithmetic are exercised.
                     o.sheet_budget_bytes = 192 * 160 * 16 * 7;

@@ -179,3 +179,13 @@ fn empty_space_skipping_changes_no_pixel() {
     }
     common::assert_clean(&gpu);
 }
+
+/// The narrow kernel's trade-off, measured: flat sheets ripple where the default Gaussian's
+/// footprints sum to a constant (the values docs/MODEL.md quotes).
+#[test]
+fn sheet_ripple_of_each_kernel() {
+    let r: Vec<f64> = voxsplat::kernel::KERNELS.iter().map(|k| k.sheet_ripple()).collect();
+    eprintln!("sheet ripple: gaussian {:.4} cubic {:.4} narrow {:.4}", r[0], r[1], r[2]);
+    assert!(r[0] < 0.01, "the default Gaussian sums flat: {}", r[0]);
+    assert!(r[2] > r[0] && r[2] > 0.01, "the narrow kernel shows the grid: {}", r[2]);
+}
