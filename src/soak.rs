@@ -3,8 +3,9 @@
 //! the allocator's report at the start of each cycle must not grow.
 use crate::camera::Camera;
 use crate::error::Result;
+use crate::kernel::KERNELS;
 use crate::pipeline::{Antialias, Composite, RenderOptions};
-use crate::{scene, Kernel, OrderKind, Renderer};
+use crate::{scene, OrderKind, Renderer};
 
 /// Frames per repetition of the sequence.
 pub const CYCLE: usize = 12;
@@ -93,7 +94,7 @@ pub fn soak(r: &mut Renderer, frames: usize, size: u32, mut progress: impl FnMut
         let opts = RenderOptions {
             order: [OrderKind::Pbtf, OrderKind::Wbtf][step % 2],
             composite: if step % 3 == 2 { Composite::Sheet } else { Composite::Splat },
-            kernel: if step % 4 < 2 { Kernel::Gaussian } else { Kernel::Cubic },
+            kernel: KERNELS[step / 2 % KERNELS.len()],
             antialias: [Antialias::None, Antialias::Swan, Antialias::Ewa][step % 3],
             ..Default::default()
         };
