@@ -49,12 +49,10 @@ fn simpson(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
 impl std::str::FromStr for Kernel {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        match s {
-            "gaussian" => Ok(Self::Gaussian),
-            "cubic" => Ok(Self::Cubic),
-            "narrow" => Ok(Self::Narrow),
-            _ => Err(Error::InvalidArgument(format!("unknown kernel '{s}' (gaussian, cubic, narrow)"))),
-        }
+        KERNELS.into_iter().find(|k| k.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = KERNELS.iter().map(|k| k.name()).collect();
+            Error::InvalidArgument(format!("unknown kernel '{s}' ({})", names.join(", ")))
+        })
     }
 }
 
