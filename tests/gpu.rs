@@ -169,19 +169,19 @@ fn renderer_on_an_adopted_host_device_matches_an_owning_one() {
     let set = scene::build("cube40").unwrap();
     let cam = Camera::framing(set.grid(), 96, 80);
     owner.set_scene(set.clone()).unwrap();
-    // One raster for both: `auto` may differ, since an adopted device does not tell us whether the
-    // host enabled large points (so it draws no point sprites wider than a pixel).
-    let mut opts = RenderOptions::default();
-    opts.raster = voxsplat::Raster::Graphics;
-    let want = owner.render(&cam, &opts).unwrap().image;
+    // `auto` included: the host's handles say it enabled large points, so both pick the same raster.
+    let opts = RenderOptions::default();
+    let owned = owner.render(&cam, &opts).unwrap();
+    let want = owned.image;
     {
         // The "host" here is the owning renderer's context; the adopted one must not destroy it.
         let host = owner.context().unwrap().handles();
         let ctx = voxsplat::vk::Context::from_host(host).unwrap();
         let mut guest = voxsplat::Renderer::with_context(ctx).unwrap();
         guest.set_scene(set).unwrap();
-        let got = guest.render(&cam, &opts).unwrap().image;
-        assert_eq!(diff_rgba8(&got, &want).unwrap().1, 0);
+        let got = guest.render(&cam, &opts).unwrap();
+        assert_eq!(got.raster.map(|c| c.raster), owned.raster.map(|c| c.raster));
+        assert_eq!(diff_rgba8(&got.image, &want).unwrap().1, 0);
     }
     // The owner still works after the guest is gone.
     let again = owner.render(&cam, &opts).unwrap().image;

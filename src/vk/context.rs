@@ -33,6 +33,9 @@ pub struct HostHandles {
     pub device: ash::Device,
     pub queue: vk::Queue,
     pub queue_family: u32,
+    /// Whether `device` was created with the `largePoints` feature: point sprites wider than one
+    /// pixel, which `auto` prefers on a CPU device. Without it voxsplat draws no wide sprites.
+    pub large_points: bool,
 }
 
 /// The Vulkan objects every resource needs. Resources hold an `Arc<Context>` so it outlives them.
@@ -49,6 +52,8 @@ pub struct Context {
     owned: bool,
     /// Nanoseconds per timestamp tick; `None` when the queue has no timestamps.
     pub(crate) timestamp_period: Option<f64>,
+    /// The device was created with `largePoints` (by us, or as its host says).
+    large_points: bool,
     device_name: String,
     device_type: vk::PhysicalDeviceType,
     /// Set once a call reports VK_ERROR_DEVICE_LOST: later submissions fail fast.
@@ -183,7 +188,9 @@ impl Context {
         };
         // SAFETY: queue family and index were requested above.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
-        Self::finish(entry, instance, physical, device, queue, queue_family, debug, debug_state, true)
+        let large_points = supported.large_points == vk::TRUE;
+        let handles = HostHandles { entry, instance, physical, device, queue, queue_family, large_points };
+        Self::finish(handles, debug, debug_state, true)
     }
 
     /// Adopt a host program's instance, device and queue. The host keeps ownership (nothing is
@@ -191,17 +198,7 @@ impl Context {
     /// The device needs Vulkan 1.2 `shaderOutputLayer` enabled and a graphics+compute queue; the
     /// host must not use `queue` from another thread while voxsplat submits to it.
     pub fn from_host(host: HostHandles) -> Result<Arc<Self>> {
-        Self::finish(
-            host.entry,
-            host.instance,
-            host.physical,
-            host.device,
-            host.queue,
-            host.queue_family,
-            None,
-            Box::default(),
-            false,
-        )
+        Self::finish(host, None, Box::default(), false)
     }
 
     /// This context's Vulkan objects, for a host that wants to share them (for example to draw
@@ -214,21 +211,17 @@ impl Context {
             device: self.device.clone(),
             queue: self.queue.lock().map(|q| *q).unwrap_or_default(),
             queue_family: self.queue_family,
+            large_points: self.large_points,
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn finish(
-        entry: ash::Entry,
-        instance: ash::Instance,
-        physical: vk::PhysicalDevice,
-        device: ash::Device,
-        queue: vk::Queue,
-        queue_family: u32,
+        handles: HostHandles,
         debug: Option<Debug>,
         debug_state: Box<DebugState>,
         owned: bool,
     ) -> Result<Arc<Self>> {
+        let HostHandles { entry, instance, physical, device, queue, queue_family, large_points } = handles;
         // SAFETY: plain queries on a valid physical device.
         let (props, families) = unsafe {
             (
@@ -276,6 +269,7 @@ impl Context {
             debug_state,
             owned,
             timestamp_period,
+            large_points,
             device_name,
             device_type: props.device_type,
             lost: AtomicBool::new(false),
@@ -347,20 +341,14 @@ impl Context {
     }
 
     /// Widest point sprite the device draws, in pixels (1 without the `largePoints` feature, which
-    /// a host-created device may not have enabled: then points wider than one pixel are refused).
+    /// a host says in `HostHandles::large_points`: then points wider than one pixel are refused).
     pub fn point_size_max(&self) -> f32 {
-        // SAFETY: plain queries on a valid physical device.
-        let (features, props) = unsafe {
-            (
-                self.instance.get_physical_device_features(self.physical),
-                self.instance.get_physical_device_properties(self.physical),
-            )
-        };
-        if self.owned && features.large_points == vk::TRUE {
-            props.limits.point_size_range[1]
-        } else {
-            1.0
+        if !self.large_points {
+            return 1.0;
         }
+        // SAFETY: plain query on a valid physical device.
+        let props = unsafe { self.instance.get_physical_device_properties(self.physical) };
+        props.limits.point_size_range[1]
     }
 
     /// True for a CPU implementation such as lavapipe.
