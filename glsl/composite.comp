@@ -11,6 +11,8 @@ layout(binding = 1, rgba32f) uniform image2D accum;
 layout(std430, binding = 2) writeonly buffer Occlusion { float occlusion[]; };
 // The compute raster's layers: fixed-point (rgb * tau, tau), SUM_FIXED_SCALE per unit.
 layout(std430, binding = 3) readonly buffer SumsFixed { uvec4 sums_fixed[]; };
+// Per tile, the lowest sheet reaching it and the highest + 1 (sheet_tiles.comp).
+layout(std430, binding = 4) readonly buffer SheetTiles { uint sheet_tiles[]; };
 // 1: read the sums from sums_fixed (footprint_sum.comp), 0: from the sums image (the raster pass).
 layout(constant_id = 0) const uint SUMS_FIXED = 0u;
 layout(push_constant) uniform Push {
@@ -18,7 +20,21 @@ layout(push_constant) uniform Push {
     uint back_to_front;
     uint width;
     uint height;
+    uint rank_base;  // global sheet of layer 0 (FootprintPush::rank_base)
+    int rank_dir;    // +1 or -1: the batch's direction in sheet order
+    uint tiles;      // composite tiles in the image
+    uint pad;
 } pc;
+
+// The batch's layers [first, last] that footprints reach on this workgroup's tile.
+ivec2 layer_range() {
+    uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    uint lo = sheet_tiles[tile], hi = sheet_tiles[pc.tiles + tile];
+    if (hi == 0u) return ivec2(0, -1);
+    int a = int(lo) - int(pc.rank_base), b = int(hi) - 1 - int(pc.rank_base);
+    ivec2 r = pc.rank_dir > 0 ? ivec2(a, b) : ivec2(-b, -a);
+    return ivec2(max(r.x, 0), min(r.y, int(pc.layers) - 1));
+}
 
 shared float tile_transmittance[COMPOSITE_TILE * COMPOSITE_TILE];
 
@@ -28,7 +44,9 @@ void main() {
     float transmittance = 0.0; // outside the image: nothing left to cover
     if (inside) {
         vec4 acc = imageLoad(accum, ivec2(px));
-        for (uint l = 0u; l < pc.layers; ++l) {
+        ivec2 range = layer_range();
+        for (int i = range.x; i <= range.y; ++i) {
+            uint l = uint(i);
             vec4 s;
             if (SUMS_FIXED != 0u) {
                 s = vec4(sums_fixed[(l * pc.height + px.y) * pc.width + px.x]) / float(SUM_FIXED_SCALE);

@@ -58,6 +58,8 @@ struct Stages {
     tile_offsets: Pipeline,
     tile_scatter: Pipeline,
     tile_composite: Pipeline,
+    /// Sheet modes' per-tile sheet ranges: [axis quads, axis points, slab quads, slab points].
+    sheet_tiles: [Pipeline; 4],
     composite_layout: Layout,
     composite: Pipeline,
     composite_fixed: Pipeline,
@@ -119,6 +121,11 @@ struct TargetGpu {
     accum: Image,
     /// Largest transmittance left per composite tile (front-to-back early termination).
     occlusion: Buffer,
+    /// Per composite tile, the lowest sheet reaching it, then the highest + 1 (sheet_tiles.comp).
+    sheet_tiles: Buffer,
+    /// Its host copy, written at the end of every sheet-mode frame (32 KB at 512²).
+    sheet_tiles_back: Buffer,
+    tiles: u32,
     /// The compute raster's fixed-point summation layers, allocated on first use.
     fixed: Option<Buffer>,
     composite_set: DescriptorSet,
@@ -182,7 +189,7 @@ impl GpuPipeline {
         // glsl/shared/footprint.glsl: 0-4 frame, params, draw list, splats, ranks; 5 radial table,
         // 6 slice table;
         // 7 occlusion; 8 fixed-point sums; 9-11 tile counts, starts, entries; 12 accumulation;
-        // 13 screen quads.
+        // 13 screen quads; 14 per-tile sheet ranges.
         let footprint_layout = Layout::new(
             &ctx,
             &[
@@ -200,13 +207,14 @@ impl GpuPipeline {
                 Slot::Storage,
                 Slot::StorageImage,
                 Slot::Storage,
+                Slot::Storage,
             ],
             SS::VERTEX | SS::FRAGMENT | SS::COMPUTE,
             std::mem::size_of::<FootprintPush>() as u32,
         )?;
         let composite_layout = Layout::new(
             &ctx,
-            &[Slot::StorageImage, Slot::StorageImage, Slot::Storage, Slot::Storage],
+            &[Slot::StorageImage, Slot::StorageImage, Slot::Storage, Slot::Storage, Slot::Storage],
             compute,
             std::mem::size_of::<CompositePush>() as u32,
         )?;
@@ -256,6 +264,17 @@ impl GpuPipeline {
             tile_offsets: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_offsets.comp"))?,
             tile_scatter: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp"))?,
             tile_composite: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_composite.comp"))?,
+            sheet_tiles: {
+                let pipe = |mode, points| {
+                    Pipeline::compute_specialized(&ctx, &footprint_layout, spirv!("sheet_tiles.comp"), &[mode, points])
+                };
+                [
+                    pipe(SHEET_MODE_AXIS, 0)?,
+                    pipe(SHEET_MODE_AXIS, 1)?,
+                    pipe(SHEET_MODE_SLAB, 0)?,
+                    pipe(SHEET_MODE_SLAB, 1)?,
+                ]
+            },
             composite_fixed: Pipeline::compute_specialized(&ctx, &composite_layout, spirv!("composite.comp"), &[1])?,
             composite: Pipeline::compute(&ctx, &composite_layout, spirv!("composite.comp"))?,
             slab_count: Pipeline::compute(&ctx, &slab_layout, spirv!("slab_count.comp"))?,
@@ -610,6 +629,7 @@ impl GpuPipeline {
                 Bind::Buffer(entries),
                 Bind::Image(&target.accum),
                 Bind::Buffer(quads),
+                Bind::Buffer(&target.sheet_tiles),
             ])?);
         }
         scene.footprint_sets = sets;
@@ -651,11 +671,20 @@ impl GpuPipeline {
         let tiles = width.div_ceil(COMPOSITE_TILE) as u64 * height.div_ceil(COMPOSITE_TILE) as u64;
         let occlusion =
             Buffer::new(ctx, "occlusion", tiles * 4, BU::STORAGE_BUFFER | BU::TRANSFER_DST, Memory::Device)?;
+        let sheet_tiles = Buffer::new(
+            ctx,
+            "sheet tiles",
+            tiles * 8,
+            BU::STORAGE_BUFFER | BU::TRANSFER_DST | BU::TRANSFER_SRC,
+            Memory::Device,
+        )?;
+        let sheet_tiles_back = Buffer::new(ctx, "sheet tiles readback", tiles * 8, BU::TRANSFER_DST, Memory::Readback)?;
         let composite_set = self.stages.composite_layout.bind(&[
             Bind::Image(&sums),
             Bind::Image(&accum),
             Bind::Buffer(&occlusion),
             Bind::Buffer(&occlusion), // stands in for the fixed-point layers until they exist
+            Bind::Buffer(&sheet_tiles),
         ])?;
         let readback =
             Buffer::new(ctx, "readback", width as u64 * height as u64 * 16, BU::TRANSFER_DST, Memory::Readback)?;
@@ -669,6 +698,9 @@ impl GpuPipeline {
             sums_fb,
             accum,
             occlusion,
+            sheet_tiles,
+            sheet_tiles_back,
+            tiles: tiles as u32,
             fixed: None,
             composite_set,
             readback,
@@ -691,12 +723,20 @@ impl GpuPipeline {
             Bind::Image(&target.accum),
             Bind::Buffer(&target.occlusion),
             Bind::Buffer(&fixed),
+            Bind::Buffer(&target.sheet_tiles),
         ])?;
         target.fixed = Some(fixed);
         if let Some(scene) = self.scene.as_mut() {
             scene.footprint_sets.clear();
         }
         Ok(())
+    }
+
+    /// The per-tile sheet ranges of the last sheet-mode frame (`sheet_tiles.comp`).
+    pub fn last_sheet_tiles(&self) -> Result<Vec<u32>> {
+        let target = self.target.as_ref().ok_or_else(|| Error::InvalidArgument("nothing rendered yet".into()))?;
+        let bytes = target.sheet_tiles_back.read()?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&bytes[..target.tiles as usize * 8]).to_vec())
     }
 
     /// Run the GPU PBTF order stage alone and read the draw sequence back.
@@ -809,7 +849,7 @@ impl GpuPipeline {
     pub fn roofline_composite(&mut self, width: u32, height: u32, layers: u32) -> Result<(f64, f64)> {
         self.ensure_target(width, height, layers)?;
         let (st, target) = (&self.stages, self.target.as_ref().expect("ensured"));
-        let push = CompositePush { layers, back_to_front: 0, width, height };
+        let push = CompositePush { layers, width, height, rank_dir: 1, tiles: target.tiles, ..Default::default() };
         let groups = [width.div_ceil(COMPOSITE_TILE), height.div_ceil(COMPOSITE_TILE), 1];
         let bytes = bytemuck::bytes_of(&push);
         let set = &target.composite_set;
@@ -821,6 +861,11 @@ impl GpuPipeline {
                     rec.begin_pass(&st.sheet_pass, &target.sums_fb);
                     rec.end_pass();
                     rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
+                    // Every layer reaches every tile: the composite reads them all.
+                    let half = target.tiles as u64 * 4;
+                    rec.fill_buffer_range(&target.sheet_tiles, 0, half, 0);
+                    rec.fill_buffer_range(&target.sheet_tiles, half, half, layers);
+                    rec.barrier(Stage::Transfer, Stage::Compute);
                 }),
             ),
             (
@@ -1024,6 +1069,25 @@ impl GpuPipeline {
                         rec.barrier(Stage::Transfer, Stage::All);
                     }),
                 ));
+                if let Some(first) = batches.first() {
+                    let slab = first.push.sheet_mode == SHEET_MODE_SLAB;
+                    let push = crate::pipeline::sheet_tiles_push(&batches, first);
+                    let entries = push.count;
+                    steps.push((
+                        "sheet_tiles",
+                        Box::new(move |rec| {
+                            let half = target.tiles as u64 * 4;
+                            rec.fill_buffer_range(&target.sheet_tiles, 0, half, u32::MAX);
+                            rec.fill_buffer_range(&target.sheet_tiles, half, half, 0);
+                            rec.barrier(Stage::Transfer, Stage::Compute);
+                            let pipe = &st.sheet_tiles[2 * slab as usize + points as usize];
+                            let bytes = bytemuck::bytes_of(&push);
+                            rec.dispatch(pipe, &st.footprint_layout, set, bytes, groups_1d(entries));
+                            rec.barrier(Stage::Compute, Stage::All);
+                            rec.copy_buffer(&target.sheet_tiles, &target.sheet_tiles_back, target.tiles as u64 * 8);
+                        }),
+                    ));
+                }
                 for b in &batches {
                     let slab = b.push.sheet_mode == SHEET_MODE_SLAB;
                     steps.push((
@@ -1055,8 +1119,7 @@ impl GpuPipeline {
                     steps.push((
                         "composite",
                         Box::new(move |rec| {
-                            let push =
-                                CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
+                            let push = crate::pipeline::composite_push(b, btf, w, h);
                             let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
                             let set = &target.composite_set;
                             let pipe = if compute { &st.composite_fixed } else { &st.composite };

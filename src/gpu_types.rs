@@ -127,13 +127,19 @@ pub struct CompositePush {
     pub back_to_front: u32,
     pub width: u32,
     pub height: u32,
+    /// Global sheet of layer 0 and the batch's direction (the footprint push's rank_base, rank_dir).
+    pub rank_base: u32,
+    pub rank_dir: i32,
+    /// Composite tiles in the image (the second half of the sheet_tiles buffer starts there).
+    pub tiles: u32,
+    pub pad: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 288);
+const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 48);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
-const _: () = assert!(std::mem::size_of::<CompositePush>() == 16);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -188,6 +188,37 @@ impl Renderer {
         Ok((bins.start, bins.entries))
     }
 
+    /// The sheet modes' per-tile sheet ranges of this frame, as the backend computes them (the GPU
+    /// `sheet_tiles` stage, or its CPU mirror): for each composite tile, the lowest sheet (global
+    /// rank; slab mode: slab) whose footprints reach it (`u32::MAX`: none), then for each tile the
+    /// highest + 1. Renders the frame to get them.
+    pub fn sheet_tiles(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
+        if options.composite == Composite::Splat {
+            return Err(Error::InvalidArgument("sheet ranges exist only in the sheet and slab modes".into()));
+        }
+        self.render_with_sheet_tiles(camera, options)
+    }
+
+    fn render_with_sheet_tiles(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let mut tiles = Vec::new();
+        match &mut self.gpu {
+            Some(_) => {
+                self.render(camera, options)?;
+                let g = self.gpu.as_mut().expect("matched");
+                tiles = g.last_sheet_tiles()?;
+            }
+            None => {
+                let mut opts = options.clone();
+                let device = raster::Device { cpu: true, point_size_max: f32::INFINITY };
+                opts.raster = raster::choose(&prep.set, camera, options, device)?.raster;
+                pipeline::render_cpu_with(prep, camera, &opts, &mut tiles)?;
+            }
+        }
+        Ok(tiles)
+    }
+
     /// The PBTF draw sequence as the backend computes it (the GPU order stage, or its CPU mirror).
     pub fn pbtf_order(&mut self, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
         camera.validate()?;

@@ -377,6 +377,27 @@ pub fn tile_push(opts: &RenderOptions, n: u32, width: u32, height: u32) -> Footp
     }
 }
 
+/// Push constants of `sheet_tiles.comp` for a frame's sheet batches: every entry of the sheet
+/// list from 0, layers numbered by global sheet (rank base 0, direction +1), no occlusion culling.
+pub fn sheet_tiles_push(batches: &[Batch], first: &Batch) -> FootprintPush {
+    let entries = batches.iter().map(|b| b.first_instance + b.instances).max().unwrap_or(0);
+    FootprintPush { rank_base: 0, rank_dir: 1, first: 0, count: entries, occluded: 0.0, ..first.push }
+}
+
+/// Push constants of `composite.comp` for batch `b`.
+pub fn composite_push(b: &Batch, btf: bool, width: u32, height: u32) -> CompositePush {
+    CompositePush {
+        layers: b.layers,
+        back_to_front: btf as u32,
+        width,
+        height,
+        rank_base: b.push.rank_base,
+        rank_dir: b.push.rank_dir,
+        tiles: width.div_ceil(COMPOSITE_TILE) * height.div_ceil(COMPOSITE_TILE),
+        pad: 0,
+    }
+}
+
 /// Workgroup counts for `n` invocations of a 1D stage (spilling into y past `MAX_GROUPS_X`).
 pub fn groups_1d(n: u32) -> [u32; 3] {
     let g = n.div_ceil(WORKGROUP_SIZE).max(1);
@@ -385,6 +406,17 @@ pub fn groups_1d(n: u32) -> [u32; 3] {
 
 /// The whole frame on the CPU mirrors, stage by stage.
 pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Rendered> {
+    render_cpu_with(prep, camera, opts, &mut Vec::new())
+}
+
+/// `render_cpu`, leaving the sheet modes' per-tile sheet ranges (`cpu::sheet_tiles`) in
+/// `sheet_tiles`.
+pub fn render_cpu_with(
+    prep: &Prepared,
+    camera: &Camera,
+    opts: &RenderOptions,
+    sheet_tiles: &mut Vec<u32>,
+) -> Result<Rendered> {
     camera.validate()?;
     let set = &prep.set;
     let direction = opts.direction();
@@ -460,6 +492,22 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
             opts.set_early_termination(&mut batches);
             let tiles = w.div_ceil(COMPOSITE_TILE) as usize * h.div_ceil(COMPOSITE_TILE) as usize;
             let mut occlusion = vec![1.0f32; tiles];
+            *sheet_tiles = vec![0u32; 2 * tiles];
+            if let Some(first) = batches.first() {
+                let inputs = cpu::footprint::FootprintInputs {
+                    frame: &frame,
+                    params: &params,
+                    draw_list: &draw_list,
+                    splats: set.splats(),
+                    sheet_rank: &prep.ranks,
+                    table: &table,
+                    slice_table: &slice_table,
+                    occlusion: &[],
+                };
+                let push = sheet_tiles_push(&batches, first);
+                cpu::sheet_tiles(&inputs, &push, points, sheet_tiles);
+                lap("sheet_tiles", &mut timings);
+            }
             let (mut raster_ms, mut comp_ms) = (0.0, 0.0);
             for b in &batches {
                 let inputs = cpu::footprint::FootprintInputs {
@@ -484,8 +532,8 @@ pub fn render_cpu(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Res
                     layers
                 };
                 let t1 = Instant::now();
-                let push = CompositePush { layers: b.layers, back_to_front: btf as u32, width: w, height: h };
-                cpu::composite(&push, &layers, &mut image, &mut occlusion);
+                let push = composite_push(b, btf, w, h);
+                cpu::composite(&push, &layers, sheet_tiles, &mut image, &mut occlusion);
                 raster_ms += (t1 - t0).as_secs_f64() * 1e3;
                 comp_ms += t1.elapsed().as_secs_f64() * 1e3;
             }

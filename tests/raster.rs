@@ -290,3 +290,96 @@ fn auto_rule_points_where_they_fit_sums_for_small_sheets_else_compute_or_graphic
     assert!(choice.reason.starts_with("auto: CPU device"), "{}", choice.reason);
     assert_clean(&gpu);
 }
+
+/// Every pixel a sheet's footprints write lies on a composite tile whose sheet range holds that
+/// sheet (so the composite, which reads only those layers, misses nothing), for quads and points:
+/// all entries drawn at once into one layer per global sheet by the footprint mirror.
+fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tiles: &[u32]) -> usize {
+    use voxsplat::cpu::footprint::{footprint, Blend, FootprintInputs};
+    use voxsplat::pipeline::{frame_for, sheet_plan, sheet_tiles_push, Prepared};
+    let prep = Prepared::new(set.clone());
+    let frame = frame_for(set, cam, o);
+    let mut params = vec![Default::default(); set.len()];
+    voxsplat::cpu::splat_params(&frame, set.splats(), &mut params);
+    let (draw, batches) = if o.composite == Composite::Sheet {
+        let (axis, batches) = sheet_plan(&prep, cam, o.direction(), 1 << 16);
+        (prep.slices[axis].1.clone(), batches)
+    } else {
+        let pc = voxsplat::slab::slab_geometry(&frame, set.grid(), set.len(), o.slab_thickness, o.direction()).unwrap();
+        voxsplat::slab::slab_bins_cpu(&pc, &params, 1 << 16).unwrap()
+    };
+    let push = sheet_tiles_push(&batches, &batches[0]);
+    let sheets = batches.iter().map(|b| b.push.rank_base as usize + b.layers as usize).max().unwrap() + 1;
+    let (table, slice_table) = (o.kernel.radial_table(), o.kernel.slice_table());
+    let inputs = FootprintInputs {
+        frame: &frame,
+        params: &params,
+        draw_list: &draw,
+        splats: set.splats(),
+        sheet_rank: &prep.ranks,
+        table: &table,
+        slice_table: &slice_table,
+        occlusion: &[],
+    };
+    let mut layers = vec![ImageF32::new(cam.width, cam.height); sheets];
+    let points = o.raster == Raster::Points;
+    footprint(&inputs, &push, Blend::Add, points, 0, push.count, &mut layers);
+    let tile = voxsplat::constants::COMPOSITE_TILE;
+    let (tiles_x, n) = (cam.width.div_ceil(tile), tiles.len() / 2);
+    let mut written = 0;
+    for (s, layer) in layers.iter().enumerate() {
+        for (i, px) in layer.pixels.iter().enumerate() {
+            if px.iter().all(|&c| c == 0.0) {
+                continue;
+            }
+            let (x, y) = (i as u32 % cam.width, i as u32 / cam.width);
+            let t = ((y / tile) * tiles_x + x / tile) as usize;
+            let (lo, hi) = (tiles[t], tiles[n + t]);
+            assert!(lo as usize <= s && s < hi as usize, "pixel ({x}, {y}) of sheet {s}: tile {t} holds {lo}..{hi}");
+            written += 1;
+        }
+    }
+    written
+}
+
+#[test]
+fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
+    let mut gpu = common::gpu();
+    let mut cpu = common::cpu();
+    let mut rng = Rng(77);
+    let (near_set, near_cam) = close_up();
+    let mut cases = vec![(near_set, near_cam)];
+    for set in [scene::build("cube40").unwrap(), random_sparse(3, [19, 11, 16], 0.3)] {
+        for kind in [ViewKind::Outside, ViewKind::Inside, ViewKind::Orthographic] {
+            let mut cam = random_camera(&mut rng, set.grid(), kind);
+            (cam.width, cam.height) = (83, 69);
+            cases.push((set.clone(), cam));
+        }
+    }
+    let mut skipped_share = Vec::new();
+    for (set, cam) in &cases {
+        gpu.set_scene(set.clone()).unwrap();
+        cpu.set_scene(set.clone()).unwrap();
+        for composite in [Composite::Sheet, Composite::Slab] {
+            for raster in [Raster::Graphics, Raster::Points, Raster::Compute] {
+                let o = opts(composite, raster);
+                let tiles = match gpu.sheet_tiles(cam, &o) {
+                    Err(Error::InvalidArgument(_)) if raster == Raster::Points => continue, // wider than a point
+                    t => t.unwrap(),
+                };
+                assert_eq!(tiles, cpu.sheet_tiles(cam, &o).unwrap(), "{composite:?} {raster:?}: GPU = mirror");
+                let written = check_sheet_tiles_cover(set, cam, &o, &tiles);
+                assert!(written > 0, "{composite:?} {raster:?}: something drawn");
+                // The share of (tile, sheet) pairs the composite no longer visits.
+                let n = tiles.len() / 2;
+                let sheets = (0..n).filter(|&t| tiles[n + t] > 0).map(|t| tiles[n + t]).max().unwrap_or(0);
+                let visited: u64 = (0..n).map(|t| tiles[n + t].saturating_sub(tiles[t].min(tiles[n + t])) as u64).sum();
+                skipped_share.push(1.0 - visited as f64 / (n as u64 * sheets as u64) as f64);
+            }
+        }
+    }
+    // Not a bound on speed: that the ranges skip anything at all on these sparse scenes.
+    let mean = skipped_share.iter().sum::<f64>() / skipped_share.len() as f64;
+    assert!(mean > 0.2, "tile ranges skip {:.0}% of (tile, sheet) pairs", 100.0 * mean);
+    assert_clean(&gpu);
+}

@@ -4,14 +4,40 @@ use crate::constants::COMPOSITE_TILE;
 use crate::gpu_types::CompositePush;
 use rayon::prelude::*;
 
-/// Composite the batch into `accum`, then write each tile's largest remaining transmittance into
-/// `occlusion` (row-major tiles of `COMPOSITE_TILE`² pixels).
-pub fn composite(push: &CompositePush, sums: &[ImageF32], accum: &mut ImageF32, occlusion: &mut [f32]) {
+/// Mirror of `layer_range` in `composite.comp`: the batch's layers that footprints reach on tile
+/// `tile`, from the per-tile sheet ranges of `sheet_tiles`.
+pub fn layer_range(push: &CompositePush, sheet_tiles: &[u32], tile: usize) -> std::ops::Range<usize> {
+    let (lo, hi) = (sheet_tiles[tile], sheet_tiles[push.tiles as usize + tile]);
+    if hi == 0 {
+        return 0..0;
+    }
+    let (a, b) = (lo as i64 - push.rank_base as i64, hi as i64 - 1 - push.rank_base as i64);
+    let (first, last) = if push.rank_dir > 0 { (a, b) } else { (-b, -a) };
+    let (first, last) = (first.max(0), last.min(push.layers as i64 - 1));
+    if first > last {
+        0..0
+    } else {
+        first as usize..last as usize + 1
+    }
+}
+
+/// Composite the batch into `accum` (at each tile only the layers `sheet_tiles` says footprints
+/// reach), then write each tile's largest remaining transmittance into `occlusion` (row-major
+/// tiles of `COMPOSITE_TILE`² pixels).
+pub fn composite(
+    push: &CompositePush,
+    sums: &[ImageF32],
+    sheet_tiles: &[u32],
+    accum: &mut ImageF32,
+    occlusion: &mut [f32],
+) {
     let width = push.width as usize;
+    let (tile, tiles_x) = (COMPOSITE_TILE as usize, push.width.div_ceil(COMPOSITE_TILE) as usize);
     accum.pixels.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
             let mut acc = *px;
-            for s in sums.iter().take(push.layers as usize) {
+            let range = layer_range(push, sheet_tiles, (y / tile) * tiles_x + x / tile);
+            for s in sums.iter().take(push.layers as usize).skip(range.start).take(range.len()) {
                 let v = s.pixels[y * width + x];
                 let t = v[3];
                 if t <= 0.0 {
@@ -35,7 +61,6 @@ pub fn composite(push: &CompositePush, sums: &[ImageF32], accum: &mut ImageF32, 
             *px = acc;
         }
     });
-    let (tile, tiles_x) = (COMPOSITE_TILE as usize, push.width.div_ceil(COMPOSITE_TILE) as usize);
     occlusion.iter_mut().for_each(|o| *o = 0.0);
     for (i, p) in accum.pixels.iter().enumerate() {
         let (x, y) = (i % width, i / width);

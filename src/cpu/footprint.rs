@@ -72,7 +72,11 @@ pub struct FootprintInputs<'a> {
 
 /// Mirror of `entry_splat` + `entry_layer` in `glsl/shared/footprint.glsl`: draw-list entry `e`'s
 /// splat, its summation layer within the batch and how it is weighed; `None` when it is culled.
-fn entry<'a>(inputs: &FootprintInputs<'a>, push: &FootprintPush, e: u32) -> Option<(usize, usize, Weight<'a>)> {
+pub(crate) fn entry<'a>(
+    inputs: &FootprintInputs<'a>,
+    push: &FootprintPush,
+    e: u32,
+) -> Option<(usize, usize, Weight<'a>)> {
     let slab_mode = push.sheet_mode == SHEET_MODE_SLAB;
     let splat = if slab_mode { inputs.draw_list[2 * e as usize] } else { inputs.draw_list[e as usize] } as usize;
     let p = &inputs.params[splat];
@@ -251,7 +255,7 @@ pub fn occluded(inputs: &FootprintInputs<'_>, p: &SplatParams, threshold: f32) -
 /// What a fragment weighs: the whole pre-integrated footprint, or the slice between two slab
 /// faces (radius units, relative to the splat's centre).
 #[derive(Clone, Copy)]
-enum Weight<'a> {
+pub(crate) enum Weight<'a> {
     Footprint(&'a [f32]),
     Slice(&'a [f32], [f32; 2]),
 }

@@ -98,6 +98,16 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value) };
     }
 
+    /// Fill `bytes` from `offset` (both multiples of 4, clamped to the buffer) with `value`.
+    pub fn fill_buffer_range(&self, buffer: &Buffer, offset: u64, bytes: u64, value: u32) {
+        let size = bytes.min(buffer.size().saturating_sub(offset)) & !3;
+        if size == 0 || offset % 4 != 0 {
+            return;
+        }
+        // SAFETY: outside a render pass; TRANSFER_DST buffer; the range lies within it.
+        unsafe { self.ctx.device.cmd_fill_buffer(self.cmd, buffer.raw, offset, size, value) };
+    }
+
     pub fn copy_buffer(&self, src: &Buffer, dst: &Buffer, bytes: u64) {
         let size = bytes.min(src.size()).min(dst.size());
         if size == 0 {
