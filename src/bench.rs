@@ -84,7 +84,9 @@ pub struct MatrixOptions {
 }
 
 impl MatrixOptions {
-    /// The full matrix: three scenes at 512x512, every order and kernel, sheets, three ray steps.
+    /// The full matrix: three scenes at 512x512, every order with both classic kernels, sheets,
+    /// slabs, the raster variants, the narrow kernel (per-splat quads and points, sheets), three
+    /// ray steps.
     pub fn full() -> Self {
         let mut methods = Vec::new();
         for kernel in [Kernel::Gaussian, Kernel::Cubic] {
@@ -99,6 +101,17 @@ impl MatrixOptions {
                 methods.push(rastered(composite, raster));
             }
         }
+        // The narrow kernel: fewer fragments per splat, at the cost of ripple on flat sheets.
+        let narrow = Kernel::Narrow;
+        methods.push(splat(OrderKind::Pbtf, Composite::Splat, narrow));
+        methods.push(splat(OrderKind::Pbtf, Composite::Sheet, narrow));
+        methods.push(Method::Splat {
+            order: OrderKind::Pbtf,
+            composite: Composite::Splat,
+            kernel: narrow,
+            aa: Antialias::None,
+            raster: Raster::Points,
+        });
         for step in [1.0, 0.5, 0.25] {
             methods.push(Method::Raycast { step });
         }
