@@ -1069,7 +1069,21 @@ impl GpuPipeline {
                         rec.barrier(Stage::Transfer, Stage::All);
                     }),
                 ));
-                if let Some(first) = batches.first() {
+                let ranges = batches.first().filter(|_| crate::pipeline::sheet_tiles_pay(&batches, w, h));
+                if ranges.is_none() {
+                    steps.push((
+                        UNTIMED,
+                        Box::new(|rec| {
+                            let half = target.tiles as u64 * 4;
+                            let [lo, hi] = crate::pipeline::ALL_SHEETS;
+                            rec.fill_buffer_range(&target.sheet_tiles, 0, half, lo);
+                            rec.fill_buffer_range(&target.sheet_tiles, half, half, hi);
+                            rec.barrier(Stage::Transfer, Stage::All);
+                            rec.copy_buffer(&target.sheet_tiles, &target.sheet_tiles_back, half * 2);
+                        }),
+                    ));
+                }
+                if let Some(first) = ranges {
                     let slab = first.push.sheet_mode == SHEET_MODE_SLAB;
                     let push = crate::pipeline::sheet_tiles_push(&batches, first);
                     let entries = push.count;

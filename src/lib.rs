@@ -191,7 +191,8 @@ impl Renderer {
     /// The sheet modes' per-tile sheet ranges of this frame, as the backend computes them (the GPU
     /// `sheet_tiles` stage, or its CPU mirror): for each composite tile, the lowest sheet (global
     /// rank; slab mode: slab) whose footprints reach it (`u32::MAX`: none), then for each tile the
-    /// highest + 1. Renders the frame to get them.
+    /// highest + 1; every tile `pipeline::ALL_SHEETS` where the pass would not pay
+    /// (`pipeline::sheet_tiles_pay`). Renders the frame to get them.
     pub fn sheet_tiles(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
         if options.composite == Composite::Splat {
             return Err(Error::InvalidArgument("sheet ranges exist only in the sheet and slab modes".into()));

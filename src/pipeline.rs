@@ -384,6 +384,23 @@ pub fn sheet_tiles_push(batches: &[Batch], first: &Batch) -> FootprintPush {
     FootprintPush { rank_base: 0, rank_dir: 1, first: 0, count: entries, occluded: 0.0, ..first.push }
 }
 
+/// Whether finding each tile's sheet range (`sheet_tiles`) can pay for itself: the composite must
+/// read at least `SHEET_TILES_MIN_RATIO` layer pixels per entry of the sheet list (measured on
+/// lavapipe: the pass costs 30–70 ns per entry, the composite ~8 ns per layer pixel). A single
+/// sheet seen head-on (the raster sweep) falls below, the volume scenes far above.
+pub fn sheet_tiles_pay(batches: &[Batch], width: u32, height: u32) -> bool {
+    let entries = batches.iter().map(|b| b.first_instance + b.instances).max().unwrap_or(0) as u64;
+    let layer_pixels: u64 = batches.iter().map(|b| b.layers as u64).sum::<u64>() * width as u64 * height as u64;
+    entries > 0 && layer_pixels >= SHEET_TILES_MIN_RATIO * entries
+}
+
+/// See `sheet_tiles_pay`.
+pub const SHEET_TILES_MIN_RATIO: u64 = 8;
+
+/// Per-tile sheet ranges that let the composite read every layer (the `sheet_tiles` pass skipped):
+/// lowest 0, highest + 1 `i32::MAX`.
+pub const ALL_SHEETS: [u32; 2] = [0, i32::MAX as u32];
+
 /// Push constants of `composite.comp` for batch `b`.
 pub fn composite_push(b: &Batch, btf: bool, width: u32, height: u32) -> CompositePush {
     CompositePush {
@@ -454,18 +471,18 @@ pub fn render_cpu_with(
     let mut image = ImageF32::new(w, h);
     let points = opts.raster == Raster::Points;
     let compute = opts.raster == Raster::Compute;
+    let inputs = cpu::footprint::FootprintInputs {
+        frame: &frame,
+        params: &params,
+        draw_list: &draw,
+        splats: set.splats(),
+        sheet_rank: &prep.ranks,
+        table: &table,
+        slice_table: &slice_table,
+        occlusion: &[],
+    };
     match opts.composite {
         Composite::Splat => {
-            let inputs = cpu::footprint::FootprintInputs {
-                frame: &frame,
-                params: &params,
-                draw_list: &draw,
-                splats: set.splats(),
-                sheet_rank: &prep.ranks,
-                table: &table,
-                slice_table: &slice_table,
-                occlusion: &[],
-            };
             if compute {
                 let push = tile_push(opts, n as u32, w, h);
                 let bins = cpu::tile::tile_bins_cpu(&inputs, &push)?;
@@ -493,33 +510,21 @@ pub fn render_cpu_with(
             let tiles = w.div_ceil(COMPOSITE_TILE) as usize * h.div_ceil(COMPOSITE_TILE) as usize;
             let mut occlusion = vec![1.0f32; tiles];
             *sheet_tiles = vec![0u32; 2 * tiles];
-            if let Some(first) = batches.first() {
-                let inputs = cpu::footprint::FootprintInputs {
-                    frame: &frame,
-                    params: &params,
-                    draw_list: &draw_list,
-                    splats: set.splats(),
-                    sheet_rank: &prep.ranks,
-                    table: &table,
-                    slice_table: &slice_table,
-                    occlusion: &[],
-                };
-                let push = sheet_tiles_push(&batches, first);
-                cpu::sheet_tiles(&inputs, &push, points, sheet_tiles);
-                lap("sheet_tiles", &mut timings);
+            let sheet_inputs = cpu::footprint::FootprintInputs { draw_list: &draw_list, ..inputs };
+            match batches.first() {
+                Some(first) if sheet_tiles_pay(&batches, w, h) => {
+                    let push = sheet_tiles_push(&batches, first);
+                    cpu::sheet_tiles(&sheet_inputs, &push, points, sheet_tiles);
+                    lap("sheet_tiles", &mut timings);
+                }
+                _ => {
+                    sheet_tiles[..tiles].fill(ALL_SHEETS[0]);
+                    sheet_tiles[tiles..].fill(ALL_SHEETS[1]);
+                }
             }
             let (mut raster_ms, mut comp_ms) = (0.0, 0.0);
             for b in &batches {
-                let inputs = cpu::footprint::FootprintInputs {
-                    frame: &frame,
-                    params: &params,
-                    draw_list: &draw_list,
-                    splats: set.splats(),
-                    sheet_rank: &prep.ranks,
-                    table: &table,
-                    slice_table: &slice_table,
-                    occlusion: &occlusion,
-                };
+                let inputs = cpu::footprint::FootprintInputs { occlusion: &occlusion, ..sheet_inputs };
                 let t0 = Instant::now();
                 let layers = if compute {
                     let mut sums = vec![0u32; b.layers as usize * w as usize * h as usize * 4];

@@ -378,6 +378,15 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
             }
         }
     }
+    // A single sheet seen head-on: too few layer pixels per splat for the pass to pay; every tile
+    // then lets the composite read every layer.
+    let sheet = voxsplat::rates::rate_scene(64).unwrap();
+    let cam = voxsplat::rates::rate_camera(sheet.grid(), 5.0).unwrap();
+    gpu.set_scene(sheet).unwrap();
+    let tiles = gpu.sheet_tiles(&cam, &opts(Composite::Sheet, Raster::Compute)).unwrap();
+    let n = tiles.len() / 2;
+    let [lo, hi] = voxsplat::pipeline::ALL_SHEETS;
+    assert!(tiles[..n].iter().all(|&t| t == lo) && tiles[n..].iter().all(|&t| t == hi), "single sheet: all layers");
     // Not a bound on speed: that the ranges skip anything at all on these sparse scenes.
     let mean = skipped_share.iter().sum::<f64>() / skipped_share.len() as f64;
     assert!(mean > 0.2, "tile ranges skip {:.0}% of (tile, sheet) pairs", 100.0 * mean);

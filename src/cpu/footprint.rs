@@ -56,6 +56,7 @@ pub fn sample_slice_table(table: &[f32], r: f32, z: f32) -> f32 {
 }
 
 /// The draw call's inputs, as bound on the GPU.
+#[derive(Clone, Copy)]
 pub struct FootprintInputs<'a> {
     pub frame: &'a Frame,
     pub params: &'a [SplatParams],
