@@ -37,9 +37,9 @@ void main() {
         if (!screen_quad(p, inv, box)) return;
     }
     ivec2 last = ivec2(size) - 1;
+    if (box.x > last.x + 1 || box.y > last.y + 1 || box.z < -1 || box.w < -1) return;
     ivec2 lo = clamp(box.xy - 1, ivec2(0), last);
     ivec2 hi = clamp(box.zw + 1, ivec2(0), last);
-    if (box.x > last.x + 1 || box.y > last.y + 1 || box.z < -1 || box.w < -1) return;
     uvec2 t0 = uvec2(lo) / COMPOSITE_TILE, t1 = uvec2(hi) / COMPOSITE_TILE;
     uint tiles_x = (uint(size.x) + COMPOSITE_TILE - 1u) / COMPOSITE_TILE;
     uint tiles = tiles_x * ((uint(size.y) + COMPOSITE_TILE - 1u) / COMPOSITE_TILE);

@@ -123,8 +123,6 @@ struct TargetGpu {
     occlusion: Buffer,
     /// Per composite tile, the lowest sheet reaching it, then the highest + 1 (sheet_tiles.comp).
     sheet_tiles: Buffer,
-    /// Its host copy, written at the end of every sheet-mode frame (32 KB at 512²).
-    sheet_tiles_back: Buffer,
     tiles: u32,
     /// The compute raster's fixed-point summation layers, allocated on first use.
     fixed: Option<Buffer>,
@@ -678,7 +676,6 @@ impl GpuPipeline {
             BU::STORAGE_BUFFER | BU::TRANSFER_DST | BU::TRANSFER_SRC,
             Memory::Device,
         )?;
-        let sheet_tiles_back = Buffer::new(ctx, "sheet tiles readback", tiles * 8, BU::TRANSFER_DST, Memory::Readback)?;
         let composite_set = self.stages.composite_layout.bind(&[
             Bind::Image(&sums),
             Bind::Image(&accum),
@@ -699,7 +696,6 @@ impl GpuPipeline {
             accum,
             occlusion,
             sheet_tiles,
-            sheet_tiles_back,
             tiles: tiles as u32,
             fixed: None,
             composite_set,
@@ -735,8 +731,14 @@ impl GpuPipeline {
     /// The per-tile sheet ranges of the last sheet-mode frame (`sheet_tiles.comp`).
     pub fn last_sheet_tiles(&self) -> Result<Vec<u32>> {
         let target = self.target.as_ref().ok_or_else(|| Error::InvalidArgument("nothing rendered yet".into()))?;
-        let bytes = target.sheet_tiles_back.read()?;
-        Ok(bytemuck::cast_slice::<u8, u32>(&bytes[..target.tiles as usize * 8]).to_vec())
+        let bytes = target.tiles as u64 * 8;
+        let back = Buffer::new(&self.ctx, "sheet tiles readback", bytes, BU::TRANSFER_DST, Memory::Readback)?;
+        self.ctx.submit(|rec| {
+            rec.barrier(Stage::All, Stage::Transfer);
+            rec.copy_buffer(&target.sheet_tiles, &back, bytes);
+            Ok(())
+        })?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&back.read()?[..bytes as usize]).to_vec())
     }
 
     /// Run the GPU PBTF order stage alone and read the draw sequence back.
@@ -1079,7 +1081,6 @@ impl GpuPipeline {
                             rec.fill_buffer_range(&target.sheet_tiles, 0, half, lo);
                             rec.fill_buffer_range(&target.sheet_tiles, half, half, hi);
                             rec.barrier(Stage::Transfer, Stage::All);
-                            rec.copy_buffer(&target.sheet_tiles, &target.sheet_tiles_back, half * 2);
                         }),
                     ));
                 }
@@ -1097,8 +1098,7 @@ impl GpuPipeline {
                             let pipe = &st.sheet_tiles[2 * slab as usize + points as usize];
                             let bytes = bytemuck::bytes_of(&push);
                             rec.dispatch(pipe, &st.footprint_layout, set, bytes, groups_1d(entries));
-                            rec.barrier(Stage::Compute, Stage::All);
-                            rec.copy_buffer(&target.sheet_tiles, &target.sheet_tiles_back, target.tiles as u64 * 8);
+                            rec.barrier(Stage::Compute, Stage::Compute);
                         }),
                     ));
                 }
