@@ -36,28 +36,46 @@ fn main() {
             _ => continue,
         };
         let source = std::fs::read_to_string(path).unwrap();
-        let mut opts = shaderc::CompileOptions::new().unwrap();
-        opts.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
-        opts.set_optimization_level(shaderc::OptimizationLevel::Performance);
-        opts.set_generate_debug_info();
-        for (name, value) in constants::GLSL_DEFINES {
-            opts.add_macro_definition(name, Some(&value.to_string()));
-        }
-        let shared_dir = glsl.join("shared");
-        opts.set_include_callback(move |name, _ty, _from, _depth| {
-            let p = shared_dir.join(name);
-            std::fs::read_to_string(&p)
-                .map(|content| shaderc::ResolvedInclude { resolved_name: p.display().to_string(), content })
-                .map_err(|e| format!("cannot include {}: {e}", p.display()))
-        });
-        let file = path.display().to_string();
-        match compiler.compile_into_spirv(&source, kind, &file, "main", Some(&opts)) {
-            Ok(art) => {
-                let name = path.file_name().unwrap().to_str().unwrap();
-                std::fs::write(out.join(format!("{name}.spv")), art.as_binary_u8()).unwrap();
+        let options = || {
+            let mut opts = shaderc::CompileOptions::new().unwrap();
+            opts.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
+            opts.set_optimization_level(shaderc::OptimizationLevel::Performance);
+            opts.set_generate_debug_info();
+            for (name, value) in constants::GLSL_DEFINES {
+                opts.add_macro_definition(name, Some(&value.to_string()));
             }
-            // shaderc's message already carries "file:line: error: ...".
-            Err(e) => failed.push(e.to_string()),
+            let shared_dir = glsl.join("shared");
+            opts.set_include_callback(move |name, _ty, _from, _depth| {
+                let p = shared_dir.join(name);
+                std::fs::read_to_string(&p)
+                    .map(|content| shaderc::ResolvedInclude { resolved_name: p.display().to_string(), content })
+                    .map_err(|e| format!("cannot include {}: {e}", p.display()))
+            });
+            opts
+        };
+        let file = path.display().to_string();
+        let name = path.file_name().unwrap().to_str().unwrap();
+        // A stage whose source names `// variants: A B` is also built with each macro defined,
+        // as `<stage>.A.spv` (for code that needs device features the plain build must not).
+        let variants = source
+            .lines()
+            .find_map(|l| l.strip_prefix("// variants:"))
+            .map(|v| v.split_whitespace().map(str::to_owned).collect::<Vec<_>>())
+            .unwrap_or_default();
+        for variant in std::iter::once(None).chain(variants.iter().map(Some)) {
+            let mut opts = options();
+            let out_name = match variant {
+                Some(v) => {
+                    opts.add_macro_definition(v, Some("1"));
+                    format!("{name}.{v}.spv")
+                }
+                None => format!("{name}.spv"),
+            };
+            match compiler.compile_into_spirv(&source, kind, &file, "main", Some(&opts)) {
+                Ok(art) => std::fs::write(out.join(out_name), art.as_binary_u8()).unwrap(),
+                // shaderc's message already carries "file:line: error: ...".
+                Err(e) => failed.push(e.to_string()),
+            }
         }
     }
     if !failed.is_empty() {

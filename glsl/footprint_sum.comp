@@ -5,12 +5,25 @@
 // summation layer with fixed-point atomics: order-independent, so the sums are bit-identical run to
 // run (float atomics would round differently with every interleaving). composite.comp reads the
 // fixed-point layers directly (its SUMS_FIXED variant). Mirror: cpu::footprint_sum.
+// variants: SUM64
+// SUM64 (devices with shaderBufferInt64Atomics): two channels per 64-bit atomic, (r, g) and
+// (b, tau), the same memory layout; llvmpipe runs each atomic lane by lane, so halving them makes
+// the stage ~1.3x faster. A channel's sum would carry into its neighbour where a 32-bit sum would
+// wrap, past 4096 units of optical depth in one pixel of one sheet.
+#ifdef SUM64
+#extension GL_EXT_shader_atomic_int64 : require
+#extension GL_ARB_gpu_shader_int64 : require
+#endif
 #define FOOTPRINT_COMPUTE
 #include "footprint.glsl"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "linear.glsl"
+#ifdef SUM64
+layout(std430, binding = 8) buffer Sums { uint64_t sums[]; };
+#else
 layout(std430, binding = 8) buffer Sums { uint sums[]; };
+#endif
 
 // One contribution in fixed point; clamped so no single add can wrap a pixel's sum.
 uint fixed_point(float v) {
@@ -39,12 +52,21 @@ void main() {
             if (abs(uv.x) > 1.0 || abs(uv.y) > 1.0) continue;
             float tau = energy * footprint_weight(slices, slab, uv, p.axis_v.w, faces);
             if (tau <= 0.0) continue;
+            uvec4 add = uvec4(fixed_point(p.emit.r * tau), fixed_point(p.emit.g * tau),
+                              fixed_point(p.emit.b * tau), fixed_point(tau));
+#ifdef SUM64
+            uint idx = 2u * (base + uint(y) * width + uint(x));
+            if (idx + 1u >= uint(sums.length())) continue;
+            atomicAdd(sums[idx], uint64_t(add.r) | (uint64_t(add.g) << 32));
+            atomicAdd(sums[idx + 1u], uint64_t(add.b) | (uint64_t(add.a) << 32));
+#else
             uint idx = 4u * (base + uint(y) * width + uint(x));
             if (idx + 3u >= uint(sums.length())) continue;
-            atomicAdd(sums[idx], fixed_point(p.emit.r * tau));
-            atomicAdd(sums[idx + 1u], fixed_point(p.emit.g * tau));
-            atomicAdd(sums[idx + 2u], fixed_point(p.emit.b * tau));
-            atomicAdd(sums[idx + 3u], fixed_point(tau));
+            atomicAdd(sums[idx], add.r);
+            atomicAdd(sums[idx + 1u], add.g);
+            atomicAdd(sums[idx + 2u], add.b);
+            atomicAdd(sums[idx + 3u], add.a);
+#endif
         }
     }
 }

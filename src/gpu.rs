@@ -228,6 +228,8 @@ impl GpuPipeline {
         let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
         let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
         let (vert, frag) = (spirv!("footprint.vert"), spirv!("footprint.frag"));
+        let sum_spirv: &[u8] =
+            if ctx.int64_atomics() { spirv!("footprint_sum.comp.SUM64") } else { spirv!("footprint_sum.comp") };
         let footprint_pipe = |blend, primitive, mode, pass: &RenderPass| {
             let points = (primitive == Primitive::Points) as u32;
             Pipeline::graphics(&ctx, &footprint_layout, pass, vert, frag, blend, primitive, &[mode, points])
@@ -245,18 +247,8 @@ impl GpuPipeline {
             under_points: footprint_pipe(Blend::Under, Primitive::Points, SHEET_MODE_SPLAT, &target_pass)?,
             add_points: footprint_pipe(Blend::Add, Primitive::Points, SHEET_MODE_AXIS, &sheet_pass)?,
             add_slab_points: footprint_pipe(Blend::Add, Primitive::Points, SHEET_MODE_SLAB, &sheet_pass)?,
-            sum_axis: Pipeline::compute_specialized(
-                &ctx,
-                &footprint_layout,
-                spirv!("footprint_sum.comp"),
-                &[SHEET_MODE_AXIS],
-            )?,
-            sum_slab: Pipeline::compute_specialized(
-                &ctx,
-                &footprint_layout,
-                spirv!("footprint_sum.comp"),
-                &[SHEET_MODE_SLAB],
-            )?,
+            sum_axis: Pipeline::compute_specialized(&ctx, &footprint_layout, sum_spirv, &[SHEET_MODE_AXIS])?,
+            sum_slab: Pipeline::compute_specialized(&ctx, &footprint_layout, sum_spirv, &[SHEET_MODE_SLAB])?,
             tile_count: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_count.comp"))?,
             tile_scan: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scan.comp"))?,
             tile_offsets: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_offsets.comp"))?,

@@ -189,6 +189,33 @@ fn renderer_on_an_adopted_host_device_matches_an_owning_one() {
     assert_clean(&owner);
 }
 
+/// The compute sheet sums add two channels per 64-bit atomic where the device has them; a host
+/// device without them gets the 32-bit build: the same fixed-point sums, so the same image bit for
+/// bit (sheets and slabs).
+#[test]
+fn sheet_sums_without_64_bit_atomics_match_the_64_bit_build() {
+    let mut owner = common::gpu();
+    assert!(owner.context().unwrap().int64_atomics(), "lavapipe has shaderBufferInt64Atomics");
+    let set = scene::build("cube40-attenuated").unwrap();
+    let cam = Camera::framing(set.grid(), 96, 80);
+    owner.set_scene(set.clone()).unwrap();
+    let mut host = owner.context().unwrap().handles();
+    host.int64_atomics = false;
+    let mut guest = voxsplat::Renderer::with_context(voxsplat::vk::Context::from_host(host).unwrap()).unwrap();
+    guest.set_scene(set).unwrap();
+    for composite in [Composite::Sheet, Composite::Slab] {
+        let mut o = RenderOptions::default();
+        o.composite = composite;
+        o.raster = Raster::Compute;
+        let (a, b) = (owner.render(&cam, &o).unwrap().image, guest.render(&cam, &o).unwrap().image);
+        assert!(a.pixels.iter().any(|p| p[3] > 0.0), "{composite:?}: something drawn");
+        let differ = a.pixels.iter().zip(&b.pixels).filter(|(p, q)| p != q).count();
+        assert_eq!(differ, 0, "{composite:?}: pixels where 64-bit and 32-bit sums disagree");
+    }
+    drop(guest);
+    assert_clean(&owner);
+}
+
 #[test]
 fn splat_params_stage_matches_its_mirror() {
     let mut gpu = common::gpu();

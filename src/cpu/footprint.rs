@@ -179,8 +179,10 @@ fn fixed_point(v: f32) -> u32 {
     (v.min(64.0) * SUM_FIXED_SCALE as f32 + 0.5) as u32
 }
 
-/// Mirror of `footprint_sum.comp`: add `push.count` entries from `push.first` to the fixed-point
-/// layers `sums` (layer-major rows of width x 4 channels), wrapping as the GPU's u32 atomics do.
+/// Mirror of `footprint_sum.comp` (its SUM64 build): add `push.count` entries from `push.first` to
+/// the fixed-point layers `sums` (layer-major rows of width x 4 channels), channels (r, g) and
+/// (b, tau) added as one 64-bit word each, wrapping as the GPU's atomics do (the 32-bit build
+/// differs only where a channel's sum wraps, which `SUM_FIXED_SCALE` keeps out of reach).
 pub fn footprint_sum(inputs: &FootprintInputs<'_>, push: &FootprintPush, sums: &mut [u32]) {
     let (width, height) = (inputs.frame.blur[2] as usize, inputs.frame.blur[3] as usize);
     for e in push.first..push.first + push.count {
@@ -200,8 +202,11 @@ pub fn footprint_sum(inputs: &FootprintInputs<'_>, push: &FootprintPush, sums: &
                 }
                 let idx = 4 * ((layer * height + y as usize) * width + x as usize);
                 let Some(px) = sums.get_mut(idx..idx + 4) else { continue };
-                for (c, v) in px.iter_mut().zip([p.emit[0] * tau, p.emit[1] * tau, p.emit[2] * tau, tau]) {
-                    *c = c.wrapping_add(fixed_point(v));
+                let add = [p.emit[0] * tau, p.emit[1] * tau, p.emit[2] * tau, tau].map(fixed_point);
+                for (pair, add) in px.chunks_exact_mut(2).zip(add.chunks_exact(2)) {
+                    let word =
+                        (pair[0] as u64 | (pair[1] as u64) << 32).wrapping_add(add[0] as u64 | (add[1] as u64) << 32);
+                    (pair[0], pair[1]) = (word as u32, (word >> 32) as u32);
                 }
             }
         }

@@ -36,6 +36,9 @@ pub struct HostHandles {
     /// Whether `device` was created with the `largePoints` feature: point sprites wider than one
     /// pixel, which `auto` prefers on a CPU device. Without it voxsplat draws no wide sprites.
     pub large_points: bool,
+    /// Whether `device` was created with `shaderInt64` and `shaderBufferInt64Atomics`: the compute
+    /// sheet sums then add two channels per atomic (~1.3x faster on lavapipe), else one.
+    pub int64_atomics: bool,
 }
 
 /// The Vulkan objects every resource needs. Resources hold an `Arc<Context>` so it outlives them.
@@ -54,6 +57,7 @@ pub struct Context {
     pub(crate) timestamp_period: Option<f64>,
     /// The device was created with `largePoints` (by us, or as its host says).
     large_points: bool,
+    int64_atomics: bool,
     device_name: String,
     device_type: vk::PhysicalDeviceType,
     /// Set once a call reports VK_ERROR_DEVICE_LOST: later submissions fail fast.
@@ -165,11 +169,20 @@ impl Context {
         let priorities = [1.0f32];
         let queues =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
-        let mut f12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true);
-        // Point sprites wider than one pixel (`--raster points`) when the device has them.
-        // SAFETY: plain query on a valid physical device.
-        let supported = unsafe { instance.get_physical_device_features(physical) };
-        let core = vk::PhysicalDeviceFeatures::default().large_points(supported.large_points == vk::TRUE);
+        // Point sprites wider than one pixel (`--raster points`) and 64-bit buffer atomics (the
+        // compute sheet sums) when the device has them.
+        let mut has12 = vk::PhysicalDeviceVulkan12Features::default();
+        let mut has = vk::PhysicalDeviceFeatures2::default().push_next(&mut has12);
+        // SAFETY: plain query on a valid physical device; the chain lives on the stack.
+        unsafe { instance.get_physical_device_features2(physical, &mut has) };
+        let supported = has.features;
+        let int64_atomics = supported.shader_int64 == vk::TRUE && has12.shader_buffer_int64_atomics == vk::TRUE;
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
+            .shader_output_layer(true)
+            .shader_buffer_int64_atomics(int64_atomics);
+        let core = vk::PhysicalDeviceFeatures::default()
+            .large_points(supported.large_points == vk::TRUE)
+            .shader_int64(int64_atomics);
         let device_info =
             vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut f12);
         // SAFETY: `physical` came from this instance; features were checked in pick_device.
@@ -189,7 +202,8 @@ impl Context {
         // SAFETY: queue family and index were requested above.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let large_points = supported.large_points == vk::TRUE;
-        let handles = HostHandles { entry, instance, physical, device, queue, queue_family, large_points };
+        let handles =
+            HostHandles { entry, instance, physical, device, queue, queue_family, large_points, int64_atomics };
         Self::finish(handles, debug, debug_state, true)
     }
 
@@ -212,6 +226,7 @@ impl Context {
             queue: self.queue.lock().map(|q| *q).unwrap_or_default(),
             queue_family: self.queue_family,
             large_points: self.large_points,
+            int64_atomics: self.int64_atomics,
         }
     }
 
@@ -221,7 +236,8 @@ impl Context {
         debug_state: Box<DebugState>,
         owned: bool,
     ) -> Result<Arc<Self>> {
-        let HostHandles { entry, instance, physical, device, queue, queue_family, large_points } = handles;
+        let HostHandles { entry, instance, physical, device, queue, queue_family, large_points, int64_atomics } =
+            handles;
         // SAFETY: plain queries on a valid physical device.
         let (props, families) = unsafe {
             (
@@ -270,6 +286,7 @@ impl Context {
             owned,
             timestamp_period,
             large_points,
+            int64_atomics,
             device_name,
             device_type: props.device_type,
             lost: AtomicBool::new(false),
@@ -349,6 +366,11 @@ impl Context {
         // SAFETY: plain query on a valid physical device.
         let props = unsafe { self.instance.get_physical_device_properties(self.physical) };
         props.limits.point_size_range[1]
+    }
+
+    /// Whether 64-bit buffer atomics are enabled (`HostHandles::int64_atomics`).
+    pub fn int64_atomics(&self) -> bool {
+        self.int64_atomics
     }
 
     /// True for a CPU implementation such as lavapipe.
