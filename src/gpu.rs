@@ -856,9 +856,7 @@ impl GpuPipeline {
                     rec.end_pass();
                     rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
                     // Every layer reaches every tile: the composite reads them all.
-                    let half = target.tiles as u64 * 4;
-                    rec.fill_buffer_range(&target.sheet_tiles, 0, half, 0);
-                    rec.fill_buffer_range(&target.sheet_tiles, half, half, layers);
+                    fill_sheet_tiles(rec, target, [0, layers]);
                     rec.barrier(Stage::Transfer, Stage::Compute);
                 }),
             ),
@@ -1063,36 +1061,31 @@ impl GpuPipeline {
                         rec.barrier(Stage::Transfer, Stage::All);
                     }),
                 ));
-                let ranges = batches.first().filter(|_| crate::pipeline::sheet_tiles_pay(&batches, w, h));
-                if ranges.is_none() {
-                    steps.push((
+                match batches.first().filter(|_| crate::pipeline::sheet_tiles_pay(&batches, w, h)) {
+                    None => steps.push((
                         UNTIMED,
                         Box::new(|rec| {
-                            let half = target.tiles as u64 * 4;
-                            let [lo, hi] = crate::pipeline::ALL_SHEETS;
-                            rec.fill_buffer_range(&target.sheet_tiles, 0, half, lo);
-                            rec.fill_buffer_range(&target.sheet_tiles, half, half, hi);
+                            fill_sheet_tiles(rec, target, crate::pipeline::ALL_SHEETS);
                             rec.barrier(Stage::Transfer, Stage::All);
                         }),
-                    ));
-                }
-                if let Some(first) = ranges {
-                    let slab = first.push.sheet_mode == SHEET_MODE_SLAB;
-                    let push = crate::pipeline::sheet_tiles_push(&batches, first);
-                    let entries = push.count;
-                    steps.push((
-                        "sheet_tiles",
-                        Box::new(move |rec| {
-                            let half = target.tiles as u64 * 4;
-                            rec.fill_buffer_range(&target.sheet_tiles, 0, half, u32::MAX);
-                            rec.fill_buffer_range(&target.sheet_tiles, half, half, 0);
-                            rec.barrier(Stage::Transfer, Stage::Compute);
-                            let pipe = &st.sheet_tiles[2 * slab as usize + points as usize];
-                            let bytes = bytemuck::bytes_of(&push);
-                            rec.dispatch(pipe, &st.footprint_layout, set, bytes, groups_1d(entries));
-                            rec.barrier(Stage::Compute, Stage::Compute);
-                        }),
-                    ));
+                    )),
+                    Some(first) => {
+                        let slab = first.push.sheet_mode == SHEET_MODE_SLAB;
+                        let push = crate::pipeline::sheet_tiles_push(&batches, first);
+                        let entries = push.count;
+                        steps.push((
+                            "sheet_tiles",
+                            Box::new(move |rec| {
+                                // No sheet reaches any tile until the pass says so.
+                                fill_sheet_tiles(rec, target, [u32::MAX, 0]);
+                                rec.barrier(Stage::Transfer, Stage::Compute);
+                                let pipe = &st.sheet_tiles[2 * slab as usize + points as usize];
+                                let bytes = bytemuck::bytes_of(&push);
+                                rec.dispatch(pipe, &st.footprint_layout, set, bytes, groups_1d(entries));
+                                rec.barrier(Stage::Compute, Stage::Compute);
+                            }),
+                        ));
+                    }
                 }
                 for b in &batches {
                     let slab = b.push.sheet_mode == SHEET_MODE_SLAB;
@@ -1230,6 +1223,13 @@ fn upload_host_order(
     dir: Direction,
 ) -> Result<()> {
     scene.order.write(bytemuck::cast_slice(&order::visibility_order(&prep.set, camera, kind, dir)))
+}
+
+/// Set every tile's sheet range to [lowest, highest + 1) = `range`.
+fn fill_sheet_tiles(rec: &Recorder<'_>, target: &TargetGpu, range: [u32; 2]) {
+    let half = target.tiles as u64 * 4;
+    rec.fill_buffer_range(&target.sheet_tiles, 0, half, range[0]);
+    rec.fill_buffer_range(&target.sheet_tiles, half, half, range[1]);
 }
 
 /// Workgroups of the tile binning passes that walk the draw list chunk by chunk.

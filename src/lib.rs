@@ -129,6 +129,16 @@ impl Renderer {
     }
 
     pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
+        self.render_keeping(camera, options, None)
+    }
+
+    /// `render`, also leaving the sheet modes' per-tile sheet ranges in `sheet_tiles` when given.
+    fn render_keeping(
+        &mut self,
+        camera: &Camera,
+        options: &RenderOptions,
+        sheet_tiles: Option<&mut Vec<u32>>,
+    ) -> Result<Rendered> {
         options.validate()?;
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
@@ -142,10 +152,17 @@ impl Renderer {
         let choice = raster::choose(&prep.set, camera, options, device)?;
         let mut opts = options.clone();
         opts.raster = choice.raster;
-        let mut out = match &mut self.gpu {
-            Some(g) => g.render(prep, camera, &opts),
-            None => pipeline::render_cpu(prep, camera, &opts),
-        }?;
+        let mut out = match (&mut self.gpu, sheet_tiles) {
+            (Some(g), tiles) => {
+                let out = g.render(prep, camera, &opts)?;
+                if let Some(tiles) = tiles {
+                    *tiles = g.last_sheet_tiles()?;
+                }
+                out
+            }
+            (None, Some(tiles)) => pipeline::render_cpu_with(prep, camera, &opts, tiles)?,
+            (None, None) => pipeline::render_cpu(prep, camera, &opts)?,
+        };
         out.raster = Some(choice);
         Ok(out)
     }
@@ -197,26 +214,8 @@ impl Renderer {
         if options.composite == Composite::Splat {
             return Err(Error::InvalidArgument("sheet ranges exist only in the sheet and slab modes".into()));
         }
-        self.render_with_sheet_tiles(camera, options)
-    }
-
-    fn render_with_sheet_tiles(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         let mut tiles = Vec::new();
-        match &mut self.gpu {
-            Some(_) => {
-                self.render(camera, options)?;
-                let g = self.gpu.as_mut().expect("matched");
-                tiles = g.last_sheet_tiles()?;
-            }
-            None => {
-                let mut opts = options.clone();
-                let device = raster::Device { cpu: true, point_size_max: f32::INFINITY };
-                opts.raster = raster::choose(&prep.set, camera, options, device)?.raster;
-                pipeline::render_cpu_with(prep, camera, &opts, &mut tiles)?;
-            }
-        }
+        self.render_keeping(camera, options, Some(&mut tiles))?;
         Ok(tiles)
     }
 

@@ -380,8 +380,12 @@ pub fn tile_push(opts: &RenderOptions, n: u32, width: u32, height: u32) -> Footp
 /// Push constants of `sheet_tiles.comp` for a frame's sheet batches: every entry of the sheet
 /// list from 0, layers numbered by global sheet (rank base 0, direction +1), no occlusion culling.
 pub fn sheet_tiles_push(batches: &[Batch], first: &Batch) -> FootprintPush {
-    let entries = batches.iter().map(|b| b.first_instance + b.instances).max().unwrap_or(0);
-    FootprintPush { rank_base: 0, rank_dir: 1, first: 0, count: entries, occluded: 0.0, ..first.push }
+    FootprintPush { rank_base: 0, rank_dir: 1, first: 0, count: sheet_entries(batches), occluded: 0.0, ..first.push }
+}
+
+/// Entries of the frame's sheet list that the batches draw (they cover it from 0).
+fn sheet_entries(batches: &[Batch]) -> u32 {
+    batches.iter().map(|b| b.first_instance + b.instances).max().unwrap_or(0)
 }
 
 /// Whether finding each tile's sheet range (`sheet_tiles`) can pay for itself: the composite must
@@ -389,7 +393,7 @@ pub fn sheet_tiles_push(batches: &[Batch], first: &Batch) -> FootprintPush {
 /// lavapipe: the pass costs 30–70 ns per entry, the composite ~8 ns per layer pixel). A single
 /// sheet seen head-on (the raster sweep) falls below, the volume scenes far above.
 pub fn sheet_tiles_pay(batches: &[Batch], width: u32, height: u32) -> bool {
-    let entries = batches.iter().map(|b| b.first_instance + b.instances).max().unwrap_or(0) as u64;
+    let entries = sheet_entries(batches) as u64;
     let layer_pixels: u64 = batches.iter().map(|b| b.layers as u64).sum::<u64>() * width as u64 * height as u64;
     entries > 0 && layer_pixels >= SHEET_TILES_MIN_RATIO * entries
 }
