@@ -6,7 +6,7 @@
 // footprint. Mirror: cpu::footprint.
 #include "types.glsl"
 
-layout(std430, binding = 5) readonly buffer Radial { float radial[]; };
+layout(std430, binding = 5) readonly buffer Radial { vec2 radial[]; };  // Kernel::radial_pairs
 layout(binding = 6) uniform sampler2D slices;
 #include "footprint_table.glsl"
 // The modes are fixed per pipeline (a branch on the push constant made llvmpipe pay for both

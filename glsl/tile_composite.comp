@@ -7,7 +7,13 @@
 // pixels have (early termination): no pixel then differs by more than that threshold.
 // Per-pixel tests of every entry (one invocation per pixel) cost llvmpipe ~5x more.
 // Mirror: cpu::tile::tile_composite.
+// variants: SHUFFLE
 #extension GL_KHR_shader_subgroup_vote : require
+#ifdef SHUFFLE
+// llvmpipe loads a buffer lane by lane, so every row loading the same entry costs eight loads;
+// instead each lane loads one entry of a batch and the batch is passed round by shuffles (~1.3x).
+#extension GL_KHR_shader_subgroup_shuffle : require
+#endif
 #define FOOTPRINT_COMPUTE
 #include "footprint.glsl"
 
@@ -31,34 +37,66 @@ void main() {
     for (uint i = 0u; i < RASTER_TILE; ++i) acc[i] = vec4(0.0);
     // Pixels of this row still open (all of them when not terminating early).
     int open = y < int(size.y) ? x_end - x0 + 1 : 0;
-    // The loop stays uniform across the rows (no divergent continue or exit), so the compiler
-    // loads each entry once for all of them instead of once per lane.
-    for (uint k = tile_start[tile]; k < end; ++k) {
+#ifdef SHUFFLE
+    // A workgroup narrower than its subgroup fills the subgroup's first lanes.
+    uint lane = gl_SubgroupInvocationID;
+    uint batch = min(gl_SubgroupSize, RASTER_TILE);
+#else
+    uint batch = 1u;
+#endif
+    // The loops stay uniform across the rows (no divergent continue or exit), so every entry is
+    // loaded once for all of them.
+    // A closed pixel takes no more entries, so testing once per batch changes no pixel.
+    for (uint k0 = tile_start[tile]; k0 < end; k0 += batch) {
         if (terminate && subgroupAll(open == 0)) break;
-        ScreenQuad q = quads[tile_entries[k]];
-        bool row = y >= q.box.y && y <= q.box.w;
-        // A fixed trip count unrolls, so acc[] stays in registers (an indexed private array costs
-        // llvmpipe a gather and a scatter per access).
-        for (int i = 0; i < int(RASTER_TILE); ++i) {
-            int x = x0 + i;
-            vec4 a = acc[i];
-            vec3 p = vec3(float(x) + 0.5, float(y) + 0.5, 1.0);
-            vec2 uv = vec2(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p)) / dot(q.inv2.xyz, p);
-            bool live = row && x >= q.box.x && x <= q.box.z && abs(uv.x) <= 1.0 && abs(uv.y) <= 1.0 &&
-                        (!terminate || 1.0 - a.a > pc.occluded);
-            if (live) {
-                float tau = q.emit.a * footprint_weight(slices, false, uv, q.inv0.w, vec2(0.0));
-                float alpha = 1.0 - exp(-tau);
-                vec4 src = vec4(q.emit.rgb * alpha, alpha);
-                if (btf) {
-                    a = src + (1.0 - alpha) * a;
-                } else {
-                    a += (1.0 - a.a) * src;
-                    if (terminate && 1.0 - a.a <= pc.occluded) open -= 1;
+#ifdef SHUFFLE
+        ScreenQuad mine;
+        if (lane < batch && k0 + lane < end) mine = quads[tile_entries[k0 + lane]];
+        uint n = min(batch, end - k0);
+#else
+        uint n = 1u;
+#endif
+        // do-while, here and below: llvmpipe runs the body of a loop once more, masked, for the test
+        // that ends it at the top; tested at the bottom it ends right away (n >= 1 and every entry's
+        // box meets the tile, so both loops take at least one pass).
+        uint j = 0u;
+        do {
+#ifdef SHUFFLE
+            ScreenQuad q;
+            q.inv0 = subgroupShuffle(mine.inv0, j);
+            q.inv1 = subgroupShuffle(mine.inv1, j);
+            q.inv2 = subgroupShuffle(mine.inv2, j);
+            q.box = subgroupShuffle(mine.box, j);
+            q.emit = subgroupShuffle(mine.emit, j);
+#else
+            ScreenQuad q = quads[tile_entries[k0]];
+#endif
+            bool row = y >= q.box.y && y <= q.box.w;
+            // Only the box's columns: llvmpipe runs a masked branch whatever its mask, so a column
+            // outside the box would cost as much as one inside. The index into acc[] is then not a
+            // constant (a gather and a scatter per access), still ~1.5x cheaper at 3-7 px footprints.
+            int c1 = min(q.box.z, x_end) - x0;
+            int i = max(q.box.x, x0) - x0;
+            do {
+                int x = x0 + i;
+                vec4 a = acc[i];
+                vec3 p = vec3(float(x) + 0.5, float(y) + 0.5, 1.0);
+                vec2 uv = vec2(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p)) / dot(q.inv2.xyz, p);
+                bool live = row && abs(uv.x) <= 1.0 && abs(uv.y) <= 1.0 && (!terminate || 1.0 - a.a > pc.occluded);
+                if (live) {
+                    float tau = q.emit.a * footprint_weight(slices, false, uv, q.inv0.w, vec2(0.0));
+                    float alpha = 1.0 - exp(-tau);
+                    vec4 src = vec4(q.emit.rgb * alpha, alpha);
+                    if (btf) {
+                        a = src + (1.0 - alpha) * a;
+                    } else {
+                        a += (1.0 - a.a) * src;
+                        if (terminate && 1.0 - a.a <= pc.occluded) open -= 1;
+                    }
+                    acc[i] = a;
                 }
-                acc[i] = a;
-            }
-        }
+            } while (++i <= c1);
+        } while (++j < n);
     }
     for (int i = 0; i < int(RASTER_TILE); ++i) {
         if (y < int(size.y) && x0 + i <= x_end) imageStore(accum, ivec2(x0 + i, y), acc[i]);

@@ -133,7 +133,7 @@ struct TargetGpu {
 pub struct GpuPipeline {
     stages: Stages,
     frame: Buffer,
-    /// The radial footprint table (`Kernel::radial_table`).
+    /// The radial footprint table (`Kernel::radial_pairs`).
     radial: Buffer,
     /// The kernel-slice table of the image-aligned sheets.
     slices: Image,
@@ -253,7 +253,15 @@ impl GpuPipeline {
             tile_scan: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scan.comp"))?,
             tile_offsets: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_offsets.comp"))?,
             tile_scatter: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp"))?,
-            tile_composite: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_composite.comp"))?,
+            tile_composite: Pipeline::compute(
+                &ctx,
+                &footprint_layout,
+                if ctx.subgroup_shuffle() {
+                    spirv!("tile_composite.comp.SHUFFLE")
+                } else {
+                    spirv!("tile_composite.comp")
+                },
+            )?,
             sheet_tiles: {
                 let pipe = |mode, points| {
                     Pipeline::compute_specialized(&ctx, &footprint_layout, spirv!("sheet_tiles.comp"), &[mode, points])
@@ -295,7 +303,7 @@ impl GpuPipeline {
         let frame =
             Buffer::new(&ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::STORAGE_BUFFER, Memory::Upload)?;
         let n = FOOTPRINT_TABLE_SIZE;
-        let radial_bytes = (RADIAL_TABLE_SIZE as u64 + 1) * 4;
+        let radial_bytes = RADIAL_TABLE_SIZE as u64 * 8;
         let radial = Buffer::new(&ctx, "radial table", radial_bytes, BU::STORAGE_BUFFER, Memory::Upload)?;
         let slices =
             Image::new(&ctx, "slice table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
@@ -312,7 +320,7 @@ impl GpuPipeline {
         if self.kernel == Some(kernel) {
             return Ok(());
         }
-        self.radial.write(bytemuck::cast_slice(&kernel.radial_table()))?;
+        self.radial.write(bytemuck::cast_slice(&kernel.radial_pairs()))?;
         let slice = kernel.slice_table();
         let staging =
             Buffer::with_data(&self.ctx, "slice table staging", bytemuck::cast_slice(&slice), BU::TRANSFER_SRC)?;

@@ -7,6 +7,7 @@
 //! variant draws the same picture: equal error is checked, not assumed.
 use crate::bench::{median, rastered, time_method};
 use crate::camera::{Camera, Projection};
+use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
 use crate::metrics::compare;
 use crate::pipeline::Composite;
@@ -89,6 +90,7 @@ pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
 /// variant's time is the median over rounds, so a drift of the shared machine during a size lands
 /// on all variants alike.
 pub const RATE_ROUNDS: usize = 3;
+const _: () = assert!(RATE_ROUNDS > 0);
 
 /// Time every variant of `RATE_VARIANTS` at each footprint size on an `n` x `n` sheet
 /// (`RATE_ROUNDS` interleaved rounds of `frames` frames after a warm-up).
@@ -112,10 +114,19 @@ pub fn raster_rates(
             &camera,
             &TruthOptions { reconstruction: Reconstruction::Kernel(Kernel::Gaussian), ..Default::default() },
         )?;
-        for (composite, raster) in RATE_VARIANTS {
-            let t = time_method(r, &rastered(composite, raster), &camera, 1, frames)?;
-            let before: f64 = t.stages.iter().filter(|s| matches!(s.0, "order" | "splat_params")).map(|s| s.1).sum();
-            let raster_ms = t.time_ms - before;
+        // Per variant: its raster time in each round and its last image.
+        let mut runs: Vec<(Vec<f64>, Option<ImageF32>)> = RATE_VARIANTS.iter().map(|_| (Vec::new(), None)).collect();
+        for _ in 0..RATE_ROUNDS {
+            for (&(composite, raster), run) in RATE_VARIANTS.iter().zip(&mut runs) {
+                let t = time_method(r, &rastered(composite, raster), &camera, 1, frames)?;
+                let before: f64 =
+                    t.stages.iter().filter(|s| matches!(s.0, "order" | "splat_params")).map(|s| s.1).sum();
+                run.0.push(t.time_ms - before);
+                run.1 = Some(t.image);
+            }
+        }
+        for (&(composite, raster), (mut times, image)) in RATE_VARIANTS.iter().zip(runs) {
+            let raster_ms = median(&mut times);
             out.push(RatePoint {
                 composite,
                 raster,
@@ -123,7 +134,7 @@ pub fn raster_rates(
                 splats,
                 raster_ms,
                 splats_per_s: splats as f64 / (raster_ms * 1e-3),
-                rmse: compare(&t.image, &truth)?.rmse,
+                rmse: compare(&image.expect("RATE_ROUNDS > 0"), &truth)?.rmse,
             });
         }
     }

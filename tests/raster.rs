@@ -183,6 +183,39 @@ fn footprints_larger_than_a_tile_and_straddling_tiles_render_correctly() {
     assert_clean(&gpu);
 }
 
+/// The tile compositor's two builds (entries loaded one per lane and passed round by subgroup
+/// shuffles, or loaded by every row) composite the same entries with the same arithmetic.
+#[test]
+fn tile_compositor_without_subgroup_shuffles_matches_the_shuffled_build() {
+    let mut owner = common::gpu();
+    assert!(owner.context().unwrap().subgroup_shuffle(), "lavapipe has compute subgroup shuffles");
+    let ctx = voxsplat::vk::Context::from_host(owner.context().unwrap().handles()).unwrap();
+    ctx.disable_subgroup_shuffle();
+    let mut guest = voxsplat::Renderer::with_context(ctx).unwrap();
+    let cube = scene::build("cube40-attenuated").unwrap();
+    let solid = scene::build("solid40").unwrap();
+    let (near, near_cam) = close_up();
+    let cases = [
+        (cube.clone(), Camera::framing(cube.grid(), 96, 80), None, 0.0),
+        (cube.clone(), Camera::framing(cube.grid(), 96, 80), Some(Direction::BackToFront), 0.0),
+        (solid.clone(), Camera::framing(solid.grid(), 96, 80), None, 0.3),
+        (near, near_cam, None, 0.0),
+    ];
+    for (i, (set, cam, direction, threshold)) in cases.into_iter().enumerate() {
+        owner.set_scene(set.clone()).unwrap();
+        guest.set_scene(set).unwrap();
+        let mut o = opts(Composite::Splat, Raster::Compute);
+        o.direction = direction;
+        o.early_termination = threshold;
+        let (a, b) = (owner.render(&cam, &o).unwrap().image, guest.render(&cam, &o).unwrap().image);
+        assert!(a.pixels.iter().any(|p| p[3] > 0.0), "case {i}: something drawn");
+        let differ = a.pixels.iter().zip(&b.pixels).filter(|(p, q)| p != q).count();
+        assert_eq!(differ, 0, "case {i}: pixels where the shuffled and the plain build disagree");
+    }
+    drop(guest);
+    assert_clean(&owner);
+}
+
 #[test]
 fn compute_raster_is_bit_identical_run_to_run() {
     let mut gpu = common::gpu();

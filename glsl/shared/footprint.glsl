@@ -9,7 +9,7 @@ layout(std430, binding = 1) readonly buffer Params { SplatParams params[]; };
 layout(std430, binding = 2) readonly buffer DrawList { uint draw_list[]; };
 layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 4) readonly buffer SheetRank { uint sheet_rank[]; };
-layout(std430, binding = 5) readonly buffer Radial { float radial[]; };
+layout(std430, binding = 5) readonly buffer Radial { vec2 radial[]; };  // Kernel::radial_pairs
 layout(binding = 6) uniform sampler2D slices;
 #include "footprint_table.glsl"
 layout(std430, binding = 7) readonly buffer Occlusion { float occlusion[]; };

@@ -35,14 +35,14 @@ float sample_slice_table(sampler2D slices, float r, float z) {
     return top + (bottom - top) * w.y;
 }
 
-// Lookup in the radial footprint table (Kernel::radial_table): s = r² in radius units, linear
+// Lookup in the radial footprint table (Kernel::radial_pairs): s = r² in radius units, linear
 // between RADIAL_TABLE_SIZE + 1 samples. The includer declares the `radial` buffer.
 // Mirror: sample_radial in src/cpu/footprint.rs.
 float sample_radial(float s) {
     float t = clamp(s, 0.0, 1.0) * float(RADIAL_TABLE_SIZE);
     uint i = min(uint(t), RADIAL_TABLE_SIZE - 1u);
-    float a = radial[i];
-    return a + (radial[i + 1u] - a) * (t - float(i));
+    vec2 e = radial[i];  // (value, step to the next)
+    return e.x + e.y * (t - float(i));
 }
 
 // A footprint's weight at quad coordinates uv: the pre-integrated kernel across the motion segment

@@ -58,6 +58,8 @@ pub struct Context {
     /// The device was created with `largePoints` (by us, or as its host says).
     large_points: bool,
     int64_atomics: bool,
+    /// Compute shaders have subgroup shuffles and votes (a property, so adopted devices have it too).
+    subgroup_shuffle: AtomicBool,
     device_name: String,
     device_type: vk::PhysicalDeviceType,
     /// Set once a call reports VK_ERROR_DEVICE_LOST: later submissions fail fast.
@@ -248,6 +250,13 @@ impl Context {
         let ts_bits = families.get(queue_family as usize).map(|f| f.timestamp_valid_bits).unwrap_or(0);
         let timestamp_period =
             (ts_bits > 0 && props.limits.timestamp_period > 0.0).then_some(props.limits.timestamp_period as f64);
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+        // SAFETY: plain query on a valid physical device; the chain lives on the stack.
+        unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
+        let ops = vk::SubgroupFeatureFlags::SHUFFLE | vk::SubgroupFeatureFlags::VOTE;
+        let subgroup_shuffle = subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
+            && subgroup.supported_operations.contains(ops);
         let device_name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
@@ -287,6 +296,7 @@ impl Context {
             timestamp_period,
             large_points,
             int64_atomics,
+            subgroup_shuffle: AtomicBool::new(subgroup_shuffle),
             device_name,
             device_type: props.device_type,
             lost: AtomicBool::new(false),
@@ -371,6 +381,19 @@ impl Context {
     /// Whether 64-bit buffer atomics are enabled (`HostHandles::int64_atomics`).
     pub fn int64_atomics(&self) -> bool {
         self.int64_atomics
+    }
+
+    /// Whether compute shaders have subgroup shuffles and votes: the tile compositor then loads a
+    /// batch of entries, one per lane, and passes them round (llvmpipe loads buffers lane by lane).
+    pub fn subgroup_shuffle(&self) -> bool {
+        self.subgroup_shuffle.load(Ordering::Relaxed)
+    }
+
+    /// Test hook: renderers created on this context afterwards use the tile compositor's build
+    /// without subgroup shuffles, as on a device that lacks them.
+    #[doc(hidden)]
+    pub fn disable_subgroup_shuffle(&self) {
+        self.subgroup_shuffle.store(false, Ordering::Relaxed);
     }
 
     /// True for a CPU implementation such as lavapipe.
