@@ -43,6 +43,12 @@ pub struct RatePoint {
     pub splats_per_s: f64,
     /// RMSE against the volumetric-summation truth.
     pub rmse: f64,
+    /// Speed over the quads with the same compositing: the median over rounds of the quads' time
+    /// over this variant's time in the same round (a paired ratio: both timed within about a
+    /// second, so a slow spell of the shared machine lands on both).
+    pub vs_quads: f64,
+    /// Smallest and largest of those per-round ratios.
+    pub vs_quads_range: (f64, f64),
 }
 
 impl RatePoint {
@@ -86,10 +92,11 @@ pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
     })
 }
 
-/// Rounds of the sweep at each size: every variant is timed once per round, in turn, and each
+/// Rounds of the sweep at each size: every variant is timed once per round, in turn (forward in
+/// even rounds, backward in odd ones, so neither of a pair is always timed first), and each
 /// variant's time is the median over rounds, so a drift of the shared machine during a size lands
 /// on all variants alike.
-pub const RATE_ROUNDS: usize = 3;
+pub const RATE_ROUNDS: usize = 5;
 const _: () = assert!(RATE_ROUNDS > 0);
 
 /// Time every variant of `RATE_VARIANTS` at each footprint size on an `n` x `n` sheet
@@ -116,17 +123,28 @@ pub fn raster_rates(
         )?;
         // Per variant: its raster time in each round and its last image.
         let mut runs: Vec<(Vec<f64>, Option<ImageF32>)> = RATE_VARIANTS.iter().map(|_| (Vec::new(), None)).collect();
-        for _ in 0..RATE_ROUNDS {
-            for (&(composite, raster), run) in RATE_VARIANTS.iter().zip(&mut runs) {
+        for round in 0..RATE_ROUNDS {
+            let mut turn: Vec<usize> = (0..RATE_VARIANTS.len()).collect();
+            if round % 2 == 1 {
+                turn.reverse();
+            }
+            for v in turn {
+                let (composite, raster) = RATE_VARIANTS[v];
                 let t = time_method(r, &rastered(composite, raster), &camera, 1, frames)?;
                 let before: f64 =
                     t.stages.iter().filter(|s| matches!(s.0, "order" | "splat_params")).map(|s| s.1).sum();
-                run.0.push(t.time_ms - before);
-                run.1 = Some(t.image);
+                runs[v].0.push(t.time_ms - before);
+                runs[v].1 = Some(t.image);
             }
         }
-        for (&(composite, raster), (mut times, image)) in RATE_VARIANTS.iter().zip(runs) {
-            let raster_ms = median(&mut times);
+        for (v, &(composite, raster)) in RATE_VARIANTS.iter().enumerate() {
+            let quads = RATE_VARIANTS.iter().position(|&(c, r)| c == composite && r == Raster::Graphics);
+            let mut paired: Vec<f64> = match quads {
+                Some(q) => runs[q].0.iter().zip(&runs[v].0).map(|(g, t)| g / t).collect(),
+                None => vec![f64::NAN],
+            };
+            let range = paired.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+            let raster_ms = median(&mut runs[v].0);
             out.push(RatePoint {
                 composite,
                 raster,
@@ -134,7 +152,9 @@ pub fn raster_rates(
                 splats,
                 raster_ms,
                 splats_per_s: splats as f64 / (raster_ms * 1e-3),
-                rmse: compare(&image.expect("RATE_ROUNDS > 0"), &truth)?.rmse,
+                rmse: compare(runs[v].1.as_ref().expect("RATE_ROUNDS > 0"), &truth)?.rmse,
+                vs_quads: median(&mut paired),
+                vs_quads_range: range,
             });
         }
     }
@@ -151,17 +171,18 @@ pub fn write_rates_csv(points: &[RatePoint], path: &Path) -> Result<()> {
 
 /// The sweep as CSV text.
 pub fn rates_csv(points: &[RatePoint]) -> String {
-    let mut s = String::from("variant,size_px,splats,raster_ms,splats_per_s,rmse\n");
+    let mut s = String::from("variant,size_px,splats,raster_ms,splats_per_s,rmse,vs_quads\n");
     for p in points {
         let _ = writeln!(
             s,
-            "{},{},{},{:.4},{:.0},{:.6}",
+            "{},{},{},{:.4},{:.0},{:.6},{:.4}",
             p.label(),
             p.size_px,
             p.splats,
             p.raster_ms,
             p.splats_per_s,
-            p.rmse
+            p.rmse,
+            p.vs_quads
         );
     }
     s
@@ -227,28 +248,28 @@ pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str
         s,
         "One sheet of {} voxels, head-on and orthographic, footprint quads exactly N px wide; rate = splats \
          over the time of the stages after `splat_params` (median of {RATE_ROUNDS} rounds that take the \
-         variants in turn, each round the median of its frames); RMSE against the volumetric-summation \
-         truth. Roofline: additive quads with the cheapest shaders (`roofline.vert/.frag`).\n",
+         variants in turn, forward then backward, each round the median of its frames); RMSE against the \
+         volumetric-summation truth; *vs quads* = the median over rounds of the quads' time over the \
+         variant's in the same round (smallest–largest round in brackets). Roofline: additive quads \
+         with the cheapest shaders (`roofline.vert/.frag`).\n",
         points.first().map(|p| p.splats).unwrap_or(0)
     );
     let _ = writeln!(
         s,
-        "| variant | px | ms | Msplats/s | RMSE | vs quads (same compositing) |\n|---|---:|---:|---:|---:|---:|"
+        "| variant | px | ms | Msplats/s | RMSE | vs quads (same compositing) |\n|---|---:|---:|---:|---:|---|"
     );
     for p in points {
-        let quads = points
-            .iter()
-            .find(|q| q.composite == p.composite && q.raster == Raster::Graphics && q.size_px == p.size_px);
-        let ratio = quads.map(|q| p.splats_per_s / q.splats_per_s).unwrap_or(f64::NAN);
         let _ = writeln!(
             s,
-            "| {} | {} | {:.2} | {:.3} | {:.5} | {:.2}x |",
+            "| {} | {} | {:.2} | {:.3} | {:.5} | {:.2}x ({:.2}–{:.2}) |",
             p.label(),
             p.size_px,
             p.raster_ms,
             p.splats_per_s / 1e6,
             p.rmse,
-            ratio
+            p.vs_quads,
+            p.vs_quads_range.0,
+            p.vs_quads_range.1
         );
     }
     if !roofline.is_empty() {
@@ -264,7 +285,7 @@ pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str
                 .iter()
                 .find(|q| q.composite == composite && q.raster == Raster::Graphics && q.size_px == p.size_px)
             {
-                ratios.push((p.size_px, p.splats_per_s / q.splats_per_s, p.rmse / q.rmse.max(1e-12)));
+                ratios.push((p.size_px, p.vs_quads, p.vs_quads_range, p.rmse / q.rmse.max(1e-12)));
             }
         }
         if ratios.is_empty() {
@@ -272,8 +293,10 @@ pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str
         }
         let mut r: Vec<f64> = ratios.iter().map(|x| x.1).collect();
         let worst = r.iter().cloned().fold(f64::INFINITY, f64::min);
-        let cells: Vec<String> =
-            ratios.iter().map(|(px, k, e)| format!("{px} px {k:.2}x (error ratio {e:.3})")).collect();
+        let cells: Vec<String> = ratios
+            .iter()
+            .map(|(px, k, (lo, hi), e)| format!("{px} px {k:.2}x ({lo:.2}–{hi:.2}; error ratio {e:.3})"))
+            .collect();
         lines.push(format!(
             "{}: {} — worst {:.2}x, median {:.2}x: {}",
             if composite == Composite::Splat { "per-splat (tile compositor)" } else { "sheet (fixed-point sums)" },
