@@ -118,9 +118,10 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
 
 /// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device, per-splat
 /// compositing (tile compositor, where point sprites are not allowed: motion blur) and sheet modes
-/// (fixed-point sums). Measured on lavapipe (`voxsplat rates`, docs/RESULTS.md): the tile
-/// compositor 1.9x the quads at 3 px, ~1.0x at 5-7 px, 0.9x at 14 px in perspective (the peer
-/// scene); the sums 3.2-3.6x at 3-7 px, 1.4-1.7x at 11-15 px, ahead of point sprites up to 11 px.
+/// (fixed-point sums). Measured on lavapipe (`voxsplat rates`, docs/RESULTS.md, one run): the tile
+/// compositor 3.2x, 2.3x and 1.8x the quads at 3, 5 and 7 px, 1.3-1.4x at 11-15 px, about level
+/// with them at 14 px in perspective (the peer scene); the sums 8.4x, 4.8x and 3.0x at 3-7 px,
+/// 1.5-1.7x at 11-15 px, ahead of or level with point sprites up to 11 px.
 pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 8.0;
 pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 /// Narrowest footprint (px) for which `auto` draws point sprites. Below about a pixel the device
