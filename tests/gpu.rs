@@ -207,10 +207,7 @@ fn sheet_sums_without_64_bit_atomics_match_the_64_bit_build() {
         let mut o = RenderOptions::default();
         o.composite = composite;
         o.raster = Raster::Compute;
-        let (a, b) = (owner.render(&cam, &o).unwrap().image, guest.render(&cam, &o).unwrap().image);
-        assert!(a.pixels.iter().any(|p| p[3] > 0.0), "{composite:?}: something drawn");
-        let differ = a.pixels.iter().zip(&b.pixels).filter(|(p, q)| p != q).count();
-        assert_eq!(differ, 0, "{composite:?}: pixels where 64-bit and 32-bit sums disagree");
+        common::assert_same_frame(&mut owner, &mut guest, &cam, &o, &format!("{composite:?}, 64-bit vs 32-bit sums"));
     }
     drop(guest);
     assert_clean(&owner);

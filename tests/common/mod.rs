@@ -1,6 +1,6 @@
 #![allow(dead_code)]
 use glam::Vec3;
-use voxsplat::{Backend, Camera, Grid, Projection, Renderer, RendererOptions, SplatSet};
+use voxsplat::{Backend, Camera, Grid, Projection, RenderOptions, Renderer, RendererOptions, SplatSet};
 
 /// A GPU renderer with validation on (every GPU test asks for it).
 pub fn gpu() -> Renderer {
@@ -17,6 +17,14 @@ pub fn cpu() -> Renderer {
 }
 
 /// Fails the test on any validation message, printing them.
+/// Two renderers (two builds of a stage) draw `cam` bit for bit alike, and draw something.
+pub fn assert_same_frame(a: &mut Renderer, b: &mut Renderer, cam: &Camera, o: &RenderOptions, what: &str) {
+    let (a, b) = (a.render(cam, o).unwrap().image, b.render(cam, o).unwrap().image);
+    assert!(a.pixels.iter().any(|p| p[3] > 0.0), "{what}: something drawn");
+    let differ = a.pixels.iter().zip(&b.pixels).filter(|(p, q)| p != q).count();
+    assert_eq!(differ, 0, "{what}: pixels where the two builds disagree");
+}
+
 pub fn assert_clean(r: &Renderer) {
     let n = r.validation_count();
     if n > 0 {
