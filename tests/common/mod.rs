@@ -16,7 +16,6 @@ pub fn cpu() -> Renderer {
     Renderer::new(&o).expect("cpu renderer")
 }
 
-/// Fails the test on any validation message, printing them.
 /// Two renderers (two builds of a stage) draw `cam` bit for bit alike, and draw something.
 pub fn assert_same_frame(a: &mut Renderer, b: &mut Renderer, cam: &Camera, o: &RenderOptions, what: &str) {
     let (a, b) = (a.render(cam, o).unwrap().image, b.render(cam, o).unwrap().image);
@@ -25,6 +24,7 @@ pub fn assert_same_frame(a: &mut Renderer, b: &mut Renderer, cam: &Camera, o: &R
     assert_eq!(differ, 0, "{what}: pixels where the two builds disagree");
 }
 
+/// Fails the test on any validation message, printing them.
 pub fn assert_clean(r: &Renderer) {
     let n = r.validation_count();
     if n > 0 {
