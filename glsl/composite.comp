@@ -45,7 +45,10 @@ void main() {
     if (inside) {
         vec4 acc = imageLoad(accum, ivec2(px));
         ivec2 range = layer_range();
-        for (int i = range.x; i <= range.y; ++i) {
+        // Bottom-tested behind the emptiness test: llvmpipe runs a top-tested loop's body once more,
+        // masked, for the test that ends it (the test is uniform per tile).
+        int i = range.x;
+        if (i <= range.y) do {
             uint l = uint(i);
             vec4 s;
             if (SUMS_FIXED != 0u) {
@@ -63,7 +66,7 @@ void main() {
                 float r = 1.0 - acc.a;
                 acc = vec4(acc.rgb + r * rgb, acc.a + r * a);
             }
-        }
+        } while (++i <= range.y);
         imageStore(accum, ivec2(px), acc);
         transmittance = 1.0 - acc.a;
     }

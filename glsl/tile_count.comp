@@ -22,8 +22,13 @@ void main() {
         quads[splat] = q;
         uvec4 r;
         if (!tile_range(q.box, r)) continue;
-        for (uint ty = r.y; ty <= r.w; ++ty) {
-            for (uint tx = r.x; tx <= r.z; ++tx) counts[(ty * grid.x + tx) * pc.chunks + chunk] += 1u;
-        }
+        // Bottom-tested: the range is not empty (see tile_composite.comp on llvmpipe's loops).
+        uint ty = r.y;
+        do {
+            uint tx = r.x;
+            do {
+                counts[(ty * grid.x + tx) * pc.chunks + chunk] += 1u;
+            } while (++tx <= r.z);
+        } while (++ty <= r.w);
     }
 }

@@ -23,14 +23,17 @@ void main() {
         uint splat = draw_list[e];
         uvec4 r;
         if (!tile_range(quads[splat].box, r)) continue;
-        for (uint ty = r.y; ty <= r.w; ++ty) {
-            for (uint tx = r.x; tx <= r.z; ++tx) {
+        // Bottom-tested: the range is not empty (see tile_composite.comp on llvmpipe's loops).
+        uint ty = r.y;
+        do {
+            uint tx = r.x;
+            do {
                 uint tile = ty * grid.x + tx;
                 uint cell = tile * pc.chunks + chunk;
                 uint at = counts[cell];
                 counts[cell] = at + 1u;
                 tile_entries[tile_start[tile] + at] = splat;
-            }
-        }
+            } while (++tx <= r.z);
+        } while (++ty <= r.w);
     }
 }
