@@ -37,7 +37,9 @@ md = ["## Side by side with the peers (issue 9)", "",
       "caster (llvmpipe, EGL) and each voxsplat mode, alternating tool by tool; each time is the median over "
       "rounds of a median of 5 frames after 2 warm-up frames (VTK: render + completion; voxsplat: render "
       "call to image on the host). Scores: PSNR over the object's pixels, 8-bit RGB over black, against "
-      "voxsplat's ray integration of the interpolated scalar at a 0.1-voxel step (the truth).", ""]
+      "voxsplat's ray integration of the interpolated scalar at a 0.1-voxel step (the truth). Rows labelled "
+      "`scale s` draw on a grid s times 512 on a side and resample it bilinearly to 512×512 "
+      "(`--render-scale`); they are scored at 512×512 like every other row.", ""]
 for n in sizes:
     truth, alpha = rgb_over_black(os.path.join(out, f"truth-scalar-{n}.png"))
     fine, _ = rgb_over_black(os.path.join(out, f"vtk-gpu-fine-{n}.png"))
@@ -87,13 +89,22 @@ for n in sizes:
             md.append(f"- vs VTK fixed-point CPU ray casting: **{r:.2f}×** (target ≥ 1×: {'met' if r >= 1 else 'missed'}).")
     else:
         md.append("No voxsplat mode reaches 40 dB against the truth here.")
-    # Issue 10: the fastest *splatting* mode (any raster variant) against VTK's fixed-point caster.
+    # Issue 10: the fastest *splatting* mode (any raster variant) against VTK's fixed-point caster, at
+    # no less accuracy than it; then the same at full size (render scale 1) for comparison.
+    fixed_p = next((p for (l, _, p) in rows if l == "vtk fixed"), None)
     splats = [(ms, l, p) for (ms, l, p) in good if "raycast" not in l]
-    if splats and "vtk fixed" in vtk:
-        ms, l, p = min(splats)
-        r = vtk["vtk fixed"] / ms
-        md.append(f"- Fastest splatting mode at ≥ 40 dB: **{l}** ({ms:.1f} ms, {p:.1f} dB), **{r:.2f}×** VTK "
-                  f"fixed-point (issue 10 target: faster than it, {'met' if r >= 1 else 'missed'}).")
+    if splats and "vtk fixed" in vtk and fixed_p is not None:
+        for title, pool in [
+            (f"at least as accurate as VTK fixed point (≥ {fixed_p:.1f} dB)", [s for s in splats if s[2] >= fixed_p]),
+            ("at full size (no render scale), ≥ 40 dB", [s for s in splats if "scale" not in s[1]]),
+        ]:
+            if not pool:
+                md.append(f"- No splatting mode {title}.")
+                continue
+            ms, l, p = min(pool)
+            r = vtk["vtk fixed"] / ms
+            md.append(f"- Fastest splatting mode {title}: **{l}** ({ms:.1f} ms, {p:.1f} dB), **{r:.2f}×** VTK "
+                      f"fixed-point (issue 10 target: faster than it, {'met' if r >= 1 else 'missed'}).")
     md.append("")
 open(os.path.join(docs, "peers.md"), "w").write("\n".join(md) + "\n")
 

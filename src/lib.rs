@@ -34,6 +34,7 @@ pub mod peer;
 pub mod pipeline;
 pub mod raster;
 pub mod rates;
+pub mod resample;
 pub mod scene;
 pub mod slab;
 pub mod soak;
@@ -132,7 +133,8 @@ impl Renderer {
         self.render_keeping(camera, options, None)
     }
 
-    /// `render`, also leaving the sheet modes' per-tile sheet ranges in `sheet_tiles` when given.
+    /// `render`, also leaving the sheet modes' per-tile sheet ranges in `sheet_tiles` when given
+    /// (of the grid actually drawn: the coarse one under a render scale).
     fn render_keeping(
         &mut self,
         camera: &Camera,
@@ -140,9 +142,19 @@ impl Renderer {
         sheet_tiles: Option<&mut Vec<u32>>,
     ) -> Result<Rendered> {
         options.validate()?;
+        camera.validate()?;
+        if options.render_scale < 1.0 {
+            // The coarse frame, then the resampling, timed on the host as its own stage.
+            let low = resample::scaled_camera(camera, options.render_scale)?;
+            let full = RenderOptions { render_scale: 1.0, ..options.clone() };
+            let mut out = self.render_keeping(&low, &full, sheet_tiles)?;
+            let t = std::time::Instant::now();
+            out.image = resample::upsample(&out.image, camera.width, camera.height)?;
+            out.timings.push(StageTime { stage: "upsample", ms: t.elapsed().as_secs_f64() * 1e3 });
+            return Ok(out);
+        }
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
-        camera.validate()?;
         let device = match &self.gpu {
             Some(g) => {
                 raster::Device { cpu: g.context().is_cpu_device(), point_size_max: g.context().point_size_max() }

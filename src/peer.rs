@@ -111,6 +111,11 @@ pub fn variants(n: u32) -> Vec<crate::stability::Variant> {
         Variant::Rastered(Composite::Splat, Raster::Points),
         Variant::Rastered(Composite::Splat, Raster::Compute),
         Variant::Kernel(crate::Kernel::Narrow, Raster::Points),
+        // Drawn on a coarser grid and resampled (`RenderOptions::render_scale`): at 128³ a voxel
+        // covers ~3.5 px, so the kernel is far wider than a pixel.
+        Variant::Scaled(crate::Kernel::Gaussian, Raster::Compute, 0.5),
+        Variant::Scaled(crate::Kernel::Narrow, Raster::Compute, 0.4),
+        Variant::Scaled(crate::Kernel::Narrow, Raster::Points, 0.5),
         Variant::Sheet,
         Variant::Rastered(Composite::Sheet, Raster::Compute),
     ];

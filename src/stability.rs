@@ -33,6 +33,8 @@ pub enum Variant {
     Rastered(Composite, Raster),
     /// PBTF per-splat compositing with another reconstruction kernel, through a raster variant.
     Kernel(crate::Kernel, Raster),
+    /// `Kernel` drawn at a render scale (`RenderOptions::render_scale`) and resampled to full size.
+    Scaled(crate::Kernel, Raster, f32),
 }
 
 impl Variant {
@@ -48,6 +50,7 @@ impl Variant {
                 Composite::Slab => format!("image-aligned slab 1 {r}"),
             },
             Variant::Kernel(k, r) => format!("pbtf splat {r} {}", k.name()),
+            Variant::Scaled(k, r, s) => format!("pbtf splat {r} {} scale {s}", k.name()),
         }
     }
 
@@ -55,7 +58,7 @@ impl Variant {
     pub fn reconstruction(&self) -> Reconstruction {
         match self {
             Variant::Raycast(_) => Reconstruction::Trilinear,
-            Variant::Kernel(k, _) => Reconstruction::Kernel(*k),
+            Variant::Kernel(k, _) | Variant::Scaled(k, _, _) => Reconstruction::Kernel(*k),
             _ => Reconstruction::Kernel(crate::Kernel::Gaussian),
         }
     }
@@ -70,6 +73,11 @@ impl Variant {
             Variant::Kernel(kernel, raster) => {
                 o.kernel = kernel;
                 o.raster = raster;
+            }
+            Variant::Scaled(kernel, raster, scale) => {
+                o.kernel = kernel;
+                o.raster = raster;
+                o.render_scale = scale;
             }
             Variant::Splat(order) => o.order = order,
             Variant::Sheet => o.composite = Composite::Sheet,

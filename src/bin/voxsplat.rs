@@ -260,6 +260,10 @@ struct RenderArgs {
     /// graphics; graphics on hardware; it prints what it picked).
     #[arg(long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"])]
     raster: String,
+    /// Draw on a grid this fraction of --size and resample it bilinearly to full size (1/16 to 1):
+    /// faster where voxels cover several pixels; the added error is in docs/RESULTS.md (peers).
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    render_scale: f32,
     /// Reconstruction kernel: Westover's Gaussian (sigma 0.6, radius 2), the Crawfis-Max-style cubic
     /// (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: fewer fragments, sharper, flat
     /// sheets ripple by 7.6%).
@@ -485,6 +489,8 @@ fn run(cli: Cli) -> Result<()> {
             opts.slab_thickness = a.slab_thickness;
             opts.early_termination = a.early_termination;
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
+            opts.render_scale = a.render_scale;
+            opts.validate()?;
             let splats = set.len();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
             let frame = if a.truth {
