@@ -235,9 +235,9 @@ fn peer_subcommand_times_every_mode() {
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(
         rows.len(),
-        9,
-        "splat (quads, points, compute, points with the narrow kernel), sheet (quads, compute), slab, two \
-         ray-caster steps: {csv}"
+        12,
+        "splat (quads, points, compute, points with the narrow kernel; three at a render scale), sheet \
+         (quads, compute), slab, two ray-caster steps: {csv}"
     );
     for r in rows {
         let (label, ms) = r.rsplit_once(',').unwrap();
