@@ -115,7 +115,7 @@ pub fn variants(n: u32) -> Vec<crate::stability::Variant> {
         // covers ~3.5 px, so the kernel is far wider than a pixel.
         Variant::Scaled(crate::Kernel::Gaussian, Raster::Compute, 0.5),
         Variant::Scaled(crate::Kernel::Narrow, Raster::Compute, 0.4),
-        Variant::Scaled(crate::Kernel::Narrow, Raster::Points, 0.5),
+        Variant::Scaled(crate::Kernel::Narrow, Raster::Points, 0.4),
         Variant::Sheet,
         Variant::Rastered(Composite::Sheet, Raster::Compute),
     ];
