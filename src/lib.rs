@@ -143,15 +143,11 @@ impl Renderer {
     ) -> Result<Rendered> {
         options.validate()?;
         camera.validate()?;
-        if options.render_scale < 1.0 {
-            // The coarse frame, then the resampling, timed on the host as its own stage.
-            let low = resample::scaled_camera(camera, options.render_scale)?;
+        if options.render_scale != 1.0 {
             let full = RenderOptions { render_scale: 1.0, ..options.clone() };
-            let mut out = self.render_keeping(&low, &full, sheet_tiles)?;
-            let t = std::time::Instant::now();
-            out.image = resample::upsample(&out.image, camera.width, camera.height)?;
-            out.timings.push(StageTime { stage: "upsample", ms: t.elapsed().as_secs_f64() * 1e3 });
-            return Ok(out);
+            return resample::render_scaled(camera, options.render_scale, |low| {
+                self.render_keeping(low, &full, sheet_tiles)
+            });
         }
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
@@ -269,6 +265,10 @@ impl Renderer {
         camera.validate()?;
         if !(options.step.is_finite() && options.step > 0.0) {
             return Err(Error::InvalidArgument("ray caster step must be positive".into()));
+        }
+        if options.render_scale != 1.0 {
+            let full = cpu::raycast::RaycastOptions { render_scale: 1.0, ..*options };
+            return resample::render_scaled(camera, options.render_scale, |low| self.raycast(low, &full));
         }
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;

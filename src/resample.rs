@@ -10,6 +10,7 @@
 use crate::camera::Camera;
 use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
+use crate::pipeline::{Rendered, StageTime};
 use rayon::prelude::*;
 
 /// Smallest render scale accepted: below it a 512-px view would have fewer than 32 rows.
@@ -33,6 +34,20 @@ pub fn scaled_camera(camera: &Camera, scale: f32) -> Result<Camera> {
     let rows = ((camera.height as f64 * scale as f64).round() as u32).max(1);
     let cols = ((camera.width as f64 * rows as f64 / camera.height as f64).ceil() as u32).max(1);
     Ok(Camera { width: cols, height: rows, ..*camera })
+}
+
+/// `draw` at `scale`: on `scaled_camera`'s grid, then resampled to `camera`'s size (timed on the
+/// host as stage `upsample`). Scale 1 draws `camera` itself.
+pub fn render_scaled(camera: &Camera, scale: f32, draw: impl FnOnce(&Camera) -> Result<Rendered>) -> Result<Rendered> {
+    check_scale(scale)?;
+    if scale == 1.0 {
+        return draw(camera);
+    }
+    let mut out = draw(&scaled_camera(camera, scale)?)?;
+    let t = std::time::Instant::now();
+    out.image = upsample(&out.image, camera.width, camera.height)?;
+    out.timings.push(StageTime { stage: "upsample", ms: t.elapsed().as_secs_f64() * 1e3 });
+    Ok(out)
 }
 
 /// Bilinear resampling of `low` (drawn by `scaled_camera`) to `width` x `height`: each full-size

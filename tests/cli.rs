@@ -106,6 +106,7 @@ fn bad_arguments_fail_cleanly() {
         &["render", "--scene", "cube40", "--render-scale", "0", "--out", "x.png"],
         &["render", "--scene", "cube40", "--render-scale", "1.5", "--out", "x.png"],
         &["render", "--scene", "cube40", "--render-scale", "nan", "--out", "x.png"],
+        &["render", "--scene", "cube40", "--render-scale", "0.5", "--truth", "--out", "x.png"],
         &["render", "--scene", "cube40", "--out", "x.bmp", "--cpu"],
         &["render", "--scene", "cube40", "--near", "10", "--far", "5", "--out", "x.png"],
         &["order", "--scene", "cube40", "--dump", "/nonexistent-dir/x.csv", "--cpu"],

@@ -2,6 +2,7 @@
 //! is the backend's own frame of `scaled_camera`, resampled; close to the full-size frame where
 //! voxels cover several pixels; bad scales are typed errors.
 mod common;
+use voxsplat::cpu::raycast::RaycastOptions;
 use voxsplat::cpu::ImageF32;
 use voxsplat::resample::{scaled_camera, upsample};
 use voxsplat::{classify, peer, scene, Camera, Error, Kernel, Raster, RenderOptions, Renderer};
@@ -53,6 +54,13 @@ fn a_scaled_frame_is_the_coarse_frame_resampled() {
         assert!(expect.pixels.iter().any(|p| p[3] > 0.0));
         assert_eq!(scaled.image, expect, "{raster}");
     }
+    // The ray caster takes the same knob.
+    let rc = |scale| RaycastOptions { step: 1.0, render_scale: scale, ..Default::default() };
+    let scaled = r.raycast(&cam, &rc(0.5)).unwrap();
+    assert!(scaled.timings.iter().any(|t| t.stage == "upsample"));
+    let coarse = r.raycast(&scaled_camera(&cam, 0.5).unwrap(), &rc(1.0)).unwrap().image;
+    assert_eq!(scaled.image, upsample(&coarse, cam.width, cam.height).unwrap(), "ray caster");
+    assert!(matches!(r.raycast(&cam, &rc(0.0)), Err(Error::InvalidArgument(_))));
     common::assert_clean(&r);
     // The CPU mirrors take the same path.
     let mut c = common::cpu();

@@ -493,6 +493,9 @@ fn run(cli: Cli) -> Result<()> {
             opts.validate()?;
             let splats = set.len();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
+            if a.truth && a.render_scale != 1.0 {
+                return Err(Error::InvalidArgument("--truth is the full-size reference: drop --render-scale".into()));
+            }
             let frame = if a.truth {
                 let t = std::time::Instant::now();
                 let opts = voxsplat::truth::TruthOptions {
@@ -507,7 +510,11 @@ fn run(cli: Cli) -> Result<()> {
                 r.set_scene(set)?;
                 let f = match a.raycast {
                     Some(step) => {
-                        let o = voxsplat::cpu::raycast::RaycastOptions { step, ..Default::default() };
+                        let o = voxsplat::cpu::raycast::RaycastOptions {
+                            step,
+                            render_scale: a.render_scale,
+                            ..Default::default()
+                        };
                         r.raycast(&cam, &o)?
                     }
                     None => {

@@ -20,6 +20,9 @@ pub struct RaycastOptions {
     /// Empty-space skipping over bricks of this many voxels per side (0: off). Exact: only samples
     /// that read nothing but empty voxels are skipped.
     pub brick: u32,
+    /// Cast on a grid this fraction of the camera's size and resample (`crate::resample`; the
+    /// inverse of an image sample distance). 1: full size.
+    pub render_scale: f32,
 }
 
 /// Default brick side of the empty-space skipping.
@@ -84,7 +87,7 @@ fn skip_brick(rc: &RaycastParams, b: [i32; 3], nb: [i32; 3], a: Vec3, dir: Vec3,
 
 impl Default for RaycastOptions {
     fn default() -> Self {
-        Self { step: 0.5, min_transmittance: 1e-3, max_steps: 1 << 16, brick: DEFAULT_BRICK }
+        Self { step: 0.5, min_transmittance: 1e-3, max_steps: 1 << 16, brick: DEFAULT_BRICK, render_scale: 1.0 }
     }
 }
 
