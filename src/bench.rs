@@ -19,8 +19,21 @@ use std::time::Instant;
 /// One rendering method of the matrix.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Method {
-    Splat { order: OrderKind, composite: Composite, kernel: Kernel, aa: Antialias, raster: Raster },
-    Raycast { step: f32 },
+    Splat {
+        order: OrderKind,
+        composite: Composite,
+        kernel: Kernel,
+        aa: Antialias,
+        raster: Raster,
+    },
+    Raycast {
+        step: f32,
+    },
+    /// A method drawn at a render scale (`RenderOptions::render_scale`) and resampled.
+    Scaled {
+        method: Box<Method>,
+        scale: f32,
+    },
 }
 
 fn aa_suffix(aa: Antialias) -> String {
@@ -60,6 +73,7 @@ impl Method {
                 format!("slab {kernel:?}{}{}", aa_suffix(*aa), raster_suffix(*raster))
             }
             Method::Raycast { step } => format!("raycast {step}"),
+            Method::Scaled { method, scale } => format!("{} scale {scale}", method.label()),
         }
         .to_lowercase()
     }
@@ -68,6 +82,7 @@ impl Method {
         match self {
             Method::Splat { kernel, .. } => Reconstruction::Kernel(*kernel),
             Method::Raycast { .. } => Reconstruction::Trilinear,
+            Method::Scaled { method, .. } => method.reconstruction(),
         }
     }
 }
@@ -115,6 +130,9 @@ impl MatrixOptions {
         for step in [1.0, 0.5, 0.25] {
             methods.push(Method::Raycast { step });
         }
+        // Half the grid, resampled: pays where footprints span many pixels, blurs where they do not.
+        methods.push(Method::Scaled { method: Box::new(rastered(Composite::Splat, Raster::Compute)), scale: 0.5 });
+        methods.push(Method::Scaled { method: Box::new(Method::Raycast { step: 1.0 }), scale: 0.5 });
         Self {
             scenes: vec!["cube60", "cube40-attenuated", "plane"],
             methods,
@@ -139,6 +157,7 @@ impl MatrixOptions {
                 rastered(Composite::Sheet, Raster::Compute),
                 Method::Raycast { step: 1.0 },
                 Method::Raycast { step: 0.5 },
+                Method::Scaled { method: Box::new(rastered(Composite::Splat, Raster::Compute)), scale: 0.5 },
             ],
             width: 128,
             height: 128,
@@ -182,6 +201,10 @@ pub fn bench_camera(grid: &Grid, width: u32, height: u32) -> Camera {
 }
 
 fn render_method(r: &mut Renderer, m: &Method, camera: &Camera) -> Result<Rendered> {
+    render_method_at(r, m, camera, 1.0)
+}
+
+fn render_method_at(r: &mut Renderer, m: &Method, camera: &Camera, render_scale: f32) -> Result<Rendered> {
     match m {
         Method::Splat { order, composite, kernel, aa, raster } => {
             let o = RenderOptions {
@@ -190,11 +213,15 @@ fn render_method(r: &mut Renderer, m: &Method, camera: &Camera) -> Result<Render
                 kernel: *kernel,
                 antialias: *aa,
                 raster: *raster,
+                render_scale,
                 ..Default::default()
             };
             r.render(camera, &o)
         }
-        Method::Raycast { step } => r.raycast(camera, &RaycastOptions { step: *step, ..Default::default() }),
+        Method::Raycast { step } => {
+            r.raycast(camera, &RaycastOptions { step: *step, render_scale, ..Default::default() })
+        }
+        Method::Scaled { method, scale } => render_method_at(r, method, camera, *scale),
     }
 }
 
@@ -754,7 +781,12 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
     // 3. Sheet buffer against the ray caster.
     for sc in &scenes {
         let Some(sheet) = row(rep.rows, sc, "sheet gaussian") else { continue };
-        let casts: Vec<&Row> = rep.rows.iter().filter(|r| r.scene == *sc && r.method.starts_with("raycast")).collect();
+        // Full-size ray casts only: the target compares drawing methods at the same grid.
+        let casts: Vec<&Row> = rep
+            .rows
+            .iter()
+            .filter(|r| r.scene == *sc && r.method.starts_with("raycast") && !r.method.contains(" scale "))
+            .collect();
         if casts.is_empty() {
             continue;
         }
