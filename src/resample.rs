@@ -39,7 +39,7 @@ pub fn scaled_camera(camera: &Camera, scale: f32) -> Result<Camera> {
 /// `draw` at `scale`: on `scaled_camera`'s grid, then resampled to `camera`'s size (timed on the
 /// host as stage `upsample`). Scale 1 draws `camera` itself.
 pub fn render_scaled(camera: &Camera, scale: f32, draw: impl FnOnce(&Camera) -> Result<Rendered>) -> Result<Rendered> {
-    check_scale(scale)?;
+    // `scaled_camera` checks the scale.
     if scale == 1.0 {
         return draw(camera);
     }
