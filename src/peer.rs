@@ -112,9 +112,11 @@ pub fn variants(n: u32) -> Vec<crate::stability::Variant> {
         Variant::Rastered(Composite::Splat, Raster::Compute),
         Variant::Kernel(crate::Kernel::Narrow, Raster::Points),
         // Drawn on a coarser grid and resampled (`RenderOptions::render_scale`): at 128³ a voxel
-        // covers ~3.5 px, so the kernel is far wider than a pixel.
+        // covers ~3.5 px, so the kernel is far wider than a pixel. Two scales of the compositor
+        // trace its speed-accuracy curve beside VTK's image sample distances (scripts/peers.sh).
         Variant::Scaled(crate::Kernel::Gaussian, Raster::Compute, 0.5),
         Variant::Scaled(crate::Kernel::Narrow, Raster::Compute, 0.4),
+        Variant::Scaled(crate::Kernel::Narrow, Raster::Compute, 0.25),
         Variant::Scaled(crate::Kernel::Narrow, Raster::Points, 0.4),
         Variant::Sheet,
         Variant::Rastered(Composite::Sheet, Raster::Compute),

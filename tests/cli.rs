@@ -239,8 +239,8 @@ fn peer_subcommand_times_every_mode() {
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(
         rows.len(),
-        12,
-        "splat (quads, points, compute, points with the narrow kernel; three at a render scale), sheet \
+        13,
+        "splat (quads, points, compute, points with the narrow kernel; four at a render scale), sheet \
          (quads, compute), slab, two ray-caster steps: {csv}"
     );
     for r in rows {
