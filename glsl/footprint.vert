@@ -17,7 +17,7 @@ layout(location = 3) flat out vec2 out_slab;
 void main() {
     uint entry = POINTS != 0u ? uint(gl_VertexIndex) : uint(gl_InstanceIndex);
     uint splat = entry_splat(entry);
-    SplatParams p = params[splat];
+    SplatParams p = params_at(splat);
     vec2 c = CORNERS[gl_VertexIndex & 3];
     out_uv = c;
     out_emit = vec4(p.emit.rgb, p.emit.a * p.axis_u.w);

@@ -25,6 +25,10 @@ layout(std430, binding = 8) buffer Sums { uint64_t sums[]; };
 layout(std430, binding = 8) buffer Sums { uint sums[]; };
 #endif
 
+// llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a footprint
+// box that large (about 250 x 250 pixels) is cut short, which bit 2 tells the host (gpu.rs).
+layout(std430, binding = 17) buffer Status { uint loop_budget_spent; };
+
 // One contribution in fixed point; clamped so no single add can wrap a pixel's sum.
 uint fixed_point(float v) {
     return uint(min(v, 64.0) * float(SUM_FIXED_SCALE) + 0.5);
@@ -35,7 +39,7 @@ void main() {
     if (i >= pc.count) return;
     uint e = pc.first + i;
     uint splat = entry_splat(e);
-    SplatParams p = params[splat];
+    SplatParams p = params_at(splat);
     if (p.center.w == 0.0 || (pc.occluded > 0.0 && occluded(p))) return;
     vec2 faces;
     int layer = entry_layer(e, splat, p, faces);
@@ -46,8 +50,11 @@ void main() {
     uint base = uint(layer) * width * uint(frame.blur.w);
     float energy = p.emit.a * p.axis_u.w;
     bool slab = SHEET_MODE == SHEET_MODE_SLAB;
+    // Set on the box's last pixel, so a loop cut short leaves it false (see tile_count.comp).
+    bool reached_end = false;
     for (int y = box.y; y <= box.w; ++y) {
         for (int x = box.x; x <= box.z; ++x) {
+            reached_end = reached_end || (y == box.w && x == box.z);
             vec2 uv = quad_uv(inv, ivec2(x, y));
             if (abs(uv.x) > 1.0 || abs(uv.y) > 1.0) continue;
             float tau = energy * footprint_weight(slices, slab, uv, p.axis_v.w, faces);
@@ -69,4 +76,5 @@ void main() {
 #endif
         }
     }
+    if (!reached_end && box.x <= box.z && box.y <= box.w) atomicOr(loop_budget_spent, 2u);
 }

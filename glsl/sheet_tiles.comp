@@ -19,7 +19,7 @@ void main() {
     uint e = linear_invocation();
     if (e >= pc.count) return;
     uint splat = entry_splat(e);
-    SplatParams p = params[splat];
+    SplatParams p = params_at(splat);
     vec2 faces;
     // The push constant's rank_base = 0 and rank_dir = +1 make this the sheet's global rank.
     int sheet = entry_layer(e, splat, p, faces);

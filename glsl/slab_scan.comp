@@ -5,7 +5,8 @@
 #include "types.glsl"
 
 layout(local_size_x = SCAN_WORKGROUP_SIZE) in;
-layout(std430, binding = 0) readonly buffer Params { SplatParams params[]; };
+layout(std430, binding = 0) readonly buffer Params { SplatParams params_lo[]; };
+layout(std430, binding = 4) readonly buffer ParamsHi { SplatParams params_hi[]; };
 layout(std430, binding = 1) buffer Counts { uint counts[]; };
 layout(std430, binding = 3) writeonly buffer SlabStart { uint slab_start[]; };
 #include "slab.glsl"

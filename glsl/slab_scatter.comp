@@ -7,7 +7,9 @@
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "linear.glsl"
-layout(std430, binding = 0) readonly buffer Params { SplatParams params[]; };
+layout(std430, binding = 0) readonly buffer Params { SplatParams params_lo[]; };
+layout(std430, binding = 4) readonly buffer ParamsHi { SplatParams params_hi[]; };
+PAGED_READER(SplatParams, params_at, params_lo, params_hi)
 layout(std430, binding = 1) buffer Counts { uint counts[]; };
 layout(std430, binding = 2) writeonly buffer Pairs { uint pairs[]; };
 #include "slab.glsl"
@@ -18,7 +20,7 @@ void main() {
     uint end = min((chunk + 1u) * SLAB_CHUNK, pc.n);
     for (uint s = chunk * SLAB_CHUNK; s < end; ++s) {
         uint first, last;
-        if (!slab_range(params[s], first, last)) continue;
+        if (!slab_range(params_at(s), first, last)) continue;
         for (uint slab = first; slab <= last; ++slab) {
             uint cell = slab_pos(slab) * pc.chunks + chunk;
             uint at = counts[cell];

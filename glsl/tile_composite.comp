@@ -5,6 +5,9 @@
 // footprint's box and composites them front to back (under) or back to front (over). Front to
 // back, a pixel stops once its transmittance is at most pc.occluded and the row stops when all its
 // pixels have (early termination): no pixel then differs by more than that threshold.
+// A dispatch takes TILE_SEGMENT entries of each list (segment pc.first), carrying the accumulators
+// in the image between segments: llvmpipe silently ends every loop once an invocation has made
+// 65535 loop iterations in all, which longer lists would pass.
 // Per-pixel tests of every entry (one invocation per pixel) cost llvmpipe ~5x more.
 // Mirror: cpu::tile::tile_composite.
 // variants: SHUFFLE
@@ -20,8 +23,10 @@
 layout(local_size_x = RASTER_TILE) in;
 layout(std430, binding = 10) readonly buffer TileStart { uint tile_start[]; };
 layout(std430, binding = 11) readonly buffer TileEntries { uint tile_entries[]; };
-layout(binding = 12, rgba32f) uniform writeonly image2D accum;
-layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads[]; };
+layout(binding = 12, rgba32f) uniform image2D accum;
+layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads_lo[]; };
+layout(std430, binding = 16) readonly buffer QuadsHi { ScreenQuad quads_hi[]; };
+PAGED_READER(ScreenQuad, quads_at, quads_lo, quads_hi)
 
 void main() {
     uvec2 size = uvec2(frame.blur.zw);
@@ -30,13 +35,21 @@ void main() {
     int x_end = min(x0 + int(RASTER_TILE), int(size.x)) - 1;
     uint tiles_x = (size.x + RASTER_TILE - 1u) / RASTER_TILE;
     uint tile = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
-    uint end = tile_start[tile + 1u];
+    uint list_end = tile_start[tile + 1u];
+    uint begin = tile_start[tile] + pc.first * TILE_SEGMENT;
+    // A later segment with nothing of this list leaves its pixels as they are.
+    if (pc.first > 0u && begin >= list_end) return;
+    uint end = min(list_end, begin + TILE_SEGMENT);
     bool btf = pc.back_to_front != 0u;
     bool terminate = !btf && pc.occluded > 0.0;
     vec4 acc[RASTER_TILE];
-    for (uint i = 0u; i < RASTER_TILE; ++i) acc[i] = vec4(0.0);
     // Pixels of this row still open (all of them when not terminating early).
-    int open = y < int(size.y) ? x_end - x0 + 1 : 0;
+    int open = 0;
+    for (int i = 0; i < int(RASTER_TILE); ++i) {
+        bool inside = y < int(size.y) && x0 + i <= x_end;
+        acc[i] = pc.first > 0u && inside ? imageLoad(accum, ivec2(x0 + i, y)) : vec4(0.0);
+        open += inside && (!terminate || 1.0 - acc[i].a > pc.occluded) ? 1 : 0;
+    }
 #ifdef SHUFFLE
     // A workgroup narrower than its subgroup fills the subgroup's first lanes.
     uint lane = gl_SubgroupInvocationID;
@@ -47,11 +60,14 @@ void main() {
     // The loops stay uniform across the rows (no divergent continue or exit), so every entry is
     // loaded once for all of them. A closed pixel takes no more entries, so testing for early
     // termination once per batch changes no pixel.
-    for (uint k0 = tile_start[tile]; k0 < end; k0 += batch) {
+    for (uint k0 = begin; k0 < end; k0 += batch) {
         if (terminate && subgroupAll(open == 0)) break;
 #ifdef SHUFFLE
         ScreenQuad mine;
-        if (lane < batch && k0 + lane < end) mine = quads[tile_entries[k0 + lane]];
+        if (lane < batch && k0 + lane < end) {
+            uint e = tile_entries[k0 + lane];
+            mine = quads_at(e);
+        }
         uint n = min(batch, end - k0);
 #else
         uint n = 1u;
@@ -69,7 +85,8 @@ void main() {
             q.box = subgroupShuffle(mine.box, j);
             q.emit = subgroupShuffle(mine.emit, j);
 #else
-            ScreenQuad q = quads[tile_entries[k0]];
+            uint e = tile_entries[k0];
+            ScreenQuad q = quads_at(e);
 #endif
             bool row = y >= q.box.y && y <= q.box.w;
             // Only the box's columns: llvmpipe runs a masked branch whatever its mask, so a column

@@ -12,7 +12,8 @@ layout(local_size_x = TILE_BIN_WORKGROUP) in;
 layout(std430, binding = 9) buffer Counts { uint counts[]; };
 layout(std430, binding = 10) readonly buffer TileStart { uint tile_start[]; };
 layout(std430, binding = 11) writeonly buffer TileEntries { uint tile_entries[]; };
-layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads[]; };
+layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads_lo[]; };
+layout(std430, binding = 16) readonly buffer QuadsHi { ScreenQuad quads_hi[]; };
 
 void main() {
     uint chunk = gl_GlobalInvocationID.x;
@@ -22,7 +23,8 @@ void main() {
     for (uint e = range.x; e < range.y; ++e) {
         uint splat = draw_list[e];
         uvec4 r;
-        if (!tile_range(quads[splat].box, r)) continue;
+        ivec4 box = splat < SPLAT_PAGE ? quads_lo[splat].box : quads_hi[splat - SPLAT_PAGE].box;
+        if (!tile_range(box, r)) continue;
         // Bottom-tested: the range is not empty (see tile_composite.comp on llvmpipe's loops).
         uint ty = r.y;
         do {

@@ -25,6 +25,19 @@ pub const TILE_BIN_WORKGROUP: u32 = 8;
 /// optical depth, so a pixel's sum within one sheet may reach 4096 before the u32 wraps and each
 /// contribution is rounded to within 5e-7.
 pub const SUM_FIXED_SCALE: u32 = 1 << 20;
+/// Records of a page of the per-splat arrays of 80-byte records (`SplatParams`, `ScreenQuad`): each
+/// array is bound as two pages of one buffer, because one storage binding may not exceed the device's
+/// `maxStorageBufferRange`, which is only guaranteed to reach 2^27 bytes (lavapipe's limit; 1.68 M such
+/// records). 1.6 M records = 128 000 000 bytes, a multiple of every allowed offset alignment.
+pub const SPLAT_PAGE: u32 = 1_600_000;
+/// Splats the GPU path takes (two pages); larger scenes get a typed error (the CPU backend has no such limit).
+pub const MAX_GPU_SPLATS: u32 = 2 * SPLAT_PAGE;
+/// Entries of each tile's list one dispatch of `tile_composite` takes (longer lists take several
+/// dispatches, the accumulators carried in the image between them): llvmpipe ends every loop of a
+/// shader invocation once it has made 65535 loop iterations in all (`LP_MAX_TGSI_LOOP_ITERATIONS`),
+/// silently, and an entry costs the compositor at most 1 + RASTER_TILE of them (plus one per batch).
+pub const TILE_SEGMENT: u32 = 4096;
+const _: () = assert!(TILE_SEGMENT as u64 * (2 + RASTER_TILE as u64) < 65535);
 /// Workgroups per dispatch row: larger 1D dispatches spill into y so they stay under the 65535 limit.
 pub const MAX_GROUPS_X: u32 = 32768;
 
@@ -40,4 +53,6 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("TILE_CHUNK", TILE_CHUNK),
     ("TILE_BIN_WORKGROUP", TILE_BIN_WORKGROUP),
     ("SUM_FIXED_SCALE", SUM_FIXED_SCALE),
+    ("SPLAT_PAGE", SPLAT_PAGE),
+    ("TILE_SEGMENT", TILE_SEGMENT),
 ];

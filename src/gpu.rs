@@ -1,6 +1,9 @@
 //! The stage list executed on Vulkan through the safe `vk` layer.
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, RADIAL_TABLE_SIZE, RASTER_TILE, TILE_BIN_WORKGROUP};
+use crate::constants::{
+    COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, RASTER_TILE, SPLAT_PAGE,
+    TILE_BIN_WORKGROUP, TILE_SEGMENT,
+};
 use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
@@ -138,6 +141,9 @@ pub struct GpuPipeline {
     /// The kernel-slice table of the image-aligned sheets.
     slices: Image,
     sampler: Sampler,
+    /// Set by stages whose loops ran out of llvmpipe's budget (`LOOP_BUDGET_*`), and its copy.
+    status: Buffer,
+    status_back: Buffer,
     kernel: Option<Kernel>,
     scene: Option<SceneGpu>,
     target: Option<TargetGpu>,
@@ -170,6 +176,21 @@ fn grow_readable(ctx: &Arc<Context>, slot: &mut Option<(Buffer, Buffer)>, name: 
     Ok(true)
 }
 
+/// Bits of the status word (binding 17): a binning invocation, or a footprint-sum invocation, made
+/// llvmpipe's 65535 loop iterations and was cut short (glsl/tile_count.comp, footprint_sum.comp).
+const LOOP_BUDGET_BINNING: u32 = 1;
+const LOOP_BUDGET_SUMS: u32 = 2;
+
+/// The two bindings of a per-splat array of 80-byte records (`SPLAT_PAGE` records each, see
+/// constants.rs); while the array fits in one page the second binding repeats the first.
+fn pages(buf: &Buffer) -> [Bind<'_>; 2] {
+    const PAGE: u64 = SPLAT_PAGE as u64 * std::mem::size_of::<SplatParams>() as u64;
+    const _: () = assert!(std::mem::size_of::<SplatParams>() == std::mem::size_of::<crate::gpu_types::ScreenQuad>());
+    let size = buf.size();
+    let hi = if size > PAGE { Bind::Range(buf, PAGE, (size - PAGE).min(PAGE)) } else { Bind::Range(buf, 0, size) };
+    [Bind::Range(buf, 0, size.min(PAGE)), hi]
+}
+
 fn storage(ctx: &Arc<Context>, name: &str, data: &[u8]) -> Result<Buffer> {
     Buffer::with_data(ctx, name, data, BU::STORAGE_BUFFER)
 }
@@ -183,11 +204,13 @@ impl GpuPipeline {
             compute,
             0,
         )?;
-        let params_layout = Layout::new(&ctx, &[Slot::Storage, Slot::Storage, Slot::Storage], compute, 0)?;
+        // glsl/splat_params.comp: frame, splats, the two pages of params.
+        let params_layout = Layout::new(&ctx, &[Slot::Storage; 4], compute, 0)?;
         // glsl/shared/footprint.glsl: 0-4 frame, params, draw list, splats, ranks; 5 radial table,
         // 6 slice table;
         // 7 occlusion; 8 fixed-point sums; 9-11 tile counts, starts, entries; 12 accumulation;
-        // 13 screen quads; 14 per-tile sheet ranges.
+        // 13 screen quads; 14 per-tile sheet ranges; 15, 16 the second pages of params and quads;
+        // 17 the loop-budget status word.
         let footprint_layout = Layout::new(
             &ctx,
             &[
@@ -206,6 +229,9 @@ impl GpuPipeline {
                 Slot::StorageImage,
                 Slot::Storage,
                 Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
+                Slot::Storage,
             ],
             SS::VERTEX | SS::FRAGMENT | SS::COMPUTE,
             std::mem::size_of::<FootprintPush>() as u32,
@@ -218,12 +244,8 @@ impl GpuPipeline {
         )?;
         let raycast_layout =
             Layout::new(&ctx, &[Slot::Storage, Slot::Texture, Slot::StorageImage, Slot::Storage], compute, 0)?;
-        let slab_layout = Layout::new(
-            &ctx,
-            &[Slot::Storage, Slot::Storage, Slot::Storage, Slot::Storage],
-            compute,
-            std::mem::size_of::<SlabPush>() as u32,
-        )?;
+        // glsl/slab_*.comp: params, counts, pairs, starts, the second page of params.
+        let slab_layout = Layout::new(&ctx, &[Slot::Storage; 5], compute, std::mem::size_of::<SlabPush>() as u32)?;
         let roofline_layout = Layout::new(&ctx, &[Slot::Uniform], SS::VERTEX | SS::FRAGMENT, 16)?;
         let target_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
         let sheet_pass = RenderPass::new(&ctx, COLOR_FORMAT, IL::GENERAL)?;
@@ -309,7 +331,23 @@ impl GpuPipeline {
             Image::new(&ctx, "slice table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
         let sampler = Sampler::nearest(&ctx)?;
         let timer = Timer::new(&ctx, 16)?;
-        Ok(Self { stages, frame, radial, slices, sampler, kernel: None, scene: None, target: None, timer, ctx })
+        let status =
+            Buffer::new(&ctx, "status", 4, BU::STORAGE_BUFFER | BU::TRANSFER_SRC | BU::TRANSFER_DST, Memory::Device)?;
+        let status_back = Buffer::new(&ctx, "status readback", 4, BU::TRANSFER_DST, Memory::Readback)?;
+        Ok(Self {
+            stages,
+            frame,
+            radial,
+            slices,
+            sampler,
+            status,
+            status_back,
+            kernel: None,
+            scene: None,
+            target: None,
+            timer,
+            ctx,
+        })
     }
 
     pub fn context(&self) -> &Arc<Context> {
@@ -342,6 +380,14 @@ impl GpuPipeline {
         self.scene = None;
         let ctx = &self.ctx;
         let set = &prep.set;
+        if set.len() > MAX_GPU_SPLATS as usize {
+            return Err(Error::TooLarge(format!(
+                "{} splats: the GPU path takes at most {MAX_GPU_SPLATS} (two {SPLAT_PAGE}-record pages of 80-byte \
+                 per-splat parameters; one storage binding is limited to maxStorageBufferRange). Classify fewer \
+                 voxels as non-empty or use the CPU backend",
+                set.len()
+            )));
+        }
         let n = set.len() as u32;
         let rows = (set.row_start().len() - 1) as u32;
         let splats = storage(ctx, "splats", bytemuck::cast_slice(set.splats()))?;
@@ -371,8 +417,9 @@ impl GpuPipeline {
             Bind::Buffer(&segments),
             Bind::Buffer(&order),
         ])?;
+        let [params_lo, params_hi] = pages(&params);
         let params_set =
-            st.params_layout.bind(&[Bind::Buffer(&self.frame), Bind::Buffer(&splats), Bind::Buffer(&params)])?;
+            st.params_layout.bind(&[Bind::Buffer(&self.frame), Bind::Buffer(&splats), params_lo, params_hi])?;
         self.scene = Some(SceneGpu {
             n,
             rows,
@@ -453,8 +500,53 @@ impl GpuPipeline {
 
     /// Compute tile compositing, first half: the order (when on the GPU), `splat_params`, the tile
     /// counts and their scan, then read back the total to size the entry list (checked against
-    /// `MAX_TILE_ENTRIES` before allocating).
-    fn tile_prepass(&mut self, frame: &Frame, push: &FootprintPush, gpu_order: bool) -> Result<Vec<StageTime>> {
+    /// `MAX_TILE_ENTRIES` before allocating). Also returns the longest tile list. When a binning
+    /// invocation ran out of llvmpipe's loop budget (footprints covering many tiles), the counts
+    /// are redone with chunks a quarter as long (`push.chunks` says what the scatter must use).
+    fn tile_prepass(
+        &mut self,
+        frame: &Frame,
+        push: &mut FootprintPush,
+        gpu_order: bool,
+    ) -> Result<(Vec<StageTime>, u32)> {
+        let (tx, ty) = crate::cpu::tile::tile_grid(frame);
+        let tiles = tx as u64 * ty as u64;
+        let most = (crate::raster::MAX_TILE_CELLS / tiles.max(1)).min(push.count.max(1) as u64) as u32;
+        let mut timings: Vec<StageTime> = Vec::new();
+        let mut first = true;
+        loop {
+            let (t, longest, spent) = self.tile_bins_once(frame, push, gpu_order && first, first)?;
+            for t in t {
+                match timings.iter_mut().find(|p| p.stage == t.stage) {
+                    Some(p) => p.ms += t.ms,
+                    None => timings.push(t),
+                }
+            }
+            if !spent {
+                return Ok((timings, longest));
+            }
+            if push.chunks >= most {
+                return Err(Error::TooLarge(format!(
+                    "the compute tile binning ran out of llvmpipe's 65535 loop iterations per invocation even in \
+                     {} chunks (footprints covering very many {RASTER_TILE}-pixel tiles): draw this frame with \
+                     --raster graphics or points",
+                    push.chunks
+                )));
+            }
+            push.chunks = push.chunks.saturating_mul(4).min(most);
+            first = false;
+        }
+    }
+
+    /// One binning pass of `tile_prepass`: its timings, the longest list, and whether a binning
+    /// invocation ran out of loop iterations (its counts are then incomplete).
+    fn tile_bins_once(
+        &mut self,
+        frame: &Frame,
+        push: &FootprintPush,
+        gpu_order: bool,
+        with_params: bool,
+    ) -> Result<(Vec<StageTime>, u32, bool)> {
         let ctx = self.ctx.clone();
         let (tx, ty) = crate::cpu::tile::tile_grid(frame);
         let tiles = tx as u64 * ty as u64;
@@ -477,7 +569,7 @@ impl GpuPipeline {
         if gpu_order && n > 0 {
             steps.push(("order", Box::new(|rec| record_order(rec, st, scene))));
         }
-        if n > 0 {
+        if with_params && n > 0 {
             steps.push((
                 "splat_params",
                 Box::new(|rec| {
@@ -487,10 +579,12 @@ impl GpuPipeline {
             ));
         }
         let counts = scene.tile_counts.as_ref().expect("grown");
+        let (status, status_back) = (&self.status, &self.status_back);
         steps.push((
             "tile_bins",
             Box::new(move |rec| {
                 rec.fill_buffer(counts, 0);
+                rec.fill_buffer(status, 0);
                 rec.barrier(Stage::Transfer, Stage::Compute);
                 rec.dispatch(&st.tile_count, &st.footprint_layout, set, bytes, tile_chunk_groups(push));
                 rec.barrier(Stage::Compute, Stage::Compute);
@@ -499,17 +593,22 @@ impl GpuPipeline {
                 rec.dispatch(&st.tile_offsets, &st.footprint_layout, set, bytes, [1, 1, 1]);
                 rec.barrier(Stage::Compute, Stage::Transfer);
                 rec.copy_buffer(dev, back, (tiles + 1) * 4);
+                rec.copy_buffer(status, status_back, 4);
             }),
         ));
         let timings = execute(&self.ctx, &mut self.timer, &steps)?;
         drop(steps);
-        let total = bytemuck::cast_slice::<u8, u32>(&back.read()?[..(tiles as usize + 1) * 4])[tiles as usize] as u64;
+        let spent = bytemuck::cast_slice::<u8, u32>(&self.status_back.read()?[..4])[0] & LOOP_BUDGET_BINNING != 0;
+        let starts = back.read()?;
+        let starts = bytemuck::cast_slice::<u8, u32>(&starts[..(tiles as usize + 1) * 4]);
+        let total = starts[tiles as usize] as u64;
+        let longest = starts.windows(2).map(|w| w[1].saturating_sub(w[0])).max().unwrap_or(0);
         crate::raster::check_tile_entries(total)?;
         let scene = self.scene.as_mut().expect("checked above");
         if grow(&self.ctx, &mut scene.tile_entries, "tile entries", total * 4, Memory::Device)? {
             scene.footprint_sets.clear();
         }
-        Ok(timings)
+        Ok((timings, longest, spent))
     }
 
     /// Run the tile binning of the compute tile compositor for this frame and read it back:
@@ -530,8 +629,8 @@ impl GpuPipeline {
         if !gpu_order {
             upload_host_order(scene, prep, camera, opts.order, opts.direction())?;
         }
-        let push = tile_push(opts, scene.n, w, h);
-        self.tile_prepass(&frame, &push, gpu_order)?;
+        let mut push = tile_push(opts, scene.n, w, h);
+        self.tile_prepass(&frame, &mut push, gpu_order)?;
         self.ensure_footprint_sets()?;
         let scene = self.scene.as_ref().expect("checked above");
         let (tx, ty) = crate::cpu::tile::tile_grid(&frame);
@@ -585,11 +684,13 @@ impl GpuPipeline {
             return Err(Error::InvalidArgument("slab buffers not allocated".into()));
         };
         let pairs = scene.slab_pairs.as_ref().unwrap_or(&scene.order);
+        let [params_lo, params_hi] = pages(&scene.params);
         scene.slab_set = Some(self.stages.slab_layout.bind(&[
-            Bind::Buffer(&scene.params),
+            params_lo,
             Bind::Buffer(counts),
             Bind::Buffer(pairs),
             Bind::Buffer(starts),
+            params_hi,
         ])?);
         Ok(())
     }
@@ -612,9 +713,11 @@ impl GpuPipeline {
         let quads = scene.tile_quads.as_ref().unwrap_or(stand_in);
         let mut sets = Vec::with_capacity(5);
         for list in [&scene.order, &scene.draw[0], &scene.draw[1], &scene.draw[2], pairs] {
+            let [params_lo, params_hi] = pages(&scene.params);
+            let [quads_lo, quads_hi] = pages(quads);
             sets.push(self.stages.footprint_layout.bind(&[
                 Bind::Buffer(&self.frame),
-                Bind::Buffer(&scene.params),
+                params_lo,
                 Bind::Buffer(list),
                 Bind::Buffer(&scene.splats),
                 Bind::Buffer(&scene.ranks),
@@ -626,8 +729,11 @@ impl GpuPipeline {
                 Bind::Buffer(starts),
                 Bind::Buffer(entries),
                 Bind::Image(&target.accum),
-                Bind::Buffer(quads),
+                quads_lo,
                 Bind::Buffer(&target.sheet_tiles),
+                params_hi,
+                quads_hi,
+                Bind::Buffer(&self.status),
             ])?);
         }
         scene.footprint_sets = sets;
@@ -969,13 +1075,19 @@ impl GpuPipeline {
             host_ms = Some(("order_cpu", t));
         }
         let host_ms = host_ms.map(|(stage, t)| StageTime { stage, ms: t.elapsed().as_secs_f64() * 1e3 });
-        let tile_pc = tile_push(opts, scene.n, w, h);
+        let mut tile_pc = tile_push(opts, scene.n, w, h);
+        // The compositor takes each tile's list TILE_SEGMENT entries per dispatch (see constants.rs).
+        let mut segments = vec![tile_pc];
         if tiles {
-            pre_timings = self.tile_prepass(&frame, &tile_pc, gpu_order)?;
+            let (timings, longest) = self.tile_prepass(&frame, &mut tile_pc, gpu_order)?;
+            pre_timings = timings;
+            segments =
+                (0..longest.div_ceil(TILE_SEGMENT).max(1)).map(|s| FootprintPush { first: s, ..tile_pc }).collect();
         }
         self.ensure_footprint_sets()?;
         let (st, scene, target) =
             (&self.stages, self.scene.as_ref().expect("set above"), self.target.as_ref().expect("ensured"));
+        let (status, status_back) = (&self.status, &self.status_back);
         let n = scene.n;
         let mut steps: Vec<Step<'_>> = Vec::new();
         if gpu_order && n > 0 && !tiles {
@@ -1020,8 +1132,11 @@ impl GpuPipeline {
                     "footprint",
                     Box::new(move |rec| {
                         let groups = [w.div_ceil(RASTER_TILE), h.div_ceil(RASTER_TILE), 1];
-                        rec.dispatch(&st.tile_composite, &st.footprint_layout, set, push, groups);
-                        rec.barrier(Stage::Compute, Stage::Compute);
+                        for segment in &segments {
+                            let push = bytemuck::bytes_of(segment);
+                            rec.dispatch(&st.tile_composite, &st.footprint_layout, set, push, groups);
+                            rec.barrier(Stage::Compute, Stage::Compute);
+                        }
                     }),
                 ));
                 steps.push((UNTIMED, Box::new(|rec| read_back_accum(rec, target))));
@@ -1063,6 +1178,7 @@ impl GpuPipeline {
                         rec.clear_image(&target.accum, IL::GENERAL, [0.0; 4]);
                         rec.fill_buffer(&target.occlusion, 1.0f32.to_bits());
                         if compute {
+                            rec.fill_buffer(status, 0);
                             // composite.comp's fixed-point variant still names the sums image.
                             rec.transition(&target.sums, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
                         }
@@ -1136,11 +1252,27 @@ impl GpuPipeline {
                         }),
                     ));
                 }
-                steps.push((UNTIMED, Box::new(|rec| read_back_accum(rec, target))));
+                steps.push((
+                    UNTIMED,
+                    Box::new(move |rec| {
+                        read_back_accum(rec, target);
+                        if compute {
+                            rec.copy_buffer(status, status_back, 4);
+                        }
+                    }),
+                ));
             }
         }
         let mut timings = execute(&self.ctx, &mut self.timer, &steps)?;
         drop(steps);
+        let sums = compute && matches!(opts.composite, Composite::Sheet | Composite::Slab);
+        if sums && bytemuck::cast_slice::<u8, u32>(&self.status_back.read()?[..4])[0] & LOOP_BUDGET_SUMS != 0 {
+            return Err(Error::TooLarge(
+                "a footprint larger than about 250 x 250 pixels: the compute sheet sums ran out of llvmpipe's 65535 \
+                 loop iterations per invocation; draw this frame with --raster graphics or points"
+                    .into(),
+            ));
+        }
         if let Some(t) = host_ms {
             timings.insert(0, t);
         }

@@ -91,7 +91,8 @@ pub struct FootprintPush {
     /// Early termination: skip footprints over tiles with at most this transmittance (0 = off);
     /// the tile compositor stops a pixel once its transmittance is at most this.
     pub occluded: f32,
-    /// Compute raster: first draw-list entry of the batch and the entry count.
+    /// Compute raster: first draw-list entry of the batch and the entry count. Tile compositing:
+    /// `first` is the segment (entries `first * TILE_SEGMENT..` of every tile's list).
     pub first: u32,
     pub count: u32,
     /// Tile binning: chunks of the draw list (columns of the tile x chunk count matrix), each

@@ -5,7 +5,9 @@
 #include "types.glsl"
 
 layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
-layout(std430, binding = 1) readonly buffer Params { SplatParams params[]; };
+layout(std430, binding = 1) readonly buffer Params { SplatParams params_lo[]; };
+layout(std430, binding = 15) readonly buffer ParamsHi { SplatParams params_hi[]; };
+PAGED_READER(SplatParams, params_at, params_lo, params_hi)
 layout(std430, binding = 2) readonly buffer DrawList { uint draw_list[]; };
 layout(std430, binding = 3) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 4) readonly buffer SheetRank { uint sheet_rank[]; };
@@ -28,7 +30,8 @@ layout(push_constant) uniform Push {
     float slab_dz;     // slab mode: slab thickness (world units)
     float occluded;    // early termination: skip a splat whose every tile has at most this
                        // transmittance left; the tile compositor stops a pixel there (0: off)
-    uint first;        // compute raster: the batch's first draw-list entry
+    uint first;        // compute raster: the batch's first draw-list entry; tile compositing: the
+                       // segment (entries first * TILE_SEGMENT.. of each tile's list)
     uint count;        // compute raster: entries in the batch (tile binning: in the list)
     uint chunks;       // tile binning: draw-list chunks of ceil(count / chunks) entries
     uint back_to_front;// tile compositing: 1 = the list runs back to front

@@ -367,6 +367,13 @@ impl Context {
         )
     }
 
+    /// Largest range of one storage-buffer binding (`maxStorageBufferRange`; 2^27 bytes on lavapipe).
+    pub fn max_storage_range(&self) -> u64 {
+        // SAFETY: plain query on a valid physical device.
+        let l = unsafe { self.instance.get_physical_device_properties(self.physical) }.limits;
+        l.max_storage_buffer_range as u64
+    }
+
     /// Widest point sprite the device draws, in pixels (1 without the `largePoints` feature, which
     /// a host says in `HostHandles::large_points`: then points wider than one pixel are refused).
     pub fn point_size_max(&self) -> f32 {

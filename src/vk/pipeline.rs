@@ -29,7 +29,10 @@ impl Slot {
 
 /// A resource bound to a slot.
 pub enum Bind<'a> {
+    /// The whole buffer; a storage buffer larger than the device's binding range is refused.
     Buffer(&'a Buffer),
+    /// `range` bytes of a buffer from `offset` (a multiple of the device's offset alignment).
+    Range(&'a Buffer, u64, u64),
     Image(&'a Image),
     Texture(&'a Image, &'a Sampler),
     None,
@@ -109,10 +112,31 @@ impl Layout {
 
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
+        let limit = self.ctx.max_storage_range();
+        let too_large = |bytes: u64| {
+            Error::TooLarge(format!(
+                "a storage binding of {bytes} bytes exceeds this device's maxStorageBufferRange ({limit} bytes)"
+            ))
+        };
         for (slot, b) in self.slots.iter().zip(binds) {
             match (slot, b) {
                 (Slot::Uniform | Slot::Storage, Bind::Buffer(buf)) => {
+                    if *slot == Slot::Storage && buf.size() > limit {
+                        return Err(too_large(buf.size()));
+                    }
                     buffer_infos.push(vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE })
+                }
+                (Slot::Uniform | Slot::Storage, Bind::Range(buf, offset, range)) => {
+                    if *slot == Slot::Storage && *range > limit {
+                        return Err(too_large(*range));
+                    }
+                    if *range == 0 || offset + range > buf.size() {
+                        return Err(Error::InvalidArgument(format!(
+                            "binding range {offset}+{range} outside a buffer of {} bytes",
+                            buf.size()
+                        )));
+                    }
+                    buffer_infos.push(vk::DescriptorBufferInfo { buffer: buf.raw, offset: *offset, range: *range })
                 }
                 (Slot::StorageImage, Bind::Image(img)) => image_infos.push(vk::DescriptorImageInfo {
                     sampler: vk::Sampler::null(),

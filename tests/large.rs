@@ -1,0 +1,128 @@
+//! Scenes past a device limit: per-splat arrays longer than one storage binding may be (lavapipe's
+//! maxStorageBufferRange is 2^27 bytes, 1.68 M of the 80-byte records) are bound as two pages, and
+//! scenes past two pages get a typed error.
+mod common;
+use common::{assert_clean, cpu, gpu};
+use voxsplat::constants::{MAX_GPU_SPLATS, SPLAT_PAGE};
+use voxsplat::{Antialias, Camera, Composite, Error, Grid, Kernel, Raster, RenderOptions, SplatSet};
+
+/// `nx` x 100 x 100 translucent splats with a colour ramp, so neighbouring records differ.
+fn block(nx: u32) -> SplatSet {
+    let grid = Grid::centered([nx, 100, 100], [1.0; 3]).unwrap();
+    SplatSet::from_fn(grid, |i, j, k| Some([i as f32 / nx as f32, j as f32 / 100.0, k as f32 / 100.0, 0.02])).unwrap()
+}
+
+fn max_diff(a: &voxsplat::cpu::ImageF32, b: &voxsplat::cpu::ImageF32) -> f32 {
+    a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs())).fold(0.0, f32::max)
+}
+
+#[test]
+fn per_splat_records_past_one_binding_range_are_paged() {
+    let set = block(170);
+    assert!(set.len() > SPLAT_PAGE as usize && set.len() * 80 > 1 << 27, "{} splats", set.len());
+    let (mut g, mut c) = (gpu(), cpu());
+    g.set_scene(set.clone()).unwrap();
+    c.set_scene(set.clone()).unwrap();
+    let cam = Camera::framing(set.grid(), 40, 32);
+    let gp = g.splat_params(&cam, Kernel::Gaussian, Antialias::None).unwrap();
+    let cp = c.splat_params(&cam, Kernel::Gaussian, Antialias::None).unwrap();
+    // The second page holds the last splats; unpaged, a binding clipped to the device's range lost them.
+    let page = SPLAT_PAGE as usize;
+    for (i, (a, b)) in gp.iter().zip(&cp).enumerate().skip(page - 2) {
+        for (x, y) in [(a.center, b.center), (a.axis_u, b.axis_u), (a.emit, b.emit), (a.screen, b.screen)] {
+            for k in 0..4 {
+                assert!((x[k] - y[k]).abs() <= 1e-4 * (1.0 + y[k].abs()), "splat {i}: gpu {x:?} cpu {y:?}");
+            }
+        }
+    }
+    // Frames that read the second page: quads, compute sheet sums, and the tile compositor (whose
+    // screen records are paged too).
+    for (composite, raster) in
+        [(Composite::Splat, Raster::Graphics), (Composite::Sheet, Raster::Compute), (Composite::Splat, Raster::Compute)]
+    {
+        let mut o = RenderOptions::default();
+        o.composite = composite;
+        o.raster = raster;
+        let (a, b) = (g.render(&cam, &o).unwrap().image, c.render(&cam, &o).unwrap().image);
+        let d = max_diff(&a, &b);
+        assert!(d <= 1.0 / 255.0, "{composite:?} {raster:?}: GPU and mirror differ by {d}");
+    }
+    assert_clean(&g);
+}
+
+#[test]
+fn scenes_past_two_pages_are_refused_with_a_typed_error() {
+    let set = block(MAX_GPU_SPLATS / 10_000 + 1);
+    assert!(set.len() > MAX_GPU_SPLATS as usize);
+    let mut g = gpu();
+    match g.set_scene(set) {
+        Err(Error::TooLarge(m)) => assert!(m.contains("at most") && m.contains("CPU backend"), "{m}"),
+        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
+    }
+    assert_clean(&g);
+}
+
+/// llvmpipe ends every loop of a shader invocation once it has made 65535 iterations in all,
+/// silently. Tile lists longer than one compositor dispatch can take (here up to ~10^5 entries),
+/// front to back with and without early termination and back to front, composite in segments
+/// that carry the accumulators; footprints so large that a binning chunk runs out are binned again
+/// in shorter chunks. Both match the mirror, which has no such budget.
+#[test]
+fn work_past_llvmpipes_loop_budget_is_split_not_cut_short() {
+    use voxsplat::constants::TILE_SEGMENT;
+    use voxsplat::Direction;
+    let (mut g, mut c) = (gpu(), cpu());
+    let set = voxsplat::scene::build("stripes128").unwrap();
+    g.set_scene(set.clone()).unwrap();
+    c.set_scene(set.clone()).unwrap();
+    let cam = Camera::framing(set.grid(), 32, 32);
+    let mut o = RenderOptions::default();
+    o.raster = Raster::Compute;
+    let (starts, _) = g.tile_lists(&cam, &o).unwrap();
+    let longest = starts.windows(2).map(|w| w[1] - w[0]).max().unwrap();
+    assert!(longest > 8 * TILE_SEGMENT, "longest list {longest}");
+    for (direction, stop) in
+        [(None, 0.0), (Some(Direction::FrontToBack), 0.0), (Some(Direction::FrontToBack), 1.0 / 64.0)]
+    {
+        o.direction = direction;
+        o.early_termination = stop;
+        let d = max_diff(&g.render(&cam, &o).unwrap().image, &c.render(&cam, &o).unwrap().image);
+        assert!(d <= 1.0 / 255.0, "{direction:?} stop {stop}: GPU and mirror differ by {d}");
+    }
+
+    // 1024 footprints 100 px wide: one binning chunk would visit ~190 000 tiles.
+    let sheet = voxsplat::rates::rate_scene(32).unwrap();
+    let cam = voxsplat::rates::rate_camera(sheet.grid(), 100.0).unwrap();
+    g.set_scene(sheet.clone()).unwrap();
+    c.set_scene(sheet).unwrap();
+    o.direction = None;
+    o.early_termination = 0.0;
+    let (gs, ge) = g.tile_lists(&cam, &o).unwrap();
+    let (cs, ce) = c.tile_lists(&cam, &o).unwrap();
+    assert_eq!((gs.len(), ge.len()), (cs.len(), ce.len()), "tile lists");
+    assert!(gs == cs && ge == ce, "the GPU's tile lists are the mirror's");
+    let d = max_diff(&g.render(&cam, &o).unwrap().image, &c.render(&cam, &o).unwrap().image);
+    assert!(d <= 1.0 / 255.0, "large footprints: GPU and mirror differ by {d}");
+    assert_clean(&g);
+}
+
+/// The compute sheet sums give each footprint one invocation; one past the loop budget (a box of
+/// 300 x 300 pixels) is a typed error naming the raster modes that draw it, not a cut footprint.
+#[test]
+fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
+    let sheet = voxsplat::rates::rate_scene(4).unwrap();
+    let cam = voxsplat::rates::rate_camera(sheet.grid(), 300.0).unwrap();
+    let mut g = gpu();
+    g.set_scene(sheet).unwrap();
+    let mut o = RenderOptions::default();
+    o.composite = Composite::Sheet;
+    o.raster = Raster::Compute;
+    match g.render(&cam, &o) {
+        Err(Error::TooLarge(m)) => assert!(m.contains("--raster graphics"), "{m}"),
+        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
+    }
+    o.raster = Raster::Graphics;
+    let img = g.render(&cam, &o).unwrap().image;
+    assert!(img.pixels.iter().any(|p| p[3] > 0.0));
+    assert_clean(&g);
+}
