@@ -38,6 +38,9 @@ pub const MAX_GPU_SPLATS: u32 = 2 * SPLAT_PAGE;
 /// silently, and an entry costs the compositor at most 1 + RASTER_TILE of them (plus one per batch).
 pub const TILE_SEGMENT: u32 = 4096;
 const _: () = assert!(TILE_SEGMENT as u64 * (2 + RASTER_TILE as u64) < 65535);
+/// Samples the GPU ray caster takes per ray at most (a typed error past it): its sample loop shares
+/// llvmpipe's 65535 loop iterations per invocation with the brick skips.
+pub const MAX_GPU_RAY_STEPS: u32 = 60_000;
 /// Workgroups per dispatch row: larger 1D dispatches spill into y so they stay under the 65535 limit.
 pub const MAX_GROUPS_X: u32 = 32768;
 

@@ -1,8 +1,8 @@
 //! The stage list executed on Vulkan through the safe `vk` layer.
 use crate::camera::Camera;
 use crate::constants::{
-    COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, RASTER_TILE, SPLAT_PAGE,
-    TILE_BIN_WORKGROUP, TILE_SEGMENT,
+    COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, MAX_GPU_RAY_STEPS, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, RASTER_TILE,
+    SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT,
 };
 use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
@@ -865,6 +865,16 @@ impl GpuPipeline {
     /// The GPU ray caster (`raycast.comp`), uploading the dense field on first use.
     pub fn raycast(&mut self, prep: &Prepared, camera: &Camera, opts: &RaycastOptions) -> Result<Rendered> {
         camera.validate()?;
+        let params = raycast_params(&prep.set, camera, opts);
+        let diagonal =
+            glam::Vec3::from_slice(&params.box_max[..3]).distance(glam::Vec3::from_slice(&params.box_min[..3]));
+        let steps = (diagonal / params.box_min[3]).ceil().min(opts.max_steps as f32);
+        if steps > MAX_GPU_RAY_STEPS as f32 {
+            return Err(Error::TooLarge(format!(
+                "rays of up to {steps} samples: the GPU ray caster takes at most {MAX_GPU_RAY_STEPS} per ray (llvmpipe ends \
+                 a shader's loops after 65535 iterations); use a longer step, a lower max_steps or the CPU backend"
+            )));
+        }
         self.ensure_target(camera.width, camera.height, self.target.as_ref().map(|t| t.layers).unwrap_or(1))?;
         let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene set".into()))?;
         let need_bricks = scene.bricks.as_ref().is_none_or(|(b, _)| *b != opts.brick);
@@ -900,7 +910,6 @@ impl GpuPipeline {
             })?;
             scene.field = Some(image);
         }
-        let params = raycast_params(&prep.set, camera, opts);
         let ubo = Buffer::with_data(&self.ctx, "raycast params", bytemuck::bytes_of(&params), BU::STORAGE_BUFFER)?;
         let (st, scene, target) =
             (&self.stages, self.scene.as_ref().expect("set"), self.target.as_ref().expect("ensured"));

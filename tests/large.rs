@@ -126,3 +126,23 @@ fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
     assert!(img.pixels.iter().any(|p| p[3] > 0.0));
     assert_clean(&g);
 }
+
+/// The GPU ray caster's sample loop shares llvmpipe's loop budget: rays that could need more than
+/// `MAX_GPU_RAY_STEPS` samples are a typed error, not rays cut short; a `max_steps` under it draws.
+#[test]
+fn gpu_rays_past_the_loop_budget_are_refused() {
+    use voxsplat::constants::MAX_GPU_RAY_STEPS;
+    let set = voxsplat::scene::build("cube40").unwrap();
+    let cam = Camera::framing(set.grid(), 24, 24);
+    let mut g = gpu();
+    g.set_scene(set).unwrap();
+    let mut o = voxsplat::cpu::raycast::RaycastOptions::default();
+    o.step = 0.001; // ~70 voxel diagonal: 70 000 samples
+    match g.raycast(&cam, &o) {
+        Err(Error::TooLarge(m)) => assert!(m.contains(&MAX_GPU_RAY_STEPS.to_string()), "{m}"),
+        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
+    }
+    o.max_steps = 50_000;
+    assert!(g.raycast(&cam, &o).unwrap().image.pixels.iter().any(|p| p[3] > 0.0));
+    assert_clean(&g);
+}
