@@ -136,8 +136,8 @@ fn gpu_rays_past_the_loop_budget_are_refused() {
     let cam = Camera::framing(set.grid(), 24, 24);
     let mut g = gpu();
     g.set_scene(set).unwrap();
-    let mut o = voxsplat::cpu::raycast::RaycastOptions::default();
-    o.step = 0.001; // ~70 voxel diagonal: 70 000 samples
+    // A ~70-voxel diagonal at a 0.001-voxel step: 70 000 samples.
+    let mut o = voxsplat::cpu::raycast::RaycastOptions { step: 0.001, ..Default::default() };
     match g.raycast(&cam, &o) {
         Err(Error::TooLarge(m)) => assert!(m.contains(&MAX_GPU_RAY_STEPS.to_string()), "{m}"),
         other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
