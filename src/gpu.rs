@@ -1043,7 +1043,12 @@ impl GpuPipeline {
         let (w, h) = (camera.width, camera.height);
         let direction = opts.direction();
         let btf = direction == Direction::BackToFront;
-        let layers = opts.batch_layers(w, h).min(max_layers.max(1));
+        let mut layers = opts.batch_layers(w, h).min(max_layers.max(1));
+        if opts.raster == Raster::Compute && opts.composite != Composite::Splat {
+            // The fixed-point layers are one storage binding: no more than its range allows.
+            let layer_bytes = w as u64 * h as u64 * 16;
+            layers = layers.min((self.ctx.max_storage_range() / layer_bytes.max(1)).max(1) as u32);
+        }
         let frame = frame_for(&prep.set, camera, opts);
         let mut host_ms = None;
         let mut pre_timings = Vec::new();

@@ -186,8 +186,9 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
 
 /// Most cells of the tile x chunk count matrix (4 bytes each: 64 MiB).
 pub const MAX_TILE_CELLS: u64 = 1 << 24;
-/// Most (tile, splat) entries in one frame (4 bytes each: 512 MiB).
-pub const MAX_TILE_ENTRIES: u64 = 1 << 27;
+/// Most (tile, splat) entries in one frame (4 bytes each: 128 MiB, the one storage binding every
+/// device allows, 2^27 bytes).
+pub const MAX_TILE_ENTRIES: u64 = 1 << 25;
 
 /// The count matrix's cells, checked before it is allocated.
 pub fn check_tile_cells(tiles: u64, chunks: u32) -> Result<u64> {

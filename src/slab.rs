@@ -25,8 +25,9 @@ use glam::Vec3;
 
 /// Thinnest slab allowed, in voxel spacings (pairs grow as 2R/Δ).
 pub const MIN_SLAB_THICKNESS: f32 = 0.25;
-/// Most (splat, slab) pairs in one frame (8 bytes each: 1 GiB).
-pub const MAX_SLAB_PAIRS: u64 = 1 << 27;
+/// Most (splat, slab) pairs in one frame (8 bytes each: 128 MiB, the one storage binding every
+/// device allows, 2^27 bytes).
+pub const MAX_SLAB_PAIRS: u64 = 1 << 24;
 /// Most cells of the slab x chunk count matrix (4 bytes each: 64 MiB).
 pub const MAX_SLAB_CELLS: u64 = 1 << 24;
 

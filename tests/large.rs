@@ -146,3 +146,24 @@ fn gpu_rays_past_the_loop_budget_are_refused() {
     assert!(g.raycast(&cam, &o).unwrap().image.pixels.iter().any(|p| p[3] > 0.0));
     assert_clean(&g);
 }
+
+/// The compute sheet sums keep a batch's fixed-point layers in one storage binding: at 512², the
+/// default 256 MiB batch budget (64 layers of 4 MiB) would pass lavapipe's 128 MiB range, so the
+/// batch is cut to fit; the frame matches the sheets drawn as quads.
+#[test]
+fn fixed_point_sheet_batches_fit_one_binding() {
+    let set = voxsplat::scene::build("cube60").unwrap();
+    let cam = Camera::framing(set.grid(), 512, 512);
+    let mut g = gpu();
+    g.set_scene(set).unwrap();
+    let mut o = RenderOptions::default();
+    o.composite = Composite::Sheet;
+    assert!(o.batch_layers(512, 512) as u64 * 512 * 512 * 16 > 1 << 27, "the default budget passes one binding");
+    o.raster = Raster::Compute;
+    let sums = g.render(&cam, &o).unwrap().image;
+    o.raster = Raster::Graphics;
+    let quads = g.render(&cam, &o).unwrap().image;
+    let d = max_diff(&sums, &quads);
+    assert!(d <= 2.0 / 255.0, "sums and quads differ by {d}");
+    assert_clean(&g);
+}
