@@ -12,6 +12,15 @@ fn block(nx: u32) -> SplatSet {
     SplatSet::from_fn(grid, |i, j, k| Some([i as f32 / nx as f32, j as f32 / 100.0, k as f32 / 100.0, 0.02])).unwrap()
 }
 
+/// The message of a `TooLarge` error; anything else fails the test.
+fn too_large<T>(r: voxsplat::Result<T>) -> String {
+    match r {
+        Err(Error::TooLarge(m)) => m,
+        Err(e) => panic!("expected TooLarge, got {e}"),
+        Ok(_) => panic!("expected TooLarge, got a result"),
+    }
+}
+
 fn max_diff(a: &voxsplat::cpu::ImageF32, b: &voxsplat::cpu::ImageF32) -> f32 {
     a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs())).fold(0.0, f32::max)
 }
@@ -55,10 +64,8 @@ fn scenes_past_two_pages_are_refused_with_a_typed_error() {
     let set = block(MAX_GPU_SPLATS / 10_000 + 1);
     assert!(set.len() > MAX_GPU_SPLATS as usize);
     let mut g = gpu();
-    match g.set_scene(set) {
-        Err(Error::TooLarge(m)) => assert!(m.contains("at most") && m.contains("CPU backend"), "{m}"),
-        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
-    }
+    let m = too_large(g.set_scene(set));
+    assert!(m.contains("at most") && m.contains("CPU backend"), "{m}");
     assert_clean(&g);
 }
 
@@ -117,10 +124,8 @@ fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
     let mut o = RenderOptions::default();
     o.composite = Composite::Sheet;
     o.raster = Raster::Compute;
-    match g.render(&cam, &o) {
-        Err(Error::TooLarge(m)) => assert!(m.contains("--raster graphics"), "{m}"),
-        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
-    }
+    let m = too_large(g.render(&cam, &o));
+    assert!(m.contains("--raster graphics"), "{m}");
     o.raster = Raster::Graphics;
     let img = g.render(&cam, &o).unwrap().image;
     assert!(img.pixels.iter().any(|p| p[3] > 0.0));
@@ -138,10 +143,8 @@ fn gpu_rays_past_the_loop_budget_are_refused() {
     g.set_scene(set).unwrap();
     // A ~70-voxel diagonal at a 0.001-voxel step: 70 000 samples.
     let mut o = voxsplat::cpu::raycast::RaycastOptions { step: 0.001, ..Default::default() };
-    match g.raycast(&cam, &o) {
-        Err(Error::TooLarge(m)) => assert!(m.contains(&MAX_GPU_RAY_STEPS.to_string()), "{m}"),
-        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
-    }
+    let m = too_large(g.raycast(&cam, &o));
+    assert!(m.contains(&MAX_GPU_RAY_STEPS.to_string()), "{m}");
     o.max_steps = 50_000;
     assert!(g.raycast(&cam, &o).unwrap().image.pixels.iter().any(|p| p[3] > 0.0));
     assert_clean(&g);

@@ -781,7 +781,7 @@ fn bench(a: BenchArgs) -> Result<()> {
         Vec::new()
     } else {
         let (cubes, images): (&[u32], &[u32]) =
-            if a.quick { (&[22, 46], &[128, 256]) } else { (&[22, 46, 100, 215], &[128, 256, 512, 1024, 2048]) };
+            if a.quick { (&[22, 46], &[128, 256]) } else { (&[22, 46, 100, 146], &[128, 256, 512, 1024, 2048]) };
         let s = scaling(&mut r, cubes, images, 5, |msg| eprintln!("{msg}"))?;
         write_scaling_csv(&s, &a.out_dir.join("scaling.csv"))?;
         scaling_svg(&s, &a.out_dir.join("scaling.svg"))?;
