@@ -26,7 +26,8 @@ layout(std430, binding = 8) buffer Sums { uint sums[]; };
 #endif
 
 // llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a footprint
-// box that large (about 250 x 250 pixels) is cut short, which bit 2 tells the host (gpu.rs).
+// box whose loops would pass LOOP_BUDGET (about 240 x 240 pixels) is not drawn but flagged (bit 2)
+// for the host to refuse the frame (gpu.rs).
 layout(std430, binding = 17) buffer Status { uint loop_budget_spent; };
 
 // One contribution in fixed point; clamped so no single add can wrap a pixel's sum.
@@ -50,11 +51,13 @@ void main() {
     uint base = uint(layer) * width * uint(frame.blur.w);
     float energy = p.emit.a * p.axis_u.w;
     bool slab = SHEET_MODE == SHEET_MODE_SLAB;
-    // Set on the box's last pixel, so a loop cut short leaves it false (see tile_count.comp).
-    bool reached_end = false;
+    // Top-tested loops run one more (masked) pass each: (rows + 1) * (cols + 2) bounds the count.
+    if (box.x <= box.z && box.y <= box.w && uint(box.w - box.y + 2) * uint(box.z - box.x + 3) > LOOP_BUDGET) {
+        atomicOr(loop_budget_spent, 2u);
+        return;
+    }
     for (int y = box.y; y <= box.w; ++y) {
         for (int x = box.x; x <= box.z; ++x) {
-            reached_end = reached_end || (y == box.w && x == box.z);
             vec2 uv = quad_uv(inv, ivec2(x, y));
             if (abs(uv.x) > 1.0 || abs(uv.y) > 1.0) continue;
             float tau = energy * footprint_weight(slices, slab, uv, p.axis_v.w, faces);
@@ -76,5 +79,4 @@ void main() {
 #endif
         }
     }
-    if (!reached_end && box.x <= box.z && box.y <= box.w) atomicOr(loop_budget_spent, 2u);
 }

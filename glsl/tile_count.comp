@@ -11,8 +11,9 @@ layout(local_size_x = TILE_BIN_WORKGROUP) in;
 layout(std430, binding = 9) buffer Counts { uint counts[]; };
 layout(std430, binding = 13) writeonly buffer Quads { ScreenQuad quads_lo[]; };
 layout(std430, binding = 16) writeonly buffer QuadsHi { ScreenQuad quads_hi[]; };
-// llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a chunk cut
-// short says so here (bit 1) and the host bins again in shorter chunks (gpu.rs, tile_prepass).
+// llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a chunk whose
+// loops would pass LOOP_BUDGET says so here (bit 1) and the host bins again in shorter chunks
+// (gpu.rs, tile_prepass). tile_scatter's loops are the same, so a chunk that fits here fits there.
 layout(std430, binding = 17) buffer Status { uint loop_budget_spent; };
 
 void main() {
@@ -20,10 +21,9 @@ void main() {
     if (chunk >= pc.chunks) return;
     uvec2 grid = tile_grid();
     uvec2 range = chunk_entries(chunk);
-    // Set on the chunk's last step, so a loop cut short leaves it false. (A test of the loop
-    // variables after the loop would not do: compilers fold it, as loops end only by their tests.)
-    bool reached_end = false;
+    uint planned = 0u;  // loop iterations so far: one per entry, per tile row and per tile
     for (uint e = range.x; e < range.y; ++e) {
+        planned += 1u;
         uint splat = draw_list[e];
         ScreenQuad q = screen_record(params_at(splat));
         if (splat < SPLAT_PAGE) {
@@ -32,19 +32,19 @@ void main() {
             quads_hi[splat - SPLAT_PAGE] = q;
         }
         uvec4 r;
-        if (!tile_range(q.box, r)) {
-            reached_end = reached_end || e + 1u == range.y;
-            continue;
+        if (!tile_range(q.box, r)) continue;
+        planned += (r.w - r.y + 1u) * (r.z - r.x + 2u);
+        if (planned > LOOP_BUDGET) {
+            atomicOr(loop_budget_spent, 1u);
+            break;
         }
         // Bottom-tested: the range is not empty (see tile_composite.comp on llvmpipe's loops).
         uint ty = r.y;
         do {
             uint tx = r.x;
             do {
-                reached_end = reached_end || (e + 1u == range.y && tx == r.z && ty == r.w);
                 counts[(ty * grid.x + tx) * pc.chunks + chunk] += 1u;
             } while (++tx <= r.z);
         } while (++ty <= r.w);
     }
-    if (range.x < range.y && !reached_end) atomicOr(loop_budget_spent, 1u);
 }

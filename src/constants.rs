@@ -38,6 +38,10 @@ pub const MAX_GPU_SPLATS: u32 = 2 * SPLAT_PAGE;
 /// silently, and an entry costs the compositor at most 1 + RASTER_TILE of them (plus one per batch).
 pub const TILE_SEGMENT: u32 = 4096;
 const _: () = assert!(TILE_SEGMENT as u64 * (2 + RASTER_TILE as u64) < 65535);
+/// Loop iterations a binning or footprint-sum invocation may plan for: llvmpipe ends every loop of
+/// an invocation once it has made 65535 in all, so those stages count theirs ahead and flag work
+/// that would pass this (gpu.rs: re-binned in shorter chunks, or a typed error).
+pub const LOOP_BUDGET: u32 = 60_000;
 /// Samples the GPU ray caster takes per ray at most (a typed error past it): its sample loop shares
 /// llvmpipe's 65535 loop iterations per invocation with the brick skips.
 pub const MAX_GPU_RAY_STEPS: u32 = 60_000;
@@ -58,4 +62,5 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("SUM_FIXED_SCALE", SUM_FIXED_SCALE),
     ("SPLAT_PAGE", SPLAT_PAGE),
     ("TILE_SEGMENT", TILE_SEGMENT),
+    ("LOOP_BUDGET", LOOP_BUDGET),
 ];
