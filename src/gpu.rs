@@ -176,6 +176,16 @@ fn grow_readable(ctx: &Arc<Context>, slot: &mut Option<(Buffer, Buffer)>, name: 
     Ok(true)
 }
 
+/// Add `more` to `into`, summing a stage named in both.
+fn merge_timings(into: &mut Vec<StageTime>, more: Vec<StageTime>) {
+    for t in more {
+        match into.iter_mut().find(|p| p.stage == t.stage) {
+            Some(p) => p.ms += t.ms,
+            None => into.push(t),
+        }
+    }
+}
+
 /// Bits of the status word (binding 17): a binning invocation, or a footprint-sum invocation, made
 /// llvmpipe's 65535 loop iterations and was cut short (glsl/tile_count.comp, footprint_sum.comp).
 const LOOP_BUDGET_BINNING: u32 = 1;
@@ -516,12 +526,7 @@ impl GpuPipeline {
         let mut first = true;
         loop {
             let (t, longest, spent) = self.tile_bins_once(frame, push, gpu_order && first, first)?;
-            for t in t {
-                match timings.iter_mut().find(|p| p.stage == t.stage) {
-                    Some(p) => p.ms += t.ms,
-                    None => timings.push(t),
-                }
-            }
+            merge_timings(&mut timings, t);
             if !spent {
                 return Ok((timings, longest));
             }
@@ -536,6 +541,11 @@ impl GpuPipeline {
             push.chunks = push.chunks.saturating_mul(4).min(most);
             first = false;
         }
+    }
+
+    /// The status word as the last submission that copied it left it (`LOOP_BUDGET_*` bits).
+    fn status(&self) -> Result<u32> {
+        Ok(bytemuck::cast_slice::<u8, u32>(&self.status_back.read()?[..4])[0])
     }
 
     /// One binning pass of `tile_prepass`: its timings, the longest list, and whether a binning
@@ -598,7 +608,7 @@ impl GpuPipeline {
         ));
         let timings = execute(&self.ctx, &mut self.timer, &steps)?;
         drop(steps);
-        let spent = bytemuck::cast_slice::<u8, u32>(&self.status_back.read()?[..4])[0] & LOOP_BUDGET_BINNING != 0;
+        let spent = self.status()? & LOOP_BUDGET_BINNING != 0;
         let starts = back.read()?;
         let starts = bytemuck::cast_slice::<u8, u32>(&starts[..(tiles as usize + 1) * 4]);
         let total = starts[tiles as usize] as u64;
@@ -1280,9 +1290,9 @@ impl GpuPipeline {
         let mut timings = execute(&self.ctx, &mut self.timer, &steps)?;
         drop(steps);
         let sums = compute && matches!(opts.composite, Composite::Sheet | Composite::Slab);
-        if sums && bytemuck::cast_slice::<u8, u32>(&self.status_back.read()?[..4])[0] & LOOP_BUDGET_SUMS != 0 {
+        if sums && self.status()? & LOOP_BUDGET_SUMS != 0 {
             return Err(Error::TooLarge(
-                "a footprint larger than about 250 x 250 pixels: the compute sheet sums ran out of llvmpipe's 65535 \
+                "a footprint larger than about 240 x 240 pixels: the compute sheet sums ran out of llvmpipe's 65535 \
                  loop iterations per invocation; draw this frame with --raster graphics or points"
                     .into(),
             ));
@@ -1290,13 +1300,8 @@ impl GpuPipeline {
         if let Some(t) = host_ms {
             timings.insert(0, t);
         }
-        // The slab pre-pass ran first; a stage named in both lists is summed.
-        for t in timings {
-            match pre_timings.iter_mut().find(|p| p.stage == t.stage) {
-                Some(p) => p.ms += t.ms,
-                None => pre_timings.push(t),
-            }
-        }
+        // The slab or tile pre-pass ran first.
+        merge_timings(&mut pre_timings, timings);
         let timings = pre_timings;
         let target = self.target.as_ref().expect("ensured");
         Ok(Rendered { image: read_image(&target.readback, w, h)?, timings, raster: None })
