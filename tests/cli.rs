@@ -254,3 +254,32 @@ fn peer_subcommand_times_every_mode() {
         assert!(String::from_utf8_lossy(&out.stderr).contains("error"));
     }
 }
+
+/// `voxsplat info` counts a file's splats and says when they pass the GPU path's limit.
+#[test]
+fn info_counts_splats_and_names_the_gpu_limit() {
+    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/stent/stent.nrrd");
+    let out = voxsplat(&["info", stent]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("splats: 184675") && !text.contains("over the GPU path"), "{text}");
+    // A 150^3 block of full-scale voxels but one at zero, so the ramp spans 0..255 (an .npy written
+    // here): 3 374 999 splats.
+    let n = 150usize;
+    let mut header = format!("{{'descr': '|u1', 'fortran_order': False, 'shape': ({n}, {n}, {n}), }}");
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    bytes.push(0);
+    bytes.extend(std::iter::repeat_n(255u8, n * n * n - 1));
+    let path = tmp("block150.npy");
+    std::fs::write(&path, bytes).unwrap();
+    let out = voxsplat(&["info", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("splats: 3374999") && text.contains("over the GPU path's 3200000 splats"), "{text}");
+}

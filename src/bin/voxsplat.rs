@@ -643,6 +643,10 @@ fn run(cli: Cli) -> Result<()> {
             };
             println!("splats: {}", set.len());
             println!("bytes per splat: {:.0}", voxsplat::gpu_bytes_per_splat(&set));
+            let most = voxsplat::constants::MAX_GPU_SPLATS as usize;
+            if set.len() > most {
+                println!("over the GPU path's {most} splats: render it with --cpu, or classify fewer voxels");
+            }
             Ok(())
         }
         Command::Compare { a, b } => {
