@@ -394,7 +394,7 @@ impl GpuPipeline {
             return Err(Error::TooLarge(format!(
                 "{} splats: the GPU path takes at most {MAX_GPU_SPLATS} (two {SPLAT_PAGE}-record pages of 80-byte \
                  per-splat parameters; one storage binding is limited to maxStorageBufferRange). Classify fewer \
-                 voxels as non-empty or use the CPU backend",
+                 voxels as non-empty or use the CPU backend (--cpu)",
                 set.len()
             )));
         }
