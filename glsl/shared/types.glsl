@@ -9,7 +9,6 @@ struct Splat {
     vec4 color;   // straight rgb; a: opacity of one voxel-length of material, in [0, 1)
 };
 
-// Output of splat_params, input of the footprint stage. 80 bytes.
 // The per-splat record arrays are bound as two pages of SPLAT_PAGE records (src/constants.rs): one
 // storage binding may not pass maxStorageBufferRange. PAGED_READER defines `T name(uint i)`, which
 // reads record i of the pair lo, hi (a function: SPIR-V gives each block's struct its own type).
@@ -19,6 +18,7 @@ struct Splat {
         return hi[i - SPLAT_PAGE];    \
     }
 
+// Output of splat_params, input of the footprint stage. 80 bytes.
 struct SplatParams {
     vec4 center;  // world-space centre; w: 1 if drawn, 0 if culled
     vec4 axis_u;  // world-space half-extent vector of the footprint quad; w: energy scale
