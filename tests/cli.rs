@@ -1,5 +1,6 @@
 //! The command-line contract: listed scenes, rendered files, order dumps, and clear errors (never
 //! a panic) for bad input.
+mod common;
 use std::process::{Command, Output};
 
 fn voxsplat(args: &[&str]) -> Output {
@@ -265,17 +266,10 @@ fn info_counts_splats_and_names_the_gpu_limit() {
     assert!(text.contains("splats: 184675") && !text.contains("over the GPU path"), "{text}");
     // A 150^3 block of full-scale voxels but one at zero, so the ramp spans 0..255 (an .npy written
     // here): 3 374 999 splats.
-    let n = 150usize;
-    let mut header = format!("{{'descr': '|u1', 'fortran_order': False, 'shape': ({n}, {n}, {n}), }}");
-    while (10 + header.len() + 1) % 64 != 0 {
-        header.push(' ');
-    }
-    header.push('\n');
-    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
-    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    bytes.extend_from_slice(header.as_bytes());
-    bytes.push(0);
-    bytes.extend(std::iter::repeat_n(255u8, n * n * n - 1));
+    let n = 150u64;
+    let mut data = vec![255u8; (n * n * n) as usize];
+    data[0] = 0;
+    let bytes = common::npy(&[n, n, n], "|u1", &data);
     let path = tmp("block150.npy");
     std::fs::write(&path, bytes).unwrap();
     let out = voxsplat(&["info", path.to_str().unwrap()]);

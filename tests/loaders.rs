@@ -53,23 +53,6 @@ fn nifti(v: &[f32]) -> Vec<u8> {
     h
 }
 
-fn npy(shape: &[u64], descr: &str, data: &[u8]) -> Vec<u8> {
-    let shape_s = shape.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ");
-    let mut header = format!(
-        "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({shape_s}{}), }}",
-        if shape.len() == 1 { "," } else { "" }
-    );
-    while (10 + header.len() + 1) % 64 != 0 {
-        header.push(' ');
-    }
-    header.push('\n');
-    let mut b = b"\x93NUMPY\x01\x00".to_vec();
-    b.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    b.extend_from_slice(header.as_bytes());
-    b.extend_from_slice(data);
-    b
-}
-
 fn tiff_u16(w: u32, h: u32, v: &[u16]) -> Vec<u8> {
     let mut out = std::io::Cursor::new(Vec::new());
     let mut enc = tiff::encoder::TiffEncoder::new(&mut out).unwrap();
@@ -100,7 +83,7 @@ fn every_format_round_trips() {
         assert_eq!((n.dims, n.spacing, n.values.clone()), (DIMS, [1.0, 2.0, 0.5], v.clone()));
     }
     let f32_data: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
-    let (shape, got) = npy_from_bytes(&npy(&[4, 5, 7], "<f4", &f32_data), "npy").unwrap();
+    let (shape, got) = npy_from_bytes(&common::npy(&[4, 5, 7], "<f4", &f32_data), "npy").unwrap();
     assert_eq!((shape, got), (vec![4, 5, 7], v.clone()));
     // Raw with a TOML sidecar, through load_volume.
     std::fs::write(dir.join("vol.raw"), u16_bytes(&v, true)).unwrap();
@@ -138,7 +121,7 @@ fn malformed_input_returns_errors() {
         ("nrrd-gz", nrrd("gzip", &gzip(&u16_bytes(&v, false))), Box::new(|b| nrrd_from_bytes(b, None, "nrrd").is_ok())),
         ("nifti", nifti(&v), Box::new(|b| nifti_from_bytes(b, "nii").is_ok())),
         ("nifti-gz", gzip(&nifti(&v)), Box::new(|b| nifti_from_bytes(b, "nii").is_ok())),
-        ("npy", npy(&[4, 5, 7], "<f4", &f32_data), Box::new(|b| npy_from_bytes(b, "npy").is_ok())),
+        ("npy", common::npy(&[4, 5, 7], "<f4", &f32_data), Box::new(|b| npy_from_bytes(b, "npy").is_ok())),
         ("tiff", tiff_u16(7, 5, &(0..35).collect::<Vec<u16>>()), Box::new(|b| tiff_heights(b, "tif").is_ok())),
     ];
     let mut rng = Rng(2024);

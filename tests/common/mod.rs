@@ -126,3 +126,21 @@ pub fn random_camera(rng: &mut Rng, grid: &Grid, kind: ViewKind) -> Camera {
         height: 64,
     }
 }
+
+/// An .npy file (format 1.0, C order) of `shape` holding `data` as `descr` (e.g. `|u1`, `<f4`).
+pub fn npy(shape: &[u64], descr: &str, data: &[u8]) -> Vec<u8> {
+    let shape_s = shape.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ");
+    let mut header = format!(
+        "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({shape_s}{}), }}",
+        if shape.len() == 1 { "," } else { "" }
+    );
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut b = b"\x93NUMPY\x01\x00".to_vec();
+    b.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    b.extend_from_slice(header.as_bytes());
+    b.extend_from_slice(data);
+    b
+}
