@@ -55,8 +55,9 @@ fn main() {
         };
         let file = path.display().to_string();
         let name = path.file_name().unwrap().to_str().unwrap();
-        // A stage whose source names `// variants: A B` is also built with each macro defined,
-        // as `<stage>.A.spv` (for code that needs device features the plain build must not).
+        // A stage whose source names `// variants: A B C+D` is also built with each macro (or each
+        // `+`-joined set of macros) defined, as `<stage>.A.spv`, `<stage>.C+D.spv` (for code that
+        // needs device features the plain build must not, or that holds for some scenes only).
         let variants = source
             .lines()
             .find_map(|l| l.strip_prefix("// variants:"))
@@ -66,7 +67,9 @@ fn main() {
             let mut opts = options();
             let out_name = match variant {
                 Some(v) => {
-                    opts.add_macro_definition(v, Some("1"));
+                    for m in v.split('+') {
+                        opts.add_macro_definition(m, Some("1"));
+                    }
                     format!("{name}.{v}.spv")
                 }
                 None => format!("{name}.spv"),

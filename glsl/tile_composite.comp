@@ -1,8 +1,9 @@
 #version 450
-// Compute per-splat compositing: one workgroup per RASTER_TILE² screen tile and one invocation per
-// tile row (llvmpipe runs the rows as the lanes of one SIMD group). Every row walks the tile's list
-// in draw-list (PBTF) order; for each footprint it visits only the pixels of its row inside the
-// footprint's box and composites them front to back (under) or back to front (over). Front to
+// Compute per-splat compositing: one workgroup per screen tile of RASTER_TILE_H rows by RASTER_TILE_W
+// columns, run as the RASTER_LANES lanes of one SIMD group: lane (row, phase) owns the columns
+// phase, phase + RASTER_PHASES, ... of its row (src/constants.rs). Every lane walks the tile's list
+// in draw-list (PBTF) order; for each footprint it visits only its pixels inside the footprint's
+// box and composites them front to back (under) or back to front (over). Front to
 // back, a pixel stops once its transmittance is at most pc.occluded and the row stops when all its
 // pixels have (early termination): no pixel then differs by more than that threshold.
 // A dispatch takes TILE_SEGMENT entries of each list (segment pc.first), carrying the accumulators
@@ -10,7 +11,8 @@
 // 65535 loop iterations in all, which longer lists would pass.
 // Per-pixel tests of every entry (one invocation per pixel) cost llvmpipe ~5x more.
 // Mirror: cpu::tile::tile_composite.
-// variants: SHUFFLE
+// ONE_PAGE: scenes of at most SPLAT_PAGE splats read the first page only (types.glsl).
+// variants: SHUFFLE ONE_PAGE SHUFFLE+ONE_PAGE
 #extension GL_KHR_shader_subgroup_vote : require
 #ifdef SHUFFLE
 // llvmpipe loads a buffer lane by lane, so every row loading the same entry costs eight loads;
@@ -20,7 +22,7 @@
 #define FOOTPRINT_COMPUTE
 #include "footprint.glsl"
 
-layout(local_size_x = RASTER_TILE) in;
+layout(local_size_x = RASTER_LANES) in;
 layout(std430, binding = 10) readonly buffer TileStart { uint tile_start[]; };
 layout(std430, binding = 11) readonly buffer TileEntries { uint tile_entries[]; };
 layout(binding = 12, rgba32f) uniform image2D accum;
@@ -30,10 +32,12 @@ PAGED_READER(ScreenQuad, quads_at, quads_lo, quads_hi)
 
 void main() {
     uvec2 size = uvec2(frame.blur.zw);
-    int x0 = int(gl_WorkGroupID.x * RASTER_TILE);
-    int y = int(gl_WorkGroupID.y * RASTER_TILE + gl_LocalInvocationID.x);
-    int x_end = min(x0 + int(RASTER_TILE), int(size.x)) - 1;
-    uint tiles_x = (size.x + RASTER_TILE - 1u) / RASTER_TILE;
+    int tx0 = int(gl_WorkGroupID.x * RASTER_TILE_W);
+    int y = int(gl_WorkGroupID.y * RASTER_TILE_H + gl_LocalInvocationID.x / RASTER_PHASES);
+    // This lane's column i is x0 + i * RASTER_PHASES.
+    int x0 = tx0 + int(gl_LocalInvocationID.x % RASTER_PHASES);
+    int x_end = min(tx0 + int(RASTER_TILE_W), int(size.x)) - 1;
+    uint tiles_x = (size.x + RASTER_TILE_W - 1u) / RASTER_TILE_W;
     uint tile = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
     uint list_end = tile_start[tile + 1u];
     uint begin = tile_start[tile] + pc.first * TILE_SEGMENT;
@@ -42,18 +46,19 @@ void main() {
     uint end = min(list_end, begin + TILE_SEGMENT);
     bool btf = pc.back_to_front != 0u;
     bool terminate = !btf && pc.occluded > 0.0;
-    vec4 acc[RASTER_TILE];
-    // Pixels of this row still open (all of them when not terminating early).
+    vec4 acc[RASTER_COLUMNS];
+    // Pixels of this lane still open (all of them when not terminating early).
     int open = 0;
-    for (int i = 0; i < int(RASTER_TILE); ++i) {
-        bool inside = y < int(size.y) && x0 + i <= x_end;
-        acc[i] = pc.first > 0u && inside ? imageLoad(accum, ivec2(x0 + i, y)) : vec4(0.0);
+    for (int i = 0; i < int(RASTER_COLUMNS); ++i) {
+        int x = x0 + i * int(RASTER_PHASES);
+        bool inside = y < int(size.y) && x <= x_end;
+        acc[i] = pc.first > 0u && inside ? imageLoad(accum, ivec2(x, y)) : vec4(0.0);
         open += inside && (!terminate || 1.0 - acc[i].a > pc.occluded) ? 1 : 0;
     }
 #ifdef SHUFFLE
     // A workgroup narrower than its subgroup fills the subgroup's first lanes.
     uint lane = gl_SubgroupInvocationID;
-    uint batch = min(gl_SubgroupSize, RASTER_TILE);
+    uint batch = min(gl_SubgroupSize, RASTER_LANES);
 #else
     uint batch = 1u;
 #endif
@@ -93,14 +98,17 @@ void main() {
             // outside the box would cost as much as one inside. The index into acc[] is then not a
             // constant (a gather and a scatter per access), still 1.5x cheaper at 3 px, and at 7 px
             // once the loops are tested at the bottom (~1.25x with it).
-            int c1 = min(q.box.z, x_end) - x0;
-            int i = max(q.box.x, x0) - x0;
+            // The steps cover the box's columns for every phase (the lanes' step i differ by a
+            // column), so a lane tests its pixel against the box.
+            int i1 = (min(q.box.z, x_end) - tx0) / int(RASTER_PHASES);
+            int i = (max(q.box.x, tx0) - tx0) / int(RASTER_PHASES);
             do {
-                int x = x0 + i;
+                int x = x0 + i * int(RASTER_PHASES);
                 vec4 a = acc[i];
                 vec3 p = vec3(float(x) + 0.5, float(y) + 0.5, 1.0);
                 vec2 uv = vec2(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p)) / dot(q.inv2.xyz, p);
-                bool live = row && abs(uv.x) <= 1.0 && abs(uv.y) <= 1.0 && (!terminate || 1.0 - a.a > pc.occluded);
+                bool live = row && x >= q.box.x && x <= q.box.z && abs(uv.x) <= 1.0 && abs(uv.y) <= 1.0
+                    && (!terminate || 1.0 - a.a > pc.occluded);
                 if (live) {
                     float tau = q.emit.a * footprint_weight(slices, false, uv, q.inv0.w, vec2(0.0));
                     float alpha = 1.0 - exp(-tau);
@@ -113,10 +121,11 @@ void main() {
                     }
                     acc[i] = a;
                 }
-            } while (++i <= c1);
+            } while (++i <= i1);
         } while (++j < n);
     }
-    for (int i = 0; i < int(RASTER_TILE); ++i) {
-        if (y < int(size.y) && x0 + i <= x_end) imageStore(accum, ivec2(x0 + i, y), acc[i]);
+    for (int i = 0; i < int(RASTER_COLUMNS); ++i) {
+        int x = x0 + i * int(RASTER_PHASES);
+        if (y < int(size.y) && x <= x_end) imageStore(accum, ivec2(x, y), acc[i]);
     }
 }

@@ -1,8 +1,8 @@
 //! The stage list executed on Vulkan through the safe `vk` layer.
 use crate::camera::Camera;
 use crate::constants::{
-    COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, MAX_GPU_RAY_STEPS, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, RASTER_TILE,
-    SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT,
+    COMPOSITE_TILE, FOOTPRINT_TABLE_SIZE, MAX_GPU_RAY_STEPS, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, RASTER_TILE_H,
+    RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT,
 };
 use crate::cpu::raycast::{raycast_params, RaycastOptions};
 use crate::cpu::ImageF32;
@@ -60,7 +60,8 @@ struct Stages {
     tile_scan: Pipeline,
     tile_offsets: Pipeline,
     tile_scatter: Pipeline,
-    tile_composite: Pipeline,
+    /// Indexed by whether the scene fits one page of splat records (`ONE_PAGE` build, types.glsl).
+    tile_composite: [Pipeline; 2],
     /// Sheet modes' per-tile sheet ranges: [axis quads, axis points, slab quads, slab points].
     sheet_tiles: [Pipeline; 4],
     composite_layout: Layout,
@@ -285,15 +286,17 @@ impl GpuPipeline {
             tile_scan: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scan.comp"))?,
             tile_offsets: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_offsets.comp"))?,
             tile_scatter: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp"))?,
-            tile_composite: Pipeline::compute(
-                &ctx,
-                &footprint_layout,
-                if ctx.subgroup_shuffle() {
-                    spirv!("tile_composite.comp.SHUFFLE")
+            tile_composite: {
+                let (paged, one_page): (&[u8], &[u8]) = if ctx.subgroup_shuffle() {
+                    (spirv!("tile_composite.comp.SHUFFLE"), spirv!("tile_composite.comp.SHUFFLE+ONE_PAGE"))
                 } else {
-                    spirv!("tile_composite.comp")
-                },
-            )?,
+                    (spirv!("tile_composite.comp"), spirv!("tile_composite.comp.ONE_PAGE"))
+                };
+                [
+                    Pipeline::compute(&ctx, &footprint_layout, paged)?,
+                    Pipeline::compute(&ctx, &footprint_layout, one_page)?,
+                ]
+            },
             sheet_tiles: {
                 let pipe = |mode, points| {
                     Pipeline::compute_specialized(&ctx, &footprint_layout, spirv!("sheet_tiles.comp"), &[mode, points])
@@ -533,7 +536,7 @@ impl GpuPipeline {
             if push.chunks >= most {
                 return Err(Error::TooLarge(format!(
                     "the compute tile binning ran out of llvmpipe's 65535 loop iterations per invocation even in \
-                     {} chunks (footprints covering very many {RASTER_TILE}-pixel tiles): draw this frame with \
+                     {} chunks (footprints covering very many {RASTER_TILE_W}x{RASTER_TILE_H}-pixel tiles): draw this frame with \
                      --raster graphics or points",
                     push.chunks
                 )));
@@ -1155,10 +1158,11 @@ impl GpuPipeline {
                 steps.push((
                     "footprint",
                     Box::new(move |rec| {
-                        let groups = [w.div_ceil(RASTER_TILE), h.div_ceil(RASTER_TILE), 1];
+                        let groups = [w.div_ceil(RASTER_TILE_W), h.div_ceil(RASTER_TILE_H), 1];
+                        let pipe = &st.tile_composite[usize::from(n <= SPLAT_PAGE)];
                         for segment in &segments {
                             let push = bytemuck::bytes_of(segment);
-                            rec.dispatch(&st.tile_composite, &st.footprint_layout, set, push, groups);
+                            rec.dispatch(pipe, &st.footprint_layout, set, push, groups);
                             rec.barrier(Stage::Compute, Stage::Compute);
                         }
                     }),

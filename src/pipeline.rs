@@ -7,7 +7,7 @@
 //! | footprint      | `footprint.vert/.frag`       | `cpu::footprint`        |
 //! | composite      | `composite.comp`             | `cpu::composite`        |
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE, TILE_CHUNK, WORKGROUP_SIZE};
+use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE_H, RASTER_TILE_W, TILE_CHUNK, WORKGROUP_SIZE};
 use crate::cpu::{self, footprint::Blend, ImageF32};
 use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS};
@@ -372,7 +372,7 @@ pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_la
 /// matrix would pass `raster::MAX_TILE_CELLS`.
 pub fn tile_push(opts: &RenderOptions, n: u32, width: u32, height: u32) -> FootprintPush {
     let btf = opts.direction() == Direction::BackToFront;
-    let tiles = (width.div_ceil(RASTER_TILE) as u64 * height.div_ceil(RASTER_TILE) as u64).max(1);
+    let tiles = (width.div_ceil(RASTER_TILE_W) as u64 * height.div_ceil(RASTER_TILE_H) as u64).max(1);
     let most = (crate::raster::MAX_TILE_CELLS / tiles).max(1);
     FootprintPush {
         count: n,

@@ -77,7 +77,7 @@ fn raster_variants_agree_with_the_graphics_path() {
 /// The validator: every tile's list is the subsequence of the draw order made of exactly the splats
 /// whose footprint box overlaps the tile.
 fn check_tile_lists(order: &[u32], boxes: &[Option<[i32; 4]>], tiles_x: u32, start: &[u32], entries: &[u32]) {
-    let tile = voxsplat::constants::RASTER_TILE as i32;
+    let (tw, th) = (voxsplat::constants::RASTER_TILE_W as i32, voxsplat::constants::RASTER_TILE_H as i32);
     let mut pos = vec![u32::MAX; boxes.len()];
     for (i, &s) in order.iter().enumerate() {
         pos[s as usize] = i as u32;
@@ -93,7 +93,7 @@ fn check_tile_lists(order: &[u32], boxes: &[Option<[i32; 4]>], tiles_x: u32, sta
             .copied()
             .filter(|&s| {
                 boxes[s as usize]
-                    .is_some_and(|b| b[0] / tile <= tx && tx <= b[2] / tile && b[1] / tile <= ty && ty <= b[3] / tile)
+                    .is_some_and(|b| b[0] / tw <= tx && tx <= b[2] / tw && b[1] / th <= ty && ty <= b[3] / th)
             })
             .collect();
         assert_eq!(list, &want[..], "tile {t} holds exactly the overlapping splats");

@@ -4,7 +4,7 @@
 //! front to back with early termination or back to front).
 use super::footprint::{footprint_weight, screen_quad, FootprintInputs};
 use super::ImageF32;
-use crate::constants::RASTER_TILE;
+use crate::constants::{RASTER_TILE_H, RASTER_TILE_W};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams};
 use glam::{IVec4, Mat3, Vec2, Vec3};
@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 /// Tiles across and down an image of the frame's size.
 pub fn tile_grid(frame: &Frame) -> (u32, u32) {
-    ((frame.blur[2] as u32).div_ceil(RASTER_TILE), (frame.blur[3] as u32).div_ceil(RASTER_TILE))
+    ((frame.blur[2] as u32).div_ceil(RASTER_TILE_W), (frame.blur[3] as u32).div_ceil(RASTER_TILE_H))
 }
 
 /// Mirror of `screen_record` in `glsl/shared/tiles.glsl`.
@@ -28,7 +28,8 @@ pub fn screen_record(frame: &Frame, p: &SplatParams) -> ScreenQuad {
 
 /// Inclusive tile range (x0, y0, x1, y1) of a footprint box; `None` when the box is empty.
 pub fn tile_range(bx: [i32; 4]) -> Option<[u32; 4]> {
-    (bx[0] <= bx[2] && bx[1] <= bx[3]).then(|| bx.map(|v| v.max(0) as u32 / RASTER_TILE))
+    let tile = [RASTER_TILE_W, RASTER_TILE_H, RASTER_TILE_W, RASTER_TILE_H];
+    (bx[0] <= bx[2] && bx[1] <= bx[3]).then(|| [0, 1, 2, 3].map(|i| bx[i].max(0) as u32 / tile[i]))
 }
 
 fn chunk_entries(push: &FootprintPush, chunk: u32) -> std::ops::Range<usize> {
@@ -126,7 +127,7 @@ pub fn tile_composite(
     let width = image.width;
     image.pixels.par_iter_mut().enumerate().for_each(|(i, px)| {
         let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
-        let tile = ((y as u32 / RASTER_TILE) * tiles_x + x as u32 / RASTER_TILE) as usize;
+        let tile = ((y as u32 / RASTER_TILE_H) * tiles_x + x as u32 / RASTER_TILE_W) as usize;
         let mut acc = [0.0f32; 4];
         for &splat in &entries[tile_start[tile] as usize..tile_start[tile + 1] as usize] {
             if terminate && 1.0 - acc[3] <= push.occluded {
