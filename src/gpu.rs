@@ -60,8 +60,8 @@ struct Stages {
     tile_scan: Pipeline,
     tile_offsets: Pipeline,
     tile_scatter: Pipeline,
-    /// Indexed by whether the scene fits one page of splat records (`ONE_PAGE` build, types.glsl).
-    tile_composite: [Pipeline; 2],
+    /// See [`tile_composite_pipe`].
+    tile_composite: Vec<Pipeline>,
     /// Sheet modes' per-tile sheet ranges: [axis quads, axis points, slab quads, slab points].
     sheet_tiles: [Pipeline; 4],
     composite_layout: Layout,
@@ -292,10 +292,14 @@ impl GpuPipeline {
                 } else {
                     (spirv!("tile_composite.comp"), spirv!("tile_composite.comp.ONE_PAGE"))
                 };
-                [
-                    Pipeline::compute(&ctx, &footprint_layout, paged)?,
-                    Pipeline::compute(&ctx, &footprint_layout, one_page)?,
-                ]
+                let mut pipes = Vec::new();
+                for spirv in [paged, one_page] {
+                    for (btf, terminate) in TILE_COMPOSITE_MODES {
+                        let spec = [SHEET_MODE_SPLAT, btf as u32, terminate as u32];
+                        pipes.push(Pipeline::compute_specialized(&ctx, &footprint_layout, spirv, &spec)?);
+                    }
+                }
+                pipes
             },
             sheet_tiles: {
                 let pipe = |mode, points| {
@@ -1159,7 +1163,7 @@ impl GpuPipeline {
                     "footprint",
                     Box::new(move |rec| {
                         let groups = [w.div_ceil(RASTER_TILE_W), h.div_ceil(RASTER_TILE_H), 1];
-                        let pipe = &st.tile_composite[usize::from(n <= SPLAT_PAGE)];
+                        let pipe = tile_composite_pipe(st, n, &tile_pc);
                         for segment in &segments {
                             let push = bytemuck::bytes_of(segment);
                             rec.dispatch(pipe, &st.footprint_layout, set, push, groups);
@@ -1393,6 +1397,18 @@ fn fill_sheet_tiles(rec: &Recorder<'_>, target: &TargetGpu, range: [u32; 2]) {
     let half = target.tiles as u64 * 4;
     rec.fill_buffer_range(&target.sheet_tiles, 0, half, range[0]);
     rec.fill_buffer_range(&target.sheet_tiles, half, half, range[1]);
+}
+
+/// The tile compositor's builds: (back to front, early termination), each for two pages of splat
+/// records and for one (`ONE_PAGE`, types.glsl).
+const TILE_COMPOSITE_MODES: [(bool, bool); 3] = [(true, false), (false, false), (false, true)];
+
+/// The compositor pipeline for a scene of `n` splats and the frame's push constants.
+fn tile_composite_pipe<'a>(st: &'a Stages, n: u32, push: &FootprintPush) -> &'a Pipeline {
+    let btf = push.back_to_front != 0;
+    let mode = (btf, !btf && push.occluded > 0.0);
+    let m = TILE_COMPOSITE_MODES.iter().position(|&x| x == mode).expect("every mode is built");
+    &st.tile_composite[usize::from(n <= SPLAT_PAGE) * TILE_COMPOSITE_MODES.len() + m]
 }
 
 /// Workgroups of the tile binning passes that walk the draw list chunk by chunk.
