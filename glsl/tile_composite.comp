@@ -27,6 +27,9 @@ layout(local_size_x = RASTER_LANES) in;
 // on a push constant: ~5 % here); the push constants carry the same for the CPU mirror.
 layout(constant_id = 1) const bool BACK_TO_FRONT = false;
 layout(constant_id = 2) const bool TERMINATE = false;  // front to back, pc.occluded > 0
+// Whether the frame is motion-blurred (else every splat's stretch is 0: one shuffle and the
+// stretch's arithmetic per pixel less).
+layout(constant_id = 3) const bool MOTION_BLUR = true;
 layout(std430, binding = 10) readonly buffer TileStart { uint tile_start[]; };
 layout(std430, binding = 11) readonly buffer TileEntries { uint tile_entries[]; };
 layout(binding = 12, rgba32f) uniform image2D accum;
@@ -77,6 +80,8 @@ void main() {
             uint e = tile_entries[k0 + lane];
             mine = quads_at(e);
         }
+        // Box corners are at most 16383 (camera.rs, MAX_IMAGE_SIDE): two shuffles instead of four.
+        uvec2 box_packed = uvec2(mine.box.xy) | (uvec2(mine.box.zw) << 16);
         uint n = min(batch, end - k0);
 #else
         uint n = 1u;
@@ -88,14 +93,17 @@ void main() {
         do {
 #ifdef SHUFFLE
             ScreenQuad q;
-            q.inv0 = subgroupShuffle(mine.inv0, j);
-            q.inv1 = subgroupShuffle(mine.inv1, j);
-            q.inv2 = subgroupShuffle(mine.inv2, j);
-            q.box = subgroupShuffle(mine.box, j);
+            q.inv0.xyz = subgroupShuffle(mine.inv0.xyz, j);
+            q.inv0.w = MOTION_BLUR ? subgroupShuffle(mine.inv0.w, j) : 0.0;
+            q.inv1.xyz = subgroupShuffle(mine.inv1.xyz, j);
+            q.inv2.xyz = subgroupShuffle(mine.inv2.xyz, j);
+            uvec2 b = subgroupShuffle(box_packed, j);
+            q.box = ivec4(b & 0xffffu, b >> 16);
             q.emit = subgroupShuffle(mine.emit, j);
 #else
             uint e = tile_entries[k0];
             ScreenQuad q = quads_at(e);
+            if (!MOTION_BLUR) q.inv0.w = 0.0;
 #endif
             bool row = y >= q.box.y && y <= q.box.w;
             // Only the box's columns: llvmpipe runs a masked branch whatever its mask, so a column

@@ -295,8 +295,10 @@ impl GpuPipeline {
                 let mut pipes = Vec::new();
                 for spirv in [paged, one_page] {
                     for (btf, terminate) in TILE_COMPOSITE_MODES {
-                        let spec = [SHEET_MODE_SPLAT, btf as u32, terminate as u32];
-                        pipes.push(Pipeline::compute_specialized(&ctx, &footprint_layout, spirv, &spec)?);
+                        for blur in [false, true] {
+                            let spec = [SHEET_MODE_SPLAT, btf as u32, terminate as u32, blur as u32];
+                            pipes.push(Pipeline::compute_specialized(&ctx, &footprint_layout, spirv, &spec)?);
+                        }
                     }
                 }
                 pipes
@@ -1163,7 +1165,7 @@ impl GpuPipeline {
                     "footprint",
                     Box::new(move |rec| {
                         let groups = [w.div_ceil(RASTER_TILE_W), h.div_ceil(RASTER_TILE_H), 1];
-                        let pipe = tile_composite_pipe(st, n, &tile_pc);
+                        let pipe = tile_composite_pipe(st, n, &tile_pc, opts.motion.is_some());
                         for segment in &segments {
                             let push = bytemuck::bytes_of(segment);
                             rec.dispatch(pipe, &st.footprint_layout, set, push, groups);
@@ -1399,16 +1401,17 @@ fn fill_sheet_tiles(rec: &Recorder<'_>, target: &TargetGpu, range: [u32; 2]) {
     rec.fill_buffer_range(&target.sheet_tiles, half, half, range[1]);
 }
 
-/// The tile compositor's builds: (back to front, early termination), each for two pages of splat
-/// records and for one (`ONE_PAGE`, types.glsl).
+/// The tile compositor's builds: (back to front, early termination), each still and motion-blurred,
+/// for two pages of splat records and for one (`ONE_PAGE`, types.glsl).
 const TILE_COMPOSITE_MODES: [(bool, bool); 3] = [(true, false), (false, false), (false, true)];
 
-/// The compositor pipeline for a scene of `n` splats and the frame's push constants.
-fn tile_composite_pipe<'a>(st: &'a Stages, n: u32, push: &FootprintPush) -> &'a Pipeline {
+/// The compositor pipeline for a scene of `n` splats, the frame's push constants and whether it is
+/// motion-blurred.
+fn tile_composite_pipe<'a>(st: &'a Stages, n: u32, push: &FootprintPush, blur: bool) -> &'a Pipeline {
     let btf = push.back_to_front != 0;
     let mode = (btf, !btf && push.occluded > 0.0);
     let m = TILE_COMPOSITE_MODES.iter().position(|&x| x == mode).expect("every mode is built");
-    &st.tile_composite[usize::from(n <= SPLAT_PAGE) * TILE_COMPOSITE_MODES.len() + m]
+    &st.tile_composite[(usize::from(n <= SPLAT_PAGE) * TILE_COMPOSITE_MODES.len() + m) * 2 + usize::from(blur)]
 }
 
 /// Workgroups of the tile binning passes that walk the draw list chunk by chunk.
