@@ -54,6 +54,9 @@ void main() {
     const bool btf = BACK_TO_FRONT;
     const bool terminate = !btf && TERMINATE;
     vec4 acc[RASTER_COLUMNS];
+    // The lane's last column in the image (-1: none).
+    int d = x_end - x0;
+    int i_last = y < int(size.y) && d >= 0 ? d / int(RASTER_PHASES) : -1;
     // Pixels of this lane still open (all of them when not terminating early).
     int open = 0;
     for (int i = 0; i < int(RASTER_COLUMNS); ++i) {
@@ -109,20 +112,26 @@ void main() {
             // Only the box's columns: llvmpipe runs a masked branch whatever its mask, so a column
             // outside the box would cost as much as one inside. The index into acc[] is then not a
             // constant (a gather and a scatter per access), still 1.5x cheaper at 3 px, and at 7 px
-            // once the loops are tested at the bottom (~1.25x with it).
-            // The steps cover the box's columns for every phase (the lanes' step i differ by a
-            // column), so a lane tests its pixel against the box.
+            // once the loops are tested at the bottom (~1.25x with it). The steps cover the box's
+            // columns for every phase, so a lane's first or last step may fall outside the box.
             int i1 = (min(q.box.z, x_end) - tx0) / int(RASTER_PHASES);
             int i = (max(q.box.x, tx0) - tx0) / int(RASTER_PHASES);
+            // Homogeneous quad coordinates of the lane's pixel, stepped RASTER_PHASES columns at a time.
+            vec3 p = vec3(float(x0 + i * int(RASTER_PHASES)) + 0.5, float(y) + 0.5, 1.0);
+            vec3 h = vec3(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p), dot(q.inv2.xyz, p));
+            vec3 dh = float(RASTER_PHASES) * vec3(q.inv0.x, q.inv1.x, q.inv2.x);
             do {
-                int x = x0 + i * int(RASTER_PHASES);
                 vec4 a = acc[i];
-                vec3 p = vec3(float(x) + 0.5, float(y) + 0.5, 1.0);
-                vec2 uv = vec2(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p)) / dot(q.inv2.xyz, p);
-                bool live = row && x >= q.box.x && x <= q.box.z && abs(uv.x) <= 1.0 && abs(uv.y) <= 1.0
-                    && (!terminate || 1.0 - a.a > pc.occluded);
+                vec2 uv = h.xy * (1.0 / h.z);
+                float along = MOTION_BLUR ? max(abs(uv.x) * (1.0 + q.inv0.w) - q.inv0.w, 0.0) : uv.x;
+                float s = along * along + uv.y * uv.y;
+                // No test against the box or the quad: beyond the footprint's disc (or its blur's
+                // capsule) the radial table is exactly 0, which leaves a pixel as it is, and every
+                // pixel outside the quad has s > 1 (behind the quad plane's horizon too); `s < 1`
+                // also rejects a NaN there. Early termination counts only the lane's pixels.
+                bool live = row && s < 1.0 && (!terminate || (i <= i_last && 1.0 - a.a > pc.occluded));
                 if (live) {
-                    float tau = q.emit.a * footprint_weight(slices, false, uv, q.inv0.w, vec2(0.0));
+                    float tau = q.emit.a * sample_radial(s);
                     float alpha = 1.0 - exp(-tau);
                     vec4 src = vec4(q.emit.rgb * alpha, alpha);
                     if (btf) {
@@ -133,6 +142,7 @@ void main() {
                     }
                     acc[i] = a;
                 }
+                h += dh;
             } while (++i <= i1);
         } while (++j < n);
     }
