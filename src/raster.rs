@@ -8,10 +8,10 @@
 //!
 //! The graphics pass is the design and what a hardware rasteriser is built for. A CPU device
 //! (lavapipe) pays per primitive, not per pixel (../shared/peers/README.md), so there small
-//! footprints are cheaper in compute. `auto`: graphics on a hardware device; on a CPU device the
-//! fixed-point sums for sheet modes with small footprints, else point sprites where they fit
-//! (no motion blur, footprints from `AUTO_POINTS_MIN_PX` to the device's point size), else compute
-//! for small footprints, else graphics. Point sprites draw a screen-aligned square of the
+//! footprints are cheaper in compute. `auto`: graphics on a hardware device; on a CPU device
+//! compute for small footprints (the tile compositor per splat, the fixed-point sums for sheets),
+//! else point sprites where they fit (no motion blur, footprints from `AUTO_POINTS_MIN_PX` to the
+//! device's point size), else graphics. Point sprites draw a screen-aligned square of the
 //! footprint's radius at its centre: exact in orthographic views; for perspective splats they
 //! ignore the eye-facing quad's off-axis elongation, which measured no worse against the truth than
 //! the quads (docs/MODEL.md); they cannot stretch along a motion path.
@@ -116,12 +116,12 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
     FootprintSize { typical_px: diameter(centre), max_px: diameter(near), min_px: diameter(far) }
 }
 
-/// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device, per-splat
-/// compositing (tile compositor, where point sprites are not allowed: motion blur) and sheet modes
-/// (fixed-point sums). Measured on lavapipe (`voxsplat rates`, docs/RESULTS.md, one run): the tile
-/// compositor 3.2x, 2.3x and 1.8x the quads at 3, 5 and 7 px, 1.3-1.4x at 11-15 px, about level
-/// with them at 14 px in perspective (the peer scene); the sums 8.4x, 4.8x and 3.0x at 3-7 px,
-/// 1.5-1.7x at 11-15 px, ahead of or level with point sprites up to 11 px.
+/// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device: the tile
+/// compositor for per-splat compositing, the fixed-point sums for sheet modes. Measured on lavapipe
+/// (`voxsplat rates`, docs/RESULTS.md, two full runs): the compositor 4.8x/4.6x, 3.4x/3.3x and
+/// 2.2x/2.5x the quads at 3, 5 and 7 px, ahead of the point sprites there (2.4-2.5x, 2.1-2.5x,
+/// 1.7-2.2x) and level with them at 11-15 px (1.4-1.5x both); the sums 6.0x/8.0x, 5.2x/4.6x and
+/// 3.5x/2.9x at 3-7 px, 1.5-1.9x at 11-15 px, ahead of or level with the sprites up to 11 px.
 pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 8.0;
 pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 /// Narrowest footprint (px) for which `auto` draws point sprites. Below about a pixel the device
@@ -167,15 +167,14 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
             let view = if camera.is_perspective() { "perspective" } else { "orthographic" };
             let (raster, why) = if !device.cpu {
                 (Raster::Graphics, "hardware rasteriser".to_string())
-            } else if sheets && px <= limit {
-                (Raster::Compute, format!("CPU device, footprints ~{px:.1} px <= {limit:.0} px: fixed-point sums"))
+            } else if px <= limit {
+                let how = if sheets { "fixed-point sums" } else { "tile compositor" };
+                (Raster::Compute, format!("CPU device, footprints ~{px:.1} px <= {limit:.0} px: {how}"))
             } else if points_fit {
                 (
                     Raster::Points,
                     format!("CPU device, {view} view, footprints up to {:.0} px: point sprites", size.max_px),
                 )
-            } else if px <= limit {
-                (Raster::Compute, format!("CPU device, footprints ~{px:.1} px <= {limit:.0} px"))
             } else {
                 (Raster::Graphics, format!("CPU device, footprints ~{px:.1} px > {limit:.0} px"))
             };

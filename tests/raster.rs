@@ -295,7 +295,7 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
 }
 
 #[test]
-fn auto_rule_points_where_they_fit_sums_for_small_sheets_else_compute_or_graphics_and_says_so() {
+fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphics_and_says_so() {
     use voxsplat::raster::{choose, Device};
     let set = scene::build("cube40").unwrap();
     let small = Camera::framing(set.grid(), 96, 80);
@@ -305,7 +305,13 @@ fn auto_rule_points_where_they_fit_sums_for_small_sheets_else_compute_or_graphic
     let mut blurred = opts(Composite::Splat, Raster::Auto);
     blurred.motion = Some(voxsplat::pipeline::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
 
+    // Small footprints: the tile compositor (ahead of the sprites up to 8 px, docs/RESULTS.md).
     let c = pick(&set, &small, &opts(Composite::Splat, Raster::Auto), cpu);
+    assert_eq!(c.raster, Raster::Compute, "{}", c.reason);
+    assert!(c.reason.contains("tile compositor"), "{}", c.reason);
+    // Wider ones: point sprites wherever they fit, in perspective too.
+    let large = Camera::framing(set.grid(), 320, 256);
+    let c = pick(&set, &large, &opts(Composite::Splat, Raster::Auto), cpu);
     assert_eq!(c.raster, Raster::Points, "{}", c.reason);
     assert!(c.reason.contains("perspective"), "{}", c.reason);
     // Sub-pixel footprints: the device would clamp a sprite to its smallest point; compute
@@ -313,8 +319,9 @@ fn auto_rule_points_where_they_fit_sums_for_small_sheets_else_compute_or_graphic
     let tiny = Camera::framing(set.grid(), 24, 20);
     let c = pick(&set, &tiny, &opts(Composite::Splat, Raster::Auto), cpu);
     assert_eq!(c.raster, Raster::Compute, "{}", c.reason);
-    let ortho = Camera { projection: Projection::Orthographic { height: 80.0 }, ..small };
-    assert_eq!(pick(&set, &ortho, &opts(Composite::Splat, Raster::Auto), cpu).raster, Raster::Points);
+    let ortho = Camera { projection: Projection::Orthographic { height: 80.0 }, ..large };
+    let c = pick(&set, &ortho, &opts(Composite::Splat, Raster::Auto), cpu);
+    assert_eq!(c.raster, Raster::Points, "{}", c.reason);
     let c = pick(&set, &small, &opts(Composite::Sheet, Raster::Auto), cpu);
     assert_eq!(c.raster, Raster::Compute, "small sheet footprints: fixed-point sums: {}", c.reason);
     let c = pick(&set, &small, &blurred, cpu);
