@@ -3,6 +3,8 @@
 // draw-list entries, records each one's footprint in screen space for the later stages and counts,
 // serially and without atomics, how many of them each screen tile receives (its column of the
 // tile x chunk count matrix). Mirror: cpu::tile::tile_count.
+// ONE_PAGE: scenes within one page of splat records (types.glsl).
+// variants: ONE_PAGE
 #define FOOTPRINT_COMPUTE
 #include "footprint.glsl"
 #include "tiles.glsl"
@@ -26,11 +28,15 @@ void main() {
         planned += 1u;
         uint splat = draw_list[e];
         ScreenQuad q = screen_record(params_at(splat));
+#ifdef ONE_PAGE
+        quads_lo[splat] = q;
+#else
         if (splat < SPLAT_PAGE) {
             quads_lo[splat] = q;
         } else {
             quads_hi[splat - SPLAT_PAGE] = q;
         }
+#endif
         uvec4 r;
         if (!tile_range(q.box, r)) continue;
         planned += (r.w - r.y + 1u) * (r.z - r.x + 2u);

@@ -4,6 +4,8 @@
 // list order inside every tile's run and each chunk is walked in list order, so every tile's list
 // keeps the draw list's (PBTF) order: a stable counting sort, no depth sort.
 // Mirror: cpu::tile::tile_scatter.
+// ONE_PAGE: scenes within one page of splat records (types.glsl).
+// variants: ONE_PAGE
 #define FOOTPRINT_COMPUTE
 #include "footprint.glsl"
 #include "tiles.glsl"
@@ -23,7 +25,11 @@ void main() {
     for (uint e = range.x; e < range.y; ++e) {
         uint splat = draw_list[e];
         uvec4 r;
+#ifdef ONE_PAGE
+        ivec4 box = quads_lo[splat].box;
+#else
         ivec4 box = splat < SPLAT_PAGE ? quads_lo[splat].box : quads_hi[splat - SPLAT_PAGE].box;
+#endif
         if (!tile_range(box, r)) continue;
         // Bottom-tested: the range is not empty (see tile_composite.comp on llvmpipe's loops).
         uint ty = r.y;

@@ -56,10 +56,11 @@ struct Stages {
     /// Compute raster: fixed-point sheet sums (axis, slab) and the tile compositor's stages.
     sum_axis: Pipeline,
     sum_slab: Pipeline,
-    tile_count: Pipeline,
+    /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): index `one_page(n)`.
+    tile_count: [Pipeline; 2],
     tile_scan: Pipeline,
     tile_offsets: Pipeline,
-    tile_scatter: Pipeline,
+    tile_scatter: [Pipeline; 2],
     /// See [`tile_composite_pipe`].
     tile_composite: Vec<Pipeline>,
     /// Sheet modes' per-tile sheet ranges: [axis quads, axis points, slab quads, slab points].
@@ -282,10 +283,16 @@ impl GpuPipeline {
             add_slab_points: footprint_pipe(Blend::Add, Primitive::Points, SHEET_MODE_SLAB, &sheet_pass)?,
             sum_axis: Pipeline::compute_specialized(&ctx, &footprint_layout, sum_spirv, &[SHEET_MODE_AXIS])?,
             sum_slab: Pipeline::compute_specialized(&ctx, &footprint_layout, sum_spirv, &[SHEET_MODE_SLAB])?,
-            tile_count: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_count.comp"))?,
+            tile_count: [
+                Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_count.comp"))?,
+                Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_count.comp.ONE_PAGE"))?,
+            ],
             tile_scan: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scan.comp"))?,
             tile_offsets: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_offsets.comp"))?,
-            tile_scatter: Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp"))?,
+            tile_scatter: [
+                Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp"))?,
+                Pipeline::compute(&ctx, &footprint_layout, spirv!("tile_scatter.comp.ONE_PAGE"))?,
+            ],
             tile_composite: {
                 let (paged, one_page): (&[u8], &[u8]) = if ctx.subgroup_shuffle() {
                     (spirv!("tile_composite.comp.SHUFFLE"), spirv!("tile_composite.comp.SHUFFLE+ONE_PAGE"))
@@ -605,7 +612,7 @@ impl GpuPipeline {
                 rec.fill_buffer(counts, 0);
                 rec.fill_buffer(status, 0);
                 rec.barrier(Stage::Transfer, Stage::Compute);
-                rec.dispatch(&st.tile_count, &st.footprint_layout, set, bytes, tile_chunk_groups(push));
+                rec.dispatch(&st.tile_count[one_page(n)], &st.footprint_layout, set, bytes, tile_chunk_groups(push));
                 rec.barrier(Stage::Compute, Stage::Compute);
                 rec.dispatch(&st.tile_scan, &st.footprint_layout, set, bytes, groups_1d(tiles as u32));
                 rec.barrier(Stage::Compute, Stage::Compute);
@@ -663,7 +670,7 @@ impl GpuPipeline {
         let set = &scene.footprint_sets[0];
         self.ctx.submit(|rec| {
             rec.dispatch(
-                &st.tile_scatter,
+                &st.tile_scatter[one_page(scene.n)],
                 &st.footprint_layout,
                 set,
                 bytemuck::bytes_of(&push),
@@ -1151,7 +1158,13 @@ impl GpuPipeline {
                 steps.push((
                     "tile_bins",
                     Box::new(move |rec| {
-                        rec.dispatch(&st.tile_scatter, &st.footprint_layout, set, push, tile_chunk_groups(&tile_pc));
+                        rec.dispatch(
+                            &st.tile_scatter[one_page(n)],
+                            &st.footprint_layout,
+                            set,
+                            push,
+                            tile_chunk_groups(&tile_pc),
+                        );
                         rec.barrier(Stage::Compute, Stage::Compute);
                     }),
                 ));
@@ -1411,7 +1424,13 @@ fn tile_composite_pipe<'a>(st: &'a Stages, n: u32, push: &FootprintPush, blur: b
     let btf = push.back_to_front != 0;
     let mode = (btf, !btf && push.occluded > 0.0);
     let m = TILE_COMPOSITE_MODES.iter().position(|&x| x == mode).expect("every mode is built");
-    &st.tile_composite[(usize::from(n <= SPLAT_PAGE) * TILE_COMPOSITE_MODES.len() + m) * 2 + usize::from(blur)]
+    &st.tile_composite[(one_page(n) * TILE_COMPOSITE_MODES.len() + m) * 2 + usize::from(blur)]
+}
+
+/// 1 where a scene of `n` splats fits one page of splat records (the `ONE_PAGE` builds read only
+/// that page: llvmpipe runs both sides of the paged reader's branch), else 0.
+fn one_page(n: u32) -> usize {
+    usize::from(n <= SPLAT_PAGE)
 }
 
 /// Workgroups of the tile binning passes that walk the draw list chunk by chunk.
