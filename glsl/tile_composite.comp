@@ -4,7 +4,7 @@
 // phase, phase + RASTER_PHASES, ... of its row (src/constants.rs). Every lane walks the tile's list
 // in draw-list (PBTF) order; for each footprint it visits only its pixels inside the footprint's
 // box and composites them front to back (under) or back to front (over). Front to
-// back, a pixel stops once its transmittance is at most pc.occluded and the row stops when all its
+// back, a pixel stops once its transmittance is at most pc.occluded and the tile stops when all its
 // pixels have (early termination): no pixel then differs by more than that threshold.
 // A dispatch takes TILE_SEGMENT entries of each list (segment pc.first), carrying the accumulators
 // in the image between segments: llvmpipe silently ends every loop once an invocation has made
@@ -123,8 +123,7 @@ void main() {
             do {
                 vec4 a = acc[i];
                 vec2 uv = h.xy * (1.0 / h.z);
-                float along = MOTION_BLUR ? max(abs(uv.x) * (1.0 + q.inv0.w) - q.inv0.w, 0.0) : uv.x;
-                float s = along * along + uv.y * uv.y;
+                float s = footprint_r2(uv, MOTION_BLUR ? q.inv0.w : 0.0);
                 // No test against the box or the quad: beyond the footprint's disc (or its blur's
                 // capsule) the radial table is exactly 0, which leaves a pixel as it is, and every
                 // pixel outside the quad has s > 1 (behind the quad plane's horizon too); `s < 1`

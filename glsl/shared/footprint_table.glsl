@@ -45,12 +45,18 @@ float sample_radial(float s) {
     return e.x + e.y * (t - float(i));
 }
 
+// r² (radius units) at quad coordinates uv of a footprint stretched along u across its motion
+// segment (stretch, radius units; 0: round). Mirror: Weight::at in src/cpu/footprint.rs.
+float footprint_r2(vec2 uv, float stretch) {
+    float along = max(abs(uv.x) * (1.0 + stretch) - stretch, 0.0);
+    return along * along + uv.y * uv.y;
+}
+
 // A footprint's weight at quad coordinates uv: the pre-integrated kernel across the motion segment
 // (stretch, radius units along u) or, for a slab, the kernel slice between its faces (radius units).
 // Mirror: Weight::at in src/cpu/footprint.rs.
 float footprint_weight(sampler2D slices, bool slab, vec2 uv, float stretch, vec2 faces) {
-    float along = max(abs(uv.x) * (1.0 + stretch) - stretch, 0.0);
-    float s = along * along + uv.y * uv.y;
+    float s = footprint_r2(uv, stretch);
     if (slab) {
         float r = sqrt(s);
         return sample_slice_table(slices, r, faces.y) - sample_slice_table(slices, r, faces.x);
