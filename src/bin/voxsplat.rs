@@ -255,9 +255,9 @@ struct RenderArgs {
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     slab_thickness: f32,
     /// How footprints become pixels: instanced quads (graphics), point sprites (points), compute
-    /// shaders (tile compositing / fixed-point sheet sums), or auto (on a CPU device: sums for small
-    /// sheet footprints, else point sprites where they fit, else compute for small footprints, else
-    /// graphics; graphics on hardware; it prints what it picked).
+    /// shaders (tile compositing / fixed-point sheet sums), or auto (on a CPU device: compute for
+    /// small footprints, else point sprites where they fit, else graphics; graphics on hardware; it
+    /// prints what it picked).
     #[arg(long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"])]
     raster: String,
     /// Draw on a grid this fraction of --size and resample it bilinearly to full size (1/16 to 1):
