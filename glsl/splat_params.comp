@@ -10,6 +10,7 @@ layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 1) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 2) writeonly buffer Params { SplatParams params_lo[]; };
 layout(std430, binding = 3) writeonly buffer ParamsHi { SplatParams params_hi[]; };
+PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
 
 const float MAX_OPACITY = 0.999;
 const float CULL_RADII = 1.5;
@@ -68,9 +69,5 @@ void main() {
     float dist = length(center - frame.eye.xyz);
     float pixels = frame.eye.w > 0.5 ? radius * frame.up.w / max(depth, 1e-6) : radius * frame.up.w;
     p.screen = vec4(depth, dist, pixels, scale);
-    if (s < SPLAT_PAGE) {
-        params_lo[s] = p;
-    } else {
-        params_hi[s - SPLAT_PAGE] = p;
-    }
+    params_store(s, p);
 }

@@ -13,6 +13,7 @@ layout(local_size_x = TILE_BIN_WORKGROUP) in;
 layout(std430, binding = 9) buffer Counts { uint counts[]; };
 layout(std430, binding = 13) writeonly buffer Quads { ScreenQuad quads_lo[]; };
 layout(std430, binding = 16) writeonly buffer QuadsHi { ScreenQuad quads_hi[]; };
+PAGED_WRITER(ScreenQuad, quads_store, quads_lo, quads_hi)
 // llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a chunk whose
 // loops would pass LOOP_BUDGET says so here (bit 1) and the host bins again in shorter chunks
 // (gpu.rs, tile_prepass). tile_scatter's loops are the same, so a chunk that fits here fits there.
@@ -28,15 +29,7 @@ void main() {
         planned += 1u;
         uint splat = draw_list[e];
         ScreenQuad q = screen_record(params_at(splat));
-#ifdef ONE_PAGE
-        quads_lo[splat] = q;
-#else
-        if (splat < SPLAT_PAGE) {
-            quads_lo[splat] = q;
-        } else {
-            quads_hi[splat - SPLAT_PAGE] = q;
-        }
-#endif
+        quads_store(splat, q);
         uvec4 r;
         if (!tile_range(q.box, r)) continue;
         planned += (r.w - r.y + 1u) * (r.z - r.x + 2u);
