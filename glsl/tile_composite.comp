@@ -1,23 +1,25 @@
 #version 450
 // Compute per-splat compositing: one workgroup per screen tile of RASTER_TILE_H rows by RASTER_TILE_W
-// columns, run as the RASTER_LANES lanes of one SIMD group: lane (row, phase) owns the columns
-// phase, phase + RASTER_PHASES, ... of its row (src/constants.rs). Every lane walks the tile's list
-// in draw-list (PBTF) order; for each footprint it visits only its pixels inside the footprint's
-// box and composites them front to back (under) or back to front (over). Front to
+// columns, run as the RASTER_LANES lanes of one SIMD group, the tile's accumulators in shared
+// memory. The lanes walk the tile's list in draw-list (PBTF) order; for each footprint they deal
+// out the pixels of its box inside the tile, RASTER_LANES at a time, and composite them front to
+// back (under) or back to front (over); each entry ends with a barrier, since a pixel may pass
+// to another lane with the next one. Front to
 // back, a pixel stops once its transmittance is at most pc.occluded and the tile stops when all its
 // pixels have (early termination): no pixel then differs by more than that threshold.
 // A dispatch takes TILE_SEGMENT entries of each list (segment pc.first), carrying the accumulators
 // in the image between segments: llvmpipe silently ends every loop once an invocation has made
 // 65535 loop iterations in all, which longer lists would pass.
-// Per-pixel tests of every entry (one invocation per pixel) cost llvmpipe ~5x more.
+// Per-pixel tests of every entry (one invocation per pixel) cost llvmpipe ~5x more; a lane per row
+// (or per row and column parity) with private accumulators took 1.4x more steps at 7 px.
 // Mirror: cpu::tile::tile_composite.
 // ONE_PAGE: scenes of at most SPLAT_PAGE splats read the first page only (types.glsl).
 // variants: SHUFFLE ONE_PAGE SHUFFLE+ONE_PAGE
-#extension GL_KHR_shader_subgroup_vote : require
 #ifdef SHUFFLE
 // llvmpipe loads a buffer lane by lane, so every row loading the same entry costs eight loads;
 // instead each lane loads one entry of a batch and the batch is passed round by shuffles (~1.3x).
 #extension GL_KHR_shader_subgroup_shuffle : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #endif
 #define FOOTPRINT_COMPUTE
 #include "footprint.glsl"
@@ -37,13 +39,31 @@ layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads_lo[]; };
 layout(std430, binding = 16) readonly buffer QuadsHi { ScreenQuad quads_hi[]; };
 PAGED_READER(ScreenQuad, quads_at, quads_lo, quads_hi)
 
+const uint TILE_PIXELS = RASTER_TILE_W * RASTER_TILE_H;
+// The tile's accumulators, pixel (x, y) of the tile at y * RASTER_TILE_W + x.
+shared vec4 tile_acc[TILE_PIXELS];
+
+// Between entries a pixel may pass from one lane to another. With subgroup operations the
+// workgroup is one subgroup (gpu.rs picks this build only where the subgroup holds RASTER_LANES).
+void sync_lanes() {
+#ifdef SHUFFLE
+    subgroupBarrier();
+#else
+    barrier();
+#endif
+}
+
+#ifndef SHUFFLE
+// The tile's open pixels, without subgroup arithmetic to sum the lanes' counts.
+shared int tile_open;
+#endif
+
 void main() {
     uvec2 size = uvec2(frame.blur.zw);
-    int tx0 = int(gl_WorkGroupID.x * RASTER_TILE_W);
-    int y = int(gl_WorkGroupID.y * RASTER_TILE_H + gl_LocalInvocationID.x / RASTER_PHASES);
-    // This lane's column i is x0 + i * RASTER_PHASES.
-    int x0 = tx0 + int(gl_LocalInvocationID.x % RASTER_PHASES);
-    int x_end = min(tx0 + int(RASTER_TILE_W), int(size.x)) - 1;
+    uint lane = gl_LocalInvocationID.x;
+    ivec2 t0 = ivec2(gl_WorkGroupID.xy * uvec2(RASTER_TILE_W, RASTER_TILE_H));
+    // The tile's last pixel inside the image.
+    ivec2 t1 = min(t0 + ivec2(RASTER_TILE_W, RASTER_TILE_H), ivec2(size)) - 1;
     uint tiles_x = (size.x + RASTER_TILE_W - 1u) / RASTER_TILE_W;
     uint tile = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
     uint list_end = tile_start[tile + 1u];
@@ -53,30 +73,36 @@ void main() {
     uint end = min(list_end, begin + TILE_SEGMENT);
     const bool btf = BACK_TO_FRONT;
     const bool terminate = !btf && TERMINATE;
-    vec4 acc[RASTER_COLUMNS];
-    // The lane's last column in the image (-1: none).
-    int d = x_end - x0;
-    int i_last = y < int(size.y) && d >= 0 ? d / int(RASTER_PHASES) : -1;
-    // Pixels of this lane still open (all of them when not terminating early).
+    // Pixels still open, counted by the lanes that opened or closed them (only their sum means
+    // anything).
     int open = 0;
-    for (int i = 0; i < int(RASTER_COLUMNS); ++i) {
-        int x = x0 + i * int(RASTER_PHASES);
-        bool inside = y < int(size.y) && x <= x_end;
-        acc[i] = pc.first > 0u && inside ? imageLoad(accum, ivec2(x, y)) : vec4(0.0);
-        open += inside && (!terminate || 1.0 - acc[i].a > pc.occluded) ? 1 : 0;
+    for (uint t = lane; t < TILE_PIXELS; t += RASTER_LANES) {
+        ivec2 xy = t0 + ivec2(t % RASTER_TILE_W, t / RASTER_TILE_W);
+        bool inside = all(lessThanEqual(xy, t1));
+        vec4 a = pc.first > 0u && inside ? imageLoad(accum, xy) : vec4(0.0);
+        tile_acc[t] = a;
+        open += inside && (!terminate || 1.0 - a.a > pc.occluded) ? 1 : 0;
     }
+#ifndef SHUFFLE
+    if (lane == 0u) tile_open = 0;
+    barrier();
+    atomicAdd(tile_open, open);
+#endif
+    sync_lanes();
 #ifdef SHUFFLE
     // A workgroup narrower than its subgroup fills the subgroup's first lanes.
-    uint lane = gl_SubgroupInvocationID;
     uint batch = min(gl_SubgroupSize, RASTER_LANES);
 #else
     uint batch = 1u;
 #endif
-    // The loops stay uniform across the rows (no divergent continue or exit), so every entry is
-    // loaded once for all of them. A closed pixel takes no more entries, so testing for early
-    // termination once per batch changes no pixel.
+    // The loops stay uniform across the lanes (no divergent continue or exit). A closed pixel
+    // takes no more entries, so testing for early termination once per batch changes no pixel.
     for (uint k0 = begin; k0 < end; k0 += batch) {
-        if (terminate && subgroupAll(open == 0)) break;
+#ifdef SHUFFLE
+        if (terminate && subgroupAdd(open) == 0) break;
+#else
+        if (terminate && tile_open == 0) break;
+#endif
 #ifdef SHUFFLE
         ScreenQuad mine;
         if (lane < batch && k0 + lane < end) {
@@ -108,27 +134,36 @@ void main() {
             ScreenQuad q = quads_at(e);
             if (!MOTION_BLUR) q.inv0.w = 0.0;
 #endif
-            bool row = y >= q.box.y && y <= q.box.w;
-            // Only the box's columns: llvmpipe runs a masked branch whatever its mask, so a column
-            // outside the box would cost as much as one inside. The index into acc[] is then not a
-            // constant (a gather and a scatter per access), still 1.5x cheaper at 3 px, and at 7 px
-            // once the loops are tested at the bottom (~1.25x with it). The steps cover the box's
-            // columns for every phase, so a lane's first or last step may fall outside the box.
-            int i1 = (min(q.box.z, x_end) - tx0) / int(RASTER_PHASES);
-            int i = (max(q.box.x, tx0) - tx0) / int(RASTER_PHASES);
-            // Homogeneous quad coordinates of the lane's pixel, stepped RASTER_PHASES columns at a time.
-            vec3 p = vec3(float(x0 + i * int(RASTER_PHASES)) + 0.5, float(y) + 0.5, 1.0);
-            vec3 h = vec3(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p), dot(q.inv2.xyz, p));
-            vec3 dh = float(RASTER_PHASES) * vec3(q.inv0.x, q.inv1.x, q.inv2.x);
+            // The box's pixels inside the tile, dealt to the lanes in turn: every lane works on
+            // every step but the last (a lane per row or column would idle on rows or columns the
+            // box misses).
+            ivec2 b0 = max(q.box.xy, t0);
+            ivec2 bw = min(q.box.zw, t1) - b0 + 1;
+            uint count = uint(bw.x * bw.y);
+            float inv_w = 1.0 / float(bw.x);
+            // Homogeneous quad coordinates at the first pixel's centre and their steps.
+            vec3 p = vec3(vec2(b0) + 0.5, 1.0);
+            vec3 h0 = vec3(dot(q.inv0.xyz, p), dot(q.inv1.xyz, p), dot(q.inv2.xyz, p));
+            vec3 hx = vec3(q.inv0.x, q.inv1.x, q.inv2.x);
+            vec3 hy = vec3(q.inv0.y, q.inv1.y, q.inv2.y);
+            uint base = uint(b0.y - t0.y) * RASTER_TILE_W + uint(b0.x - t0.x);
+            uint t = lane;
             do {
-                vec4 a = acc[i];
+                // Row and column of pixel t of the box (exact: t < 2^8, so the quotient's
+                // fraction is at least 1 / (2 bw.x) from a whole number).
+                float r = floor((float(t) + 0.5) * inv_w);
+                float c = float(t) - r * float(bw.x);
+                // Masked into the tile for the last step's lanes past the box (they change nothing).
+                uint at = (base + uint(r) * RASTER_TILE_W + uint(c)) & (TILE_PIXELS - 1u);
+                vec3 h = h0 + c * hx + r * hy;
                 vec2 uv = h.xy * (1.0 / h.z);
                 float s = footprint_r2(uv, MOTION_BLUR ? q.inv0.w : 0.0);
-                // No test against the box or the quad: beyond the footprint's disc (or its blur's
-                // capsule) the radial table is exactly 0, which leaves a pixel as it is, and every
-                // pixel outside the quad has s > 1 (behind the quad plane's horizon too); `s < 1`
-                // also rejects a NaN there. Early termination counts only the lane's pixels.
-                bool live = row && s < 1.0 && (!terminate || (i <= i_last && 1.0 - a.a > pc.occluded));
+                vec4 a = tile_acc[at];
+                // No test against the quad: beyond the footprint's disc (or its blur's capsule)
+                // the radial table is exactly 0, which leaves a pixel as it is, and every pixel
+                // outside the quad has s > 1 (behind the quad plane's horizon too); `s < 1` also
+                // rejects a NaN there.
+                bool live = t < count && s < 1.0 && (!terminate || 1.0 - a.a > pc.occluded);
                 if (live) {
                     float tau = q.emit.a * sample_radial(s);
                     float alpha = 1.0 - exp(-tau);
@@ -137,16 +172,23 @@ void main() {
                         a = src + (1.0 - alpha) * a;
                     } else {
                         a += (1.0 - a.a) * src;
-                        if (terminate && 1.0 - a.a <= pc.occluded) open -= 1;
+                        if (terminate && 1.0 - a.a <= pc.occluded) {
+#ifdef SHUFFLE
+                            open -= 1;
+#else
+                            atomicAdd(tile_open, -1);
+#endif
+                        }
                     }
-                    acc[i] = a;
+                    tile_acc[at] = a;
                 }
-                h += dh;
-            } while (++i <= i1);
+                t += RASTER_LANES;
+            } while (t < count);
+            sync_lanes();
         } while (++j < n);
     }
-    for (int i = 0; i < int(RASTER_COLUMNS); ++i) {
-        int x = x0 + i * int(RASTER_PHASES);
-        if (y < int(size.y) && x <= x_end) imageStore(accum, ivec2(x, y), acc[i]);
+    for (uint t = lane; t < TILE_PIXELS; t += RASTER_LANES) {
+        ivec2 xy = t0 + ivec2(t % RASTER_TILE_W, t / RASTER_TILE_W);
+        if (all(lessThanEqual(xy, t1))) imageStore(accum, xy, tile_acc[t]);
     }
 }

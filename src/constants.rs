@@ -14,18 +14,14 @@ pub const RADIAL_TABLE_SIZE: u32 = 256;
 /// Splats per invocation of the slab binning stages (one column of the slab x chunk count matrix).
 pub const SLAB_CHUNK: u32 = 1024;
 /// Screen tile of the compute per-splat compositor (`tile_composite.comp`): RASTER_TILE_H rows of
-/// RASTER_TILE_W pixels, run by one SIMD group of RASTER_LANES lanes. Lane (row, phase) owns the
-/// columns phase, phase + RASTER_PHASES, ... of its row, so a footprint box of w columns costs each
-/// lane about w / RASTER_PHASES steps, and a short tile wastes fewer lanes on rows a small footprint
-/// misses (4 x 16 takes 1.22x fewer steps than 8 x 8 at 7 px, docs/results-notes.md).
+/// RASTER_TILE_W pixels, run by one SIMD group of RASTER_LANES lanes that deal each footprint box's
+/// pixels in the tile among themselves.
 pub const RASTER_TILE_W: u32 = 16;
-pub const RASTER_TILE_H: u32 = 4;
-pub const RASTER_PHASES: u32 = 2;
+pub const RASTER_TILE_H: u32 = 16;
 /// Lanes of a compositor workgroup (llvmpipe's SIMD width on AVX2).
-pub const RASTER_LANES: u32 = RASTER_TILE_H * RASTER_PHASES;
-/// Accumulators per lane.
-pub const RASTER_COLUMNS: u32 = RASTER_TILE_W / RASTER_PHASES;
-const _: () = assert!(RASTER_TILE_W % RASTER_PHASES == 0 && RASTER_LANES == 8);
+pub const RASTER_LANES: u32 = 8;
+const _: () = assert!((RASTER_TILE_W * RASTER_TILE_H) % RASTER_LANES == 0 && RASTER_TILE_W * RASTER_TILE_H <= 256);
+const _: () = assert!((RASTER_TILE_W * RASTER_TILE_H).is_power_of_two());
 /// Draw-list entries per invocation of the tile binning stages.
 pub const TILE_CHUNK: u32 = 1024;
 /// Invocations per workgroup of the tile binning stages: few chunks still fill several workgroups
@@ -45,9 +41,11 @@ pub const MAX_GPU_SPLATS: u32 = 2 * SPLAT_PAGE;
 /// Entries of each tile's list one dispatch of `tile_composite` takes (longer lists take several
 /// dispatches, the accumulators carried in the image between them): llvmpipe ends every loop of a
 /// shader invocation once it has made 65535 loop iterations in all (`LP_MAX_TGSI_LOOP_ITERATIONS`),
-/// silently, and an entry costs the compositor at most 1 + RASTER_COLUMNS of them (plus one per batch).
-pub const TILE_SEGMENT: u32 = 4096;
-const _: () = assert!(TILE_SEGMENT as u64 * (2 + RASTER_COLUMNS as u64) < 65535);
+/// silently, and an entry costs the compositor at most one per RASTER_LANES pixels of the tile
+/// (plus one per batch, and the tile's pixels once each to load and store).
+pub const TILE_SEGMENT: u32 = 1536;
+const TILE_STEPS: u64 = (RASTER_TILE_W * RASTER_TILE_H / RASTER_LANES) as u64;
+const _: () = assert!(TILE_SEGMENT as u64 * (2 + TILE_STEPS) + 2 * TILE_STEPS < 65535);
 /// Loop iterations a binning or footprint-sum invocation may plan for: llvmpipe ends every loop of
 /// an invocation once it has made 65535 in all, so those stages count theirs ahead and flag work
 /// that would pass this (gpu.rs: re-binned in shorter chunks, or a typed error).
@@ -68,9 +66,7 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("SLAB_CHUNK", SLAB_CHUNK),
     ("RASTER_TILE_W", RASTER_TILE_W),
     ("RASTER_TILE_H", RASTER_TILE_H),
-    ("RASTER_PHASES", RASTER_PHASES),
     ("RASTER_LANES", RASTER_LANES),
-    ("RASTER_COLUMNS", RASTER_COLUMNS),
     ("TILE_CHUNK", TILE_CHUNK),
     ("TILE_BIN_WORKGROUP", TILE_BIN_WORKGROUP),
     ("SUM_FIXED_SCALE", SUM_FIXED_SCALE),

@@ -111,8 +111,8 @@ pub fn tile_scatter(
     }
 }
 
-/// Composite every tile's list into `image` (which it overwrites), pixel by pixel as each tile
-/// row does on the GPU.
+/// Composite every tile's list into `image` (which it overwrites), pixel by pixel: every pixel takes
+/// its tile's entries in list order, whichever GPU lane composites it.
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,

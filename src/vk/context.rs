@@ -58,7 +58,8 @@ pub struct Context {
     /// The device was created with `largePoints` (by us, or as its host says).
     large_points: bool,
     int64_atomics: bool,
-    /// Compute shaders have subgroup shuffles and votes (a property, so adopted devices have it too).
+    /// Compute shaders have subgroup shuffles and arithmetic in subgroups of at least RASTER_LANES
+    /// (a property, so adopted devices have it too).
     subgroup_shuffle: AtomicBool,
     device_name: String,
     device_type: vk::PhysicalDeviceType,
@@ -254,9 +255,12 @@ impl Context {
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
         // SAFETY: plain query on a valid physical device; the chain lives on the stack.
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
-        let ops = vk::SubgroupFeatureFlags::SHUFFLE | vk::SubgroupFeatureFlags::VOTE;
+        let ops = vk::SubgroupFeatureFlags::SHUFFLE | vk::SubgroupFeatureFlags::ARITHMETIC;
+        // The compositor's lanes share their tile's pixels with subgroup barriers only, so its
+        // workgroup must fit one subgroup.
         let subgroup_shuffle = subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
-            && subgroup.supported_operations.contains(ops);
+            && subgroup.supported_operations.contains(ops)
+            && subgroup.subgroup_size >= crate::constants::RASTER_LANES;
         let device_name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
@@ -390,8 +394,9 @@ impl Context {
         self.int64_atomics
     }
 
-    /// Whether compute shaders have subgroup shuffles and votes: the tile compositor then loads a
-    /// batch of entries, one per lane, and passes them round (llvmpipe loads buffers lane by lane).
+    /// Whether compute shaders have subgroup shuffles and arithmetic in subgroups that hold the tile
+    /// compositor's workgroup: it then loads a batch of entries, one per lane, and passes them round
+    /// (llvmpipe loads buffers lane by lane), and syncs its lanes with subgroup barriers.
     pub fn subgroup_shuffle(&self) -> bool {
         self.subgroup_shuffle.load(Ordering::Relaxed)
     }
