@@ -101,7 +101,12 @@ void main() {
 #ifdef SHUFFLE
         if (terminate && subgroupAdd(open) == 0) break;
 #else
-        if (terminate && tile_open == 0) break;
+        if (terminate) {
+            // Every lane reads the count before any lane may change it again: the exit stays uniform.
+            bool closed = tile_open == 0;
+            barrier();
+            if (closed) break;
+        }
 #endif
 #ifdef SHUFFLE
         ScreenQuad mine;

@@ -203,7 +203,8 @@ fn footprints_larger_than_a_tile_and_straddling_tiles_render_correctly() {
 }
 
 /// The tile compositor's two builds (entries loaded one per lane and passed round by subgroup
-/// shuffles, or loaded by every row) composite the same entries with the same arithmetic.
+/// shuffles, lanes synced by subgroup barriers; or loaded by every lane, synced by workgroup
+/// barriers, with a shared open-pixel count) composite the same entries with the same arithmetic.
 #[test]
 fn tile_compositor_without_subgroup_shuffles_matches_the_shuffled_build() {
     let mut owner = common::gpu();
