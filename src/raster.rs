@@ -118,11 +118,12 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
 
 /// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device: the tile
 /// compositor for per-splat compositing, the fixed-point sums for sheet modes. Measured on lavapipe
-/// (`voxsplat rates`, docs/RESULTS.md, three full runs): the compositor 4.5-4.8x, 2.9-3.4x and
-/// 2.2-2.5x the quads at 3, 5 and 7 px, ahead of the point sprites there (2.4-2.5x, 2.1-2.5x,
-/// 1.7-2.2x) and about level with them at 11-15 px (1.3-1.6x both); the sums 6.0-9.7x, 4.6-5.4x
-/// and 2.9-3.5x at 3-7 px, 1.5-2.0x at 11-15 px, ahead of or level with the sprites up to 11 px.
-pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 8.0;
+/// (`voxsplat rates`, docs/RESULTS.md) since the compositor deals each box's pixels to its lanes:
+/// 5.5x, 3.4x, 2.5-3.7x the quads at 3, 5, 7 px and 1.9x at 11 and 15 px, ahead of the point
+/// sprites at every size (2.4x, 2.0x, 1.9-2.3x, 1.4-1.6x, 1.5-1.6x), and level with them on the
+/// peers' 128^3 scene (~14 px in perspective: 306 and 228 ms against 274 and 244 ms); the sums
+/// 7.4x, 3.7x, 3.4x at 3-7 px, 1.6-1.7x at 11-15 px, ahead of or level with the sprites up to 11 px.
+pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 15.0;
 pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 /// Narrowest footprint (px) for which `auto` draws point sprites. Below about a pixel the device
 /// clamps a sprite to its minimum point size and evaluates the footprint at the sprite's centre, so

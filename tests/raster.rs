@@ -306,12 +306,12 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
     let mut blurred = opts(Composite::Splat, Raster::Auto);
     blurred.motion = Some(voxsplat::pipeline::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
 
-    // Small footprints: the tile compositor (ahead of the sprites up to 8 px, docs/RESULTS.md).
+    // Small footprints: the tile compositor (ahead of the sprites up to 15 px, docs/RESULTS.md).
     let c = pick(&set, &small, &opts(Composite::Splat, Raster::Auto), cpu);
     assert_eq!(c.raster, Raster::Compute, "{}", c.reason);
     assert!(c.reason.contains("tile compositor"), "{}", c.reason);
     // Wider ones: point sprites wherever they fit, in perspective too.
-    let large = Camera::framing(set.grid(), 320, 256);
+    let large = Camera::framing(set.grid(), 480, 384);
     let c = pick(&set, &large, &opts(Composite::Splat, Raster::Auto), cpu);
     assert_eq!(c.raster, Raster::Points, "{}", c.reason);
     assert!(c.reason.contains("perspective"), "{}", c.reason);
