@@ -92,15 +92,17 @@ pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
     })
 }
 
-/// Rounds of the sweep at each size: every variant is timed once per round, in turn (forward in
-/// even rounds, backward in odd ones, so neither of a pair is always timed first), and each
-/// variant's time is the median over rounds, so a drift of the shared machine during a size lands
-/// on all variants alike.
+/// Rounds of the sweep at each size. A round takes a warm-up frame of every variant, then its
+/// frames one per variant in turn (forward in even rounds, backward in odd ones, so neither of a
+/// pair is always timed first): the variants' frames interleave, so a slow spell of the shared
+/// machine (they last seconds) lands on all of them alike. A variant's time in a round is the
+/// median of its frames; its time at a size is the median over rounds.
 pub const RATE_ROUNDS: usize = 5;
 const _: () = assert!(RATE_ROUNDS > 0);
 
 /// Time every variant of `RATE_VARIANTS` at each footprint size on an `n` x `n` sheet
-/// (`RATE_ROUNDS` interleaved rounds of `frames` frames after a warm-up).
+/// (`RATE_ROUNDS` rounds of `frames` frames per variant after a warm-up, the variants' frames
+/// interleaved).
 pub fn raster_rates(
     r: &mut Renderer,
     n: u32,
@@ -128,13 +130,22 @@ pub fn raster_rates(
             if round % 2 == 1 {
                 turn.reverse();
             }
-            for v in turn {
-                let (composite, raster) = RATE_VARIANTS[v];
-                let t = time_method(r, &rastered(composite, raster), &camera, 1, frames)?;
-                let before: f64 =
-                    t.stages.iter().filter(|s| matches!(s.0, "order" | "splat_params")).map(|s| s.1).sum();
-                runs[v].0.push(t.time_ms - before);
-                runs[v].1 = Some(t.image);
+            // Frame 0 of each variant is its warm-up.
+            let mut times: Vec<Vec<f64>> = RATE_VARIANTS.iter().map(|_| Vec::new()).collect();
+            for frame in 0..=frames.max(1) {
+                for &v in &turn {
+                    let (composite, raster) = RATE_VARIANTS[v];
+                    let t = time_method(r, &rastered(composite, raster), &camera, 0, 1)?;
+                    let before: f64 =
+                        t.stages.iter().filter(|s| matches!(s.0, "order" | "splat_params")).map(|s| s.1).sum();
+                    if frame > 0 {
+                        times[v].push(t.time_ms - before);
+                    }
+                    runs[v].1 = Some(t.image);
+                }
+            }
+            for (v, t) in times.iter_mut().enumerate() {
+                runs[v].0.push(median(t));
             }
         }
         for (v, &(composite, raster)) in RATE_VARIANTS.iter().enumerate() {
@@ -247,8 +258,9 @@ pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str
     let _ = writeln!(
         s,
         "One sheet of {} voxels, head-on and orthographic, footprint quads exactly N px wide; rate = splats \
-         over the time of the stages after `splat_params` (median of {RATE_ROUNDS} rounds that take the \
-         variants in turn, forward then backward, each round the median of its frames); RMSE against the \
+         over the time of the stages after `splat_params` (median of {RATE_ROUNDS} rounds; a round takes a \
+         warm-up frame of each variant, then its frames one per variant in turn, forward then backward, \
+         and its time for a variant is the median of that variant's frames); RMSE against the \
          volumetric-summation truth; *vs quads* = the median over rounds of the quads' time over the \
          variant's in the same round (smallest–largest round in brackets). Roofline: additive quads \
          with the cheapest shaders (`roofline.vert/.frag`).\n",
