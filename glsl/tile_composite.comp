@@ -4,9 +4,9 @@
 // memory. The lanes walk the tile's list in draw-list (PBTF) order; for each footprint they deal
 // out the pixels of its box inside the tile, RASTER_LANES at a time, and composite them front to
 // back (under) or back to front (over); each entry ends with a barrier, since a pixel may pass
-// to another lane with the next one. Front to
-// back, a pixel stops once its transmittance is at most pc.occluded and the tile stops when all its
-// pixels have (early termination): no pixel then differs by more than that threshold.
+// to another lane with the next one. Front to back, a pixel stops once its transmittance is at
+// most pc.occluded and the tile stops when all its pixels have (early termination): no pixel then
+// differs by more than that threshold.
 // A dispatch takes TILE_SEGMENT entries of each list (segment pc.first), carrying the accumulators
 // in the image between segments: llvmpipe silently ends every loop once an invocation has made
 // 65535 loop iterations in all, which longer lists would pass.
@@ -16,7 +16,7 @@
 // ONE_PAGE: scenes of at most SPLAT_PAGE splats read the first page only (types.glsl).
 // variants: SHUFFLE ONE_PAGE SHUFFLE+ONE_PAGE
 #ifdef SHUFFLE
-// llvmpipe loads a buffer lane by lane, so every row loading the same entry costs eight loads;
+// llvmpipe loads a buffer lane by lane, so every lane loading the same entry costs eight loads;
 // instead each lane loads one entry of a batch and the batch is passed round by shuffles (~1.3x).
 #extension GL_KHR_shader_subgroup_shuffle : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -44,7 +44,8 @@ const uint TILE_PIXELS = RASTER_TILE_W * RASTER_TILE_H;
 shared vec4 tile_acc[TILE_PIXELS];
 
 // Between entries a pixel may pass from one lane to another. With subgroup operations the
-// workgroup is one subgroup (gpu.rs picks this build only where the subgroup holds RASTER_LANES).
+// workgroup is one subgroup (Context::subgroup_shuffle: this build only where a subgroup holds
+// RASTER_LANES).
 void sync_lanes() {
 #ifdef SHUFFLE
     subgroupBarrier();
