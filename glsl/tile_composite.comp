@@ -54,6 +54,11 @@ void sync_lanes() {
 #endif
 }
 
+// Pixel t of the tile whose first pixel is t0 (row-major), in image coordinates.
+ivec2 tile_pixel(ivec2 t0, uint t) {
+    return t0 + ivec2(t % RASTER_TILE_W, t / RASTER_TILE_W);
+}
+
 #ifndef SHUFFLE
 // The tile's open pixels, without subgroup arithmetic to sum the lanes' counts.
 shared int tile_open;
@@ -78,7 +83,7 @@ void main() {
     // anything).
     int open = 0;
     for (uint t = lane; t < TILE_PIXELS; t += RASTER_LANES) {
-        ivec2 xy = t0 + ivec2(t % RASTER_TILE_W, t / RASTER_TILE_W);
+        ivec2 xy = tile_pixel(t0, t);
         bool inside = all(lessThanEqual(xy, t1));
         vec4 a = pc.first > 0u && inside ? imageLoad(accum, xy) : vec4(0.0);
         tile_acc[t] = a;
@@ -194,7 +199,7 @@ void main() {
         } while (++j < n);
     }
     for (uint t = lane; t < TILE_PIXELS; t += RASTER_LANES) {
-        ivec2 xy = t0 + ivec2(t % RASTER_TILE_W, t / RASTER_TILE_W);
+        ivec2 xy = tile_pixel(t0, t);
         if (all(lessThanEqual(xy, t1))) imageStore(accum, xy, tile_acc[t]);
     }
 }
