@@ -16,6 +16,7 @@ layout(std430, binding = 10) readonly buffer TileStart { uint tile_start[]; };
 layout(std430, binding = 11) writeonly buffer TileEntries { uint tile_entries[]; };
 layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads_lo[]; };
 layout(std430, binding = 16) readonly buffer QuadsHi { ScreenQuad quads_hi[]; };
+PAGED_FIELD_READER(ivec4, box_at, quads_lo, quads_hi, box)
 
 void main() {
     uint chunk = gl_GlobalInvocationID.x;
@@ -25,11 +26,7 @@ void main() {
     for (uint e = range.x; e < range.y; ++e) {
         uint splat = draw_list[e];
         uvec4 r;
-#ifdef ONE_PAGE
-        ivec4 box = quads_lo[splat].box;
-#else
-        ivec4 box = splat < SPLAT_PAGE ? quads_lo[splat].box : quads_hi[splat - SPLAT_PAGE].box;
-#endif
+        ivec4 box = box_at(splat);
         if (!tile_range(box, r)) continue;
         // Bottom-tested: the range is not empty (see tile_composite.comp on llvmpipe's loops).
         uint ty = r.y;

@@ -14,10 +14,14 @@ struct Splat {
 // reads record i of the pair lo, hi (a function: SPIR-V gives each block's struct its own type).
 // Built with ONE_PAGE (for scenes of at most SPLAT_PAGE splats) it reads lo only: llvmpipe runs both
 // sides of the branch, each load lane by lane, which cost the tile compositor ~5-10 %.
-// PAGED_WRITER defines `void name(uint i, T v)`, which stores record i the same way.
+// PAGED_FIELD_READER defines `T name(uint i)` reading one field of record i (a whole record is
+// loaded word by word, lane by lane on llvmpipe); PAGED_WRITER defines `void name(uint i, T v)`,
+// which stores record i the same way.
 #ifdef ONE_PAGE
 #define PAGED_READER(T, name, lo, hi) \
     T name(uint i) { return lo[i]; }
+#define PAGED_FIELD_READER(T, name, lo, hi, field) \
+    T name(uint i) { return lo[i].field; }
 #define PAGED_WRITER(T, name, lo, hi) \
     void name(uint i, T v) { lo[i] = v; }
 #else
@@ -25,6 +29,11 @@ struct Splat {
     T name(uint i) {                  \
         if (i < SPLAT_PAGE) return lo[i]; \
         return hi[i - SPLAT_PAGE];    \
+    }
+#define PAGED_FIELD_READER(T, name, lo, hi, field)       \
+    T name(uint i) {                                     \
+        if (i < SPLAT_PAGE) return lo[i].field;          \
+        return hi[i - SPLAT_PAGE].field;                 \
     }
 #define PAGED_WRITER(T, name, lo, hi)  \
     void name(uint i, T v) {           \
