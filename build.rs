@@ -26,6 +26,7 @@ fn main() {
 
     let compiler = shaderc::Compiler::new().expect("shaderc compiler");
     let mut failed = Vec::new();
+    let mut built = Vec::new();
     for path in &stages {
         println!("cargo:rerun-if-changed={}", path.display());
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
@@ -75,7 +76,10 @@ fn main() {
                 None => format!("{name}.spv"),
             };
             match compiler.compile_into_spirv(&source, kind, &file, "main", Some(&opts)) {
-                Ok(art) => std::fs::write(out.join(out_name), art.as_binary_u8()).unwrap(),
+                Ok(art) => {
+                    std::fs::write(out.join(&out_name), art.as_binary_u8()).unwrap();
+                    built.push(out_name);
+                }
                 // shaderc's message already carries "file:line: error: ...".
                 Err(e) => failed.push(e.to_string()),
             }
@@ -87,4 +91,14 @@ fn main() {
         }
         panic!("GLSL compilation failed:\n{}", failed.join("\n"));
     }
+    // The table the GPU pipelines look builds up in: (build name, SPIR-V words).
+    let mut table = String::from(
+        "/// Every SPIR-V build, by name (`<stage>.<ext>[.<DEFINES>]`).\npub static SPIRV: &[(&str, &[u8])] = &[\n",
+    );
+    for name in &built {
+        let stem = name.strip_suffix(".spv").unwrap();
+        table += &format!("    ({stem:?}, include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{name}\"))),\n");
+    }
+    table += "];\n";
+    std::fs::write(out.join("spirv_table.rs"), table).unwrap();
 }

@@ -1,6 +1,6 @@
 //! Chapter 3 helpers: where k falls on a single-sheet scene, and the k line overlay.
 use crate::camera::Camera;
-use crate::cpu::ImageF32;
+use crate::image::ImageF32;
 use crate::truth::pixel_ray;
 use crate::volume::SplatSet;
 use glam::Mat4;

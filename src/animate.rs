@@ -2,9 +2,9 @@
 //! file or built in; frames rendered still, with motion-blurred splats, or with an accumulation
 //! buffer of N sub-frames over the shutter interval.
 use crate::camera::{Camera, Projection};
-use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
-use crate::pipeline::{Motion, RenderOptions};
+use crate::image::ImageF32;
+use crate::options::{Motion, RenderOptions};
 use crate::volume::Grid;
 use crate::Renderer;
 use glam::{Mat4, Quat, Vec3};

@@ -3,11 +3,11 @@
 //! docs/RESULTS.md. Medians over frames after warm-up.
 use crate::camera::Camera;
 use crate::cpu::raycast::RaycastOptions;
-use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
+use crate::image::ImageF32;
 use crate::metrics::{compare, ImageMetrics};
+use crate::options::{Antialias, Composite, RenderOptions, Rendered};
 use crate::order::{count_violations, visibility_order};
-use crate::pipeline::{Antialias, Composite, RenderOptions, Rendered};
 use crate::raster::Raster;
 use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use crate::volume::{Grid, SplatSet};

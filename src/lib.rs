@@ -18,6 +18,7 @@
 pub mod aa;
 pub mod animate;
 pub mod bench;
+pub mod bisect;
 pub mod camera;
 pub mod classify;
 pub mod constants;
@@ -25,13 +26,15 @@ pub mod cpu;
 mod error;
 mod gpu;
 pub mod gpu_types;
+pub mod image;
 pub mod kernel;
 pub mod loaders;
 pub mod metrics;
+pub mod options;
 pub mod order;
 pub mod output;
 pub mod peer;
-pub mod pipeline;
+pub mod plan;
 pub mod raster;
 pub mod rates;
 pub mod resample;
@@ -39,26 +42,32 @@ pub mod scene;
 pub mod slab;
 pub mod soak;
 pub mod stability;
+pub mod stages;
 pub mod terrain;
 pub mod truth;
 #[allow(unsafe_code)]
 pub mod vk;
 pub mod volume;
 
+pub use bisect::Bisect;
 pub use camera::{Camera, Projection};
 pub use error::{Error, Result};
+pub use image::ImageF32;
 pub use kernel::Kernel;
+pub use options::{Antialias, Composite, Motion, RenderOptions, Rendered, StageTime};
 pub use order::{Direction, OrderKind};
-pub use pipeline::{Antialias, Composite, RenderOptions, Rendered, StageTime};
 pub use raster::{Raster, RasterChoice};
 pub use volume::{Grid, SplatSet, Volume};
 
-use pipeline::Prepared;
+use cpu::exec::CpuEngine;
+use plan::Prepared;
+use stages::{record_frame, Engine, Res, StageId};
 use std::sync::Arc;
 
 /// Where the frame is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Backend {
+    /// Vulkan.
     #[default]
     Gpu,
     /// The CPU mirrors, stage by stage.
@@ -69,6 +78,7 @@ pub enum Backend {
 #[derive(Clone, Debug, Default)]
 #[non_exhaustive]
 pub struct RendererOptions {
+    /// Vulkan or the CPU mirrors.
     pub backend: Backend,
     /// Khronos validation with synchronization validation; messages are counted, see
     /// [`Renderer::validation_messages`].
@@ -79,11 +89,13 @@ pub struct RendererOptions {
 
 /// A scene on a backend. `Send`: one renderer per thread.
 pub struct Renderer {
-    gpu: Option<gpu::GpuPipeline>,
+    gpu: Option<gpu::Gpu>,
     scene: Option<Prepared>,
+    bisect: Option<Bisect>,
 }
 
 impl Renderer {
+    /// A renderer on its own Vulkan device (or the CPU mirrors).
     pub fn new(options: &RendererOptions) -> Result<Self> {
         let gpu = match options.backend {
             Backend::Gpu => {
@@ -91,16 +103,16 @@ impl Renderer {
                     validation: options.validation,
                     device_name: options.device_name.clone(),
                 })?;
-                Some(gpu::GpuPipeline::new(ctx)?)
+                Some(gpu::Gpu::new(ctx)?)
             }
             Backend::Cpu => None,
         };
-        Ok(Self { gpu, scene: None })
+        Ok(Self { gpu, scene: None, bisect: None })
     }
 
     /// A renderer on a host program's Vulkan device (see [`vk::Context::from_host`]).
     pub fn with_context(ctx: Arc<vk::Context>) -> Result<Self> {
-        Ok(Self { gpu: Some(gpu::GpuPipeline::new(ctx)?), scene: None })
+        Ok(Self { gpu: Some(gpu::Gpu::new(ctx)?), scene: None, bisect: None })
     }
 
     /// The Vulkan device's name, or "cpu".
@@ -108,6 +120,7 @@ impl Renderer {
         self.gpu.as_ref().map(|g| g.context().device_name().to_string()).unwrap_or_else(|| "cpu".into())
     }
 
+    /// Where frames are computed.
     pub fn backend(&self) -> Backend {
         if self.gpu.is_some() {
             Backend::Gpu
@@ -116,6 +129,7 @@ impl Renderer {
         }
     }
 
+    /// Make `set` the scene (uploaded to the device on the GPU backend).
     pub fn set_scene(&mut self, set: SplatSet) -> Result<()> {
         let prep = Prepared::new(set);
         if let Some(g) = &mut self.gpu {
@@ -125,32 +139,56 @@ impl Renderer {
         Ok(())
     }
 
+    /// The scene, if one is set.
     pub fn scene(&self) -> Option<&SplatSet> {
         self.scene.as_ref().map(|p| &p.set)
     }
 
-    pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
-        self.render_keeping(camera, options, None)
+    /// Split every frame between the device and the CPU mirrors at a stage (`None`: the backend
+    /// runs it all), to find which stage departs from its mirror. Needs the GPU backend.
+    pub fn set_bisect(&mut self, bisect: Option<Bisect>) -> Result<()> {
+        if bisect.is_some() && self.gpu.is_none() {
+            return Err(Error::InvalidArgument("bisecting needs the GPU backend".into()));
+        }
+        self.bisect = bisect;
+        Ok(())
     }
 
-    /// `render`, also leaving the sheet modes' per-tile sheet ranges in `sheet_tiles` when given
-    /// (of the grid actually drawn: the coarse one under a render scale).
-    fn render_keeping(
-        &mut self,
-        camera: &Camera,
-        options: &RenderOptions,
-        sheet_tiles: Option<&mut Vec<u32>>,
-    ) -> Result<Rendered> {
+    fn prepared(&self) -> Result<&Prepared> {
+        self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
+    }
+
+    /// Draw a frame.
+    pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
         options.validate()?;
         camera.validate()?;
         if options.render_scale != 1.0 {
             let full = RenderOptions { render_scale: 1.0, ..options.clone() };
-            return resample::render_scaled(camera, options.render_scale, |low| {
-                self.render_keeping(low, &full, sheet_tiles)
-            });
+            return resample::render_scaled(camera, options.render_scale, |low| self.render(low, &full));
         }
+        let (opts, choice) = self.choose(camera, options)?;
+        let bisect = self.bisect;
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let mut cpu = CpuEngine::new(prep);
+        let recorded = match (&mut self.gpu, bisect) {
+            (Some(g), None) => record_frame(&mut g.engine(), prep, camera, &opts)?,
+            (Some(g), Some(b)) => {
+                let mut gpu = g.engine();
+                let mut split = match b {
+                    Bisect::GpuUntil(at) => bisect::Split::new(&mut gpu, &mut cpu, at),
+                    Bisect::CpuUntil(at) => bisect::Split::new(&mut cpu, &mut gpu, at),
+                };
+                record_frame(&mut split, prep, camera, &opts)?
+            }
+            (None, _) => record_frame(&mut cpu, prep, camera, &opts)?,
+        };
+        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice) })
+    }
+
+    /// The options with the raster variant `Raster::Auto` resolved for this device and view.
+    fn choose(&self, camera: &Camera, options: &RenderOptions) -> Result<(RenderOptions, RasterChoice)> {
+        let prep = self.prepared()?;
         let device = match &self.gpu {
             Some(g) => {
                 raster::Device { cpu: g.context().is_cpu_device(), point_size_max: g.context().point_size_max() }
@@ -160,104 +198,112 @@ impl Renderer {
         let choice = raster::choose(&prep.set, camera, options, device)?;
         let mut opts = options.clone();
         opts.raster = choice.raster;
-        let mut out = match (&mut self.gpu, sheet_tiles) {
-            (Some(g), tiles) => {
-                let out = g.render(prep, camera, &opts)?;
-                if let Some(tiles) = tiles {
-                    *tiles = g.last_sheet_tiles()?;
-                }
-                out
-            }
-            (None, Some(tiles)) => pipeline::render_cpu_with(prep, camera, &opts, tiles)?,
-            (None, None) => pipeline::render_cpu(prep, camera, &opts)?,
+        Ok((opts, choice))
+    }
+
+    /// Run this frame's recording through stage `after` (the backend's engine) and read `what`
+    /// back, whole: a probe for tests and inspection.
+    #[doc(hidden)]
+    pub fn probe(
+        &mut self,
+        camera: &Camera,
+        options: &RenderOptions,
+        after: StageId,
+        what: &[Res],
+    ) -> Result<Vec<Vec<u32>>> {
+        options.validate()?;
+        camera.validate()?;
+        let (opts, _) = self.choose(camera, options)?;
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let run = |e: &mut dyn Engine| -> Result<Vec<Vec<u32>>> {
+            record_frame(&mut bisect::Stop::new(e, after), prep, camera, &opts)?;
+            let what: Vec<_> = what.iter().map(|&r| (r, e.words(r))).collect();
+            e.read(&what)
         };
-        out.raster = Some(choice);
-        Ok(out)
+        match &mut self.gpu {
+            Some(g) => run(&mut g.engine()),
+            None => run(&mut CpuEngine::new(prep)),
+        }
     }
 
     /// The compute tile compositor's binning for this frame (GPU stages or their CPU mirrors):
     /// each screen tile's first entry plus the total, and the entries (splat indices, each tile's
     /// run in draw-list order).
+    #[doc(hidden)]
     pub fn tile_lists(&mut self, camera: &Camera, options: &RenderOptions) -> Result<(Vec<u32>, Vec<u32>)> {
-        camera.validate()?;
-        options.validate()?;
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         let mut opts = options.clone();
         opts.raster = Raster::Compute;
         opts.composite = Composite::Splat;
-        if let Some(g) = &mut self.gpu {
-            return g.tile_lists(prep, camera, &opts);
-        }
-        let frame = pipeline::frame_for(&prep.set, camera, &opts);
-        let draw = match opts.order {
-            OrderKind::Pbtf => cpu_pbtf_order(prep, camera, opts.direction()),
-            kind => order::visibility_order(&prep.set, camera, kind, opts.direction()),
-        };
-        let mut params = vec![Default::default(); prep.set.len()];
-        cpu::splat_params(&frame, prep.set.splats(), &mut params);
-        let inputs = cpu::footprint::FootprintInputs {
-            frame: &frame,
-            params: &params,
-            draw_list: &draw,
-            splats: prep.set.splats(),
-            sheet_rank: &prep.ranks,
-            table: &[],
-            slice_table: &[],
-            occlusion: &[],
-        };
-        let bins = cpu::tile::tile_bins_cpu(
-            &inputs,
-            &pipeline::tile_push(&opts, prep.set.len() as u32, camera.width, camera.height),
-        )?;
-        Ok((bins.start, bins.entries))
+        let got = self.probe(camera, &opts, StageId::TileScatter, &[Res::TileStart, Res::TileEntries])?;
+        let frame = plan::frame_for(&self.prepared()?.set, camera, &opts);
+        let (tx, ty) = cpu::tile::tile_grid(&frame);
+        let tiles = tx as usize * ty as usize;
+        let starts = got[0][..tiles + 1].to_vec();
+        let entries = got[1][..starts[tiles] as usize].to_vec();
+        Ok((starts, entries))
     }
 
     /// The sheet modes' per-tile sheet ranges of this frame, as the backend computes them (the GPU
-    /// `sheet_tiles` stage, or its CPU mirror): for each composite tile, the lowest sheet (global
-    /// rank; slab mode: slab) whose footprints reach it (`u32::MAX`: none), then for each tile the
-    /// highest + 1; every tile `pipeline::ALL_SHEETS` where the pass would not pay
-    /// (`pipeline::sheet_tiles_pay`). Renders the frame to get them.
+    /// `sheet_tiles` stage, or its CPU mirror), of the grid actually drawn (the coarse one under a
+    /// render scale): for each composite tile, the lowest sheet (global rank; slab mode: slab)
+    /// whose footprints reach it (`u32::MAX`: none), then for each tile the highest + 1; every
+    /// tile `plan::ALL_SHEETS` where the pass would not pay (`plan::sheet_tiles_pay`).
+    #[doc(hidden)]
     pub fn sheet_tiles(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
         if options.composite == Composite::Splat {
             return Err(Error::InvalidArgument("sheet ranges exist only in the sheet and slab modes".into()));
         }
-        let mut tiles = Vec::new();
-        self.render_keeping(camera, options, Some(&mut tiles))?;
-        Ok(tiles)
+        options.validate()?;
+        let camera =
+            if options.render_scale != 1.0 { resample::scaled_camera(camera, options.render_scale)? } else { *camera };
+        let opts = RenderOptions { render_scale: 1.0, ..options.clone() };
+        let got = self.probe(&camera, &opts, StageId::SheetTiles, &[Res::SheetTiles])?;
+        let c = constants::COMPOSITE_TILE;
+        let tiles = camera.width.div_ceil(c) as usize * camera.height.div_ceil(c) as usize;
+        Ok(got[0][..2 * tiles].to_vec())
     }
 
-    /// The PBTF draw sequence as the backend computes it (the GPU order stage, or its CPU mirror).
+    /// The PBTF draw sequence as the backend computes it (the GPU order stages, or their mirrors).
+    #[doc(hidden)]
     pub fn pbtf_order(&mut self, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
-        camera.validate()?;
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
-        match &mut self.gpu {
-            Some(g) => g.order(prep, camera, direction),
-            None => Ok(cpu_pbtf_order(prep, camera, direction)),
-        }
+        let mut opts = RenderOptions::default();
+        opts.raster = Raster::Graphics;
+        opts.direction = Some(direction);
+        let n = self.prepared()?.set.len();
+        let got = self.probe(camera, &opts, StageId::OrderScatter, &[Res::Order])?;
+        Ok(got[0][..n].to_vec())
     }
 
     /// The image-aligned sheets' binning for this camera: the (splat, slab) pairs, interleaved, in
-    /// visiting order (GPU stages `splat_params`, `slab_count`, `slab_scan`, `slab_scatter`, or
-    /// their CPU mirrors), for comparison and inspection.
+    /// visiting order (stages `splat_params`, `slab_count`, `slab_scan`, `slab_scatter`).
+    #[doc(hidden)]
     pub fn slab_pairs(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
-        camera.validate()?;
-        options.validate()?;
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
-        let direction = options.direction();
-        let set = &prep.set;
-        let frame = pipeline::frame_for(set, camera, options);
-        let pc = slab::slab_geometry(&frame, set.grid(), set.len(), options.slab_thickness, direction)?;
-        match &mut self.gpu {
-            Some(g) => g.slab_pairs(&frame, &pc),
-            None => {
-                let mut params = vec![gpu_types::SplatParams::default(); set.len()];
-                cpu::splat_params(&frame, set.splats(), &mut params);
-                Ok(slab::slab_bins_cpu(&pc, &params, u32::MAX)?.0)
-            }
-        }
+        let opts = RenderOptions { composite: Composite::Slab, render_scale: 1.0, ..options.clone() };
+        let set = &self.prepared()?.set;
+        let frame = plan::frame_for(set, camera, &opts);
+        let pc = slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, opts.direction())?;
+        let got = self.probe(camera, &opts, StageId::SlabScatter, &[Res::SlabStart, Res::SlabPairs])?;
+        let pairs = got[0][pc.slabs as usize] as usize * 2;
+        Ok(got[1][..pairs].to_vec())
+    }
+
+    /// The splat_params stage's output for this camera (GPU stage, or its CPU mirror).
+    #[doc(hidden)]
+    pub fn splat_params(
+        &mut self,
+        camera: &Camera,
+        kernel: Kernel,
+        antialias: Antialias,
+    ) -> Result<Vec<gpu_types::SplatParams>> {
+        let mut opts = RenderOptions::default();
+        opts.raster = Raster::Graphics;
+        opts.direction = Some(Direction::BackToFront);
+        opts.kernel = kernel;
+        opts.antialias = antialias;
+        let n = self.prepared()?.set.len();
+        let got = self.probe(camera, &opts, StageId::SplatParams, &[Res::Params])?;
+        Ok(bytemuck::cast_slice(&got[0][..n * std::mem::size_of::<gpu_types::SplatParams>() / 4]).to_vec())
     }
 
     /// The ray caster: `raycast.comp` on the GPU, or its CPU mirror.
@@ -285,29 +331,6 @@ impl Renderer {
                     timings: vec![StageTime { stage: "raycast", ms: t.elapsed().as_secs_f64() * 1e3 }],
                     raster: None,
                 })
-            }
-        }
-    }
-
-    /// The splat_params stage's output for this camera (GPU stage, or its CPU mirror).
-    pub fn splat_params(
-        &mut self,
-        camera: &Camera,
-        kernel: Kernel,
-        antialias: Antialias,
-    ) -> Result<Vec<gpu_types::SplatParams>> {
-        camera.validate()?;
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
-        match &mut self.gpu {
-            Some(g) => g.splat_params(prep, camera, kernel, antialias),
-            None => {
-                let set = &prep.set;
-                let frame =
-                    pipeline::make_frame(set, camera, kernel, antialias, None, order::pbtf_split(set, camera), true);
-                let mut out = vec![gpu_types::SplatParams::default(); set.len()];
-                cpu::splat_params(&frame, set.splats(), &mut out);
-                Ok(out)
             }
         }
     }
@@ -352,18 +375,4 @@ pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
     let per_splat =
         (std::mem::size_of::<gpu_types::Splat>() + std::mem::size_of::<gpu_types::SplatParams>() + 16) as f64;
     per_splat + (rows * (4.0 + 4.0 + 8.0) + (dims[0] + dims[1] + dims[2]) as f64 * 4.0) / n
-}
-
-/// The three order stages' CPU mirrors run in sequence.
-fn cpu_pbtf_order(prep: &Prepared, camera: &Camera, direction: Direction) -> Vec<u32> {
-    let set = &prep.set;
-    let frame = pipeline::order_frame(set, camera, direction);
-    let rows = set.row_start().len() - 1;
-    let mut row_split = vec![0u32; rows];
-    let mut segments = vec![0u32; 2 * rows];
-    let mut out = vec![0u32; set.len()];
-    cpu::order_count(&frame, set.splats(), set.row_start(), &mut row_split, &mut segments);
-    cpu::order_scan(&frame, &mut segments);
-    cpu::order_scatter(&frame, set.splats(), set.row_start(), &row_split, &segments, &mut out);
-    out
 }

@@ -1,7 +1,7 @@
 //! Image and animation error metrics, used by tests, the bench and `voxsplat compare`. All work on
 //! premultiplied RGBA with values clamped to [0, 1].
-use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
+use crate::image::ImageF32;
 
 /// How far one image is from a reference.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,7 +1,7 @@
 //! Writing frames: RGBA8 PNG with straight (un-premultiplied) alpha, and RGBA32F EXR with
 //! premultiplied alpha (EXR's own convention). Values are written as computed: no sRGB curve.
-use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
+use crate::image::ImageF32;
 use std::path::Path;
 
 /// Straight-alpha RGBA8 pixels of a premultiplied float image.

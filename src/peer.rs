@@ -97,7 +97,7 @@ pub struct PeerRun {
     pub label: String,
     /// Median wall time of a whole frame (render call to image on the host), ms.
     pub median_ms: f64,
-    pub image: crate::cpu::ImageF32,
+    pub image: crate::image::ImageF32,
 }
 
 /// The configurations compared with the peers on an `n`³ volume. Image-aligned slabs draw each of

@@ -17,7 +17,7 @@
 //! the quads (docs/MODEL.md); they cannot stretch along a motion path.
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::pipeline::{Composite, RenderOptions};
+use crate::options::{Composite, RenderOptions};
 use crate::volume::SplatSet;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -93,7 +93,7 @@ pub struct FootprintSize {
 /// Footprint diameter estimate for `set` seen from `camera` with `opts` (anti-aliasing widens far
 /// splats, which only matters for the typical size).
 pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> FootprintSize {
-    let frame = crate::pipeline::frame_for(set, camera, opts);
+    let frame = crate::plan::frame_for(set, camera, opts);
     let g = set.grid();
     let eye = camera.eye;
     let forward = camera.forward();

@@ -7,10 +7,10 @@
 //! variant draws the same picture: equal error is checked, not assumed.
 use crate::bench::{median, rastered, time_method};
 use crate::camera::{Camera, Projection};
-use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
+use crate::image::ImageF32;
 use crate::metrics::compare;
-use crate::pipeline::Composite;
+use crate::options::Composite;
 use crate::raster::Raster;
 use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use crate::volume::{Grid, SplatSet};

@@ -8,9 +8,9 @@
 //! the full-size truth (docs/RESULTS.md, peers section), not assumed. It is the splatting analogue
 //! of a ray caster's image sample distance (its inverse).
 use crate::camera::Camera;
-use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
-use crate::pipeline::{Rendered, StageTime};
+use crate::image::ImageF32;
+use crate::options::{Rendered, StageTime};
 use rayon::prelude::*;
 
 /// Smallest render scale accepted: below it a 512-px view would have fewer than 32 rows.

@@ -19,7 +19,7 @@ use crate::cpu::splat_params::footprint_scale;
 use crate::error::{Error, Result};
 use crate::gpu_types::{FootprintPush, Frame, SlabPush, SplatParams, SHEET_MODE_SLAB};
 use crate::order::Direction;
-use crate::pipeline::Batch;
+use crate::plan::Batch;
 use crate::volume::Grid;
 use glam::Vec3;
 

@@ -4,7 +4,7 @@
 use crate::camera::Camera;
 use crate::error::Result;
 use crate::kernel::KERNELS;
-use crate::pipeline::{Antialias, Composite, RenderOptions};
+use crate::options::{Antialias, Composite, RenderOptions};
 use crate::{scene, OrderKind, Renderer};
 
 /// Frames per repetition of the sequence.

@@ -6,11 +6,12 @@
 use crate::bench::median;
 use crate::camera::{Camera, Projection};
 use crate::cpu::raycast::RaycastOptions;
-use crate::cpu::ImageF32;
 use crate::error::Result;
+use crate::image::ImageF32;
 use crate::metrics::{compare, frame_changes, temporal_of};
+use crate::options::{Composite, RenderOptions, Rendered};
 use crate::order::{count_violations, visibility_order, Direction, OrderKind};
-use crate::pipeline::{sheet_axis, Composite, RenderOptions, Rendered};
+use crate::plan::sheet_axis;
 use crate::raster::Raster;
 use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use crate::volume::{Grid, SplatSet};
@@ -626,7 +627,7 @@ pub fn early_termination_study(r: &mut Renderer, size: u32, frames: usize) -> Re
                 Ok((median(&mut t), last.expect("one frame")))
             };
             let (off_ms, off) = time(&o, r)?;
-            o.early_termination = crate::pipeline::DEFAULT_EARLY_TERMINATION;
+            o.early_termination = crate::options::DEFAULT_EARLY_TERMINATION;
             let (on_ms, on) = time(&o, r)?;
             let max_change = off
                 .pixels
@@ -653,8 +654,8 @@ pub fn early_markdown(rows: &[EarlyRow], size: u32) -> String {
          (transmittance left per 8x8 tile; batches of at most {} sheets so the occlusion map updates): \
          medians with it off and on, and the largest change it made to any pixel channel.\n\n\
          | scene | mode | off ms | on ms | speed-up | max change |\n|---|---|---:|---:|---:|---:|\n",
-        crate::pipeline::DEFAULT_EARLY_TERMINATION,
-        crate::pipeline::EARLY_TERMINATION_BATCH
+        crate::options::DEFAULT_EARLY_TERMINATION,
+        crate::options::EARLY_TERMINATION_BATCH
     );
     for r in rows {
         md += &format!(

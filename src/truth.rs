@@ -6,8 +6,8 @@
 //! the emission–absorption model at a depth step of at most a quarter voxel, in f64. It does not
 //! store the m×m×n buffer: each column is integrated as it is reconstructed.
 use crate::camera::Camera;
-use crate::cpu::ImageF32;
 use crate::error::{Error, Result};
+use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::volume::SplatSet;
 use glam::{DMat4, DVec3, DVec4, Mat4};

@@ -1,7 +1,7 @@
 //! Chapter 3: Swan's anti-aliasing in the per-splat stage, and EWA beside it.
 mod common;
 use glam::Vec3;
-use voxsplat::pipeline::Prepared;
+use voxsplat::plan::Prepared;
 use voxsplat::truth::{supersampled, TruthOptions};
 use voxsplat::{scene, Antialias, Camera, Composite, Grid, Kernel, Projection, RenderOptions, SplatSet};
 

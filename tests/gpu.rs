@@ -14,7 +14,7 @@ fn options(composite: Composite, kernel: Kernel) -> RenderOptions {
 }
 
 /// On a mismatch, write the GPU image, the CPU image and their difference for inspection.
-fn save_failure(tag: &str, gpu: &voxsplat::cpu::ImageF32, cpu: &voxsplat::cpu::ImageF32) {
+fn save_failure(tag: &str, gpu: &voxsplat::ImageF32, cpu: &voxsplat::ImageF32) {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("mirror-failures");
     std::fs::create_dir_all(&dir).unwrap();
     let mut diff = gpu.clone();

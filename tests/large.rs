@@ -21,7 +21,7 @@ fn too_large<T>(r: voxsplat::Result<T>) -> String {
     }
 }
 
-fn max_diff(a: &voxsplat::cpu::ImageF32, b: &voxsplat::cpu::ImageF32) -> f32 {
+fn max_diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> f32 {
     a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs())).fold(0.0, f32::max)
 }
 

@@ -159,7 +159,7 @@ fn steep_heights() -> voxsplat::loaders::HeightGrid {
 
 /// Pixels inside the silhouette of the voxels of `set` (ray-traced, eroded by 2 pixels) whose alpha
 /// in `img` is below 0.95.
-fn coverage_holes(img: &voxsplat::cpu::ImageF32, set: &voxsplat::SplatSet, cam: &Camera) -> usize {
+fn coverage_holes(img: &voxsplat::ImageF32, set: &voxsplat::SplatSet, cam: &Camera) -> usize {
     let g = set.grid();
     let inv = cam.view_proj().as_dmat4().inverse();
     let (w, h) = (img.width, img.height);

@@ -4,7 +4,7 @@ use common::assert_clean;
 use glam::{Mat4, Vec3};
 use voxsplat::animate::{render_frame, Animation, Blur};
 use voxsplat::output::diff_rgba8;
-use voxsplat::pipeline::Motion;
+use voxsplat::Motion;
 use voxsplat::{Antialias, Camera, Composite, Grid, Kernel, Projection, Raster, RenderOptions, SplatSet};
 
 fn one_voxel() -> SplatSet {

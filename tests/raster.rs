@@ -5,8 +5,8 @@
 mod common;
 use common::{assert_clean, random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
-use voxsplat::cpu::ImageF32;
 use voxsplat::output::diff_rgba8;
+use voxsplat::ImageF32;
 use voxsplat::{scene, Camera, Composite, Direction, Error, Grid, Projection, Raster, RenderOptions, SplatSet};
 
 fn opts(composite: Composite, raster: Raster) -> RenderOptions {
@@ -118,7 +118,7 @@ fn tile_lists_keep_the_pbtf_order_and_hold_exactly_the_overlapping_splats() {
                 let (start, entries) = gpu.tile_lists(&cam, &o).unwrap();
                 assert_eq!((start.clone(), entries.clone()), cpu.tile_lists(&cam, &o).unwrap(), "GPU = mirror");
                 let order = gpu.pbtf_order(&cam, direction).unwrap();
-                let frame = voxsplat::pipeline::frame_for(&set, &cam, &o);
+                let frame = voxsplat::plan::frame_for(&set, &cam, &o);
                 let mut params = vec![Default::default(); set.len()];
                 voxsplat::cpu::splat_params(&frame, set.splats(), &mut params);
                 let boxes: Vec<_> = params
@@ -159,7 +159,7 @@ fn early_termination_in_the_tile_compositor_changes_no_pixel_beyond_the_threshol
 }
 
 fn check_early_termination(gpu: &mut voxsplat::Renderer, cpu: &mut voxsplat::Renderer, cam: &Camera, full: &ImageF32) {
-    for threshold in [voxsplat::pipeline::DEFAULT_EARLY_TERMINATION, 0.3] {
+    for threshold in [voxsplat::options::DEFAULT_EARLY_TERMINATION, 0.3] {
         let mut o = opts(Composite::Splat, Raster::Compute);
         o.early_termination = threshold;
         let g = gpu.render(cam, &o).unwrap().image;
@@ -281,7 +281,7 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
     let cam = Camera::framing(set.grid(), 64, 48);
     gpu.set_scene(set).unwrap();
     let mut o = opts(Composite::Splat, Raster::Points);
-    o.motion = Some(voxsplat::pipeline::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
+    o.motion = Some(voxsplat::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
     assert!(matches!(gpu.render(&cam, &o), Err(Error::InvalidArgument(m)) if m.contains("motion")));
     // A voxel a hair in front of the eye: its footprint is thousands of pixels wide.
     let (set, mut close) = close_up();
@@ -304,7 +304,7 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
     let wide_points = Device { cpu: true, point_size_max: 256.0 };
     let pick = |set: &SplatSet, cam: &Camera, o: &RenderOptions, d: Device| choose(set, cam, o, d).unwrap();
     let mut blurred = opts(Composite::Splat, Raster::Auto);
-    blurred.motion = Some(voxsplat::pipeline::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
+    blurred.motion = Some(voxsplat::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
 
     // Small footprints: the tile compositor (ahead of the sprites up to 15 px, docs/RESULTS.md).
     let c = pick(&set, &small, &opts(Composite::Splat, Raster::Auto), cpu);
@@ -353,7 +353,7 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
 /// all entries drawn at once into one layer per global sheet by the footprint mirror.
 fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tiles: &[u32]) -> usize {
     use voxsplat::cpu::footprint::{footprint, Blend, FootprintInputs};
-    use voxsplat::pipeline::{frame_for, sheet_plan, sheet_tiles_push, Prepared};
+    use voxsplat::plan::{frame_for, sheet_plan, sheet_tiles_push, Prepared};
     let prep = Prepared::new(set.clone());
     let frame = frame_for(set, cam, o);
     let mut params = vec![Default::default(); set.len()];
@@ -442,7 +442,7 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
     gpu.set_scene(sheet).unwrap();
     let tiles = gpu.sheet_tiles(&cam, &opts(Composite::Sheet, Raster::Compute)).unwrap();
     let n = tiles.len() / 2;
-    let [lo, hi] = voxsplat::pipeline::ALL_SHEETS;
+    let [lo, hi] = voxsplat::plan::ALL_SHEETS;
     assert!(tiles[..n].iter().all(|&t| t == lo) && tiles[n..].iter().all(|&t| t == hi), "single sheet: all layers");
     // Not a bound on speed: that the ranges skip anything at all on these sparse scenes.
     let mean = skipped_share.iter().sum::<f64>() / skipped_share.len() as f64;

@@ -3,8 +3,8 @@
 //! voxels cover several pixels; bad scales are typed errors.
 mod common;
 use voxsplat::cpu::raycast::RaycastOptions;
-use voxsplat::cpu::ImageF32;
 use voxsplat::resample::{scaled_camera, upsample};
+use voxsplat::ImageF32;
 use voxsplat::{classify, peer, scene, Camera, Error, Kernel, Raster, RenderOptions, Renderer};
 
 fn opts(raster: Raster, kernel: Kernel, scale: f32) -> RenderOptions {

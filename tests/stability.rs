@@ -2,9 +2,9 @@
 //! sheet buffer (slabs) that avoids them. Figures go to the bench (docs/RESULTS.md).
 mod common;
 use glam::Vec3;
-use voxsplat::cpu::ImageF32;
 use voxsplat::output::diff_rgba8;
 use voxsplat::stability::{self, Variant};
+use voxsplat::ImageF32;
 use voxsplat::{Camera, Composite, Direction, Grid, Kernel, OrderKind, Projection, RenderOptions, SplatSet};
 
 #[test]

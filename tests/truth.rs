@@ -4,9 +4,9 @@ mod common;
 use common::assert_clean;
 use glam::Vec3;
 use voxsplat::cpu::raycast::{raycast, raycast_params, RaycastOptions};
-use voxsplat::cpu::ImageF32;
 use voxsplat::metrics::{compare, temporal};
 use voxsplat::truth::{volumetric_summation, DenseField, Reconstruction, TruthOptions};
+use voxsplat::ImageF32;
 use voxsplat::{scene, Camera, Grid, Kernel, Projection, SplatSet};
 
 fn ortho_down_z(center: Vec3, size: u32) -> Camera {

@@ -3,7 +3,7 @@ mod common;
 use glam::Vec3;
 use voxsplat::constants::{FOOTPRINT_TABLE_SIZE, MAX_GROUPS_X, WORKGROUP_SIZE};
 use voxsplat::order::Direction;
-use voxsplat::pipeline::{groups_1d, sheet_plan, Prepared};
+use voxsplat::plan::{groups_1d, sheet_plan, Prepared};
 use voxsplat::{scene, Camera, Error, Grid, Kernel, Projection, SplatSet, Volume};
 
 #[test]

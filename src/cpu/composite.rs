@@ -1,8 +1,12 @@
 //! Mirror of `composite.comp`.
 use super::ImageF32;
 use crate::constants::COMPOSITE_TILE;
+use crate::error::Result;
 use crate::gpu_types::CompositePush;
+use crate::stages::{Dispatch, Res};
 use rayon::prelude::*;
+
+use super::exec::Bindings;
 
 /// Mirror of `layer_range` in `composite.comp`: the batch's layers that footprints reach on tile
 /// `tile`, from the per-tile sheet ranges of `sheet_tiles`.
@@ -67,4 +71,22 @@ pub fn composite(
         let o = &mut occlusion[(y / tile) * tiles_x + x / tile];
         *o = o.max(1.0 - p[3]);
     }
+}
+
+pub(crate) fn composite_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let push: CompositePush = d.push_as();
+    let mut occlusion = b.take(Res::Occlusion);
+    let mut accum = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
+    let fixed: Vec<ImageF32>;
+    let layers = if d.spec(0) == 1 {
+        let sums = b.get::<u32>(Res::Fixed);
+        fixed = (0..push.layers as usize).map(|l| super::footprint::fixed_layer(sums, l, b.width, b.height)).collect();
+        &fixed
+    } else {
+        &b.sums
+    };
+    composite(&push, layers, b.get(Res::SheetTiles), &mut accum, bytemuck::cast_slice_mut(&mut occlusion));
+    b.accum = accum;
+    b.put(Res::Occlusion, occlusion);
+    Ok(())
 }

@@ -6,8 +6,12 @@
 //! the projective map of `screen_quad`).
 use super::ImageF32;
 use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
+use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB};
+use crate::stages::{Dispatch, Pass, Res};
 use glam::{DMat4, DVec3, DVec4, IVec4, Mat3, Mat4, Vec2, Vec3, Vec4};
+
+use super::exec::Bindings;
 
 /// How a fragment combines with the attachment (premultiplied colour).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -390,4 +394,29 @@ fn raster_quad(
             shade(p, sheet, blend, weight, u as f32, v as f32, dst);
         }
     }
+}
+
+/// The draw: the raster target or the summation layers are cleared (the render pass's load) and
+/// the footprints drawn into them.
+pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let state = d.stage.desc().variants[d.variant].draw.expect("footprint variants are draws");
+    let count = match state.pass {
+        Pass::Target => 1,
+        Pass::Sheet => b.sums.len(),
+    };
+    let mut layers = vec![ImageF32::new(b.width, b.height); count];
+    let (inputs, push) = (b.inputs(d.list), d.push_as());
+    footprint(&inputs, &push, state.blend, state.points, d.groups[0], d.groups[1], &mut layers);
+    match state.pass {
+        Pass::Target => b.color = layers.remove(0),
+        Pass::Sheet => b.sums = layers,
+    }
+    Ok(())
+}
+
+pub(crate) fn footprint_sum_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let mut sums = b.take(Res::Fixed);
+    footprint_sum(&b.inputs(d.list), &d.push_as(), &mut sums);
+    b.put(Res::Fixed, sums);
+    Ok(())
 }

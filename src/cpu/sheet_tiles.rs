@@ -1,7 +1,10 @@
 //! Mirror of `sheet_tiles.comp`.
+use super::exec::Bindings;
 use super::footprint::{entry, screen_quad, FootprintInputs};
 use crate::constants::COMPOSITE_TILE;
+use crate::error::Result;
 use crate::gpu_types::FootprintPush;
+use crate::stages::{Dispatch, Res};
 use glam::{IVec2, Mat4, Vec2, Vec4};
 
 /// For each composite tile, the lowest sheet whose footprints reach it (`u32::MAX`: none) in
@@ -46,4 +49,11 @@ pub fn sheet_tiles(inputs: &FootprintInputs<'_>, push: &FootprintPush, points: b
             }
         }
     }
+}
+
+pub(crate) fn sheet_tiles_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let mut tiles = b.take(Res::SheetTiles);
+    sheet_tiles(&b.inputs(d.list), &d.push_as(), d.spec(1) == 1, &mut tiles);
+    b.put(Res::SheetTiles, tiles);
+    Ok(())
 }

@@ -4,11 +4,14 @@
 //! front to back with early termination or back to front).
 use super::footprint::{footprint_weight, screen_quad, FootprintInputs};
 use super::ImageF32;
-use crate::constants::{RASTER_TILE_H, RASTER_TILE_W};
+use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams};
+use crate::stages::{Dispatch, Res};
 use glam::{IVec4, Mat3, Vec2, Vec3};
 use rayon::prelude::*;
+
+use super::exec::Bindings;
 
 /// Tiles across and down an image of the frame's size.
 pub fn tile_grid(frame: &Frame) -> (u32, u32) {
@@ -111,8 +114,9 @@ pub fn tile_scatter(
     }
 }
 
-/// Composite every tile's list into `image` (which it overwrites), pixel by pixel: every pixel takes
-/// its tile's entries in list order, whichever GPU lane composites it.
+/// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it,
+/// later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
+/// order, whichever GPU lane composites it.
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
@@ -128,8 +132,15 @@ pub fn tile_composite(
     image.pixels.par_iter_mut().enumerate().for_each(|(i, px)| {
         let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
         let tile = ((y as u32 / RASTER_TILE_H) * tiles_x + x as u32 / RASTER_TILE_W) as usize;
-        let mut acc = [0.0f32; 4];
-        for &splat in &entries[tile_start[tile] as usize..tile_start[tile + 1] as usize] {
+        // Segment `push.first`: TILE_SEGMENT entries of the list, carrying the pixel across segments.
+        let list_end = tile_start[tile + 1] as usize;
+        let begin = tile_start[tile] as usize + (push.first * TILE_SEGMENT) as usize;
+        if push.first > 0 && begin >= list_end {
+            return;
+        }
+        let end = list_end.min(begin + TILE_SEGMENT as usize);
+        let mut acc = if push.first > 0 { *px } else { [0.0f32; 4] };
+        for &splat in &entries[begin..end] {
             if terminate && 1.0 - acc[3] <= push.occluded {
                 break;
             }
@@ -160,30 +171,42 @@ pub fn tile_composite(
     });
 }
 
-/// The whole binning on the CPU mirrors, sizes checked against the limits before allocating:
-/// (tile_start, entries).
-pub fn tile_bins_cpu(inputs: &FootprintInputs<'_>, push: &FootprintPush) -> Result<TileBins> {
-    let (tx, ty) = tile_grid(inputs.frame);
-    let tiles = (tx * ty) as usize;
-    let cells = crate::raster::check_tile_cells(tiles as u64, push.chunks)?;
-    let mut counts = vec![0u32; cells as usize];
-    let mut start = vec![0u32; tiles + 1];
-    let mut quads = vec![ScreenQuad::default(); inputs.params.len()];
-    tile_count(inputs, push, &mut counts, &mut quads);
-    tile_scan(inputs, push, &mut counts, &mut start);
-    tile_offsets(inputs, &mut start);
-    crate::raster::check_tile_entries(start[tiles] as u64)?;
-    let mut entries = vec![0u32; start[tiles] as usize];
-    tile_scatter(inputs, push, &quads, &start, &mut counts, &mut entries);
-    Ok(TileBins { start, entries, quads })
+pub(crate) fn tile_count_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let (mut counts, mut quads) = (b.take(Res::TileCounts), b.take(Res::Quads));
+    tile_count(&b.inputs(d.list), &d.push_as(), &mut counts, bytemuck::cast_slice_mut(&mut quads));
+    b.put(Res::TileCounts, counts);
+    b.put(Res::Quads, quads);
+    Ok(())
 }
 
-/// The tile binning's output.
-pub struct TileBins {
-    /// Each tile's first entry, then the total.
-    pub start: Vec<u32>,
-    /// Splat indices, tile by tile, each run in draw-list order.
-    pub entries: Vec<u32>,
-    /// Every splat's footprint in screen space.
-    pub quads: Vec<ScreenQuad>,
+pub(crate) fn tile_scan_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let (mut counts, mut start) = (b.take(Res::TileCounts), b.take(Res::TileStart));
+    tile_scan(&b.inputs(d.list), &d.push_as(), &mut counts, &mut start);
+    b.put(Res::TileCounts, counts);
+    b.put(Res::TileStart, start);
+    Ok(())
+}
+
+pub(crate) fn tile_offsets_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let mut start = b.take(Res::TileStart);
+    tile_offsets(&b.inputs(d.list), &mut start);
+    b.put(Res::TileStart, start);
+    Ok(())
+}
+
+pub(crate) fn tile_scatter_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let (mut counts, mut entries) = (b.take(Res::TileCounts), b.take(Res::TileEntries));
+    let (inputs, push) = (b.inputs(d.list), d.push_as());
+    tile_scatter(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), &mut counts, &mut entries);
+    b.put(Res::TileCounts, counts);
+    b.put(Res::TileEntries, entries);
+    Ok(())
+}
+
+pub(crate) fn tile_composite_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+    let mut image = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
+    let (inputs, push) = (b.inputs(d.list), d.push_as());
+    tile_composite(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);
+    b.accum = image;
+    Ok(())
 }

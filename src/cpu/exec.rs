@@ -1,0 +1,236 @@
+//! The CPU engine: runs a frame's recording (`crate::stages`) on the mirrors, each dispatch through
+//! its stage's `mirror` entry, over host copies of the same resources the GPU binds.
+use crate::error::{Error, Result};
+use crate::gpu_types::Frame;
+use crate::image::ImageF32;
+use crate::kernel::Kernel;
+use crate::options::StageTime;
+use crate::plan::Prepared;
+use crate::stages::{Dispatch, Engine, Limits, List, Res};
+use std::collections::{BTreeSet, HashMap};
+use std::time::Instant;
+
+use super::footprint::FootprintInputs;
+
+/// What a mirror reads and writes: the scene, the frame's uniforms and tables, and the frame's
+/// resources by name (buffers as 32-bit words, images as `ImageF32`).
+pub struct Bindings<'a> {
+    pub prep: &'a Prepared,
+    pub frame: Frame,
+    /// The radial footprint table and the kernel-slice table (`Kernel::radial_table`,
+    /// `Kernel::slice_table`).
+    pub table: Vec<f32>,
+    pub slice_table: Vec<f32>,
+    pub width: u32,
+    pub height: u32,
+    bufs: HashMap<Res, Vec<u32>>,
+    pub color: ImageF32,
+    pub accum: ImageF32,
+    /// The summation layers.
+    pub sums: Vec<ImageF32>,
+}
+
+impl<'a> Bindings<'a> {
+    fn new(prep: &'a Prepared) -> Self {
+        Self {
+            prep,
+            frame: Frame::default(),
+            table: Vec::new(),
+            slice_table: Vec::new(),
+            width: 0,
+            height: 0,
+            bufs: HashMap::new(),
+            color: ImageF32::new(0, 0),
+            accum: ImageF32::new(0, 0),
+            sums: Vec::new(),
+        }
+    }
+
+    /// A frame buffer as `T`s (empty when it does not exist).
+    pub fn get<T: bytemuck::Pod>(&self, res: Res) -> &[T] {
+        self.bufs.get(&res).map(|v| bytemuck::cast_slice(v.as_slice())).unwrap_or(&[])
+    }
+
+    /// Take a frame buffer out to write it (put it back with `put`).
+    pub fn take(&mut self, res: Res) -> Vec<u32> {
+        self.bufs.remove(&res).unwrap_or_default()
+    }
+
+    pub fn put(&mut self, res: Res, words: Vec<u32>) {
+        self.bufs.insert(res, words);
+    }
+
+    /// The dispatch's draw list.
+    pub fn list(&self, list: List) -> &[u32] {
+        match list {
+            List::Order => self.get(Res::Order),
+            List::Slices(axis) => &self.prep.slices[axis as usize].1,
+            List::SlabPairs => self.get(Res::SlabPairs),
+        }
+    }
+
+    /// The footprint stages' inputs, as bound on the GPU.
+    pub fn inputs(&self, list: List) -> FootprintInputs<'_> {
+        FootprintInputs {
+            frame: &self.frame,
+            params: self.get(Res::Params),
+            draw_list: self.list(list),
+            splats: self.prep.set.splats(),
+            sheet_rank: &self.prep.ranks,
+            table: &self.table,
+            slice_table: &self.slice_table,
+            occlusion: self.get(Res::Occlusion),
+        }
+    }
+
+    fn image_mut(&mut self, res: Res) -> Vec<&mut ImageF32> {
+        match res {
+            Res::Accum => vec![&mut self.accum],
+            Res::Color => vec![&mut self.color],
+            _ => self.sums.iter_mut().collect(),
+        }
+    }
+}
+
+/// The CPU engine of one frame.
+pub struct CpuEngine<'a> {
+    b: Bindings<'a>,
+    timings: Vec<StageTime>,
+    live: BTreeSet<Res>,
+}
+
+impl<'a> CpuEngine<'a> {
+    pub fn new(prep: &'a Prepared) -> Self {
+        Self { b: Bindings::new(prep), timings: Vec::new(), live: BTreeSet::new() }
+    }
+}
+
+/// Add `ms` to the stage named `stage` (first-seen order).
+pub fn add_time(timings: &mut Vec<StageTime>, stage: &'static str, ms: f64) {
+    match timings.iter_mut().find(|t| t.stage == stage) {
+        Some(t) => t.ms += ms,
+        None => timings.push(StageTime { stage, ms }),
+    }
+}
+
+impl Engine for CpuEngine<'_> {
+    fn begin(&mut self, frame: &Frame, kernel: Kernel, width: u32, height: u32) -> Result<()> {
+        let b = &mut self.b;
+        b.frame = *frame;
+        b.table = kernel.radial_table();
+        b.slice_table = kernel.slice_table();
+        (b.width, b.height) = (width, height);
+        b.color = ImageF32::new(width, height);
+        b.accum = ImageF32::new(width, height);
+        b.sums.clear();
+        Ok(())
+    }
+
+    fn layers(&mut self, layers: u32) -> Result<()> {
+        self.b.sums = vec![ImageF32::new(self.b.width, self.b.height); layers as usize];
+        Ok(())
+    }
+
+    fn ensure(&mut self, res: Res, bytes: u64) -> Result<()> {
+        if res.is_image() || res.is_constant() {
+            return Ok(());
+        }
+        let words = bytes.div_ceil(4);
+        let words = usize::try_from(words).map_err(|_| Error::TooLarge(format!("{bytes} bytes of {res:?}")))?;
+        let buf = self.b.bufs.entry(res).or_default();
+        if buf.len() < words {
+            buf.resize(words, 0);
+        }
+        Ok(())
+    }
+
+    fn fill(&mut self, res: Res, range: Option<(u64, u64)>, value: u32) -> Result<()> {
+        self.live.insert(res);
+        if res.is_image() {
+            for img in self.b.image_mut(res) {
+                img.pixels.fill([f32::from_bits(value); 4]);
+            }
+            return Ok(());
+        }
+        let buf = self.b.bufs.entry(res).or_default();
+        let len = buf.len();
+        let (first, count) = range.map(|(f, c)| (f as usize, c as usize)).unwrap_or((0, len));
+        buf[first.min(len)..(first + count).min(len)].fill(value);
+        Ok(())
+    }
+
+    fn upload(&mut self, res: Res, data: &[u32]) -> Result<()> {
+        self.live.insert(res);
+        if res.is_image() {
+            let mut words = data.chunks_exact(4);
+            for img in self.b.image_mut(res) {
+                for (px, w) in img.pixels.iter_mut().zip(&mut words) {
+                    *px = [0, 1, 2, 3].map(|i| f32::from_bits(w[i]));
+                }
+            }
+            return Ok(());
+        }
+        self.ensure(res, data.len() as u64 * 4)?;
+        self.b.bufs.get_mut(&res).expect("ensured")[..data.len()].copy_from_slice(data);
+        Ok(())
+    }
+
+    fn run(&mut self, d: &Dispatch) -> Result<()> {
+        let t = Instant::now();
+        let desc = d.stage.desc();
+        (desc.mirror)(&mut self.b, d)?;
+        self.live.extend(desc.writes.iter().copied());
+        add_time(&mut self.timings, desc.timing, t.elapsed().as_secs_f64() * 1e3);
+        Ok(())
+    }
+
+    fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>> {
+        Ok(what
+            .iter()
+            .map(|&(res, words)| {
+                if res.is_image() {
+                    let b = &mut self.b;
+                    let imgs: Vec<&ImageF32> = match res {
+                        Res::Accum => vec![&b.accum],
+                        Res::Color => vec![&b.color],
+                        _ => b.sums.iter().collect(),
+                    };
+                    let all = imgs.iter().flat_map(|i| i.pixels.iter().flat_map(|p| p.map(f32::to_bits)));
+                    all.take(words).collect()
+                } else {
+                    let buf = self.b.get::<u32>(res);
+                    buf[..words.min(buf.len())].to_vec()
+                }
+            })
+            .collect())
+    }
+
+    fn words(&self, res: Res) -> usize {
+        let px = self.b.width as usize * self.b.height as usize * 4;
+        match res {
+            Res::Accum | Res::Color => px,
+            Res::Sums => px * self.b.sums.len(),
+            _ => self.b.get::<u32>(res).len(),
+        }
+    }
+
+    fn host_time(&mut self, stage: &'static str, ms: f64) {
+        add_time(&mut self.timings, stage, ms);
+    }
+
+    fn finish(&mut self) -> Result<Vec<StageTime>> {
+        Ok(std::mem::take(&mut self.timings))
+    }
+
+    fn live(&self) -> Vec<Res> {
+        self.live.iter().copied().collect()
+    }
+
+    fn limits(&self) -> Limits {
+        Limits { max_layers: u32::MAX, max_storage_range: u64::MAX }
+    }
+
+    fn is_device(&self) -> bool {
+        false
+    }
+}

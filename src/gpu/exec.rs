@@ -1,0 +1,344 @@
+//! The Vulkan engine: runs a frame's recording (`crate::stages`). Commands queue up until the
+//! recording reads something back, then go in one submission; each stage is timed.
+use super::resources::Target;
+use super::Gpu;
+use crate::cpu::exec::add_time;
+use crate::error::{Error, Result};
+use crate::gpu_types::Frame;
+use crate::kernel::Kernel;
+use crate::options::StageTime;
+use crate::stages::{Dispatch, Engine, Kind, Limits, Pass, Res};
+use crate::vk::{Buffer, BufferUsageFlags as BU, Image, ImageLayout as IL, Recorder, Stage, Timer};
+use std::collections::BTreeSet;
+use std::time::Instant;
+
+enum Cmd {
+    Run(Dispatch),
+    Fill(Res, Option<(u64, u64)>, u32),
+    Upload(Res, Buffer),
+    /// Copy the first bytes of a resource to its readback buffer.
+    Copy(Res, u64),
+}
+
+/// The Vulkan engine of one frame.
+pub struct GpuEngine<'a> {
+    gpu: &'a mut Gpu,
+    /// Commands and the timing they count towards ("" for transfers, which join the next stage).
+    pending: Vec<(&'static str, Cmd)>,
+    timings: Vec<StageTime>,
+    live: BTreeSet<Res>,
+    width: u32,
+    height: u32,
+    layers: u32,
+    /// Where the accumulation image, the summation layers and the raster target stand.
+    layouts: [IL; 3],
+}
+
+impl<'a> GpuEngine<'a> {
+    pub fn new(gpu: &'a mut Gpu) -> Self {
+        Self {
+            gpu,
+            pending: Vec::new(),
+            timings: Vec::new(),
+            live: BTreeSet::new(),
+            width: 0,
+            height: 0,
+            layers: 1,
+            layouts: [IL::UNDEFINED; 3],
+        }
+    }
+
+    /// Submit the queued commands. On a GPU: one submission with a timestamp after each run of
+    /// same-named stages. On a CPU device (lavapipe) timestamps are taken when the rasterizer next
+    /// flushes, not when compute work ends, so there each run is its own submission timed on the
+    /// host (fence to fence, submission overhead included).
+    fn flush(&mut self) -> Result<()> {
+        if self.pending.is_empty() {
+            return Ok(());
+        }
+        let pending = std::mem::take(&mut self.pending);
+        let gpu = &mut *self.gpu;
+        for (_, cmd) in &pending {
+            if let Cmd::Run(d) = cmd {
+                gpu.res.ensure_set(&gpu.pipes, d.stage, d.list)?;
+            }
+        }
+        // Runs of commands with one timing; transfers join the stage after them.
+        let mut runs: Vec<(&'static str, Vec<&Cmd>)> = Vec::new();
+        let mut waiting: Vec<&Cmd> = Vec::new();
+        for (name, cmd) in &pending {
+            waiting.push(cmd);
+            if name.is_empty() {
+                continue;
+            }
+            match runs.last_mut() {
+                Some((last, cmds)) if last == name => cmds.append(&mut waiting),
+                _ => runs.push((name, std::mem::take(&mut waiting))),
+            }
+        }
+        if !waiting.is_empty() {
+            runs.push(("", waiting));
+        }
+        let ctx = gpu.ctx.clone();
+        let host_timed = ctx.is_cpu_device() || ctx.timestamp_period.is_none();
+        let needed = runs.len() as u32 + 1;
+        if !host_timed && gpu.timer.capacity < needed {
+            gpu.timer = Timer::new(&ctx, needed.next_power_of_two())?;
+        }
+        let mut layouts = self.layouts;
+        let gpu = &*self.gpu;
+        let target = gpu.res.current_target()?;
+        let mut per_run = vec![0.0f64; runs.len()];
+        if host_timed {
+            for (i, (_, cmds)) in runs.iter().enumerate() {
+                let t = Instant::now();
+                ctx.submit(|rec| {
+                    for cmd in cmds {
+                        record(rec, gpu, target, &mut layouts, cmd)?;
+                    }
+                    Ok(())
+                })?;
+                per_run[i] = t.elapsed().as_secs_f64() * 1e3;
+            }
+        } else {
+            let timer = &gpu.timer;
+            ctx.submit(|rec| {
+                rec.reset_timer(timer);
+                rec.timestamp(timer, 0);
+                for (i, (_, cmds)) in runs.iter().enumerate() {
+                    for cmd in cmds {
+                        record(rec, gpu, target, &mut layouts, cmd)?;
+                    }
+                    rec.timestamp(timer, i as u32 + 1);
+                }
+                Ok(())
+            })?;
+            if let Some(ms) = timer.read_ms(needed)? {
+                per_run.copy_from_slice(&ms);
+            }
+        }
+        self.layouts = layouts;
+        for ((name, _), ms) in runs.iter().zip(per_run) {
+            if !name.is_empty() {
+                add_time(&mut self.timings, name, ms);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Move `image` (tracked in `layout`) to `to`.
+fn to_layout(rec: &Recorder<'_>, image: &Image, layout: &mut IL, to: IL) {
+    if *layout != to {
+        rec.transition(image, *layout, to, Stage::All, Stage::All);
+        *layout = to;
+    }
+}
+
+fn image_of(target: &Target, res: Res) -> (&Image, usize) {
+    match res {
+        Res::Accum => (&target.accum, 0),
+        Res::Sums => (&target.sums, 1),
+        _ => (&target.color, 2),
+    }
+}
+
+fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3], cmd: &Cmd) -> Result<()> {
+    let res = &gpu.res;
+    match cmd {
+        Cmd::Run(d) => {
+            let desc = d.stage.desc();
+            let stage = &gpu.pipes.stages[d.stage as usize];
+            let (pipe, set) = (&stage.variants[d.variant], res.set(d.stage, d.list)?);
+            match desc.kind {
+                Kind::Compute => {
+                    for &r in desc.bindings.iter().filter(|r| matches!(r, Res::Accum | Res::Sums)) {
+                        let (image, i) = image_of(target, r);
+                        to_layout(rec, image, &mut layouts[i], IL::GENERAL);
+                    }
+                    rec.dispatch(pipe, &stage.layout, set, &d.push, d.groups);
+                    rec.barrier(Stage::Compute, Stage::All);
+                }
+                Kind::Draw => {
+                    let state = desc.variants[d.variant].draw.expect("draw variants carry raster state");
+                    let (first, count) = (d.groups[0], d.groups[1]);
+                    match state.pass {
+                        Pass::Target => {
+                            rec.begin_pass(&gpu.pipes.target_pass, &target.color_fb);
+                            layouts[2] = IL::TRANSFER_SRC_OPTIMAL;
+                        }
+                        Pass::Sheet => {
+                            rec.begin_pass(&gpu.pipes.sheet_pass, &target.sums_fb);
+                            layouts[1] = IL::GENERAL;
+                        }
+                    }
+                    if count > 0 {
+                        if state.points {
+                            rec.draw_points(pipe, &stage.layout, set, &d.push, first, count);
+                        } else {
+                            rec.draw_quads(pipe, &stage.layout, set, &d.push, first, count);
+                        }
+                    }
+                    rec.end_pass();
+                    rec.barrier(Stage::All, Stage::All);
+                }
+            }
+        }
+        Cmd::Fill(r, range, value) => {
+            if r.is_image() {
+                let (image, i) = image_of(target, *r);
+                to_layout(rec, image, &mut layouts[i], IL::GENERAL);
+                rec.clear_image(image, IL::GENERAL, [f32::from_bits(*value); 4]);
+            } else {
+                let buf = res.buffer(*r)?;
+                match range {
+                    Some((first, count)) => rec.fill_buffer_range(buf, first * 4, count * 4, *value),
+                    None => rec.fill_buffer(buf, *value),
+                }
+            }
+            rec.barrier(Stage::Transfer, Stage::All);
+        }
+        Cmd::Upload(r, staging) => {
+            if r.is_image() {
+                let (image, i) = image_of(target, *r);
+                to_layout(rec, image, &mut layouts[i], IL::TRANSFER_DST_OPTIMAL);
+                rec.copy_buffer_to_image(staging, image);
+            } else {
+                rec.copy_buffer(staging, res.buffer(*r)?, staging.size());
+            }
+            rec.barrier(Stage::Transfer, Stage::All);
+        }
+        Cmd::Copy(r, bytes) => {
+            let back = res.readback(*r)?;
+            rec.barrier(Stage::All, Stage::Transfer);
+            if r.is_image() {
+                let (image, i) = image_of(target, *r);
+                to_layout(rec, image, &mut layouts[i], IL::TRANSFER_SRC_OPTIMAL);
+                rec.copy_image_to_buffer(image, IL::TRANSFER_SRC_OPTIMAL, back);
+            } else {
+                rec.copy_buffer(res.buffer(*r)?, back, *bytes);
+            }
+            rec.barrier(Stage::Transfer, Stage::Host);
+        }
+    }
+    Ok(())
+}
+
+impl Engine for GpuEngine<'_> {
+    fn begin(&mut self, frame: &Frame, kernel: Kernel, width: u32, height: u32) -> Result<()> {
+        let (max_side, _) = self.gpu.ctx.image_limits();
+        if width > max_side || height > max_side {
+            return Err(Error::InvalidArgument(format!(
+                "image {width}x{height} exceeds the device's limit of {max_side} per side"
+            )));
+        }
+        self.gpu.res.scene()?;
+        self.gpu.res.set_kernel(kernel)?;
+        self.gpu.res.frame.write(bytemuck::bytes_of(frame))?;
+        let layers = match self.gpu.res.current_target() {
+            Ok(t) if (t.width, t.height) == (width, height) => t.layers,
+            _ => 1,
+        };
+        (self.width, self.height, self.layers) = (width, height, layers);
+        self.gpu.res.target(&self.gpu.pipes, width, height, layers)?;
+        self.layouts = [IL::UNDEFINED; 3];
+        Ok(())
+    }
+
+    fn layers(&mut self, layers: u32) -> Result<()> {
+        if layers != self.layers {
+            self.flush()?;
+            self.gpu.res.target(&self.gpu.pipes, self.width, self.height, layers)?;
+            self.layers = layers;
+            self.layouts = [IL::UNDEFINED; 3];
+        }
+        Ok(())
+    }
+
+    fn ensure(&mut self, res: Res, bytes: u64) -> Result<()> {
+        if self.gpu.res.must_grow(res, bytes) {
+            self.flush()?;
+            self.gpu.res.ensure(res, bytes)?;
+        }
+        Ok(())
+    }
+
+    fn fill(&mut self, res: Res, range: Option<(u64, u64)>, value: u32) -> Result<()> {
+        self.live.insert(res);
+        self.pending.push(("", Cmd::Fill(res, range, value)));
+        Ok(())
+    }
+
+    fn upload(&mut self, res: Res, data: &[u32]) -> Result<()> {
+        if res == Res::Sums || res == Res::Color {
+            return Err(Error::Unsupported(format!("uploading {res:?} to the device")));
+        }
+        if !res.is_image() {
+            self.ensure(res, data.len() as u64 * 4)?;
+        }
+        self.live.insert(res);
+        if data.is_empty() {
+            return Ok(());
+        }
+        let staging =
+            Buffer::with_data(&self.gpu.ctx, &format!("{res:?} upload"), bytemuck::cast_slice(data), BU::TRANSFER_SRC)?;
+        self.pending.push(("", Cmd::Upload(res, staging)));
+        Ok(())
+    }
+
+    fn run(&mut self, d: &Dispatch) -> Result<()> {
+        let desc = d.stage.desc();
+        self.live.extend(desc.writes.iter().copied());
+        self.pending.push((desc.timing, Cmd::Run(d.clone())));
+        Ok(())
+    }
+
+    fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>> {
+        for &(res, words) in what {
+            if res == Res::Sums {
+                return Err(Error::Unsupported("reading the summation layers back".into()));
+            }
+            let bytes = words as u64 * 4;
+            self.gpu.res.ensure_readback(res, bytes)?;
+            self.pending.push(("", Cmd::Copy(res, bytes)));
+        }
+        self.flush()?;
+        what.iter()
+            .map(|&(res, words)| {
+                let bytes = self.gpu.res.readback(res)?.read()?;
+                let n = (words * 4).min(bytes.len());
+                Ok(bytemuck::cast_slice::<u8, u32>(&bytes[..n & !3]).to_vec())
+            })
+            .collect()
+    }
+
+    fn words(&self, res: Res) -> usize {
+        match res {
+            Res::Accum | Res::Color => self.width as usize * self.height as usize * 4,
+            Res::Sums => self.width as usize * self.height as usize * 4 * self.layers as usize,
+            _ => (self.gpu.res.size(res) / 4) as usize,
+        }
+    }
+
+    fn host_time(&mut self, stage: &'static str, ms: f64) {
+        add_time(&mut self.timings, stage, ms);
+    }
+
+    fn finish(&mut self) -> Result<Vec<StageTime>> {
+        self.flush()?;
+        Ok(std::mem::take(&mut self.timings))
+    }
+
+    fn live(&self) -> Vec<Res> {
+        self.live.iter().copied().collect()
+    }
+
+    fn limits(&self) -> Limits {
+        let ctx = &self.gpu.ctx;
+        Limits { max_layers: ctx.image_limits().1, max_storage_range: ctx.max_storage_range() }
+    }
+
+    fn is_device(&self) -> bool {
+        true
+    }
+}

@@ -1,0 +1,222 @@
+//! The Vulkan side: pipelines built from the stage table (`pipelines`), resources by name
+//! (`resources`), the engine that runs a frame's recording (`exec`); and the two passes outside
+//! the frame recording: the ray caster (`raycast.comp`, the reference) and the bench's rooflines.
+pub mod exec;
+pub mod pipelines;
+pub mod resources;
+
+use crate::camera::Camera;
+use crate::constants::{COMPOSITE_TILE, MAX_GPU_RAY_STEPS};
+use crate::cpu::raycast::{raycast_params, RaycastOptions};
+use crate::error::{Error, Result};
+use crate::gpu_types::CompositePush;
+use crate::image::ImageF32;
+use crate::options::{Rendered, StageTime};
+use crate::plan::Prepared;
+use crate::stages::{List, Res, StageId};
+use crate::truth::DenseField;
+use crate::vk::{
+    Bind, Blend, Buffer, BufferUsageFlags as BU, Context, Format, Image, ImageLayout as IL, ImageUsageFlags as IU,
+    Layout, Pipeline, Primitive, ShaderStageFlags as SS, Slot, Stage, Timer,
+};
+use pipelines::{spirv, Pipelines};
+use resources::Resources;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Passes that are not stages of a frame: the ray caster and the rooflines.
+struct Extra {
+    raycast_layout: Layout,
+    raycast: Pipeline,
+    roofline_layout: Layout,
+    roofline_quads: Pipeline,
+    roofline_composite: Pipeline,
+}
+
+/// A renderer's device state.
+pub struct Gpu {
+    pub(crate) pipes: Pipelines,
+    pub(crate) res: Resources,
+    pub(crate) timer: Timer,
+    extra: Extra,
+    pub(crate) ctx: Arc<Context>,
+}
+
+impl Gpu {
+    pub fn new(ctx: Arc<Context>) -> Result<Self> {
+        let pipes = Pipelines::new(&ctx)?;
+        let raycast_layout =
+            Layout::new(&ctx, &[Slot::Storage, Slot::Texture, Slot::StorageImage, Slot::Storage], SS::COMPUTE, 0)?;
+        let roofline_layout = Layout::new(&ctx, &[Slot::Uniform], SS::VERTEX | SS::FRAGMENT, 16)?;
+        let composite_layout = &pipes.stages[StageId::Composite as usize].layout;
+        let extra = Extra {
+            raycast: Pipeline::compute(&ctx, &raycast_layout, spirv("raycast.comp")?)?,
+            raycast_layout,
+            roofline_quads: Pipeline::graphics(
+                &ctx,
+                &roofline_layout,
+                &pipes.target_pass,
+                spirv("roofline.vert")?,
+                spirv("roofline.frag")?,
+                Blend::Add,
+                Primitive::Quads,
+                &[],
+            )?,
+            roofline_composite: Pipeline::compute(&ctx, composite_layout, spirv("roofline.comp")?)?,
+            roofline_layout,
+        };
+        Ok(Self { res: Resources::new(&ctx)?, timer: Timer::new(&ctx, 16)?, pipes, extra, ctx })
+    }
+
+    pub fn context(&self) -> &Arc<Context> {
+        &self.ctx
+    }
+
+    pub fn set_scene(&mut self, prep: &Prepared) -> Result<()> {
+        self.res.set_scene(prep)
+    }
+
+    /// An engine for one frame.
+    pub fn engine(&mut self) -> exec::GpuEngine<'_> {
+        exec::GpuEngine::new(self)
+    }
+
+    /// The GPU ray caster (`raycast.comp`), uploading the dense field on first use.
+    pub fn raycast(&mut self, prep: &Prepared, camera: &Camera, opts: &RaycastOptions) -> Result<Rendered> {
+        camera.validate()?;
+        let params = raycast_params(&prep.set, camera, opts);
+        let diagonal =
+            glam::Vec3::from_slice(&params.box_max[..3]).distance(glam::Vec3::from_slice(&params.box_min[..3]));
+        let steps = (diagonal / params.box_min[3]).ceil().min(opts.max_steps as f32);
+        if steps > MAX_GPU_RAY_STEPS as f32 {
+            return Err(Error::TooLarge(format!(
+                "rays of up to {steps} samples: the GPU ray caster takes at most {MAX_GPU_RAY_STEPS} per ray (llvmpipe ends \
+                 a shader's loops after 65535 iterations); use a longer step, a lower max_steps or the CPU backend"
+            )));
+        }
+        let (w, h) = (camera.width, camera.height);
+        let layers = self.res.current_target().map(|t| t.layers).unwrap_or(1);
+        self.res.target(&self.pipes, w, h, layers)?;
+        self.upload_field(prep, opts.brick)?;
+        self.res.ensure_readback(Res::Accum, w as u64 * h as u64 * 16)?;
+        let ubo = Buffer::with_data(&self.ctx, "raycast params", bytemuck::bytes_of(&params), BU::STORAGE_BUFFER)?;
+        let (res, target) = (&self.res, self.res.current_target()?);
+        let scene = res.scene()?;
+        let (Some(field), Some((_, bricks))) = (&scene.field, &scene.bricks) else {
+            return Err(Error::InvalidArgument("the ray caster's field is not uploaded".into()));
+        };
+        let set = self.extra.raycast_layout.bind(&[
+            Bind::Buffer(&ubo),
+            Bind::Texture(field, &res.sampler),
+            Bind::Image(&target.accum),
+            Bind::Buffer(bricks),
+        ])?;
+        let back = res.readback(Res::Accum)?;
+        let t = Instant::now();
+        self.ctx.submit(|rec| {
+            rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
+            let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
+            rec.dispatch(&self.extra.raycast, &self.extra.raycast_layout, &set, &[], groups);
+            rec.barrier(Stage::Compute, Stage::Transfer);
+            rec.transition(&target.accum, IL::GENERAL, IL::TRANSFER_SRC_OPTIMAL, Stage::Compute, Stage::Transfer);
+            rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, back);
+            Ok(())
+        })?;
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let floats: &[f32] = bytemuck::cast_slice(&back.read()?[..(w * h * 16) as usize]);
+        let pixels = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let image = ImageF32 { width: w, height: h, pixels };
+        Ok(Rendered { image, timings: vec![StageTime { stage: "raycast", ms }], raster: None })
+    }
+
+    /// The dense field as a 3D texture and its brick occupancy for `brick`, built once per scene
+    /// (the host copy is dropped after the upload).
+    fn upload_field(&mut self, prep: &Prepared, brick: u32) -> Result<()> {
+        let scene = self.res.scene_mut()?;
+        let need_bricks = scene.bricks.as_ref().is_none_or(|(b, _)| *b != brick);
+        if scene.field.is_some() && !need_bricks {
+            return Ok(());
+        }
+        let dense = DenseField::new(&prep.set)?;
+        if need_bricks {
+            let (_, occ) = crate::cpu::raycast::brick_occupancy(&dense, brick.max(1));
+            scene.bricks = None;
+            let buf = Buffer::with_data(&self.ctx, "raycast bricks", bytemuck::cast_slice(&occ), BU::STORAGE_BUFFER)?;
+            scene.bricks = Some((brick, buf));
+        }
+        if scene.field.is_none() {
+            let [nx, ny, nz] = dense.dims;
+            let usage = IU::SAMPLED | IU::TRANSFER_DST;
+            let image = Image::new_3d(&self.ctx, "raycast field", (nx, ny, nz), Format::R32G32B32A32_SFLOAT, usage)?;
+            let staging =
+                Buffer::with_data(&self.ctx, "field staging", bytemuck::cast_slice(&dense.values), BU::TRANSFER_SRC)?;
+            self.ctx.submit(|rec| {
+                rec.transition(&image, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::Compute, Stage::Transfer);
+                rec.copy_buffer_to_image(&staging, &image);
+                let to = IL::SHADER_READ_ONLY_OPTIMAL;
+                rec.transition(&image, IL::TRANSFER_DST_OPTIMAL, to, Stage::Transfer, Stage::Compute);
+                Ok(())
+            })?;
+            scene.field = Some(image);
+        }
+        Ok(())
+    }
+
+    /// GPU milliseconds for `instances` additive `size`-pixel quads into a `width`x`height` RGBA32F
+    /// target with the cheapest shaders (the raster roofline).
+    pub fn roofline_quads(&mut self, width: u32, height: u32, size: u32, instances: u32) -> Result<f64> {
+        let layers = self.res.current_target().map(|t| t.layers).unwrap_or(1);
+        self.res.target(&self.pipes, width, height, layers)?;
+        let set = self.extra.roofline_layout.bind(&[Bind::Buffer(&self.res.frame)])?;
+        let push: [u32; 4] = [(width / size).max(1), size, width, height];
+        let target = self.res.current_target()?;
+        let t = Instant::now();
+        self.ctx.submit(|rec| {
+            rec.begin_pass(&self.pipes.target_pass, &target.color_fb);
+            let (pipe, layout) = (&self.extra.roofline_quads, &self.extra.roofline_layout);
+            rec.draw_quads(pipe, layout, &set, bytemuck::bytes_of(&push), 0, instances);
+            rec.end_pass();
+            Ok(())
+        })?;
+        Ok(t.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// GPU milliseconds of the compositing roofline (`roofline.comp`: read `layers` summation
+    /// layers, write the accumulation image) and of `composite.comp` on the same data.
+    pub fn roofline_composite(&mut self, width: u32, height: u32, layers: u32) -> Result<(f64, f64)> {
+        self.res.target(&self.pipes, width, height, layers)?;
+        let tiles = width.div_ceil(COMPOSITE_TILE) as u64 * height.div_ceil(COMPOSITE_TILE) as u64;
+        self.res.ensure(Res::Occlusion, tiles * 4)?;
+        self.res.ensure(Res::SheetTiles, tiles * 8)?;
+        self.res.ensure_set(&self.pipes, StageId::Composite, List::Order)?;
+        let push = CompositePush { layers, width, height, rank_dir: 1, tiles: tiles as u32, ..Default::default() };
+        let groups = [width.div_ceil(COMPOSITE_TILE), height.div_ceil(COMPOSITE_TILE), 1];
+        let (res, target) = (&self.res, self.res.current_target()?);
+        let set = res.set(StageId::Composite, List::Order)?;
+        let stage = &self.pipes.stages[StageId::Composite as usize];
+        let sheet_tiles = res.buffer(Res::SheetTiles)?;
+        self.ctx.submit(|rec| {
+            // An empty sheet pass clears the layers and leaves them in GENERAL.
+            rec.begin_pass(&self.pipes.sheet_pass, &target.sums_fb);
+            rec.end_pass();
+            rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
+            // Every layer reaches every tile: the composite reads them all.
+            rec.fill_buffer_range(sheet_tiles, 0, tiles * 4, 0);
+            rec.fill_buffer_range(sheet_tiles, tiles * 4, tiles * 4, layers);
+            rec.barrier(Stage::Transfer, Stage::Compute);
+            Ok(())
+        })?;
+        let time = |pipe: &Pipeline| -> Result<f64> {
+            let t = Instant::now();
+            self.ctx.submit(|rec| {
+                rec.dispatch(pipe, &stage.layout, set, bytemuck::bytes_of(&push), groups);
+                rec.barrier(Stage::Compute, Stage::Compute);
+                Ok(())
+            })?;
+            Ok(t.elapsed().as_secs_f64() * 1e3)
+        };
+        let roofline = time(&self.extra.roofline_composite)?;
+        let composite = time(&stage.variants[0])?;
+        Ok((roofline, composite))
+    }
+}

@@ -1,0 +1,105 @@
+//! Every stage's descriptor layout and pipelines, built from the stage table.
+use crate::error::{Error, Result};
+use crate::stages::{Feature, Kind, Pass, Res, StageDesc, STAGES};
+use crate::vk::{
+    Blend, Context, Format, ImageLayout as IL, Layout, Pipeline, Primitive, RenderPass, ShaderStageFlags as SS, Slot,
+};
+use std::sync::Arc;
+
+include!(concat!(env!("OUT_DIR"), "/spirv_table.rs"));
+
+/// The attachments' format (RGBA32F, blendable on lavapipe).
+pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
+
+/// A SPIR-V build by name (`<stage>.<ext>[.<DEFINES>]`).
+pub fn spirv(name: &str) -> Result<&'static [u8]> {
+    SPIRV
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, b)| *b)
+        .ok_or_else(|| Error::Unsupported(format!("no SPIR-V build named {name}")))
+}
+
+/// What binding slot a resource takes.
+fn slot(res: Res) -> Slot {
+    match res {
+        Res::SliceTable => Slot::Texture,
+        Res::Accum | Res::Sums => Slot::StorageImage,
+        Res::Color => Slot::Unused,
+        _ => Slot::Storage,
+    }
+}
+
+/// One stage's layout and its builds, in the order of its `variants`.
+pub struct StagePipelines {
+    pub layout: Layout,
+    pub variants: Vec<Pipeline>,
+}
+
+/// The pipelines of every stage (indexed like `STAGES`) and the two render passes.
+pub struct Pipelines {
+    pub stages: Vec<StagePipelines>,
+    /// Into the raster target (left in TRANSFER_SRC for the readback), and into the summation
+    /// layers (left in GENERAL for the composite pass).
+    pub target_pass: RenderPass,
+    pub sheet_pass: RenderPass,
+}
+
+impl Pipelines {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let target_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
+        let sheet_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::GENERAL)?;
+        let mut stages = Vec::with_capacity(STAGES.len());
+        for desc in STAGES.iter() {
+            stages.push(build(ctx, desc, &target_pass, &sheet_pass)?);
+        }
+        Ok(Self { stages, target_pass, sheet_pass })
+    }
+}
+
+fn has(ctx: &Context, feature: Feature) -> bool {
+    match feature {
+        Feature::SubgroupShuffle => ctx.subgroup_shuffle(),
+        Feature::Int64Atomics => ctx.int64_atomics(),
+    }
+}
+
+fn build(ctx: &Arc<Context>, desc: &StageDesc, target: &RenderPass, sheet: &RenderPass) -> Result<StagePipelines> {
+    let slots: Vec<Slot> = desc.bindings.iter().map(|&r| slot(r)).collect();
+    let flags = match desc.kind {
+        Kind::Compute => SS::COMPUTE,
+        Kind::Draw => SS::VERTEX | SS::FRAGMENT,
+    };
+    let layout = Layout::new(ctx, &slots, flags, desc.push)?;
+    let device = desc.device_build.filter(|(f, _)| has(ctx, *f)).map(|(_, d)| d);
+    let mut variants = Vec::with_capacity(desc.variants.len());
+    for v in desc.variants {
+        let defines: Vec<&str> = device.into_iter().chain((!v.defines.is_empty()).then_some(v.defines)).collect();
+        let suffix = if defines.is_empty() { String::new() } else { format!(".{}", defines.join("+")) };
+        let pipe = match (desc.kind, v.draw) {
+            (Kind::Compute, _) => {
+                Pipeline::compute_specialized(ctx, &layout, spirv(&format!("{}.comp{suffix}", desc.name))?, v.spec)?
+            }
+            (Kind::Draw, Some(state)) => {
+                let vert = spirv(&format!("{}.vert{suffix}", desc.name))?;
+                let frag = spirv(&format!("{}.frag{suffix}", desc.name))?;
+                let blend = match state.blend {
+                    crate::cpu::footprint::Blend::Over => Blend::Over,
+                    crate::cpu::footprint::Blend::Under => Blend::Under,
+                    crate::cpu::footprint::Blend::Add => Blend::Add,
+                };
+                let primitive = if state.points { Primitive::Points } else { Primitive::Quads };
+                let pass = match state.pass {
+                    Pass::Target => target,
+                    Pass::Sheet => sheet,
+                };
+                Pipeline::graphics(ctx, &layout, pass, vert, frag, blend, primitive, v.spec)?
+            }
+            (Kind::Draw, None) => {
+                return Err(Error::Unsupported(format!("{}: a draw variant without raster state", desc.name)))
+            }
+        };
+        variants.push(pipe);
+    }
+    Ok(StagePipelines { layout, variants })
+}

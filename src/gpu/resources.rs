@@ -1,0 +1,300 @@
+//! The GPU's resources by name: per renderer (uniforms, kernel tables), per scene (splats, rows,
+//! slice lists, ranks), per frame (every other `Res`, grown on demand) and the render target;
+//! descriptor sets built from the stage table's binding lists and kept until a resource they name
+//! is replaced.
+use super::pipelines::{Pipelines, COLOR_FORMAT};
+use crate::constants::{FOOTPRINT_TABLE_SIZE, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, SPLAT_PAGE};
+use crate::error::{Error, Result};
+use crate::gpu_types::{Frame, SplatParams};
+use crate::kernel::Kernel;
+use crate::plan::Prepared;
+use crate::stages::{List, Res, StageId};
+use crate::vk::{
+    Bind, Buffer, BufferUsageFlags as BU, Context, DescriptorSet, Format, Framebuffer, Image, ImageLayout as IL,
+    ImageUsageFlags as IU, Memory, Sampler, Stage,
+};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// A scene on the device.
+pub struct SceneBuffers {
+    pub splats: Buffer,
+    pub row_start: Buffer,
+    /// Slice-grouped draw lists of axes x, y, z.
+    pub draw: [Buffer; 3],
+    pub ranks: Buffer,
+    /// The ray caster's 3D texture of (colour * tau, tau), and its brick occupancy (brick side,
+    /// flags): built on first use.
+    pub field: Option<Image>,
+    pub bricks: Option<(u32, Buffer)>,
+}
+
+/// The images a frame draws into.
+pub struct Target {
+    pub width: u32,
+    pub height: u32,
+    pub layers: u32,
+    pub color: Image,
+    pub color_fb: Framebuffer,
+    pub sums: Image,
+    pub sums_fb: Framebuffer,
+    pub accum: Image,
+}
+
+pub struct Resources {
+    ctx: Arc<Context>,
+    pub frame: Buffer,
+    /// The radial footprint table (`Kernel::radial_pairs`) and the kernel-slice table.
+    pub radial: Buffer,
+    pub slices: Image,
+    pub sampler: Sampler,
+    kernel: Option<Kernel>,
+    scene: Option<SceneBuffers>,
+    bufs: HashMap<Res, Buffer>,
+    target: Option<Target>,
+    readback: HashMap<Res, Buffer>,
+    sets: HashMap<(StageId, List), DescriptorSet>,
+    /// Stands in for frame buffers not allocated yet (the stage in use never reads them).
+    stand_in: Buffer,
+}
+
+const USAGE: BU = BU::from_raw(BU::STORAGE_BUFFER.as_raw() | BU::TRANSFER_SRC.as_raw() | BU::TRANSFER_DST.as_raw());
+
+fn storage(ctx: &Arc<Context>, name: &str, data: &[u8]) -> Result<Buffer> {
+    Buffer::with_data(ctx, name, data, BU::STORAGE_BUFFER)
+}
+
+/// The two bindings of a per-splat array of 80-byte records (`SPLAT_PAGE` records each, see
+/// constants.rs); while the array fits in one page the second binding repeats the first.
+fn pages(buf: &Buffer) -> [Bind<'_>; 2] {
+    const PAGE: u64 = SPLAT_PAGE as u64 * std::mem::size_of::<SplatParams>() as u64;
+    const _: () = assert!(std::mem::size_of::<SplatParams>() == std::mem::size_of::<crate::gpu_types::ScreenQuad>());
+    let size = buf.size();
+    let hi = if size > PAGE { Bind::Range(buf, PAGE, (size - PAGE).min(PAGE)) } else { Bind::Range(buf, 0, size) };
+    [Bind::Range(buf, 0, size.min(PAGE)), hi]
+}
+
+/// Per-splat arrays are sized exactly (they are large and fixed per scene); lists whose length
+/// changes every frame grow by powers of two.
+fn exact(res: Res) -> bool {
+    matches!(res, Res::Order | Res::Params | Res::Quads | Res::RowSplit | Res::Segments | Res::Fixed)
+}
+
+impl Resources {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let frame = Buffer::new(ctx, "frame", std::mem::size_of::<Frame>() as u64, BU::STORAGE_BUFFER, Memory::Upload)?;
+        let radial_bytes = RADIAL_TABLE_SIZE as u64 * 8;
+        let radial = Buffer::new(ctx, "radial table", radial_bytes, BU::STORAGE_BUFFER, Memory::Upload)?;
+        let n = FOOTPRINT_TABLE_SIZE;
+        let slices =
+            Image::new(ctx, "slice table", (n, n, 1), Format::R32_SFLOAT, IU::SAMPLED | IU::TRANSFER_DST, false)?;
+        Ok(Self {
+            ctx: ctx.clone(),
+            frame,
+            radial,
+            slices,
+            sampler: Sampler::nearest(ctx)?,
+            kernel: None,
+            scene: None,
+            bufs: HashMap::new(),
+            target: None,
+            readback: HashMap::new(),
+            sets: HashMap::new(),
+            stand_in: Buffer::new(ctx, "stand-in", 16, USAGE, Memory::Device)?,
+        })
+    }
+
+    /// Upload a scene's splats, rows, slice lists and ranks; the previous scene's frame buffers go.
+    pub fn set_scene(&mut self, prep: &Prepared) -> Result<()> {
+        self.ctx.wait_idle();
+        self.sets.clear();
+        self.bufs.clear();
+        self.scene = None;
+        let set = &prep.set;
+        if set.len() > MAX_GPU_SPLATS as usize {
+            return Err(Error::TooLarge(format!(
+                "{} splats: the GPU path takes at most {MAX_GPU_SPLATS} (two {SPLAT_PAGE}-record pages of 80-byte \
+                 per-splat parameters; one storage binding is limited to maxStorageBufferRange). Classify fewer \
+                 voxels as non-empty or use the CPU backend (--cpu)",
+                set.len()
+            )));
+        }
+        let ctx = &self.ctx;
+        self.scene = Some(SceneBuffers {
+            splats: storage(ctx, "splats", bytemuck::cast_slice(set.splats()))?,
+            row_start: storage(ctx, "row_start", bytemuck::cast_slice(set.row_start()))?,
+            draw: [
+                storage(ctx, "slices x", bytemuck::cast_slice(&prep.slices[0].1))?,
+                storage(ctx, "slices y", bytemuck::cast_slice(&prep.slices[1].1))?,
+                storage(ctx, "slices z", bytemuck::cast_slice(&prep.slices[2].1))?,
+            ],
+            ranks: storage(ctx, "sheet ranks", bytemuck::cast_slice(&prep.ranks))?,
+            field: None,
+            bricks: None,
+        });
+        Ok(())
+    }
+
+    pub fn scene(&self) -> Result<&SceneBuffers> {
+        self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
+    }
+
+    pub fn scene_mut(&mut self) -> Result<&mut SceneBuffers> {
+        self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
+    }
+
+    /// Upload the kernel's tables unless they are already there.
+    pub fn set_kernel(&mut self, kernel: Kernel) -> Result<()> {
+        if self.kernel == Some(kernel) {
+            return Ok(());
+        }
+        self.radial.write(bytemuck::cast_slice(&kernel.radial_pairs()))?;
+        let slice = kernel.slice_table();
+        let staging =
+            Buffer::with_data(&self.ctx, "slice table staging", bytemuck::cast_slice(&slice), BU::TRANSFER_SRC)?;
+        let table = &self.slices;
+        self.ctx.submit(|rec| {
+            rec.transition(table, IL::UNDEFINED, IL::TRANSFER_DST_OPTIMAL, Stage::All, Stage::Transfer);
+            rec.copy_buffer_to_image(&staging, table);
+            rec.transition(table, IL::TRANSFER_DST_OPTIMAL, IL::SHADER_READ_ONLY_OPTIMAL, Stage::Transfer, Stage::All);
+            Ok(())
+        })?;
+        // Sets name the table objects, not their contents: no rebinding.
+        self.kernel = Some(kernel);
+        Ok(())
+    }
+
+    /// Whether `res` must be replaced to hold `bytes` (pending work naming it must run first).
+    pub fn must_grow(&self, res: Res, bytes: u64) -> bool {
+        !res.is_image() && !res.is_constant() && self.bufs.get(&res).is_none_or(|b| b.size() < bytes)
+    }
+
+    /// Make `res` hold at least `bytes`.
+    pub fn ensure(&mut self, res: Res, bytes: u64) -> Result<()> {
+        if !self.must_grow(res, bytes) {
+            return Ok(());
+        }
+        let bytes = bytes.max(4);
+        let range = self.ctx.max_storage_range();
+        let size = if exact(res) || bytes > range { bytes } else { bytes.next_power_of_two().min(range) };
+        self.sets.clear();
+        self.bufs.remove(&res);
+        self.bufs.insert(res, Buffer::new(&self.ctx, &format!("{res:?}"), size, USAGE, Memory::Device)?);
+        Ok(())
+    }
+
+    /// A frame buffer (or a per-renderer/per-scene one) by name.
+    pub fn buffer(&self, res: Res) -> Result<&Buffer> {
+        let scene = || self.scene();
+        Ok(match res {
+            Res::Frame => &self.frame,
+            Res::Radial => &self.radial,
+            Res::Splats => &scene()?.splats,
+            Res::RowStart => &scene()?.row_start,
+            Res::Ranks => &scene()?.ranks,
+            other => self
+                .bufs
+                .get(&other)
+                .ok_or_else(|| Error::InvalidArgument(format!("{other:?} is not allocated in this frame")))?,
+        })
+    }
+
+    /// Bytes a frame buffer holds (0 when absent).
+    pub fn size(&self, res: Res) -> u64 {
+        self.bufs.get(&res).map(|b| b.size()).unwrap_or(0)
+    }
+
+    /// The images for a `width` x `height` frame with `layers` summation layers (replaced when
+    /// any of them differs).
+    pub fn target(&mut self, pipes: &Pipelines, width: u32, height: u32, layers: u32) -> Result<&Target> {
+        let same = self.target.as_ref().is_some_and(|t| (t.width, t.height, t.layers) == (width, height, layers));
+        if !same {
+            self.ctx.wait_idle();
+            self.sets.clear();
+            self.target = None;
+            let ctx = &self.ctx;
+            let usage = IU::COLOR_ATTACHMENT | IU::TRANSFER_SRC;
+            let color = Image::new(ctx, "color", (width, height, 1), COLOR_FORMAT, usage, false)?;
+            let color_fb = Framebuffer::new(ctx, &pipes.target_pass, &color)?;
+            let usage = IU::COLOR_ATTACHMENT | IU::STORAGE | IU::TRANSFER_SRC;
+            let sums = Image::new(ctx, "sheet sums", (width, height, layers), COLOR_FORMAT, usage, true)?;
+            let sums_fb = Framebuffer::new(ctx, &pipes.sheet_pass, &sums)?;
+            let usage = IU::STORAGE | IU::TRANSFER_SRC | IU::TRANSFER_DST;
+            let accum = Image::new(ctx, "accumulation", (width, height, 1), COLOR_FORMAT, usage, false)?;
+            self.target = Some(Target { width, height, layers, color, color_fb, sums, sums_fb, accum });
+        }
+        self.current_target()
+    }
+
+    pub fn current_target(&self) -> Result<&Target> {
+        self.target.as_ref().ok_or_else(|| Error::InvalidArgument("nothing rendered yet".into()))
+    }
+
+    /// A host-readable buffer of at least `bytes` for `res`'s readback.
+    pub fn ensure_readback(&mut self, res: Res, bytes: u64) -> Result<()> {
+        if self.readback.get(&res).is_some_and(|b| b.size() >= bytes) {
+            return Ok(());
+        }
+        self.readback.remove(&res);
+        let size = bytes.max(4).next_power_of_two();
+        let buf = Buffer::new(&self.ctx, &format!("{res:?} readback"), size, BU::TRANSFER_DST, Memory::Readback)?;
+        self.readback.insert(res, buf);
+        Ok(())
+    }
+
+    pub fn readback(&self, res: Res) -> Result<&Buffer> {
+        self.readback.get(&res).ok_or_else(|| Error::InvalidArgument(format!("no readback for {res:?}")))
+    }
+
+    /// Build the descriptor set of `stage` with `list` as its draw list unless it exists.
+    pub fn ensure_set(&mut self, pipes: &Pipelines, stage: StageId, list: List) -> Result<()> {
+        if self.sets.contains_key(&(stage, list)) {
+            return Ok(());
+        }
+        let set = self.build_set(pipes, stage, list)?;
+        self.sets.insert((stage, list), set);
+        Ok(())
+    }
+
+    pub fn set(&self, stage: StageId, list: List) -> Result<&DescriptorSet> {
+        self.sets.get(&(stage, list)).ok_or_else(|| Error::InvalidArgument(format!("no set for {stage:?}")))
+    }
+
+    fn build_set(&self, pipes: &Pipelines, stage: StageId, list: List) -> Result<DescriptorSet> {
+        let target = self.current_target()?;
+        let frame_buf = |res: Res| self.bufs.get(&res).unwrap_or(&self.stand_in);
+        let mut binds = Vec::new();
+        for &res in stage.desc().bindings {
+            binds.push(match res {
+                Res::SliceTable => Bind::Texture(&self.slices, &self.sampler),
+                Res::Accum => Bind::Image(&target.accum),
+                Res::Sums => Bind::Image(&target.sums),
+                Res::Color => Bind::None,
+                Res::Params | Res::ParamsHi | Res::Quads | Res::QuadsHi => {
+                    let base = if matches!(res, Res::Params | Res::ParamsHi) { Res::Params } else { Res::Quads };
+                    let [lo, hi] = pages(frame_buf(base));
+                    if matches!(res, Res::Params | Res::Quads) {
+                        lo
+                    } else {
+                        hi
+                    }
+                }
+                Res::DrawList => Bind::Buffer(match list {
+                    List::Order => frame_buf(Res::Order),
+                    List::Slices(axis) => &self.scene()?.draw[axis as usize],
+                    List::SlabPairs => frame_buf(Res::SlabPairs),
+                }),
+                Res::Frame | Res::Radial | Res::Splats | Res::RowStart | Res::Ranks => Bind::Buffer(self.buffer(res)?),
+                other => Bind::Buffer(frame_buf(other)),
+            });
+        }
+        pipes.stages[stage as usize].layout.bind(&binds)
+    }
+}
+
+impl Drop for Resources {
+    fn drop(&mut self) {
+        // Resources free themselves; make sure the GPU is done with them first.
+        self.ctx.wait_idle();
+    }
+}

@@ -1,0 +1,199 @@
+//! Per-frame choices (`RenderOptions` and its enums) and what a frame returns.
+use crate::error::{Error, Result};
+use crate::image::ImageF32;
+use crate::kernel::Kernel;
+use crate::order::{Direction, OrderKind};
+use crate::raster::{Raster, RasterChoice};
+
+/// How splats become pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Composite {
+    /// Every footprint is composited (over / under) in visibility order.
+    #[default]
+    Splat,
+    /// Westover's sheet summation buffer: splats summed per sheet, sheets composited in order.
+    Sheet,
+    /// Image-aligned sheet buffer (Mueller & Crawfis 1998): slabs parallel to the image plane, each
+    /// splat's kernel sliced into the slabs it overlaps (`crate::slab`).
+    Slab,
+}
+
+impl std::str::FromStr for Composite {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "splat" => Ok(Self::Splat),
+            "sheet" => Ok(Self::Sheet),
+            "slab" => Ok(Self::Slab),
+            _ => Err(Error::InvalidArgument(format!("unknown compositing '{s}' (splat, sheet, slab)"))),
+        }
+    }
+}
+
+/// Anti-aliasing of distant splats (chapter 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Antialias {
+    /// Footprints keep their world size at every distance.
+    #[default]
+    None,
+    /// Swan's method: beyond k = s·D/p a splat's radius grows by d/k and its energy by (k/d)².
+    Swan,
+    /// EWA-style screen-space low-pass (Zwicker et al. 2001): the footprint convolved with a
+    /// Gaussian of `EWA_LOWPASS_PX` pixels standard deviation, energy preserved.
+    Ewa,
+}
+
+/// Standard deviation, in pixels, of the EWA low-pass filter: variance ½ px² (full width at half
+/// maximum 1.7 px), about one pixel wide; with less, a distant footprint is point-sampled too
+/// coarsely to keep its energy (0.5 px loses 1.7 % at d = 4k).
+pub const EWA_LOWPASS_PX: f32 = std::f32::consts::FRAC_1_SQRT_2;
+
+impl Antialias {
+    /// The mode code `splat_params` reads (`Frame::aa[0]`).
+    pub fn code(self) -> f32 {
+        match self {
+            Antialias::None => 0.0,
+            Antialias::Swan => 1.0,
+            Antialias::Ewa => 2.0,
+        }
+    }
+}
+
+impl std::str::FromStr for Antialias {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "none" => Ok(Self::None),
+            "swan" => Ok(Self::Swan),
+            "ewa" => Ok(Self::Ewa),
+            _ => Err(Error::InvalidArgument(format!("unknown anti-aliasing '{s}' (none, swan, ewa)"))),
+        }
+    }
+}
+
+/// Motion blur of one frame (chapter 4): where every grid point was at the previous time step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// Maps a grid point (the scene's own coordinates, as drawn this frame) to its position at
+    /// t_{i-1} relative to the eye at t_i: `(V_i M_i)^-1 V_{i-1} M_{i-1}` for object transforms M and
+    /// view transforms V.
+    pub previous: glam::Mat4,
+    /// Splats whose projected path is at most this many pixels are drawn unblurred (delta).
+    pub delta_px: f32,
+}
+
+/// Per-frame choices. `Default` gives PBTF, per-splat back-to-front compositing, the Gaussian.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RenderOptions {
+    pub order: OrderKind,
+    pub composite: Composite,
+    pub kernel: Kernel,
+    pub antialias: Antialias,
+    /// Motion-blurred splats (chapter 4); `None` draws the frame still.
+    pub motion: Option<Motion>,
+    /// `None`: back to front for per-splat compositing, front to back for sheets.
+    pub direction: Option<Direction>,
+    /// Memory allowed for one batch of sheet summation layers (RGBA32F each).
+    pub sheet_budget_bytes: u64,
+    /// Image-aligned slab thickness in voxel spacings (`Composite::Slab`): thinner is closer to the
+    /// volume integral and costs more primitives (about 2R/Δ + 1 per splat).
+    pub slab_thickness: f32,
+    /// Front-to-back early termination for the sheet modes (Mueller et al. 1999): after each batch,
+    /// footprints lying wholly over composite tiles whose remaining transmittance is at most this
+    /// are skipped. No pixel changes by more than this much. 0 (the default) turns it off; back to
+    /// front ignores it. It pays on opaque data (1.2-1.8x on `solid40`) and costs on translucent data,
+    /// where nothing is culled but batches are smaller (docs/RESULTS.md). The compute tile
+    /// compositor (`Raster::Compute` with `Composite::Splat`) stops each pixel at this transmittance.
+    pub early_termination: f32,
+    /// How the footprint stage rasterises (`crate::raster`); `Auto` picks per device and footprint
+    /// size, and `Rendered::raster` says what it picked.
+    pub raster: Raster,
+    /// Draw the frame on a grid this fraction of the camera's size and resample it bilinearly to
+    /// full size (`crate::resample`; a ray caster's image sample distance is its inverse). Pays
+    /// where voxels cover several pixels and the kernel already blurs finer than the grid; the
+    /// error it adds is measured against the full-size truth. 1 (the default) draws full size.
+    pub render_scale: f32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            order: OrderKind::Pbtf,
+            composite: Composite::Splat,
+            kernel: Kernel::Gaussian,
+            antialias: Antialias::None,
+            motion: None,
+            direction: None,
+            sheet_budget_bytes: 256 << 20,
+            slab_thickness: 1.0,
+            early_termination: 0.0,
+            raster: Raster::Auto,
+            render_scale: 1.0,
+        }
+    }
+}
+
+/// Suggested transmittance threshold of front-to-back early termination: a quarter of an 8-bit step.
+pub const DEFAULT_EARLY_TERMINATION: f32 = 1.0 / 1024.0;
+
+/// Most summation layers in one batch when front-to-back early termination is on.
+pub const EARLY_TERMINATION_BATCH: u32 = 8;
+
+/// Most summation layers in one batch, whatever the budget.
+pub const MAX_BATCH_LAYERS: u32 = 256;
+
+impl RenderOptions {
+    /// The visiting direction: as set, else back to front for per-splat compositing through the
+    /// graphics pipeline (the over operator needs no destination alpha) and front to back
+    /// otherwise (sheets, and the compute tile compositor, which can then stop early).
+    pub fn direction(&self) -> Direction {
+        self.direction.unwrap_or(match (self.composite, self.raster) {
+            (Composite::Splat, Raster::Compute) => Direction::FrontToBack,
+            (Composite::Splat, _) => Direction::BackToFront,
+            (Composite::Sheet | Composite::Slab, _) => Direction::FrontToBack,
+        })
+    }
+
+    /// Reject values no frame can use.
+    pub fn validate(&self) -> Result<()> {
+        if !(0.0..1.0).contains(&self.early_termination) {
+            return Err(Error::InvalidArgument(format!(
+                "early-termination transmittance {} must be in [0, 1)",
+                self.early_termination
+            )));
+        }
+        if self.sheet_budget_bytes == 0 {
+            return Err(Error::InvalidArgument("the sheet budget must be positive".into()));
+        }
+        crate::resample::check_scale(self.render_scale)
+    }
+
+    /// Layers per batch for an image of this size. With early termination on, batches hold at most
+    /// `EARLY_TERMINATION_BATCH` layers: the occlusion map only changes between batches.
+    pub fn batch_layers(&self, width: u32, height: u32) -> u32 {
+        let layer = width as u64 * height as u64 * 16;
+        let most = if self.direction() == Direction::FrontToBack && self.early_termination > 0.0 {
+            EARLY_TERMINATION_BATCH
+        } else {
+            MAX_BATCH_LAYERS
+        };
+        (self.sheet_budget_bytes / layer.max(1)).clamp(1, most as u64) as u32
+    }
+}
+
+/// One named stage's time in milliseconds (GPU timestamps, or wall time on the CPU path).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageTime {
+    pub stage: &'static str,
+    pub ms: f64,
+}
+
+/// A rendered frame: premultiplied RGBA32F, row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    pub image: ImageF32,
+    pub timings: Vec<StageTime>,
+    /// The footprint stage's raster variant and why (`None` for the ray caster and the truth).
+    pub raster: Option<RasterChoice>,
+}

@@ -1,0 +1,233 @@
+//! Per-frame decisions made without a device: the frame uniforms, sheet batches, push constants
+//! and workgroup counts the recording (`crate::stages`) hands to either engine; and `Prepared`, a
+//! scene's per-axis slice lists.
+use crate::camera::Camera;
+use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE_H, RASTER_TILE_W, TILE_CHUNK, WORKGROUP_SIZE};
+use crate::error::Result;
+use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS};
+use crate::kernel::Kernel;
+use crate::options::{Antialias, Motion, RenderOptions, EWA_LOWPASS_PX};
+use crate::order::{self, Direction};
+use crate::volume::SplatSet;
+use glam::Vec3;
+
+/// A scene ready to draw: the splat rows plus, per axis, the splats grouped by slice and each
+/// slice's rank among non-empty slices (what the sheet batches index).
+pub struct Prepared {
+    pub set: SplatSet,
+    pub slices: [(Vec<u32>, Vec<u32>); 3],
+    pub ranks: Vec<u32>,
+    pub rank_offsets: [u32; 3],
+    /// The CPU ray caster's dense (colour * tau, tau) field, built on first use and kept with the
+    /// scene (the GPU path uploads it to a 3D texture and drops the host copy).
+    field: std::sync::OnceLock<crate::truth::DenseField>,
+}
+
+impl Prepared {
+    pub fn new(set: SplatSet) -> Self {
+        let slices = [0, 1, 2].map(|a| set.slices(a));
+        let mut ranks = Vec::new();
+        let mut rank_offsets = [0; 3];
+        for a in 0..3 {
+            rank_offsets[a] = ranks.len() as u32;
+            ranks.extend(SplatSet::sheet_ranks(&slices[a].0));
+        }
+        Self { set, slices, ranks, rank_offsets, field: std::sync::OnceLock::new() }
+    }
+
+    /// The dense field for ray casting, built once per scene.
+    pub fn dense_field(&self) -> Result<&crate::truth::DenseField> {
+        if let Some(f) = self.field.get() {
+            return Ok(f);
+        }
+        let f = crate::truth::DenseField::new(&self.set)?;
+        Ok(self.field.get_or_init(|| f))
+    }
+}
+
+/// The per-frame uniforms shared by every stage.
+pub fn make_frame(
+    set: &SplatSet,
+    camera: &Camera,
+    kernel: Kernel,
+    antialias: Antialias,
+    motion: Option<&Motion>,
+    split: [u32; 3],
+    back_to_front: bool,
+) -> Frame {
+    let g = set.grid();
+    let radius_vox = kernel.radius();
+    let f = camera.forward();
+    let r = camera.right();
+    let u = camera.true_up();
+    let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
+    Frame {
+        view_proj: camera.view_proj().to_cols_array_2d(),
+        eye: v4(camera.eye, if camera.is_perspective() { 1.0 } else { 0.0 }),
+        forward: v4(f, camera.near),
+        right: v4(r, camera.far),
+        up: v4(u, camera.pixels_per_unit()),
+        origin: [g.origin[0], g.origin[1], g.origin[2], radius_vox],
+        spacing: [g.spacing[0], g.spacing[1], g.spacing[2], radius_vox * g.kernel_spacing()],
+        dims: [g.dims[0], g.dims[1], g.dims[2], set.len() as u32],
+        split: [split[0], split[1], split[2], back_to_front as u32],
+        aa: [antialias.code(), kernel.footprint_sigma() as f32, EWA_LOWPASS_PX, 0.0],
+        motion: motion.map(|m| m.previous).unwrap_or(glam::Mat4::IDENTITY).to_cols_array_2d(),
+        blur: [
+            motion.map(|m| m.delta_px.max(1e-6)).unwrap_or(0.0),
+            kernel.motion_g() as f32,
+            camera.width as f32,
+            camera.height as f32,
+        ],
+    }
+}
+
+/// The per-frame constants for rendering `set` from `camera` with `opts`.
+pub fn frame_for(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> Frame {
+    let split = order::pbtf_split(set, camera);
+    let btf = opts.direction() == Direction::BackToFront;
+    make_frame(set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf)
+}
+
+/// The uniforms the order stage alone needs (no anti-aliasing or motion).
+pub fn order_frame(set: &SplatSet, camera: &Camera, direction: Direction) -> Frame {
+    let split = order::pbtf_split(set, camera);
+    make_frame(set, camera, Kernel::Gaussian, Antialias::None, None, split, direction == Direction::BackToFront)
+}
+
+/// One batch of sheets drawn into summation layers and composited together.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Batch {
+    pub first_instance: u32,
+    pub instances: u32,
+    pub layers: u32,
+    pub push: FootprintPush,
+}
+
+/// The grid axis most perpendicular to the view plane: the axis-aligned sheets' normal.
+pub fn sheet_axis(camera: &Camera) -> usize {
+    let f = camera.forward().abs();
+    if f.x >= f.y && f.x >= f.z {
+        0
+    } else if f.y >= f.z {
+        1
+    } else {
+        2
+    }
+}
+
+/// The sheet axis (the grid axis most perpendicular to the view plane) and its batches in visiting
+/// order. Empty sheets are skipped; a batch never straddles the eye's plane, so its splats are one
+/// contiguous run of the slice-grouped draw list.
+pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_layers: u32) -> (usize, Vec<Batch>) {
+    let axis = sheet_axis(camera);
+    let split = order::pbtf_split(&prep.set, camera)[axis];
+    let n = prep.set.grid().dims[axis];
+    let offsets = &prep.slices[axis].0;
+    let nonempty = |s: &u32| offsets[*s as usize + 1] > offsets[*s as usize];
+    let low: Vec<u32> = (0..split).rev().filter(nonempty).collect();
+    let high: Vec<u32> = (split..n).filter(nonempty).collect();
+    let mut sides = vec![low, high];
+    if direction == Direction::BackToFront {
+        sides.reverse();
+        for s in &mut sides {
+            s.reverse();
+        }
+    }
+    let rank_of = |s: u32| prep.ranks[(prep.rank_offsets[axis] + s) as usize];
+    let mut batches = Vec::new();
+    for side in &sides {
+        for chunk in side.chunks(max_layers.max(1) as usize) {
+            let (first, last) = (chunk[0], chunk[chunk.len() - 1]);
+            let (lo, hi) = (first.min(last), first.max(last));
+            let start = offsets[lo as usize];
+            let end = offsets[hi as usize + 1];
+            batches.push(Batch {
+                first_instance: start,
+                instances: end - start,
+                layers: chunk.len() as u32,
+                push: FootprintPush {
+                    sheet_mode: SHEET_MODE_AXIS,
+                    axis: axis as u32,
+                    rank_offset: prep.rank_offsets[axis],
+                    rank_base: rank_of(first),
+                    rank_dir: if last >= first { 1 } else { -1 },
+                    ..Default::default()
+                },
+            });
+        }
+    }
+    (axis, batches)
+}
+
+/// Push constants of the tile binning and compositing stages for a draw list of `n` entries on a
+/// `width` x `height` image: chunks of `TILE_CHUNK` entries, fewer (and longer) where the count
+/// matrix would pass `raster::MAX_TILE_CELLS`.
+pub fn tile_push(opts: &RenderOptions, n: u32, width: u32, height: u32) -> FootprintPush {
+    let btf = opts.direction() == Direction::BackToFront;
+    let tiles = (width.div_ceil(RASTER_TILE_W) as u64 * height.div_ceil(RASTER_TILE_H) as u64).max(1);
+    let most = (crate::raster::MAX_TILE_CELLS / tiles).max(1);
+    FootprintPush {
+        count: n,
+        chunks: (n.div_ceil(TILE_CHUNK) as u64).clamp(1, most) as u32,
+        back_to_front: btf as u32,
+        occluded: if btf { 0.0 } else { opts.early_termination },
+        ..Default::default()
+    }
+}
+
+/// Push constants of `sheet_tiles.comp` for a frame's sheet batches: every entry of the sheet
+/// list from 0, layers numbered by global sheet (rank base 0, direction +1), no occlusion culling.
+pub fn sheet_tiles_push(batches: &[Batch], first: &Batch) -> FootprintPush {
+    FootprintPush { rank_base: 0, rank_dir: 1, first: 0, count: sheet_entries(batches), occluded: 0.0, ..first.push }
+}
+
+/// Entries of the frame's sheet list that the batches draw (they cover it from 0).
+fn sheet_entries(batches: &[Batch]) -> u32 {
+    batches.iter().map(|b| b.first_instance + b.instances).max().unwrap_or(0)
+}
+
+/// Whether finding each tile's sheet range (`sheet_tiles`) can pay for itself: the composite must
+/// read at least `SHEET_TILES_MIN_RATIO` layer pixels per entry of the sheet list (measured on
+/// lavapipe: the pass costs 30–70 ns per entry, the composite ~8 ns per layer pixel). A single
+/// sheet seen head-on (the raster sweep) falls below, the volume scenes far above.
+pub fn sheet_tiles_pay(batches: &[Batch], width: u32, height: u32) -> bool {
+    let entries = sheet_entries(batches) as u64;
+    let layer_pixels: u64 = batches.iter().map(|b| b.layers as u64).sum::<u64>() * width as u64 * height as u64;
+    entries > 0 && layer_pixels >= SHEET_TILES_MIN_RATIO * entries
+}
+
+/// See `sheet_tiles_pay`.
+pub const SHEET_TILES_MIN_RATIO: u64 = 8;
+
+/// Per-tile sheet ranges that let the composite read every layer (the `sheet_tiles` pass skipped):
+/// lowest 0, highest + 1 `i32::MAX`.
+pub const ALL_SHEETS: [u32; 2] = [0, i32::MAX as u32];
+
+/// Push constants of `composite.comp` for batch `b`.
+pub fn composite_push(b: &Batch, btf: bool, width: u32, height: u32) -> CompositePush {
+    CompositePush {
+        layers: b.layers,
+        back_to_front: btf as u32,
+        width,
+        height,
+        rank_base: b.push.rank_base,
+        rank_dir: b.push.rank_dir,
+        tiles: width.div_ceil(COMPOSITE_TILE) * height.div_ceil(COMPOSITE_TILE),
+        pad: 0,
+    }
+}
+
+/// Workgroup counts for `n` invocations of a 1D stage (spilling into y past `MAX_GROUPS_X`).
+pub fn groups_1d(n: u32) -> [u32; 3] {
+    let g = n.div_ceil(WORKGROUP_SIZE).max(1);
+    [g.min(MAX_GROUPS_X), g.div_ceil(MAX_GROUPS_X), 1]
+}
+
+/// Put the early-termination threshold in the batches' push constants (front to back only).
+pub fn set_early_termination(opts: &RenderOptions, batches: &mut [Batch]) {
+    let on = opts.direction() == Direction::FrontToBack && opts.early_termination > 0.0;
+    for b in batches {
+        b.push.occluded = if on { opts.early_termination } else { 0.0 };
+    }
+}

@@ -1,0 +1,819 @@
+//! THE stage table, and the one recording of a frame that both engines run.
+//!
+//! Every GPU stage is declared once in [`STAGES`]: its name (the name of its GLSL file in `glsl/`
+//! and of its CPU mirror in `src/cpu/`), its builds, what binding i of its descriptor set holds,
+//! what it writes, its workgroup, the timing it is reported under, and the mirror's entry point.
+//! [`record_frame`] writes a frame once, as a sequence of stage dispatches built from the options,
+//! and runs it on an [`Engine`]: the Vulkan one (`crate::gpu`), the CPU mirrors (`cpu::exec`), or a
+//! split of the two (`crate::bisect`). Adding a stage is its shader, its mirror, its row here and
+//! its line in the recording.
+use crate::camera::Camera;
+use crate::constants::{
+    COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT, WORKGROUP_SIZE,
+};
+use crate::cpu::exec::Bindings;
+use crate::cpu::footprint::Blend;
+use crate::error::{Error, Result};
+use crate::gpu_types::{
+    CompositePush, FootprintPush, Frame, ScreenQuad, SlabPush, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB,
+    SHEET_MODE_SPLAT,
+};
+use crate::image::ImageF32;
+use crate::kernel::Kernel;
+use crate::options::{Composite, RenderOptions, StageTime};
+use crate::order::{Direction, OrderKind};
+use crate::plan::{self, groups_1d, Prepared};
+use crate::raster::Raster;
+use std::time::Instant;
+
+/// A resource of a frame, named alike on both engines: stage bindings, probes and the bisect
+/// switch's transfers name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Res {
+    /// The per-frame uniforms (`Frame`).
+    Frame,
+    /// The kernel's radial footprint table and its kernel-slice table (a texture).
+    Radial,
+    SliceTable,
+    /// The scene: splats, PBTF rows, sheet ranks.
+    Splats,
+    RowStart,
+    Ranks,
+    /// PBTF order working buffers and the draw order it writes.
+    RowSplit,
+    Segments,
+    Order,
+    /// `SplatParams` per splat; `ParamsHi` binds its second page (`SPLAT_PAGE` records on).
+    Params,
+    ParamsHi,
+    /// The dispatch's draw list: the order, a slice-grouped list or the slab pairs ([`List`]).
+    DrawList,
+    Occlusion,
+    /// Fixed-point sheet sums of the compute raster.
+    Fixed,
+    TileCounts,
+    TileStart,
+    TileEntries,
+    /// `ScreenQuad` per splat; `QuadsHi` binds its second page.
+    Quads,
+    QuadsHi,
+    SheetTiles,
+    /// The loop-budget status word (`LOOP_BUDGET_*`).
+    Status,
+    SlabCounts,
+    SlabStart,
+    SlabPairs,
+    /// Images: the compute passes' accumulation image, the summation layers, the raster target.
+    Accum,
+    Sums,
+    Color,
+}
+
+impl Res {
+    /// Made before any frame (renderer or scene) and never changed by a stage.
+    pub fn is_constant(self) -> bool {
+        matches!(self, Res::Frame | Res::Radial | Res::SliceTable | Res::Splats | Res::RowStart | Res::Ranks)
+    }
+
+    /// An image rather than a buffer.
+    pub fn is_image(self) -> bool {
+        matches!(self, Res::Accum | Res::Sums | Res::Color)
+    }
+}
+
+/// Which list a dispatch binds as [`Res::DrawList`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum List {
+    /// The visibility order (`Res::Order`).
+    Order,
+    /// The splats grouped by slice along axis 0, 1 or 2 (sheet mode).
+    Slices(u8),
+    /// The (splat, slab) pairs (slab mode).
+    SlabPairs,
+}
+
+/// How a stage runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Compute,
+    /// Instanced quads or point sprites through the raster pipeline, into the raster target
+    /// (per-splat compositing) or the summation layers.
+    Draw,
+}
+
+/// A device capability that selects a stage's build (`<stage>.<DEFINE>` in build.rs' naming).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Feature {
+    /// Subgroup shuffle and arithmetic in subgroups of at least `RASTER_LANES` lanes.
+    SubgroupShuffle,
+    /// 64-bit buffer atomics.
+    Int64Atomics,
+}
+
+/// Where a draw goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// The single raster target (`Res::Color`).
+    Target,
+    /// The summation layers (`Res::Sums`).
+    Sheet,
+}
+
+/// A draw variant's fixed-function state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawState {
+    pub blend: Blend,
+    pub points: bool,
+    pub pass: Pass,
+}
+
+/// One build of a stage: macros defined (`+`-joined, as in the `// variants:` line of the shader),
+/// specialization constants 0.., and for draws the fixed-function state.
+#[derive(Clone, Copy, Debug)]
+pub struct Variant {
+    pub defines: &'static str,
+    pub spec: &'static [u32],
+    pub draw: Option<DrawState>,
+}
+
+/// A stage's workgroup shape: how invocation counts become workgroup counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Workgroup {
+    /// `n` invocations in groups of this many (spilling into y, [`groups_1d`]).
+    Linear(u32),
+    /// One workgroup per tile of this many pixels across and down.
+    Tile(u32, u32),
+    /// One workgroup of this many invocations.
+    Single(u32),
+    /// A draw: one instance per entry.
+    Instances,
+}
+
+/// The CPU mirror's entry point: runs one dispatch on the CPU engine's bindings.
+pub type Mirror = fn(&mut Bindings<'_>, &Dispatch) -> Result<()>;
+
+/// One row of the stage table.
+pub struct StageDesc {
+    /// The stage's name: `glsl/<name>.comp` (draws: `.vert` + `.frag`) and `cpu::<name>`.
+    pub name: &'static str,
+    pub kind: Kind,
+    /// Binding i of the stage's descriptor set holds `bindings[i]`.
+    pub bindings: &'static [Res],
+    /// What it writes (the bisect switch hands these over).
+    pub writes: &'static [Res],
+    /// Push-constant bytes.
+    pub push: u32,
+    pub workgroup: Workgroup,
+    /// The name its time is reported under (`StageTime::stage`).
+    pub timing: &'static str,
+    /// A build chosen by a device capability, when the device has it.
+    pub device_build: Option<(Feature, &'static str)>,
+    pub variants: &'static [Variant],
+    pub mirror: Mirror,
+}
+
+const fn v(defines: &'static str, spec: &'static [u32]) -> Variant {
+    Variant { defines, spec, draw: None }
+}
+
+const fn d(blend: Blend, points: bool, pass: Pass, spec: &'static [u32]) -> Variant {
+    Variant { defines: "", spec, draw: Some(DrawState { blend, points, pass }) }
+}
+
+const ORDER: &[Res] = &[Res::Frame, Res::Splats, Res::RowStart, Res::RowSplit, Res::Segments, Res::Order];
+const PARAMS: &[Res] = &[Res::Frame, Res::Splats, Res::Params, Res::ParamsHi];
+const SLAB: &[Res] = &[Res::Params, Res::SlabCounts, Res::SlabPairs, Res::SlabStart, Res::ParamsHi];
+const COMPOSITE: &[Res] = &[Res::Sums, Res::Accum, Res::Occlusion, Res::Fixed, Res::SheetTiles];
+/// glsl/shared/footprint.glsl's bindings, shared by every footprint-reading stage.
+const FOOTPRINT: &[Res] = &[
+    Res::Frame,
+    Res::Params,
+    Res::DrawList,
+    Res::Splats,
+    Res::Ranks,
+    Res::Radial,
+    Res::SliceTable,
+    Res::Occlusion,
+    Res::Fixed,
+    Res::TileCounts,
+    Res::TileStart,
+    Res::TileEntries,
+    Res::Accum,
+    Res::Quads,
+    Res::SheetTiles,
+    Res::ParamsHi,
+    Res::QuadsHi,
+    Res::Status,
+];
+const ONE: &[Variant] = &[v("", &[])];
+/// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
+const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];
+const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
+const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
+
+/// The stages, indexed by [`StageId`].
+pub static STAGES: [StageDesc; 16] = [
+    StageDesc {
+        name: "order_count",
+        kind: Kind::Compute,
+        bindings: ORDER,
+        writes: &[Res::RowSplit, Res::Segments],
+        push: 0,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "order",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::order::order_count_stage,
+    },
+    StageDesc {
+        name: "order_scan",
+        kind: Kind::Compute,
+        bindings: ORDER,
+        writes: &[Res::Segments],
+        push: 0,
+        workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
+        timing: "order",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::order::order_scan_stage,
+    },
+    StageDesc {
+        name: "order_scatter",
+        kind: Kind::Compute,
+        bindings: ORDER,
+        writes: &[Res::Order],
+        push: 0,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "order",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::order::order_scatter_stage,
+    },
+    StageDesc {
+        name: "splat_params",
+        kind: Kind::Compute,
+        bindings: PARAMS,
+        writes: &[Res::Params],
+        push: 0,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "splat_params",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::splat_params::splat_params_stage,
+    },
+    StageDesc {
+        name: "slab_count",
+        kind: Kind::Compute,
+        bindings: SLAB,
+        writes: &[Res::SlabCounts],
+        push: SLAB_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "slab_bins",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::slab::slab_count_stage,
+    },
+    StageDesc {
+        name: "slab_scan",
+        kind: Kind::Compute,
+        bindings: SLAB,
+        writes: &[Res::SlabCounts, Res::SlabStart],
+        push: SLAB_PUSH,
+        workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
+        timing: "slab_bins",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::slab::slab_scan_stage,
+    },
+    StageDesc {
+        name: "slab_scatter",
+        kind: Kind::Compute,
+        bindings: SLAB,
+        writes: &[Res::SlabCounts, Res::SlabPairs],
+        push: SLAB_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "slab_bins",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::slab::slab_scatter_stage,
+    },
+    StageDesc {
+        name: "tile_count",
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::TileCounts, Res::Quads, Res::Status],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Linear(TILE_BIN_WORKGROUP),
+        timing: "tile_bins",
+        device_build: None,
+        variants: PAGED,
+        mirror: crate::cpu::tile::tile_count_stage,
+    },
+    StageDesc {
+        name: "tile_scan",
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::TileCounts, Res::TileStart],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "tile_bins",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::tile::tile_scan_stage,
+    },
+    StageDesc {
+        name: "tile_offsets",
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::TileStart],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
+        timing: "tile_bins",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::tile::tile_offsets_stage,
+    },
+    StageDesc {
+        name: "tile_scatter",
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::TileCounts, Res::TileEntries],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Linear(TILE_BIN_WORKGROUP),
+        timing: "tile_bins",
+        device_build: None,
+        variants: PAGED,
+        mirror: crate::cpu::tile::tile_scatter_stage,
+    },
+    StageDesc {
+        name: "tile_composite",
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::Accum],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Tile(RASTER_TILE_W, RASTER_TILE_H),
+        timing: "footprint",
+        device_build: Some((Feature::SubgroupShuffle, "SHUFFLE")),
+        // [paged, one page] x [back to front, front to back, front to back terminating] x
+        // [still, motion-blurred]: see `tile_composite_variant`.
+        variants: &[
+            v("", &[SHEET_MODE_SPLAT, 1, 0, 0]),
+            v("", &[SHEET_MODE_SPLAT, 1, 0, 1]),
+            v("", &[SHEET_MODE_SPLAT, 0, 0, 0]),
+            v("", &[SHEET_MODE_SPLAT, 0, 0, 1]),
+            v("", &[SHEET_MODE_SPLAT, 0, 1, 0]),
+            v("", &[SHEET_MODE_SPLAT, 0, 1, 1]),
+            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 1, 0, 0]),
+            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 1, 0, 1]),
+            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 0, 0]),
+            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 0, 1]),
+            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 0]),
+            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 1]),
+        ],
+        mirror: crate::cpu::tile::tile_composite_stage,
+    },
+    StageDesc {
+        name: "sheet_tiles",
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::SheetTiles],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "sheet_tiles",
+        device_build: None,
+        // [axis quads, axis points, slab quads, slab points].
+        variants: &[
+            v("", &[SHEET_MODE_AXIS, 0]),
+            v("", &[SHEET_MODE_AXIS, 1]),
+            v("", &[SHEET_MODE_SLAB, 0]),
+            v("", &[SHEET_MODE_SLAB, 1]),
+        ],
+        mirror: crate::cpu::sheet_tiles::sheet_tiles_stage,
+    },
+    StageDesc {
+        name: "footprint",
+        kind: Kind::Draw,
+        bindings: FOOTPRINT,
+        writes: &[Res::Color, Res::Sums],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Instances,
+        timing: "footprint",
+        device_build: None,
+        // See `footprint_variant`.
+        variants: &[
+            d(Blend::Over, false, Pass::Target, &[SHEET_MODE_SPLAT, 0]),
+            d(Blend::Under, false, Pass::Target, &[SHEET_MODE_SPLAT, 0]),
+            d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_AXIS, 0]),
+            d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_SLAB, 0]),
+            d(Blend::Over, true, Pass::Target, &[SHEET_MODE_SPLAT, 1]),
+            d(Blend::Under, true, Pass::Target, &[SHEET_MODE_SPLAT, 1]),
+            d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_AXIS, 1]),
+            d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_SLAB, 1]),
+        ],
+        mirror: crate::cpu::footprint::footprint_stage,
+    },
+    StageDesc {
+        name: "footprint_sum",
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::Fixed, Res::Status],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "footprint",
+        device_build: Some((Feature::Int64Atomics, "SUM64")),
+        variants: &[v("", &[SHEET_MODE_AXIS]), v("", &[SHEET_MODE_SLAB])],
+        mirror: crate::cpu::footprint::footprint_sum_stage,
+    },
+    StageDesc {
+        name: "composite",
+        kind: Kind::Compute,
+        bindings: COMPOSITE,
+        writes: &[Res::Accum, Res::Occlusion],
+        push: std::mem::size_of::<CompositePush>() as u32,
+        workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
+        timing: "composite",
+        device_build: None,
+        // Float layers (the summation image), fixed-point layers (`Res::Fixed`).
+        variants: &[v("", &[]), v("", &[1])],
+        mirror: crate::cpu::composite::composite_stage,
+    },
+];
+
+/// Index into [`STAGES`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum StageId {
+    OrderCount,
+    OrderScan,
+    OrderScatter,
+    SplatParams,
+    SlabCount,
+    SlabScan,
+    SlabScatter,
+    TileCount,
+    TileScan,
+    TileOffsets,
+    TileScatter,
+    TileComposite,
+    SheetTiles,
+    Footprint,
+    FootprintSum,
+    Composite,
+}
+
+impl StageId {
+    /// Its row of the table.
+    pub fn desc(self) -> &'static StageDesc {
+        &STAGES[self as usize]
+    }
+
+    /// The stage of this name.
+    pub fn named(name: &str) -> Result<StageId> {
+        const ALL: [StageId; 16] = [
+            StageId::OrderCount,
+            StageId::OrderScan,
+            StageId::OrderScatter,
+            StageId::SplatParams,
+            StageId::SlabCount,
+            StageId::SlabScan,
+            StageId::SlabScatter,
+            StageId::TileCount,
+            StageId::TileScan,
+            StageId::TileOffsets,
+            StageId::TileScatter,
+            StageId::TileComposite,
+            StageId::SheetTiles,
+            StageId::Footprint,
+            StageId::FootprintSum,
+            StageId::Composite,
+        ];
+        ALL.into_iter().find(|s| s.desc().name == name).ok_or_else(|| {
+            let names: Vec<_> = STAGES.iter().map(|s| s.name).collect();
+            Error::InvalidArgument(format!("unknown stage '{name}' (stages: {})", names.join(", ")))
+        })
+    }
+}
+
+const _: () = assert!(StageId::Composite as usize + 1 == STAGES.len());
+
+/// One stage invocation of a recording.
+#[derive(Clone, Debug)]
+pub struct Dispatch {
+    pub stage: StageId,
+    /// Index into the stage's `variants`.
+    pub variant: usize,
+    /// Compute: workgroups. Draws: `[first instance, instances, 0]`.
+    pub groups: [u32; 3],
+    pub list: List,
+    pub push: Vec<u8>,
+}
+
+impl Dispatch {
+    fn new(stage: StageId, variant: usize, groups: [u32; 3], list: List, push: &[u8]) -> Self {
+        debug_assert_eq!(push.len() as u32, stage.desc().push, "{}: push size", stage.desc().name);
+        Self { stage, variant, groups, list, push: push.to_vec() }
+    }
+
+    /// The push constants as the stage's struct.
+    pub fn push_as<T: bytemuck::Pod>(&self) -> T {
+        bytemuck::pod_read_unaligned(&self.push)
+    }
+
+    /// The variant's specialization constant `i` (0 when it sets none).
+    pub fn spec(&self, i: usize) -> u32 {
+        self.stage.desc().variants[self.variant].spec.get(i).copied().unwrap_or(0)
+    }
+}
+
+/// What an engine can hold, which the frame's plan must respect.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Most layers of the summation image.
+    pub max_layers: u32,
+    /// Largest storage binding in bytes (the fixed-point layers are one).
+    pub max_storage_range: u64,
+}
+
+/// Runs a recording: the Vulkan device, the CPU mirrors, or a split of the two.
+pub trait Engine {
+    /// A frame of `width` x `height` begins: its uniforms and kernel tables.
+    fn begin(&mut self, frame: &Frame, kernel: Kernel, width: u32, height: u32) -> Result<()>;
+    /// The summation image holds `layers` layers this frame.
+    fn layers(&mut self, layers: u32) -> Result<()>;
+    /// `res` holds at least `bytes`.
+    fn ensure(&mut self, res: Res, bytes: u64) -> Result<()>;
+    /// Set 32-bit words of `res` (all, or `count` from `first`) to `value`.
+    fn fill(&mut self, res: Res, range: Option<(u64, u64)>, value: u32) -> Result<()>;
+    /// Write host data into `res` from its start.
+    fn upload(&mut self, res: Res, data: &[u32]) -> Result<()>;
+    fn run(&mut self, dispatch: &Dispatch) -> Result<()>;
+    /// Finish the work so far and read the first `words` 32-bit words of each resource.
+    fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>>;
+    /// Words `res` holds now (0 when it does not exist).
+    fn words(&self, res: Res) -> usize;
+    /// Work done on the host, reported as a stage.
+    fn host_time(&mut self, stage: &'static str, ms: f64);
+    /// Finish the frame: the stage times.
+    fn finish(&mut self) -> Result<Vec<StageTime>>;
+    /// The frame resources written so far (what a split hands over).
+    fn live(&self) -> Vec<Res>;
+    fn limits(&self) -> Limits;
+    /// Whether this is a device (host orders are then reported as `order_cpu`).
+    fn is_device(&self) -> bool;
+}
+
+/// Bits of the status word (binding 17): a binning invocation, or a footprint-sum invocation, made
+/// llvmpipe's 65535 loop iterations and was cut short (glsl/tile_count.comp, footprint_sum.comp).
+pub const LOOP_BUDGET_BINNING: u32 = 1;
+pub const LOOP_BUDGET_SUMS: u32 = 2;
+
+/// 1 where a scene of `n` splats fits one page of splat records (the `ONE_PAGE` builds read only
+/// that page: llvmpipe runs both sides of the paged reader's branch), else 0.
+pub fn one_page(n: u32) -> usize {
+    usize::from(n <= SPLAT_PAGE)
+}
+
+/// The footprint draw's variant.
+pub fn footprint_variant(blend: Blend, points: bool, mode: u32) -> usize {
+    let base = match (blend, mode) {
+        (Blend::Over, _) => 0,
+        (Blend::Under, _) => 1,
+        (Blend::Add, m) if m == SHEET_MODE_SLAB => 3,
+        (Blend::Add, _) => 2,
+    };
+    base + 4 * points as usize
+}
+
+/// The tile compositor's variant for a scene of `n` splats, the frame's push constants and
+/// whether it is motion-blurred.
+pub fn tile_composite_variant(n: u32, push: &FootprintPush, blur: bool) -> usize {
+    let btf = push.back_to_front != 0;
+    let mode = if btf {
+        0
+    } else if push.occluded > 0.0 {
+        2
+    } else {
+        1
+    };
+    (one_page(n) * 3 + mode) * 2 + usize::from(blur)
+}
+
+/// Workgroups of the tile binning passes that walk the draw list chunk by chunk.
+fn tile_chunk_groups(push: &FootprintPush) -> [u32; 3] {
+    [push.chunks.div_ceil(TILE_BIN_WORKGROUP), 1, 1]
+}
+
+/// Workgroups covering a `width` x `height` image in tiles.
+fn tile_groups(stage: StageId, width: u32, height: u32) -> [u32; 3] {
+    match stage.desc().workgroup {
+        Workgroup::Tile(tw, th) => [width.div_ceil(tw), height.div_ceil(th), 1],
+        _ => [1, 1, 1],
+    }
+}
+
+/// A frame's words of an image resource (RGBA32F).
+fn image_words(width: u32, height: u32) -> usize {
+    width as usize * height as usize * 4
+}
+
+/// The output of [`record_frame`].
+pub struct Recorded {
+    pub image: ImageF32,
+    pub timings: Vec<StageTime>,
+}
+
+/// THE recording of a frame: `prep` drawn from `camera` with `opts` (whose raster is already
+/// chosen), on `e`.
+pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
+    camera.validate()?;
+    let set = &prep.set;
+    let (w, h) = (camera.width, camera.height);
+    let direction = opts.direction();
+    let btf = direction == Direction::BackToFront;
+    let frame = plan::frame_for(set, camera, opts);
+    let n = set.len() as u32;
+    let rows = (set.row_start().len() - 1) as u32;
+    let compute = opts.raster == Raster::Compute;
+    let points = opts.raster == Raster::Points;
+    e.begin(&frame, opts.kernel, w, h)?;
+    e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+    let params = || Dispatch::new(StageId::SplatParams, 0, groups_1d(n), List::Order, &[]);
+
+    if opts.composite == Composite::Splat {
+        e.layers(1)?;
+        e.ensure(Res::Order, n as u64 * 4)?;
+        if opts.order == OrderKind::Pbtf {
+            if n > 0 {
+                e.ensure(Res::RowSplit, rows as u64 * 4)?;
+                e.ensure(Res::Segments, rows as u64 * 8)?;
+                e.run(&Dispatch::new(StageId::OrderCount, 0, groups_1d(rows), List::Order, &[]))?;
+                e.run(&Dispatch::new(StageId::OrderScan, 0, [1, 1, 1], List::Order, &[]))?;
+                e.run(&Dispatch::new(StageId::OrderScatter, 0, groups_1d(n), List::Order, &[]))?;
+            }
+        } else {
+            let t = Instant::now();
+            let order = crate::order::visibility_order(set, camera, opts.order, direction);
+            e.upload(Res::Order, &order)?;
+            let stage = if e.is_device() { "order_cpu" } else { "order" };
+            e.host_time(stage, t.elapsed().as_secs_f64() * 1e3);
+        }
+        if n > 0 {
+            e.run(&params())?;
+        }
+        if compute {
+            record_tiles(e, &frame, n, opts, w, h)?;
+            return finish(e, Res::Accum, w, h, false);
+        }
+        let blend = if btf { Blend::Over } else { Blend::Under };
+        let variant = footprint_variant(blend, points, SHEET_MODE_SPLAT);
+        let push = FootprintPush::default();
+        e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
+        return finish(e, Res::Color, w, h, false);
+    }
+
+    // Sheet and slab modes: summation layers in batches, composited in visiting order.
+    let limits = e.limits();
+    let mut layers = opts.batch_layers(w, h).min(limits.max_layers.max(1));
+    let layer_bytes = w as u64 * h as u64 * 16;
+    if compute {
+        // The fixed-point layers are one storage binding: no more than its range allows.
+        layers = layers.min((limits.max_storage_range / layer_bytes.max(1)).clamp(1, u32::MAX as u64) as u32);
+    }
+    let (list, mut batches) = if opts.composite == Composite::Sheet {
+        if n > 0 {
+            e.run(&params())?;
+        }
+        let (axis, batches) = plan::sheet_plan(prep, camera, direction, layers);
+        (List::Slices(axis as u8), batches)
+    } else {
+        let pc = crate::slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, direction)?;
+        let push = bytemuck::bytes_of(&pc);
+        e.ensure(Res::SlabCounts, pc.slabs as u64 * pc.chunks as u64 * 4)?;
+        e.ensure(Res::SlabStart, (pc.slabs as u64 + 1) * 4)?;
+        if n > 0 {
+            e.run(&params())?;
+        }
+        e.run(&Dispatch::new(StageId::SlabCount, 0, groups_1d(pc.chunks), List::Order, push))?;
+        e.run(&Dispatch::new(StageId::SlabScan, 0, [1, 1, 1], List::Order, push))?;
+        let starts = e.read(&[(Res::SlabStart, pc.slabs as usize + 1)])?.remove(0);
+        let batches = crate::slab::slab_batches(&pc, &starts, layers)?;
+        e.ensure(Res::SlabPairs, starts[pc.slabs as usize] as u64 * 8)?;
+        e.run(&Dispatch::new(StageId::SlabScatter, 0, groups_1d(pc.chunks), List::Order, push))?;
+        (List::SlabPairs, batches)
+    };
+    plan::set_early_termination(opts, &mut batches);
+    // Allocate only as many layers as the largest batch needs.
+    let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
+    e.layers(layers)?;
+    let tiles = w.div_ceil(COMPOSITE_TILE) as u64 * h.div_ceil(COMPOSITE_TILE) as u64;
+    e.ensure(Res::Occlusion, tiles * 4)?;
+    e.ensure(Res::SheetTiles, tiles * 8)?;
+    e.fill(Res::Accum, None, 0)?;
+    e.fill(Res::Occlusion, None, 1.0f32.to_bits())?;
+    if compute {
+        e.ensure(Res::Fixed, layer_bytes * layers as u64)?;
+        e.ensure(Res::Status, 4)?;
+        e.fill(Res::Status, None, 0)?;
+    }
+    let halves = |e: &mut dyn Engine, range: [u32; 2]| -> Result<()> {
+        e.fill(Res::SheetTiles, Some((0, tiles)), range[0])?;
+        e.fill(Res::SheetTiles, Some((tiles, tiles)), range[1])
+    };
+    match batches.first().filter(|_| plan::sheet_tiles_pay(&batches, w, h)) {
+        None => halves(e, plan::ALL_SHEETS)?,
+        Some(first) => {
+            // No sheet reaches any tile until the pass says so.
+            halves(e, [u32::MAX, 0])?;
+            let slab = first.push.sheet_mode == SHEET_MODE_SLAB;
+            let push = plan::sheet_tiles_push(&batches, first);
+            let variant = 2 * slab as usize + points as usize;
+            let groups = groups_1d(push.count);
+            e.run(&Dispatch::new(StageId::SheetTiles, variant, groups, list, bytemuck::bytes_of(&push)))?;
+        }
+    }
+    for b in &batches {
+        let slab = b.push.sheet_mode == SHEET_MODE_SLAB;
+        if compute {
+            e.fill(Res::Fixed, None, 0)?;
+            let push = FootprintPush { first: b.first_instance, count: b.instances, ..b.push };
+            let groups = groups_1d(b.instances);
+            e.run(&Dispatch::new(StageId::FootprintSum, slab as usize, groups, list, bytemuck::bytes_of(&push)))?;
+        } else {
+            let variant = footprint_variant(Blend::Add, points, b.push.sheet_mode);
+            let groups = [b.first_instance, b.instances, 0];
+            e.run(&Dispatch::new(StageId::Footprint, variant, groups, list, bytemuck::bytes_of(&b.push)))?;
+        }
+        let push = plan::composite_push(b, btf, w, h);
+        let groups = tile_groups(StageId::Composite, w, h);
+        e.run(&Dispatch::new(StageId::Composite, compute as usize, groups, list, bytemuck::bytes_of(&push)))?;
+    }
+    finish(e, Res::Accum, w, h, compute)
+}
+
+/// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
+/// shorter chunks when an invocation ran out of llvmpipe's loop budget), then composite each
+/// tile's list `TILE_SEGMENT` entries per dispatch.
+fn record_tiles(e: &mut dyn Engine, frame: &Frame, n: u32, opts: &RenderOptions, w: u32, h: u32) -> Result<()> {
+    let (tx, ty) = crate::cpu::tile::tile_grid(frame);
+    let tiles = tx as u64 * ty as u64;
+    let mut push = plan::tile_push(opts, n, w, h);
+    let most = (crate::raster::MAX_TILE_CELLS / tiles.max(1)).min(push.count.max(1) as u64) as u32;
+    e.ensure(Res::Quads, n as u64 * std::mem::size_of::<ScreenQuad>() as u64)?;
+    e.ensure(Res::TileStart, (tiles + 1) * 4)?;
+    e.ensure(Res::Status, 4)?;
+    let starts = loop {
+        let cells = crate::raster::check_tile_cells(tiles, push.chunks)?;
+        e.ensure(Res::TileCounts, cells * 4)?;
+        e.fill(Res::TileCounts, None, 0)?;
+        e.fill(Res::Status, None, 0)?;
+        let bytes = bytemuck::bytes_of(&push);
+        e.run(&Dispatch::new(StageId::TileCount, one_page(n), tile_chunk_groups(&push), List::Order, bytes))?;
+        e.run(&Dispatch::new(StageId::TileScan, 0, groups_1d(tiles as u32), List::Order, bytes))?;
+        e.run(&Dispatch::new(StageId::TileOffsets, 0, [1, 1, 1], List::Order, bytes))?;
+        let mut back = e.read(&[(Res::TileStart, tiles as usize + 1), (Res::Status, 1)])?;
+        let spent = back[1][0] & LOOP_BUDGET_BINNING != 0;
+        crate::raster::check_tile_entries(back[0][tiles as usize] as u64)?;
+        if !spent {
+            break back.swap_remove(0);
+        }
+        if push.chunks >= most {
+            return Err(Error::TooLarge(format!(
+                "the compute tile binning ran out of llvmpipe's 65535 loop iterations per invocation even in {} \
+                 chunks (footprints covering very many {RASTER_TILE_W}x{RASTER_TILE_H}-pixel tiles): draw this \
+                 frame with --raster graphics or points",
+                push.chunks
+            )));
+        }
+        push.chunks = push.chunks.saturating_mul(4).min(most);
+    };
+    let total = starts[tiles as usize] as u64;
+    let longest = starts.windows(2).map(|w| w[1].saturating_sub(w[0])).max().unwrap_or(0);
+    e.ensure(Res::TileEntries, total * 4)?;
+    let bytes = bytemuck::bytes_of(&push);
+    e.run(&Dispatch::new(StageId::TileScatter, one_page(n), tile_chunk_groups(&push), List::Order, bytes))?;
+    let variant = tile_composite_variant(n, &push, opts.motion.is_some());
+    for segment in 0..longest.div_ceil(TILE_SEGMENT).max(1) {
+        let push = FootprintPush { first: segment, ..push };
+        let groups = tile_groups(StageId::TileComposite, w, h);
+        e.run(&Dispatch::new(StageId::TileComposite, variant, groups, List::Order, bytemuck::bytes_of(&push)))?;
+    }
+    Ok(())
+}
+
+/// Read the frame's image (and, after compute sheet sums, the status word) and the timings.
+fn finish(e: &mut dyn Engine, image: Res, w: u32, h: u32, status: bool) -> Result<Recorded> {
+    let mut what = vec![(image, image_words(w, h))];
+    if status {
+        what.push((Res::Status, 1));
+    }
+    let back = e.read(&what)?;
+    if status && back[1][0] & LOOP_BUDGET_SUMS != 0 {
+        return Err(Error::TooLarge(
+            "a footprint larger than about 240 x 240 pixels: the compute sheet sums ran out of llvmpipe's 65535 \
+             loop iterations per invocation; draw this frame with --raster graphics or points"
+                .into(),
+        ));
+    }
+    let pixels = back[0].chunks_exact(4).map(|c| [0, 1, 2, 3].map(|i| f32::from_bits(c[i]))).collect();
+    let timings = e.finish()?;
+    Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings })
+}
