@@ -237,6 +237,11 @@ struct SceneArgs {
     /// Enable the Khronos validation layer and report its messages.
     #[arg(long)]
     validation: bool,
+    /// Split each frame between Vulkan and the CPU mirrors at a stage, to find the stage that
+    /// departs from its mirror: gpu-until:STAGE (the device runs the stages before STAGE, the
+    /// mirrors the rest) or cpu-until:STAGE. Stages: see src/stages.rs.
+    #[arg(long, conflicts_with = "cpu")]
+    bisect: Option<voxsplat::Bisect>,
 }
 
 #[derive(Args)]
@@ -436,7 +441,9 @@ fn renderer_of(a: &SceneArgs) -> Result<Renderer> {
     let mut opts = RendererOptions::default();
     opts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
     opts.validation = a.validation;
-    Renderer::new(&opts)
+    let mut r = Renderer::new(&opts)?;
+    r.set_bisect(a.bisect)?;
+    Ok(r)
 }
 
 fn report_validation(r: &Renderer) -> Result<()> {
