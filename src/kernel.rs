@@ -196,7 +196,7 @@ impl Kernel {
                 for i in -reach..=reach {
                     for j in -reach..=reach {
                         let (dx, dy) = ((x - i as f64) / rr, (y - j as f64) / rr);
-                        v += crate::cpu::footprint::sample_radial(&table, (dx * dx + dy * dy) as f32) as f64;
+                        v += sample_radial(&table, (dx * dx + dy * dy) as f32) as f64;
                     }
                 }
                 lo = lo.min(v);
@@ -259,4 +259,14 @@ impl Kernel {
         }
         t
     }
+}
+
+/// The radial table lookup, as `sample_radial` in `glsl/shared/footprint_table.glsl`: the radial footprint table at
+/// s = r² (radius units).
+pub fn sample_radial(table: &[f32], s: f32) -> f32 {
+    let n = crate::constants::RADIAL_TABLE_SIZE;
+    let t = s.clamp(0.0, 1.0) * n as f32;
+    let i = (t as u32).min(n - 1);
+    let a = table[i as usize];
+    a + (table[i as usize + 1] - a) * (t - i as f32)
 }

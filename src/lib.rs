@@ -37,6 +37,7 @@ pub mod peer;
 pub mod plan;
 pub mod raster;
 pub mod rates;
+pub mod recording;
 pub mod resample;
 pub mod scene;
 pub mod slab;
@@ -61,7 +62,8 @@ pub use volume::{Grid, SplatSet, Volume};
 
 use cpu::exec::CpuEngine;
 use plan::Prepared;
-use stages::{record_frame, Engine, Res, StageId};
+use recording::record_frame;
+use stages::{Engine, Res, StageId};
 use std::sync::Arc;
 
 /// Where the frame is computed.

@@ -8,6 +8,7 @@ use super::ImageF32;
 use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB};
+pub use crate::kernel::sample_radial;
 use crate::stages::{Dispatch, Pass, Res};
 use glam::{DMat4, DVec3, DVec4, IVec4, Mat3, Mat4, Vec2, Vec3, Vec4};
 
@@ -34,16 +35,6 @@ pub fn sample_table(table: &[f32], u: f32, v: f32) -> f32 {
     let top = at(x0, y0) + (at(x1, y0) - at(x0, y0)) * wx;
     let bottom = at(x0, y1) + (at(x1, y1) - at(x0, y1)) * wx;
     top + (bottom - top) * wy
-}
-
-/// Mirror of `sample_radial` in `glsl/shared/footprint_table.glsl`: the radial footprint table at
-/// s = r² (radius units).
-pub fn sample_radial(table: &[f32], s: f32) -> f32 {
-    let n = crate::constants::RADIAL_TABLE_SIZE;
-    let t = s.clamp(0.0, 1.0) * n as f32;
-    let i = (t as u32).min(n - 1);
-    let a = table[i as usize];
-    a + (table[i as usize + 1] - a) * (t - i as f32)
 }
 
 /// Mirror of `sample_slice_table` in `glsl/shared/footprint_table.glsl`.
