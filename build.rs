@@ -1,5 +1,10 @@
-//! Compiles every GLSL stage in `glsl/` to SPIR-V in OUT_DIR, with `glsl/shared/` as the include
-//! directory and the constants of `src/constants.rs` injected as macros.
+//! The GPU stages' SPIR-V, and `OUT_DIR/spirv_table.rs`, the table the pipelines look builds up in.
+//!
+//! With the `shaderc` feature (development and CI): every GLSL stage in `glsl/` is compiled to
+//! OUT_DIR, with `glsl/shared/` as the include directory and the constants of `src/constants.rs`
+//! injected as macros; tests/spirv.rs checks the result against the shipped copies (and refreshes
+//! them with `VOXSPLAT_BLESS_SPIRV=1`). Without it (a dependent crate): the SPIR-V shipped in
+//! `glsl/spirv/` is used as it is, so neither shaderc nor a link override is needed.
 use std::path::{Path, PathBuf};
 
 #[allow(dead_code)]
@@ -9,96 +14,122 @@ mod constants {
 
 fn main() {
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
-    let glsl = Path::new("glsl");
+    let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
     println!("cargo:rerun-if-changed=src/constants.rs");
     println!("cargo:rerun-if-changed=glsl");
-
-    let mut shared: Vec<PathBuf> =
-        std::fs::read_dir(glsl.join("shared")).expect("glsl/shared exists").map(|e| e.unwrap().path()).collect();
-    shared.sort();
-    for p in &shared {
-        println!("cargo:rerun-if-changed={}", p.display());
-    }
-
-    let mut stages: Vec<PathBuf> =
-        std::fs::read_dir(glsl).expect("glsl exists").map(|e| e.unwrap().path()).filter(|p| p.is_file()).collect();
-    stages.sort();
-
-    let compiler = shaderc::Compiler::new().expect("shaderc compiler");
-    let mut failed = Vec::new();
-    let mut built = Vec::new();
-    for path in &stages {
-        println!("cargo:rerun-if-changed={}", path.display());
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-        let kind = match ext {
-            "comp" => shaderc::ShaderKind::Compute,
-            "vert" => shaderc::ShaderKind::Vertex,
-            "frag" => shaderc::ShaderKind::Fragment,
-            _ => continue,
-        };
-        let source = std::fs::read_to_string(path).unwrap();
-        let options = || {
-            let mut opts = shaderc::CompileOptions::new().unwrap();
-            opts.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
-            opts.set_optimization_level(shaderc::OptimizationLevel::Performance);
-            opts.set_generate_debug_info();
-            for (name, value) in constants::GLSL_DEFINES {
-                opts.add_macro_definition(name, Some(&value.to_string()));
-            }
-            let shared_dir = glsl.join("shared");
-            opts.set_include_callback(move |name, _ty, _from, _depth| {
-                let p = shared_dir.join(name);
-                std::fs::read_to_string(&p)
-                    .map(|content| shaderc::ResolvedInclude { resolved_name: p.display().to_string(), content })
-                    .map_err(|e| format!("cannot include {}: {e}", p.display()))
-            });
-            opts
-        };
-        let file = path.display().to_string();
-        let name = path.file_name().unwrap().to_str().unwrap();
-        // A stage whose source names `// variants: A B C+D` is also built with each macro (or each
-        // `+`-joined set of macros) defined, as `<stage>.A.spv`, `<stage>.C+D.spv` (for code that
-        // needs device features the plain build must not, or that holds for some scenes only).
-        let variants = source
-            .lines()
-            .find_map(|l| l.strip_prefix("// variants:"))
-            .map(|v| v.split_whitespace().map(str::to_owned).collect::<Vec<_>>())
-            .unwrap_or_default();
-        for variant in std::iter::once(None).chain(variants.iter().map(Some)) {
-            let mut opts = options();
-            let out_name = match variant {
-                Some(v) => {
-                    for m in v.split('+') {
-                        opts.add_macro_definition(m, Some("1"));
-                    }
-                    format!("{name}.{v}.spv")
-                }
-                None => format!("{name}.spv"),
-            };
-            match compiler.compile_into_spirv(&source, kind, &file, "main", Some(&opts)) {
-                Ok(art) => {
-                    std::fs::write(out.join(&out_name), art.as_binary_u8()).unwrap();
-                    built.push(out_name);
-                }
-                // shaderc's message already carries "file:line: error: ...".
-                Err(e) => failed.push(e.to_string()),
-            }
-        }
-    }
-    if !failed.is_empty() {
-        for f in &failed {
-            eprintln!("{f}");
-        }
-        panic!("GLSL compilation failed:\n{}", failed.join("\n"));
-    }
-    // The table the GPU pipelines look builds up in: (build name, SPIR-V words).
-    let mut table = String::from(
-        "/// Every SPIR-V build, by name (`<stage>.<ext>[.<DEFINES>]`).\npub static SPIRV: &[(&str, &[u8])] = &[\n",
-    );
+    #[cfg(feature = "shaderc")]
+    let (dir, built) = (out.clone(), compile::compile_all(Path::new("glsl"), &out));
+    #[cfg(not(feature = "shaderc"))]
+    let (dir, built) = (manifest.join("glsl/spirv"), shipped(&manifest.join("glsl/spirv")));
+    let _ = &manifest;
+    let mut table = String::from("/// Every SPIR-V build, by name (`<stage>.<ext>[.<DEFINES>]`).\n");
+    table += "pub static SPIRV: &[(&str, &[u8])] = &[\n";
     for name in &built {
         let stem = name.strip_suffix(".spv").unwrap();
-        table += &format!("    ({stem:?}, include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{name}\"))),\n");
+        let path = dir.join(name);
+        table += &format!("    ({stem:?}, include_bytes!({:?})),\n", path.display().to_string());
     }
     table += "];\n";
     std::fs::write(out.join("spirv_table.rs"), table).unwrap();
+}
+
+/// The shipped builds' file names, sorted.
+#[cfg(not(feature = "shaderc"))]
+fn shipped(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e} (the shipped SPIR-V; build with --features shaderc)", dir.display()))
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".spv"))
+        .collect();
+    names.sort();
+    names
+}
+
+#[cfg(feature = "shaderc")]
+mod compile {
+    use super::constants;
+    use std::path::{Path, PathBuf};
+
+    /// Compile every stage (and its variants) into `out`; the file names written, sorted.
+    pub fn compile_all(glsl: &Path, out: &Path) -> Vec<String> {
+        let mut shared: Vec<PathBuf> =
+            std::fs::read_dir(glsl.join("shared")).expect("glsl/shared exists").map(|e| e.unwrap().path()).collect();
+        shared.sort();
+        for p in &shared {
+            println!("cargo:rerun-if-changed={}", p.display());
+        }
+        let mut stages: Vec<PathBuf> =
+            std::fs::read_dir(glsl).expect("glsl exists").map(|e| e.unwrap().path()).filter(|p| p.is_file()).collect();
+        stages.sort();
+
+        let compiler = shaderc::Compiler::new().expect("shaderc compiler");
+        let mut failed = Vec::new();
+        let mut built = Vec::new();
+        for path in &stages {
+            println!("cargo:rerun-if-changed={}", path.display());
+            let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+            let kind = match ext {
+                "comp" => shaderc::ShaderKind::Compute,
+                "vert" => shaderc::ShaderKind::Vertex,
+                "frag" => shaderc::ShaderKind::Fragment,
+                _ => continue,
+            };
+            let source = std::fs::read_to_string(path).unwrap();
+            let options = || {
+                let mut opts = shaderc::CompileOptions::new().unwrap();
+                opts.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
+                opts.set_optimization_level(shaderc::OptimizationLevel::Performance);
+                opts.set_generate_debug_info();
+                for (name, value) in constants::GLSL_DEFINES {
+                    opts.add_macro_definition(name, Some(&value.to_string()));
+                }
+                let shared_dir = glsl.join("shared");
+                opts.set_include_callback(move |name, _ty, _from, _depth| {
+                    let p = shared_dir.join(name);
+                    std::fs::read_to_string(&p)
+                        .map(|content| shaderc::ResolvedInclude { resolved_name: p.display().to_string(), content })
+                        .map_err(|e| format!("cannot include {}: {e}", p.display()))
+                });
+                opts
+            };
+            let file = path.display().to_string();
+            let name = path.file_name().unwrap().to_str().unwrap();
+            // A stage whose source names `// variants: A B C+D` is also built with each macro (or
+            // each `+`-joined set of macros) defined, as `<stage>.A.spv`, `<stage>.C+D.spv` (for code
+            // that needs device features the plain build must not, or that holds for some scenes only).
+            let variants = source
+                .lines()
+                .find_map(|l| l.strip_prefix("// variants:"))
+                .map(|v| v.split_whitespace().map(str::to_owned).collect::<Vec<_>>())
+                .unwrap_or_default();
+            for variant in std::iter::once(None).chain(variants.iter().map(Some)) {
+                let mut opts = options();
+                let out_name = match variant {
+                    Some(v) => {
+                        for m in v.split('+') {
+                            opts.add_macro_definition(m, Some("1"));
+                        }
+                        format!("{name}.{v}.spv")
+                    }
+                    None => format!("{name}.spv"),
+                };
+                match compiler.compile_into_spirv(&source, kind, &file, "main", Some(&opts)) {
+                    Ok(art) => {
+                        std::fs::write(out.join(&out_name), art.as_binary_u8()).unwrap();
+                        built.push(out_name);
+                    }
+                    // shaderc's message already carries "file:line: error: ...".
+                    Err(e) => failed.push(e.to_string()),
+                }
+            }
+        }
+        if !failed.is_empty() {
+            for f in &failed {
+                eprintln!("{f}");
+            }
+            panic!("GLSL compilation failed:\n{}", failed.join("\n"));
+        }
+        built.sort();
+        built
+    }
 }

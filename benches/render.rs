@@ -1,23 +1,29 @@
-//! Criterion wall-time benchmark of whole frames for the methods of the quick matrix; the full
-//! matrix with errors, roofline and scaling is `voxsplat bench` (bodies in `voxsplat::bench`).
+//! Criterion wall-time benchmark of whole frames through the library's public API, one per raster
+//! variant and compositing mode on the 60³ cube. The full matrix with errors, roofline and scaling
+//! is `voxsplat bench` (cli/src/bench.rs), and cli/benches/render.rs times its quick matrix.
 use criterion::{criterion_group, criterion_main, Criterion};
-use voxsplat::bench::{bench_camera, time_method, MatrixOptions};
-use voxsplat::{Renderer, RendererOptions};
+use voxsplat::{scene, Camera, Composite, Raster, RenderOptions, Renderer, RendererOptions};
 
 fn frames(c: &mut Criterion) {
     let mut renderer = Renderer::new(&RendererOptions::default()).expect("Vulkan device (run scripts/setup.sh)");
-    let m = MatrixOptions::quick();
+    let set = scene::build("cube60").unwrap();
+    let camera = Camera::framing(set.grid(), 256, 256);
+    renderer.set_scene(set).unwrap();
     let mut group = c.benchmark_group("frame");
     group.sample_size(10);
-    for name in ["cube60", "plane"] {
-        let set = voxsplat::scene::build(name).unwrap();
-        let camera = bench_camera(set.grid(), 512, 512);
-        renderer.set_scene(set).unwrap();
-        for method in &m.methods {
-            group.bench_function(format!("{name} {}", method.label()), |b| {
-                b.iter(|| time_method(&mut renderer, method, &camera, 0, 1).unwrap())
-            });
-        }
+    for (composite, raster) in [
+        (Composite::Splat, Raster::Graphics),
+        (Composite::Splat, Raster::Points),
+        (Composite::Splat, Raster::Compute),
+        (Composite::Sheet, Raster::Graphics),
+        (Composite::Sheet, Raster::Compute),
+    ] {
+        let mut o = RenderOptions::default();
+        o.composite = composite;
+        o.raster = raster;
+        group.bench_function(format!("cube60 256 {composite:?} {raster:?}"), |b| {
+            b.iter(|| renderer.render(&camera, &o).unwrap())
+        });
     }
     group.finish();
 }

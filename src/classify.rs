@@ -3,7 +3,7 @@
 //! extracted. Optional Phong shading with a headlight is applied to the voxels before splatting,
 //! as in the seed (docs/MODEL.md).
 use crate::error::{Error, Result};
-use crate::loaders::ScalarVolume;
+use crate::volume::ScalarVolume;
 use crate::volume::{Grid, SplatSet};
 use glam::Vec3;
 use serde::Deserialize;

@@ -17,7 +17,6 @@
 
 pub mod aa;
 pub mod animate;
-pub mod bench;
 pub mod bisect;
 pub mod camera;
 pub mod classify;
@@ -28,22 +27,22 @@ mod gpu;
 pub mod gpu_types;
 pub mod image;
 pub mod kernel;
+#[cfg(feature = "io")]
 pub mod loaders;
 pub mod metrics;
 pub mod options;
 pub mod order;
+#[cfg(feature = "io")]
 pub mod output;
 pub mod peer;
 pub mod plan;
 pub mod raster;
-pub mod rates;
 pub mod recording;
 pub mod resample;
 pub mod scene;
 pub mod slab;
-pub mod soak;
-pub mod stability;
 pub mod stages;
+#[cfg(feature = "io")]
 pub mod terrain;
 pub mod truth;
 #[allow(unsafe_code)]
@@ -53,6 +52,7 @@ pub mod volume;
 pub use bisect::Bisect;
 pub use camera::{Camera, Projection};
 pub use error::{Error, Result};
+pub use glam;
 pub use image::ImageF32;
 pub use kernel::Kernel;
 pub use options::{Antialias, Composite, Motion, RenderOptions, Rendered, StageTime};
@@ -377,4 +377,11 @@ pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
     let per_splat =
         (std::mem::size_of::<gpu_types::Splat>() + std::mem::size_of::<gpu_types::SplatParams>() + 16) as f64;
     per_splat + (rows * (4.0 + 4.0 + 8.0) + (dims[0] + dims[1] + dims[2]) as f64 * 4.0) / n
+}
+
+/// Every SPIR-V build the pipelines use, by name: compiled from `glsl/` with the `shaderc`
+/// feature, else the copies shipped in `glsl/spirv/` (tests/spirv.rs keeps the two equal).
+#[doc(hidden)]
+pub fn spirv_builds() -> &'static [(&'static str, &'static [u8])] {
+    gpu::pipelines::SPIRV
 }

@@ -3,6 +3,7 @@
 //! malformed input gives `Error::InvalidFile`-style typed errors (`Error::InvalidArgument` with the
 //! file's name), never a panic.
 use crate::error::{Error, Result};
+pub use crate::volume::{HeightGrid, ScalarVolume};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -41,14 +42,6 @@ impl std::str::FromStr for DType {
             other => Err(Error::InvalidArgument(format!("unsupported sample type '{other}' (u8, u16, i16, f32)"))),
         }
     }
-}
-
-/// A dense scalar volume as loaded: x fastest, then y, then z.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ScalarVolume {
-    pub dims: [u32; 3],
-    pub spacing: [f32; 3],
-    pub values: Vec<f32>,
 }
 
 fn bad(path: &str, msg: impl std::fmt::Display) -> Error {
@@ -423,14 +416,6 @@ pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
         v.spacing = s;
     }
     Ok(v)
-}
-
-/// A height grid: `width` × `rows` heights, row 0 first (north for the DEMs here).
-#[derive(Clone, Debug, PartialEq)]
-pub struct HeightGrid {
-    pub width: u32,
-    pub rows: u32,
-    pub heights: Vec<f32>,
 }
 
 /// Load heights from a 16-bit (or 8-bit) PNG, a GeoTIFF / TIFF, or a 2D `.npy`.

@@ -20,7 +20,7 @@ pub struct Prepared {
     pub rank_offsets: [u32; 3],
     /// The CPU ray caster's dense (colour * tau, tau) field, built on first use and kept with the
     /// scene (the GPU path uploads it to a 3D texture and drops the host copy).
-    field: std::sync::OnceLock<crate::truth::DenseField>,
+    field: std::sync::OnceLock<crate::volume::DenseField>,
 }
 
 impl Prepared {
@@ -36,11 +36,11 @@ impl Prepared {
     }
 
     /// The dense field for ray casting, built once per scene.
-    pub fn dense_field(&self) -> Result<&crate::truth::DenseField> {
+    pub fn dense_field(&self) -> Result<&crate::volume::DenseField> {
         if let Some(f) = self.field.get() {
             return Ok(f);
         }
-        let f = crate::truth::DenseField::new(&self.set)?;
+        let f = crate::volume::DenseField::new(&self.set)?;
         Ok(self.field.get_or_init(|| f))
     }
 }

@@ -1,6 +1,9 @@
 //! Built-in scenes reproducing the dissertation's test objects, listed by name.
+use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result};
+use crate::kernel::Kernel;
 use crate::volume::{Grid, SplatSet};
+use glam::Vec3;
 
 /// Opacity of one voxel-length of the built-in materials.
 pub const SCENE_OPACITY: f32 = 0.95;
@@ -69,6 +72,7 @@ pub fn build(name: &str) -> Result<SplatSet> {
             let n = crate::peer::side_of(name).expect("matched above");
             crate::classify::classify(&crate::peer::volume(n)?, &crate::peer::transfer_function(), None)
         }
+        #[cfg(feature = "io")]
         "bonsai" | "stent" => {
             let dir = crate::loaders::data_dir();
             let (file, tf) =
@@ -76,6 +80,7 @@ pub fn build(name: &str) -> Result<SplatSet> {
             let vol = crate::loaders::load_volume(&dir.join(file), &Default::default())?;
             crate::classify::classify(&vol, &crate::classify::TransferFunction::preset(tf)?, None)
         }
+        #[cfg(feature = "io")]
         "rmnp" => {
             let dir = crate::loaders::data_dir().join("rmnp");
             let heights = crate::loaders::load_heights(&dir.join("rmnp-dem.tif"))?;
@@ -86,9 +91,59 @@ pub fn build(name: &str) -> Result<SplatSet> {
                 crate::terrain::TerrainOptions { cell: 233.0, vscale: 3.0, color: Some(color), ..Default::default() };
             crate::terrain::terrain_splats(&heights, &opts)
         }
+        #[cfg(not(feature = "io"))]
+        "bonsai" | "stent" | "rmnp" => {
+            Err(Error::Unsupported(format!("scene '{name}' reads ../shared/data: build voxsplat with the io feature")))
+        }
         other => Err(Error::InvalidArgument(format!(
             "unknown scene '{other}'; built-in scenes: {}",
             SCENES.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
         ))),
     }
+}
+
+/// The close, off-axis perspective view of the 60³ cube of Figs 2.25–2.27 (the eye projects inside
+/// the grid on two axes).
+pub fn close_view(grid: &Grid, size: u32) -> Camera {
+    let c = grid.center();
+    Camera {
+        eye: c + Vec3::new(12.0, 20.0, 75.0),
+        target: c,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 60.0 },
+        near: 0.5,
+        far: 300.0,
+        width: size,
+        height: size,
+    }
+}
+
+/// The sweep's sheet of `n` x `n` voxels.
+pub fn rate_scene(n: u32) -> Result<SplatSet> {
+    let grid = Grid::centered([n, n, 1], [1.0; 3])?;
+    SplatSet::from_fn(grid, |i, j, _| {
+        let c = if (i / 4 + j / 4) % 2 == 0 { [0.9, 0.3, 0.1] } else { [0.2, 0.5, 0.9] };
+        Some([c[0], c[1], c[2], 0.3])
+    })
+}
+
+/// Head-on orthographic view of `grid` (a sheet) with footprints `size_px` wide.
+pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
+    if !(size_px.is_finite() && size_px >= 1.0) {
+        return Err(Error::InvalidArgument(format!("footprint size {size_px} px must be at least 1")));
+    }
+    let ppv = size_px / (2.0 * Kernel::Gaussian.radius());
+    let extent = grid.dims[0].max(grid.dims[1]) as f32 + 2.0 * Kernel::Gaussian.radius();
+    let side = (extent * ppv).ceil() as u32;
+    let c = grid.center();
+    Ok(Camera {
+        eye: c + Vec3::new(0.0, 0.0, 50.0),
+        target: c,
+        up: Vec3::Y,
+        projection: Projection::Orthographic { height: side as f32 / ppv },
+        near: 1.0,
+        far: 100.0,
+        width: side,
+        height: side,
+    })
 }

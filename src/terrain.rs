@@ -2,7 +2,7 @@
 //! filling the vertical gap down to the lowest 4-neighbour so the surface has no holes from a
 //! grazing view.
 use crate::error::{Error, Result};
-use crate::loaders::HeightGrid;
+use crate::volume::HeightGrid;
 use crate::volume::{Grid, SplatSet};
 
 /// Most height levels a terrain may span.

@@ -10,11 +10,9 @@ use crate::error::{Error, Result};
 use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::volume::SplatSet;
+pub use crate::volume::{DenseField, MAX_DENSE_BYTES};
 use glam::{DMat4, DVec3, DVec4, Mat4};
 use rayon::prelude::*;
-
-/// Largest dense field the references build (RGBA32F per voxel).
-pub const MAX_DENSE_BYTES: u64 = 4 << 30;
 
 /// How the continuous volume is rebuilt from the voxels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,58 +29,6 @@ impl Reconstruction {
             Reconstruction::Kernel(k) => k.radius() as f64,
             Reconstruction::Trilinear => 1.0,
         }
-    }
-}
-
-/// The voxels as a dense grid of (colour * tau, tau): what the ray caster's 3D texture holds.
-#[derive(Clone, Debug)]
-pub struct DenseField {
-    pub dims: [u32; 3],
-    pub values: Vec<[f32; 4]>,
-}
-
-impl DenseField {
-    pub fn new(set: &SplatSet) -> Result<Self> {
-        let [nx, ny, nz] = set.grid().dims;
-        let n = nx as u64 * ny as u64 * nz as u64;
-        if n * 16 > MAX_DENSE_BYTES {
-            return Err(Error::TooLarge(format!("a dense field of {n} voxels exceeds {MAX_DENSE_BYTES} bytes")));
-        }
-        let mut values = vec![[0.0f32; 4]; n as usize];
-        for sp in set.splats() {
-            let tau = crate::cpu::splat_params::optical_depth(sp.color[3]);
-            let idx = sp.ijk[0] as usize + nx as usize * (sp.ijk[1] as usize + ny as usize * sp.ijk[2] as usize);
-            values[idx] = [sp.color[0] * tau, sp.color[1] * tau, sp.color[2] * tau, tau];
-        }
-        Ok(Self { dims: [nx, ny, nz], values })
-    }
-
-    pub fn at(&self, i: i64, j: i64, k: i64) -> [f32; 4] {
-        let [nx, ny, nz] = self.dims.map(|d| d as i64);
-        if i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz {
-            return [0.0; 4];
-        }
-        self.values[(i + nx * (j + ny * k)) as usize]
-    }
-
-    /// For each voxel, whether any non-empty voxel lies within `reach` cells (Chebyshev): lets the
-    /// references skip empty space without changing the result.
-    fn occupancy(&self, reach: i64) -> Vec<bool> {
-        let [nx, ny, nz] = self.dims.map(|d| d as usize);
-        let mut occ: Vec<bool> = self.values.iter().map(|v| v[3] > 0.0).collect();
-        let strides = [1usize, nx, nx * ny];
-        for (axis, &len) in [nx, ny, nz].iter().enumerate() {
-            let stride = strides[axis];
-            let src = occ.clone();
-            for (idx, o) in occ.iter_mut().enumerate() {
-                let c = (idx / stride % len) as i64;
-                let lo = (c - reach).max(0);
-                let hi = (c + reach).min(len as i64 - 1);
-                let base = idx - c as usize * stride;
-                *o = (lo..=hi).any(|q| src[base + q as usize * stride]);
-            }
-        }
-        occ
     }
 }
 
@@ -262,7 +208,7 @@ pub fn volumetric_summation(set: &SplatSet, camera: &Camera, opts: &TruthOptions
 /// centres; per sample the transfer function's opacity, given per unit length, becomes
 /// `1 - (1 - a)^step` and colour is composited front to back. Premultiplied RGBA, in f64.
 pub fn ray_integrate_scalars(
-    volume: &crate::loaders::ScalarVolume,
+    volume: &crate::volume::ScalarVolume,
     tf: &crate::classify::TransferFunction,
     camera: &Camera,
     step: f64,

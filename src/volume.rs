@@ -205,3 +205,84 @@ impl Volume {
         })
     }
 }
+
+/// A dense scalar volume as loaded: x fastest, then y, then z.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalarVolume {
+    pub dims: [u32; 3],
+    pub spacing: [f32; 3],
+    pub values: Vec<f32>,
+}
+
+/// A height grid: `width` × `rows` heights, row 0 first (north for the DEMs here).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeightGrid {
+    pub width: u32,
+    pub rows: u32,
+    pub heights: Vec<f32>,
+}
+
+/// Largest dense field the references build (RGBA32F per voxel).
+pub const MAX_DENSE_BYTES: u64 = 4 << 30;
+
+/// The voxels as a dense grid of (colour * tau, tau): what the ray caster's 3D texture holds.
+#[derive(Clone, Debug)]
+pub struct DenseField {
+    pub dims: [u32; 3],
+    pub values: Vec<[f32; 4]>,
+}
+
+impl DenseField {
+    /// The non-empty voxels of `set` on their grid (refused past `MAX_DENSE_BYTES`).
+    pub fn new(set: &SplatSet) -> Result<Self> {
+        let [nx, ny, nz] = set.grid().dims;
+        let n = nx as u64 * ny as u64 * nz as u64;
+        if n * 16 > MAX_DENSE_BYTES {
+            return Err(Error::TooLarge(format!("a dense field of {n} voxels exceeds {MAX_DENSE_BYTES} bytes")));
+        }
+        let mut values = vec![[0.0f32; 4]; n as usize];
+        for sp in set.splats() {
+            let tau = optical_depth(sp.color[3]);
+            let idx = sp.ijk[0] as usize + nx as usize * (sp.ijk[1] as usize + ny as usize * sp.ijk[2] as usize);
+            values[idx] = [sp.color[0] * tau, sp.color[1] * tau, sp.color[2] * tau, tau];
+        }
+        Ok(Self { dims: [nx, ny, nz], values })
+    }
+
+    /// The voxel at (i, j, k); empty outside the grid.
+    pub fn at(&self, i: i64, j: i64, k: i64) -> [f32; 4] {
+        let [nx, ny, nz] = self.dims.map(|d| d as i64);
+        if i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz {
+            return [0.0; 4];
+        }
+        self.values[(i + nx * (j + ny * k)) as usize]
+    }
+
+    /// For each voxel, whether any non-empty voxel lies within `reach` cells (Chebyshev): lets the
+    /// references skip empty space without changing the result.
+    pub(crate) fn occupancy(&self, reach: i64) -> Vec<bool> {
+        let [nx, ny, nz] = self.dims.map(|d| d as usize);
+        let mut occ: Vec<bool> = self.values.iter().map(|v| v[3] > 0.0).collect();
+        let strides = [1usize, nx, nx * ny];
+        for (axis, &len) in [nx, ny, nz].iter().enumerate() {
+            let stride = strides[axis];
+            let src = occ.clone();
+            for (idx, o) in occ.iter_mut().enumerate() {
+                let c = (idx / stride % len) as i64;
+                let lo = (c - reach).max(0);
+                let hi = (c + reach).min(len as i64 - 1);
+                let base = idx - c as usize * stride;
+                *o = (lo..=hi).any(|q| src[base + q as usize * stride]);
+            }
+        }
+        occ
+    }
+}
+
+/// The largest opacity of one voxel-length of material (tau stays finite).
+pub const MAX_OPACITY: f32 = 0.999;
+
+/// tau = -ln(1 - alpha) of one voxel-length of material, alpha clamped to `MAX_OPACITY`.
+pub fn optical_depth(opacity: f32) -> f32 {
+    -(1.0 - opacity.clamp(0.0, MAX_OPACITY)).ln()
+}

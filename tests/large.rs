@@ -98,8 +98,8 @@ fn work_past_llvmpipes_loop_budget_is_split_not_cut_short() {
     }
 
     // 1024 footprints 100 px wide: one binning chunk would visit ~190 000 tiles.
-    let sheet = voxsplat::rates::rate_scene(32).unwrap();
-    let cam = voxsplat::rates::rate_camera(sheet.grid(), 100.0).unwrap();
+    let sheet = voxsplat::scene::rate_scene(32).unwrap();
+    let cam = voxsplat::scene::rate_camera(sheet.grid(), 100.0).unwrap();
     g.set_scene(sheet.clone()).unwrap();
     c.set_scene(sheet).unwrap();
     o.direction = None;
@@ -117,8 +117,8 @@ fn work_past_llvmpipes_loop_budget_is_split_not_cut_short() {
 /// 300 x 300 pixels) is a typed error naming the raster modes that draw it, not a cut footprint.
 #[test]
 fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
-    let sheet = voxsplat::rates::rate_scene(4).unwrap();
-    let cam = voxsplat::rates::rate_camera(sheet.grid(), 300.0).unwrap();
+    let sheet = voxsplat::scene::rate_scene(4).unwrap();
+    let cam = voxsplat::scene::rate_camera(sheet.grid(), 300.0).unwrap();
     let mut g = gpu();
     g.set_scene(sheet).unwrap();
     let mut o = RenderOptions::default();

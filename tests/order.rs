@@ -43,7 +43,7 @@ fn pbtf_has_no_violations_on_1000_random_viewpoints() {
 
 /// The close, off-axis perspective view of Figs 2.25-2.27 (shared with the stability study).
 fn close_view(set: &SplatSet) -> Camera {
-    voxsplat::stability::close_view(set.grid(), 256)
+    voxsplat::scene::close_view(set.grid(), 256)
 }
 
 #[test]

@@ -437,8 +437,8 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
     }
     // A single sheet seen head-on: too few layer pixels per splat for the pass to pay; every tile
     // then lets the composite read every layer.
-    let sheet = voxsplat::rates::rate_scene(64).unwrap();
-    let cam = voxsplat::rates::rate_camera(sheet.grid(), 5.0).unwrap();
+    let sheet = voxsplat::scene::rate_scene(64).unwrap();
+    let cam = voxsplat::scene::rate_camera(sheet.grid(), 5.0).unwrap();
     gpu.set_scene(sheet).unwrap();
     let tiles = gpu.sheet_tiles(&cam, &opts(Composite::Sheet, Raster::Compute)).unwrap();
     let n = tiles.len() / 2;

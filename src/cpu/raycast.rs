@@ -3,7 +3,7 @@
 use super::ImageF32;
 use crate::camera::Camera;
 use crate::gpu_types::RaycastParams;
-use crate::truth::DenseField;
+use crate::volume::DenseField;
 use crate::volume::SplatSet;
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;

@@ -5,15 +5,12 @@ use crate::gpu_types::{Frame, Splat, SplatParams};
 use crate::stages::{Dispatch, Res};
 use glam::{Mat4, Vec2, Vec3};
 
-pub const MAX_OPACITY: f32 = 0.999;
+pub use crate::volume::MAX_OPACITY;
 /// Splats closer than this many radii to the near or far plane are culled (the quad's corners
 /// must stay in front of the eye; 1.5 > sqrt 2).
 pub const CULL_RADII: f32 = 1.5;
 
-/// tau = -ln(1 - alpha) of one voxel-length of material, alpha clamped to `MAX_OPACITY`.
-pub fn optical_depth(opacity: f32) -> f32 {
-    -(1.0 - opacity.clamp(0.0, MAX_OPACITY)).ln()
-}
+pub use crate::volume::optical_depth;
 
 pub const AA_NONE: f32 = 0.0;
 pub const AA_SWAN: f32 = 1.0;

@@ -14,11 +14,11 @@ use crate::image::ImageF32;
 use crate::options::{Rendered, StageTime};
 use crate::plan::Prepared;
 use crate::stages::{List, Res, StageId};
-use crate::truth::DenseField;
 use crate::vk::{
     Bind, Blend, Buffer, BufferUsageFlags as BU, Context, Format, Image, ImageLayout as IL, ImageUsageFlags as IU,
     Layout, Pipeline, Primitive, ShaderStageFlags as SS, Slot, Stage, Timer,
 };
+use crate::volume::DenseField;
 use pipelines::{spirv, Pipelines};
 use resources::Resources;
 use std::sync::Arc;

@@ -1,11 +1,11 @@
 //! Long runs: render many frames with changing scenes, cameras and modes and watch host memory and
 //! GPU allocations (issue 7). The scene/mode sequence repeats every `CYCLE` frames, so after warm-up
 //! the allocator's report at the start of each cycle must not grow.
-use crate::camera::Camera;
-use crate::error::Result;
-use crate::kernel::KERNELS;
-use crate::options::{Antialias, Composite, RenderOptions};
-use crate::{scene, OrderKind, Renderer};
+use voxsplat::camera::Camera;
+use voxsplat::kernel::KERNELS;
+use voxsplat::options::{Antialias, Composite, RenderOptions};
+use voxsplat::Result;
+use voxsplat::{scene, OrderKind, Renderer};
 
 /// Frames per repetition of the sequence.
 pub const CYCLE: usize = 12;
@@ -91,12 +91,13 @@ pub fn soak(r: &mut Renderer, frames: usize, size: u32, mut progress: impl FnMut
         if step % 2 == 1 {
             cam.width = size + 8;
         }
-        let opts = RenderOptions {
-            order: [OrderKind::Pbtf, OrderKind::Wbtf][step % 2],
-            composite: if step % 3 == 2 { Composite::Sheet } else { Composite::Splat },
-            kernel: KERNELS[step / 2 % KERNELS.len()],
-            antialias: [Antialias::None, Antialias::Swan, Antialias::Ewa][step % 3],
-            ..Default::default()
+        let opts = {
+            let mut o = RenderOptions::default();
+            o.order = [OrderKind::Pbtf, OrderKind::Wbtf][step % 2];
+            o.composite = if step % 3 == 2 { Composite::Sheet } else { Composite::Splat };
+            o.kernel = KERNELS[step / 2 % KERNELS.len()];
+            o.antialias = [Antialias::None, Antialias::Swan, Antialias::Ewa][step % 3];
+            o
         };
         r.render(&cam, &opts)?;
         progress(f);

@@ -464,7 +464,7 @@ fn median_timings(mut frames: Vec<voxsplat::Rendered>) -> voxsplat::Rendered {
         let mut v: Vec<f64> =
             frames.iter().flat_map(|f| f.timings.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
         v.push(t.ms);
-        t.ms = voxsplat::bench::median(&mut v);
+        t.ms = voxsplat_cli::bench::median(&mut v);
     }
     last
 }
@@ -564,8 +564,8 @@ fn run(cli: Cli) -> Result<()> {
             }
             let mut r = Renderer::new(&RendererOptions::default())?;
             eprintln!("device: {}", r.device_name());
-            let pts = voxsplat::rates::raster_rates(&mut r, n, &sizes, frames, |m| eprintln!("{m}"))?;
-            print!("{}", voxsplat::rates::rates_csv(&pts));
+            let pts = voxsplat_cli::rates::raster_rates(&mut r, n, &sizes, frames, |m| eprintln!("{m}"))?;
+            print!("{}", voxsplat_cli::rates::rates_csv(&pts));
             Ok(())
         }
         Command::Peer { n, size, warmup, frames, out_dir, truth_step } => {
@@ -596,7 +596,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             let mut r = Renderer::new(&RendererOptions::default())?;
             println!("label,median_ms");
-            for run in voxsplat::peer::time_variants(&mut r, n, size, warmup, frames)? {
+            for run in voxsplat_cli::peer::time_variants(&mut r, n, size, warmup, frames)? {
                 println!("{},{:.2}", run.label, run.median_ms);
                 let file = format!("voxsplat-{}-{n}.png", run.label.replace(' ', "-"));
                 voxsplat::output::write_image(&run.image, &out_dir.join(file))?;
@@ -611,7 +611,7 @@ fn run(cli: Cli) -> Result<()> {
             ro.validation = validation;
             let mut r = Renderer::new(&ro)?;
             let bar = indicatif::ProgressBar::new(frames as u64);
-            let rep = voxsplat::soak::soak(&mut r, frames, size, |_| bar.inc(1))?;
+            let rep = voxsplat_cli::soak::soak(&mut r, frames, size, |_| bar.inc(1))?;
             bar.finish_and_clear();
             println!("frames: {}", rep.frames);
             println!("cycle,rss_mib,gpu_allocations,gpu_bytes");
@@ -623,7 +623,7 @@ fn run(cli: Cli) -> Result<()> {
             let step = rep.rss_median_step() as f64 / (1u64 << 20) as f64;
             println!(
                 "rss median step per cycle after warm-up: {step:.2} MiB ({} frames per cycle)",
-                voxsplat::soak::CYCLE
+                voxsplat_cli::soak::CYCLE
             );
             println!("validation messages: {}", rep.validation_messages);
             Ok(())
@@ -735,7 +735,7 @@ fn animate(a: AnimateArgs) -> Result<()> {
 }
 
 fn bench(a: BenchArgs) -> Result<()> {
-    use voxsplat::bench::*;
+    use voxsplat_cli::bench::*;
     let mut m = if a.quick { MatrixOptions::quick() } else { MatrixOptions::full() };
     if let Some(f) = a.frames {
         if f < 5 {
@@ -769,8 +769,8 @@ fn bench(a: BenchArgs) -> Result<()> {
     let mb = motion_study(&mut r, mb_size, mb_frame, m.frames)?;
     rows.extend(motion_rows(&mb, mb_size));
     let mb_images = write_motion_images(&mb, &a.out_dir)?;
-    let stab = voxsplat::stability::run(&mut r, a.quick, |msg| eprintln!("{msg}"))?;
-    voxsplat::stability::write_outputs(&stab, &a.out_dir)?;
+    let stab = voxsplat_cli::stability::run(&mut r, a.quick, |msg| eprintln!("{msg}"))?;
+    voxsplat_cli::stability::write_outputs(&stab, &a.out_dir)?;
     write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -785,9 +785,9 @@ fn bench(a: BenchArgs) -> Result<()> {
     let (rate_n, rate_sizes): (u32, &[f32]) =
         if a.quick { (48, &[3.0, 7.0]) } else { (256, &[3.0, 5.0, 7.0, 11.0, 15.0]) };
     let rates =
-        voxsplat::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames.clamp(3, 5), |msg| eprintln!("{msg}"))?;
-    voxsplat::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
-    voxsplat::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
+        voxsplat_cli::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames.clamp(3, 5), |msg| eprintln!("{msg}"))?;
+    voxsplat_cli::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
+    voxsplat_cli::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
     let scale = if a.no_scaling {
         Vec::new()
     } else {
@@ -816,10 +816,14 @@ fn bench(a: BenchArgs) -> Result<()> {
         let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
         let motion_md = format!(
             "{}\n{}\n{}\n{}\n{}",
-            voxsplat::rates::rates_markdown(&rates, &roof_rates, &voxsplat::bench::link(&chart_dir, "rates.svg")),
+            voxsplat_cli::rates::rates_markdown(
+                &rates,
+                &roof_rates,
+                &voxsplat_cli::bench::link(&chart_dir, "rates.svg")
+            ),
             antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
             motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
-            voxsplat::stability::markdown(&stab, &chart_dir),
+            voxsplat_cli::stability::markdown(&stab, &chart_dir),
             peers_md
         );
         let md = results_markdown(&Report {

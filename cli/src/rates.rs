@@ -6,18 +6,16 @@
 //! support is 4 voxel spacings across). Orthographic, so point sprites are exact too and every
 //! variant draws the same picture: equal error is checked, not assumed.
 use crate::bench::{median, rastered, time_method};
-use crate::camera::{Camera, Projection};
-use crate::error::{Error, Result};
-use crate::image::ImageF32;
-use crate::metrics::compare;
-use crate::options::Composite;
-use crate::raster::Raster;
-use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
-use crate::volume::{Grid, SplatSet};
-use crate::{Kernel, Renderer};
-use glam::Vec3;
 use std::fmt::Write as _;
 use std::path::Path;
+use voxsplat::image::ImageF32;
+use voxsplat::metrics::compare;
+use voxsplat::options::Composite;
+use voxsplat::raster::Raster;
+use voxsplat::scene::{rate_camera, rate_scene};
+use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
+use voxsplat::{Error, Result};
+use voxsplat::{Kernel, Renderer};
 
 /// The variants the sweep times: per-splat compositing and the sheet buffer, each through quads,
 /// point sprites and compute.
@@ -60,36 +58,6 @@ impl RatePoint {
         };
         format!("{c} {}", self.raster)
     }
-}
-
-/// The sweep's sheet of `n` x `n` voxels.
-pub fn rate_scene(n: u32) -> Result<SplatSet> {
-    let grid = Grid::centered([n, n, 1], [1.0; 3])?;
-    SplatSet::from_fn(grid, |i, j, _| {
-        let c = if (i / 4 + j / 4) % 2 == 0 { [0.9, 0.3, 0.1] } else { [0.2, 0.5, 0.9] };
-        Some([c[0], c[1], c[2], 0.3])
-    })
-}
-
-/// Head-on orthographic view of `grid` (a sheet) with footprints `size_px` wide.
-pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
-    if !(size_px.is_finite() && size_px >= 1.0) {
-        return Err(Error::InvalidArgument(format!("footprint size {size_px} px must be at least 1")));
-    }
-    let ppv = size_px / (2.0 * Kernel::Gaussian.radius());
-    let extent = grid.dims[0].max(grid.dims[1]) as f32 + 2.0 * Kernel::Gaussian.radius();
-    let side = (extent * ppv).ceil() as u32;
-    let c = grid.center();
-    Ok(Camera {
-        eye: c + Vec3::new(0.0, 0.0, 50.0),
-        target: c,
-        up: Vec3::Y,
-        projection: Projection::Orthographic { height: side as f32 / ppv },
-        near: 1.0,
-        far: 100.0,
-        width: side,
-        height: side,
-    })
 }
 
 /// Rounds of the sweep at each size. A round takes a warm-up frame of every variant, then its

@@ -1,20 +1,20 @@
 //! Benchmark bodies shared by `benches/render.rs` and `voxsplat bench`: the method matrix (time
 //! from GPU timestamps, error against the truth), the roofline, and scaling; CSV, SVG charts and
 //! docs/RESULTS.md. Medians over frames after warm-up.
-use crate::camera::Camera;
-use crate::cpu::raycast::RaycastOptions;
-use crate::error::{Error, Result};
-use crate::image::ImageF32;
-use crate::metrics::{compare, ImageMetrics};
-use crate::options::{Antialias, Composite, RenderOptions, Rendered};
-use crate::order::{count_violations, visibility_order};
-use crate::raster::Raster;
-use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
-use crate::volume::{Grid, SplatSet};
-use crate::{scene, Direction, Kernel, OrderKind, Renderer};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
+use voxsplat::camera::Camera;
+use voxsplat::cpu::raycast::RaycastOptions;
+use voxsplat::image::ImageF32;
+use voxsplat::metrics::{compare, ImageMetrics};
+use voxsplat::options::{Antialias, Composite, RenderOptions, Rendered};
+use voxsplat::order::{count_violations, visibility_order};
+use voxsplat::raster::Raster;
+use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
+use voxsplat::volume::{Grid, SplatSet};
+use voxsplat::{scene, Direction, Kernel, OrderKind, Renderer};
+use voxsplat::{Error, Result};
 
 /// One rendering method of the matrix.
 #[derive(Clone, Debug, PartialEq)]
@@ -207,14 +207,15 @@ fn render_method(r: &mut Renderer, m: &Method, camera: &Camera) -> Result<Render
 fn render_method_at(r: &mut Renderer, m: &Method, camera: &Camera, render_scale: f32) -> Result<Rendered> {
     match m {
         Method::Splat { order, composite, kernel, aa, raster } => {
-            let o = RenderOptions {
-                order: *order,
-                composite: *composite,
-                kernel: *kernel,
-                antialias: *aa,
-                raster: *raster,
-                render_scale,
-                ..Default::default()
+            let o = {
+                let mut o = RenderOptions::default();
+                o.order = *order;
+                o.composite = *composite;
+                o.kernel = *kernel;
+                o.antialias = *aa;
+                o.raster = *raster;
+                o.render_scale = render_scale;
+                o
             };
             r.render(camera, &o)
         }
@@ -473,9 +474,13 @@ pub fn roofline(
 
 /// Fragments the footprint pass of a frame touches: the quads' pixel areas (clipped to the image).
 pub fn footprint_fragments(set: &SplatSet, camera: &Camera, kernel: Kernel) -> Result<(f64, f64)> {
-    let mut r = Renderer::new(&crate::RendererOptions { backend: crate::Backend::Cpu, ..Default::default() })?;
+    let mut r = Renderer::new(&{
+        let mut o = voxsplat::RendererOptions::default();
+        o.backend = voxsplat::Backend::Cpu;
+        o
+    })?;
     r.set_scene(set.clone())?;
-    let params = r.splat_params(camera, kernel, crate::Antialias::None)?;
+    let params = r.splat_params(camera, kernel, voxsplat::Antialias::None)?;
     let cap = camera.width as f64 * camera.height as f64;
     let mut total = 0.0;
     let mut sizes = Vec::new();
@@ -871,8 +876,8 @@ pub fn antialias_study(
     let set = scene::build("plane")?;
     let camera = Camera::grazing(set.grid(), size, size);
     progress("anti-aliasing: supersampled truth");
-    let truth = crate::truth::supersampled(&set, &camera, factor, &TruthOptions::default())?;
-    let regions = crate::aa::k_regions(&set, &camera);
+    let truth = voxsplat::truth::supersampled(&set, &camera, factor, &TruthOptions::default())?;
+    let regions = voxsplat::aa::k_regions(&set, &camera);
     r.set_scene(set.clone())?;
     let mut rows = Vec::new();
     for mode in [Antialias::None, Antialias::Swan, Antialias::Ewa] {
@@ -885,8 +890,8 @@ pub fn antialias_study(
             raster: Raster::Graphics,
         };
         let t = time_method(r, &m, &camera, 1, frames)?;
-        let before = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
-        let beyond = crate::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
+        let before = voxsplat::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
+        let beyond = voxsplat::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
         // Dolly: the camera moves forward half a voxel per frame, parallel to the sheet.
         let step = glam::Vec3::new(0.0, 0.5 * set.grid().spacing[1], 0.0);
         let mut frames_img = Vec::with_capacity(dolly);
@@ -894,9 +899,9 @@ pub fn antialias_study(
         for f in 0..dolly {
             let cam = Camera { eye: camera.eye + step * f as f32, target: camera.target + step * f as f32, ..camera };
             frames_img.push(render_method(r, &m, &cam)?.image);
-            regions_f.push(crate::aa::k_regions(&set, &cam));
+            regions_f.push(voxsplat::aa::k_regions(&set, &cam));
         }
-        let shimmer = crate::metrics::shimmer(&frames_img, |t, i| regions_f[t][i] == 2).unwrap_or(f64::NAN);
+        let shimmer = voxsplat::metrics::shimmer(&frames_img, |t, i| regions_f[t][i] == 2).unwrap_or(f64::NAN);
         rows.push(AaRow {
             mode,
             time_ms: t.time_ms,
@@ -947,8 +952,8 @@ pub fn antialias_markdown(rows: &[AaRow], size: u32, factor: u32, dolly: usize) 
             "| {:?} | {:.2} | {:.2} | {:.2} | {} | {:.5} | {:.2} |",
             r.mode,
             r.time_ms,
-            crate::metrics::psnr(r.rmse_before),
-            crate::metrics::psnr(r.rmse_beyond),
+            voxsplat::metrics::psnr(r.rmse_before),
+            voxsplat::metrics::psnr(r.rmse_beyond),
             r.pixels_beyond,
             r.shimmer,
             r.metrics.psnr
@@ -958,7 +963,7 @@ pub fn antialias_markdown(rows: &[AaRow], size: u32, factor: u32, dolly: usize) 
     if let Some(none) = find(Antialias::None) {
         for m in [Antialias::Swan, Antialias::Ewa] {
             let Some(x) = find(m) else { continue };
-            let db = crate::metrics::psnr(x.rmse_beyond) - crate::metrics::psnr(none.rmse_beyond);
+            let db = voxsplat::metrics::psnr(x.rmse_beyond) - voxsplat::metrics::psnr(none.rmse_beyond);
             let sh = x.shimmer / none.shimmer;
             let tr = x.time_ms / none.time_ms;
             let met = db >= 6.0 && sh <= 0.5 && tr < 1.5;
@@ -988,7 +993,7 @@ pub struct MotionRow {
 /// The rotating box at one frame: still, blurred splats (per-splat and sheet), and 5-sub-frame
 /// accumulation, timed (median of `frames`) and scored against 64-sub-frame accumulation.
 pub fn motion_study(r: &mut Renderer, size: u32, frame: u32, frames: usize) -> Result<Vec<MotionRow>> {
-    use crate::animate::{render_frame_timed, Animation, Blur};
+    use voxsplat::animate::{render_frame_timed, Animation, Blur};
     let mut anim = Animation::builtin("rotating-box")?;
     anim.camera.width = size;
     anim.camera.height = size;
@@ -996,7 +1001,11 @@ pub fn motion_study(r: &mut Renderer, size: u32, frame: u32, frames: usize) -> R
     let grid = *set.grid();
     r.set_scene(set)?;
     let splat = RenderOptions::default();
-    let sheet = RenderOptions { composite: Composite::Sheet, ..Default::default() };
+    let sheet = {
+        let mut o = RenderOptions::default();
+        o.composite = Composite::Sheet;
+        o
+    };
     let truth = render_frame_timed(r, &anim, &grid, frame, Blur::Accum(64), &splat)?.0;
     let mut rows = Vec::new();
     for (name, blur, o) in [
@@ -1015,8 +1024,8 @@ pub fn motion_study(r: &mut Renderer, size: u32, frame: u32, frames: usize) -> R
         }
         let img = last.expect("one frame");
         let alpha = |i: usize| truth.pixels[i][3];
-        let rmse_edge = crate::metrics::rmse_masked(&img, &truth, |i| alpha(i) > 0.05 && alpha(i) < 0.95);
-        let rmse_interior = crate::metrics::rmse_masked(&img, &truth, |i| alpha(i) >= 0.95);
+        let rmse_edge = voxsplat::metrics::rmse_masked(&img, &truth, |i| alpha(i) > 0.05 && alpha(i) < 0.95);
+        let rmse_interior = voxsplat::metrics::rmse_masked(&img, &truth, |i| alpha(i) >= 0.95);
         rows.push(MotionRow {
             method: name.into(),
             time_ms: median(&mut times),
@@ -1066,7 +1075,7 @@ pub fn write_motion_images(rows: &[MotionRow], dir: &Path) -> Result<Vec<(String
             "motion-{}.png",
             r.method.split([' ', '(', ')', ':']).filter(|s| !s.is_empty()).collect::<Vec<_>>().join("-")
         );
-        crate::output::write_image(&r.image, &dir.join(&name))?;
+        voxsplat::output::write_image(&r.image, &dir.join(&name))?;
         out.push((r.method.clone(), name));
     }
     if let (Some(t), Some(b)) = (truth, rows.iter().find(|r| r.method == "blurred splats")) {
@@ -1075,7 +1084,7 @@ pub fn write_motion_images(rows: &[MotionRow], dir: &Path) -> Result<Vec<(String
             let d = (0..4).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max);
             *e = [(4.0 * d).min(1.0), (4.0 * d).min(1.0) * 0.5, 0.0, 1.0];
         }
-        crate::output::write_image(&err, &dir.join("motion-error-blurred-splats.png"))?;
+        voxsplat::output::write_image(&err, &dir.join("motion-error-blurred-splats.png"))?;
         out.push(("error of blurred splats ×4".into(), "motion-error-blurred-splats.png".into()));
     }
     Ok(out)

@@ -1,4 +1,5 @@
 //! Long runs do not leak, renderers are Send and deterministic.
+#[path = "../../tests/common/mod.rs"]
 mod common;
 use voxsplat::{scene, Camera, Composite, RenderOptions};
 
@@ -6,7 +7,7 @@ use voxsplat::{scene, Camera, Composite, RenderOptions};
 #[test]
 fn a_100_frame_soak_keeps_gpu_allocations_flat() {
     let mut r = common::gpu();
-    let rep = voxsplat::soak::soak(&mut r, 100, 64, |_| {}).unwrap();
+    let rep = voxsplat_cli::soak::soak(&mut r, 100, 64, |_| {}).unwrap();
     eprintln!("gpu per cycle {:?}", rep.gpu);
     eprintln!("rss per cycle (MiB) {:?}", rep.rss.iter().map(|b| b / (1 << 20)).collect::<Vec<_>>());
     // After the first cycle (warm-up) every cycle starts with the same live allocations. lavapipe's
@@ -105,7 +106,7 @@ fn device_loss_is_an_error_that_sticks_and_the_renderer_drops_cleanly() {
     r.render(&cam, &RenderOptions::default()).unwrap();
     let ctx = r.context().expect("gpu").clone();
     assert!(!ctx.is_lost());
-    ctx.inject_submit_fault(ash::vk::Result::ERROR_DEVICE_LOST);
+    ctx.inject_submit_fault(voxsplat::vk::ash::vk::Result::ERROR_DEVICE_LOST);
     let err = r.render(&cam, &RenderOptions::default()).unwrap_err();
     assert!(matches!(err, voxsplat::Error::DeviceLost(_)), "{err}");
     assert!(err.to_string().contains("create a new one"), "{err}");
@@ -128,7 +129,7 @@ fn out_of_memory_at_submit_is_an_error_and_the_next_frame_renders() {
     r.set_scene(scene::build("cube40").unwrap()).unwrap();
     let cam = Camera::framing(r.scene().unwrap().grid(), 48, 48);
     let before = r.render(&cam, &RenderOptions::default()).unwrap().image;
-    r.context().unwrap().inject_submit_fault(ash::vk::Result::ERROR_OUT_OF_DEVICE_MEMORY);
+    r.context().unwrap().inject_submit_fault(voxsplat::vk::ash::vk::Result::ERROR_OUT_OF_DEVICE_MEMORY);
     let err = r.render(&cam, &RenderOptions::default()).unwrap_err();
     assert!(matches!(err, voxsplat::Error::OutOfMemory(_)), "{err}");
     let after = r.render(&cam, &RenderOptions::default()).unwrap().image;

@@ -1,5 +1,6 @@
 //! The command-line contract: listed scenes, rendered files, order dumps, and clear errors (never
 //! a panic) for bad input.
+#[path = "../../tests/common/mod.rs"]
 mod common;
 use std::process::{Command, Output};
 
@@ -259,7 +260,7 @@ fn peer_subcommand_times_every_mode() {
 /// `voxsplat info` counts a file's splats and says when they pass the GPU path's limit.
 #[test]
 fn info_counts_splats_and_names_the_gpu_limit() {
-    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/stent/stent.nrrd");
+    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/stent/stent.nrrd");
     let out = voxsplat(&["info", stent]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);

@@ -1,11 +1,12 @@
 //! Issue 8: the failures of section 1.2.2.3 reproduced as qualitative facts, and the image-aligned
 //! sheet buffer (slabs) that avoids them. Figures go to the bench (docs/RESULTS.md).
+#[path = "../../tests/common/mod.rs"]
 mod common;
 use glam::Vec3;
 use voxsplat::output::diff_rgba8;
-use voxsplat::stability::{self, Variant};
 use voxsplat::ImageF32;
 use voxsplat::{Camera, Composite, Direction, Grid, Kernel, OrderKind, Projection, RenderOptions, SplatSet};
+use voxsplat_cli::stability::{self, Variant};
 
 #[test]
 fn slice_table_starts_at_zero_rises_and_ends_at_the_footprint() {

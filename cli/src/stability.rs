@@ -4,19 +4,20 @@
 //! (c) per-splat compositing's dependence on the order of overlapping splats (Figs 1.13, 1.14);
 //! (d) BTF/WBTF visibility errors in perspective (Figs 2.25, 2.26, 5.1).
 use crate::bench::median;
-use crate::camera::{Camera, Projection};
-use crate::cpu::raycast::RaycastOptions;
-use crate::error::Result;
-use crate::image::ImageF32;
-use crate::metrics::{compare, frame_changes, temporal_of};
-use crate::options::{Composite, RenderOptions, Rendered};
-use crate::order::{count_violations, visibility_order, Direction, OrderKind};
-use crate::plan::sheet_axis;
-use crate::raster::Raster;
-use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
-use crate::volume::{Grid, SplatSet};
-use crate::{scene, Renderer};
 use glam::{Quat, Vec3};
+use voxsplat::camera::{Camera, Projection};
+use voxsplat::cpu::raycast::RaycastOptions;
+use voxsplat::image::ImageF32;
+use voxsplat::metrics::{compare, frame_changes, temporal_of};
+use voxsplat::options::{Composite, RenderOptions, Rendered};
+use voxsplat::order::{count_violations, visibility_order, Direction, OrderKind};
+use voxsplat::plan::sheet_axis;
+use voxsplat::raster::Raster;
+use voxsplat::scene::close_view;
+use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
+use voxsplat::volume::{Grid, SplatSet};
+use voxsplat::Result;
+use voxsplat::{scene, Renderer};
 
 /// A renderer configuration compared by the studies.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,9 +34,9 @@ pub enum Variant {
     /// variant (the others draw instanced quads through the graphics pipeline).
     Rastered(Composite, Raster),
     /// PBTF per-splat compositing with another reconstruction kernel, through a raster variant.
-    Kernel(crate::Kernel, Raster),
+    Kernel(voxsplat::Kernel, Raster),
     /// `Kernel` drawn at a render scale (`RenderOptions::render_scale`) and resampled to full size.
-    Scaled(crate::Kernel, Raster, f32),
+    Scaled(voxsplat::Kernel, Raster, f32),
 }
 
 impl Variant {
@@ -60,12 +61,16 @@ impl Variant {
         match self {
             Variant::Raycast(_) => Reconstruction::Trilinear,
             Variant::Kernel(k, _) | Variant::Scaled(k, _, _) => Reconstruction::Kernel(*k),
-            _ => Reconstruction::Kernel(crate::Kernel::Gaussian),
+            _ => Reconstruction::Kernel(voxsplat::Kernel::Gaussian),
         }
     }
 
     pub fn render(&self, r: &mut Renderer, camera: &Camera) -> Result<Rendered> {
-        let mut o = RenderOptions { raster: Raster::Graphics, ..Default::default() };
+        let mut o = {
+            let mut o = RenderOptions::default();
+            o.raster = Raster::Graphics;
+            o
+        };
         match *self {
             Variant::Rastered(composite, raster) => {
                 o.composite = composite;
@@ -390,28 +395,16 @@ pub struct VisibilityRow {
     pub rmse_vs_truth: f64,
 }
 
-/// The close, off-axis perspective view of the 60³ cube of Figs 2.25–2.27 (the eye projects inside
-/// the grid on two axes).
-pub fn close_view(grid: &Grid, size: u32) -> Camera {
-    let c = grid.center();
-    Camera {
-        eye: c + Vec3::new(12.0, 20.0, 75.0),
-        target: c,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 60.0 },
-        near: 0.5,
-        far: 300.0,
-        width: size,
-        height: size,
-    }
-}
-
 pub fn visibility_study(r: &mut Renderer, size: u32) -> Result<Vec<VisibilityRow>> {
     let mut rows = Vec::new();
     for (view, name) in [("cube60 close (Figs 2.25-2.26)", "cube60"), ("rmnp fly-over (Fig. 5.1)", "rmnp")] {
         let set = scene::build(name)?;
         let cam = if name == "rmnp" { Camera::flyover(set.grid(), size, size) } else { close_view(set.grid(), size) };
-        let mut o = RenderOptions { order: OrderKind::Sorted, ..Default::default() };
+        let mut o = {
+            let mut o = RenderOptions::default();
+            o.order = OrderKind::Sorted;
+            o
+        };
         let orders = [OrderKind::Btf, OrderKind::Wbtf, OrderKind::Pbtf];
         let violations: Vec<u64> = orders
             .iter()
@@ -489,7 +482,7 @@ pub fn write_outputs(rep: &StabilityReport, dir: &std::path::Path) -> Result<()>
             b.map(|b| b.density_ratio).unwrap_or(f64::NAN)
         );
     }
-    std::fs::write(&path, csv).map_err(|e| crate::Error::Io { path: path.display().to_string(), source: e })?;
+    std::fs::write(&path, csv).map_err(|e| voxsplat::Error::Io { path: path.display().to_string(), source: e })?;
     let pop: Vec<(String, f64, f64)> =
         rep.switch.iter().map(|s| (s.variant.clone(), s.time_ms, s.switch_popping)).collect();
     crate::bench::scatter_svg(
@@ -614,7 +607,11 @@ pub fn early_termination_study(r: &mut Renderer, size: u32, frames: usize) -> Re
         let cam = Camera::framing(set.grid(), size, size);
         r.set_scene(set)?;
         for composite in [Composite::Sheet, Composite::Slab] {
-            let mut o = RenderOptions { composite, ..Default::default() };
+            let mut o = {
+                let mut o = RenderOptions::default();
+                o.composite = composite;
+                o
+            };
             let time = |o: &RenderOptions, r: &mut Renderer| -> Result<(f64, ImageF32)> {
                 r.render(&cam, o)?;
                 let mut t = Vec::new();
@@ -627,7 +624,7 @@ pub fn early_termination_study(r: &mut Renderer, size: u32, frames: usize) -> Re
                 Ok((median(&mut t), last.expect("one frame")))
             };
             let (off_ms, off) = time(&o, r)?;
-            o.early_termination = crate::options::DEFAULT_EARLY_TERMINATION;
+            o.early_termination = voxsplat::options::DEFAULT_EARLY_TERMINATION;
             let (on_ms, on) = time(&o, r)?;
             let max_change = off
                 .pixels
@@ -654,8 +651,8 @@ pub fn early_markdown(rows: &[EarlyRow], size: u32) -> String {
          (transmittance left per 8x8 tile; batches of at most {} sheets so the occlusion map updates): \
          medians with it off and on, and the largest change it made to any pixel channel.\n\n\
          | scene | mode | off ms | on ms | speed-up | max change |\n|---|---|---:|---:|---:|---:|\n",
-        crate::options::DEFAULT_EARLY_TERMINATION,
-        crate::options::EARLY_TERMINATION_BATCH
+        voxsplat::options::DEFAULT_EARLY_TERMINATION,
+        voxsplat::options::EARLY_TERMINATION_BATCH
     );
     for r in rows {
         md += &format!(

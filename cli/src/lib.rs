@@ -1,0 +1,9 @@
+//! The research harness around the voxsplat renderer: the benchmark matrix and its charts
+//! (`bench`), where methods fail (`stability`), the raster-rate sweep (`rates`), the peers'
+//! comparison (`peer`) and long runs (`soak`). The `voxsplat` command-line tool is this crate's
+//! binary; the renderer itself is the `voxsplat` library, which needs none of this.
+pub mod bench;
+pub mod peer;
+pub mod rates;
+pub mod soak;
+pub mod stability;
