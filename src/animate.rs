@@ -12,6 +12,7 @@ use serde::Deserialize;
 
 /// Largest frame count and accumulation sub-frame count accepted.
 pub const MAX_FRAMES: u32 = 100_000;
+/// Most sub-frames an accumulation-buffer frame may average.
 pub const MAX_SUBFRAMES: u32 = 1024;
 /// Default delta of chapter 4: paths shorter than this many pixels are not blurred.
 pub const DEFAULT_DELTA_PX: f32 = 0.5;
@@ -21,17 +22,20 @@ pub const DEFAULT_DELTA_PX: f32 = 0.5;
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Keyframe {
+    /// The frame this keyframe holds at.
     pub frame: f32,
     /// Axis (x, y, z) and angle in degrees.
     #[serde(default = "no_rotation")]
     pub rotate: [f32; 4],
     #[serde(default)]
+    /// Translation of the object, in world units.
     pub translate: [f32; 3],
     /// Camera path: the eye and look-at point at this keyframe (both or neither); frames between
     /// camera keyframes interpolate linearly, and frames outside them hold the nearest.
     #[serde(default)]
     pub eye: Option<[f32; 3]>,
     #[serde(default)]
+    /// Where the camera looks at this keyframe (optional camera path).
     pub target: Option<[f32; 3]>,
 }
 
@@ -80,12 +84,15 @@ fn default_size() -> [u32; 2] {
 /// A rigid-body animation of one scene seen by a fixed camera.
 #[derive(Clone, Debug)]
 pub struct Animation {
+    /// The built-in scene animated.
     pub scene: String,
+    /// Frames rendered.
     pub frames: u32,
     /// Fraction of the frame interval the shutter is open (the blur covers [t - shutter, t]).
     pub shutter: f32,
     /// The world camera.
     pub camera: Camera,
+    /// The object (and camera) path, interpolated linearly between keyframes.
     pub keyframes: Vec<Keyframe>,
 }
 
@@ -99,6 +106,7 @@ pub const ANIMATIONS: &[(&str, &str)] = &[
 ];
 
 impl Animation {
+    /// A built-in animation by name (`rotating-box`, `rotating-terrain`).
     pub fn builtin(name: &str) -> Result<Self> {
         match name {
             "rotating-box" => Self::from_toml(
@@ -201,7 +209,7 @@ impl Animation {
         Ok(anim)
     }
 
-    /// The world camera at time `t`: the [camera] table, moved along the keyframes' camera path.
+    /// The world camera at time `t`: the `[camera]` table, moved along the keyframes' camera path.
     pub fn camera_at(&self, t: f32) -> Camera {
         let path: Vec<(f32, Vec3, Vec3)> =
             self.keyframes.iter().filter_map(|k| Some((k.frame, Vec3::from(k.eye?), Vec3::from(k.target?)))).collect();
@@ -279,6 +287,7 @@ impl Animation {
 /// How a frame's motion is rendered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Blur {
+    /// Each frame drawn still.
     None,
     /// Motion-blurred splats.
     Splat,

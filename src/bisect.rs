@@ -145,6 +145,7 @@ pub struct Stop<'a> {
 }
 
 impl<'a> Stop<'a> {
+    /// Run `inner` until the stage after `after` begins.
     pub fn new(inner: &'a mut dyn Engine, after: StageId) -> Self {
         Self { inner, after, seen: false, done: false }
     }

@@ -11,22 +11,40 @@ pub const MAX_IMAGE_SIDE: u32 = 16384;
 pub const MAX_PIXELS: u64 = 8192 * 8192;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
+/// How the view volume maps to the image.
 pub enum Projection {
     /// Vertical field of view in degrees, in (0, 180).
-    Perspective { fov_y_deg: f32 },
+    /// A pinhole camera with this vertical field of view in degrees.
+    Perspective {
+        /// Vertical field of view in degrees.
+        fov_y_deg: f32,
+    },
     /// World-space height of the view.
-    Orthographic { height: f32 },
+    /// Parallel rays; the view is this many world units tall.
+    Orthographic {
+        /// Height of the view in world units.
+        height: f32,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
+/// A view of the scene: eye, target and up in world units, projection, clip planes and image size.
 pub struct Camera {
+    /// Where the eye is.
     pub eye: Vec3,
+    /// The point the eye looks at.
     pub target: Vec3,
+    /// The up direction (need not be orthogonal to the view direction).
     pub up: Vec3,
+    /// Perspective or orthographic.
     pub projection: Projection,
+    /// Near clip distance along the view direction.
     pub near: f32,
+    /// Far clip distance along the view direction.
     pub far: f32,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
 }
 
@@ -93,26 +111,32 @@ impl Camera {
         Ok(())
     }
 
+    /// Whether the projection is a perspective one.
     pub fn is_perspective(&self) -> bool {
         matches!(self.projection, Projection::Perspective { .. })
     }
 
+    /// Unit view direction (eye to target).
     pub fn forward(&self) -> Vec3 {
         (self.target - self.eye).normalize()
     }
 
+    /// Unit right vector of the image plane.
     pub fn right(&self) -> Vec3 {
         self.forward().cross(self.up).normalize()
     }
 
+    /// Unit up vector of the image plane (orthogonal to the view direction).
     pub fn true_up(&self) -> Vec3 {
         self.right().cross(self.forward())
     }
 
+    /// Width over height.
     pub fn aspect(&self) -> f32 {
         self.width as f32 / self.height as f32
     }
 
+    /// World to eye space (right-handed, looking down -z).
     pub fn view(&self) -> Mat4 {
         Mat4::look_at_rh(self.eye, self.target, self.up)
     }
@@ -132,6 +156,7 @@ impl Camera {
         p
     }
 
+    /// World to clip space (Vulkan depth range, y down).
     pub fn view_proj(&self) -> Mat4 {
         self.proj() * self.view()
     }

@@ -33,6 +33,7 @@ pub const TF_PRESETS: &[(&str, &str)] = &[
 ];
 
 impl TransferFunction {
+    /// A named preset: `ramp`, `ct`, `bonsai` (see README).
     pub fn preset(name: &str) -> Result<Self> {
         let p = |points: Vec<(f32, [f32; 4])>| Self { points, gradient_weight: 0.0, range: None, threshold: 0.0 };
         match name {
@@ -66,6 +67,7 @@ impl TransferFunction {
         Ok(tf)
     }
 
+    /// Reject transfer functions no classification can use.
     pub fn validate(&self) -> Result<()> {
         let bad = |m: &str| Err(Error::InvalidArgument(format!("transfer function: {m}")));
         if self.points.is_empty() || self.points.len() > 4096 {
@@ -95,6 +97,7 @@ impl TransferFunction {
         Ok(())
     }
 
+    /// Straight RGBA at normalised value `d`, linear between the points.
     pub fn eval(&self, d: f32) -> [f32; 4] {
         let pts = &self.points;
         if d <= pts[0].0 {
@@ -115,13 +118,18 @@ impl TransferFunction {
 pub struct Shading {
     /// Direction the light travels (the view direction, for a headlight), in grid coordinates.
     pub light: Vec3,
+    /// Ambient term.
     pub ambient: f32,
+    /// Diffuse (Lambert) weight.
     pub diffuse: f32,
+    /// Specular (Phong) weight.
     pub specular: f32,
+    /// Phong exponent.
     pub shininess: f32,
 }
 
 impl Shading {
+    /// Headlight shading: the light at the eye, looking along `view_dir`.
     pub fn headlight(view_dir: Vec3) -> Self {
         Self { light: view_dir.normalize_or_zero(), ambient: 0.3, diffuse: 0.7, specular: 0.25, shininess: 20.0 }
     }

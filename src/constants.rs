@@ -17,6 +17,7 @@ pub const SLAB_CHUNK: u32 = 1024;
 /// RASTER_TILE_W pixels, run by one SIMD group of RASTER_LANES lanes that deal each footprint box's
 /// pixels in the tile among themselves.
 pub const RASTER_TILE_W: u32 = 16;
+/// Pixels down a tile of the compute tile compositor.
 pub const RASTER_TILE_H: u32 = 16;
 /// Lanes of a compositor workgroup (llvmpipe's SIMD width on AVX2).
 pub const RASTER_LANES: u32 = 8;

@@ -25,18 +25,34 @@ pub enum Error {
     DeviceLost(String),
     /// A Vulkan call failed.
     #[error("Vulkan call {call} failed: {result}")]
-    Vulkan { call: &'static str, result: vk::Result },
+    Vulkan {
+        /// The Vulkan function.
+        call: &'static str,
+        /// What it returned.
+        result: vk::Result,
+    },
     /// The Vulkan loader could not be opened.
     #[error("cannot load Vulkan: {0}")]
     Loader(String),
     /// Reading or writing a file.
     #[error("I/O error on {path}: {source}")]
-    Io { path: String, source: std::io::Error },
+    Io {
+        /// The file.
+        path: String,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
     /// Encoding an output image.
     #[error("cannot write image {path}: {message}")]
-    Image { path: String, message: String },
+    Image {
+        /// The file.
+        path: String,
+        /// The encoder's message.
+        message: String,
+    },
 }
 
+/// The crate's result type.
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {

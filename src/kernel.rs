@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use std::sync::OnceLock;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// The reconstruction kernel, pre-integrated along the ray into a footprint.
 pub enum Kernel {
     /// Westover's Gaussian, sigma = 0.6 voxel, truncated at radius 2.
     #[default]
@@ -27,6 +28,7 @@ pub enum Kernel {
     Narrow,
 }
 
+/// Standard deviation of the Gaussian kernel, in voxel spacings.
 pub const GAUSSIAN_SIGMA: f64 = 0.6;
 /// Sigma of `Kernel::Narrow` (voxels).
 pub const NARROW_SIGMA: f64 = 0.5;

@@ -14,16 +14,22 @@
 //! # Ok::<(), voxsplat::Error>(())
 //! ```
 #![deny(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod aa;
 pub mod animate;
 pub mod bisect;
 pub mod camera;
 pub mod classify;
+/// Constants shared with the shaders (injected into GLSL as macros by build.rs).
 pub mod constants;
+/// The CPU mirrors of the GPU stages (public for tests and the harness; see `stages`).
+#[doc(hidden)]
 pub mod cpu;
 mod error;
 mod gpu;
+/// `#[repr(C)]` mirrors of `glsl/shared/types.glsl` (public for tests and the mirrors).
+#[doc(hidden)]
 pub mod gpu_types;
 pub mod image;
 pub mod kernel;
@@ -35,6 +41,8 @@ pub mod order;
 #[cfg(feature = "io")]
 pub mod output;
 pub mod peer;
+/// Per-frame planning without a device (public for tests and the harness).
+#[doc(hidden)]
 pub mod plan;
 pub mod raster;
 pub mod recording;
@@ -342,6 +350,7 @@ impl Renderer {
         self.gpu.as_ref().map(|g| g.context().validation_count()).unwrap_or(0)
     }
 
+    /// The validation messages counted so far (empty without validation or on the CPU).
     pub fn validation_messages(&self) -> Vec<String> {
         self.gpu.as_ref().map(|g| g.context().validation_messages()).unwrap_or_default()
     }

@@ -15,13 +15,18 @@ pub const MAX_INFLATED: u64 = MAX_VOXELS * 8 + (1 << 20);
 /// Sample types of raw and NRRD data.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DType {
+    /// Unsigned 8-bit samples.
     U8,
+    /// Unsigned 16-bit samples.
     U16,
+    /// Signed 16-bit samples.
     I16,
+    /// 32-bit float samples.
     F32,
 }
 
 impl DType {
+    /// Bytes per sample.
     pub fn size(self) -> usize {
         match self {
             DType::U8 => 1,
@@ -374,9 +379,13 @@ fn read_all<T: npyz::Deserialize>(npy: npyz::NpyFile<&[u8]>, what: &str) -> Resu
 /// Options for volumes whose files do not say everything (raw data).
 #[derive(Clone, Debug, Default)]
 pub struct VolumeHints {
+    /// Grid size of a raw file (required for raw without a sidecar).
     pub dims: Option<[u32; 3]>,
+    /// Sample type of a raw file.
     pub dtype: Option<DType>,
+    /// Whether raw samples are big-endian.
     pub big_endian: bool,
+    /// Voxel spacing, overriding the file's.
     pub spacing: Option<[f32; 3]>,
 }
 

@@ -148,6 +148,7 @@ pub struct Temporal {
     pub popping: f64,
 }
 
+/// Temporal stability of an animation's frames (at least three): changes between frames and popping.
 pub fn temporal(frames: &[ImageF32]) -> Result<Temporal> {
     if frames.len() < 3 {
         return Err(Error::InvalidArgument("temporal metrics need at least 3 frames".into()));

@@ -86,9 +86,13 @@ pub struct Motion {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RenderOptions {
+    /// The visibility order.
     pub order: OrderKind,
+    /// Per-splat compositing or sheet buffers.
     pub composite: Composite,
+    /// The reconstruction kernel.
     pub kernel: Kernel,
+    /// Anti-aliasing of distant splats.
     pub antialias: Antialias,
     /// Motion-blurred splats (chapter 4); `None` draws the frame still.
     pub motion: Option<Motion>,
@@ -185,14 +189,18 @@ impl RenderOptions {
 /// One named stage's time in milliseconds (GPU timestamps, or wall time on the CPU path).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StageTime {
+    /// The stage's name (`order`, `splat_params`, `footprint`, ...).
     pub stage: &'static str,
+    /// Milliseconds.
     pub ms: f64,
 }
 
 /// A rendered frame: premultiplied RGBA32F, row 0 at the top.
 #[derive(Clone, Debug)]
 pub struct Rendered {
+    /// The frame.
     pub image: ImageF32,
+    /// Per-stage times, in the order the stages ran.
     pub timings: Vec<StageTime>,
     /// The footprint stage's raster variant and why (`None` for the ray caster and the truth).
     pub raster: Option<RasterChoice>,

@@ -9,6 +9,7 @@ use crate::volume::SplatSet;
 use glam::DVec3;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// A visibility order of the grid's splats.
 pub enum OrderKind {
     /// Frieder et al.: one traversal direction per axis, z outermost.
     Btf,
@@ -35,8 +36,11 @@ impl std::str::FromStr for OrderKind {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which way an order runs.
 pub enum Direction {
+    /// Nearest splats first.
     FrontToBack,
+    /// Farthest splats first.
     BackToFront,
 }
 
@@ -44,11 +48,14 @@ pub enum Direction {
 /// infinity (orthographic).
 #[derive(Clone, Copy, Debug)]
 pub enum Viewer {
+    /// A perspective eye at this grid-index point.
     Eye(DVec3),
+    /// An orthographic viewer looking along this grid-index direction.
     Toward(DVec3),
 }
 
 impl Viewer {
+    /// The viewer of `camera`, in `set`'s grid index coordinates.
     pub fn of(set: &SplatSet, camera: &Camera) -> Self {
         let g = set.grid();
         let o = DVec3::from(g.origin.map(f64::from));

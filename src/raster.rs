@@ -21,6 +21,7 @@ use crate::options::{Composite, RenderOptions};
 use crate::volume::SplatSet;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// How the footprint stage turns splats into pixels.
 pub enum Raster {
     /// Instanced quads through the graphics pipeline.
     Graphics,
@@ -34,6 +35,7 @@ pub enum Raster {
 }
 
 impl Raster {
+    /// The name the CLI and the reports use.
     pub fn name(self) -> &'static str {
         match self {
             Raster::Graphics => "graphics",
@@ -66,7 +68,9 @@ impl std::fmt::Display for Raster {
 /// The variant a frame was drawn with and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RasterChoice {
+    /// The variant drawn.
     pub raster: Raster,
+    /// Why (`auto`'s rule, or "requested").
     pub reason: String,
 }
 
@@ -125,6 +129,7 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
 /// 274 and 244 ms); the sums (an earlier run) 7.4x, 3.7x, 3.4x at 3-7 px, 1.6-1.7x at 11-15 px,
 /// ahead of or level with the sprites up to 11 px.
 pub const AUTO_COMPUTE_TILES_MAX_PX: f32 = 15.0;
+/// Largest footprint, in pixels, for which `auto` picks the compute sheet sums on a CPU device.
 pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 /// Narrowest footprint (px) for which `auto` draws point sprites. Below about a pixel the device
 /// clamps a sprite to its minimum point size and evaluates the footprint at the sprite's centre, so

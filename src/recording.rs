@@ -19,6 +19,7 @@ use std::time::Instant;
 /// Bits of the status word (binding 17): a binning invocation, or a footprint-sum invocation, made
 /// llvmpipe's 65535 loop iterations and was cut short (glsl/tile_count.comp, footprint_sum.comp).
 pub const LOOP_BUDGET_BINNING: u32 = 1;
+/// See `LOOP_BUDGET_BINNING`.
 pub const LOOP_BUDGET_SUMS: u32 = 2;
 
 /// 1 where a scene of `n` splats fits one page of splat records (the `ONE_PAGE` builds read only
@@ -72,7 +73,9 @@ fn image_words(width: u32, height: u32) -> usize {
 
 /// The output of [`record_frame`].
 pub struct Recorded {
+    /// The frame.
     pub image: ImageF32,
+    /// Per-stage times.
     pub timings: Vec<StageTime>,
 }
 

@@ -25,38 +25,55 @@ pub enum Res {
     Frame,
     /// The kernel's radial footprint table and its kernel-slice table (a texture).
     Radial,
+    /// The kernel-slice table of the image-aligned sheets (a texture).
     SliceTable,
     /// The scene: splats, PBTF rows, sheet ranks.
     Splats,
+    /// Each PBTF row's first splat.
     RowStart,
+    /// Each slice's rank among the non-empty slices, per axis (sheet batches index them).
     Ranks,
     /// PBTF order working buffers and the draw order it writes.
     RowSplit,
+    /// Per-row octant segment counts, then their offsets.
     Segments,
+    /// The draw order (PBTF, or an order computed on the host).
     Order,
     /// `SplatParams` per splat; `ParamsHi` binds its second page (`SPLAT_PAGE` records on).
     Params,
+    /// The second page of `Params`.
     ParamsHi,
     /// The dispatch's draw list: the order, a slice-grouped list or the slab pairs ([`List`]).
     DrawList,
+    /// Largest transmittance left per composite tile (early termination).
     Occlusion,
     /// Fixed-point sheet sums of the compute raster.
     Fixed,
+    /// The tile x chunk count matrix of the tile binning.
     TileCounts,
+    /// Each screen tile's first entry, then the total.
     TileStart,
+    /// The tiles' lists of splat indices, each in draw order.
     TileEntries,
     /// `ScreenQuad` per splat; `QuadsHi` binds its second page.
     Quads,
+    /// The second page of `Quads`.
     QuadsHi,
+    /// Per composite tile, the lowest sheet reaching it, then the highest + 1.
     SheetTiles,
     /// The loop-budget status word (`LOOP_BUDGET_*`).
     Status,
+    /// The slab x chunk count matrix of the slab binning.
     SlabCounts,
+    /// Each slab's first pair, then the total.
     SlabStart,
+    /// The (splat, slab) pairs in visiting order.
     SlabPairs,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
+    /// The summation layers.
     Sums,
+    /// The raster target of per-splat compositing.
     Color,
 }
 
@@ -86,6 +103,7 @@ pub enum List {
 /// How a stage runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
+    /// A compute dispatch.
     Compute,
     /// Instanced quads or point sprites through the raster pipeline, into the raster target
     /// (per-splat compositing) or the summation layers.
@@ -113,8 +131,11 @@ pub enum Pass {
 /// A draw variant's fixed-function state.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DrawState {
+    /// How fragments combine with the attachment.
     pub blend: Blend,
+    /// Point sprites rather than instanced quads.
     pub points: bool,
+    /// The attachment drawn into.
     pub pass: Pass,
 }
 
@@ -122,15 +143,18 @@ pub struct DrawState {
 /// specialization constants 0.., and for draws the fixed-function state.
 #[derive(Clone, Copy, Debug)]
 pub struct Variant {
+    /// Macros defined, `+`-joined (the shader's `// variants:` names).
     pub defines: &'static str,
+    /// Specialization constants 0, 1, ...
     pub spec: &'static [u32],
+    /// A draw's fixed-function state (`None` for compute).
     pub draw: Option<DrawState>,
 }
 
 /// A stage's workgroup shape: how invocation counts become workgroup counts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Workgroup {
-    /// `n` invocations in groups of this many (spilling into y, [`groups_1d`]).
+    /// `n` invocations in groups of this many (spilling into y, `plan::groups_1d`).
     Linear(u32),
     /// One workgroup per tile of this many pixels across and down.
     Tile(u32, u32),
@@ -147,6 +171,7 @@ pub type Mirror = fn(&mut Bindings<'_>, &Dispatch) -> Result<()>;
 pub struct StageDesc {
     /// The stage's name: `glsl/<name>.comp` (draws: `.vert` + `.frag`) and `cpu::<name>`.
     pub name: &'static str,
+    /// Compute or draw.
     pub kind: Kind,
     /// Binding i of the stage's descriptor set holds `bindings[i]`.
     pub bindings: &'static [Res],
@@ -154,12 +179,15 @@ pub struct StageDesc {
     pub writes: &'static [Res],
     /// Push-constant bytes.
     pub push: u32,
+    /// How invocation counts become workgroups.
     pub workgroup: Workgroup,
     /// The name its time is reported under (`StageTime::stage`).
     pub timing: &'static str,
     /// A build chosen by a device capability, when the device has it.
     pub device_build: Option<(Feature, &'static str)>,
+    /// Its builds; a dispatch names one by index.
     pub variants: &'static [Variant],
+    /// The CPU mirror's entry point.
     pub mirror: Mirror,
 }
 
@@ -433,21 +461,37 @@ pub static STAGES: [StageDesc; 16] = [
 /// Index into [`STAGES`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum StageId {
+    /// `order_count`.
     OrderCount,
+    /// `order_scan`.
     OrderScan,
+    /// `order_scatter`.
     OrderScatter,
+    /// `splat_params`.
     SplatParams,
+    /// `slab_count`.
     SlabCount,
+    /// `slab_scan`.
     SlabScan,
+    /// `slab_scatter`.
     SlabScatter,
+    /// `tile_count`.
     TileCount,
+    /// `tile_scan`.
     TileScan,
+    /// `tile_offsets`.
     TileOffsets,
+    /// `tile_scatter`.
     TileScatter,
+    /// `tile_composite`.
     TileComposite,
+    /// `sheet_tiles`.
     SheetTiles,
+    /// `footprint`.
     Footprint,
+    /// `footprint_sum`.
     FootprintSum,
+    /// `composite`.
     Composite,
 }
 
@@ -489,12 +533,15 @@ const _: () = assert!(StageId::Composite as usize + 1 == STAGES.len());
 /// One stage invocation of a recording.
 #[derive(Clone, Debug)]
 pub struct Dispatch {
+    /// The stage.
     pub stage: StageId,
     /// Index into the stage's `variants`.
     pub variant: usize,
     /// Compute: workgroups. Draws: `[first instance, instances, 0]`.
     pub groups: [u32; 3],
+    /// What `Res::DrawList` binds.
     pub list: List,
+    /// The push constants' bytes.
     pub push: Vec<u8>,
 }
 
@@ -537,6 +584,7 @@ pub trait Engine {
     fn fill(&mut self, res: Res, range: Option<(u64, u64)>, value: u32) -> Result<()>;
     /// Write host data into `res` from its start.
     fn upload(&mut self, res: Res, data: &[u32]) -> Result<()>;
+    /// Run (or queue) one stage dispatch.
     fn run(&mut self, dispatch: &Dispatch) -> Result<()>;
     /// Finish the work so far and read the first `words` 32-bit words of each resource.
     fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>>;
@@ -548,6 +596,7 @@ pub trait Engine {
     fn finish(&mut self) -> Result<Vec<StageTime>>;
     /// The frame resources written so far (what a split hands over).
     fn live(&self) -> Vec<Res>;
+    /// What the frame's plan must respect on this engine.
     fn limits(&self) -> Limits;
     /// Whether this is a device (host orders are then reported as `order_cpu`).
     fn is_device(&self) -> bool;

@@ -9,6 +9,7 @@ use crate::volume::{Grid, SplatSet};
 pub const MAX_LEVELS: u32 = 4096;
 
 #[derive(Clone, Debug)]
+/// How a height grid becomes voxel columns.
 pub struct TerrainOptions {
     /// Horizontal size of one height cell, in height units (e.g. 233 for a 233 m DEM in metres);
     /// 0 picks one that makes the relief a sixth of the grid's width (before `vscale`).
@@ -17,6 +18,7 @@ pub struct TerrainOptions {
     pub vscale: f32,
     /// Colour image covering the same extent (row 0 = the grid's row 0); `None`: hypsometric ramp.
     pub color: Option<image::RgbaImage>,
+    /// Opacity of one voxel-length of ground.
     pub opacity: f32,
     /// Fill each column down to its lowest neighbour (on by default; off only to show the holes).
     pub fill_gaps: bool,

@@ -24,6 +24,7 @@ pub enum Reconstruction {
 }
 
 impl Reconstruction {
+    /// The reconstruction's support radius in voxel spacings.
     pub fn radius(self) -> f64 {
         match self {
             Reconstruction::Kernel(k) => k.radius() as f64,
@@ -35,6 +36,7 @@ impl Reconstruction {
 /// Options of the reference integration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TruthOptions {
+    /// How the samples between voxels are reconstructed.
     pub reconstruction: Reconstruction,
     /// Samples per voxel spacing along each ray (at least 4).
     pub oversampling: u32,

@@ -14,8 +14,11 @@ pub const MAX_DIM: u32 = 1 << 16;
 /// A rectilinear grid: dimensions, voxel spacing, and the world position of voxel (0, 0, 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
+    /// Voxels along x, y, z.
     pub dims: [u32; 3],
+    /// Voxel spacing along x, y, z, in world units.
     pub spacing: [f32; 3],
+    /// World position of voxel (0, 0, 0).
     pub origin: [f32; 3],
 }
 
@@ -28,6 +31,7 @@ impl Grid {
         Ok(g)
     }
 
+    /// Reject empty, overflowing or degenerate grids.
     pub fn validate(&self) -> Result<()> {
         if self.dims.iter().any(|&d| d == 0 || d > MAX_DIM) {
             return Err(Error::InvalidArgument(format!("grid dimensions {:?} must be in 1..={MAX_DIM}", self.dims)));
@@ -48,10 +52,12 @@ impl Grid {
         Ok(())
     }
 
+    /// World position of voxel `ijk`.
     pub fn position(&self, ijk: [u32; 3]) -> Vec3 {
         Vec3::from(self.origin) + Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) * Vec3::from(self.spacing)
     }
 
+    /// World centre of the grid.
     pub fn center(&self) -> Vec3 {
         self.position([0, 0, 0]).lerp(self.position([self.dims[0] - 1, self.dims[1] - 1, self.dims[2] - 1]), 0.5)
     }
@@ -106,22 +112,28 @@ impl SplatSet {
         Ok(Self { grid, row_start, splats })
     }
 
+    /// The grid the splats sit on.
     pub fn grid(&self) -> &Grid {
         &self.grid
     }
+    /// The splats, row by row (PBTF rows along x).
     pub fn splats(&self) -> &[Splat] {
         &self.splats
     }
+    /// Each row's first splat, then the count.
     pub fn row_start(&self) -> &[u32] {
         &self.row_start
     }
+    /// The number of splats.
     pub fn len(&self) -> usize {
         self.splats.len()
     }
+    /// Whether there are none.
     pub fn is_empty(&self) -> bool {
         self.splats.is_empty()
     }
 
+    /// The row of (j, k).
     pub fn row_index(&self, j: u32, k: u32) -> usize {
         (j + self.grid.dims[1] * k) as usize
     }
@@ -177,12 +189,16 @@ impl SplatSet {
 /// sparse [`SplatSet`] extracted from it.
 #[derive(Clone, Debug)]
 pub struct Volume {
+    /// The grid.
     pub grid: Grid,
+    /// Density per voxel (x fastest).
     pub density: Vec<f32>,
+    /// Straight RGBA per voxel.
     pub rgba: Vec<[f32; 4]>,
 }
 
 impl Volume {
+    /// A volume, checked: both arrays hold one value per voxel.
     pub fn new(grid: Grid, density: Vec<f32>, rgba: Vec<[f32; 4]>) -> Result<Self> {
         grid.validate()?;
         let n = grid.dims.iter().map(|&d| d as u64).product::<u64>();
@@ -209,16 +225,22 @@ impl Volume {
 /// A dense scalar volume as loaded: x fastest, then y, then z.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScalarVolume {
+    /// Voxels along x, y, z.
     pub dims: [u32; 3],
+    /// Voxel spacing along x, y, z.
     pub spacing: [f32; 3],
+    /// The samples, x fastest.
     pub values: Vec<f32>,
 }
 
 /// A height grid: `width` × `rows` heights, row 0 first (north for the DEMs here).
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeightGrid {
+    /// Heights across.
     pub width: u32,
+    /// Rows of heights.
     pub rows: u32,
+    /// The heights, row by row.
     pub heights: Vec<f32>,
 }
 
@@ -228,7 +250,9 @@ pub const MAX_DENSE_BYTES: u64 = 4 << 30;
 /// The voxels as a dense grid of (colour * tau, tau): what the ray caster's 3D texture holds.
 #[derive(Clone, Debug)]
 pub struct DenseField {
+    /// Voxels along x, y, z.
     pub dims: [u32; 3],
+    /// (colour * tau, tau) per voxel, x fastest.
     pub values: Vec<[f32; 4]>,
 }
 

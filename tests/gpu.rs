@@ -176,7 +176,8 @@ fn renderer_on_an_adopted_host_device_matches_an_owning_one() {
     {
         // The "host" here is the owning renderer's context; the adopted one must not destroy it.
         let host = owner.context().unwrap().handles();
-        let ctx = voxsplat::vk::Context::from_host(host).unwrap();
+        // SAFETY: the owning renderer's handles stay alive until the adopting renderer is dropped.
+        let ctx = unsafe { voxsplat::vk::Context::from_host(host) }.unwrap();
         let mut guest = voxsplat::Renderer::with_context(ctx).unwrap();
         guest.set_scene(set).unwrap();
         let got = guest.render(&cam, &opts).unwrap();
@@ -201,7 +202,9 @@ fn sheet_sums_without_64_bit_atomics_match_the_64_bit_build() {
     owner.set_scene(set.clone()).unwrap();
     let mut host = owner.context().unwrap().handles();
     host.int64_atomics = false;
-    let mut guest = voxsplat::Renderer::with_context(voxsplat::vk::Context::from_host(host).unwrap()).unwrap();
+    // SAFETY: the owning renderer's handles stay alive until the adopting renderer is dropped.
+    let mut guest =
+        voxsplat::Renderer::with_context(unsafe { voxsplat::vk::Context::from_host(host) }.unwrap()).unwrap();
     guest.set_scene(set).unwrap();
     for composite in [Composite::Sheet, Composite::Slab] {
         let mut o = RenderOptions::default();

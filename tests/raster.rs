@@ -209,7 +209,8 @@ fn footprints_larger_than_a_tile_and_straddling_tiles_render_correctly() {
 fn tile_compositor_without_subgroup_shuffles_matches_the_shuffled_build() {
     let mut owner = common::gpu();
     assert!(owner.context().unwrap().subgroup_shuffle(), "lavapipe has compute subgroup shuffles");
-    let ctx = voxsplat::vk::Context::from_host(owner.context().unwrap().handles()).unwrap();
+    // SAFETY: the owning renderer's handles stay alive until the adopting renderer is dropped.
+    let ctx = unsafe { voxsplat::vk::Context::from_host(owner.context().unwrap().handles()) }.unwrap();
     ctx.disable_subgroup_shuffle();
     let mut guest = voxsplat::Renderer::with_context(ctx).unwrap();
     let cube = scene::build("cube40-attenuated").unwrap();

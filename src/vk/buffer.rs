@@ -9,11 +9,15 @@ use std::sync::Arc;
 /// Where a buffer lives: written by the host every frame, read back by the host, or GPU only.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Memory {
+    /// Host-visible, written by the host.
     Upload,
+    /// Host-visible, read back by the host.
     Readback,
+    /// Device-local.
     Device,
 }
 
+/// A Vulkan buffer and its memory.
 pub struct Buffer {
     ctx: Arc<Context>,
     pub(crate) raw: vk::Buffer,
@@ -76,6 +80,7 @@ impl Buffer {
         Ok(b)
     }
 
+    /// Size in bytes.
     pub fn size(&self) -> u64 {
         self.size
     }

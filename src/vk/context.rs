@@ -27,11 +27,17 @@ struct Debug {
 /// A host program's Vulkan objects, handed to [`Context::from_host`].
 #[derive(Clone)]
 pub struct HostHandles {
+    /// The Vulkan loader the host loaded.
     pub entry: ash::Entry,
+    /// The host's instance.
     pub instance: ash::Instance,
+    /// The physical device `device` was created on.
     pub physical: vk::PhysicalDevice,
+    /// The host's device.
     pub device: ash::Device,
+    /// A queue of `queue_family` with graphics and compute.
     pub queue: vk::Queue,
+    /// The queue's family index.
     pub queue_family: u32,
     /// Whether `device` was created with the `largePoints` feature: point sprites wider than one
     /// pixel, which `auto` prefers on a CPU device. Without it voxsplat draws no wide sprites.
@@ -210,11 +216,22 @@ impl Context {
         Self::finish(handles, debug, debug_state, true)
     }
 
-    /// Adopt a host program's instance, device and queue. The host keeps ownership (nothing is
-    /// destroyed here) and must keep them alive longer than every renderer built on this context.
-    /// The device needs Vulkan 1.2 `shaderOutputLayer` enabled and a graphics+compute queue; the
-    /// host must not use `queue` from another thread while voxsplat submits to it.
-    pub fn from_host(host: HostHandles) -> Result<Arc<Self>> {
+    /// Adopt a host program's instance, device and queue. The host keeps ownership: nothing is
+    /// destroyed here. The device needs Vulkan 1.2 `shaderOutputLayer` enabled and a
+    /// graphics+compute queue (the feature flags in `host` say what else was enabled).
+    ///
+    /// # Safety
+    ///
+    /// - `host.entry`, `instance`, `physical`, `device` and `queue` are valid, belong together
+    ///   (the device was created from `physical` of `instance`, `queue` is queue 0 or another queue
+    ///   of `queue_family` on `device`), and stay alive until every `Context` clone and every
+    ///   renderer, buffer and image built on it are dropped.
+    /// - `large_points` and `int64_atomics` are true only if the device was created with those
+    ///   features enabled.
+    /// - The host does not use `queue` from another thread while voxsplat records or submits on
+    ///   it (Vulkan requires external synchronization of a queue), and does not destroy or reset
+    ///   objects voxsplat created.
+    pub unsafe fn from_host(host: HostHandles) -> Result<Arc<Self>> {
         Self::finish(host, None, Box::default(), false)
     }
 

@@ -6,6 +6,7 @@ use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
+/// A Vulkan image, its memory and one view.
 pub struct Image {
     ctx: Arc<Context>,
     pub(crate) raw: vk::Image,
@@ -132,6 +133,7 @@ impl Image {
         Self::range_of(self.layers)
     }
 
+    /// Width, height and depth (or layers).
     pub fn extent(&self) -> (u32, u32, u32) {
         (self.width, self.height, self.layers)
     }
@@ -161,6 +163,7 @@ pub struct Sampler {
 }
 
 impl Sampler {
+    /// A nearest-neighbour, clamp-to-edge sampler.
     pub fn nearest(ctx: &Arc<Context>) -> Result<Self> {
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::NEAREST)

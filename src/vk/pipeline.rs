@@ -7,9 +7,13 @@ use std::sync::Arc;
 /// What a binding slot holds. Slots are numbered by their position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Slot {
+    /// A uniform buffer.
     Uniform,
+    /// A storage buffer.
     Storage,
+    /// A storage image (GENERAL layout).
     StorageImage,
+    /// A sampled image with its sampler.
     Texture,
     /// A slot number the stage does not use (keeps binding numbers aligned with the GLSL).
     Unused,
@@ -33,8 +37,11 @@ pub enum Bind<'a> {
     Buffer(&'a Buffer),
     /// `range` bytes of a buffer from `offset` (a multiple of the device's offset alignment).
     Range(&'a Buffer, u64, u64),
+    /// A storage image.
     Image(&'a Image),
+    /// A sampled image and its sampler.
     Texture(&'a Image, &'a Sampler),
+    /// Nothing (an unused slot).
     None,
 }
 
@@ -48,6 +55,7 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// A layout whose slot i holds `slots[i]`, visible to `stages`, with `push_size` bytes of push constants.
     pub fn new(ctx: &Arc<Context>, slots: &[Slot], stages: vk::ShaderStageFlags, push_size: u32) -> Result<Self> {
         let bindings: Vec<_> = slots
             .iter()
@@ -185,6 +193,7 @@ impl Drop for Layout {
     }
 }
 
+/// A descriptor set in its own pool.
 pub struct DescriptorSet {
     ctx: Arc<Context>,
     pool: vk::DescriptorPool,
@@ -221,6 +230,7 @@ fn shader_module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
     unsafe { ctx.device.create_shader_module(&info, None) }.map_err(Error::vk("vkCreateShaderModule"))
 }
 
+/// A compute or graphics pipeline.
 pub struct Pipeline {
     ctx: Arc<Context>,
     pub(crate) raw: vk::Pipeline,
@@ -228,6 +238,7 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
+    /// A compute pipeline from SPIR-V.
     pub fn compute(ctx: &Arc<Context>, layout: &Layout, spirv: &[u8]) -> Result<Self> {
         Self::compute_specialized(ctx, layout, spirv, &[])
     }
@@ -385,6 +396,7 @@ pub struct RenderPass {
 }
 
 impl RenderPass {
+    /// A render pass over one `format` attachment, left in `final_layout`.
     pub fn new(ctx: &Arc<Context>, format: vk::Format, final_layout: vk::ImageLayout) -> Result<Self> {
         let attachments = [vk::AttachmentDescription::default()
             .format(format)
@@ -451,6 +463,7 @@ pub struct Framebuffer {
 }
 
 impl Framebuffer {
+    /// A framebuffer over every layer of `image` for `pass`.
     pub fn new(ctx: &Arc<Context>, pass: &RenderPass, image: &Image) -> Result<Self> {
         let views = [image.view];
         let info = vk::FramebufferCreateInfo::default()

@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use ash::vk;
 use std::sync::atomic::Ordering;
 
+/// A command buffer being recorded (see `Context::submit`).
 pub struct Recorder<'a> {
     ctx: &'a Context,
     cmd: vk::CommandBuffer,
@@ -13,10 +14,15 @@ pub struct Recorder<'a> {
 /// Pipeline stages a barrier connects (a small vocabulary is all the pipeline needs).
 #[derive(Clone, Copy, Debug)]
 pub enum Stage {
+    /// Compute shaders.
     Compute,
+    /// Copies and fills.
     Transfer,
+    /// Vertex and fragment shaders and attachments.
     Graphics,
+    /// Host reads and writes.
     Host,
+    /// Every command.
     All,
 }
 
@@ -65,12 +71,14 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_pipeline_barrier(self.cmd, s, d, vk::DependencyFlags::empty(), &[], &[], &b) };
     }
 
+    /// Clear every layer of `image` (in `layout`) to `color`.
     pub fn clear_image(&self, image: &Image, layout: vk::ImageLayout, color: [f32; 4]) {
         let value = vk::ClearColorValue { float32: color };
         // SAFETY: image is in `layout` (GENERAL or TRANSFER_DST) per the caller's transitions.
         unsafe { self.ctx.device.cmd_clear_color_image(self.cmd, image.raw, layout, &value, &[image.range()]) };
     }
 
+    /// Copy `buffer` into `image` (in TRANSFER_DST_OPTIMAL).
     pub fn copy_buffer_to_image(&self, buffer: &Buffer, image: &Image) {
         let region = [vk::BufferImageCopy::default()
             .image_subresource(vk::ImageSubresourceLayers {
@@ -108,6 +116,7 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_fill_buffer(self.cmd, buffer.raw, offset, size, value) };
     }
 
+    /// Copy the first `bytes` of `src` to `dst` (clamped to both).
     pub fn copy_buffer(&self, src: &Buffer, dst: &Buffer, bytes: u64) {
         let size = bytes.min(src.size()).min(dst.size());
         if size == 0 {
@@ -118,6 +127,7 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_copy_buffer(self.cmd, src.raw, dst.raw, &region) };
     }
 
+    /// Copy layer 0 of `image` (in `layout`) to `buffer`.
     pub fn copy_image_to_buffer(&self, image: &Image, layout: vk::ImageLayout, buffer: &Buffer) {
         let region = [vk::BufferImageCopy::default()
             .image_subresource(vk::ImageSubresourceLayers {
@@ -149,12 +159,14 @@ impl Recorder<'_> {
         }
     }
 
+    /// Bind and dispatch a compute pipeline.
     pub fn dispatch(&self, pipeline: &Pipeline, layout: &Layout, set: &DescriptorSet, push: &[u8], groups: [u32; 3]) {
         self.bind(pipeline, layout, set, push);
         // SAFETY: compute pipeline bound above.
         unsafe { self.ctx.device.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]) };
     }
 
+    /// Begin `pass` on `fb`, clearing it.
     pub fn begin_pass(&self, pass: &RenderPass, fb: &Framebuffer) {
         let clear = [vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } }];
         let area = vk::Rect2D {
@@ -212,11 +224,13 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_draw(self.cmd, count, 1, first, 0) };
     }
 
+    /// End the render pass.
     pub fn end_pass(&self) {
         // SAFETY: matches begin_pass.
         unsafe { self.ctx.device.cmd_end_render_pass(self.cmd) };
     }
 
+    /// Write timestamp `index` of `timer` when all earlier work is done.
     pub fn timestamp(&self, timer: &Timer, index: u32) {
         if let Some(pool) = timer.pool {
             if index < timer.capacity {
@@ -228,6 +242,7 @@ impl Recorder<'_> {
         }
     }
 
+    /// Reset every query of `timer`.
     pub fn reset_timer(&self, timer: &Timer) {
         if let Some(pool) = timer.pool {
             // SAFETY: outside a render pass.

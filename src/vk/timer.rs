@@ -4,6 +4,7 @@ use crate::error::{Error, Result};
 use ash::vk;
 use std::sync::Arc;
 
+/// Timestamp queries.
 pub struct Timer {
     ctx: Arc<Context>,
     pub(crate) pool: Option<vk::QueryPool>,
