@@ -26,6 +26,8 @@ pub mod constants;
 /// The CPU mirrors of the GPU stages (public for tests and the harness; see `stages`).
 #[doc(hidden)]
 pub mod cpu;
+pub mod cpu_engine;
+pub mod dispatch;
 mod error;
 mod gpu;
 /// `#[repr(C)]` mirrors of `glsl/shared/types.glsl` (public for tests and the mirrors).
@@ -68,7 +70,7 @@ pub use order::{Direction, OrderKind};
 pub use raster::{Raster, RasterChoice};
 pub use volume::{Grid, SplatSet, Volume};
 
-use cpu::exec::CpuEngine;
+use cpu_engine::CpuEngine;
 use plan::Prepared;
 use recording::record_frame;
 use stages::{Engine, Res, StageId};

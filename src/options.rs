@@ -3,7 +3,6 @@ use crate::error::{Error, Result};
 use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::order::{Direction, OrderKind};
-use crate::raster::{Raster, RasterChoice};
 
 /// How splats become pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -170,7 +169,7 @@ impl RenderOptions {
         if self.sheet_budget_bytes == 0 {
             return Err(Error::InvalidArgument("the sheet budget must be positive".into()));
         }
-        crate::resample::check_scale(self.render_scale)
+        check_scale(self.render_scale)
     }
 
     /// Layers per batch for an image of this size. With early termination on, batches hold at most
@@ -204,4 +203,70 @@ pub struct Rendered {
     pub timings: Vec<StageTime>,
     /// The footprint stage's raster variant and why (`None` for the ray caster and the truth).
     pub raster: Option<RasterChoice>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// How the footprint stage turns splats into pixels.
+pub enum Raster {
+    /// Instanced quads through the graphics pipeline.
+    Graphics,
+    /// Point sprites through the graphics pipeline (no motion blur).
+    Points,
+    /// Compute shaders: tile binning (per-splat) or fixed-point sums (sheets).
+    Compute,
+    /// Pick per device and footprint size (`choose`).
+    #[default]
+    Auto,
+}
+
+impl Raster {
+    /// The name the CLI and the reports use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Raster::Graphics => "graphics",
+            Raster::Points => "points",
+            Raster::Compute => "compute",
+            Raster::Auto => "auto",
+        }
+    }
+}
+
+impl std::str::FromStr for Raster {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "graphics" => Ok(Self::Graphics),
+            "points" => Ok(Self::Points),
+            "compute" => Ok(Self::Compute),
+            "auto" => Ok(Self::Auto),
+            _ => Err(Error::InvalidArgument(format!("unknown raster '{s}' (graphics, points, compute, auto)"))),
+        }
+    }
+}
+
+impl std::fmt::Display for Raster {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The variant a frame was drawn with and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RasterChoice {
+    /// The variant drawn.
+    pub raster: Raster,
+    /// Why (`auto`'s rule, or "requested").
+    pub reason: String,
+}
+
+/// Smallest render scale accepted: below it a 512-px view would have fewer than 32 rows.
+pub const MIN_RENDER_SCALE: f32 = 1.0 / 16.0;
+
+/// Check a render scale: finite, in [`MIN_RENDER_SCALE`], 1].
+pub fn check_scale(scale: f32) -> Result<()> {
+    if scale.is_finite() && (MIN_RENDER_SCALE..=1.0).contains(&scale) {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!("render scale {scale} must be in [{MIN_RENDER_SCALE}, 1]")))
+    }
 }

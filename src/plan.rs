@@ -162,11 +162,11 @@ pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_la
 
 /// Push constants of the tile binning and compositing stages for a draw list of `n` entries on a
 /// `width` x `height` image: chunks of `TILE_CHUNK` entries, fewer (and longer) where the count
-/// matrix would pass `raster::MAX_TILE_CELLS`.
+/// matrix would pass `MAX_TILE_CELLS`.
 pub fn tile_push(opts: &RenderOptions, n: u32, width: u32, height: u32) -> FootprintPush {
     let btf = opts.direction() == Direction::BackToFront;
     let tiles = (width.div_ceil(RASTER_TILE_W) as u64 * height.div_ceil(RASTER_TILE_H) as u64).max(1);
-    let most = (crate::raster::MAX_TILE_CELLS / tiles).max(1);
+    let most = (MAX_TILE_CELLS / tiles).max(1);
     FootprintPush {
         count: n,
         chunks: (n.div_ceil(TILE_CHUNK) as u64).clamp(1, most) as u32,
@@ -231,3 +231,6 @@ pub fn set_early_termination(opts: &RenderOptions, batches: &mut [Batch]) {
         b.push.occluded = if on { opts.early_termination } else { 0.0 };
     }
 }
+
+/// Most cells of the tile x chunk count matrix (4 bytes each: 64 MiB).
+pub const MAX_TILE_CELLS: u64 = 1 << 24;

@@ -20,59 +20,7 @@ use crate::error::{Error, Result};
 use crate::options::{Composite, RenderOptions};
 use crate::volume::SplatSet;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-/// How the footprint stage turns splats into pixels.
-pub enum Raster {
-    /// Instanced quads through the graphics pipeline.
-    Graphics,
-    /// Point sprites through the graphics pipeline (no motion blur).
-    Points,
-    /// Compute shaders: tile binning (per-splat) or fixed-point sums (sheets).
-    Compute,
-    /// Pick per device and footprint size (`choose`).
-    #[default]
-    Auto,
-}
-
-impl Raster {
-    /// The name the CLI and the reports use.
-    pub fn name(self) -> &'static str {
-        match self {
-            Raster::Graphics => "graphics",
-            Raster::Points => "points",
-            Raster::Compute => "compute",
-            Raster::Auto => "auto",
-        }
-    }
-}
-
-impl std::str::FromStr for Raster {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        match s {
-            "graphics" => Ok(Self::Graphics),
-            "points" => Ok(Self::Points),
-            "compute" => Ok(Self::Compute),
-            "auto" => Ok(Self::Auto),
-            _ => Err(Error::InvalidArgument(format!("unknown raster '{s}' (graphics, points, compute, auto)"))),
-        }
-    }
-}
-
-impl std::fmt::Display for Raster {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// The variant a frame was drawn with and why.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RasterChoice {
-    /// The variant drawn.
-    pub raster: Raster,
-    /// Why (`auto`'s rule, or "requested").
-    pub reason: String,
-}
+pub use crate::options::{Raster, RasterChoice};
 
 /// What the device offers the choice.
 #[derive(Clone, Copy, Debug)]
@@ -190,8 +138,7 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
     }
 }
 
-/// Most cells of the tile x chunk count matrix (4 bytes each: 64 MiB).
-pub const MAX_TILE_CELLS: u64 = 1 << 24;
+pub use crate::plan::MAX_TILE_CELLS;
 /// Most (tile, splat) entries in one frame (4 bytes each: 128 MiB, the one storage binding every
 /// device allows, 2^27 bytes).
 pub const MAX_TILE_ENTRIES: u64 = 1 << 25;

@@ -13,17 +13,7 @@ use crate::image::ImageF32;
 use crate::options::{Rendered, StageTime};
 use rayon::prelude::*;
 
-/// Smallest render scale accepted: below it a 512-px view would have fewer than 32 rows.
-pub const MIN_RENDER_SCALE: f32 = 1.0 / 16.0;
-
-/// Check a render scale: finite, in [`MIN_RENDER_SCALE`], 1].
-pub fn check_scale(scale: f32) -> Result<()> {
-    if scale.is_finite() && (MIN_RENDER_SCALE..=1.0).contains(&scale) {
-        Ok(())
-    } else {
-        Err(Error::InvalidArgument(format!("render scale {scale} must be in [{MIN_RENDER_SCALE}, 1]")))
-    }
-}
+pub use crate::options::{check_scale, MIN_RENDER_SCALE};
 
 /// The camera that draws `camera`'s view at `scale`: `round(height * scale)` rows and enough
 /// columns to cover the full width. Pixels stay square and the view's vertical extent is kept, so

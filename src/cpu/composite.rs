@@ -1,12 +1,12 @@
 //! Mirror of `composite.comp`.
 use super::ImageF32;
 use crate::constants::COMPOSITE_TILE;
+use crate::dispatch::{Dispatch, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::CompositePush;
-use crate::stages::{Dispatch, Res};
 use rayon::prelude::*;
 
-use super::exec::Bindings;
+use super::bindings::Bindings;
 
 /// Mirror of `layer_range` in `composite.comp`: the batch's layers that footprints reach on tile
 /// `tile`, from the per-tile sheet ranges of `sheet_tiles`.
@@ -73,12 +73,12 @@ pub fn composite(
     }
 }
 
-pub(crate) fn composite_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+pub(crate) fn composite_stage(b: &mut Bindings<'_>, d: &Dispatch, v: &Variant) -> Result<()> {
     let push: CompositePush = d.push_as();
     let mut occlusion = b.take(Res::Occlusion);
     let mut accum = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
     let fixed: Vec<ImageF32>;
-    let layers = if d.spec(0) == 1 {
+    let layers = if v.spec.first() == Some(&1) {
         let sums = b.get::<u32>(Res::Fixed);
         fixed = (0..push.layers as usize).map(|l| super::footprint::fixed_layer(sums, l, b.width, b.height)).collect();
         &fixed

@@ -6,21 +6,15 @@
 //! the projective map of `screen_quad`).
 use super::ImageF32;
 use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
+use crate::dispatch::{Dispatch, Pass, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB};
 pub use crate::kernel::sample_radial;
-use crate::stages::{Dispatch, Pass, Res};
 use glam::{DMat4, DVec3, DVec4, IVec4, Mat3, Mat4, Vec2, Vec3, Vec4};
 
-use super::exec::Bindings;
+use super::bindings::Bindings;
 
-/// How a fragment combines with the attachment (premultiplied colour).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Blend {
-    Over,
-    Under,
-    Add,
-}
+pub use crate::dispatch::Blend;
 
 /// Mirror of `sample_table` in `glsl/shared/footprint_table.glsl`.
 pub fn sample_table(table: &[f32], u: f32, v: f32) -> f32 {
@@ -389,8 +383,8 @@ fn raster_quad(
 
 /// The draw: the raster target or the summation layers are cleared (the render pass's load) and
 /// the footprints drawn into them.
-pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
-    let state = d.stage.desc().variants[d.variant].draw.expect("footprint variants are draws");
+pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Dispatch, v: &Variant) -> Result<()> {
+    let state = v.draw.expect("footprint variants are draws");
     let count = match state.pass {
         Pass::Target => 1,
         Pass::Sheet => b.sums.len(),
@@ -405,7 +399,7 @@ pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> 
     Ok(())
 }
 
-pub(crate) fn footprint_sum_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+pub(crate) fn footprint_sum_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
     let mut sums = b.take(Res::Fixed);
     footprint_sum(&b.inputs(d.list), &d.push_as(), &mut sums);
     b.put(Res::Fixed, sums);

@@ -1,7 +1,7 @@
 //! CPU mirrors of the GPU stages, one function per stage with the stage's name, written loop for
 //! loop like the shaders and reading the same `#[repr(C)]` structs.
+pub mod bindings;
 pub mod composite;
-pub mod exec;
 pub mod footprint;
 pub mod order;
 pub mod raycast;

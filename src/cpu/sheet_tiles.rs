@@ -1,10 +1,10 @@
 //! Mirror of `sheet_tiles.comp`.
-use super::exec::Bindings;
+use super::bindings::Bindings;
 use super::footprint::{entry, screen_quad, FootprintInputs};
 use crate::constants::COMPOSITE_TILE;
+use crate::dispatch::{Dispatch, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::FootprintPush;
-use crate::stages::{Dispatch, Res};
 use glam::{IVec2, Mat4, Vec2, Vec4};
 
 /// For each composite tile, the lowest sheet whose footprints reach it (`u32::MAX`: none) in
@@ -51,9 +51,9 @@ pub fn sheet_tiles(inputs: &FootprintInputs<'_>, push: &FootprintPush, points: b
     }
 }
 
-pub(crate) fn sheet_tiles_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+pub(crate) fn sheet_tiles_stage(b: &mut Bindings<'_>, d: &Dispatch, v: &Variant) -> Result<()> {
     let mut tiles = b.take(Res::SheetTiles);
-    sheet_tiles(&b.inputs(d.list), &d.push_as(), d.spec(1) == 1, &mut tiles);
+    sheet_tiles(&b.inputs(d.list), &d.push_as(), v.spec.get(1) == Some(&1), &mut tiles);
     b.put(Res::SheetTiles, tiles);
     Ok(())
 }

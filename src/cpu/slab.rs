@@ -1,9 +1,9 @@
 //! Mirrors of the slab binning stages `slab_count.comp`, `slab_scan.comp` and `slab_scatter.comp`.
-use super::exec::Bindings;
+use super::bindings::Bindings;
 use crate::constants::SLAB_CHUNK;
+use crate::dispatch::{Dispatch, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{SlabPush, SplatParams};
-use crate::stages::{Dispatch, Res};
 use glam::Vec3;
 
 fn slab_pos(pc: &SlabPush, slab: u32) -> u32 {
@@ -75,14 +75,14 @@ pub fn slab_scatter(pc: &SlabPush, params: &[SplatParams], counts: &mut [u32], p
     }
 }
 
-pub(crate) fn slab_count_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+pub(crate) fn slab_count_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
     let mut counts = b.take(Res::SlabCounts);
     slab_count(&d.push_as(), b.get(Res::Params), &mut counts);
     b.put(Res::SlabCounts, counts);
     Ok(())
 }
 
-pub(crate) fn slab_scan_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+pub(crate) fn slab_scan_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
     let (mut counts, mut start) = (b.take(Res::SlabCounts), b.take(Res::SlabStart));
     slab_scan(&d.push_as(), &mut counts, &mut start);
     b.put(Res::SlabCounts, counts);
@@ -90,7 +90,7 @@ pub(crate) fn slab_scan_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> 
     Ok(())
 }
 
-pub(crate) fn slab_scatter_stage(b: &mut Bindings<'_>, d: &Dispatch) -> Result<()> {
+pub(crate) fn slab_scatter_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
     let (mut counts, mut pairs) = (b.take(Res::SlabCounts), b.take(Res::SlabPairs));
     slab_scatter(&d.push_as(), b.get(Res::Params), &mut counts, &mut pairs);
     b.put(Res::SlabCounts, counts);

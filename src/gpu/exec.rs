@@ -2,12 +2,12 @@
 //! recording reads something back, then go in one submission; each stage is timed.
 use super::resources::Target;
 use super::Gpu;
-use crate::cpu::exec::add_time;
+use crate::cpu_engine::add_time;
+use crate::dispatch::{Dispatch, Engine, Kind, Limits, Pass, Res};
 use crate::error::{Error, Result};
 use crate::gpu_types::Frame;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
-use crate::stages::{Dispatch, Engine, Kind, Limits, Pass, Res};
 use crate::vk::{Buffer, BufferUsageFlags as BU, Image, ImageLayout as IL, Recorder, Stage, Timer};
 use std::collections::BTreeSet;
 use std::time::Instant;

@@ -1,96 +1,15 @@
-//! The CPU engine: runs a frame's recording (`crate::stages`) on the mirrors, each dispatch through
-//! its stage's `mirror` entry, over host copies of the same resources the GPU binds.
+//! The CPU engine: runs a frame's recording (`crate::recording`) on the mirrors, each dispatch
+//! through its stage's `mirror` entry in the stage table, over `cpu::bindings::Bindings`.
+use crate::cpu::bindings::Bindings;
+use crate::dispatch::{Dispatch, Engine, Limits, Res};
 use crate::error::{Error, Result};
 use crate::gpu_types::Frame;
 use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
 use crate::plan::Prepared;
-use crate::stages::{Dispatch, Engine, Limits, List, Res};
-use std::collections::{BTreeSet, HashMap};
+use std::collections::BTreeSet;
 use std::time::Instant;
-
-use super::footprint::FootprintInputs;
-
-/// What a mirror reads and writes: the scene, the frame's uniforms and tables, and the frame's
-/// resources by name (buffers as 32-bit words, images as `ImageF32`).
-pub struct Bindings<'a> {
-    pub prep: &'a Prepared,
-    pub frame: Frame,
-    /// The radial footprint table and the kernel-slice table (`Kernel::radial_table`,
-    /// `Kernel::slice_table`).
-    pub table: Vec<f32>,
-    pub slice_table: Vec<f32>,
-    pub width: u32,
-    pub height: u32,
-    bufs: HashMap<Res, Vec<u32>>,
-    pub color: ImageF32,
-    pub accum: ImageF32,
-    /// The summation layers.
-    pub sums: Vec<ImageF32>,
-}
-
-impl<'a> Bindings<'a> {
-    fn new(prep: &'a Prepared) -> Self {
-        Self {
-            prep,
-            frame: Frame::default(),
-            table: Vec::new(),
-            slice_table: Vec::new(),
-            width: 0,
-            height: 0,
-            bufs: HashMap::new(),
-            color: ImageF32::new(0, 0),
-            accum: ImageF32::new(0, 0),
-            sums: Vec::new(),
-        }
-    }
-
-    /// A frame buffer as `T`s (empty when it does not exist).
-    pub fn get<T: bytemuck::Pod>(&self, res: Res) -> &[T] {
-        self.bufs.get(&res).map(|v| bytemuck::cast_slice(v.as_slice())).unwrap_or(&[])
-    }
-
-    /// Take a frame buffer out to write it (put it back with `put`).
-    pub fn take(&mut self, res: Res) -> Vec<u32> {
-        self.bufs.remove(&res).unwrap_or_default()
-    }
-
-    pub fn put(&mut self, res: Res, words: Vec<u32>) {
-        self.bufs.insert(res, words);
-    }
-
-    /// The dispatch's draw list.
-    pub fn list(&self, list: List) -> &[u32] {
-        match list {
-            List::Order => self.get(Res::Order),
-            List::Slices(axis) => &self.prep.slices[axis as usize].1,
-            List::SlabPairs => self.get(Res::SlabPairs),
-        }
-    }
-
-    /// The footprint stages' inputs, as bound on the GPU.
-    pub fn inputs(&self, list: List) -> FootprintInputs<'_> {
-        FootprintInputs {
-            frame: &self.frame,
-            params: self.get(Res::Params),
-            draw_list: self.list(list),
-            splats: self.prep.set.splats(),
-            sheet_rank: &self.prep.ranks,
-            table: &self.table,
-            slice_table: &self.slice_table,
-            occlusion: self.get(Res::Occlusion),
-        }
-    }
-
-    fn image_mut(&mut self, res: Res) -> Vec<&mut ImageF32> {
-        match res {
-            Res::Accum => vec![&mut self.accum],
-            Res::Color => vec![&mut self.color],
-            _ => self.sums.iter_mut().collect(),
-        }
-    }
-}
 
 /// The CPU engine of one frame.
 pub struct CpuEngine<'a> {
@@ -100,6 +19,7 @@ pub struct CpuEngine<'a> {
 }
 
 impl<'a> CpuEngine<'a> {
+    /// An engine for one frame of `prep`.
     pub fn new(prep: &'a Prepared) -> Self {
         Self { b: Bindings::new(prep), timings: Vec::new(), live: BTreeSet::new() }
     }
@@ -178,7 +98,7 @@ impl Engine for CpuEngine<'_> {
     fn run(&mut self, d: &Dispatch) -> Result<()> {
         let t = Instant::now();
         let desc = d.stage.desc();
-        (desc.mirror)(&mut self.b, d)?;
+        (desc.mirror)(&mut self.b, d, &desc.variants[d.variant])?;
         self.live.extend(desc.writes.iter().copied());
         add_time(&mut self.timings, desc.timing, t.elapsed().as_secs_f64() * 1e3);
         Ok(())

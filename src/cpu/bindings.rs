@@ -1,0 +1,90 @@
+//! What the mirrors read and write: host copies of the resources the GPU binds, by name.
+use crate::dispatch::{List, Res};
+use crate::gpu_types::Frame;
+use crate::image::ImageF32;
+use crate::plan::Prepared;
+use std::collections::HashMap;
+
+use super::footprint::FootprintInputs;
+
+/// What a mirror reads and writes: the scene, the frame's uniforms and tables, and the frame's
+/// resources by name (buffers as 32-bit words, images as `ImageF32`).
+pub struct Bindings<'a> {
+    pub prep: &'a Prepared,
+    pub frame: Frame,
+    /// The radial footprint table and the kernel-slice table (`Kernel::radial_table`,
+    /// `Kernel::slice_table`).
+    pub table: Vec<f32>,
+    pub slice_table: Vec<f32>,
+    pub width: u32,
+    pub height: u32,
+    pub(crate) bufs: HashMap<Res, Vec<u32>>,
+    pub color: ImageF32,
+    pub accum: ImageF32,
+    /// The summation layers.
+    pub sums: Vec<ImageF32>,
+}
+
+impl<'a> Bindings<'a> {
+    /// Empty bindings for a frame of `prep`.
+    pub fn new(prep: &'a Prepared) -> Self {
+        Self {
+            prep,
+            frame: Frame::default(),
+            table: Vec::new(),
+            slice_table: Vec::new(),
+            width: 0,
+            height: 0,
+            bufs: HashMap::new(),
+            color: ImageF32::new(0, 0),
+            accum: ImageF32::new(0, 0),
+            sums: Vec::new(),
+        }
+    }
+
+    /// A frame buffer as `T`s (empty when it does not exist).
+    pub fn get<T: bytemuck::Pod>(&self, res: Res) -> &[T] {
+        self.bufs.get(&res).map(|v| bytemuck::cast_slice(v.as_slice())).unwrap_or(&[])
+    }
+
+    /// Take a frame buffer out to write it (put it back with `put`).
+    pub fn take(&mut self, res: Res) -> Vec<u32> {
+        self.bufs.remove(&res).unwrap_or_default()
+    }
+
+    pub fn put(&mut self, res: Res, words: Vec<u32>) {
+        self.bufs.insert(res, words);
+    }
+
+    /// The dispatch's draw list.
+    pub fn list(&self, list: List) -> &[u32] {
+        match list {
+            List::Order => self.get(Res::Order),
+            List::Slices(axis) => &self.prep.slices[axis as usize].1,
+            List::SlabPairs => self.get(Res::SlabPairs),
+        }
+    }
+
+    /// The footprint stages' inputs, as bound on the GPU.
+    pub fn inputs(&self, list: List) -> FootprintInputs<'_> {
+        FootprintInputs {
+            frame: &self.frame,
+            params: self.get(Res::Params),
+            draw_list: self.list(list),
+            splats: self.prep.set.splats(),
+            sheet_rank: &self.prep.ranks,
+            table: &self.table,
+            slice_table: &self.slice_table,
+            occlusion: self.get(Res::Occlusion),
+        }
+    }
+
+    /// The image resource `res` (its layers for `Sums`).
+    pub fn image_mut(&mut self, res: Res) -> Vec<&mut ImageF32> {
+        match res {
+            Res::Accum => vec![&mut self.accum],
+            Res::Color => vec![&mut self.color],
+            _ => self.sums.iter_mut().collect(),
+        }
+    }
+}
