@@ -27,7 +27,7 @@ layout(std430, binding = 8) buffer Sums { uint sums[]; };
 
 // llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a footprint
 // box whose loops would pass LOOP_BUDGET (about 240 x 240 pixels) is not drawn but flagged (bit 2)
-// for the host to refuse the frame (gpu.rs).
+// for the host to refuse the frame (recording.rs).
 layout(std430, binding = 17) buffer Status { uint loop_budget_spent; };
 
 // One contribution in fixed point; clamped so no single add can wrap a pixel's sum.

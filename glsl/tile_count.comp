@@ -16,7 +16,7 @@ layout(std430, binding = 16) writeonly buffer QuadsHi { ScreenQuad quads_hi[]; }
 PAGED_WRITER(ScreenQuad, quads_store, quads_lo, quads_hi)
 // llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a chunk whose
 // loops would pass LOOP_BUDGET says so here (bit 1) and the host bins again in shorter chunks
-// (gpu.rs, tile_prepass). tile_scatter's loops are the same, so a chunk that fits here fits there.
+// (recording.rs, record_tiles). tile_scatter's loops are the same, so a chunk that fits here fits there.
 layout(std430, binding = 17) buffer Status { uint loop_budget_spent; };
 
 void main() {

@@ -49,7 +49,7 @@ const TILE_STEPS: u64 = (RASTER_TILE_W * RASTER_TILE_H / RASTER_LANES) as u64;
 const _: () = assert!(TILE_SEGMENT as u64 * (2 + TILE_STEPS) + 2 * TILE_STEPS < 65535);
 /// Loop iterations a binning or footprint-sum invocation may plan for: llvmpipe ends every loop of
 /// an invocation once it has made 65535 in all, so those stages count theirs ahead and flag work
-/// that would pass this (gpu.rs: re-binned in shorter chunks, or a typed error).
+/// that would pass this (recording.rs: re-binned in shorter chunks, or a typed error).
 pub const LOOP_BUDGET: u32 = 60_000;
 /// Samples the GPU ray caster takes per ray at most (a typed error past it): its sample loop shares
 /// llvmpipe's 65535 loop iterations per invocation with the brick skips.

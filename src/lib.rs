@@ -357,7 +357,9 @@ impl Renderer {
         self.gpu.as_ref().map(|g| g.context().validation_messages()).unwrap_or_default()
     }
 
-    /// GPU roofline of the raster pass: milliseconds for `instances` additive `size`-pixel quads.
+    /// GPU roofline of the raster pass: milliseconds for `instances` additive `size`-pixel quads
+    /// (a bench probe).
+    #[doc(hidden)]
     pub fn roofline_quads(&mut self, width: u32, height: u32, size: u32, instances: u32) -> Result<f64> {
         match &mut self.gpu {
             Some(g) => g.roofline_quads(width, height, size.max(1), instances),
@@ -365,7 +367,9 @@ impl Renderer {
         }
     }
 
-    /// GPU roofline of the compositing pass: (roofline ms, composite.comp ms) over `layers` layers.
+    /// GPU roofline of the compositing pass: (roofline ms, composite.comp ms) over `layers` layers
+    /// (a bench probe).
+    #[doc(hidden)]
     pub fn roofline_composite(&mut self, width: u32, height: u32, layers: u32) -> Result<(f64, f64)> {
         match &mut self.gpu {
             Some(g) => g.roofline_composite(width, height, layers.max(1)),
