@@ -1,13 +1,14 @@
 //! The CPU engine: runs a frame's recording (`crate::recording`) on the mirrors, each dispatch
 //! through its stage's `mirror` entry in the stage table, over `cpu::bindings::Bindings`.
 use crate::cpu::bindings::Bindings;
-use crate::dispatch::{Dispatch, Engine, Limits, Res};
+use crate::dispatch::Res;
 use crate::error::{Error, Result};
 use crate::gpu_types::Frame;
 use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
 use crate::plan::Prepared;
+use crate::stages::{Dispatch, Engine, Limits};
 use std::collections::BTreeSet;
 use std::time::Instant;
 
@@ -98,7 +99,7 @@ impl Engine for CpuEngine<'_> {
     fn run(&mut self, d: &Dispatch) -> Result<()> {
         let t = Instant::now();
         let desc = d.stage.desc();
-        (desc.mirror)(&mut self.b, d, &desc.variants[d.variant])?;
+        (desc.mirror)(&mut self.b, &d.args, &desc.variants[d.variant])?;
         self.live.extend(desc.writes.iter().copied());
         add_time(&mut self.timings, desc.timing, t.elapsed().as_secs_f64() * 1e3);
         Ok(())

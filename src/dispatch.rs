@@ -1,11 +1,6 @@
-//! What a recording is made of, below both the stage table and the engines: resources by name
-//! ([`Res`], [`List`]), a stage invocation ([`Dispatch`]) and the builds a stage has
-//! ([`Variant`]), and the [`Engine`] interface that the Vulkan engine, the CPU engine and the bisect
-//! switch implement. The table itself (`crate::stages`) names the CPU mirrors, which read these.
-use crate::error::Result;
-use crate::gpu_types::Frame;
-use crate::kernel::Kernel;
-use crate::options::StageTime;
+//! What the stage table and the CPU mirrors share, below both: resources by name ([`Res`],
+//! [`List`]), a stage's builds ([`Variant`]) and a dispatch's arguments ([`Args`]). The table
+//! (`crate::stages`) names the mirrors, so the mirrors cannot name the table.
 
 /// How a fragment combines with the attachment (premultiplied colour).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -165,50 +160,9 @@ pub enum Workgroup {
     Instances,
 }
 
-/// A stage: its row of `crate::stages::STAGES` (`StageId::desc`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum StageId {
-    /// `order_count`.
-    OrderCount,
-    /// `order_scan`.
-    OrderScan,
-    /// `order_scatter`.
-    OrderScatter,
-    /// `splat_params`.
-    SplatParams,
-    /// `slab_count`.
-    SlabCount,
-    /// `slab_scan`.
-    SlabScan,
-    /// `slab_scatter`.
-    SlabScatter,
-    /// `tile_count`.
-    TileCount,
-    /// `tile_scan`.
-    TileScan,
-    /// `tile_offsets`.
-    TileOffsets,
-    /// `tile_scatter`.
-    TileScatter,
-    /// `tile_composite`.
-    TileComposite,
-    /// `sheet_tiles`.
-    SheetTiles,
-    /// `footprint`.
-    Footprint,
-    /// `footprint_sum`.
-    FootprintSum,
-    /// `composite`.
-    Composite,
-}
-
-/// One stage invocation of a recording.
+/// A dispatch's arguments, what its stage's mirror reads besides the bindings.
 #[derive(Clone, Debug)]
-pub struct Dispatch {
-    /// The stage.
-    pub stage: StageId,
-    /// Index into the stage's `variants`.
-    pub variant: usize,
+pub struct Args {
     /// Compute: workgroups. Draws: `[first instance, instances, 0]`.
     pub groups: [u32; 3],
     /// What `Res::DrawList` binds.
@@ -217,54 +171,9 @@ pub struct Dispatch {
     pub push: Vec<u8>,
 }
 
-impl Dispatch {
-    /// A dispatch of `stage`'s build `variant` (push: the stage's push-constant struct's bytes).
-    pub fn new(stage: StageId, variant: usize, groups: [u32; 3], list: List, push: &[u8]) -> Self {
-        debug_assert_eq!(push.len() as u32, stage.desc().push, "{}: push size", stage.desc().name);
-        Self { stage, variant, groups, list, push: push.to_vec() }
-    }
-
+impl Args {
     /// The push constants as the stage's struct.
     pub fn push_as<T: bytemuck::Pod>(&self) -> T {
         bytemuck::pod_read_unaligned(&self.push)
     }
-}
-
-/// What an engine can hold, which the frame's plan must respect.
-#[derive(Clone, Copy, Debug)]
-pub struct Limits {
-    /// Most layers of the summation image.
-    pub max_layers: u32,
-    /// Largest storage binding in bytes (the fixed-point layers are one).
-    pub max_storage_range: u64,
-}
-
-/// Runs a recording: the Vulkan device, the CPU mirrors, or a split of the two.
-pub trait Engine {
-    /// A frame of `width` x `height` begins: its uniforms and kernel tables.
-    fn begin(&mut self, frame: &Frame, kernel: Kernel, width: u32, height: u32) -> Result<()>;
-    /// The summation image holds `layers` layers this frame.
-    fn layers(&mut self, layers: u32) -> Result<()>;
-    /// `res` holds at least `bytes`.
-    fn ensure(&mut self, res: Res, bytes: u64) -> Result<()>;
-    /// Set 32-bit words of `res` (all, or `count` from `first`) to `value`.
-    fn fill(&mut self, res: Res, range: Option<(u64, u64)>, value: u32) -> Result<()>;
-    /// Write host data into `res` from its start.
-    fn upload(&mut self, res: Res, data: &[u32]) -> Result<()>;
-    /// Run (or queue) one stage dispatch.
-    fn run(&mut self, dispatch: &Dispatch) -> Result<()>;
-    /// Finish the work so far and read the first `words` 32-bit words of each resource.
-    fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>>;
-    /// Words `res` holds now (0 when it does not exist).
-    fn words(&self, res: Res) -> usize;
-    /// Work done on the host, reported as a stage.
-    fn host_time(&mut self, stage: &'static str, ms: f64);
-    /// Finish the frame: the stage times.
-    fn finish(&mut self) -> Result<Vec<StageTime>>;
-    /// The frame resources written so far (what a split hands over).
-    fn live(&self) -> Vec<Res>;
-    /// What the frame's plan must respect on this engine.
-    fn limits(&self) -> Limits;
-    /// Whether this is a device (host orders are then reported as `order_cpu`).
-    fn is_device(&self) -> bool;
 }

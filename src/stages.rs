@@ -13,12 +13,13 @@ use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
 use crate::gpu_types::{CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
 
-pub use crate::dispatch::{
-    Blend, Dispatch, DrawState, Engine, Feature, Kind, Limits, List, Pass, Res, StageId, Variant, Workgroup,
-};
+pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, List, Pass, Res, Variant, Workgroup};
+use crate::gpu_types::Frame;
+use crate::kernel::Kernel;
+use crate::options::StageTime;
 
 /// The CPU mirror's entry point: runs one dispatch on the CPU engine's bindings.
-pub type Mirror = fn(&mut Bindings<'_>, &Dispatch, &Variant) -> Result<()>;
+pub type Mirror = fn(&mut Bindings<'_>, &Args, &Variant) -> Result<()>;
 
 /// One row of the stage table.
 pub struct StageDesc {
@@ -84,7 +85,7 @@ const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
 const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
 
 /// The stages, indexed by [`StageId`].
-pub static STAGES: [StageDesc; 16] = [
+pub const STAGES: &[StageDesc] = &[
     StageDesc {
         name: "order_count",
         kind: Kind::Compute,
@@ -311,6 +312,77 @@ pub static STAGES: [StageDesc; 16] = [
     },
 ];
 
+const _: () = assert!(StageId::ALL.len() == STAGES.len());
+const _: () = {
+    // Row i of the table is the stage the macro's i-th id names (`OrderCount` is `order_count`).
+    let mut i = 0;
+    while i < STAGES.len() {
+        assert!(camel_is_snake(StageId::NAMES[i].as_bytes(), STAGES[i].name.as_bytes()));
+        i += 1;
+    }
+};
+
+/// Whether `camel` (`TileCount`) is `snake` (`tile_count`) in UpperCamelCase.
+const fn camel_is_snake(camel: &[u8], snake: &[u8]) -> bool {
+    let (mut i, mut j) = (0, 0);
+    while i < camel.len() {
+        let c = camel[i];
+        if c.is_ascii_uppercase() {
+            if i > 0 {
+                if j >= snake.len() || snake[j] != b'_' {
+                    return false;
+                }
+                j += 1;
+            }
+            if j >= snake.len() || snake[j] != c.to_ascii_lowercase() {
+                return false;
+            }
+        } else if j >= snake.len() || snake[j] != c {
+            return false;
+        }
+        i += 1;
+        j += 1;
+    }
+    j == snake.len()
+}
+
+/// The stage ids, in the table's order: one name per row, `UpperCamel` of the row's `name`.
+macro_rules! stage_ids {
+    ($($id:ident),* $(,)?) => {
+        /// A stage: its row of [`STAGES`] ([`StageId::desc`]).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[allow(missing_docs)]
+        pub enum StageId {
+            $($id),*
+        }
+
+        impl StageId {
+            /// Every stage, in table order.
+            pub const ALL: &'static [StageId] = &[$(StageId::$id),*];
+            const NAMES: &'static [&'static str] = &[$(stringify!($id)),*];
+        }
+    };
+}
+
+stage_ids!(
+    OrderCount,
+    OrderScan,
+    OrderScatter,
+    SplatParams,
+    SlabCount,
+    SlabScan,
+    SlabScatter,
+    TileCount,
+    TileScan,
+    TileOffsets,
+    TileScatter,
+    TileComposite,
+    SheetTiles,
+    Footprint,
+    FootprintSum,
+    Composite,
+);
+
 impl StageId {
     /// Its row of the table.
     pub fn desc(self) -> &'static StageDesc {
@@ -319,29 +391,67 @@ impl StageId {
 
     /// The stage of this name.
     pub fn named(name: &str) -> Result<StageId> {
-        const ALL: [StageId; 16] = [
-            StageId::OrderCount,
-            StageId::OrderScan,
-            StageId::OrderScatter,
-            StageId::SplatParams,
-            StageId::SlabCount,
-            StageId::SlabScan,
-            StageId::SlabScatter,
-            StageId::TileCount,
-            StageId::TileScan,
-            StageId::TileOffsets,
-            StageId::TileScatter,
-            StageId::TileComposite,
-            StageId::SheetTiles,
-            StageId::Footprint,
-            StageId::FootprintSum,
-            StageId::Composite,
-        ];
-        ALL.into_iter().find(|s| s.desc().name == name).ok_or_else(|| {
+        StageId::ALL.iter().copied().find(|s| s.desc().name == name).ok_or_else(|| {
             let names: Vec<_> = STAGES.iter().map(|s| s.name).collect();
             Error::InvalidArgument(format!("unknown stage '{name}' (stages: {})", names.join(", ")))
         })
     }
 }
 
-const _: () = assert!(StageId::Composite as usize + 1 == STAGES.len());
+/// One stage invocation of a recording.
+#[derive(Clone, Debug)]
+pub struct Dispatch {
+    /// The stage.
+    pub stage: StageId,
+    /// Index into the stage's `variants`.
+    pub variant: usize,
+    /// Workgroups, draw list and push constants.
+    pub args: Args,
+}
+
+impl Dispatch {
+    /// A dispatch of `stage`'s build `variant` (push: the stage's push-constant struct's bytes).
+    pub fn new(stage: StageId, variant: usize, groups: [u32; 3], list: List, push: &[u8]) -> Self {
+        debug_assert_eq!(push.len() as u32, stage.desc().push, "{}: push size", stage.desc().name);
+        Self { stage, variant, args: Args { groups, list, push: push.to_vec() } }
+    }
+}
+
+/// What an engine can hold, which the frame's plan must respect.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Most layers of the summation image.
+    pub max_layers: u32,
+    /// Largest storage binding in bytes (the fixed-point layers are one).
+    pub max_storage_range: u64,
+}
+
+/// Runs a recording: the Vulkan device, the CPU mirrors, or a split of the two.
+pub trait Engine {
+    /// A frame of `width` x `height` begins: its uniforms and kernel tables.
+    fn begin(&mut self, frame: &Frame, kernel: Kernel, width: u32, height: u32) -> Result<()>;
+    /// The summation image holds `layers` layers this frame.
+    fn layers(&mut self, layers: u32) -> Result<()>;
+    /// `res` holds at least `bytes`.
+    fn ensure(&mut self, res: Res, bytes: u64) -> Result<()>;
+    /// Set 32-bit words of `res` (all, or `count` from `first`) to `value`.
+    fn fill(&mut self, res: Res, range: Option<(u64, u64)>, value: u32) -> Result<()>;
+    /// Write host data into `res` from its start.
+    fn upload(&mut self, res: Res, data: &[u32]) -> Result<()>;
+    /// Run (or queue) one stage dispatch.
+    fn run(&mut self, dispatch: &Dispatch) -> Result<()>;
+    /// Finish the work so far and read the first `words` 32-bit words of each resource.
+    fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>>;
+    /// Words `res` holds now (0 when it does not exist).
+    fn words(&self, res: Res) -> usize;
+    /// Work done on the host, reported as a stage.
+    fn host_time(&mut self, stage: &'static str, ms: f64);
+    /// Finish the frame: the stage times.
+    fn finish(&mut self) -> Result<Vec<StageTime>>;
+    /// The frame resources written so far (what a split hands over).
+    fn live(&self) -> Vec<Res>;
+    /// What the frame's plan must respect on this engine.
+    fn limits(&self) -> Limits;
+    /// Whether this is a device (host orders are then reported as `order_cpu`).
+    fn is_device(&self) -> bool;
+}

@@ -1,7 +1,7 @@
 //! Mirror of `composite.comp`.
 use super::ImageF32;
 use crate::constants::COMPOSITE_TILE;
-use crate::dispatch::{Dispatch, Res, Variant};
+use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::CompositePush;
 use rayon::prelude::*;
@@ -73,7 +73,7 @@ pub fn composite(
     }
 }
 
-pub(crate) fn composite_stage(b: &mut Bindings<'_>, d: &Dispatch, v: &Variant) -> Result<()> {
+pub(crate) fn composite_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let push: CompositePush = d.push_as();
     let mut occlusion = b.take(Res::Occlusion);
     let mut accum = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));

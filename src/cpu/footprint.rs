@@ -6,7 +6,7 @@
 //! the projective map of `screen_quad`).
 use super::ImageF32;
 use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
-use crate::dispatch::{Dispatch, Pass, Res, Variant};
+use crate::dispatch::{Args, Pass, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB};
 pub use crate::kernel::sample_radial;
@@ -383,7 +383,7 @@ fn raster_quad(
 
 /// The draw: the raster target or the summation layers are cleared (the render pass's load) and
 /// the footprints drawn into them.
-pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Dispatch, v: &Variant) -> Result<()> {
+pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let state = v.draw.expect("footprint variants are draws");
     let count = match state.pass {
         Pass::Target => 1,
@@ -399,7 +399,7 @@ pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Dispatch, v: &Variant) -
     Ok(())
 }
 
-pub(crate) fn footprint_sum_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn footprint_sum_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut sums = b.take(Res::Fixed);
     footprint_sum(&b.inputs(d.list), &d.push_as(), &mut sums);
     b.put(Res::Fixed, sums);

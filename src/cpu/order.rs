@@ -1,6 +1,6 @@
 //! Mirrors of `order_count.comp`, `order_scan.comp` and `order_scatter.comp`.
 use super::bindings::Bindings;
-use crate::dispatch::{Dispatch, Res, Variant};
+use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{Frame, Splat};
 
@@ -96,7 +96,7 @@ pub fn order_scatter(
     }
 }
 
-pub(crate) fn order_count_stage(b: &mut Bindings<'_>, _: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn order_count_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let (mut row_split, mut segments) = (b.take(Res::RowSplit), b.take(Res::Segments));
     let set = &b.prep.set;
     order_count(&b.frame, set.splats(), set.row_start(), &mut row_split, &mut segments);
@@ -105,14 +105,14 @@ pub(crate) fn order_count_stage(b: &mut Bindings<'_>, _: &Dispatch, _: &Variant)
     Ok(())
 }
 
-pub(crate) fn order_scan_stage(b: &mut Bindings<'_>, _: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn order_scan_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let mut segments = b.take(Res::Segments);
     order_scan(&b.frame, &mut segments);
     b.put(Res::Segments, segments);
     Ok(())
 }
 
-pub(crate) fn order_scatter_stage(b: &mut Bindings<'_>, _: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn order_scatter_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let mut out = b.take(Res::Order);
     let set = &b.prep.set;
     order_scatter(&b.frame, set.splats(), set.row_start(), b.get(Res::RowSplit), b.get(Res::Segments), &mut out);

@@ -2,7 +2,7 @@
 use super::bindings::Bindings;
 use super::footprint::{entry, screen_quad, FootprintInputs};
 use crate::constants::COMPOSITE_TILE;
-use crate::dispatch::{Dispatch, Res, Variant};
+use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::FootprintPush;
 use glam::{IVec2, Mat4, Vec2, Vec4};
@@ -51,7 +51,7 @@ pub fn sheet_tiles(inputs: &FootprintInputs<'_>, push: &FootprintPush, points: b
     }
 }
 
-pub(crate) fn sheet_tiles_stage(b: &mut Bindings<'_>, d: &Dispatch, v: &Variant) -> Result<()> {
+pub(crate) fn sheet_tiles_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let mut tiles = b.take(Res::SheetTiles);
     sheet_tiles(&b.inputs(d.list), &d.push_as(), v.spec.get(1) == Some(&1), &mut tiles);
     b.put(Res::SheetTiles, tiles);

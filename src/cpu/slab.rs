@@ -1,7 +1,7 @@
 //! Mirrors of the slab binning stages `slab_count.comp`, `slab_scan.comp` and `slab_scatter.comp`.
 use super::bindings::Bindings;
 use crate::constants::SLAB_CHUNK;
-use crate::dispatch::{Dispatch, Res, Variant};
+use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{SlabPush, SplatParams};
 use glam::Vec3;
@@ -75,14 +75,14 @@ pub fn slab_scatter(pc: &SlabPush, params: &[SplatParams], counts: &mut [u32], p
     }
 }
 
-pub(crate) fn slab_count_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn slab_count_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut counts = b.take(Res::SlabCounts);
     slab_count(&d.push_as(), b.get(Res::Params), &mut counts);
     b.put(Res::SlabCounts, counts);
     Ok(())
 }
 
-pub(crate) fn slab_scan_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn slab_scan_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut start) = (b.take(Res::SlabCounts), b.take(Res::SlabStart));
     slab_scan(&d.push_as(), &mut counts, &mut start);
     b.put(Res::SlabCounts, counts);
@@ -90,7 +90,7 @@ pub(crate) fn slab_scan_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -
     Ok(())
 }
 
-pub(crate) fn slab_scatter_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn slab_scatter_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut pairs) = (b.take(Res::SlabCounts), b.take(Res::SlabPairs));
     slab_scatter(&d.push_as(), b.get(Res::Params), &mut counts, &mut pairs);
     b.put(Res::SlabCounts, counts);

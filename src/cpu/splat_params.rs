@@ -1,6 +1,6 @@
 //! Mirror of `splat_params.comp`.
 use super::bindings::Bindings;
-use crate::dispatch::{Dispatch, Res, Variant};
+use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{Frame, Splat, SplatParams};
 use glam::{Mat4, Vec2, Vec3};
@@ -88,7 +88,7 @@ pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams])
     }
 }
 
-pub(crate) fn splat_params_stage(b: &mut Bindings<'_>, _: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn splat_params_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let mut params = b.take(Res::Params);
     splat_params(&b.frame, b.prep.set.splats(), bytemuck::cast_slice_mut(&mut params));
     b.put(Res::Params, params);

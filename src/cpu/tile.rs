@@ -5,7 +5,7 @@
 use super::footprint::{footprint_weight, screen_quad, FootprintInputs};
 use super::ImageF32;
 use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
-use crate::dispatch::{Dispatch, Res, Variant};
+use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams};
 use glam::{IVec4, Mat3, Vec2, Vec3};
@@ -171,7 +171,7 @@ pub fn tile_composite(
     });
 }
 
-pub(crate) fn tile_count_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn tile_count_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut quads) = (b.take(Res::TileCounts), b.take(Res::Quads));
     tile_count(&b.inputs(d.list), &d.push_as(), &mut counts, bytemuck::cast_slice_mut(&mut quads));
     b.put(Res::TileCounts, counts);
@@ -179,7 +179,7 @@ pub(crate) fn tile_count_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) 
     Ok(())
 }
 
-pub(crate) fn tile_scan_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn tile_scan_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut start) = (b.take(Res::TileCounts), b.take(Res::TileStart));
     tile_scan(&b.inputs(d.list), &d.push_as(), &mut counts, &mut start);
     b.put(Res::TileCounts, counts);
@@ -187,14 +187,14 @@ pub(crate) fn tile_scan_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -
     Ok(())
 }
 
-pub(crate) fn tile_offsets_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn tile_offsets_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut start = b.take(Res::TileStart);
     tile_offsets(&b.inputs(d.list), &mut start);
     b.put(Res::TileStart, start);
     Ok(())
 }
 
-pub(crate) fn tile_scatter_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn tile_scatter_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut entries) = (b.take(Res::TileCounts), b.take(Res::TileEntries));
     let (inputs, push) = (b.inputs(d.list), d.push_as());
     tile_scatter(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), &mut counts, &mut entries);
@@ -203,7 +203,7 @@ pub(crate) fn tile_scatter_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant
     Ok(())
 }
 
-pub(crate) fn tile_composite_stage(b: &mut Bindings<'_>, d: &Dispatch, _: &Variant) -> Result<()> {
+pub(crate) fn tile_composite_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut image = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
     let (inputs, push) = (b.inputs(d.list), d.push_as());
     tile_composite(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);

@@ -3,11 +3,12 @@
 use super::resources::Target;
 use super::Gpu;
 use crate::cpu_engine::add_time;
-use crate::dispatch::{Dispatch, Engine, Kind, Limits, Pass, Res};
+use crate::dispatch::{Kind, Pass, Res};
 use crate::error::{Error, Result};
 use crate::gpu_types::Frame;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
+use crate::stages::{Dispatch, Engine, Limits};
 use crate::vk::{Buffer, BufferUsageFlags as BU, Image, ImageLayout as IL, Recorder, Stage, Timer};
 use std::collections::BTreeSet;
 use std::time::Instant;
@@ -60,7 +61,7 @@ impl<'a> GpuEngine<'a> {
         let gpu = &mut *self.gpu;
         for (_, cmd) in &pending {
             if let Cmd::Run(d) = cmd {
-                gpu.res.ensure_set(&gpu.pipes, d.stage, d.list)?;
+                gpu.res.ensure_set(&gpu.pipes, d.stage, d.args.list)?;
             }
         }
         // Runs of commands with one timing; transfers join the stage after them.
@@ -149,19 +150,19 @@ fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3],
         Cmd::Run(d) => {
             let desc = d.stage.desc();
             let stage = &gpu.pipes.stages[d.stage as usize];
-            let (pipe, set) = (&stage.variants[d.variant], res.set(d.stage, d.list)?);
+            let (pipe, set) = (&stage.variants[d.variant], res.set(d.stage, d.args.list)?);
             match desc.kind {
                 Kind::Compute => {
                     for &r in desc.bindings.iter().filter(|r| matches!(r, Res::Accum | Res::Sums)) {
                         let (image, i) = image_of(target, r);
                         to_layout(rec, image, &mut layouts[i], IL::GENERAL);
                     }
-                    rec.dispatch(pipe, &stage.layout, set, &d.push, d.groups);
+                    rec.dispatch(pipe, &stage.layout, set, &d.args.push, d.args.groups);
                     rec.barrier(Stage::Compute, Stage::All);
                 }
                 Kind::Draw => {
                     let state = desc.variants[d.variant].draw.expect("draw variants carry raster state");
-                    let (first, count) = (d.groups[0], d.groups[1]);
+                    let (first, count) = (d.args.groups[0], d.args.groups[1]);
                     match state.pass {
                         Pass::Target => {
                             rec.begin_pass(&gpu.pipes.target_pass, &target.color_fb);
@@ -174,9 +175,9 @@ fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3],
                     }
                     if count > 0 {
                         if state.points {
-                            rec.draw_points(pipe, &stage.layout, set, &d.push, first, count);
+                            rec.draw_points(pipe, &stage.layout, set, &d.args.push, first, count);
                         } else {
-                            rec.draw_quads(pipe, &stage.layout, set, &d.push, first, count);
+                            rec.draw_quads(pipe, &stage.layout, set, &d.args.push, first, count);
                         }
                     }
                     rec.end_pass();
