@@ -126,6 +126,10 @@ impl Engine for Split<'_> {
             max_storage_range: a.max_storage_range.min(b.max_storage_range),
         }
     }
+    fn prepare_field(&mut self, brick: u32) -> Result<()> {
+        self.first.prepare_field(brick)?;
+        self.second.prepare_field(brick)
+    }
     fn is_device(&self) -> bool {
         if self.switched {
             self.second.is_device()
@@ -210,6 +214,9 @@ impl Engine for Stop<'_> {
     }
     fn limits(&self) -> Limits {
         self.inner.limits()
+    }
+    fn prepare_field(&mut self, brick: u32) -> Result<()> {
+        self.inner.prepare_field(brick)
     }
     fn is_device(&self) -> bool {
         self.inner.is_device()

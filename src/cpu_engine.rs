@@ -154,4 +154,10 @@ impl Engine for CpuEngine<'_> {
     fn is_device(&self) -> bool {
         false
     }
+
+    fn prepare_field(&mut self, brick: u32) -> Result<()> {
+        let field = self.b.prep.dense_field()?;
+        self.b.bricks = crate::cpu::raycast::brick_occupancy(field, brick.max(1)).1;
+        Ok(())
+    }
 }

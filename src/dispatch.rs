@@ -65,6 +65,13 @@ pub enum Res {
     SlabStart,
     /// The (splat, slab) pairs in visiting order.
     SlabPairs,
+    /// The ray caster's uniforms (`RaycastParams`).
+    RaycastParams,
+    /// The ray caster's dense (colour * tau, tau) field, a 3D texture: a per-scene cache built on
+    /// first use (`Engine::prepare_field`).
+    Field,
+    /// Its brick occupancy (1: a brick holds a non-empty voxel), cached with it.
+    Bricks,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.
@@ -76,7 +83,17 @@ pub enum Res {
 impl Res {
     /// Made before any frame (renderer or scene) and never changed by a stage.
     pub fn is_constant(self) -> bool {
-        matches!(self, Res::Frame | Res::Radial | Res::SliceTable | Res::Splats | Res::RowStart | Res::Ranks)
+        matches!(
+            self,
+            Res::Frame
+                | Res::Radial
+                | Res::SliceTable
+                | Res::Splats
+                | Res::RowStart
+                | Res::Ranks
+                | Res::Field
+                | Res::Bricks
+        )
     }
 
     /// An image rather than a buffer.

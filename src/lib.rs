@@ -184,9 +184,9 @@ impl Renderer {
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         let mut cpu = CpuEngine::new(prep);
         let recorded = match (&mut self.gpu, bisect) {
-            (Some(g), None) => record_frame(&mut g.engine(), prep, camera, &opts)?,
+            (Some(g), None) => record_frame(&mut g.engine(prep), prep, camera, &opts)?,
             (Some(g), Some(b)) => {
-                let mut gpu = g.engine();
+                let mut gpu = g.engine(prep);
                 let mut split = match b {
                     Bisect::GpuUntil(at) => bisect::Split::new(&mut gpu, &mut cpu, at),
                     Bisect::CpuUntil(at) => bisect::Split::new(&mut cpu, &mut gpu, at),
@@ -234,7 +234,7 @@ impl Renderer {
             e.read(&what)
         };
         match &mut self.gpu {
-            Some(g) => run(&mut g.engine()),
+            Some(g) => run(&mut g.engine(prep)),
             None => run(&mut CpuEngine::new(prep)),
         }
     }
@@ -330,21 +330,11 @@ impl Renderer {
         }
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
-        match &mut self.gpu {
-            Some(g) => g.raycast(prep, camera, options),
-            None => {
-                let t = std::time::Instant::now();
-                let field = prep.dense_field()?;
-                let rc = cpu::raycast::raycast_params(&prep.set, camera, options);
-                let (_, bricks) = cpu::raycast::brick_occupancy(field, options.brick.max(1));
-                let image = cpu::raycast(&rc, field, &bricks, None);
-                Ok(Rendered {
-                    image,
-                    timings: vec![StageTime { stage: "raycast", ms: t.elapsed().as_secs_f64() * 1e3 }],
-                    raster: None,
-                })
-            }
-        }
+        let recorded = match &mut self.gpu {
+            Some(g) => recording::record_raycast(&mut g.engine(prep), prep, camera, options)?,
+            None => recording::record_raycast(&mut CpuEngine::new(prep), prep, camera, options)?,
+        };
+        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: None })
     }
 
     /// Validation messages counted so far (always 0 without validation or on the CPU).

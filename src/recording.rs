@@ -4,8 +4,11 @@
 //! starts and the loop-budget word), the engine finishes the work so far; the recording is still
 //! written once, for every engine.
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT};
+use crate::constants::{
+    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT,
+};
 use crate::cpu::footprint::Blend;
+use crate::cpu::raycast::RaycastOptions;
 use crate::error::{Error, Result};
 use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
 use crate::image::ImageF32;
@@ -274,4 +277,32 @@ fn finish(e: &mut dyn Engine, image: Res, w: u32, h: u32, status: bool) -> Resul
     let pixels = back[0].chunks_exact(4).map(|c| [0, 1, 2, 3].map(|i| f32::from_bits(c[i]))).collect();
     let timings = e.finish()?;
     Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings })
+}
+
+/// THE recording of the reference ray caster (`raycast.comp` and its mirror): `prep` cast from
+/// `camera` with `opts` (at full size: the caller resamples a render scale).
+pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RaycastOptions) -> Result<Recorded> {
+    camera.validate()?;
+    let params = crate::cpu::raycast::raycast_params(&prep.set, camera, opts);
+    if e.is_device() {
+        let diagonal =
+            glam::Vec3::from_slice(&params.box_max[..3]).distance(glam::Vec3::from_slice(&params.box_min[..3]));
+        let steps = (diagonal / params.box_min[3]).ceil().min(opts.max_steps as f32);
+        if steps > MAX_GPU_RAY_STEPS as f32 {
+            return Err(Error::TooLarge(format!(
+                "rays of up to {steps} samples: the GPU ray caster takes at most {MAX_GPU_RAY_STEPS} per ray (llvmpipe \
+                 ends a shader's loops after 65535 iterations); use a longer step, a lower max_steps or the CPU backend"
+            )));
+        }
+    }
+    let (w, h) = (camera.width, camera.height);
+    let frame = plan::frame_for(&prep.set, camera, &RenderOptions::default());
+    e.begin(&frame, crate::kernel::Kernel::Gaussian, w, h)?;
+    e.prepare_field(opts.brick)?;
+    let words: &[u32] = bytemuck::cast_slice(bytemuck::bytes_of(&params));
+    e.ensure(Res::RaycastParams, words.len() as u64 * 4)?;
+    e.upload(Res::RaycastParams, words)?;
+    let groups = tile_groups(StageId::Raycast, w, h);
+    e.run(&Dispatch::new(StageId::Raycast, 0, groups, List::Order, &[]))?;
+    finish(e, Res::Accum, w, h, false)
 }

@@ -310,6 +310,18 @@ pub const STAGES: &[StageDesc] = &[
         variants: &[v("", &[]), v("", &[1])],
         mirror: crate::cpu::composite::composite_stage,
     },
+    StageDesc {
+        name: "raycast",
+        kind: Kind::Compute,
+        bindings: &[Res::RaycastParams, Res::Field, Res::Accum, Res::Bricks],
+        writes: &[Res::Accum],
+        push: 0,
+        workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
+        timing: "raycast",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::raycast::raycast_stage,
+    },
 ];
 
 const _: () = assert!(StageId::ALL.len() == STAGES.len());
@@ -381,6 +393,7 @@ stage_ids!(
     Footprint,
     FootprintSum,
     Composite,
+    Raycast,
 );
 
 impl StageId {
@@ -452,6 +465,9 @@ pub trait Engine {
     fn live(&self) -> Vec<Res>;
     /// What the frame's plan must respect on this engine.
     fn limits(&self) -> Limits;
+    /// Make the scene's dense field and its occupancy of `brick`-voxel bricks resident (the ray
+    /// caster's `Res::Field`, `Res::Bricks`; brick 0: no skipping).
+    fn prepare_field(&mut self, brick: u32) -> Result<()>;
     /// Whether this is a device (host orders are then reported as `order_cpu`).
     fn is_device(&self) -> bool;
 }

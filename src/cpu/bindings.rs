@@ -23,6 +23,8 @@ pub struct Bindings<'a> {
     pub accum: ImageF32,
     /// The summation layers.
     pub sums: Vec<ImageF32>,
+    /// The ray caster's brick occupancy (`Res::Bricks`; the field is `prep.dense_field()`).
+    pub bricks: Vec<u32>,
 }
 
 impl<'a> Bindings<'a> {
@@ -39,6 +41,7 @@ impl<'a> Bindings<'a> {
             color: ImageF32::new(0, 0),
             accum: ImageF32::new(0, 0),
             sums: Vec::new(),
+            bricks: Vec::new(),
         }
     }
 

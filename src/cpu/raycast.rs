@@ -2,7 +2,11 @@
 //! the first sample (CPU only) for supersampled references.
 use super::ImageF32;
 use crate::camera::Camera;
+use crate::dispatch::{Args, Res, Variant};
+use crate::error::Result;
 use crate::gpu_types::RaycastParams;
+
+use super::bindings::Bindings;
 use crate::volume::DenseField;
 use crate::volume::SplatSet;
 use glam::{Mat4, Vec3, Vec4};
@@ -201,4 +205,11 @@ fn hash01(seed: u64, x: u64, y: u64) -> f32 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
     ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+}
+
+pub(crate) fn raycast_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+    let rc: RaycastParams = bytemuck::pod_read_unaligned(bytemuck::cast_slice(b.get::<u32>(Res::RaycastParams)));
+    let field = b.prep.dense_field()?;
+    b.accum = raycast(&rc, field, &b.bricks, None);
+    Ok(())
 }

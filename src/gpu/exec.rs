@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::gpu_types::Frame;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
+use crate::plan::Prepared;
 use crate::stages::{Dispatch, Engine, Limits};
 use crate::vk::{Buffer, BufferUsageFlags as BU, Image, ImageLayout as IL, Recorder, Stage, Timer};
 use std::collections::BTreeSet;
@@ -24,6 +25,7 @@ enum Cmd {
 /// The Vulkan engine of one frame.
 pub struct GpuEngine<'a> {
     gpu: &'a mut Gpu,
+    prep: &'a Prepared,
     /// Commands and the timing they count towards ("" for transfers, which join the next stage).
     pending: Vec<(&'static str, Cmd)>,
     timings: Vec<StageTime>,
@@ -36,9 +38,11 @@ pub struct GpuEngine<'a> {
 }
 
 impl<'a> GpuEngine<'a> {
-    pub fn new(gpu: &'a mut Gpu) -> Self {
+    /// An engine for a frame of `prep` on `gpu`.
+    pub fn new(gpu: &'a mut Gpu, prep: &'a Prepared) -> Self {
         Self {
             gpu,
+            prep,
             pending: Vec::new(),
             timings: Vec::new(),
             live: BTreeSet::new(),
@@ -341,5 +345,10 @@ impl Engine for GpuEngine<'_> {
 
     fn is_device(&self) -> bool {
         true
+    }
+
+    fn prepare_field(&mut self, brick: u32) -> Result<()> {
+        self.flush()?;
+        self.gpu.upload_field(self.prep, brick)
     }
 }

@@ -1,17 +1,13 @@
 //! The Vulkan side: pipelines built from the stage table (`pipelines`), resources by name
 //! (`resources`), the engine that runs a frame's recording (`exec`); and the two passes outside
-//! the frame recording: the ray caster (`raycast.comp`, the reference) and the bench's rooflines.
+//! the frame recording: the bench's rooflines (and the ray caster's field upload, a scene cache).
 pub mod exec;
 pub mod pipelines;
 pub mod resources;
 
-use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, MAX_GPU_RAY_STEPS};
-use crate::cpu::raycast::{raycast_params, RaycastOptions};
-use crate::error::{Error, Result};
+use crate::constants::COMPOSITE_TILE;
+use crate::error::Result;
 use crate::gpu_types::CompositePush;
-use crate::image::ImageF32;
-use crate::options::{Rendered, StageTime};
 use crate::plan::Prepared;
 use crate::stages::{List, Res, StageId};
 use crate::vk::{
@@ -24,10 +20,8 @@ use resources::Resources;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Passes that are not stages of a frame: the ray caster and the rooflines.
+/// Passes that are not stages of a frame: the rooflines.
 struct Extra {
-    raycast_layout: Layout,
-    raycast: Pipeline,
     roofline_layout: Layout,
     roofline_quads: Pipeline,
     roofline_composite: Pipeline,
@@ -45,13 +39,9 @@ pub struct Gpu {
 impl Gpu {
     pub fn new(ctx: Arc<Context>) -> Result<Self> {
         let pipes = Pipelines::new(&ctx)?;
-        let raycast_layout =
-            Layout::new(&ctx, &[Slot::Storage, Slot::Texture, Slot::StorageImage, Slot::Storage], SS::COMPUTE, 0)?;
         let roofline_layout = Layout::new(&ctx, &[Slot::Uniform], SS::VERTEX | SS::FRAGMENT, 16)?;
         let composite_layout = &pipes.stages[StageId::Composite as usize].layout;
         let extra = Extra {
-            raycast: Pipeline::compute(&ctx, &raycast_layout, spirv("raycast.comp")?)?,
-            raycast_layout,
             roofline_quads: Pipeline::graphics(
                 &ctx,
                 &roofline_layout,
@@ -76,67 +66,21 @@ impl Gpu {
         self.res.set_scene(prep)
     }
 
-    /// An engine for one frame.
-    pub fn engine(&mut self) -> exec::GpuEngine<'_> {
-        exec::GpuEngine::new(self)
-    }
-
-    /// The GPU ray caster (`raycast.comp`), uploading the dense field on first use.
-    pub fn raycast(&mut self, prep: &Prepared, camera: &Camera, opts: &RaycastOptions) -> Result<Rendered> {
-        camera.validate()?;
-        let params = raycast_params(&prep.set, camera, opts);
-        let diagonal =
-            glam::Vec3::from_slice(&params.box_max[..3]).distance(glam::Vec3::from_slice(&params.box_min[..3]));
-        let steps = (diagonal / params.box_min[3]).ceil().min(opts.max_steps as f32);
-        if steps > MAX_GPU_RAY_STEPS as f32 {
-            return Err(Error::TooLarge(format!(
-                "rays of up to {steps} samples: the GPU ray caster takes at most {MAX_GPU_RAY_STEPS} per ray (llvmpipe ends \
-                 a shader's loops after 65535 iterations); use a longer step, a lower max_steps or the CPU backend"
-            )));
-        }
-        let (w, h) = (camera.width, camera.height);
-        let layers = self.res.current_target().map(|t| t.layers).unwrap_or(1);
-        self.res.target(&self.pipes, w, h, layers)?;
-        self.upload_field(prep, opts.brick)?;
-        self.res.ensure_readback(Res::Accum, w as u64 * h as u64 * 16)?;
-        let ubo = Buffer::with_data(&self.ctx, "raycast params", bytemuck::bytes_of(&params), BU::STORAGE_BUFFER)?;
-        let (res, target) = (&self.res, self.res.current_target()?);
-        let scene = res.scene()?;
-        let (Some(field), Some((_, bricks))) = (&scene.field, &scene.bricks) else {
-            return Err(Error::InvalidArgument("the ray caster's field is not uploaded".into()));
-        };
-        let set = self.extra.raycast_layout.bind(&[
-            Bind::Buffer(&ubo),
-            Bind::Texture(field, &res.sampler),
-            Bind::Image(&target.accum),
-            Bind::Buffer(bricks),
-        ])?;
-        let back = res.readback(Res::Accum)?;
-        let t = Instant::now();
-        self.ctx.submit(|rec| {
-            rec.transition(&target.accum, IL::UNDEFINED, IL::GENERAL, Stage::All, Stage::Compute);
-            let groups = [w.div_ceil(COMPOSITE_TILE), h.div_ceil(COMPOSITE_TILE), 1];
-            rec.dispatch(&self.extra.raycast, &self.extra.raycast_layout, &set, &[], groups);
-            rec.barrier(Stage::Compute, Stage::Transfer);
-            rec.transition(&target.accum, IL::GENERAL, IL::TRANSFER_SRC_OPTIMAL, Stage::Compute, Stage::Transfer);
-            rec.copy_image_to_buffer(&target.accum, IL::TRANSFER_SRC_OPTIMAL, back);
-            Ok(())
-        })?;
-        let ms = t.elapsed().as_secs_f64() * 1e3;
-        let floats: &[f32] = bytemuck::cast_slice(&back.read()?[..(w * h * 16) as usize]);
-        let pixels = floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-        let image = ImageF32 { width: w, height: h, pixels };
-        Ok(Rendered { image, timings: vec![StageTime { stage: "raycast", ms }], raster: None })
+    /// An engine for one frame of `prep` (the scene `set_scene` uploaded).
+    pub fn engine<'a>(&'a mut self, prep: &'a Prepared) -> exec::GpuEngine<'a> {
+        exec::GpuEngine::new(self, prep)
     }
 
     /// The dense field as a 3D texture and its brick occupancy for `brick`, built once per scene
     /// (the host copy is dropped after the upload).
-    fn upload_field(&mut self, prep: &Prepared, brick: u32) -> Result<()> {
+    pub(crate) fn upload_field(&mut self, prep: &Prepared, brick: u32) -> Result<()> {
         let scene = self.res.scene_mut()?;
         let need_bricks = scene.bricks.as_ref().is_none_or(|(b, _)| *b != brick);
         if scene.field.is_some() && !need_bricks {
             return Ok(());
         }
+        self.res.clear_sets();
+        let scene = self.res.scene_mut()?;
         let dense = DenseField::new(&prep.set)?;
         if need_bricks {
             let (_, occ) = crate::cpu::raycast::brick_occupancy(&dense, brick.max(1));

@@ -23,7 +23,7 @@ pub fn spirv(name: &str) -> Result<&'static [u8]> {
 /// What binding slot a resource takes.
 fn slot(res: Res) -> Slot {
     match res {
-        Res::SliceTable => Slot::Texture,
+        Res::SliceTable | Res::Field => Slot::Texture,
         Res::Accum | Res::Sums => Slot::StorageImage,
         Res::Color => Slot::Unused,
         _ => Slot::Storage,

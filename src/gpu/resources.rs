@@ -164,6 +164,11 @@ impl Resources {
         Ok(())
     }
 
+    /// Forget every descriptor set (a resource they name is being replaced).
+    pub fn clear_sets(&mut self) {
+        self.sets.clear();
+    }
+
     /// Whether `res` must be replaced to hold `bytes` (pending work naming it must run first).
     pub fn must_grow(&self, res: Res, bytes: u64) -> bool {
         !res.is_image() && !res.is_constant() && self.bufs.get(&res).is_none_or(|b| b.size() < bytes)
@@ -267,6 +272,14 @@ impl Resources {
         for &res in stage.desc().bindings {
             binds.push(match res {
                 Res::SliceTable => Bind::Texture(&self.slices, &self.sampler),
+                Res::Field => match &self.scene()?.field {
+                    Some(field) => Bind::Texture(field, &self.sampler),
+                    None => return Err(Error::InvalidArgument("the ray caster's field is not uploaded".into())),
+                },
+                Res::Bricks => match &self.scene()?.bricks {
+                    Some((_, bricks)) => Bind::Buffer(bricks),
+                    None => return Err(Error::InvalidArgument("the ray caster's bricks are not uploaded".into())),
+                },
                 Res::Accum => Bind::Image(&target.accum),
                 Res::Sums => Bind::Image(&target.sums),
                 Res::Color => Bind::None,
