@@ -142,6 +142,33 @@ pub fn pbtf(set: &SplatSet, split: [u32; 3]) -> Vec<u32> {
     out
 }
 
+/// Two-level PBTF, front to back, over bricks of `brick`³ voxels (issue 23; docs/MODEL.md,
+/// "Two-level PBTF"): the bricks in PBTF order over the brick grid, and inside each brick its voxels
+/// in PBTF order, both split at the eye's cell. A CPU reference (a comparison sort on the two-level
+/// key); `brick` 1 and a brick covering the grid both give `pbtf` itself.
+pub fn pbtf_bricked(set: &SplatSet, camera: &Camera, brick: u32) -> Result<Vec<u32>> {
+    if brick == 0 {
+        return Err(Error::InvalidArgument("the brick side must be at least one voxel".into()));
+    }
+    let dims = set.grid().dims;
+    let voxel_split = pbtf_split(set, camera);
+    let brick_split: [u32; 3] = match Viewer::of(set, camera) {
+        // Brick b lies on the eye's low side when its lowest voxel does.
+        Viewer::Eye(_) => [0, 1, 2].map(|a| voxel_split[a].div_ceil(brick)),
+        Viewer::Toward(d) => [0, 1, 2].map(|a| if d[a] < 0.0 { dims[a].div_ceil(brick) } else { 0 }),
+    };
+    // (octant bits, then the outward rank along k, j, i) of index `v` split at `s`.
+    let outward = |v: u32, s: u32| if v < s { (0u64, (s - 1 - v) as u64) } else { (1, (v - s) as u64) };
+    let level = |ijk: [u32; 3], split: [u32; 3]| {
+        let [(si, ri), (sj, rj), (sk, rk)] = [0, 1, 2].map(|a| outward(ijk[a], split[a]));
+        (si | sj << 1 | sk << 2, rk, rj, ri)
+    };
+    Ok(by_key(set, |s| {
+        let [i, j, k, _] = set.splats()[s].ijk;
+        (level([i / brick, j / brick, k / brick], brick_split), level([i, j, k], voxel_split))
+    }))
+}
+
 /// Order by a per-splat key, ascending (a comparison sort: fine for the CPU reference orders).
 fn by_key<K: PartialOrd>(set: &SplatSet, key: impl Fn(usize) -> K) -> Vec<u32> {
     let keys: Vec<K> = (0..set.len()).map(key).collect();

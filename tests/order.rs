@@ -147,3 +147,55 @@ fn pbtf_is_correct_in_every_case_of_table_2_3() {
     }
     assert_eq!(cases, 216);
 }
+
+/// Two-level PBTF (bricks by PBTF over the brick grid, voxels by PBTF inside each brick) is a
+/// visibility order wherever one-level PBTF is: the same random battery, brick sides that divide
+/// the grid and sides that do not, and eyes placed on brick planes and inside bricks.
+#[test]
+fn two_level_pbtf_has_no_violations_on_random_and_brick_plane_viewpoints() {
+    let sets: Vec<SplatSet> = vec![scene::build("cube40").unwrap(), random_sparse(11, [19, 13, 17], 0.6)];
+    let mut rng = Rng(0xB12C);
+    let kinds = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic];
+    let mut btf_violations = 0;
+    for v in 0..600 {
+        let set = &sets[v % 2];
+        let brick = [2, 3, 4, 8, 5][v % 5];
+        let mut cam = random_camera(&mut rng, set.grid(), kinds[v % 4]);
+        if v % 3 == 0 && cam.is_perspective() {
+            // Move the eye onto brick planes (voxel index b * brick - 0.5) on one or more axes.
+            let g = *set.grid();
+            for a in 0..3 {
+                if rng.f32() < 0.6 {
+                    let b = (rng.f32() * (g.dims[a] / brick + 1) as f32) as u32;
+                    cam.eye[a] = g.origin[a] + (b as f32 * brick as f32 - 0.5) * g.spacing[a];
+                }
+            }
+            if cam.eye.distance(cam.target) < 1e-3 {
+                continue;
+            }
+        }
+        let ftb = voxsplat::order::pbtf_bricked(set, &cam, brick).unwrap();
+        assert!(is_permutation(&ftb, set.len()));
+        let n = count_violations(set, &cam, &ftb, Direction::FrontToBack).unwrap();
+        assert_eq!(n, 0, "two-level PBTF (brick {brick}) violations {n} for {cam:?}");
+        let btf: Vec<u32> = ftb.iter().rev().copied().collect();
+        assert_eq!(count_violations(set, &cam, &btf, Direction::BackToFront).unwrap(), 0);
+        let btf_order = visibility_order(set, &cam, OrderKind::Btf, Direction::FrontToBack);
+        btf_violations += count_violations(set, &cam, &btf_order, Direction::FrontToBack).unwrap();
+    }
+    assert!(btf_violations > 0, "the battery breaks BTF, so the validator is not vacuous");
+}
+
+#[test]
+fn two_level_pbtf_is_pbtf_for_voxel_bricks_and_one_brick() {
+    let set = random_sparse(3, [12, 10, 9], 0.5);
+    let mut rng = Rng(77);
+    for v in 0..40 {
+        let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
+        let cam = random_camera(&mut rng, set.grid(), kind);
+        let one = pbtf(&set, pbtf_split(&set, &cam));
+        assert_eq!(voxsplat::order::pbtf_bricked(&set, &cam, 1).unwrap(), one, "{kind:?}");
+        assert_eq!(voxsplat::order::pbtf_bricked(&set, &cam, 16).unwrap(), one, "{kind:?}");
+    }
+    assert!(voxsplat::order::pbtf_bricked(&set, &Camera::framing(set.grid(), 8, 8), 0).is_err());
+}
