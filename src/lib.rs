@@ -279,9 +279,7 @@ impl Renderer {
     /// The PBTF draw sequence as the backend computes it (the GPU order stages, or their mirrors).
     #[doc(hidden)]
     pub fn pbtf_order(&mut self, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
-        let mut opts = RenderOptions::default();
-        opts.raster = Raster::Graphics;
-        opts.direction = Some(direction);
+        let opts = RenderOptions { raster: Raster::Graphics, direction: Some(direction), ..Default::default() };
         let n = self.prepared()?.set.len();
         let got = self.probe(camera, &opts, StageId::OrderScatter, &[Res::Order])?;
         Ok(got[0][..n].to_vec())
@@ -308,11 +306,13 @@ impl Renderer {
         kernel: Kernel,
         antialias: Antialias,
     ) -> Result<Vec<gpu_types::SplatParams>> {
-        let mut opts = RenderOptions::default();
-        opts.raster = Raster::Graphics;
-        opts.direction = Some(Direction::BackToFront);
-        opts.kernel = kernel;
-        opts.antialias = antialias;
+        let opts = RenderOptions {
+            raster: Raster::Graphics,
+            direction: Some(Direction::BackToFront),
+            kernel,
+            antialias,
+            ..Default::default()
+        };
         let n = self.prepared()?.set.len();
         let got = self.probe(camera, &opts, StageId::SplatParams, &[Res::Params])?;
         Ok(bytemuck::cast_slice(&got[0][..n * std::mem::size_of::<gpu_types::SplatParams>() / 4]).to_vec())
