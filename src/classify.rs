@@ -156,12 +156,26 @@ pub fn classify(vol: &ScalarVolume, tf: &TransferFunction, shading: Option<Shadi
             0.0
         }
     };
+    classify_field(grid, vol.spacing, tf, shading, at)
+}
+
+/// Classify the normalised field `at` (indices clamped to the grid by `at` itself) on `grid`:
+/// the dense volume's classification (`classify`) and the bricked store's (`bricks`) share it.
+pub fn classify_field(
+    grid: Grid,
+    spacing: [f32; 3],
+    tf: &TransferFunction,
+    shading: Option<Shading>,
+    at: impl Fn(i64, i64, i64) -> f32,
+) -> Result<SplatSet> {
+    tf.validate()?;
+    let [nx, ny, nz] = grid.dims;
     let grad = |i: u32, j: u32, k: u32| -> Vec3 {
         let (i, j, k) = (i as i64, j as i64, k as i64);
         Vec3::new(
-            (at(i + 1, j, k) - at(i - 1, j, k)) / (2.0 * vol.spacing[0]),
-            (at(i, j + 1, k) - at(i, j - 1, k)) / (2.0 * vol.spacing[1]),
-            (at(i, j, k + 1) - at(i, j, k - 1)) / (2.0 * vol.spacing[2]),
+            (at(i + 1, j, k) - at(i - 1, j, k)) / (2.0 * spacing[0]),
+            (at(i, j + 1, k) - at(i, j - 1, k)) / (2.0 * spacing[1]),
+            (at(i, j, k + 1) - at(i, j, k - 1)) / (2.0 * spacing[2]),
         )
     };
     let gmax = if tf.gradient_weight > 0.0 || shading.is_some() {

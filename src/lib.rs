@@ -19,6 +19,7 @@
 pub mod aa;
 pub mod animate;
 pub mod bisect;
+pub mod bricks;
 pub mod camera;
 pub mod classify;
 /// Constants shared with the shaders (injected into GLSL as macros by build.rs).

@@ -1,0 +1,94 @@
+//! The bricked store (issue 23, host side): every value comes back through it (up to its 16-bit
+//! quantisation), it takes at most 8 bytes per stored voxel on the real volumes, and classifying
+//! through it (values and gradients by neighbour lookups) gives the dense classification.
+mod common;
+use common::Rng;
+use voxsplat::bricks::{BrickStore, BRICK};
+use voxsplat::classify::{classify, Shading, TransferFunction};
+use voxsplat::volume::ScalarVolume;
+
+#[test]
+fn every_value_comes_back_through_the_store() {
+    let mut rng = Rng(23);
+    let dims = [19, 8, 13]; // not multiples of the brick side
+    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let values: Vec<f32> = (0..n)
+        .map(|v| match v % 7 {
+            0 => 2.0,      // the minimum: empty, not stored
+            1 => f32::NAN, // non-finite: empty
+            _ => 2.0 + 10.0 * rng.f32(),
+        })
+        .collect();
+    let vol = ScalarVolume { dims, spacing: [1.0, 0.5, 2.0], values };
+    let store = BrickStore::build(&vol).unwrap();
+    let (lo, hi) = store.range;
+    assert_eq!(lo, 2.0);
+    let mut stored = 0;
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let v = vol.values[(i + dims[0] * (j + dims[1] * k)) as usize];
+                let want = if v.is_finite() && v > lo { (v - lo) / (hi - lo) } else { 0.0 };
+                stored += usize::from(v.is_finite() && v > lo);
+                let got = store.value_at(i as i64, j as i64, k as i64);
+                assert!((got - want).abs() <= 0.5 / 65535.0 + 1e-7, "({i},{j},{k}): {got} for {want}");
+            }
+        }
+    }
+    assert_eq!(store.len(), stored);
+    // Out-of-grid reads clamp, as the dense classification's do.
+    assert_eq!(store.value_at(-3, 0, 0), store.value_at(0, 0, 0));
+    assert_eq!(store.value_at(100, 7, 12), store.value_at(18, 7, 12));
+    // Each header's records lie in its brick and its range holds their values.
+    let total: u32 = store.headers.iter().map(|h| h.count).sum();
+    assert_eq!(total as usize, store.len());
+    for h in &store.headers {
+        let (qmin, qmax) = (h.range & 0xFFFF, h.range >> 16);
+        for r in &store.records[h.first as usize..(h.first + h.count) as usize] {
+            assert!((r & 0x1FF) < BRICK * BRICK * BRICK);
+            assert!((qmin..=qmax).contains(&(r >> 16)));
+        }
+    }
+    let too_wide = ScalarVolume { dims: [BRICK * 1024 + 1, 1, 1], spacing: [1.0; 3], values: vec![0.0; 8193] };
+    assert!(BrickStore::build(&too_wide).is_err());
+}
+
+#[test]
+fn real_volumes_take_under_8_bytes_a_voxel_and_classify_alike_through_the_store() {
+    let data = voxsplat::loaders::data_dir();
+    assert!(data.join("bonsai/bonsai.nii.gz").exists(), "../shared/data is needed (see README)");
+    for (file, tf) in [("bonsai/bonsai.nii.gz", "bonsai"), ("stent/stent.nrrd", "ct")] {
+        let vol = voxsplat::loaders::load_volume(&data.join(file), &Default::default()).unwrap();
+        let store = BrickStore::build(&vol).unwrap();
+        let per_voxel = store.bytes() as f64 / store.len() as f64;
+        eprintln!("{file}: {} stored voxels in {} bricks, {per_voxel:.2} bytes each", store.len(), store.headers.len());
+        assert!(per_voxel <= 8.0, "{file}: {per_voxel} bytes per stored voxel");
+        let tf = TransferFunction::preset(tf).unwrap();
+        let shading = Some(Shading::headlight(glam::Vec3::new(0.3, -0.2, -1.0)));
+        let dense = classify(&vol, &tf, shading).unwrap();
+        let bricked = store.classify(&tf, shading).unwrap();
+        // Quantisation may move a voxel across a transfer-function edge: count those, compare the rest.
+        let key = |s: &voxsplat::gpu_types::Splat| (s.ijk[2], s.ijk[1], s.ijk[0]);
+        let (a, b) = (dense.splats(), bricked.splats());
+        let (mut ia, mut ib, mut common, mut worst) = (0, 0, 0usize, 0f32);
+        while ia < a.len() && ib < b.len() {
+            match key(&a[ia]).cmp(&key(&b[ib])) {
+                std::cmp::Ordering::Less => ia += 1,
+                std::cmp::Ordering::Greater => ib += 1,
+                std::cmp::Ordering::Equal => {
+                    worst = (0..4).map(|c| (a[ia].color[c] - b[ib].color[c]).abs()).fold(worst, f32::max);
+                    common += 1;
+                    ia += 1;
+                    ib += 1;
+                }
+            }
+        }
+        eprintln!(
+            "{file}: {} dense splats, {} through the store, {common} common, max |colour diff| {worst:.2e}",
+            a.len(),
+            b.len()
+        );
+        assert!(common as f64 >= 0.999 * a.len().max(b.len()) as f64, "{file}: the same voxels are non-empty");
+        assert!(worst <= 2e-3, "{file}: colours within the quantisation's reach ({worst})");
+    }
+}
