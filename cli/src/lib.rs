@@ -7,3 +7,4 @@ pub mod peer;
 pub mod rates;
 pub mod soak;
 pub mod stability;
+pub mod volumes;

@@ -50,6 +50,23 @@ enum Command {
         #[arg(long)]
         validation: bool,
     },
+    /// Make a large test volume (never committed): FILE upsampled by an integer factor (e.g. the
+    /// 512³ bonsai from the 256³ one), or a procedural field of side N (e.g. 1024³); written as
+    /// 8-bit NRRD slice by slice.
+    MakeVolume {
+        /// Upsample this volume file (any format `render --volume` reads)...
+        #[arg(long, conflicts_with = "procedural")]
+        from: Option<PathBuf>,
+        /// ...by this factor per axis.
+        #[arg(long, default_value_t = 2)]
+        factor: u32,
+        /// Or make the procedural field of this side.
+        #[arg(long)]
+        procedural: Option<u32>,
+        /// The NRRD file to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Render the peers' scene (../shared/peers, issue 9) with every voxsplat mode: median frame
     /// times as CSV on stdout, images into --out-dir; `scripts/peers.sh` runs it beside VTK.
     Peer {
@@ -601,6 +618,32 @@ fn run(cli: Cli) -> Result<()> {
                 let file = format!("voxsplat-{}-{n}.png", run.label.replace(' ', "-"));
                 voxsplat::output::write_image(&run.image, &out_dir.join(file))?;
             }
+            Ok(())
+        }
+        Command::MakeVolume { from, factor, procedural, out } => {
+            let bar = indicatif::ProgressBar::new(0);
+            let t = std::time::Instant::now();
+            let dims = match (from, procedural) {
+                (Some(file), None) => {
+                    let vol = voxsplat::loaders::load_volume(&file, &Default::default())?;
+                    bar.set_length(vol.dims[2] as u64 * factor as u64);
+                    voxsplat_cli::volumes::upsample(&vol, factor, &out, |z| bar.set_position(z as u64))?
+                }
+                (None, Some(n)) => {
+                    bar.set_length(n as u64);
+                    voxsplat_cli::volumes::procedural(n, &out, |z| bar.set_position(z as u64))?
+                }
+                _ => return Err(Error::InvalidArgument("give --from FILE or --procedural N".into())),
+            };
+            bar.finish_and_clear();
+            println!(
+                "{} x {} x {} voxels -> {} in {:.1} s",
+                dims[0],
+                dims[1],
+                dims[2],
+                out.display(),
+                t.elapsed().as_secs_f64()
+            );
             Ok(())
         }
         Command::Soak { frames, size, validation } => {
