@@ -137,7 +137,6 @@ impl Shading {
 
 /// Classify a loaded volume into splats. Gradients by central differences on the grid.
 pub fn classify(vol: &ScalarVolume, tf: &TransferFunction, shading: Option<Shading>) -> Result<SplatSet> {
-    tf.validate()?;
     let [nx, ny, nz] = vol.dims;
     let grid = Grid::centered(vol.dims, vol.spacing)?;
     let (lo, hi) = tf.range.unwrap_or_else(|| {

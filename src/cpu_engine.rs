@@ -110,13 +110,8 @@ impl Engine for CpuEngine<'_> {
             .iter()
             .map(|&(res, words)| {
                 if res.is_image() {
-                    let b = &mut self.b;
-                    let imgs: Vec<&ImageF32> = match res {
-                        Res::Accum => vec![&b.accum],
-                        Res::Color => vec![&b.color],
-                        _ => b.sums.iter().collect(),
-                    };
-                    let all = imgs.iter().flat_map(|i| i.pixels.iter().flat_map(|p| p.map(f32::to_bits)));
+                    let all =
+                        self.b.images(res).into_iter().flat_map(|i| i.pixels.iter().flat_map(|p| p.map(f32::to_bits)));
                     all.take(words).collect()
                 } else {
                     let buf = self.b.get::<u32>(res);

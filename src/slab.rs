@@ -17,7 +17,7 @@
 use crate::constants::SLAB_CHUNK;
 use crate::cpu::splat_params::footprint_scale;
 use crate::error::{Error, Result};
-use crate::gpu_types::{FootprintPush, Frame, SlabPush, SplatParams, SHEET_MODE_SLAB};
+use crate::gpu_types::{FootprintPush, Frame, SlabPush, SHEET_MODE_SLAB};
 use crate::order::Direction;
 use crate::plan::Batch;
 use crate::volume::Grid;
@@ -105,16 +105,4 @@ pub fn slab_batches(pc: &SlabPush, slab_start: &[u32], max_layers: u32) -> Resul
         });
     }
     Ok(batches)
-}
-
-/// The whole binning on the CPU mirrors: (pairs, batches).
-pub fn slab_bins_cpu(pc: &SlabPush, params: &[SplatParams], max_layers: u32) -> Result<(Vec<u32>, Vec<Batch>)> {
-    let mut counts = vec![0u32; (pc.slabs * pc.chunks) as usize];
-    let mut start = vec![0u32; pc.slabs as usize + 1];
-    crate::cpu::slab_count(pc, params, &mut counts);
-    crate::cpu::slab_scan(pc, &mut counts, &mut start);
-    let batches = slab_batches(pc, &start, max_layers)?;
-    let mut pairs = vec![0u32; 2 * start[pc.slabs as usize] as usize];
-    crate::cpu::slab_scatter(pc, params, &mut counts, &mut pairs);
-    Ok((pairs, batches))
 }

@@ -364,7 +364,7 @@ fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tile
         (prep.slices[axis].1.clone(), batches)
     } else {
         let pc = voxsplat::slab::slab_geometry(&frame, set.grid(), set.len(), o.slab_thickness, o.direction()).unwrap();
-        voxsplat::slab::slab_bins_cpu(&pc, &params, 1 << 16).unwrap()
+        slab_bins(&pc, &params)
     };
     let push = sheet_tiles_push(&batches, &batches[0]);
     let sheets = batches.iter().map(|b| b.push.rank_base as usize + b.layers as usize).max().unwrap() + 1;
@@ -449,4 +449,20 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
     let mean = skipped_share.iter().sum::<f64>() / skipped_share.len() as f64;
     assert!(mean > 0.2, "tile ranges skip {:.0}% of (tile, sheet) pairs", 100.0 * mean);
     assert_clean(&gpu);
+}
+
+/// The slab binning on the CPU mirrors, straight (the oracle beside the recording's): the pairs
+/// and the batches.
+fn slab_bins(
+    pc: &voxsplat::gpu_types::SlabPush,
+    params: &[voxsplat::gpu_types::SplatParams],
+) -> (Vec<u32>, Vec<voxsplat::plan::Batch>) {
+    let mut counts = vec![0u32; (pc.slabs * pc.chunks) as usize];
+    let mut start = vec![0u32; pc.slabs as usize + 1];
+    voxsplat::cpu::slab_count(pc, params, &mut counts);
+    voxsplat::cpu::slab_scan(pc, &mut counts, &mut start);
+    let batches = voxsplat::slab::slab_batches(pc, &start, 1 << 16).unwrap();
+    let mut pairs = vec![0u32; 2 * start[pc.slabs as usize] as usize];
+    voxsplat::cpu::slab_scatter(pc, params, &mut counts, &mut pairs);
+    (pairs, batches)
 }

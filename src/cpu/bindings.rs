@@ -83,6 +83,15 @@ impl<'a> Bindings<'a> {
     }
 
     /// The image resource `res` (its layers for `Sums`).
+    pub fn images(&self, res: Res) -> Vec<&ImageF32> {
+        match res {
+            Res::Accum => vec![&self.accum],
+            Res::Color => vec![&self.color],
+            _ => self.sums.iter().collect(),
+        }
+    }
+
+    /// `images`, to write.
     pub fn image_mut(&mut self, res: Res) -> Vec<&mut ImageF32> {
         match res {
             Res::Accum => vec![&mut self.accum],
