@@ -1,7 +1,6 @@
 #version 450
-// Per-splat parameters: world centre, eye-facing footprint quad (section 1.2.5), culling, and the
-// energy scale. The single place where anti-aliasing (ch. 3) and motion blur (ch. 4) will scale and
-// stretch the footprint. Mirror: cpu::splat_params.
+// Per-splat parameters of a dense splat set (glsl/shared/params.glsl: footprint quad, culling,
+// anti-aliasing and motion blur). Mirror: cpu::splat_params.
 #include "types.glsl"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
@@ -11,63 +10,11 @@ layout(std430, binding = 1) readonly buffer Splats { Splat splats[]; };
 layout(std430, binding = 2) writeonly buffer Params { SplatParams params_lo[]; };
 layout(std430, binding = 3) writeonly buffer ParamsHi { SplatParams params_hi[]; };
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
-
-const float MAX_OPACITY = 0.999;
-const float CULL_RADII = 1.5;
+#include "params.glsl"
 
 void main() {
     uint s = linear_invocation();
     if (s >= frame.dims.w) return;
     Splat sp = splats[s];
-    vec3 center = frame.origin.xyz + vec3(sp.ijk.xyz) * frame.spacing.xyz;
-    vec3 forward = frame.forward.xyz;
-    float depth = dot(center - frame.eye.xyz, forward);
-    // Pixels per voxel spacing at this splat's depth (section 3.3.4: = k / d in perspective).
-    float voxel = frame.spacing.w / frame.origin.w;
-    float ppv = frame.eye.w > 0.5 ? voxel * frame.up.w / max(depth, 1e-6) : voxel * frame.up.w;
-    float scale = 1.0;
-    if (frame.aa.x == AA_SWAN) {
-        scale = max(1.0, 1.0 / ppv);                      // Eq. 3.9: radius x d/k beyond k
-    } else if (frame.aa.x == AA_EWA) {
-        float lp = frame.aa.z / (frame.aa.y * ppv);       // low-pass std relative to the footprint's
-        scale = sqrt(1.0 + lp * lp);
-    }
-    float radius = frame.spacing.w * scale;
-    bool visible = depth >= frame.forward.w + CULL_RADII * radius && depth <= frame.right.w - CULL_RADII * radius;
-    // The quad faces the eye->voxel ray (perspective) or the view direction (orthographic).
-    vec3 w = frame.eye.w > 0.5 ? normalize(center - frame.eye.xyz) : forward;
-    vec3 u = normalize(frame.right.xyz - dot(frame.right.xyz, w) * w);
-    vec3 v = cross(w, u);
-    // Chapter 4: stretch the footprint back along the projected path from t_{i-1} (Fig. 4.3), in
-    // the plane facing the eye ray at t_i (Fig. 4.4), when the path exceeds delta pixels.
-    float stretch = 0.0;
-    vec3 quad_center = center;
-    float energy = 1.0 / (scale * scale);
-    if (frame.blur.x > 0.0 && visible) {
-        vec3 prev = (frame.motion * vec4(center, 1.0)).xyz;
-        vec4 c1 = frame.view_proj * vec4(center, 1.0);
-        vec4 c0 = frame.view_proj * vec4(prev, 1.0);
-        vec2 moved = (c1.xy / c1.w - c0.xy / c0.w) * 0.5 * frame.blur.zw;
-        vec3 d = center - prev;
-        vec3 dp = d - dot(d, w) * w;
-        float len = length(dp);
-        if (c0.w > 0.0 && length(moved) > frame.blur.x && len > 1e-6 * radius) {
-            u = dp / len;
-            v = cross(w, u);
-            stretch = 0.5 * len / radius;
-            quad_center = center - 0.5 * dp;
-            energy /= 1.0 + 2.0 * stretch * frame.blur.y;   // Eq. 4.2 with effective area and width
-        }
-    }
-    float opacity = clamp(sp.color.a, 0.0, MAX_OPACITY);
-    float tau = -log(1.0 - opacity);
-    SplatParams p;
-    p.center = vec4(quad_center, visible && tau > 0.0 ? 1.0 : 0.0);
-    p.axis_u = vec4(u * radius * (1.0 + stretch), energy);   // Eq. 3.13: energy x (k/d)^2
-    p.axis_v = vec4(v * radius, stretch);
-    p.emit = vec4(sp.color.rgb, tau);
-    float dist = length(center - frame.eye.xyz);
-    float pixels = frame.eye.w > 0.5 ? radius * frame.up.w / max(depth, 1e-6) : radius * frame.up.w;
-    p.screen = vec4(depth, dist, pixels, scale);
-    params_store(s, p);
+    params_store(s, params_of(sp.ijk.xyz, sp.color));
 }

@@ -74,8 +74,10 @@ void main() {
     uint tile = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
     uint list_end = tile_start[tile + 1u];
     uint begin = tile_start[tile] + pc.first * TILE_SEGMENT;
-    // A later segment with nothing of this list leaves its pixels as they are.
-    if (pc.first > 0u && begin >= list_end) return;
+    // A later segment, or any segment of a later batch of a bricked volume (rank_base 1), carries
+    // on from the image; with nothing of this list it leaves its pixels as they are.
+    bool carry = pc.first > 0u || pc.rank_base != 0u;
+    if (carry && begin >= list_end) return;
     uint end = min(list_end, begin + TILE_SEGMENT);
     const bool btf = BACK_TO_FRONT;
     const bool terminate = !btf && TERMINATE;
@@ -85,7 +87,7 @@ void main() {
     for (uint t = lane; t < TILE_PIXELS; t += RASTER_LANES) {
         ivec2 xy = tile_pixel(t0, t);
         bool inside = all(lessThanEqual(xy, t1));
-        vec4 a = pc.first > 0u && inside ? imageLoad(accum, xy) : vec4(0.0);
+        vec4 a = carry && inside ? imageLoad(accum, xy) : vec4(0.0);
         tile_acc[t] = a;
         open += inside && (!terminate || 1.0 - a.a > pc.occluded) ? 1 : 0;
     }

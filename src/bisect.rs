@@ -124,6 +124,7 @@ impl Engine for Split<'_> {
         Limits {
             max_layers: a.max_layers.min(b.max_layers),
             max_storage_range: a.max_storage_range.min(b.max_storage_range),
+            budget_bytes: a.budget_bytes.min(b.budget_bytes),
         }
     }
     fn prepare_field(&mut self, brick: u32) -> Result<()> {

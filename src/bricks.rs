@@ -9,14 +9,16 @@
 //! at B = 8 (0.33-0.75 at B = 4), while at B = 16 nearly every brick of the stent holds a voxel and
 //! nothing is left to cull. With the 64-byte masks (for the neighbour lookups of gradients) the
 //! store takes 4.26 bytes per stored voxel on bonsai and 4.54 on the stent (tests/bricks.rs).
-//! Not yet on the device: the GPU path still draws `SplatSet`s.
+//! On the device the store is resident and `BrickScene` draws it: the brick stages
+//! (`glsl/brick_*.comp`) cull bricks, classify voxels and order them in two-level PBTF each frame.
 use crate::classify::{classify_field, Shading, TransferFunction};
+use crate::gpu_types::BrickFrame;
 use crate::error::{Error, Result};
 use crate::volume::{Grid, ScalarVolume, SplatSet};
 use bytemuck::{Pod, Zeroable};
 
 /// Voxels along each side of a brick.
-pub const BRICK: u32 = 8;
+pub const BRICK: u32 = crate::constants::BRICK_SIDE;
 const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
 /// Largest value of a quantised scalar.
 const Q: f32 = 65535.0;
@@ -54,7 +56,7 @@ pub struct BrickStore {
     /// local index order.
     pub records: Vec<u32>,
     /// Brick id (x + nbx (y + nby z)) -> index into `headers`, or `u32::MAX` when empty.
-    index: Vec<u32>,
+    pub index: Vec<u32>,
 }
 
 impl BrickStore {
@@ -171,5 +173,168 @@ impl BrickStore {
         let remap = |d: f32| if tf.range.is_some() { (lo + d * span - tlo) / tspan } else { d };
         let grid = Grid::centered(self.dims, self.spacing)?;
         classify_field(grid, self.spacing, tf, shading, |i, j, k| remap(self.value_at(i, j, k)))
+    }
+}
+
+/// A bricked volume as a scene: the store, resident on the device, and the transfer function and
+/// shading its voxels are classified with on every frame (a TF change is a small buffer write).
+#[derive(Debug, Clone)]
+pub struct BrickScene {
+    /// The store.
+    pub store: BrickStore,
+    tf: TransferFunction,
+    shading: Option<Shading>,
+    /// `tf` tabulated per quantised value (`tf_words`).
+    table: Vec<u32>,
+    /// The largest gradient magnitude in stored units (gradient weighting needs it), built once.
+    gmax: std::sync::OnceLock<f32>,
+}
+
+/// (a, b): stored value d is `tf`'s density a d + b.
+fn remap(store: &BrickStore, tf: &TransferFunction) -> (f32, f32) {
+    let (lo, hi) = store.range;
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    match tf.range {
+        Some((tlo, thi)) => {
+            let tspan = if thi > tlo { thi - tlo } else { 1.0 };
+            (span / tspan, (lo - tlo) / tspan)
+        }
+        None => (1.0, 0.0),
+    }
+}
+
+/// `tf` tabulated per quantised value (see `BrickScene::tf_words`): the classification of a
+/// stored value is exact (the quantised value is all the store keeps), so a table of 2^16 entries
+/// loses nothing and turns the per-voxel TF walk into one load.
+fn tf_table(tf: &TransferFunction, (a, b): (f32, f32)) -> Vec<u32> {
+    let n = crate::constants::TF_ENTRIES as usize;
+    let mut color = Vec::with_capacity(4 * n);
+    let mut bits = vec![0u32; n / 32];
+    for q in 0..n {
+        let d = q as f32 / Q * a + b;
+        let c = tf.eval(d);
+        color.extend(c.map(f32::to_bits));
+        if d >= tf.threshold && c[3] > 0.0 {
+            bits[q / 32] |= 1 << (q % 32);
+        }
+    }
+    let mut prefix = vec![0u32; n / 32 + 1];
+    for w in 0..n / 32 {
+        prefix[w + 1] = prefix[w] + bits[w].count_ones();
+    }
+    color.extend(bits);
+    color.extend(prefix);
+    color
+}
+
+/// Most non-empty bricks a scene holds (a brick's draw-order slot packs its header in 22 bits).
+pub const MAX_BRICKS: usize = 1 << 22;
+
+impl BrickScene {
+    /// A scene of `store` classified with `tf` and `shading`.
+    pub fn new(store: BrickStore, tf: TransferFunction, shading: Option<Shading>) -> Result<Self> {
+        if store.headers.len() > MAX_BRICKS {
+            return Err(Error::TooLarge(format!(
+                "{} non-empty bricks: a bricked volume holds at most {MAX_BRICKS}",
+                store.headers.len()
+            )));
+        }
+        tf.validate()?;
+        let table = tf_table(&tf, remap(&store, &tf));
+        Ok(Self { store, tf, shading, table, gmax: std::sync::OnceLock::new() })
+    }
+
+    /// Classify with another transfer function and shading from the next frame on.
+    pub fn set_transfer_function(&mut self, tf: TransferFunction, shading: Option<Shading>) -> Result<()> {
+        tf.validate()?;
+        self.table = tf_table(&tf, remap(&self.store, &tf));
+        (self.tf, self.shading) = (tf, shading);
+        Ok(())
+    }
+
+    /// The transfer function.
+    pub fn transfer_function(&self) -> &TransferFunction {
+        &self.tf
+    }
+
+    /// The shading.
+    pub fn shading(&self) -> Option<Shading> {
+        self.shading
+    }
+
+    /// (a, b): a stored value d is the transfer function's density a d + b (its own range, if it
+    /// sets one, re-maps the store's normalisation; `BrickStore::classify`).
+    pub fn remap(&self) -> (f32, f32) {
+        remap(&self.store, &self.tf)
+    }
+
+    /// The brick stages' uniforms for a frame whose brick grid is split at `split`.
+    pub fn uniforms(&self, split: [u32; 3]) -> BrickFrame {
+        let nb = self.store.dims.map(|d| d.div_ceil(BRICK));
+        let (a, b) = self.remap();
+        let weight = self.tf.gradient_weight;
+        let gmax = if weight > 0.0 { (a * self.gmax_stored()).max(1e-12) } else { 1.0 };
+        let (light, shade) = match self.shading {
+            Some(s) => ([s.light.x, s.light.y, s.light.z, 1.0], [s.ambient, s.diffuse, s.specular, s.shininess]),
+            None => ([0.0; 4], [0.0; 4]),
+        };
+        BrickFrame {
+            grid: [nb[0], nb[1], nb[2], self.store.headers.len() as u32],
+            split: [split[0], split[1], split[2], 0],
+            tf: [a, b, 0.0, weight],
+            light,
+            shade,
+            grad: [gmax, 0.0, 0.0, 0.0],
+        }
+    }
+
+    /// The TF buffer (`Res::Tf`, glsl/shared/brick.glsl): per quantised value q its straight
+    /// RGBA, then a bit per q (extracted: at or above the threshold with opacity > 0), then per
+    /// 32-value word the extracted values below it (and the total).
+    pub fn tf_words(&self) -> &[u32] {
+        &self.table
+    }
+
+    /// The largest central-difference gradient magnitude over the grid, in stored units: only
+    /// voxels in or next to a non-empty brick can have one.
+    fn gmax_stored(&self) -> f32 {
+        *self.gmax.get_or_init(|| {
+            let s = &self.store;
+            let nb = s.dims.map(|d| d.div_ceil(BRICK) as i64);
+            let filled = |x: i64, y: i64, z: i64| {
+                (0..nb[0]).contains(&x)
+                    && (0..nb[1]).contains(&y)
+                    && (0..nb[2]).contains(&z)
+                    && s.index[(x + nb[0] * (y + nb[1] * z)) as usize] != u32::MAX
+            };
+            let sp = s.spacing;
+            let mut most = 0.0f32;
+            for bz in 0..nb[2] {
+                for by in 0..nb[1] {
+                    for bx in 0..nb[0] {
+                        let near = (-1..=1).any(|dz| {
+                            (-1..=1).any(|dy| (-1..=1).any(|dx| filled(bx + dx, by + dy, bz + dz)))
+                        });
+                        if !near {
+                            continue;
+                        }
+                        let b = BRICK as i64;
+                        for z in bz * b..((bz + 1) * b).min(s.dims[2] as i64) {
+                            for y in by * b..((by + 1) * b).min(s.dims[1] as i64) {
+                                for x in bx * b..((bx + 1) * b).min(s.dims[0] as i64) {
+                                    let g = glam::Vec3::new(
+                                        (s.value_at(x + 1, y, z) - s.value_at(x - 1, y, z)) / (2.0 * sp[0]),
+                                        (s.value_at(x, y + 1, z) - s.value_at(x, y - 1, z)) / (2.0 * sp[1]),
+                                        (s.value_at(x, y, z + 1) - s.value_at(x, y, z - 1)) / (2.0 * sp[2]),
+                                    );
+                                    most = most.max(g.length());
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            most
+        })
     }
 }

@@ -57,6 +57,14 @@ pub const MAX_GPU_RAY_STEPS: u32 = 60_000;
 /// Workgroups per dispatch row: larger 1D dispatches spill into y so they stay under the 65535 limit.
 pub const MAX_GROUPS_X: u32 = 32768;
 
+/// Voxels along each side of a brick of the bricked store (`crate::bricks`; chosen by measurement
+/// there).
+pub const BRICK_SIDE: u32 = 8;
+/// Lanes of the brick stages' workgroups: one workgroup per brick, each lane a record in eight.
+pub const BRICK_LANES: u32 = 64;
+/// Entries of the brick stages' transfer-function table: one per 16-bit stored value.
+pub const TF_ENTRIES: u32 = 1 << 16;
+
 /// Macros injected into GLSL (name, value).
 pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
@@ -74,4 +82,7 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("SPLAT_PAGE", SPLAT_PAGE),
     ("TILE_SEGMENT", TILE_SEGMENT),
     ("LOOP_BUDGET", LOOP_BUDGET),
+    ("BRICK_SIDE", BRICK_SIDE),
+    ("BRICK_LANES", BRICK_LANES),
+    ("TF_ENTRIES", TF_ENTRIES),
 ];

@@ -9,12 +9,16 @@ use crate::kernel::Kernel;
 use crate::options::StageTime;
 use crate::plan::Prepared;
 use crate::stages::{Dispatch, Engine, Limits};
+
+/// The default device-memory budget of a frame: 1 GiB, as on a mid-range GPU (lavapipe too).
+pub const DEFAULT_GPU_BUDGET: u64 = 1 << 30;
 use std::collections::BTreeSet;
 use std::time::Instant;
 
 /// The CPU engine of one frame.
 pub struct CpuEngine<'a> {
     b: Bindings<'a>,
+    budget_bytes: u64,
     timings: Vec<StageTime>,
     live: BTreeSet<Res>,
 }
@@ -22,7 +26,13 @@ pub struct CpuEngine<'a> {
 impl<'a> CpuEngine<'a> {
     /// An engine for one frame of `prep`.
     pub fn new(prep: &'a Prepared) -> Self {
-        Self { b: Bindings::new(prep), timings: Vec::new(), live: BTreeSet::new() }
+        Self { b: Bindings::new(prep), budget_bytes: DEFAULT_GPU_BUDGET, timings: Vec::new(), live: BTreeSet::new() }
+    }
+
+    /// The same engine cutting a bricked volume's batches for a device budget of `bytes`.
+    pub fn with_budget(mut self, bytes: u64) -> Self {
+        self.budget_bytes = bytes;
+        self
     }
 }
 
@@ -143,7 +153,7 @@ impl Engine for CpuEngine<'_> {
     }
 
     fn limits(&self) -> Limits {
-        Limits { max_layers: u32::MAX, max_storage_range: u64::MAX }
+        Limits { max_layers: u32::MAX, max_storage_range: u64::MAX, budget_bytes: self.budget_bytes }
     }
 
     fn is_device(&self) -> bool {

@@ -72,6 +72,22 @@ pub enum Res {
     Field,
     /// Its brick occupancy (1: a brick holds a non-empty voxel), cached with it.
     Bricks,
+    /// A bricked volume's store (`crate::bricks`): 16-byte brick headers, resident per scene.
+    BrickHeaders,
+    /// Its 64-byte occupancy masks.
+    BrickMasks,
+    /// Its 4-byte voxel records.
+    BrickRecords,
+    /// Brick id -> header (`u32::MAX`: empty).
+    BrickIndex,
+    /// The brick stages' uniforms (`BrickFrame`).
+    BrickFrame,
+    /// The transfer function's points (a TF change rewrites only this).
+    Tf,
+    /// Per brick-grid position in draw order: header << 10 | voxels drawn, 0 when culled.
+    BrickSlots,
+    /// The visible bricks in draw order: (header, first position in its batch).
+    BrickList,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.
@@ -93,6 +109,10 @@ impl Res {
                 | Res::Ranks
                 | Res::Field
                 | Res::Bricks
+                | Res::BrickHeaders
+                | Res::BrickMasks
+                | Res::BrickRecords
+                | Res::BrickIndex
         )
     }
 
@@ -173,6 +193,8 @@ pub enum Workgroup {
     Tile(u32, u32),
     /// One workgroup of this many invocations.
     Single(u32),
+    /// One workgroup of this many invocations per item (spilling into y, `plan::groups_per_item`).
+    PerItem(u32),
     /// A draw: one instance per entry.
     Instances,
 }

@@ -84,6 +84,8 @@ pub struct FootprintPush {
     pub sheet_mode: u32,
     pub axis: u32,
     pub rank_offset: u32,
+    /// Sheet modes: the batch's first sheet. Tile compositing: 1 = a later batch of a bricked
+    /// volume (carry on from the image).
     pub rank_base: u32,
     pub rank_dir: i32,
     pub slab_z0: f32,
@@ -136,6 +138,38 @@ pub struct CompositePush {
     pub pad: u32,
 }
 
+/// Per-frame uniforms of the brick stages (`glsl/shared/brick.glsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BrickFrame {
+    /// Bricks along x, y, z; w: non-empty bricks (headers).
+    pub grid: [u32; 4],
+    /// The eye's PBTF split of the brick grid; w: transfer-function points.
+    pub split: [u32; 4],
+    /// x, y: a stored value d is the TF's density d x + y; z: extraction threshold; w: gradient
+    /// weight (0: off).
+    pub tf: [f32; 4],
+    /// Direction the light travels; w: 1 = headlight shading.
+    pub light: [f32; 4],
+    /// Ambient, diffuse, specular, shininess.
+    pub shade: [f32; 4],
+    /// x: largest gradient magnitude of the volume (gradient weighting); yzw unused.
+    pub grad: [f32; 4],
+}
+
+/// Push constants of `brick_params.comp`: the batch's entries of the visible-brick list.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BrickPush {
+    /// First entry of `Res::BrickList` in this batch.
+    pub first: u32,
+    /// Entries (bricks) in this batch.
+    pub count: u32,
+    pub pad: [u32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<BrickFrame>() == 96);
+const _: () = assert!(std::mem::size_of::<BrickPush>() == 16);
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);

@@ -88,7 +88,7 @@ pub enum Backend {
 }
 
 /// How to create a [`Renderer`].
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 #[non_exhaustive]
 pub struct RendererOptions {
     /// Vulkan or the CPU mirrors.
@@ -98,6 +98,20 @@ pub struct RendererOptions {
     pub validation: bool,
     /// Pick the Vulkan device whose name contains this text.
     pub device_name: Option<String>,
+    /// Device memory a frame may hold, in bytes (default 1 GiB, as on a mid-range GPU): a bricked
+    /// volume's splats stream through it in batches ([`Renderer::set_volume`]).
+    pub gpu_budget_bytes: u64,
+}
+
+impl Default for RendererOptions {
+    fn default() -> Self {
+        Self {
+            backend: Backend::Gpu,
+            validation: false,
+            device_name: None,
+            gpu_budget_bytes: cpu_engine::DEFAULT_GPU_BUDGET,
+        }
+    }
 }
 
 /// A scene on a backend. `Send`: one renderer per thread.
@@ -105,6 +119,7 @@ pub struct Renderer {
     gpu: Option<gpu::Gpu>,
     scene: Option<Prepared>,
     bisect: Option<Bisect>,
+    budget_bytes: u64,
 }
 
 impl Renderer {
@@ -120,12 +135,28 @@ impl Renderer {
             }
             Backend::Cpu => None,
         };
-        Ok(Self { gpu, scene: None, bisect: None })
+        let mut renderer = Self { gpu, scene: None, bisect: None, budget_bytes: 0 };
+        renderer.set_gpu_budget(options.gpu_budget_bytes)?;
+        Ok(renderer)
+    }
+
+    /// Device memory a frame may hold, in bytes (see [`RendererOptions::gpu_budget_bytes`]); the
+    /// CPU backend cuts the same batches.
+    pub fn set_gpu_budget(&mut self, bytes: u64) -> Result<()> {
+        if bytes == 0 {
+            return Err(Error::InvalidArgument("a GPU budget of 0 bytes".into()));
+        }
+        self.budget_bytes = bytes;
+        if let Some(g) = &mut self.gpu {
+            g.budget_bytes = bytes;
+        }
+        Ok(())
     }
 
     /// A renderer on a host program's Vulkan device (see [`vk::Context::from_host`]).
     pub fn with_context(ctx: Arc<vk::Context>) -> Result<Self> {
-        Ok(Self { gpu: Some(gpu::Gpu::new(ctx)?), scene: None, bisect: None })
+        let budget_bytes = cpu_engine::DEFAULT_GPU_BUDGET;
+        Ok(Self { gpu: Some(gpu::Gpu::new(ctx)?), scene: None, bisect: None, budget_bytes })
     }
 
     /// The Vulkan device's name, or "cpu".
@@ -152,7 +183,51 @@ impl Renderer {
         Ok(())
     }
 
-    /// The scene, if one is set.
+    /// Make a scalar volume the scene as a bricked store (`bricks`), classified with `tf` and
+    /// `shading` on every frame: on the GPU backend the store is resident and culling,
+    /// classification and the two-level PBTF order run on the device, so a volume of any size that
+    /// fits the budget's store draws (per splat, PBTF: sheet and slab modes need
+    /// [`Renderer::set_scene`] with a classified set). The host keeps no copy of `volume`.
+    pub fn set_volume(
+        &mut self,
+        volume: &volume::ScalarVolume,
+        tf: &classify::TransferFunction,
+        shading: Option<classify::Shading>,
+    ) -> Result<()> {
+        let store = bricks::BrickStore::build(volume)?;
+        self.set_bricks(bricks::BrickScene::new(store, tf.clone(), shading)?)
+    }
+
+    /// Make a bricked volume the scene (see [`Renderer::set_volume`]).
+    pub fn set_bricks(&mut self, scene: bricks::BrickScene) -> Result<()> {
+        self.scene = None;
+        let prep = Prepared::bricked(scene)?;
+        if let Some(g) = &mut self.gpu {
+            g.set_scene(&prep)?;
+        }
+        self.scene = Some(prep);
+        Ok(())
+    }
+
+    /// Classify the bricked volume with another transfer function and shading from the next
+    /// frame on: a buffer write and the next frame's culling, no re-extraction or upload.
+    pub fn set_transfer_function(
+        &mut self,
+        tf: &classify::TransferFunction,
+        shading: Option<classify::Shading>,
+    ) -> Result<()> {
+        let scene = self.scene.as_mut().and_then(|p| p.bricks.as_mut()).ok_or_else(|| {
+            Error::InvalidArgument("set_transfer_function needs a bricked volume (Renderer::set_volume)".into())
+        })?;
+        scene.set_transfer_function(tf.clone(), shading)
+    }
+
+    /// The bricked volume, if the scene is one.
+    pub fn volume(&self) -> Option<&bricks::BrickScene> {
+        self.scene.as_ref().and_then(|p| p.bricks.as_ref())
+    }
+
+    /// The scene, if one is set (a bricked volume's holds its grid and no splats).
     pub fn scene(&self) -> Option<&SplatSet> {
         self.scene.as_ref().map(|p| &p.set)
     }
@@ -183,7 +258,7 @@ impl Renderer {
         let bisect = self.bisect;
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
-        let mut cpu = CpuEngine::new(prep);
+        let mut cpu = CpuEngine::new(prep).with_budget(self.budget_bytes);
         let recorded = match (&mut self.gpu, bisect) {
             (Some(g), None) => record_frame(&mut g.engine(prep), prep, camera, &opts)?,
             (Some(g), Some(b)) => {
@@ -236,7 +311,7 @@ impl Renderer {
         };
         match &mut self.gpu {
             Some(g) => run(&mut g.engine(prep)),
-            None => run(&mut CpuEngine::new(prep)),
+            None => run(&mut CpuEngine::new(prep).with_budget(self.budget_bytes)),
         }
     }
 
@@ -331,6 +406,9 @@ impl Renderer {
         }
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        if prep.bricks.is_some() {
+            return Err(Error::Unsupported("the ray caster draws classified splat sets, not bricked volumes".into()));
+        }
         let recorded = match &mut self.gpu {
             Some(g) => recording::record_raycast(&mut g.engine(prep), prep, camera, options)?,
             None => recording::record_raycast(&mut CpuEngine::new(prep), prep, camera, options)?,

@@ -150,13 +150,8 @@ pub fn pbtf_bricked(set: &SplatSet, camera: &Camera, brick: u32) -> Result<Vec<u
     if brick == 0 {
         return Err(Error::InvalidArgument("the brick side must be at least one voxel".into()));
     }
-    let dims = set.grid().dims;
     let voxel_split = pbtf_split(set, camera);
-    let brick_split: [u32; 3] = match Viewer::of(set, camera) {
-        // Brick b lies on the eye's low side when its lowest voxel does.
-        Viewer::Eye(_) => [0, 1, 2].map(|a| voxel_split[a].div_ceil(brick)),
-        Viewer::Toward(d) => [0, 1, 2].map(|a| if d[a] < 0.0 { dims[a].div_ceil(brick) } else { 0 }),
-    };
+    let brick_split = brick_split(set, camera, brick);
     // (octant bits, then the outward rank along k, j, i) of index `v` split at `s`.
     let outward = |v: u32, s: u32| if v < s { (0u64, (s - 1 - v) as u64) } else { (1, (v - s) as u64) };
     let level = |ijk: [u32; 3], split: [u32; 3]| {
@@ -167,6 +162,17 @@ pub fn pbtf_bricked(set: &SplatSet, camera: &Camera, brick: u32) -> Result<Vec<u
         let [i, j, k, _] = set.splats()[s].ijk;
         (level([i / brick, j / brick, k / brick], brick_split), level([i, j, k], voxel_split))
     }))
+}
+
+/// The eye's PBTF split of the grid of `brick`-voxel bricks over `set`'s grid (`brick` > 0).
+pub fn brick_split(set: &SplatSet, camera: &Camera, brick: u32) -> [u32; 3] {
+    let dims = set.grid().dims;
+    let voxel_split = pbtf_split(set, camera);
+    match Viewer::of(set, camera) {
+        // Brick b lies on the eye's low side when its lowest voxel does.
+        Viewer::Eye(_) => [0, 1, 2].map(|a| voxel_split[a].div_ceil(brick)),
+        Viewer::Toward(d) => [0, 1, 2].map(|a| if d[a] < 0.0 { dims[a].div_ceil(brick) } else { 0 }),
+    }
 }
 
 /// Order by a per-splat key, ascending (a comparison sort: fine for the CPU reference orders).

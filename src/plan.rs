@@ -18,6 +18,8 @@ pub struct Prepared {
     pub slices: [(Vec<u32>, Vec<u32>); 3],
     pub ranks: Vec<u32>,
     pub rank_offsets: [u32; 3],
+    /// A bricked volume (then `set` holds no splats, only the grid): its splats are made per frame.
+    pub bricks: Option<crate::bricks::BrickScene>,
     /// The CPU ray caster's dense (colour * tau, tau) field, built on first use and kept with the
     /// scene (the GPU path uploads it to a 3D texture and drops the host copy).
     field: std::sync::OnceLock<crate::volume::DenseField>,
@@ -32,7 +34,16 @@ impl Prepared {
             rank_offsets[a] = ranks.len() as u32;
             ranks.extend(SplatSet::sheet_ranks(&slices[a].0));
         }
-        Self { set, slices, ranks, rank_offsets, field: std::sync::OnceLock::new() }
+        Self { set, slices, ranks, rank_offsets, bricks: None, field: std::sync::OnceLock::new() }
+    }
+
+    /// A bricked volume's scene.
+    pub fn bricked(scene: crate::bricks::BrickScene) -> Result<Self> {
+        let s = &scene.store;
+        let grid = crate::volume::Grid::centered(s.dims, s.spacing)?;
+        let mut prep = Self::new(SplatSet::empty(grid)?);
+        prep.bricks = Some(scene);
+        Ok(prep)
     }
 
     /// The dense field for ray casting, built once per scene.
@@ -221,6 +232,12 @@ pub fn composite_push(b: &Batch, btf: bool, width: u32, height: u32) -> Composit
 /// Workgroup counts for `n` invocations of a 1D stage (spilling into y past `MAX_GROUPS_X`).
 pub fn groups_1d(n: u32) -> [u32; 3] {
     let g = n.div_ceil(WORKGROUP_SIZE).max(1);
+    [g.min(MAX_GROUPS_X), g.div_ceil(MAX_GROUPS_X), 1]
+}
+
+/// Workgroups for one workgroup per item (`n` items), spilling into y past `MAX_GROUPS_X`.
+pub fn groups_per_item(n: u32) -> [u32; 3] {
+    let g = n.max(1);
     [g.min(MAX_GROUPS_X), g.div_ceil(MAX_GROUPS_X), 1]
 }
 

@@ -3,14 +3,15 @@
 //! [`Engine`]. Where the host must read a count back mid-frame (the slab starts, the tile lists'
 //! starts and the loop-budget word), the engine finishes the work so far; the recording is still
 //! written once, for every engine.
+use crate::bricks::{BrickScene, BRICK};
 use crate::camera::Camera;
-use crate::constants::{
+use crate::constants::{MAX_GPU_SPLATS, 
     COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT,
 };
 use crate::cpu::footprint::Blend;
 use crate::cpu::raycast::RaycastOptions;
 use crate::error::{Error, Result};
-use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{BrickPush, FootprintPush, Frame, ScreenQuad, SplatParams, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
 use crate::image::ImageF32;
 use crate::options::{Composite, RenderOptions, StageTime};
 use crate::order::{Direction, OrderKind};
@@ -86,6 +87,9 @@ pub struct Recorded {
 /// chosen), on `e`.
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
     camera.validate()?;
+    if let Some(scene) = &prep.bricks {
+        return record_bricks(e, prep, scene, camera, opts);
+    }
     let set = &prep.set;
     let (w, h) = (camera.width, camera.height);
     let direction = opts.direction();
@@ -121,7 +125,7 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
             e.run(&params())?;
         }
         if compute {
-            record_tiles(e, &frame, n, opts, w, h)?;
+            record_tiles(e, &frame, n, opts, w, h, false)?;
             return finish(e, Res::Accum, w, h, false);
         }
         let blend = if btf { Blend::Over } else { Blend::Under };
@@ -210,13 +214,125 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
     finish(e, Res::Accum, w, h, compute)
 }
 
+/// Device bytes a bricked frame holds per splat of a batch: its parameters (80) and order entry,
+/// and for the tile compositor its screen quad (80) and about four tile entries.
+pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 80 + 16;
+
+/// What a bricked frame keeps resident besides its batches: the store, the brick index, the
+/// draw-order slots and visible list, and the images.
+pub fn bricked_resident_bytes(scene: &BrickScene, width: u32, height: u32) -> u64 {
+    let s = &scene.store;
+    s.bytes() + s.index.len() as u64 * (4 + 4 + 8) + width as u64 * height as u64 * 16 * 3
+}
+
+/// The least budget that draws `scene` at `width` x `height`: resident data and one brick's splats.
+pub fn bricked_min_budget(scene: &BrickScene, width: u32, height: u32) -> u64 {
+    bricked_resident_bytes(scene, width, height) + (BRICK as u64).pow(3) * BATCH_BYTES_PER_SPLAT
+}
+
+/// A bricked volume's frame (issue 23): `brick_cull` culls whole bricks on the device (outside
+/// the view, or empty under the transfer function) and counts the rest's voxels at their slots in
+/// the brick grid's PBTF order; the host lists the visible bricks in that order and cuts batches
+/// that fit the budget; per batch `brick_params` classifies their voxels and writes their
+/// parameters in two-level PBTF order, and the raster draws them, the tile compositor carrying
+/// the image from batch to batch.
+fn record_bricks(
+    e: &mut dyn Engine,
+    prep: &Prepared,
+    scene: &BrickScene,
+    camera: &Camera,
+    opts: &RenderOptions,
+) -> Result<Recorded> {
+    if opts.composite != Composite::Splat || opts.order != OrderKind::Pbtf {
+        return Err(Error::Unsupported(
+            "a bricked volume is drawn per splat in PBTF order (composite splat, order pbtf); the sheet and slab modes \
+             and the other orders need a classified splat set"
+                .into(),
+        ));
+    }
+    let (w, h) = (camera.width, camera.height);
+    let budget = e.limits().budget_bytes;
+    let least = bricked_min_budget(scene, w, h);
+    if budget < least {
+        return Err(Error::TooLarge(format!(
+            "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB) and one brick of splats at \
+             {w}x{h}: the minimum is {} MiB",
+            budget >> 20,
+            scene.store.bytes() >> 20,
+            least.div_ceil(1 << 20)
+        )));
+    }
+    let capacity = ((budget - bricked_resident_bytes(scene, w, h)) / BATCH_BYTES_PER_SPLAT).min(MAX_GPU_SPLATS as u64);
+    let capacity = capacity as u32;
+    let frame = plan::frame_for(&prep.set, camera, opts);
+    let bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
+    let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
+    e.begin(&frame, opts.kernel, w, h)?;
+    e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
+    e.upload(Res::Tf, scene.tf_words())?;
+    e.ensure(Res::BrickSlots, slots as u64 * 4)?;
+    e.fill(Res::BrickSlots, None, 0)?;
+    if bf.grid[3] > 0 {
+        e.run(&Dispatch::new(StageId::BrickCull, 0, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
+    }
+    let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
+    let t = Instant::now();
+    // The visible bricks in draw order, each with its first position in its batch; batches of at
+    // most `capacity` splats, cut between bricks. (first entry, entries, splats)
+    let mut list: Vec<[u32; 2]> = Vec::new();
+    let mut batches: Vec<[u32; 3]> = vec![[0, 0, 0]];
+    for word in slot_words.into_iter().filter(|&w| w != 0) {
+        let n = word & 1023;
+        if batches.last().is_some_and(|b| b[2] + n > capacity) {
+            batches.push([list.len() as u32, 0, 0]);
+        }
+        let b = batches.last_mut().expect("one batch at least");
+        list.push([word >> 10, b[2]]);
+        b[1] += 1;
+        b[2] += n;
+    }
+    e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
+    let compute = opts.raster == Raster::Compute;
+    if !compute && batches.len() > 1 {
+        let total: u64 = batches.iter().map(|b| b[2] as u64).sum();
+        return Err(Error::Unsupported(format!(
+            "{total} splats in view exceed one batch of {capacity} within the GPU budget, and the raster pipeline draws \
+             one batch: use --raster compute (the tile compositor streams batches) or a larger --gpu-budget-mib"
+        )));
+    }
+    e.ensure(Res::BrickList, (list.len().max(1) * 8) as u64)?;
+    e.upload(Res::BrickList, bytemuck::cast_slice(&list))?;
+    let largest = batches.iter().map(|b| b[2]).max().unwrap_or(0);
+    e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+    e.ensure(Res::Order, largest as u64 * 4)?;
+    if !compute {
+        e.layers(1)?;
+    }
+    for (i, &[first, count, n]) in batches.iter().enumerate() {
+        if count > 0 {
+            let push = BrickPush { first, count, pad: [0; 2] };
+            let groups = plan::groups_per_item(count);
+            e.run(&Dispatch::new(StageId::BrickParams, 0, groups, List::Order, bytemuck::bytes_of(&push)))?;
+        }
+        if compute {
+            record_tiles(e, &frame, n, opts, w, h, i > 0)?;
+        } else {
+            let blend = if opts.direction() == Direction::BackToFront { Blend::Over } else { Blend::Under };
+            let variant = footprint_variant(blend, opts.raster == Raster::Points, SHEET_MODE_SPLAT);
+            let push = FootprintPush::default();
+            e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
+        }
+    }
+    finish(e, if compute { Res::Accum } else { Res::Color }, w, h, false)
+}
+
 /// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
 /// shorter chunks when an invocation ran out of llvmpipe's loop budget), then composite each
 /// tile's list `TILE_SEGMENT` entries per dispatch.
-fn record_tiles(e: &mut dyn Engine, frame: &Frame, n: u32, opts: &RenderOptions, w: u32, h: u32) -> Result<()> {
+fn record_tiles(e: &mut dyn Engine, frame: &Frame, n: u32, opts: &RenderOptions, w: u32, h: u32, carry: bool) -> Result<()> {
     let (tx, ty) = crate::cpu::tile::tile_grid(frame);
     let tiles = tx as u64 * ty as u64;
-    let mut push = plan::tile_push(opts, n, w, h);
+    let mut push = FootprintPush { rank_base: carry as u32, ..plan::tile_push(opts, n, w, h) };
     let most = (crate::raster::MAX_TILE_CELLS / tiles.max(1)).min(push.count.max(1) as u64) as u32;
     e.ensure(Res::Quads, n as u64 * std::mem::size_of::<ScreenQuad>() as u64)?;
     e.ensure(Res::TileStart, (tiles + 1) * 4)?;

@@ -8,10 +8,10 @@
 //! (`crate::cpu_engine`), or a split of the two (`crate::bisect`). Adding a stage is its shader,
 //! its mirror, its row here and its line in the recording. The types they share are in
 //! `crate::dispatch`, below both this table and the mirrors it names.
-use crate::constants::{COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, WORKGROUP_SIZE};
+use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, WORKGROUP_SIZE};
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
-use crate::gpu_types::{CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{BrickPush, CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
 
 pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, List, Pass, Res, Variant, Workgroup};
 use crate::gpu_types::Frame;
@@ -78,6 +78,21 @@ const FOOTPRINT: &[Res] = &[
     Res::QuadsHi,
     Res::Status,
 ];
+/// glsl/shared/brick.glsl's bindings, shared by the brick stages.
+const BRICK: &[Res] = &[
+    Res::Frame,
+    Res::BrickFrame,
+    Res::Tf,
+    Res::BrickHeaders,
+    Res::BrickMasks,
+    Res::BrickRecords,
+    Res::BrickIndex,
+    Res::BrickSlots,
+    Res::BrickList,
+    Res::Params,
+    Res::ParamsHi,
+    Res::Order,
+];
 const ONE: &[Variant] = &[v("", &[])];
 /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
 const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];
@@ -133,6 +148,30 @@ pub const STAGES: &[StageDesc] = &[
         device_build: None,
         variants: ONE,
         mirror: crate::cpu::splat_params::splat_params_stage,
+    },
+    StageDesc {
+        name: "brick_cull",
+        kind: Kind::Compute,
+        bindings: BRICK,
+        writes: &[Res::BrickSlots],
+        push: 0,
+        workgroup: Workgroup::PerItem(BRICK_LANES),
+        timing: "bricks",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::brick::brick_cull_stage,
+    },
+    StageDesc {
+        name: "brick_params",
+        kind: Kind::Compute,
+        bindings: BRICK,
+        writes: &[Res::Params, Res::Order],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::PerItem(BRICK_LANES),
+        timing: "brick_params",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::brick::brick_params_stage,
     },
     StageDesc {
         name: "slab_count",
@@ -381,6 +420,8 @@ stage_ids!(
     OrderScan,
     OrderScatter,
     SplatParams,
+    BrickCull,
+    BrickParams,
     SlabCount,
     SlabScan,
     SlabScatter,
@@ -437,6 +478,10 @@ pub struct Limits {
     pub max_layers: u32,
     /// Largest storage binding in bytes (the fixed-point layers are one).
     pub max_storage_range: u64,
+    /// Device memory a frame may hold (`RendererOptions::gpu_budget_bytes`): a bricked volume's
+    /// splats stream through it in batches. The CPU engine keeps the same budget, so it cuts the
+    /// same batches.
+    pub budget_bytes: u64,
 }
 
 /// Runs a recording: the Vulkan device, the CPU mirrors, or a split of the two.

@@ -112,6 +112,13 @@ impl SplatSet {
         Ok(Self { grid, row_start, splats })
     }
 
+    /// No splats on `grid` (a bricked volume's stand-in: its splats are made per frame).
+    pub fn empty(grid: Grid) -> Result<Self> {
+        grid.validate()?;
+        let rows = grid.dims[1] as usize * grid.dims[2] as usize + 1;
+        Ok(Self { grid, row_start: vec![0; rows], splats: Vec::new() })
+    }
+
     /// The grid the splats sit on.
     pub fn grid(&self) -> &Grid {
         &self.grid

@@ -259,6 +259,15 @@ struct SceneArgs {
     /// mirrors the rest) or cpu-until:STAGE. Stages: see src/stages.rs.
     #[arg(long, conflicts_with = "cpu")]
     bisect: Option<voxsplat::Bisect>,
+    /// Classify --volume on the host into a splat set (as before the bricked store): needed by the
+    /// sheet and slab modes, the other orders, --truth, --raycast and --k-line, which pick it
+    /// themselves. Without it a volume is a bricked store classified on the device.
+    #[arg(long)]
+    dense: bool,
+    /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
+    /// batches.
+    #[arg(long, default_value = "1024")]
+    gpu_budget_mib: u64,
 }
 
 #[derive(Args)]
@@ -406,27 +415,54 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
     Ok(cam)
 }
 
+type VolumeParts =
+    (voxsplat::volume::ScalarVolume, voxsplat::classify::TransferFunction, Option<voxsplat::classify::Shading>);
+
+/// The --volume file, its transfer function and shading.
+fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumeParts> {
+    let hints = voxsplat::loaders::VolumeHints {
+        dims: a.dims,
+        dtype: a.dtype.as_deref().map(str::parse).transpose()?,
+        big_endian: a.big_endian,
+        spacing: a.spacing.map(|v| v.to_array()),
+    };
+    let vol = voxsplat::loaders::load_volume(path, &hints)?;
+    let tf = if a.tf.ends_with(".toml") {
+        let text = std::fs::read_to_string(&a.tf).map_err(|e| Error::Io { path: a.tf.clone(), source: e })?;
+        voxsplat::classify::TransferFunction::from_toml(&text)?
+    } else {
+        voxsplat::classify::TransferFunction::preset(&a.tf)?
+    };
+    let shading = a.shade.then(|| {
+        let g = voxsplat::Grid::centered(vol.dims, vol.spacing).ok();
+        let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
+        voxsplat::classify::Shading::headlight(-dir)
+    });
+    Ok((vol, tf, shading))
+}
+
+/// The --volume file as a bricked scene, with a one-line report of the store.
+fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::bricks::BrickScene> {
+    let (vol, tf, shading) = load_volume_parts(a, path)?;
+    let store = voxsplat::bricks::BrickStore::build(&vol)?;
+    drop(vol);
+    eprintln!(
+        "{} stored voxels in {} bricks of {}^3, {:.2} bytes per stored voxel on the GPU ({} x {} x {} grid)",
+        store.len(),
+        store.headers.len(),
+        voxsplat::bricks::BRICK,
+        store.bytes() as f64 / store.len().max(1) as f64,
+        store.dims[0],
+        store.dims[1],
+        store.dims[2]
+    );
+    voxsplat::bricks::BrickScene::new(store, tf, shading)
+}
+
 /// The splats named by --volume, --terrain or --scene, with a one-line report of what was loaded.
 fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
     let set = if let Some(path) = &a.volume {
-        let hints = voxsplat::loaders::VolumeHints {
-            dims: a.dims,
-            dtype: a.dtype.as_deref().map(str::parse).transpose()?,
-            big_endian: a.big_endian,
-            spacing: a.spacing.map(|v| v.to_array()),
-        };
-        let vol = voxsplat::loaders::load_volume(path, &hints)?;
-        let tf = if a.tf.ends_with(".toml") {
-            let text = std::fs::read_to_string(&a.tf).map_err(|e| Error::Io { path: a.tf.clone(), source: e })?;
-            voxsplat::classify::TransferFunction::from_toml(&text)?
-        } else {
-            voxsplat::classify::TransferFunction::preset(&a.tf)?
-        };
-        let shading = a.shade.then(|| {
-            let g = voxsplat::Grid::centered(vol.dims, vol.spacing).ok();
-            let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
-            voxsplat::classify::Shading::headlight(-dir)
-        });
+        let (vol, tf, shading) = load_volume_parts(a, path)?;
         voxsplat::classify::classify(&vol, &tf, shading)?
     } else if let Some(path) = &a.terrain {
         let heights = voxsplat::loaders::load_heights(path)?;
@@ -458,6 +494,10 @@ fn renderer_of(a: &SceneArgs) -> Result<Renderer> {
     let mut opts = RendererOptions::default();
     opts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
     opts.validation = a.validation;
+    if a.gpu_budget_mib == 0 {
+        return Err(Error::InvalidArgument("--gpu-budget-mib must be positive".into()));
+    }
+    opts.gpu_budget_bytes = a.gpu_budget_mib << 20;
     let mut r = Renderer::new(&opts)?;
     r.set_bisect(a.bisect)?;
     Ok(r)
@@ -495,11 +535,27 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Render(a) => {
-            let set = load_scene(&a.scene)?;
+            let order = a.scene.order.parse::<OrderKind>()?;
+            let composite = a.composite.parse::<Composite>()?;
+            // A volume is a bricked store classified on the device unless a mode needs host splats.
+            let host_splats = a.scene.dense
+                || composite != Composite::Splat
+                || order != OrderKind::Pbtf
+                || a.truth
+                || a.raycast.is_some()
+                || a.k_line;
+            let bricked = match &a.scene.volume {
+                Some(path) if !host_splats => Some(load_bricked(&a.scene, path)?),
+                _ => None,
+            };
+            let set = match &bricked {
+                Some(b) => voxsplat::SplatSet::empty(voxsplat::Grid::centered(b.store.dims, b.store.spacing)?)?,
+                None => load_scene(&a.scene)?,
+            };
             let cam = camera_of(&a.scene, set.grid())?;
             let mut opts = RenderOptions::default();
-            opts.order = a.scene.order.parse::<OrderKind>()?;
-            opts.composite = a.composite.parse::<Composite>()?;
+            opts.order = order;
+            opts.composite = composite;
             opts.kernel = a.kernel.parse::<Kernel>()?;
             opts.antialias = a.aa.parse::<voxsplat::Antialias>()?;
             opts.direction =
@@ -515,7 +571,8 @@ fn run(cli: Cli) -> Result<()> {
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
             opts.render_scale = a.render_scale;
             opts.validate()?;
-            let splats = set.len();
+            let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
+            let r_bricked = bricked.is_some();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
             if a.truth && a.render_scale != 1.0 {
                 return Err(Error::InvalidArgument("--truth is the full-size reference: drop --render-scale".into()));
@@ -531,7 +588,10 @@ fn run(cli: Cli) -> Result<()> {
                 voxsplat::Rendered { image, timings: vec![voxsplat::StageTime { stage: "truth", ms }], raster: None }
             } else {
                 let mut r = renderer_of(&a.scene)?;
-                r.set_scene(set)?;
+                match bricked {
+                    Some(b) => r.set_bricks(b)?,
+                    None => r.set_scene(set)?,
+                }
                 let f = match a.raycast {
                     Some(step) => {
                         let o = voxsplat::cpu::raycast::RaycastOptions {
@@ -563,7 +623,8 @@ fn run(cli: Cli) -> Result<()> {
                 voxsplat::aa::draw_k_line(&mut image, &regions);
             }
             voxsplat::output::write_image(&image, &a.out)?;
-            eprintln!("{} splats -> {}", splats, a.out.display());
+            let what = if r_bricked { "stored voxels" } else { "splats" };
+            eprintln!("{splats} {what} -> {}", a.out.display());
             if let Some(c) = &frame.raster {
                 eprintln!("raster: {} ({})", c.raster, c.reason);
             }
@@ -689,13 +750,23 @@ fn run(cli: Cli) -> Result<()> {
                 let (lo, hi) =
                     v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
                 println!("volume: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
+                let store = voxsplat::bricks::BrickStore::build(&v)?;
+                println!(
+                    "bricked store: {} stored voxels in {} bricks of {}^3, {} bytes on the GPU, {:.2} bytes per stored \
+                     voxel",
+                    store.len(),
+                    store.headers.len(),
+                    voxsplat::bricks::BRICK,
+                    store.bytes(),
+                    store.bytes() as f64 / store.len().max(1) as f64
+                );
                 voxsplat::classify::classify(&v, &voxsplat::classify::TransferFunction::preset(&tf)?, None)?
             };
             println!("splats: {}", set.len());
-            println!("bytes per splat: {:.0}", voxsplat::gpu_bytes_per_splat(&set));
+            println!("bytes per splat (--dense): {:.0}", voxsplat::gpu_bytes_per_splat(&set));
             let most = voxsplat::constants::MAX_GPU_SPLATS as usize;
             if set.len() > most {
-                println!("over the GPU path's {most} splats: render it with --cpu, or classify fewer voxels");
+                println!("over the dense GPU path's {most} splats: render it bricked (the default for volumes)");
             }
             Ok(())
         }

@@ -24,7 +24,8 @@ layout(push_constant) uniform Push {
     uint sheet_mode;   // SHEET_MODE_*
     uint axis;         // sheet axis
     uint rank_offset;  // start of this axis in sheet_rank
-    uint rank_base;    // rank of the batch's first sheet (slab mode: its first slab)
+    uint rank_base;    // rank of the batch's first sheet (slab mode: its first slab); tile
+                       // compositing: 1 = a later batch, carrying on from the image
     int rank_dir;      // +1 or -1: direction of the batch in rank space
     float slab_z0;     // slab mode: eye-space depth of slab 0's near face
     float slab_dz;     // slab mode: slab thickness (world units)

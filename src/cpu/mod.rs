@@ -1,6 +1,7 @@
 //! CPU mirrors of the GPU stages, one function per stage with the stage's name, written loop for
 //! loop like the shaders and reading the same `#[repr(C)]` structs.
 pub mod bindings;
+pub mod brick;
 pub mod composite;
 pub mod footprint;
 pub mod order;
@@ -11,6 +12,7 @@ pub mod splat_params;
 pub mod tile;
 
 pub use crate::image::ImageF32;
+pub use brick::{brick_cull, brick_params};
 pub use composite::composite;
 pub use footprint::{footprint, footprint_sum, sample_table};
 pub use order::{order_count, order_scan, order_scatter};

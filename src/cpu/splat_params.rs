@@ -1,4 +1,4 @@
-//! Mirror of `splat_params.comp`.
+//! Mirror of `splat_params.comp` and of `glsl/shared/params.glsl`.
 use super::bindings::Bindings;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
@@ -30,61 +30,61 @@ pub fn footprint_scale(frame: &Frame, depth: f32) -> f32 {
     }
 }
 
-pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams]) {
+/// Mirror of `params_of` in `glsl/shared/params.glsl`: a splat's parameters from its grid index
+/// and colour (the dense path's `splat_params` and the bricks' `brick_params` share it).
+pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right, origin, spacing) =
         (v3(frame.eye), v3(frame.forward), v3(frame.right), v3(frame.origin), v3(frame.spacing));
-    for (s, sp) in splats.iter().enumerate().take(frame.dims[3] as usize) {
-        let ijk = Vec3::new(sp.ijk[0] as f32, sp.ijk[1] as f32, sp.ijk[2] as f32);
-        let center = origin + ijk * spacing;
-        let depth = (center - eye).dot(forward);
-        let scale = footprint_scale(frame, depth);
-        let radius = frame.spacing[3] * scale;
-        let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
-        let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
-        let mut u = (right - right.dot(w) * w).normalize();
-        let mut v = w.cross(u);
-        let mut stretch = 0.0f32;
-        let mut quad_center = center;
-        let mut energy = 1.0 / (scale * scale);
-        if frame.blur[0] > 0.0 && visible {
-            let m = Mat4::from_cols_array_2d(&frame.motion);
-            let vp = Mat4::from_cols_array_2d(&frame.view_proj);
-            let prev = (m * center.extend(1.0)).truncate();
-            let c1 = vp * center.extend(1.0);
-            let c0 = vp * prev.extend(1.0);
-            let moved = (c1.truncate().truncate() / c1.w - c0.truncate().truncate() / c0.w)
-                * 0.5
-                * Vec2::new(frame.blur[2], frame.blur[3]);
-            let d = center - prev;
-            let dp = d - d.dot(w) * w;
-            let len = dp.length();
-            if c0.w > 0.0 && moved.length() > frame.blur[0] && len > 1e-6 * radius {
-                u = dp / len;
-                v = w.cross(u);
-                stretch = 0.5 * len / radius;
-                quad_center = center - 0.5 * dp;
-                energy /= 1.0 + 2.0 * stretch * frame.blur[1];
-            }
+    let ijk = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32);
+    let center = origin + ijk * spacing;
+    let depth = (center - eye).dot(forward);
+    let scale = footprint_scale(frame, depth);
+    let radius = frame.spacing[3] * scale;
+    let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
+    let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
+    let mut u = (right - right.dot(w) * w).normalize();
+    let mut v = w.cross(u);
+    let mut stretch = 0.0f32;
+    let mut quad_center = center;
+    let mut energy = 1.0 / (scale * scale);
+    if frame.blur[0] > 0.0 && visible {
+        let m = Mat4::from_cols_array_2d(&frame.motion);
+        let vp = Mat4::from_cols_array_2d(&frame.view_proj);
+        let prev = (m * center.extend(1.0)).truncate();
+        let c1 = vp * center.extend(1.0);
+        let c0 = vp * prev.extend(1.0);
+        let moved =
+            (c1.truncate().truncate() / c1.w - c0.truncate().truncate() / c0.w) * 0.5 * Vec2::new(frame.blur[2], frame.blur[3]);
+        let d = center - prev;
+        let dp = d - d.dot(w) * w;
+        let len = dp.length();
+        if c0.w > 0.0 && moved.length() > frame.blur[0] && len > 1e-6 * radius {
+            u = dp / len;
+            v = w.cross(u);
+            stretch = 0.5 * len / radius;
+            quad_center = center - 0.5 * dp;
+            energy /= 1.0 + 2.0 * stretch * frame.blur[1];
         }
-        let tau = optical_depth(sp.color[3]);
-        params[s] = SplatParams {
-            center: [quad_center.x, quad_center.y, quad_center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
-            axis_u: [
-                u.x * radius * (1.0 + stretch),
-                u.y * radius * (1.0 + stretch),
-                u.z * radius * (1.0 + stretch),
-                energy,
-            ],
-            axis_v: [v.x * radius, v.y * radius, v.z * radius, stretch],
-            emit: [sp.color[0], sp.color[1], sp.color[2], tau],
-            screen: [
-                depth,
-                (center - eye).length(),
-                if frame.eye[3] > 0.5 { radius * frame.up[3] / depth.max(1e-6) } else { radius * frame.up[3] },
-                scale,
-            ],
-        };
+    }
+    let tau = optical_depth(color[3]);
+    SplatParams {
+        center: [quad_center.x, quad_center.y, quad_center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
+        axis_u: [u.x * radius * (1.0 + stretch), u.y * radius * (1.0 + stretch), u.z * radius * (1.0 + stretch), energy],
+        axis_v: [v.x * radius, v.y * radius, v.z * radius, stretch],
+        emit: [color[0], color[1], color[2], tau],
+        screen: [
+            depth,
+            (center - eye).length(),
+            if frame.eye[3] > 0.5 { radius * frame.up[3] / depth.max(1e-6) } else { radius * frame.up[3] },
+            scale,
+        ],
+    }
+}
+
+pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams]) {
+    for (s, sp) in splats.iter().enumerate().take(frame.dims[3] as usize) {
+        params[s] = params_of(frame, [sp.ijk[0], sp.ijk[1], sp.ijk[2]], sp.color);
     }
 }
 

@@ -114,8 +114,8 @@ pub fn tile_scatter(
     }
 }
 
-/// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it,
-/// later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
+/// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it
+/// unless `push.rank_base` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
 /// order, whichever GPU lane composites it.
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
@@ -135,11 +135,12 @@ pub fn tile_composite(
         // Segment `push.first`: TILE_SEGMENT entries of the list, carrying the pixel across segments.
         let list_end = tile_start[tile + 1] as usize;
         let begin = tile_start[tile] as usize + (push.first * TILE_SEGMENT) as usize;
-        if push.first > 0 && begin >= list_end {
+        let carry = push.first > 0 || push.rank_base != 0;
+        if carry && begin >= list_end {
             return;
         }
         let end = list_end.min(begin + TILE_SEGMENT as usize);
-        let mut acc = if push.first > 0 { *px } else { [0.0f32; 4] };
+        let mut acc = if carry { *px } else { [0.0f32; 4] };
         for &splat in &entries[begin..end] {
             if terminate && 1.0 - acc[3] <= push.occluded {
                 break;

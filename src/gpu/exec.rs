@@ -340,7 +340,11 @@ impl Engine for GpuEngine<'_> {
 
     fn limits(&self) -> Limits {
         let ctx = &self.gpu.ctx;
-        Limits { max_layers: ctx.image_limits().1, max_storage_range: ctx.max_storage_range() }
+        Limits {
+            max_layers: ctx.image_limits().1,
+            max_storage_range: ctx.max_storage_range(),
+            budget_bytes: self.gpu.budget_bytes,
+        }
     }
 
     fn is_device(&self) -> bool {

@@ -34,6 +34,8 @@ pub struct Gpu {
     pub(crate) timer: Timer,
     extra: Extra,
     pub(crate) ctx: Arc<Context>,
+    /// Device memory a frame may hold (`Limits::budget_bytes`).
+    pub(crate) budget_bytes: u64,
 }
 
 impl Gpu {
@@ -55,7 +57,8 @@ impl Gpu {
             roofline_composite: Pipeline::compute(&ctx, composite_layout, spirv("roofline.comp")?)?,
             roofline_layout,
         };
-        Ok(Self { res: Resources::new(&ctx)?, timer: Timer::new(&ctx, 16)?, pipes, extra, ctx })
+        let budget_bytes = crate::cpu_engine::DEFAULT_GPU_BUDGET;
+        Ok(Self { res: Resources::new(&ctx)?, timer: Timer::new(&ctx, 16)?, pipes, extra, ctx, budget_bytes })
     }
 
     pub fn context(&self) -> &Arc<Context> {

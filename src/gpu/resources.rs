@@ -27,6 +27,8 @@ pub struct SceneBuffers {
     /// flags): built on first use.
     pub field: Option<Image>,
     pub bricks: Option<(u32, Buffer)>,
+    /// A bricked volume's store: headers, masks, records, brick index (`Res::BrickHeaders`..).
+    pub store: Option<[Buffer; 4]>,
 }
 
 /// The images a frame draws into.
@@ -131,6 +133,20 @@ impl Resources {
             ranks: storage(ctx, "sheet ranks", bytemuck::cast_slice(&prep.ranks))?,
             field: None,
             bricks: None,
+            store: match &prep.bricks {
+                // At least one word each: a TF that leaves nothing must not make a zero-sized buffer.
+                Some(b) => {
+                    let s = &b.store;
+                    let words = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
+                    Some([
+                        storage(ctx, "brick headers", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.headers))))?,
+                        storage(ctx, "brick masks", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.masks))))?,
+                        storage(ctx, "brick records", bytemuck::cast_slice(&words(&s.records)))?,
+                        storage(ctx, "brick index", bytemuck::cast_slice(&words(&s.index)))?,
+                    ])
+                }
+                None => None,
+            },
         });
         Ok(())
     }
@@ -197,6 +213,10 @@ impl Resources {
             Res::Splats => &scene()?.splats,
             Res::RowStart => &scene()?.row_start,
             Res::Ranks => &scene()?.ranks,
+            Res::BrickHeaders | Res::BrickMasks | Res::BrickRecords | Res::BrickIndex => {
+                let store = scene()?.store.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
+                &store[res as usize - Res::BrickHeaders as usize]
+            }
             other => self
                 .bufs
                 .get(&other)
@@ -297,7 +317,15 @@ impl Resources {
                     List::Slices(axis) => &self.scene()?.draw[axis as usize],
                     List::SlabPairs => frame_buf(Res::SlabPairs),
                 }),
-                Res::Frame | Res::Radial | Res::Splats | Res::RowStart | Res::Ranks => Bind::Buffer(self.buffer(res)?),
+                Res::Frame
+                | Res::Radial
+                | Res::Splats
+                | Res::RowStart
+                | Res::Ranks
+                | Res::BrickHeaders
+                | Res::BrickMasks
+                | Res::BrickRecords
+                | Res::BrickIndex => Bind::Buffer(self.buffer(res)?),
                 other => Bind::Buffer(frame_buf(other)),
             });
         }

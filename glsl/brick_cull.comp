@@ -1,0 +1,28 @@
+#version 450
+// Bricks, pass 1 (issue 23): one workgroup per non-empty brick. A brick outside the view, or whose
+// value range the transfer function leaves empty, is culled whole; otherwise its lanes count the
+// voxels the TF extracts, and the brick writes header << 10 | count at its position in the PBTF
+// order of the brick grid (the host then lists the visible bricks in draw order and cuts batches
+// within the memory budget: recording.rs). Mirror: cpu::brick::brick_cull.
+layout(local_size_x = BRICK_LANES) in;
+#include "brick.glsl"
+
+shared uint drawn;
+
+void main() {
+    uint h = workgroup_item();
+    if (h >= bf.grid.w) return;
+    uvec4 hd = headers[h];
+    uvec3 b = brick_coords(hd.x);
+    if (tf_empty(hd.w & 0xffffu, hd.w >> 16u) || outside_view(b)) return;
+    uint lane = gl_LocalInvocationID.x;
+    if (lane == 0u) drawn = 0u;
+    barrier();
+    uint n = 0u;
+    for (uint r = lane; r < hd.z; r += BRICK_LANES) {
+        if (emits(records[hd.y + r] >> 16u)) n++;
+    }
+    atomicAdd(drawn, n);
+    barrier();
+    if (lane == 0u && drawn > 0u) slots[brick_slot(b)] = (h << 10u) | drawn;
+}

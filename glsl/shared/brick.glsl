@@ -1,0 +1,176 @@
+// The brick stages' bindings and helpers (issue 23), shared by brick_cull and brick_params: the
+// bricked store (src/bricks.rs: 16-byte headers, 64-byte occupancy masks, 4-byte records of local
+// index | 16-bit value << 16), the transfer function as a small buffer, classification on the
+// device, and the dense PBTF position of a cell in a split grid (the brick grid, or a brick's
+// BRICK_SIDE^3 cells). Mirror: src/cpu/brick.rs.
+#include "types.glsl"
+#include "pbtf.glsl"
+
+struct BrickFrame {
+    uvec4 grid;    // bricks along x, y, z; w: non-empty bricks (headers)
+    uvec4 split;   // the eye's PBTF split of the brick grid; w: unused
+    vec4 tf;       // x, y: a stored value d is the TF's density d x + y (gradients); zw: unused
+    vec4 light;    // direction the light travels; w: 1 = headlight shading
+    vec4 shade;    // ambient, diffuse, specular, shininess
+    vec4 grad;     // x: the volume's largest gradient magnitude (gradient weighting)
+};
+
+layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
+layout(std430, binding = 1) readonly buffer BrickFrameBlock { BrickFrame bf; };
+// The transfer function tabulated per quantised value q (BrickScene::tf_words): straight RGBA,
+// whether q is extracted (a bit), and the extracted values below each 32-value word.
+layout(std430, binding = 2) readonly buffer Tf {
+    vec4 tf_color[TF_ENTRIES];
+    uint tf_emit[TF_ENTRIES / 32];
+    uint tf_prefix[];
+};
+// brick (x | y << 10 | z << 20), first record, records, quantised min | max << 16.
+layout(std430, binding = 3) readonly buffer Headers { uvec4 headers[]; };
+layout(std430, binding = 4) readonly buffer Masks { uint masks[]; };
+layout(std430, binding = 5) readonly buffer Records { uint records[]; };
+// Brick id (x + nx (y + ny z)) -> header, or 0xffffffff when the brick stores nothing.
+layout(std430, binding = 6) readonly buffer BrickIndex { uint brick_index[]; };
+// Per brick-grid position in draw order: header << 10 | voxels drawn, 0 when culled.
+layout(std430, binding = 7) buffer BrickSlots { uint slots[]; };
+// The batch's visible bricks in draw order: header, its first position in the batch.
+layout(std430, binding = 8) readonly buffer BrickList { uvec2 brick_list[]; };
+layout(std430, binding = 9) writeonly buffer Params { SplatParams params_lo[]; };
+layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]; };
+layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
+
+const float Q_MAX = 65535.0;
+const uint MASK_WORDS = BRICK_SIDE * BRICK_SIDE * BRICK_SIDE / 32u;
+
+// Workgroups spill into y past MAX_GROUPS_X (plan::groups_per_item): one workgroup per item.
+uint workgroup_item() {
+    return gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+}
+
+uvec3 brick_coords(uint packed) {
+    return uvec3(packed & 1023u, (packed >> 10u) & 1023u, packed >> 20u);
+}
+
+uvec3 local_cell(uint l) {
+    return uvec3(l % BRICK_SIDE, (l / BRICK_SIDE) % BRICK_SIDE, l / (BRICK_SIDE * BRICK_SIDE));
+}
+
+// Position of cell c in the PBTF sequence of a dense n-cell grid split at s (front to back):
+// octants in turn, inside each k outward, then j, then i (order.rs, pbtf_bricked's key).
+uint dense_pbtf(uvec3 c, uvec3 n, uvec3 s) {
+    uint si = c.x < s.x ? 0u : 1u;
+    uint sj = c.y < s.y ? 0u : 1u;
+    uint sk = c.z < s.z ? 0u : 1u;
+    uint octant = si + 2u * sj + 4u * sk;
+    uint base = 0u;
+    for (uint o = 0u; o < octant; ++o) {
+        base += side_count(n.x, s.x, o & 1u) * side_count(n.y, s.y, (o >> 1u) & 1u)
+            * side_count(n.z, s.z, (o >> 2u) & 1u);
+    }
+    uint ni = side_count(n.x, s.x, si);
+    uint nj = side_count(n.y, s.y, sj);
+    return base + (outward(c.z, s.z, sk) * nj + outward(c.y, s.y, sj)) * ni + outward(c.x, s.x, si);
+}
+
+// Whether voxels of quantised value q are extracted (classify_field: at or above the threshold,
+// opacity > 0).
+bool emits(uint q) {
+    return ((tf_emit[q >> 5u] >> (q & 31u)) & 1u) != 0u;
+}
+
+// Extracted values below q.
+uint emitted_below(uint q) {
+    uint w = q >> 5u;
+    if ((q & 31u) == 0u) return tf_prefix[w];
+    return tf_prefix[w] + uint(bitCount(tf_emit[w] & ((1u << (q & 31u)) - 1u)));
+}
+
+// Whether no value in [lo, hi] is extracted: a brick of that range draws nothing.
+bool tf_empty(uint lo, uint hi) {
+    return emitted_below(hi + 1u) == emitted_below(lo);
+}
+
+// The stored (normalised) value at voxel v, indices clamped to the grid: 0 where nothing is stored.
+float stored_at(ivec3 v) {
+    uvec3 c = uvec3(clamp(v, ivec3(0), ivec3(frame.dims.xyz) - 1));
+    uvec3 b = c / BRICK_SIDE;
+    uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
+    if (h == 0xffffffffu) return 0.0;
+    uvec3 lc = c % BRICK_SIDE;
+    uint l = lc.x + BRICK_SIDE * (lc.y + BRICK_SIDE * lc.z);
+    uint word = masks[h * MASK_WORDS + l / 32u];
+    if (((word >> (l % 32u)) & 1u) == 0u) return 0.0;
+    // The record's rank among the brick's: stored voxels below it in local index order.
+    uint below = bitCount(word & ((1u << (l % 32u)) - 1u));
+    for (uint w = 0u; w < l / 32u; ++w) below += uint(bitCount(masks[h * MASK_WORDS + w]));
+    return float(records[headers[h].y + below] >> 16u) / Q_MAX;
+}
+
+float density_at(ivec3 v) {
+    return stored_at(v) * bf.tf.x + bf.tf.y;
+}
+
+// Colour and opacity of the voxel at v of quantised value q: the TF, its gradient weighting and
+// headlight shading, gradients by central differences read through the store (classify_field).
+vec4 classify_voxel(ivec3 v, uint q) {
+    vec4 c = tf_color[q];
+    bool weighted = bf.tf.w > 0.0;
+    bool shaded = bf.light.w > 0.5;
+    if (weighted || shaded) {
+        vec3 s = frame.spacing.xyz;
+        vec3 g = vec3(
+            (density_at(v + ivec3(1, 0, 0)) - density_at(v - ivec3(1, 0, 0))) / (2.0 * s.x),
+            (density_at(v + ivec3(0, 1, 0)) - density_at(v - ivec3(0, 1, 0))) / (2.0 * s.y),
+            (density_at(v + ivec3(0, 0, 1)) - density_at(v - ivec3(0, 0, 1))) / (2.0 * s.z));
+        float len = length(g);
+        if (weighted) c.a *= pow(len / bf.grad.x, bf.tf.w);
+        if (shaded) {
+            vec3 n = len > 0.0 ? g / len : vec3(0.0);
+            float ndl = abs(dot(n, -bf.light.xyz));
+            float lit = bf.shade.x + bf.shade.y * ndl;
+            float spec = bf.shade.z * pow(ndl, bf.shade.w);
+            c.rgb = min(c.rgb * lit + spec, vec3(1.0));
+        }
+    }
+    return c;
+}
+
+PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
+#include "params.glsl"
+
+// Whether brick b's footprints all miss the view: its voxel centres' box widened by the footprint
+// reach at its far side lies beyond the near or far plane, or wholly outside one side plane. Not
+// with motion blur (a blurred quad reaches back along its path).
+bool outside_view(uvec3 b) {
+    if (frame.blur.x > 0.0) return false;
+    vec3 lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
+    vec3 hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
+    float far_depth = -1e30;
+    for (uint c = 0u; c < 8u; ++c) {
+        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
+        far_depth = max(far_depth, dot(p - frame.eye.xyz, frame.forward.xyz));
+    }
+    float reach = CULL_RADII * frame.spacing.w * footprint_scale(max(far_depth, 1e-6));
+    lo -= reach;
+    hi += reach;
+    float dmin = 1e30;
+    float dmax = -1e30;
+    bool front = true;
+    uvec4 out_lo = uvec4(1u);  // every corner beyond x = -w, x = w, y = -w, y = w
+    for (uint c = 0u; c < 8u; ++c) {
+        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
+        float d = dot(p - frame.eye.xyz, frame.forward.xyz);
+        dmin = min(dmin, d);
+        dmax = max(dmax, d);
+        vec4 q = frame.view_proj * vec4(p, 1.0);
+        front = front && q.w > 0.0;
+        out_lo &= uvec4(q.x < -q.w, q.x > q.w, q.y < -q.w, q.y > q.w);
+    }
+    if (dmax < frame.forward.w || dmin > frame.right.w) return true;
+    return front && any(notEqual(out_lo, uvec4(0u)));
+}
+
+// Brick b's position in the draw order of the brick grid (PBTF; reversed back to front).
+uint brick_slot(uvec3 b) {
+    uint p = dense_pbtf(b, bf.grid.xyz, bf.split.xyz);
+    return frame.split.w != 0u ? bf.grid.x * bf.grid.y * bf.grid.z - 1u - p : p;
+}

@@ -1,0 +1,259 @@
+//! Mirrors of `brick_cull.comp` and `brick_params.comp`, and of `glsl/shared/brick.glsl`'s
+//! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer.
+use super::bindings::Bindings;
+use super::splat_params::{footprint_scale, params_of, CULL_RADII};
+use crate::bricks::{BrickStore, BRICK};
+use crate::constants::TF_ENTRIES;
+use crate::dispatch::{Args, Res, Variant};
+use crate::error::{Error, Result};
+use crate::gpu_types::{BrickFrame, BrickPush, Frame, SplatParams};
+use glam::{Mat4, Vec3, Vec4};
+
+const CELL_WORDS: usize = (BRICK * BRICK * BRICK / 32) as usize;
+
+fn side_count(n: u32, split: u32, side: u32) -> u32 {
+    if side == 0 {
+        split
+    } else {
+        n - split
+    }
+}
+
+fn outward(idx: u32, split: u32, side: u32) -> u32 {
+    if side == 0 {
+        split - 1 - idx
+    } else {
+        idx - split
+    }
+}
+
+/// Mirror of `dense_pbtf`: cell `c`'s position in the PBTF sequence of a dense `n`-cell grid split
+/// at `s`.
+pub fn dense_pbtf(c: [u32; 3], n: [u32; 3], s: [u32; 3]) -> u32 {
+    let side = |a: usize| u32::from(c[a] >= s[a]);
+    let (si, sj, sk) = (side(0), side(1), side(2));
+    let octant = si + 2 * sj + 4 * sk;
+    let mut base = 0;
+    for o in 0..octant {
+        base += side_count(n[0], s[0], o & 1) * side_count(n[1], s[1], (o >> 1) & 1) * side_count(n[2], s[2], (o >> 2) & 1);
+    }
+    let (ni, nj) = (side_count(n[0], s[0], si), side_count(n[1], s[1], sj));
+    base + (outward(c[2], s[2], sk) * nj + outward(c[1], s[1], sj)) * ni + outward(c[0], s[0], si)
+}
+
+/// What the brick stages read: the frame, its brick uniforms, the TF table and the store.
+pub struct BrickInputs<'a> {
+    pub frame: &'a Frame,
+    pub bf: BrickFrame,
+    /// `BrickScene::tf_words`.
+    pub tf: &'a [u32],
+    pub store: &'a BrickStore,
+}
+
+const TF_BITS: usize = 4 * TF_ENTRIES as usize;
+const TF_PREFIX: usize = TF_BITS + TF_ENTRIES as usize / 32;
+
+impl BrickInputs<'_> {
+    /// Mirror of `emits`.
+    fn emits(&self, q: u32) -> bool {
+        self.tf[TF_BITS + (q >> 5) as usize] >> (q & 31) & 1 != 0
+    }
+
+    /// Mirror of `emitted_below`.
+    fn emitted_below(&self, q: u32) -> u32 {
+        let w = (q >> 5) as usize;
+        if q & 31 == 0 {
+            return self.tf[TF_PREFIX + w];
+        }
+        self.tf[TF_PREFIX + w] + (self.tf[TF_BITS + w] & ((1u32 << (q & 31)) - 1)).count_ones()
+    }
+
+    /// Mirror of `tf_empty`.
+    pub fn tf_empty(&self, lo: u32, hi: u32) -> bool {
+        self.emitted_below(hi + 1) == self.emitted_below(lo)
+    }
+
+    fn density_at(&self, i: i64, j: i64, k: i64) -> f32 {
+        self.store.value_at(i, j, k) * self.bf.tf[0] + self.bf.tf[1]
+    }
+
+    /// Mirror of `classify_voxel`.
+    fn classify_voxel(&self, v: [i64; 3], q: u32) -> [f32; 4] {
+        let mut c = [0, 1, 2, 3].map(|i| f32::from_bits(self.tf[4 * q as usize + i]));
+        let (weighted, shaded) = (self.bf.tf[3] > 0.0, self.bf.light[3] > 0.5);
+        if weighted || shaded {
+            let s = &self.frame.spacing;
+            let [i, j, k] = v;
+            let g = Vec3::new(
+                (self.density_at(i + 1, j, k) - self.density_at(i - 1, j, k)) / (2.0 * s[0]),
+                (self.density_at(i, j + 1, k) - self.density_at(i, j - 1, k)) / (2.0 * s[1]),
+                (self.density_at(i, j, k + 1) - self.density_at(i, j, k - 1)) / (2.0 * s[2]),
+            );
+            let len = g.length();
+            if weighted {
+                c[3] *= (len / self.bf.grad[0]).powf(self.bf.tf[3]);
+            }
+            if shaded {
+                let n = if len > 0.0 { g / len } else { Vec3::ZERO };
+                let light = Vec3::new(self.bf.light[0], self.bf.light[1], self.bf.light[2]);
+                let ndl = n.dot(-light).abs();
+                let lit = self.bf.shade[0] + self.bf.shade[1] * ndl;
+                let spec = self.bf.shade[2] * ndl.powf(self.bf.shade[3]);
+                for ch in c.iter_mut().take(3) {
+                    *ch = (*ch * lit + spec).min(1.0);
+                }
+            }
+        }
+        c
+    }
+
+    /// Mirror of `outside_view`.
+    fn outside_view(&self, b: [u32; 3]) -> bool {
+        let f = self.frame;
+        if f.blur[0] > 0.0 {
+            return false;
+        }
+        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        let (origin, spacing, eye, forward) = (v3(f.origin), v3(f.spacing), v3(f.eye), v3(f.forward));
+        let first = Vec3::new((b[0] * BRICK) as f32, (b[1] * BRICK) as f32, (b[2] * BRICK) as f32);
+        let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
+        let (mut lo, mut hi) = (origin + first * spacing, origin + Vec3::from(last) * spacing);
+        let corner = |lo: Vec3, hi: Vec3, c: u32| {
+            Vec3::new(
+                if c & 1 == 1 { hi.x } else { lo.x },
+                if c >> 1 & 1 == 1 { hi.y } else { lo.y },
+                if c >> 2 & 1 == 1 { hi.z } else { lo.z },
+            )
+        };
+        let far = (0..8).map(|c| (corner(lo, hi, c) - eye).dot(forward)).fold(-1e30f32, f32::max);
+        let reach = CULL_RADII * f.spacing[3] * footprint_scale(f, far.max(1e-6));
+        lo -= Vec3::splat(reach);
+        hi += Vec3::splat(reach);
+        let vp = Mat4::from_cols_array_2d(&f.view_proj);
+        let (mut dmin, mut dmax, mut front) = (1e30f32, -1e30f32, true);
+        let mut out = [true; 4];
+        for c in 0..8 {
+            let p = corner(lo, hi, c);
+            let d = (p - eye).dot(forward);
+            (dmin, dmax) = (dmin.min(d), dmax.max(d));
+            let q: Vec4 = vp * p.extend(1.0);
+            front &= q.w > 0.0;
+            let beyond = [q.x < -q.w, q.x > q.w, q.y < -q.w, q.y > q.w];
+            for (o, b) in out.iter_mut().zip(beyond) {
+                *o &= b;
+            }
+        }
+        if dmax < f.forward[3] || dmin > f.right[3] {
+            return true;
+        }
+        front && out.iter().any(|&o| o)
+    }
+
+    /// Mirror of `brick_slot`.
+    fn brick_slot(&self, b: [u32; 3]) -> u32 {
+        let g = self.bf.grid;
+        let p = dense_pbtf(b, [g[0], g[1], g[2]], [self.bf.split[0], self.bf.split[1], self.bf.split[2]]);
+        if self.frame.split[3] != 0 {
+            g[0] * g[1] * g[2] - 1 - p
+        } else {
+            p
+        }
+    }
+}
+
+fn brick_coords(packed: u32) -> [u32; 3] {
+    [packed & 1023, (packed >> 10) & 1023, packed >> 20]
+}
+
+fn local_cell(l: u32) -> [u32; 3] {
+    [l % BRICK, (l / BRICK) % BRICK, l / (BRICK * BRICK)]
+}
+
+/// Pass 1: cull each non-empty brick or write its header and count at its draw-order slot.
+pub fn brick_cull(inputs: &BrickInputs<'_>, slots: &mut [u32]) {
+    let store = inputs.store;
+    for (h, hd) in store.headers.iter().enumerate() {
+        let b = brick_coords(hd.brick);
+        if inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) || inputs.outside_view(b) {
+            continue;
+        }
+        let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
+        let drawn = records.iter().filter(|&&r| inputs.emits(r >> 16)).count() as u32;
+        if drawn > 0 {
+            slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | drawn;
+        }
+    }
+}
+
+/// Pass 2: classify the voxels of the batch's bricks and write their parameters in two-level PBTF
+/// order from each brick's first position.
+pub fn brick_params(
+    inputs: &BrickInputs<'_>,
+    list: &[[u32; 2]],
+    push: &BrickPush,
+    params: &mut [SplatParams],
+    order: &mut [u32],
+) {
+    let (store, frame) = (inputs.store, inputs.frame);
+    for entry in &list[push.first as usize..(push.first + push.count) as usize] {
+        let hd = store.headers[entry[0] as usize];
+        let b = brick_coords(hd.brick);
+        let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
+        let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
+        let mut cells = [0u32; CELL_WORDS];
+        let position = |rec: u32| dense_pbtf(local_cell(rec & 511), [BRICK; 3], split);
+        for &rec in records {
+            if inputs.emits(rec >> 16) {
+                let p = position(rec);
+                cells[p as usize / 32] |= 1 << (p % 32);
+            }
+        }
+        let mut below = [0u32; CELL_WORDS + 1];
+        for w in 0..CELL_WORDS {
+            below[w + 1] = below[w] + cells[w].count_ones();
+        }
+        let total = below[CELL_WORDS];
+        for &rec in records {
+            let q = rec >> 16;
+            if !inputs.emits(q) {
+                continue;
+            }
+            let p = position(rec);
+            let rank = below[p as usize / 32] + (cells[p as usize / 32] & ((1u32 << (p % 32)) - 1)).count_ones();
+            let rank = if frame.split[3] != 0 { total - 1 - rank } else { rank };
+            let pos = (entry[1] + rank) as usize;
+            let lc = local_cell(rec & 511);
+            let ijk = [0, 1, 2].map(|a| b[a] * BRICK + lc[a]);
+            let color = inputs.classify_voxel(ijk.map(|c| c as i64), q);
+            params[pos] = params_of(frame, ijk, color);
+            order[pos] = pos as u32;
+        }
+    }
+}
+
+fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
+    let scene = b.prep.bricks.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
+    let bf: &[BrickFrame] = b.get(Res::BrickFrame);
+    Ok(BrickInputs { frame: &b.frame, bf: bf[0], tf: b.get(Res::Tf), store: &scene.store })
+}
+
+pub(crate) fn brick_cull_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+    let mut slots = b.take(Res::BrickSlots);
+    brick_cull(&inputs(b)?, &mut slots);
+    b.put(Res::BrickSlots, slots);
+    Ok(())
+}
+
+pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+    let (mut params, mut order) = (b.take(Res::Params), b.take(Res::Order));
+    brick_params(
+        &inputs(b)?,
+        b.get(Res::BrickList),
+        &args.push_as(),
+        bytemuck::cast_slice_mut(&mut params),
+        &mut order,
+    );
+    b.put(Res::Params, params);
+    b.put(Res::Order, order);
+    Ok(())
+}

@@ -1,0 +1,243 @@
+//! Bricked volumes on the GPU path (issue 23): the brick stages (`brick_cull`, `brick_params`)
+//! against their CPU mirrors, the two-level PBTF order they write against `order::pbtf_bricked`
+//! over a random view battery, streaming through a small budget, transfer-function changes, and
+//! bad budgets. Validation on: any message fails.
+mod common;
+use common::{assert_clean, random_camera, Rng, ViewKind};
+use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
+use voxsplat::classify::{classify, Shading, TransferFunction};
+use voxsplat::gpu_types::SplatParams;
+use voxsplat::stages::{Res, StageId};
+use voxsplat::volume::ScalarVolume;
+use voxsplat::{Camera, Direction, Error, Raster, RenderOptions, Renderer, RendererOptions};
+
+/// A lumpy blob with empty space around it and a hollow, on a grid whose sides are not multiples
+/// of the brick side.
+fn blob(dims: [u32; 3]) -> ScalarVolume {
+    let c = dims.map(|d| d as f32 / 2.0);
+    let mut values = Vec::new();
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let p = [i, j, k].map(|v| v as f32);
+                let r = ((0..3).map(|a| ((p[a] - c[a]) / c[a]).powi(2)).sum::<f32>()).sqrt();
+                let wobble = 0.15 * ((p[0] * 0.7).sin() * (p[1] * 0.5).cos() + (p[2] * 0.9).sin());
+                values.push(if r < 0.9 { (1.0 - r + wobble).max(0.0) * 100.0 } else { 0.0 });
+            }
+        }
+    }
+    ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
+}
+
+fn tf() -> TransferFunction {
+    TransferFunction {
+        points: vec![(0.1, [0.0, 0.0, 0.0, 0.0]), (0.3, [0.9, 0.4, 0.2, 0.3]), (1.0, [0.9, 0.9, 1.0, 0.8])],
+        gradient_weight: 0.0,
+        range: None,
+        threshold: 0.0,
+    }
+}
+
+fn renderer(gpu: bool, budget: Option<u64>) -> Renderer {
+    let mut r = if gpu { common::gpu() } else { common::cpu() };
+    if let Some(b) = budget {
+        r.set_gpu_budget(b).unwrap();
+    }
+    r
+}
+
+fn opts(raster: Raster, direction: Direction) -> RenderOptions {
+    let mut o = RenderOptions::default();
+    (o.raster, o.direction) = (raster, Some(direction));
+    o
+}
+
+fn compute(direction: Direction) -> RenderOptions {
+    opts(Raster::Compute, direction)
+}
+
+/// Largest and mean absolute channel difference.
+fn diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> (f32, f32) {
+    let d: Vec<f32> = a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).collect();
+    (d.iter().copied().fold(0.0, f32::max), d.iter().sum::<f32>() / d.len() as f32)
+}
+
+#[test]
+fn gpu_frames_match_the_cpu_mirrors_and_the_dense_classification() {
+    let vol = blob([37, 29, 23]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 80);
+    let shading = Some(Shading::headlight(cam.forward()));
+    let mut weighted = tf();
+    weighted.gradient_weight = 0.5;
+    for (tf, shading, what) in [(tf(), None, "plain"), (tf(), shading, "shaded"), (weighted, shading, "weighted")] {
+        let (mut g, mut c) = (renderer(true, None), renderer(false, None));
+        g.set_volume(&vol, &tf, shading).unwrap();
+        c.set_volume(&vol, &tf, shading).unwrap();
+        let mut dense = renderer(true, None);
+        dense.set_scene(classify(&vol, &tf, shading).unwrap()).unwrap();
+        for (raster, direction) in [
+            (Raster::Compute, Direction::FrontToBack),
+            (Raster::Compute, Direction::BackToFront),
+            (Raster::Graphics, Direction::BackToFront),
+            (Raster::Points, Direction::FrontToBack),
+        ] {
+            let o = opts(raster, direction);
+            let a = g.render(&cam, &o).unwrap().image;
+            let b = c.render(&cam, &o).unwrap().image;
+            assert!(a.pixels.iter().any(|p| p[3] > 0.1), "{what} {raster:?}: something drawn");
+            let (most, mean) = diff(&a, &b);
+            assert!(most <= 2e-3 && mean <= 1e-5, "{what} {raster:?} {direction:?}: GPU vs mirror {most} / {mean}");
+            // The same splats as the dense classification, in another valid visibility order.
+            let d = dense.render(&cam, &o).unwrap().image;
+            let (most, mean) = diff(&a, &d);
+            assert!(most <= 0.05 && mean <= 2e-3, "{what} {raster:?} {direction:?}: bricked vs dense {most} / {mean}");
+        }
+        assert_clean(&g);
+        assert_clean(&dense);
+    }
+}
+
+/// The voxels of the frame's splats in draw order (read back after `brick_params`), and whether
+/// every non-empty brick was kept.
+fn drawn_sequence(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 3]> {
+    let got = r.probe(cam, o, StageId::BrickParams, &[Res::BrickSlots, Res::Params]).unwrap();
+    let total: u32 = got[0].iter().map(|w| w & 1023).sum();
+    let params: &[SplatParams] = bytemuck::cast_slice(&got[1]);
+    let grid = r.scene().unwrap().grid().clone();
+    params[..total as usize]
+        .iter()
+        .map(|p| [0, 1, 2].map(|a| ((p.center[a] - grid.origin[a]) / grid.spacing[a]).round() as u32))
+        .collect()
+}
+
+#[test]
+fn the_two_level_order_is_pbtf_over_bricks_then_voxels_on_both_engines() {
+    let vol = blob([37, 29, 23]);
+    let store = BrickStore::build(&vol).unwrap();
+    let set = store.classify(&tf(), None).unwrap();
+    let grid = *set.grid();
+    let (mut g, mut c) = (renderer(true, None), renderer(false, None));
+    g.set_volume(&vol, &tf(), None).unwrap();
+    c.set_volume(&vol, &tf(), None).unwrap();
+    let mut rng = Rng(2323);
+    let mut views = 0;
+    for kind in [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic] {
+        for v in 0..12 {
+            let mut cam = random_camera(&mut rng, &grid, kind);
+            if v % 3 == 0 {
+                // The eye on a brick plane.
+                let a = v as usize % 3;
+                cam.eye[a] = grid.origin[a] + (BRICK as f32 * (1 + v % 2) as f32 - 0.5 * (v % 2) as f32) * grid.spacing[a];
+            }
+            if cam.validate().is_err() {
+                continue;
+            }
+            for direction in [Direction::FrontToBack, Direction::BackToFront] {
+                let o = opts(Raster::Graphics, direction);
+                let got = drawn_sequence(&mut g, &cam, &o);
+                assert_eq!(got, drawn_sequence(&mut c, &cam, &o), "{kind:?} {v}: GPU vs mirror sequence");
+                let mut want: Vec<[u32; 3]> = voxsplat::order::pbtf_bricked(&set, &cam, BRICK)
+                    .unwrap()
+                    .iter()
+                    .map(|&s| {
+                        let ijk = set.splats()[s as usize].ijk;
+                        [ijk[0], ijk[1], ijk[2]]
+                    })
+                    .collect();
+                if direction == Direction::BackToFront {
+                    want.reverse();
+                }
+                // Culled bricks drop out; what is drawn keeps the reference's sequence.
+                let kept: std::collections::HashSet<[u32; 3]> = got.iter().copied().collect();
+                want.retain(|v| kept.contains(v));
+                assert_eq!(got.len(), want.len(), "{kind:?} {v}: drawn voxels are the classified ones");
+                assert_eq!(got, want, "{kind:?} {v} {direction:?}: two-level PBTF");
+                views += 1;
+            }
+        }
+    }
+    assert!(views >= 80, "{views} views checked");
+    // From outside, framing the grid, nothing is culled.
+    let cam = Camera::framing(&grid, 64, 64);
+    let o = opts(Raster::Graphics, Direction::BackToFront);
+    assert_eq!(drawn_sequence(&mut g, &cam, &o).len(), set.len());
+    assert_clean(&g);
+}
+
+#[test]
+fn streaming_through_a_small_budget_draws_the_same_frame() {
+    let vol = blob([61, 53, 47]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    for gpu in [true, false] {
+        let mut whole = renderer(gpu, None);
+        whole.set_volume(&vol, &tf(), None).unwrap();
+        let scene = whole.volume().unwrap();
+        // Room for about a fifth of the splats in each batch.
+        let least = voxsplat::recording::bricked_min_budget(scene, 80, 80);
+        let splats = scene.store.len() as u64;
+        let budget = least + splats / 5 * voxsplat::recording::BATCH_BYTES_PER_SPLAT;
+        let mut streamed = renderer(gpu, Some(budget));
+        streamed.set_volume(&vol, &tf(), None).unwrap();
+        let slots = streamed.probe(&cam, &compute(Direction::FrontToBack), StageId::BrickCull, &[Res::BrickSlots]);
+        let drawn: u64 = slots.unwrap()[0].iter().map(|w| (w & 1023) as u64).sum();
+        assert!(drawn > 3 * (splats / 5 + 512), "{drawn} splats: several batches");
+        for direction in [Direction::FrontToBack, Direction::BackToFront] {
+            let o = compute(direction);
+            let a = whole.render(&cam, &o).unwrap().image;
+            let b = streamed.render(&cam, &o).unwrap();
+            assert!(a.pixels.iter().any(|p| p[3] > 0.1));
+            assert_eq!(a.pixels, b.image.pixels, "gpu {gpu} {direction:?}: streamed batches change the frame");
+            // The raster pipeline draws one batch: a clear error, not a wrong frame.
+            let g = opts(Raster::Graphics, direction);
+            let err = streamed.render(&cam, &g).unwrap_err();
+            assert!(matches!(err, Error::Unsupported(ref m) if m.contains("--raster compute")), "{err}");
+        }
+        // A budget below the store and one brick of splats names the minimum.
+        let mut tiny = renderer(gpu, Some(least - 1));
+        tiny.set_volume(&vol, &tf(), None).unwrap();
+        let err = tiny.render(&cam, &compute(Direction::FrontToBack)).unwrap_err();
+        let mib = least.div_ceil(1 << 20);
+        assert!(matches!(err, Error::TooLarge(ref m) if m.contains(&format!("minimum is {mib} MiB"))), "{err}");
+        if gpu {
+            assert_clean(&whole);
+            assert_clean(&streamed);
+        }
+    }
+}
+
+#[test]
+fn a_transfer_function_change_is_the_new_classification_and_empty_is_an_empty_frame() {
+    let vol = blob([37, 29, 23]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 64);
+    let o = compute(Direction::FrontToBack);
+    let mut other = tf();
+    other.points = vec![(0.0, [0.2, 0.8, 0.3, 0.0]), (0.5, [0.2, 0.8, 0.3, 0.5]), (0.6, [0.0; 4])];
+    other.range = Some((10.0, 90.0));
+    let mut changed = renderer(true, None);
+    changed.set_volume(&vol, &tf(), None).unwrap();
+    let before = changed.render(&cam, &o).unwrap().image;
+    changed.set_transfer_function(&other, None).unwrap();
+    let after = changed.render(&cam, &o).unwrap().image;
+    let mut fresh = renderer(true, None);
+    fresh.set_volume(&vol, &other, None).unwrap();
+    assert_eq!(after.pixels, fresh.render(&cam, &o).unwrap().image.pixels);
+    assert_ne!(before.pixels, after.pixels);
+    // Nothing extracted: an empty frame, no error (and every brick culled by its range).
+    let nothing = TransferFunction { points: vec![(0.0, [1.0, 1.0, 1.0, 0.0])], ..tf() };
+    changed.set_transfer_function(&nothing, None).unwrap();
+    let empty = changed.render(&cam, &o).unwrap().image;
+    assert!(empty.pixels.iter().all(|p| *p == [0.0; 4]));
+    let slots = changed.probe(&cam, &o, StageId::BrickCull, &[Res::BrickSlots]).unwrap();
+    assert!(slots[0].iter().all(|&w| w == 0));
+    // A volume with nothing above its minimum stores nothing and draws nothing.
+    let flat = ScalarVolume { dims: [9, 9, 9], spacing: [1.0; 3], values: vec![3.0; 729] };
+    changed.set_volume(&flat, &tf(), None).unwrap();
+    assert!(changed.render(&cam, &o).unwrap().image.pixels.iter().all(|p| *p == [0.0; 4]));
+    assert_clean(&changed);
+    // Not a bricked scene: a typed error.
+    let mut dense = renderer(false, None);
+    dense.set_scene(voxsplat::scene::build("cube40").unwrap()).unwrap();
+    assert!(matches!(dense.set_transfer_function(&other, None), Err(Error::InvalidArgument(_))));
+    let _ = BrickScene::new; // the scene type embedders build themselves
+    let _ = RendererOptions::default().gpu_budget_bytes;
+}
