@@ -1,59 +1,23 @@
 #version 450
-// Bricks, pass 2 (issue 23): one workgroup per visible brick of a batch. Its lanes mark the cells
-// the TF extracts at their dense PBTF positions in the brick (split at the eye's voxel split,
-// clamped to the brick), so a voxel's rank among the marked cells is its place in the brick's PBTF
-// sequence: the two-level order (docs/MODEL.md), no sort. Each voxel is classified on the device
-// (TF, gradient weighting, headlight shading; gradients read through the store) and its splat
-// parameters written at the brick's first position + its rank. Mirror: cpu::brick::brick_params.
-layout(local_size_x = BRICK_LANES) in;
+// Bricks, pass 3 (issue 23): per splat of a batch, in draw order, classify its voxel on the device
+// (TF table, gradient weighting, headlight shading; gradients read through the store) and make its
+// splat parameters (params.glsl, as splat_params does for a dense set). Mirror:
+// cpu::brick::brick_params.
+layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
+#include "linear.glsl"
 
 layout(push_constant) uniform Push {
-    uint first;  // the batch's first entry of brick_list
-    uint count;  // its entries
-    uint pad0;
-    uint pad1;
+    uint first;   // the batch's first entry of brick_list
+    uint count;   // its entries
+    uint splats;  // its splats
+    uint pad;
 } pc;
 
-shared uint cells[MASK_WORDS];
-shared uint below[MASK_WORDS + 1u];
-
 void main() {
-    uint e = workgroup_item();
-    if (e >= pc.count) return;
-    uvec2 entry = brick_list[pc.first + e];
-    uvec4 hd = headers[entry.x];
-    uvec3 b = brick_coords(hd.x);
-    uvec3 split = uvec3(clamp(ivec3(frame.split.xyz) - ivec3(b * BRICK_SIDE), ivec3(0), ivec3(BRICK_SIDE)));
-    uint lane = gl_LocalInvocationID.x;
-    for (uint w = lane; w < MASK_WORDS; w += BRICK_LANES) cells[w] = 0u;
-    barrier();
-    for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        uint rec = records[hd.y + r];
-        if (emits(rec >> 16u)) {
-            uint p = dense_pbtf(local_cell(rec & 511u), uvec3(BRICK_SIDE), split);
-            atomicOr(cells[p / 32u], 1u << (p % 32u));
-        }
-    }
-    barrier();
-    // Marked cells below each word.
-    if (lane == 0u) {
-        below[0] = 0u;
-        for (uint w = 0u; w < MASK_WORDS; ++w) below[w + 1u] = below[w] + uint(bitCount(cells[w]));
-    }
-    barrier();
-    uint total = below[MASK_WORDS];
-    for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        uint rec = records[hd.y + r];
-        uint q = rec >> 16u;
-        if (!emits(q)) continue;
-        uvec3 lc = local_cell(rec & 511u);
-        uint p = dense_pbtf(lc, uvec3(BRICK_SIDE), split);
-        uint rank = below[p / 32u] + uint(bitCount(cells[p / 32u] & ((1u << (p % 32u)) - 1u)));
-        if (frame.split.w != 0u) rank = total - 1u - rank;
-        uint pos = entry.y + rank;
-        uvec3 ijk = b * BRICK_SIDE + lc;
-        params_store(pos, params_of(ijk, classify_voxel(ivec3(ijk), q)));
-        order_out[pos] = pos;
-    }
+    uint s = linear_invocation();
+    if (s >= pc.splats) return;
+    uvec2 v = voxels[s];
+    uvec3 ijk = uvec3(v.x & 0xffffu, v.x >> 16u, v.y & 0xffffu);
+    params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u)));
 }

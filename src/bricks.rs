@@ -12,8 +12,8 @@
 //! On the device the store is resident and `BrickScene` draws it: the brick stages
 //! (`glsl/brick_*.comp`) cull bricks, classify voxels and order them in two-level PBTF each frame.
 use crate::classify::{classify_field, Shading, TransferFunction};
-use crate::gpu_types::BrickFrame;
 use crate::error::{Error, Result};
+use crate::gpu_types::BrickFrame;
 use crate::volume::{Grid, ScalarVolume, SplatSet};
 use bytemuck::{Pod, Zeroable};
 
@@ -312,9 +312,8 @@ impl BrickScene {
             for bz in 0..nb[2] {
                 for by in 0..nb[1] {
                     for bx in 0..nb[0] {
-                        let near = (-1..=1).any(|dz| {
-                            (-1..=1).any(|dy| (-1..=1).any(|dx| filled(bx + dx, by + dy, bz + dz)))
-                        });
+                        let near =
+                            (-1..=1).any(|dz| (-1..=1).any(|dy| (-1..=1).any(|dx| filled(bx + dx, by + dy, bz + dz))));
                         if !near {
                             continue;
                         }

@@ -88,6 +88,8 @@ pub enum Res {
     BrickSlots,
     /// The visible bricks in draw order: (header, first position in its batch).
     BrickList,
+    /// A batch's voxels in draw order: (i | j << 16, k | stored value << 16).
+    BrickVoxels,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

@@ -157,7 +157,8 @@ pub struct BrickFrame {
     pub grad: [f32; 4],
 }
 
-/// Push constants of `brick_params.comp`: the batch's entries of the visible-brick list.
+/// Push constants of `brick_order.comp` and `brick_params.comp`: the batch's entries of the
+/// visible-brick list and its splats.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BrickPush {
@@ -165,7 +166,9 @@ pub struct BrickPush {
     pub first: u32,
     /// Entries (bricks) in this batch.
     pub count: u32,
-    pub pad: [u32; 2],
+    /// Splats in this batch.
+    pub splats: u32,
+    pub pad: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<BrickFrame>() == 96);

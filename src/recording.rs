@@ -5,8 +5,9 @@
 //! written once, for every engine.
 use crate::bricks::{BrickScene, BRICK};
 use crate::camera::Camera;
-use crate::constants::{MAX_GPU_SPLATS, 
-    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP, TILE_SEGMENT,
+use crate::constants::{
+    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, MAX_GPU_SPLATS, RASTER_TILE_H, RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP,
+    TILE_SEGMENT,
 };
 use crate::cpu::footprint::Blend;
 use crate::cpu::raycast::RaycastOptions;
@@ -214,9 +215,10 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
     finish(e, Res::Accum, w, h, compute)
 }
 
-/// Device bytes a bricked frame holds per splat of a batch: its parameters (80) and order entry,
+/// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
+/// voxel (8),
 /// and for the tile compositor its screen quad (80) and about four tile entries.
-pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 80 + 16;
+pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 8 + 80 + 16;
 
 /// What a bricked frame keeps resident besides its batches: the store, the brick index, the
 /// draw-order slots and visible list, and the images.
@@ -233,8 +235,8 @@ pub fn bricked_min_budget(scene: &BrickScene, width: u32, height: u32) -> u64 {
 /// A bricked volume's frame (issue 23): `brick_cull` culls whole bricks on the device (outside
 /// the view, or empty under the transfer function) and counts the rest's voxels at their slots in
 /// the brick grid's PBTF order; the host lists the visible bricks in that order and cuts batches
-/// that fit the budget; per batch `brick_params` classifies their voxels and writes their
-/// parameters in two-level PBTF order, and the raster draws them, the tile compositor carrying
+/// that fit the budget; per batch `brick_order` writes their voxels in two-level PBTF order,
+/// `brick_params` classifies them and makes their parameters, and the raster draws them, the tile compositor carrying
 /// the image from batch to batch.
 fn record_bricks(
     e: &mut dyn Engine,
@@ -305,14 +307,16 @@ fn record_bricks(
     let largest = batches.iter().map(|b| b[2]).max().unwrap_or(0);
     e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, largest as u64 * 4)?;
+    e.ensure(Res::BrickVoxels, largest as u64 * 8)?;
     if !compute {
         e.layers(1)?;
     }
     for (i, &[first, count, n]) in batches.iter().enumerate() {
         if count > 0 {
-            let push = BrickPush { first, count, pad: [0; 2] };
-            let groups = plan::groups_per_item(count);
-            e.run(&Dispatch::new(StageId::BrickParams, 0, groups, List::Order, bytemuck::bytes_of(&push)))?;
+            let push = BrickPush { first, count, splats: n, pad: 0 };
+            let push = bytemuck::bytes_of(&push);
+            e.run(&Dispatch::new(StageId::BrickOrder, 0, plan::groups_per_item(count), List::Order, push))?;
+            e.run(&Dispatch::new(StageId::BrickParams, 0, groups_1d(n), List::Order, push))?;
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, i > 0)?;
@@ -329,7 +333,15 @@ fn record_bricks(
 /// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
 /// shorter chunks when an invocation ran out of llvmpipe's loop budget), then composite each
 /// tile's list `TILE_SEGMENT` entries per dispatch.
-fn record_tiles(e: &mut dyn Engine, frame: &Frame, n: u32, opts: &RenderOptions, w: u32, h: u32, carry: bool) -> Result<()> {
+fn record_tiles(
+    e: &mut dyn Engine,
+    frame: &Frame,
+    n: u32,
+    opts: &RenderOptions,
+    w: u32,
+    h: u32,
+    carry: bool,
+) -> Result<()> {
     let (tx, ty) = crate::cpu::tile::tile_grid(frame);
     let tiles = tx as u64 * ty as u64;
     let mut push = FootprintPush { rank_base: carry as u32, ..plan::tile_push(opts, n, w, h) };

@@ -11,7 +11,9 @@
 use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, WORKGROUP_SIZE};
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickPush, CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{
+    BrickPush, CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_SLAB, SHEET_MODE_SPLAT,
+};
 
 pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, List, Pass, Res, Variant, Workgroup};
 use crate::gpu_types::Frame;
@@ -92,6 +94,7 @@ const BRICK: &[Res] = &[
     Res::Params,
     Res::ParamsHi,
     Res::Order,
+    Res::BrickVoxels,
 ];
 const ONE: &[Variant] = &[v("", &[])];
 /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
@@ -162,13 +165,25 @@ pub const STAGES: &[StageDesc] = &[
         mirror: crate::cpu::brick::brick_cull_stage,
     },
     StageDesc {
+        name: "brick_order",
+        kind: Kind::Compute,
+        bindings: BRICK,
+        writes: &[Res::BrickVoxels, Res::Order],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::PerItem(BRICK_LANES),
+        timing: "order",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::brick::brick_order_stage,
+    },
+    StageDesc {
         name: "brick_params",
         kind: Kind::Compute,
         bindings: BRICK,
-        writes: &[Res::Params, Res::Order],
+        writes: &[Res::Params],
         push: std::mem::size_of::<BrickPush>() as u32,
-        workgroup: Workgroup::PerItem(BRICK_LANES),
-        timing: "brick_params",
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "splat_params",
         device_build: None,
         variants: ONE,
         mirror: crate::cpu::brick::brick_params_stage,
@@ -421,6 +436,7 @@ stage_ids!(
     OrderScatter,
     SplatParams,
     BrickCull,
+    BrickOrder,
     BrickParams,
     SlabCount,
     SlabScan,

@@ -1,4 +1,4 @@
-//! Bricked volumes on the GPU path (issue 23): the brick stages (`brick_cull`, `brick_params`)
+//! Bricked volumes on the GPU path (issue 23): the brick stages (`brick_cull`, `brick_order`, `brick_params`)
 //! against their CPU mirrors, the two-level PBTF order they write against `order::pbtf_bricked`
 //! over a random view battery, streaming through a small budget, transfer-function changes, and
 //! bad budgets. Validation on: any message fails.
@@ -58,7 +58,8 @@ fn compute(direction: Direction) -> RenderOptions {
 
 /// Largest and mean absolute channel difference.
 fn diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> (f32, f32) {
-    let d: Vec<f32> = a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).collect();
+    let d: Vec<f32> =
+        a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).collect();
     (d.iter().copied().fold(0.0, f32::max), d.iter().sum::<f32>() / d.len() as f32)
 }
 
@@ -127,7 +128,8 @@ fn the_two_level_order_is_pbtf_over_bricks_then_voxels_on_both_engines() {
             if v % 3 == 0 {
                 // The eye on a brick plane.
                 let a = v as usize % 3;
-                cam.eye[a] = grid.origin[a] + (BRICK as f32 * (1 + v % 2) as f32 - 0.5 * (v % 2) as f32) * grid.spacing[a];
+                cam.eye[a] =
+                    grid.origin[a] + (BRICK as f32 * (1 + v % 2) as f32 - 0.5 * (v % 2) as f32) * grid.spacing[a];
             }
             if cam.validate().is_err() {
                 continue;

@@ -276,7 +276,17 @@ fn info_counts_splats_and_names_the_gpu_limit() {
     let out = voxsplat(&["info", path.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("splats: 3374999") && text.contains("over the GPU path's 3200000 splats"), "{text}");
+    assert!(text.contains("splats: 3374999") && text.contains("over the dense GPU path's 3200000 splats"), "{text}");
+    assert!(text.contains("bricked store: 3374999 stored voxels in 6859 bricks of 8^3"), "{text}");
+    // The dense path refuses it; the bricked store (the default for a volume) renders it on the GPU.
+    let png = tmp("block150.png");
+    let args = ["render", "--volume", path.to_str().unwrap(), "--size", "48x48", "--validation", "--out"];
+    let dense = voxsplat(&[&args[..], &[png.to_str().unwrap(), "--dense"]].concat());
+    assert!(!dense.status.success() && String::from_utf8_lossy(&dense.stderr).contains("at most 3200000"));
+    let out = voxsplat(&[&args[..], &[png.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = voxsplat::output::read_image(&png).unwrap();
+    assert!(img.pixels.iter().any(|p| p[3] > 0.5), "the block is drawn");
 }
 
 /// `make-volume` writes NRRD files that the loaders read back: the procedural field, and a volume

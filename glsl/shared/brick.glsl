@@ -37,6 +37,8 @@ layout(std430, binding = 8) readonly buffer BrickList { uvec2 brick_list[]; };
 layout(std430, binding = 9) writeonly buffer Params { SplatParams params_lo[]; };
 layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]; };
 layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
+// The batch's voxels in draw order: i | j << 16, k | stored value << 16.
+layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
 
 const float Q_MAX = 65535.0;
 const uint MASK_WORDS = BRICK_SIDE * BRICK_SIDE * BRICK_SIDE / 32u;

@@ -1,4 +1,4 @@
-//! Mirrors of `brick_cull.comp` and `brick_params.comp`, and of `glsl/shared/brick.glsl`'s
+//! Mirrors of `brick_cull.comp`, `brick_order.comp` and `brick_params.comp`, and of `glsl/shared/brick.glsl`'s
 //! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer.
 use super::bindings::Bindings;
 use super::splat_params::{footprint_scale, params_of, CULL_RADII};
@@ -35,7 +35,8 @@ pub fn dense_pbtf(c: [u32; 3], n: [u32; 3], s: [u32; 3]) -> u32 {
     let octant = si + 2 * sj + 4 * sk;
     let mut base = 0;
     for o in 0..octant {
-        base += side_count(n[0], s[0], o & 1) * side_count(n[1], s[1], (o >> 1) & 1) * side_count(n[2], s[2], (o >> 2) & 1);
+        base +=
+            side_count(n[0], s[0], o & 1) * side_count(n[1], s[1], (o >> 1) & 1) * side_count(n[2], s[2], (o >> 2) & 1);
     }
     let (ni, nj) = (side_count(n[0], s[0], si), side_count(n[1], s[1], sj));
     base + (outward(c[2], s[2], sk) * nj + outward(c[1], s[1], sj)) * ni + outward(c[0], s[0], si)
@@ -185,13 +186,13 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, slots: &mut [u32]) {
     }
 }
 
-/// Pass 2: classify the voxels of the batch's bricks and write their parameters in two-level PBTF
-/// order from each brick's first position.
-pub fn brick_params(
+/// Pass 2: the batch's voxels (grid index, stored value) in two-level PBTF order from each
+/// brick's first position.
+pub fn brick_order(
     inputs: &BrickInputs<'_>,
     list: &[[u32; 2]],
     push: &BrickPush,
-    params: &mut [SplatParams],
+    voxels: &mut [[u32; 2]],
     order: &mut [u32],
 ) {
     let (store, frame) = (inputs.store, inputs.frame);
@@ -213,21 +214,25 @@ pub fn brick_params(
             below[w + 1] = below[w] + cells[w].count_ones();
         }
         let total = below[CELL_WORDS];
-        for &rec in records {
-            let q = rec >> 16;
-            if !inputs.emits(q) {
-                continue;
-            }
+        for &rec in records.iter().filter(|&&rec| inputs.emits(rec >> 16)) {
             let p = position(rec);
             let rank = below[p as usize / 32] + (cells[p as usize / 32] & ((1u32 << (p % 32)) - 1)).count_ones();
             let rank = if frame.split[3] != 0 { total - 1 - rank } else { rank };
             let pos = (entry[1] + rank) as usize;
             let lc = local_cell(rec & 511);
             let ijk = [0, 1, 2].map(|a| b[a] * BRICK + lc[a]);
-            let color = inputs.classify_voxel(ijk.map(|c| c as i64), q);
-            params[pos] = params_of(frame, ijk, color);
+            voxels[pos] = [ijk[0] | ijk[1] << 16, ijk[2] | (rec & 0xffff_0000)];
             order[pos] = pos as u32;
         }
+    }
+}
+
+/// Pass 3: per splat of the batch, classify its voxel and make its parameters.
+pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
+    for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
+        let ijk = [v[0] & 0xffff, v[0] >> 16, v[1] & 0xffff];
+        let color = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16);
+        params[s] = params_of(inputs.frame, ijk, color);
     }
 }
 
@@ -244,16 +249,17 @@ pub(crate) fn brick_cull_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> R
     Ok(())
 }
 
-pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
-    let (mut params, mut order) = (b.take(Res::Params), b.take(Res::Order));
-    brick_params(
-        &inputs(b)?,
-        b.get(Res::BrickList),
-        &args.push_as(),
-        bytemuck::cast_slice_mut(&mut params),
-        &mut order,
-    );
-    b.put(Res::Params, params);
+pub(crate) fn brick_order_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+    let (mut voxels, mut order) = (b.take(Res::BrickVoxels), b.take(Res::Order));
+    brick_order(&inputs(b)?, b.get(Res::BrickList), &args.push_as(), bytemuck::cast_slice_mut(&mut voxels), &mut order);
+    b.put(Res::BrickVoxels, voxels);
     b.put(Res::Order, order);
+    Ok(())
+}
+
+pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+    let mut params = b.take(Res::Params);
+    brick_params(&inputs(b)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
+    b.put(Res::Params, params);
     Ok(())
 }

@@ -54,8 +54,9 @@ pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
         let prev = (m * center.extend(1.0)).truncate();
         let c1 = vp * center.extend(1.0);
         let c0 = vp * prev.extend(1.0);
-        let moved =
-            (c1.truncate().truncate() / c1.w - c0.truncate().truncate() / c0.w) * 0.5 * Vec2::new(frame.blur[2], frame.blur[3]);
+        let moved = (c1.truncate().truncate() / c1.w - c0.truncate().truncate() / c0.w)
+            * 0.5
+            * Vec2::new(frame.blur[2], frame.blur[3]);
         let d = center - prev;
         let dp = d - d.dot(w) * w;
         let len = dp.length();
@@ -70,7 +71,12 @@ pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
     let tau = optical_depth(color[3]);
     SplatParams {
         center: [quad_center.x, quad_center.y, quad_center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
-        axis_u: [u.x * radius * (1.0 + stretch), u.y * radius * (1.0 + stretch), u.z * radius * (1.0 + stretch), energy],
+        axis_u: [
+            u.x * radius * (1.0 + stretch),
+            u.y * radius * (1.0 + stretch),
+            u.z * radius * (1.0 + stretch),
+            energy,
+        ],
         axis_v: [v.x * radius, v.y * radius, v.z * radius, stretch],
         emit: [color[0], color[1], color[2], tau],
         screen: [

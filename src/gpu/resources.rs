@@ -214,7 +214,8 @@ impl Resources {
             Res::RowStart => &scene()?.row_start,
             Res::Ranks => &scene()?.ranks,
             Res::BrickHeaders | Res::BrickMasks | Res::BrickRecords | Res::BrickIndex => {
-                let store = scene()?.store.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
+                let store =
+                    scene()?.store.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
                 &store[res as usize - Res::BrickHeaders as usize]
             }
             other => self
