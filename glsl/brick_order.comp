@@ -11,8 +11,8 @@ layout(local_size_x = BRICK_LANES) in;
 layout(push_constant) uniform Push {
     uint first;   // the batch's first entry of brick_list
     uint count;   // its entries
-    uint splats;  // its splats
-    uint pad;
+    uint splats;     // its splats
+    float occluded;  // brick_hidden's threshold
 } pc;
 
 shared uint cells[MASK_WORDS];

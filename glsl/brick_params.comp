@@ -10,8 +10,8 @@ layout(local_size_x = WORKGROUP_SIZE) in;
 layout(push_constant) uniform Push {
     uint first;   // the batch's first entry of brick_list
     uint count;   // its entries
-    uint splats;  // its splats
-    uint pad;
+    uint splats;     // its splats
+    float occluded;  // brick_hidden's threshold
 } pc;
 
 void main() {

@@ -90,6 +90,8 @@ pub enum Res {
     BrickList,
     /// A batch's voxels in draw order: (i | j << 16, k | stored value << 16).
     BrickVoxels,
+    /// Per brick of the next batch, 1 when hidden (front to back, early termination).
+    BrickHidden,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

@@ -168,7 +168,8 @@ pub struct BrickPush {
     pub count: u32,
     /// Splats in this batch.
     pub splats: u32,
-    pub pad: u32,
+    /// `brick_hidden`: the early-termination threshold.
+    pub occluded: f32,
 }
 
 const _: () = assert!(std::mem::size_of::<BrickFrame>() == 96);

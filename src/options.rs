@@ -109,6 +109,10 @@ pub struct RenderOptions {
     /// where nothing is culled but batches are smaller (docs/RESULTS.md). The compute tile
     /// compositor (`Raster::Compute` with `Composite::Splat`) stops each pixel at this transmittance.
     pub early_termination: f32,
+    /// Bricked volumes, front to back with early termination on the tile compositor: cut the
+    /// frame into several batches and drop, before each later batch, the bricks the image so far
+    /// already hides (the same frame; on by default, off to measure what it saves).
+    pub cull_hidden_bricks: bool,
     /// How the footprint stage rasterises (`crate::raster`); `Auto` picks per device and footprint
     /// size, and `Rendered::raster` says what it picked.
     pub raster: Raster,
@@ -131,6 +135,7 @@ impl Default for RenderOptions {
             sheet_budget_bytes: 256 << 20,
             slab_thickness: 1.0,
             early_termination: 0.0,
+            cull_hidden_bricks: true,
             raster: Raster::Auto,
             render_scale: 1.0,
         }

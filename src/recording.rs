@@ -237,7 +237,8 @@ pub fn bricked_min_budget(scene: &BrickScene, width: u32, height: u32) -> u64 {
 /// the brick grid's PBTF order; the host lists the visible bricks in that order and cuts batches
 /// that fit the budget; per batch `brick_order` writes their voxels in two-level PBTF order,
 /// `brick_params` classifies them and makes their parameters, and the raster draws them, the tile compositor carrying
-/// the image from batch to batch.
+/// the image from batch to batch. Front to back with early termination, before each later batch
+/// `tile_occlusion` and `brick_hidden` drop the bricks that the image so far already hides.
 fn record_bricks(
     e: &mut dyn Engine,
     prep: &Prepared,
@@ -279,43 +280,84 @@ fn record_bricks(
     }
     let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
     let t = Instant::now();
-    // The visible bricks in draw order, each with its first position in its batch; batches of at
-    // most `capacity` splats, cut between bricks. (first entry, entries, splats)
-    let mut list: Vec<[u32; 2]> = Vec::new();
-    let mut batches: Vec<[u32; 3]> = vec![[0, 0, 0]];
+    let compute = opts.raster == Raster::Compute;
+    // Front to back with early termination, later batches drop the bricks that what is drawn
+    // already hides: cut the frame into a few batches even when it fits one.
+    let cull_hidden = compute
+        && opts.cull_hidden_bricks
+        && opts.direction() == Direction::FrontToBack
+        && opts.early_termination > 0.0;
+    let capacity = if cull_hidden {
+        let total: u32 = slot_words.iter().map(|w| w & 1023).sum();
+        capacity.min(total.div_ceil(HIDDEN_BATCHES).max(HIDDEN_BATCH_MIN))
+    } else {
+        capacity
+    };
+    // The visible bricks in draw order (header, first position in its batch, voxels), cut into
+    // batches of at most `capacity` splats between bricks.
+    let mut batches: Vec<Vec<[u32; 3]>> = vec![Vec::new()];
+    let mut filled = 0;
     for word in slot_words.into_iter().filter(|&w| w != 0) {
         let n = word & 1023;
-        if batches.last().is_some_and(|b| b[2] + n > capacity) {
-            batches.push([list.len() as u32, 0, 0]);
+        if filled + n > capacity {
+            batches.push(Vec::new());
+            filled = 0;
         }
-        let b = batches.last_mut().expect("one batch at least");
-        list.push([word >> 10, b[2]]);
-        b[1] += 1;
-        b[2] += n;
+        batches.last_mut().expect("one batch at least").push([word >> 10, filled, n]);
+        filled += n;
     }
     e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
-    let compute = opts.raster == Raster::Compute;
+    let splats = |b: &[[u32; 3]]| b.last().map(|l| l[1] + l[2]).unwrap_or(0);
     if !compute && batches.len() > 1 {
-        let total: u64 = batches.iter().map(|b| b[2] as u64).sum();
+        let total: u64 = batches.iter().map(|b| splats(b) as u64).sum();
         return Err(Error::Unsupported(format!(
             "{total} splats in view exceed one batch of {capacity} within the GPU budget, and the raster pipeline draws \
              one batch: use --raster compute (the tile compositor streams batches) or a larger --gpu-budget-mib"
         )));
     }
-    e.ensure(Res::BrickList, (list.len().max(1) * 8) as u64)?;
-    e.upload(Res::BrickList, bytemuck::cast_slice(&list))?;
-    let largest = batches.iter().map(|b| b[2]).max().unwrap_or(0);
+    let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
+    e.ensure(Res::BrickList, most_entries * 8)?;
+    let largest = batches.iter().map(|b| splats(b)).max().unwrap_or(0);
     e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, largest as u64 * 4)?;
     e.ensure(Res::BrickVoxels, largest as u64 * 8)?;
+    if cull_hidden && batches.len() > 1 {
+        let tiles = w.div_ceil(COMPOSITE_TILE) as u64 * h.div_ceil(COMPOSITE_TILE) as u64;
+        e.ensure(Res::Occlusion, tiles * 4)?;
+        e.ensure(Res::BrickHidden, most_entries * 4)?;
+    }
     if !compute {
         e.layers(1)?;
     }
-    for (i, &[first, count, n]) in batches.iter().enumerate() {
-        if count > 0 {
-            let push = BrickPush { first, count, splats: n, pad: 0 };
+    let pairs = |b: &[[u32; 3]]| b.iter().flat_map(|l| [l[0], l[1]]).collect::<Vec<u32>>();
+    for (i, mut batch) in batches.into_iter().enumerate() {
+        if cull_hidden && i > 0 && !batch.is_empty() {
+            let count = batch.len() as u32;
+            e.upload(Res::BrickList, &pairs(&batch))?;
+            let tiles = w.div_ceil(COMPOSITE_TILE) * h.div_ceil(COMPOSITE_TILE);
+            e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, &[]))?;
+            let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
+            e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
+            let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
+            let mut at = 0;
+            batch = batch.into_iter().zip(hidden).filter(|(_, h)| *h == 0).map(|(l, _)| l).collect();
+            for l in &mut batch {
+                l[1] = at;
+                at += l[2];
+            }
+        }
+        let n = splats(&batch);
+        if !batch.is_empty() {
+            e.upload(Res::BrickList, &pairs(&batch))?;
+            let push = BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 };
             let push = bytemuck::bytes_of(&push);
-            e.run(&Dispatch::new(StageId::BrickOrder, 0, plan::groups_per_item(count), List::Order, push))?;
+            e.run(&Dispatch::new(
+                StageId::BrickOrder,
+                0,
+                plan::groups_per_item(batch.len() as u32),
+                List::Order,
+                push,
+            ))?;
             e.run(&Dispatch::new(StageId::BrickParams, 0, groups_1d(n), List::Order, push))?;
         }
         if compute {
@@ -329,6 +371,12 @@ fn record_bricks(
     }
     finish(e, if compute { Res::Accum } else { Res::Color }, w, h, false)
 }
+
+/// Front to back with early termination, a bricked frame is cut into at least this many batches
+/// (of at least `HIDDEN_BATCH_MIN` splats), so later batches can drop hidden bricks.
+pub const HIDDEN_BATCHES: u32 = 4;
+/// See `HIDDEN_BATCHES`.
+pub const HIDDEN_BATCH_MIN: u32 = 1 << 16;
 
 /// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
 /// shorter chunks when an invocation ran out of llvmpipe's loop budget), then composite each

@@ -95,6 +95,8 @@ const BRICK: &[Res] = &[
     Res::ParamsHi,
     Res::Order,
     Res::BrickVoxels,
+    Res::Occlusion,
+    Res::BrickHidden,
 ];
 const ONE: &[Variant] = &[v("", &[])];
 /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
@@ -187,6 +189,30 @@ pub const STAGES: &[StageDesc] = &[
         device_build: None,
         variants: ONE,
         mirror: crate::cpu::brick::brick_params_stage,
+    },
+    StageDesc {
+        name: "tile_occlusion",
+        kind: Kind::Compute,
+        bindings: &[Res::Frame, Res::Accum, Res::Occlusion],
+        writes: &[Res::Occlusion],
+        push: 0,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "bricks",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::brick::tile_occlusion_stage,
+    },
+    StageDesc {
+        name: "brick_hidden",
+        kind: Kind::Compute,
+        bindings: BRICK,
+        writes: &[Res::BrickHidden],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "bricks",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::brick::brick_hidden_stage,
     },
     StageDesc {
         name: "slab_count",
@@ -438,6 +464,8 @@ stage_ids!(
     BrickCull,
     BrickOrder,
     BrickParams,
+    TileOcclusion,
+    BrickHidden,
     SlabCount,
     SlabScan,
     SlabScatter,

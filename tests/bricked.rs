@@ -104,7 +104,7 @@ fn drawn_sequence(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32
     let got = r.probe(cam, o, StageId::BrickParams, &[Res::BrickSlots, Res::Params]).unwrap();
     let total: u32 = got[0].iter().map(|w| w & 1023).sum();
     let params: &[SplatParams] = bytemuck::cast_slice(&got[1]);
-    let grid = r.scene().unwrap().grid().clone();
+    let grid = *r.scene().unwrap().grid();
     params[..total as usize]
         .iter()
         .map(|p| [0, 1, 2].map(|a| ((p.center[a] - grid.origin[a]) / grid.spacing[a]).round() as u32))
@@ -242,4 +242,29 @@ fn a_transfer_function_change_is_the_new_classification_and_empty_is_an_empty_fr
     assert!(matches!(dense.set_transfer_function(&other, None), Err(Error::InvalidArgument(_))));
     let _ = BrickScene::new; // the scene type embedders build themselves
     let _ = RendererOptions::default().gpu_budget_bytes;
+}
+
+#[test]
+fn dropping_hidden_bricks_front_to_back_changes_nothing_and_drops_some() {
+    let vol = blob([120, 100, 90]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
+    // Opaque material: most bricks lie behind the front ones.
+    let opaque = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.95])], ..tf() };
+    for gpu in [true, false] {
+        let mut r = renderer(gpu, None);
+        r.set_volume(&vol, &opaque, None).unwrap();
+        let mut o = compute(Direction::FrontToBack);
+        o.early_termination = 1.0 / 1024.0;
+        let culled = r.render(&cam, &o).unwrap().image;
+        let hidden = r.probe(&cam, &o, StageId::BrickHidden, &[Res::BrickHidden]).unwrap();
+        let dropped = hidden[0].iter().filter(|&&h| h == 1).count();
+        assert!(dropped > 10, "gpu {gpu}: {dropped} bricks dropped in the second batch");
+        o.cull_hidden_bricks = false;
+        let kept = r.render(&cam, &o).unwrap().image;
+        assert!(kept.pixels.iter().any(|p| p[3] > 0.5));
+        assert_eq!(culled.pixels, kept.pixels, "gpu {gpu}: dropping hidden bricks changed the frame");
+        if gpu {
+            assert_clean(&r);
+        }
+    }
 }

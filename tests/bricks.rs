@@ -42,10 +42,15 @@ fn every_value_comes_back_through_the_store() {
     // Each header's records lie in its brick and its range holds their values.
     let total: u32 = store.headers.iter().map(|h| h.count).sum();
     assert_eq!(total as usize, store.len());
-    for h in &store.headers {
+    for (h, mask) in store.headers.iter().zip(&store.masks) {
         let (qmin, qmax) = (h.range & 0xFFFF, h.range >> 16);
-        for r in &store.records[h.first as usize..(h.first + h.count) as usize] {
-            assert!((r & 0x1FF) < BRICK * BRICK * BRICK);
+        let records = &store.records[h.first as usize..(h.first + h.count) as usize];
+        // The mask marks exactly the records' local positions, which ascend.
+        assert_eq!(mask.iter().map(|w| w.count_ones()).sum::<u32>(), h.count);
+        for (i, r) in records.iter().enumerate() {
+            let l = (r & 0x1FF) as usize;
+            assert!(mask[l / 64] >> (l % 64) & 1 == 1);
+            assert!(i == 0 || (records[i - 1] & 0x1FF) < r & 0x1FF);
             assert!((qmin..=qmax).contains(&(r >> 16)));
         }
     }

@@ -3,6 +3,7 @@
 //! comparison (`peer`) and long runs (`soak`). The `voxsplat` command-line tool is this crate's
 //! binary; the renderer itself is the `voxsplat` library, which needs none of this.
 pub mod bench;
+pub mod bricked;
 pub mod peer;
 pub mod rates;
 pub mod soak;

@@ -67,6 +67,30 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// The bricked-volume study (issue 23): store sizes, dense against bricked frames, a TF change,
+    /// hidden-brick culling and the 512³ bonsai against the 256³, alternating variants in one
+    /// process; a markdown section on stdout. With --volume: one volume's load, store, frame and
+    /// peak resident set (one file per process, for the memory target).
+    Bricks {
+        /// The 256³ bonsai.
+        #[arg(long, default_value = "../shared/data/bonsai/bonsai.nii.gz")]
+        bonsai: PathBuf,
+        /// Its 2x upsampling (scripts/large-volumes.sh), if made.
+        #[arg(long)]
+        large: Option<PathBuf>,
+        /// Image side.
+        #[arg(long, default_value_t = 512)]
+        size: u32,
+        /// Rounds of alternating frames.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Measure this one volume instead.
+        #[arg(long)]
+        volume: Option<PathBuf>,
+        /// Device-memory budget for --volume, MiB.
+        #[arg(long, default_value_t = 1024)]
+        gpu_budget_mib: u64,
+    },
     /// Render the peers' scene (../shared/peers, issue 9) with every voxsplat mode: median frame
     /// times as CSV on stdout, images into --out-dir; `scripts/peers.sh` runs it beside VTK.
     Peer {
@@ -282,6 +306,10 @@ struct RenderArgs {
     /// most this (0 = off; 0.001 suits opaque data). No pixel changes by more than this.
     #[arg(long, value_parser = parse_finite, default_value = "0")]
     early_termination: f32,
+    /// Bricked volumes: keep the bricks that earlier batches hide (front to back, early
+    /// termination), to measure what dropping them saves.
+    #[arg(long)]
+    keep_hidden_bricks: bool,
     /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25).
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     slab_thickness: f32,
@@ -568,6 +596,7 @@ fn run(cli: Cli) -> Result<()> {
             opts.sheet_budget_bytes = a.sheet_budget_mib << 20;
             opts.slab_thickness = a.slab_thickness;
             opts.early_termination = a.early_termination;
+            opts.cull_hidden_bricks = !a.keep_hidden_bricks;
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
             opts.render_scale = a.render_scale;
             opts.validate()?;
@@ -781,6 +810,16 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Bench(a) => bench(a),
+        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib } => {
+            if frames < 1 || size < 16 {
+                return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
+            }
+            match volume {
+                Some(v) => println!("{}", voxsplat_cli::bricked::one_volume(&v, size, gpu_budget_mib)?),
+                None => print!("{}", voxsplat_cli::bricked::study(&bonsai, large.as_deref(), size, frames)?),
+            }
+            Ok(())
+        }
         Command::Order(a) => {
             let set = load_scene(&a.scene)?;
             let cam = camera_of(&a.scene, set.grid())?;

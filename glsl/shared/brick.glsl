@@ -39,6 +39,10 @@ layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]
 layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
 // The batch's voxels in draw order: i | j << 16, k | stored value << 16.
 layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
+// Per composite tile, the largest transmittance left (tile_occlusion).
+layout(std430, binding = 13) readonly buffer Occlusion { float occlusion[]; };
+// Per brick of the next batch, 1 when it is hidden (brick_hidden).
+layout(std430, binding = 14) writeonly buffer Hidden { uint hidden_out[]; };
 
 const float Q_MAX = 65535.0;
 const uint MASK_WORDS = BRICK_SIDE * BRICK_SIDE * BRICK_SIDE / 32u;
@@ -139,13 +143,11 @@ vec4 classify_voxel(ivec3 v, uint q) {
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
 #include "params.glsl"
 
-// Whether brick b's footprints all miss the view: its voxel centres' box widened by the footprint
-// reach at its far side lies beyond the near or far plane, or wholly outside one side plane. Not
-// with motion blur (a blurred quad reaches back along its path).
-bool outside_view(uvec3 b) {
-    if (frame.blur.x > 0.0) return false;
-    vec3 lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
-    vec3 hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
+// The world box holding every footprint of brick b: its voxel centres' box widened by the
+// footprint reach at its far side (anti-aliasing widens with depth).
+void footprint_box(uvec3 b, out vec3 lo, out vec3 hi) {
+    lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
+    hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
     float far_depth = -1e30;
     for (uint c = 0u; c < 8u; ++c) {
         vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
@@ -154,6 +156,16 @@ bool outside_view(uvec3 b) {
     float reach = CULL_RADII * frame.spacing.w * footprint_scale(max(far_depth, 1e-6));
     lo -= reach;
     hi += reach;
+}
+
+// Whether brick b's footprints all miss the view: its footprint box lies beyond the near or far
+// plane, or wholly outside one side plane. Not with motion blur (a blurred quad reaches back along
+// its path).
+bool outside_view(uvec3 b) {
+    if (frame.blur.x > 0.0) return false;
+    vec3 lo;
+    vec3 hi;
+    footprint_box(b, lo, hi);
     float dmin = 1e30;
     float dmax = -1e30;
     bool front = true;

@@ -12,7 +12,7 @@ pub mod splat_params;
 pub mod tile;
 
 pub use crate::image::ImageF32;
-pub use brick::{brick_cull, brick_order, brick_params};
+pub use brick::{brick_cull, brick_hidden, brick_order, brick_params, tile_occlusion};
 pub use composite::composite;
 pub use footprint::{footprint, footprint_sum, sample_table};
 pub use order::{order_count, order_scan, order_scatter};

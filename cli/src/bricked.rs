@@ -1,0 +1,200 @@
+//! The bricked-volume study (issue 23): what a volume costs as a bricked store and what a frame
+//! costs from it, alternating the variants frame by frame in one process (`voxsplat bricks`).
+//! Prints a markdown section for docs/RESULTS.md.
+use crate::bench::median;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+use voxsplat::bricks::{BrickScene, BrickStore};
+use voxsplat::classify::{classify, TransferFunction};
+use voxsplat::{Camera, Direction, Error, Grid, Raster, RenderOptions, Renderer, RendererOptions, Result};
+
+/// The process's peak resident set (VmHWM) in MiB, where /proc says (Linux).
+pub fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+fn frame_ms(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Result<f64> {
+    let t = Instant::now();
+    r.render(cam, o)?;
+    Ok(ms(t))
+}
+
+/// A loaded volume as a bricked scene, with its load and build times.
+pub struct Loaded {
+    pub scene: BrickScene,
+    pub load_ms: f64,
+    pub build_ms: f64,
+    pub voxels: u64,
+}
+
+pub fn load(path: &Path, tf: &TransferFunction) -> Result<Loaded> {
+    let t = Instant::now();
+    let vol = voxsplat::loaders::load_volume(path, &Default::default())?;
+    let load_ms = ms(t);
+    let voxels = vol.values.len() as u64;
+    let t = Instant::now();
+    let store = BrickStore::build(&vol)?;
+    drop(vol);
+    let build_ms = ms(t);
+    Ok(Loaded { scene: BrickScene::new(store, tf.clone(), None)?, load_ms, build_ms, voxels })
+}
+
+fn renderer() -> Result<Renderer> {
+    Renderer::new(&RendererOptions::default())
+}
+
+fn opts(early_termination: f32) -> RenderOptions {
+    let mut o = RenderOptions::default();
+    (o.raster, o.direction, o.early_termination) = (Raster::Compute, Some(Direction::FrontToBack), early_termination);
+    o
+}
+
+/// The study on `bonsai` (256³) and, when given, its 2x upsampling `large` (512³), `frames`
+/// rounds each, at `size`².
+pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> Result<String> {
+    let tf = TransferFunction::preset("bonsai")?;
+    let small = load(bonsai, &tf)?;
+    let grid = Grid::centered(small.scene.store.dims, small.scene.store.spacing)?;
+    let cam = Camera::framing(&grid, size, size);
+    let mut s = String::new();
+    let _ = writeln!(s, "## Bricked volumes (issue 23)\n");
+    let _ = writeln!(
+        s,
+        "`voxsplat bricks`, one process, {size}², the framing view, tile compositor front to back; every \
+         variant of a pair alternates frame by frame, {frames} rounds after a warm-up frame; medians.\n"
+    );
+    let _ = writeln!(s, "| volume | voxels | stored | bricks | GPU bytes / stored voxel | load ms | brick ms |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    let row = |s: &mut String, name: &str, l: &Loaded| {
+        let st = &l.scene.store;
+        let _ = writeln!(
+            s,
+            "| {name} | {} | {} | {} | {:.2} | {:.0} | {:.0} |",
+            l.voxels,
+            st.len(),
+            st.headers.len(),
+            st.bytes() as f64 / st.len().max(1) as f64,
+            l.load_ms,
+            l.build_ms
+        );
+    };
+    row(&mut s, "bonsai 256³", &small);
+    let large = large.map(|p| load(p, &tf)).transpose()?;
+    if let Some(l) = &large {
+        row(&mut s, "bonsai 512³ (2x upsampled)", l);
+    }
+
+    // Dense classified splats against the bricked store, and a TF change against a plain frame.
+    let vol = voxsplat::loaders::load_volume(bonsai, &Default::default())?;
+    let mut dense = renderer()?;
+    dense.set_scene(classify(&vol, &tf, None)?)?;
+    drop(vol);
+    let mut bricked = renderer()?;
+    bricked.set_bricks(small.scene.clone())?;
+    let other = TransferFunction::preset("ct")?;
+    let o = opts(0.0);
+    let a = dense.render(&cam, &o)?.image;
+    let b = bricked.render(&cam, &o)?.image;
+    let m = voxsplat::metrics::compare(&a, &b)?;
+    frame_ms(&mut bricked, &cam, &o)?;
+    let (mut t_dense, mut t_bricked, mut t_tf) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..frames {
+        t_dense.push(frame_ms(&mut dense, &cam, &o)?);
+        t_bricked.push(frame_ms(&mut bricked, &cam, &o)?);
+        // A TF change, then the frame it gives (alternating two transfer functions).
+        let t = Instant::now();
+        bricked.set_transfer_function(if i % 2 == 0 { &other } else { &tf }, None)?;
+        bricked.render(&cam, &o)?;
+        t_tf.push(ms(t));
+        bricked.set_transfer_function(&tf, None)?;
+    }
+    let (d, b, t) = (median(&mut t_dense), median(&mut t_bricked), median(&mut t_tf));
+    let _ = writeln!(s, "\n| bonsai 256³ frame | median ms | ratio |");
+    let _ = writeln!(s, "|---|---|---|");
+    let _ = writeln!(s, "| dense classified splats (`--dense`) | {d:.0} | 1.00 |");
+    let _ = writeln!(s, "| bricked store, classified on the device | {b:.0} | {:.2} |", b / d);
+    let _ = writeln!(s, "| bricked, a TF change then its frame | {t:.0} | {:.2} of the bricked frame |", t / b);
+    let _ = writeln!(
+        s,
+        "\nBricked against dense, same view: {:.1} dB PSNR, largest difference {:.4} (the same splats in \
+         another valid visibility order, and values quantised to 16 bits).",
+        m.psnr, m.max_abs
+    );
+
+    // Hidden bricks, front to back with early termination.
+    let et = opts(voxsplat::options::DEFAULT_EARLY_TERMINATION);
+    let keep = RenderOptions { cull_hidden_bricks: false, ..et.clone() };
+    frame_ms(&mut bricked, &cam, &et)?;
+    let (mut culled, mut kept) = (Vec::new(), Vec::new());
+    for _ in 0..frames {
+        culled.push(frame_ms(&mut bricked, &cam, &et)?);
+        kept.push(frame_ms(&mut bricked, &cam, &keep)?);
+    }
+    let (c, k) = (median(&mut culled), median(&mut kept));
+    let _ = writeln!(
+        s,
+        "\nEarly termination at 1/1024, front to back: dropping hidden bricks between batches {c:.0} ms, keeping \
+         them {k:.0} ms ({:.2}x; the same frame).",
+        k / c
+    );
+
+    if let Some(l) = large {
+        let lgrid = Grid::centered(l.scene.store.dims, l.scene.store.spacing)?;
+        let lcam = Camera::framing(&lgrid, size, size);
+        let mut big = renderer()?;
+        big.set_bricks(l.scene)?;
+        frame_ms(&mut big, &lcam, &o)?;
+        let (mut t_small, mut t_big, mut t_big_et) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..frames {
+            t_small.push(frame_ms(&mut bricked, &cam, &o)?);
+            t_big.push(frame_ms(&mut big, &lcam, &o)?);
+            t_big_et.push(frame_ms(&mut big, &lcam, &et)?);
+        }
+        let (sm, bg, be) = (median(&mut t_small), median(&mut t_big), median(&mut t_big_et));
+        let _ = writeln!(s, "\n| frame, same view | median ms | over the 256³ frame |");
+        let _ = writeln!(s, "|---|---|---|");
+        let _ = writeln!(s, "| bonsai 256³ bricked | {sm:.0} | 1.00 |");
+        let _ = writeln!(s, "| bonsai 512³ bricked | {bg:.0} | {:.2} |", bg / sm);
+        let _ = writeln!(s, "| bonsai 512³ bricked, early termination 1/1024 | {be:.0} | {:.2} |", be / sm);
+    }
+    if let Some(rss) = peak_rss_mib() {
+        let _ = writeln!(s, "\nPeak resident set of the whole study process: {rss:.0} MiB.");
+    }
+    Ok(s)
+}
+
+/// Load `path` as a bricked scene and draw one frame on the GPU: the load time, the store, the
+/// frame time and the peak resident set, for the RSS target (run one file per process).
+pub fn one_volume(path: &Path, size: u32, budget_mib: u64) -> Result<String> {
+    let tf = TransferFunction::preset("ramp")?;
+    let l = load(path, &tf)?;
+    let rss_loaded = peak_rss_mib().unwrap_or(0.0);
+    let grid = Grid::centered(l.scene.store.dims, l.scene.store.spacing)?;
+    let cam = Camera::framing(&grid, size, size);
+    let mut o = RendererOptions::default();
+    o.gpu_budget_bytes = budget_mib << 20;
+    let mut r = Renderer::new(&o)?;
+    let (stored, bytes) = (l.scene.store.len(), l.scene.store.bytes());
+    r.set_bricks(l.scene)?;
+    let first = frame_ms(&mut r, &cam, &opts(0.0))?;
+    let second = frame_ms(&mut r, &cam, &opts(0.0))?;
+    let rss = peak_rss_mib().ok_or_else(|| Error::Unsupported("no /proc/self/status".into()))?;
+    Ok(format!(
+        "{}: {} voxels ({:.0} MiB at one byte each), {stored} stored ({:.0} MiB store), load {:.0} ms, bricks {:.0} ms, \
+         frames {first:.0} / {second:.0} ms, peak RSS {rss_loaded:.0} MiB after loading, {rss:.0} MiB after the frames",
+        path.display(),
+        l.voxels,
+        l.voxels as f64 / 1048576.0,
+        bytes as f64 / 1048576.0,
+        l.load_ms,
+        l.build_ms
+    ))
+}
