@@ -1,4 +1,5 @@
 #version 450
+// variants: PAGED_RECORDS
 // Bricks, pass 1 (issue 23): one workgroup per non-empty brick. A brick outside the view, or whose
 // value range the transfer function leaves empty, is culled whole; otherwise its lanes count the
 // voxels the TF extracts, and the brick writes header << 10 | count at its position in the PBTF
@@ -20,7 +21,7 @@ void main() {
     barrier();
     uint n = 0u;
     for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        if (emits(records[hd.y + r] >> 16u)) n++;
+        if (emits(record_at(hd.y + r) >> 16u)) n++;
     }
     atomicAdd(drawn, n);
     barrier();

@@ -1,4 +1,5 @@
 #version 450
+// variants: PAGED_RECORDS
 // Bricks, pass 2 (issue 23): one workgroup per visible brick of a batch. Its lanes mark the cells
 // the TF extracts at their dense PBTF positions in the brick (split at the eye's voxel split,
 // clamped to the brick), so a voxel's rank among the marked cells is its place in the brick's PBTF
@@ -29,7 +30,7 @@ void main() {
     for (uint w = lane; w < MASK_WORDS; w += BRICK_LANES) cells[w] = 0u;
     barrier();
     for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        uint rec = records[hd.y + r];
+        uint rec = record_at(hd.y + r);
         if (emits(rec >> 16u)) {
             uint p = dense_pbtf(local_cell(rec & 511u), uvec3(BRICK_SIDE), split);
             atomicOr(cells[p / 32u], 1u << (p % 32u));
@@ -44,7 +45,7 @@ void main() {
     barrier();
     uint total = below[MASK_WORDS];
     for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        uint rec = records[hd.y + r];
+        uint rec = record_at(hd.y + r);
         if (!emits(rec >> 16u)) continue;
         uvec3 lc = local_cell(rec & 511u);
         uint p = dense_pbtf(lc, uvec3(BRICK_SIDE), split);

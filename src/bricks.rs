@@ -62,32 +62,59 @@ pub struct BrickStore {
 impl BrickStore {
     /// Cut `vol` into bricks, keeping every voxel whose value lies above the minimum.
     pub fn build(vol: &ScalarVolume) -> Result<Self> {
-        let [nx, ny, nz] = vol.dims;
-        if vol.dims.iter().any(|&d| d == 0 || d > BRICK << 10) {
+        let plane = vol.dims[0] as usize * vol.dims[1] as usize;
+        Self::from_slices(vol.dims, vol.spacing, |z0, count, out| {
+            out.clear();
+            out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + count) as usize * plane]);
+            Ok(())
+        })
+    }
+
+    /// Build the store from z-slices without holding the volume: `read(z0, count, out)` puts
+    /// slices `z0..z0 + count` (x fastest) in `out`. Two passes: the value range, then the bricks,
+    /// `BRICK` slices at a time. Refused before any large allocation when the store could exceed
+    /// the host's available memory.
+    pub fn from_slices(
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
+    ) -> Result<Self> {
+        let [nx, ny, nz] = dims;
+        if dims.iter().any(|&d| d == 0 || d > BRICK << 10) {
             return Err(Error::InvalidArgument(format!(
-                "a bricked volume is 1 to {} voxels a side, not {:?}",
-                BRICK << 10,
-                vol.dims
+                "a bricked volume is 1 to {} voxels a side, not {dims:?}",
+                BRICK << 10
             )));
         }
-        let (lo, hi) = vol
-            .values
-            .iter()
-            .filter(|v| v.is_finite())
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        let nb = dims.map(|d| d.div_ceil(BRICK));
+        let bricks = nb[0] as u64 * nb[1] as u64 * nb[2] as u64;
+        let voxels = nx as u64 * ny as u64 * nz as u64;
+        check_host_memory(
+            voxels * 4 + bricks * (4 + 16 + BRICK_VOXELS as u64 / 8),
+            &format!("a {dims:?} bricked store"),
+        )?;
+        let mut slab = Vec::new();
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for z0 in (0..nz).step_by(BRICK as usize) {
+            read(z0, BRICK.min(nz - z0), &mut slab)?;
+            for &v in slab.iter().filter(|v| v.is_finite()) {
+                (lo, hi) = (lo.min(v), hi.max(v));
+            }
+        }
         let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
         let span = if hi > lo { hi - lo } else { 1.0 };
-        let nb = vol.dims.map(|d| d.div_ceil(BRICK));
         let mut store = Self {
-            dims: vol.dims,
-            spacing: vol.spacing,
+            dims,
+            spacing,
             range: (lo, hi),
             headers: Vec::new(),
             masks: Vec::new(),
             records: Vec::new(),
-            index: vec![u32::MAX; nb[0] as usize * nb[1] as usize * nb[2] as usize],
+            index: vec![u32::MAX; bricks as usize],
         };
+        let plane = nx as usize * ny as usize;
         for bz in 0..nb[2] {
+            read(bz * BRICK, BRICK.min(nz - bz * BRICK), &mut slab)?;
             for by in 0..nb[1] {
                 for bx in 0..nb[0] {
                     let first = store.records.len() as u32;
@@ -98,7 +125,7 @@ impl BrickStore {
                         if x >= nx || y >= ny || z >= nz {
                             continue;
                         }
-                        let v = vol.values[(x + nx * (y + ny * z)) as usize];
+                        let v = slab[(z - bz * BRICK) as usize * plane + (x + nx * y) as usize];
                         if !(v.is_finite() && v > lo) {
                             continue;
                         }
@@ -120,6 +147,27 @@ impl BrickStore {
                     }
                 }
             }
+        }
+        Ok(store)
+    }
+
+    /// Load a volume file as a store (`hints` as `loaders::load_volume` takes them): an
+    /// uncompressed NRRD streams slice by slice, never held whole (volumes past the dense
+    /// loader's `MAX_VOXELS` too); any other file is loaded, cut and dropped.
+    #[cfg(feature = "io")]
+    pub fn load(path: &std::path::Path, hints: &crate::loaders::VolumeHints) -> Result<Self> {
+        let mut store = match crate::loaders::SliceReader::nrrd(path)? {
+            Some(mut reader) => {
+                let (dims, spacing) = (reader.dims, reader.spacing);
+                Self::from_slices(dims, spacing, |z0, count, out| reader.read(z0, count, out))?
+            }
+            None => Self::build(&crate::loaders::load_volume(path, hints)?)?,
+        };
+        if let Some(s) = hints.spacing {
+            if s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(Error::InvalidArgument(format!("{}: spacing must be positive", path.display())));
+            }
+            store.spacing = s;
         }
         Ok(store)
     }
@@ -188,6 +236,23 @@ pub struct BrickScene {
     table: Vec<u32>,
     /// The largest gradient magnitude in stored units (gradient weighting needs it), built once.
     gmax: std::sync::OnceLock<f32>,
+}
+
+/// Refuse `bytes` of host memory for `what` when the host has less available (Linux's
+/// MemAvailable; elsewhere nothing is checked).
+pub fn check_host_memory(bytes: u64, what: &str) -> Result<()> {
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?.to_string();
+        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
+    });
+    match available {
+        Some(a) if bytes > a => Err(Error::TooLarge(format!(
+            "{what} may need {} MiB of host memory; {} MiB are available",
+            bytes >> 20,
+            a >> 20
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// (a, b): stored value d is `tf`'s density a d + b.

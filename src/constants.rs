@@ -62,6 +62,11 @@ pub const MAX_GROUPS_X: u32 = 32768;
 pub const BRICK_SIDE: u32 = 8;
 /// Lanes of the brick stages' workgroups: one workgroup per brick, each lane a record in eight.
 pub const BRICK_LANES: u32 = 64;
+/// Records of a bricked store per storage binding (128 MiB, the binding every device allows);
+/// a store binds up to `RECORD_PAGES` of them.
+pub const RECORD_PAGE: u32 = 1 << 25;
+/// Most pages of store records (1 GiB, the default device budget).
+pub const RECORD_PAGES: u32 = 8;
 /// Entries of the brick stages' transfer-function table: one per 16-bit stored value.
 pub const TF_ENTRIES: u32 = 1 << 16;
 
@@ -85,4 +90,5 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("BRICK_SIDE", BRICK_SIDE),
     ("BRICK_LANES", BRICK_LANES),
     ("TF_ENTRIES", TF_ENTRIES),
+    ("RECORD_PAGE", RECORD_PAGE),
 ];

@@ -76,8 +76,22 @@ pub enum Res {
     BrickHeaders,
     /// Its 64-byte occupancy masks.
     BrickMasks,
-    /// Its 4-byte voxel records.
+    /// Its 4-byte voxel records (page 0 of `RECORD_PAGES`; the next are `BrickRecords1`..).
     BrickRecords,
+    /// Pages 1-7 of the records (page 0 again where the store is shorter).
+    BrickRecords1,
+    #[allow(missing_docs)]
+    BrickRecords2,
+    #[allow(missing_docs)]
+    BrickRecords3,
+    #[allow(missing_docs)]
+    BrickRecords4,
+    #[allow(missing_docs)]
+    BrickRecords5,
+    #[allow(missing_docs)]
+    BrickRecords6,
+    #[allow(missing_docs)]
+    BrickRecords7,
     /// Brick id -> header (`u32::MAX`: empty).
     BrickIndex,
     /// The brick stages' uniforms (`BrickFrame`).
@@ -116,6 +130,13 @@ impl Res {
                 | Res::BrickHeaders
                 | Res::BrickMasks
                 | Res::BrickRecords
+                | Res::BrickRecords1
+                | Res::BrickRecords2
+                | Res::BrickRecords3
+                | Res::BrickRecords4
+                | Res::BrickRecords5
+                | Res::BrickRecords6
+                | Res::BrickRecords7
                 | Res::BrickIndex
         )
     }

@@ -55,14 +55,19 @@ fn bad(path: &str, msg: impl std::fmt::Display) -> Error {
 
 /// Checked voxel count of `dims`.
 pub fn voxel_count(dims: &[u64], what: &str) -> Result<u64> {
+    voxel_count_within(dims, what, MAX_VOXELS)
+}
+
+/// Checked voxel count of `dims`, at most `limit`.
+fn voxel_count_within(dims: &[u64], what: &str, limit: u64) -> Result<u64> {
     let mut n: u64 = 1;
     for &d in dims {
         if d == 0 {
             return Err(bad(what, "a dimension is zero"));
         }
         n = n.checked_mul(d).ok_or_else(|| bad(what, "dimensions overflow"))?;
-        if n > MAX_VOXELS {
-            return Err(Error::TooLarge(format!("{what}: more than {MAX_VOXELS} voxels")));
+        if n > limit {
+            return Err(Error::TooLarge(format!("{what}: more than {limit} voxels")));
         }
     }
     Ok(n)
@@ -153,7 +158,21 @@ fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
 
 /// NRRD with an attached or detached header, raw or gzip encoding. `dir` resolves detached data
 /// files.
-pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<ScalarVolume> {
+/// An NRRD header's fields.
+struct NrrdHeader {
+    dtype: DType,
+    dims: [u64; 3],
+    voxels: u64,
+    encoding: String,
+    big_endian: bool,
+    spacing: [f32; 3],
+    data_file: Option<String>,
+    /// Offset of attached data.
+    data_start: usize,
+}
+
+/// Parse the header at the start of `bytes`, allowing at most `limit` voxels.
+fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHeader> {
     if !bytes.starts_with(b"NRRD000") {
         return Err(bad(what, "not an NRRD file (no NRRD000x magic)"));
     }
@@ -207,11 +226,28 @@ pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<S
     }
     let mut d3 = [1u64; 3];
     d3[..sizes.len()].copy_from_slice(&sizes);
-    let n = voxel_count(&d3, what)?;
+    let n = voxel_count_within(&d3, what, limit)?;
     if d3.iter().any(|&d| d > crate::volume::MAX_DIM as u64) {
         return Err(Error::TooLarge(format!("{what}: a dimension exceeds {}", crate::volume::MAX_DIM)));
     }
     check_spacing(spacing, what)?;
+    Ok(NrrdHeader {
+        dtype,
+        dims: d3,
+        voxels: n,
+        encoding: enc.unwrap_or_else(|| "raw".into()),
+        big_endian: endian_big,
+        spacing,
+        data_file,
+        data_start,
+    })
+}
+
+/// NRRD (attached or detached data, raw or gzip) as a dense volume.
+pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<ScalarVolume> {
+    let NrrdHeader { dtype, dims: d3, voxels: n, encoding, big_endian: endian_big, spacing, data_file, data_start } =
+        nrrd_header(bytes, what, MAX_VOXELS)?;
+    let enc = Some(encoding);
     let need = n * dtype.size() as u64;
     let payload: Vec<u8> = match &data_file {
         Some(f) => {
@@ -425,6 +461,86 @@ pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
         v.spacing = s;
     }
     Ok(v)
+}
+
+/// Most voxels of a volume streamed slice by slice into a bricked store (`SliceReader`): 2^34,
+/// with the host's available memory checked against the store's worst case.
+pub const MAX_STREAMED_VOXELS: u64 = 1 << 34;
+
+/// An uncompressed NRRD volume read z-slices at a time, so a bricked store is built from it
+/// without the volume in memory (`BrickStore::from_slices`).
+pub struct SliceReader {
+    file: std::fs::File,
+    offset: u64,
+    /// Voxels along x, y, z.
+    pub dims: [u32; 3],
+    /// Voxel spacing.
+    pub spacing: [f32; 3],
+    dtype: DType,
+    big_endian: bool,
+    what: String,
+    bytes: Vec<u8>,
+}
+
+impl SliceReader {
+    /// `path` when it is an NRRD with raw (uncompressed) data, attached or detached; `None` for
+    /// any other file (load it whole with `load_volume`). Sizes are checked against
+    /// `MAX_STREAMED_VOXELS` and the data's length before anything is read.
+    pub fn nrrd(path: &Path) -> Result<Option<Self>> {
+        let what = path.display().to_string();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+        if !(name.ends_with(".nrrd") || name.ends_with(".nhdr")) {
+            return Ok(None);
+        }
+        let io = |p: &Path| {
+            let p = p.display().to_string();
+            move |e| Error::Io { path: p, source: e }
+        };
+        let mut file = std::fs::File::open(path).map_err(io(path))?;
+        let mut head = Vec::new();
+        (&mut file).take(1 << 20).read_to_end(&mut head).map_err(io(path))?;
+        let h = nrrd_header(&head, &what, MAX_STREAMED_VOXELS)?;
+        if h.encoding != "raw" {
+            return Ok(None);
+        }
+        let (file, offset, data_path) = match &h.data_file {
+            Some(f) => {
+                let p = path.parent().ok_or_else(|| bad(&what, "detached data file without a directory"))?.join(f);
+                (std::fs::File::open(&p).map_err(io(&p))?, 0, p)
+            }
+            None => (file, h.data_start as u64, path.to_path_buf()),
+        };
+        let len = file.metadata().map_err(io(&data_path))?.len();
+        let need = h.voxels * h.dtype.size() as u64;
+        if len < offset + need {
+            return Err(bad(&what, format!("data is truncated: {} bytes for {need}", len.saturating_sub(offset))));
+        }
+        Ok(Some(Self {
+            file,
+            offset,
+            dims: h.dims.map(|d| d as u32),
+            spacing: h.spacing,
+            dtype: h.dtype,
+            big_endian: h.big_endian,
+            what,
+            bytes: Vec::new(),
+        }))
+    }
+
+    /// Slices `z0..z0 + count` (x fastest) into `out`.
+    pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
+        use std::io::{Seek, SeekFrom};
+        let plane = self.dims[0] as u64 * self.dims[1] as u64;
+        let sample = self.dtype.size() as u64;
+        let n = plane * count as u64;
+        self.bytes.resize((n * sample) as usize, 0);
+        let io = |e| Error::Io { path: self.what.clone(), source: e };
+        self.file.seek(SeekFrom::Start(self.offset + plane * z0 as u64 * sample)).map_err(io)?;
+        let io = |e| Error::Io { path: self.what.clone(), source: e };
+        self.file.read_exact(&mut self.bytes).map_err(io)?;
+        *out = decode(&self.bytes, n, self.dtype, self.big_endian, &self.what)?;
+        Ok(())
+    }
 }
 
 /// Load heights from a 16-bit (or 8-bit) PNG, a GeoTIFF / TIFF, or a 2D `.npy`.

@@ -6,8 +6,8 @@
 use crate::bricks::{BrickScene, BRICK};
 use crate::camera::Camera;
 use crate::constants::{
-    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, MAX_GPU_SPLATS, RASTER_TILE_H, RASTER_TILE_W, SPLAT_PAGE, TILE_BIN_WORKGROUP,
-    TILE_SEGMENT,
+    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, MAX_GPU_SPLATS, RASTER_TILE_H, RASTER_TILE_W, RECORD_PAGE, SPLAT_PAGE,
+    TILE_BIN_WORKGROUP, TILE_SEGMENT,
 };
 use crate::cpu::footprint::Blend;
 use crate::cpu::raycast::RaycastOptions;
@@ -270,13 +270,15 @@ fn record_bricks(
     let frame = plan::frame_for(&prep.set, camera, opts);
     let bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
+    // The brick stages' build: one page of store records, or the paged reader.
+    let paged = usize::from(scene.store.len() > RECORD_PAGE as usize);
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
     e.ensure(Res::BrickSlots, slots as u64 * 4)?;
     e.fill(Res::BrickSlots, None, 0)?;
     if bf.grid[3] > 0 {
-        e.run(&Dispatch::new(StageId::BrickCull, 0, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
+        e.run(&Dispatch::new(StageId::BrickCull, paged, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
     }
     let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
     let t = Instant::now();
@@ -351,14 +353,9 @@ fn record_bricks(
             e.upload(Res::BrickList, &pairs(&batch))?;
             let push = BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 };
             let push = bytemuck::bytes_of(&push);
-            e.run(&Dispatch::new(
-                StageId::BrickOrder,
-                0,
-                plan::groups_per_item(batch.len() as u32),
-                List::Order,
-                push,
-            ))?;
-            e.run(&Dispatch::new(StageId::BrickParams, 0, groups_1d(n), List::Order, push))?;
+            let groups = plan::groups_per_item(batch.len() as u32);
+            e.run(&Dispatch::new(StageId::BrickOrder, paged, groups, List::Order, push))?;
+            e.run(&Dispatch::new(StageId::BrickParams, paged, groups_1d(n), List::Order, push))?;
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, i > 0)?;

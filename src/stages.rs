@@ -96,8 +96,17 @@ const BRICK: &[Res] = &[
     Res::Order,
     Res::BrickVoxels,
     Res::Occlusion,
+    Res::BrickRecords1,
+    Res::BrickRecords2,
+    Res::BrickRecords3,
+    Res::BrickRecords4,
+    Res::BrickRecords5,
+    Res::BrickRecords6,
+    Res::BrickRecords7,
     Res::BrickHidden,
 ];
+/// One page of store records, and up to `RECORD_PAGES` (see `record_pages_variant`).
+const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[])];
 const ONE: &[Variant] = &[v("", &[])];
 /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
 const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];
@@ -163,7 +172,7 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::PerItem(BRICK_LANES),
         timing: "bricks",
         device_build: None,
-        variants: ONE,
+        variants: RECORD_PAGED,
         mirror: crate::cpu::brick::brick_cull_stage,
     },
     StageDesc {
@@ -175,7 +184,7 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::PerItem(BRICK_LANES),
         timing: "order",
         device_build: None,
-        variants: ONE,
+        variants: RECORD_PAGED,
         mirror: crate::cpu::brick::brick_order_stage,
     },
     StageDesc {
@@ -187,7 +196,7 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: ONE,
+        variants: RECORD_PAGED,
         mirror: crate::cpu::brick::brick_params_stage,
     },
     StageDesc {

@@ -97,3 +97,41 @@ fn real_volumes_take_under_8_bytes_a_voxel_and_classify_alike_through_the_store(
         assert!(worst <= 2e-3, "{file}: colours within the quantisation's reach ({worst})");
     }
 }
+
+/// An uncompressed NRRD streams into the same store as the volume loaded whole; a truncated one
+/// and one past the streaming limit are typed errors before any large allocation.
+#[test]
+fn a_raw_nrrd_streams_into_the_same_store() {
+    let dir = std::env::temp_dir().join(format!("voxsplat-bricks-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dims = [21u32, 18, 11];
+    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let mut rng = Rng(5);
+    let data: Vec<u8> = (0..n).map(|v| if v % 3 == 0 { 7 } else { 7 + (rng.f32() * 200.0) as u8 }).collect();
+    let write = |name: &str, sizes: &str, data: &[u8]| {
+        let path = dir.join(name);
+        let mut bytes =
+            format!("NRRD0004\ntype: uint8\ndimension: 3\nsizes: {sizes}\nspacings: 1 0.5 2\nencoding: raw\n\n")
+                .into_bytes();
+        bytes.extend_from_slice(data);
+        std::fs::write(&path, bytes).unwrap();
+        path
+    };
+    let path = write("small.nrrd", "21 18 11", &data);
+    let whole = BrickStore::build(&voxsplat::loaders::load_volume(&path, &Default::default()).unwrap()).unwrap();
+    let streamed = BrickStore::load(&path, &Default::default()).unwrap();
+    assert!(voxsplat::loaders::SliceReader::nrrd(&path).unwrap().is_some());
+    assert_eq!(streamed.range, whole.range);
+    assert_eq!(streamed.spacing, [1.0, 0.5, 2.0]);
+    assert_eq!(streamed.headers, whole.headers);
+    assert_eq!(streamed.masks, whole.masks);
+    assert_eq!(streamed.records, whole.records);
+    let truncated = write("truncated.nrrd", "21 18 11", &data[..n - 1]);
+    assert!(
+        matches!(BrickStore::load(&truncated, &Default::default()), Err(voxsplat::Error::InvalidArgument(m)) if m.contains("truncated"))
+    );
+    // 2^35 voxels: past what streaming takes, refused from the header alone.
+    let huge = write("huge.nrrd", "32768 32768 32", &data);
+    assert!(matches!(BrickStore::load(&huge, &Default::default()), Err(voxsplat::Error::TooLarge(_))));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -446,6 +446,16 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
 type VolumeParts =
     (voxsplat::volume::ScalarVolume, voxsplat::classify::TransferFunction, Option<voxsplat::classify::Shading>);
 
+/// The --tf preset or TOML file.
+fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFunction> {
+    if a.tf.ends_with(".toml") {
+        let text = std::fs::read_to_string(&a.tf).map_err(|e| Error::Io { path: a.tf.clone(), source: e })?;
+        voxsplat::classify::TransferFunction::from_toml(&text)
+    } else {
+        voxsplat::classify::TransferFunction::preset(&a.tf)
+    }
+}
+
 /// The --volume file, its transfer function and shading.
 fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumeParts> {
     let hints = voxsplat::loaders::VolumeHints {
@@ -455,12 +465,7 @@ fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumePart
         spacing: a.spacing.map(|v| v.to_array()),
     };
     let vol = voxsplat::loaders::load_volume(path, &hints)?;
-    let tf = if a.tf.ends_with(".toml") {
-        let text = std::fs::read_to_string(&a.tf).map_err(|e| Error::Io { path: a.tf.clone(), source: e })?;
-        voxsplat::classify::TransferFunction::from_toml(&text)?
-    } else {
-        voxsplat::classify::TransferFunction::preset(&a.tf)?
-    };
+    let tf = transfer_function(a)?;
     let shading = a.shade.then(|| {
         let g = voxsplat::Grid::centered(vol.dims, vol.spacing).ok();
         let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
@@ -471,9 +476,19 @@ fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumePart
 
 /// The --volume file as a bricked scene, with a one-line report of the store.
 fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::bricks::BrickScene> {
-    let (vol, tf, shading) = load_volume_parts(a, path)?;
-    let store = voxsplat::bricks::BrickStore::build(&vol)?;
-    drop(vol);
+    let hints = voxsplat::loaders::VolumeHints {
+        dims: a.dims,
+        dtype: a.dtype.as_deref().map(str::parse).transpose()?,
+        big_endian: a.big_endian,
+        spacing: a.spacing.map(|v| v.to_array()),
+    };
+    let store = voxsplat::bricks::BrickStore::load(path, &hints)?;
+    let tf = transfer_function(a)?;
+    let shading = a.shade.then(|| {
+        let g = voxsplat::Grid::centered(store.dims, store.spacing).ok();
+        let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
+        voxsplat::classify::Shading::headlight(-dir)
+    });
     eprintln!(
         "{} stored voxels in {} bricks of {}^3, {:.2} bytes per stored voxel on the GPU ({} x {} x {} grid)",
         store.len(),

@@ -27,7 +27,35 @@ layout(std430, binding = 2) readonly buffer Tf {
 // brick (x | y << 10 | z << 20), first record, records, quantised min | max << 16.
 layout(std430, binding = 3) readonly buffer Headers { uvec4 headers[]; };
 layout(std430, binding = 4) readonly buffer Masks { uint masks[]; };
-layout(std430, binding = 5) readonly buffer Records { uint records[]; };
+layout(std430, binding = 5) readonly buffer Records { uint records_0[]; };
+// Stores of more than RECORD_PAGE records bind them as up to 8 pages (one storage binding may not
+// pass maxStorageBufferRange); PAGED_RECORDS builds read through the pages.
+#ifdef PAGED_RECORDS
+layout(std430, binding = 14) readonly buffer Records1 { uint records_1[]; };
+layout(std430, binding = 15) readonly buffer Records2 { uint records_2[]; };
+layout(std430, binding = 16) readonly buffer Records3 { uint records_3[]; };
+layout(std430, binding = 17) readonly buffer Records4 { uint records_4[]; };
+layout(std430, binding = 18) readonly buffer Records5 { uint records_5[]; };
+layout(std430, binding = 19) readonly buffer Records6 { uint records_6[]; };
+layout(std430, binding = 20) readonly buffer Records7 { uint records_7[]; };
+uint record_at(uint i) {
+    uint j = i % RECORD_PAGE;
+    switch (i / RECORD_PAGE) {
+        case 0u: return records_0[j];
+        case 1u: return records_1[j];
+        case 2u: return records_2[j];
+        case 3u: return records_3[j];
+        case 4u: return records_4[j];
+        case 5u: return records_5[j];
+        case 6u: return records_6[j];
+        default: return records_7[j];
+    }
+}
+#else
+uint record_at(uint i) {
+    return records_0[i];
+}
+#endif
 // Brick id (x + nx (y + ny z)) -> header, or 0xffffffff when the brick stores nothing.
 layout(std430, binding = 6) readonly buffer BrickIndex { uint brick_index[]; };
 // Per brick-grid position in draw order: header << 10 | voxels drawn, 0 when culled.
@@ -42,7 +70,7 @@ layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
 // Per composite tile, the largest transmittance left (tile_occlusion).
 layout(std430, binding = 13) readonly buffer Occlusion { float occlusion[]; };
 // Per brick of the next batch, 1 when it is hidden (brick_hidden).
-layout(std430, binding = 14) writeonly buffer Hidden { uint hidden_out[]; };
+layout(std430, binding = 21) writeonly buffer Hidden { uint hidden_out[]; };
 
 const float Q_MAX = 65535.0;
 const uint MASK_WORDS = BRICK_SIDE * BRICK_SIDE * BRICK_SIDE / 32u;
@@ -108,7 +136,7 @@ float stored_at(ivec3 v) {
     // The record's rank among the brick's: stored voxels below it in local index order.
     uint below = bitCount(word & ((1u << (l % 32u)) - 1u));
     for (uint w = 0u; w < l / 32u; ++w) below += uint(bitCount(masks[h * MASK_WORDS + w]));
-    return float(records[headers[h].y + below] >> 16u) / Q_MAX;
+    return float(record_at(headers[h].y + below) >> 16u) / Q_MAX;
 }
 
 float density_at(ivec3 v) {

@@ -3,7 +3,9 @@
 //! descriptor sets built from the stage table's binding lists and kept until a resource they name
 //! is replaced.
 use super::pipelines::{Pipelines, COLOR_FORMAT};
-use crate::constants::{FOOTPRINT_TABLE_SIZE, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, SPLAT_PAGE};
+use crate::constants::{
+    FOOTPRINT_TABLE_SIZE, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, RECORD_PAGE, RECORD_PAGES, SPLAT_PAGE,
+};
 use crate::error::{Error, Result};
 use crate::gpu_types::{Frame, SplatParams};
 use crate::kernel::Kernel;
@@ -121,6 +123,16 @@ impl Resources {
                 set.len()
             )));
         }
+        if let Some(b) = &prep.bricks {
+            let most = RECORD_PAGE as u64 * RECORD_PAGES as u64;
+            if b.store.len() as u64 > most {
+                return Err(Error::TooLarge(format!(
+                    "a bricked store of {} voxels: the GPU path binds at most {most} ({RECORD_PAGES} storage bindings \
+                     of {RECORD_PAGE} records)",
+                    b.store.len()
+                )));
+            }
+        }
         let ctx = &self.ctx;
         self.scene = Some(SceneBuffers {
             splats: storage(ctx, "splats", bytemuck::cast_slice(set.splats()))?,
@@ -216,7 +228,12 @@ impl Resources {
             Res::BrickHeaders | Res::BrickMasks | Res::BrickRecords | Res::BrickIndex => {
                 let store =
                     scene()?.store.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
-                &store[res as usize - Res::BrickHeaders as usize]
+                &store[match res {
+                    Res::BrickHeaders => 0,
+                    Res::BrickMasks => 1,
+                    Res::BrickRecords => 2,
+                    _ => 3,
+                }]
             }
             other => self
                 .bufs
@@ -318,6 +335,25 @@ impl Resources {
                     List::Slices(axis) => &self.scene()?.draw[axis as usize],
                     List::SlabPairs => frame_buf(Res::SlabPairs),
                 }),
+                Res::BrickRecords
+                | Res::BrickRecords1
+                | Res::BrickRecords2
+                | Res::BrickRecords3
+                | Res::BrickRecords4
+                | Res::BrickRecords5
+                | Res::BrickRecords6
+                | Res::BrickRecords7 => {
+                    // Page k of the records, or page 0 again past the store's end.
+                    const PAGE: u64 = RECORD_PAGE as u64 * 4;
+                    let buf = self.buffer(Res::BrickRecords)?;
+                    let k = res as u64 - Res::BrickRecords as u64;
+                    let (size, at) = (buf.size(), k * PAGE);
+                    if at < size {
+                        Bind::Range(buf, at, (size - at).min(PAGE))
+                    } else {
+                        Bind::Range(buf, 0, size.min(PAGE))
+                    }
+                }
                 Res::Frame
                 | Res::Radial
                 | Res::Splats
@@ -325,7 +361,6 @@ impl Resources {
                 | Res::Ranks
                 | Res::BrickHeaders
                 | Res::BrickMasks
-                | Res::BrickRecords
                 | Res::BrickIndex => Bind::Buffer(self.buffer(res)?),
                 other => Bind::Buffer(frame_buf(other)),
             });
