@@ -268,3 +268,57 @@ fn dropping_hidden_bricks_front_to_back_changes_nothing_and_drops_some() {
         }
     }
 }
+
+/// A store past one storage binding of records (`RECORD_PAGE`) binds them as pages: the brick
+/// stages' paged builds read the same voxels as the mirrors, from the last page too (the eye on the
+/// high-z side, so the first batch holds the bricks whose records come last).
+#[test]
+fn a_store_of_more_than_one_record_page_reads_every_page() {
+    let dims = [340u32, 340, 300];
+    let n = dims.iter().map(|&d| d as usize).product::<usize>();
+    assert!(n > voxsplat::constants::RECORD_PAGE as usize);
+    let mut values = vec![200.0f32; n];
+    values[0] = 0.0;
+    for (i, v) in values.iter_mut().enumerate() {
+        if i % 7 == 3 {
+            *v = 120.0 + (i % 50) as f32;
+        }
+    }
+    let vol = ScalarVolume { dims, spacing: [1.0; 3], values };
+    let grid = voxsplat::Grid::centered(dims, vol.spacing).unwrap();
+    let store = BrickStore::build(&vol).unwrap();
+    drop(vol);
+    let scene = BrickScene::new(store, tf(), None).unwrap();
+    let mut cam = Camera::framing(&grid, 48, 48);
+    cam.eye = grid.center() + glam::Vec3::new(30.0, 40.0, 900.0);
+    cam.far = 2000.0;
+    let o = compute(Direction::FrontToBack);
+    let what = [Res::BrickSlots, Res::BrickVoxels];
+    let (mut g, mut c) = (renderer(true, None), renderer(false, None));
+    g.set_bricks(scene.clone()).unwrap();
+    c.set_bricks(scene).unwrap();
+    let a = g.probe(&cam, &o, StageId::BrickOrder, &what).unwrap();
+    let b = c.probe(&cam, &o, StageId::BrickOrder, &what).unwrap();
+    let differ: Vec<_> = a[0].iter().zip(&b[0]).enumerate().filter(|(_, (x, y))| x != y).take(4).collect();
+    let count = a[0].iter().zip(&b[0]).filter(|(x, y)| x != y).count();
+    assert_eq!(count, 0, "brick_cull's counts differ at {count} slots, first {differ:?}");
+    // The first batch's splats: the bricks in slot order up to the batch capacity.
+    let resident = voxsplat::recording::bricked_resident_bytes(g.volume().unwrap(), 48, 48);
+    let capacity = ((voxsplat::cpu_engine::DEFAULT_GPU_BUDGET - resident) / voxsplat::recording::BATCH_BYTES_PER_SPLAT)
+        .min(voxsplat::constants::MAX_GPU_SPLATS as u64) as u32;
+    let mut first = 0;
+    for w in a[0].iter().filter(|&&w| w != 0) {
+        if first + (w & 1023) > capacity {
+            break;
+        }
+        first += w & 1023;
+    }
+    let batch = 2 * first as usize;
+    assert!(batch > 0 && a[1].len() >= batch && b[1].len() >= batch);
+    let count = a[1][..batch].iter().zip(&b[1][..batch]).filter(|(x, y)| x != y).count();
+    assert_eq!(count, 0, "brick_order's voxels differ in {count} words");
+    // The first batch reaches the last page: its voxels lie at the high-z end of the grid.
+    let top = a[1][..batch].chunks(2).filter(|v| v[1] & 0xffff >= 290).count();
+    assert!(top > 1000, "{top} voxels of the last slices in the first batch");
+    assert_clean(&g);
+}
