@@ -446,6 +446,18 @@ fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
 type VolumeParts =
     (voxsplat::volume::ScalarVolume, voxsplat::classify::TransferFunction, Option<voxsplat::classify::Shading>);
 
+/// `info`'s line about the bricked store.
+fn print_store(store: &voxsplat::bricks::BrickStore) {
+    println!(
+        "bricked store: {} stored voxels in {} bricks of {}^3, {} bytes on the GPU, {:.2} bytes per stored voxel",
+        store.len(),
+        store.headers.len(),
+        voxsplat::bricks::BRICK,
+        store.bytes(),
+        store.bytes() as f64 / store.len().max(1) as f64
+    );
+}
+
 /// The --tf preset or TOML file.
 fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFunction> {
     if a.tf.ends_with(".toml") {
@@ -790,20 +802,28 @@ fn run(cli: Cli) -> Result<()> {
                     dtype: dtype.as_deref().map(str::parse).transpose()?,
                     ..Default::default()
                 };
+                // Past the dense loader (an uncompressed NRRD of more than MAX_VOXELS): the store only.
+                if let Some(reader) = voxsplat::loaders::SliceReader::nrrd(&file)? {
+                    let voxels: u64 = reader.dims.iter().map(|&d| d as u64).product();
+                    if voxels > voxsplat::loaders::MAX_VOXELS {
+                        let store = voxsplat::bricks::BrickStore::load(&file, &hints)?;
+                        println!(
+                            "volume: {:?} voxels, spacing {:?}, values {} .. {}",
+                            store.dims, store.spacing, store.range.0, store.range.1
+                        );
+                        print_store(&store);
+                        println!(
+                            "splats: not counted (more than the dense loader's {} voxels): rendered bricked",
+                            voxsplat::loaders::MAX_VOXELS
+                        );
+                        return Ok(());
+                    }
+                }
                 let v = voxsplat::loaders::load_volume(&file, &hints)?;
                 let (lo, hi) =
                     v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
                 println!("volume: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
-                let store = voxsplat::bricks::BrickStore::build(&v)?;
-                println!(
-                    "bricked store: {} stored voxels in {} bricks of {}^3, {} bytes on the GPU, {:.2} bytes per stored \
-                     voxel",
-                    store.len(),
-                    store.headers.len(),
-                    voxsplat::bricks::BRICK,
-                    store.bytes(),
-                    store.bytes() as f64 / store.len().max(1) as f64
-                );
+                print_store(&voxsplat::bricks::BrickStore::build(&v)?);
                 voxsplat::classify::classify(&v, &voxsplat::classify::TransferFunction::preset(&tf)?, None)?
             };
             println!("splats: {}", set.len());
