@@ -90,6 +90,9 @@ enum Command {
         /// Device-memory budget for --volume, MiB.
         #[arg(long, default_value_t = 1024)]
         gpu_budget_mib: u64,
+        /// Transfer-function preset for --volume.
+        #[arg(long, default_value = "ramp")]
+        tf: String,
     },
     /// Render the peers' scene (../shared/peers, issue 9) with every voxsplat mode: median frame
     /// times as CSV on stdout, images into --out-dir; `scripts/peers.sh` runs it beside VTK.
@@ -845,12 +848,12 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Bench(a) => bench(a),
-        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib } => {
+        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf } => {
             if frames < 1 || size < 16 {
                 return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
             }
             match volume {
-                Some(v) => println!("{}", voxsplat_cli::bricked::one_volume(&v, size, gpu_budget_mib)?),
+                Some(v) => println!("{}", voxsplat_cli::bricked::one_volume(&v, size, gpu_budget_mib, &tf, frames)?),
                 None => print!("{}", voxsplat_cli::bricked::study(&bonsai, large.as_deref(), size, frames)?),
             }
             Ok(())
@@ -1001,9 +1004,11 @@ fn bench(a: BenchArgs) -> Result<()> {
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
         // The peer comparison is its own run (scripts/peers.sh); its section is kept when present.
         let peers_md = std::fs::read_to_string(a.out_dir.join("peers.md")).unwrap_or_default();
+        // So is the bricked-volume study (`voxsplat bricks`, run by scripts/results.sh).
+        let bricks_md = std::fs::read_to_string(a.out_dir.join("bricks.md")).unwrap_or_default();
         let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
         let motion_md = format!(
-            "{}\n{}\n{}\n{}\n{}",
+            "{}\n{}\n{}\n{}\n{}\n{}",
             voxsplat_cli::rates::rates_markdown(
                 &rates,
                 &roof_rates,
@@ -1012,7 +1017,8 @@ fn bench(a: BenchArgs) -> Result<()> {
             antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
             motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
             voxsplat_cli::stability::markdown(&stab, &chart_dir),
-            peers_md
+            peers_md,
+            bricks_md
         );
         let md = results_markdown(&Report {
             device,

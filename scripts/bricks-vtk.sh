@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Bricked volumes beside VTK's fixed-point CPU ray caster on the same files (issue 23): the 256³
+# bonsai, its 2x upsampling (512³) and the procedural 1024³ field (scripts/large-volumes.sh), the
+# same transfer-function preset and view (scripts/vtk_file.py copies voxsplat's framing camera),
+# 512x512, alternating the two tools file by file in one run. Each voxsplat run is its own process
+# (`voxsplat bricks --volume`: load, store, median frame, peak RSS). Prints a markdown table.
+# Installs VTK (PyPI) in a virtual environment when missing, as scripts/peers.sh does.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+VENV=${VENV_VTK:-$HOME/.cache/peers/venv}
+LARGE=${LARGE:-target/large}
+FRAMES=${FRAMES:-5}
+if [ ! -x "$VENV/bin/python" ] || ! "$VENV/bin/python" -c "import vtk" 2>/dev/null; then
+  python3 -m venv "$VENV" && "$VENV/bin/pip" install -q vtk numpy pillow
+fi
+[ -f "$LARGE/procedural1024.nrrd" ] || ./scripts/large-volumes.sh "$LARGE" >&2
+cargo build --release --quiet
+export VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow
+cat <<'TEXT'
+### Beside VTK on the same files
+
+`scripts/bricks-vtk.sh`, one run, the two tools alternating file by file: VTK's fixed-point CPU ray
+caster (`scripts/vtk_file.py`: the same preset mapped over the data's range, opacity per voxel
+length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat bricks --volume`, its
+own process per file), 512², 5 frames after a warm-up, medians.
+
+TEXT
+echo "| file | VTK fixed point: load s, median ms, peak RSS MiB | voxsplat bricked, GPU path (1 GiB budget) | VTK ms / voxsplat ms |"
+echo "|---|---|---|---|"
+for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/procedural1024.nrrd"; do
+  tf=bonsai; [[ $f == *procedural* ]] && tf=ramp
+  vtk=$( { /usr/bin/time -f "rss=%M" "$VENV/bin/python" scripts/vtk_file.py --file "$f" --tf $tf --frames "$FRAMES" \
+    --out "target/vtk-$(basename "$f").png"; } 2>&1 | grep -E "median=|rss=" | tr '\n' ' ')
+  vs=$(./target/release/voxsplat bricks --volume "$f" --tf $tf --frames "$FRAMES")
+  vtk_ms=$(sed -E 's/.*median=([0-9.]+)s.*/\1/' <<< "$vtk" | awk '{print $1 * 1000}')
+  vtk_load=$(sed -E 's/.*load=([0-9.]+)s.*/\1/' <<< "$vtk")
+  vtk_rss=$(sed -E 's/.*rss=([0-9]+).*/\1/' <<< "$vtk" | awk '{printf "%.0f", $1 / 1024}')
+  vs_ms=$(sed -E 's/.*median frame ([0-9.]+) ms.*/\1/' <<< "$vs")
+  ratio=$(awk -v a="$vtk_ms" -v b="$vs_ms" 'BEGIN {printf "%.3f", a / b}')
+  echo "| $(basename "$f") ($tf) | $vtk_load, $vtk_ms, $vtk_rss | ${vs#*: } | $ratio |"
+done

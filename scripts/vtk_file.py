@@ -1,0 +1,99 @@
+"""VTK's fixed-point CPU ray caster on a volume file, for the bricked-volume comparison (issue 23):
+the same file, transfer-function preset and view as `voxsplat render --volume FILE --tf TF` (the
+framing camera: src/camera.rs), 512x512 by default. Prints the median frame time.
+Usage: python vtk_file.py --file F.nrrd|F.nii.gz --tf bonsai|ramp|ct --frames 5 --out out.png
+"""
+import argparse, math, statistics, sys, time
+import vtk
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--file", required=True)
+ap.add_argument("--tf", default="bonsai")
+ap.add_argument("--size", type=int, default=512)
+ap.add_argument("--frames", type=int, default=5)
+ap.add_argument("--warmup", type=int, default=1)
+ap.add_argument("--out", default="vtk.png")
+a = ap.parse_args()
+
+# voxsplat's presets (src/classify.rs): density normalised over the data's range, RGB, opacity of
+# one voxel length of material.
+PRESETS = {
+    "ramp": [(0.1, (0, 0, 0, 0)), (1.0, (1, 1, 1, 0.6))],
+    "ct": [(0.0, (0, 0, 0, 0)), (0.12, (0, 0, 0, 0)), (0.2, (0.8, 0.3, 0.2, 0.03)), (0.45, (1, 0.9, 0.8, 0.6)),
+           (1.0, (1, 1, 1, 0.95))],
+    "bonsai": [(0.0, (0, 0, 0, 0)), (0.15, (0, 0, 0, 0)), (0.25, (0.25, 0.6, 0.15, 0.35)), (0.45, (0.3, 0.55, 0.15, 0.6)),
+               (0.6, (0.55, 0.35, 0.15, 0.9)), (1.0, (0.7, 0.5, 0.3, 0.95))],
+}
+
+t0 = time.perf_counter()
+if a.file.endswith(".nrrd") or a.file.endswith(".nhdr"):
+    reader = vtk.vtkNrrdReader()
+else:
+    reader = vtk.vtkNIFTIImageReader()
+reader.SetFileName(a.file)
+reader.Update()
+img = reader.GetOutput()
+load_s = time.perf_counter() - t0
+lo, hi = img.GetScalarRange()
+dims = img.GetDimensions()
+sp = img.GetSpacing()
+
+ctf = vtk.vtkColorTransferFunction()
+otf = vtk.vtkPiecewiseFunction()
+for d, (r, g, b, op) in PRESETS[a.tf]:
+    v = lo + d * (hi - lo)
+    ctf.AddRGBPoint(v, r, g, b)
+    otf.AddPoint(v, op)
+prop = vtk.vtkVolumeProperty()
+prop.SetColor(ctf)
+prop.SetScalarOpacity(otf)
+prop.SetScalarOpacityUnitDistance(max(sp))
+prop.SetInterpolationTypeToLinear()
+prop.ShadeOff()
+
+mapper = vtk.vtkFixedPointVolumeRayCastMapper()
+mapper.SetAutoAdjustSampleDistances(0)
+mapper.SetInputData(img)
+mapper.SetBlendModeToComposite()
+volume = vtk.vtkVolume()
+volume.SetMapper(mapper)
+volume.SetProperty(prop)
+ren = vtk.vtkRenderer()
+ren.AddVolume(volume)
+ren.SetBackground(0, 0, 0)
+rw = vtk.vtkRenderWindow()
+rw.SetOffScreenRendering(1)
+rw.AddRenderer(ren)
+rw.SetSize(a.size, a.size)
+
+# voxsplat's Camera::framing.
+ext = [(dims[i] - 1) * sp[i] for i in range(3)]
+c = [e / 2 for e in ext]
+radius = 0.5 * max(math.sqrt(sum(e * e for e in ext)), 1.0)
+dist = radius / math.sin(math.radians(17.5)) * 1.05
+d = (0.55, 0.45, 1.0)
+n = math.sqrt(sum(x * x for x in d))
+cam = ren.GetActiveCamera()
+cam.SetFocalPoint(*c)
+cam.SetPosition(*[c[i] + d[i] / n * dist for i in range(3)])
+cam.SetViewUp(0, 1, 0)
+cam.SetViewAngle(35.0)
+ren.ResetCameraClippingRange()
+
+for i in range(a.warmup):
+    rw.Render()
+times = []
+for i in range(a.frames):
+    cam.Azimuth(0.5 if i % 2 == 0 else -0.5)
+    ren.ResetCameraClippingRange()
+    t = time.perf_counter()
+    rw.Render()
+    times.append(time.perf_counter() - t)
+w2i = vtk.vtkWindowToImageFilter()
+w2i.SetInput(rw)
+w2i.Update()
+wr = vtk.vtkPNGWriter()
+wr.SetFileName(a.out)
+wr.SetInputConnection(w2i.GetOutputPort())
+wr.Write()
+print(f"file={a.file} dims={dims} load={load_s:.3f}s median={statistics.median(times):.3f}s")
