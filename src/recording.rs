@@ -310,13 +310,6 @@ fn record_bricks(
     }
     e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
     let splats = |b: &[[u32; 3]]| b.last().map(|l| l[1] + l[2]).unwrap_or(0);
-    if !compute && batches.len() > 1 {
-        let total: u64 = batches.iter().map(|b| splats(b) as u64).sum();
-        return Err(Error::Unsupported(format!(
-            "{total} splats in view exceed one batch of {capacity} within the GPU budget, and the raster pipeline draws \
-             one batch: use --raster compute (the tile compositor streams batches) or a larger --gpu-budget-mib"
-        )));
-    }
     let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
     e.ensure(Res::BrickList, most_entries * 8)?;
     let largest = batches.iter().map(|b| splats(b)).max().unwrap_or(0);
@@ -362,7 +355,8 @@ fn record_bricks(
         } else {
             let blend = if opts.direction() == Direction::BackToFront { Blend::Over } else { Blend::Under };
             let variant = footprint_variant(blend, opts.raster == Raster::Points, SHEET_MODE_SPLAT);
-            let push = FootprintPush::default();
+            // A later batch draws on the target (the LOAD pass).
+            let push = FootprintPush { rank_base: u32::from(i > 0), ..Default::default() };
             e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
         }
     }

@@ -382,15 +382,17 @@ fn raster_quad(
 }
 
 /// The draw: the raster target or the summation layers are cleared (the render pass's load) and
-/// the footprints drawn into them.
+/// the footprints drawn into them; a later batch of a bricked volume (`rank_base` 1) draws on the
+/// raster target as it is.
 pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let state = v.draw.expect("footprint variants are draws");
-    let count = match state.pass {
-        Pass::Target => 1,
-        Pass::Sheet => b.sums.len(),
+    let push: FootprintPush = d.push_as();
+    let mut layers = match state.pass {
+        Pass::Target if push.rank_base != 0 => vec![std::mem::replace(&mut b.color, ImageF32::new(0, 0))],
+        Pass::Target => vec![ImageF32::new(b.width, b.height)],
+        Pass::Sheet => vec![ImageF32::new(b.width, b.height); b.sums.len()],
     };
-    let mut layers = vec![ImageF32::new(b.width, b.height); count];
-    let (inputs, push) = (b.inputs(d.list), d.push_as());
+    let inputs = b.inputs(d.list);
     footprint(&inputs, &push, state.blend, state.points, d.groups[0], d.groups[1], &mut layers);
     match state.pass {
         Pass::Target => b.color = layers.remove(0),

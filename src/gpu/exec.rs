@@ -169,7 +169,10 @@ fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3],
                     let (first, count) = (d.args.groups[0], d.args.groups[1]);
                     match state.pass {
                         Pass::Target => {
-                            rec.begin_pass(&gpu.pipes.target_pass, &target.color_fb);
+                            // A later batch (push rank_base 1) draws on what the earlier left.
+                            let carry = d.args.push_as::<crate::gpu_types::FootprintPush>().rank_base != 0;
+                            let pass = if carry { &gpu.pipes.target_load_pass } else { &gpu.pipes.target_pass };
+                            rec.begin_pass(pass, &target.color_fb);
                             layouts[2] = IL::TRANSFER_SRC_OPTIMAL;
                         }
                         Pass::Sheet => {

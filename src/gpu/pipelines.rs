@@ -42,18 +42,21 @@ pub struct Pipelines {
     /// Into the raster target (left in TRANSFER_SRC for the readback), and into the summation
     /// layers (left in GENERAL for the composite pass).
     pub target_pass: RenderPass,
+    /// The same, drawing on the target (a later batch of a bricked volume).
+    pub target_load_pass: RenderPass,
     pub sheet_pass: RenderPass,
 }
 
 impl Pipelines {
     pub fn new(ctx: &Arc<Context>) -> Result<Self> {
-        let target_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL)?;
-        let sheet_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::GENERAL)?;
+        let target_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL, false)?;
+        let target_load_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL, true)?;
+        let sheet_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::GENERAL, false)?;
         let mut stages = Vec::with_capacity(STAGES.len());
         for desc in STAGES.iter() {
             stages.push(build(ctx, desc, &target_pass, &sheet_pass)?);
         }
-        Ok(Self { stages, target_pass, sheet_pass })
+        Ok(Self { stages, target_pass, target_load_pass, sheet_pass })
     }
 }
 

@@ -388,24 +388,32 @@ pub enum Blend {
     Add,
 }
 
-/// A single-subpass render pass over one RGBA32F colour attachment, cleared on load. Its external
-/// dependencies order it after earlier compute/attachment work and before compute reads or copies.
+/// A single-subpass render pass over one RGBA32F colour attachment, cleared on load (or loaded, to
+/// draw on). Its external dependencies order it after earlier compute/attachment work and before
+/// compute reads or copies.
 pub struct RenderPass {
     ctx: Arc<Context>,
     pub(crate) raw: vk::RenderPass,
 }
 
 impl RenderPass {
-    /// A render pass over one `format` attachment, left in `final_layout`.
-    pub fn new(ctx: &Arc<Context>, format: vk::Format, final_layout: vk::ImageLayout) -> Result<Self> {
+    /// A render pass over one `format` attachment, left in `final_layout`; `load`: drawing on what
+    /// the attachment holds (in `final_layout`, where an earlier such pass left it), else cleared.
+    /// Both kinds are compatible, so one framebuffer and one pipeline serve both.
+    pub fn new(ctx: &Arc<Context>, format: vk::Format, final_layout: vk::ImageLayout, load: bool) -> Result<Self> {
+        let (load_op, initial) = if load {
+            (vk::AttachmentLoadOp::LOAD, final_layout)
+        } else {
+            (vk::AttachmentLoadOp::CLEAR, vk::ImageLayout::UNDEFINED)
+        };
         let attachments = [vk::AttachmentDescription::default()
             .format(format)
             .samples(vk::SampleCountFlags::TYPE_1)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .load_op(load_op)
             .store_op(vk::AttachmentStoreOp::STORE)
             .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
             .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-            .initial_layout(vk::ImageLayout::UNDEFINED)
+            .initial_layout(initial)
             .final_layout(final_layout)];
         let color_refs = [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }];
         let subpasses = [vk::SubpassDescription::default()
