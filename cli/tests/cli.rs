@@ -330,3 +330,33 @@ fn make_volume_writes_readable_large_test_volumes() {
         assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     }
 }
+
+/// A bricked volume through the CLI: a budget below the store and one brick of splats names the
+/// minimum, a zero budget is refused, the sheet modes fall back to host-classified splats, and
+/// `bricks --volume` measures one file.
+#[test]
+fn bricked_volumes_take_a_budget_and_fall_back_where_they_must() {
+    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/stent/stent.nrrd");
+    let png = tmp("stent.png");
+    let base = ["render", "--volume", stent, "--tf", "ct", "--size", "40x40", "--out", png.to_str().unwrap()];
+    let out = voxsplat(&[&base[..], &["--gpu-budget-mib", "1"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("GPU budget of 1 MiB") && err.contains("the minimum is"), "{err}");
+    let out = voxsplat(&[&base[..], &["--gpu-budget-mib", "0"]].concat());
+    assert!(
+        !out.status.success() && String::from_utf8_lossy(&out.stderr).contains("--gpu-budget-mib must be positive")
+    );
+    // Sheets need host-classified splats: picked without --dense.
+    let out = voxsplat(&[&base[..], &["--composite", "sheet", "--validation"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("bytes per splat") && !err.contains("stored voxels in"), "{err}");
+    let out = voxsplat(&[&base[..], &["--validation"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success() && err.contains("stored voxels in") && err.contains("bytes per stored voxel"),
+        "{err}"
+    );
+    let out = voxsplat(&["bricks", "--volume", stent, "--tf", "ct", "--size", "32", "--frames", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("stored") && text.contains("median frame"), "{text}");
+}

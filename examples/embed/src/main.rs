@@ -1,5 +1,7 @@
 //! An embedder's program: it makes its own scalar field, classifies it with a transfer function,
-//! renders an orbit of frames with voxsplat and writes the last one. Usage: `embed [OUT.png]`.
+//! renders an orbit of frames with voxsplat and writes the last one; then hands the same field to
+//! voxsplat as a bricked volume (classified on the device) and changes its transfer function.
+//! Usage: `embed [OUT.png]`.
 use voxsplat::classify::{classify, TransferFunction};
 use voxsplat::glam::{Quat, Vec3};
 use voxsplat::volume::ScalarVolume;
@@ -41,5 +43,23 @@ fn main() -> Result<(), voxsplat::Error> {
     }
     voxsplat::output::write_image(&last.expect("eight frames"), out.as_ref())?;
     println!("-> {out} on {}", renderer.device_name());
+
+    // The same field as a bricked store, classified on the device every frame: a new transfer
+    // function is a table write, not a re-extraction.
+    let mut options = RendererOptions::default();
+    options.gpu_budget_bytes = 64 << 20;
+    let mut bricked = Renderer::new(&options)?;
+    bricked.set_volume(&volume, &TransferFunction::preset("ramp")?, None)?;
+    let store = &bricked.volume().expect("set above").store;
+    println!("bricked: {} voxels stored in {} bricks, {} bytes", store.len(), store.headers.len(), store.bytes());
+    for tf in ["ramp", "ct"] {
+        bricked.set_transfer_function(&TransferFunction::preset(tf)?, None)?;
+        let frame = bricked.render(&start, &RenderOptions::default())?;
+        let covered = frame.image.pixels.iter().filter(|p| p[3] > 0.1).count();
+        println!("bricked, {tf}: {covered} px covered");
+        if covered == 0 {
+            return Err(voxsplat::Error::InvalidArgument(format!("the bricked {tf} frame is empty")));
+        }
+    }
     Ok(())
 }
