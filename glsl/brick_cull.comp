@@ -1,5 +1,5 @@
 #version 450
-// variants: PAGED_RECORDS
+// variants: PAGED_RECORDS STREAMED_STORE
 // Bricks, pass 1 (issue 23): one workgroup per non-empty brick. A brick outside the view, or whose
 // value range the transfer function leaves empty, is culled whole; otherwise its lanes count the
 // voxels the TF extracts, and the brick writes header << 10 | count at its position in the PBTF
@@ -17,6 +17,10 @@ void main() {
     uvec3 b = brick_coords(hd.x);
     if (tf_empty(hd.w & 0xffffu, hd.w >> 16u) || outside_view(b)) return;
     uint lane = gl_LocalInvocationID.x;
+#ifdef STREAMED_STORE
+    // The records stay on the host, which counted each brick's drawn voxels with the TF table.
+    if (lane == 0u && brick_counts[h] > 0u) slots[brick_slot(b)] = (h << 10u) | brick_counts[h];
+#else
     if (lane == 0u) drawn = 0u;
     barrier();
     uint n = 0u;
@@ -26,4 +30,5 @@ void main() {
     atomicAdd(drawn, n);
     barrier();
     if (lane == 0u && drawn > 0u) slots[brick_slot(b)] = (h << 10u) | drawn;
+#endif
 }

@@ -47,6 +47,6 @@ bool hidden(uvec3 b) {
 void main() {
     uint e = linear_invocation();
     if (e >= pc.count) return;
-    uvec2 entry = brick_list[pc.first + e];
+    uvec4 entry = brick_list[pc.first + e];
     hidden_out[e] = hidden(brick_coords(headers[entry.x].x)) ? 1u : 0u;
 }

@@ -1,5 +1,5 @@
 #version 450
-// variants: PAGED_RECORDS
+// variants: PAGED_RECORDS STREAMED_STORE
 // Bricks, pass 2 (issue 23): one workgroup per visible brick of a batch. Its lanes mark the cells
 // the TF extracts at their dense PBTF positions in the brick (split at the eye's voxel split,
 // clamped to the brick), so a voxel's rank among the marked cells is its place in the brick's PBTF
@@ -22,7 +22,7 @@ shared uint below[MASK_WORDS + 1u];
 void main() {
     uint e = workgroup_item();
     if (e >= pc.count) return;
-    uvec2 entry = brick_list[pc.first + e];
+    uvec4 entry = brick_list[pc.first + e];
     uvec4 hd = headers[entry.x];
     uvec3 b = brick_coords(hd.x);
     uvec3 split = uvec3(clamp(ivec3(frame.split.xyz) - ivec3(b * BRICK_SIDE), ivec3(0), ivec3(BRICK_SIDE)));
@@ -30,7 +30,7 @@ void main() {
     for (uint w = lane; w < MASK_WORDS; w += BRICK_LANES) cells[w] = 0u;
     barrier();
     for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        uint rec = record_at(hd.y + r);
+        uint rec = record_at(entry.z + r);
         if (emits(rec >> 16u)) {
             uint p = dense_pbtf(local_cell(rec & 511u), uvec3(BRICK_SIDE), split);
             atomicOr(cells[p / 32u], 1u << (p % 32u));
@@ -45,7 +45,7 @@ void main() {
     barrier();
     uint total = below[MASK_WORDS];
     for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        uint rec = record_at(hd.y + r);
+        uint rec = record_at(entry.z + r);
         if (!emits(rec >> 16u)) continue;
         uvec3 lc = local_cell(rec & 511u);
         uint p = dense_pbtf(lc, uvec3(BRICK_SIDE), split);

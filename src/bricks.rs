@@ -234,6 +234,8 @@ pub struct BrickScene {
     shading: Option<Shading>,
     /// `tf` tabulated per quantised value (`tf_words`).
     table: Vec<u32>,
+    /// Per non-empty brick, the voxels `tf` draws (a streamed store's `Res::BrickCounts`).
+    drawn: std::sync::OnceLock<Vec<u32>>,
     /// The largest gradient magnitude in stored units (gradient weighting needs it), built once.
     gmax: std::sync::OnceLock<f32>,
 }
@@ -306,13 +308,14 @@ impl BrickScene {
         }
         tf.validate()?;
         let table = tf_table(&tf, remap(&store, &tf));
-        Ok(Self { store, tf, shading, table, gmax: std::sync::OnceLock::new() })
+        Ok(Self { store, tf, shading, table, drawn: std::sync::OnceLock::new(), gmax: std::sync::OnceLock::new() })
     }
 
     /// Classify with another transfer function and shading from the next frame on.
     pub fn set_transfer_function(&mut self, tf: TransferFunction, shading: Option<Shading>) -> Result<()> {
         tf.validate()?;
         self.table = tf_table(&tf, remap(&self.store, &tf));
+        self.drawn = std::sync::OnceLock::new();
         (self.tf, self.shading) = (tf, shading);
         Ok(())
     }
@@ -358,6 +361,29 @@ impl BrickScene {
     /// 32-value word the extracted values below it (and the total).
     pub fn tf_words(&self) -> &[u32] {
         &self.table
+    }
+
+    /// Whether the store stays on the host under a device budget of `budget` bytes, its records
+    /// streamed batch by batch: when they would take more than half the budget.
+    pub fn streams(&self, budget: u64) -> bool {
+        self.store.records.len() as u64 * 4 > budget / 2
+    }
+
+    /// Per non-empty brick, the voxels the transfer function draws (extracted values, by the
+    /// table's bits), counted once per transfer function: a streamed store's brick counts.
+    pub fn drawn_counts(&self) -> &[u32] {
+        self.drawn.get_or_init(|| {
+            let bits = &self.table[4 * crate::constants::TF_ENTRIES as usize..];
+            let emits = |r: u32| bits[(r >> 21) as usize] >> (r >> 16 & 31) & 1 != 0;
+            let s = &self.store;
+            s.headers
+                .iter()
+                .map(|h| {
+                    s.records[h.first as usize..(h.first + h.count) as usize].iter().filter(|&&r| emits(r)).count()
+                        as u32
+                })
+                .collect()
+        })
     }
 
     /// The largest central-difference gradient magnitude over the grid, in stored units: only

@@ -106,6 +106,10 @@ pub enum Res {
     BrickVoxels,
     /// Per brick of the next batch, 1 when hidden (front to back, early termination).
     BrickHidden,
+    /// A streamed store's records for one batch (the store stays on the host).
+    BatchRecords,
+    /// A streamed store's drawn voxels per brick under the current TF (counted on the host).
+    BrickCounts,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

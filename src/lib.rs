@@ -149,6 +149,10 @@ impl Renderer {
         self.budget_bytes = bytes;
         if let Some(g) = &mut self.gpu {
             g.budget_bytes = bytes;
+            // Whether a bricked store's records stay on the host follows the budget.
+            if let Some(prep) = self.scene.as_ref().filter(|p| p.bricks.is_some()) {
+                g.set_scene(prep)?;
+            }
         }
         Ok(())
     }

@@ -220,25 +220,35 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
 /// and for the tile compositor its screen quad (80) and about four tile entries.
 pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 8 + 80 + 16;
 
-/// What a bricked frame keeps resident besides its batches: the store, the brick index, the
-/// draw-order slots and visible list, and the images.
-pub fn bricked_resident_bytes(scene: &BrickScene, width: u32, height: u32) -> u64 {
+/// What a bricked frame keeps resident besides its batches under `budget`: the store (without its
+/// records when they stream, `BrickScene::streams`; then the per-brick counts), the brick index,
+/// the draw-order slots and visible list, and the images.
+pub fn bricked_resident_bytes(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
     let s = &scene.store;
-    s.bytes() + s.index.len() as u64 * (4 + 4 + 8) + width as u64 * height as u64 * 16 * 3
+    let store = if scene.streams(budget) {
+        s.bytes() - s.records.len() as u64 * 4 + s.headers.len() as u64 * 4
+    } else {
+        s.bytes()
+    };
+    store + s.index.len() as u64 * (4 + 4 + 16) + width as u64 * height as u64 * 16 * 3
 }
 
-/// The least budget that draws `scene` at `width` x `height`: resident data and one brick's splats.
-pub fn bricked_min_budget(scene: &BrickScene, width: u32, height: u32) -> u64 {
-    bricked_resident_bytes(scene, width, height) + (BRICK as u64).pow(3) * BATCH_BYTES_PER_SPLAT
+/// The least budget that draws `scene` at `width` x `height`: resident data and one brick's splats
+/// (and records, when they stream).
+pub fn bricked_min_budget(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
+    let brick = (BRICK as u64).pow(3) * (BATCH_BYTES_PER_SPLAT + 4 * scene.streams(budget) as u64);
+    bricked_resident_bytes(scene, budget, width, height) + brick
 }
 
 /// A bricked volume's frame (issue 23): `brick_cull` culls whole bricks on the device (outside
 /// the view, or empty under the transfer function) and counts the rest's voxels at their slots in
 /// the brick grid's PBTF order; the host lists the visible bricks in that order and cuts batches
 /// that fit the budget; per batch `brick_order` writes their voxels in two-level PBTF order,
-/// `brick_params` classifies them and makes their parameters, and the raster draws them, the tile compositor carrying
-/// the image from batch to batch. Front to back with early termination, before each later batch
-/// `tile_occlusion` and `brick_hidden` drop the bricks that the image so far already hides.
+/// `brick_params` classifies them and makes their parameters, and the raster draws them, each
+/// batch carrying on from the image the earlier left. Front to back with early termination, before
+/// each later batch `tile_occlusion` and `brick_hidden` drop the bricks that the image so far
+/// already hides. A store whose records would take more than half the budget keeps them on the
+/// host: each batch uploads its bricks' records, and the bricks' drawn counts come from the host.
 fn record_bricks(
     e: &mut dyn Engine,
     prep: &Prepared,
@@ -255,7 +265,18 @@ fn record_bricks(
     }
     let (w, h) = (camera.width, camera.height);
     let budget = e.limits().budget_bytes;
-    let least = bricked_min_budget(scene, w, h);
+    let streamed = scene.streams(budget);
+    if streamed && (scene.shading().is_some() || scene.transfer_function().gradient_weight > 0.0) {
+        return Err(Error::Unsupported(format!(
+            "this volume's store ({} MiB) streams through the {} MiB GPU budget, and gradients (shading, gradient \
+             weighting) read neighbouring bricks that a batch does not hold: a budget of at least {} MiB keeps it \
+             resident",
+            scene.store.bytes() >> 20,
+            budget >> 20,
+            (scene.store.records.len() as u64 * 8).div_ceil(1 << 20) + 1
+        )));
+    }
+    let least = bricked_min_budget(scene, budget, w, h);
     if budget < least {
         return Err(Error::TooLarge(format!(
             "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB) and one brick of splats at \
@@ -265,20 +286,24 @@ fn record_bricks(
             least.div_ceil(1 << 20)
         )));
     }
-    let capacity = ((budget - bricked_resident_bytes(scene, w, h)) / BATCH_BYTES_PER_SPLAT).min(MAX_GPU_SPLATS as u64);
-    let capacity = capacity as u32;
+    let available = budget - bricked_resident_bytes(scene, budget, w, h);
     let frame = plan::frame_for(&prep.set, camera, opts);
     let bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
-    // The brick stages' build: one page of store records, or the paged reader.
-    let paged = usize::from(scene.store.len() > RECORD_PAGE as usize);
+    // The brick stages' build: one page of store records, the paged reader, or streamed records.
+    let build = if streamed { 2 } else { usize::from(scene.store.len() > RECORD_PAGE as usize) };
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
+    if streamed {
+        let counts = scene.drawn_counts();
+        e.ensure(Res::BrickCounts, counts.len().max(1) as u64 * 4)?;
+        e.upload(Res::BrickCounts, counts)?;
+    }
     e.ensure(Res::BrickSlots, slots as u64 * 4)?;
     e.fill(Res::BrickSlots, None, 0)?;
     if bf.grid[3] > 0 {
-        e.run(&Dispatch::new(StageId::BrickCull, paged, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
+        e.run(&Dispatch::new(StageId::BrickCull, build, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
     }
     let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
     let t = Instant::now();
@@ -291,27 +316,32 @@ fn record_bricks(
         && opts.early_termination > 0.0;
     let capacity = if cull_hidden {
         let total: u32 = slot_words.iter().map(|w| w & 1023).sum();
-        capacity.min(total.div_ceil(HIDDEN_BATCHES).max(HIDDEN_BATCH_MIN))
+        MAX_GPU_SPLATS.min(total.div_ceil(HIDDEN_BATCHES).max(HIDDEN_BATCH_MIN))
     } else {
-        capacity
+        MAX_GPU_SPLATS
     };
-    // The visible bricks in draw order (header, first position in its batch, voxels), cut into
-    // batches of at most `capacity` splats between bricks.
-    let mut batches: Vec<Vec<[u32; 3]>> = vec![Vec::new()];
-    let mut filled = 0;
+    // The visible bricks in draw order (header, first position in its batch, first record: in
+    // the store, or in the batch's records when they stream; voxels), cut between bricks into
+    // batches of at most `capacity` splats whose bytes fit what the budget leaves.
+    let mut batches: Vec<Vec<[u32; 4]>> = vec![Vec::new()];
+    let (mut filled, mut records, mut bytes) = (0u32, 0u32, 0u64);
     for word in slot_words.into_iter().filter(|&w| w != 0) {
-        let n = word & 1023;
-        if filled + n > capacity {
+        let (header, n) = (word >> 10, word & 1023);
+        let hd = &scene.store.headers[header as usize];
+        let cost = n as u64 * BATCH_BYTES_PER_SPLAT + if streamed { hd.count as u64 * 4 } else { 0 };
+        let open = batches.last().is_some_and(|b| !b.is_empty());
+        if open && (filled + n > capacity || bytes + cost > available) {
             batches.push(Vec::new());
-            filled = 0;
+            (filled, records, bytes) = (0, 0, 0);
         }
-        batches.last_mut().expect("one batch at least").push([word >> 10, filled, n]);
-        filled += n;
+        let first = if streamed { records } else { hd.first };
+        batches.last_mut().expect("one batch at least").push([header, filled, first, n]);
+        (filled, records, bytes) = (filled + n, records + hd.count, bytes + cost);
     }
     e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
-    let splats = |b: &[[u32; 3]]| b.last().map(|l| l[1] + l[2]).unwrap_or(0);
+    let splats = |b: &[[u32; 4]]| b.last().map(|l| l[1] + l[3]).unwrap_or(0);
     let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
-    e.ensure(Res::BrickList, most_entries * 8)?;
+    e.ensure(Res::BrickList, most_entries * 16)?;
     let largest = batches.iter().map(|b| splats(b)).max().unwrap_or(0);
     e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, largest as u64 * 4)?;
@@ -324,31 +354,47 @@ fn record_bricks(
     if !compute {
         e.layers(1)?;
     }
-    let pairs = |b: &[[u32; 3]]| b.iter().flat_map(|l| [l[0], l[1]]).collect::<Vec<u32>>();
+    let words = |b: &[[u32; 4]]| b.iter().flatten().copied().collect::<Vec<u32>>();
     for (i, mut batch) in batches.into_iter().enumerate() {
         if cull_hidden && i > 0 && !batch.is_empty() {
             let count = batch.len() as u32;
-            e.upload(Res::BrickList, &pairs(&batch))?;
+            e.upload(Res::BrickList, &words(&batch))?;
             let tiles = w.div_ceil(COMPOSITE_TILE) * h.div_ceil(COMPOSITE_TILE);
             e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, &[]))?;
             let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
             e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
             let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
-            let mut at = 0;
             batch = batch.into_iter().zip(hidden).filter(|(_, h)| *h == 0).map(|(l, _)| l).collect();
+            let (mut at, mut rec) = (0, 0);
             for l in &mut batch {
                 l[1] = at;
-                at += l[2];
+                at += l[3];
+                if streamed {
+                    l[2] = rec;
+                    rec += scene.store.headers[l[0] as usize].count;
+                }
             }
         }
         let n = splats(&batch);
         if !batch.is_empty() {
-            e.upload(Res::BrickList, &pairs(&batch))?;
+            if streamed {
+                // The batch's bricks' records, in list order.
+                let s = &scene.store;
+                let recs: Vec<u32> = batch
+                    .iter()
+                    .flat_map(|l| {
+                        let hd = &s.headers[l[0] as usize];
+                        s.records[hd.first as usize..(hd.first + hd.count) as usize].iter().copied()
+                    })
+                    .collect();
+                e.upload(Res::BatchRecords, &recs)?;
+            }
+            e.upload(Res::BrickList, &words(&batch))?;
             let push = BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 };
             let push = bytemuck::bytes_of(&push);
             let groups = plan::groups_per_item(batch.len() as u32);
-            e.run(&Dispatch::new(StageId::BrickOrder, paged, groups, List::Order, push))?;
-            e.run(&Dispatch::new(StageId::BrickParams, paged, groups_1d(n), List::Order, push))?;
+            e.run(&Dispatch::new(StageId::BrickOrder, build, groups, List::Order, push))?;
+            e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, push))?;
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, i > 0)?;

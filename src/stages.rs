@@ -104,9 +104,12 @@ const BRICK: &[Res] = &[
     Res::BrickRecords6,
     Res::BrickRecords7,
     Res::BrickHidden,
+    Res::BatchRecords,
+    Res::BrickCounts,
 ];
-/// One page of store records, and up to `RECORD_PAGES` (see `record_pages_variant`).
-const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[])];
+/// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
+/// (`recording::record_bricks` picks).
+const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
 const ONE: &[Variant] = &[v("", &[])];
 /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
 const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];

@@ -28,9 +28,17 @@ layout(std430, binding = 2) readonly buffer Tf {
 layout(std430, binding = 3) readonly buffer Headers { uvec4 headers[]; };
 layout(std430, binding = 4) readonly buffer Masks { uint masks[]; };
 layout(std430, binding = 5) readonly buffer Records { uint records_0[]; };
+// A store larger than the budget allows stays on the host: each batch's bricks' records arrive in
+// BatchRecords (STREAMED_STORE builds, which count a brick's drawn voxels from BrickCounts).
+layout(std430, binding = 22) readonly buffer BatchRecords { uint batch_records[]; };
+layout(std430, binding = 23) readonly buffer BrickCounts { uint brick_counts[]; };
 // Stores of more than RECORD_PAGE records bind them as up to 8 pages (one storage binding may not
 // pass maxStorageBufferRange); PAGED_RECORDS builds read through the pages.
-#ifdef PAGED_RECORDS
+#if defined(STREAMED_STORE)
+uint record_at(uint i) {
+    return batch_records[i];
+}
+#elif defined(PAGED_RECORDS)
 layout(std430, binding = 14) readonly buffer Records1 { uint records_1[]; };
 layout(std430, binding = 15) readonly buffer Records2 { uint records_2[]; };
 layout(std430, binding = 16) readonly buffer Records3 { uint records_3[]; };
@@ -60,8 +68,9 @@ uint record_at(uint i) {
 layout(std430, binding = 6) readonly buffer BrickIndex { uint brick_index[]; };
 // Per brick-grid position in draw order: header << 10 | voxels drawn, 0 when culled.
 layout(std430, binding = 7) buffer BrickSlots { uint slots[]; };
-// The batch's visible bricks in draw order: header, its first position in the batch.
-layout(std430, binding = 8) readonly buffer BrickList { uvec2 brick_list[]; };
+// The batch's visible bricks in draw order: header, its first position in the batch, its first
+// record (in the resident store, or in the batch's records when the store streams), unused.
+layout(std430, binding = 8) readonly buffer BrickList { uvec4 brick_list[]; };
 layout(std430, binding = 9) writeonly buffer Params { SplatParams params_lo[]; };
 layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]; };
 layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };

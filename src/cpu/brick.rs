@@ -195,7 +195,7 @@ pub fn tile_occlusion(accum: &ImageF32, occlusion: &mut [u32]) {
 /// composite tiles with at most `push.occluded` transmittance left.
 pub fn brick_hidden(
     inputs: &BrickInputs<'_>,
-    list: &[[u32; 2]],
+    list: &[[u32; 4]],
     push: &BrickPush,
     occlusion: &[f32],
     hidden: &mut [u32],
@@ -237,16 +237,22 @@ fn local_cell(l: u32) -> [u32; 3] {
     [l % BRICK, (l / BRICK) % BRICK, l / (BRICK * BRICK)]
 }
 
-/// Pass 1: cull each non-empty brick or write its header and count at its draw-order slot.
-pub fn brick_cull(inputs: &BrickInputs<'_>, slots: &mut [u32]) {
+/// Pass 1: cull each non-empty brick or write its header and count at its draw-order slot
+/// (`counts`: a streamed store's drawn voxels per brick, counted on the host).
+pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut [u32]) {
     let store = inputs.store;
     for (h, hd) in store.headers.iter().enumerate() {
         let b = brick_coords(hd.brick);
         if inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) || inputs.outside_view(b) {
             continue;
         }
-        let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
-        let drawn = records.iter().filter(|&&r| inputs.emits(r >> 16)).count() as u32;
+        let drawn = match counts {
+            Some(c) => c[h],
+            None => {
+                let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
+                records.iter().filter(|&&r| inputs.emits(r >> 16)).count() as u32
+            }
+        };
         if drawn > 0 {
             slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | drawn;
         }
@@ -254,10 +260,12 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, slots: &mut [u32]) {
 }
 
 /// Pass 2: the batch's voxels (grid index, stored value) in two-level PBTF order from each
-/// brick's first position.
+/// brick's first position; each brick's records from its entry's first record in `records` (the
+/// store's, or the batch's when the store streams).
 pub fn brick_order(
     inputs: &BrickInputs<'_>,
-    list: &[[u32; 2]],
+    list: &[[u32; 4]],
+    records: &[u32],
     push: &BrickPush,
     voxels: &mut [[u32; 2]],
     order: &mut [u32],
@@ -267,7 +275,7 @@ pub fn brick_order(
         let hd = store.headers[entry[0] as usize];
         let b = brick_coords(hd.brick);
         let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
-        let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
+        let records = &records[entry[2] as usize..(entry[2] + hd.count) as usize];
         let mut cells = [0u32; CELL_WORDS];
         let position = |rec: u32| dense_pbtf(local_cell(rec & 511), [BRICK; 3], split);
         for &rec in records {
@@ -309,16 +317,31 @@ fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
     Ok(BrickInputs { frame: &b.frame, bf: bf[0], tf: b.get(Res::Tf), store: &scene.store })
 }
 
-pub(crate) fn brick_cull_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+/// Whether a brick stage's build reads streamed records.
+fn streamed(v: &Variant) -> bool {
+    v.defines.contains("STREAMED_STORE")
+}
+
+pub(crate) fn brick_cull_stage(b: &mut Bindings<'_>, _: &Args, v: &Variant) -> Result<()> {
     let mut slots = b.take(Res::BrickSlots);
-    brick_cull(&inputs(b)?, &mut slots);
+    let counts = streamed(v).then(|| b.get::<u32>(Res::BrickCounts));
+    brick_cull(&inputs(b)?, counts, &mut slots);
     b.put(Res::BrickSlots, slots);
     Ok(())
 }
 
-pub(crate) fn brick_order_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn brick_order_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut voxels, mut order) = (b.take(Res::BrickVoxels), b.take(Res::Order));
-    brick_order(&inputs(b)?, b.get(Res::BrickList), &args.push_as(), bytemuck::cast_slice_mut(&mut voxels), &mut order);
+    let inputs = inputs(b)?;
+    let records = if streamed(v) { b.get(Res::BatchRecords) } else { &inputs.store.records[..] };
+    brick_order(
+        &inputs,
+        b.get(Res::BrickList),
+        records,
+        &args.push_as(),
+        bytemuck::cast_slice_mut(&mut voxels),
+        &mut order,
+    );
     b.put(Res::BrickVoxels, voxels);
     b.put(Res::Order, order);
     Ok(())

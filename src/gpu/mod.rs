@@ -66,7 +66,7 @@ impl Gpu {
     }
 
     pub fn set_scene(&mut self, prep: &Prepared) -> Result<()> {
-        self.res.set_scene(prep)
+        self.res.set_scene(prep, self.budget_bytes)
     }
 
     /// An engine for one frame of `prep` (the scene `set_scene` uploaded).

@@ -109,7 +109,9 @@ impl Resources {
     }
 
     /// Upload a scene's splats, rows, slice lists and ranks; the previous scene's frame buffers go.
-    pub fn set_scene(&mut self, prep: &Prepared) -> Result<()> {
+    /// `budget`: a bricked store that streams under it (`BrickScene::streams`) keeps its records
+    /// on the host.
+    pub fn set_scene(&mut self, prep: &Prepared, budget: u64) -> Result<()> {
         self.ctx.wait_idle();
         self.sets.clear();
         self.bufs.clear();
@@ -123,7 +125,7 @@ impl Resources {
                 set.len()
             )));
         }
-        if let Some(b) = &prep.bricks {
+        if let Some(b) = prep.bricks.as_ref().filter(|b| !b.streams(budget)) {
             let most = RECORD_PAGE as u64 * RECORD_PAGES as u64;
             if b.store.len() as u64 > most {
                 return Err(Error::TooLarge(format!(
@@ -153,7 +155,11 @@ impl Resources {
                     Some([
                         storage(ctx, "brick headers", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.headers))))?,
                         storage(ctx, "brick masks", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.masks))))?,
-                        storage(ctx, "brick records", bytemuck::cast_slice(&words(&s.records)))?,
+                        storage(
+                            ctx,
+                            "brick records",
+                            bytemuck::cast_slice(&words(if b.streams(budget) { &[] } else { &s.records })),
+                        )?,
                         storage(ctx, "brick index", bytemuck::cast_slice(&words(&s.index)))?,
                     ])
                 }
