@@ -3,7 +3,8 @@
 # bonsai, its 2x upsampling (512³) and the procedural 1024³ field (scripts/large-volumes.sh), the
 # same transfer-function preset and view (scripts/vtk_file.py copies voxsplat's framing camera),
 # 512x512, alternating the two tools file by file in one run. Each voxsplat run is its own process
-# (`voxsplat bricks --volume`: load, store, median frame, peak RSS). Prints a markdown table.
+# (`voxsplat bricks --volume`: load, store, median frame, peak RSS). Prints a markdown table and
+# draws docs/bench/bricks-scaling.svg (frame time against voxels, both tools).
 # Installs VTK (PyPI) in a virtual environment when missing, as scripts/peers.sh does.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,6 +26,8 @@ length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat br
 own process per file), 512², 5 frames after a warm-up, medians.
 
 TEXT
+csv=target/bricks-scaling.csv
+echo "voxels,vtk_ms,voxsplat_ms" > "$csv"
 echo "| file | VTK fixed point: load s, median ms, peak RSS MiB | voxsplat bricked, GPU path (1 GiB budget) | VTK ms / voxsplat ms |"
 echo "|---|---|---|---|"
 for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/procedural1024.nrrd"; do
@@ -38,4 +41,9 @@ for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/pro
   vs_ms=$(sed -E 's/.*median frame ([0-9.]+) ms.*/\1/' <<< "$vs")
   ratio=$(awk -v a="$vtk_ms" -v b="$vs_ms" 'BEGIN {printf "%.3f", a / b}')
   echo "| $(basename "$f") ($tf) | $vtk_load, $vtk_ms, $vtk_rss | ${vs#*: } | $ratio |"
+  voxels=$(sed -E 's/^[^:]*: ([0-9]+) voxels.*/\1/' <<< "$vs")
+  echo "$voxels,$vtk_ms,$vs_ms" >> "$csv"
 done
+./target/release/voxsplat bricks --chart "$csv" --chart-out docs/bench/bricks-scaling.svg
+echo
+echo "![bricked volumes against VTK, frame time against voxels](bench/bricks-scaling.svg)"

@@ -154,6 +154,14 @@ fn the_two_level_order_is_pbtf_over_bricks_then_voxels_on_both_engines() {
                 want.retain(|v| kept.contains(v));
                 assert_eq!(got.len(), want.len(), "{kind:?} {v}: drawn voxels are the classified ones");
                 assert_eq!(got, want, "{kind:?} {v} {direction:?}: two-level PBTF");
+                // And the order validator on what is drawn: no 6-neighbour pair against its plane.
+                let drawn = voxsplat::SplatSet::from_fn(grid, |i, j, k| {
+                    kept.contains(&[i, j, k]).then_some([1.0, 1.0, 1.0, 0.5])
+                })
+                .unwrap();
+                let seq: Vec<u32> = got.iter().map(|v| drawn.find(v[0], v[1], v[2]).unwrap() as u32).collect();
+                let bad = voxsplat::order::count_violations(&drawn, &cam, &seq, direction).unwrap();
+                assert_eq!(bad, 0, "{kind:?} {v} {direction:?}: validator violations");
                 views += 1;
             }
         }

@@ -93,6 +93,13 @@ enum Command {
         /// Transfer-function preset for --volume.
         #[arg(long, default_value = "ramp")]
         tf: String,
+        /// Draw the scaling chart from this CSV (voxels,vtk_ms,voxsplat_ms; scripts/bricks-vtk.sh)
+        /// into --chart-out instead.
+        #[arg(long, requires = "chart_out")]
+        chart: Option<PathBuf>,
+        /// The chart's SVG.
+        #[arg(long)]
+        chart_out: Option<PathBuf>,
     },
     /// Render the peers' scene (../shared/peers, issue 9) with every voxsplat mode: median frame
     /// times as CSV on stdout, images into --out-dir; `scripts/peers.sh` runs it beside VTK.
@@ -848,7 +855,10 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Bench(a) => bench(a),
-        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf } => {
+        Command::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => {
+            voxsplat_cli::bricked::scaling_chart(&csv, &svg)
+        }
+        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, .. } => {
             if frames < 1 || size < 16 {
                 return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
             }

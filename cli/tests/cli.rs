@@ -339,7 +339,9 @@ fn bricked_volumes_take_a_budget_and_fall_back_where_they_must() {
     let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/stent/stent.nrrd");
     let png = tmp("stent.png");
     let base = ["render", "--volume", stent, "--tf", "ct", "--size", "40x40", "--out", png.to_str().unwrap()];
-    let out = voxsplat(&[&base[..], &["--gpu-budget-mib", "1"]].concat());
+    // 1 MiB cannot hold even the images of a 400x400 frame (the store would stream).
+    let big = ["render", "--volume", stent, "--tf", "ct", "--size", "400x400", "--out", png.to_str().unwrap()];
+    let out = voxsplat(&[&big[..], &["--gpu-budget-mib", "1"]].concat());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("GPU budget of 1 MiB") && err.contains("the minimum is"), "{err}");
     let out = voxsplat(&[&base[..], &["--gpu-budget-mib", "0"]].concat());
