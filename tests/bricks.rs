@@ -135,3 +135,31 @@ fn a_raw_nrrd_streams_into_the_same_store() {
     assert!(matches!(BrickStore::load(&huge, &Default::default()), Err(voxsplat::Error::TooLarge(_))));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The streamed NRRD path under truncation and header corruption: typed errors or a store, never
+/// a panic; every truncation of the data is an error.
+#[test]
+fn a_streamed_nrrd_survives_truncation_and_corruption() {
+    let dir = std::env::temp_dir().join(format!("voxsplat-bricks-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut rng = Rng(77);
+    let data: Vec<u8> = (0..(9 * 10 * 11)).map(|_| (rng.f32() * 255.0) as u8).collect();
+    let mut good = b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 9 10 11\nencoding: raw\n\n".to_vec();
+    let header = good.len();
+    good.extend_from_slice(&data);
+    let path = dir.join("v.nrrd");
+    let load = |bytes: &[u8]| {
+        std::fs::write(&path, bytes).unwrap();
+        BrickStore::load(&path, &Default::default())
+    };
+    assert!(load(&good).is_ok());
+    for _ in 0..300 {
+        let cut = header + (rng.f32() * data.len() as f32) as usize;
+        assert!(load(&good[..cut.min(good.len() - 1)]).is_err(), "a truncation at {cut} loads");
+        let mut bad = good.clone();
+        let at = (rng.f32() * header as f32) as usize;
+        bad[at] = (rng.f32() * 256.0) as u8;
+        let _ = load(&bad); // an error or a store: no panic
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
