@@ -105,3 +105,43 @@ fn bisect_names_are_parsed_and_checked() {
     let mut cpu = common::cpu();
     assert!(cpu.set_bisect(Some(b)).is_err(), "the CPU backend has no device to split with");
 }
+
+/// A bricked volume splits at every brick stage both ways (the device's buffers, grown by powers
+/// of two, handed to the mirrors and back): right after `brick_cull` or `brick_order` the rest is
+/// the other backend's frame bit for bit; the split frames stay within the mirror tolerance.
+#[test]
+fn bricked_volumes_split_at_the_brick_stages() {
+    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/stent/stent.nrrd");
+    let vol = voxsplat::loaders::load_volume(stent.as_ref(), &Default::default()).unwrap();
+    let tf = voxsplat::classify::TransferFunction::preset("ct").unwrap();
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
+    let (mut gpu, mut cpu) = (common::gpu(), common::cpu());
+    gpu.set_volume(&vol, &tf, None).unwrap();
+    cpu.set_volume(&vol, &tf, None).unwrap();
+    let mut o = RenderOptions::default();
+    o.raster = Raster::Compute;
+    for stage in [StageId::BrickCull, StageId::BrickOrder, StageId::BrickParams, StageId::TileCount] {
+        for split in [Bisect::GpuUntil(stage), Bisect::CpuUntil(stage)] {
+            gpu.set_bisect(Some(split)).unwrap();
+            let s = gpu.render(&cam, &o).unwrap().image;
+            gpu.set_bisect(None).unwrap();
+            let g = gpu.render(&cam, &o).unwrap().image;
+            let c = cpu.render(&cam, &o).unwrap().image;
+            assert!(s.pixels.iter().any(|p| p[3] > 0.1), "{split:?}: something drawn");
+            let most = |a: &ImageF32, b: &ImageF32| {
+                a.pixels
+                    .iter()
+                    .zip(&b.pixels)
+                    .flat_map(|(p, q)| (0..4).map(move |i| (p[i] - q[i]).abs()))
+                    .fold(0.0, f32::max)
+            };
+            assert!(most(&s, &g) <= 2e-3 && most(&s, &c) <= 2e-3, "{split:?}: {} / {}", most(&s, &g), most(&s, &c));
+            // The stages before brick_params compute integers alike: the rest is one backend's.
+            if matches!(stage, StageId::BrickCull | StageId::BrickOrder) {
+                let rest = if matches!(split, Bisect::GpuUntil(_)) { &c } else { &g };
+                assert!(identical(&s, rest), "{split:?}: the other backend's frame bit for bit");
+            }
+        }
+    }
+    assert_clean(&gpu);
+}

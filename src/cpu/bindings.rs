@@ -45,9 +45,12 @@ impl<'a> Bindings<'a> {
         }
     }
 
-    /// A frame buffer as `T`s (empty when it does not exist).
+    /// A frame buffer as `T`s (empty when it does not exist): its whole `T`s, since a buffer
+    /// handed over from the device may be longer than the records it holds (grown by powers of two).
     pub fn get<T: bytemuck::Pod>(&self, res: Res) -> &[T] {
-        self.bufs.get(&res).map(|v| bytemuck::cast_slice(v.as_slice())).unwrap_or(&[])
+        let Some(v) = self.bufs.get(&res) else { return &[] };
+        let words = v.len() / (std::mem::size_of::<T>() / 4).max(1) * (std::mem::size_of::<T>() / 4).max(1);
+        bytemuck::cast_slice(&v[..words])
     }
 
     /// Take a frame buffer out to write it (put it back with `put`).
