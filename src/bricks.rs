@@ -164,9 +164,7 @@ impl BrickStore {
             None => Self::build(&crate::loaders::load_volume(path, hints)?)?,
         };
         if let Some(s) = hints.spacing {
-            if s.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-                return Err(Error::InvalidArgument(format!("{}: spacing must be positive", path.display())));
-            }
+            crate::loaders::check_spacing(s, &path.display().to_string())?;
             store.spacing = s;
         }
         Ok(store)
@@ -268,6 +266,12 @@ fn remap(store: &BrickStore, tf: &TransferFunction) -> (f32, f32) {
         }
         None => (1.0, 0.0),
     }
+}
+
+/// Whether the TF table `table` (`BrickScene::tf_words`) extracts voxels of quantised value `q`
+/// (glsl/shared/brick.glsl's `emits`).
+pub fn emits(table: &[u32], q: u32) -> bool {
+    table[4 * crate::constants::TF_ENTRIES as usize + (q >> 5) as usize] >> (q & 31) & 1 != 0
 }
 
 /// `tf` tabulated per quantised value (see `BrickScene::tf_words`): the classification of a
@@ -373,16 +377,12 @@ impl BrickScene {
     /// table's bits), counted once per transfer function: a streamed store's brick counts.
     pub fn drawn_counts(&self) -> &[u32] {
         self.drawn.get_or_init(|| {
-            let bits = &self.table[4 * crate::constants::TF_ENTRIES as usize..];
-            let emits = |r: u32| bits[(r >> 21) as usize] >> (r >> 16 & 31) & 1 != 0;
             let s = &self.store;
-            s.headers
-                .iter()
-                .map(|h| {
-                    s.records[h.first as usize..(h.first + h.count) as usize].iter().filter(|&&r| emits(r)).count()
-                        as u32
-                })
-                .collect()
+            let drawn = |h: &BrickHeader| {
+                let records = &s.records[h.first as usize..(h.first + h.count) as usize];
+                records.iter().filter(|&&r| emits(&self.table, r >> 16)).count() as u32
+            };
+            s.headers.iter().map(drawn).collect()
         })
     }
 

@@ -133,16 +133,23 @@ impl Res {
                 | Res::Bricks
                 | Res::BrickHeaders
                 | Res::BrickMasks
-                | Res::BrickRecords
-                | Res::BrickRecords1
-                | Res::BrickRecords2
-                | Res::BrickRecords3
-                | Res::BrickRecords4
-                | Res::BrickRecords5
-                | Res::BrickRecords6
-                | Res::BrickRecords7
                 | Res::BrickIndex
-        )
+        ) || self.record_page().is_some()
+    }
+
+    /// Which page of the store's records this binding holds (`BrickRecords` is page 0).
+    pub fn record_page(self) -> Option<u64> {
+        Some(match self {
+            Res::BrickRecords => 0,
+            Res::BrickRecords1 => 1,
+            Res::BrickRecords2 => 2,
+            Res::BrickRecords3 => 3,
+            Res::BrickRecords4 => 4,
+            Res::BrickRecords5 => 5,
+            Res::BrickRecords6 => 6,
+            Res::BrickRecords7 => 7,
+            _ => return None,
+        })
     }
 
     /// An image rather than a buffer.

@@ -179,7 +179,11 @@ impl Renderer {
 
     /// Make `set` the scene (uploaded to the device on the GPU backend).
     pub fn set_scene(&mut self, set: SplatSet) -> Result<()> {
-        let prep = Prepared::new(set);
+        self.install(Prepared::new(set))
+    }
+
+    /// Upload `prep` (GPU backend) and make it the scene.
+    fn install(&mut self, prep: Prepared) -> Result<()> {
         if let Some(g) = &mut self.gpu {
             g.set_scene(&prep)?;
         }
@@ -204,13 +208,9 @@ impl Renderer {
 
     /// Make a bricked volume the scene (see [`Renderer::set_volume`]).
     pub fn set_bricks(&mut self, scene: bricks::BrickScene) -> Result<()> {
+        // The old scene goes first: a large store should not sit beside the new one.
         self.scene = None;
-        let prep = Prepared::bricked(scene)?;
-        if let Some(g) = &mut self.gpu {
-            g.set_scene(&prep)?;
-        }
-        self.scene = Some(prep);
-        Ok(())
+        self.install(Prepared::bricked(scene)?)
     }
 
     /// Classify the bricked volume with another transfer function and shading from the next

@@ -148,7 +148,7 @@ pub fn raw_from_bytes(
     Ok(ScalarVolume { dims, spacing, values: decode(bytes, n, dtype, big_endian, what)? })
 }
 
-fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
+pub(crate) fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
     if s.iter().all(|v| v.is_finite() && *v > 0.0) {
         Ok(())
     } else {

@@ -346,9 +346,9 @@ fn record_bricks(
     e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, largest as u64 * 4)?;
     e.ensure(Res::BrickVoxels, largest as u64 * 8)?;
+    let tiles = w.div_ceil(COMPOSITE_TILE) * h.div_ceil(COMPOSITE_TILE);
     if cull_hidden && batches.len() > 1 {
-        let tiles = w.div_ceil(COMPOSITE_TILE) as u64 * h.div_ceil(COMPOSITE_TILE) as u64;
-        e.ensure(Res::Occlusion, tiles * 4)?;
+        e.ensure(Res::Occlusion, tiles as u64 * 4)?;
         e.ensure(Res::BrickHidden, most_entries * 4)?;
     }
     if !compute {
@@ -359,7 +359,6 @@ fn record_bricks(
         if cull_hidden && i > 0 && !batch.is_empty() {
             let count = batch.len() as u32;
             e.upload(Res::BrickList, &words(&batch))?;
-            let tiles = w.div_ceil(COMPOSITE_TILE) * h.div_ceil(COMPOSITE_TILE);
             e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, &[]))?;
             let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
             e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;

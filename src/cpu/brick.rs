@@ -1,6 +1,7 @@
 //! Mirrors of `brick_cull.comp`, `brick_order.comp` and `brick_params.comp`, and of `glsl/shared/brick.glsl`'s
 //! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer.
 use super::bindings::Bindings;
+use super::order::{outward, side_count};
 use super::splat_params::{footprint_scale, params_of, CULL_RADII};
 use crate::bricks::{BrickStore, BRICK};
 use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
@@ -11,22 +12,6 @@ use crate::image::ImageF32;
 use glam::{Mat4, Vec3, Vec4};
 
 const CELL_WORDS: usize = (BRICK * BRICK * BRICK / 32) as usize;
-
-fn side_count(n: u32, split: u32, side: u32) -> u32 {
-    if side == 0 {
-        split
-    } else {
-        n - split
-    }
-}
-
-fn outward(idx: u32, split: u32, side: u32) -> u32 {
-    if side == 0 {
-        split - 1 - idx
-    } else {
-        idx - split
-    }
-}
 
 /// Mirror of `dense_pbtf`: cell `c`'s position in the PBTF sequence of a dense `n`-cell grid split
 /// at `s`.
@@ -58,7 +43,7 @@ const TF_PREFIX: usize = TF_BITS + TF_ENTRIES as usize / 32;
 impl BrickInputs<'_> {
     /// Mirror of `emits`.
     fn emits(&self, q: u32) -> bool {
-        self.tf[TF_BITS + (q >> 5) as usize] >> (q & 31) & 1 != 0
+        crate::bricks::emits(self.tf, q)
     }
 
     /// Mirror of `emitted_below`.

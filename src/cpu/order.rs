@@ -4,7 +4,8 @@ use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{Frame, Splat};
 
-fn side_count(n: u32, split: u32, side: u32) -> u32 {
+/// Cells of an `n`-cell axis on `side` of `split` (glsl/shared/pbtf.glsl).
+pub(crate) fn side_count(n: u32, split: u32, side: u32) -> u32 {
     if side == 0 {
         split
     } else {
@@ -12,7 +13,8 @@ fn side_count(n: u32, split: u32, side: u32) -> u32 {
     }
 }
 
-fn outward(idx: u32, split: u32, side: u32) -> u32 {
+/// Rank of `idx` on its `side` of `split`, outward from the eye (glsl/shared/pbtf.glsl).
+pub(crate) fn outward(idx: u32, split: u32, side: u32) -> u32 {
     if side == 0 {
         split - 1 - idx
     } else {

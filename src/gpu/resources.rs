@@ -341,18 +341,11 @@ impl Resources {
                     List::Slices(axis) => &self.scene()?.draw[axis as usize],
                     List::SlabPairs => frame_buf(Res::SlabPairs),
                 }),
-                Res::BrickRecords
-                | Res::BrickRecords1
-                | Res::BrickRecords2
-                | Res::BrickRecords3
-                | Res::BrickRecords4
-                | Res::BrickRecords5
-                | Res::BrickRecords6
-                | Res::BrickRecords7 => {
+                page if page.record_page().is_some() => {
                     // Page k of the records, or page 0 again past the store's end.
                     const PAGE: u64 = RECORD_PAGE as u64 * 4;
                     let buf = self.buffer(Res::BrickRecords)?;
-                    let k = res as u64 - Res::BrickRecords as u64;
+                    let k = page.record_page().unwrap_or(0);
                     let (size, at) = (buf.size(), k * PAGE);
                     if at < size {
                         Bind::Range(buf, at, (size - at).min(PAGE))
