@@ -74,9 +74,9 @@ void main() {
     uint tile = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
     uint list_end = tile_start[tile + 1u];
     uint begin = tile_start[tile] + pc.first * TILE_SEGMENT;
-    // A later segment, or any segment of a later batch of a bricked volume (rank_base 1), carries
+    // A later segment, or any segment of a later batch of a bricked volume (carry 1), carries
     // on from the image; with nothing of this list it leaves its pixels as they are.
-    bool carry = pc.first > 0u || pc.rank_base != 0u;
+    bool carry = pc.first > 0u || pc.carry != 0u;
     if (carry && begin >= list_end) return;
     uint end = min(list_end, begin + TILE_SEGMENT);
     const bool btf = BACK_TO_FRONT;

@@ -4,7 +4,8 @@
 # same transfer-function preset and view (scripts/vtk_file.py copies voxsplat's framing camera),
 # 512x512, alternating the two tools file by file in one run. Each voxsplat run is its own process
 # (`voxsplat bricks --volume`: load, store, median frame, peak RSS). Prints a markdown table and
-# draws docs/bench/bricks-scaling.svg (frame time against voxels, both tools).
+# draws docs/bench/bricks-scaling.svg (frame time against voxels, both tools); its CSV,
+# docs/bench/bricks-scaling.csv, is the third panel of the bench's scaling.svg.
 # Installs VTK (PyPI) in a virtual environment when missing, as scripts/peers.sh does.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,7 +27,7 @@ length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat br
 own process per file), 512², 5 frames after a warm-up, medians.
 
 TEXT
-csv=target/bricks-scaling.csv
+csv=docs/bench/bricks-scaling.csv
 echo "voxels,vtk_ms,voxsplat_ms" > "$csv"
 echo "| file | VTK fixed point: load s, median ms, peak RSS MiB | voxsplat bricked, GPU path (1 GiB budget) | VTK ms / voxsplat ms |"
 echo "|---|---|---|---|"

@@ -39,6 +39,13 @@ pub struct BrickHeader {
 
 const _: () = assert!(std::mem::size_of::<BrickHeader>() == 16);
 
+impl BrickHeader {
+    /// The brick's coordinates in the brick grid.
+    pub fn coords(&self) -> [u32; 3] {
+        [self.brick & 1023, (self.brick >> 10) & 1023, self.brick >> 20]
+    }
+}
+
 /// A scalar volume as bricks of compact records.
 #[derive(Clone, Debug)]
 pub struct BrickStore {
@@ -151,12 +158,13 @@ impl BrickStore {
         Ok(store)
     }
 
-    /// Load a volume file as a store (`hints` as `loaders::load_volume` takes them): an
-    /// uncompressed NRRD streams slice by slice, never held whole (volumes past the dense
-    /// loader's `MAX_VOXELS` too); any other file is loaded, cut and dropped.
+    /// Load a volume file as a store (`hints` as `loaders::load_volume` takes them): raw NRRD,
+    /// NIfTI (`.nii.gz` inflated as it is read) and raw files stream slice by slice, never held
+    /// whole (volumes past the dense loader's `MAX_VOXELS` too); a compressed NRRD or an `.npy`
+    /// is loaded, cut and dropped.
     #[cfg(feature = "io")]
     pub fn load(path: &std::path::Path, hints: &crate::loaders::VolumeHints) -> Result<Self> {
-        let mut store = match crate::loaders::SliceReader::nrrd(path)? {
+        let mut store = match crate::loaders::SliceReader::open(path, hints)? {
             Some(mut reader) => {
                 let (dims, spacing) = (reader.dims, reader.spacing);
                 Self::from_slices(dims, spacing, |z0, count, out| reader.read(z0, count, out))?

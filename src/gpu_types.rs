@@ -84,8 +84,7 @@ pub struct FootprintPush {
     pub sheet_mode: u32,
     pub axis: u32,
     pub rank_offset: u32,
-    /// Sheet modes: the batch's first sheet. Tile compositing: 1 = a later batch of a bricked
-    /// volume (carry on from the image).
+    /// Sheet modes: the batch's first sheet.
     pub rank_base: u32,
     pub rank_dir: i32,
     pub slab_z0: f32,
@@ -102,12 +101,18 @@ pub struct FootprintPush {
     pub chunks: u32,
     /// Tile compositing: 1 = the list runs back to front (over), 0 = front to back (under).
     pub back_to_front: u32,
+    /// 1: carry on from what an earlier part drew (a bricked volume's later batch: the target,
+    /// the tile compositor's image, or a sheet batch's layers), 0: start from cleared images.
+    pub carry: u32,
 }
 
 /// `sheet_mode` values (glsl/shared/types.glsl).
 pub const SHEET_MODE_SPLAT: u32 = 0;
 pub const SHEET_MODE_AXIS: u32 = 1;
 pub const SHEET_MODE_SLAB: u32 = 2;
+/// Axis-aligned sheets whose draw list holds (splat, sheet) pairs binned on the device (a bricked
+/// volume's splats have no host-side slice lists).
+pub const SHEET_MODE_BINNED: u32 = 3;
 
 /// Push constants of the slab binning stages (`glsl/shared/slab.glsl`).
 #[repr(C)]
@@ -119,7 +124,9 @@ pub struct SlabPush {
     pub chunks: u32,
     pub ftb: u32,
     pub n: u32,
-    pub pad: [u32; 2],
+    /// `AXIS_SHEETS` builds: the sheet axis (the slabs are the grid's voxel planes along it).
+    pub axis: u32,
+    pub pad: u32,
 }
 
 /// Push constants of `composite.comp`.
@@ -179,6 +186,6 @@ const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 288);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
-const _: () = assert!(std::mem::size_of::<FootprintPush>() == 48);
+const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

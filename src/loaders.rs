@@ -7,6 +7,9 @@ pub use crate::volume::{HeightGrid, ScalarVolume};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+mod slices;
+pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
+
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
 pub const MAX_VOXELS: u64 = 1 << 28;
 /// Most bytes a compressed stream may inflate to.
@@ -278,7 +281,46 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
     let head = if is_gzip(bytes) { gunzip_prefix(bytes, 348, what)? } else { bytes.to_vec() };
     let need_total = nifti_size(&head, what)?;
     let data = if is_gzip(bytes) { gunzip(bytes, need_total, what)? } else { head };
-    let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&data[..]))
+    let l = nifti_layout(&data, MAX_VOXELS, what)?;
+    if l.offset > data.len() as u64 {
+        return Err(bad(what, format!("voxel offset {} outside the file", l.offset)));
+    }
+    let n = l.dims.iter().map(|&d| d as u64).product();
+    let mut values = decode(&data[l.offset as usize..], n, l.dtype, l.big_endian, what)?;
+    l.rescale(&mut values);
+    Ok(ScalarVolume { dims: l.dims, spacing: l.spacing, values })
+}
+
+/// Where a NIfTI-1 file's voxels are and how to read them, from its checked header.
+pub(crate) struct NiftiLayout {
+    pub dims: [u32; 3],
+    pub dtype: DType,
+    /// Byte offset of the voxels.
+    pub offset: u64,
+    pub big_endian: bool,
+    pub spacing: [f32; 3],
+    /// `scl_slope`, `scl_inter` when they change the values.
+    scale: Option<(f32, f32)>,
+}
+
+impl NiftiLayout {
+    /// Apply the header's value scaling.
+    pub fn rescale(&self, values: &mut [f32]) {
+        if let Some((slope, inter)) = self.scale {
+            for v in values {
+                *v = *v * slope + inter;
+            }
+        }
+    }
+}
+
+/// The layout of the NIfTI-1 file whose first bytes are `head` (at least the 348-byte header),
+/// its voxel count checked against `limit`.
+pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiLayout> {
+    if head.len() < 348 {
+        return Err(bad(what, "shorter than a NIfTI-1 header"));
+    }
+    let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&head[..348]))
         .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
     let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
     if dim.is_empty() || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
@@ -288,7 +330,7 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
     for (i, d) in dim.iter().take(3).enumerate() {
         d3[i] = *d as u64;
     }
-    let n = voxel_count(&d3, what)?;
+    voxel_count_within(&d3, what, limit)?;
     let dtype = match header.data_type().map_err(|e| bad(what, format!("NIfTI type: {e}")))? {
         nifti::NiftiType::Uint8 => DType::U8,
         nifti::NiftiType::Uint16 => DType::U16,
@@ -297,24 +339,26 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
         other => return Err(bad(what, format!("unsupported NIfTI type {other:?}"))),
     };
     let off = header.vox_offset;
-    if !(off.is_finite() && off >= 348.0) || off as u64 > data.len() as u64 {
+    if !(off.is_finite() && (348.0..=1e7).contains(&off)) {
         return Err(bad(what, format!("voxel offset {off} outside the file")));
     }
-    let big = header.endianness == nifti::Endianness::Big;
-    let mut values = decode(&data[off as usize..], n, dtype, big, what)?;
     let (slope, inter) = (header.scl_slope, header.scl_inter);
-    if slope.is_finite() && slope != 0.0 && (slope != 1.0 || inter != 0.0) && inter.is_finite() {
-        for v in &mut values {
-            *v = *v * slope + inter;
-        }
-    }
+    let scale = (slope.is_finite() && slope != 0.0 && (slope != 1.0 || inter != 0.0) && inter.is_finite())
+        .then_some((slope, inter));
     let mut spacing = [1.0f32; 3];
     for (s, p) in spacing.iter_mut().zip(&header.pixdim[1..4]) {
         if p.is_finite() && p.abs() > 0.0 {
             *s = p.abs();
         }
     }
-    Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
+    Ok(NiftiLayout {
+        dims: d3.map(|d| d as u32),
+        dtype,
+        offset: off as u64,
+        big_endian: header.endianness == nifti::Endianness::Big,
+        spacing,
+        scale,
+    })
 }
 
 /// The first `n` inflated bytes of a gzip stream (fewer if it is shorter).
@@ -461,86 +505,6 @@ pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
         v.spacing = s;
     }
     Ok(v)
-}
-
-/// Most voxels of a volume streamed slice by slice into a bricked store (`SliceReader`): 2^34,
-/// with the host's available memory checked against the store's worst case.
-pub const MAX_STREAMED_VOXELS: u64 = 1 << 34;
-
-/// An uncompressed NRRD volume read z-slices at a time, so a bricked store is built from it
-/// without the volume in memory (`BrickStore::from_slices`).
-pub struct SliceReader {
-    file: std::fs::File,
-    offset: u64,
-    /// Voxels along x, y, z.
-    pub dims: [u32; 3],
-    /// Voxel spacing.
-    pub spacing: [f32; 3],
-    dtype: DType,
-    big_endian: bool,
-    what: String,
-    bytes: Vec<u8>,
-}
-
-impl SliceReader {
-    /// `path` when it is an NRRD with raw (uncompressed) data, attached or detached; `None` for
-    /// any other file (load it whole with `load_volume`). Sizes are checked against
-    /// `MAX_STREAMED_VOXELS` and the data's length before anything is read.
-    pub fn nrrd(path: &Path) -> Result<Option<Self>> {
-        let what = path.display().to_string();
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
-        if !(name.ends_with(".nrrd") || name.ends_with(".nhdr")) {
-            return Ok(None);
-        }
-        let io = |p: &Path| {
-            let p = p.display().to_string();
-            move |e| Error::Io { path: p, source: e }
-        };
-        let mut file = std::fs::File::open(path).map_err(io(path))?;
-        let mut head = Vec::new();
-        (&mut file).take(1 << 20).read_to_end(&mut head).map_err(io(path))?;
-        let h = nrrd_header(&head, &what, MAX_STREAMED_VOXELS)?;
-        if h.encoding != "raw" {
-            return Ok(None);
-        }
-        let (file, offset, data_path) = match &h.data_file {
-            Some(f) => {
-                let p = path.parent().ok_or_else(|| bad(&what, "detached data file without a directory"))?.join(f);
-                (std::fs::File::open(&p).map_err(io(&p))?, 0, p)
-            }
-            None => (file, h.data_start as u64, path.to_path_buf()),
-        };
-        let len = file.metadata().map_err(io(&data_path))?.len();
-        let need = h.voxels * h.dtype.size() as u64;
-        if len < offset + need {
-            return Err(bad(&what, format!("data is truncated: {} bytes for {need}", len.saturating_sub(offset))));
-        }
-        Ok(Some(Self {
-            file,
-            offset,
-            dims: h.dims.map(|d| d as u32),
-            spacing: h.spacing,
-            dtype: h.dtype,
-            big_endian: h.big_endian,
-            what,
-            bytes: Vec::new(),
-        }))
-    }
-
-    /// Slices `z0..z0 + count` (x fastest) into `out`.
-    pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
-        use std::io::{Seek, SeekFrom};
-        let plane = self.dims[0] as u64 * self.dims[1] as u64;
-        let sample = self.dtype.size() as u64;
-        let n = plane * count as u64;
-        self.bytes.resize((n * sample) as usize, 0);
-        let io = |e| Error::Io { path: self.what.clone(), source: e };
-        self.file.seek(SeekFrom::Start(self.offset + plane * z0 as u64 * sample)).map_err(io)?;
-        let io = |e| Error::Io { path: self.what.clone(), source: e };
-        self.file.read_exact(&mut self.bytes).map_err(io)?;
-        *out = decode(&self.bytes, n, self.dtype, self.big_endian, &self.what)?;
-        Ok(())
-    }
 }
 
 /// Load heights from a 16-bit (or 8-bit) PNG, a GeoTIFF / TIFF, or a 2D `.npy`.

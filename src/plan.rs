@@ -4,7 +4,7 @@
 use crate::camera::Camera;
 use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE_H, RASTER_TILE_W, TILE_CHUNK, WORKGROUP_SIZE};
 use crate::error::Result;
-use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS};
+use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS, SHEET_MODE_BINNED};
 use crate::kernel::Kernel;
 use crate::options::{Antialias, Motion, RenderOptions, EWA_LOWPASS_PX};
 use crate::order::{self, Direction};
@@ -133,9 +133,41 @@ pub fn sheet_axis(camera: &Camera) -> usize {
 pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_layers: u32) -> (usize, Vec<Batch>) {
     let axis = sheet_axis(camera);
     let split = order::pbtf_split(&prep.set, camera)[axis];
-    let n = prep.set.grid().dims[axis];
-    let offsets = &prep.slices[axis].0;
-    let nonempty = |s: &u32| offsets[*s as usize + 1] > offsets[*s as usize];
+    let base = prep.rank_offsets[axis];
+    let push =
+        FootprintPush { sheet_mode: SHEET_MODE_AXIS, axis: axis as u32, rank_offset: base, ..Default::default() };
+    let rank_of = |s: u32| Some(prep.ranks[(base + s) as usize]);
+    (axis, sheet_batches(&prep.slices[axis].0, split, &rank_of, push, direction, max_layers))
+}
+
+/// The sheet batches of a bricked volume's frame, whose sheets `binned_sheets` grouped by index
+/// (`offsets`: each sheet's first entry, sheets + 1 entries) on the device: ranked by index, so a
+/// batch's layers include its empty sheets (a batch of empty sheets only is dropped).
+pub fn binned_sheet_plan(
+    offsets: &[u32],
+    axis: usize,
+    split: u32,
+    direction: Direction,
+    max_layers: u32,
+) -> Vec<Batch> {
+    let push = FootprintPush { sheet_mode: SHEET_MODE_BINNED, axis: axis as u32, ..Default::default() };
+    sheet_batches(offsets, split, &|_| None, push, direction, max_layers)
+}
+
+/// Batches of at most `max_layers` sheets of a slice-grouped list (`offsets`), per side of the
+/// eye's plane (`split`), in visiting order. `rank_of` gives a sheet's rank among non-empty sheets
+/// (empty sheets skipped), or `None`: sheets ranked by index.
+fn sheet_batches(
+    offsets: &[u32],
+    split: u32,
+    rank_of: &dyn Fn(u32) -> Option<u32>,
+    push: FootprintPush,
+    direction: Direction,
+    max_layers: u32,
+) -> Vec<Batch> {
+    let n = offsets.len().saturating_sub(1) as u32;
+    let split = split.min(n);
+    let nonempty = |s: &u32| offsets[*s as usize + 1] > offsets[*s as usize] || rank_of(*s).is_none();
     let low: Vec<u32> = (0..split).rev().filter(nonempty).collect();
     let high: Vec<u32> = (split..n).filter(nonempty).collect();
     let mut sides = vec![low, high];
@@ -145,7 +177,6 @@ pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_la
             s.reverse();
         }
     }
-    let rank_of = |s: u32| prep.ranks[(prep.rank_offsets[axis] + s) as usize];
     let mut batches = Vec::new();
     for side in &sides {
         for chunk in side.chunks(max_layers.max(1) as usize) {
@@ -153,22 +184,22 @@ pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_la
             let (lo, hi) = (first.min(last), first.max(last));
             let start = offsets[lo as usize];
             let end = offsets[hi as usize + 1];
+            if end == start {
+                continue;
+            }
             batches.push(Batch {
                 first_instance: start,
                 instances: end - start,
                 layers: chunk.len() as u32,
                 push: FootprintPush {
-                    sheet_mode: SHEET_MODE_AXIS,
-                    axis: axis as u32,
-                    rank_offset: prep.rank_offsets[axis],
-                    rank_base: rank_of(first),
+                    rank_base: rank_of(first).unwrap_or(first),
                     rank_dir: if last >= first { 1 } else { -1 },
-                    ..Default::default()
+                    ..push
                 },
             });
         }
     }
-    (axis, batches)
+    batches
 }
 
 /// Push constants of the tile binning and compositing stages for a draw list of `n` entries on a

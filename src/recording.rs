@@ -3,22 +3,28 @@
 //! [`Engine`]. Where the host must read a count back mid-frame (the slab starts, the tile lists'
 //! starts and the loop-budget word), the engine finishes the work so far; the recording is still
 //! written once, for every engine.
-use crate::bricks::{BrickScene, BRICK};
+mod bricked;
 use crate::camera::Camera;
 use crate::constants::{
-    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, MAX_GPU_SPLATS, RASTER_TILE_H, RASTER_TILE_W, RECORD_PAGE, SPLAT_PAGE,
-    TILE_BIN_WORKGROUP, TILE_SEGMENT,
+    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, RECORD_PAGE, SPLAT_PAGE, TILE_BIN_WORKGROUP,
+    TILE_SEGMENT,
 };
 use crate::cpu::footprint::Blend;
 use crate::cpu::raycast::RaycastOptions;
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickPush, FootprintPush, Frame, ScreenQuad, SplatParams, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{
+    BrickPush, FootprintPush, Frame, ScreenQuad, SlabPush, SplatParams, SHEET_MODE_BINNED, SHEET_MODE_SLAB,
+    SHEET_MODE_SPLAT,
+};
 use crate::image::ImageF32;
 use crate::options::{Composite, RenderOptions, StageTime};
 use crate::order::{Direction, OrderKind};
 use crate::plan::{self, groups_1d, Prepared};
 use crate::raster::Raster;
 use crate::stages::{Dispatch, Engine, List, Res, StageId, Workgroup};
+pub use bricked::{
+    bricked_min_budget, bricked_resident_bytes, BATCH_BYTES_PER_SPLAT, HIDDEN_BATCHES, HIDDEN_BATCH_MIN,
+};
 use std::time::Instant;
 
 /// Bits of the status word (binding 17): a binning invocation, or a footprint-sum invocation, made
@@ -35,13 +41,13 @@ pub fn one_page(n: u32) -> usize {
 
 /// The footprint draw's variant.
 pub fn footprint_variant(blend: Blend, points: bool, mode: u32) -> usize {
-    let base = match (blend, mode) {
-        (Blend::Over, _) => 0,
-        (Blend::Under, _) => 1,
-        (Blend::Add, m) if m == SHEET_MODE_SLAB => 3,
-        (Blend::Add, _) => 2,
-    };
-    base + 4 * points as usize
+    match (blend, mode) {
+        (Blend::Add, m) if m == SHEET_MODE_BINNED => 8 + points as usize,
+        (Blend::Over, _) => 4 * points as usize,
+        (Blend::Under, _) => 1 + 4 * points as usize,
+        (Blend::Add, m) if m == SHEET_MODE_SLAB => 3 + 4 * points as usize,
+        (Blend::Add, _) => 2 + 4 * points as usize,
+    }
 }
 
 /// The tile compositor's variant for a scene of `n` splats, the frame's push constants and
@@ -89,7 +95,7 @@ pub struct Recorded {
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
     camera.validate()?;
     if let Some(scene) = &prep.bricks {
-        return record_bricks(e, prep, scene, camera, opts);
+        return bricked::record_bricks(e, prep, scene, camera, opts);
     }
     let set = &prep.set;
     let (w, h) = (camera.width, camera.height);
@@ -137,14 +143,8 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
     }
 
     // Sheet and slab modes: summation layers in batches, composited in visiting order.
-    let limits = e.limits();
-    let mut layers = opts.batch_layers(w, h).min(limits.max_layers.max(1));
-    let layer_bytes = w as u64 * h as u64 * 16;
-    if compute {
-        // The fixed-point layers are one storage binding: no more than its range allows.
-        layers = layers.min((limits.max_storage_range / layer_bytes.max(1)).clamp(1, u32::MAX as u64) as u32);
-    }
-    let (list, mut batches) = if opts.composite == Composite::Sheet {
+    let layers = sheet_layers(e, opts, w, h);
+    let (list, batches) = if opts.composite == Composite::Sheet {
         if n > 0 {
             e.run(&params())?;
         }
@@ -152,21 +152,80 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
         (List::Slices(axis as u8), batches)
     } else {
         let pc = crate::slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, direction)?;
-        let push = bytemuck::bytes_of(&pc);
-        e.ensure(Res::SlabCounts, pc.slabs as u64 * pc.chunks as u64 * 4)?;
-        e.ensure(Res::SlabStart, (pc.slabs as u64 + 1) * 4)?;
         if n > 0 {
             e.run(&params())?;
         }
-        e.run(&Dispatch::new(StageId::SlabCount, 0, groups_1d(pc.chunks), List::Order, push))?;
-        e.run(&Dispatch::new(StageId::SlabScan, 0, [1, 1, 1], List::Order, push))?;
-        let starts = e.read(&[(Res::SlabStart, pc.slabs as usize + 1)])?.remove(0);
-        let batches = crate::slab::slab_batches(&pc, &starts, layers)?;
-        e.ensure(Res::SlabPairs, starts[pc.slabs as usize] as u64 * 8)?;
-        e.run(&Dispatch::new(StageId::SlabScatter, 0, groups_1d(pc.chunks), List::Order, push))?;
-        (List::SlabPairs, batches)
+        let starts = record_slab_bins(e, &pc, 0)?;
+        (List::SlabPairs, crate::slab::slab_batches(&pc, &starts, layers)?)
     };
+    record_sheets(e, list, batches, opts, w, h)
+}
+
+/// The slab binning stages (`variant` 1: a bricked batch's axis-aligned sheets) over the splats'
+/// parameters: (splat, slab) pairs grouped by slab in visiting order (`Res::SlabPairs`). Returns
+/// each slab's first pair (slabs + 1 entries, read back to cut the batches).
+fn record_slab_bins(e: &mut dyn Engine, pc: &SlabPush, variant: usize) -> Result<Vec<u32>> {
+    let push = bytemuck::bytes_of(pc);
+    e.ensure(Res::SlabCounts, pc.slabs as u64 * pc.chunks as u64 * 4)?;
+    e.ensure(Res::SlabStart, (pc.slabs as u64 + 1) * 4)?;
+    e.run(&Dispatch::new(StageId::SlabCount, variant, groups_1d(pc.chunks), List::Order, push))?;
+    e.run(&Dispatch::new(StageId::SlabScan, 0, [1, 1, 1], List::Order, push))?;
+    let starts = e.read(&[(Res::SlabStart, pc.slabs as usize + 1)])?.remove(0);
+    let total = starts[pc.slabs as usize] as u64;
+    if total > crate::slab::MAX_SLAB_PAIRS {
+        let limit = crate::slab::MAX_SLAB_PAIRS;
+        return Err(Error::TooLarge(format!("{total} splat-slab pairs (limit {limit}): use thicker slabs")));
+    }
+    e.ensure(Res::SlabPairs, total * 8)?;
+    e.run(&Dispatch::new(StageId::SlabScatter, variant, groups_1d(pc.chunks), List::Order, push))?;
+    Ok(starts)
+}
+
+/// Summation layers a sheet batch may use at `w` x `h`: the options' memory budget, the device's
+/// layer limit and, for the fixed-point layers (one storage binding), its range.
+fn sheet_layers(e: &dyn Engine, opts: &RenderOptions, w: u32, h: u32) -> u32 {
+    let limits = e.limits();
+    let layers = opts.batch_layers(w, h).min(limits.max_layers.max(1));
+    let layer_bytes = w as u64 * h as u64 * 16;
+    if opts.raster == Raster::Compute {
+        layers.min((limits.max_storage_range / layer_bytes.max(1)).clamp(1, u32::MAX as u64) as u32)
+    } else {
+        layers
+    }
+}
+
+/// Sheet and slab modes after binning: each batch's sheets summed into layers (footprint draws
+/// or, with the compute raster, fixed-point sums), then composited onto the frame in visiting order.
+fn record_sheets(
+    e: &mut dyn Engine,
+    list: List,
+    mut batches: Vec<plan::Batch>,
+    opts: &RenderOptions,
+    w: u32,
+    h: u32,
+) -> Result<Recorded> {
     plan::set_early_termination(opts, &mut batches);
+    let tiles_pass = plan::sheet_tiles_pay(&batches, w, h);
+    begin_sheets(e, list, &batches, opts, w, h, tiles_pass)?;
+    for b in &batches {
+        sum_sheets(e, list, b, opts, b.first_instance, b.instances, false)?;
+        composite_sheets(e, list, b, opts, w, h)?;
+    }
+    finish(e, Res::Accum, w, h, opts.raster == Raster::Compute)
+}
+
+/// The sheet modes' images and per-frame state for `batches`; with `tiles_pass`, `sheet_tiles`
+/// finds each composite tile's sheet range over the batches' whole list.
+fn begin_sheets(
+    e: &mut dyn Engine,
+    list: List,
+    batches: &[plan::Batch],
+    opts: &RenderOptions,
+    w: u32,
+    h: u32,
+    tiles_pass: bool,
+) -> Result<()> {
+    let compute = opts.raster == Raster::Compute;
     // Allocate only as many layers as the largest batch needs.
     let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
     e.layers(layers)?;
@@ -176,7 +235,7 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
     e.fill(Res::Accum, None, 0)?;
     e.fill(Res::Occlusion, None, 1.0f32.to_bits())?;
     if compute {
-        e.ensure(Res::Fixed, layer_bytes * layers as u64)?;
+        e.ensure(Res::Fixed, w as u64 * h as u64 * 16 * layers as u64)?;
         e.ensure(Res::Status, 4)?;
         e.fill(Res::Status, None, 0)?;
     }
@@ -184,235 +243,57 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
         e.fill(Res::SheetTiles, Some((0, tiles)), range[0])?;
         e.fill(Res::SheetTiles, Some((tiles, tiles)), range[1])
     };
-    match batches.first().filter(|_| plan::sheet_tiles_pay(&batches, w, h)) {
-        None => halves(e, plan::ALL_SHEETS)?,
+    match batches.first().filter(|_| tiles_pass) {
+        None => halves(e, plan::ALL_SHEETS),
         Some(first) => {
             // No sheet reaches any tile until the pass says so.
             halves(e, [u32::MAX, 0])?;
-            let slab = first.push.sheet_mode == SHEET_MODE_SLAB;
-            let push = plan::sheet_tiles_push(&batches, first);
-            let variant = 2 * slab as usize + points as usize;
+            let push = plan::sheet_tiles_push(batches, first);
+            let variant = 2 * (first.push.sheet_mode as usize - 1) + (opts.raster == Raster::Points) as usize;
             let groups = groups_1d(push.count);
-            e.run(&Dispatch::new(StageId::SheetTiles, variant, groups, list, bytemuck::bytes_of(&push)))?;
+            e.run(&Dispatch::new(StageId::SheetTiles, variant, groups, list, bytemuck::bytes_of(&push)))
         }
     }
-    for b in &batches {
-        let slab = b.push.sheet_mode == SHEET_MODE_SLAB;
-        if compute {
-            e.fill(Res::Fixed, None, 0)?;
-            let push = FootprintPush { first: b.first_instance, count: b.instances, ..b.push };
-            let groups = groups_1d(b.instances);
-            e.run(&Dispatch::new(StageId::FootprintSum, slab as usize, groups, list, bytemuck::bytes_of(&push)))?;
-        } else {
-            let variant = footprint_variant(Blend::Add, points, b.push.sheet_mode);
-            let groups = [b.first_instance, b.instances, 0];
-            e.run(&Dispatch::new(StageId::Footprint, variant, groups, list, bytemuck::bytes_of(&b.push)))?;
-        }
-        let push = plan::composite_push(b, btf, w, h);
-        let groups = tile_groups(StageId::Composite, w, h);
-        e.run(&Dispatch::new(StageId::Composite, compute as usize, groups, list, bytemuck::bytes_of(&push)))?;
-    }
-    finish(e, Res::Accum, w, h, compute)
 }
 
-/// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
-/// voxel (8),
-/// and for the tile compositor its screen quad (80) and about four tile entries.
-pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 8 + 80 + 16;
-
-/// What a bricked frame keeps resident besides its batches under `budget`: the store (without its
-/// records when they stream, `BrickScene::streams`; then the per-brick counts), the brick index,
-/// the draw-order slots and visible list, and the images.
-pub fn bricked_resident_bytes(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
-    let s = &scene.store;
-    let store = if scene.streams(budget) {
-        s.bytes() - s.records.len() as u64 * 4 + s.headers.len() as u64 * 4
-    } else {
-        s.bytes()
-    };
-    store + s.index.len() as u64 * (4 + 4 + 16) + width as u64 * height as u64 * 16 * 3
-}
-
-/// The least budget that draws `scene` at `width` x `height`: resident data and one brick's splats
-/// (and records, when they stream).
-pub fn bricked_min_budget(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
-    let brick = (BRICK as u64).pow(3) * (BATCH_BYTES_PER_SPLAT + 4 * scene.streams(budget) as u64);
-    bricked_resident_bytes(scene, budget, width, height) + brick
-}
-
-/// A bricked volume's frame (issue 23): `brick_cull` culls whole bricks on the device (outside
-/// the view, or empty under the transfer function) and counts the rest's voxels at their slots in
-/// the brick grid's PBTF order; the host lists the visible bricks in that order and cuts batches
-/// that fit the budget; per batch `brick_order` writes their voxels in two-level PBTF order,
-/// `brick_params` classifies them and makes their parameters, and the raster draws them, each
-/// batch carrying on from the image the earlier left. Front to back with early termination, before
-/// each later batch `tile_occlusion` and `brick_hidden` drop the bricks that the image so far
-/// already hides. A store whose records would take more than half the budget keeps them on the
-/// host: each batch uploads its bricks' records, and the bricks' drawn counts come from the host.
-fn record_bricks(
+/// Sum `count` entries of the list from `first` into batch `b`'s layers; `carry`: onto what an
+/// earlier part of the batch summed (a bricked volume streamed in parts), else onto cleared layers.
+fn sum_sheets(
     e: &mut dyn Engine,
-    prep: &Prepared,
-    scene: &BrickScene,
-    camera: &Camera,
+    list: List,
+    b: &plan::Batch,
     opts: &RenderOptions,
-) -> Result<Recorded> {
-    if opts.composite != Composite::Splat || opts.order != OrderKind::Pbtf {
-        return Err(Error::Unsupported(
-            "a bricked volume is drawn per splat in PBTF order (composite splat, order pbtf); the sheet and slab modes \
-             and the other orders need a classified splat set"
-                .into(),
-        ));
-    }
-    let (w, h) = (camera.width, camera.height);
-    let budget = e.limits().budget_bytes;
-    let streamed = scene.streams(budget);
-    if streamed && (scene.shading().is_some() || scene.transfer_function().gradient_weight > 0.0) {
-        return Err(Error::Unsupported(format!(
-            "this volume's store ({} MiB) streams through the {} MiB GPU budget, and gradients (shading, gradient \
-             weighting) read neighbouring bricks that a batch does not hold: a budget of at least {} MiB keeps it \
-             resident",
-            scene.store.bytes() >> 20,
-            budget >> 20,
-            (scene.store.records.len() as u64 * 8).div_ceil(1 << 20) + 1
-        )));
-    }
-    let least = bricked_min_budget(scene, budget, w, h);
-    if budget < least {
-        return Err(Error::TooLarge(format!(
-            "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB) and one brick of splats at \
-             {w}x{h}: the minimum is {} MiB",
-            budget >> 20,
-            scene.store.bytes() >> 20,
-            least.div_ceil(1 << 20)
-        )));
-    }
-    let available = budget - bricked_resident_bytes(scene, budget, w, h);
-    let frame = plan::frame_for(&prep.set, camera, opts);
-    let bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
-    let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
-    // The brick stages' build: one page of store records, the paged reader, or streamed records.
-    let build = if streamed { 2 } else { usize::from(scene.store.len() > RECORD_PAGE as usize) };
-    e.begin(&frame, opts.kernel, w, h)?;
-    e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
-    e.upload(Res::Tf, scene.tf_words())?;
-    if streamed {
-        let counts = scene.drawn_counts();
-        e.ensure(Res::BrickCounts, counts.len().max(1) as u64 * 4)?;
-        e.upload(Res::BrickCounts, counts)?;
-    }
-    e.ensure(Res::BrickSlots, slots as u64 * 4)?;
-    e.fill(Res::BrickSlots, None, 0)?;
-    if bf.grid[3] > 0 {
-        e.run(&Dispatch::new(StageId::BrickCull, build, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
-    }
-    let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
-    let t = Instant::now();
-    let compute = opts.raster == Raster::Compute;
-    // Front to back with early termination, later batches drop the bricks that what is drawn
-    // already hides: cut the frame into a few batches even when it fits one.
-    let cull_hidden = compute
-        && opts.cull_hidden_bricks
-        && opts.direction() == Direction::FrontToBack
-        && opts.early_termination > 0.0;
-    let capacity = if cull_hidden {
-        let total: u32 = slot_words.iter().map(|w| w & 1023).sum();
-        MAX_GPU_SPLATS.min(total.div_ceil(HIDDEN_BATCHES).max(HIDDEN_BATCH_MIN))
+    first: u32,
+    count: u32,
+    carry: bool,
+) -> Result<()> {
+    let push = FootprintPush { first, count, carry: carry as u32, ..b.push };
+    if opts.raster == Raster::Compute {
+        if !carry {
+            e.fill(Res::Fixed, None, 0)?;
+        }
+        let variant = b.push.sheet_mode as usize - 1;
+        e.run(&Dispatch::new(StageId::FootprintSum, variant, groups_1d(count), list, bytemuck::bytes_of(&push)))
     } else {
-        MAX_GPU_SPLATS
-    };
-    // The visible bricks in draw order (header, first position in its batch, first record: in
-    // the store, or in the batch's records when they stream; voxels), cut between bricks into
-    // batches of at most `capacity` splats whose bytes fit what the budget leaves.
-    let mut batches: Vec<Vec<[u32; 4]>> = vec![Vec::new()];
-    let (mut filled, mut records, mut bytes) = (0u32, 0u32, 0u64);
-    for word in slot_words.into_iter().filter(|&w| w != 0) {
-        let (header, n) = (word >> 10, word & 1023);
-        let hd = &scene.store.headers[header as usize];
-        let cost = n as u64 * BATCH_BYTES_PER_SPLAT + if streamed { hd.count as u64 * 4 } else { 0 };
-        let open = batches.last().is_some_and(|b| !b.is_empty());
-        if open && (filled + n > capacity || bytes + cost > available) {
-            batches.push(Vec::new());
-            (filled, records, bytes) = (0, 0, 0);
-        }
-        let first = if streamed { records } else { hd.first };
-        batches.last_mut().expect("one batch at least").push([header, filled, first, n]);
-        (filled, records, bytes) = (filled + n, records + hd.count, bytes + cost);
+        let variant = footprint_variant(Blend::Add, opts.raster == Raster::Points, b.push.sheet_mode);
+        e.run(&Dispatch::new(StageId::Footprint, variant, [first, count, 0], list, bytemuck::bytes_of(&push)))
     }
-    e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
-    let splats = |b: &[[u32; 4]]| b.last().map(|l| l[1] + l[3]).unwrap_or(0);
-    let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
-    e.ensure(Res::BrickList, most_entries * 16)?;
-    let largest = batches.iter().map(|b| splats(b)).max().unwrap_or(0);
-    e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
-    e.ensure(Res::Order, largest as u64 * 4)?;
-    e.ensure(Res::BrickVoxels, largest as u64 * 8)?;
-    let tiles = w.div_ceil(COMPOSITE_TILE) * h.div_ceil(COMPOSITE_TILE);
-    if cull_hidden && batches.len() > 1 {
-        e.ensure(Res::Occlusion, tiles as u64 * 4)?;
-        e.ensure(Res::BrickHidden, most_entries * 4)?;
-    }
-    if !compute {
-        e.layers(1)?;
-    }
-    let words = |b: &[[u32; 4]]| b.iter().flatten().copied().collect::<Vec<u32>>();
-    for (i, mut batch) in batches.into_iter().enumerate() {
-        if cull_hidden && i > 0 && !batch.is_empty() {
-            let count = batch.len() as u32;
-            e.upload(Res::BrickList, &words(&batch))?;
-            e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, &[]))?;
-            let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
-            e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
-            let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
-            batch = batch.into_iter().zip(hidden).filter(|(_, h)| *h == 0).map(|(l, _)| l).collect();
-            let (mut at, mut rec) = (0, 0);
-            for l in &mut batch {
-                l[1] = at;
-                at += l[3];
-                if streamed {
-                    l[2] = rec;
-                    rec += scene.store.headers[l[0] as usize].count;
-                }
-            }
-        }
-        let n = splats(&batch);
-        if !batch.is_empty() {
-            if streamed {
-                // The batch's bricks' records, in list order.
-                let s = &scene.store;
-                let recs: Vec<u32> = batch
-                    .iter()
-                    .flat_map(|l| {
-                        let hd = &s.headers[l[0] as usize];
-                        s.records[hd.first as usize..(hd.first + hd.count) as usize].iter().copied()
-                    })
-                    .collect();
-                e.upload(Res::BatchRecords, &recs)?;
-            }
-            e.upload(Res::BrickList, &words(&batch))?;
-            let push = BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 };
-            let push = bytemuck::bytes_of(&push);
-            let groups = plan::groups_per_item(batch.len() as u32);
-            e.run(&Dispatch::new(StageId::BrickOrder, build, groups, List::Order, push))?;
-            e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, push))?;
-        }
-        if compute {
-            record_tiles(e, &frame, n, opts, w, h, i > 0)?;
-        } else {
-            let blend = if opts.direction() == Direction::BackToFront { Blend::Over } else { Blend::Under };
-            let variant = footprint_variant(blend, opts.raster == Raster::Points, SHEET_MODE_SPLAT);
-            // A later batch draws on the target (the LOAD pass).
-            let push = FootprintPush { rank_base: u32::from(i > 0), ..Default::default() };
-            e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
-        }
-    }
-    finish(e, if compute { Res::Accum } else { Res::Color }, w, h, false)
 }
 
-/// Front to back with early termination, a bricked frame is cut into at least this many batches
-/// (of at least `HIDDEN_BATCH_MIN` splats), so later batches can drop hidden bricks.
-pub const HIDDEN_BATCHES: u32 = 4;
-/// See `HIDDEN_BATCHES`.
-pub const HIDDEN_BATCH_MIN: u32 = 1 << 16;
+/// Composite batch `b`'s layers onto the frame.
+fn composite_sheets(
+    e: &mut dyn Engine,
+    list: List,
+    b: &plan::Batch,
+    opts: &RenderOptions,
+    w: u32,
+    h: u32,
+) -> Result<()> {
+    let compute = opts.raster == Raster::Compute;
+    let push = plan::composite_push(b, opts.direction() == Direction::BackToFront, w, h);
+    let groups = tile_groups(StageId::Composite, w, h);
+    e.run(&Dispatch::new(StageId::Composite, compute as usize, groups, list, bytemuck::bytes_of(&push)))
+}
 
 /// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
 /// shorter chunks when an invocation ran out of llvmpipe's loop budget), then composite each
@@ -428,7 +309,7 @@ fn record_tiles(
 ) -> Result<()> {
     let (tx, ty) = crate::cpu::tile::tile_grid(frame);
     let tiles = tx as u64 * ty as u64;
-    let mut push = FootprintPush { rank_base: carry as u32, ..plan::tile_push(opts, n, w, h) };
+    let mut push = FootprintPush { carry: carry as u32, ..plan::tile_push(opts, n, w, h) };
     let most = (crate::raster::MAX_TILE_CELLS / tiles.max(1)).min(push.count.max(1) as u64) as u32;
     e.ensure(Res::Quads, n as u64 * std::mem::size_of::<ScreenQuad>() as u64)?;
     e.ensure(Res::TileStart, (tiles + 1) * 4)?;

@@ -69,8 +69,42 @@ pub fn slab_geometry(frame: &Frame, grid: &Grid, n: usize, thickness: f32, direc
         chunks: chunks as u32,
         ftb: (direction == Direction::FrontToBack) as u32,
         n: n as u32,
-        pad: [0; 2],
+        axis: 0,
+        pad: 0,
     })
+}
+
+/// The slabs (first, last) that voxels with grid indices in the box `lo..=hi` may reach: their
+/// depths lie between the box corners', and their kernels reach no further than `slab_geometry`
+/// allows any splat's (the same bound the binning widens by). Splits a bricked frame's slabs
+/// between its bricks.
+pub fn box_slabs(pc: &SlabPush, frame: &Frame, grid: &Grid, lo: [u32; 3], hi: [u32; 3]) -> (u32, u32) {
+    let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+    let (eye, forward) = (v3(frame.eye), v3(frame.forward));
+    let (mut near, mut far) = (f32::INFINITY, f32::NEG_INFINITY);
+    for c in 0..8u32 {
+        let ijk = [0, 1, 2].map(|a| if c >> a & 1 == 1 { hi[a] } else { lo[a] });
+        let d = (grid.position(ijk) - eye).dot(forward);
+        near = near.min(d);
+        far = far.max(d);
+    }
+    let scale = footprint_scale(frame, near.max(1e-6)).max(footprint_scale(frame, far.max(1e-6)));
+    let r = frame.spacing[3] * scale * 1.001;
+    let slab_of = |z: f32| ((z - pc.z0) / pc.dz).floor().clamp(0.0, (pc.slabs - 1) as f32) as u32;
+    (slab_of(near - r), slab_of(far + r))
+}
+
+/// A bricked volume's axis-aligned sheets as the binning stages' push constants (`AXIS_SHEETS`
+/// builds): one bin per voxel plane along `axis`, in index order, for `n` splats.
+pub fn sheet_geometry(grid: &Grid, n: u32, axis: usize) -> Result<SlabPush> {
+    let slabs = grid.dims[axis].max(1);
+    let chunks = n.div_ceil(SLAB_CHUNK).max(1);
+    if slabs as u64 * chunks as u64 > MAX_SLAB_CELLS {
+        return Err(Error::TooLarge(format!(
+            "{slabs} sheets x {chunks} splat chunks exceed {MAX_SLAB_CELLS} binning cells: draw this volume per splat"
+        )));
+    }
+    Ok(SlabPush { z0: 0.0, dz: 1.0, slabs, chunks, ftb: 1, n, axis: axis as u32, pad: 0 })
 }
 
 /// The batches of at most `max_layers` consecutive slabs in visiting order, from each slab's first

@@ -12,7 +12,8 @@ use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
 use crate::gpu_types::{
-    BrickPush, CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_SLAB, SHEET_MODE_SPLAT,
+    BrickPush, CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB,
+    SHEET_MODE_SPLAT,
 };
 
 pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, List, Pass, Res, Variant, Workgroup};
@@ -57,7 +58,9 @@ const fn d(blend: Blend, points: bool, pass: Pass, spec: &'static [u32]) -> Vari
 
 const ORDER: &[Res] = &[Res::Frame, Res::Splats, Res::RowStart, Res::RowSplit, Res::Segments, Res::Order];
 const PARAMS: &[Res] = &[Res::Frame, Res::Splats, Res::Params, Res::ParamsHi];
-const SLAB: &[Res] = &[Res::Params, Res::SlabCounts, Res::SlabPairs, Res::SlabStart, Res::ParamsHi];
+const SLAB: &[Res] = &[Res::Params, Res::SlabCounts, Res::SlabPairs, Res::SlabStart, Res::ParamsHi, Res::BrickVoxels];
+/// Slabs along the view; a bricked volume's axis-aligned sheets binned by voxel plane (`AXIS_SHEETS`).
+const SLAB_BUILDS: &[Variant] = &[v("", &[]), v("AXIS_SHEETS", &[])];
 const COMPOSITE: &[Res] = &[Res::Sums, Res::Accum, Res::Occlusion, Res::Fixed, Res::SheetTiles];
 /// glsl/shared/footprint.glsl's bindings, shared by every footprint-reading stage.
 const FOOTPRINT: &[Res] = &[
@@ -235,7 +238,7 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "slab_bins",
         device_build: None,
-        variants: ONE,
+        variants: SLAB_BUILDS,
         mirror: crate::cpu::slab::slab_count_stage,
     },
     StageDesc {
@@ -259,7 +262,7 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "slab_bins",
         device_build: None,
-        variants: ONE,
+        variants: SLAB_BUILDS,
         mirror: crate::cpu::slab::slab_scatter_stage,
     },
     StageDesc {
@@ -346,12 +349,14 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "sheet_tiles",
         device_build: None,
-        // [axis quads, axis points, slab quads, slab points].
+        // [axis, slab, binned] x [quads or compute sums, points].
         variants: &[
             v("", &[SHEET_MODE_AXIS, 0]),
             v("", &[SHEET_MODE_AXIS, 1]),
             v("", &[SHEET_MODE_SLAB, 0]),
             v("", &[SHEET_MODE_SLAB, 1]),
+            v("", &[SHEET_MODE_BINNED, 0]),
+            v("", &[SHEET_MODE_BINNED, 1]),
         ],
         mirror: crate::cpu::sheet_tiles::sheet_tiles_stage,
     },
@@ -374,6 +379,8 @@ pub const STAGES: &[StageDesc] = &[
             d(Blend::Under, true, Pass::Target, &[SHEET_MODE_SPLAT, 1]),
             d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_AXIS, 1]),
             d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_SLAB, 1]),
+            d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_BINNED, 0]),
+            d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_BINNED, 1]),
         ],
         mirror: crate::cpu::footprint::footprint_stage,
     },
@@ -386,7 +393,8 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "footprint",
         device_build: Some((Feature::Int64Atomics, "SUM64")),
-        variants: &[v("", &[SHEET_MODE_AXIS]), v("", &[SHEET_MODE_SLAB])],
+        // Indexed by `sheet_mode - 1`.
+        variants: &[v("", &[SHEET_MODE_AXIS]), v("", &[SHEET_MODE_SLAB]), v("", &[SHEET_MODE_BINNED])],
         mirror: crate::cpu::footprint::footprint_sum_stage,
     },
     StageDesc {

@@ -379,3 +379,98 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
         }
     }
 }
+
+#[test]
+fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classification() {
+    use voxsplat::Composite;
+    let vol = blob([37, 29, 23]);
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let mut rng = Rng(23);
+    // Outside, and inside the volume (the sheets split at the eye's plane).
+    let cams = [Camera::framing(&grid, 96, 80), random_camera(&mut rng, &grid, ViewKind::Inside)];
+    let shading = Some(Shading::headlight(cams[0].forward()));
+    for (shading, what) in [(None, "plain"), (shading, "shaded")] {
+        let (mut g, mut c) = (renderer(true, None), renderer(false, None));
+        g.set_volume(&vol, &tf(), shading).unwrap();
+        c.set_volume(&vol, &tf(), shading).unwrap();
+        let mut dense = renderer(true, None);
+        dense.set_scene(classify(&vol, &tf(), shading).unwrap()).unwrap();
+        for (v, cam) in cams.iter().enumerate() {
+            for composite in [Composite::Sheet, Composite::Slab] {
+                for (raster, direction) in [
+                    (Raster::Compute, Direction::FrontToBack),
+                    (Raster::Compute, Direction::BackToFront),
+                    (Raster::Graphics, Direction::BackToFront),
+                    (Raster::Points, Direction::FrontToBack),
+                ] {
+                    if v == 1 && raster == Raster::Points {
+                        continue; // footprints next to the eye pass the widest point sprite
+                    }
+                    let mut o = opts(raster, direction);
+                    o.composite = composite;
+                    // Small batches: several batches of layers per frame.
+                    o.sheet_budget_bytes = 6 * cam.width as u64 * cam.height as u64 * 16;
+                    let tag = format!("{what} view {v} {composite:?} {raster:?} {direction:?}");
+                    let a = g.render(cam, &o).unwrap().image;
+                    let b = c.render(cam, &o).unwrap().image;
+                    assert!(a.pixels.iter().any(|p| p[3] > 0.05), "{tag}: something drawn");
+                    let (most, mean) = diff(&a, &b);
+                    assert!(most <= 2e-3 && mean <= 1e-5, "{tag}: GPU vs mirror {most} / {mean}");
+                    // The same splats in the same sheets: only the stored values' 16-bit
+                    // quantisation (and, for float sums, the summation order) differ.
+                    let d = dense.render(cam, &o).unwrap().image;
+                    let (most, mean) = diff(&a, &d);
+                    assert!(most <= 2e-3 && mean <= 2e-5, "{tag}: bricked vs dense {most} / {mean}");
+                }
+            }
+        }
+        assert_clean(&g);
+        assert_clean(&dense);
+    }
+    // Through a budget that holds a fraction of the visible voxels, the sheets stream: per batch
+    // of sheets, the bricks that reach it, part by part. Fixed-point sums are exact whatever the
+    // order, so the compute frames are the same bit for bit; float sums differ in rounding only.
+    let cam = &cams[0];
+    let sheet_budget = 6 * cam.width as u64 * cam.height as u64 * 16;
+    for gpu in [true, false] {
+        let mut whole = renderer(gpu, None);
+        whole.set_volume(&vol, &tf(), None).unwrap();
+        let least = voxsplat::recording::bricked_min_budget(whole.volume().unwrap(), u64::MAX, 96, 80);
+        let splats = whole.volume().unwrap().store.len() as u64;
+        let budget = least + 2 * sheet_budget + splats / 6 * voxsplat::recording::BATCH_BYTES_PER_SPLAT;
+        let mut small = renderer(gpu, Some(budget));
+        small.set_volume(&vol, &tf(), None).unwrap();
+        for composite in [Composite::Sheet, Composite::Slab] {
+            for (raster, direction) in [
+                (Raster::Compute, Direction::FrontToBack),
+                (Raster::Compute, Direction::BackToFront),
+                (Raster::Graphics, Direction::BackToFront),
+                (Raster::Points, Direction::FrontToBack),
+            ] {
+                let mut o = opts(raster, direction);
+                (o.composite, o.sheet_budget_bytes) = (composite, sheet_budget);
+                let tag = format!("gpu {gpu} {composite:?} {raster:?} {direction:?}");
+                let a = whole.render(cam, &o).unwrap().image;
+                let b = small.render(cam, &o).unwrap().image;
+                assert!(a.pixels.iter().any(|p| p[3] > 0.05), "{tag}: something drawn");
+                if raster == Raster::Compute {
+                    assert!(a.pixels == b.pixels, "{tag}: streamed sheets change the frame");
+                } else {
+                    let (most, _) = diff(&a, &b);
+                    assert!(most <= 1e-5, "{tag}: streamed sheets change the frame by {most}");
+                }
+            }
+        }
+        // Below the layers and one brick of splats: a typed error naming what to change.
+        let mut tiny = renderer(gpu, Some(least + 4096));
+        tiny.set_volume(&vol, &tf(), None).unwrap();
+        let mut o = compute(Direction::FrontToBack);
+        (o.composite, o.sheet_budget_bytes) = (Composite::Sheet, sheet_budget);
+        let err = tiny.render(cam, &o).unwrap_err();
+        assert!(matches!(err, Error::TooLarge(ref m) if m.contains("--sheet-budget-mib")), "{err}");
+        if gpu {
+            assert_clean(&whole);
+            assert_clean(&small);
+        }
+    }
+}

@@ -163,3 +163,52 @@ fn a_streamed_nrrd_survives_truncation_and_corruption() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// NIfTI (plain, and gzip inflated as it is read, a pass going back restarting the stream) and raw
+/// files stream into the same store as the volume loaded whole; truncations are typed errors.
+#[test]
+fn nifti_and_raw_files_stream_into_the_same_store() {
+    let dir = std::env::temp_dir().join(format!("voxsplat-bricks-nii-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let gz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bonsai/bonsai.nii.gz");
+    let packed = std::fs::read(&gz).unwrap();
+    let plain = voxsplat::loaders::gunzip(&packed, 1 << 26, "bonsai").unwrap();
+    let nii = dir.join("bonsai.nii");
+    std::fs::write(&nii, &plain).unwrap();
+    let whole = BrickStore::build(&voxsplat::loaders::load_volume(&gz, &Default::default()).unwrap()).unwrap();
+    assert!(whole.len() > 1_000_000, "{} stored voxels", whole.len());
+    let same = |s: &BrickStore, what: &str| {
+        assert_eq!((s.dims, s.spacing, s.range), (whole.dims, whole.spacing, whole.range), "{what}");
+        assert!(s.headers == whole.headers && s.masks == whole.masks && s.records == whole.records, "{what}");
+    };
+    same(&BrickStore::load(&gz, &Default::default()).unwrap(), "nii.gz");
+    same(&BrickStore::load(&nii, &Default::default()).unwrap(), "nii");
+    // The same voxels as a raw file with its dims and type.
+    let offset = plain.len() - whole.dims.iter().product::<u32>() as usize;
+    let raw = dir.join("bonsai.raw");
+    std::fs::write(&raw, &plain[offset..]).unwrap();
+    let hints = voxsplat::loaders::VolumeHints {
+        dims: Some(whole.dims),
+        dtype: Some(voxsplat::loaders::DType::U8),
+        spacing: Some(whole.spacing),
+        ..Default::default()
+    };
+    same(&BrickStore::load(&raw, &hints).unwrap(), "raw");
+    // Truncated: the plain file and the raw one before reading, the gzip stream while it inflates.
+    let cut = |path: &std::path::Path, bytes: &[u8], at: usize, h: &voxsplat::loaders::VolumeHints| {
+        std::fs::write(path, &bytes[..at]).unwrap();
+        BrickStore::load(path, h)
+    };
+    for frac in [0.1, 0.5, 0.999] {
+        let at = |n: usize| (n as f64 * frac) as usize;
+        let err = cut(&nii, &plain, at(plain.len()), &Default::default()).unwrap_err();
+        assert!(
+            matches!(err, voxsplat::Error::InvalidArgument(ref m) if m.contains("truncated") || m.contains("NIfTI")),
+            "{err}"
+        );
+        let err = cut(&dir.join("t.nii.gz"), &packed, at(packed.len()).max(400), &Default::default()).unwrap_err();
+        assert!(matches!(err, voxsplat::Error::InvalidArgument(_)), "{err}");
+        assert!(cut(&raw, &plain[offset..], at(plain.len() - offset), &hints).is_err());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

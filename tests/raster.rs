@@ -459,10 +459,10 @@ fn slab_bins(
 ) -> (Vec<u32>, Vec<voxsplat::plan::Batch>) {
     let mut counts = vec![0u32; (pc.slabs * pc.chunks) as usize];
     let mut start = vec![0u32; pc.slabs as usize + 1];
-    voxsplat::cpu::slab_count(pc, params, &mut counts);
+    voxsplat::cpu::slab_count(pc, params, None, &mut counts);
     voxsplat::cpu::slab_scan(pc, &mut counts, &mut start);
     let batches = voxsplat::slab::slab_batches(pc, &start, 1 << 16).unwrap();
     let mut pairs = vec![0u32; 2 * start[pc.slabs as usize] as usize];
-    voxsplat::cpu::slab_scatter(pc, params, &mut counts, &mut pairs);
+    voxsplat::cpu::slab_scatter(pc, params, None, &mut counts, &mut pairs);
     (pairs, batches)
 }

@@ -573,12 +573,18 @@ pub fn write_scaling_csv(points: &[ScalePoint], path: &Path) -> Result<()> {
     std::fs::write(path, s).map_err(io_err(path))
 }
 
-/// Log-log time against size for both scaling series.
-pub fn scaling_svg(points: &[ScalePoint], path: &Path) -> Result<()> {
+/// Log-log time against size for both scaling series and, with `bricks` (rows of
+/// `crate::bricked::read_scaling_csv`), a third panel: bricked volumes up to 10⁹ voxels beside
+/// VTK's fixed-point caster on the same files.
+pub fn scaling_svg(points: &[ScalePoint], bricks: Option<&[(f64, f64, f64)]>, path: &Path) -> Result<()> {
     use plotters::prelude::*;
-    let root = SVGBackend::new(path, (900, 420)).into_drawing_area();
+    let panels = 2 + bricks.is_some() as usize;
+    let root = SVGBackend::new(path, (450 * panels as u32, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-    let halves = root.split_evenly((1, 2));
+    let halves = root.split_evenly((1, panels));
+    if let (Some(rows), Some(area)) = (bricks, halves.get(2)) {
+        crate::bricked::bricks_panel(area, rows, "bricked volumes vs VTK fixed point, 512^2", path)?;
+    }
     let colours = [BLUE, GREEN, RED];
     for (area, what) in halves.iter().zip(["splats", "image"]) {
         let series = |raster: Raster| -> Vec<(f64, f64)> {

@@ -294,8 +294,7 @@ struct SceneArgs {
     #[arg(long, conflicts_with = "cpu")]
     bisect: Option<voxsplat::Bisect>,
     /// Classify --volume on the host into a splat set (as before the bricked store): needed by the
-    /// sheet and slab modes, the other orders, --truth, --raycast and --k-line, which pick it
-    /// themselves. Without it a volume is a bricked store classified on the device.
+    /// other orders, --truth, --raycast and --k-line, which pick it themselves. Without it a volume is a bricked store classified on the device.
     #[arg(long)]
     dense: bool,
     /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
@@ -603,12 +602,7 @@ fn run(cli: Cli) -> Result<()> {
             let order = a.scene.order.parse::<OrderKind>()?;
             let composite = a.composite.parse::<Composite>()?;
             // A volume is a bricked store classified on the device unless a mode needs host splats.
-            let host_splats = a.scene.dense
-                || composite != Composite::Splat
-                || order != OrderKind::Pbtf
-                || a.truth
-                || a.raycast.is_some()
-                || a.k_line;
+            let host_splats = a.scene.dense || order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line;
             let bricked = match &a.scene.volume {
                 Some(path) if !host_splats => Some(load_bricked(&a.scene, path)?),
                 _ => None,
@@ -812,8 +806,8 @@ fn run(cli: Cli) -> Result<()> {
                     dtype: dtype.as_deref().map(str::parse).transpose()?,
                     ..Default::default()
                 };
-                // Past the dense loader (an uncompressed NRRD of more than MAX_VOXELS): the store only.
-                if let Some(reader) = voxsplat::loaders::SliceReader::nrrd(&file)? {
+                // Past the dense loader (a file read slice by slice, of more than MAX_VOXELS): the store only.
+                if let Some(reader) = voxsplat::loaders::SliceReader::open(&file, &hints)? {
                     let voxels: u64 = reader.dims.iter().map(|&d| d as u64).product();
                     if voxels > voxsplat::loaders::MAX_VOXELS {
                         let store = voxsplat::bricks::BrickStore::load(&file, &hints)?;
@@ -996,7 +990,10 @@ fn bench(a: BenchArgs) -> Result<()> {
             if a.quick { (&[22, 46], &[128, 256]) } else { (&[22, 46, 100, 146], &[128, 256, 512, 1024, 2048]) };
         let s = scaling(&mut r, cubes, images, 5, |msg| eprintln!("{msg}"))?;
         write_scaling_csv(&s, &a.out_dir.join("scaling.csv"))?;
-        scaling_svg(&s, &a.out_dir.join("scaling.svg"))?;
+        // The bricked volumes' series (scripts/bricks-vtk.sh, run first by scripts/results.sh).
+        let bricks = a.out_dir.join("bricks-scaling.csv");
+        let bricks = bricks.exists().then(|| voxsplat_cli::bricked::read_scaling_csv(&bricks)).transpose()?;
+        scaling_svg(&s, bricks.as_deref(), &a.out_dir.join("scaling.svg"))?;
         s
     };
     if let Some(path) = &a.results {

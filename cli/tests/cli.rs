@@ -332,7 +332,8 @@ fn make_volume_writes_readable_large_test_volumes() {
 }
 
 /// A bricked volume through the CLI: a budget below the store and one brick of splats names the
-/// minimum, a zero budget is refused, the sheet modes fall back to host-classified splats, and
+/// minimum, a zero budget is refused, the other orders fall back to host-classified splats, the
+/// sheet modes draw the bricks, and
 /// `bricks --volume` measures one file.
 #[test]
 fn bricked_volumes_take_a_budget_and_fall_back_where_they_must() {
@@ -348,10 +349,13 @@ fn bricked_volumes_take_a_budget_and_fall_back_where_they_must() {
     assert!(
         !out.status.success() && String::from_utf8_lossy(&out.stderr).contains("--gpu-budget-mib must be positive")
     );
-    // Sheets need host-classified splats: picked without --dense.
-    let out = voxsplat(&[&base[..], &["--composite", "sheet", "--validation"]].concat());
+    // Other orders need host-classified splats: picked without --dense. The sheets draw bricks.
+    let out = voxsplat(&[&base[..], &["--order", "btf", "--validation"]].concat());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && err.contains("bytes per splat") && !err.contains("stored voxels in"), "{err}");
+    let out = voxsplat(&[&base[..], &["--composite", "sheet", "--validation"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("stored voxels in"), "{err}");
     let out = voxsplat(&[&base[..], &["--validation"]].concat());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(

@@ -24,8 +24,7 @@ layout(push_constant) uniform Push {
     uint sheet_mode;   // SHEET_MODE_*
     uint axis;         // sheet axis
     uint rank_offset;  // start of this axis in sheet_rank
-    uint rank_base;    // rank of the batch's first sheet (slab mode: its first slab); tile
-                       // compositing: 1 = a later batch, carrying on from the image
+    uint rank_base;    // rank of the batch's first sheet (slab mode: its first slab)
     int rank_dir;      // +1 or -1: direction of the batch in rank space
     float slab_z0;     // slab mode: eye-space depth of slab 0's near face
     float slab_dz;     // slab mode: slab thickness (world units)
@@ -36,6 +35,8 @@ layout(push_constant) uniform Push {
     uint count;        // compute raster: entries in the batch (tile binning: in the list)
     uint chunks;       // tile binning: draw-list chunks of ceil(count / chunks) entries
     uint back_to_front;// tile compositing: 1 = the list runs back to front
+    uint carry;        // 1: a later part of a bricked frame, carrying on from the image (and
+                       // layers) an earlier part drew
 } pc;
 
 const vec2 CORNERS[4] = vec2[](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
@@ -67,9 +68,9 @@ bool occluded(SplatParams p) {
     return true;
 }
 
-// The splat of draw-list entry e (slab mode: the list holds (splat, slab) pairs).
+// The splat of draw-list entry e (slab and binned modes: the list holds (splat, slab or sheet) pairs).
 uint entry_splat(uint e) {
-    return SHEET_MODE == SHEET_MODE_SLAB ? draw_list[2u * e] : draw_list[e];
+    return SHEET_MODE == SHEET_MODE_SLAB || SHEET_MODE == SHEET_MODE_BINNED ? draw_list[2u * e] : draw_list[e];
 }
 
 // The summation layer of entry e within its batch and, in slab mode, the slab's faces relative to
@@ -82,8 +83,10 @@ int entry_layer(uint e, uint splat, SplatParams p, out vec2 faces) {
         float near_face = pc.slab_z0 + float(slab) * pc.slab_dz - p.screen.x;
         faces = vec2(near_face, near_face + pc.slab_dz) / radius;
         return pc.rank_dir > 0 ? int(slab - pc.rank_base) : int(pc.rank_base - slab);
-    } else if (SHEET_MODE == SHEET_MODE_AXIS) {
-        uint rank = sheet_rank[pc.rank_offset + splats[splat].ijk[pc.axis]];
+    } else if (SHEET_MODE == SHEET_MODE_AXIS || SHEET_MODE == SHEET_MODE_BINNED) {
+        // Binned sheets (a bricked volume's) are ranked by their index: empty ones keep a layer.
+        uint rank = SHEET_MODE == SHEET_MODE_BINNED ? draw_list[2u * e + 1u]
+                                                    : sheet_rank[pc.rank_offset + splats[splat].ijk[pc.axis]];
         return pc.rank_dir > 0 ? int(rank - pc.rank_base) : int(pc.rank_base - rank);
     }
     return 0;

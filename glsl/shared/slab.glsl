@@ -7,7 +7,7 @@ layout(push_constant) uniform SlabPush {
     uint chunks;    // splat chunks of SLAB_CHUNK (columns of the count matrix)
     uint ftb;       // 1: slabs visited near to far, 0: far to near
     uint n;         // splat count
-    uint pad0;
+    uint axis;      // AXIS_SHEETS: the sheet axis
     uint pad1;
 } pc;
 
@@ -21,11 +21,18 @@ uint slab_of(float z) {
 }
 
 // First and last slab the splat's kernel overlaps (a hair wide, so no slice is ever dropped);
-// false for a culled splat.
-bool slab_range(SplatParams p, out uint first, out uint last) {
+// false for a culled splat. AXIS_SHEETS builds (a bricked volume's axis-aligned sheets): the
+// splat's voxel plane along pc.axis, read from the batch's voxels (brick_order).
+bool slab_range(uint s, SplatParams p, out uint first, out uint last) {
     if (p.center.w == 0.0) return false;
+#ifdef AXIS_SHEETS
+    uvec2 v = voxels[s];
+    first = pc.axis == 0u ? v.x & 0xffffu : (pc.axis == 1u ? v.x >> 16u : v.y & 0xffffu);
+    last = first;
+#else
     float r = length(p.axis_v.xyz) * 1.0001;
     first = slab_of(p.screen.x - r);
     last = slab_of(p.screen.x + r);
+#endif
     return true;
 }

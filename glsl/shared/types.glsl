@@ -104,6 +104,7 @@ struct RaycastParams {
 #define SHEET_MODE_SPLAT 0u  // per-splat over / under compositing
 #define SHEET_MODE_AXIS 1u   // axis-aligned sheet summation
 #define SHEET_MODE_SLAB 2u   // image-aligned sheets (slabs)
+#define SHEET_MODE_BINNED 3u // axis-aligned sheets binned on the device: (splat, sheet) pairs
 
 #define KERNEL_GAUSSIAN 0u
 #define KERNEL_CUBIC 1u

@@ -210,12 +210,8 @@ pub fn brick_hidden(
             .all(|y| (t0.x as i64..=t1.x as i64).all(|x| occlusion[(y * tiles_x + x) as usize] <= push.occluded))
     };
     for (e, entry) in list[push.first as usize..(push.first + push.count) as usize].iter().enumerate() {
-        hidden[e] = u32::from(is_hidden(brick_coords(inputs.store.headers[entry[0] as usize].brick)));
+        hidden[e] = u32::from(is_hidden(inputs.store.headers[entry[0] as usize].coords()));
     }
-}
-
-fn brick_coords(packed: u32) -> [u32; 3] {
-    [packed & 1023, (packed >> 10) & 1023, packed >> 20]
 }
 
 fn local_cell(l: u32) -> [u32; 3] {
@@ -227,7 +223,7 @@ fn local_cell(l: u32) -> [u32; 3] {
 pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut [u32]) {
     let store = inputs.store;
     for (h, hd) in store.headers.iter().enumerate() {
-        let b = brick_coords(hd.brick);
+        let b = hd.coords();
         if inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) || inputs.outside_view(b) {
             continue;
         }
@@ -258,7 +254,7 @@ pub fn brick_order(
     let (store, frame) = (inputs.store, inputs.frame);
     for entry in &list[push.first as usize..(push.first + push.count) as usize] {
         let hd = store.headers[entry[0] as usize];
-        let b = brick_coords(hd.brick);
+        let b = hd.coords();
         let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
         let records = &records[entry[2] as usize..(entry[2] + hd.count) as usize];
         let mut cells = [0u32; CELL_WORDS];

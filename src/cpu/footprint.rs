@@ -8,7 +8,7 @@ use super::ImageF32;
 use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
 use crate::dispatch::{Args, Pass, Res, Variant};
 use crate::error::Result;
-use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_SLAB};
+use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB};
 pub use crate::kernel::sample_radial;
 use glam::{DMat4, DVec3, DVec4, IVec4, Mat3, Mat4, Vec2, Vec3, Vec4};
 
@@ -68,7 +68,8 @@ pub(crate) fn entry<'a>(
     e: u32,
 ) -> Option<(usize, usize, Weight<'a>)> {
     let slab_mode = push.sheet_mode == SHEET_MODE_SLAB;
-    let splat = if slab_mode { inputs.draw_list[2 * e as usize] } else { inputs.draw_list[e as usize] } as usize;
+    let pairs = slab_mode || push.sheet_mode == SHEET_MODE_BINNED;
+    let splat = if pairs { inputs.draw_list[2 * e as usize] } else { inputs.draw_list[e as usize] } as usize;
     let p = &inputs.params[splat];
     if p.center[3] == 0.0 || (push.occluded > 0.0 && occluded(inputs, p, push.occluded)) {
         return None;
@@ -85,8 +86,13 @@ pub(crate) fn entry<'a>(
         } else {
             push.rank_base.wrapping_sub(slab)
         }
-    } else if push.sheet_mode == SHEET_MODE_AXIS {
-        let rank = inputs.sheet_rank[(push.rank_offset + inputs.splats[splat].ijk[push.axis as usize]) as usize];
+    } else if push.sheet_mode == SHEET_MODE_AXIS || push.sheet_mode == SHEET_MODE_BINNED {
+        // Binned sheets (a bricked volume's) are ranked by their index: empty ones keep a layer.
+        let rank = if pairs {
+            inputs.draw_list[2 * e as usize + 1]
+        } else {
+            inputs.sheet_rank[(push.rank_offset + inputs.splats[splat].ijk[push.axis as usize]) as usize]
+        };
         if push.rank_dir > 0 {
             rank.wrapping_sub(push.rank_base)
         } else {
@@ -382,14 +388,15 @@ fn raster_quad(
 }
 
 /// The draw: the raster target or the summation layers are cleared (the render pass's load) and
-/// the footprints drawn into them; a later batch of a bricked volume (`rank_base` 1) draws on the
-/// raster target as it is.
+/// the footprints drawn into them; a later part of a bricked frame (`carry` 1) draws on them as
+/// they are.
 pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let state = v.draw.expect("footprint variants are draws");
     let push: FootprintPush = d.push_as();
     let mut layers = match state.pass {
-        Pass::Target if push.rank_base != 0 => vec![std::mem::replace(&mut b.color, ImageF32::new(0, 0))],
+        Pass::Target if push.carry != 0 => vec![std::mem::replace(&mut b.color, ImageF32::new(0, 0))],
         Pass::Target => vec![ImageF32::new(b.width, b.height)],
+        Pass::Sheet if push.carry != 0 => std::mem::take(&mut b.sums),
         Pass::Sheet => vec![ImageF32::new(b.width, b.height); b.sums.len()],
     };
     let inputs = b.inputs(d.list);

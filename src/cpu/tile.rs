@@ -115,7 +115,7 @@ pub fn tile_scatter(
 }
 
 /// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it
-/// unless `push.rank_base` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
+/// unless `push.carry` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
 /// order, whichever GPU lane composites it.
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
@@ -135,7 +135,7 @@ pub fn tile_composite(
         // Segment `push.first`: TILE_SEGMENT entries of the list, carrying the pixel across segments.
         let list_end = tile_start[tile + 1] as usize;
         let begin = tile_start[tile] as usize + (push.first * TILE_SEGMENT) as usize;
-        let carry = push.first > 0 || push.rank_base != 0;
+        let carry = push.first > 0 || push.carry != 0;
         if carry && begin >= list_end {
             return;
         }

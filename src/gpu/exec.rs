@@ -167,16 +167,17 @@ fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3],
                 Kind::Draw => {
                     let state = desc.variants[d.variant].draw.expect("draw variants carry raster state");
                     let (first, count) = (d.args.groups[0], d.args.groups[1]);
+                    let carry = d.args.push_as::<crate::gpu_types::FootprintPush>().carry != 0;
                     match state.pass {
+                        // A later part of a bricked frame (push carry 1) draws on what the earlier left.
                         Pass::Target => {
-                            // A later batch (push rank_base 1) draws on what the earlier left.
-                            let carry = d.args.push_as::<crate::gpu_types::FootprintPush>().rank_base != 0;
                             let pass = if carry { &gpu.pipes.target_load_pass } else { &gpu.pipes.target_pass };
                             rec.begin_pass(pass, &target.color_fb);
                             layouts[2] = IL::TRANSFER_SRC_OPTIMAL;
                         }
                         Pass::Sheet => {
-                            rec.begin_pass(&gpu.pipes.sheet_pass, &target.sums_fb);
+                            let pass = if carry { &gpu.pipes.sheet_load_pass } else { &gpu.pipes.sheet_pass };
+                            rec.begin_pass(pass, &target.sums_fb);
                             layouts[1] = IL::GENERAL;
                         }
                     }

@@ -45,6 +45,8 @@ pub struct Pipelines {
     /// The same, drawing on the target (a later batch of a bricked volume).
     pub target_load_pass: RenderPass,
     pub sheet_pass: RenderPass,
+    /// The same, summing onto the layers (a later part of a bricked volume's sheet batch).
+    pub sheet_load_pass: RenderPass,
 }
 
 impl Pipelines {
@@ -52,11 +54,12 @@ impl Pipelines {
         let target_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL, false)?;
         let target_load_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL, true)?;
         let sheet_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::GENERAL, false)?;
+        let sheet_load_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::GENERAL, true)?;
         let mut stages = Vec::with_capacity(STAGES.len());
         for desc in STAGES.iter() {
             stages.push(build(ctx, desc, &target_pass, &sheet_pass)?);
         }
-        Ok(Self { stages, target_pass, target_load_pass, sheet_pass })
+        Ok(Self { stages, target_pass, target_load_pass, sheet_pass, sheet_load_pass })
     }
 }
 

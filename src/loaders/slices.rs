@@ -1,0 +1,224 @@
+//! Volumes read a few z-slices at a time, so a bricked store is built without the volume in
+//! memory (`BrickStore::from_slices`): uncompressed NRRD (attached or detached), NIfTI-1 (`.nii`,
+//! and `.nii.gz` inflated as it is read) and raw files with their dims and type. Every size comes
+//! from a checked header and is checked against the file's length (a gzip stream's against what it
+//! inflates to, as it is read) before a slice is read.
+use super::{bad, decode, is_gzip, nifti_layout, nrrd_header, raw_sidecar, sidecar_hints, DType, VolumeHints};
+use crate::error::{Error, Result};
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+
+/// Most voxels of a volume streamed slice by slice into a bricked store (`SliceReader`): 2^34,
+/// with the host's available memory checked against the store's worst case.
+pub const MAX_STREAMED_VOXELS: u64 = 1 << 34;
+
+/// Where the samples come from.
+enum Source {
+    File(std::fs::File),
+    /// A gzip stream, inflated from its start again whenever a read goes back (a store's build
+    /// reads the volume twice, front to back).
+    Gzip {
+        path: PathBuf,
+        stream: Box<dyn Read + Send>,
+        at: u64,
+    },
+}
+
+fn open_gzip(path: &Path) -> std::io::Result<Box<dyn Read + Send>> {
+    let file = std::io::BufReader::with_capacity(1 << 16, std::fs::File::open(path)?);
+    Ok(Box::new(flate2::read::MultiGzDecoder::new(file)))
+}
+
+impl Source {
+    /// `buf.len()` bytes from byte `at` of the (inflated) data.
+    fn read_at(&mut self, at: u64, buf: &mut [u8]) -> std::io::Result<()> {
+        match self {
+            Source::File(f) => {
+                f.seek(SeekFrom::Start(at))?;
+                f.read_exact(buf)
+            }
+            Source::Gzip { path, stream, at: pos } => {
+                if at < *pos {
+                    (*stream, *pos) = (open_gzip(path)?, 0);
+                }
+                let skip = at - *pos;
+                if std::io::copy(&mut stream.by_ref().take(skip), &mut std::io::sink())? < skip {
+                    return Err(std::io::ErrorKind::UnexpectedEof.into());
+                }
+                stream.read_exact(buf)?;
+                *pos = at + buf.len() as u64;
+                Ok(())
+            }
+        }
+    }
+}
+
+/// A volume file read z-slices at a time.
+pub struct SliceReader {
+    source: Source,
+    offset: u64,
+    /// Voxels along x, y, z.
+    pub dims: [u32; 3],
+    /// Voxel spacing.
+    pub spacing: [f32; 3],
+    dtype: DType,
+    big_endian: bool,
+    /// NIfTI value scaling.
+    rescale: Option<super::NiftiLayout>,
+    what: String,
+    bytes: Vec<u8>,
+}
+
+fn io_err(p: &Path) -> impl FnOnce(std::io::Error) -> Error {
+    let p = p.display().to_string();
+    move |e| Error::Io { path: p, source: e }
+}
+
+impl SliceReader {
+    /// `path` read slice by slice when its format allows (see the module), else `None` (load it
+    /// whole with `load_volume`: compressed NRRD, `.npy`). `hints` as `load_volume` takes them
+    /// (a raw file's dims and type); sizes are checked against `MAX_STREAMED_VOXELS` and the
+    /// data's length before anything is read.
+    pub fn open(path: &Path, hints: &VolumeHints) -> Result<Option<Self>> {
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+        if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
+            Self::nrrd(path)
+        } else if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+            Self::nifti(path).map(Some)
+        } else if name.ends_with(".npy") {
+            Ok(None)
+        } else {
+            Self::raw(path, hints).map(Some)
+        }
+    }
+
+    /// `path` when it is an NRRD with raw (uncompressed) data, attached or detached; `None` for
+    /// any other encoding.
+    pub fn nrrd(path: &Path) -> Result<Option<Self>> {
+        let what = path.display().to_string();
+        let mut file = std::fs::File::open(path).map_err(io_err(path))?;
+        let mut head = Vec::new();
+        (&mut file).take(1 << 20).read_to_end(&mut head).map_err(io_err(path))?;
+        let h = nrrd_header(&head, &what, MAX_STREAMED_VOXELS)?;
+        if h.encoding != "raw" {
+            return Ok(None);
+        }
+        let (file, offset, data_path) = match &h.data_file {
+            Some(f) => {
+                let p = path.parent().ok_or_else(|| bad(&what, "detached data file without a directory"))?.join(f);
+                (std::fs::File::open(&p).map_err(io_err(&p))?, 0, p)
+            }
+            None => (file, h.data_start as u64, path.to_path_buf()),
+        };
+        let dims = h.dims.map(|d| d as u32);
+        Self::from_file(file, &data_path, offset, dims, h.spacing, h.dtype, h.big_endian, what).map(Some)
+    }
+
+    /// A NIfTI-1 file, compressed or not.
+    pub fn nifti(path: &Path) -> Result<Self> {
+        let what = path.display().to_string();
+        let mut file = std::fs::File::open(path).map_err(io_err(path))?;
+        let mut magic = [0u8; 2];
+        let gz = file.read_exact(&mut magic).is_ok() && is_gzip(&magic);
+        let mut head = Vec::new();
+        if gz {
+            open_gzip(path).map_err(io_err(path))?.take(348).read_to_end(&mut head).map_err(io_err(path))?;
+        } else {
+            file.seek(SeekFrom::Start(0)).map_err(io_err(path))?;
+            (&mut file).take(348).read_to_end(&mut head).map_err(io_err(path))?;
+        }
+        let l = nifti_layout(&head, MAX_STREAMED_VOXELS, &what)?;
+        let (dims, spacing, dtype, big, offset) = (l.dims, l.spacing, l.dtype, l.big_endian, l.offset);
+        let mut reader = if gz {
+            let stream = open_gzip(path).map_err(io_err(path))?;
+            let source = Source::Gzip { path: path.to_path_buf(), stream, at: 0 };
+            Self::new(source, offset, dims, spacing, dtype, big, what)
+        } else {
+            Self::from_file(file, path, offset, dims, spacing, dtype, big, what)?
+        };
+        reader.rescale = Some(l);
+        Ok(reader)
+    }
+
+    /// A raw file of `hints.dims` samples of `hints.dtype` (or its `.toml` sidecar's).
+    pub fn raw(path: &Path, hints: &VolumeHints) -> Result<Self> {
+        let what = path.display().to_string();
+        let side = match raw_sidecar(path) {
+            Some(p) => sidecar_hints(&std::fs::read_to_string(&p).map_err(io_err(&p))?, &what)?,
+            None => VolumeHints::default(),
+        };
+        let dims =
+            hints.dims.or(side.dims).ok_or_else(|| bad(&what, "raw data needs --dims X,Y,Z or a .toml sidecar"))?;
+        let dtype =
+            hints.dtype.or(side.dtype).ok_or_else(|| bad(&what, "raw data needs --dtype or a .toml sidecar"))?;
+        let spacing = hints.spacing.or(side.spacing).unwrap_or([1.0; 3]);
+        super::check_spacing(spacing, &what)?;
+        super::voxel_count_within(&dims.map(u64::from), &what, MAX_STREAMED_VOXELS)?;
+        let file = std::fs::File::open(path).map_err(io_err(path))?;
+        let big = hints.big_endian || side.big_endian;
+        let r = Self::from_file(file, path, 0, dims, spacing, dtype, big, what)?;
+        let len = std::fs::metadata(path).map_err(io_err(path))?.len();
+        let need = r.plane_bytes() * dims[2] as u64;
+        if len != need {
+            return Err(bad(&r.what, format!("has {len} bytes; {dims:?} of {dtype:?} needs {need}")));
+        }
+        Ok(r)
+    }
+
+    /// A file whose data starts at `offset`, checked to hold all of it.
+    #[allow(clippy::too_many_arguments)]
+    fn from_file(
+        file: std::fs::File,
+        data_path: &Path,
+        offset: u64,
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        dtype: DType,
+        big_endian: bool,
+        what: String,
+    ) -> Result<Self> {
+        let len = file.metadata().map_err(io_err(data_path))?.len();
+        let r = Self::new(Source::File(file), offset, dims, spacing, dtype, big_endian, what);
+        let need = r.plane_bytes() * dims[2] as u64;
+        if len < offset + need {
+            return Err(bad(&r.what, format!("data is truncated: {} bytes for {need}", len.saturating_sub(offset))));
+        }
+        Ok(r)
+    }
+
+    fn new(
+        source: Source,
+        offset: u64,
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        dtype: DType,
+        big_endian: bool,
+        what: String,
+    ) -> Self {
+        Self { source, offset, dims, spacing, dtype, big_endian, rescale: None, what, bytes: Vec::new() }
+    }
+
+    fn plane_bytes(&self) -> u64 {
+        self.dims[0] as u64 * self.dims[1] as u64 * self.dtype.size() as u64
+    }
+
+    /// Slices `z0..z0 + count` (x fastest) into `out`.
+    pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
+        let plane = self.dims[0] as u64 * self.dims[1] as u64;
+        let n = plane * count as u64;
+        self.bytes.resize((self.plane_bytes() * count as u64) as usize, 0);
+        let at = self.offset + self.plane_bytes() * z0 as u64;
+        self.source.read_at(at, &mut self.bytes).map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => {
+                bad(&self.what, format!("data is truncated before slice {}", z0 + count))
+            }
+            std::io::ErrorKind::InvalidInput | std::io::ErrorKind::InvalidData => bad(&self.what, format!("gzip: {e}")),
+            _ => Error::Io { path: self.what.clone(), source: e },
+        })?;
+        *out = decode(&self.bytes, n, self.dtype, self.big_endian, &self.what)?;
+        if let Some(l) = &self.rescale {
+            l.rescale(out);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,357 @@
+//! A bricked volume's frame (issue 23): culling and listing the visible bricks, batches under the
+//! device budget, and the per-splat, sheet and slab modes over them. Part of THE recording.
+use super::*;
+use crate::bricks::{BrickScene, BRICK};
+use crate::constants::MAX_GPU_SPLATS;
+/// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
+/// voxel (8),
+/// and for the tile compositor its screen quad (80) and about four tile entries.
+pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 8 + 80 + 16;
+
+/// What a bricked frame keeps resident besides its batches under `budget`: the store (without its
+/// records when they stream, `BrickScene::streams`; then the per-brick counts), the brick index,
+/// the draw-order slots and visible list, and the images.
+pub fn bricked_resident_bytes(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
+    let s = &scene.store;
+    let store = if scene.streams(budget) {
+        s.bytes() - s.records.len() as u64 * 4 + s.headers.len() as u64 * 4
+    } else {
+        s.bytes()
+    };
+    store + s.index.len() as u64 * (4 + 4 + 16) + width as u64 * height as u64 * 16 * 3
+}
+
+/// The least budget that draws `scene` at `width` x `height`: resident data and one brick's splats
+/// (and records, when they stream).
+pub fn bricked_min_budget(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
+    let brick = (BRICK as u64).pow(3) * (BATCH_BYTES_PER_SPLAT + 4 * scene.streams(budget) as u64);
+    bricked_resident_bytes(scene, budget, width, height) + brick
+}
+
+/// A bricked volume's frame (issue 23): `brick_cull` culls whole bricks on the device (outside
+/// the view, or empty under the transfer function) and counts the rest's voxels at their slots in
+/// the brick grid's PBTF order; the host lists the visible bricks in that order and cuts batches
+/// that fit the budget; per batch `brick_order` writes their voxels in two-level PBTF order,
+/// `brick_params` classifies them and makes their parameters, and the raster draws them, each
+/// batch carrying on from the image the earlier left. Front to back with early termination, before
+/// each later batch `tile_occlusion` and `brick_hidden` drop the bricks that the image so far
+/// already hides. A store whose records would take more than half the budget keeps them on the
+/// host: each batch uploads its bricks' records, and the bricks' drawn counts come from the host.
+pub(super) fn record_bricks(
+    e: &mut dyn Engine,
+    prep: &Prepared,
+    scene: &BrickScene,
+    camera: &Camera,
+    opts: &RenderOptions,
+) -> Result<Recorded> {
+    let sheets = opts.composite != Composite::Splat;
+    if !sheets && opts.order != OrderKind::Pbtf {
+        return Err(Error::Unsupported(
+            "a bricked volume is drawn per splat in PBTF order; the other orders need a classified splat set".into(),
+        ));
+    }
+    let (w, h) = (camera.width, camera.height);
+    let budget = e.limits().budget_bytes;
+    let streamed = scene.streams(budget);
+    if streamed && (scene.shading().is_some() || scene.transfer_function().gradient_weight > 0.0) {
+        return Err(Error::Unsupported(format!(
+            "this volume's store ({} MiB) streams through the {} MiB GPU budget, and gradients (shading, gradient \
+             weighting) read neighbouring bricks that a batch does not hold: a budget of at least {} MiB keeps it \
+             resident",
+            scene.store.bytes() >> 20,
+            budget >> 20,
+            (scene.store.records.len() as u64 * 8).div_ceil(1 << 20) + 1
+        )));
+    }
+    let least = bricked_min_budget(scene, budget, w, h);
+    if budget < least {
+        return Err(Error::TooLarge(format!(
+            "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB) and one brick of splats at \
+             {w}x{h}: the minimum is {} MiB",
+            budget >> 20,
+            scene.store.bytes() >> 20,
+            least.div_ceil(1 << 20)
+        )));
+    }
+    let available = budget - bricked_resident_bytes(scene, budget, w, h);
+    let frame = plan::frame_for(&prep.set, camera, opts);
+    let bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
+    let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
+    // The brick stages' build: one page of store records, the paged reader, or streamed records.
+    let build = if streamed { 2 } else { usize::from(scene.store.len() > RECORD_PAGE as usize) };
+    e.begin(&frame, opts.kernel, w, h)?;
+    e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
+    e.upload(Res::Tf, scene.tf_words())?;
+    if streamed {
+        let counts = scene.drawn_counts();
+        e.ensure(Res::BrickCounts, counts.len().max(1) as u64 * 4)?;
+        e.upload(Res::BrickCounts, counts)?;
+    }
+    e.ensure(Res::BrickSlots, slots as u64 * 4)?;
+    e.fill(Res::BrickSlots, None, 0)?;
+    if bf.grid[3] > 0 {
+        e.run(&Dispatch::new(StageId::BrickCull, build, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
+    }
+    let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
+    let t = Instant::now();
+    let compute = opts.raster == Raster::Compute;
+    // Front to back with early termination, later batches drop the bricks that what is drawn
+    // already hides: cut the frame into a few batches even when it fits one.
+    let cull_hidden = compute
+        && !sheets
+        && opts.cull_hidden_bricks
+        && opts.direction() == Direction::FrontToBack
+        && opts.early_termination > 0.0;
+    let capacity = if cull_hidden {
+        let total: u32 = slot_words.iter().map(|w| w & 1023).sum();
+        MAX_GPU_SPLATS.min(total.div_ceil(HIDDEN_BATCHES).max(HIDDEN_BATCH_MIN))
+    } else {
+        MAX_GPU_SPLATS
+    };
+    // The visible bricks in draw order, cut between bricks into batches.
+    let cut = Cut { streamed, build, available };
+    let visible = slot_words.into_iter().filter(|&w| w != 0).map(|w| [w >> 10, 0, 0, w & 1023]);
+    let batches = cut.batches(scene, visible, capacity, available);
+    e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
+    let splats = |b: &[[u32; 4]]| b.last().map(|l| l[1] + l[3]).unwrap_or(0);
+    let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
+    e.ensure(Res::BrickList, most_entries * 16)?;
+    let largest = batches.iter().map(|b| splats(b)).max().unwrap_or(0);
+    e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+    e.ensure(Res::Order, largest as u64 * 4)?;
+    e.ensure(Res::BrickVoxels, largest as u64 * 8)?;
+    let tiles = w.div_ceil(COMPOSITE_TILE) * h.div_ceil(COMPOSITE_TILE);
+    if cull_hidden && batches.len() > 1 {
+        e.ensure(Res::Occlusion, tiles as u64 * 4)?;
+        e.ensure(Res::BrickHidden, most_entries * 4)?;
+    }
+    if sheets {
+        return record_bricked_sheets(e, prep, scene, camera, opts, &frame, batches.concat(), cut);
+    }
+    if !compute {
+        e.layers(1)?;
+    }
+    let words = |b: &[[u32; 4]]| b.iter().flatten().copied().collect::<Vec<u32>>();
+    for (i, mut batch) in batches.into_iter().enumerate() {
+        if cull_hidden && i > 0 && !batch.is_empty() {
+            let count = batch.len() as u32;
+            e.upload(Res::BrickList, &words(&batch))?;
+            e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, &[]))?;
+            let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
+            e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
+            let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
+            batch = batch.into_iter().zip(hidden).filter(|(_, h)| *h == 0).map(|(l, _)| l).collect();
+            let (mut at, mut rec) = (0, 0);
+            for l in &mut batch {
+                l[1] = at;
+                at += l[3];
+                if streamed {
+                    l[2] = rec;
+                    rec += scene.store.headers[l[0] as usize].count;
+                }
+            }
+        }
+        let n = splats(&batch);
+        if !batch.is_empty() {
+            record_brick_batch(e, scene, &batch, streamed, build)?;
+        }
+        if compute {
+            record_tiles(e, &frame, n, opts, w, h, i > 0)?;
+        } else {
+            let blend = if opts.direction() == Direction::BackToFront { Blend::Over } else { Blend::Under };
+            let variant = footprint_variant(blend, opts.raster == Raster::Points, SHEET_MODE_SPLAT);
+            // A later batch draws on the target (the LOAD pass).
+            let push = FootprintPush { carry: u32::from(i > 0), ..Default::default() };
+            e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
+        }
+    }
+    finish(e, if compute { Res::Accum } else { Res::Color }, w, h, false)
+}
+
+/// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
+/// brick stages' build, and the budget's bytes for batches.
+struct Cut {
+    streamed: bool,
+    build: usize,
+    available: u64,
+}
+
+impl Cut {
+    /// `entries` (header, -, -, voxels) cut, in their order, into batches of at most `capacity`
+    /// splats within `available` bytes (header, first position in its batch, first record: in the
+    /// store, or in the batch's records when they stream; voxels).
+    fn batches(
+        &self,
+        scene: &BrickScene,
+        entries: impl IntoIterator<Item = [u32; 4]>,
+        capacity: u32,
+        available: u64,
+    ) -> Vec<Vec<[u32; 4]>> {
+        let mut batches: Vec<Vec<[u32; 4]>> = vec![Vec::new()];
+        let (mut filled, mut records, mut bytes) = (0u32, 0u32, 0u64);
+        for [header, _, _, n] in entries {
+            let hd = &scene.store.headers[header as usize];
+            let cost = n as u64 * BATCH_BYTES_PER_SPLAT + if self.streamed { hd.count as u64 * 4 } else { 0 };
+            let open = batches.last().is_some_and(|b| !b.is_empty());
+            if open && (filled + n > capacity || bytes + cost > available) {
+                batches.push(Vec::new());
+                (filled, records, bytes) = (0, 0, 0);
+            }
+            let first = if self.streamed { records } else { hd.first };
+            batches.last_mut().expect("one batch at least").push([header, filled, first, n]);
+            (filled, records, bytes) = (filled + n, records + hd.count, bytes + cost);
+        }
+        batches
+    }
+}
+
+/// Sheet and slab modes over a bricked volume (`visible`: its visible bricks in draw order, as
+/// listed for the per-splat frame). When every visible voxel fits one batch, its splats are made
+/// and binned once and drawn as a dense set's are. Otherwise the frame streams: per batch of
+/// sheets (in visiting order), the bricks that reach its sheets are made, binned and summed part
+/// by part into its layers (each part carrying on from the layers the earlier left), then the
+/// batch is composited; a brick spanning two batches of sheets is made twice.
+#[allow(clippy::too_many_arguments)]
+fn record_bricked_sheets(
+    e: &mut dyn Engine,
+    prep: &Prepared,
+    scene: &BrickScene,
+    camera: &Camera,
+    opts: &RenderOptions,
+    frame: &Frame,
+    visible: Vec<[u32; 4]>,
+    cut: Cut,
+) -> Result<Recorded> {
+    let (w, h) = (camera.width, camera.height);
+    let grid = prep.set.grid();
+    let compute = opts.raster == Raster::Compute;
+    let direction = opts.direction();
+    let sheet = opts.composite == Composite::Sheet;
+    let axis = plan::sheet_axis(camera);
+    let layers = sheet_layers(e, opts, w, h);
+    // The layers (and the compute raster's fixed-point copy) come out of the budget too.
+    let layer_bytes = w as u64 * h as u64 * 16 * layers as u64 * (1 + compute as u64);
+    let brick_bytes = (BRICK as u64).pow(3) * BATCH_BYTES_PER_SPLAT;
+    let Some(available) = cut.available.checked_sub(layer_bytes).filter(|&a| a >= brick_bytes) else {
+        return Err(Error::TooLarge(format!(
+            "the {} MiB GPU budget cannot hold this volume's store, {layers} summation layers of {w}x{h} and one \
+             brick of splats: raise it by {} MiB or lower --sheet-budget-mib",
+            e.limits().budget_bytes >> 20,
+            (layer_bytes + brick_bytes).saturating_sub(cut.available).div_ceil(1 << 20)
+        )));
+    };
+    let geometry = |n: u32| {
+        if sheet {
+            crate::slab::sheet_geometry(grid, n, axis)
+        } else {
+            crate::slab::slab_geometry(frame, grid, n as usize, opts.slab_thickness, direction)
+        }
+    };
+    let variant = sheet as usize;
+    let split = crate::order::pbtf_split(&prep.set, camera)[axis];
+    let plan_of = |pc: &SlabPush, starts: &[u32]| {
+        if sheet {
+            Ok(plan::binned_sheet_plan(starts, axis, split, direction, layers))
+        } else {
+            crate::slab::slab_batches(pc, starts, layers)
+        }
+    };
+    let parts = cut.batches(scene, visible.iter().copied(), MAX_GPU_SPLATS, available);
+    if parts.len() == 1 {
+        let part = &parts[0];
+        let n = part.last().map(|l| l[1] + l[3]).unwrap_or(0);
+        if n > 0 {
+            record_brick_batch(e, scene, part, cut.streamed, cut.build)?;
+        }
+        let pc = geometry(n)?;
+        let starts = record_slab_bins(e, &pc, variant)?;
+        return record_sheets(e, List::SlabPairs, plan_of(&pc, &starts)?, opts, w, h);
+    }
+    // Each brick's bins (sheets or slabs, in index order) and each bin's reach (bricks), in
+    // visiting position order for the slabs, index order for the sheets, as the binning writes.
+    let total: u32 = visible.iter().map(|l| l[3]).sum();
+    let pc = geometry(total)?;
+    let bins = pc.slabs as usize;
+    let position = |bin: u32| if sheet || pc.ftb != 0 { bin } else { pc.slabs - 1 - bin };
+    let reach: Vec<(u32, u32)> = visible
+        .iter()
+        .map(|l| {
+            let lo = scene.store.headers[l[0] as usize].coords().map(|c| c * BRICK);
+            let hi = [0, 1, 2].map(|a| (lo[a] + BRICK - 1).min(grid.dims[a] - 1));
+            if sheet {
+                (lo[axis], hi[axis])
+            } else {
+                crate::slab::box_slabs(&pc, frame, grid, lo, hi)
+            }
+        })
+        .collect();
+    let mut starts = vec![0u32; bins + 1];
+    for &(lo, hi) in &reach {
+        for bin in lo..=hi {
+            starts[position(bin) as usize + 1] += 1;
+        }
+    }
+    for i in 0..bins {
+        starts[i + 1] += starts[i];
+    }
+    let mut groups = plan_of(&pc, &starts)?;
+    plan::set_early_termination(opts, &mut groups);
+    begin_sheets(e, List::SlabPairs, &groups, opts, w, h, false)?;
+    for g in &groups {
+        let (lo, hi) = if g.push.rank_dir > 0 {
+            (g.push.rank_base, g.push.rank_base + g.layers - 1)
+        } else {
+            (g.push.rank_base + 1 - g.layers, g.push.rank_base)
+        };
+        let near = visible.iter().zip(&reach).filter(|(_, r)| r.0 <= hi && r.1 >= lo).map(|(l, _)| *l);
+        let (p0, p1) = (position(lo).min(position(hi)), position(lo).max(position(hi)));
+        for (k, part) in cut.batches(scene, near, MAX_GPU_SPLATS, available).iter().enumerate() {
+            let n = part.last().map(|l| l[1] + l[3]).unwrap_or(0);
+            if n > 0 {
+                record_brick_batch(e, scene, part, cut.streamed, cut.build)?;
+            }
+            let starts = record_slab_bins(e, &geometry(n)?, variant)?;
+            let (first, end) = (starts[p0 as usize], starts[p1 as usize + 1]);
+            sum_sheets(e, List::SlabPairs, g, opts, first, end - first, k > 0)?;
+        }
+        composite_sheets(e, List::SlabPairs, g, opts, w, h)?;
+    }
+    finish(e, Res::Accum, w, h, compute)
+}
+
+/// One batch of visible bricks (entries: header, first position, first record, voxels): its
+/// records when they stream, then `brick_order` and `brick_params` make its splats' parameters.
+fn record_brick_batch(
+    e: &mut dyn Engine,
+    scene: &BrickScene,
+    batch: &[[u32; 4]],
+    streamed: bool,
+    build: usize,
+) -> Result<()> {
+    let n = batch.last().map(|l| l[1] + l[3]).unwrap_or(0);
+    if streamed {
+        // The batch's bricks' records, in list order.
+        let s = &scene.store;
+        let recs: Vec<u32> = batch
+            .iter()
+            .flat_map(|l| {
+                let hd = &s.headers[l[0] as usize];
+                s.records[hd.first as usize..(hd.first + hd.count) as usize].iter().copied()
+            })
+            .collect();
+        e.upload(Res::BatchRecords, &recs)?;
+    }
+    let words: Vec<u32> = batch.iter().flatten().copied().collect();
+    e.upload(Res::BrickList, &words)?;
+    let push = BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 };
+    let push = bytemuck::bytes_of(&push);
+    let groups = plan::groups_per_item(batch.len() as u32);
+    e.run(&Dispatch::new(StageId::BrickOrder, build, groups, List::Order, push))?;
+    e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, push))
+}
+
+/// Front to back with early termination, a bricked frame is cut into at least this many batches
+/// (of at least `HIDDEN_BATCH_MIN` splats), so later batches can drop hidden bricks.
+pub const HIDDEN_BATCHES: u32 = 4;
+/// See `HIDDEN_BATCHES`.
+pub const HIDDEN_BATCH_MIN: u32 = 1 << 16;
