@@ -142,6 +142,24 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
         k / c
     );
 
+    // The sheet modes over the bricks against the same modes over dense splats.
+    let _ = writeln!(s, "\n| bonsai 256³, compute raster | dense ms | bricked ms | bricked / dense | PSNR dB |");
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for composite in [voxsplat::Composite::Sheet, voxsplat::Composite::Slab] {
+        let mut so = o.clone();
+        so.composite = composite;
+        let a = dense.render(&cam, &so)?.image;
+        let b = bricked.render(&cam, &so)?.image;
+        let m = voxsplat::metrics::compare(&a, &b)?;
+        let (mut td, mut tb) = (Vec::new(), Vec::new());
+        for _ in 0..frames {
+            td.push(frame_ms(&mut dense, &cam, &so)?);
+            tb.push(frame_ms(&mut bricked, &cam, &so)?);
+        }
+        let (d, b) = (median(&mut td), median(&mut tb));
+        let _ = writeln!(s, "| {composite:?} | {d:.0} | {b:.0} | {:.2} | {:.1} |", b / d, m.psnr);
+    }
+
     if let Some(l) = large {
         let lgrid = Grid::centered(l.scene.store.dims, l.scene.store.spacing)?;
         let lcam = Camera::framing(&lgrid, size, size);
@@ -154,12 +172,17 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
             t_big.push(frame_ms(&mut big, &lcam, &o)?);
             t_big_et.push(frame_ms(&mut big, &lcam, &et)?);
         }
+        // The sheets at 512³ stream (the visible voxels pass one batch): once, after the others.
+        let mut so = o.clone();
+        so.composite = voxsplat::Composite::Sheet;
+        let sheet = frame_ms(&mut big, &lcam, &so)?;
         let (sm, bg, be) = (median(&mut t_small), median(&mut t_big), median(&mut t_big_et));
         let _ = writeln!(s, "\n| frame, same view | median ms | over the 256³ frame |");
         let _ = writeln!(s, "|---|---|---|");
         let _ = writeln!(s, "| bonsai 256³ bricked | {sm:.0} | 1.00 |");
         let _ = writeln!(s, "| bonsai 512³ bricked | {bg:.0} | {:.2} |", bg / sm);
         let _ = writeln!(s, "| bonsai 512³ bricked, early termination 1/1024 | {be:.0} | {:.2} |", be / sm);
+        let _ = writeln!(s, "| bonsai 512³ bricked, sheets streamed (one frame) | {sheet:.0} | {:.2} |", sheet / sm);
     }
     if let Some(rss) = peak_rss_mib() {
         let _ = writeln!(s, "\nPeak resident set of the whole study process: {rss:.0} MiB.");
