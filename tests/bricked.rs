@@ -380,6 +380,14 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
     }
 }
 
+/// The raster variants and directions the sheet-mode tests draw.
+const SHEET_RASTERS: [(Raster, Direction); 4] = [
+    (Raster::Compute, Direction::FrontToBack),
+    (Raster::Compute, Direction::BackToFront),
+    (Raster::Graphics, Direction::BackToFront),
+    (Raster::Points, Direction::FrontToBack),
+];
+
 #[test]
 fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classification() {
     use voxsplat::Composite;
@@ -397,12 +405,7 @@ fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classificat
         dense.set_scene(classify(&vol, &tf(), shading).unwrap()).unwrap();
         for (v, cam) in cams.iter().enumerate() {
             for composite in [Composite::Sheet, Composite::Slab] {
-                for (raster, direction) in [
-                    (Raster::Compute, Direction::FrontToBack),
-                    (Raster::Compute, Direction::BackToFront),
-                    (Raster::Graphics, Direction::BackToFront),
-                    (Raster::Points, Direction::FrontToBack),
-                ] {
+                for (raster, direction) in SHEET_RASTERS {
                     if v == 1 && raster == Raster::Points {
                         continue; // footprints next to the eye pass the widest point sprite
                     }
@@ -441,12 +444,7 @@ fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classificat
         let mut small = renderer(gpu, Some(budget));
         small.set_volume(&vol, &tf(), None).unwrap();
         for composite in [Composite::Sheet, Composite::Slab] {
-            for (raster, direction) in [
-                (Raster::Compute, Direction::FrontToBack),
-                (Raster::Compute, Direction::BackToFront),
-                (Raster::Graphics, Direction::BackToFront),
-                (Raster::Points, Direction::FrontToBack),
-            ] {
+            for (raster, direction) in SHEET_RASTERS {
                 let mut o = opts(raster, direction);
                 (o.composite, o.sheet_budget_bytes) = (composite, sheet_budget);
                 let tag = format!("gpu {gpu} {composite:?} {raster:?} {direction:?}");

@@ -69,6 +69,15 @@ pub struct SliceReader {
     bytes: Vec<u8>,
 }
 
+/// Where a file's samples are and what they are.
+struct Layout {
+    offset: u64,
+    dims: [u32; 3],
+    spacing: [f32; 3],
+    dtype: DType,
+    big_endian: bool,
+}
+
 fn io_err(p: &Path) -> impl FnOnce(std::io::Error) -> Error {
     let p = p.display().to_string();
     move |e| Error::Io { path: p, source: e }
@@ -110,8 +119,14 @@ impl SliceReader {
             }
             None => (file, h.data_start as u64, path.to_path_buf()),
         };
-        let dims = h.dims.map(|d| d as u32);
-        Self::from_file(file, &data_path, offset, dims, h.spacing, h.dtype, h.big_endian, what).map(Some)
+        let layout = Layout {
+            offset,
+            dims: h.dims.map(|d| d as u32),
+            spacing: h.spacing,
+            dtype: h.dtype,
+            big_endian: h.big_endian,
+        };
+        Self::from_file(file, &data_path, layout, what).map(Some)
     }
 
     /// A NIfTI-1 file, compressed or not.
@@ -128,13 +143,13 @@ impl SliceReader {
             (&mut file).take(348).read_to_end(&mut head).map_err(io_err(path))?;
         }
         let l = nifti_layout(&head, MAX_STREAMED_VOXELS, &what)?;
-        let (dims, spacing, dtype, big, offset) = (l.dims, l.spacing, l.dtype, l.big_endian, l.offset);
+        let layout =
+            Layout { offset: l.offset, dims: l.dims, spacing: l.spacing, dtype: l.dtype, big_endian: l.big_endian };
         let mut reader = if gz {
             let stream = open_gzip(path).map_err(io_err(path))?;
-            let source = Source::Gzip { path: path.to_path_buf(), stream, at: 0 };
-            Self::new(source, offset, dims, spacing, dtype, big, what)
+            Self::new(Source::Gzip { path: path.to_path_buf(), stream, at: 0 }, layout, what)
         } else {
-            Self::from_file(file, path, offset, dims, spacing, dtype, big, what)?
+            Self::from_file(file, path, layout, what)?
         };
         reader.rescale = Some(l);
         Ok(reader)
@@ -156,7 +171,7 @@ impl SliceReader {
         super::voxel_count_within(&dims.map(u64::from), &what, MAX_STREAMED_VOXELS)?;
         let file = std::fs::File::open(path).map_err(io_err(path))?;
         let big = hints.big_endian || side.big_endian;
-        let r = Self::from_file(file, path, 0, dims, spacing, dtype, big, what)?;
+        let r = Self::from_file(file, path, Layout { offset: 0, dims, spacing, dtype, big_endian: big }, what)?;
         let len = std::fs::metadata(path).map_err(io_err(path))?.len();
         let need = r.plane_bytes() * dims[2] as u64;
         if len != need {
@@ -165,36 +180,19 @@ impl SliceReader {
         Ok(r)
     }
 
-    /// A file whose data starts at `offset`, checked to hold all of it.
-    #[allow(clippy::too_many_arguments)]
-    fn from_file(
-        file: std::fs::File,
-        data_path: &Path,
-        offset: u64,
-        dims: [u32; 3],
-        spacing: [f32; 3],
-        dtype: DType,
-        big_endian: bool,
-        what: String,
-    ) -> Result<Self> {
+    /// A file whose data (`layout`) it is checked to hold whole.
+    fn from_file(file: std::fs::File, data_path: &Path, layout: Layout, what: String) -> Result<Self> {
         let len = file.metadata().map_err(io_err(data_path))?.len();
-        let r = Self::new(Source::File(file), offset, dims, spacing, dtype, big_endian, what);
-        let need = r.plane_bytes() * dims[2] as u64;
-        if len < offset + need {
-            return Err(bad(&r.what, format!("data is truncated: {} bytes for {need}", len.saturating_sub(offset))));
+        let r = Self::new(Source::File(file), layout, what);
+        let need = r.plane_bytes() * r.dims[2] as u64;
+        if len < r.offset + need {
+            return Err(bad(&r.what, format!("data is truncated: {} bytes for {need}", len.saturating_sub(r.offset))));
         }
         Ok(r)
     }
 
-    fn new(
-        source: Source,
-        offset: u64,
-        dims: [u32; 3],
-        spacing: [f32; 3],
-        dtype: DType,
-        big_endian: bool,
-        what: String,
-    ) -> Self {
+    fn new(source: Source, l: Layout, what: String) -> Self {
+        let (offset, dims, spacing, dtype, big_endian) = (l.offset, l.dims, l.spacing, l.dtype, l.big_endian);
         Self { source, offset, dims, spacing, dtype, big_endian, rescale: None, what, bytes: Vec::new() }
     }
 
