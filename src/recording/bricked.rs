@@ -3,9 +3,10 @@
 use super::*;
 use crate::bricks::{BrickScene, BRICK};
 use crate::constants::MAX_GPU_SPLATS;
+
 /// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
-/// voxel (8),
-/// and for the tile compositor its screen quad (80) and about four tile entries.
+/// voxel (8), and for the tile compositor its screen quad (80) and about four tile entries (the
+/// sheet modes' (splat, slab) pairs fit in the last two).
 pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 8 + 80 + 16;
 
 /// What a bricked frame keeps resident besides its batches under `budget`: the store (without its
@@ -37,6 +38,7 @@ pub fn bricked_min_budget(scene: &BrickScene, budget: u64, width: u32, height: u
 /// each later batch `tile_occlusion` and `brick_hidden` drop the bricks that the image so far
 /// already hides. A store whose records would take more than half the budget keeps them on the
 /// host: each batch uploads its bricks' records, and the bricks' drawn counts come from the host.
+/// The sheet and slab modes take the visible list to `record_bricked_sheets`.
 pub(super) fn record_bricks(
     e: &mut dyn Engine,
     prep: &Prepared,
