@@ -158,10 +158,10 @@ impl BrickStore {
         Ok(store)
     }
 
-    /// Load a volume file as a store (`hints` as `loaders::load_volume` takes them): raw NRRD,
-    /// NIfTI (`.nii.gz` inflated as it is read) and raw files stream slice by slice, never held
-    /// whole (volumes past the dense loader's `MAX_VOXELS` too); a compressed NRRD or an `.npy`
-    /// is loaded, cut and dropped.
+    /// Load a volume file as a store (`hints` as `loaders::load_volume` takes them): NRRD (raw
+    /// or gzip), NIfTI and raw files stream slice by slice (gzip inflated as it is read), never
+    /// held whole (volumes past the dense loader's `MAX_VOXELS` too); an `.npy` is loaded, cut
+    /// and dropped.
     #[cfg(feature = "io")]
     pub fn load(path: &std::path::Path, hints: &crate::loaders::VolumeHints) -> Result<Self> {
         let mut store = match crate::loaders::SliceReader::open(path, hints)? {

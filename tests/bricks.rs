@@ -212,3 +212,25 @@ fn nifti_and_raw_files_stream_into_the_same_store() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A gzip-encoded NRRD (the stent) streams, inflated as it is read, into the store the whole
+/// volume builds; cut anywhere in its data, it is a typed error.
+#[test]
+fn a_gzip_nrrd_streams_into_the_same_store() {
+    let stent = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/stent/stent.nrrd");
+    let whole = BrickStore::build(&voxsplat::loaders::load_volume(&stent, &Default::default()).unwrap()).unwrap();
+    assert!(voxsplat::loaders::SliceReader::nrrd(&stent).unwrap().is_some(), "gzip data streams");
+    let s = BrickStore::load(&stent, &Default::default()).unwrap();
+    assert_eq!((s.dims, s.spacing, s.range), (whole.dims, whole.spacing, whole.range));
+    assert!(s.headers == whole.headers && s.masks == whole.masks && s.records == whole.records);
+    let bytes = std::fs::read(&stent).unwrap();
+    let dir = std::env::temp_dir().join(format!("voxsplat-bricks-gz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cut = dir.join("cut.nrrd");
+    for frac in [0.2, 0.6, 0.99] {
+        std::fs::write(&cut, &bytes[..(bytes.len() as f64 * frac) as usize]).unwrap();
+        let err = BrickStore::load(&cut, &Default::default()).unwrap_err();
+        assert!(matches!(err, voxsplat::Error::InvalidArgument(_)), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,6 +1,6 @@
 //! Volumes read a few z-slices at a time, so a bricked store is built without the volume in
-//! memory (`BrickStore::from_slices`): uncompressed NRRD (attached or detached), NIfTI-1 (`.nii`,
-//! and `.nii.gz` inflated as it is read) and raw files with their dims and type. Every size comes
+//! memory (`BrickStore::from_slices`): NRRD (raw or gzip data, attached or detached), NIfTI-1
+//! (`.nii`, `.nii.gz`) and raw files with their dims and type; gzip data is inflated as it is read. Every size comes
 //! from a checked header and is checked against the file's length (a gzip stream's against what it
 //! inflates to, as it is read) before a slice is read.
 use super::{bad, decode, is_gzip, nifti_layout, nrrd_header, raw_sidecar, sidecar_hints, DType, VolumeHints};
@@ -15,18 +15,27 @@ pub const MAX_STREAMED_VOXELS: u64 = 1 << 34;
 /// Where the samples come from.
 enum Source {
     File(std::fs::File),
-    /// A gzip stream, inflated from its start again whenever a read goes back (a store's build
-    /// reads the volume twice, front to back).
+    /// A gzip stream from byte `start` of `path`, inflated from its start again whenever a read
+    /// goes back (a store's build reads the volume twice, front to back).
     Gzip {
         path: PathBuf,
+        start: u64,
         stream: Box<dyn Read + Send>,
         at: u64,
     },
 }
 
-fn open_gzip(path: &Path) -> std::io::Result<Box<dyn Read + Send>> {
-    let file = std::io::BufReader::with_capacity(1 << 16, std::fs::File::open(path)?);
-    Ok(Box::new(flate2::read::MultiGzDecoder::new(file)))
+fn open_gzip(path: &Path, start: u64) -> std::io::Result<Box<dyn Read + Send>> {
+    let mut file = std::fs::File::open(path)?;
+    file.seek(SeekFrom::Start(start))?;
+    Ok(Box::new(flate2::read::MultiGzDecoder::new(std::io::BufReader::with_capacity(1 << 16, file))))
+}
+
+impl Source {
+    fn gzip(path: &Path, start: u64) -> Result<Self> {
+        let stream = open_gzip(path, start).map_err(io_err(path))?;
+        Ok(Source::Gzip { path: path.to_path_buf(), start, stream, at: 0 })
+    }
 }
 
 impl Source {
@@ -37,9 +46,9 @@ impl Source {
                 f.seek(SeekFrom::Start(at))?;
                 f.read_exact(buf)
             }
-            Source::Gzip { path, stream, at: pos } => {
+            Source::Gzip { path, start, stream, at: pos } => {
                 if at < *pos {
-                    (*stream, *pos) = (open_gzip(path)?, 0);
+                    (*stream, *pos) = (open_gzip(path, *start)?, 0);
                 }
                 let skip = at - *pos;
                 if std::io::copy(&mut stream.by_ref().take(skip), &mut std::io::sink())? < skip {
@@ -85,7 +94,7 @@ fn io_err(p: &Path) -> impl FnOnce(std::io::Error) -> Error {
 
 impl SliceReader {
     /// `path` read slice by slice when its format allows (see the module), else `None` (load it
-    /// whole with `load_volume`: compressed NRRD, `.npy`). `hints` as `load_volume` takes them
+    /// whole with `load_volume`: NRRD in other encodings, `.npy`). `hints` as `load_volume` takes them
     /// (a raw file's dims and type); sizes are checked against `MAX_STREAMED_VOXELS` and the
     /// data's length before anything is read.
     pub fn open(path: &Path, hints: &VolumeHints) -> Result<Option<Self>> {
@@ -101,17 +110,19 @@ impl SliceReader {
         }
     }
 
-    /// `path` when it is an NRRD with raw (uncompressed) data, attached or detached; `None` for
-    /// any other encoding.
+    /// `path` when it is an NRRD with raw or gzip data, attached or detached; `None` for any other
+    /// encoding.
     pub fn nrrd(path: &Path) -> Result<Option<Self>> {
         let what = path.display().to_string();
         let mut file = std::fs::File::open(path).map_err(io_err(path))?;
         let mut head = Vec::new();
         (&mut file).take(1 << 20).read_to_end(&mut head).map_err(io_err(path))?;
         let h = nrrd_header(&head, &what, MAX_STREAMED_VOXELS)?;
-        if h.encoding != "raw" {
-            return Ok(None);
-        }
+        let gz = match h.encoding.as_str() {
+            "raw" => false,
+            "gzip" | "gz" => true,
+            _ => return Ok(None),
+        };
         let (file, offset, data_path) = match &h.data_file {
             Some(f) => {
                 let p = path.parent().ok_or_else(|| bad(&what, "detached data file without a directory"))?.join(f);
@@ -119,14 +130,13 @@ impl SliceReader {
             }
             None => (file, h.data_start as u64, path.to_path_buf()),
         };
-        let layout = Layout {
-            offset,
-            dims: h.dims.map(|d| d as u32),
-            spacing: h.spacing,
-            dtype: h.dtype,
-            big_endian: h.big_endian,
-        };
-        Self::from_file(file, &data_path, layout, what).map(Some)
+        let (dims, spacing, dtype, big_endian) = (h.dims.map(|d| d as u32), h.spacing, h.dtype, h.big_endian);
+        if gz {
+            // The inflated data starts at its first byte.
+            let layout = Layout { offset: 0, dims, spacing, dtype, big_endian };
+            return Ok(Some(Self::new(Source::gzip(&data_path, offset)?, layout, what)));
+        }
+        Self::from_file(file, &data_path, Layout { offset, dims, spacing, dtype, big_endian }, what).map(Some)
     }
 
     /// A NIfTI-1 file, compressed or not.
@@ -137,7 +147,7 @@ impl SliceReader {
         let gz = file.read_exact(&mut magic).is_ok() && is_gzip(&magic);
         let mut head = Vec::new();
         if gz {
-            open_gzip(path).map_err(io_err(path))?.take(348).read_to_end(&mut head).map_err(io_err(path))?;
+            open_gzip(path, 0).map_err(io_err(path))?.take(348).read_to_end(&mut head).map_err(io_err(path))?;
         } else {
             file.seek(SeekFrom::Start(0)).map_err(io_err(path))?;
             (&mut file).take(348).read_to_end(&mut head).map_err(io_err(path))?;
@@ -146,8 +156,7 @@ impl SliceReader {
         let layout =
             Layout { offset: l.offset, dims: l.dims, spacing: l.spacing, dtype: l.dtype, big_endian: l.big_endian };
         let mut reader = if gz {
-            let stream = open_gzip(path).map_err(io_err(path))?;
-            Self::new(Source::Gzip { path: path.to_path_buf(), stream, at: 0 }, layout, what)
+            Self::new(Source::gzip(path, 0)?, layout, what)
         } else {
             Self::from_file(file, path, layout, what)?
         };
