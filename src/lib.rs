@@ -192,10 +192,12 @@ impl Renderer {
     }
 
     /// Make a scalar volume the scene as a bricked store (`bricks`), classified with `tf` and
-    /// `shading` on every frame: on the GPU backend the store is resident and culling,
+    /// `shading` on every frame: on the GPU backend the store is resident (or its records stream
+    /// through the budget, `bricks::BrickScene::streams`) and culling,
     /// classification and the two-level PBTF order run on the device, so a volume of any size that
-    /// fits the budget's store draws (per splat, PBTF: sheet and slab modes need
-    /// [`Renderer::set_scene`] with a classified set). The host keeps no copy of `volume`.
+    /// fits host memory draws, streaming through the device budget when it must: per splat (PBTF),
+    /// and in the sheet and slab modes. The other orders and the ray caster need
+    /// [`Renderer::set_scene`] with a classified set. The host keeps no copy of `volume`.
     pub fn set_volume(
         &mut self,
         volume: &volume::ScalarVolume,
