@@ -271,8 +271,8 @@ fn record_bricked_sheets(
     }
     // Each brick's bins (sheets or slabs, in index order) and each bin's reach (bricks), in
     // visiting position order for the slabs, index order for the sheets, as the binning writes.
-    let total: u32 = visible.iter().map(|l| l[3]).sum();
-    let pc = geometry(total)?;
+    // (The bins do not depend on the splat count; the binning's cell limit is per part.)
+    let pc = geometry(MAX_GPU_SPLATS)?;
     let bins = pc.slabs as usize;
     let position = |bin: u32| if sheet || pc.ftb != 0 { bin } else { pc.slabs - 1 - bin };
     let reach: Vec<(u32, u32)> = visible
