@@ -19,6 +19,6 @@ void main() {
     uint s = linear_invocation();
     if (s >= pc.splats) return;
     uvec2 v = voxels[s];
-    uvec3 ijk = uvec3(v.x & 0xffffu, v.x >> 16u, v.y & 0xffffu);
+    uvec3 ijk = voxel_ijk(v);
     params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u)));
 }

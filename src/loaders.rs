@@ -469,6 +469,23 @@ pub struct VolumeHints {
     pub spacing: Option<[f32; 3]>,
 }
 
+/// A raw file's dims, sample type, byte order and spacing: `hints` first, then its `.toml`
+/// sidecar (`raw_sidecar`); dims and type are required.
+pub(crate) fn raw_layout(path: &Path, hints: &VolumeHints, what: &str) -> Result<([u32; 3], DType, bool, [f32; 3])> {
+    let side = match raw_sidecar(path) {
+        Some(p) => {
+            let text =
+                std::fs::read_to_string(&p).map_err(|e| Error::Io { path: p.display().to_string(), source: e })?;
+            sidecar_hints(&text, what)?
+        }
+        None => VolumeHints::default(),
+    };
+    let dims = hints.dims.or(side.dims).ok_or_else(|| bad(what, "raw data needs --dims X,Y,Z or a .toml sidecar"))?;
+    let dtype = hints.dtype.or(side.dtype).ok_or_else(|| bad(what, "raw data needs --dtype or a .toml sidecar"))?;
+    let spacing = hints.spacing.or(side.spacing).unwrap_or([1.0; 3]);
+    Ok((dims, dtype, hints.big_endian || side.big_endian, spacing))
+}
+
 /// Load a volume by its extension: `.nrrd`/`.nhdr`, `.nii`/`.nii.gz`, `.npy`, anything else raw.
 pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
     let what = path.display().to_string();
@@ -485,20 +502,8 @@ pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
         }
         ScalarVolume { dims: [shape[2] as u32, shape[1] as u32, shape[0] as u32], spacing: [1.0; 3], values }
     } else {
-        let side = match raw_sidecar(path) {
-            Some(p) => {
-                let text =
-                    std::fs::read_to_string(&p).map_err(|e| Error::Io { path: p.display().to_string(), source: e })?;
-                sidecar_hints(&text, &what)?
-            }
-            None => VolumeHints::default(),
-        };
-        let dims =
-            hints.dims.or(side.dims).ok_or_else(|| bad(&what, "raw data needs --dims X,Y,Z or a .toml sidecar"))?;
-        let dtype =
-            hints.dtype.or(side.dtype).ok_or_else(|| bad(&what, "raw data needs --dtype or a .toml sidecar"))?;
-        let big = hints.big_endian || side.big_endian;
-        raw_from_bytes(&bytes, dims, dtype, big, hints.spacing.or(side.spacing).unwrap_or([1.0; 3]), &what)?
+        let (dims, dtype, big, spacing) = raw_layout(path, hints, &what)?;
+        raw_from_bytes(&bytes, dims, dtype, big, spacing, &what)?
     };
     if let Some(s) = hints.spacing {
         check_spacing(s, &what)?;

@@ -477,39 +477,38 @@ fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFuncti
     }
 }
 
-/// The --volume file, its transfer function and shading.
-fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumeParts> {
-    let hints = voxsplat::loaders::VolumeHints {
+/// The --dims, --dtype, --big-endian and --spacing hints for the --volume file.
+fn volume_hints(a: &SceneArgs) -> Result<voxsplat::loaders::VolumeHints> {
+    Ok(voxsplat::loaders::VolumeHints {
         dims: a.dims,
         dtype: a.dtype.as_deref().map(str::parse).transpose()?,
         big_endian: a.big_endian,
         spacing: a.spacing.map(|v| v.to_array()),
-    };
-    let vol = voxsplat::loaders::load_volume(path, &hints)?;
-    let tf = transfer_function(a)?;
-    let shading = a.shade.then(|| {
-        let g = voxsplat::Grid::centered(vol.dims, vol.spacing).ok();
+    })
+}
+
+/// With --shade, a headlight along the view of a grid of `dims` x `spacing`.
+fn headlight(a: &SceneArgs, dims: [u32; 3], spacing: [f32; 3]) -> Option<voxsplat::classify::Shading> {
+    a.shade.then(|| {
+        let g = voxsplat::Grid::centered(dims, spacing).ok();
         let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
         voxsplat::classify::Shading::headlight(-dir)
-    });
+    })
+}
+
+/// The --volume file, its transfer function and shading.
+fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumeParts> {
+    let vol = voxsplat::loaders::load_volume(path, &volume_hints(a)?)?;
+    let tf = transfer_function(a)?;
+    let shading = headlight(a, vol.dims, vol.spacing);
     Ok((vol, tf, shading))
 }
 
 /// The --volume file as a bricked scene, with a one-line report of the store.
 fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::bricks::BrickScene> {
-    let hints = voxsplat::loaders::VolumeHints {
-        dims: a.dims,
-        dtype: a.dtype.as_deref().map(str::parse).transpose()?,
-        big_endian: a.big_endian,
-        spacing: a.spacing.map(|v| v.to_array()),
-    };
-    let store = voxsplat::bricks::BrickStore::load(path, &hints)?;
+    let store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
     let tf = transfer_function(a)?;
-    let shading = a.shade.then(|| {
-        let g = voxsplat::Grid::centered(store.dims, store.spacing).ok();
-        let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
-        voxsplat::classify::Shading::headlight(-dir)
-    });
+    let shading = headlight(a, store.dims, store.spacing);
     eprintln!(
         "{} stored voxels in {} bricks of {}^3, {:.2} bytes per stored voxel on the GPU ({} x {} x {} grid)",
         store.len(),
@@ -807,10 +806,13 @@ fn run(cli: Cli) -> Result<()> {
                     ..Default::default()
                 };
                 // Past the dense loader (a file read slice by slice, of more than MAX_VOXELS): the store only.
-                if let Some(reader) = voxsplat::loaders::SliceReader::open(&file, &hints)? {
+                if let Some(mut reader) = voxsplat::loaders::SliceReader::open(&file, &hints)? {
                     let voxels: u64 = reader.dims.iter().map(|&d| d as u64).product();
                     if voxels > voxsplat::loaders::MAX_VOXELS {
-                        let store = voxsplat::bricks::BrickStore::load(&file, &hints)?;
+                        let (dims, spacing) = (reader.dims, reader.spacing);
+                        let store = voxsplat::bricks::BrickStore::from_slices(dims, spacing, |z0, count, out| {
+                            reader.read(z0, count, out)
+                        })?;
                         println!(
                             "volume: {:?} voxels, spacing {:?}, values {} .. {}",
                             store.dims, store.spacing, store.range.0, store.range.1

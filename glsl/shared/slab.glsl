@@ -26,8 +26,7 @@ uint slab_of(float z) {
 bool slab_range(uint s, SplatParams p, out uint first, out uint last) {
     if (p.center.w == 0.0) return false;
 #ifdef AXIS_SHEETS
-    uvec2 v = voxels[s];
-    first = pc.axis == 0u ? v.x & 0xffffu : (pc.axis == 1u ? v.x >> 16u : v.y & 0xffffu);
+    first = voxel_ijk(voxels[s])[pc.axis];
     last = first;
 #else
     float r = length(p.axis_v.xyz) * 1.0001;

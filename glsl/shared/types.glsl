@@ -106,6 +106,12 @@ struct RaycastParams {
 #define SHEET_MODE_SLAB 2u   // image-aligned sheets (slabs)
 #define SHEET_MODE_BINNED 3u // axis-aligned sheets binned on the device: (splat, sheet) pairs
 
+// A bricked batch's voxel as brick_order writes it (i | j << 16, k | stored value << 16): its grid
+// index. Mirror: cpu::brick::voxel_ijk.
+uvec3 voxel_ijk(uvec2 v) {
+    return uvec3(v.x & 0xffffu, v.x >> 16u, v.y & 0xffffu);
+}
+
 #define KERNEL_GAUSSIAN 0u
 #define KERNEL_CUBIC 1u
 

@@ -214,6 +214,11 @@ pub fn brick_hidden(
     }
 }
 
+/// Mirror of `voxel_ijk` (types.glsl): the grid index of a voxel as `brick_order` writes it.
+pub fn voxel_ijk(v: [u32; 2]) -> [u32; 3] {
+    [v[0] & 0xffff, v[0] >> 16, v[1] & 0xffff]
+}
+
 fn local_cell(l: u32) -> [u32; 3] {
     [l % BRICK, (l / BRICK) % BRICK, l / (BRICK * BRICK)]
 }
@@ -286,7 +291,7 @@ pub fn brick_order(
 /// Pass 3: per splat of the batch, classify its voxel and make its parameters.
 pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
     for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
-        let ijk = [v[0] & 0xffff, v[0] >> 16, v[1] & 0xffff];
+        let ijk = voxel_ijk(*v);
         let color = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16);
         params[s] = params_of(inputs.frame, ijk, color);
     }

@@ -26,8 +26,7 @@ pub fn slab_range(pc: &SlabPush, s: usize, p: &SplatParams, voxels: Option<&[[u3
         return None;
     }
     if let Some(v) = voxels {
-        let [a, b] = v[s];
-        let sheet = [a & 0xffff, a >> 16, b & 0xffff][pc.axis as usize];
+        let sheet = super::brick::voxel_ijk(v[s])[pc.axis as usize];
         return Some((sheet, sheet));
     }
     let r = Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length() * 1.0001;

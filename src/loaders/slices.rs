@@ -3,7 +3,7 @@
 //! (`.nii`, `.nii.gz`) and raw files with their dims and type; gzip data is inflated as it is read. Every size comes
 //! from a checked header and is checked against the file's length (a gzip stream's against what it
 //! inflates to, as it is read) before a slice is read.
-use super::{bad, decode, is_gzip, nifti_layout, nrrd_header, raw_sidecar, sidecar_hints, DType, VolumeHints};
+use super::{bad, decode, is_gzip, nifti_layout, nrrd_header, DType, VolumeHints};
 use crate::error::{Error, Result};
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
@@ -167,26 +167,15 @@ impl SliceReader {
     /// A raw file of `hints.dims` samples of `hints.dtype` (or its `.toml` sidecar's).
     pub fn raw(path: &Path, hints: &VolumeHints) -> Result<Self> {
         let what = path.display().to_string();
-        let side = match raw_sidecar(path) {
-            Some(p) => sidecar_hints(&std::fs::read_to_string(&p).map_err(io_err(&p))?, &what)?,
-            None => VolumeHints::default(),
-        };
-        let dims =
-            hints.dims.or(side.dims).ok_or_else(|| bad(&what, "raw data needs --dims X,Y,Z or a .toml sidecar"))?;
-        let dtype =
-            hints.dtype.or(side.dtype).ok_or_else(|| bad(&what, "raw data needs --dtype or a .toml sidecar"))?;
-        let spacing = hints.spacing.or(side.spacing).unwrap_or([1.0; 3]);
+        let (dims, dtype, big_endian, spacing) = super::raw_layout(path, hints, &what)?;
         super::check_spacing(spacing, &what)?;
-        super::voxel_count_within(&dims.map(u64::from), &what, MAX_STREAMED_VOXELS)?;
+        let need = super::voxel_count_within(&dims.map(u64::from), &what, MAX_STREAMED_VOXELS)? * dtype.size() as u64;
         let file = std::fs::File::open(path).map_err(io_err(path))?;
-        let big = hints.big_endian || side.big_endian;
-        let r = Self::from_file(file, path, Layout { offset: 0, dims, spacing, dtype, big_endian: big }, what)?;
-        let len = std::fs::metadata(path).map_err(io_err(path))?.len();
-        let need = r.plane_bytes() * dims[2] as u64;
+        let len = file.metadata().map_err(io_err(path))?.len();
         if len != need {
-            return Err(bad(&r.what, format!("has {len} bytes; {dims:?} of {dtype:?} needs {need}")));
+            return Err(bad(&what, format!("has {len} bytes; {dims:?} of {dtype:?} needs {need}")));
         }
-        Ok(r)
+        Ok(Self::new(Source::File(file), Layout { offset: 0, dims, spacing, dtype, big_endian }, what))
     }
 
     /// A file whose data (`layout`) it is checked to hold whole.

@@ -115,13 +115,8 @@ pub(super) fn record_bricks(
     let visible = slot_words.into_iter().filter(|&w| w != 0).map(|w| [w >> 10, 0, 0, w & 1023]);
     let batches = cut.batches(scene, visible, capacity, available);
     e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
-    let splats = |b: &[[u32; 4]]| b.last().map(|l| l[1] + l[3]).unwrap_or(0);
     let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
     e.ensure(Res::BrickList, most_entries * 16)?;
-    let largest = batches.iter().map(|b| splats(b)).max().unwrap_or(0);
-    e.ensure(Res::Params, largest as u64 * std::mem::size_of::<SplatParams>() as u64)?;
-    e.ensure(Res::Order, largest as u64 * 4)?;
-    e.ensure(Res::BrickVoxels, largest as u64 * 8)?;
     let tiles = w.div_ceil(COMPOSITE_TILE) * h.div_ceil(COMPOSITE_TILE);
     if cull_hidden && batches.len() > 1 {
         e.ensure(Res::Occlusion, tiles as u64 * 4)?;
@@ -142,18 +137,11 @@ pub(super) fn record_bricks(
             let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
             e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
             let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
-            batch = batch.into_iter().zip(hidden).filter(|(_, h)| *h == 0).map(|(l, _)| l).collect();
-            let (mut at, mut rec) = (0, 0);
-            for l in &mut batch {
-                l[1] = at;
-                at += l[3];
-                if streamed {
-                    l[2] = rec;
-                    rec += scene.store.headers[l[0] as usize].count;
-                }
-            }
+            // The bricks left, their positions (and streamed records) laid out again.
+            let kept = batch.into_iter().zip(hidden).filter(|(_, h)| *h == 0).map(|(l, _)| l);
+            batch = cut.batches(scene, kept, u32::MAX, u64::MAX).swap_remove(0);
         }
-        let n = splats(&batch);
+        let n = batch_splats(&batch);
         if !batch.is_empty() {
             record_brick_batch(e, scene, &batch, streamed, build)?;
         }
@@ -261,7 +249,7 @@ fn record_bricked_sheets(
     let parts = cut.batches(scene, visible.iter().copied(), MAX_GPU_SPLATS, available);
     if parts.len() == 1 {
         let part = &parts[0];
-        let n = part.last().map(|l| l[1] + l[3]).unwrap_or(0);
+        let n = batch_splats(part);
         if n > 0 {
             record_brick_batch(e, scene, part, cut.streamed, cut.build)?;
         }
@@ -308,7 +296,7 @@ fn record_bricked_sheets(
         let near = visible.iter().zip(&reach).filter(|(_, r)| r.0 <= hi && r.1 >= lo).map(|(l, _)| *l);
         let (p0, p1) = (position(lo).min(position(hi)), position(lo).max(position(hi)));
         for (k, part) in cut.batches(scene, near, MAX_GPU_SPLATS, available).iter().enumerate() {
-            let n = part.last().map(|l| l[1] + l[3]).unwrap_or(0);
+            let n = batch_splats(part);
             if n > 0 {
                 record_brick_batch(e, scene, part, cut.streamed, cut.build)?;
             }
@@ -321,8 +309,14 @@ fn record_bricked_sheets(
     finish(e, Res::Accum, w, h, compute)
 }
 
+/// Splats of a batch of visible bricks (entries: header, first position, first record, voxels).
+fn batch_splats(batch: &[[u32; 4]]) -> u32 {
+    batch.last().map(|l| l[1] + l[3]).unwrap_or(0)
+}
+
 /// One batch of visible bricks (entries: header, first position, first record, voxels): its
-/// records when they stream, then `brick_order` and `brick_params` make its splats' parameters.
+/// records when they stream, then `brick_order` and `brick_params` make its splats' parameters
+/// (in buffers sized for the batch: the sheet modes cut their own).
 fn record_brick_batch(
     e: &mut dyn Engine,
     scene: &BrickScene,
@@ -330,7 +324,10 @@ fn record_brick_batch(
     streamed: bool,
     build: usize,
 ) -> Result<()> {
-    let n = batch.last().map(|l| l[1] + l[3]).unwrap_or(0);
+    let n = batch_splats(batch);
+    e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+    e.ensure(Res::Order, n as u64 * 4)?;
+    e.ensure(Res::BrickVoxels, n as u64 * 8)?;
     if streamed {
         // The batch's bricks' records, in list order.
         let s = &scene.store;
