@@ -2,7 +2,8 @@
 // variants: PAGED_RECORDS STREAMED_STORE
 // Bricks, pass 3 (issue 23): per splat of a batch, in draw order, classify its voxel on the device
 // (TF table, gradient weighting, headlight shading; gradients read through the store) and make its
-// splat parameters (params.glsl, as splat_params does for a dense set). Mirror:
+// splat parameters (params.glsl, as splat_params does for a dense set); a coarse cell of levels of
+// detail reads its pyramid cell (brick_pyramid). Mirror:
 // cpu::brick::brick_params.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
@@ -20,5 +21,17 @@ void main() {
     if (s >= pc.splats) return;
     uvec2 v = voxels[s];
     uvec3 ijk = voxel_ijk(v);
-    params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u)));
+    uint level = voxel_level(v);
+    if (level == 0u) {
+        params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5)));
+        return;
+    }
+    // A coarse cell: its prefiltered colour, shaded at its gradient, and optical depth per cell.
+    uvec3 b = ijk / BRICK_SIDE;
+    uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
+    vec3 normal;
+    vec4 c = cell_color(h, v.y >> 16u, normal);
+    if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
+    float cell = float(1u << level);
+    params_store(s, params_at(vec3(ijk) + 0.5 * (cell - 1.0), cell, c.rgb, c.a));
 }

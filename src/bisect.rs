@@ -99,6 +99,12 @@ impl Engine for Split<'_> {
     fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>> {
         self.active().read(what)
     }
+    fn tag(&self, _: Res) -> u64 {
+        // A split frame rebuilds every cache: which engine ends up holding it depends on the stage
+        // the frame switches at.
+        0
+    }
+    fn set_tag(&mut self, _: Res, _: u64) {}
     fn words(&self, res: Res) -> usize {
         if self.switched {
             self.second.words(res)
@@ -203,6 +209,14 @@ impl Engine for Stop<'_> {
     }
     fn words(&self, res: Res) -> usize {
         self.inner.words(res)
+    }
+    fn tag(&self, res: Res) -> u64 {
+        self.inner.tag(res)
+    }
+    fn set_tag(&mut self, res: Res, tag: u64) {
+        if !self.done {
+            self.inner.set_tag(res, tag)
+        }
     }
     fn host_time(&mut self, stage: &'static str, ms: f64) {
         self.inner.host_time(stage, ms)

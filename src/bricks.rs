@@ -244,6 +244,15 @@ pub struct BrickScene {
     drawn: std::sync::OnceLock<Vec<u32>>,
     /// The largest gradient magnitude in stored units (gradient weighting needs it), built once.
     gmax: std::sync::OnceLock<f32>,
+    /// Names this store under this classification (TF and shading): what a device's level-of-detail
+    /// pyramid was built from (`Engine::tag`). Unique in the process.
+    classification: u64,
+}
+
+/// The next `BrickScene::classification` (0 is never one).
+fn next_classification() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Refuse `bytes` of host memory for `what` when the host has less available (Linux's
@@ -320,7 +329,15 @@ impl BrickScene {
         }
         tf.validate()?;
         let table = tf_table(&tf, remap(&store, &tf));
-        Ok(Self { store, tf, shading, table, drawn: std::sync::OnceLock::new(), gmax: std::sync::OnceLock::new() })
+        Ok(Self {
+            store,
+            tf,
+            shading,
+            table,
+            drawn: std::sync::OnceLock::new(),
+            gmax: std::sync::OnceLock::new(),
+            classification: next_classification(),
+        })
     }
 
     /// Classify with another transfer function and shading from the next frame on.
@@ -329,7 +346,13 @@ impl BrickScene {
         self.table = tf_table(&tf, remap(&self.store, &tf));
         self.drawn = std::sync::OnceLock::new();
         (self.tf, self.shading) = (tf, shading);
+        self.classification = next_classification();
         Ok(())
+    }
+
+    /// This store under its current transfer function and shading, as a tag unique in the process.
+    pub fn classification(&self) -> u64 {
+        self.classification
     }
 
     /// The transfer function.

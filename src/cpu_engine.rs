@@ -21,12 +21,19 @@ pub struct CpuEngine<'a> {
     budget_bytes: u64,
     timings: Vec<StageTime>,
     live: BTreeSet<Res>,
+    tags: std::collections::HashMap<Res, u64>,
 }
 
 impl<'a> CpuEngine<'a> {
     /// An engine for one frame of `prep`.
     pub fn new(prep: &'a Prepared) -> Self {
-        Self { b: Bindings::new(prep), budget_bytes: DEFAULT_GPU_BUDGET, timings: Vec::new(), live: BTreeSet::new() }
+        Self {
+            b: Bindings::new(prep),
+            budget_bytes: DEFAULT_GPU_BUDGET,
+            timings: Vec::new(),
+            live: BTreeSet::new(),
+            tags: Default::default(),
+        }
     }
 
     /// The same engine cutting a bricked volume's batches for a device budget of `bytes`.
@@ -71,6 +78,7 @@ impl Engine for CpuEngine<'_> {
         let buf = self.b.bufs.entry(res).or_default();
         if buf.len() < words {
             buf.resize(words, 0);
+            self.tags.remove(&res);
         }
         Ok(())
     }
@@ -129,6 +137,14 @@ impl Engine for CpuEngine<'_> {
                 }
             })
             .collect())
+    }
+
+    fn tag(&self, res: Res) -> u64 {
+        self.tags.get(&res).copied().unwrap_or(0)
+    }
+
+    fn set_tag(&mut self, res: Res, tag: u64) {
+        self.tags.insert(res, tag);
     }
 
     fn words(&self, res: Res) -> usize {

@@ -110,6 +110,11 @@ pub enum Res {
     BatchRecords,
     /// A streamed store's drawn voxels per brick under the current TF (counted on the host).
     BrickCounts,
+    /// Levels of detail: per brick the cells of levels 1-3 (`brick_pyramid`), kept while the
+    /// classification lasts (`Engine::tag`).
+    Pyramid,
+    /// Per brick its levels' drawn cells and errors.
+    LodSummary,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

@@ -160,7 +160,8 @@ pub struct BrickFrame {
     pub light: [f32; 4],
     /// Ambient, diffuse, specular, shininess.
     pub shade: [f32; 4],
-    /// x: largest gradient magnitude of the volume (gradient weighting); yzw unused.
+    /// x: largest gradient magnitude of the volume (gradient weighting); y: levels of detail,
+    /// the largest cell spacing in pixels (0: off); z: their largest error; w unused.
     pub grad: [f32; 4],
 }
 

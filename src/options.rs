@@ -121,6 +121,27 @@ pub struct RenderOptions {
     /// where voxels cover several pixels and the kernel already blurs finer than the grid; the
     /// error it adds is measured against the full-size truth. 1 (the default) draws full size.
     pub render_scale: f32,
+    /// Levels of detail of a bricked volume drawn per splat (issue 24): `Auto` draws each brick
+    /// at the coarsest level of its prefiltered pyramid whose cells project to at most
+    /// `lod_pixels` pixels and whose error is at most `lod_error` (docs/MODEL.md). Off by default
+    /// until its targets hold (docs/RESULTS.md). Sheet and slab modes and stores whose records
+    /// stream draw full detail.
+    pub lod: Lod,
+    /// Largest projected cell spacing, in pixels, of a coarse level (at the brick's nearest point).
+    pub lod_pixels: f32,
+    /// Largest error of a coarse level: how far, in opacity per voxel length (or colour weighted
+    /// by it), any voxel departs from the cell that stands for it, summed down the levels.
+    pub lod_error: f32,
+}
+
+/// Levels of detail (`RenderOptions::lod`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Lod {
+    /// Every voxel is a splat.
+    #[default]
+    Off,
+    /// Each brick at the coarsest level its projection and error allow.
+    Auto,
 }
 
 impl Default for RenderOptions {
@@ -138,9 +159,15 @@ impl Default for RenderOptions {
             cull_hidden_bricks: true,
             raster: Raster::Auto,
             render_scale: 1.0,
+            lod: Lod::Off,
+            lod_pixels: 1.0,
+            lod_error: DEFAULT_LOD_ERROR,
         }
     }
 }
+
+/// Default `RenderOptions::lod_error`.
+pub const DEFAULT_LOD_ERROR: f32 = 0.25;
 
 /// Suggested transmittance threshold of front-to-back early termination: a quarter of an 8-bit step.
 pub const DEFAULT_EARLY_TERMINATION: f32 = 1.0 / 1024.0;
@@ -169,6 +196,18 @@ impl RenderOptions {
             return Err(Error::InvalidArgument(format!(
                 "early-termination transmittance {} must be in [0, 1)",
                 self.early_termination
+            )));
+        }
+        if !(self.lod_pixels.is_finite() && self.lod_pixels > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "the level-of-detail pixel size {} must be positive and finite",
+                self.lod_pixels
+            )));
+        }
+        if !(self.lod_error.is_finite() && self.lod_error >= 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "the level-of-detail error {} must be finite and at least 0",
+                self.lod_error
             )));
         }
         if self.sheet_budget_bytes == 0 {
@@ -232,6 +271,17 @@ impl Raster {
             Raster::Points => "points",
             Raster::Compute => "compute",
             Raster::Auto => "auto",
+        }
+    }
+}
+
+impl std::str::FromStr for Lod {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "off" => Ok(Self::Off),
+            "auto" => Ok(Self::Auto),
+            _ => Err(Error::InvalidArgument(format!("unknown level-of-detail mode '{s}' (off, auto)"))),
         }
     }
 }

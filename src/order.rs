@@ -57,7 +57,11 @@ pub enum Viewer {
 impl Viewer {
     /// The viewer of `camera`, in `set`'s grid index coordinates.
     pub fn of(set: &SplatSet, camera: &Camera) -> Self {
-        let g = set.grid();
+        Self::of_grid(set.grid(), camera)
+    }
+
+    /// The viewer of `camera`, in `g`'s index coordinates.
+    pub fn of_grid(g: &crate::volume::Grid, camera: &Camera) -> Self {
         let o = DVec3::from(g.origin.map(f64::from));
         let s = DVec3::from(g.spacing.map(f64::from));
         if camera.is_perspective() {
@@ -272,6 +276,66 @@ pub fn count_violations(set: &SplatSet, camera: &Camera, order: &[u32], directio
             let want_lower_first = lower_front == (direction == Direction::FrontToBack);
             if lower_first != want_lower_first {
                 violations += 1;
+            }
+        }
+    }
+    Ok(violations)
+}
+
+/// The validator over a sequence of cells of mixed sizes (levels of detail, issue 24): `cells`
+/// in draw order, each (i, j, k, side), the cube of `side` voxels a side from voxel (i, j, k),
+/// clipped to `grid`. Counts pairs of 6-neighbour voxels in different cells whose cells are drawn
+/// in the wrong order with respect to the grid plane between them and the eye (the plane between
+/// two cells that share a face). Cells must not overlap.
+pub fn count_cell_violations(
+    grid: &crate::volume::Grid,
+    camera: &Camera,
+    cells: &[[u32; 4]],
+    direction: Direction,
+) -> Result<u64> {
+    let [nx, ny, nz] = grid.dims.map(|d| d as usize);
+    let mut pos = vec![u32::MAX; nx * ny * nz];
+    for (p, &[i, j, k, side]) in cells.iter().enumerate() {
+        if side == 0 || i as usize >= nx || j as usize >= ny || k as usize >= nz {
+            return Err(Error::InvalidArgument(format!("cell {p} ({i}, {j}, {k}; side {side}) is not in the grid")));
+        }
+        for z in k as usize..(k as usize + side as usize).min(nz) {
+            for y in j as usize..(j as usize + side as usize).min(ny) {
+                for x in i as usize..(i as usize + side as usize).min(nx) {
+                    let slot = &mut pos[x + nx * (y + ny * z)];
+                    if *slot != u32::MAX {
+                        return Err(Error::InvalidArgument(format!("cells {} and {p} overlap", *slot)));
+                    }
+                    *slot = p as u32;
+                }
+            }
+        }
+    }
+    let viewer = Viewer::of_grid(grid, camera);
+    let mut violations = 0u64;
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let a = pos[x + nx * (y + ny * z)];
+                if a == u32::MAX {
+                    continue;
+                }
+                let v = [x, y, z];
+                for axis in 0..3 {
+                    let mut n = v;
+                    n[axis] += 1;
+                    if n[axis] >= grid.dims[axis] as usize {
+                        continue;
+                    }
+                    let b = pos[n[0] + nx * (n[1] + ny * n[2])];
+                    if b == u32::MAX || b == a {
+                        continue;
+                    }
+                    let Some(lower_front) = viewer.lower_in_front(axis, v[axis] as u32) else { continue };
+                    if (a < b) != (lower_front == (direction == Direction::FrontToBack)) {
+                        violations += 1;
+                    }
+                }
             }
         }
     }

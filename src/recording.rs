@@ -17,7 +17,7 @@ use crate::gpu_types::{
     SHEET_MODE_SPLAT,
 };
 use crate::image::ImageF32;
-use crate::options::{Composite, RenderOptions, StageTime};
+use crate::options::{Composite, Lod, RenderOptions, StageTime};
 use crate::order::{Direction, OrderKind};
 use crate::plan::{self, groups_1d, Prepared};
 use crate::raster::Raster;

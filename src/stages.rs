@@ -109,10 +109,14 @@ const BRICK: &[Res] = &[
     Res::BrickHidden,
     Res::BatchRecords,
     Res::BrickCounts,
+    Res::Pyramid,
+    Res::LodSummary,
 ];
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
 const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
+/// The same, without the streamed build (the stage needs the records on the device).
+const RECORD_RESIDENT: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[])];
 const ONE: &[Variant] = &[v("", &[])];
 /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
 const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];
@@ -168,6 +172,18 @@ pub const STAGES: &[StageDesc] = &[
         device_build: None,
         variants: ONE,
         mirror: crate::cpu::splat_params::splat_params_stage,
+    },
+    StageDesc {
+        name: "brick_pyramid",
+        kind: Kind::Compute,
+        bindings: BRICK,
+        writes: &[Res::Pyramid, Res::LodSummary],
+        push: 0,
+        workgroup: Workgroup::PerItem(BRICK_LANES),
+        timing: "lod",
+        device_build: None,
+        variants: RECORD_RESIDENT,
+        mirror: crate::cpu::lod::brick_pyramid_stage,
     },
     StageDesc {
         name: "brick_cull",
@@ -481,6 +497,7 @@ stage_ids!(
     OrderScan,
     OrderScatter,
     SplatParams,
+    BrickPyramid,
     BrickCull,
     BrickOrder,
     BrickParams,
@@ -566,6 +583,11 @@ pub trait Engine {
     fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>>;
     /// Words `res` holds now (0 when it does not exist).
     fn words(&self, res: Res) -> usize;
+    /// What `res` holds across frames (0: nothing known): a tag the recording sets after writing
+    /// a cache (`set_tag`), forgotten when the buffer is replaced.
+    fn tag(&self, res: Res) -> u64;
+    /// Say that `res` holds `tag`.
+    fn set_tag(&mut self, res: Res, tag: u64);
     /// Work done on the host, reported as a stage.
     fn host_time(&mut self, stage: &'static str, ms: f64);
     /// Finish the frame: the stage times.

@@ -332,6 +332,16 @@ struct RenderArgs {
     /// faster where voxels cover several pixels; the added error is in docs/RESULTS.md (peers).
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     render_scale: f32,
+    /// Levels of detail of a bricked --volume drawn per splat: off, or auto (each brick at the
+    /// coarsest prefiltered level within --lod-pixels and --lod-error; docs/MODEL.md).
+    #[arg(long, default_value = "off")]
+    lod: String,
+    /// Largest projected cell spacing of a coarse level, in pixels.
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    lod_pixels: f32,
+    /// Largest error of a coarse level (opacity per voxel length, summed down the levels).
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
+    lod_error: f32,
     /// Reconstruction kernel: Westover's Gaussian (sigma 0.6, radius 2), the Crawfis-Max-style cubic
     /// (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: fewer fragments, sharper, flat
     /// sheets ripple by 7.6%).
@@ -629,6 +639,8 @@ fn run(cli: Cli) -> Result<()> {
             opts.cull_hidden_bricks = !a.keep_hidden_bricks;
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
             opts.render_scale = a.render_scale;
+            opts.lod = a.lod.parse()?;
+            (opts.lod_pixels, opts.lod_error) = (a.lod_pixels, a.lod_error);
             opts.validate()?;
             let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
             let r_bricked = bricked.is_some();

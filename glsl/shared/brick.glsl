@@ -12,7 +12,8 @@ struct BrickFrame {
     vec4 tf;       // x, y: a stored value d is the TF's density d x + y (gradients); zw: unused
     vec4 light;    // direction the light travels; w: 1 = headlight shading
     vec4 shade;    // ambient, diffuse, specular, shininess
-    vec4 grad;     // x: the volume's largest gradient magnitude (gradient weighting)
+    vec4 grad;     // x: the volume's largest gradient magnitude (gradient weighting); y: levels of
+                   // detail, largest cell spacing in pixels (0: off); z: their largest error
 };
 
 layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
@@ -152,37 +153,113 @@ float density_at(ivec3 v) {
     return stored_at(v) * bf.tf.x + bf.tf.y;
 }
 
+// Central-difference gradient of the density at voxel v, read through the store (classify_field).
+vec3 gradient_at(ivec3 v) {
+    vec3 s = frame.spacing.xyz;
+    return vec3(
+        (density_at(v + ivec3(1, 0, 0)) - density_at(v - ivec3(1, 0, 0))) / (2.0 * s.x),
+        (density_at(v + ivec3(0, 1, 0)) - density_at(v - ivec3(0, 1, 0))) / (2.0 * s.y),
+        (density_at(v + ivec3(0, 0, 1)) - density_at(v - ivec3(0, 0, 1))) / (2.0 * s.z));
+}
+
+// Headlight shading (two-sided) of colour rgb at a gradient g.
+vec3 shade(vec3 rgb, vec3 g) {
+    float len = length(g);
+    vec3 n = len > 0.0 ? g / len : vec3(0.0);
+    float ndl = abs(dot(n, -bf.light.xyz));
+    float lit = bf.shade.x + bf.shade.y * ndl;
+    float spec = bf.shade.z * pow(ndl, bf.shade.w);
+    return min(rgb * lit + spec, vec3(1.0));
+}
+
 // Colour and opacity of the voxel at v of quantised value q: the TF, its gradient weighting and
-// headlight shading, gradients by central differences read through the store (classify_field).
-vec4 classify_voxel(ivec3 v, uint q) {
+// headlight shading (`shaded`), gradients read through the store (classify_field).
+vec4 classify_voxel(ivec3 v, uint q, bool shaded) {
     vec4 c = tf_color[q];
     bool weighted = bf.tf.w > 0.0;
-    bool shaded = bf.light.w > 0.5;
     if (weighted || shaded) {
-        vec3 s = frame.spacing.xyz;
-        vec3 g = vec3(
-            (density_at(v + ivec3(1, 0, 0)) - density_at(v - ivec3(1, 0, 0))) / (2.0 * s.x),
-            (density_at(v + ivec3(0, 1, 0)) - density_at(v - ivec3(0, 1, 0))) / (2.0 * s.y),
-            (density_at(v + ivec3(0, 0, 1)) - density_at(v - ivec3(0, 0, 1))) / (2.0 * s.z));
-        float len = length(g);
-        if (weighted) c.a *= pow(len / bf.grad.x, bf.tf.w);
-        if (shaded) {
-            vec3 n = len > 0.0 ? g / len : vec3(0.0);
-            float ndl = abs(dot(n, -bf.light.xyz));
-            float lit = bf.shade.x + bf.shade.y * ndl;
-            float spec = bf.shade.z * pow(ndl, bf.shade.w);
-            c.rgb = min(c.rgb * lit + spec, vec3(1.0));
-        }
+        vec3 g = gradient_at(v);
+        if (weighted) c.a *= pow(length(g) / bf.grad.x, bf.tf.w);
+        if (shaded) c.rgb = shade(c.rgb, g);
     }
     return c;
+}
+
+// Levels of detail (issue 24): per header a pyramid of LOD_CELLS cells, levels 1..3 of a brick
+// (64 + 8 + 1 cells of 2^l voxels a side), each 3 words: its optical depth per cell length (f32),
+// red | green << 16 (unorm16), blue | octahedral normal << 16 (unorm16, snorm 8 + 8); and a summary:
+// x: drawn cells of level 1 | level 2 << 8 | level 3 << 12; yzw: the largest error of levels 1..3.
+// Built by brick_pyramid when the classification changes. Mirror: cpu::lod.
+layout(std430, binding = 24) buffer Pyramid { uint pyramid[]; };
+layout(std430, binding = 25) buffer LodSummary { uvec4 lod_summary[]; };
+const uint LOD_CELLS = 73u;
+const uint CELL_WORDS = 3u;
+// The octahedral bytes of a zero gradient (-128 is never written for a unit vector).
+const uint NO_NORMAL = 0x8080u;
+
+// First cell of level l (1..3) in a brick's pyramid.
+uint level_offset(uint l) {
+    return l == 1u ? 0u : (l == 2u ? 64u : 72u);
+}
+
+// The eye's PBTF split of level l's cells (2^l voxels a side) inside brick b: a cell lies on the
+// eye's low side when its lowest voxel does (as a brick does; order.rs, brick_split).
+uvec3 level_split(uvec3 b, uint l) {
+    uint side = BRICK_SIDE >> l;
+    ivec3 global = ivec3((frame.split.xyz + (1u << l) - 1u) >> l);
+    return uvec3(clamp(global - ivec3(b * side), ivec3(0), ivec3(side)));
+}
+
+// Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
+// bf.grad.y pixels at the brick's nearest depth and whose error is at most bf.grad.z (0: off).
+uint brick_level(uint h, uvec3 b) {
+    if (bf.grad.y <= 0.0) return 0u;
+    vec3 lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
+    vec3 hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
+    float near_depth = 1e30;
+    for (uint c = 0u; c < 8u; ++c) {
+        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
+        near_depth = min(near_depth, dot(p - frame.eye.xyz, frame.forward.xyz));
+    }
+    float voxel = frame.spacing.w / frame.origin.w;
+    float px = frame.eye.w > 0.5 ? voxel * frame.up.w / max(near_depth, frame.forward.w) : voxel * frame.up.w;
+    uvec4 s = lod_summary[h];
+    uint level = 0u;
+    for (uint l = 1u; l <= 3u; ++l) {
+        if (px * float(1u << l) > bf.grad.y || uintBitsToFloat(s[l]) > bf.grad.z) break;
+        level = l;
+    }
+    return level;
+}
+
+// Drawn cells of level l (1..3) in header h's brick.
+uint level_count(uint h, uint l) {
+    uint x = lod_summary[h].x;
+    return l == 1u ? x & 255u : (l == 2u ? (x >> 8u) & 15u : (x >> 12u) & 1u);
+}
+
+// Cell i of header h's pyramid: optical depth per cell length, straight colour, gradient direction.
+float cell_tau(uint h, uint i) {
+    return uintBitsToFloat(pyramid[(h * LOD_CELLS + i) * CELL_WORDS]);
+}
+
+vec4 cell_color(uint h, uint i, out vec3 normal) {
+    uint base = (h * LOD_CELLS + i) * CELL_WORDS;
+    vec2 rg = unpackUnorm2x16(pyramid[base + 1u]);
+    uint w = pyramid[base + 2u];
+    vec2 oct = unpackSnorm4x8(w >> 16u).xy;
+    vec3 n = vec3(oct, 1.0 - abs(oct.x) - abs(oct.y));
+    if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    normal = w >> 16u == NO_NORMAL ? vec3(0.0) : normalize(n);
+    return vec4(rg, unpackUnorm2x16(w).x, uintBitsToFloat(pyramid[base]));
 }
 
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
 #include "params.glsl"
 
-// The world box holding every footprint of brick b: its voxel centres' box widened by the
-// footprint reach at its far side (anti-aliasing widens with depth).
-void footprint_box(uvec3 b, out vec3 lo, out vec3 hi) {
+// The world box holding every footprint of brick b drawn with cells `cell` voxels a side: its voxel
+// centres' box widened by the footprint reach at its far side (anti-aliasing widens with depth).
+void footprint_box(uvec3 b, float cell, out vec3 lo, out vec3 hi) {
     lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
     hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
     float far_depth = -1e30;
@@ -190,7 +267,7 @@ void footprint_box(uvec3 b, out vec3 lo, out vec3 hi) {
         vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
         far_depth = max(far_depth, dot(p - frame.eye.xyz, frame.forward.xyz));
     }
-    float reach = CULL_RADII * frame.spacing.w * footprint_scale(max(far_depth, 1e-6));
+    float reach = CULL_RADII * cell * frame.spacing.w * footprint_scale(max(far_depth, 1e-6), cell);
     lo -= reach;
     hi += reach;
 }
@@ -198,11 +275,11 @@ void footprint_box(uvec3 b, out vec3 lo, out vec3 hi) {
 // Whether brick b's footprints all miss the view: its footprint box lies beyond the near or far
 // plane, or wholly outside one side plane. Not with motion blur (a blurred quad reaches back along
 // its path).
-bool outside_view(uvec3 b) {
+bool outside_view(uvec3 b, float cell) {
     if (frame.blur.x > 0.0) return false;
     vec3 lo;
     vec3 hi;
-    footprint_box(b, lo, hi);
+    footprint_box(b, cell, lo, hi);
     float dmin = 1e30;
     float dmax = -1e30;
     bool front = true;

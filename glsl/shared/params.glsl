@@ -7,10 +7,11 @@
 const float MAX_OPACITY = 0.999;
 const float CULL_RADII = 1.5;
 
-// The anti-aliasing radius scale at eye-space `depth` (1 before k; Eq. 3.9 or the EWA low-pass).
-float footprint_scale(float depth) {
-    // Pixels per voxel spacing at this depth (section 3.3.4: = k / d in perspective).
-    float voxel = frame.spacing.w / frame.origin.w;
+// The anti-aliasing radius scale at eye-space `depth` of a splat `cell` voxels a side (1 before
+// k; Eq. 3.9 or the EWA low-pass).
+float footprint_scale(float depth, float cell) {
+    // Pixels per splat spacing at this depth (section 3.3.4: = k / d in perspective).
+    float voxel = cell * frame.spacing.w / frame.origin.w;
     float ppv = frame.eye.w > 0.5 ? voxel * frame.up.w / max(depth, 1e-6) : voxel * frame.up.w;
     float scale = 1.0;
     if (frame.aa.x == AA_SWAN) {
@@ -22,12 +23,14 @@ float footprint_scale(float depth) {
     return scale;
 }
 
-SplatParams params_of(uvec3 ijk, vec4 color) {
-    vec3 center = frame.origin.xyz + vec3(ijk) * frame.spacing.xyz;
+// A splat of `cell` voxels a side (a voxel, or a coarse cell of levels of detail: its kernel
+// `cell` times wider) at grid position `at`, of straight colour rgb and optical depth tau per cell.
+SplatParams params_at(vec3 at, float cell, vec3 rgb, float tau) {
+    vec3 center = frame.origin.xyz + at * frame.spacing.xyz;
     vec3 forward = frame.forward.xyz;
     float depth = dot(center - frame.eye.xyz, forward);
-    float scale = footprint_scale(depth);
-    float radius = frame.spacing.w * scale;
+    float scale = footprint_scale(depth, cell);
+    float radius = cell * frame.spacing.w * scale;
     bool visible = depth >= frame.forward.w + CULL_RADII * radius && depth <= frame.right.w - CULL_RADII * radius;
     // The quad faces the eye->voxel ray (perspective) or the view direction (orthographic).
     vec3 w = frame.eye.w > 0.5 ? normalize(center - frame.eye.xyz) : forward;
@@ -54,15 +57,18 @@ SplatParams params_of(uvec3 ijk, vec4 color) {
             energy /= 1.0 + 2.0 * stretch * frame.blur.y;   // Eq. 4.2 with effective area and width
         }
     }
-    float opacity = clamp(color.a, 0.0, MAX_OPACITY);
-    float tau = -log(1.0 - opacity);
     SplatParams p;
     p.center = vec4(quad_center, visible && tau > 0.0 ? 1.0 : 0.0);
     p.axis_u = vec4(u * radius * (1.0 + stretch), energy);   // Eq. 3.13: energy x (k/d)^2
     p.axis_v = vec4(v * radius, stretch);
-    p.emit = vec4(color.rgb, tau);
+    p.emit = vec4(rgb, tau);
     float dist = length(center - frame.eye.xyz);
     float pixels = frame.eye.w > 0.5 ? radius * frame.up.w / max(depth, 1e-6) : radius * frame.up.w;
     p.screen = vec4(depth, dist, pixels, scale);
     return p;
+}
+
+SplatParams params_of(uvec3 ijk, vec4 color) {
+    float opacity = clamp(color.a, 0.0, MAX_OPACITY);
+    return params_at(vec3(ijk), 1.0, color.rgb, -log(1.0 - opacity));
 }

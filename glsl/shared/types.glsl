@@ -106,10 +106,15 @@ struct RaycastParams {
 #define SHEET_MODE_SLAB 2u   // image-aligned sheets (slabs)
 #define SHEET_MODE_BINNED 3u // axis-aligned sheets binned on the device: (splat, sheet) pairs
 
-// A bricked batch's voxel as brick_order writes it (i | j << 16, k | stored value << 16): its grid
-// index. Mirror: cpu::brick::voxel_ijk.
+// A bricked batch's voxel as brick_order writes it (i | j << 16, k | level << 13 | stored value or
+// pyramid cell << 16): its grid index (a coarse cell's lowest voxel). Mirror: cpu::brick::voxel_ijk.
 uvec3 voxel_ijk(uvec2 v) {
-    return uvec3(v.x & 0xffffu, v.x >> 16u, v.y & 0xffffu);
+    return uvec3(v.x & 0xffffu, v.x >> 16u, v.y & 0x1fffu);
+}
+
+// Its level of detail (0: a voxel; l: a cell of 2^l voxels a side). Mirror: cpu::brick::voxel_level.
+uint voxel_level(uvec2 v) {
+    return (v.y >> 13u) & 3u;
 }
 
 #define KERNEL_GAUSSIAN 0u

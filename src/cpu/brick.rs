@@ -1,8 +1,10 @@
 //! Mirrors of `brick_cull.comp`, `brick_order.comp` and `brick_params.comp`, and of `glsl/shared/brick.glsl`'s
-//! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer.
+//! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer (levels of
+//! detail: `cpu::lod`).
 use super::bindings::Bindings;
+use super::lod::{cell_color, cell_tau, level_count, level_offset, level_split};
 use super::order::{outward, side_count};
-use super::splat_params::{footprint_scale, params_of, CULL_RADII};
+use super::splat_params::{cell_footprint_scale, params_at, params_of, CULL_RADII};
 use crate::bricks::{BrickStore, BRICK};
 use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
 use crate::dispatch::{Args, Res, Variant};
@@ -35,6 +37,9 @@ pub struct BrickInputs<'a> {
     /// `BrickScene::tf_words`.
     pub tf: &'a [u32],
     pub store: &'a BrickStore,
+    /// Levels of detail: the pyramid cells and per-brick summaries (empty when off).
+    pub pyramid: &'a [u32],
+    pub summary: &'a [[u32; 4]],
 }
 
 const TF_BITS: usize = 4 * TF_ENTRIES as usize;
@@ -42,7 +47,7 @@ const TF_PREFIX: usize = TF_BITS + TF_ENTRIES as usize / 32;
 
 impl BrickInputs<'_> {
     /// Mirror of `emits`.
-    fn emits(&self, q: u32) -> bool {
+    pub(crate) fn emits(&self, q: u32) -> bool {
         crate::bricks::emits(self.tf, q)
     }
 
@@ -64,38 +69,48 @@ impl BrickInputs<'_> {
         self.store.value_at(i, j, k) * self.bf.tf[0] + self.bf.tf[1]
     }
 
+    /// Mirror of `gradient_at`.
+    pub(crate) fn gradient_at(&self, v: [i64; 3]) -> Vec3 {
+        let s = &self.frame.spacing;
+        let [i, j, k] = v;
+        Vec3::new(
+            (self.density_at(i + 1, j, k) - self.density_at(i - 1, j, k)) / (2.0 * s[0]),
+            (self.density_at(i, j + 1, k) - self.density_at(i, j - 1, k)) / (2.0 * s[1]),
+            (self.density_at(i, j, k + 1) - self.density_at(i, j, k - 1)) / (2.0 * s[2]),
+        )
+    }
+
+    /// Mirror of `shade`.
+    fn shade(&self, c: &mut [f32; 4], g: Vec3) {
+        let len = g.length();
+        let n = if len > 0.0 { g / len } else { Vec3::ZERO };
+        let light = Vec3::new(self.bf.light[0], self.bf.light[1], self.bf.light[2]);
+        let ndl = n.dot(-light).abs();
+        let lit = self.bf.shade[0] + self.bf.shade[1] * ndl;
+        let spec = self.bf.shade[2] * ndl.powf(self.bf.shade[3]);
+        for ch in c.iter_mut().take(3) {
+            *ch = (*ch * lit + spec).min(1.0);
+        }
+    }
+
     /// Mirror of `classify_voxel`.
-    fn classify_voxel(&self, v: [i64; 3], q: u32) -> [f32; 4] {
+    pub(crate) fn classify_voxel(&self, v: [i64; 3], q: u32, shaded: bool) -> [f32; 4] {
         let mut c = [0, 1, 2, 3].map(|i| f32::from_bits(self.tf[4 * q as usize + i]));
-        let (weighted, shaded) = (self.bf.tf[3] > 0.0, self.bf.light[3] > 0.5);
+        let weighted = self.bf.tf[3] > 0.0;
         if weighted || shaded {
-            let s = &self.frame.spacing;
-            let [i, j, k] = v;
-            let g = Vec3::new(
-                (self.density_at(i + 1, j, k) - self.density_at(i - 1, j, k)) / (2.0 * s[0]),
-                (self.density_at(i, j + 1, k) - self.density_at(i, j - 1, k)) / (2.0 * s[1]),
-                (self.density_at(i, j, k + 1) - self.density_at(i, j, k - 1)) / (2.0 * s[2]),
-            );
-            let len = g.length();
+            let g = self.gradient_at(v);
             if weighted {
-                c[3] *= (len / self.bf.grad[0]).powf(self.bf.tf[3]);
+                c[3] *= (g.length() / self.bf.grad[0]).powf(self.bf.tf[3]);
             }
             if shaded {
-                let n = if len > 0.0 { g / len } else { Vec3::ZERO };
-                let light = Vec3::new(self.bf.light[0], self.bf.light[1], self.bf.light[2]);
-                let ndl = n.dot(-light).abs();
-                let lit = self.bf.shade[0] + self.bf.shade[1] * ndl;
-                let spec = self.bf.shade[2] * ndl.powf(self.bf.shade[3]);
-                for ch in c.iter_mut().take(3) {
-                    *ch = (*ch * lit + spec).min(1.0);
-                }
+                self.shade(&mut c, g);
             }
         }
         c
     }
 
     /// Mirror of `footprint_box`.
-    fn footprint_box(&self, b: [u32; 3]) -> (Vec3, Vec3) {
+    fn footprint_box(&self, b: [u32; 3], cell: f32) -> (Vec3, Vec3) {
         let f = self.frame;
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         let (origin, spacing, eye, forward) = (v3(f.origin), v3(f.spacing), v3(f.eye), v3(f.forward));
@@ -103,19 +118,19 @@ impl BrickInputs<'_> {
         let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
         let (lo, hi) = (origin + first * spacing, origin + Vec3::from(last) * spacing);
         let far = (0..8).map(|c| (corner(lo, hi, c) - eye).dot(forward)).fold(-1e30f32, f32::max);
-        let reach = CULL_RADII * f.spacing[3] * footprint_scale(f, far.max(1e-6));
+        let reach = CULL_RADII * cell * f.spacing[3] * cell_footprint_scale(f, far.max(1e-6), cell);
         (lo - Vec3::splat(reach), hi + Vec3::splat(reach))
     }
 
     /// Mirror of `outside_view`.
-    fn outside_view(&self, b: [u32; 3]) -> bool {
+    fn outside_view(&self, b: [u32; 3], cell: f32) -> bool {
         let f = self.frame;
         if f.blur[0] > 0.0 {
             return false;
         }
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         let (eye, forward) = (v3(f.eye), v3(f.forward));
-        let (lo, hi) = self.footprint_box(b);
+        let (lo, hi) = self.footprint_box(b, cell);
         let vp = Mat4::from_cols_array_2d(&f.view_proj);
         let (mut dmin, mut dmax, mut front) = (1e30f32, -1e30f32, true);
         let mut out = [true; 4];
@@ -149,7 +164,7 @@ impl BrickInputs<'_> {
 }
 
 /// Corner `c` (bit a: the high end along axis a) of the box `lo`..`hi`.
-fn corner(lo: Vec3, hi: Vec3, c: u32) -> Vec3 {
+pub(crate) fn corner(lo: Vec3, hi: Vec3, c: u32) -> Vec3 {
     Vec3::new(
         if c & 1 == 1 { hi.x } else { lo.x },
         if c >> 1 & 1 == 1 { hi.y } else { lo.y },
@@ -190,8 +205,8 @@ pub fn brick_hidden(
     let size = glam::Vec2::new(f.blur[2], f.blur[3]);
     let tile = COMPOSITE_TILE as f32;
     let tiles_x = (size.x / tile).ceil() as i64;
-    let is_hidden = |b: [u32; 3]| {
-        let (lo, hi) = inputs.footprint_box(b);
+    let is_hidden = |h: u32, b: [u32; 3]| {
+        let (lo, hi) = inputs.footprint_box(b, (1u32 << inputs.brick_level(h, b)) as f32);
         let (mut slo, mut shi) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
         for c in 0..8 {
             let q: Vec4 = vp * corner(lo, hi, c).extend(1.0);
@@ -210,16 +225,21 @@ pub fn brick_hidden(
             .all(|y| (t0.x as i64..=t1.x as i64).all(|x| occlusion[(y * tiles_x + x) as usize] <= push.occluded))
     };
     for (e, entry) in list[push.first as usize..(push.first + push.count) as usize].iter().enumerate() {
-        hidden[e] = u32::from(is_hidden(inputs.store.headers[entry[0] as usize].coords()));
+        hidden[e] = u32::from(is_hidden(entry[0], inputs.store.headers[entry[0] as usize].coords()));
     }
 }
 
 /// Mirror of `voxel_ijk` (types.glsl): the grid index of a voxel as `brick_order` writes it.
 pub fn voxel_ijk(v: [u32; 2]) -> [u32; 3] {
-    [v[0] & 0xffff, v[0] >> 16, v[1] & 0xffff]
+    [v[0] & 0xffff, v[0] >> 16, v[1] & 0x1fff]
 }
 
-fn local_cell(l: u32) -> [u32; 3] {
+/// Mirror of `voxel_level`: 0 for a voxel, l for a cell of 2^l voxels a side.
+pub fn voxel_level(v: [u32; 2]) -> u32 {
+    v[1] >> 13 & 3
+}
+
+pub(crate) fn local_cell(l: u32) -> [u32; 3] {
     [l % BRICK, (l / BRICK) % BRICK, l / (BRICK * BRICK)]
 }
 
@@ -229,10 +249,15 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
     let store = inputs.store;
     for (h, hd) in store.headers.iter().enumerate() {
         let b = hd.coords();
-        if inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) || inputs.outside_view(b) {
+        if inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) {
+            continue;
+        }
+        let level = inputs.brick_level(h as u32, b);
+        if inputs.outside_view(b, (1u32 << level) as f32) {
             continue;
         }
         let drawn = match counts {
+            _ if level > 0 => level_count(inputs.summary, h as u32, level),
             Some(c) => c[h],
             None => {
                 let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
@@ -260,6 +285,11 @@ pub fn brick_order(
     for entry in &list[push.first as usize..(push.first + push.count) as usize] {
         let hd = store.headers[entry[0] as usize];
         let b = hd.coords();
+        let level = inputs.brick_level(entry[0], b);
+        if level > 0 {
+            coarse(inputs, entry, b, level, voxels, order);
+            continue;
+        }
         let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
         let records = &records[entry[2] as usize..(entry[2] + hd.count) as usize];
         let mut cells = [0u32; CELL_WORDS];
@@ -288,19 +318,72 @@ pub fn brick_order(
     }
 }
 
-/// Pass 3: per splat of the batch, classify its voxel and make its parameters.
-pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
-    for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
-        let ijk = voxel_ijk(*v);
-        let color = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16);
-        params[s] = params_of(inputs.frame, ijk, color);
+/// Mirror of `coarse` in brick_order.comp: brick `b`'s drawn cells of `level` in PBTF order.
+fn coarse(
+    inputs: &BrickInputs<'_>,
+    entry: &[u32; 4],
+    b: [u32; 3],
+    level: u32,
+    voxels: &mut [[u32; 2]],
+    order: &mut [u32],
+) {
+    let side = BRICK >> level;
+    let off = level_offset(level);
+    let split = level_split(inputs.frame.split, b, level);
+    let cell = |c: u32| [c % side, (c / side) % side, c / (side * side)];
+    let drawn: Vec<u32> =
+        (0..side * side * side).filter(|&c| cell_tau(inputs.pyramid, entry[0], off + c) > 0.0).collect();
+    let mut marks = 0u64;
+    for &c in &drawn {
+        marks |= 1 << dense_pbtf(cell(c), [side; 3], split);
+    }
+    let total = marks.count_ones();
+    for &c in &drawn {
+        let p = dense_pbtf(cell(c), [side; 3], split);
+        let rank = (marks & ((1u64 << p) - 1)).count_ones();
+        let rank = if inputs.frame.split[3] != 0 { total - 1 - rank } else { rank };
+        let pos = (entry[1] + rank) as usize;
+        let ijk = [0, 1, 2].map(|a| b[a] * BRICK + (cell(c)[a] << level));
+        voxels[pos] = [ijk[0] | ijk[1] << 16, ijk[2] | level << 13 | (off + c) << 16];
+        order[pos] = pos as u32;
     }
 }
 
-fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
+/// Pass 3: per splat of the batch, classify its voxel (or read its coarse cell) and make its
+/// parameters.
+pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
+    let shaded = inputs.bf.light[3] > 0.5;
+    for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
+        let ijk = voxel_ijk(*v);
+        let level = voxel_level(*v);
+        if level == 0 {
+            let color = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
+            params[s] = params_of(inputs.frame, ijk, color);
+            continue;
+        }
+        let nb = inputs.bf.grid;
+        let h = inputs.store.index[(ijk[0] / BRICK + nb[0] * (ijk[1] / BRICK + nb[1] * (ijk[2] / BRICK))) as usize];
+        let (mut c, normal) = cell_color(inputs.pyramid, h, v[1] >> 16);
+        if shaded {
+            inputs.shade(&mut c, normal);
+        }
+        let cell = (1u32 << level) as f32;
+        let at = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5 * (cell - 1.0);
+        params[s] = params_at(inputs.frame, at, cell, [c[0], c[1], c[2]], c[3]);
+    }
+}
+
+pub(crate) fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
     let scene = b.prep.bricks.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
     let bf: &[BrickFrame] = b.get(Res::BrickFrame);
-    Ok(BrickInputs { frame: &b.frame, bf: bf[0], tf: b.get(Res::Tf), store: &scene.store })
+    Ok(BrickInputs {
+        frame: &b.frame,
+        bf: bf[0],
+        tf: b.get(Res::Tf),
+        store: &scene.store,
+        pyramid: b.get(Res::Pyramid),
+        summary: b.get(Res::LodSummary),
+    })
 }
 
 /// Whether a brick stage's build reads streamed records.

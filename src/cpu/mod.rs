@@ -4,6 +4,7 @@ pub mod bindings;
 pub mod brick;
 pub mod composite;
 pub mod footprint;
+pub mod lod;
 pub mod order;
 pub mod raycast;
 pub mod sheet_tiles;

@@ -18,7 +18,12 @@ pub const AA_EWA: f32 = 2.0;
 
 /// The anti-aliasing radius scale at eye-space `depth` (1 before k; Eq. 3.9 or the EWA low-pass).
 pub fn footprint_scale(frame: &Frame, depth: f32) -> f32 {
-    let voxel = frame.spacing[3] / frame.origin[3];
+    cell_footprint_scale(frame, depth, 1.0)
+}
+
+/// Mirror of `footprint_scale` in params.glsl: the scale of a splat `cell` voxels a side.
+pub fn cell_footprint_scale(frame: &Frame, depth: f32, cell: f32) -> f32 {
+    let voxel = cell * frame.spacing[3] / frame.origin[3];
     let ppv = if frame.eye[3] > 0.5 { voxel * frame.up[3] / depth.max(1e-6) } else { voxel * frame.up[3] };
     if frame.aa[0] == AA_SWAN {
         (1.0 / ppv).max(1.0)
@@ -33,14 +38,20 @@ pub fn footprint_scale(frame: &Frame, depth: f32) -> f32 {
 /// Mirror of `params_of` in `glsl/shared/params.glsl`: a splat's parameters from its grid index
 /// and colour (the dense path's `splat_params` and the bricks' `brick_params` share it).
 pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
+    let at = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32);
+    params_at(frame, at, 1.0, [color[0], color[1], color[2]], optical_depth(color[3]))
+}
+
+/// Mirror of `params_at`: a splat `cell` voxels a side at grid position `at`, of straight colour
+/// `rgb` and optical depth `tau` per cell.
+pub fn params_at(frame: &Frame, at: Vec3, cell: f32, rgb: [f32; 3], tau: f32) -> SplatParams {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right, origin, spacing) =
         (v3(frame.eye), v3(frame.forward), v3(frame.right), v3(frame.origin), v3(frame.spacing));
-    let ijk = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32);
-    let center = origin + ijk * spacing;
+    let center = origin + at * spacing;
     let depth = (center - eye).dot(forward);
-    let scale = footprint_scale(frame, depth);
-    let radius = frame.spacing[3] * scale;
+    let scale = cell_footprint_scale(frame, depth, cell);
+    let radius = cell * frame.spacing[3] * scale;
     let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
     let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
     let mut u = (right - right.dot(w) * w).normalize();
@@ -68,7 +79,6 @@ pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
             energy /= 1.0 + 2.0 * stretch * frame.blur[1];
         }
     }
-    let tau = optical_depth(color[3]);
     SplatParams {
         center: [quad_center.x, quad_center.y, quad_center.z, if visible && tau > 0.0 { 1.0 } else { 0.0 }],
         axis_u: [
@@ -78,7 +88,7 @@ pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
             energy,
         ],
         axis_v: [v.x * radius, v.y * radius, v.z * radius, stretch],
-        emit: [color[0], color[1], color[2], tau],
+        emit: [rgb[0], rgb[1], rgb[2], tau],
         screen: [
             depth,
             (center - eye).length(),

@@ -333,6 +333,14 @@ impl Engine for GpuEngine<'_> {
         add_time(&mut self.timings, stage, ms);
     }
 
+    fn tag(&self, res: Res) -> u64 {
+        self.gpu.res.tags.get(&res).copied().unwrap_or(0)
+    }
+
+    fn set_tag(&mut self, res: Res, tag: u64) {
+        self.gpu.res.tags.insert(res, tag);
+    }
+
     fn finish(&mut self) -> Result<Vec<StageTime>> {
         self.flush()?;
         Ok(std::mem::take(&mut self.timings))

@@ -55,6 +55,8 @@ pub struct Resources {
     kernel: Option<Kernel>,
     scene: Option<SceneBuffers>,
     bufs: HashMap<Res, Buffer>,
+    /// What a buffer kept across frames holds (`Engine::tag`); gone with the buffer.
+    pub tags: HashMap<Res, u64>,
     target: Option<Target>,
     readback: HashMap<Res, Buffer>,
     sets: HashMap<(StageId, List), DescriptorSet>,
@@ -101,6 +103,7 @@ impl Resources {
             kernel: None,
             scene: None,
             bufs: HashMap::new(),
+            tags: HashMap::new(),
             target: None,
             readback: HashMap::new(),
             sets: HashMap::new(),
@@ -115,6 +118,7 @@ impl Resources {
         self.ctx.wait_idle();
         self.sets.clear();
         self.bufs.clear();
+        self.tags.clear();
         self.scene = None;
         let set = &prep.set;
         if set.len() > MAX_GPU_SPLATS as usize {
@@ -218,6 +222,7 @@ impl Resources {
         let size = if exact(res) || bytes > range { bytes } else { bytes.next_power_of_two().min(range) };
         self.sets.clear();
         self.bufs.remove(&res);
+        self.tags.remove(&res);
         self.bufs.insert(res, Buffer::new(&self.ctx, &format!("{res:?}"), size, USAGE, Memory::Device)?);
         Ok(())
     }

@@ -65,7 +65,11 @@ pub(super) fn record_bricks(
             (scene.store.records.len() as u64 * 8).div_ceil(1 << 20) + 1
         )));
     }
-    let least = bricked_min_budget(scene, budget, w, h);
+    // Levels of detail: per splat, with the store's records on the device (the pyramid is built
+    // from them when the classification changes).
+    let lod = opts.lod == Lod::Auto && !sheets && !streamed;
+    let pyramid = if lod { crate::cpu::lod::pyramid_bytes(scene.store.headers.len().max(1)) } else { 0 };
+    let least = bricked_min_budget(scene, budget, w, h) + pyramid;
     if budget < least {
         return Err(Error::TooLarge(format!(
             "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB) and one brick of splats at \
@@ -75,15 +79,29 @@ pub(super) fn record_bricks(
             least.div_ceil(1 << 20)
         )));
     }
-    let available = budget - bricked_resident_bytes(scene, budget, w, h);
+    let available = budget - bricked_resident_bytes(scene, budget, w, h) - pyramid;
     let frame = plan::frame_for(&prep.set, camera, opts);
-    let bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
+    let mut bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
+    if lod {
+        (bf.grad[1], bf.grad[2]) = (opts.lod_pixels, opts.lod_error);
+    }
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
     // The brick stages' build: one page of store records, the paged reader, or streamed records.
     let build = if streamed { 2 } else { usize::from(scene.store.len() > RECORD_PAGE as usize) };
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
+    if lod {
+        e.ensure(Res::Pyramid, pyramid - scene.store.headers.len().max(1) as u64 * 16)?;
+        e.ensure(Res::LodSummary, scene.store.headers.len().max(1) as u64 * 16)?;
+        let id = scene.classification();
+        if (e.tag(Res::Pyramid) != id || e.tag(Res::LodSummary) != id) && bf.grid[3] > 0 {
+            let groups = plan::groups_per_item(bf.grid[3]);
+            e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, &[]))?;
+            e.set_tag(Res::Pyramid, id);
+            e.set_tag(Res::LodSummary, id);
+        }
+    }
     if streamed {
         let counts = scene.drawn_counts();
         e.ensure(Res::BrickCounts, counts.len().max(1) as u64 * 4)?;

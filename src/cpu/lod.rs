@@ -1,0 +1,213 @@
+//! Levels of detail over a bricked volume (issue 24): mirror of `brick_pyramid.comp` and of the
+//! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
+//! `cell_color`).
+use super::bindings::Bindings;
+use super::brick::{inputs, local_cell, BrickInputs};
+use super::splat_params::MAX_OPACITY;
+use crate::bricks::BRICK;
+use crate::dispatch::{Args, Res, Variant};
+use crate::error::Result;
+use glam::Vec3;
+
+/// Cells of levels 1-3 in a brick's pyramid (64 + 8 + 1).
+pub const LOD_CELLS: usize = 73;
+/// Words per pyramid cell.
+pub const CELL_WORDS: usize = 3;
+/// Coarse levels (level l: cells of 2^l voxels a side).
+pub const LOD_LEVELS: u32 = 3;
+/// The octahedral bytes of a zero gradient.
+const NO_NORMAL: u32 = 0x8080;
+
+/// Device bytes of the pyramid and summary of `bricks` non-empty bricks.
+pub fn pyramid_bytes(bricks: usize) -> u64 {
+    bricks as u64 * (LOD_CELLS * CELL_WORDS * 4 + 16) as u64
+}
+
+/// First cell of level `l` (1..3) in a brick's pyramid.
+pub fn level_offset(l: u32) -> u32 {
+    match l {
+        1 => 0,
+        2 => 64,
+        _ => 72,
+    }
+}
+
+/// Mirror of `packSnorm4x8`'s low two bytes, rounding as `f32::round` does.
+fn snorm8(v: f32) -> u32 {
+    ((v.clamp(-1.0, 1.0) * 127.0).round() as i32 as u32) & 0xff
+}
+
+fn unorm16(v: f32) -> u32 {
+    (v.clamp(0.0, 1.0) * 65535.0).round() as u32
+}
+
+/// Mirror of `pack_normal`: octahedral bytes of gradient `g`.
+fn pack_normal(g: Vec3) -> u32 {
+    let len = g.x.abs() + g.y.abs() + g.z.abs();
+    if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return NO_NORMAL;
+    }
+    let n = g / len;
+    let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
+    let (ox, oy) = if n.z < 0.0 { ((1.0 - n.y.abs()) * sign(n.x), (1.0 - n.x.abs()) * sign(n.y)) } else { (n.x, n.y) };
+    snorm8(ox) | snorm8(oy) << 8
+}
+
+/// Mirror of `cell_color`: cell `i` of header `h`: straight colour, optical depth per cell
+/// length, and its gradient direction (zero when it has none).
+pub fn cell_color(pyramid: &[u32], h: u32, i: u32) -> ([f32; 4], Vec3) {
+    let base = (h as usize * LOD_CELLS + i as usize) * CELL_WORDS;
+    let un = |w: u32| (w & 0xffff) as f32 / 65535.0;
+    let w = pyramid[base + 2];
+    let sn = |b: u32| ((b & 0xff) as u8 as i8 as f32 / 127.0).max(-1.0);
+    let (ox, oy) = (sn(w >> 16), sn(w >> 24));
+    let mut n = Vec3::new(ox, oy, 1.0 - ox.abs() - oy.abs());
+    if n.z < 0.0 {
+        let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
+        (n.x, n.y) = ((1.0 - oy.abs()) * sign(ox), (1.0 - ox.abs()) * sign(oy));
+    }
+    let normal = if w >> 16 == NO_NORMAL { Vec3::ZERO } else { n.normalize() };
+    let rgba = [un(pyramid[base + 1]), un(pyramid[base + 1] >> 16), un(w), f32::from_bits(pyramid[base])];
+    (rgba, normal)
+}
+
+/// Mirror of `cell_tau`.
+pub fn cell_tau(pyramid: &[u32], h: u32, i: u32) -> f32 {
+    f32::from_bits(pyramid[(h as usize * LOD_CELLS + i as usize) * CELL_WORDS])
+}
+
+/// Mirror of `level_count`.
+pub fn level_count(summary: &[[u32; 4]], h: u32, l: u32) -> u32 {
+    let x = summary[h as usize][0];
+    match l {
+        1 => x & 255,
+        2 => x >> 8 & 15,
+        _ => x >> 12 & 1,
+    }
+}
+
+/// Mirror of `level_split`: the eye's PBTF split of level `l`'s cells inside brick `b`.
+pub fn level_split(split: [u32; 4], b: [u32; 3], l: u32) -> [u32; 3] {
+    let side = BRICK >> l;
+    [0, 1, 2].map(|a| {
+        let global = ((split[a] + (1 << l) - 1) >> l) as i64;
+        (global - (b[a] * side) as i64).clamp(0, side as i64) as u32
+    })
+}
+
+impl BrickInputs<'_> {
+    /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame.
+    pub fn brick_level(&self, h: u32, b: [u32; 3]) -> u32 {
+        let (f, bf) = (self.frame, &self.bf);
+        if bf.grad[1] <= 0.0 {
+            return 0;
+        }
+        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        let (origin, spacing, eye, forward) = (v3(f.origin), v3(f.spacing), v3(f.eye), v3(f.forward));
+        let first = Vec3::new((b[0] * BRICK) as f32, (b[1] * BRICK) as f32, (b[2] * BRICK) as f32);
+        let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
+        let (lo, hi) = (origin + first * spacing, origin + Vec3::from(last) * spacing);
+        let near = (0..8).map(|c| (super::brick::corner(lo, hi, c) - eye).dot(forward)).fold(1e30f32, f32::min);
+        let voxel = f.spacing[3] / f.origin[3];
+        let px = if f.eye[3] > 0.5 { voxel * f.up[3] / near.max(f.forward[3]) } else { voxel * f.up[3] };
+        let s = self.summary[h as usize];
+        let mut level = 0;
+        for l in 1..=LOD_LEVELS {
+            if px * (1u32 << l) as f32 > bf.grad[1] || f32::from_bits(s[l as usize]) > bf.grad[2] {
+                break;
+            }
+            level = l;
+        }
+        level
+    }
+}
+
+/// Per-level sums of a brick's cells: optical depth, tau-weighted colour and gradient, error.
+#[derive(Clone, Copy, Default)]
+struct Sums {
+    tau: f32,
+    col: Vec3,
+    grad: Vec3,
+    err: f32,
+}
+
+/// Mirror of `brick_pyramid.comp`: every non-empty brick's pyramid cells and summary.
+pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mut [[u32; 4]]) {
+    let store = inputs.store;
+    let shaded = inputs.bf.light[3] > 0.5;
+    let fine_n = (BRICK * BRICK * BRICK) as usize;
+    for (h, hd) in store.headers.iter().enumerate() {
+        let b = hd.coords();
+        let mut fine = vec![Sums::default(); fine_n];
+        for &rec in &store.records[hd.first as usize..(hd.first + hd.count) as usize] {
+            if !inputs.emits(rec >> 16) {
+                continue;
+            }
+            let l = rec & 511;
+            let lc = local_cell(l);
+            let v = [0, 1, 2].map(|a| (b[a] * BRICK + lc[a]) as i64);
+            let c = inputs.classify_voxel(v, rec >> 16, false);
+            let t = -(1.0 - c[3].clamp(0.0, MAX_OPACITY)).ln();
+            let grad = if shaded { inputs.gradient_at(v) * t } else { Vec3::ZERO };
+            fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0 };
+        }
+        let mut cells = [Sums::default(); LOD_CELLS];
+        let mut stored = [0f32; LOD_CELLS];
+        for l in 1..=LOD_LEVELS {
+            let n = BRICK >> l;
+            let voxels = (1u32 << (3 * l)) as f32;
+            for c in 0..n * n * n {
+                let cc = [c % n, (c / n) % n, c / (n * n)];
+                let children: [Sums; 8] = std::array::from_fn(|d| {
+                    let d = d as u32;
+                    let k = [0, 1, 2].map(|a| 2 * cc[a] + (d >> a & 1));
+                    let m = 2 * n;
+                    let i = (k[0] + m * (k[1] + m * k[2])) as usize;
+                    if l == 1 {
+                        fine[i]
+                    } else {
+                        cells[level_offset(l - 1) as usize + i]
+                    }
+                });
+                let (mut t, mut col, mut g) = (0.0f32, Vec3::ZERO, Vec3::ZERO);
+                for k in &children {
+                    (t, col, g) = (t + k.tau, col + k.col, g + k.grad);
+                }
+                let a = 1.0 - (-t / voxels).exp();
+                let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
+                let mut err = 0.0f32;
+                for k in &children {
+                    let ak = 1.0 - (-k.tau * 8.0 / voxels).exp();
+                    let sk = if k.tau > 0.0 { k.col / k.tau } else { Vec3::ZERO };
+                    let dc = (sk - straight).abs();
+                    err = err.max(k.err + (ak - a).abs().max(ak * dc.x.max(dc.y.max(dc.z))));
+                }
+                let i = level_offset(l) as usize + c as usize;
+                cells[i] = Sums { tau: t, col, grad: g, err };
+                stored[i] = t / voxels * (1u32 << l) as f32;
+                let base = (h * LOD_CELLS + i) * CELL_WORDS;
+                pyramid[base] = stored[i].to_bits();
+                pyramid[base + 1] = unorm16(straight.x) | unorm16(straight.y) << 16;
+                pyramid[base + 2] = unorm16(straight.z) | pack_normal(g) << 16;
+            }
+        }
+        let mut s = [0u32; 4];
+        for l in 1..=LOD_LEVELS {
+            let n = BRICK >> l;
+            let range = level_offset(l) as usize..(level_offset(l) + n * n * n) as usize;
+            let drawn = stored[range.clone()].iter().filter(|&&t| t > 0.0).count() as u32;
+            let most = cells[range].iter().map(|c| c.err).fold(0.0f32, f32::max);
+            s[0] |= drawn << [0, 8, 12][l as usize - 1];
+            s[l as usize] = most.to_bits();
+        }
+        summary[h] = s;
+    }
+}
+
+pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+    let (mut pyramid, mut summary) = (b.take(Res::Pyramid), b.take(Res::LodSummary));
+    brick_pyramid(&inputs(b)?, &mut pyramid, bytemuck::cast_slice_mut(&mut summary));
+    b.put(Res::Pyramid, pyramid);
+    b.put(Res::LodSummary, summary);
+    Ok(())
+}
