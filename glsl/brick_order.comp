@@ -4,8 +4,8 @@
 // the TF extracts at their dense PBTF positions in the brick (split at the eye's voxel split,
 // clamped to the brick), so a voxel's rank among the marked cells is its place in the brick's PBTF
 // sequence: the two-level order (docs/MODEL.md), no sort. Each extracted voxel is written (grid
-// index and stored value) at the brick's first position + its rank, for brick_params. A brick
-// drawn at a coarser level of detail writes its level's cells the same way (`coarse`).
+// index and stored value) at the brick's first position + its rank, for brick_params. Bricks drawn
+// at a coarser level of detail are brick_cells'.
 // Mirror: cpu::brick::brick_order.
 layout(local_size_x = BRICK_LANES) in;
 #include "brick.glsl"
@@ -20,51 +20,14 @@ layout(push_constant) uniform Push {
 shared uint cells[MASK_WORDS];
 shared uint below[MASK_WORDS + 1u];
 
-// A brick drawn at level l > 0: its pyramid's drawn cells in PBTF order over the brick's cells
-// of 2^l voxels (split like the brick grid: level_split), written as (lowest voxel, level, cell).
-void coarse(uvec4 entry, uvec3 b, uint level) {
-    uint side = BRICK_SIDE >> level;
-    uint cells_n = side * side * side;
-    uint off = level_offset(level);
-    uvec3 split = level_split(b, level);
-    uint lane = gl_LocalInvocationID.x;
-    if (lane == 0u) {
-        cells[0] = 0u;
-        cells[1] = 0u;
-    }
-    barrier();
-    for (uint c = lane; c < cells_n; c += BRICK_LANES) {
-        if (cell_tau(entry.x, off + c) > 0.0) {
-            uvec3 cc = uvec3(c % side, (c / side) % side, c / (side * side));
-            uint p = dense_pbtf(cc, uvec3(side), split);
-            atomicOr(cells[p / 32u], 1u << (p % 32u));
-        }
-    }
-    barrier();
-    uint total = uint(bitCount(cells[0])) + uint(bitCount(cells[1]));
-    for (uint c = lane; c < cells_n; c += BRICK_LANES) {
-        if (!(cell_tau(entry.x, off + c) > 0.0)) continue;
-        uvec3 cc = uvec3(c % side, (c / side) % side, c / (side * side));
-        uint p = dense_pbtf(cc, uvec3(side), split);
-        uint rank = (p >= 32u ? uint(bitCount(cells[0])) : 0u) + uint(bitCount(cells[p / 32u] & ((1u << (p % 32u)) - 1u)));
-        uint pos = entry.y + (frame.split.w != 0u ? total - 1u - rank : rank);
-        uvec3 ijk = b * BRICK_SIDE + (cc << level);
-        voxels[pos] = uvec2(ijk.x | (ijk.y << 16u), ijk.z | (level << 13u) | ((off + c) << 16u));
-        order_out[pos] = pos;
-    }
-}
-
 void main() {
     uint e = workgroup_item();
     if (e >= pc.count) return;
     uvec4 entry = brick_list[pc.first + e];
     uvec4 hd = headers[entry.x];
     uvec3 b = brick_coords(hd.x);
-    uint level = brick_level(entry.x, b);
-    if (level > 0u) {
-        coarse(entry, b, level);
-        return;
-    }
+    // Coarse bricks are brick_cells'.
+    if ((entry.w >> 16u) != 0u) return;
     uvec3 split = uvec3(clamp(ivec3(frame.split.xyz) - ivec3(b * BRICK_SIDE), ivec3(0), ivec3(BRICK_SIDE)));
     uint lane = gl_LocalInvocationID.x;
     for (uint w = lane; w < MASK_WORDS; w += BRICK_LANES) cells[w] = 0u;

@@ -1,7 +1,8 @@
 #version 450
 // variants: PAGED_RECORDS
 // Levels of detail (issue 24), built when the classification changes: one workgroup per
-// non-empty brick. Its voxels are classified (TF and gradient weighting; shading waits for the
+// non-empty brick, a lane per level-1 cell reading its 8 voxels through the occupancy mask. Its
+// voxels are classified (TF and gradient weighting; shading waits for the
 // frame's light) into optical depth per voxel length tau, tau-weighted colour and tau-weighted
 // gradient; levels 1..3 sum them over 2x2x2 children, so a coarse cell holds its children's
 // extinction and extinction-weighted colour (Swan's energy argument, at build time: its splat is
@@ -13,17 +14,18 @@
 layout(local_size_x = BRICK_LANES) in;
 #include "brick.glsl"
 
-const uint FINE = BRICK_SIDE * BRICK_SIDE * BRICK_SIDE;
-// Level 0: per voxel; levels 1..3 at level_offset(l): sums over the cell's voxels.
-shared float tau0[FINE];
-shared vec3 col0[FINE];
-shared vec3 grad0[FINE];
+// Levels 1..3 at level_offset(l): sums over the cell's voxels.
 shared float tau_l[LOD_CELLS];
 shared vec3 col_l[LOD_CELLS];
 shared vec3 grad_l[LOD_CELLS];
 shared float err_l[LOD_CELLS];
 // The optical depth per cell length each cell stores (drawn when > 0).
 shared float stored_l[LOD_CELLS];
+// Drawn voxels per level-1 cell.
+shared uint drawn_1[64];
+// The brick's occupancy mask and the stored voxels below each of its words.
+shared uint mask_w[MASK_WORDS];
+shared uint mask_below[MASK_WORDS];
 
 // Octahedral bytes (snorm 8 + 8) of gradient g, NO_NORMAL when it is zero.
 uint pack_normal(vec3 g) {
@@ -43,32 +45,88 @@ uint child(uint l, uvec3 c, uint n, uint d) {
     return l == 1u ? i : level_offset(l - 1u) + i;
 }
 
+// Store level l's cell i (sums t, col, g; error err) and its pyramid words.
+void put_cell(uint h, uint l, uint i, float t, vec3 col, vec3 g, float err) {
+    float voxels = float(1u << (3u * l));
+    vec3 straight = t > 0.0 ? col / t : vec3(0.0);
+    tau_l[i] = t;
+    col_l[i] = col;
+    grad_l[i] = g;
+    err_l[i] = err;
+    // Optical depth per cell length: 2^l voxel lengths of the mean per voxel.
+    stored_l[i] = t / voxels * float(1u << l);
+    uint base = (h * LOD_CELLS + i) * CELL_WORDS;
+    pyramid[base] = floatBitsToUint(stored_l[i]);
+    pyramid[base + 1u] = packUnorm2x16(straight.rg);
+    pyramid[base + 2u] = (packUnorm2x16(vec2(straight.b, 0.0)) & 0xffffu) | (pack_normal(g) << 16u);
+}
+
+// The error of a cell of mean opacity a and colour straight against a child (sums tk, ck; error
+// ek) of `voxels` voxels.
+float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float voxels) {
+    float ak = 1.0 - exp(-tk / voxels);
+    vec3 sk = tk > 0.0 ? ck / tk : vec3(0.0);
+    vec3 dc = abs(sk - straight);
+    return ek + max(abs(ak - a), ak * max(dc.x, max(dc.y, dc.z)));
+}
+
 void main() {
     uint h = workgroup_item();
     if (h >= bf.grid.w) return;
     uvec4 hd = headers[h];
     uvec3 b = brick_coords(hd.x);
     uint lane = gl_LocalInvocationID.x;
-    for (uint c = lane; c < FINE; c += BRICK_LANES) {
-        tau0[c] = 0.0;
-        col0[c] = vec3(0.0);
-        grad0[c] = vec3(0.0);
+    if (lane < MASK_WORDS) mask_w[lane] = masks[h * MASK_WORDS + lane];
+    barrier();
+    if (lane == 0u) {
+        uint below = 0u;
+        for (uint w = 0u; w < MASK_WORDS; ++w) {
+            mask_below[w] = below;
+            below += uint(bitCount(mask_w[w]));
+        }
     }
     barrier();
     bool shaded = bf.light.w > 0.5;
-    for (uint r = lane; r < hd.z; r += BRICK_LANES) {
-        uint rec = record_at(hd.y + r);
-        if (!emits(rec >> 16u)) continue;
-        uint l = rec & 511u;
-        ivec3 v = ivec3(b * BRICK_SIDE + local_cell(l));
-        vec4 c = classify_voxel(v, rec >> 16u, false);
-        float t = -log(1.0 - clamp(c.a, 0.0, MAX_OPACITY));
-        tau0[l] = t;
-        col0[l] = c.rgb * t;
-        grad0[l] = shaded ? gradient_at(v) * t : vec3(0.0);
+    // Level 1: one lane per cell, its 8 voxels classified (TF, gradient weighting) in turn.
+    for (uint c = lane; c < 64u; c += BRICK_LANES) {
+        uvec3 cc = uvec3(c % 4u, (c / 4u) % 4u, c / 16u);
+        float tk[8];
+        vec3 ck[8];
+        float t = 0.0;
+        vec3 col = vec3(0.0);
+        vec3 g = vec3(0.0);
+        uint drawn = 0u;
+        for (uint d = 0u; d < 8u; ++d) {
+            uvec3 k = 2u * cc + (uvec3(d, d >> 1u, d >> 2u) & 1u);
+            uint l = k.x + BRICK_SIDE * (k.y + BRICK_SIDE * k.z);
+            tk[d] = 0.0;
+            ck[d] = vec3(0.0);
+            uint word = mask_w[l / 32u];
+            if (((word >> (l % 32u)) & 1u) != 0u) {
+                uint rank = mask_below[l / 32u] + uint(bitCount(word & ((1u << (l % 32u)) - 1u)));
+                uint q = record_at(hd.y + rank) >> 16u;
+                if (emits(q)) {
+                    ivec3 v = ivec3(b * BRICK_SIDE + k);
+                    vec4 cl = classify_voxel(v, q, false);
+                    tk[d] = -log(1.0 - clamp(cl.a, 0.0, MAX_OPACITY));
+                    ck[d] = cl.rgb * tk[d];
+                    if (shaded) g += gradient_at(v) * tk[d];
+                    drawn += tk[d] > 0.0 ? 1u : 0u;
+                }
+            }
+            t += tk[d];
+            col += ck[d];
+        }
+        float a = 1.0 - exp(-t / 8.0);
+        vec3 straight = t > 0.0 ? col / t : vec3(0.0);
+        float err = 0.0;
+        for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0));
+        put_cell(h, 1u, c, t, col, g, err);
+        drawn_1[c] = drawn;
     }
     barrier();
-    for (uint l = 1u; l <= 3u; ++l) {
+    // Levels 2 and 3 from the level below.
+    for (uint l = 2u; l <= 3u; ++l) {
         uint n = BRICK_SIDE >> l;
         float voxels = float(1u << (3u * l));
         for (uint c = lane; c < n * n * n; c += BRICK_LANES) {
@@ -78,39 +136,24 @@ void main() {
             vec3 g = vec3(0.0);
             for (uint d = 0u; d < 8u; ++d) {
                 uint k = child(l, cc, n, d);
-                t += l == 1u ? tau0[k] : tau_l[k];
-                col += l == 1u ? col0[k] : col_l[k];
-                g += l == 1u ? grad0[k] : grad_l[k];
+                t += tau_l[k];
+                col += col_l[k];
+                g += grad_l[k];
             }
             float a = 1.0 - exp(-t / voxels);
             vec3 straight = t > 0.0 ? col / t : vec3(0.0);
             float err = 0.0;
             for (uint d = 0u; d < 8u; ++d) {
                 uint k = child(l, cc, n, d);
-                float tk = l == 1u ? tau0[k] : tau_l[k];
-                vec3 ck = l == 1u ? col0[k] : col_l[k];
-                float ek = l == 1u ? 0.0 : err_l[k];
-                float ak = 1.0 - exp(-tk * 8.0 / voxels);
-                vec3 sk = tk > 0.0 ? ck / tk : vec3(0.0);
-                vec3 dc = abs(sk - straight);
-                err = max(err, ek + max(abs(ak - a), ak * max(dc.x, max(dc.y, dc.z))));
+                err = max(err, child_error(a, straight, tau_l[k], col_l[k], err_l[k], voxels / 8.0));
             }
-            uint i = level_offset(l) + c;
-            tau_l[i] = t;
-            col_l[i] = col;
-            grad_l[i] = g;
-            err_l[i] = err;
-            uint base = (h * LOD_CELLS + i) * CELL_WORDS;
-            // Optical depth per cell length: 2^l voxel lengths of the mean per voxel.
-            stored_l[i] = t / voxels * float(1u << l);
-            pyramid[base] = floatBitsToUint(stored_l[i]);
-            pyramid[base + 1u] = packUnorm2x16(straight.rg);
-            pyramid[base + 2u] = (packUnorm2x16(vec2(straight.b, 0.0)) & 0xffffu) | (pack_normal(g) << 16u);
+            put_cell(h, l, level_offset(l) + c, t, col, g, err);
         }
         barrier();
     }
     if (lane == 0u) {
         uvec4 s = uvec4(0u);
+        for (uint c = 0u; c < 64u; ++c) s.x += drawn_1[c] << 16u;
         for (uint l = 1u; l <= 3u; ++l) {
             uint n = BRICK_SIDE >> l;
             uint drawn = 0u;

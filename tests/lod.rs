@@ -48,10 +48,10 @@ fn diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> (f32, f32) {
     (d.iter().copied().fold(0.0, f32::max), d.iter().sum::<f32>() / d.len() as f32)
 }
 
-/// The frame's cells in draw order, (i, j, k, side), read back after `brick_order`.
+/// The frame's cells in draw order, (i, j, k, side), read back after `brick_params`.
 fn drawn_cells(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 4]> {
-    let got = r.probe(cam, o, StageId::BrickOrder, &[Res::BrickSlots, Res::BrickVoxels]).unwrap();
-    let total: u32 = got[0].iter().map(|w| w & 1023).sum();
+    let got = r.probe(cam, o, StageId::BrickParams, &[Res::BrickSlots, Res::BrickVoxels]).unwrap();
+    let total: u32 = got[0].iter().filter(|&&w| w != 0).map(|&w| voxsplat::bricks::slot_entry(w).2).sum();
     got[1]
         .chunks_exact(2)
         .take(total as usize)

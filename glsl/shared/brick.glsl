@@ -70,7 +70,8 @@ layout(std430, binding = 6) readonly buffer BrickIndex { uint brick_index[]; };
 // Per brick-grid position in draw order: header << 10 | voxels drawn, 0 when culled.
 layout(std430, binding = 7) buffer BrickSlots { uint slots[]; };
 // The batch's visible bricks in draw order: header, its first position in the batch, its first
-// record (in the resident store, or in the batch's records when the store streams), unused.
+// record (in the resident store, or in the batch's records when the store streams), its splats |
+// its level of detail << 16.
 layout(std430, binding = 8) readonly buffer BrickList { uvec4 brick_list[]; };
 layout(std430, binding = 9) writeonly buffer Params { SplatParams params_lo[]; };
 layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]; };
@@ -188,7 +189,8 @@ vec4 classify_voxel(ivec3 v, uint q, bool shaded) {
 // Levels of detail (issue 24): per header a pyramid of LOD_CELLS cells, levels 1..3 of a brick
 // (64 + 8 + 1 cells of 2^l voxels a side), each 3 words: its optical depth per cell length (f32),
 // red | green << 16 (unorm16), blue | octahedral normal << 16 (unorm16, snorm 8 + 8); and a summary:
-// x: drawn cells of level 1 | level 2 << 8 | level 3 << 12; yzw: the largest error of levels 1..3.
+// x: drawn cells of level 1 | level 2 << 8 | level 3 << 12 | drawn voxels << 16; yzw: the largest
+// error of levels 1..3.
 // Built by brick_pyramid when the classification changes. Mirror: cpu::lod.
 layout(std430, binding = 24) buffer Pyramid { uint pyramid[]; };
 layout(std430, binding = 25) buffer LodSummary { uvec4 lod_summary[]; };
@@ -232,10 +234,16 @@ uint brick_level(uint h, uvec3 b) {
     return level;
 }
 
-// Drawn cells of level l (1..3) in header h's brick.
+// Drawn cells of level l in header h's brick (level 0: its drawn voxels).
 uint level_count(uint h, uint l) {
     uint x = lod_summary[h].x;
+    if (l == 0u) return x >> 16u;
     return l == 1u ? x & 255u : (l == 2u ? (x >> 8u) & 15u : (x >> 12u) & 1u);
+}
+
+// A brick's slot code for n splats at level l, in 10 bits (bricks::slot_entry decodes it).
+uint slot_code(uint l, uint n) {
+    return l == 0u ? n : (l == 1u ? 512u + n : (l == 2u ? 576u + n : 585u));
 }
 
 // Cell i of header h's pyramid: optical depth per cell length, straight colour, gradient direction.

@@ -2,7 +2,7 @@
 //! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer (levels of
 //! detail: `cpu::lod`).
 use super::bindings::Bindings;
-use super::lod::{cell_color, cell_tau, level_count, level_offset, level_split};
+use super::lod::{cell_color, level_count};
 use super::order::{outward, side_count};
 use super::splat_params::{cell_footprint_scale, params_at, params_of, CULL_RADII};
 use crate::bricks::{BrickStore, BRICK};
@@ -205,8 +205,8 @@ pub fn brick_hidden(
     let size = glam::Vec2::new(f.blur[2], f.blur[3]);
     let tile = COMPOSITE_TILE as f32;
     let tiles_x = (size.x / tile).ceil() as i64;
-    let is_hidden = |h: u32, b: [u32; 3]| {
-        let (lo, hi) = inputs.footprint_box(b, (1u32 << inputs.brick_level(h, b)) as f32);
+    let is_hidden = |level: u32, b: [u32; 3]| {
+        let (lo, hi) = inputs.footprint_box(b, (1u32 << level) as f32);
         let (mut slo, mut shi) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
         for c in 0..8 {
             let q: Vec4 = vp * corner(lo, hi, c).extend(1.0);
@@ -225,7 +225,17 @@ pub fn brick_hidden(
             .all(|y| (t0.x as i64..=t1.x as i64).all(|x| occlusion[(y * tiles_x + x) as usize] <= push.occluded))
     };
     for (e, entry) in list[push.first as usize..(push.first + push.count) as usize].iter().enumerate() {
-        hidden[e] = u32::from(is_hidden(entry[0], inputs.store.headers[entry[0] as usize].coords()));
+        hidden[e] = u32::from(is_hidden(entry[3] >> 16, inputs.store.headers[entry[0] as usize].coords()));
+    }
+}
+
+/// Mirror of `slot_code`: a brick's slot code for `n` splats at level `l` (`bricks::slot_entry`).
+pub fn slot_code(l: u32, n: u32) -> u32 {
+    match l {
+        0 => n,
+        1 => 512 + n,
+        2 => 576 + n,
+        _ => 585,
     }
 }
 
@@ -257,7 +267,7 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
             continue;
         }
         let drawn = match counts {
-            _ if level > 0 => level_count(inputs.summary, h as u32, level),
+            _ if inputs.bf.grad[1] > 0.0 => level_count(inputs.summary, h as u32, level),
             Some(c) => c[h],
             None => {
                 let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
@@ -265,7 +275,7 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
             }
         };
         if drawn > 0 {
-            slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | drawn;
+            slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(level, drawn);
         }
     }
 }
@@ -285,9 +295,8 @@ pub fn brick_order(
     for entry in &list[push.first as usize..(push.first + push.count) as usize] {
         let hd = store.headers[entry[0] as usize];
         let b = hd.coords();
-        let level = inputs.brick_level(entry[0], b);
-        if level > 0 {
-            coarse(inputs, entry, b, level, voxels, order);
+        // Coarse bricks are brick_cells'.
+        if entry[3] >> 16 != 0 {
             continue;
         }
         let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
@@ -315,37 +324,6 @@ pub fn brick_order(
             voxels[pos] = [ijk[0] | ijk[1] << 16, ijk[2] | (rec & 0xffff_0000)];
             order[pos] = pos as u32;
         }
-    }
-}
-
-/// Mirror of `coarse` in brick_order.comp: brick `b`'s drawn cells of `level` in PBTF order.
-fn coarse(
-    inputs: &BrickInputs<'_>,
-    entry: &[u32; 4],
-    b: [u32; 3],
-    level: u32,
-    voxels: &mut [[u32; 2]],
-    order: &mut [u32],
-) {
-    let side = BRICK >> level;
-    let off = level_offset(level);
-    let split = level_split(inputs.frame.split, b, level);
-    let cell = |c: u32| [c % side, (c / side) % side, c / (side * side)];
-    let drawn: Vec<u32> =
-        (0..side * side * side).filter(|&c| cell_tau(inputs.pyramid, entry[0], off + c) > 0.0).collect();
-    let mut marks = 0u64;
-    for &c in &drawn {
-        marks |= 1 << dense_pbtf(cell(c), [side; 3], split);
-    }
-    let total = marks.count_ones();
-    for &c in &drawn {
-        let p = dense_pbtf(cell(c), [side; 3], split);
-        let rank = (marks & ((1u64 << p) - 1)).count_ones();
-        let rank = if inputs.frame.split[3] != 0 { total - 1 - rank } else { rank };
-        let pos = (entry[1] + rank) as usize;
-        let ijk = [0, 1, 2].map(|a| b[a] * BRICK + (cell(c)[a] << level));
-        voxels[pos] = [ijk[0] | ijk[1] << 16, ijk[2] | level << 13 | (off + c) << 16];
-        order[pos] = pos as u32;
     }
 }
 

@@ -7,6 +7,8 @@ use super::splat_params::MAX_OPACITY;
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
+use crate::gpu_types::BrickPush;
+use super::order::side_count;
 use glam::Vec3;
 
 /// Cells of levels 1-3 in a brick's pyramid (64 + 8 + 1).
@@ -80,6 +82,7 @@ pub fn cell_tau(pyramid: &[u32], h: u32, i: u32) -> f32 {
 pub fn level_count(summary: &[[u32; 4]], h: u32, l: u32) -> u32 {
     let x = summary[h as usize][0];
     match l {
+        0 => x >> 16,
         1 => x & 255,
         2 => x >> 8 & 15,
         _ => x >> 12 & 1,
@@ -191,7 +194,7 @@ pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mu
                 pyramid[base + 2] = unorm16(straight.z) | pack_normal(g) << 16;
             }
         }
-        let mut s = [0u32; 4];
+        let mut s = [fine.iter().filter(|f| f.tau > 0.0).count() as u32 * (1 << 16), 0, 0, 0];
         for l in 1..=LOD_LEVELS {
             let n = BRICK >> l;
             let range = level_offset(l) as usize..(level_offset(l) + n * n * n) as usize;
@@ -202,6 +205,52 @@ pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mu
         }
         summary[h] = s;
     }
+}
+
+/// Mirror of `brick_cells.comp`: each coarse brick of the batch writes its level's drawn cells in
+/// PBTF order over the brick's cells.
+pub fn brick_cells(inputs: &BrickInputs<'_>, list: &[[u32; 4]], push: &BrickPush, voxels: &mut [[u32; 2]], order: &mut [u32]) {
+    for entry in &list[push.first as usize..(push.first + push.count) as usize] {
+        let level = entry[3] >> 16;
+        if level == 0 {
+            continue;
+        }
+        let b = inputs.store.headers[entry[0] as usize].coords();
+        let n = BRICK >> level;
+        let off = level_offset(level);
+        let split = level_split(inputs.frame.split, b, level);
+        let total = entry[3] & 0xffff;
+        let mut rank = 0;
+        let axis = |side: u32, s: u32, t: u32| if side == 0 { s - 1 - t } else { s + t };
+        for o in 0..8u32 {
+            let side = [o & 1, o >> 1 & 1, o >> 2 & 1];
+            let len = [0, 1, 2].map(|a| side_count(n, split[a], side[a]));
+            for tk in 0..len[2] {
+                for tj in 0..len[1] {
+                    for ti in 0..len[0] {
+                        let cc = [axis(side[0], split[0], ti), axis(side[1], split[1], tj), axis(side[2], split[2], tk)];
+                        let c = cc[0] + n * (cc[1] + n * cc[2]);
+                        if cell_tau(inputs.pyramid, entry[0], off + c).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                            continue;
+                        }
+                        let pos = entry[1] + if inputs.frame.split[3] != 0 { total - 1 - rank } else { rank };
+                        let ijk = [0, 1, 2].map(|a| b[a] * BRICK + (cc[a] << level));
+                        voxels[pos as usize] = [ijk[0] | ijk[1] << 16, ijk[2] | level << 13 | (off + c) << 16];
+                        order[pos as usize] = pos;
+                        rank += 1;
+                    }
+                }
+            }
+        }
+    }
+}
+
+pub(crate) fn brick_cells_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+    let (mut voxels, mut order) = (b.take(Res::BrickVoxels), b.take(Res::Order));
+    brick_cells(&inputs(b)?, b.get(Res::BrickList), &args.push_as(), bytemuck::cast_slice_mut(&mut voxels), &mut order);
+    b.put(Res::BrickVoxels, voxels);
+    b.put(Res::Order, order);
+    Ok(())
 }
 
 pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {

@@ -1,7 +1,7 @@
 //! A bricked volume's frame (issue 23): culling and listing the visible bricks, batches under the
 //! device budget, and the per-splat, sheet and slab modes over them. Part of THE recording.
 use super::*;
-use crate::bricks::{BrickScene, BRICK};
+use crate::bricks::{slot_entry, BrickScene, BRICK};
 use crate::constants::MAX_GPU_SPLATS;
 
 /// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
@@ -110,7 +110,7 @@ pub(super) fn record_bricks(
     e.ensure(Res::BrickSlots, slots as u64 * 4)?;
     e.fill(Res::BrickSlots, None, 0)?;
     if bf.grid[3] > 0 {
-        e.run(&Dispatch::new(StageId::BrickCull, build, plan::groups_per_item(bf.grid[3]), List::Order, &[]))?;
+        e.run(&Dispatch::new(StageId::BrickCull, build, groups_1d(bf.grid[3]), List::Order, &[]))?;
     }
     let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
     let t = Instant::now();
@@ -123,14 +123,17 @@ pub(super) fn record_bricks(
         && opts.direction() == Direction::FrontToBack
         && opts.early_termination > 0.0;
     let capacity = if cull_hidden {
-        let total: u32 = slot_words.iter().map(|w| w & 1023).sum();
+        let total: u32 = slot_words.iter().map(|&w| slot_entry(w).2).sum();
         MAX_GPU_SPLATS.min(total.div_ceil(HIDDEN_BATCHES).max(HIDDEN_BATCH_MIN))
     } else {
         MAX_GPU_SPLATS
     };
     // The visible bricks in draw order, cut between bricks into batches.
     let cut = Cut { streamed, build, available };
-    let visible = slot_words.into_iter().filter(|&w| w != 0).map(|w| [w >> 10, 0, 0, w & 1023]);
+    let visible = slot_words.into_iter().filter(|&w| w != 0).map(|w| {
+        let (header, level, n) = slot_entry(w);
+        [header, 0, 0, n | level << 16]
+    });
     let batches = cut.batches(scene, visible, capacity, available);
     e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
     let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
@@ -197,7 +200,8 @@ impl Cut {
     ) -> Vec<Vec<[u32; 4]>> {
         let mut batches: Vec<Vec<[u32; 4]>> = vec![Vec::new()];
         let (mut filled, mut records, mut bytes) = (0u32, 0u32, 0u64);
-        for [header, _, _, n] in entries {
+        for [header, _, _, w] in entries {
+            let n = w & 0xffff;
             let hd = &scene.store.headers[header as usize];
             let cost = n as u64 * BATCH_BYTES_PER_SPLAT + if self.streamed { hd.count as u64 * 4 } else { 0 };
             let open = batches.last().is_some_and(|b| !b.is_empty());
@@ -206,7 +210,7 @@ impl Cut {
                 (filled, records, bytes) = (0, 0, 0);
             }
             let first = if self.streamed { records } else { hd.first };
-            batches.last_mut().expect("one batch at least").push([header, filled, first, n]);
+            batches.last_mut().expect("one batch at least").push([header, filled, first, w]);
             (filled, records, bytes) = (filled + n, records + hd.count, bytes + cost);
         }
         batches
@@ -329,7 +333,7 @@ fn record_bricked_sheets(
 
 /// Splats of a batch of visible bricks (entries: header, first position, first record, voxels).
 fn batch_splats(batch: &[[u32; 4]]) -> u32 {
-    batch.last().map(|l| l[1] + l[3]).unwrap_or(0)
+    batch.last().map(|l| l[1] + (l[3] & 0xffff)).unwrap_or(0)
 }
 
 /// One batch of visible bricks (entries: header, first position, first record, voxels): its
@@ -358,12 +362,22 @@ fn record_brick_batch(
             .collect();
         e.upload(Res::BatchRecords, &recs)?;
     }
-    let words: Vec<u32> = batch.iter().flatten().copied().collect();
+    // Voxel bricks first (brick_order's workgroups), then coarse ones (brick_cells' lanes): each
+    // entry names its own first position, so the list's order is free.
+    let (fine, coarse): (Vec<[u32; 4]>, Vec<[u32; 4]>) = batch.iter().partition(|l| l[3] >> 16 == 0);
+    let words: Vec<u32> = fine.iter().chain(&coarse).flatten().copied().collect();
     e.upload(Res::BrickList, &words)?;
-    let push = BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 };
+    let push = BrickPush { first: 0, count: fine.len() as u32, splats: n, occluded: 0.0 };
+    if !fine.is_empty() {
+        let groups = plan::groups_per_item(fine.len() as u32);
+        e.run(&Dispatch::new(StageId::BrickOrder, build, groups, List::Order, bytemuck::bytes_of(&push)))?;
+    }
+    if !coarse.is_empty() {
+        let cells = BrickPush { first: fine.len() as u32, count: coarse.len() as u32, ..push };
+        let groups = groups_1d(coarse.len() as u32);
+        e.run(&Dispatch::new(StageId::BrickCells, 0, groups, List::Order, bytemuck::bytes_of(&cells)))?;
+    }
     let push = bytemuck::bytes_of(&push);
-    let groups = plan::groups_per_item(batch.len() as u32);
-    e.run(&Dispatch::new(StageId::BrickOrder, build, groups, List::Order, push))?;
     e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, push))
 }
 
