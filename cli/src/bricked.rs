@@ -100,7 +100,11 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
     let b = bricked.render(&cam, &o)?.image;
     let m = voxsplat::metrics::compare(&a, &b)?;
     frame_ms(&mut bricked, &cam, &o)?;
+    let mut with_lod = o.clone();
+    with_lod.lod = voxsplat::Lod::Auto;
+    frame_ms(&mut bricked, &cam, &with_lod)?;
     let (mut t_dense, mut t_bricked, mut t_tf) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut t_lod, mut t_tf_lod) = (Vec::new(), Vec::new());
     for i in 0..frames {
         t_dense.push(frame_ms(&mut dense, &cam, &o)?);
         t_bricked.push(frame_ms(&mut bricked, &cam, &o)?);
@@ -110,13 +114,29 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
         bricked.render(&cam, &o)?;
         t_tf.push(ms(t));
         bricked.set_transfer_function(&tf, None)?;
+        // With levels of detail a TF change rebuilds the pyramid too: a plain LOD frame after one
+        // that rebuilt it, then a TF change and its LOD frame.
+        bricked.render(&cam, &with_lod)?;
+        t_lod.push(frame_ms(&mut bricked, &cam, &with_lod)?);
+        let t = Instant::now();
+        bricked.set_transfer_function(if i % 2 == 0 { &other } else { &tf }, None)?;
+        bricked.render(&cam, &with_lod)?;
+        t_tf_lod.push(ms(t));
+        bricked.set_transfer_function(&tf, None)?;
     }
     let (d, b, t) = (median(&mut t_dense), median(&mut t_bricked), median(&mut t_tf));
+    let (tl, ttl) = (median(&mut t_lod), median(&mut t_tf_lod));
     let _ = writeln!(s, "\n| bonsai 256³ frame | median ms | ratio |");
     let _ = writeln!(s, "|---|---|---|");
     let _ = writeln!(s, "| dense classified splats (`--dense`) | {d:.0} | 1.00 |");
     let _ = writeln!(s, "| bricked store, classified on the device | {b:.0} | {:.2} |", b / d);
     let _ = writeln!(s, "| bricked, a TF change then its frame | {t:.0} | {:.2} of the bricked frame |", t / b);
+    let _ = writeln!(s, "| bricked, LOD auto (1 px) | {tl:.0} | {:.2} |", tl / d);
+    let _ = writeln!(
+        s,
+        "| bricked, LOD auto, a TF change (pyramid rebuilt) then its frame | {ttl:.0} | {:.2} of the LOD frame |",
+        ttl / tl
+    );
     let _ = writeln!(
         s,
         "\nBricked against dense, same view: {:.1} dB PSNR, largest difference {:.4} (the same splats in \
@@ -165,24 +185,63 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
         let lcam = Camera::framing(&lgrid, size, size);
         let mut big = renderer()?;
         big.set_bricks(l.scene)?;
-        frame_ms(&mut big, &lcam, &o)?;
-        let (mut t_small, mut t_big, mut t_big_et) = (Vec::new(), Vec::new(), Vec::new());
+        let lod = |pixels: f32| {
+            let mut x = o.clone();
+            (x.lod, x.lod_pixels) = (voxsplat::Lod::Auto, pixels);
+            x
+        };
+        let (lod1, lod15) = (lod(1.0), lod(1.5));
+        // Warm-up frames (the pyramids are built here, once per classification), and each frame's
+        // distance from full detail.
+        let full_small = bricked.render(&cam, &o)?.image;
+        let full_big = big.render(&lcam, &o)?.image;
+        let psnr = |a: &voxsplat::ImageF32, b: &voxsplat::ImageF32| voxsplat::metrics::compare(a, b).map(|m| m.psnr);
+        let p_small = psnr(&full_small, &bricked.render(&cam, &lod1)?.image)?;
+        let p_big1 = psnr(&full_big, &big.render(&lcam, &lod1)?.image)?;
+        let p_big15 = psnr(&full_big, &big.render(&lcam, &lod15)?.image)?;
+        let mut t: [Vec<f64>; 6] = Default::default();
         for _ in 0..frames {
-            t_small.push(frame_ms(&mut bricked, &cam, &o)?);
-            t_big.push(frame_ms(&mut big, &lcam, &o)?);
-            t_big_et.push(frame_ms(&mut big, &lcam, &et)?);
+            t[0].push(frame_ms(&mut bricked, &cam, &o)?);
+            t[1].push(frame_ms(&mut bricked, &cam, &lod1)?);
+            t[2].push(frame_ms(&mut big, &lcam, &o)?);
+            t[3].push(frame_ms(&mut big, &lcam, &et)?);
+            t[4].push(frame_ms(&mut big, &lcam, &lod1)?);
+            t[5].push(frame_ms(&mut big, &lcam, &lod15)?);
         }
         // The sheets at 512³ stream (the visible voxels pass one batch): once, after the others.
         let mut so = o.clone();
         so.composite = voxsplat::Composite::Sheet;
         let sheet = frame_ms(&mut big, &lcam, &so)?;
-        let (sm, bg, be) = (median(&mut t_small), median(&mut t_big), median(&mut t_big_et));
-        let _ = writeln!(s, "\n| frame, same view | median ms | over the 256³ frame |");
-        let _ = writeln!(s, "|---|---|---|");
-        let _ = writeln!(s, "| bonsai 256³ bricked | {sm:.0} | 1.00 |");
-        let _ = writeln!(s, "| bonsai 512³ bricked | {bg:.0} | {:.2} |", bg / sm);
-        let _ = writeln!(s, "| bonsai 512³ bricked, early termination 1/1024 | {be:.0} | {:.2} |", be / sm);
-        let _ = writeln!(s, "| bonsai 512³ bricked, sheets streamed (one frame) | {sheet:.0} | {:.2} |", sheet / sm);
+        let [sm, sl, bg, be, bl, bl15] = t.map(|mut v| median(&mut v));
+        let _ = writeln!(
+            s,
+            "\n| frame, same view | median ms | over the 256³ full-detail frame | over the 256³ frame, same options \
+             | PSNR dB against its full detail |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|");
+        let _ = writeln!(s, "| bonsai 256³ bricked | {sm:.0} | 1.00 | 1.00 | |");
+        let _ = writeln!(s, "| bonsai 256³ bricked, LOD auto 1 px | {sl:.0} | {:.2} | 1.00 | {p_small:.1} |", sl / sm);
+        let _ = writeln!(s, "| bonsai 512³ bricked | {bg:.0} | {:.2} | {:.2} | |", bg / sm, bg / sm);
+        let _ = writeln!(
+            s,
+            "| bonsai 512³ bricked, early termination 1/1024 | {be:.0} | {:.2} | {:.2} | |",
+            be / sm,
+            be / sm
+        );
+        let _ = writeln!(
+            s,
+            "| bonsai 512³ bricked, LOD auto 1 px | {bl:.0} | {:.2} | {:.2} | {p_big1:.1} |",
+            bl / sm,
+            bl / sl
+        );
+        let _ = writeln!(
+            s,
+            "| bonsai 512³ bricked, LOD auto 1.5 px | {bl15:.0} | {:.2} | {:.2} | {p_big15:.1} |",
+            bl15 / sm,
+            bl15 / sl
+        );
+        let _ =
+            writeln!(s, "| bonsai 512³ bricked, sheets streamed (one frame) | {sheet:.0} | {:.2} | | |", sheet / sm);
     }
     if let Some(rss) = peak_rss_mib() {
         let _ = writeln!(s, "\nPeak resident set of the whole study process: {rss:.0} MiB.");

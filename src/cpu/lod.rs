@@ -3,12 +3,12 @@
 //! `cell_color`).
 use super::bindings::Bindings;
 use super::brick::{inputs, local_cell, BrickInputs};
+use super::order::side_count;
 use super::splat_params::MAX_OPACITY;
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::BrickPush;
-use super::order::side_count;
 use glam::Vec3;
 
 /// Cells of levels 1-3 in a brick's pyramid (64 + 8 + 1).
@@ -209,7 +209,13 @@ pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mu
 
 /// Mirror of `brick_cells.comp`: each coarse brick of the batch writes its level's drawn cells in
 /// PBTF order over the brick's cells.
-pub fn brick_cells(inputs: &BrickInputs<'_>, list: &[[u32; 4]], push: &BrickPush, voxels: &mut [[u32; 2]], order: &mut [u32]) {
+pub fn brick_cells(
+    inputs: &BrickInputs<'_>,
+    list: &[[u32; 4]],
+    push: &BrickPush,
+    voxels: &mut [[u32; 2]],
+    order: &mut [u32],
+) {
     for entry in &list[push.first as usize..(push.first + push.count) as usize] {
         let level = entry[3] >> 16;
         if level == 0 {
@@ -228,9 +234,12 @@ pub fn brick_cells(inputs: &BrickInputs<'_>, list: &[[u32; 4]], push: &BrickPush
             for tk in 0..len[2] {
                 for tj in 0..len[1] {
                     for ti in 0..len[0] {
-                        let cc = [axis(side[0], split[0], ti), axis(side[1], split[1], tj), axis(side[2], split[2], tk)];
+                        let cc =
+                            [axis(side[0], split[0], ti), axis(side[1], split[1], tj), axis(side[2], split[2], tk)];
                         let c = cc[0] + n * (cc[1] + n * cc[2]);
-                        if cell_tau(inputs.pyramid, entry[0], off + c).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                        if cell_tau(inputs.pyramid, entry[0], off + c).partial_cmp(&0.0)
+                            != Some(std::cmp::Ordering::Greater)
+                        {
                             continue;
                         }
                         let pos = entry[1] + if inputs.frame.split[3] != 0 { total - 1 - rank } else { rank };
