@@ -16,8 +16,9 @@ void main() {
     uvec4 hd = headers[h];
     uvec3 b = brick_coords(hd.x);
     if (tf_empty(hd.w & 0xffffu, hd.w >> 16u)) return;
-    uint level = brick_level(h, b);
-    if (outside_view(b, float(1u << level))) return;
+    float morph;
+    uint level = brick_level(h, b, morph);
+    if (outside_view(b, float(1u << level) * (1.0 + morph))) return;
     uint n = 0u;
     if (bf.grad.y > 0.0) {
         n = level_count(h, level);
@@ -32,4 +33,5 @@ void main() {
 #endif
     }
     if (n > 0u) slots[brick_slot(b)] = (h << 10u) | slot_code(level, n);
+    if (bf.grad.y > 0.0) brick_morph[h] = morph;
 }

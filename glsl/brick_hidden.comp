@@ -18,10 +18,10 @@ layout(push_constant) uniform Push {
 // Most composite tiles a brick may span and still be tested (larger ones are always drawn).
 const int MAX_BRICK_TILES = 256;
 
-bool hidden(uint level, uvec3 b) {
+bool hidden(uint h, uint level, uvec3 b) {
     vec3 lo;
     vec3 hi;
-    footprint_box(b, float(1u << level), lo, hi);
+    footprint_box(b, float(1u << level) * (1.0 + (bf.grad.y > 0.0 ? brick_morph[h] : 0.0)), lo, hi);
     vec2 size = frame.blur.zw;
     vec2 slo = vec2(1e30);
     vec2 shi = vec2(-1e30);
@@ -48,5 +48,5 @@ void main() {
     uint e = linear_invocation();
     if (e >= pc.count) return;
     uvec4 entry = brick_list[pc.first + e];
-    hidden_out[e] = hidden(entry.w >> 16u, brick_coords(headers[entry.x].x)) ? 1u : 0u;
+    hidden_out[e] = hidden(entry.x, entry.w >> 16u, brick_coords(headers[entry.x].x)) ? 1u : 0u;
 }

@@ -22,16 +22,23 @@ void main() {
     uvec2 v = voxels[s];
     uvec3 ijk = voxel_ijk(v);
     uint level = voxel_level(v);
-    if (level == 0u) {
+    if (bf.grad.y <= 0.0) {
         params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5)));
         return;
     }
-    // A coarse cell: its prefiltered colour, shaded at its gradient, and optical depth per cell.
     uvec3 b = ijk / BRICK_SIDE;
     uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
+    vec3 at = vec3(ijk) + 0.5 * (float(1u << level) - 1.0);
+    float grow = brick_morph[h] > 0.0 ? splat_growth(at, level) : 1.0;
+    if (level == 0u) {
+        vec4 c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);
+        float opacity = clamp(c.a, 0.0, MAX_OPACITY);
+        params_store(s, params_at(at, 1.0, grow, c.rgb, -log(1.0 - opacity)));
+        return;
+    }
+    // A coarse cell: its prefiltered colour, shaded at its gradient, and optical depth per cell.
     vec3 normal;
     vec4 c = cell_color(h, v.y >> 16u, normal);
     if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
-    float cell = float(1u << level);
-    params_store(s, params_at(vec3(ijk) + 0.5 * (cell - 1.0), cell, c.rgb, c.a));
+    params_store(s, params_at(at, float(1u << level), grow, c.rgb, c.a));
 }

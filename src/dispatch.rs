@@ -115,6 +115,8 @@ pub enum Res {
     Pyramid,
     /// Per brick its levels' drawn cells and errors.
     LodSummary,
+    /// Per brick, this frame, how far its splats morph toward the next level (`brick_cull`).
+    BrickMorph,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

@@ -161,7 +161,8 @@ pub struct BrickFrame {
     /// Ambient, diffuse, specular, shininess.
     pub shade: [f32; 4],
     /// x: largest gradient magnitude of the volume (gradient weighting); y: levels of detail,
-    /// the largest cell spacing in pixels (0: off); z: their largest error; w unused.
+    /// the largest cell spacing in pixels (0: off); z: their largest error; w: their morphing
+    /// band, in octaves of projected size (0: none).
     pub grad: [f32; 4],
 }
 

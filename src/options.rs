@@ -132,6 +132,10 @@ pub struct RenderOptions {
     /// Largest error of a coarse level: how far, in opacity per voxel length (or colour weighted
     /// by it), any voxel departs from the cell that stands for it, summed down the levels.
     pub lod_error: f32,
+    /// Levels of detail: over the last `lod_band` octaves (0 to 1) before a brick's next level
+    /// takes over, its splats move and widen toward that level's cells (geomorphing), so a level
+    /// change is continuous in time and across brick faces. 0: abrupt changes.
+    pub lod_band: f32,
 }
 
 /// Levels of detail (`RenderOptions::lod`).
@@ -162,6 +166,7 @@ impl Default for RenderOptions {
             lod: Lod::Off,
             lod_pixels: 1.0,
             lod_error: DEFAULT_LOD_ERROR,
+            lod_band: 1.0,
         }
     }
 }
@@ -208,6 +213,12 @@ impl RenderOptions {
             return Err(Error::InvalidArgument(format!(
                 "the level-of-detail error {} must be finite and at least 0",
                 self.lod_error
+            )));
+        }
+        if !(0.0..=1.0).contains(&self.lod_band) {
+            return Err(Error::InvalidArgument(format!(
+                "the level-of-detail band {} must be in [0, 1]",
+                self.lod_band
             )));
         }
         if self.sheet_budget_bytes == 0 {

@@ -111,6 +111,7 @@ const BRICK: &[Res] = &[
     Res::BrickCounts,
     Res::Pyramid,
     Res::LodSummary,
+    Res::BrickMorph,
 ];
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).

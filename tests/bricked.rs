@@ -3,40 +3,13 @@
 //! over a random view battery, streaming through a small budget, transfer-function changes, and
 //! bad budgets. Validation on: any message fails.
 mod common;
-use common::{assert_clean, random_camera, Rng, ViewKind};
+use common::{assert_clean, blob, blob_tf as tf, random_camera, Rng, ViewKind};
 use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
 use voxsplat::classify::{classify, Shading, TransferFunction};
 use voxsplat::gpu_types::SplatParams;
 use voxsplat::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
 use voxsplat::{Camera, Direction, Error, Raster, RenderOptions, Renderer, RendererOptions};
-
-/// A lumpy blob with empty space around it and a hollow, on a grid whose sides are not multiples
-/// of the brick side.
-fn blob(dims: [u32; 3]) -> ScalarVolume {
-    let c = dims.map(|d| d as f32 / 2.0);
-    let mut values = Vec::new();
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            for i in 0..dims[0] {
-                let p = [i, j, k].map(|v| v as f32);
-                let r = ((0..3).map(|a| ((p[a] - c[a]) / c[a]).powi(2)).sum::<f32>()).sqrt();
-                let wobble = 0.15 * ((p[0] * 0.7).sin() * (p[1] * 0.5).cos() + (p[2] * 0.9).sin());
-                values.push(if r < 0.9 { (1.0 - r + wobble).max(0.0) * 100.0 } else { 0.0 });
-            }
-        }
-    }
-    ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
-}
-
-fn tf() -> TransferFunction {
-    TransferFunction {
-        points: vec![(0.1, [0.0, 0.0, 0.0, 0.0]), (0.3, [0.9, 0.4, 0.2, 0.3]), (1.0, [0.9, 0.9, 1.0, 0.8])],
-        gradient_weight: 0.0,
-        range: None,
-        threshold: 0.0,
-    }
-}
 
 fn renderer(gpu: bool, budget: Option<u64>) -> Renderer {
     let mut r = if gpu { common::gpu() } else { common::cpu() };

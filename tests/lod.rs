@@ -3,37 +3,11 @@
 //! validator over a random view battery, and the pyramid rebuilt when the classification
 //! changes. Validation on: any message fails.
 mod common;
-use common::{assert_clean, random_camera, Rng, ViewKind};
+use common::{assert_clean, blob, blob_tf as tf, random_camera, Rng, ViewKind};
 use voxsplat::classify::{Shading, TransferFunction};
 use voxsplat::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
 use voxsplat::{Camera, Direction, Lod, Raster, RenderOptions, Renderer};
-
-/// A lumpy blob with empty space around it, on a grid whose sides are not multiples of 8.
-fn blob(dims: [u32; 3]) -> ScalarVolume {
-    let c = dims.map(|d| d as f32 / 2.0);
-    let mut values = Vec::new();
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            for i in 0..dims[0] {
-                let p = [i, j, k].map(|v| v as f32);
-                let r = ((0..3).map(|a| ((p[a] - c[a]) / c[a]).powi(2)).sum::<f32>()).sqrt();
-                let wobble = 0.15 * ((p[0] * 0.7).sin() * (p[1] * 0.5).cos() + (p[2] * 0.9).sin());
-                values.push(if r < 0.9 { (1.0 - r + wobble).max(0.0) * 100.0 } else { 0.0 });
-            }
-        }
-    }
-    ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
-}
-
-fn tf() -> TransferFunction {
-    TransferFunction {
-        points: vec![(0.1, [0.0, 0.0, 0.0, 0.0]), (0.3, [0.9, 0.4, 0.2, 0.3]), (1.0, [0.9, 0.9, 1.0, 0.8])],
-        gradient_weight: 0.0,
-        range: None,
-        threshold: 0.0,
-    }
-}
 
 fn lod(raster: Raster, direction: Direction, pixels: f32) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -100,9 +74,15 @@ fn coarse_levels_match_the_cpu_mirrors_on_every_raster() {
             let (most, mean) = diff(&a, &b);
             assert!(most <= 2e-3 && mean <= 1e-5, "{what} {raster:?} {direction:?}: GPU vs mirror {most} / {mean}");
             if raster == Raster::Graphics {
-                // The prefiltered levels stand for the voxels: close to full detail, not equal.
-                let (most, mean) = diff(&a, &all);
+                // The prefiltered levels stand for the voxels: close to full detail, not equal
+                // (without morphing: each brick exactly at its level).
+                let mut abrupt = o.clone();
+                abrupt.lod_band = 0.0;
+                let (most, mean) = diff(&g.render(&cam, &abrupt).unwrap().image, &all);
                 assert!(mean > 1e-5 && mean <= 0.02, "{what}: coarse against full detail {most} / {mean}");
+                let (most, mean) =
+                    diff(&c.render(&cam, &abrupt).unwrap().image, &g.render(&cam, &abrupt).unwrap().image);
+                assert!(most <= 2e-3 && mean <= 1e-5, "{what}: unmorphed GPU vs mirror {most} / {mean}");
             }
         }
         assert_clean(&g);
@@ -180,4 +160,135 @@ fn the_pyramid_follows_the_classification() {
     let stages = |r: &voxsplat::Rendered| r.timings.iter().filter(|t| t.stage == "lod").count();
     assert_eq!(stages(&g.render(&cam, &o).unwrap()), 0);
     assert_clean(&g);
+}
+
+/// A constant-density cube (one empty corner voxel: the store keeps values above the minimum).
+fn constant_cube(n: u32) -> (ScalarVolume, TransferFunction) {
+    let mut values = vec![1.0; (n * n * n) as usize];
+    values[0] = 0.0;
+    let tf = TransferFunction {
+        points: vec![(0.0, [0.8, 0.6, 0.4, 0.0]), (0.4, [0.8, 0.6, 0.4, 0.05]), (1.0, [0.8, 0.6, 0.4, 0.05])],
+        gradient_weight: 0.0,
+        range: Some((0.0, 2.0)),
+        threshold: 0.0,
+    };
+    (ScalarVolume { dims: [n; 3], spacing: [1.0; 3], values }, tf)
+}
+
+/// Popping along a steady dolly, locally: the largest ratio between a frame-to-frame change and
+/// the mean of its two neighbours (either way). A level switching abruptly makes one change jump
+/// or dip against the changes around it; the dolly alone changes them smoothly. (The global score,
+/// the largest change over the median, also follows the image's blur as levels coarsen.)
+fn local_popping(frames: &[voxsplat::ImageF32]) -> f64 {
+    let c = voxsplat::metrics::frame_changes(frames).unwrap();
+    c.windows(3)
+        .map(|w| {
+            let around = 0.5 * (w[0] + w[2]);
+            (w[1] / around).max(around / w[1])
+        })
+        .fold(1.0, f64::max)
+}
+
+#[test]
+fn a_dolly_across_level_boundaries_changes_smoothly_with_morphing() {
+    let vol = blob([40, 40, 40]);
+    let mut g = common::gpu();
+    g.set_volume(&vol, &tf(), None).unwrap();
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let mut dolly = |band: f32, lod: Lod| -> f64 {
+        let mut frames = Vec::new();
+        let mut o = RenderOptions::default();
+        (o.raster, o.lod, o.lod_pixels, o.lod_error, o.lod_band) = (Raster::Compute, lod, 4.0, 100.0, band);
+        for f in 0..24 {
+            let mut cam = Camera::framing(&grid, 96, 96);
+            cam.target = glam::Vec3::ZERO;
+            // A steady dolly: the projected size shrinks by the same ratio every frame.
+            cam.eye = glam::Vec3::new(0.0, 0.0, 90.0 * 1.03f32.powi(f));
+            cam.far = cam.eye.z + 60.0;
+            frames.push(g.render(&cam, &o).unwrap().image);
+        }
+        local_popping(&frames)
+    };
+    let off = dolly(0.0, Lod::Off);
+    let abrupt = dolly(0.0, Lod::Auto);
+    let morphed = dolly(RenderOptions::default().lod_band, Lod::Auto);
+    assert!(abrupt > 1.3 * off, "abrupt level changes pop: {abrupt} against full detail's {off}");
+    assert!(morphed < abrupt && morphed <= 1.25 * off, "morphing: {morphed}, abrupt {abrupt}, full detail {off}");
+    assert_clean(&g);
+}
+
+#[test]
+fn level_boundaries_keep_the_brightness_of_a_constant_slab_and_cube() {
+    // The slab seen obliquely (its depth varies across the face: level boundaries cross it), the
+    // cube face on (front bricks finer than back ones: rays cross level boundaries).
+    let views = [
+        ("slab", [64u32, 64, 6], glam::Vec3::new(0.0, -45.0, 55.0)),
+        ("cube", [48, 48, 48], glam::Vec3::new(0.0, 0.0, 70.0)),
+    ];
+    for (name, dims, eye) in views {
+        let (mut vol, tf) = constant_cube(1);
+        vol.dims = dims;
+        vol.values = vec![1.0; (dims[0] * dims[1] * dims[2]) as usize];
+        vol.values[0] = 0.0;
+        let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+        let mut cam = Camera::framing(&grid, 128, 128);
+        (cam.eye, cam.target, cam.near, cam.far) = (eye, glam::Vec3::ZERO, 1.0, 200.0);
+        let mut g = common::gpu();
+        g.set_volume(&vol, &tf, None).unwrap();
+        let mut full = RenderOptions::default();
+        full.raster = Raster::Compute;
+        let a = g.render(&cam, &full).unwrap().image;
+        // Away from the silhouette, where a coarse footprint is wider: in the middle half, pixels
+        // whose neighbours 8 pixels away are all covered.
+        let opaque = a.pixels.iter().map(|p| p[3]).fold(0.0f32, f32::max);
+        let covered = |x: usize, y: usize| a.pixels[y * 128 + x][3] >= 0.5 * opaque;
+        let inside = |i: usize| {
+            let (x, y) = (i % 128, i / 128);
+            (32..96).contains(&x)
+                && (32..96).contains(&y)
+                && [(x - 8, y), (x + 8, y), (x, y - 8), (x, y + 8)].iter().all(|&(x, y)| covered(x, y))
+        };
+        assert!((0..a.pixels.len()).filter(|&i| inside(i)).count() > 1000, "{name}: pixels compared");
+        let (mut boundaries, mut abrupt_step) = (0, 0.0f32);
+        for step in 0..10 {
+            let pixels = 1.5 * 1.15f32.powi(step);
+            for band in [0.0, RenderOptions::default().lod_band] {
+                let mut o = full.clone();
+                (o.lod, o.lod_pixels, o.lod_error, o.lod_band) = (Lod::Auto, pixels, 100.0, band);
+                let cells = drawn_cells(&mut g, &cam, &o);
+                let sides: std::collections::BTreeSet<u32> = cells.iter().map(|c| c[3]).collect();
+                boundaries += usize::from(sides.len() >= 2);
+                let b = g.render(&cam, &o).unwrap().image;
+                // Against full detail, over 4x4-pixel tiles (full detail's own lattice ripple, a
+                // period under 2 pixels, averages out): a seam or a crack at a level boundary is a
+                // step in the ratio; a level's uniform bias is not.
+                let mut ratios = Vec::new();
+                for ty in (32..96).step_by(4) {
+                    for tx in (32..96).step_by(4) {
+                        let tile: Vec<usize> =
+                            (0..16).map(|k| (ty + k / 4) * 128 + tx + k % 4).filter(|&i| inside(i)).collect();
+                        if tile.len() == 16 {
+                            let sum = |img: &voxsplat::ImageF32| tile.iter().map(|&i| img.pixels[i][3]).sum::<f32>();
+                            ratios.push(sum(&b) / sum(&a));
+                        }
+                    }
+                }
+                let (lo, hi) = ratios.iter().fold((f32::MAX, 0.0f32), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+                let mean = ratios.iter().sum::<f32>() / ratios.len() as f32;
+                let what = format!("{name} {pixels} px band {band} levels {sides:?}");
+                assert!((mean - 1.0).abs() <= 0.02, "{what}: brightness against full detail {mean}");
+                if band > 0.0 {
+                    assert!(hi - lo <= 0.01, "{what}: brightness against full detail spreads over {lo}..{hi}");
+                } else if sides.len() >= 2 {
+                    abrupt_step = abrupt_step.max(hi - lo);
+                }
+            }
+        }
+        assert!(boundaries >= 2, "{name}: views with a level boundary {boundaries}");
+        if name == "slab" {
+            // The check sees seams: abrupt level changes step by more than the bound.
+            assert!(abrupt_step > 0.01, "slab: largest step at an abrupt level boundary {abrupt_step}");
+        }
+        assert_clean(&g);
+    }
 }

@@ -342,6 +342,10 @@ struct RenderArgs {
     /// Largest error of a coarse level (opacity per voxel length, summed down the levels).
     #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
     lod_error: f32,
+    /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
+    /// before it takes over (0: abrupt level changes).
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    lod_band: f32,
     /// Reconstruction kernel: Westover's Gaussian (sigma 0.6, radius 2), the Crawfis-Max-style cubic
     /// (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: fewer fragments, sharper, flat
     /// sheets ripple by 7.6%).
@@ -644,7 +648,7 @@ fn run(cli: Cli) -> Result<()> {
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
             opts.render_scale = a.render_scale;
             opts.lod = a.lod.parse()?;
-            (opts.lod_pixels, opts.lod_error) = (a.lod_pixels, a.lod_error);
+            (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
             opts.validate()?;
             let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
             let r_bricked = bricked.is_some();

@@ -212,9 +212,17 @@ uvec3 level_split(uvec3 b, uint l) {
     return uvec3(clamp(global - ivec3(b * side), ivec3(0), ivec3(side)));
 }
 
+// Pixels per voxel spacing at eye-space depth `depth`.
+float voxel_pixels(float depth) {
+    float voxel = frame.spacing.w / frame.origin.w;
+    return frame.eye.w > 0.5 ? voxel * frame.up.w / max(depth, frame.forward.w) : voxel * frame.up.w;
+}
+
 // Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
-// bf.grad.y pixels at the brick's nearest depth and whose error is at most bf.grad.z (0: off).
-uint brick_level(uint h, uvec3 b) {
+// bf.grad.y pixels at the brick's nearest depth and whose error is at most bf.grad.z (0: off);
+// `morph`: 1 when its splats may morph toward the next level (allowed there too; splat_morph).
+uint brick_level(uint h, uvec3 b, out float morph) {
+    morph = 0.0;
     if (bf.grad.y <= 0.0) return 0u;
     vec3 lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
     vec3 hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
@@ -223,15 +231,31 @@ uint brick_level(uint h, uvec3 b) {
         vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
         near_depth = min(near_depth, dot(p - frame.eye.xyz, frame.forward.xyz));
     }
-    float voxel = frame.spacing.w / frame.origin.w;
-    float px = frame.eye.w > 0.5 ? voxel * frame.up.w / max(near_depth, frame.forward.w) : voxel * frame.up.w;
+    float px = voxel_pixels(near_depth);
     uvec4 s = lod_summary[h];
     uint level = 0u;
     for (uint l = 1u; l <= 3u; ++l) {
         if (px * float(1u << l) > bf.grad.y || uintBitsToFloat(s[l]) > bf.grad.z) break;
         level = l;
     }
+    if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z) morph = 1.0;
     return level;
+}
+
+// Per brick, 1 when its splats may morph toward the next level this frame (brick_cull).
+layout(std430, binding = 26) buffer BrickMorph { float brick_morph[]; };
+
+// Geomorphing (levels of detail): over the last bf.grad.w octaves of projected size before the
+// next level's threshold, a level-l splat at grid position `at` widens toward the next level's
+// footprint (twice as wide) by its own depth, so the growth is continuous from splat to splat and
+// brick to brick and reaches 2 where the next level takes over. Its energy falls by growth^2 (the
+// optical depth over its footprint is kept). The splats stay on their lattice: moving them toward
+// their parent's centre made a flat slab's summed footprints ripple by 5 %, and a growth per brick
+// left 2 % steps at brick faces.
+float splat_growth(vec3 at, uint l) {
+    vec3 center = frame.origin.xyz + at * frame.spacing.xyz;
+    float octaves = log2(bf.grad.y / voxel_pixels(dot(center - frame.eye.xyz, frame.forward.xyz))) - float(l);
+    return 1.0 + clamp((octaves - (1.0 - bf.grad.w)) / bf.grad.w, 0.0, 1.0);
 }
 
 // Drawn cells of level l in header h's brick (level 0: its drawn voxels).

@@ -24,13 +24,14 @@ float footprint_scale(float depth, float cell) {
 }
 
 // A splat of `cell` voxels a side (a voxel, or a coarse cell of levels of detail: its kernel
-// `cell` times wider) at grid position `at`, of straight colour rgb and optical depth tau per cell.
-SplatParams params_at(vec3 at, float cell, vec3 rgb, float tau) {
+// `cell` times wider) at grid position `at`, of straight colour rgb and optical depth tau per cell;
+// `grow` widens it further with its energy scaled by 1 / grow^2 (levels of detail's morphing).
+SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
     vec3 center = frame.origin.xyz + at * frame.spacing.xyz;
     vec3 forward = frame.forward.xyz;
     float depth = dot(center - frame.eye.xyz, forward);
     float scale = footprint_scale(depth, cell);
-    float radius = cell * frame.spacing.w * scale;
+    float radius = grow * cell * frame.spacing.w * scale;
     bool visible = depth >= frame.forward.w + CULL_RADII * radius && depth <= frame.right.w - CULL_RADII * radius;
     // The quad faces the eye->voxel ray (perspective) or the view direction (orthographic).
     vec3 w = frame.eye.w > 0.5 ? normalize(center - frame.eye.xyz) : forward;
@@ -40,7 +41,7 @@ SplatParams params_at(vec3 at, float cell, vec3 rgb, float tau) {
     // the plane facing the eye ray at t_i (Fig. 4.4), when the path exceeds delta pixels.
     float stretch = 0.0;
     vec3 quad_center = center;
-    float energy = 1.0 / (scale * scale);
+    float energy = 1.0 / (scale * scale * grow * grow);
     if (frame.blur.x > 0.0 && visible) {
         vec3 prev = (frame.motion * vec4(center, 1.0)).xyz;
         vec4 c1 = frame.view_proj * vec4(center, 1.0);
@@ -70,5 +71,5 @@ SplatParams params_at(vec3 at, float cell, vec3 rgb, float tau) {
 
 SplatParams params_of(uvec3 ijk, vec4 color) {
     float opacity = clamp(color.a, 0.0, MAX_OPACITY);
-    return params_at(vec3(ijk), 1.0, color.rgb, -log(1.0 - opacity));
+    return params_at(vec3(ijk), 1.0, 1.0, color.rgb, -log(1.0 - opacity));
 }

@@ -4,7 +4,7 @@
 use super::bindings::Bindings;
 use super::lod::{cell_color, level_count};
 use super::order::{outward, side_count};
-use super::splat_params::{cell_footprint_scale, params_at, params_of, CULL_RADII};
+use super::splat_params::{cell_footprint_scale, optical_depth, params_at, params_of, CULL_RADII};
 use crate::bricks::{BrickStore, BRICK};
 use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
 use crate::dispatch::{Args, Res, Variant};
@@ -40,6 +40,8 @@ pub struct BrickInputs<'a> {
     /// Levels of detail: the pyramid cells and per-brick summaries (empty when off).
     pub pyramid: &'a [u32],
     pub summary: &'a [[u32; 4]],
+    /// Per brick its splats' morph this frame (`brick_cull`).
+    pub morphs: &'a [f32],
 }
 
 const TF_BITS: usize = 4 * TF_ENTRIES as usize;
@@ -205,8 +207,9 @@ pub fn brick_hidden(
     let size = glam::Vec2::new(f.blur[2], f.blur[3]);
     let tile = COMPOSITE_TILE as f32;
     let tiles_x = (size.x / tile).ceil() as i64;
-    let is_hidden = |level: u32, b: [u32; 3]| {
-        let (lo, hi) = inputs.footprint_box(b, (1u32 << level) as f32);
+    let is_hidden = |h: u32, level: u32, b: [u32; 3]| {
+        let morph = if inputs.bf.grad[1] > 0.0 { inputs.morphs[h as usize] } else { 0.0 };
+        let (lo, hi) = inputs.footprint_box(b, (1u32 << level) as f32 * (1.0 + morph));
         let (mut slo, mut shi) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
         for c in 0..8 {
             let q: Vec4 = vp * corner(lo, hi, c).extend(1.0);
@@ -225,7 +228,7 @@ pub fn brick_hidden(
             .all(|y| (t0.x as i64..=t1.x as i64).all(|x| occlusion[(y * tiles_x + x) as usize] <= push.occluded))
     };
     for (e, entry) in list[push.first as usize..(push.first + push.count) as usize].iter().enumerate() {
-        hidden[e] = u32::from(is_hidden(entry[3] >> 16, inputs.store.headers[entry[0] as usize].coords()));
+        hidden[e] = u32::from(is_hidden(entry[0], entry[3] >> 16, inputs.store.headers[entry[0] as usize].coords()));
     }
 }
 
@@ -254,16 +257,17 @@ pub(crate) fn local_cell(l: u32) -> [u32; 3] {
 }
 
 /// Pass 1: cull each non-empty brick or write its header and count at its draw-order slot
-/// (`counts`: a streamed store's drawn voxels per brick, counted on the host).
-pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut [u32]) {
+/// (`counts`: a streamed store's drawn voxels per brick, counted on the host), and with levels of
+/// detail its splats' morph.
+pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut [u32], morphs: &mut [f32]) {
     let store = inputs.store;
     for (h, hd) in store.headers.iter().enumerate() {
         let b = hd.coords();
         if inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) {
             continue;
         }
-        let level = inputs.brick_level(h as u32, b);
-        if inputs.outside_view(b, (1u32 << level) as f32) {
+        let (level, morph) = inputs.brick_level(h as u32, b);
+        if inputs.outside_view(b, (1u32 << level) as f32 * (1.0 + morph)) {
             continue;
         }
         let drawn = match counts {
@@ -276,6 +280,9 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
         };
         if drawn > 0 {
             slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(level, drawn);
+        }
+        if inputs.bf.grad[1] > 0.0 {
+            morphs[h] = morph;
         }
     }
 }
@@ -334,20 +341,25 @@ pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 
     for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
         let ijk = voxel_ijk(*v);
         let level = voxel_level(*v);
-        if level == 0 {
+        if inputs.bf.grad[1] <= 0.0 {
             let color = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
             params[s] = params_of(inputs.frame, ijk, color);
             continue;
         }
         let nb = inputs.bf.grid;
         let h = inputs.store.index[(ijk[0] / BRICK + nb[0] * (ijk[1] / BRICK + nb[1] * (ijk[2] / BRICK))) as usize];
+        let at = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5 * ((1u32 << level) as f32 - 1.0);
+        let grow = if inputs.morphs[h as usize] > 0.0 { inputs.splat_growth(at, level) } else { 1.0 };
+        if level == 0 {
+            let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
+            params[s] = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
+            continue;
+        }
         let (mut c, normal) = cell_color(inputs.pyramid, h, v[1] >> 16);
         if shaded {
             inputs.shade(&mut c, normal);
         }
-        let cell = (1u32 << level) as f32;
-        let at = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5 * (cell - 1.0);
-        params[s] = params_at(inputs.frame, at, cell, [c[0], c[1], c[2]], c[3]);
+        params[s] = params_at(inputs.frame, at, (1u32 << level) as f32, grow, [c[0], c[1], c[2]], c[3]);
     }
 }
 
@@ -361,6 +373,7 @@ pub(crate) fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
         store: &scene.store,
         pyramid: b.get(Res::Pyramid),
         summary: b.get(Res::LodSummary),
+        morphs: b.get(Res::BrickMorph),
     })
 }
 
@@ -370,10 +383,11 @@ fn streamed(v: &Variant) -> bool {
 }
 
 pub(crate) fn brick_cull_stage(b: &mut Bindings<'_>, _: &Args, v: &Variant) -> Result<()> {
-    let mut slots = b.take(Res::BrickSlots);
+    let (mut slots, mut morphs) = (b.take(Res::BrickSlots), b.take(Res::BrickMorph));
     let counts = streamed(v).then(|| b.get::<u32>(Res::BrickCounts));
-    brick_cull(&inputs(b)?, counts, &mut slots);
+    brick_cull(&inputs(b)?, counts, &mut slots, bytemuck::cast_slice_mut(&mut morphs));
     b.put(Res::BrickSlots, slots);
+    b.put(Res::BrickMorph, morphs);
     Ok(())
 }
 

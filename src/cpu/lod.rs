@@ -20,9 +20,9 @@ pub const LOD_LEVELS: u32 = 3;
 /// The octahedral bytes of a zero gradient.
 const NO_NORMAL: u32 = 0x8080;
 
-/// Device bytes of the pyramid and summary of `bricks` non-empty bricks.
+/// Device bytes of the pyramid, summary and morph of `bricks` non-empty bricks.
 pub fn pyramid_bytes(bricks: usize) -> u64 {
-    bricks as u64 * (LOD_CELLS * CELL_WORDS * 4 + 16) as u64
+    bricks as u64 * (LOD_CELLS * CELL_WORDS * 4 + 16 + 4) as u64
 }
 
 /// First cell of level `l` (1..3) in a brick's pyramid.
@@ -99,11 +99,32 @@ pub fn level_split(split: [u32; 4], b: [u32; 3], l: u32) -> [u32; 3] {
 }
 
 impl BrickInputs<'_> {
-    /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame.
-    pub fn brick_level(&self, h: u32, b: [u32; 3]) -> u32 {
+    /// Mirror of `voxel_pixels`.
+    fn voxel_pixels(&self, depth: f32) -> f32 {
+        let f = self.frame;
+        let voxel = f.spacing[3] / f.origin[3];
+        if f.eye[3] > 0.5 {
+            voxel * f.up[3] / depth.max(f.forward[3])
+        } else {
+            voxel * f.up[3]
+        }
+    }
+
+    /// Mirror of `splat_growth`.
+    pub fn splat_growth(&self, at: Vec3, l: u32) -> f32 {
+        let (f, bf) = (self.frame, &self.bf);
+        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        let center = v3(f.origin) + at * v3(f.spacing);
+        let octaves = (bf.grad[1] / self.voxel_pixels((center - v3(f.eye)).dot(v3(f.forward)))).log2() - l as f32;
+        1.0 + ((octaves - (1.0 - bf.grad[3])) / bf.grad[3]).clamp(0.0, 1.0)
+    }
+
+    /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame, and 1 when
+    /// its splats may morph toward the next.
+    pub fn brick_level(&self, h: u32, b: [u32; 3]) -> (u32, f32) {
         let (f, bf) = (self.frame, &self.bf);
         if bf.grad[1] <= 0.0 {
-            return 0;
+            return (0, 0.0);
         }
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         let (origin, spacing, eye, forward) = (v3(f.origin), v3(f.spacing), v3(f.eye), v3(f.forward));
@@ -111,8 +132,7 @@ impl BrickInputs<'_> {
         let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
         let (lo, hi) = (origin + first * spacing, origin + Vec3::from(last) * spacing);
         let near = (0..8).map(|c| (super::brick::corner(lo, hi, c) - eye).dot(forward)).fold(1e30f32, f32::min);
-        let voxel = f.spacing[3] / f.origin[3];
-        let px = if f.eye[3] > 0.5 { voxel * f.up[3] / near.max(f.forward[3]) } else { voxel * f.up[3] };
+        let px = self.voxel_pixels(near);
         let s = self.summary[h as usize];
         let mut level = 0;
         for l in 1..=LOD_LEVELS {
@@ -121,7 +141,8 @@ impl BrickInputs<'_> {
             }
             level = l;
         }
-        level
+        let morph = level < 3 && bf.grad[3] > 0.0 && f32::from_bits(s[level as usize + 1]) <= bf.grad[2];
+        (level, if morph { 1.0 } else { 0.0 })
     }
 }
 

@@ -39,26 +39,26 @@ pub fn cell_footprint_scale(frame: &Frame, depth: f32, cell: f32) -> f32 {
 /// and colour (the dense path's `splat_params` and the bricks' `brick_params` share it).
 pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
     let at = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32);
-    params_at(frame, at, 1.0, [color[0], color[1], color[2]], optical_depth(color[3]))
+    params_at(frame, at, 1.0, 1.0, [color[0], color[1], color[2]], optical_depth(color[3]))
 }
 
-/// Mirror of `params_at`: a splat `cell` voxels a side at grid position `at`, of straight colour
-/// `rgb` and optical depth `tau` per cell.
-pub fn params_at(frame: &Frame, at: Vec3, cell: f32, rgb: [f32; 3], tau: f32) -> SplatParams {
+/// Mirror of `params_at`: a splat `cell` voxels a side at grid position `at`, widened by `grow`
+/// (energy / grow²), of straight colour `rgb` and optical depth `tau` per cell.
+pub fn params_at(frame: &Frame, at: Vec3, cell: f32, grow: f32, rgb: [f32; 3], tau: f32) -> SplatParams {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right, origin, spacing) =
         (v3(frame.eye), v3(frame.forward), v3(frame.right), v3(frame.origin), v3(frame.spacing));
     let center = origin + at * spacing;
     let depth = (center - eye).dot(forward);
     let scale = cell_footprint_scale(frame, depth, cell);
-    let radius = cell * frame.spacing[3] * scale;
+    let radius = grow * cell * frame.spacing[3] * scale;
     let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
     let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
     let mut u = (right - right.dot(w) * w).normalize();
     let mut v = w.cross(u);
     let mut stretch = 0.0f32;
     let mut quad_center = center;
-    let mut energy = 1.0 / (scale * scale);
+    let mut energy = 1.0 / (scale * scale * grow * grow);
     if frame.blur[0] > 0.0 && visible {
         let m = Mat4::from_cols_array_2d(&frame.motion);
         let vp = Mat4::from_cols_array_2d(&frame.view_proj);

@@ -83,7 +83,7 @@ pub(super) fn record_bricks(
     let frame = plan::frame_for(&prep.set, camera, opts);
     let mut bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
     if lod {
-        (bf.grad[1], bf.grad[2]) = (opts.lod_pixels, opts.lod_error);
+        (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, opts.lod_error, opts.lod_band);
     }
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
     // The brick stages' build: one page of store records, the paged reader, or streamed records.
@@ -94,6 +94,7 @@ pub(super) fn record_bricks(
     if lod {
         e.ensure(Res::Pyramid, pyramid - scene.store.headers.len().max(1) as u64 * 16)?;
         e.ensure(Res::LodSummary, scene.store.headers.len().max(1) as u64 * 16)?;
+        e.ensure(Res::BrickMorph, scene.store.headers.len().max(1) as u64 * 4)?;
         let id = scene.classification();
         if (e.tag(Res::Pyramid) != id || e.tag(Res::LodSummary) != id) && bf.grid[3] > 0 {
             let groups = plan::groups_per_item(bf.grid[3]);

@@ -144,3 +144,31 @@ pub fn npy(shape: &[u64], descr: &str, data: &[u8]) -> Vec<u8> {
     b.extend_from_slice(data);
     b
 }
+
+/// A lumpy blob with empty space around it and a hollow, on a grid whose sides are not multiples
+/// of the brick side.
+pub fn blob(dims: [u32; 3]) -> voxsplat::volume::ScalarVolume {
+    let c = dims.map(|d| d as f32 / 2.0);
+    let mut values = Vec::new();
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let p = [i, j, k].map(|v| v as f32);
+                let r = ((0..3).map(|a| ((p[a] - c[a]) / c[a]).powi(2)).sum::<f32>()).sqrt();
+                let wobble = 0.15 * ((p[0] * 0.7).sin() * (p[1] * 0.5).cos() + (p[2] * 0.9).sin());
+                values.push(if r < 0.9 { (1.0 - r + wobble).max(0.0) * 100.0 } else { 0.0 });
+            }
+        }
+    }
+    voxsplat::volume::ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
+}
+
+/// The bricked tests' transfer function for `blob`.
+pub fn blob_tf() -> voxsplat::classify::TransferFunction {
+    voxsplat::classify::TransferFunction {
+        points: vec![(0.1, [0.0, 0.0, 0.0, 0.0]), (0.3, [0.9, 0.4, 0.2, 0.3]), (1.0, [0.9, 0.9, 1.0, 0.8])],
+        gradient_weight: 0.0,
+        range: None,
+        threshold: 0.0,
+    }
+}
