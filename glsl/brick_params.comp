@@ -1,5 +1,5 @@
 #version 450
-// variants: PAGED_RECORDS STREAMED_STORE
+// variants: PAGED_RECORDS STREAMED_STORE LOD PAGED_RECORDS+LOD
 // Bricks, pass 3 (issue 23): per splat of a batch, in draw order, classify its voxel on the device
 // (TF table, gradient weighting, headlight shading; gradients read through the store) and make its
 // splat parameters (params.glsl, as splat_params does for a dense set); a coarse cell of levels of
@@ -21,24 +21,26 @@ void main() {
     if (s >= pc.splats) return;
     uvec2 v = voxels[s];
     uvec3 ijk = voxel_ijk(v);
+#ifndef LOD
+    params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5)));
+#else
+    // Levels of detail (its own build: llvmpipe ran this path's loads and maths under a mask even
+    // when levels of detail were off, and the frame's brick_params took 2.7x as long).
     uint level = voxel_level(v);
-    if (bf.grad.y <= 0.0) {
-        params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5)));
-        return;
-    }
     uvec3 b = ijk / BRICK_SIDE;
     uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
     vec3 at = vec3(ijk) + 0.5 * (float(1u << level) - 1.0);
     float grow = brick_morph[h] > 0.0 ? splat_growth(at, level) : 1.0;
+    vec4 c;
     if (level == 0u) {
-        vec4 c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);
-        float opacity = clamp(c.a, 0.0, MAX_OPACITY);
-        params_store(s, params_at(at, 1.0, grow, c.rgb, -log(1.0 - opacity)));
-        return;
+        c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);
+        c.a = -log(1.0 - clamp(c.a, 0.0, MAX_OPACITY));
+    } else {
+        // A coarse cell: its prefiltered colour, shaded at its gradient, and optical depth per cell.
+        vec3 normal;
+        c = cell_color(h, v.y >> 16u, normal);
+        if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
     }
-    // A coarse cell: its prefiltered colour, shaded at its gradient, and optical depth per cell.
-    vec3 normal;
-    vec4 c = cell_color(h, v.y >> 16u, normal);
-    if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
     params_store(s, params_at(at, float(1u << level), grow, c.rgb, c.a));
+#endif
 }

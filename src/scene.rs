@@ -8,8 +8,10 @@ use glam::Vec3;
 /// Opacity of one voxel-length of the built-in materials.
 pub const SCENE_OPACITY: f32 = 0.95;
 const RED: [f32; 3] = [0.85, 0.1, 0.1];
-const WHITE: [f32; 3] = [0.95, 0.95, 0.95];
-const BLACK: [f32; 3] = [0.08, 0.08, 0.08];
+/// The checkerboard's white.
+pub const WHITE: [f32; 3] = [0.95, 0.95, 0.95];
+/// The checkerboard's black.
+pub const BLACK: [f32; 3] = [0.08, 0.08, 0.08];
 
 /// (name, description) of every built-in scene.
 pub const SCENES: &[(&str, &str)] = &[

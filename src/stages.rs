@@ -116,6 +116,9 @@ const BRICK: &[Res] = &[
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
 const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
+/// The same, and with levels of detail (`LOD`; never streamed): `record_brick_batch` picks.
+const RECORD_PAGED_LOD: &[Variant] =
+    &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[]), v("LOD", &[]), v("PAGED_RECORDS+LOD", &[])];
 /// The same, without the streamed build (the stage needs the records on the device).
 const RECORD_RESIDENT: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[])];
 const ONE: &[Variant] = &[v("", &[])];
@@ -231,7 +234,7 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: RECORD_PAGED,
+        variants: RECORD_PAGED_LOD,
         mirror: crate::cpu::brick::brick_params_stage,
     },
     StageDesc {

@@ -165,7 +165,7 @@ pub(super) fn record_bricks(
         }
         let n = batch_splats(&batch);
         if !batch.is_empty() {
-            record_brick_batch(e, scene, &batch, streamed, build)?;
+            record_brick_batch(e, scene, &batch, streamed, build, lod)?;
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, i > 0)?;
@@ -274,7 +274,7 @@ fn record_bricked_sheets(
         let part = &parts[0];
         let n = batch_splats(part);
         if n > 0 {
-            record_brick_batch(e, scene, part, cut.streamed, cut.build)?;
+            record_brick_batch(e, scene, part, cut.streamed, cut.build, false)?;
         }
         let pc = geometry(n)?;
         let starts = record_slab_bins(e, &pc, variant)?;
@@ -321,7 +321,7 @@ fn record_bricked_sheets(
         for (k, part) in cut.batches(scene, near, MAX_GPU_SPLATS, available).iter().enumerate() {
             let n = batch_splats(part);
             if n > 0 {
-                record_brick_batch(e, scene, part, cut.streamed, cut.build)?;
+                record_brick_batch(e, scene, part, cut.streamed, cut.build, false)?;
             }
             let starts = record_slab_bins(e, &geometry(n)?, variant)?;
             let (first, end) = (starts[p0 as usize], starts[p1 as usize + 1]);
@@ -346,6 +346,7 @@ fn record_brick_batch(
     batch: &[[u32; 4]],
     streamed: bool,
     build: usize,
+    lod: bool,
 ) -> Result<()> {
     let n = batch_splats(batch);
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
@@ -379,7 +380,9 @@ fn record_brick_batch(
         e.run(&Dispatch::new(StageId::BrickCells, 0, groups, List::Order, bytemuck::bytes_of(&cells)))?;
     }
     let push = bytemuck::bytes_of(&push);
-    e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, push))
+    // The LOD builds follow the three record builds (stages.rs).
+    let params = if lod { build + 3 } else { build };
+    e.run(&Dispatch::new(StageId::BrickParams, params, groups_1d(n), List::Order, push))
 }
 
 /// Front to back with early termination, a bricked frame is cut into at least this many batches
