@@ -398,8 +398,10 @@ pub fn lod_antialias(size: u32, factor: u32, dolly: usize, frames: usize) -> Res
     let mut lod = o.clone();
     lod.lod = voxsplat::Lod::Auto;
     variants.push(("LOD auto (1 px)".into(), lod.clone()));
+    lod.lod_error = f32::MAX;
+    variants.push(("LOD auto (1 px), error unbounded".into(), lod.clone()));
     lod.lod_band = 0.0;
-    variants.push(("LOD auto, abrupt levels".into(), lod));
+    variants.push(("LOD auto (1 px), error unbounded, abrupt levels".into(), lod));
     let psnr = |rmse: f64| -20.0 * rmse.max(1e-12).log10();
     let mut s = String::new();
     let _ = writeln!(
