@@ -166,7 +166,7 @@ impl Default for RenderOptions {
             lod: Lod::Off,
             lod_pixels: 1.0,
             lod_error: DEFAULT_LOD_ERROR,
-            lod_band: 1.0,
+            lod_band: 0.75,
         }
     }
 }

@@ -244,6 +244,7 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
             writeln!(s, "| bonsai 512³ bricked, sheets streamed (one frame) | {sheet:.0} | {:.2} | | |", sheet / sm);
     }
     s += &lod_antialias(256, 8, 60, frames)?;
+    s += &lod_peer(256, size, frames)?;
     if let Some(rss) = peak_rss_mib() {
         let _ = writeln!(s, "\nPeak resident set of the whole study process: {rss:.0} MiB.");
     }
@@ -440,6 +441,58 @@ pub fn lod_antialias(size: u32, factor: u32, dolly: usize, frames: usize) -> Res
             psnr(beyond),
             shimmer / none_shimmer
         );
+    }
+    Ok(s)
+}
+
+/// Levels of detail on the peers' volume (issue 24's peer256 target): `n`³ at `size`², the peers'
+/// camera and transfer function, the bricked store at full detail and with levels of detail over
+/// an error sweep (the LOD curve), against the peers' truth (scalar ray integration, step 0.25
+/// voxel), alternated frame by frame over `frames` rounds; the dense classified splats beside them.
+pub fn lod_peer(n: u32, size: u32, frames: usize) -> Result<String> {
+    let vol = voxsplat::peer::volume(n)?;
+    let tf = voxsplat::peer::transfer_function();
+    let camera = voxsplat::peer::camera(n, size);
+    let truth = voxsplat::truth::ray_integrate_scalars(&vol, &tf, &camera, 0.25)?;
+    let mut dense = renderer()?;
+    dense.set_scene(classify(&vol, &tf, None)?)?;
+    let mut bricked = renderer()?;
+    bricked.set_bricks(BrickScene::new(BrickStore::build(&vol)?, tf, None)?)?;
+    drop(vol);
+    let mut o = RenderOptions::default();
+    o.raster = Raster::Compute;
+    let mut variants: Vec<(String, bool, RenderOptions)> =
+        vec![("dense classified splats".into(), true, o.clone()), ("bricked, full detail".into(), false, o.clone())];
+    for (pixels, error) in [(1.0, 0.05), (1.0, 0.25), (1.0, 1.0), (1.0, f32::MAX), (1.5, 0.25), (2.0, 0.25)] {
+        let mut x = o.clone();
+        (x.lod, x.lod_pixels, x.lod_error) = (voxsplat::Lod::Auto, pixels, error);
+        let e = if error == f32::MAX { "unbounded".to_string() } else { format!("{error}") };
+        variants.push((format!("bricked, LOD auto {pixels} px, error {e}"), false, x));
+    }
+    let mut images = Vec::new();
+    for (_, is_dense, x) in &variants {
+        let r = if *is_dense { &mut dense } else { &mut bricked };
+        images.push(r.render(&camera, x)?.image);
+    }
+    let mut times = vec![Vec::new(); variants.len()];
+    for _ in 0..frames {
+        for (t, (_, is_dense, x)) in times.iter_mut().zip(&variants) {
+            t.push(frame_ms(if *is_dense { &mut dense } else { &mut bricked }, &camera, x)?);
+        }
+    }
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "\n### Levels of detail on peer{n} (issue 24)\n\nThe peers' volume, camera and transfer function, {size}², tile \
+         compositor; PSNR against the peers' truth (scalar ray integration, step 0.25 voxel); every variant alternates \
+         frame by frame, {frames} rounds after a warm-up; medians.\n"
+    );
+    let _ = writeln!(s, "| variant | median ms | over bricked full detail | PSNR dB against the truth |");
+    let _ = writeln!(s, "|---|---:|---:|---:|");
+    let medians: Vec<f64> = times.iter_mut().map(|t| median(t)).collect();
+    for (((name, _, _), image), ms) in variants.iter().zip(&images).zip(&medians) {
+        let m = voxsplat::metrics::compare(image, &truth)?;
+        let _ = writeln!(s, "| {name} | {ms:.0} | {:.2} | {:.2} |", ms / medians[1], m.psnr);
     }
     Ok(s)
 }

@@ -344,7 +344,7 @@ struct RenderArgs {
     lod_error: f32,
     /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
     /// before it takes over (0: abrupt level changes).
-    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    #[arg(long, value_parser = parse_finite, default_value = "0.75")]
     lod_band: f32,
     /// Reconstruction kernel: Westover's Gaussian (sigma 0.6, radius 2), the Crawfis-Max-style cubic
     /// (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: fewer fragments, sharper, flat
