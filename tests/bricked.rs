@@ -3,7 +3,7 @@
 //! over a random view battery, streaming through a small budget, transfer-function changes, and
 //! bad budgets. Validation on: any message fails.
 mod common;
-use common::{assert_clean, blob, blob_tf as tf, random_camera, Rng, ViewKind};
+use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
 use voxsplat::classify::{classify, Shading, TransferFunction};
 use voxsplat::gpu_types::SplatParams;
@@ -27,13 +27,6 @@ fn opts(raster: Raster, direction: Direction) -> RenderOptions {
 
 fn compute(direction: Direction) -> RenderOptions {
     opts(Raster::Compute, direction)
-}
-
-/// Largest and mean absolute channel difference.
-fn diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> (f32, f32) {
-    let d: Vec<f32> =
-        a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).collect();
-    (d.iter().copied().fold(0.0, f32::max), d.iter().sum::<f32>() / d.len() as f32)
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! validator over a random view battery, and the pyramid rebuilt when the classification
 //! changes. Validation on: any message fails.
 mod common;
-use common::{assert_clean, blob, blob_tf as tf, random_camera, Rng, ViewKind};
+use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 use voxsplat::classify::{Shading, TransferFunction};
 use voxsplat::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
@@ -13,13 +13,6 @@ fn lod(raster: Raster, direction: Direction, pixels: f32) -> RenderOptions {
     let mut o = RenderOptions::default();
     (o.raster, o.direction, o.lod, o.lod_pixels, o.lod_error) = (raster, Some(direction), Lod::Auto, pixels, 100.0);
     o
-}
-
-/// Largest and mean absolute channel difference.
-fn diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> (f32, f32) {
-    let d: Vec<f32> =
-        a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).collect();
-    (d.iter().copied().fold(0.0, f32::max), d.iter().sum::<f32>() / d.len() as f32)
 }
 
 /// The frame's cells in draw order, (i, j, k, side), read back after `brick_params`.

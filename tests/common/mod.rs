@@ -172,3 +172,10 @@ pub fn blob_tf() -> voxsplat::classify::TransferFunction {
         threshold: 0.0,
     }
 }
+
+/// Largest and mean absolute channel difference.
+pub fn diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> (f32, f32) {
+    let d: Vec<f32> =
+        a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).collect();
+    (d.iter().copied().fold(0.0, f32::max), d.iter().sum::<f32>() / d.len() as f32)
+}
