@@ -34,7 +34,7 @@ void main() {
     vec4 c;
     if (level == 0u) {
         c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);
-        c.a = -log(1.0 - clamp(c.a, 0.0, MAX_OPACITY));
+        c.a = optical_depth(c.a);
     } else {
         // A coarse cell: its prefiltered colour, shaded at its gradient, and optical depth per cell.
         vec3 normal;

@@ -33,7 +33,7 @@ uint pack_normal(vec3 g) {
     if (!(len > 0.0)) return NO_NORMAL;
     vec3 n = g / len;
     vec2 o = n.xy;
-    if (n.z < 0.0) o = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    if (n.z < 0.0) o = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
     return packSnorm4x8(vec4(o, 0.0, 0.0)) & 0xffffu;
 }
 
@@ -108,7 +108,7 @@ void main() {
                 if (emits(q)) {
                     ivec3 v = ivec3(b * BRICK_SIDE + k);
                     vec4 cl = classify_voxel(v, q, false);
-                    tk[d] = -log(1.0 - clamp(cl.a, 0.0, MAX_OPACITY));
+                    tk[d] = optical_depth(cl.a);
                     ck[d] = cl.rgb * tk[d];
                     if (shaded) g += gradient_at(v) * tk[d];
                     drawn += tk[d] > 0.0 ? 1u : 0u;

@@ -105,24 +105,24 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
     frame_ms(&mut bricked, &cam, &with_lod)?;
     let (mut t_dense, mut t_bricked, mut t_tf) = (Vec::new(), Vec::new(), Vec::new());
     let (mut t_lod, mut t_tf_lod) = (Vec::new(), Vec::new());
+    // A TF change, then the frame it gives (alternating two transfer functions), then back.
+    let tf_change = |r: &mut Renderer, o: &RenderOptions, i: usize| -> Result<f64> {
+        let t = Instant::now();
+        r.set_transfer_function(if i % 2 == 0 { &other } else { &tf }, None)?;
+        r.render(&cam, o)?;
+        let spent = ms(t);
+        r.set_transfer_function(&tf, None)?;
+        Ok(spent)
+    };
     for i in 0..frames {
         t_dense.push(frame_ms(&mut dense, &cam, &o)?);
         t_bricked.push(frame_ms(&mut bricked, &cam, &o)?);
-        // A TF change, then the frame it gives (alternating two transfer functions).
-        let t = Instant::now();
-        bricked.set_transfer_function(if i % 2 == 0 { &other } else { &tf }, None)?;
-        bricked.render(&cam, &o)?;
-        t_tf.push(ms(t));
-        bricked.set_transfer_function(&tf, None)?;
+        t_tf.push(tf_change(&mut bricked, &o, i)?);
         // With levels of detail a TF change rebuilds the pyramid too: a plain LOD frame after one
         // that rebuilt it, then a TF change and its LOD frame.
         bricked.render(&cam, &with_lod)?;
         t_lod.push(frame_ms(&mut bricked, &cam, &with_lod)?);
-        let t = Instant::now();
-        bricked.set_transfer_function(if i % 2 == 0 { &other } else { &tf }, None)?;
-        bricked.render(&cam, &with_lod)?;
-        t_tf_lod.push(ms(t));
-        bricked.set_transfer_function(&tf, None)?;
+        t_tf_lod.push(tf_change(&mut bricked, &with_lod, i)?);
     }
     let (d, b, t) = (median(&mut t_dense), median(&mut t_bricked), median(&mut t_tf));
     let (tl, ttl) = (median(&mut t_lod), median(&mut t_tf_lod));

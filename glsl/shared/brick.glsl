@@ -212,6 +212,12 @@ uvec3 level_split(uvec3 b, uint l) {
     return uvec3(clamp(global - ivec3(b * side), ivec3(0), ivec3(side)));
 }
 
+// The world box of brick b's voxel centres.
+void voxel_box(uvec3 b, out vec3 lo, out vec3 hi) {
+    lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
+    hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
+}
+
 // Pixels per voxel spacing at eye-space depth `depth`.
 float voxel_pixels(float depth) {
     float voxel = frame.spacing.w / frame.origin.w;
@@ -224,8 +230,9 @@ float voxel_pixels(float depth) {
 uint brick_level(uint h, uvec3 b, out float morph) {
     morph = 0.0;
     if (bf.grad.y <= 0.0) return 0u;
-    vec3 lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
-    vec3 hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
+    vec3 lo;
+    vec3 hi;
+    voxel_box(b, lo, hi);
     float near_depth = 1e30;
     for (uint c = 0u; c < 8u; ++c) {
         vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
@@ -275,13 +282,18 @@ float cell_tau(uint h, uint i) {
     return uintBitsToFloat(pyramid[(h * LOD_CELLS + i) * CELL_WORDS]);
 }
 
+// Octahedral normals fold the lower hemisphere with the signs of x and y, 0 counted positive.
+vec2 sign_not_zero(vec2 v) {
+    return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);
+}
+
 vec4 cell_color(uint h, uint i, out vec3 normal) {
     uint base = (h * LOD_CELLS + i) * CELL_WORDS;
     vec2 rg = unpackUnorm2x16(pyramid[base + 1u]);
     uint w = pyramid[base + 2u];
     vec2 oct = unpackSnorm4x8(w >> 16u).xy;
     vec3 n = vec3(oct, 1.0 - abs(oct.x) - abs(oct.y));
-    if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
     normal = w >> 16u == NO_NORMAL ? vec3(0.0) : normalize(n);
     return vec4(rg, unpackUnorm2x16(w).x, uintBitsToFloat(pyramid[base]));
 }
@@ -292,8 +304,7 @@ PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
 // The world box holding every footprint of brick b drawn with cells `cell` voxels a side: its voxel
 // centres' box widened by the footprint reach at its far side (anti-aliasing widens with depth).
 void footprint_box(uvec3 b, float cell, out vec3 lo, out vec3 hi) {
-    lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
-    hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
+    voxel_box(b, lo, hi);
     float far_depth = -1e30;
     for (uint c = 0u; c < 8u; ++c) {
         vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));

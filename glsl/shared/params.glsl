@@ -69,7 +69,11 @@ SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
     return p;
 }
 
+// Optical depth of one voxel-length of opacity a (clamped below 1). Mirror: volume::optical_depth.
+float optical_depth(float a) {
+    return -log(1.0 - clamp(a, 0.0, MAX_OPACITY));
+}
+
 SplatParams params_of(uvec3 ijk, vec4 color) {
-    float opacity = clamp(color.a, 0.0, MAX_OPACITY);
-    return params_at(vec3(ijk), 1.0, 1.0, color.rgb, -log(1.0 - opacity));
+    return params_at(vec3(ijk), 1.0, 1.0, color.rgb, optical_depth(color.a));
 }

@@ -111,14 +111,22 @@ impl BrickInputs<'_> {
         c
     }
 
+    /// Mirror of `voxel_box`: the world box of brick `b`'s voxel centres.
+    pub(crate) fn voxel_box(&self, b: [u32; 3]) -> (Vec3, Vec3) {
+        let f = self.frame;
+        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        let (origin, spacing) = (v3(f.origin), v3(f.spacing));
+        let first = Vec3::new((b[0] * BRICK) as f32, (b[1] * BRICK) as f32, (b[2] * BRICK) as f32);
+        let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
+        (origin + first * spacing, origin + Vec3::from(last) * spacing)
+    }
+
     /// Mirror of `footprint_box`.
     fn footprint_box(&self, b: [u32; 3], cell: f32) -> (Vec3, Vec3) {
         let f = self.frame;
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-        let (origin, spacing, eye, forward) = (v3(f.origin), v3(f.spacing), v3(f.eye), v3(f.forward));
-        let first = Vec3::new((b[0] * BRICK) as f32, (b[1] * BRICK) as f32, (b[2] * BRICK) as f32);
-        let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
-        let (lo, hi) = (origin + first * spacing, origin + Vec3::from(last) * spacing);
+        let (eye, forward) = (v3(f.eye), v3(f.forward));
+        let (lo, hi) = self.voxel_box(b);
         let far = (0..8).map(|c| (corner(lo, hi, c) - eye).dot(forward)).fold(-1e30f32, f32::max);
         let reach = CULL_RADII * cell * f.spacing[3] * cell_footprint_scale(f, far.max(1e-6), cell);
         (lo - Vec3::splat(reach), hi + Vec3::splat(reach))

@@ -4,7 +4,7 @@
 use super::bindings::Bindings;
 use super::brick::{inputs, local_cell, BrickInputs};
 use super::order::side_count;
-use super::splat_params::MAX_OPACITY;
+use super::splat_params::optical_depth;
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
@@ -20,9 +20,14 @@ pub const LOD_LEVELS: u32 = 3;
 /// The octahedral bytes of a zero gradient.
 const NO_NORMAL: u32 = 0x8080;
 
-/// Device bytes of the pyramid, summary and morph of `bricks` non-empty bricks.
+/// The buffers levels of detail add, and their bytes per non-empty brick: the pyramid's cells, its
+/// summary, this frame's morph.
+pub const LOD_BUFFERS: [(Res, u64); 3] =
+    [(Res::Pyramid, (LOD_CELLS * CELL_WORDS * 4) as u64), (Res::LodSummary, 16), (Res::BrickMorph, 4)];
+
+/// Device bytes of `LOD_BUFFERS` for `bricks` non-empty bricks.
 pub fn pyramid_bytes(bricks: usize) -> u64 {
-    bricks as u64 * (LOD_CELLS * CELL_WORDS * 4 + 16 + 4) as u64
+    bricks as u64 * LOD_BUFFERS.iter().map(|(_, per)| per).sum::<u64>()
 }
 
 /// First cell of level `l` (1..3) in a brick's pyramid.
@@ -43,6 +48,15 @@ fn unorm16(v: f32) -> u32 {
     (v.clamp(0.0, 1.0) * 65535.0).round() as u32
 }
 
+/// Mirror of `sign_not_zero` (one component).
+fn sign_not_zero(v: f32) -> f32 {
+    if v >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
 /// Mirror of `pack_normal`: octahedral bytes of gradient `g`.
 fn pack_normal(g: Vec3) -> u32 {
     let len = g.x.abs() + g.y.abs() + g.z.abs();
@@ -50,8 +64,11 @@ fn pack_normal(g: Vec3) -> u32 {
         return NO_NORMAL;
     }
     let n = g / len;
-    let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
-    let (ox, oy) = if n.z < 0.0 { ((1.0 - n.y.abs()) * sign(n.x), (1.0 - n.x.abs()) * sign(n.y)) } else { (n.x, n.y) };
+    let (ox, oy) = if n.z < 0.0 {
+        ((1.0 - n.y.abs()) * sign_not_zero(n.x), (1.0 - n.x.abs()) * sign_not_zero(n.y))
+    } else {
+        (n.x, n.y)
+    };
     snorm8(ox) | snorm8(oy) << 8
 }
 
@@ -65,8 +82,7 @@ pub fn cell_color(pyramid: &[u32], h: u32, i: u32) -> ([f32; 4], Vec3) {
     let (ox, oy) = (sn(w >> 16), sn(w >> 24));
     let mut n = Vec3::new(ox, oy, 1.0 - ox.abs() - oy.abs());
     if n.z < 0.0 {
-        let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
-        (n.x, n.y) = ((1.0 - oy.abs()) * sign(ox), (1.0 - ox.abs()) * sign(oy));
+        (n.x, n.y) = ((1.0 - oy.abs()) * sign_not_zero(ox), (1.0 - ox.abs()) * sign_not_zero(oy));
     }
     let normal = if w >> 16 == NO_NORMAL { Vec3::ZERO } else { n.normalize() };
     let rgba = [un(pyramid[base + 1]), un(pyramid[base + 1] >> 16), un(w), f32::from_bits(pyramid[base])];
@@ -127,10 +143,8 @@ impl BrickInputs<'_> {
             return (0, 0.0);
         }
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-        let (origin, spacing, eye, forward) = (v3(f.origin), v3(f.spacing), v3(f.eye), v3(f.forward));
-        let first = Vec3::new((b[0] * BRICK) as f32, (b[1] * BRICK) as f32, (b[2] * BRICK) as f32);
-        let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
-        let (lo, hi) = (origin + first * spacing, origin + Vec3::from(last) * spacing);
+        let (eye, forward) = (v3(f.eye), v3(f.forward));
+        let (lo, hi) = self.voxel_box(b);
         let near = (0..8).map(|c| (super::brick::corner(lo, hi, c) - eye).dot(forward)).fold(1e30f32, f32::min);
         let px = self.voxel_pixels(near);
         let s = self.summary[h as usize];
@@ -159,10 +173,10 @@ struct Sums {
 pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mut [[u32; 4]]) {
     let store = inputs.store;
     let shaded = inputs.bf.light[3] > 0.5;
-    let fine_n = (BRICK * BRICK * BRICK) as usize;
+    let mut fine = vec![Sums::default(); (BRICK * BRICK * BRICK) as usize];
     for (h, hd) in store.headers.iter().enumerate() {
         let b = hd.coords();
-        let mut fine = vec![Sums::default(); fine_n];
+        fine.fill(Sums::default());
         for &rec in &store.records[hd.first as usize..(hd.first + hd.count) as usize] {
             if !inputs.emits(rec >> 16) {
                 continue;
@@ -171,7 +185,7 @@ pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mu
             let lc = local_cell(l);
             let v = [0, 1, 2].map(|a| (b[a] * BRICK + lc[a]) as i64);
             let c = inputs.classify_voxel(v, rec >> 16, false);
-            let t = -(1.0 - c[3].clamp(0.0, MAX_OPACITY)).ln();
+            let t = optical_depth(c[3]);
             let grad = if shaded { inputs.gradient_at(v) * t } else { Vec3::ZERO };
             fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0 };
         }

@@ -92,9 +92,9 @@ pub(super) fn record_bricks(
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
     if lod {
-        e.ensure(Res::Pyramid, pyramid - scene.store.headers.len().max(1) as u64 * 16)?;
-        e.ensure(Res::LodSummary, scene.store.headers.len().max(1) as u64 * 16)?;
-        e.ensure(Res::BrickMorph, scene.store.headers.len().max(1) as u64 * 4)?;
+        for (res, per_brick) in crate::cpu::lod::LOD_BUFFERS {
+            e.ensure(res, scene.store.headers.len().max(1) as u64 * per_brick)?;
+        }
         let id = scene.classification();
         if (e.tag(Res::Pyramid) != id || e.tag(Res::LodSummary) != id) && bf.grid[3] > 0 {
             let groups = plan::groups_per_item(bf.grid[3]);
