@@ -29,7 +29,9 @@ void main() {
     uint level = voxel_level(v);
     uvec3 b = ijk / BRICK_SIDE;
     uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
-    vec3 at = vec3(ijk) + 0.5 * (float(1u << level) - 1.0);
+    // The cell's centre: the middle of its voxels inside the grid (a cell the grid's end cuts
+    // would otherwise sit up to 3.5 voxels off a thin sheet).
+    vec3 at = vec3(ijk) + 0.5 * (vec3(min(uvec3(1u << level), frame.dims.xyz - ijk)) - 1.0);
     float grow = brick_morph[h] > 0.0 ? splat_growth(at, level) : 1.0;
     vec4 c;
     if (level == 0u) {

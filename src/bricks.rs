@@ -69,8 +69,13 @@ pub struct BrickStore {
 impl BrickStore {
     /// Cut `vol` into bricks, keeping every voxel whose value lies above the minimum.
     pub fn build(vol: &ScalarVolume) -> Result<Self> {
+        Self::build_over(vol, f32::INFINITY)
+    }
+
+    /// `build`, with the empty value at most `background` (`from_slices_over`).
+    fn build_over(vol: &ScalarVolume, background: f32) -> Result<Self> {
         let plane = vol.dims[0] as usize * vol.dims[1] as usize;
-        Self::from_slices(vol.dims, vol.spacing, |z0, count, out| {
+        Self::from_slices_over(vol.dims, vol.spacing, background, |z0, count, out| {
             out.clear();
             out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + count) as usize * plane]);
             Ok(())
@@ -84,6 +89,17 @@ impl BrickStore {
     pub fn from_slices(
         dims: [u32; 3],
         spacing: [f32; 3],
+        read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
+    ) -> Result<Self> {
+        Self::from_slices_over(dims, spacing, f32::INFINITY, read)
+    }
+
+    /// `from_slices`, with the empty value at most `background` (a volume with no empty voxel
+    /// keeps its minimum).
+    fn from_slices_over(
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        background: f32,
         mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
         let [nx, ny, nz] = dims;
@@ -108,7 +124,8 @@ impl BrickStore {
                 (lo, hi) = (lo.min(v), hi.max(v));
             }
         }
-        let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
+        let lo = lo.min(background);
+        let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo)) } else { (0.0, 0.0) };
         let span = if hi > lo { hi - lo } else { 1.0 };
         let mut store = Self {
             dims,
@@ -332,6 +349,9 @@ pub fn slot_entry(word: u32) -> (u32, u32, u32) {
     (word >> 10, level, count)
 }
 
+/// Most colours `BrickScene::from_palette` takes.
+pub const MAX_PALETTE: usize = 64;
+
 impl BrickScene {
     /// A scene of `store` classified with `tf` and `shading`.
     pub fn new(store: BrickStore, tf: TransferFunction, shading: Option<Shading>) -> Result<Self> {
@@ -352,6 +372,52 @@ impl BrickScene {
             gmax: std::sync::OnceLock::new(),
             classification: next_classification(),
         })
+    }
+
+    /// A scene of few colours (a built-in scene's splats) as a bricked volume, so the bricked path
+    /// and its levels of detail can be measured on the same objects as the dense splats: colour p
+    /// (in first-seen order) is stored value p + 1 and a flat stretch of the transfer function, so
+    /// classification reproduces every splat's colour and opacity exactly. More than
+    /// `MAX_PALETTE` colours is an error.
+    pub fn from_palette(set: &SplatSet) -> Result<Self> {
+        let mut palette: Vec<[f32; 4]> = Vec::new();
+        let mut index = Vec::with_capacity(set.len());
+        for s in set.splats() {
+            let p = match palette.iter().position(|c| *c == s.color) {
+                Some(p) => p,
+                None if palette.len() < MAX_PALETTE => {
+                    palette.push(s.color);
+                    palette.len() - 1
+                }
+                None => {
+                    return Err(Error::InvalidArgument(format!(
+                        "the scene has more than {MAX_PALETTE} colours: a palette volume holds at most that many"
+                    )))
+                }
+            };
+            index.push(p);
+        }
+        let g = set.grid();
+        if g.origin != Grid::centered(g.dims, g.spacing)?.origin {
+            return Err(Error::InvalidArgument("a palette volume's grid must be centred on the origin".into()));
+        }
+        let n = palette.len().max(1) as f32;
+        let mut values = vec![0.0f32; g.dims.iter().map(|&d| d as usize).product()];
+        for (s, &p) in set.splats().iter().zip(&index) {
+            let [i, j, k, _] = s.ijk.map(|c| c as usize);
+            values[i + g.dims[0] as usize * (j + g.dims[1] as usize * k)] = (p + 1) as f32;
+        }
+        // Value p + 1 normalises to (p + 1) / n; a plateau of half a step either side absorbs the
+        // store's 16-bit quantisation.
+        let mut points = vec![(0.0, [0.0; 4])];
+        for (p, c) in palette.iter().enumerate() {
+            let at = (p + 1) as f32 / n;
+            points.push((at - 0.25 / n, *c));
+            points.push((at + 0.25 / n, *c));
+        }
+        let tf = TransferFunction { points, gradient_weight: 0.0, range: Some((0.0, n)), threshold: 0.5 / n };
+        let vol = ScalarVolume { dims: g.dims, spacing: g.spacing, values };
+        Self::new(BrickStore::build_over(&vol, 0.0)?, tf, None)
     }
 
     /// Classify with another transfer function and shading from the next frame on.

@@ -438,3 +438,23 @@ fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classificat
         }
     }
 }
+
+#[test]
+fn a_built_in_scene_as_a_palette_volume_classifies_back_to_its_splats() {
+    // The plane fills its grid (no empty voxel to be the store's minimum); the cubes are hollow.
+    for name in ["plane", "cube40", "cube40-attenuated"] {
+        let set = voxsplat::scene::build(name).unwrap();
+        let scene = BrickScene::from_palette(&set).unwrap();
+        let back = scene.store.classify(scene.transfer_function(), None).unwrap();
+        assert_eq!(back.len(), set.len(), "{name}: splats");
+        for (a, b) in set.splats().iter().zip(back.splats()) {
+            assert_eq!(a.ijk, b.ijk, "{name}");
+            assert!(a.color.iter().zip(&b.color).all(|(x, y)| (x - y).abs() < 1e-6), "{name}: {a:?} vs {b:?}");
+        }
+    }
+    let grid = voxsplat::Grid::centered([70, 1, 1], [1.0; 3]).unwrap();
+    let many = voxsplat::SplatSet::from_fn(grid, |i, _, _| Some([i as f32 / 70.0, 0.5, 0.5, 0.5])).unwrap();
+    let err = BrickScene::from_palette(&many).unwrap_err();
+    assert!(matches!(err, voxsplat::Error::InvalidArgument(_)), "{err}");
+    assert!(err.to_string().contains("more than 64 colours"), "{err}");
+}

@@ -285,3 +285,46 @@ fn level_boundaries_keep_the_brightness_of_a_constant_slab_and_cube() {
         assert_clean(&g);
     }
 }
+
+/// The alpha-weighted mean row of an image.
+fn mean_row(img: &voxsplat::ImageF32) -> f64 {
+    let w = img.width as usize;
+    let (mut sum, mut weight) = (0.0f64, 0.0f64);
+    for (i, p) in img.pixels.iter().enumerate() {
+        sum += (i / w) as f64 * p[3] as f64;
+        weight += p[3] as f64;
+    }
+    sum / weight
+}
+
+#[test]
+fn a_coarse_cell_the_grid_end_cuts_sits_on_the_voxels_it_holds() {
+    // A one-voxel plate seen from 17 degrees above, orthographic (a wider footprint grows the
+    // plate's image alike at both ends): its coarse cells span one voxel of their 2-8 in z, and a
+    // centre at the cell's middle would lift the plate by up to 3.5 voxels.
+    // (A store keeps the voxels above its minimum: one corner voxel is the empty value.)
+    let mut values = vec![1.0; 64 * 64];
+    values[0] = 0.0;
+    let vol = ScalarVolume { dims: [64, 64, 1], spacing: [1.0; 3], values };
+    let mut plate = tf();
+    plate.points = vec![(0.0, [0.9, 0.8, 0.7, 0.6]), (1.0, [0.9, 0.8, 0.7, 0.6])];
+    plate.threshold = 0.0;
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let mut cam = Camera::framing(&grid, 96, 96);
+    cam.eye = grid.center() + glam::Vec3::new(0.0, -110.0, 34.0);
+    cam.projection = voxsplat::camera::Projection::Orthographic { height: 80.0 };
+    // Planes well clear of the plate: splats within 1.5 radii of one are dropped.
+    (cam.near, cam.far) = (1.0, 1000.0);
+    for mut r in [common::gpu(), common::cpu()] {
+        r.set_volume(&vol, &plate, None).unwrap();
+        let fine = lod(Raster::Compute, Direction::BackToFront, 1e6);
+        let mut full = fine.clone();
+        full.lod = Lod::Off;
+        let cells = drawn_cells(&mut r, &cam, &fine);
+        assert!(cells.iter().all(|c| c[3] == 8), "every cell at level 3");
+        let (a, b) = (r.render(&cam, &full).unwrap().image, r.render(&cam, &fine).unwrap().image);
+        let shift = mean_row(&b) - mean_row(&a);
+        assert!(shift.abs() < 0.5, "the coarse plate moved {shift:.2} rows");
+        assert_clean(&r);
+    }
+}

@@ -29,6 +29,11 @@ pub enum Method {
     Raycast {
         step: f32,
     },
+    /// PBTF Gaussian splats through the tile compositor from the scene as a bricked volume
+    /// (`BrickScene::from_palette`), with levels of detail when `lod` is (pixels, error).
+    Bricked {
+        lod: Option<(f32, f32)>,
+    },
     /// A method drawn at a render scale (`RenderOptions::render_scale`) and resampled.
     Scaled {
         method: Box<Method>,
@@ -73,6 +78,10 @@ impl Method {
                 format!("slab {kernel:?}{}{}", aa_suffix(*aa), raster_suffix(*raster))
             }
             Method::Raycast { step } => format!("raycast {step}"),
+            Method::Bricked { lod: None } => "bricked compute".into(),
+            Method::Bricked { lod: Some((px, e)) } if *px >= LOD_UNBOUNDED => format!("{LOD_CURVE} {e} compute"),
+            Method::Bricked { lod: Some((px, e)) } if *e >= LOD_UNBOUNDED => format!("bricked lod {px}px compute"),
+            Method::Bricked { lod: Some((px, e)) } => format!("bricked lod {px}px error {e} compute"),
             Method::Scaled { method, scale } => format!("{} scale {scale}", method.label()),
         }
         .to_lowercase()
@@ -81,10 +90,30 @@ impl Method {
     fn reconstruction(&self) -> Reconstruction {
         match self {
             Method::Splat { kernel, .. } => Reconstruction::Kernel(*kernel),
+            Method::Bricked { .. } => Reconstruction::Kernel(Kernel::Gaussian),
             Method::Raycast { .. } => Reconstruction::Trilinear,
             Method::Scaled { method, .. } => method.reconstruction(),
         }
     }
+}
+
+/// `lod_pixels` that lets every level pass the pixel test: levels chosen by their error alone
+/// (Laur and Hanrahan's cut).
+pub const LOD_UNBOUNDED: f32 = 1e6;
+/// Label prefix of the levels-of-detail curve (error swept, pixels unbounded) on the charts.
+pub const LOD_CURVE: &str = "bricked lod error";
+
+/// The bricked path at full detail, levels of detail at their defaults and with the error test
+/// off (mip-splats: every cell within a pixel), and the levels-of-detail curve: the error bound
+/// swept with the pixel test off.
+pub fn bricked_methods(errors: &[f32]) -> Vec<Method> {
+    let mut m = vec![
+        Method::Bricked { lod: None },
+        Method::Bricked { lod: Some((1.0, voxsplat::options::DEFAULT_LOD_ERROR)) },
+        Method::Bricked { lod: Some((1.0, LOD_UNBOUNDED)) },
+    ];
+    m.extend(errors.iter().map(|&e| Method::Bricked { lod: Some((LOD_UNBOUNDED, e)) }));
+    m
 }
 
 /// What `run_matrix` covers.
@@ -133,6 +162,7 @@ impl MatrixOptions {
         // Half the grid, resampled: pays where footprints span many pixels, blurs where they do not.
         methods.push(Method::Scaled { method: Box::new(rastered(Composite::Splat, Raster::Compute)), scale: 0.5 });
         methods.push(Method::Scaled { method: Box::new(Method::Raycast { step: 1.0 }), scale: 0.5 });
+        methods.extend(bricked_methods(&[0.01, 0.03, 0.1, 0.3, 1.0]));
         Self {
             scenes: vec!["cube60", "cube40-attenuated", "plane"],
             methods,
@@ -158,7 +188,10 @@ impl MatrixOptions {
                 Method::Raycast { step: 1.0 },
                 Method::Raycast { step: 0.5 },
                 Method::Scaled { method: Box::new(rastered(Composite::Splat, Raster::Compute)), scale: 0.5 },
-            ],
+            ]
+            .into_iter()
+            .chain(bricked_methods(&[0.1]))
+            .collect(),
             width: 128,
             height: 128,
             warmup: 1,
@@ -222,6 +255,14 @@ fn render_method_at(r: &mut Renderer, m: &Method, camera: &Camera, render_scale:
         Method::Raycast { step } => {
             r.raycast(camera, &RaycastOptions { step: *step, render_scale, ..Default::default() })
         }
+        Method::Bricked { lod } => {
+            let mut o = RenderOptions::default();
+            (o.raster, o.render_scale) = (Raster::Compute, render_scale);
+            if let Some((pixels, error)) = *lod {
+                (o.lod, o.lod_pixels, o.lod_error) = (voxsplat::Lod::Auto, pixels, error);
+            }
+            r.render(camera, &o)
+        }
         Method::Scaled { method, scale } => render_method_at(r, method, camera, *scale),
     }
 }
@@ -280,6 +321,8 @@ pub fn run_matrix(
         let set = scene::build(name)?;
         let camera = bench_camera(set.grid(), opts.width, opts.height);
         r.set_scene(set.clone())?;
+        // Whether the renderer holds the scene as bricks (Method::Bricked) rather than splats.
+        let mut bricked = false;
         let mut truths: Vec<(Reconstruction, ImageF32)> = Vec::new();
         for m in &opts.methods {
             progress(done, total, &format!("{name}: {}", m.label()));
@@ -291,6 +334,15 @@ pub fn run_matrix(
                 truths.push((rec, t));
             }
             let truth = &truths.iter().find(|(k, _)| *k == rec).expect("computed").1;
+            let wants_bricks = matches!(m, Method::Bricked { .. });
+            if wants_bricks != bricked {
+                if wants_bricks {
+                    r.set_bricks(voxsplat::bricks::BrickScene::from_palette(&set)?)?;
+                } else {
+                    r.set_scene(set.clone())?;
+                }
+                bricked = wants_bricks;
+            }
             let Timed { time_ms, wall_ms, stages, image } = time_method(r, m, &camera, opts.warmup, opts.frames)?;
             let violations = match m {
                 Method::Splat { order, composite: Composite::Splat, .. } => {
@@ -384,10 +436,20 @@ pub fn chart_svg(rows: &[Row], scene: &str, path: &Path) -> Result<()> {
 
 /// Labelled points, time per frame (log x) against `y_desc`, with the Pareto front (lower is better).
 pub fn scatter_svg(points: &[(String, f64, f64)], title: &str, y_desc: &str, path: &Path) -> Result<()> {
+    scatter(points, title, y_desc, false, path)
+}
+
+/// `scatter_svg` for a measure where higher is better (PSNR).
+pub fn scatter_svg_higher(points: &[(String, f64, f64)], title: &str, y_desc: &str, path: &Path) -> Result<()> {
+    scatter(points, title, y_desc, true, path)
+}
+
+fn scatter(points: &[(String, f64, f64)], title: &str, y_desc: &str, higher: bool, path: &Path) -> Result<()> {
     use plotters::prelude::*;
     let pts: Vec<(f64, f64)> = points.iter().map(|p| (p.1.max(1e-3), p.2)).collect();
     let (xmin, xmax) = pts.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
     let ymax = pts.iter().filter(|p| p.1.is_finite()).fold(0.0f64, |a, p| a.max(p.1));
+    let ymin = if higher { pts.iter().filter(|p| p.1.is_finite()).fold(ymax, |a, p| a.min(p.1)) * 0.9 } else { 0.0 };
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
     let mut chart = ChartBuilder::on(&root)
@@ -395,11 +457,25 @@ pub fn scatter_svg(points: &[(String, f64, f64)], title: &str, y_desc: &str, pat
         .margin(16)
         .x_label_area_size(40)
         .y_label_area_size(70)
-        .build_cartesian_2d((xmin * 0.7..xmax * 1.4).log_scale(), 0.0..ymax * 1.15 + 1e-6)
+        .build_cartesian_2d((xmin * 0.7..xmax * 1.4).log_scale(), ymin..ymax * 1.15 + 1e-6)
         .map_err(|e| plot_err(path, e))?;
     chart.configure_mesh().x_desc("time per frame, ms (log)").y_desc(y_desc).draw().map_err(|e| plot_err(path, e))?;
-    let front: Vec<(f64, f64)> = pareto_front(&pts).into_iter().map(|i| pts[i]).collect();
+    let sign = if higher { -1.0 } else { 1.0 };
+    let signed: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (x, sign * y)).collect();
+    let front: Vec<(f64, f64)> = pareto_front(&signed).into_iter().map(|i| pts[i]).collect();
     chart.draw_series(LineSeries::new(front, RED.stroke_width(2))).map_err(|e| plot_err(path, e))?;
+    // The levels-of-detail curve (error swept), joined in order of its error bound.
+    let curve: Vec<(f64, f64)> =
+        points.iter().zip(&pts).filter(|(p, _)| p.0.starts_with(LOD_CURVE)).map(|(_, &xy)| xy).collect();
+    if curve.len() > 1 {
+        let green = RGBColor(0, 150, 60);
+        chart
+            .draw_series(LineSeries::new(curve, green.stroke_width(2)))
+            .map_err(|e| plot_err(path, e))?
+            .label("levels of detail, error bound swept")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], green.stroke_width(2)));
+        chart.configure_series_labels().border_style(BLACK).draw().map_err(|e| plot_err(path, e))?;
+    }
     chart
         .draw_series(points.iter().zip(&pts).map(|(p, &(x, y))| {
             EmptyElement::at((x, y))
@@ -859,7 +935,10 @@ pub fn results_markdown(rep: &Report<'_>) -> Result<String> {
 /// One anti-aliasing mode on the grazing checkerboard view (chapter 3).
 #[derive(Clone, Debug)]
 pub struct AaRow {
-    pub mode: Antialias,
+    /// The method's label (`Method::label`).
+    pub method: String,
+    /// The anti-aliasing mode of a splat method; `None` for the bricked levels of detail.
+    pub mode: Option<Antialias>,
     pub time_ms: f64,
     pub rmse_before: f64,
     pub rmse_beyond: f64,
@@ -868,6 +947,11 @@ pub struct AaRow {
     pub shimmer: f64,
     pub metrics: ImageMetrics,
 }
+
+/// The levels-of-detail curve's error bounds in the anti-aliasing study.
+const AA_LOD_ERRORS: [f32; 3] = [0.03, 0.3, 1.0];
+/// The pixel bounds swept (error test off) in the anti-aliasing study.
+const AA_LOD_PIXELS: [f32; 3] = [2.0, 4.0, 8.0];
 
 /// The plane at the grazing view: error against a `factor`× supersampled truth before and beyond
 /// k, shimmer along a `dolly` frame camera dolly, and time, for every anti-aliasing mode.
@@ -885,16 +969,34 @@ pub fn antialias_study(
     let truth = voxsplat::truth::supersampled(&set, &camera, factor, &TruthOptions::default())?;
     let regions = voxsplat::aa::k_regions(&set, &camera);
     r.set_scene(set.clone())?;
+    let mut methods: Vec<(Option<Antialias>, Method)> = [Antialias::None, Antialias::Swan, Antialias::Ewa]
+        .into_iter()
+        .map(|aa| {
+            let kernel = Kernel::Gaussian;
+            (
+                Some(aa),
+                Method::Splat {
+                    order: OrderKind::Pbtf,
+                    composite: Composite::Splat,
+                    kernel,
+                    aa,
+                    raster: Raster::Graphics,
+                },
+            )
+        })
+        .collect();
+    // Levels of detail: the prefiltered cells (issue 24), from the plane as bricks.
+    methods.extend(bricked_methods(&AA_LOD_ERRORS).into_iter().map(|m| (None, m)));
+    // Coarser than a pixel: the isotropic cells trade shimmer for blur along the unforeshortened axis.
+    methods.extend(AA_LOD_PIXELS.iter().map(|&px| (None, Method::Bricked { lod: Some((px, LOD_UNBOUNDED)) })));
     let mut rows = Vec::new();
-    for mode in [Antialias::None, Antialias::Swan, Antialias::Ewa] {
-        progress(&format!("anti-aliasing: {mode:?}"));
-        let m = Method::Splat {
-            order: OrderKind::Pbtf,
-            composite: Composite::Splat,
-            kernel: Kernel::Gaussian,
-            aa: mode,
-            raster: Raster::Graphics,
-        };
+    let mut bricked = false;
+    for (mode, m) in methods {
+        progress(&format!("anti-aliasing: {}", m.label()));
+        if mode.is_none() && !bricked {
+            r.set_bricks(voxsplat::bricks::BrickScene::from_palette(&set)?)?;
+            bricked = true;
+        }
         let t = time_method(r, &m, &camera, 1, frames)?;
         let before = voxsplat::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
         let beyond = voxsplat::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
@@ -909,6 +1011,7 @@ pub fn antialias_study(
         }
         let shimmer = voxsplat::metrics::shimmer(&frames_img, |t, i| regions_f[t][i] == 2).unwrap_or(f64::NAN);
         rows.push(AaRow {
+            method: m.label(),
             mode,
             time_ms: t.time_ms,
             rmse_before: before,
@@ -926,7 +1029,7 @@ pub fn antialias_rows(rows: &[AaRow], size: u32) -> Vec<Row> {
     rows.iter()
         .map(|r| Row {
             scene: "plane-grazing".into(),
-            method: format!("pbtf splat gaussian aa={:?}", r.mode).to_lowercase(),
+            method: r.method.clone(),
             width: size,
             height: size,
             splats: 498 * 398,
@@ -950,13 +1053,13 @@ pub fn antialias_markdown(rows: &[AaRow], size: u32, factor: u32, dolly: usize) 
     );
     let _ = writeln!(
         s,
-        "| aa | ms | PSNR before k | PSNR beyond k | beyond-k pixels | shimmer | whole-frame PSNR |\n|---|---:|---:|---:|---:|---:|---:|"
+        "| method | ms | PSNR before k | PSNR beyond k | beyond-k pixels | shimmer | whole-frame PSNR |\n|---|---:|---:|---:|---:|---:|---:|"
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {:?} | {:.2} | {:.2} | {:.2} | {} | {:.5} | {:.2} |",
-            r.mode,
+            "| {} | {:.2} | {:.2} | {:.2} | {} | {:.5} | {:.2} |",
+            r.method,
             r.time_ms,
             voxsplat::metrics::psnr(r.rmse_before),
             voxsplat::metrics::psnr(r.rmse_beyond),
@@ -965,7 +1068,7 @@ pub fn antialias_markdown(rows: &[AaRow], size: u32, factor: u32, dolly: usize) 
             r.metrics.psnr
         );
     }
-    let find = |m: Antialias| rows.iter().find(|r| r.mode == m);
+    let find = |m: Antialias| rows.iter().find(|r| r.mode == Some(m));
     if let Some(none) = find(Antialias::None) {
         for m in [Antialias::Swan, Antialias::Ewa] {
             let Some(x) = find(m) else { continue };
@@ -977,6 +1080,18 @@ pub fn antialias_markdown(rows: &[AaRow], size: u32, factor: u32, dolly: usize) 
                 s,
                 "\n- **{m:?} vs none beyond k:** {db:+.2} dB, shimmer × {sh:.2}, time × {tr:.2} (target: ≥ +6 dB, ≤ × 0.5, < × 1.5{}): {}.",
                 if m == Antialias::Ewa { ", applied to Swan; EWA measured beside it" } else { "" },
+                if met { "met" } else { "missed" }
+            );
+        }
+        for x in rows.iter().filter(|r| r.mode.is_none() && r.method.contains("lod")) {
+            let db = voxsplat::metrics::psnr(x.rmse_beyond) - voxsplat::metrics::psnr(none.rmse_beyond);
+            let sh = x.shimmer / none.shimmer;
+            let met = db >= 3.0 && sh <= 0.5;
+            let _ = writeln!(
+                s,
+                "- **{} vs none beyond k:** {db:+.2} dB, shimmer × {sh:.2}, time × {:.2} (issue 24's target: ≥ +3 dB, ≤ × 0.5): {}.",
+                x.method,
+                x.time_ms / none.time_ms,
                 if met { "met" } else { "missed" }
             );
         }

@@ -55,7 +55,13 @@ fn opts(early_termination: f32) -> RenderOptions {
 
 /// The study on `bonsai` (256³) and, when given, its 2x upsampling `large` (512³), `frames`
 /// rounds each, at `size`².
-pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> Result<String> {
+pub fn study(
+    bonsai: &Path,
+    large: Option<&Path>,
+    size: u32,
+    frames: usize,
+    lod_chart: Option<&Path>,
+) -> Result<String> {
     let tf = TransferFunction::preset("bonsai")?;
     let small = load(bonsai, &tf)?;
     let grid = Grid::centered(small.scene.store.dims, small.scene.store.spacing)?;
@@ -243,8 +249,7 @@ pub fn study(bonsai: &Path, large: Option<&Path>, size: u32, frames: usize) -> R
         let _ =
             writeln!(s, "| bonsai 512³ bricked, sheets streamed (one frame) | {sheet:.0} | {:.2} | | |", sheet / sm);
     }
-    s += &lod_antialias(256, 8, 60, frames)?;
-    s += &lod_peer(256, size, frames)?;
+    s += &lod_peer(256, size, frames, lod_chart)?;
     if let Some(rss) = peak_rss_mib() {
         let _ = writeln!(s, "\nPeak resident set of the whole study process: {rss:.0} MiB.");
     }
@@ -350,106 +355,15 @@ pub fn scaling_chart(csv: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The checkerboard plane (scene "plane") as a bricked scalar volume: squares of value 1 (black)
-/// and 2 (white), one empty corner voxel (the store keeps values above the minimum), and a
-/// transfer function that gives exactly the scene's colours and opacity.
-pub fn bricked_plane() -> Result<BrickScene> {
-    let (nx, ny) = (498u32, 398u32);
-    let mut values: Vec<f32> =
-        (0..nx * ny).map(|p| if ((p % nx) / 10 + (p / nx) / 10) % 2 == 0 { 1.0 } else { 2.0 }).collect();
-    values[0] = 0.0;
-    let vol = voxsplat::volume::ScalarVolume { dims: [nx, ny, 1], spacing: [1.0; 3], values };
-    let a = voxsplat::scene::SCENE_OPACITY;
-    let (b, w) = (voxsplat::scene::BLACK, voxsplat::scene::WHITE);
-    let tf = TransferFunction {
-        points: vec![
-            (0.0, [b[0], b[1], b[2], 0.0]),
-            (0.4, [b[0], b[1], b[2], a]),
-            (0.6, [b[0], b[1], b[2], a]),
-            (0.9, [w[0], w[1], w[2], a]),
-            (1.0, [w[0], w[1], w[2], a]),
-        ],
-        gradient_weight: 0.0,
-        range: None,
-        threshold: 0.3,
-    };
-    BrickScene::new(BrickStore::build(&vol)?, tf, None)
-}
-
-/// Anti-aliasing through levels of detail (issue 24): the bricked checkerboard plane at the
-/// grazing view, `size`², against its truth supersampled `factor`× and box-filtered: no
-/// anti-aliasing, Swan's widening, the EWA low-pass, and levels of detail (prefiltered cells beyond
-/// a pixel); error before and beyond k, shimmer over a `dolly`-frame dolly, and frame time.
-pub fn lod_antialias(size: u32, factor: u32, dolly: usize, frames: usize) -> Result<String> {
-    let scene = bricked_plane()?;
-    let set = scene.store.classify(scene.transfer_function(), None)?;
-    let camera = Camera::grazing(set.grid(), size, size);
-    let truth = voxsplat::truth::supersampled(&set, &camera, factor, &Default::default())?;
-    let regions = voxsplat::aa::k_regions(&set, &camera);
-    let mut r = renderer()?;
-    r.set_bricks(scene)?;
-    let mut o = RenderOptions::default();
-    o.raster = Raster::Graphics;
-    let mut variants = Vec::new();
-    for aa in [voxsplat::Antialias::None, voxsplat::Antialias::Swan, voxsplat::Antialias::Ewa] {
-        let mut x = o.clone();
-        x.antialias = aa;
-        variants.push((format!("{aa:?}"), x));
-    }
-    let mut lod = o.clone();
-    lod.lod = voxsplat::Lod::Auto;
-    variants.push(("LOD auto (1 px)".into(), lod.clone()));
-    lod.lod_error = f32::MAX;
-    variants.push(("LOD auto (1 px), error unbounded".into(), lod.clone()));
-    lod.lod_band = 0.0;
-    variants.push(("LOD auto (1 px), error unbounded, abrupt levels".into(), lod));
-    let psnr = |rmse: f64| -20.0 * rmse.max(1e-12).log10();
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "\n### Anti-aliasing through levels of detail (issue 24)\n\nThe checkerboard plane as a bricked volume \
-         (`bricks::bricked_plane`: the scene's colours and opacity through a transfer function), grazing view, {size}², \
-         per-splat quads; PSNR against its truth supersampled {factor}×{factor} and box-filtered, before and beyond k; \
-         shimmer = mean frame-to-frame RMSE over the beyond-k pixels along a {dolly}-frame dolly (half a voxel per \
-         frame); median of {frames} frames.\n"
-    );
-    let _ = writeln!(s, "| mode | ms | PSNR before k | PSNR beyond k | shimmer | shimmer / none's |");
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|");
-    let mut none_shimmer = f64::NAN;
-    for (name, x) in &variants {
-        let image = r.render(&camera, x)?.image;
-        let mut times: Vec<f64> = (0..frames).map(|_| frame_ms(&mut r, &camera, x)).collect::<Result<_>>()?;
-        let before = voxsplat::metrics::rmse_masked(&image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
-        let beyond = voxsplat::metrics::rmse_masked(&image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
-        let step = glam::Vec3::new(0.0, 0.5 * set.grid().spacing[1], 0.0);
-        let mut shots = Vec::with_capacity(dolly);
-        let mut masks = Vec::with_capacity(dolly);
-        for f in 0..dolly {
-            let cam = Camera { eye: camera.eye + step * f as f32, target: camera.target + step * f as f32, ..camera };
-            shots.push(r.render(&cam, x)?.image);
-            masks.push(voxsplat::aa::k_regions(&set, &cam));
-        }
-        let shimmer = voxsplat::metrics::shimmer(&shots, |t, i| masks[t][i] == 2).unwrap_or(f64::NAN);
-        if name == "None" {
-            none_shimmer = shimmer;
-        }
-        let _ = writeln!(
-            s,
-            "| {name} | {:.1} | {:.2} | {:.2} | {shimmer:.5} | {:.2} |",
-            median(&mut times),
-            psnr(before),
-            psnr(beyond),
-            shimmer / none_shimmer
-        );
-    }
-    Ok(s)
-}
+/// The error bounds of the levels-of-detail curve on peer256.
+const LOD_CURVE_ERRORS: [f32; 5] = [0.003, 0.01, 0.02, 0.05, 0.25];
 
 /// Levels of detail on the peers' volume (issue 24's peer256 target): `n`³ at `size`², the peers'
 /// camera and transfer function, the bricked store at full detail and with levels of detail over
 /// an error sweep (the LOD curve), against the peers' truth (scalar ray integration, step 0.25
 /// voxel), alternated frame by frame over `frames` rounds; the dense classified splats beside them.
-pub fn lod_peer(n: u32, size: u32, frames: usize) -> Result<String> {
+/// The levels-of-detail curve (pixel test off, error swept) goes on a chart at `chart`.
+pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Result<String> {
     let vol = voxsplat::peer::volume(n)?;
     let tf = voxsplat::peer::transfer_function();
     let camera = voxsplat::peer::camera(n, size);
@@ -463,11 +377,19 @@ pub fn lod_peer(n: u32, size: u32, frames: usize) -> Result<String> {
     o.raster = Raster::Compute;
     let mut variants: Vec<(String, bool, RenderOptions)> =
         vec![("dense classified splats".into(), true, o.clone()), ("bricked, full detail".into(), false, o.clone())];
-    for (pixels, error) in [(1.0, 0.05), (1.0, 0.25), (1.0, 1.0), (1.0, f32::MAX), (1.5, 0.25), (2.0, 0.25)] {
+    let unbounded = crate::bench::LOD_UNBOUNDED;
+    let mut lods = vec![(1.0, 0.25), (1.0, 1e6), (1.5, 0.25), (2.0, 0.25), (4.0, 0.25)];
+    lods.extend(LOD_CURVE_ERRORS.iter().map(|&e| (unbounded, e)));
+    for (pixels, error) in lods {
         let mut x = o.clone();
         (x.lod, x.lod_pixels, x.lod_error) = (voxsplat::Lod::Auto, pixels, error);
-        let e = if error == f32::MAX { "unbounded".to_string() } else { format!("{error}") };
-        variants.push((format!("bricked, LOD auto {pixels} px, error {e}"), false, x));
+        let e = if error >= 1e6 { "unbounded".to_string() } else { format!("{error}") };
+        let name = if pixels >= unbounded {
+            format!("{} {error}", crate::bench::LOD_CURVE)
+        } else {
+            format!("bricked, LOD auto {pixels} px, error {e}")
+        };
+        variants.push((name, false, x));
     }
     let mut images = Vec::new();
     for (_, is_dense, x) in &variants {
@@ -490,9 +412,17 @@ pub fn lod_peer(n: u32, size: u32, frames: usize) -> Result<String> {
     let _ = writeln!(s, "| variant | median ms | over bricked full detail | PSNR dB against the truth |");
     let _ = writeln!(s, "|---|---:|---:|---:|");
     let medians: Vec<f64> = times.iter_mut().map(|t| median(t)).collect();
+    let mut points = Vec::new();
     for (((name, _, _), image), ms) in variants.iter().zip(&images).zip(&medians) {
         let m = voxsplat::metrics::compare(image, &truth)?;
         let _ = writeln!(s, "| {name} | {ms:.0} | {:.2} | {:.2} |", ms / medians[1], m.psnr);
+        points.push((name.clone(), *ms, m.psnr));
+    }
+    if let Some(path) = chart {
+        let title = format!("peer{n}, {size}²: frame time against PSNR (higher is better)");
+        crate::bench::scatter_svg_higher(&points, &title, "PSNR dB against the truth", path)?;
+        let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+        let _ = writeln!(s, "\n![levels of detail on peer{n}](bench/{file})");
     }
     Ok(s)
 }

@@ -93,6 +93,9 @@ enum Command {
         /// Transfer-function preset for --volume.
         #[arg(long, default_value = "ramp")]
         tf: String,
+        /// Chart of the levels-of-detail study on peer256 (its markdown links it as bench/FILE).
+        #[arg(long)]
+        lod_chart: Option<PathBuf>,
         /// Draw the scaling chart from this CSV (voxels,vtk_ms,voxsplat_ms; scripts/bricks-vtk.sh)
         /// into --chart-out instead.
         #[arg(long, requires = "chart_out")]
@@ -874,13 +877,16 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => {
             voxsplat_cli::bricked::scaling_chart(&csv, &svg)
         }
-        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, .. } => {
+        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, lod_chart, .. } => {
             if frames < 1 || size < 16 {
                 return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
             }
             match volume {
                 Some(v) => println!("{}", voxsplat_cli::bricked::one_volume(&v, size, gpu_budget_mib, &tf, frames)?),
-                None => print!("{}", voxsplat_cli::bricked::study(&bonsai, large.as_deref(), size, frames)?),
+                None => print!(
+                    "{}",
+                    voxsplat_cli::bricked::study(&bonsai, large.as_deref(), size, frames, lod_chart.as_deref())?
+                ),
             }
             Ok(())
         }

@@ -138,9 +138,10 @@ fn quick_bench_writes_valid_csv_and_svg() {
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(
         rows.len(),
-        2 * 9 + 3 + 4,
-        "two scenes x nine methods (one at a render scale), three anti-aliasing modes, four motion-blur \
-         methods"
+        2 * (9 + 4) + (3 + 9) + 4,
+        "two scenes x nine methods (one at a render scale) and four bricked (full detail, levels of detail at \
+         1 px with and without the error test, one point of the error curve); three anti-aliasing modes and nine \
+         bricked; four motion-blur methods"
     );
     for r in &rows {
         assert_eq!(r.len(), header.len());
@@ -171,6 +172,13 @@ fn quick_bench_writes_valid_csv_and_svg() {
     }
     let chart = std::fs::read_to_string(dir.join("chart-plane.svg")).unwrap();
     assert!(chart.contains("sheet gaussian") && chart.contains("pbtf splat gaussian compute"));
+    // The bricked scene draws what its splats draw; the grazing chart carries the error curve.
+    for scene in ["cube40", "plane"] {
+        let (bricked, dense) = (rm(scene, "bricked compute"), rm(scene, "pbtf splat gaussian compute"));
+        assert!((bricked - dense).abs() <= 0.1 * dense, "{scene}: bricked RMSE {bricked} against the splats' {dense}");
+    }
+    let grazing = std::fs::read_to_string(dir.join("chart-plane-grazing.svg")).unwrap();
+    assert!(grazing.contains("levels of detail, error bound swept"), "the levels-of-detail curve");
     let scaling = std::fs::read_to_string(dir.join("scaling.csv")).unwrap();
     assert_eq!(scaling.lines().count(), 1 + 3 * (2 + 2), "three raster variants x four points");
     // The raster sweep: six variants at two footprint sizes, every variant drawing the same picture.

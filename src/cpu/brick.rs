@@ -356,7 +356,10 @@ pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 
         }
         let nb = inputs.bf.grid;
         let h = inputs.store.index[(ijk[0] / BRICK + nb[0] * (ijk[1] / BRICK + nb[1] * (ijk[2] / BRICK))) as usize];
-        let at = Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) + 0.5 * ((1u32 << level) as f32 - 1.0);
+        let dims = inputs.frame.dims;
+        let at = Vec3::from_array(
+            [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
+        );
         let grow = if inputs.morphs[h as usize] > 0.0 { inputs.splat_growth(at, level) } else { 1.0 };
         if level == 0 {
             let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
