@@ -117,6 +117,76 @@ pub fn rmse_masked(img: &ImageF32, truth: &ImageF32, keep: impl Fn(usize) -> boo
     (n > 0).then(|| (se / n as f64).sqrt())
 }
 
+/// Aliasing energy of `img` against a properly filtered `reference` over the bounding box of the
+/// pixels where `keep(pixel index)` holds: the luma power spectra of both (mean removed, Hann
+/// window), and the power `img` has in excess of the reference summed over all frequencies,
+/// relative to the reference's total. A blur only takes power away (a deficit, not counted);
+/// content above the pixels' Nyquist frequency folded back (moire, jaggies, shimmer's frozen
+/// frame) adds power the reference lacks. `None` when the box is under 4 pixels a side.
+pub fn aliasing_energy(img: &ImageF32, reference: &ImageF32, keep: impl Fn(usize) -> bool) -> Option<f64> {
+    let w = img.width as usize;
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for i in (0..img.pixels.len()).filter(|&i| keep(i)) {
+        (x0, y0, x1, y1) = (x0.min(i % w), y0.min(i / w), x1.max(i % w), y1.max(i / w));
+    }
+    if x0 == usize::MAX || x1 - x0 < 3 || y1 - y0 < 3 {
+        return None;
+    }
+    let (bw, bh) = (x1 - x0 + 1, y1 - y0 + 1);
+    let hann = |i: usize, n: usize| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * (i as f64 + 0.5) / n as f64).cos();
+    let power = |im: &ImageF32| -> Vec<f64> {
+        let luma: Vec<f64> = (0..bw * bh)
+            .map(|k| {
+                let p = im.pixels[(y0 + k / bw) * w + x0 + k % bw];
+                0.2126 * clamp01(p[0]) + 0.7152 * clamp01(p[1]) + 0.0722 * clamp01(p[2])
+            })
+            .collect();
+        let mean = luma.iter().sum::<f64>() / luma.len() as f64;
+        let windowed: Vec<f64> =
+            luma.iter().enumerate().map(|(k, v)| (v - mean) * hann(k % bw, bw) * hann(k / bw, bh)).collect();
+        dft2_power(&windowed, bw, bh)
+    };
+    let (pi, pr) = (power(img), power(reference));
+    let total: f64 = pr.iter().sum();
+    let excess: f64 = pi.iter().zip(&pr).map(|(a, b)| (a - b).max(0.0)).sum();
+    (total > 0.0).then(|| excess / total)
+}
+
+/// |DFT|^2 of a real w x h image (row-major), separably: O(w h (w + h)), enough for crops of a
+/// few hundred pixels.
+fn dft2_power(v: &[f64], w: usize, h: usize) -> Vec<f64> {
+    let twiddles = |n: usize| -> Vec<(f64, f64)> {
+        (0..n).map(|k| (2.0 * std::f64::consts::PI * k as f64 / n as f64).sin_cos()).map(|(s, c)| (c, -s)).collect()
+    };
+    let (tw, th) = (twiddles(w), twiddles(h));
+    let mut rows = vec![(0.0f64, 0.0f64); w * h];
+    for y in 0..h {
+        for u in 0..w {
+            let (mut re, mut im) = (0.0, 0.0);
+            for x in 0..w {
+                let (c, s) = tw[(u * x) % w];
+                re += v[y * w + x] * c;
+                im += v[y * w + x] * s;
+            }
+            rows[y * w + u] = (re, im);
+        }
+    }
+    let mut out = vec![0.0f64; w * h];
+    for u in 0..w {
+        for k in 0..h {
+            let (mut re, mut im) = (0.0, 0.0);
+            for y in 0..h {
+                let (c, s) = th[(k * y) % h];
+                let (a, b) = rows[y * w + u];
+                re += a * c - b * s;
+                im += a * s + b * c;
+            }
+            out[k * w + u] = re * re + im * im;
+        }
+    }
+    out
+}
+
 /// Shimmer of an animation: the mean over consecutive frames of their RMSE over the pixels where
 /// `keep(frame, pixel)` holds in both frames (for anti-aliasing: the pixels beyond k). `None` when
 /// no pair shares a kept pixel.

@@ -117,3 +117,54 @@ fn orthographic_dense_volume_lies_wholly_beyond_k() {
     let want = 1.0 / (cam.pixels_per_unit());
     assert!(p.iter().all(|q| (q.screen[3] - want).abs() < 1e-4 * want));
 }
+
+/// A `w` x `h` image of luma `f(x, y)`, opaque.
+fn luma_image(w: u32, h: u32, f: impl Fn(f32, f32) -> f32) -> voxsplat::ImageF32 {
+    let mut img = voxsplat::ImageF32::new(w, h);
+    for (i, p) in img.pixels.iter_mut().enumerate() {
+        let v = f((i % w as usize) as f32, (i / w as usize) as f32);
+        *p = [v, v, v, 1.0];
+    }
+    img
+}
+
+#[test]
+fn lanczos_keeps_what_the_pixels_can_hold_and_drops_what_they_cannot() {
+    use voxsplat::truth::{downsample, Downsample};
+    let f = 8usize;
+    let sine = |period: f32| {
+        luma_image(64 * f as u32, 8 * f as u32, move |x, _| 0.5 + 0.4 * (x * std::f32::consts::TAU / period).sin())
+    };
+    let amplitude = |img: &voxsplat::ImageF32| {
+        let row: Vec<f32> = (8..56).map(|x| img.pixels[4 * 64 + x][0]).collect();
+        (row.iter().cloned().fold(0.0f32, f32::max) - row.iter().cloned().fold(1.0f32, f32::min)) / 2.0
+    };
+    // 8 output pixels a period (a quarter of Nyquist): both filters keep most of it.
+    let slow = sine(8.0 * f as f32);
+    assert!(amplitude(&downsample(&slow, f, Downsample::Lanczos3)) > 0.35);
+    // 1.6 output pixels a period (above Nyquist): Lanczos leaves a trace, the box lets a lot through.
+    let fast = sine(1.6 * f as f32);
+    let (l, b) =
+        (amplitude(&downsample(&fast, f, Downsample::Lanczos3)), amplitude(&downsample(&fast, f, Downsample::Box)));
+    assert!(l < 0.05 && b > 2.0 * l, "above Nyquist: Lanczos {l}, box {b}");
+    // A constant stays itself to the edges (the weights are normalised there).
+    let flat = downsample(&luma_image(64, 64, |_, _| 0.7), 4, Downsample::Lanczos3);
+    assert!(flat.pixels.iter().all(|p| (p[0] - 0.7).abs() < 1e-5 && (p[3] - 1.0).abs() < 1e-5));
+}
+
+#[test]
+fn aliasing_energy_counts_added_patterns_not_blur() {
+    use voxsplat::metrics::aliasing_energy;
+    let scene = |x: f32, y: f32| 0.5 + 0.3 * (x * 0.2).sin() * (y * 0.15).cos();
+    let reference = luma_image(64, 48, scene);
+    let all = |_: usize| true;
+    assert_eq!(aliasing_energy(&reference, &reference, all), Some(0.0));
+    // A blur takes power away: nothing in excess.
+    let blurred = luma_image(64, 48, |x, y| 0.5 + 0.15 * (x * 0.2).sin() * (y * 0.15).cos());
+    assert!(aliasing_energy(&blurred, &reference, all).unwrap() < 1e-9);
+    // A moire-like pattern the reference lacks is counted.
+    let moire = luma_image(64, 48, |x, y| scene(x, y) + 0.1 * (x * 2.1 + y * 0.7).sin());
+    let e = aliasing_energy(&moire, &reference, all).unwrap();
+    assert!(e > 0.05, "aliasing energy {e}");
+    assert_eq!(aliasing_energy(&moire, &reference, |i| i < 2), None, "a box under 4 pixels");
+}
