@@ -1,9 +1,11 @@
 #version 450
+// variants: STREAMED_STORE
 // Levels of detail (issue 24), pass 2 for the coarse bricks of a batch: one lane per entry of
 // brick_list. A brick drawn at level l > 0 writes its pyramid's drawn cells, visiting the brick's
 // cells of 2^l voxels in PBTF order (split like the brick grid: level_split), each as (lowest
 // voxel, level, cell) at the brick's first position + its rank: the two-level order with cells for
-// voxels, no sort. Voxel bricks are brick_order's. Mirror: cpu::lod::brick_cells.
+// voxels, no sort. Voxel bricks are brick_order's. A streamed store's pyramid holds the batch's
+// bricks (STREAMED_STORE: pyramid_index). Mirror: cpu::lod::brick_cells.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
 #include "linear.glsl"

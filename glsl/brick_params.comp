@@ -1,5 +1,5 @@
 #version 450
-// variants: PAGED_RECORDS STREAMED_STORE LOD PAGED_RECORDS+LOD
+// variants: PAGED_RECORDS STREAMED_STORE LOD PAGED_RECORDS+LOD STREAMED_STORE+LOD
 // Bricks, pass 3 (issue 23): per splat of a batch, in draw order, classify its voxel on the device
 // (TF table, gradient weighting, headlight shading; gradients read through the store) and make its
 // splat parameters (params.glsl, as splat_params does for a dense set); a coarse cell of levels of

@@ -1,5 +1,5 @@
 #version 450
-// variants: PAGED_RECORDS
+// variants: PAGED_RECORDS STREAMED_STORE
 // Levels of detail (issue 24), built when the classification changes: one workgroup per
 // non-empty brick, a lane per level-1 cell reading its 8 voxels through the occupancy mask. Its
 // voxels are classified (TF and gradient weighting; shading waits for the
@@ -9,10 +9,19 @@
 // 2^l times wider and carries 2^l times the mean optical depth per voxel). Each cell's error is
 // how far its children depart from it (Laur-Hanrahan): the largest over its children of their own
 // error plus the difference of opacity per voxel length, or of colour weighted by the child's
-// opacity. Writes the pyramid cells and each brick's summary (brick.glsl). Mirror:
+// opacity. Writes the pyramid cells and each brick's summary (brick.glsl). A streamed store
+// (STREAMED_STORE) builds the pyramids of one batch's bricks from its records, a workgroup per
+// entry of brick_list from pc.first, into the entries' slots (pyramid_slot). Mirror:
 // cpu::lod::brick_pyramid.
 layout(local_size_x = BRICK_LANES) in;
 #include "brick.glsl"
+
+layout(push_constant) uniform Push {
+    uint first;      // STREAMED_STORE: the batch's first entry of brick_list to build
+    uint count;      // and how many
+    uint splats;
+    float occluded;
+} pc;
 
 // Levels 1..3 at level_offset(l): sums over the cell's voxels.
 shared float tau_l[LOD_CELLS];
@@ -45,8 +54,8 @@ uint child(uint l, uvec3 c, uint n, uint d) {
     return l == 1u ? i : level_offset(l - 1u) + i;
 }
 
-// Store level l's cell i (sums t, col, g; error err) and its pyramid words.
-void put_cell(uint h, uint l, uint i, float t, vec3 col, vec3 g, float err) {
+// Store level l's cell i (sums t, col, g; error err) and its pyramid words at `slot`.
+void put_cell(uint slot, uint l, uint i, float t, vec3 col, vec3 g, float err) {
     float voxels = float(1u << (3u * l));
     vec3 straight = t > 0.0 ? col / t : vec3(0.0);
     tau_l[i] = t;
@@ -55,7 +64,7 @@ void put_cell(uint h, uint l, uint i, float t, vec3 col, vec3 g, float err) {
     err_l[i] = err;
     // Optical depth per cell length: 2^l voxel lengths of the mean per voxel.
     stored_l[i] = t / voxels * float(1u << l);
-    uint base = (h * LOD_CELLS + i) * CELL_WORDS;
+    uint base = (slot * LOD_CELLS + i) * CELL_WORDS;
     pyramid[base] = floatBitsToUint(stored_l[i]);
     pyramid[base + 1u] = packUnorm2x16(straight.rg);
     pyramid[base + 2u] = (packUnorm2x16(vec2(straight.b, 0.0)) & 0xffffu) | (pack_normal(g) << 16u);
@@ -71,8 +80,17 @@ float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float vox
 }
 
 void main() {
+#ifdef STREAMED_STORE
+    if (workgroup_item() >= pc.count) return;
+    uint slot = pc.first + workgroup_item();
+    uint h = brick_list[slot].x;
+    uint first = brick_list[slot].z;
+#else
     uint h = workgroup_item();
     if (h >= bf.grid.w) return;
+    uint slot = h;
+    uint first = headers[h].y;
+#endif
     uvec4 hd = headers[h];
     uvec3 b = brick_coords(hd.x);
     uint lane = gl_LocalInvocationID.x;
@@ -104,7 +122,7 @@ void main() {
             uint word = mask_w[l / 32u];
             if (((word >> (l % 32u)) & 1u) != 0u) {
                 uint rank = mask_below[l / 32u] + uint(bitCount(word & ((1u << (l % 32u)) - 1u)));
-                uint q = record_at(hd.y + rank) >> 16u;
+                uint q = record_at(first + rank) >> 16u;
                 if (emits(q)) {
                     ivec3 v = ivec3(b * BRICK_SIDE + k);
                     vec4 cl = classify_voxel(v, q, false);
@@ -121,7 +139,7 @@ void main() {
         vec3 straight = t > 0.0 ? col / t : vec3(0.0);
         float err = 0.0;
         for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0));
-        put_cell(h, 1u, c, t, col, g, err);
+        put_cell(slot, 1u, c, t, col, g, err);
         drawn_1[c] = drawn;
     }
     barrier();
@@ -147,7 +165,7 @@ void main() {
                 uint k = child(l, cc, n, d);
                 err = max(err, child_error(a, straight, tau_l[k], col_l[k], err_l[k], voxels / 8.0));
             }
-            put_cell(h, l, level_offset(l) + c, t, col, g, err);
+            put_cell(slot, l, level_offset(l) + c, t, col, g, err);
         }
         barrier();
     }
@@ -167,5 +185,8 @@ void main() {
             s[l] = floatBitsToUint(most);
         }
         lod_summary[h] = s;
+#ifdef STREAMED_STORE
+        pyramid_slot[h] = slot;
+#endif
     }
 }

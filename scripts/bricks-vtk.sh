@@ -3,7 +3,8 @@
 # bonsai, its 2x upsampling (512³) and the procedural 1024³ field (scripts/large-volumes.sh), the
 # same transfer-function preset and view (scripts/vtk_file.py copies voxsplat's framing camera),
 # 512x512, alternating the two tools file by file in one run. Each voxsplat run is its own process
-# (`voxsplat bricks --volume`: load, store, median frame, peak RSS). Prints a markdown table and
+# (`voxsplat bricks --volume`: load, store, median frame at full detail and with levels of detail,
+# peak RSS). Prints a markdown table and
 # draws docs/bench/bricks-scaling.svg (frame time against voxels, both tools); its CSV,
 # docs/bench/bricks-scaling.csv, is the third panel of the bench's scaling.svg.
 # Installs VTK (PyPI) in a virtual environment when missing, as scripts/peers.sh does.
@@ -24,13 +25,15 @@ cat <<'TEXT'
 `scripts/bricks-vtk.sh`, one run, the two tools alternating file by file: VTK's fixed-point CPU ray
 caster (`scripts/vtk_file.py`: the same preset mapped over the data's range, opacity per voxel
 length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat bricks --volume`, its
-own process per file), 512², 5 frames after a warm-up, medians.
+own process per file), 512², 5 frames after a warm-up, medians. voxsplat alternates full detail
+with levels of detail (`--lod auto`, 1 px; PSNR against its own full detail): the last column is
+issue 24's moonshot, LOD frame time against VTK's.
 
 TEXT
 csv=docs/bench/bricks-scaling.csv
 echo "voxels,vtk_ms,voxsplat_ms" > "$csv"
-echo "| file | VTK fixed point: load s, median ms, peak RSS MiB | voxsplat bricked, GPU path (1 GiB budget) | VTK ms / voxsplat ms |"
-echo "|---|---|---|---|"
+echo "| file | VTK fixed point: load s, median ms, peak RSS MiB | voxsplat bricked, GPU path (1 GiB budget) | VTK ms / voxsplat ms | VTK ms / voxsplat LOD ms |"
+echo "|---|---|---|---|---|"
 for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/procedural1024.nrrd"; do
   tf=bonsai; [[ $f == *procedural* ]] && tf=ramp
   vtk=$( { /usr/bin/time -f "rss=%M" "$VENV/bin/python" scripts/vtk_file.py --file "$f" --tf $tf --frames "$FRAMES" \
@@ -40,8 +43,10 @@ for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/pro
   vtk_load=$(sed -E 's/.*load=([0-9.]+)s.*/\1/' <<< "$vtk")
   vtk_rss=$(sed -E 's/.*rss=([0-9]+).*/\1/' <<< "$vtk" | awk '{printf "%.0f", $1 / 1024}')
   vs_ms=$(sed -E 's/.*median frame ([0-9.]+) ms.*/\1/' <<< "$vs")
+  lod_ms=$(sed -E 's/.*levels of detail \(1 px\) ([0-9.]+) ms.*/\1/' <<< "$vs")
   ratio=$(awk -v a="$vtk_ms" -v b="$vs_ms" 'BEGIN {printf "%.3f", a / b}')
-  echo "| $(basename "$f") ($tf) | $vtk_load, $vtk_ms, $vtk_rss | ${vs#*: } | $ratio |"
+  lod_ratio=$(awk -v a="$vtk_ms" -v b="$lod_ms" 'BEGIN {printf "%.3f", a / b}')
+  echo "| $(basename "$f") ($tf) | $vtk_load, $vtk_ms, $vtk_rss | ${vs#*: } | $ratio | $lod_ratio |"
   voxels=$(sed -E 's/^[^:]*: ([0-9]+) voxels.*/\1/' <<< "$vs")
   echo "$voxels,$vtk_ms,$vs_ms" >> "$csv"
 done

@@ -117,6 +117,8 @@ pub enum Res {
     LodSummary,
     /// Per brick, this frame, how far its splats morph toward the next level (`brick_cull`).
     BrickMorph,
+    /// A streamed store's pyramid holds one batch's bricks: per brick, its slot there.
+    PyramidSlot,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

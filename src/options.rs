@@ -124,8 +124,7 @@ pub struct RenderOptions {
     /// Levels of detail of a bricked volume drawn per splat (issue 24): `Auto` draws each brick
     /// at the coarsest level of its prefiltered pyramid whose cells project to at most
     /// `lod_pixels` pixels and whose error is at most `lod_error` (docs/MODEL.md). Off by default
-    /// until its targets hold (docs/RESULTS.md). Sheet and slab modes and stores whose records
-    /// stream draw full detail.
+    /// until its targets hold (docs/RESULTS.md). Sheet and slab modes draw full detail.
     pub lod: Lod,
     /// Largest projected cell spacing, in pixels, of a coarse level (at the brick's nearest point).
     pub lod_pixels: f32,

@@ -112,15 +112,22 @@ const BRICK: &[Res] = &[
     Res::Pyramid,
     Res::LodSummary,
     Res::BrickMorph,
+    Res::PyramidSlot,
 ];
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
 const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
-/// The same, and with levels of detail (`LOD`; never streamed): `record_brick_batch` picks.
-const RECORD_PAGED_LOD: &[Variant] =
-    &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[]), v("LOD", &[]), v("PAGED_RECORDS+LOD", &[])];
-/// The same, without the streamed build (the stage needs the records on the device).
-const RECORD_RESIDENT: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[])];
+/// The same, and with levels of detail (`LOD`): `record_brick_batch` picks.
+const RECORD_PAGED_LOD: &[Variant] = &[
+    v("", &[]),
+    v("PAGED_RECORDS", &[]),
+    v("STREAMED_STORE", &[]),
+    v("LOD", &[]),
+    v("PAGED_RECORDS+LOD", &[]),
+    v("STREAMED_STORE+LOD", &[]),
+];
+/// A resident pyramid, or a streamed store's batch of pyramids (`brick_cells`).
+const PYRAMID_STREAMED: &[Variant] = &[v("", &[]), v("STREAMED_STORE", &[])];
 const ONE: &[Variant] = &[v("", &[])];
 /// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
 const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];
@@ -181,12 +188,12 @@ pub const STAGES: &[StageDesc] = &[
         name: "brick_pyramid",
         kind: Kind::Compute,
         bindings: BRICK,
-        writes: &[Res::Pyramid, Res::LodSummary],
-        push: 0,
+        writes: &[Res::Pyramid, Res::LodSummary, Res::PyramidSlot],
+        push: std::mem::size_of::<BrickPush>() as u32,
         workgroup: Workgroup::PerItem(BRICK_LANES),
         timing: "lod",
         device_build: None,
-        variants: RECORD_RESIDENT,
+        variants: RECORD_PAGED,
         mirror: crate::cpu::lod::brick_pyramid_stage,
     },
     StageDesc {
@@ -222,7 +229,7 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "order",
         device_build: None,
-        variants: ONE,
+        variants: PYRAMID_STREAMED,
         mirror: crate::cpu::lod::brick_cells_stage,
     },
     StageDesc {

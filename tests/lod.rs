@@ -328,3 +328,58 @@ fn a_coarse_cell_the_grid_end_cuts_sits_on_the_voxels_it_holds() {
         assert_clean(&r);
     }
 }
+
+#[test]
+fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
+    let vol = blob([61, 53, 47]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    let mut other = tf();
+    other.points[1].1[3] *= 0.5;
+    let mut frames = Vec::new();
+    for gpu in [true, false] {
+        let mut resident = if gpu { common::gpu() } else { common::cpu() };
+        resident.set_volume(&vol, &tf(), None).unwrap();
+        let records = resident.volume().unwrap().store.records.len() as u64 * 4;
+        let mut streamed = if gpu { common::gpu() } else { common::cpu() };
+        // Under twice the records the store streams, in several batches.
+        streamed.set_gpu_budget(2 * records - 1).unwrap();
+        streamed.set_volume(&vol, &tf(), None).unwrap();
+        assert!(streamed.volume().unwrap().streams(2 * records - 1));
+        let mut levels = std::collections::BTreeSet::new();
+        for pixels in [2.0, 4.0, 8.0] {
+            levels.extend(
+                drawn_cells(&mut resident, &cam, &lod(Raster::Compute, Direction::BackToFront, pixels))
+                    .iter()
+                    .map(|c| c[3]),
+            );
+            for (raster, direction) in [
+                (Raster::Compute, Direction::FrontToBack),
+                (Raster::Compute, Direction::BackToFront),
+                (Raster::Graphics, Direction::BackToFront),
+            ] {
+                let o = lod(raster, direction, pixels);
+                let (a, b) = (resident.render(&cam, &o).unwrap().image, streamed.render(&cam, &o).unwrap().image);
+                assert!(a.pixels.iter().any(|p| p[3] > 0.1));
+                assert!(a.pixels == b.pixels, "gpu {gpu} {pixels} px {raster:?} {direction:?}: streamed frame differs");
+                frames.push(b);
+            }
+        }
+        assert!(levels.len() >= 3, "gpu {gpu}: levels drawn {levels:?}");
+        // A new classification: the streamed summaries are rebuilt.
+        resident.set_transfer_function(&other, None).unwrap();
+        streamed.set_transfer_function(&other, None).unwrap();
+        let o = lod(Raster::Compute, Direction::BackToFront, 4.0);
+        let (a, b) = (resident.render(&cam, &o).unwrap().image, streamed.render(&cam, &o).unwrap().image);
+        assert!(a.pixels == b.pixels, "gpu {gpu}: after a TF change");
+        if gpu {
+            assert_clean(&resident);
+            assert_clean(&streamed);
+        }
+    }
+    // The GPU's streamed frames are the mirror's.
+    let n = frames.len() / 2;
+    for (g, c) in frames[..n].iter().zip(&frames[n..]) {
+        let (most, _) = diff(g, c);
+        assert!(most <= 2e-3, "GPU vs mirror, streamed: {most}");
+    }
+}

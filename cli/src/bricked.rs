@@ -270,18 +270,29 @@ pub fn one_volume(path: &Path, size: u32, budget_mib: u64, tf: &str, frames: usi
     let mut r = Renderer::new(&o)?;
     let (stored, bytes) = (l.scene.store.len(), l.scene.store.bytes());
     r.set_bricks(l.scene)?;
-    frame_ms(&mut r, &cam, &opts(0.0))?;
-    let mut times = (0..frames.max(1)).map(|_| frame_ms(&mut r, &cam, &opts(0.0))).collect::<Result<Vec<_>>>()?;
+    // Full detail and levels of detail (1 px), alternating frame by frame after a warm-up each.
+    let full = opts(0.0);
+    let mut lod = full.clone();
+    lod.lod = voxsplat::Lod::Auto;
+    let reference = r.render(&cam, &full)?.image;
+    let psnr = voxsplat::metrics::compare(&r.render(&cam, &lod)?.image, &reference)?.psnr;
+    let (mut times, mut lod_times) = (Vec::new(), Vec::new());
+    for _ in 0..frames.max(1) {
+        times.push(frame_ms(&mut r, &cam, &full)?);
+        lod_times.push(frame_ms(&mut r, &cam, &lod)?);
+    }
     let rss = peak_rss_mib().ok_or_else(|| Error::Unsupported("no /proc/self/status".into()))?;
     Ok(format!(
         "{}: {} voxels ({:.0} MiB at one byte each), {stored} stored ({:.0} MiB store), load and bricks {:.0} ms, \
-         median frame {:.0} ms, peak RSS {rss_loaded:.0} MiB after loading, {rss:.0} MiB after the frames",
+         median frame {:.0} ms, levels of detail (1 px) {:.0} ms at {psnr:.1} dB against full detail, peak RSS \
+         {rss_loaded:.0} MiB after loading, {rss:.0} MiB after the frames",
         path.display(),
         l.voxels,
         l.voxels as f64 / 1048576.0,
         bytes as f64 / 1048576.0,
         l.load_ms,
         median(&mut times),
+        median(&mut lod_times),
     ))
 }
 

@@ -277,9 +277,22 @@ uint slot_code(uint l, uint n) {
     return l == 0u ? n : (l == 1u ? 512u + n : (l == 2u ? 576u + n : 585u));
 }
 
+// A streamed store's pyramid holds a batch's bricks (brick_pyramid's STREAMED_STORE build): per
+// header, its slot in the batch.
+layout(std430, binding = 27) buffer PyramidSlot { uint pyramid_slot[]; };
+
+// Header h's place in the pyramid: h, or its slot in the batch when the store streams.
+uint pyramid_index(uint h) {
+#ifdef STREAMED_STORE
+    return pyramid_slot[h];
+#else
+    return h;
+#endif
+}
+
 // Cell i of header h's pyramid: optical depth per cell length, straight colour, gradient direction.
 float cell_tau(uint h, uint i) {
-    return uintBitsToFloat(pyramid[(h * LOD_CELLS + i) * CELL_WORDS]);
+    return uintBitsToFloat(pyramid[(pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS]);
 }
 
 // Octahedral normals fold the lower hemisphere with the signs of x and y, 0 counted positive.
@@ -288,7 +301,7 @@ vec2 sign_not_zero(vec2 v) {
 }
 
 vec4 cell_color(uint h, uint i, out vec3 normal) {
-    uint base = (h * LOD_CELLS + i) * CELL_WORDS;
+    uint base = (pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS;
     vec2 rg = unpackUnorm2x16(pyramid[base + 1u]);
     uint w = pyramid[base + 2u];
     vec2 oct = unpackSnorm4x8(w >> 16u).xy;

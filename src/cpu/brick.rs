@@ -42,6 +42,16 @@ pub struct BrickInputs<'a> {
     pub summary: &'a [[u32; 4]],
     /// Per brick its splats' morph this frame (`brick_cull`).
     pub morphs: &'a [f32],
+    /// A streamed store's pyramid holds one batch's bricks: per header its slot (STREAMED_STORE
+    /// builds), or `None`: the pyramid is indexed by header.
+    pub pyramid_slot: Option<&'a [u32]>,
+}
+
+impl BrickInputs<'_> {
+    /// Mirror of `pyramid_index`.
+    pub fn pyramid_index(&self, h: u32) -> u32 {
+        self.pyramid_slot.map_or(h, |s| s[h as usize])
+    }
 }
 
 const TF_BITS: usize = 4 * TF_ENTRIES as usize;
@@ -366,7 +376,7 @@ pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 
             params[s] = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
             continue;
         }
-        let (mut c, normal) = cell_color(inputs.pyramid, h, v[1] >> 16);
+        let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16);
         if shaded {
             inputs.shade(&mut c, normal);
         }
@@ -385,11 +395,21 @@ pub(crate) fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
         pyramid: b.get(Res::Pyramid),
         summary: b.get(Res::LodSummary),
         morphs: b.get(Res::BrickMorph),
+        pyramid_slot: None,
     })
 }
 
+/// `inputs`, with a streamed build's pyramid slots.
+pub(crate) fn inputs_for<'a>(b: &'a Bindings<'_>, v: &Variant) -> Result<BrickInputs<'a>> {
+    let mut i = inputs(b)?;
+    if streamed(v) {
+        i.pyramid_slot = Some(b.get(Res::PyramidSlot));
+    }
+    Ok(i)
+}
+
 /// Whether a brick stage's build reads streamed records.
-fn streamed(v: &Variant) -> bool {
+pub(crate) fn streamed(v: &Variant) -> bool {
     v.defines.contains("STREAMED_STORE")
 }
 
@@ -419,9 +439,9 @@ pub(crate) fn brick_order_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) 
     Ok(())
 }
 
-pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let mut params = b.take(Res::Params);
-    brick_params(&inputs(b)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
+    brick_params(&inputs_for(b, v)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
     b.put(Res::Params, params);
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
 //! `cell_color`).
 use super::bindings::Bindings;
-use super::brick::{inputs, local_cell, BrickInputs};
+use super::brick::{inputs, inputs_for, local_cell, streamed, BrickInputs};
 use super::order::side_count;
 use super::splat_params::optical_depth;
 use crate::bricks::BRICK;
@@ -20,14 +20,20 @@ pub const LOD_LEVELS: u32 = 3;
 /// The octahedral bytes of a zero gradient.
 const NO_NORMAL: u32 = 0x8080;
 
+/// Bytes of one brick's pyramid cells.
+pub const PYRAMID_BYTES: u64 = (LOD_CELLS * CELL_WORDS * 4) as u64;
+
 /// The buffers levels of detail add, and their bytes per non-empty brick: the pyramid's cells, its
 /// summary, this frame's morph.
-pub const LOD_BUFFERS: [(Res, u64); 3] =
-    [(Res::Pyramid, (LOD_CELLS * CELL_WORDS * 4) as u64), (Res::LodSummary, 16), (Res::BrickMorph, 4)];
+pub const LOD_BUFFERS: &[(Res, u64)] = &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, 16), (Res::BrickMorph, 4)];
 
-/// Device bytes of `LOD_BUFFERS` for `bricks` non-empty bricks.
-pub fn pyramid_bytes(bricks: usize) -> u64 {
-    bricks as u64 * LOD_BUFFERS.iter().map(|(_, per)| per).sum::<u64>()
+/// The same for a streamed store, whose pyramid holds one batch's bricks (`PYRAMID_BYTES` per
+/// entry of the batch): the summary, the morph, and each brick's slot in the batch.
+pub const STREAMED_LOD_BUFFERS: &[(Res, u64)] = &[(Res::LodSummary, 16), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
+
+/// Resident device bytes of `buffers` for `bricks` non-empty bricks.
+pub fn pyramid_bytes(buffers: &[(Res, u64)], bricks: usize) -> u64 {
+    bricks as u64 * buffers.iter().map(|(_, per)| per).sum::<u64>()
 }
 
 /// First cell of level `l` (1..3) in a brick's pyramid.
@@ -169,12 +175,28 @@ struct Sums {
     err: f32,
 }
 
-/// Mirror of `brick_pyramid.comp`: every non-empty brick's pyramid cells and summary.
-pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mut [[u32; 4]]) {
+/// Mirror of `brick_pyramid.comp`: every non-empty brick's pyramid cells and summary, or with
+/// `batch` (a streamed store: brick_list's entries and the push's range) the range's bricks' into
+/// their slots, recording each brick's slot in `batch`'s third part.
+pub fn brick_pyramid(
+    inputs: &BrickInputs<'_>,
+    batch: Option<(&[[u32; 4]], &BrickPush, &mut [u32])>,
+    pyramid: &mut [u32],
+    summary: &mut [[u32; 4]],
+) {
     let store = inputs.store;
     let shaded = inputs.bf.light[3] > 0.5;
     let mut fine = vec![Sums::default(); (BRICK * BRICK * BRICK) as usize];
-    for (h, hd) in store.headers.iter().enumerate() {
+    // (header, slot) of the bricks to build.
+    let (bricks, mut slots): (Vec<(usize, usize)>, _) = match batch {
+        Some((list, push, slots)) => {
+            let range = push.first as usize..(push.first + push.count) as usize;
+            (range.map(|e| (list[e][0] as usize, e)).collect(), Some(slots))
+        }
+        None => ((0..store.headers.len()).map(|h| (h, h)).collect(), None),
+    };
+    for (h, slot) in bricks {
+        let hd = &store.headers[h];
         let b = hd.coords();
         fine.fill(Sums::default());
         for &rec in &store.records[hd.first as usize..(hd.first + hd.count) as usize] {
@@ -223,7 +245,7 @@ pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mu
                 let i = level_offset(l) as usize + c as usize;
                 cells[i] = Sums { tau: t, col, grad: g, err };
                 stored[i] = t / voxels * (1u32 << l) as f32;
-                let base = (h * LOD_CELLS + i) * CELL_WORDS;
+                let base = (slot * LOD_CELLS + i) * CELL_WORDS;
                 pyramid[base] = stored[i].to_bits();
                 pyramid[base + 1] = unorm16(straight.x) | unorm16(straight.y) << 16;
                 pyramid[base + 2] = unorm16(straight.z) | pack_normal(g) << 16;
@@ -239,6 +261,9 @@ pub fn brick_pyramid(inputs: &BrickInputs<'_>, pyramid: &mut [u32], summary: &mu
             s[l as usize] = most.to_bits();
         }
         summary[h] = s;
+        if let Some(slots) = slots.as_deref_mut() {
+            slots[h] = slot as u32;
+        }
     }
 }
 
@@ -272,7 +297,7 @@ pub fn brick_cells(
                         let cc =
                             [axis(side[0], split[0], ti), axis(side[1], split[1], tj), axis(side[2], split[2], tk)];
                         let c = cc[0] + n * (cc[1] + n * cc[2]);
-                        if cell_tau(inputs.pyramid, entry[0], off + c).partial_cmp(&0.0)
+                        if cell_tau(inputs.pyramid, inputs.pyramid_index(entry[0]), off + c).partial_cmp(&0.0)
                             != Some(std::cmp::Ordering::Greater)
                         {
                             continue;
@@ -289,17 +314,32 @@ pub fn brick_cells(
     }
 }
 
-pub(crate) fn brick_cells_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn brick_cells_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut voxels, mut order) = (b.take(Res::BrickVoxels), b.take(Res::Order));
-    brick_cells(&inputs(b)?, b.get(Res::BrickList), &args.push_as(), bytemuck::cast_slice_mut(&mut voxels), &mut order);
+    brick_cells(
+        &inputs_for(b, v)?,
+        b.get(Res::BrickList),
+        &args.push_as(),
+        bytemuck::cast_slice_mut(&mut voxels),
+        &mut order,
+    );
     b.put(Res::BrickVoxels, voxels);
     b.put(Res::Order, order);
     Ok(())
 }
 
-pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut pyramid, mut summary) = (b.take(Res::Pyramid), b.take(Res::LodSummary));
-    brick_pyramid(&inputs(b)?, &mut pyramid, bytemuck::cast_slice_mut(&mut summary));
+    let summary_words = bytemuck::cast_slice_mut(&mut summary);
+    if streamed(v) {
+        let mut slots = b.take(Res::PyramidSlot);
+        let push: BrickPush = args.push_as();
+        let batch = Some((b.get(Res::BrickList), &push, &mut slots[..]));
+        brick_pyramid(&inputs(b)?, batch, &mut pyramid, summary_words);
+        b.put(Res::PyramidSlot, slots);
+    } else {
+        brick_pyramid(&inputs(b)?, None, &mut pyramid, summary_words);
+    }
     b.put(Res::Pyramid, pyramid);
     b.put(Res::LodSummary, summary);
     Ok(())

@@ -3,6 +3,7 @@
 use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
 use crate::constants::MAX_GPU_SPLATS;
+use crate::cpu::lod::{pyramid_bytes, LOD_BUFFERS, PYRAMID_BYTES, STREAMED_LOD_BUFFERS};
 
 /// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
 /// voxel (8), and for the tile compositor its screen quad (80) and about four tile entries (the
@@ -65,10 +66,14 @@ pub(super) fn record_bricks(
             (scene.store.records.len() as u64 * 8).div_ceil(1 << 20) + 1
         )));
     }
-    // Levels of detail: per splat, with the store's records on the device (the pyramid is built
-    // from them when the classification changes).
-    let lod = opts.lod == Lod::Auto && !sheets && !streamed;
-    let pyramid = if lod { crate::cpu::lod::pyramid_bytes(scene.store.headers.len().max(1)) } else { 0 };
+    // Levels of detail, per splat: the pyramid is built from the records on the device when the
+    // classification changes; a streamed store keeps only the bricks' summaries (built batch by
+    // batch when the classification changes) and builds its coarse bricks' pyramids per batch.
+    let lod = opts.lod == Lod::Auto && !sheets;
+    let lod_buffers = if streamed { STREAMED_LOD_BUFFERS } else { LOD_BUFFERS };
+    let headers = scene.store.headers.len().max(1);
+    let batch_pyramid = if lod && streamed { PYRAMID_BYTES } else { 0 };
+    let pyramid = if lod { pyramid_bytes(lod_buffers, headers) + batch_pyramid } else { 0 };
     let least = bricked_min_budget(scene, budget, w, h) + pyramid;
     if budget < least {
         return Err(Error::TooLarge(format!(
@@ -91,14 +96,36 @@ pub(super) fn record_bricks(
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
+    let cut = Cut { streamed, build, available, pyramid: batch_pyramid };
     if lod {
-        for (res, per_brick) in crate::cpu::lod::LOD_BUFFERS {
-            e.ensure(res, scene.store.headers.len().max(1) as u64 * per_brick)?;
+        for &(res, per_brick) in lod_buffers {
+            e.ensure(res, headers as u64 * per_brick)?;
         }
         let id = scene.classification();
-        if (e.tag(Res::Pyramid) != id || e.tag(Res::LodSummary) != id) && bf.grid[3] > 0 {
+        let all = BrickPush { first: 0, count: bf.grid[3], splats: 0, occluded: 0.0 };
+        if streamed {
+            if e.tag(Res::LodSummary) != id && bf.grid[3] > 0 {
+                // Every brick's summary, batch by batch through the budget.
+                let every = (0..bf.grid[3]).map(|h| [h, 0, 0, 0]);
+                for batch in cut.batches(scene, every, u32::MAX, available) {
+                    upload_batch(e, scene, &batch, &batch, true)?;
+                    let push = BrickPush { count: batch.len() as u32, ..all };
+                    let groups = plan::groups_per_item(push.count);
+                    e.run(&Dispatch::new(
+                        StageId::BrickPyramid,
+                        build,
+                        groups,
+                        List::Order,
+                        bytemuck::bytes_of(&push),
+                    ))?;
+                }
+                e.set_tag(Res::LodSummary, id);
+            }
+            // It holds batches' pyramids now, not the store's.
+            e.set_tag(Res::Pyramid, 0);
+        } else if (e.tag(Res::Pyramid) != id || e.tag(Res::LodSummary) != id) && bf.grid[3] > 0 {
             let groups = plan::groups_per_item(bf.grid[3]);
-            e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, &[]))?;
+            e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(&all)))?;
             e.set_tag(Res::Pyramid, id);
             e.set_tag(Res::LodSummary, id);
         }
@@ -130,7 +157,6 @@ pub(super) fn record_bricks(
         MAX_GPU_SPLATS
     };
     // The visible bricks in draw order, cut between bricks into batches.
-    let cut = Cut { streamed, build, available };
     let visible = slot_words.into_iter().filter(|&w| w != 0).map(|w| {
         let (header, level, n) = slot_entry(w);
         [header, 0, 0, n | level << 16]
@@ -181,11 +207,13 @@ pub(super) fn record_bricks(
 }
 
 /// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
-/// brick stages' build, and the budget's bytes for batches.
+/// brick stages' build, the budget's bytes for batches, and each entry's pyramid bytes (a
+/// streamed store's levels of detail).
 struct Cut {
     streamed: bool,
     build: usize,
     available: u64,
+    pyramid: u64,
 }
 
 impl Cut {
@@ -204,7 +232,8 @@ impl Cut {
         for [header, _, _, w] in entries {
             let n = w & 0xffff;
             let hd = &scene.store.headers[header as usize];
-            let cost = n as u64 * BATCH_BYTES_PER_SPLAT + if self.streamed { hd.count as u64 * 4 } else { 0 };
+            let cost =
+                n as u64 * BATCH_BYTES_PER_SPLAT + if self.streamed { hd.count as u64 * 4 } else { 0 } + self.pyramid;
             let open = batches.last().is_some_and(|b| !b.is_empty());
             if open && (filled + n > capacity || bytes + cost > available) {
                 batches.push(Vec::new());
@@ -352,23 +381,15 @@ fn record_brick_batch(
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, n as u64 * 4)?;
     e.ensure(Res::BrickVoxels, n as u64 * 8)?;
-    if streamed {
-        // The batch's bricks' records, in list order.
-        let s = &scene.store;
-        let recs: Vec<u32> = batch
-            .iter()
-            .flat_map(|l| {
-                let hd = &s.headers[l[0] as usize];
-                s.records[hd.first as usize..(hd.first + hd.count) as usize].iter().copied()
-            })
-            .collect();
-        e.upload(Res::BatchRecords, &recs)?;
-    }
     // Voxel bricks first (brick_order's workgroups), then coarse ones (brick_cells' lanes): each
     // entry names its own first position, so the list's order is free.
     let (fine, coarse): (Vec<[u32; 4]>, Vec<[u32; 4]>) = batch.iter().partition(|l| l[3] >> 16 == 0);
-    let words: Vec<u32> = fine.iter().chain(&coarse).flatten().copied().collect();
-    e.upload(Res::BrickList, &words)?;
+    let listed: Vec<[u32; 4]> = fine.iter().chain(&coarse).copied().collect();
+    if streamed {
+        upload_batch(e, scene, batch, &listed, lod)?;
+    } else {
+        e.upload(Res::BrickList, bytemuck::cast_slice(&listed))?;
+    }
     let push = BrickPush { first: 0, count: fine.len() as u32, splats: n, occluded: 0.0 };
     if !fine.is_empty() {
         let groups = plan::groups_per_item(fine.len() as u32);
@@ -376,13 +397,46 @@ fn record_brick_batch(
     }
     if !coarse.is_empty() {
         let cells = BrickPush { first: fine.len() as u32, count: coarse.len() as u32, ..push };
+        if streamed {
+            // The coarse bricks' pyramids, into their entries' slots.
+            let groups = plan::groups_per_item(cells.count);
+            e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(&cells)))?;
+        }
         let groups = groups_1d(coarse.len() as u32);
-        e.run(&Dispatch::new(StageId::BrickCells, 0, groups, List::Order, bytemuck::bytes_of(&cells)))?;
+        let variant = usize::from(streamed);
+        e.run(&Dispatch::new(StageId::BrickCells, variant, groups, List::Order, bytemuck::bytes_of(&cells)))?;
     }
     let push = bytemuck::bytes_of(&push);
     // The LOD builds follow the three record builds (stages.rs).
     let params = if lod { build + 3 } else { build };
     e.run(&Dispatch::new(StageId::BrickParams, params, groups_1d(n), List::Order, push))
+}
+
+/// A streamed store's batch on the device: its bricks' records in `batch`'s order (the entries'
+/// first records count in it), `list` (the same entries in any order), and with levels of detail
+/// room for their pyramids.
+fn upload_batch(
+    e: &mut dyn Engine,
+    scene: &BrickScene,
+    batch: &[[u32; 4]],
+    list: &[[u32; 4]],
+    lod: bool,
+) -> Result<()> {
+    let s = &scene.store;
+    let recs: Vec<u32> = batch
+        .iter()
+        .flat_map(|l| {
+            let hd = &s.headers[l[0] as usize];
+            s.records[hd.first as usize..(hd.first + hd.count) as usize].iter().copied()
+        })
+        .collect();
+    e.ensure(Res::BrickList, list.len().max(1) as u64 * 16)?;
+    e.upload(Res::BrickList, bytemuck::cast_slice(list))?;
+    e.upload(Res::BatchRecords, &recs)?;
+    if lod {
+        e.ensure(Res::Pyramid, list.len().max(1) as u64 * PYRAMID_BYTES)?;
+    }
+    Ok(())
 }
 
 /// Front to back with early termination, a bricked frame is cut into at least this many batches
