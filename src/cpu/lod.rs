@@ -175,12 +175,19 @@ struct Sums {
     err: f32,
 }
 
+/// A streamed store's batch for `brick_pyramid`: brick_list, the push's range of it, and per
+/// header its slot (written).
+pub struct PyramidBatch<'a> {
+    pub list: &'a [[u32; 4]],
+    pub push: BrickPush,
+    pub slots: &'a mut [u32],
+}
+
 /// Mirror of `brick_pyramid.comp`: every non-empty brick's pyramid cells and summary, or with
-/// `batch` (a streamed store: brick_list's entries and the push's range) the range's bricks' into
-/// their slots, recording each brick's slot in `batch`'s third part.
+/// `batch` (a streamed store) the batch range's bricks' into their entries' slots.
 pub fn brick_pyramid(
     inputs: &BrickInputs<'_>,
-    batch: Option<(&[[u32; 4]], &BrickPush, &mut [u32])>,
+    batch: Option<PyramidBatch<'_>>,
     pyramid: &mut [u32],
     summary: &mut [[u32; 4]],
 ) {
@@ -189,7 +196,7 @@ pub fn brick_pyramid(
     let mut fine = vec![Sums::default(); (BRICK * BRICK * BRICK) as usize];
     // (header, slot) of the bricks to build.
     let (bricks, mut slots): (Vec<(usize, usize)>, _) = match batch {
-        Some((list, push, slots)) => {
+        Some(PyramidBatch { list, push, slots }) => {
             let range = push.first as usize..(push.first + push.count) as usize;
             (range.map(|e| (list[e][0] as usize, e)).collect(), Some(slots))
         }
@@ -333,8 +340,7 @@ pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant
     let summary_words = bytemuck::cast_slice_mut(&mut summary);
     if streamed(v) {
         let mut slots = b.take(Res::PyramidSlot);
-        let push: BrickPush = args.push_as();
-        let batch = Some((b.get(Res::BrickList), &push, &mut slots[..]));
+        let batch = Some(PyramidBatch { list: b.get(Res::BrickList), push: args.push_as(), slots: &mut slots });
         brick_pyramid(&inputs(b)?, batch, &mut pyramid, summary_words);
         b.put(Res::PyramidSlot, slots);
     } else {
