@@ -11,7 +11,8 @@
 // error plus the difference of opacity per voxel length, or of colour weighted by the child's
 // opacity. Writes the pyramid cells and each brick's summary (brick.glsl). A streamed store
 // (STREAMED_STORE) builds the pyramids of one batch's bricks from its records, a workgroup per
-// entry of brick_list from pc.first, into the entries' slots (pyramid_slot). Mirror:
+// entry of brick_list from pc.first, into the entries' slots or, when the pyramid is resident,
+// the bricks' own (pyramid_slot). Mirror:
 // cpu::lod::brick_pyramid.
 layout(local_size_x = BRICK_LANES) in;
 #include "brick.glsl"
@@ -19,7 +20,7 @@ layout(local_size_x = BRICK_LANES) in;
 layout(push_constant) uniform Push {
     uint first;      // STREAMED_STORE: the batch's first entry of brick_list to build
     uint count;      // and how many
-    uint splats;
+    uint splats;     // not 0: into each brick's own slot (a resident pyramid), else the entry's
     float occluded;
 } pc;
 
@@ -65,9 +66,9 @@ void put_cell(uint slot, uint l, uint i, float t, vec3 col, vec3 g, float err) {
     // Optical depth per cell length: 2^l voxel lengths of the mean per voxel.
     stored_l[i] = t / voxels * float(1u << l);
     uint base = (slot * LOD_CELLS + i) * CELL_WORDS;
-    pyramid[base] = floatBitsToUint(stored_l[i]);
-    pyramid[base + 1u] = packUnorm2x16(straight.rg);
-    pyramid[base + 2u] = (packUnorm2x16(vec2(straight.b, 0.0)) & 0xffffu) | (pack_normal(g) << 16u);
+    pyramid_put(base, floatBitsToUint(stored_l[i]));
+    pyramid_put(base + 1u, packUnorm2x16(straight.rg));
+    pyramid_put(base + 2u, (packUnorm2x16(vec2(straight.b, 0.0)) & 0xffffu) | (pack_normal(g) << 16u));
 }
 
 // The error of a cell of mean opacity a and colour straight against a child (sums tk, ck; error
@@ -82,9 +83,10 @@ float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float vox
 void main() {
 #ifdef STREAMED_STORE
     if (workgroup_item() >= pc.count) return;
-    uint slot = pc.first + workgroup_item();
-    uint h = brick_list[slot].x;
-    uint first = brick_list[slot].z;
+    uint e = pc.first + workgroup_item();
+    uint h = brick_list[e].x;
+    uint first = brick_list[e].z;
+    uint slot = pc.splats != 0u ? h : e;
 #else
     uint h = workgroup_item();
     if (h >= bf.grid.w) return;

@@ -67,6 +67,11 @@ pub const BRICK_LANES: u32 = 64;
 pub const RECORD_PAGE: u32 = 1 << 25;
 /// Most pages of store records (1 GiB, the default device budget).
 pub const RECORD_PAGES: u32 = 8;
+/// Words of one storage binding of the levels-of-detail pyramid (2^27 bytes, lavapipe's binding
+/// limit); it binds up to `PYRAMID_PAGES` of them (`Res::Pyramid`, `Res::Pyramid1`..).
+pub const PYRAMID_PAGE: u32 = 1 << 25;
+/// See `PYRAMID_PAGE`.
+pub const PYRAMID_PAGES: u32 = 4;
 /// Entries of the brick stages' transfer-function table: one per 16-bit stored value.
 pub const TF_ENTRIES: u32 = 1 << 16;
 
@@ -91,4 +96,5 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("BRICK_LANES", BRICK_LANES),
     ("TF_ENTRIES", TF_ENTRIES),
     ("RECORD_PAGE", RECORD_PAGE),
+    ("PYRAMID_PAGE", PYRAMID_PAGE),
 ];

@@ -119,6 +119,12 @@ pub enum Res {
     BrickMorph,
     /// A streamed store's pyramid holds one batch's bricks: per brick, its slot there.
     PyramidSlot,
+    /// Pages 1-3 of `Pyramid` (`PYRAMID_PAGE` words each; `Pyramid` binds page 0).
+    Pyramid1,
+    /// Page 2 of `Pyramid`.
+    Pyramid2,
+    /// Page 3 of `Pyramid`.
+    Pyramid3,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.
@@ -157,6 +163,17 @@ impl Res {
             Res::BrickRecords5 => 5,
             Res::BrickRecords6 => 6,
             Res::BrickRecords7 => 7,
+            _ => return None,
+        })
+    }
+
+    /// Which page of the pyramid this binding holds (`Pyramid` is page 0).
+    pub fn pyramid_page(self) -> Option<u64> {
+        Some(match self {
+            Res::Pyramid => 0,
+            Res::Pyramid1 => 1,
+            Res::Pyramid2 => 2,
+            Res::Pyramid3 => 3,
             _ => return None,
         })
     }

@@ -113,6 +113,9 @@ const BRICK: &[Res] = &[
     Res::LodSummary,
     Res::BrickMorph,
     Res::PyramidSlot,
+    Res::Pyramid1,
+    Res::Pyramid2,
+    Res::Pyramid3,
 ];
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).

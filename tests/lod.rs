@@ -5,6 +5,7 @@
 mod common;
 use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 use voxsplat::classify::{Shading, TransferFunction};
+use voxsplat::cpu::lod::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
 use voxsplat::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
 use voxsplat::{Camera, Direction, Lod, Raster, RenderOptions, Renderer};
@@ -331,8 +332,10 @@ fn a_coarse_cell_the_grid_end_cuts_sits_on_the_voxels_it_holds() {
 
 #[test]
 fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
-    let vol = blob([61, 53, 47]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    // A small image: its frame buffers leave the pyramid room under a budget the store streams in.
+    const SIDE: u32 = 32;
+    let vol = blob([80, 72, 64]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), SIDE, SIDE);
     let mut other = tf();
     other.points[1].1[3] *= 0.5;
     let mut frames = Vec::new();
@@ -340,13 +343,36 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
         let mut resident = if gpu { common::gpu() } else { common::cpu() };
         resident.set_volume(&vol, &tf(), None).unwrap();
         let records = resident.volume().unwrap().store.records.len() as u64 * 4;
-        let mut streamed = if gpu { common::gpu() } else { common::cpu() };
-        // Under twice the records the store streams, in several batches.
-        streamed.set_gpu_budget(2 * records - 1).unwrap();
-        streamed.set_volume(&vol, &tf(), None).unwrap();
-        assert!(streamed.volume().unwrap().streams(2 * records - 1));
+        // Under twice the records the store streams, in several batches: its pyramid resident,
+        // and under a budget where the pyramid would take more than half the room, only the
+        // summaries, each batch building its coarse bricks' pyramids.
+        let scene = resident.volume().unwrap();
+        let headers = scene.store.headers.len();
+        let per_batch = voxsplat::recording::bricked_min_budget(scene, records, SIDE, SIDE)
+            + pyramid_bytes(STREAMED_LOD_BUFFERS, headers)
+            + 64 * PYRAMID_BYTES;
+        // The resident pyramid built in one batch, and in several (room for it and under all
+        // the records).
+        let slotted = pyramid_bytes(SLOTTED_LOD_BUFFERS, headers);
+        let several = voxsplat::recording::bricked_resident_bytes(scene, 2 * records - 1, SIDE, SIDE) + 2 * slotted;
+        assert!(slotted < records, "the pyramid and a batch leave less room than the records take");
+        let budgets = [2 * records - 1, several, per_batch];
+        for (k, &budget) in budgets.iter().enumerate() {
+            let room = budget - voxsplat::recording::bricked_resident_bytes(scene, budget, SIDE, SIDE);
+            assert!(scene.streams(budget));
+            assert_eq!(slotted <= room / 2, k < 2, "{budget}");
+        }
+        let mut streamed: Vec<Renderer> = budgets
+            .iter()
+            .map(|&budget| {
+                let mut r = if gpu { common::gpu() } else { common::cpu() };
+                r.set_gpu_budget(budget).unwrap();
+                r.set_volume(&vol, &tf(), None).unwrap();
+                r
+            })
+            .collect();
         let mut levels = std::collections::BTreeSet::new();
-        for pixels in [2.0, 4.0, 8.0] {
+        for pixels in [0.5, 1.0, 2.0] {
             levels.extend(
                 drawn_cells(&mut resident, &cam, &lod(Raster::Compute, Direction::BackToFront, pixels))
                     .iter()
@@ -358,22 +384,29 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
                 (Raster::Graphics, Direction::BackToFront),
             ] {
                 let o = lod(raster, direction, pixels);
-                let (a, b) = (resident.render(&cam, &o).unwrap().image, streamed.render(&cam, &o).unwrap().image);
+                let a = resident.render(&cam, &o).unwrap().image;
                 assert!(a.pixels.iter().any(|p| p[3] > 0.1));
-                assert!(a.pixels == b.pixels, "gpu {gpu} {pixels} px {raster:?} {direction:?}: streamed frame differs");
-                frames.push(b);
+                for (k, s) in streamed.iter_mut().enumerate() {
+                    let b = s.render(&cam, &o).unwrap().image;
+                    assert!(a.pixels == b.pixels, "gpu {gpu} {pixels} px {raster:?} {direction:?} budget {k}: differs");
+                    frames.push(b);
+                }
             }
         }
         assert!(levels.len() >= 3, "gpu {gpu}: levels drawn {levels:?}");
         // A new classification: the streamed summaries are rebuilt.
         resident.set_transfer_function(&other, None).unwrap();
-        streamed.set_transfer_function(&other, None).unwrap();
-        let o = lod(Raster::Compute, Direction::BackToFront, 4.0);
-        let (a, b) = (resident.render(&cam, &o).unwrap().image, streamed.render(&cam, &o).unwrap().image);
-        assert!(a.pixels == b.pixels, "gpu {gpu}: after a TF change");
+        let o = lod(Raster::Compute, Direction::BackToFront, 1.0);
+        let a = resident.render(&cam, &o).unwrap().image;
+        for s in &mut streamed {
+            s.set_transfer_function(&other, None).unwrap();
+            assert!(a.pixels == s.render(&cam, &o).unwrap().image.pixels, "gpu {gpu}: after a TF change");
+            if gpu {
+                assert_clean(s);
+            }
+        }
         if gpu {
             assert_clean(&resident);
-            assert_clean(&streamed);
         }
     }
     // The GPU's streamed frames are the mirror's.

@@ -192,7 +192,31 @@ vec4 classify_voxel(ivec3 v, uint q, bool shaded) {
 // x: drawn cells of level 1 | level 2 << 8 | level 3 << 12 | drawn voxels << 16; yzw: the largest
 // error of levels 1..3.
 // Built by brick_pyramid when the classification changes. Mirror: cpu::lod.
-layout(std430, binding = 24) buffer Pyramid { uint pyramid[]; };
+// Up to 4 storage bindings of PYRAMID_PAGE words (one binding may not pass maxStorageBufferRange).
+layout(std430, binding = 24) buffer Pyramid { uint pyramid_0[]; };
+layout(std430, binding = 28) buffer Pyramid1 { uint pyramid_1[]; };
+layout(std430, binding = 29) buffer Pyramid2 { uint pyramid_2[]; };
+layout(std430, binding = 30) buffer Pyramid3 { uint pyramid_3[]; };
+
+uint pyramid_word(uint i) {
+    uint j = i % PYRAMID_PAGE;
+    switch (i / PYRAMID_PAGE) {
+        case 0u: return pyramid_0[j];
+        case 1u: return pyramid_1[j];
+        case 2u: return pyramid_2[j];
+        default: return pyramid_3[j];
+    }
+}
+
+void pyramid_put(uint i, uint v) {
+    uint j = i % PYRAMID_PAGE;
+    switch (i / PYRAMID_PAGE) {
+        case 0u: pyramid_0[j] = v; break;
+        case 1u: pyramid_1[j] = v; break;
+        case 2u: pyramid_2[j] = v; break;
+        default: pyramid_3[j] = v; break;
+    }
+}
 layout(std430, binding = 25) buffer LodSummary { uvec4 lod_summary[]; };
 const uint LOD_CELLS = 73u;
 const uint CELL_WORDS = 3u;
@@ -292,7 +316,7 @@ uint pyramid_index(uint h) {
 
 // Cell i of header h's pyramid: optical depth per cell length, straight colour, gradient direction.
 float cell_tau(uint h, uint i) {
-    return uintBitsToFloat(pyramid[(pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS]);
+    return uintBitsToFloat(pyramid_word((pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS));
 }
 
 // Octahedral normals fold the lower hemisphere with the signs of x and y, 0 counted positive.
@@ -302,13 +326,13 @@ vec2 sign_not_zero(vec2 v) {
 
 vec4 cell_color(uint h, uint i, out vec3 normal) {
     uint base = (pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS;
-    vec2 rg = unpackUnorm2x16(pyramid[base + 1u]);
-    uint w = pyramid[base + 2u];
+    vec2 rg = unpackUnorm2x16(pyramid_word(base + 1u));
+    uint w = pyramid_word(base + 2u);
     vec2 oct = unpackSnorm4x8(w >> 16u).xy;
     vec3 n = vec3(oct, 1.0 - abs(oct.x) - abs(oct.y));
     if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
     normal = w >> 16u == NO_NORMAL ? vec3(0.0) : normalize(n);
-    return vec4(rg, unpackUnorm2x16(w).x, uintBitsToFloat(pyramid[base]));
+    return vec4(rg, unpackUnorm2x16(w).x, uintBitsToFloat(pyramid_word(base)));
 }
 
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)

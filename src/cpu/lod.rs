@@ -27,7 +27,12 @@ pub const PYRAMID_BYTES: u64 = (LOD_CELLS * CELL_WORDS * 4) as u64;
 /// summary, this frame's morph.
 pub const LOD_BUFFERS: &[(Res, u64)] = &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, 16), (Res::BrickMorph, 4)];
 
-/// The same for a streamed store, whose pyramid holds one batch's bricks (`PYRAMID_BYTES` per
+/// The same for a store whose records stream, its pyramid resident: and each brick's slot
+/// (its own header).
+pub const SLOTTED_LOD_BUFFERS: &[(Res, u64)] =
+    &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, 16), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
+
+/// The same for a streamed store whose pyramid holds one batch's bricks (`PYRAMID_BYTES` per
 /// entry of the batch): the summary, the morph, and each brick's slot in the batch.
 pub const STREAMED_LOD_BUFFERS: &[(Res, u64)] = &[(Res::LodSummary, 16), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
 
@@ -175,8 +180,9 @@ struct Sums {
     err: f32,
 }
 
-/// A streamed store's batch for `brick_pyramid`: brick_list, the push's range of it, and per
-/// header its slot (written).
+/// A streamed store's batch for `brick_pyramid`: brick_list, the push's range of it (its `splats`
+/// not 0: each brick into its own header's slot, a resident pyramid), and per header its slot
+/// (written).
 pub struct PyramidBatch<'a> {
     pub list: &'a [[u32; 4]],
     pub push: BrickPush,
@@ -198,7 +204,11 @@ pub fn brick_pyramid(
     let (bricks, mut slots): (Vec<(usize, usize)>, _) = match batch {
         Some(PyramidBatch { list, push, slots }) => {
             let range = push.first as usize..(push.first + push.count) as usize;
-            (range.map(|e| (list[e][0] as usize, e)).collect(), Some(slots))
+            let by_header = push.splats != 0;
+            (
+                range.map(|e| (list[e][0] as usize, if by_header { list[e][0] as usize } else { e })).collect(),
+                Some(slots),
+            )
         }
         None => ((0..store.headers.len()).map(|h| (h, h)).collect(), None),
     };

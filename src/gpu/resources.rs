@@ -4,7 +4,7 @@
 //! is replaced.
 use super::pipelines::{Pipelines, COLOR_FORMAT};
 use crate::constants::{
-    FOOTPRINT_TABLE_SIZE, MAX_GPU_SPLATS, RADIAL_TABLE_SIZE, RECORD_PAGE, RECORD_PAGES, SPLAT_PAGE,
+    FOOTPRINT_TABLE_SIZE, MAX_GPU_SPLATS, PYRAMID_PAGE, RADIAL_TABLE_SIZE, RECORD_PAGE, RECORD_PAGES, SPLAT_PAGE,
 };
 use crate::error::{Error, Result};
 use crate::gpu_types::{Frame, SplatParams};
@@ -346,6 +346,18 @@ impl Resources {
                     List::Slices(axis) => &self.scene()?.draw[axis as usize],
                     List::SlabPairs => frame_buf(Res::SlabPairs),
                 }),
+                page if page.pyramid_page().is_some() => {
+                    // Page k of the pyramid, or page 0 again past its end.
+                    const PAGE: u64 = PYRAMID_PAGE as u64 * 4;
+                    let buf = frame_buf(Res::Pyramid);
+                    let k = page.pyramid_page().unwrap_or(0);
+                    let (size, at) = (buf.size(), k * PAGE);
+                    if at < size {
+                        Bind::Range(buf, at, (size - at).min(PAGE))
+                    } else {
+                        Bind::Range(buf, 0, size.min(PAGE))
+                    }
+                }
                 page if page.record_page().is_some() => {
                     // Page k of the records, or page 0 again past the store's end.
                     const PAGE: u64 = RECORD_PAGE as u64 * 4;

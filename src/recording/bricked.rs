@@ -2,8 +2,8 @@
 //! device budget, and the per-splat, sheet and slab modes over them. Part of THE recording.
 use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
-use crate::constants::MAX_GPU_SPLATS;
-use crate::cpu::lod::{pyramid_bytes, LOD_BUFFERS, PYRAMID_BYTES, STREAMED_LOD_BUFFERS};
+use crate::constants::{MAX_GPU_SPLATS, PYRAMID_PAGE, PYRAMID_PAGES};
+use crate::cpu::lod::{pyramid_bytes, LOD_BUFFERS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
 
 /// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
 /// voxel (8), and for the tile compositor its screen quad (80) and about four tile entries (the
@@ -67,12 +67,32 @@ pub(super) fn record_bricks(
         )));
     }
     // Levels of detail, per splat: the pyramid is built from the records on the device when the
-    // classification changes; a streamed store keeps only the bricks' summaries (built batch by
-    // batch when the classification changes) and builds its coarse bricks' pyramids per batch.
+    // classification changes (a streamed store's batch by batch: its coarse bricks then need no
+    // records). When a streamed store's pyramid would take more than half of what the budget
+    // leaves, only the bricks' summaries stay, and each batch rebuilds its coarse bricks' pyramids.
     let lod = opts.lod == Lod::Auto && !sheets;
-    let lod_buffers = if streamed { STREAMED_LOD_BUFFERS } else { LOD_BUFFERS };
     let headers = scene.store.headers.len().max(1);
-    let batch_pyramid = if lod && streamed { PYRAMID_BYTES } else { 0 };
+    let room = budget.saturating_sub(bricked_resident_bytes(scene, budget, w, h));
+    let slotted = pyramid_bytes(SLOTTED_LOD_BUFFERS, headers);
+    // The pyramid binds as up to PYRAMID_PAGES storage ranges.
+    let most_cells = PYRAMID_PAGE as u64 * 4 * PYRAMID_PAGES as u64;
+    let fits = headers as u64 * PYRAMID_BYTES <= most_cells;
+    if lod && !streamed && !fits {
+        return Err(Error::TooLarge(format!(
+            "levels of detail: the pyramid of {headers} bricks takes {} MiB, more than the {} MiB its {PYRAMID_PAGES} \
+             storage bindings hold; a GPU budget under twice the store's records streams them, and the pyramid then \
+             builds batch by batch",
+            (headers as u64 * PYRAMID_BYTES) >> 20,
+            most_cells >> 20
+        )));
+    }
+    let lod_buffers = match (streamed, fits && slotted <= room / 2) {
+        (false, _) => LOD_BUFFERS,
+        (true, true) => SLOTTED_LOD_BUFFERS,
+        (true, false) => STREAMED_LOD_BUFFERS,
+    };
+    let per_batch = lod && lod_buffers == STREAMED_LOD_BUFFERS;
+    let batch_pyramid = if per_batch { PYRAMID_BYTES } else { 0 };
     let pyramid = if lod { pyramid_bytes(lod_buffers, headers) + batch_pyramid } else { 0 };
     let least = bricked_min_budget(scene, budget, w, h) + pyramid;
     if budget < least {
@@ -96,20 +116,23 @@ pub(super) fn record_bricks(
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
-    let cut = Cut { streamed, build, available, pyramid: batch_pyramid };
+    let range = e.limits().max_storage_range;
+    let cut = Cut { streamed, build, available, pyramid: batch_pyramid, coarse_records: per_batch, range };
     if lod {
         for &(res, per_brick) in lod_buffers {
             e.ensure(res, headers as u64 * per_brick)?;
         }
         let id = scene.classification();
         let all = BrickPush { first: 0, count: bf.grid[3], splats: 0, occluded: 0.0 };
+        let built = e.tag(Res::LodSummary) == id && (per_batch || e.tag(Res::Pyramid) == id);
         if streamed {
-            if e.tag(Res::LodSummary) != id && bf.grid[3] > 0 {
-                // Every brick's summary, batch by batch through the budget.
+            if !built && bf.grid[3] > 0 {
+                // Every brick's summary (and with a resident pyramid its cells, into its own
+                // slot), batch by batch through the budget.
                 let every = (0..bf.grid[3]).map(|h| [h, 0, 0, 0]);
                 for batch in cut.batches(scene, every, u32::MAX, available) {
-                    upload_batch(e, scene, &batch, &batch, true)?;
-                    let push = BrickPush { count: batch.len() as u32, ..all };
+                    upload_batch(e, scene, &batch, &batch, &cut)?;
+                    let push = BrickPush { count: batch.len() as u32, splats: u32::from(!per_batch), ..all };
                     let groups = plan::groups_per_item(push.count);
                     e.run(&Dispatch::new(
                         StageId::BrickPyramid,
@@ -121,9 +144,9 @@ pub(super) fn record_bricks(
                 }
                 e.set_tag(Res::LodSummary, id);
             }
-            // It holds batches' pyramids now, not the store's.
-            e.set_tag(Res::Pyramid, 0);
-        } else if (e.tag(Res::Pyramid) != id || e.tag(Res::LodSummary) != id) && bf.grid[3] > 0 {
+            // Per batch it holds batches' pyramids, not the store's.
+            e.set_tag(Res::Pyramid, if per_batch { 0 } else { id });
+        } else if !built && bf.grid[3] > 0 {
             let groups = plan::groups_per_item(bf.grid[3]);
             e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(&all)))?;
             e.set_tag(Res::Pyramid, id);
@@ -191,7 +214,7 @@ pub(super) fn record_bricks(
         }
         let n = batch_splats(&batch);
         if !batch.is_empty() {
-            record_brick_batch(e, scene, &batch, streamed, build, lod)?;
+            record_brick_batch(e, scene, &batch, &cut, lod)?;
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, i > 0)?;
@@ -207,13 +230,16 @@ pub(super) fn record_bricks(
 }
 
 /// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
-/// brick stages' build, the budget's bytes for batches, and each entry's pyramid bytes (a
-/// streamed store's levels of detail).
+/// brick stages' build, the budget's bytes for batches, each entry's pyramid bytes and whether
+/// coarse entries need their records (a streamed store's levels of detail, pyramids per batch).
 struct Cut {
     streamed: bool,
     build: usize,
     available: u64,
     pyramid: u64,
+    coarse_records: bool,
+    /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
+    range: u64,
 }
 
 impl Cut {
@@ -232,18 +258,25 @@ impl Cut {
         for [header, _, _, w] in entries {
             let n = w & 0xffff;
             let hd = &scene.store.headers[header as usize];
-            let cost =
-                n as u64 * BATCH_BYTES_PER_SPLAT + if self.streamed { hd.count as u64 * 4 } else { 0 } + self.pyramid;
+            let recs = if self.uploads(w) { hd.count } else { 0 };
+            let cost = n as u64 * BATCH_BYTES_PER_SPLAT + recs as u64 * 4 + self.pyramid;
+            let entries = batches.last().map_or(0, |b| b.len()) as u64 + 1;
+            let binding = (entries * 16).max(entries * self.pyramid).max((records + recs) as u64 * 4);
             let open = batches.last().is_some_and(|b| !b.is_empty());
-            if open && (filled + n > capacity || bytes + cost > available) {
+            if open && (filled + n > capacity || bytes + cost > available || binding > self.range) {
                 batches.push(Vec::new());
                 (filled, records, bytes) = (0, 0, 0);
             }
             let first = if self.streamed { records } else { hd.first };
             batches.last_mut().expect("one batch at least").push([header, filled, first, w]);
-            (filled, records, bytes) = (filled + n, records + hd.count, bytes + cost);
+            (filled, records, bytes) = (filled + n, records + recs, bytes + cost);
         }
         batches
+    }
+
+    /// Whether an entry (splats | level << 16) uploads its brick's records.
+    fn uploads(&self, w: u32) -> bool {
+        self.streamed && (w >> 16 == 0 || self.coarse_records)
     }
 }
 
@@ -303,7 +336,7 @@ fn record_bricked_sheets(
         let part = &parts[0];
         let n = batch_splats(part);
         if n > 0 {
-            record_brick_batch(e, scene, part, cut.streamed, cut.build, false)?;
+            record_brick_batch(e, scene, part, &cut, false)?;
         }
         let pc = geometry(n)?;
         let starts = record_slab_bins(e, &pc, variant)?;
@@ -350,7 +383,7 @@ fn record_bricked_sheets(
         for (k, part) in cut.batches(scene, near, MAX_GPU_SPLATS, available).iter().enumerate() {
             let n = batch_splats(part);
             if n > 0 {
-                record_brick_batch(e, scene, part, cut.streamed, cut.build, false)?;
+                record_brick_batch(e, scene, part, &cut, false)?;
             }
             let starts = record_slab_bins(e, &geometry(n)?, variant)?;
             let (first, end) = (starts[p0 as usize], starts[p1 as usize + 1]);
@@ -369,14 +402,8 @@ fn batch_splats(batch: &[[u32; 4]]) -> u32 {
 /// One batch of visible bricks (entries: header, first position, first record, voxels): its
 /// records when they stream, then `brick_order` and `brick_params` make its splats' parameters
 /// (in buffers sized for the batch: the sheet modes cut their own).
-fn record_brick_batch(
-    e: &mut dyn Engine,
-    scene: &BrickScene,
-    batch: &[[u32; 4]],
-    streamed: bool,
-    build: usize,
-    lod: bool,
-) -> Result<()> {
+fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]], cut: &Cut, lod: bool) -> Result<()> {
+    let (streamed, build) = (cut.streamed, cut.build);
     let n = batch_splats(batch);
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, n as u64 * 4)?;
@@ -386,7 +413,7 @@ fn record_brick_batch(
     let (fine, coarse): (Vec<[u32; 4]>, Vec<[u32; 4]>) = batch.iter().partition(|l| l[3] >> 16 == 0);
     let listed: Vec<[u32; 4]> = fine.iter().chain(&coarse).copied().collect();
     if streamed {
-        upload_batch(e, scene, batch, &listed, lod)?;
+        upload_batch(e, scene, batch, &listed, cut)?;
     } else {
         e.upload(Res::BrickList, bytemuck::cast_slice(&listed))?;
     }
@@ -397,10 +424,17 @@ fn record_brick_batch(
     }
     if !coarse.is_empty() {
         let cells = BrickPush { first: fine.len() as u32, count: coarse.len() as u32, ..push };
-        if streamed {
+        if cut.pyramid > 0 {
             // The coarse bricks' pyramids, into their entries' slots.
             let groups = plan::groups_per_item(cells.count);
-            e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(&cells)))?;
+            let into_entries = BrickPush { splats: 0, ..cells };
+            e.run(&Dispatch::new(
+                StageId::BrickPyramid,
+                build,
+                groups,
+                List::Order,
+                bytemuck::bytes_of(&into_entries),
+            ))?;
         }
         let groups = groups_1d(coarse.len() as u32);
         let variant = usize::from(streamed);
@@ -413,18 +447,19 @@ fn record_brick_batch(
 }
 
 /// A streamed store's batch on the device: its bricks' records in `batch`'s order (the entries'
-/// first records count in it), `list` (the same entries in any order), and with levels of detail
-/// room for their pyramids.
+/// first records count in it; `Cut::uploads`), `list` (the same entries in any order), and room
+/// for their pyramids when each batch builds its own.
 fn upload_batch(
     e: &mut dyn Engine,
     scene: &BrickScene,
     batch: &[[u32; 4]],
     list: &[[u32; 4]],
-    lod: bool,
+    cut: &Cut,
 ) -> Result<()> {
     let s = &scene.store;
     let recs: Vec<u32> = batch
         .iter()
+        .filter(|l| cut.uploads(l[3]))
         .flat_map(|l| {
             let hd = &s.headers[l[0] as usize];
             s.records[hd.first as usize..(hd.first + hd.count) as usize].iter().copied()
@@ -433,8 +468,8 @@ fn upload_batch(
     e.ensure(Res::BrickList, list.len().max(1) as u64 * 16)?;
     e.upload(Res::BrickList, bytemuck::cast_slice(list))?;
     e.upload(Res::BatchRecords, &recs)?;
-    if lod {
-        e.ensure(Res::Pyramid, list.len().max(1) as u64 * PYRAMID_BYTES)?;
+    if cut.pyramid > 0 {
+        e.ensure(Res::Pyramid, list.len().max(1) as u64 * cut.pyramid)?;
     }
     Ok(())
 }
