@@ -347,28 +347,10 @@ impl Resources {
                     List::SlabPairs => frame_buf(Res::SlabPairs),
                 }),
                 page if page.pyramid_page().is_some() => {
-                    // Page k of the pyramid, or page 0 again past its end.
-                    const PAGE: u64 = PYRAMID_PAGE as u64 * 4;
-                    let buf = frame_buf(Res::Pyramid);
-                    let k = page.pyramid_page().unwrap_or(0);
-                    let (size, at) = (buf.size(), k * PAGE);
-                    if at < size {
-                        Bind::Range(buf, at, (size - at).min(PAGE))
-                    } else {
-                        Bind::Range(buf, 0, size.min(PAGE))
-                    }
+                    page_range(frame_buf(Res::Pyramid), page.pyramid_page().unwrap_or(0), PYRAMID_PAGE)
                 }
                 page if page.record_page().is_some() => {
-                    // Page k of the records, or page 0 again past the store's end.
-                    const PAGE: u64 = RECORD_PAGE as u64 * 4;
-                    let buf = self.buffer(Res::BrickRecords)?;
-                    let k = page.record_page().unwrap_or(0);
-                    let (size, at) = (buf.size(), k * PAGE);
-                    if at < size {
-                        Bind::Range(buf, at, (size - at).min(PAGE))
-                    } else {
-                        Bind::Range(buf, 0, size.min(PAGE))
-                    }
+                    page_range(self.buffer(Res::BrickRecords)?, page.record_page().unwrap_or(0), RECORD_PAGE)
                 }
                 Res::Frame
                 | Res::Radial
@@ -389,5 +371,17 @@ impl Drop for Resources {
     fn drop(&mut self) {
         // Resources free themselves; make sure the GPU is done with them first.
         self.ctx.wait_idle();
+    }
+}
+
+/// Page `k` of `words`-word pages of `buf` as a binding, or page 0 again past its end (one storage
+/// binding may not pass maxStorageBufferRange).
+fn page_range(buf: &Buffer, k: u64, words: u32) -> Bind<'_> {
+    let page = words as u64 * 4;
+    let (size, at) = (buf.size(), k * page);
+    if at < size {
+        Bind::Range(buf, at, (size - at).min(page))
+    } else {
+        Bind::Range(buf, 0, size.min(page))
     }
 }

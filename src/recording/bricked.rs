@@ -133,22 +133,14 @@ pub(super) fn record_bricks(
                 for batch in cut.batches(scene, every, u32::MAX, available) {
                     upload_batch(e, scene, &batch, &batch, &cut)?;
                     let push = BrickPush { count: batch.len() as u32, splats: u32::from(!per_batch), ..all };
-                    let groups = plan::groups_per_item(push.count);
-                    e.run(&Dispatch::new(
-                        StageId::BrickPyramid,
-                        build,
-                        groups,
-                        List::Order,
-                        bytemuck::bytes_of(&push),
-                    ))?;
+                    build_pyramids(e, build, &push)?;
                 }
                 e.set_tag(Res::LodSummary, id);
             }
             // Per batch it holds batches' pyramids, not the store's.
             e.set_tag(Res::Pyramid, if per_batch { 0 } else { id });
         } else if !built && bf.grid[3] > 0 {
-            let groups = plan::groups_per_item(bf.grid[3]);
-            e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(&all)))?;
+            build_pyramids(e, build, &all)?;
             e.set_tag(Res::Pyramid, id);
             e.set_tag(Res::LodSummary, id);
         }
@@ -426,15 +418,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         let cells = BrickPush { first: fine.len() as u32, count: coarse.len() as u32, ..push };
         if cut.pyramid > 0 {
             // The coarse bricks' pyramids, into their entries' slots.
-            let groups = plan::groups_per_item(cells.count);
-            let into_entries = BrickPush { splats: 0, ..cells };
-            e.run(&Dispatch::new(
-                StageId::BrickPyramid,
-                build,
-                groups,
-                List::Order,
-                bytemuck::bytes_of(&into_entries),
-            ))?;
+            build_pyramids(e, build, &BrickPush { splats: 0, ..cells })?;
         }
         let groups = groups_1d(coarse.len() as u32);
         let variant = usize::from(streamed);
@@ -444,6 +428,13 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     // The LOD builds follow the three record builds (stages.rs).
     let params = if lod { build + 3 } else { build };
     e.run(&Dispatch::new(StageId::BrickParams, params, groups_1d(n), List::Order, push))
+}
+
+/// `brick_pyramid` over `push.count` bricks (a resident store's all; a streamed store's batch entries
+/// from `push.first`, into their own slots when `push.splats` is not 0).
+fn build_pyramids(e: &mut dyn Engine, build: usize, push: &BrickPush) -> Result<()> {
+    let groups = plan::groups_per_item(push.count);
+    e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(push)))
 }
 
 /// A streamed store's batch on the device: its bricks' records in `batch`'s order (the entries'
