@@ -128,9 +128,10 @@ pub(super) fn record_bricks(
         if streamed {
             if !built && bf.grid[3] > 0 {
                 // Every brick's summary (and with a resident pyramid its cells, into its own
-                // slot), batch by batch through the budget.
+                // slot), batch by batch through the budget, in batches of at most
+                // SUMMARY_BATCH_BYTES: larger ones gain nothing and the host copies each to upload.
                 let every = (0..bf.grid[3]).map(|h| [h, 0, 0, 0]);
-                for batch in cut.batches(scene, every, u32::MAX, available) {
+                for batch in cut.batches(scene, every, u32::MAX, available.min(SUMMARY_BATCH_BYTES)) {
                     upload_batch(e, scene, &batch, &batch, &cut)?;
                     let push = BrickPush { count: batch.len() as u32, splats: u32::from(!per_batch), ..all };
                     build_pyramids(e, build, &push)?;
@@ -464,6 +465,9 @@ fn upload_batch(
     }
     Ok(())
 }
+
+/// Most bytes of one batch of a streamed store's one-time pyramid build.
+const SUMMARY_BATCH_BYTES: u64 = 64 << 20;
 
 /// Front to back with early termination, a bricked frame is cut into at least this many batches
 /// (of at least `HIDDEN_BATCH_MIN` splats), so later batches can drop hidden bricks.
