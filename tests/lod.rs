@@ -416,3 +416,35 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
         assert!(most <= 2e-3, "GPU vs mirror, streamed: {most}");
     }
 }
+
+#[test]
+fn no_level_is_taken_whose_splats_the_near_plane_would_drop() {
+    // A plate 20 units in front of the eye, the near plane at 1: level-3 splats (eight voxels
+    // wide) reach past the near plane and would all be dropped; the cut keeps finer levels there.
+    let mut values = vec![1.0; 64 * 64];
+    values[0] = 0.0;
+    let vol = ScalarVolume { dims: [64, 64, 1], spacing: [1.0; 3], values };
+    let mut plate = tf();
+    plate.points = vec![(0.0, [0.9, 0.8, 0.7, 0.6]), (1.0, [0.9, 0.8, 0.7, 0.6])];
+    plate.threshold = 0.0;
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let mut cam = Camera::framing(&grid, 64, 64);
+    cam.eye = grid.center() + glam::Vec3::new(0.0, 0.0, 20.0);
+    (cam.near, cam.far) = (1.0, 1000.0);
+    let coverage = |img: &voxsplat::ImageF32| img.pixels.iter().map(|p| p[3] as f64).sum::<f64>();
+    for mut r in [common::gpu(), common::cpu()] {
+        r.set_volume(&vol, &plate, None).unwrap();
+        let coarse = lod(Raster::Compute, Direction::BackToFront, 1e6);
+        let mut full = coarse.clone();
+        full.lod = Lod::Off;
+        let (a, b) = (r.render(&cam, &full).unwrap().image, r.render(&cam, &coarse).unwrap().image);
+        assert!(coverage(&a) > 1000.0);
+        let ratio = coverage(&b) / coverage(&a);
+        assert!((ratio - 1.0).abs() < 0.05, "coverage with levels of detail over full detail: {ratio}");
+        // Far from the planes the same cut takes the coarsest level.
+        cam.eye = grid.center() + glam::Vec3::new(0.0, 0.0, 200.0);
+        assert!(drawn_cells(&mut r, &cam, &coarse).iter().all(|c| c[3] == 8), "level 3 away from the planes");
+        cam.eye = grid.center() + glam::Vec3::new(0.0, 0.0, 20.0);
+        assert_clean(&r);
+    }
+}

@@ -248,31 +248,6 @@ float voxel_pixels(float depth) {
     return frame.eye.w > 0.5 ? voxel * frame.up.w / max(depth, frame.forward.w) : voxel * frame.up.w;
 }
 
-// Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
-// bf.grad.y pixels at the brick's nearest depth and whose error is at most bf.grad.z (0: off);
-// `morph`: 1 when its splats may morph toward the next level (allowed there too; splat_morph).
-uint brick_level(uint h, uvec3 b, out float morph) {
-    morph = 0.0;
-    if (bf.grad.y <= 0.0) return 0u;
-    vec3 lo;
-    vec3 hi;
-    voxel_box(b, lo, hi);
-    float near_depth = 1e30;
-    for (uint c = 0u; c < 8u; ++c) {
-        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
-        near_depth = min(near_depth, dot(p - frame.eye.xyz, frame.forward.xyz));
-    }
-    float px = voxel_pixels(near_depth);
-    uvec4 s = lod_summary[h];
-    uint level = 0u;
-    for (uint l = 1u; l <= 3u; ++l) {
-        if (px * float(1u << l) > bf.grad.y || uintBitsToFloat(s[l]) > bf.grad.z) break;
-        level = l;
-    }
-    if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z) morph = 1.0;
-    return level;
-}
-
 // Per brick, 1 when its splats may morph toward the next level this frame (brick_cull).
 layout(std430, binding = 26) buffer BrickMorph { float brick_morph[]; };
 
@@ -337,6 +312,42 @@ vec4 cell_color(uint h, uint i, out vec3 normal) {
 
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
 #include "params.glsl"
+
+// Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
+// bf.grad.y pixels at the brick's nearest depth, whose error is at most bf.grad.z (0: off) and
+// whose splats keep clear of the near and far planes;
+// `morph`: 1 when its splats may morph toward the next level (allowed there too; splat_morph).
+uint brick_level(uint h, uvec3 b, out float morph) {
+    morph = 0.0;
+    if (bf.grad.y <= 0.0) return 0u;
+    vec3 lo;
+    vec3 hi;
+    voxel_box(b, lo, hi);
+    float near_depth = 1e30;
+    float far_depth = -1e30;
+    for (uint c = 0u; c < 8u; ++c) {
+        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
+        float d = dot(p - frame.eye.xyz, frame.forward.xyz);
+        near_depth = min(near_depth, d);
+        far_depth = max(far_depth, d);
+    }
+    float px = voxel_pixels(near_depth);
+    uvec4 s = lod_summary[h];
+    uint level = 0u;
+    for (uint l = 1u; l <= 3u; ++l) {
+        if (px * float(1u << l) > bf.grad.y || uintBitsToFloat(s[l]) > bf.grad.z) break;
+        // Splats within CULL_RADII radii of the near or far plane are dropped (params_at): no level
+        // whose wider splats (morphed: up to twice) would be dropped where the brick reaches a plane.
+        float cell = float(1u << l);
+        float near_reach = CULL_RADII * 2.0 * cell * frame.spacing.w * footprint_scale(max(near_depth, 1e-6), cell);
+        float far_reach = CULL_RADII * 2.0 * cell * frame.spacing.w * footprint_scale(max(far_depth, 1e-6), cell);
+        if (near_depth < frame.forward.w + near_reach || far_depth > frame.right.w - far_reach) break;
+        level = l;
+    }
+    if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z) morph = 1.0;
+    return level;
+}
+
 
 // The world box holding every footprint of brick b drawn with cells `cell` voxels a side: its voxel
 // centres' box widened by the footprint reach at its far side (anti-aliasing widens with depth).
