@@ -298,12 +298,9 @@ fn mean_row(img: &voxsplat::ImageF32) -> f64 {
     sum / weight
 }
 
-#[test]
-fn a_coarse_cell_the_grid_end_cuts_sits_on_the_voxels_it_holds() {
-    // A one-voxel plate seen from 17 degrees above, orthographic (a wider footprint grows the
-    // plate's image alike at both ends): its coarse cells span one voxel of their 2-8 in z, and a
-    // centre at the cell's middle would lift the plate by up to 3.5 voxels.
-    // (A store keeps the voxels above its minimum: one corner voxel is the empty value.)
+/// A one-voxel 64 x 64 plate of constant colour and opacity, its transfer function and grid (a
+/// store keeps the voxels above its minimum: one corner voxel is the empty value).
+fn plate() -> (ScalarVolume, TransferFunction, voxsplat::Grid) {
     let mut values = vec![1.0; 64 * 64];
     values[0] = 0.0;
     let vol = ScalarVolume { dims: [64, 64, 1], spacing: [1.0; 3], values };
@@ -311,6 +308,15 @@ fn a_coarse_cell_the_grid_end_cuts_sits_on_the_voxels_it_holds() {
     plate.points = vec![(0.0, [0.9, 0.8, 0.7, 0.6]), (1.0, [0.9, 0.8, 0.7, 0.6])];
     plate.threshold = 0.0;
     let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    (vol, plate, grid)
+}
+
+#[test]
+fn a_coarse_cell_the_grid_end_cuts_sits_on_the_voxels_it_holds() {
+    // A one-voxel plate seen from 17 degrees above, orthographic (a wider footprint grows the
+    // plate's image alike at both ends): its coarse cells span one voxel of their 2-8 in z, and a
+    // centre at the cell's middle would lift the plate by up to 3.5 voxels.
+    let (vol, plate, grid) = plate();
     let mut cam = Camera::framing(&grid, 96, 96);
     cam.eye = grid.center() + glam::Vec3::new(0.0, -110.0, 34.0);
     cam.projection = voxsplat::camera::Projection::Orthographic { height: 80.0 };
@@ -421,13 +427,7 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
 fn no_level_is_taken_whose_splats_the_near_plane_would_drop() {
     // A plate 20 units in front of the eye, the near plane at 1: level-3 splats (eight voxels
     // wide) reach past the near plane and would all be dropped; the cut keeps finer levels there.
-    let mut values = vec![1.0; 64 * 64];
-    values[0] = 0.0;
-    let vol = ScalarVolume { dims: [64, 64, 1], spacing: [1.0; 3], values };
-    let mut plate = tf();
-    plate.points = vec![(0.0, [0.9, 0.8, 0.7, 0.6]), (1.0, [0.9, 0.8, 0.7, 0.6])];
-    plate.threshold = 0.0;
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let (vol, plate, grid) = plate();
     let mut cam = Camera::framing(&grid, 64, 64);
     cam.eye = grid.center() + glam::Vec3::new(0.0, 0.0, 20.0);
     (cam.near, cam.far) = (1.0, 1000.0);
