@@ -313,6 +313,23 @@ vec4 cell_color(uint h, uint i, out vec3 normal) {
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
 #include "params.glsl"
 
+// The depths along the view of the box lo..hi's nearest and farthest corners.
+vec2 box_depths(vec3 lo, vec3 hi) {
+    vec2 d = vec2(1e30, -1e30);
+    for (uint c = 0u; c < 8u; ++c) {
+        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
+        float z = dot(p - frame.eye.xyz, frame.forward.xyz);
+        d = vec2(min(d.x, z), max(d.y, z));
+    }
+    return d;
+}
+
+// How far a splat `cell` voxels a side at eye-space `depth` reaches from its centre: CULL_RADII
+// radii, params_at's culling margin (anti-aliasing widens it with depth).
+float cull_reach(float depth, float cell) {
+    return CULL_RADII * cell * frame.spacing.w * footprint_scale(max(depth, 1e-6), cell);
+}
+
 // Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
 // bf.grad.y pixels at the brick's nearest depth, whose error is at most bf.grad.z (0: off) and
 // whose splats keep clear of the near and far planes;
@@ -323,15 +340,8 @@ uint brick_level(uint h, uvec3 b, out float morph) {
     vec3 lo;
     vec3 hi;
     voxel_box(b, lo, hi);
-    float near_depth = 1e30;
-    float far_depth = -1e30;
-    for (uint c = 0u; c < 8u; ++c) {
-        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
-        float d = dot(p - frame.eye.xyz, frame.forward.xyz);
-        near_depth = min(near_depth, d);
-        far_depth = max(far_depth, d);
-    }
-    float px = voxel_pixels(near_depth);
+    vec2 depths = box_depths(lo, hi);
+    float px = voxel_pixels(depths.x);
     uvec4 s = lod_summary[h];
     uint level = 0u;
     for (uint l = 1u; l <= 3u; ++l) {
@@ -339,26 +349,20 @@ uint brick_level(uint h, uvec3 b, out float morph) {
         // Splats within CULL_RADII radii of the near or far plane are dropped (params_at): no level
         // whose wider splats (morphed: up to twice) would be dropped where the brick reaches a plane.
         float cell = float(1u << l);
-        float near_reach = CULL_RADII * 2.0 * cell * frame.spacing.w * footprint_scale(max(near_depth, 1e-6), cell);
-        float far_reach = CULL_RADII * 2.0 * cell * frame.spacing.w * footprint_scale(max(far_depth, 1e-6), cell);
-        if (near_depth < frame.forward.w + near_reach || far_depth > frame.right.w - far_reach) break;
+        float near_reach = 2.0 * cull_reach(depths.x, cell);
+        float far_reach = 2.0 * cull_reach(depths.y, cell);
+        if (depths.x < frame.forward.w + near_reach || depths.y > frame.right.w - far_reach) break;
         level = l;
     }
     if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z) morph = 1.0;
     return level;
 }
 
-
 // The world box holding every footprint of brick b drawn with cells `cell` voxels a side: its voxel
 // centres' box widened by the footprint reach at its far side (anti-aliasing widens with depth).
 void footprint_box(uvec3 b, float cell, out vec3 lo, out vec3 hi) {
     voxel_box(b, lo, hi);
-    float far_depth = -1e30;
-    for (uint c = 0u; c < 8u; ++c) {
-        vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
-        far_depth = max(far_depth, dot(p - frame.eye.xyz, frame.forward.xyz));
-    }
-    float reach = CULL_RADII * cell * frame.spacing.w * footprint_scale(max(far_depth, 1e-6), cell);
+    float reach = cull_reach(box_depths(lo, hi).y, cell);
     lo -= reach;
     hi += reach;
 }

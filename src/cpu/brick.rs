@@ -131,14 +131,25 @@ impl BrickInputs<'_> {
         (origin + first * spacing, origin + Vec3::from(last) * spacing)
     }
 
-    /// Mirror of `footprint_box`.
-    fn footprint_box(&self, b: [u32; 3], cell: f32) -> (Vec3, Vec3) {
+    /// Mirror of `box_depths`: the depths along the view of the box's nearest and farthest corners.
+    pub(crate) fn box_depths(&self, lo: Vec3, hi: Vec3) -> (f32, f32) {
         let f = self.frame;
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         let (eye, forward) = (v3(f.eye), v3(f.forward));
+        let depths = (0..8).map(|c| (corner(lo, hi, c) - eye).dot(forward));
+        depths.fold((1e30f32, -1e30f32), |(n, x), d| (n.min(d), x.max(d)))
+    }
+
+    /// Mirror of `cull_reach`: how far a splat `cell` voxels a side at `depth` reaches.
+    pub(crate) fn cull_reach(&self, depth: f32, cell: f32) -> f32 {
+        let f = self.frame;
+        CULL_RADII * cell * f.spacing[3] * cell_footprint_scale(f, depth.max(1e-6), cell)
+    }
+
+    /// Mirror of `footprint_box`.
+    fn footprint_box(&self, b: [u32; 3], cell: f32) -> (Vec3, Vec3) {
         let (lo, hi) = self.voxel_box(b);
-        let far = (0..8).map(|c| (corner(lo, hi, c) - eye).dot(forward)).fold(-1e30f32, f32::max);
-        let reach = CULL_RADII * cell * f.spacing[3] * cell_footprint_scale(f, far.max(1e-6), cell);
+        let reach = self.cull_reach(self.box_depths(lo, hi).1, cell);
         (lo - Vec3::splat(reach), hi + Vec3::splat(reach))
     }
 

@@ -4,7 +4,7 @@
 use super::bindings::Bindings;
 use super::brick::{inputs, inputs_for, local_cell, streamed, BrickInputs};
 use super::order::side_count;
-use super::splat_params::{cell_footprint_scale, optical_depth, CULL_RADII};
+use super::splat_params::optical_depth;
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
@@ -153,11 +153,8 @@ impl BrickInputs<'_> {
         if bf.grad[1] <= 0.0 {
             return (0, 0.0);
         }
-        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-        let (eye, forward) = (v3(f.eye), v3(f.forward));
         let (lo, hi) = self.voxel_box(b);
-        let depths = (0..8).map(|c| (super::brick::corner(lo, hi, c) - eye).dot(forward));
-        let (near, far) = depths.fold((1e30f32, -1e30f32), |(n, x), d| (n.min(d), x.max(d)));
+        let (near, far) = self.box_depths(lo, hi);
         let px = self.voxel_pixels(near);
         let s = self.summary[h as usize];
         let mut level = 0;
@@ -166,8 +163,9 @@ impl BrickInputs<'_> {
                 break;
             }
             let cell = (1u32 << l) as f32;
-            let reach = |d: f32| CULL_RADII * 2.0 * cell * f.spacing[3] * cell_footprint_scale(f, d.max(1e-6), cell);
-            if near < f.forward[3] + reach(near) || far > f.right[3] - reach(far) {
+            if near < f.forward[3] + 2.0 * self.cull_reach(near, cell)
+                || far > f.right[3] - 2.0 * self.cull_reach(far, cell)
+            {
                 break;
             }
             level = l;
