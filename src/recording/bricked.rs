@@ -117,7 +117,7 @@ pub(super) fn record_bricks(
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
     let range = e.limits().max_storage_range;
-    let cut = Cut { streamed, build, available, pyramid: batch_pyramid, coarse_records: per_batch, range };
+    let cut = Cut { streamed, build, available, pyramid: batch_pyramid, range };
     if lod {
         for &(res, per_brick) in lod_buffers {
             e.ensure(res, headers as u64 * per_brick)?;
@@ -223,14 +223,13 @@ pub(super) fn record_bricks(
 }
 
 /// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
-/// brick stages' build, the budget's bytes for batches, each entry's pyramid bytes and whether
-/// coarse entries need their records (a streamed store's levels of detail, pyramids per batch).
+/// brick stages' build, the budget's bytes for batches, and each entry's pyramid bytes (a streamed
+/// store's levels of detail with pyramids built per batch, whose coarse entries need their records).
 struct Cut {
     streamed: bool,
     build: usize,
     available: u64,
     pyramid: u64,
-    coarse_records: bool,
     /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
     range: u64,
 }
@@ -269,7 +268,7 @@ impl Cut {
 
     /// Whether an entry (splats | level << 16) uploads its brick's records.
     fn uploads(&self, w: u32) -> bool {
-        self.streamed && (w >> 16 == 0 || self.coarse_records)
+        self.streamed && (w >> 16 == 0 || self.pyramid > 0)
     }
 }
 
