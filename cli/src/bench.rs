@@ -87,6 +87,14 @@ impl Method {
         .to_lowercase()
     }
 
+    /// The anti-aliasing mode of a splat method (`None` for the others).
+    fn antialias(&self) -> Option<Antialias> {
+        match self {
+            Method::Splat { aa, .. } => Some(*aa),
+            _ => None,
+        }
+    }
+
     fn reconstruction(&self) -> Reconstruction {
         match self {
             Method::Splat { kernel, .. } => Reconstruction::Kernel(*kernel),
@@ -334,15 +342,7 @@ pub fn run_matrix(
                 truths.push((rec, t));
             }
             let truth = &truths.iter().find(|(k, _)| *k == rec).expect("computed").1;
-            let wants_bricks = matches!(m, Method::Bricked { .. });
-            if wants_bricks != bricked {
-                if wants_bricks {
-                    r.set_bricks(voxsplat::bricks::BrickScene::from_palette(&set)?)?;
-                } else {
-                    r.set_scene(set.clone())?;
-                }
-                bricked = wants_bricks;
-            }
+            hold_scene_for(r, &set, m, &mut bricked)?;
             let Timed { time_ms, wall_ms, stages, image } = time_method(r, m, &camera, opts.warmup, opts.frames)?;
             let violations = match m {
                 Method::Splat { order, composite: Composite::Splat, .. } => {
@@ -367,6 +367,21 @@ pub fn run_matrix(
     }
     progress(done, total, "done");
     Ok(rows)
+}
+
+/// Make `r` hold `set` as `m` draws it: as bricks (`BrickScene::from_palette`) for
+/// `Method::Bricked`, else as splats; `bricked` says which it holds and is kept up to date.
+fn hold_scene_for(r: &mut Renderer, set: &SplatSet, m: &Method, bricked: &mut bool) -> Result<()> {
+    let wants_bricks = matches!(m, Method::Bricked { .. });
+    if wants_bricks != *bricked {
+        if wants_bricks {
+            r.set_bricks(voxsplat::bricks::BrickScene::from_palette(set)?)?;
+        } else {
+            r.set_scene(set.clone())?;
+        }
+        *bricked = wants_bricks;
+    }
+    Ok(())
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
@@ -972,34 +987,20 @@ pub fn antialias_study(
     let truth = voxsplat::truth::supersampled_with(&set, &camera, factor, lanczos, &TruthOptions::default())?;
     let regions = voxsplat::aa::k_regions(&set, &camera);
     r.set_scene(set.clone())?;
-    let mut methods: Vec<(Option<Antialias>, Method)> = [Antialias::None, Antialias::Swan, Antialias::Ewa]
+    let (order, composite, kernel, raster) = (OrderKind::Pbtf, Composite::Splat, Kernel::Gaussian, Raster::Graphics);
+    let mut methods: Vec<Method> = [Antialias::None, Antialias::Swan, Antialias::Ewa]
         .into_iter()
-        .map(|aa| {
-            let kernel = Kernel::Gaussian;
-            (
-                Some(aa),
-                Method::Splat {
-                    order: OrderKind::Pbtf,
-                    composite: Composite::Splat,
-                    kernel,
-                    aa,
-                    raster: Raster::Graphics,
-                },
-            )
-        })
+        .map(|aa| Method::Splat { order, composite, kernel, aa, raster })
         .collect();
     // Levels of detail: the prefiltered cells (issue 24), from the plane as bricks.
-    methods.extend(bricked_methods(&AA_LOD_ERRORS).into_iter().map(|m| (None, m)));
+    methods.extend(bricked_methods(&AA_LOD_ERRORS));
     // Coarser than a pixel: the isotropic cells trade shimmer for blur along the unforeshortened axis.
-    methods.extend(AA_LOD_PIXELS.iter().map(|&px| (None, Method::Bricked { lod: Some((px, LOD_UNBOUNDED)) })));
+    methods.extend(AA_LOD_PIXELS.iter().map(|&px| Method::Bricked { lod: Some((px, LOD_UNBOUNDED)) }));
     let mut rows = Vec::new();
     let mut bricked = false;
-    for (mode, m) in methods {
+    for m in methods {
         progress(&format!("anti-aliasing: {}", m.label()));
-        if mode.is_none() && !bricked {
-            r.set_bricks(voxsplat::bricks::BrickScene::from_palette(&set)?)?;
-            bricked = true;
-        }
+        hold_scene_for(r, &set, &m, &mut bricked)?;
         let t = time_method(r, &m, &camera, 1, frames)?;
         let before = voxsplat::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 1).unwrap_or(f64::NAN);
         let beyond = voxsplat::metrics::rmse_masked(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
@@ -1016,7 +1017,7 @@ pub fn antialias_study(
         let aliasing = voxsplat::metrics::aliasing_energy(&t.image, &truth, |i| regions[i] == 2).unwrap_or(f64::NAN);
         rows.push(AaRow {
             method: m.label(),
-            mode,
+            mode: m.antialias(),
             time_ms: t.time_ms,
             rmse_before: before,
             rmse_beyond: beyond,
