@@ -120,15 +120,6 @@ const BRICK: &[Res] = &[
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
 const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
-/// The same, and with levels of detail (`LOD`): `record_brick_batch` picks.
-const RECORD_PAGED_LOD: &[Variant] = &[
-    v("", &[]),
-    v("PAGED_RECORDS", &[]),
-    v("STREAMED_STORE", &[]),
-    v("LOD", &[]),
-    v("PAGED_RECORDS+LOD", &[]),
-    v("STREAMED_STORE+LOD", &[]),
-];
 /// A resident pyramid, or a streamed store's batch of pyramids (`brick_cells`).
 const PYRAMID_STREAMED: &[Variant] = &[v("", &[]), v("STREAMED_STORE", &[])];
 const ONE: &[Variant] = &[v("", &[])];
@@ -244,8 +235,20 @@ pub const STAGES: &[StageDesc] = &[
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: RECORD_PAGED_LOD,
+        variants: RECORD_PAGED,
         mirror: crate::cpu::brick::brick_params_stage,
+    },
+    StageDesc {
+        name: "brick_lod_params",
+        kind: Kind::Compute,
+        bindings: BRICK,
+        writes: &[Res::Params],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::PerItem(BRICK_LANES),
+        timing: "splat_params",
+        device_build: None,
+        variants: RECORD_PAGED,
+        mirror: crate::cpu::lod::brick_lod_params_stage,
     },
     StageDesc {
         name: "tile_occlusion",
@@ -528,6 +531,7 @@ stage_ids!(
     BrickOrder,
     BrickCells,
     BrickParams,
+    BrickLodParams,
     TileOcclusion,
     BrickHidden,
     SlabCount,

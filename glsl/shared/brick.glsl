@@ -333,7 +333,8 @@ float cull_reach(float depth, float cell) {
 // Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
 // bf.grad.y pixels at the brick's nearest depth, whose error is at most bf.grad.z (0: off) and
 // whose splats keep clear of the near and far planes;
-// `morph`: 1 when its splats may morph toward the next level (allowed there too; splat_morph).
+// `morph`: 1 when its splats may morph toward the next level (allowed there too, and some of its
+// splats within the band; splat_growth).
 uint brick_level(uint h, uvec3 b, out float morph) {
     morph = 0.0;
     if (bf.grad.y <= 0.0) return 0u;
@@ -354,7 +355,10 @@ uint brick_level(uint h, uvec3 b, out float morph) {
         if (depths.x < frame.forward.w + near_reach || depths.y > frame.right.w - far_reach) break;
         level = l;
     }
-    if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z) morph = 1.0;
+    // Its splats grow (splat_growth) only within the band, which its farthest reaches first.
+    float octaves = log2(bf.grad.y / voxel_pixels(depths.y)) - float(level);
+    if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z && octaves > 1.0 - bf.grad.w)
+        morph = 1.0;
     return level;
 }
 

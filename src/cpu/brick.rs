@@ -2,9 +2,9 @@
 //! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer (levels of
 //! detail: `cpu::lod`).
 use super::bindings::Bindings;
-use super::lod::{cell_color, level_count};
+use super::lod::level_count;
 use super::order::{outward, side_count};
-use super::splat_params::{cell_footprint_scale, optical_depth, params_at, params_of, CULL_RADII};
+use super::splat_params::{cell_footprint_scale, params_of, CULL_RADII};
 use crate::bricks::{BrickStore, BRICK};
 use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
 use crate::dispatch::{Args, Res, Variant};
@@ -93,7 +93,7 @@ impl BrickInputs<'_> {
     }
 
     /// Mirror of `shade`.
-    fn shade(&self, c: &mut [f32; 4], g: Vec3) {
+    pub(crate) fn shade(&self, c: &mut [f32; 4], g: Vec3) {
         let len = g.length();
         let n = if len > 0.0 { g / len } else { Vec3::ZERO };
         let light = Vec3::new(self.bf.light[0], self.bf.light[1], self.bf.light[2]);
@@ -363,35 +363,15 @@ pub fn brick_order(
     }
 }
 
-/// Pass 3: per splat of the batch, classify its voxel (or read its coarse cell) and make its
-/// parameters.
+/// Pass 3: per splat of the batch, classify its voxel and make its parameters at full size
+/// (coarse cells are `brick_lod_params`').
 pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
     let shaded = inputs.bf.light[3] > 0.5;
     for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
-        let ijk = voxel_ijk(*v);
-        let level = voxel_level(*v);
-        if inputs.bf.grad[1] <= 0.0 {
-            let color = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
-            params[s] = params_of(inputs.frame, ijk, color);
-            continue;
+        if voxel_level(*v) == 0 {
+            let ijk = voxel_ijk(*v);
+            params[s] = params_of(inputs.frame, ijk, inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded));
         }
-        let nb = inputs.bf.grid;
-        let h = inputs.store.index[(ijk[0] / BRICK + nb[0] * (ijk[1] / BRICK + nb[1] * (ijk[2] / BRICK))) as usize];
-        let dims = inputs.frame.dims;
-        let at = Vec3::from_array(
-            [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
-        );
-        let grow = if inputs.morphs[h as usize] > 0.0 { inputs.splat_growth(at, level) } else { 1.0 };
-        if level == 0 {
-            let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
-            params[s] = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
-            continue;
-        }
-        let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16);
-        if shaded {
-            inputs.shade(&mut c, normal);
-        }
-        params[s] = params_at(inputs.frame, at, (1u32 << level) as f32, grow, [c[0], c[1], c[2]], c[3]);
     }
 }
 

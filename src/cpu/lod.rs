@@ -2,13 +2,13 @@
 //! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
 //! `cell_color`).
 use super::bindings::Bindings;
-use super::brick::{inputs, inputs_for, local_cell, streamed, BrickInputs};
+use super::brick::{inputs, inputs_for, local_cell, streamed, voxel_ijk, BrickInputs};
 use super::order::side_count;
-use super::splat_params::optical_depth;
+use super::splat_params::{optical_depth, params_at};
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
-use crate::gpu_types::BrickPush;
+use crate::gpu_types::{BrickPush, SplatParams};
 use glam::Vec3;
 
 /// Cells of levels 1-3 in a brick's pyramid (64 + 8 + 1).
@@ -170,7 +170,11 @@ impl BrickInputs<'_> {
             }
             level = l;
         }
-        let morph = level < 3 && bf.grad[3] > 0.0 && f32::from_bits(s[level as usize + 1]) <= bf.grad[2];
+        let octaves = (bf.grad[1] / self.voxel_pixels(far)).log2() - level as f32;
+        let morph = level < 3
+            && bf.grad[3] > 0.0
+            && f32::from_bits(s[level as usize + 1]) <= bf.grad[2]
+            && octaves > 1.0 - bf.grad[3];
         (level, if morph { 1.0 } else { 0.0 })
     }
 }
@@ -333,6 +337,58 @@ pub fn brick_cells(
             }
         }
     }
+}
+
+/// Mirror of `brick_lod_params.comp`: per entry of the batch whose brick is coarse or morphs, its
+/// splats' parameters (a coarse cell from its pyramid cell, a voxel grown toward the next level).
+pub fn brick_lod_params(
+    inputs: &BrickInputs<'_>,
+    list: &[[u32; 4]],
+    push: &BrickPush,
+    voxels: &[[u32; 2]],
+    params: &mut [SplatParams],
+) {
+    let shaded = inputs.bf.light[3] > 0.5;
+    let dims = inputs.frame.dims;
+    for entry in &list[push.first as usize..(push.first + push.count) as usize] {
+        let (h, level) = (entry[0], entry[3] >> 16);
+        let morphs = inputs.morphs[h as usize] > 0.0;
+        if level == 0 && !morphs {
+            continue;
+        }
+        for s in entry[1] as usize..(entry[1] + (entry[3] & 0xffff)) as usize {
+            let v = voxels[s];
+            let ijk = voxel_ijk(v);
+            let at = Vec3::from_array(
+                [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
+            );
+            let grow = if morphs { inputs.splat_growth(at, level) } else { 1.0 };
+            let (rgb, tau) = if level == 0 {
+                let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
+                ([c[0], c[1], c[2]], optical_depth(c[3]))
+            } else {
+                let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16);
+                if shaded {
+                    inputs.shade(&mut c, normal);
+                }
+                ([c[0], c[1], c[2]], c[3])
+            };
+            params[s] = params_at(inputs.frame, at, (1u32 << level) as f32, grow, rgb, tau);
+        }
+    }
+}
+
+pub(crate) fn brick_lod_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+    let mut params = b.take(Res::Params);
+    brick_lod_params(
+        &inputs_for(b, v)?,
+        b.get(Res::BrickList),
+        &args.push_as(),
+        b.get(Res::BrickVoxels),
+        bytemuck::cast_slice_mut(&mut params),
+    );
+    b.put(Res::Params, params);
+    Ok(())
 }
 
 pub(crate) fn brick_cells_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {

@@ -424,10 +424,13 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         let variant = usize::from(streamed);
         e.run(&Dispatch::new(StageId::BrickCells, variant, groups, List::Order, bytemuck::bytes_of(&cells)))?;
     }
-    let push = bytemuck::bytes_of(&push);
-    // The LOD builds follow the three record builds (stages.rs).
-    let params = if lod { build + 3 } else { build };
-    e.run(&Dispatch::new(StageId::BrickParams, params, groups_1d(n), List::Order, push))
+    e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, bytemuck::bytes_of(&push)))?;
+    if lod {
+        let all = BrickPush { count: listed.len() as u32, ..push };
+        let groups = plan::groups_per_item(all.count);
+        e.run(&Dispatch::new(StageId::BrickLodParams, build, groups, List::Order, bytemuck::bytes_of(&all)))?;
+    }
+    Ok(())
 }
 
 /// `brick_pyramid` over `push.count` bricks (a resident store's all; a streamed store's batch entries
