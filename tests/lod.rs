@@ -55,6 +55,11 @@ fn coarse_levels_match_the_cpu_mirrors_on_every_raster() {
         let mut full = o.clone();
         full.lod = Lod::Off;
         let all = g.render(&cam, &full).unwrap().image;
+        // Where nothing coarsens or morphs, levels of detail change no pixel.
+        let mut fine = o.clone();
+        fine.lod_pixels = 0.01;
+        assert!(drawn_cells(&mut g, &cam, &fine).iter().all(|c| c[3] == 1), "{what}: all at full detail");
+        assert_eq!(diff(&g.render(&cam, &fine).unwrap().image, &all).0, 0.0, "{what}: levels of detail, none coarse");
         for (raster, direction) in [
             (Raster::Compute, Direction::FrontToBack),
             (Raster::Compute, Direction::BackToFront),
