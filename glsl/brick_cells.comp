@@ -32,6 +32,7 @@ void main() {
     uvec3 b = brick_coords(headers[entry.x].x);
     uint n = BRICK_SIDE >> level;
     uint off = level_offset(level);
+    uint morphs = brick_morph[entry.x] > 0.0 ? VOXEL_MORPHS : 0u;
     uvec3 split = level_split(b, level);
     uint total = entry.w & 0xffffu;
     uint rank = 0u;
@@ -47,7 +48,7 @@ void main() {
                     if (!(cell_tau(entry.x, off + c) > 0.0)) continue;
                     uint pos = entry.y + (frame.split.w != 0u ? total - 1u - rank : rank);
                     uvec3 ijk = b * BRICK_SIDE + (cc << level);
-                    voxels[pos] = uvec2(ijk.x | (ijk.y << 16u), ijk.z | (level << 13u) | ((off + c) << 16u));
+                    voxels[pos] = uvec2(ijk.x | (ijk.y << 16u), ijk.z | (level << 13u) | morphs | ((off + c) << 16u));
                     order_out[pos] = pos;
                     rank++;
                 }

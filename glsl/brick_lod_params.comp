@@ -1,48 +1,36 @@
 #version 450
 // variants: PAGED_RECORDS STREAMED_STORE
-// Levels of detail, after brick_params (which made every voxel's splat at full size and skipped
-// coarse cells): a workgroup per entry of the batch whose brick is coarse or morphs, its lanes over
-// the brick's splats (contiguous from the entry's first position): a coarse cell from its pyramid
-// cell (colour shaded at its gradient, optical depth per cell), a voxel grown toward the next
-// level (splat_growth). Its own pass because llvmpipe runs a branch's code under a mask even where
-// no lane takes it: in brick_params, this path cost every voxel of every frame (brick_params took
-// twice as long with levels of detail on where none was coarse). Mirror:
-// cpu::lod::brick_lod_params.
-layout(local_size_x = BRICK_LANES) in;
+// Levels of detail, beside brick_params (which makes the voxels' splats and skips coarse cells): a
+// lane per coarse splat of the batch (lod_splats: their positions, listed by the host), its
+// parameters from its pyramid cell: prefiltered colour shaded at the cell's gradient, optical depth
+// per cell, a splat 2^l voxels wide at the middle of its voxels inside the grid, grown toward the
+// next level when its brick morphs. Mirror: cpu::lod::brick_lod_params.
+layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
+#include "linear.glsl"
 
 layout(push_constant) uniform Push {
-    uint first;      // the batch's first entry of brick_list
-    uint count;      // its entries
-    uint splats;     // its splats
-    float occluded;  // brick_hidden's threshold
+    uint first;      // unused
+    uint count;      // unused
+    uint splats;     // the batch's coarse splats
+    float occluded;  // unused
 } pc;
 
 void main() {
-    uint e = workgroup_item();
-    if (e >= pc.count) return;
-    uvec4 entry = brick_list[pc.first + e];
-    uint h = entry.x;
-    uint level = entry.w >> 16u;
-    bool morphs = brick_morph[h] > 0.0;
-    if (level == 0u && !morphs) return;
-    for (uint r = gl_LocalInvocationID.x; r < (entry.w & 0xffffu); r += BRICK_LANES) {
-        uint s = entry.y + r;
-        uvec2 v = voxels[s];
-        uvec3 ijk = voxel_ijk(v);
-        // The cell's centre: the middle of its voxels inside the grid (a cell the grid's end cuts
-        // would otherwise sit up to 3.5 voxels off a thin sheet).
-        vec3 at = vec3(ijk) + 0.5 * (vec3(min(uvec3(1u << level), frame.dims.xyz - ijk)) - 1.0);
-        float grow = morphs ? splat_growth(at, level) : 1.0;
-        vec4 c;
-        if (level == 0u) {
-            c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);
-            c.a = optical_depth(c.a);
-        } else {
-            vec3 normal;
-            c = cell_color(h, v.y >> 16u, normal);
-            if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
-        }
-        params_store(s, params_at(at, float(1u << level), grow, c.rgb, c.a));
-    }
+    uint i = linear_invocation();
+    if (i >= pc.splats) return;
+    uint s = lod_splats[i];
+    uvec2 v = voxels[s];
+    uvec3 ijk = voxel_ijk(v);
+    uint level = voxel_level(v);
+    uvec3 b = ijk / BRICK_SIDE;
+    uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
+    // The middle of its voxels inside the grid (a cell the grid's end cuts would otherwise sit up
+    // to 3.5 voxels off a thin sheet).
+    vec3 at = vec3(ijk) + 0.5 * (vec3(min(uvec3(1u << level), frame.dims.xyz - ijk)) - 1.0);
+    float grow = (v.y & VOXEL_MORPHS) != 0u ? splat_growth(at, level) : 1.0;
+    vec3 normal;
+    vec4 c = cell_color(h, v.y >> 16u, normal);
+    if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
+    params_store(s, params_at(at, float(1u << level), grow, c.rgb, c.a));
 }

@@ -28,6 +28,7 @@ void main() {
     uvec3 b = brick_coords(hd.x);
     // Coarse bricks are brick_cells'.
     if ((entry.w >> 16u) != 0u) return;
+    uint morphs = bf.grad.y > 0.0 && brick_morph[entry.x] > 0.0 ? VOXEL_MORPHS : 0u;
     uvec3 split = uvec3(clamp(ivec3(frame.split.xyz) - ivec3(b * BRICK_SIDE), ivec3(0), ivec3(BRICK_SIDE)));
     uint lane = gl_LocalInvocationID.x;
     for (uint w = lane; w < MASK_WORDS; w += BRICK_LANES) cells[w] = 0u;
@@ -55,7 +56,7 @@ void main() {
         uint rank = below[p / 32u] + uint(bitCount(cells[p / 32u] & ((1u << (p % 32u)) - 1u)));
         uint pos = entry.y + (frame.split.w != 0u ? total - 1u - rank : rank);
         uvec3 ijk = b * BRICK_SIDE + lc;
-        voxels[pos] = uvec2(ijk.x | (ijk.y << 16u), ijk.z | (rec & 0xffff0000u));
+        voxels[pos] = uvec2(ijk.x | (ijk.y << 16u), ijk.z | morphs | (rec & 0xffff0000u));
         order_out[pos] = pos;
     }
 }

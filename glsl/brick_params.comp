@@ -2,9 +2,10 @@
 // variants: PAGED_RECORDS STREAMED_STORE
 // Bricks, pass 3 (issue 23): per splat of a batch, in draw order, classify its voxel on the device
 // (TF table, gradient weighting, headlight shading; gradients read through the store) and make its
-// splat parameters (params.glsl, as splat_params does for a dense set), each at full size; with
-// levels of detail, brick_lod_params then makes coarse cells' and morphing voxels'. Mirror:
-// cpu::brick::brick_params.
+// splat parameters (params.glsl, as splat_params does for a dense set); a voxel of a morphing brick
+// grows toward its next level (levels of detail). Coarse cells are brick_lod_params': a branch to
+// them here would cost every voxel, since llvmpipe runs a branch's code under a mask even where no
+// lane takes it. Mirror: cpu::brick::brick_params.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
 #include "linear.glsl"
@@ -20,8 +21,9 @@ void main() {
     uint s = linear_invocation();
     if (s >= pc.splats) return;
     uvec2 v = voxels[s];
-    uvec3 ijk = voxel_ijk(v);
-    // Coarse cells are brick_lod_params' (levels of detail).
     if (voxel_level(v) != 0u) return;
-    params_store(s, params_of(ijk, classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5)));
+    uvec3 ijk = voxel_ijk(v);
+    vec4 c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);
+    float grow = (v.y & VOXEL_MORPHS) != 0u ? splat_growth(vec3(ijk), 0u) : 1.0;
+    params_store(s, params_at(vec3(ijk), 1.0, grow, c.rgb, optical_depth(c.a)));
 }

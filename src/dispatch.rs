@@ -125,6 +125,8 @@ pub enum Res {
     Pyramid2,
     /// Page 3 of `Pyramid`.
     Pyramid3,
+    /// Levels of detail: a batch's coarse splats' positions (`brick_lod_params`' lanes).
+    LodSplats,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

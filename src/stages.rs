@@ -116,6 +116,7 @@ const BRICK: &[Res] = &[
     Res::Pyramid1,
     Res::Pyramid2,
     Res::Pyramid3,
+    Res::LodSplats,
 ];
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
@@ -244,7 +245,7 @@ pub const STAGES: &[StageDesc] = &[
         bindings: BRICK,
         writes: &[Res::Params],
         push: std::mem::size_of::<BrickPush>() as u32,
-        workgroup: Workgroup::PerItem(BRICK_LANES),
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
         variants: RECORD_PAGED,

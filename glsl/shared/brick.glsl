@@ -217,6 +217,8 @@ void pyramid_put(uint i, uint v) {
         default: pyramid_3[j] = v; break;
     }
 }
+// A batch's coarse splats' positions (brick_lod_params).
+layout(std430, binding = 31) readonly buffer LodSplats { uint lod_splats[]; };
 layout(std430, binding = 25) buffer LodSummary { uvec4 lod_summary[]; };
 const uint LOD_CELLS = 73u;
 const uint CELL_WORDS = 3u;

@@ -4,7 +4,7 @@
 use super::bindings::Bindings;
 use super::lod::level_count;
 use super::order::{outward, side_count};
-use super::splat_params::{cell_footprint_scale, params_of, CULL_RADII};
+use super::splat_params::{cell_footprint_scale, optical_depth, params_at, CULL_RADII};
 use crate::bricks::{BrickStore, BRICK};
 use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
 use crate::dispatch::{Args, Res, Variant};
@@ -271,6 +271,20 @@ pub fn slot_code(l: u32, n: u32) -> u32 {
     }
 }
 
+/// Mirror of `VOXEL_MORPHS` (types.glsl): set in a bricked voxel whose brick morphs.
+pub const VOXEL_MORPHS: u32 = 0x8000;
+
+impl BrickInputs<'_> {
+    /// `VOXEL_MORPHS` when header `h`'s brick morphs this frame (levels of detail on).
+    pub fn morph_bit(&self, h: u32) -> u32 {
+        if self.bf.grad[1] > 0.0 && self.morphs[h as usize] > 0.0 {
+            VOXEL_MORPHS
+        } else {
+            0
+        }
+    }
+}
+
 /// Mirror of `voxel_ijk` (types.glsl): the grid index of a voxel as `brick_order` writes it.
 pub fn voxel_ijk(v: [u32; 2]) -> [u32; 3] {
     [v[0] & 0xffff, v[0] >> 16, v[1] & 0x1fff]
@@ -335,6 +349,7 @@ pub fn brick_order(
         if entry[3] >> 16 != 0 {
             continue;
         }
+        let morphs = inputs.morph_bit(entry[0]);
         let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
         let records = &records[entry[2] as usize..(entry[2] + hd.count) as usize];
         let mut cells = [0u32; CELL_WORDS];
@@ -357,21 +372,25 @@ pub fn brick_order(
             let pos = (entry[1] + rank) as usize;
             let lc = local_cell(rec & 511);
             let ijk = [0, 1, 2].map(|a| b[a] * BRICK + lc[a]);
-            voxels[pos] = [ijk[0] | ijk[1] << 16, ijk[2] | (rec & 0xffff_0000)];
+            voxels[pos] = [ijk[0] | ijk[1] << 16, ijk[2] | morphs | (rec & 0xffff_0000)];
             order[pos] = pos as u32;
         }
     }
 }
 
-/// Pass 3: per splat of the batch, classify its voxel and make its parameters at full size
-/// (coarse cells are `brick_lod_params`').
+/// Pass 3: per splat of the batch, classify its voxel and make its parameters, grown when its
+/// brick morphs (coarse cells are `brick_lod_params`').
 pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
     let shaded = inputs.bf.light[3] > 0.5;
     for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
-        if voxel_level(*v) == 0 {
-            let ijk = voxel_ijk(*v);
-            params[s] = params_of(inputs.frame, ijk, inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded));
+        if voxel_level(*v) != 0 {
+            continue;
         }
+        let ijk = voxel_ijk(*v);
+        let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
+        let at = Vec3::from_array(ijk.map(|c| c as f32));
+        let grow = if v[1] & VOXEL_MORPHS != 0 { inputs.splat_growth(at, 0) } else { 1.0 };
+        params[s] = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
     }
 }
 

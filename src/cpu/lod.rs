@@ -2,7 +2,7 @@
 //! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
 //! `cell_color`).
 use super::bindings::Bindings;
-use super::brick::{inputs, inputs_for, local_cell, streamed, voxel_ijk, BrickInputs};
+use super::brick::{inputs, inputs_for, local_cell, streamed, voxel_ijk, voxel_level, BrickInputs, VOXEL_MORPHS};
 use super::order::side_count;
 use super::splat_params::{optical_depth, params_at};
 use crate::bricks::BRICK;
@@ -310,6 +310,7 @@ pub fn brick_cells(
         let n = BRICK >> level;
         let off = level_offset(level);
         let split = level_split(inputs.frame.split, b, level);
+        let morphs = inputs.morph_bit(entry[0]);
         let total = entry[3] & 0xffff;
         let mut rank = 0;
         let axis = |side: u32, s: u32, t: u32| if side == 0 { s - 1 - t } else { s + t };
@@ -329,7 +330,7 @@ pub fn brick_cells(
                         }
                         let pos = entry[1] + if inputs.frame.split[3] != 0 { total - 1 - rank } else { rank };
                         let ijk = [0, 1, 2].map(|a| b[a] * BRICK + (cc[a] << level));
-                        voxels[pos as usize] = [ijk[0] | ijk[1] << 16, ijk[2] | level << 13 | (off + c) << 16];
+                        voxels[pos as usize] = [ijk[0] | ijk[1] << 16, ijk[2] | level << 13 | morphs | (off + c) << 16];
                         order[pos as usize] = pos;
                         rank += 1;
                     }
@@ -339,42 +340,29 @@ pub fn brick_cells(
     }
 }
 
-/// Mirror of `brick_lod_params.comp`: per entry of the batch whose brick is coarse or morphs, its
-/// splats' parameters (a coarse cell from its pyramid cell, a voxel grown toward the next level).
+/// Mirror of `brick_lod_params.comp`: the parameters of the coarse splats at positions
+/// `lod_splats` (`push.splats` of them) from their pyramid cells.
 pub fn brick_lod_params(
     inputs: &BrickInputs<'_>,
-    list: &[[u32; 4]],
+    lod_splats: &[u32],
     push: &BrickPush,
     voxels: &[[u32; 2]],
     params: &mut [SplatParams],
 ) {
-    let shaded = inputs.bf.light[3] > 0.5;
-    let dims = inputs.frame.dims;
-    for entry in &list[push.first as usize..(push.first + push.count) as usize] {
-        let (h, level) = (entry[0], entry[3] >> 16);
-        let morphs = inputs.morphs[h as usize] > 0.0;
-        if level == 0 && !morphs {
-            continue;
+    let (shaded, dims, nb) = (inputs.bf.light[3] > 0.5, inputs.frame.dims, inputs.bf.grid);
+    for &s in &lod_splats[..push.splats as usize] {
+        let v = voxels[s as usize];
+        let (ijk, level) = (voxel_ijk(v), voxel_level(v));
+        let h = inputs.store.index[(ijk[0] / BRICK + nb[0] * (ijk[1] / BRICK + nb[1] * (ijk[2] / BRICK))) as usize];
+        let at = Vec3::from_array(
+            [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
+        );
+        let grow = if v[1] & VOXEL_MORPHS != 0 { inputs.splat_growth(at, level) } else { 1.0 };
+        let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16);
+        if shaded {
+            inputs.shade(&mut c, normal);
         }
-        for s in entry[1] as usize..(entry[1] + (entry[3] & 0xffff)) as usize {
-            let v = voxels[s];
-            let ijk = voxel_ijk(v);
-            let at = Vec3::from_array(
-                [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
-            );
-            let grow = if morphs { inputs.splat_growth(at, level) } else { 1.0 };
-            let (rgb, tau) = if level == 0 {
-                let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
-                ([c[0], c[1], c[2]], optical_depth(c[3]))
-            } else {
-                let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16);
-                if shaded {
-                    inputs.shade(&mut c, normal);
-                }
-                ([c[0], c[1], c[2]], c[3])
-            };
-            params[s] = params_at(inputs.frame, at, (1u32 << level) as f32, grow, rgb, tau);
-        }
+        params[s as usize] = params_at(inputs.frame, at, (1u32 << level) as f32, grow, [c[0], c[1], c[2]], c[3]);
     }
 }
 
@@ -382,7 +370,7 @@ pub(crate) fn brick_lod_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Vari
     let mut params = b.take(Res::Params);
     brick_lod_params(
         &inputs_for(b, v)?,
-        b.get(Res::BrickList),
+        b.get(Res::LodSplats),
         &args.push_as(),
         b.get(Res::BrickVoxels),
         bytemuck::cast_slice_mut(&mut params),

@@ -207,7 +207,7 @@ pub(super) fn record_bricks(
         }
         let n = batch_splats(&batch);
         if !batch.is_empty() {
-            record_brick_batch(e, scene, &batch, &cut, lod)?;
+            record_brick_batch(e, scene, &batch, &cut)?;
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, i > 0)?;
@@ -328,7 +328,7 @@ fn record_bricked_sheets(
         let part = &parts[0];
         let n = batch_splats(part);
         if n > 0 {
-            record_brick_batch(e, scene, part, &cut, false)?;
+            record_brick_batch(e, scene, part, &cut)?;
         }
         let pc = geometry(n)?;
         let starts = record_slab_bins(e, &pc, variant)?;
@@ -375,7 +375,7 @@ fn record_bricked_sheets(
         for (k, part) in cut.batches(scene, near, MAX_GPU_SPLATS, available).iter().enumerate() {
             let n = batch_splats(part);
             if n > 0 {
-                record_brick_batch(e, scene, part, &cut, false)?;
+                record_brick_batch(e, scene, part, &cut)?;
             }
             let starts = record_slab_bins(e, &geometry(n)?, variant)?;
             let (first, end) = (starts[p0 as usize], starts[p1 as usize + 1]);
@@ -394,7 +394,7 @@ fn batch_splats(batch: &[[u32; 4]]) -> u32 {
 /// One batch of visible bricks (entries: header, first position, first record, voxels): its
 /// records when they stream, then `brick_order` and `brick_params` make its splats' parameters
 /// (in buffers sized for the batch: the sheet modes cut their own).
-fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]], cut: &Cut, lod: bool) -> Result<()> {
+fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]], cut: &Cut) -> Result<()> {
     let (streamed, build) = (cut.streamed, cut.build);
     let n = batch_splats(batch);
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
@@ -425,10 +425,14 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         e.run(&Dispatch::new(StageId::BrickCells, variant, groups, List::Order, bytemuck::bytes_of(&cells)))?;
     }
     e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, bytemuck::bytes_of(&push)))?;
-    if lod {
-        let all = BrickPush { count: listed.len() as u32, ..push };
-        let groups = plan::groups_per_item(all.count);
-        e.run(&Dispatch::new(StageId::BrickLodParams, build, groups, List::Order, bytemuck::bytes_of(&all)))?;
+    // The coarse splats' positions, for brick_lod_params' lanes.
+    let lod_splats: Vec<u32> = coarse.iter().flat_map(|l| l[1]..l[1] + (l[3] & 0xffff)).collect();
+    if !lod_splats.is_empty() {
+        e.ensure(Res::LodSplats, lod_splats.len() as u64 * 4)?;
+        e.upload(Res::LodSplats, &lod_splats)?;
+        let cells = BrickPush { splats: lod_splats.len() as u32, ..push };
+        let groups = groups_1d(cells.splats);
+        e.run(&Dispatch::new(StageId::BrickLodParams, build, groups, List::Order, bytemuck::bytes_of(&cells)))?;
     }
     Ok(())
 }
