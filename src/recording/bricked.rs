@@ -9,6 +9,8 @@ use crate::cpu::lod::{pyramid_bytes, LOD_BUFFERS, PYRAMID_BYTES, SLOTTED_LOD_BUF
 /// voxel (8), and for the tile compositor its screen quad (80) and about four tile entries (the
 /// sheet modes' (splat, slab) pairs fit in the last two).
 pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 8 + 80 + 16;
+/// And per coarse splat (levels of detail), its position in `Res::LodSplats`.
+const LOD_SPLAT_BYTES: u64 = 4;
 
 /// What a bricked frame keeps resident besides its batches under `budget`: the store (without its
 /// records when they stream, `BrickScene::streams`; then the per-brick counts), the brick index,
@@ -251,7 +253,8 @@ impl Cut {
             let n = w & 0xffff;
             let hd = &scene.store.headers[header as usize];
             let recs = if self.uploads(w) { hd.count } else { 0 };
-            let cost = n as u64 * BATCH_BYTES_PER_SPLAT + recs as u64 * 4 + self.pyramid;
+            let per_splat = BATCH_BYTES_PER_SPLAT + if w >> 16 != 0 { LOD_SPLAT_BYTES } else { 0 };
+            let cost = n as u64 * per_splat + recs as u64 * 4 + self.pyramid;
             let entries = batches.last().map_or(0, |b| b.len()) as u64 + 1;
             let binding = (entries * 16).max(entries * self.pyramid).max((records + recs) as u64 * 4);
             let open = batches.last().is_some_and(|b| !b.is_empty());
