@@ -395,8 +395,9 @@ fn batch_splats(batch: &[[u32; 4]]) -> u32 {
 }
 
 /// One batch of visible bricks (entries: header, first position, first record, voxels): its
-/// records when they stream, then `brick_order` and `brick_params` make its splats' parameters
-/// (in buffers sized for the batch: the sheet modes cut their own).
+/// records when they stream, then `brick_order` and `brick_cells` list its splats and
+/// `brick_params` (voxels) and `brick_lod_params` (coarse cells) make their parameters (in buffers
+/// sized for the batch: the sheet modes cut their own).
 fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]], cut: &Cut) -> Result<()> {
     let (streamed, build) = (cut.streamed, cut.build);
     let n = batch_splats(batch);
@@ -431,7 +432,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     // The coarse splats' positions, for brick_lod_params' lanes.
     let lod_splats: Vec<u32> = coarse.iter().flat_map(|l| l[1]..l[1] + (l[3] & 0xffff)).collect();
     if !lod_splats.is_empty() {
-        e.ensure(Res::LodSplats, lod_splats.len() as u64 * 4)?;
+        e.ensure(Res::LodSplats, lod_splats.len() as u64 * LOD_SPLAT_BYTES)?;
         e.upload(Res::LodSplats, &lod_splats)?;
         let cells = BrickPush { splats: lod_splats.len() as u32, ..push };
         let groups = groups_1d(cells.splats);
