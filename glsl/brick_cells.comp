@@ -32,7 +32,7 @@ void main() {
     uvec3 b = brick_coords(headers[entry.x].x);
     uint n = BRICK_SIDE >> level;
     uint off = level_offset(level);
-    uint morphs = brick_morph[entry.x] > 0.0 ? VOXEL_MORPHS : 0u;
+    uint morphs = morph_bit(entry.x);
     uvec3 split = level_split(b, level);
     uint total = entry.w & 0xffffu;
     uint rank = 0u;

@@ -23,8 +23,7 @@ void main() {
     uvec2 v = voxels[s];
     uvec3 ijk = voxel_ijk(v);
     uint level = voxel_level(v);
-    uvec3 b = ijk / BRICK_SIDE;
-    uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
+    uint h = header_of(ijk);
     // The middle of its voxels inside the grid (a cell the grid's end cuts would otherwise sit up
     // to 3.5 voxels off a thin sheet).
     vec3 at = vec3(ijk) + 0.5 * (vec3(min(uvec3(1u << level), frame.dims.xyz - ijk)) - 1.0);

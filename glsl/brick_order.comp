@@ -28,7 +28,7 @@ void main() {
     uvec3 b = brick_coords(hd.x);
     // Coarse bricks are brick_cells'.
     if ((entry.w >> 16u) != 0u) return;
-    uint morphs = bf.grad.y > 0.0 && brick_morph[entry.x] > 0.0 ? VOXEL_MORPHS : 0u;
+    uint morphs = morph_bit(entry.x);
     uvec3 split = uvec3(clamp(ivec3(frame.split.xyz) - ivec3(b * BRICK_SIDE), ivec3(0), ivec3(BRICK_SIDE)));
     uint lane = gl_LocalInvocationID.x;
     for (uint w = lane; w < MASK_WORDS; w += BRICK_LANES) cells[w] = 0u;

@@ -210,14 +210,19 @@ impl BrickStore {
         (self.headers.len() * (std::mem::size_of::<BrickHeader>() + BRICK_VOXELS / 8) + self.records.len() * 4) as u64
     }
 
+    /// The header of the brick holding voxel `v` (`u32::MAX`: an empty brick; `header_of` in
+    /// glsl/shared/brick.glsl).
+    pub fn header_of(&self, v: [u32; 3]) -> u32 {
+        let nb = self.dims.map(|d| d.div_ceil(BRICK));
+        self.index[(v[0] / BRICK + nb[0] * (v[1] / BRICK + nb[1] * (v[2] / BRICK))) as usize]
+    }
+
     /// The normalised value in [0, 1] at voxel (i, j, k), indices clamped to the grid (as the
     /// CPU classification reads it): 0 where nothing is stored.
     pub fn value_at(&self, i: i64, j: i64, k: i64) -> f32 {
         let [x, y, z] = [i, j, k].map(|c| c.max(0) as u32);
         let [x, y, z] = [x.min(self.dims[0] - 1), y.min(self.dims[1] - 1), z.min(self.dims[2] - 1)];
-        let nb = self.dims.map(|d| d.div_ceil(BRICK));
-        let id = (x / BRICK + nb[0] * (y / BRICK + nb[1] * (z / BRICK))) as usize;
-        let h = self.index[id];
+        let h = self.header_of([x, y, z]);
         if h == u32::MAX {
             return 0.0;
         }

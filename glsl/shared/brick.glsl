@@ -134,11 +134,17 @@ bool tf_empty(uint lo, uint hi) {
     return emitted_below(hi + 1u) == emitted_below(lo);
 }
 
+// The header of the brick holding voxel c (0xffffffff: an empty brick). Mirror:
+// BrickStore::header_of.
+uint header_of(uvec3 c) {
+    uvec3 b = c / BRICK_SIDE;
+    return brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
+}
+
 // The stored (normalised) value at voxel v, indices clamped to the grid: 0 where nothing is stored.
 float stored_at(ivec3 v) {
     uvec3 c = uvec3(clamp(v, ivec3(0), ivec3(frame.dims.xyz) - 1));
-    uvec3 b = c / BRICK_SIDE;
-    uint h = brick_index[b.x + bf.grid.x * (b.y + bf.grid.y * b.z)];
+    uint h = header_of(c);
     if (h == 0xffffffffu) return 0.0;
     uvec3 lc = c % BRICK_SIDE;
     uint l = lc.x + BRICK_SIDE * (lc.y + BRICK_SIDE * lc.z);
@@ -250,8 +256,19 @@ float voxel_pixels(float depth) {
     return frame.eye.w > 0.5 ? voxel * frame.up.w / max(depth, frame.forward.w) : voxel * frame.up.w;
 }
 
+// Octaves of projected size a level-l splat at eye-space `depth` has before the next level takes
+// over: 0 where its cells project to bf.grad.y pixels, 1 where the next level's do.
+float level_octaves(float depth, uint l) {
+    return log2(bf.grad.y / voxel_pixels(depth)) - float(l);
+}
+
 // Per brick, 1 when its splats may morph toward the next level this frame (brick_cull).
 layout(std430, binding = 26) buffer BrickMorph { float brick_morph[]; };
+
+// VOXEL_MORPHS when header h's brick morphs this frame (levels of detail on), for its voxels.
+uint morph_bit(uint h) {
+    return bf.grad.y > 0.0 && brick_morph[h] > 0.0 ? VOXEL_MORPHS : 0u;
+}
 
 // Geomorphing (levels of detail): over the last bf.grad.w octaves of projected size before the
 // next level's threshold, a level-l splat at grid position `at` widens toward the next level's
@@ -262,7 +279,7 @@ layout(std430, binding = 26) buffer BrickMorph { float brick_morph[]; };
 // left 2 % steps at brick faces.
 float splat_growth(vec3 at, uint l) {
     vec3 center = frame.origin.xyz + at * frame.spacing.xyz;
-    float octaves = log2(bf.grad.y / voxel_pixels(dot(center - frame.eye.xyz, frame.forward.xyz))) - float(l);
+    float octaves = level_octaves(dot(center - frame.eye.xyz, frame.forward.xyz), l);
     return 1.0 + clamp((octaves - (1.0 - bf.grad.w)) / bf.grad.w, 0.0, 1.0);
 }
 
@@ -358,7 +375,7 @@ uint brick_level(uint h, uvec3 b, out float morph) {
         level = l;
     }
     // Its splats grow (splat_growth) only within the band, which its farthest reaches first.
-    float octaves = log2(bf.grad.y / voxel_pixels(depths.y)) - float(level);
+    float octaves = level_octaves(depths.y, level);
     if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z && octaves > 1.0 - bf.grad.w)
         morph = 1.0;
     return level;

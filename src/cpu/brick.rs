@@ -275,7 +275,8 @@ pub fn slot_code(l: u32, n: u32) -> u32 {
 pub const VOXEL_MORPHS: u32 = 0x8000;
 
 impl BrickInputs<'_> {
-    /// `VOXEL_MORPHS` when header `h`'s brick morphs this frame (levels of detail on).
+    /// Mirror of `morph_bit`: `VOXEL_MORPHS` when header `h`'s brick morphs this frame (levels of
+    /// detail on).
     pub fn morph_bit(&self, h: u32) -> u32 {
         if self.bf.grad[1] > 0.0 && self.morphs[h as usize] > 0.0 {
             VOXEL_MORPHS

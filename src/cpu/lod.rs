@@ -137,12 +137,17 @@ impl BrickInputs<'_> {
         }
     }
 
+    /// Mirror of `level_octaves`.
+    fn level_octaves(&self, depth: f32, l: u32) -> f32 {
+        (self.bf.grad[1] / self.voxel_pixels(depth)).log2() - l as f32
+    }
+
     /// Mirror of `splat_growth`.
     pub fn splat_growth(&self, at: Vec3, l: u32) -> f32 {
         let (f, bf) = (self.frame, &self.bf);
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         let center = v3(f.origin) + at * v3(f.spacing);
-        let octaves = (bf.grad[1] / self.voxel_pixels((center - v3(f.eye)).dot(v3(f.forward)))).log2() - l as f32;
+        let octaves = self.level_octaves((center - v3(f.eye)).dot(v3(f.forward)), l);
         1.0 + ((octaves - (1.0 - bf.grad[3])) / bf.grad[3]).clamp(0.0, 1.0)
     }
 
@@ -170,7 +175,7 @@ impl BrickInputs<'_> {
             }
             level = l;
         }
-        let octaves = (bf.grad[1] / self.voxel_pixels(far)).log2() - level as f32;
+        let octaves = self.level_octaves(far, level);
         let morph = level < 3
             && bf.grad[3] > 0.0
             && f32::from_bits(s[level as usize + 1]) <= bf.grad[2]
@@ -349,11 +354,11 @@ pub fn brick_lod_params(
     voxels: &[[u32; 2]],
     params: &mut [SplatParams],
 ) {
-    let (shaded, dims, nb) = (inputs.bf.light[3] > 0.5, inputs.frame.dims, inputs.bf.grid);
+    let (shaded, dims) = (inputs.bf.light[3] > 0.5, inputs.frame.dims);
     for &s in &lod_splats[..push.splats as usize] {
         let v = voxels[s as usize];
         let (ijk, level) = (voxel_ijk(v), voxel_level(v));
-        let h = inputs.store.index[(ijk[0] / BRICK + nb[0] * (ijk[1] / BRICK + nb[1] * (ijk[2] / BRICK))) as usize];
+        let h = inputs.store.header_of(ijk);
         let at = Vec3::from_array(
             [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
         );
