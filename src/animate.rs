@@ -226,6 +226,28 @@ impl Animation {
         Camera { eye, target, ..self.camera }
     }
 
+    /// Check the camera at every time `blur` renders, before any frame is drawn (a path through
+    /// eye == target would otherwise fail after earlier frames were written); the error names the
+    /// frame.
+    pub fn check_path(&self, grid: &Grid, blur: Blur) -> Result<()> {
+        for i in 0..self.frames {
+            let t = i as f32;
+            let times: Vec<f32> = match blur {
+                Blur::None => vec![t],
+                Blur::Splat => vec![t - self.shutter, t],
+                Blur::Accum(n) => (0..n).map(|k| t - self.shutter + (k + 1) as f32 / n as f32 * self.shutter).collect(),
+            };
+            for tk in times {
+                let checked = self.camera_at(tk).validate().and_then(|_| self.object_camera(grid, tk).validate());
+                checked.map_err(|e| match e {
+                    Error::InvalidCamera(m) => Error::InvalidCamera(format!("frame {i} (time {tk}): {m}")),
+                    other => other,
+                })?;
+            }
+        }
+        Ok(())
+    }
+
     /// The object's transform at time `t` (in frames): rotation about the grid centre, slerped
     /// between keyframes, and linearly interpolated translation.
     pub fn model(&self, grid: &Grid, t: f32) -> Mat4 {

@@ -126,6 +126,9 @@ impl BrickStore {
         }
         let lo = lo.min(background);
         let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo)) } else { (0.0, 0.0) };
+        // A constant volume has no background: keep its voxels (its minimum would drop them all,
+        // and a one-voxel opaque volume would draw nothing) and let the TF classify them.
+        let lo = if hi > lo { lo } else { lo - lo.abs().max(1.0) };
         let span = if hi > lo { hi - lo } else { 1.0 };
         let mut store = Self {
             dims,

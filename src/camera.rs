@@ -9,6 +9,10 @@ use glam::{Mat4, Vec3, Vec4};
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 /// Most pixels accepted (8192^2: 1 GiB per RGBA32F image).
 pub const MAX_PIXELS: u64 = 8192 * 8192;
+/// Largest eye or target coordinate: squared distances stay finite in f32.
+pub const MAX_WORLD: f32 = 1e15;
+/// Smallest pixel, relative to the view's coordinates (2^-18: 32 f32 steps).
+const MIN_PIXEL_RELATIVE: f32 = 1.0 / (1u32 << 18) as f32;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 /// How the view volume maps to the image.
@@ -54,15 +58,20 @@ impl Camera {
         let center = grid.center();
         let radius = 0.5 * grid.diagonal().max(1.0);
         let fov = 35.0f32;
-        let dist = radius / (0.5 * fov.to_radians()).sin() * 1.05;
+        // The nearest splats must clear the near plane by the cull margin (CULL_RADII of the widest
+        // kernel's radius), or a grid a few voxels wide would frame its eye inside it and draw nothing.
+        let reach = crate::cpu::splat_params::CULL_RADII
+            * crate::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max)
+            * grid.kernel_spacing();
+        let dist = (radius / (0.5 * fov.to_radians()).sin() * 1.05).max((radius + reach) / 0.98);
         let dir = Vec3::new(0.55, 0.45, 1.0).normalize();
         Self {
             eye: center + dir * dist,
             target: center,
             up: Vec3::Y,
             projection: Projection::Perspective { fov_y_deg: fov },
-            near: (dist - radius * 1.5).max(dist * 0.01),
-            far: dist + radius * 1.5,
+            near: (dist - radius * 1.5).min(dist - radius - reach).max(dist * 0.01),
+            far: (dist + radius * 1.5).max(dist + radius + reach),
             width,
             height,
         }
@@ -82,6 +91,11 @@ impl Camera {
         }
         if self.width as u64 * self.height as u64 > MAX_PIXELS {
             return Err(Error::InvalidCamera(format!("image has more than {MAX_PIXELS} pixels")));
+        }
+        if self.eye.abs().max_element() > MAX_WORLD || self.target.abs().max_element() > MAX_WORLD {
+            return Err(Error::InvalidCamera(format!(
+                "eye and target must lie within {MAX_WORLD:e} world units of the origin on each axis"
+            )));
         }
         let view = self.target - self.eye;
         if view.length() < 1e-6 * (1.0 + self.eye.length()) {
@@ -108,7 +122,28 @@ impl Camera {
                 }
             }
         }
+        // A pixel must span enough f32 steps of the view's coordinates to be told from its
+        // neighbours: below that the rasterizers fill parts of the frame or none of it.
+        let scale = view.length().max(self.eye.abs().max_element()).max(self.target.abs().max_element());
+        let pixel = self.pixel_size();
+        if pixel.is_nan() || pixel < scale * MIN_PIXEL_RELATIVE {
+            return Err(Error::InvalidCamera(format!(
+                "a pixel spans {pixel:e} world units at the target, below 2^-18 of the view's coordinates ({scale:e}): \
+                 f32 cannot resolve it; widen the view or move the scene nearer the origin"
+            )));
+        }
         Ok(())
+    }
+
+    /// World units a pixel spans at the target's distance.
+    pub fn pixel_size(&self) -> f32 {
+        let height = match self.projection {
+            Projection::Perspective { fov_y_deg } => {
+                2.0 * (self.target - self.eye).length() * (0.5 * fov_y_deg.to_radians()).tan()
+            }
+            Projection::Orthographic { height } => height,
+        };
+        height / self.height as f32
     }
 
     /// Whether the projection is a perspective one.

@@ -42,6 +42,14 @@ pub enum Error {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// Decoding an input image (PNG, EXR).
+    #[error("cannot read image {path}: {message}")]
+    ImageRead {
+        /// The file.
+        path: String,
+        /// The decoder's message.
+        message: String,
+    },
     /// Encoding an output image.
     #[error("cannot write image {path}: {message}")]
     Image {
@@ -50,6 +58,22 @@ pub enum Error {
         /// The encoder's message.
         message: String,
     },
+}
+
+/// Longest message a decoder may put in an error: a corrupt file can make a decoder describe
+/// itself at length (one flipped bit in a TIFF gave 315,815 bytes).
+const MAX_MESSAGE: usize = 400;
+
+/// `message`, cut at `MAX_MESSAGE` bytes with a note of how much was left out.
+pub(crate) fn clip_message(message: impl std::fmt::Display) -> String {
+    let mut m = message.to_string();
+    if m.len() > MAX_MESSAGE {
+        let cut = (0..=MAX_MESSAGE).rev().find(|&i| m.is_char_boundary(i)).unwrap_or(0);
+        let left = m.len() - cut;
+        m.truncate(cut);
+        m.push_str(&format!("... ({left} more bytes)"));
+    }
+    m
 }
 
 /// The crate's result type.

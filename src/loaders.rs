@@ -53,7 +53,20 @@ impl std::str::FromStr for DType {
 }
 
 fn bad(path: &str, msg: impl std::fmt::Display) -> Error {
-    Error::InvalidArgument(format!("{path}: {msg}"))
+    Error::InvalidArgument(format!("{path}: {}", crate::error::clip_message(msg)))
+}
+
+/// A NIfTI header's `dim[1..=dim[0]]` as the signed values the format stores (the parser reads
+/// them unsigned, so -256 would read as 65280), each checked to be positive.
+fn nifti_dims(header: &nifti::NiftiHeader, what: &str) -> Result<Vec<u64>> {
+    let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
+    dim.iter()
+        .enumerate()
+        .map(|(i, &d)| match d as i16 {
+            d if d > 0 => Ok(d as u64),
+            d => Err(bad(what, format!("NIfTI dim[{}] = {d}: dimensions must be positive", i + 1))),
+        })
+        .collect()
 }
 
 /// Checked voxel count of `dims`.
@@ -110,10 +123,6 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
             .collect(),
     };
     Ok(v)
-}
-
-fn read_file(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| Error::Io { path: path.display().to_string(), source: e })
 }
 
 /// Inflate gzip data, refusing to produce more than `limit` bytes.
@@ -260,7 +269,7 @@ pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<S
             if !enc.as_deref().unwrap_or("raw").starts_with("gz") && len < need {
                 return Err(bad(what, format!("data file {} has {len} bytes, needs {need}", p.display())));
             }
-            read_file(&p)?
+            read_bounded(&p, MAX_INFLATED, what)?
         }
         None => bytes[data_start.min(bytes.len())..].to_vec(),
     };
@@ -322,13 +331,13 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
     }
     let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&head[..348]))
         .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
-    let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
+    let dim = nifti_dims(&header, what)?;
     if dim.is_empty() || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
         return Err(bad(what, "only 3D NIfTI volumes (or 4D with one frame) are supported"));
     }
     let mut d3 = [1u64; 3];
     for (i, d) in dim.iter().take(3).enumerate() {
-        d3[i] = *d as u64;
+        d3[i] = *d;
     }
     voxel_count_within(&d3, what, limit)?;
     let dtype = match header.data_type().map_err(|e| bad(what, format!("NIfTI type: {e}")))? {
@@ -345,11 +354,13 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
     let (slope, inter) = (header.scl_slope, header.scl_inter);
     let scale = (slope.is_finite() && slope != 0.0 && (slope != 1.0 || inter != 0.0) && inter.is_finite())
         .then_some((slope, inter));
+    // pixdim must be finite and non-zero, as NRRD's spacings must be (its sign is the qform's).
     let mut spacing = [1.0f32; 3];
-    for (s, p) in spacing.iter_mut().zip(&header.pixdim[1..4]) {
-        if p.is_finite() && p.abs() > 0.0 {
-            *s = p.abs();
+    for (i, (s, p)) in spacing.iter_mut().zip(&header.pixdim[1..4]).enumerate() {
+        if !(p.is_finite() && p.abs() > 0.0) {
+            return Err(bad(what, format!("pixdim[{}] = {p}: voxel spacings must be finite and non-zero", i + 1)));
         }
+        *s = p.abs();
     }
     Ok(NiftiLayout {
         dims: d3.map(|d| d as u32),
@@ -378,9 +389,7 @@ fn nifti_size(head: &[u8], what: &str) -> Result<u64> {
     }
     let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&head[..348]))
         .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
-    let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
-    let dims: Vec<u64> = dim.iter().map(|&d| d as u64).collect();
-    let n = voxel_count(&dims, what)?;
+    let n = voxel_count(&nifti_dims(&header, what)?, what)?;
     let size = (header.bitpix.max(8) as u64) / 8;
     let off = header.vox_offset;
     if !(off.is_finite() && (348.0..=1e7).contains(&off)) {
@@ -487,24 +496,28 @@ pub(crate) fn raw_layout(path: &Path, hints: &VolumeHints, what: &str) -> Result
 }
 
 /// Load a volume by its extension: `.nrrd`/`.nhdr`, `.nii`/`.nii.gz`, `.npy`, anything else raw.
+/// Only the bytes its header (or `hints`) says the data needs are read, slice by slice where the
+/// format allows (`SliceReader`), after the file is checked to hold them: a device or a file far
+/// larger than its header says is never read whole.
 pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
     let what = path.display().to_string();
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
-    let bytes = read_file(path)?;
-    let mut v = if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
-        nrrd_from_bytes(&bytes, path.parent(), &what)?
-    } else if name.ends_with(".nii") || name.ends_with(".nii.gz") {
-        nifti_from_bytes(&bytes, &what)?
+    let mut v = if let Some(mut reader) = SliceReader::open(path, hints)? {
+        voxel_count(&reader.dims.map(u64::from), &what)?;
+        let mut values = Vec::new();
+        reader.read(0, reader.dims[2], &mut values)?;
+        ScalarVolume { dims: reader.dims, spacing: reader.spacing, values }
     } else if name.ends_with(".npy") {
-        let (shape, values) = npy_from_bytes(&bytes, &what)?;
+        let (shape, values) = npy_from_bytes(&read_npy(path, &what)?, &what)?;
         if shape.len() != 3 {
             return Err(bad(&what, "a volume .npy must be 3D (z, y, x)"));
         }
         ScalarVolume { dims: [shape[2] as u32, shape[1] as u32, shape[0] as u32], spacing: [1.0; 3], values }
     } else {
-        let (dims, dtype, big, spacing) = raw_layout(path, hints, &what)?;
-        raw_from_bytes(&bytes, dims, dtype, big, spacing, &what)?
+        // NRRD in an encoding the slice reader does not take: nrrd_from_bytes refuses it by name.
+        nrrd_from_bytes(&read_bounded(path, MAX_INFLATED, &what)?, path.parent(), &what)?
     };
+    check_finite(&v.values, &what)?;
     if let Some(s) = hints.spacing {
         check_spacing(s, &what)?;
         v.spacing = s;
@@ -512,21 +525,121 @@ pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
     Ok(v)
 }
 
-/// Load heights from a 16-bit (or 8-bit) PNG, a GeoTIFF / TIFF, or a 2D `.npy`.
+/// Whether `path` is raw data by its name (anything but NRRD, NIfTI and npy).
+pub fn is_raw(path: &Path) -> bool {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+    ![".nrrd", ".nhdr", ".nii", ".nii.gz", ".npy"].iter().any(|e| name.ends_with(e))
+}
+
+/// Dims, sample type and byte order describe raw files only: given for a file whose header says
+/// them, they would be ignored, so they are refused.
+pub(crate) fn check_raw_hints(path: &Path, hints: &VolumeHints) -> Result<()> {
+    if !is_raw(path) && (hints.dims.is_some() || hints.dtype.is_some() || hints.big_endian) {
+        return Err(bad(
+            &path.display().to_string(),
+            "dims, sample type and byte order (--dims, --dtype, --big-endian) describe raw files; this file's header gives its own",
+        ));
+    }
+    Ok(())
+}
+
+/// Every loader's rule for samples: NaN and infinities (in the file, or made by a NIfTI
+/// `scl_slope`) are refused, since classification would silently drop or saturate them.
+pub(crate) fn check_finite(values: &[f32], what: &str) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(bad(what, format!("sample {i} is {} (samples must be finite)", values[i]))),
+    }
+}
+
+/// The whole of `path`, refused without reading it when it holds more than `limit` bytes (and
+/// never reading more than `limit` + 1 from a device or pipe that does not say its length).
+fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>> {
+    let io = |e| Error::Io { path: what.to_string(), source: e };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if meta.is_file() && meta.len() > limit {
+        return Err(Error::TooLarge(format!("{what}: {} bytes, more than the {limit} a loader reads", meta.len())));
+    }
+    let mut out = Vec::new();
+    file.take(limit + 1).read_to_end(&mut out).map_err(io)?;
+    if out.len() as u64 > limit {
+        return Err(Error::TooLarge(format!("{what}: more than the {limit} bytes a loader reads")));
+    }
+    Ok(out)
+}
+
+/// An open `.npy` file's header bytes (magic to padding), its shape, and the bytes of data they
+/// say follow.
+fn npy_header(file: &mut std::fs::File, what: &str) -> Result<(Vec<u8>, Vec<u64>, u64)> {
+    let io = |e| Error::Io { path: what.to_string(), source: e };
+    let mut head = Vec::with_capacity(12);
+    let got = file.take(12).read_to_end(&mut head).map_err(io)?;
+    if got < 10 || !head.starts_with(b"\x93NUMPY") {
+        return Err(bad(what, "npy: not an .npy file (no \\x93NUMPY magic)"));
+    }
+    // Version 1 stores the header's length in 2 bytes, versions 2 and 3 in 4.
+    let (len, start) = match head[6] {
+        1 => (u16::from_le_bytes([head[8], head[9]]) as usize, 10),
+        2 | 3 if got == 12 => (u32::from_le_bytes([head[8], head[9], head[10], head[11]]) as usize, 12),
+        v => return Err(bad(what, format!("npy: unsupported format version {v}"))),
+    };
+    if len > 1 << 20 || start + len < got {
+        return Err(bad(what, format!("npy: a header of {len} bytes")));
+    }
+    file.take((start + len - got) as u64).read_to_end(&mut head).map_err(io)?;
+    let npy = npyz::NpyFile::new(&head[..]).map_err(|e| bad(what, format!("npy: {e}")))?;
+    let shape = npy.shape().to_vec();
+    let n = voxel_count(&shape, what)?;
+    let npyz::DType::Plain(ts) = npy.dtype() else { return Err(bad(what, "structured npy arrays are not supported")) };
+    let need = n.checked_mul(ts.size_field()).ok_or_else(|| bad(what, "size overflows"))?;
+    Ok((head, shape, need))
+}
+
+/// The shape an `.npy` file's header gives (its data unread): rank 2 is a height grid, 3 a volume.
+pub fn npy_shape(path: &Path) -> Result<Vec<u64>> {
+    let what = path.display().to_string();
+    let mut file = std::fs::File::open(path).map_err(|e| Error::Io { path: what.clone(), source: e })?;
+    Ok(npy_header(&mut file, &what)?.1)
+}
+
+/// An `.npy` file's header and exactly the data its shape and type need (checked against the
+/// file's length first).
+fn read_npy(path: &Path, what: &str) -> Result<Vec<u8>> {
+    let io = |e| Error::Io { path: what.to_string(), source: e };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let (mut bytes, _, need) = npy_header(&mut file, what)?;
+    let on_disk = file.metadata().map_err(io)?.len();
+    if on_disk < bytes.len() as u64 + need {
+        return Err(bad(
+            what,
+            format!("data is truncated: {} bytes for {need}", on_disk.saturating_sub(bytes.len() as u64)),
+        ));
+    }
+    file.take(need).read_to_end(&mut bytes).map_err(io)?;
+    Ok(bytes)
+}
+
+/// Load heights from a 16-bit (or 8-bit) PNG, a GeoTIFF / TIFF, or a 2D `.npy` (finite values,
+/// as `check_finite` requires of volumes).
 pub fn load_heights(path: &Path) -> Result<HeightGrid> {
+    let grid = load_height_file(path)?;
+    check_finite(&grid.heights, &path.display().to_string())?;
+    Ok(grid)
+}
+
+fn load_height_file(path: &Path) -> Result<HeightGrid> {
     let what = path.display().to_string();
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
     if name.ends_with(".npy") {
-        let bytes = read_file(path)?;
-        let (shape, heights) = npy_from_bytes(&bytes, &what)?;
+        let (shape, heights) = npy_from_bytes(&read_npy(path, &what)?, &what)?;
         if shape.len() != 2 {
             return Err(bad(&what, "a height .npy must be 2D (rows, columns)"));
         }
         return Ok(HeightGrid { width: shape[1] as u32, rows: shape[0] as u32, heights });
     }
     if name.ends_with(".tif") || name.ends_with(".tiff") {
-        let bytes = read_file(path)?;
-        return tiff_heights(&bytes, &what);
+        return tiff_heights(&read_bounded(path, MAX_INFLATED, &what)?, &what);
     }
     let mut reader = image::ImageReader::open(path)
         .map_err(|e| Error::Io { path: what.clone(), source: e })?

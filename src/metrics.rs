@@ -41,18 +41,39 @@ pub fn compare(img: &ImageF32, truth: &ImageF32) -> Result<ImageMetrics> {
     let n = (img.pixels.len() * 4).max(1) as f64;
     let rmse = (se / n).sqrt();
     let psnr = if rmse > 0.0 { 20.0 * (1.0 / rmse).log10() } else { f64::INFINITY };
-    let luma = |im: &ImageF32| -> Vec<f64> {
-        im.pixels.iter().map(|p| 0.2126 * clamp01(p[0]) + 0.7152 * clamp01(p[1]) + 0.0722 * clamp01(p[2])).collect()
-    };
-    let alpha = |im: &ImageF32| -> Vec<f64> { im.pixels.iter().map(|p| clamp01(p[3])).collect() };
-    let (w, h) = (img.width as usize, img.height as usize);
+    let luma = |p: &[f32; 4]| 0.2126 * clamp01(p[0]) + 0.7152 * clamp01(p[1]) + 0.0722 * clamp01(p[2]);
     Ok(ImageMetrics {
         rmse,
         psnr,
         max_abs,
-        ssim_luma: ssim(&luma(img), &luma(truth), w, h),
-        ssim_alpha: ssim(&alpha(img), &alpha(truth), w, h),
+        ssim_luma: ssim_banded(img, truth, luma),
+        ssim_alpha: ssim_banded(img, truth, |p| clamp01(p[3])),
     })
+}
+
+/// Rows per band of `ssim_banded`.
+const SSIM_BAND: usize = 64;
+
+/// `ssim` of the channel `f` of two images of one size, band by band of rows with the window's
+/// 5-row halo: the same value (the window never reaches past a band's halo), with memory that
+/// follows a band instead of the image (an 8192² comparison held gigabytes of whole-image
+/// buffers), and bands in parallel.
+fn ssim_banded(a: &ImageF32, b: &ImageF32, f: impl Fn(&[f32; 4]) -> f64 + Sync) -> f64 {
+    use rayon::prelude::*;
+    let (w, h) = (a.width as usize, a.height as usize);
+    if w * h == 0 {
+        return 1.0;
+    }
+    let sum: f64 = (0..h.div_ceil(SSIM_BAND))
+        .into_par_iter()
+        .map(|band| {
+            let (y0, y1) = (band * SSIM_BAND, ((band + 1) * SSIM_BAND).min(h));
+            let (h0, h1) = (y0.saturating_sub(5), (y1 + 5).min(h));
+            let take = |im: &ImageF32| -> Vec<f64> { im.pixels[h0 * w..h1 * w].iter().map(&f).collect() };
+            ssim_map_sum(&take(a), &take(b), w, h1 - h0, y0 - h0..y1 - h0)
+        })
+        .sum();
+    sum / (w * h) as f64
 }
 
 /// Separable Gaussian blur (sigma 1.5, 11 taps, edges clamped), the SSIM window of Wang et al.
@@ -89,17 +110,22 @@ pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize) -> f64 {
     if a.is_empty() {
         return 1.0;
     }
+    ssim_map_sum(a, b, w, h, 0..h) / a.len() as f64
+}
+
+/// The SSIM map of `a` against `b` (`w` x `h`) summed over `rows`.
+fn ssim_map_sum(a: &[f64], b: &[f64], w: usize, h: usize, rows: std::ops::Range<usize>) -> f64 {
     let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));
     let prod = |x: &[f64], y: &[f64]| -> Vec<f64> { x.iter().zip(y).map(|(p, q)| p * q).collect() };
     let (ma, mb) = (blur(a, w, h), blur(b, w, h));
     let (aa, bb, ab) = (blur(&prod(a, a), w, h), blur(&prod(b, b), w, h), blur(&prod(a, b), w, h));
     let mut sum = 0.0;
-    for i in 0..a.len() {
+    for i in rows.start * w..rows.end * w {
         let (va, vb, cov) = (aa[i] - ma[i] * ma[i], bb[i] - mb[i] * mb[i], ab[i] - ma[i] * mb[i]);
         sum +=
             ((2.0 * ma[i] * mb[i] + c1) * (2.0 * cov + c2)) / ((ma[i] * ma[i] + mb[i] * mb[i] + c1) * (va + vb + c2));
     }
-    sum / a.len() as f64
+    sum
 }
 
 /// RMSE over the pixels where `keep(pixel index)` holds; `None` when no pixel is kept.

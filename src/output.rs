@@ -2,6 +2,9 @@
 //! premultiplied alpha (EXR's own convention). Values are written as computed: no sRGB curve.
 use crate::error::{Error, Result};
 use crate::image::ImageF32;
+use image::ImageEncoder as _;
+use std::fs::File;
+use std::io::{BufWriter, Write as _};
 use std::path::Path;
 
 /// Straight-alpha RGBA8 pixels of a premultiplied float image.
@@ -16,44 +19,150 @@ pub fn to_rgba8(img: &ImageF32) -> Vec<u8> {
     out
 }
 
-/// Write `img` as PNG or EXR, chosen by the extension.
-pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
-    let name = path.display().to_string();
-    let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("png") => image::save_buffer(path, &to_rgba8(img), img.width, img.height, image::ExtendedColorType::Rgba8)
-            .map_err(|e| Error::Image { path: name, message: e.to_string() }),
-        Some("exr") => {
-            let w = img.width as usize;
-            exr::prelude::write_rgba_file(path, w, img.height as usize, |x, y| {
-                let p = img.pixels[y * w + x];
-                (p[0], p[1], p[2], p[3])
-            })
-            .map_err(|e| Error::Image { path: name, message: e.to_string() })
+/// The formats `write_image` writes, by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// RGBA8, straight alpha.
+    Png,
+    /// RGBA32F, premultiplied alpha.
+    Exr,
+}
+
+impl ImageFormat {
+    /// The format `path`'s extension names, or a typed error: callers check `--out` before
+    /// rendering, not after.
+    pub fn of(path: &Path) -> Result<Self> {
+        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+            Some("png") => Ok(ImageFormat::Png),
+            Some("exr") => Ok(ImageFormat::Exr),
+            _ => Err(Error::InvalidArgument(format!("output '{}' must end in .png or .exr", path.display()))),
         }
-        _ => Err(Error::InvalidArgument(format!("output '{name}' must end in .png or .exr"))),
     }
 }
 
-/// An animated GIF of premultiplied frames over a dark background, `delay_ms` per frame.
-pub fn write_gif(frames: &[ImageF32], path: &Path, delay_ms: u32) -> Result<()> {
-    use image::codecs::gif::{GifEncoder, Repeat};
+/// Create `path` and write it through a buffer whose last flush is checked: a full disk or a
+/// closed pipe is an error, not a short file and a success.
+fn write_file(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<()> {
     let name = path.display().to_string();
-    let file = std::fs::File::create(path).map_err(|e| Error::Io { path: name.clone(), source: e })?;
-    let mut enc = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
-    enc.set_repeat(Repeat::Infinite).map_err(|e| Error::Image { path: name.clone(), message: e.to_string() })?;
-    let bg = [0.12f32, 0.12, 0.16];
-    for f in frames {
+    let io = |source| Error::Io { path: name.clone(), source };
+    let mut w = BufWriter::new(File::create(path).map_err(io)?);
+    write(&mut w)?;
+    w.flush().map_err(io)
+}
+
+/// Write `img` as PNG or EXR, chosen by the extension.
+pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
+    let format = ImageFormat::of(path)?;
+    let encoding = |message: String| Error::Image { path: path.display().to_string(), message };
+    write_file(path, |w| match format {
+        ImageFormat::Png => image::codecs::png::PngEncoder::new(w)
+            .write_image(&to_rgba8(img), img.width, img.height, image::ExtendedColorType::Rgba8)
+            .map_err(|e| encoding(e.to_string())),
+        ImageFormat::Exr => {
+            use exr::prelude::WritableImage as _;
+            let width = img.width as usize;
+            let channels =
+                exr::prelude::SpecificChannels::rgba(|exr::prelude::Vec2(x, y): exr::prelude::Vec2<usize>| {
+                    let p = img.pixels[y * width + x];
+                    (p[0], p[1], p[2], p[3])
+                });
+            exr::prelude::Image::from_channels((width, img.height as usize), channels)
+                .write()
+                .to_buffered(w)
+                .map_err(|e| encoding(e.to_string()))
+        }
+    })
+}
+
+/// An animated GIF written frame by frame over a dark background (`delay_ms` per frame), so a
+/// long animation holds one frame at a time; `finish` writes the trailer and checks the flush.
+pub struct GifWriter {
+    path: std::path::PathBuf,
+    encoder: image::codecs::gif::GifEncoder<SharedWriter>,
+    file: std::sync::Arc<std::sync::Mutex<BufWriter<File>>>,
+    delay_ms: u32,
+}
+
+/// The GIF encoder's handle on the file: the encoder writes its trailer when dropped, and the
+/// file is flushed after that, through the other handle.
+struct SharedWriter(std::sync::Arc<std::sync::Mutex<BufWriter<File>>>);
+
+impl std::io::Write for SharedWriter {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().map_err(|_| std::io::Error::other("GIF writer poisoned"))?.write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.lock().map_err(|_| std::io::Error::other("GIF writer poisoned"))?.flush()
+    }
+}
+
+impl GifWriter {
+    /// Create `path`.
+    pub fn create(path: &Path, delay_ms: u32) -> Result<Self> {
+        let name = path.display().to_string();
+        let file = File::create(path).map_err(|source| Error::Io { path: name.clone(), source })?;
+        let file = std::sync::Arc::new(std::sync::Mutex::new(BufWriter::new(file)));
+        let mut encoder = image::codecs::gif::GifEncoder::new_with_speed(SharedWriter(file.clone()), 10);
+        encoder
+            .set_repeat(image::codecs::gif::Repeat::Infinite)
+            .map_err(|e| Error::Image { path: name, message: e.to_string() })?;
+        Ok(Self { path: path.to_path_buf(), encoder, file, delay_ms })
+    }
+
+    /// Append a premultiplied frame.
+    pub fn push(&mut self, f: &ImageF32) -> Result<()> {
+        let bg = [0.12f32, 0.12, 0.16];
         let mut rgba = image::RgbaImage::new(f.width, f.height);
         for (px, p) in rgba.pixels_mut().zip(&f.pixels) {
             let a = p[3].clamp(0.0, 1.0);
             let c = |i: usize| ((p[i] + bg[i] * (1.0 - a)).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
             *px = image::Rgba([c(0), c(1), c(2), 255]);
         }
-        let frame = image::Frame::from_parts(rgba, 0, 0, image::Delay::from_numer_denom_ms(delay_ms, 1));
-        enc.encode_frame(frame).map_err(|e| Error::Image { path: name.clone(), message: e.to_string() })?;
+        let frame = image::Frame::from_parts(rgba, 0, 0, image::Delay::from_numer_denom_ms(self.delay_ms, 1));
+        self.encoder
+            .encode_frame(frame)
+            .map_err(|e| Error::Image { path: self.path.display().to_string(), message: e.to_string() })
     }
-    Ok(())
+
+    /// Write the trailer and flush, checked.
+    pub fn finish(self) -> Result<()> {
+        let name = self.path.display().to_string();
+        let io = |source| Error::Io { path: name.clone(), source };
+        // The trailer is written when the encoder is dropped.
+        drop(self.encoder);
+        let mut w = self.file.lock().map_err(|_| io(std::io::Error::other("GIF writer poisoned")))?;
+        w.flush().map_err(io)
+    }
+}
+
+/// An animated GIF of premultiplied frames over a dark background, `delay_ms` per frame.
+pub fn write_gif(frames: &[ImageF32], path: &Path, delay_ms: u32) -> Result<()> {
+    let mut gif = GifWriter::create(path, delay_ms)?;
+    for f in frames {
+        gif.push(f)?;
+    }
+    gif.finish()
+}
+
+/// A PNG (or any format `image` guesses) as straight RGBA8, within `MAX_PIXELS` (a terrain's
+/// colour image).
+pub fn read_rgba8(path: &Path) -> Result<image::RgbaImage> {
+    let name = path.display().to_string();
+    let mut reader = image::ImageReader::open(path)
+        .map_err(|e| Error::Io { path: name.clone(), source: e })?
+        .with_guessed_format()
+        .map_err(|e| Error::Io { path: name.clone(), source: e })?;
+    reader.limits(image_limits());
+    Ok(reader.decode().map_err(|e| Error::ImageRead { path: name, message: crate::error::clip_message(e) })?.to_rgba8())
+}
+
+/// Decoder limits for input images: `MAX_IMAGE_SIDE` a side, `MAX_PIXELS` RGBA32F in memory.
+fn image_limits() -> image::Limits {
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(crate::camera::MAX_IMAGE_SIDE);
+    limits.max_image_height = Some(crate::camera::MAX_IMAGE_SIDE);
+    limits.max_alloc = Some(crate::camera::MAX_PIXELS * 16);
+    limits
 }
 
 /// Read a PNG (straight alpha, 8 or 16 bit) or an EXR (premultiplied) as a premultiplied float
@@ -61,7 +170,7 @@ pub fn write_gif(frames: &[ImageF32], path: &Path, delay_ms: u32) -> Result<()> 
 pub fn read_image(path: &Path) -> Result<ImageF32> {
     use crate::camera::MAX_PIXELS;
     let name = path.display().to_string();
-    let bad = |message: String| Error::Image { path: name.clone(), message };
+    let bad = |message: String| Error::ImageRead { path: name.clone(), message: crate::error::clip_message(message) };
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     match ext.as_deref() {
         Some("png") => {
@@ -69,14 +178,20 @@ pub fn read_image(path: &Path) -> Result<ImageF32> {
                 .map_err(|e| Error::Io { path: name.clone(), source: e })?
                 .with_guessed_format()
                 .map_err(|e| Error::Io { path: name.clone(), source: e })?;
-            let mut limits = image::Limits::default();
-            limits.max_image_width = Some(crate::camera::MAX_IMAGE_SIDE);
-            limits.max_image_height = Some(crate::camera::MAX_IMAGE_SIDE);
-            limits.max_alloc = Some(MAX_PIXELS * 16);
-            reader.limits(limits);
-            let img = reader.decode().map_err(|e| bad(e.to_string()))?.to_rgba32f();
-            let (width, height) = img.dimensions();
-            let pixels = img.pixels().map(|p| [p[0] * p[3], p[1] * p[3], p[2] * p[3], p[3]]).collect();
+            reader.limits(image_limits());
+            let img = reader.decode().map_err(|e| bad(e.to_string()))?;
+            let (width, height) = (img.width(), img.height());
+            let premultiplied = |p: [f32; 4]| [p[0] * p[3], p[1] * p[3], p[2] * p[3], p[3]];
+            // Straight to premultiplied floats, without a whole RGBA32F copy in between.
+            let pixels = match &img {
+                image::DynamicImage::ImageRgba8(b) => {
+                    b.pixels().map(|p| premultiplied(p.0.map(|v| v as f32 / 255.0))).collect()
+                }
+                image::DynamicImage::ImageRgba16(b) => {
+                    b.pixels().map(|p| premultiplied(p.0.map(|v| v as f32 / 65535.0))).collect()
+                }
+                other => other.to_rgba32f().pixels().map(|p| premultiplied(p.0)).collect(),
+            };
             Ok(ImageF32 { width, height, pixels })
         }
         Some("exr") => {

@@ -64,6 +64,16 @@ pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet>
     }
     let (hmin, hmax) = finite.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
     let cell = if opts.cell > 0.0 { opts.cell } else { ((hmax - hmin) / (w.max(rows) as f32 / 6.0)).max(1e-6) };
+    // The top level in f64 before any cast: a huge --vscale would saturate the u32 and wrap the
+    // grid's height to 0.
+    let top = ((hmax as f64 - hmin as f64) / cell as f64 * opts.vscale as f64).round();
+    if top.is_nan() || top >= MAX_LEVELS as f64 {
+        return Err(Error::TooLarge(format!(
+            "{top:e} height levels (relief {} at cell {cell} and vscale {}) exceed {MAX_LEVELS}: lower --vscale",
+            hmax - hmin,
+            opts.vscale
+        )));
+    }
     let level_of = |v: f32| -> u32 {
         let v = if v.is_finite() { v } else { hmin };
         ((v - hmin) / cell * opts.vscale).round().max(0.0) as u32

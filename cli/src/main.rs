@@ -33,9 +33,15 @@ enum Command {
         dims: Option<[u32; 3]>,
         #[arg(long, value_parser = ["u8", "u16", "i16", "f32"])]
         dtype: Option<String>,
-        /// Transfer function for the splat count.
+        /// Transfer function for the splat count: a preset (ramp, ct, bonsai) or a TOML file.
         #[arg(long, default_value = "ramp")]
         tf: String,
+        /// Vertical exaggeration of a height grid (as `render --vscale`).
+        #[arg(long, value_parser = parse_finite, default_value = "1")]
+        vscale: f32,
+        /// Horizontal cell size of a height grid (as `render --cell`; 0: relief a sixth of the width).
+        #[arg(long, value_parser = parse_finite, default_value = "0")]
+        cell: f32,
     },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
     Animate(AnimateArgs),
@@ -218,7 +224,7 @@ fn parse_finite(s: &str) -> std::result::Result<f32, String> {
 #[derive(Args)]
 struct SceneArgs {
     /// Built-in scene name (see `voxsplat scenes`).
-    #[arg(long, default_value = "cube60")]
+    #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain"])]
     scene: String,
     /// Eye position (default: a three-quarter view framing the scene).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -253,16 +259,16 @@ struct SceneArgs {
     #[arg(long, conflicts_with = "terrain")]
     volume: Option<PathBuf>,
     /// Raw volume dimensions.
-    #[arg(long, value_parser = parse_dims)]
+    #[arg(long, value_parser = parse_dims, requires = "volume")]
     dims: Option<[u32; 3]>,
     /// Raw sample type.
-    #[arg(long, value_parser = ["u8", "u16", "i16", "f32"])]
+    #[arg(long, value_parser = ["u8", "u16", "i16", "f32"], requires = "volume")]
     dtype: Option<String>,
     /// Raw data is big-endian.
-    #[arg(long)]
+    #[arg(long, requires = "volume")]
     big_endian: bool,
     /// Voxel spacing (overrides the file's).
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, requires = "volume")]
     spacing: Option<Vec3>,
     /// Transfer function: a preset (ramp, ct, bonsai) or a TOML file.
     #[arg(long, default_value = "ramp")]
@@ -377,7 +383,7 @@ struct RenderArgs {
     timings: bool,
     /// Render the frame this many times and report each stage's median (the first frames pay
     /// one-off costs: allocation, shader compilation on some drivers).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, conflicts_with_all = ["raycast", "truth"])]
     repeat: u32,
     /// Output file, .png or .exr.
     #[arg(long)]
@@ -490,11 +496,16 @@ fn print_store(store: &voxsplat::bricks::BrickStore) {
 
 /// The --tf preset or TOML file.
 fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFunction> {
-    if a.tf.ends_with(".toml") {
-        let text = std::fs::read_to_string(&a.tf).map_err(|e| Error::Io { path: a.tf.clone(), source: e })?;
+    load_tf(&a.tf)
+}
+
+/// A transfer-function preset by name, or a TOML file.
+fn load_tf(spec: &str) -> Result<voxsplat::classify::TransferFunction> {
+    if spec.ends_with(".toml") {
+        let text = std::fs::read_to_string(spec).map_err(|e| Error::Io { path: spec.to_string(), source: e })?;
         voxsplat::classify::TransferFunction::from_toml(&text)
     } else {
-        voxsplat::classify::TransferFunction::preset(&a.tf)
+        voxsplat::classify::TransferFunction::preset(spec)
     }
 }
 
@@ -551,11 +562,7 @@ fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
     } else if let Some(path) = &a.terrain {
         let heights = voxsplat::loaders::load_heights(path)?;
         let color = match &a.color {
-            Some(c) => Some(
-                image::open(c)
-                    .map_err(|e| Error::Image { path: c.display().to_string(), message: e.to_string() })?
-                    .to_rgba8(),
-            ),
+            Some(c) => Some(voxsplat::output::read_rgba8(c)?),
             None => None,
         };
         let opts = voxsplat::terrain::TerrainOptions { cell: a.cell, vscale: a.vscale, color, ..Default::default() };
@@ -574,14 +581,22 @@ fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
     Ok(set)
 }
 
+/// `mib` MiB in bytes: positive, and without wrapping past u64.
+fn mib_bytes(mib: u64, flag: &str) -> Result<u64> {
+    match mib.checked_mul(1 << 20) {
+        Some(b) if b > 0 => Ok(b),
+        Some(_) => Err(Error::InvalidArgument(format!("{flag} must be positive"))),
+        None => {
+            Err(Error::InvalidArgument(format!("{flag} {mib} overflows a byte count (at most {} MiB)", u64::MAX >> 20)))
+        }
+    }
+}
+
 fn renderer_of(a: &SceneArgs) -> Result<Renderer> {
     let mut opts = RendererOptions::default();
     opts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
     opts.validation = a.validation;
-    if a.gpu_budget_mib == 0 {
-        return Err(Error::InvalidArgument("--gpu-budget-mib must be positive".into()));
-    }
-    opts.gpu_budget_bytes = a.gpu_budget_mib << 20;
+    opts.gpu_budget_bytes = mib_bytes(a.gpu_budget_mib, "--gpu-budget-mib")?;
     let mut r = Renderer::new(&opts)?;
     r.set_bisect(a.bisect)?;
     Ok(r)
@@ -619,6 +634,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Render(a) => {
+            voxsplat::output::ImageFormat::of(&a.out)?;
             let order = a.scene.order.parse::<OrderKind>()?;
             let composite = a.composite.parse::<Composite>()?;
             // A volume is a bricked store classified on the device unless a mode needs host splats.
@@ -641,10 +657,7 @@ fn run(cli: Cli) -> Result<()> {
                 a.direction
                     .as_deref()
                     .map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
-            if a.sheet_budget_mib == 0 {
-                return Err(Error::InvalidArgument("--sheet-budget-mib must be positive".into()));
-            }
-            opts.sheet_budget_bytes = a.sheet_budget_mib << 20;
+            opts.sheet_budget_bytes = mib_bytes(a.sheet_budget_mib, "--sheet-budget-mib")?;
             opts.slab_thickness = a.slab_thickness;
             opts.early_termination = a.early_termination;
             opts.cull_hidden_bricks = !a.keep_hidden_bricks;
@@ -814,14 +827,29 @@ fn run(cli: Cli) -> Result<()> {
             println!("validation messages: {}", rep.validation_messages);
             Ok(())
         }
-        Command::Info { file, dims, dtype, tf } => {
+        Command::Info { file, dims, dtype, tf, vscale, cell } => {
             let name = file.display().to_string().to_ascii_lowercase();
-            let set = if name.ends_with(".tif") || name.ends_with(".tiff") || name.ends_with(".png") {
+            let heights = name.ends_with(".tif")
+                || name.ends_with(".tiff")
+                || name.ends_with(".png")
+                || (name.ends_with(".npy") && voxsplat::loaders::npy_shape(&file)?.len() == 2);
+            if heights && (dims.is_some() || dtype.is_some() || tf != "ramp") {
+                return Err(Error::InvalidArgument(
+                    "--dims, --dtype and --tf describe volumes, not height grids".into(),
+                ));
+            }
+            if !heights && (vscale != 1.0 || cell != 0.0) {
+                return Err(Error::InvalidArgument("--vscale and --cell describe height grids, not volumes".into()));
+            }
+            let tf = load_tf(&tf)?;
+            let set = if heights {
                 let h = voxsplat::loaders::load_heights(&file)?;
                 let (lo, hi) =
                     h.heights.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
                 println!("height grid: {} x {} cells, heights {lo} .. {hi}", h.width, h.rows);
-                voxsplat::terrain::terrain_splats(&h, &Default::default())?
+                // The columns `render --terrain` draws with the same --cell and --vscale.
+                let opts = voxsplat::terrain::TerrainOptions { cell, vscale, ..Default::default() };
+                voxsplat::terrain::terrain_splats(&h, &opts)?
             } else {
                 let hints = voxsplat::loaders::VolumeHints {
                     dims,
@@ -853,7 +881,7 @@ fn run(cli: Cli) -> Result<()> {
                     v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
                 println!("volume: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
                 print_store(&voxsplat::bricks::BrickStore::build(&v)?);
-                voxsplat::classify::classify(&v, &voxsplat::classify::TransferFunction::preset(&tf)?, None)?
+                voxsplat::classify::classify(&v, &tf, None)?
             };
             println!("splats: {}", set.len());
             println!("bytes per splat (--dense): {:.0}", voxsplat::gpu_bytes_per_splat(&set));
@@ -882,7 +910,16 @@ fn run(cli: Cli) -> Result<()> {
                 return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
             }
             match volume {
-                Some(v) => println!("{}", voxsplat_cli::bricked::one_volume(&v, size, gpu_budget_mib, &tf, frames)?),
+                Some(v) => println!(
+                    "{}",
+                    voxsplat_cli::bricked::one_volume(
+                        &v,
+                        size,
+                        mib_bytes(gpu_budget_mib, "--gpu-budget-mib")? >> 20,
+                        &tf,
+                        frames
+                    )?
+                ),
                 None => print!(
                     "{}",
                     voxsplat_cli::bricked::study(&bonsai, large.as_deref(), size, frames, lod_chart.as_deref())?
@@ -932,8 +969,10 @@ fn animate(a: AnimateArgs) -> Result<()> {
         Animation::builtin(&a.anim)?
     };
     let blur: Blur = a.blur.parse()?;
+    voxsplat::output::ImageFormat::of(std::path::Path::new(&format!("frame.{}", a.format)))?;
     let set = scene::build(&anim.scene)?;
     let grid = *set.grid();
+    anim.check_path(&grid, blur)?;
     let mut opts = RenderOptions::default();
     opts.composite = a.composite.parse::<Composite>()?;
     opts.order = a.order.parse::<OrderKind>()?;
@@ -943,16 +982,16 @@ fn animate(a: AnimateArgs) -> Result<()> {
     r.set_scene(set)?;
     std::fs::create_dir_all(&a.out_dir).map_err(|e| Error::Io { path: a.out_dir.display().to_string(), source: e })?;
     let bar = indicatif::ProgressBar::new(anim.frames as u64);
-    let mut gif_frames = Vec::new();
+    // Frames go to the GIF as they are drawn: one frame held at a time.
+    let mut gif = voxsplat::output::GifWriter::create(&a.out_dir.join("anim.gif"), 1000 / 12)?;
     for i in 0..anim.frames {
         let img = render_frame(&mut r, &anim, &grid, i, blur, &opts)?;
         voxsplat::output::write_image(&img, &a.out_dir.join(format!("frame{i:04}.{}", a.format)))?;
-        gif_frames.push(img);
+        gif.push(&img)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let gif = a.out_dir.join("anim.gif");
-    voxsplat::output::write_gif(&gif_frames, &gif, 1000 / 12)?;
+    gif.finish()?;
     eprintln!("{} frames -> {}", anim.frames, a.out_dir.display());
     Ok(())
 }

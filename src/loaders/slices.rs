@@ -99,6 +99,7 @@ impl SliceReader {
     /// data's length before anything is read.
     pub fn open(path: &Path, hints: &VolumeHints) -> Result<Option<Self>> {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+        super::check_raw_hints(path, hints)?;
         if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
             Self::nrrd(path)
         } else if name.ends_with(".nii") || name.ends_with(".nii.gz") {
@@ -215,6 +216,6 @@ impl SliceReader {
         if let Some(l) = &self.rescale {
             l.rescale(out);
         }
-        Ok(())
+        super::check_finite(out, &self.what)
     }
 }
