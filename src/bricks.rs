@@ -126,9 +126,10 @@ impl BrickStore {
         }
         let lo = lo.min(background);
         let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo)) } else { (0.0, 0.0) };
-        // A constant volume has no background: keep its voxels (its minimum would drop them all,
-        // and a one-voxel opaque volume would draw nothing) and let the TF classify them.
-        let lo = if hi > lo { lo } else { lo - lo.abs().max(1.0) };
+        // A constant volume has no background: its voxels are kept (the minimum would drop them
+        // all, and a one-voxel opaque volume drew nothing) at quantised 0, which the TF classifies
+        // as the dense path does (density 0 without a TF range, the value's own with one).
+        let constant = hi <= lo;
         let span = if hi > lo { hi - lo } else { 1.0 };
         let mut store = Self {
             dims,
@@ -153,7 +154,7 @@ impl BrickStore {
                             continue;
                         }
                         let v = slab[(z - bz * BRICK) as usize * plane + (x + nx * y) as usize];
-                        if !(v.is_finite() && v > lo) {
+                        if !(v.is_finite() && (v > lo || constant)) {
                             continue;
                         }
                         let q = ((v - lo) / span * Q).round().clamp(0.0, Q) as u32;

@@ -60,7 +60,7 @@ impl Camera {
         let fov = 35.0f32;
         // The nearest splats must clear the near plane by the cull margin (CULL_RADII of the widest
         // kernel's radius), or a grid a few voxels wide would frame its eye inside it and draw nothing.
-        let reach = crate::cpu::splat_params::CULL_RADII
+        let reach = crate::constants::CULL_RADII
             * crate::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max)
             * grid.kernel_spacing();
         let dist = (radius / (0.5 * fov.to_radians()).sin() * 1.05).max((radius + reach) / 0.98);

@@ -98,3 +98,7 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("RECORD_PAGE", RECORD_PAGE),
     ("PYRAMID_PAGE", PYRAMID_PAGE),
 ];
+
+/// Splats closer than this many radii to the near or far plane are culled (the quad's corners
+/// must stay in front of the eye; 1.5 > sqrt 2); the framing view keeps the nearest voxels clear.
+pub const CULL_RADII: f32 = 1.5;

@@ -1,7 +1,9 @@
 //! Volume and height-grid loaders. Every size that comes from a header is checked against
-//! `MAX_VOXELS` and against the bytes actually present before anything is allocated from it;
-//! malformed input gives `Error::InvalidFile`-style typed errors (`Error::InvalidArgument` with the
-//! file's name), never a panic.
+//! `MAX_VOXELS` and against the bytes actually present before anything is allocated from it, and
+//! files are read only as far as their header (or `--dims`) says the data goes; malformed input
+//! gives typed errors (`Error::InvalidArgument` with the file's name, `Error::TooLarge`), never a
+//! panic. One rule for values in every format: samples must be finite (NaN, infinities, and a
+//! NIfTI `scl_slope` that overflows are errors), spacings finite and non-zero.
 use crate::error::{Error, Result};
 pub use crate::volume::{HeightGrid, ScalarVolume};
 use std::io::Read;
@@ -157,7 +159,9 @@ pub fn raw_from_bytes(
         return Err(bad(what, format!("has {} bytes; {dims:?} of {dtype:?} needs {need}", bytes.len())));
     }
     check_spacing(spacing, what)?;
-    Ok(ScalarVolume { dims, spacing, values: decode(bytes, n, dtype, big_endian, what)? })
+    let values = decode(bytes, n, dtype, big_endian, what)?;
+    check_finite(&values, what)?;
+    Ok(ScalarVolume { dims, spacing, values })
 }
 
 pub(crate) fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
@@ -279,6 +283,7 @@ pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<S
         other => return Err(bad(what, format!("unsupported encoding '{other}' (raw, gzip)"))),
     };
     let values = decode(&data, n, dtype, endian_big, what)?;
+    check_finite(&values, what)?;
     Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
 }
 
@@ -297,6 +302,7 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
     let n = l.dims.iter().map(|&d| d as u64).product();
     let mut values = decode(&data[l.offset as usize..], n, l.dtype, l.big_endian, what)?;
     l.rescale(&mut values);
+    check_finite(&values, what)?;
     Ok(ScalarVolume { dims: l.dims, spacing: l.spacing, values })
 }
 
@@ -458,6 +464,7 @@ pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> 
     if values.len() as u64 != n {
         return Err(bad(what, "data is truncated"));
     }
+    check_finite(&values, what)?;
     Ok((shape, values))
 }
 

@@ -379,17 +379,17 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
     let params = crate::cpu::raycast::raycast_params(&prep.set, camera, opts);
     let diagonal = glam::Vec3::from_slice(&params.box_max[..3]).distance(glam::Vec3::from_slice(&params.box_min[..3]));
     let steps = (diagonal / params.box_min[3]).ceil();
+    if e.is_device() && steps > MAX_GPU_RAY_STEPS as f32 {
+        return Err(Error::TooLarge(format!(
+            "rays of up to {steps} samples: the GPU ray caster takes at most {MAX_GPU_RAY_STEPS} per ray (llvmpipe \
+             ends a shader's loops after 65535 iterations); use a longer step or the CPU backend"
+        )));
+    }
     // Both engines refuse rays that max_steps would end early (a silently faint picture otherwise).
     if steps.is_nan() || steps > opts.max_steps as f32 {
         return Err(Error::TooLarge(format!(
             "rays of up to {steps} samples at step {}: more than max_steps ({}); use a longer step",
             opts.step, opts.max_steps
-        )));
-    }
-    if e.is_device() && steps > MAX_GPU_RAY_STEPS as f32 {
-        return Err(Error::TooLarge(format!(
-            "rays of up to {steps} samples: the GPU ray caster takes at most {MAX_GPU_RAY_STEPS} per ray (llvmpipe \
-             ends a shader's loops after 65535 iterations); use a longer step or the CPU backend"
         )));
     }
     let (w, h) = (camera.width, camera.height);

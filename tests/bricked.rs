@@ -210,7 +210,8 @@ fn a_transfer_function_change_is_the_new_classification_and_empty_is_an_empty_fr
     assert!(empty.pixels.iter().all(|p| *p == [0.0; 4]));
     let slots = changed.probe(&cam, &o, StageId::BrickCull, &[Res::BrickSlots]).unwrap();
     assert!(slots[0].iter().all(|&w| w == 0));
-    // A volume with nothing above its minimum stores nothing and draws nothing.
+    // A volume with nothing above its minimum draws what the TF makes of that one value, as the
+    // dense path does: nothing under this ramp (tests/hostile.rs: an opaque one draws).
     let flat = ScalarVolume { dims: [9, 9, 9], spacing: [1.0; 3], values: vec![3.0; 729] };
     changed.set_volume(&flat, &tf(), None).unwrap();
     assert!(changed.render(&cam, &o).unwrap().image.pixels.iter().all(|p| *p == [0.0; 4]));

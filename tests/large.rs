@@ -133,7 +133,8 @@ fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
 }
 
 /// The GPU ray caster's sample loop shares llvmpipe's loop budget: rays that could need more than
-/// `MAX_GPU_RAY_STEPS` samples are a typed error, not rays cut short; a `max_steps` under it draws.
+/// `MAX_GPU_RAY_STEPS` samples are a typed error, not rays cut short; so are rays longer than
+/// `max_steps`, on both engines (issue 25: the mirror stopped there silently); under both it draws.
 #[test]
 fn gpu_rays_past_the_loop_budget_are_refused() {
     use voxsplat::constants::MAX_GPU_RAY_STEPS;
@@ -145,8 +146,10 @@ fn gpu_rays_past_the_loop_budget_are_refused() {
     let mut o = voxsplat::cpu::raycast::RaycastOptions { step: 0.001, ..Default::default() };
     let m = too_large(g.raycast(&cam, &o));
     assert!(m.contains(&MAX_GPU_RAY_STEPS.to_string()), "{m}");
-    o.max_steps = 50_000;
+    o.step = 0.002;
     assert!(g.raycast(&cam, &o).unwrap().image.pixels.iter().any(|p| p[3] > 0.0));
+    o.max_steps = 20_000;
+    assert!(too_large(g.raycast(&cam, &o)).contains("max_steps"));
     assert_clean(&g);
 }
 

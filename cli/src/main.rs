@@ -560,6 +560,12 @@ fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
         let (vol, tf, shading) = load_volume_parts(a, path)?;
         voxsplat::classify::classify(&vol, &tf, shading)?
     } else if let Some(path) = &a.terrain {
+        // (clap drops `requires = "volume"` when --terrain, which conflicts with it, is given.)
+        if a.dims.is_some() || a.dtype.is_some() || a.big_endian || a.spacing.is_some() {
+            return Err(Error::InvalidArgument(
+                "--dims, --dtype, --big-endian and --spacing describe --volume files, not --terrain".into(),
+            ));
+        }
         let heights = voxsplat::loaders::load_heights(path)?;
         let color = match &a.color {
             Some(c) => Some(voxsplat::output::read_rgba8(c)?),

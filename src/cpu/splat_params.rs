@@ -5,10 +5,8 @@ use crate::error::Result;
 use crate::gpu_types::{Frame, Splat, SplatParams};
 use glam::{Mat4, Vec2, Vec3};
 
+pub use crate::constants::CULL_RADII;
 pub use crate::volume::MAX_OPACITY;
-/// Splats closer than this many radii to the near or far plane are culled (the quad's corners
-/// must stay in front of the eye; 1.5 > sqrt 2).
-pub const CULL_RADII: f32 = 1.5;
 
 pub use crate::volume::optical_depth;
 

@@ -1,0 +1,122 @@
+//! Issue 25 through the command line: what a hostile user tried, each now a clear error (exit 2,
+//! a message that names the problem) or the right output. The library's side: tests/hostile.rs.
+#[path = "../../tests/common/mod.rs"]
+mod common;
+use std::process::{Command, Output};
+
+fn voxsplat(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_voxsplat")).args(args).output().expect("run voxsplat")
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("voxsplat-hostile-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn data(rel: &str) -> String {
+    format!("{}/../../shared/data/{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Exit 2 with `needle` in the message, and no panic.
+fn fails_with(args: &[&str], needle: &str) -> String {
+    let out = voxsplat(args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{args:?} should fail: {err}");
+    assert!(err.contains(needle) && !err.contains("panicked"), "{args:?}: {err}");
+    err
+}
+
+#[test]
+fn bad_values_are_refused_with_a_reason() {
+    let out = tmp("x.png");
+    let out = out.to_str().unwrap();
+    let link = tmp("full.png");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink("/dev/full", &link).unwrap();
+    fails_with(&["render", "--size", "96x64", "--out", link.to_str().unwrap()], "No space left");
+    fails_with(&["render", "--size", "32x32", "--raycast", "0.000001", "--cpu", "--out", out], "max_steps");
+    fails_with(&["render", "--size", "32x32", "--ortho", "1e-7", "--out", out], "f32 cannot resolve");
+    fails_with(&["render", "--size", "32x32", "--eye", "0,0,1e30", "--out", out], "within 1e15");
+    fails_with(&["render", "--sheet-budget-mib", "17592186044416", "--out", out], "overflows");
+    fails_with(&["render", "--gpu-budget-mib", "0", "--out", out], "must be positive");
+    let dem = data("rmnp/rmnp-dem.tif");
+    fails_with(&["render", "--terrain", &dem, "--vscale", "1e30", "--out", out], "lower --vscale");
+    // A bad extension is found before anything is drawn.
+    let err = fails_with(&["render", "--size", "32x32", "--out", tmp("x.jpg").to_str().unwrap()], "must end in .png");
+    assert!(!err.contains("splats"), "rendered first: {err}");
+}
+
+#[test]
+fn flags_that_would_be_ignored_are_refused() {
+    let out = tmp("y.png");
+    let out = out.to_str().unwrap();
+    let stent = data("stent/stent.nrrd");
+    fails_with(&["render", "--volume", &stent, "--dims", "4,4,4", "--out", out], "describe raw files");
+    fails_with(&["render", "--volume", &stent, "--scene", "cube40", "--out", out], "cannot be used with");
+    let npy = tmp("v.npy");
+    std::fs::write(&npy, common::npy(&[2, 2, 2], "|u1", &[1, 2, 3, 4, 5, 6, 7, 8])).unwrap();
+    fails_with(&["render", "--volume", npy.to_str().unwrap(), "--big-endian", "--out", out], "describe raw files");
+    let dem = data("rmnp/rmnp-dem.tif");
+    fails_with(&["render", "--terrain", &dem, "--spacing", "1,1,2", "--out", out], "--volume");
+    fails_with(&["render", "--raycast", "0.5", "--repeat", "3", "--out", out], "cannot be used with");
+    fails_with(&["info", &stent, "--vscale", "2"], "describe height grids");
+}
+
+#[test]
+fn info_agrees_with_render() {
+    // The terrain's splat count is render's (info counted 1,553,333 with another cell size).
+    let dem = data("rmnp/rmnp-dem.tif");
+    let info = voxsplat(&["info", &dem]);
+    assert!(info.status.success());
+    let text = String::from_utf8_lossy(&info.stdout);
+    let count = text.lines().find_map(|l| l.strip_prefix("splats: ")).expect("a splat count").to_string();
+    let render =
+        voxsplat(&["render", "--terrain", &dem, "--size", "32x32", "--cpu", "--out", tmp("t.png").to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&render.stderr);
+    assert!(render.status.success() && err.contains(&format!("{count} splats ->")), "info {count}, render: {err}");
+    // A TOML transfer function, as render takes it.
+    let tf = tmp("tf.toml");
+    std::fs::write(&tf, "points = [[0.0, [1.0, 1.0, 1.0, 0.0]], [1.0, [1.0, 1.0, 1.0, 1.0]]]\n").unwrap();
+    let out = voxsplat(&["info", &data("stent/stent.nrrd"), "--tf", tf.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // A 2-D .npy is a height grid (its help says "volume or height file").
+    let heights: Vec<u8> = (0..12u8).collect();
+    let npy = tmp("h.npy");
+    std::fs::write(&npy, common::npy(&[3, 4], "|u1", &heights)).unwrap();
+    let out = voxsplat(&["info", npy.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("height grid: 4 x 3 cells"), "{text}");
+}
+
+#[test]
+fn an_animation_fails_before_writing_a_frame() {
+    let anim = tmp("through.toml");
+    std::fs::write(
+        &anim,
+        "scene = \"cube40\"\nframes = 10\nsize = [32, 32]\n[camera]\neye = [0.0, 0.0, 100.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[keyframe]]\nframe = 0\neye = [0.0, 0.0, 100.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[keyframe]]\nframe = 8\neye = [0.0, 0.0, -100.0]\ntarget = [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    let dir = tmp("anim-out");
+    fails_with(&["animate", "--anim", anim.to_str().unwrap(), "--out-dir", dir.to_str().unwrap()], "frame 4");
+    assert!(!dir.exists() || std::fs::read_dir(&dir).unwrap().next().is_none(), "frames were written");
+    // A short one streams to the GIF; on a full disk it fails.
+    let short = tmp("short.toml");
+    std::fs::write(
+        &short,
+        "scene = \"cube40\"\nframes = 2\nsize = [32, 32]\n[camera]\neye = [0.0, 0.0, 100.0]\ntarget = [0.0, 0.0, 0.0]\n\
+         [[keyframe]]\nframe = 0\nrotate = [0.0, 1.0, 0.0, 10.0]\n",
+    )
+    .unwrap();
+    let ok = tmp("anim-ok");
+    let out = voxsplat(&["animate", "--anim", short.to_str().unwrap(), "--out-dir", ok.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(ok.join("anim.gif").exists() && ok.join("frame0001.png").exists());
+    let full = tmp("anim-full");
+    std::fs::create_dir_all(&full).unwrap();
+    let _ = std::fs::remove_file(full.join("anim.gif"));
+    std::os::unix::fs::symlink("/dev/full", full.join("anim.gif")).unwrap();
+    fails_with(&["animate", "--anim", short.to_str().unwrap(), "--out-dir", full.to_str().unwrap()], "No space left");
+}

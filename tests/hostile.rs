@@ -1,0 +1,260 @@
+//! Issue 25: input a hostile user would try, each a typed error or a right picture, never a hang,
+//! a wrap-around or a silently wrong frame (the CLI's side: cli/tests/hostile.rs).
+mod common;
+use common::{assert_clean, cpu, gpu};
+use std::path::{Path, PathBuf};
+use voxsplat::bricks::{BrickScene, BrickStore};
+use voxsplat::classify::TransferFunction;
+use voxsplat::cpu::raycast::RaycastOptions;
+use voxsplat::loaders::{load_volume, npy_from_bytes, DType, VolumeHints};
+use voxsplat::volume::ScalarVolume;
+use voxsplat::{Camera, Error, Grid, ImageF32, Projection, Raster, RenderOptions};
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxsplat-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn covered(img: &ImageF32) -> usize {
+    img.pixels.iter().filter(|p| p[3] > 0.01).count()
+}
+
+#[test]
+fn loaders_read_only_what_the_header_or_dims_need() {
+    let hints = VolumeHints { dims: Some([16, 16, 16]), dtype: Some(DType::U8), ..Default::default() };
+    // A device that never ends is refused from its length, not read until memory runs out.
+    let e = load_volume(Path::new("/dev/zero"), &hints).unwrap_err();
+    assert!(e.to_string().contains("needs 4096"), "{e}");
+    // A sparse file far longer than --dims says: refused before a byte is read.
+    let big = dir().join("sparse.raw");
+    std::fs::File::create(&big).unwrap().set_len(1 << 31).unwrap();
+    let e = load_volume(&big, &hints).unwrap_err();
+    assert!(e.to_string().contains("has 2147483648 bytes"), "{e}");
+    std::fs::remove_file(&big).unwrap();
+    // An NRRD whose data is followed by a 2 GiB tail loads its data and leaves the tail unread.
+    let tail = dir().join("tail.nrrd");
+    let mut bytes = b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 2 2\nencoding: raw\n\n".to_vec();
+    bytes.extend((0u8..16).map(|i| i * 3));
+    std::fs::write(&tail, &bytes).unwrap();
+    std::fs::OpenOptions::new().write(true).open(&tail).unwrap().set_len(1 << 31).unwrap();
+    let v = load_volume(&tail, &VolumeHints::default()).unwrap();
+    assert_eq!(v.values, (0..16).map(|i| (i * 3) as f32).collect::<Vec<_>>());
+    std::fs::remove_file(&tail).unwrap();
+    // An npy whose header promises more than the file holds.
+    let npy = common::npy(&[64, 64, 64], "|u1", &[7u8; 64]);
+    let short = dir().join("short.npy");
+    std::fs::write(&short, &npy).unwrap();
+    let e = load_volume(&short, &VolumeHints::default()).unwrap_err();
+    assert!(e.to_string().contains("truncated"), "{e}");
+    // Dims, type and byte order describe raw files: given for a file with a header, refused.
+    std::fs::write(&tail, &bytes).unwrap();
+    let e = load_volume(&tail, &VolumeHints { big_endian: true, ..Default::default() }).unwrap_err();
+    assert!(e.to_string().contains("describe raw files"), "{e}");
+}
+
+#[test]
+fn non_finite_samples_and_spacings_are_errors_in_every_format() {
+    // An all-NaN npy (it reported "values 1 .. 1").
+    let nan: Vec<u8> = (0..8).flat_map(|_| f32::NAN.to_le_bytes()).collect();
+    let e = npy_from_bytes(&common::npy(&[2, 2, 2], "<f4", &nan), "nan.npy").unwrap_err();
+    assert!(e.to_string().contains("must be finite"), "{e}");
+    let raw = dir().join("inf.raw");
+    let mut v: Vec<u8> = (0..8).flat_map(|i| (i as f32).to_le_bytes()).collect();
+    v[12..16].copy_from_slice(&f32::INFINITY.to_le_bytes());
+    std::fs::write(&raw, &v).unwrap();
+    let hints = VolumeHints { dims: Some([2, 2, 2]), dtype: Some(DType::F32), ..Default::default() };
+    let e = load_volume(&raw, &hints).unwrap_err();
+    assert!(e.to_string().contains("sample 3 is inf"), "{e}");
+    // NIfTI: a scl_slope that overflows f32 (it dropped 97 % of the splats), pixdim NaN or 0 (it
+    // became 1), and a negative dim (it said "more than 268435456 voxels").
+    let nifti = |edit: &dyn Fn(&mut Vec<u8>)| {
+        let mut h = vec![0u8; 352];
+        h[0..4].copy_from_slice(&348i32.to_le_bytes());
+        for (i, d) in [3i16, 2, 2, 2, 1, 1, 1, 1].iter().enumerate() {
+            h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+        }
+        h[70..72].copy_from_slice(&2i16.to_le_bytes()); // uint8
+        h[72..74].copy_from_slice(&8i16.to_le_bytes());
+        for i in 0..8 {
+            h[76 + 4 * i..80 + 4 * i].copy_from_slice(&1f32.to_le_bytes());
+        }
+        h[108..112].copy_from_slice(&352f32.to_le_bytes());
+        h[112..116].copy_from_slice(&1f32.to_le_bytes());
+        h[344..348].copy_from_slice(b"n+1\0");
+        h.extend_from_slice(&[0, 50, 100, 150, 200, 250, 255, 1]);
+        edit(&mut h);
+        let path = dir().join("edit.nii");
+        std::fs::write(&path, &h).unwrap();
+        load_volume(&path, &VolumeHints::default())
+    };
+    assert!(nifti(&|_| {}).is_ok());
+    let e = nifti(&|h| h[112..116].copy_from_slice(&3e38f32.to_le_bytes())).unwrap_err();
+    assert!(e.to_string().contains("is inf"), "{e}");
+    for p in [f32::NAN, 0.0] {
+        let e = nifti(&|h| h[80..84].copy_from_slice(&p.to_le_bytes())).unwrap_err();
+        assert!(e.to_string().contains("pixdim[1]"), "{e}");
+    }
+    let e = nifti(&|h| h[42..44].copy_from_slice(&(-256i16).to_le_bytes())).unwrap_err();
+    assert!(e.to_string().contains("dim[1] = -256"), "{e}");
+}
+
+#[test]
+fn full_disks_fail_writes_instead_of_leaving_short_files() {
+    let img = ImageF32 { width: 96, height: 64, pixels: vec![[0.2, 0.3, 0.4, 0.5]; 96 * 64] };
+    for name in ["full.png", "full.exr"] {
+        let link = dir().join(name);
+        let _ = std::fs::remove_file(&link);
+        std::os::unix::fs::symlink("/dev/full", &link).unwrap();
+        let e = voxsplat::output::write_image(&img, &link).unwrap_err();
+        assert!(e.to_string().contains("No space left"), "{name}: {e}");
+    }
+    let mut gif = voxsplat::output::GifWriter::create(Path::new("/dev/full"), 80).unwrap();
+    let pushed = gif.push(&img).and_then(|_| gif.push(&img));
+    assert!(pushed.is_err() || gif.finish().is_err(), "a GIF on a full disk must fail");
+    // A good GIF streams and reads back with its frames.
+    let path = dir().join("ok.gif");
+    let mut gif = voxsplat::output::GifWriter::create(&path, 80).unwrap();
+    for _ in 0..3 {
+        gif.push(&img).unwrap();
+    }
+    gif.finish().unwrap();
+    use image::AnimationDecoder as _;
+    let frames = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()))
+        .unwrap()
+        .into_frames()
+        .count();
+    assert_eq!(frames, 3);
+}
+
+/// An opaque one-voxel volume: every splat path draws it (the framing view put the eye inside the
+/// near-plane cull, and the store dropped a constant volume's only value as background).
+#[test]
+fn a_one_voxel_volume_is_drawn_by_every_path() {
+    let vol = ScalarVolume { dims: [1, 1, 1], spacing: [1.0; 3], values: vec![200.0] };
+    let tf = TransferFunction::from_toml(
+        "points = [[0.0, [1.0, 1.0, 1.0, 1.0]], [1.0, [1.0, 1.0, 1.0, 1.0]]]\nrange = [0.0, 255.0]",
+    )
+    .unwrap();
+    let cam = Camera::framing(&Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 48);
+    let mut reference = cpu();
+    let splats = voxsplat::classify::classify(&vol, &tf, None).unwrap();
+    reference.set_scene(splats.clone()).unwrap();
+    let truth = covered(&reference.raycast(&cam, &RaycastOptions::default()).unwrap().image);
+    assert!(truth > 500, "the ray caster covers {truth} px");
+    for raster in [Raster::Graphics, Raster::Compute, Raster::Points] {
+        for mut r in [gpu(), cpu()] {
+            let mut o = RenderOptions::default();
+            o.raster = raster;
+            r.set_scene(splats.clone()).unwrap();
+            let dense = covered(&r.render(&cam, &o).unwrap().image);
+            r.set_bricks(BrickScene::new(BrickStore::build(&vol).unwrap(), tf.clone(), None).unwrap()).unwrap();
+            let bricked = covered(&r.render(&cam, &o).unwrap().image);
+            for (what, n) in [("dense", dense), ("bricked", bricked)] {
+                // The kernel's footprint is wider than the trilinear voxel's: drawn, not blank.
+                assert!(n * 4 > truth && n < truth * 4, "{raster:?} {what}: {n} px against the ray caster's {truth}");
+            }
+            assert_clean(&r);
+        }
+    }
+}
+
+#[test]
+fn the_ray_casters_refuse_rays_max_steps_would_cut() {
+    // The mirror stopped at max_steps and drew an almost transparent picture; the GPU names its
+    // own loop budget first.
+    for (mut r, says) in [(cpu(), "max_steps"), (gpu(), "the GPU ray caster takes at most")] {
+        let set = voxsplat::scene::build("cube60").unwrap();
+        let cam = Camera::framing(set.grid(), 32, 32);
+        r.set_scene(set).unwrap();
+        let e = r.raycast(&cam, &RaycastOptions { step: 1e-6, ..Default::default() }).unwrap_err();
+        assert!(matches!(e, Error::TooLarge(_)) && e.to_string().contains(says), "{e}");
+        assert!(r.raycast(&cam, &RaycastOptions::default()).is_ok());
+    }
+}
+
+#[test]
+fn views_f32_cannot_resolve_are_refused() {
+    let grid = Grid::centered([60, 60, 60], [1.0; 3]).unwrap();
+    let base = Camera::framing(&grid, 64, 64);
+    for h in [1e-7f32, 1e-20, 1e-30] {
+        let cam = Camera { projection: Projection::Orthographic { height: h }, ..base };
+        let e = cam.validate().unwrap_err();
+        assert!(e.to_string().contains("f32 cannot resolve"), "{h}: {e}");
+    }
+    assert!(Camera { projection: Projection::Orthographic { height: 0.5 }, ..base }.validate().is_ok());
+    let far = Camera { eye: glam::Vec3::new(0.0, 0.0, 1e30), ..base };
+    assert!(far.validate().unwrap_err().to_string().contains("within 1e15"));
+    let telephoto = Camera { projection: Projection::Perspective { fov_y_deg: 1e-9 }, ..base };
+    assert!(telephoto.validate().is_err());
+}
+
+#[test]
+fn an_animation_path_is_checked_before_any_frame() {
+    let text = r#"
+scene = "cube40"
+frames = 10
+[camera]
+eye = [0.0, 0.0, 100.0]
+target = [0.0, 0.0, 0.0]
+[[keyframe]]
+frame = 0
+eye = [0.0, 0.0, 100.0]
+target = [0.0, 0.0, 0.0]
+[[keyframe]]
+frame = 8
+eye = [0.0, 0.0, -100.0]
+target = [0.0, 0.0, 0.0]
+"#;
+    let anim = voxsplat::animate::Animation::from_toml(text).unwrap();
+    let grid = *voxsplat::scene::build("cube40").unwrap().grid();
+    let e = anim.check_path(&grid, voxsplat::animate::Blur::None).unwrap_err();
+    assert!(matches!(e, Error::InvalidCamera(_)) && e.to_string().contains("frame 4"), "{e}");
+}
+
+#[test]
+fn terrain_levels_and_messages_do_not_wrap() {
+    let h = voxsplat::volume::HeightGrid { width: 4, rows: 4, heights: (0..16).map(|i| i as f32).collect() };
+    let opts = voxsplat::terrain::TerrainOptions { vscale: 1e30, ..Default::default() };
+    let e = voxsplat::terrain::terrain_splats(&h, &opts).unwrap_err();
+    assert!(matches!(e, Error::TooLarge(_)), "{e}");
+    // A corrupt TIFF's decoder message is cut to a readable length.
+    let mut tiff = std::io::Cursor::new(Vec::new());
+    tiff::encoder::TiffEncoder::new(&mut tiff)
+        .unwrap()
+        .write_image::<tiff::encoder::colortype::Gray16>(64, 64, &[7u16; 64 * 64])
+        .unwrap();
+    let good = tiff.into_inner();
+    let mut longest = 0;
+    for i in 0..good.len().min(400) {
+        for bit in 0..8 {
+            let mut b = good.clone();
+            b[i] ^= 1 << bit;
+            if let Err(e) = voxsplat::loaders::tiff_heights(&b, "flip.tif") {
+                longest = longest.max(e.to_string().len());
+            }
+        }
+    }
+    assert!(longest > 0 && longest < 600, "longest message {longest} bytes");
+    // Reading a missing or broken image says so (it said "cannot write image").
+    let bad = dir().join("broken.png");
+    std::fs::write(&bad, b"\x89PNG\r\n\x1a\nnot really").unwrap();
+    let e = voxsplat::output::read_image(&bad).unwrap_err();
+    assert!(e.to_string().starts_with("cannot read image"), "{e}");
+}
+
+#[test]
+fn banded_ssim_is_the_whole_image_ssim() {
+    let mut rng = common::Rng(7);
+    let (w, h) = (150usize, 133usize);
+    let img = |rng: &mut common::Rng| ImageF32 {
+        width: w as u32,
+        height: h as u32,
+        pixels: (0..w * h).map(|_| [rng.f32(), rng.f32(), rng.f32(), rng.f32()]).collect(),
+    };
+    let (a, b) = (img(&mut rng), img(&mut rng));
+    let m = voxsplat::metrics::compare(&a, &b).unwrap();
+    let alpha = |im: &ImageF32| im.pixels.iter().map(|p| p[3].clamp(0.0, 1.0) as f64).collect::<Vec<_>>();
+    let whole = voxsplat::metrics::ssim(&alpha(&a), &alpha(&b), w, h);
+    assert!((m.ssim_alpha - whole).abs() < 1e-12, "{} against {whole}", m.ssim_alpha);
+}
