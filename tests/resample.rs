@@ -70,6 +70,20 @@ fn a_scaled_frame_is_the_coarse_frame_resampled() {
     let low = scaled_camera(&cam, 0.5).unwrap();
     let coarse = c.render(&low, &opts(Raster::Graphics, Kernel::Gaussian, 1.0)).unwrap().image;
     assert_eq!(c.render(&cam, &o).unwrap().image, upsample(&coarse, 96, 72).unwrap());
+    // Analytically: a linear ramp survives the resampling. A full-size pixel centre X lies at
+    // 0.5 X - 0.25 on the half-size grid (clamped at its edges), where the ramp is linear.
+    let ramp = |x: f64, y: f64| 0.01 * x + 0.02 * y;
+    let coarse = voxsplat::ImageF32 {
+        width: 8,
+        height: 6,
+        pixels: (0..48).map(|i| [ramp((i % 8) as f64, (i / 8) as f64) as f32, 0.0, 0.0, 1.0]).collect(),
+    };
+    let fine = upsample(&coarse, 16, 12).unwrap();
+    for (i, p) in fine.pixels.iter().enumerate() {
+        let at = |x: usize, n: f64| (0.5 * x as f64 - 0.25).clamp(0.0, n - 1.0);
+        let want = ramp(at(i % 16, 8.0), at(i / 16, 6.0));
+        assert!((p[0] as f64 - want).abs() < 1e-6 && p[3] == 1.0, "pixel {i}: {} against {want}", p[0]);
+    }
 }
 
 /// Where a voxel covers ~3.5 px (the peers' scene), half the grid changes little: the scaled frame

@@ -170,6 +170,7 @@ fn empty_space_skipping_changes_no_pixel() {
             let off = RaycastOptions { brick: 0, ..Default::default() };
             for r in [&mut gpu, &mut cpu] {
                 let reference = r.raycast(&cam, &off).unwrap().image;
+                assert!(common::covered(&reference) > 0, "view {v}: something in view");
                 for brick in [2, 8, 16] {
                     let o = RaycastOptions { brick, ..Default::default() };
                     assert_eq!(r.raycast(&cam, &o).unwrap().image.pixels, reference.pixels, "view {v} brick {brick}");
@@ -186,6 +187,8 @@ fn empty_space_skipping_changes_no_pixel() {
 fn sheet_ripple_of_each_kernel() {
     let r: Vec<f64> = voxsplat::kernel::KERNELS.iter().map(|k| k.sheet_ripple()).collect();
     eprintln!("sheet ripple: gaussian {:.4} cubic {:.4} narrow {:.4}", r[0], r[1], r[2]);
-    assert!(r[0] < 0.01, "the default Gaussian sums flat: {}", r[0]);
-    assert!(r[2] > r[0] && r[2] > 0.01, "the narrow kernel shows the grid: {}", r[2]);
+    // Pinned at the measured values (docs/MODEL.md quotes them): 0.44 %, 3.0 %, 7.6 %.
+    for (k, (got, want)) in ["gaussian", "cubic", "narrow"].iter().zip(r.iter().zip([0.0043, 0.0300, 0.0757])) {
+        assert!((got - want).abs() <= 0.002, "{k}: sheet ripple {got}, measured {want}");
+    }
 }

@@ -8,7 +8,7 @@ use voxsplat::{scene, Camera, Error, Grid, Kernel, Projection, SplatSet, Volume}
 
 #[test]
 fn footprint_tables_integrate_to_one_and_vanish_at_the_radius() {
-    for k in [Kernel::Gaussian, Kernel::Cubic] {
+    for k in voxsplat::kernel::KERNELS {
         let t = k.footprint_table();
         let n = FOOTPRINT_TABLE_SIZE as usize;
         let texel = (2.0 * k.radius() as f64 / n as f64).powi(2);
@@ -31,7 +31,9 @@ fn footprint_tables_integrate_to_one_and_vanish_at_the_radius() {
                 }
             }
         }
-        assert!((sum - 1.0).abs() < 0.1, "{k:?} sheet sum {sum}");
+        // Within the kernel's measured ripple (peak to peak about the mean of 1) and the table's
+        // sampling: 0.44 % for the Gaussian, 3.0 % cubic, 7.6 % narrow.
+        assert!((sum - 1.0).abs() <= k.sheet_ripple() + 2e-3, "{k:?} sheet sum {sum}, ripple {}", k.sheet_ripple());
     }
     // Gaussian pre-integration matches the closed form 1/(2 pi s^2) exp(-rho^2 / 2 s^2).
     let s = voxsplat::kernel::GAUSSIAN_SIGMA;

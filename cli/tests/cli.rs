@@ -228,6 +228,19 @@ fn compare_prints_metrics_and_rejects_bad_files() {
     }
     let same = voxsplat(&["compare", a.to_str().unwrap(), a.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&same.stdout).contains("rmse:       0.000000"));
+    // Known values: red off by 0.25 everywhere, the other channels equal: RMSE sqrt(0.25^2 / 4).
+    let flat = |r: f32, path: &std::path::Path| {
+        let img = voxsplat::ImageF32 { width: 20, height: 10, pixels: vec![[r, 0.5, 0.5, 1.0]; 200] };
+        voxsplat::output::write_image(&img, path).unwrap();
+    };
+    let (x, y) = (tmp("known-x.exr"), tmp("known-y.exr"));
+    flat(0.5, &x);
+    flat(0.25, &y);
+    let known = voxsplat(&["compare", x.to_str().unwrap(), y.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&known.stdout);
+    for line in ["rmse:       0.125000", "psnr:       18.06 dB", "max_abs:    0.250000"] {
+        assert!(text.contains(line), "{line} in {text}");
+    }
     let junk = tmp("junk.png");
     std::fs::write(&junk, b"not a png").unwrap();
     for args in [[a.to_str().unwrap(), junk.to_str().unwrap()], [a.to_str().unwrap(), "/nonexistent.exr"]] {
