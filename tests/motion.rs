@@ -109,7 +109,8 @@ fn accumulation_with_one_subframe_is_the_still_frame() {
     let a = r.render(&anim.object_camera(&grid, 7.0 - s + 0.5 * s), &o).unwrap().image;
     let b = r.render(&anim.object_camera(&grid, 7.0), &o).unwrap().image;
     assert!(common::covered(&a) > 64 * 64 / 10 && a.pixels != b.pixels);
-    let mean: Vec<[f32; 4]> = a.pixels.iter().zip(&b.pixels).map(|(p, q)| [0, 1, 2, 3].map(|c| (p[c] + q[c]) * 0.5)).collect();
+    let mean: Vec<[f32; 4]> =
+        a.pixels.iter().zip(&b.pixels).map(|(p, q)| [0, 1, 2, 3].map(|c| (p[c] + q[c]) * 0.5)).collect();
     assert_eq!(render_frame(&mut r, &anim, &grid, 7, Blur::Accum(2), &o).unwrap().pixels, mean);
 }
 

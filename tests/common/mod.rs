@@ -193,7 +193,13 @@ pub fn assert_mirrors(g: &voxsplat::ImageF32, c: &voxsplat::ImageF32, tag: &str)
     assert_eq!((g.width, g.height), (c.width, c.height), "{tag}: sizes");
     let (mut max, mut sum, mut n) = (0.0f32, 0.0f64, 0usize);
     for (p, q) in g.pixels.iter().zip(&c.pixels) {
-        let d = (0..4).map(|k| (p[k] - q[k]).abs()).fold(0.0f32, |m, x| if x.is_nan() || m.is_nan() { f32::NAN } else { m.max(x) });
+        let d = (0..4).map(|k| (p[k] - q[k]).abs()).fold(0.0f32, |m, x| {
+            if x.is_nan() || m.is_nan() {
+                f32::NAN
+            } else {
+                m.max(x)
+            }
+        });
         assert!(!d.is_nan(), "{tag}: a NaN pixel");
         max = max.max(d);
         if p[3] > 0.0 || q[3] > 0.0 {
