@@ -14,11 +14,14 @@ MUTANTS=(
   "off-by-one in the tile bins|src/cpu/tile.rs|            for tx in x0..=x1 {|            for tx in x0..x1 {|--test raster"
   "skip a stage (tile offsets)|src/recording.rs|        e.run(&Dispatch::new(StageId::TileOffsets, 0, [1, 1, 1], List::Order, bytes))?;|        let _ = StageId::TileOffsets;|--test raster"
   "wrong blend equation (alpha)|src/cpu/composite.rs|                        a + (1.0 - a) * acc[3],|                        a + acc[3],|--test gpu"
-  "stale TF (no new classification)|src/bricks.rs|        self.classification = next_classification();\n        Ok(())|        Ok(())|--test bricked"
+  "stale TF (no new classification)|src/bricks.rs|        self.classification = next_classification();\n        Ok(())|        Ok(())|--test lod"
 )
 filter=${1:-}
 backup=$(mktemp -d)
-restore() { for f in "$backup"/*; do [ -e "$f" ] && cp "$f" "$(cat "$f.path")"; done; rm -rf "$backup"; }
+restore() {
+  for p in "$backup"/*.path; do [ -e "$p" ] && cp "${p%.path}" "$(cat "$p")"; done
+  rm -rf "$backup"
+}
 trap restore EXIT
 echo "| bug | file | tests | result | seconds |"
 echo "|---|---|---|---|---:|"
@@ -43,7 +46,10 @@ PY
   elif grep -q "^error\[E" target/mutant.log; then
     result="**did not compile**"; survived=1
   else
-    result="caught: $(grep -m1 -oE "^test [a-z0-9_]+ \.\.\. FAILED" target/mutant.log | sed -E 's/^test ([a-z0-9_]+).*/`\1`/')"
+    # The first failing test, from the "failures:" list (`cargo test -q` prints no per-test lines).
+    first=$(grep -m1 -E "^    [a-z0-9_]+$" target/mutant.log | tr -d ' ' || true)
+    failed=$(grep -cE "^    [a-z0-9_]+$" target/mutant.log || true)
+    result="caught: \`$first\` (failing tests listed: $failed)"
   fi
   cp "$backup/$key" "$file" && rm "$backup/$key" "$backup/$key.path"
   echo "| $name | \`$file\` | \`cargo test $tests\` | $result | $(( $(date +%s) - start )) |"

@@ -1,17 +1,12 @@
 //! The command-line contract: listed scenes, rendered files, order dumps, and clear errors (never
 //! a panic) for bad input.
+mod cmd;
 #[path = "../../tests/common/mod.rs"]
 mod common;
-use std::process::{Command, Output};
-
-fn voxsplat(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_voxsplat")).args(args).output().expect("run voxsplat")
-}
+use cmd::voxsplat;
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("voxsplat-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    cmd::tmp_in("cli", name)
 }
 
 #[test]

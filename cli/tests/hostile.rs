@@ -1,17 +1,12 @@
 //! Issue 25 through the command line: what a hostile user tried, each now a clear error (exit 2,
 //! a message that names the problem) or the right output. The library's side: tests/hostile.rs.
+mod cmd;
 #[path = "../../tests/common/mod.rs"]
 mod common;
-use std::process::{Command, Output};
-
-fn voxsplat(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_voxsplat")).args(args).output().expect("run voxsplat")
-}
+use cmd::voxsplat;
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("voxsplat-hostile-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    cmd::tmp_in("hostile-cli", name)
 }
 
 fn data(rel: &str) -> String {
