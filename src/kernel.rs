@@ -15,9 +15,8 @@ pub enum Kernel {
     /// Westover's Gaussian, sigma = 0.6 voxel, truncated at radius 2.
     #[default]
     Gaussian,
-    /// The Crawfis–Max piecewise-cubic radial kernel shape, radius 1.6 voxel: h(r) = 1 - 3x^2 + 2x^3
-    /// with x = r / 1.6 (zero value and slope at the edge). Crawfis and Max optimised their cubic's
-    /// coefficients numerically; this is the Hermite cubic with the same support, not their exact fit.
+    /// The Hermite cubic with Crawfis and Max's support, radius 1.6 voxel: h(r) = 1 - 3x^2 + 2x^3
+    /// with x = r / 1.6 (zero value and slope at the edge); their fitted kernel is `CrawfisMax`.
     Cubic,
     /// A narrower Gaussian, sigma = 0.5 voxel truncated at radius 1.5 (3 sigma): 56% of the
     /// default's footprint area, so fewer fragments, and closer to renderers that interpolate the
@@ -26,6 +25,10 @@ pub enum Kernel {
     /// (`Kernel::sheet_ripple`: 7.6% peak to peak, against 0.4% for the default and 3.0% for the
     /// cubic).
     Narrow,
+    /// Crawfis and Max's criterion with their support (radius 1.6): the piecewise cubic
+    /// (`CRAWFIS_MAX`, two C1 Hermite pieces) whose footprints sum over a unit lattice with the
+    /// smallest variance, fitted here (`fit_crawfis_max`) since their coefficients are not at hand.
+    CrawfisMax,
 }
 
 /// Standard deviation of the Gaussian kernel, in voxel spacings.
@@ -34,9 +37,9 @@ pub const GAUSSIAN_SIGMA: f64 = 0.6;
 pub const NARROW_SIGMA: f64 = 0.5;
 
 /// Every kernel, in cache-slot order.
-pub const KERNELS: [Kernel; 3] = [Kernel::Gaussian, Kernel::Cubic, Kernel::Narrow];
+pub const KERNELS: [Kernel; 4] = [Kernel::Gaussian, Kernel::Cubic, Kernel::Narrow, Kernel::CrawfisMax];
 
-type KernelTables = [OnceLock<Vec<f32>>; 3];
+type KernelTables = [OnceLock<Vec<f32>>; 4];
 
 /// Simpson's rule over [a, b] with `n` (even) intervals.
 fn simpson(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
@@ -65,6 +68,7 @@ impl Kernel {
             Kernel::Gaussian => "gaussian",
             Kernel::Cubic => "cubic",
             Kernel::Narrow => "narrow",
+            Kernel::CrawfisMax => "crawfis-max",
         }
     }
 
@@ -74,6 +78,7 @@ impl Kernel {
             Kernel::Gaussian => 2.0,
             Kernel::Cubic => 1.6,
             Kernel::Narrow => 1.5,
+            Kernel::CrawfisMax => CRAWFIS_MAX_RADIUS as f32,
         }
     }
 
@@ -90,6 +95,7 @@ impl Kernel {
                 let x = r / rr;
                 1.0 - 3.0 * x * x + 2.0 * x * x * x
             }
+            Kernel::CrawfisMax => CRAWFIS_MAX.eval(r / rr),
         }
     }
 
@@ -119,7 +125,7 @@ impl Kernel {
     pub fn footprint_sigma(self) -> f64 {
         match self {
             Kernel::Gaussian => GAUSSIAN_SIGMA,
-            Kernel::Cubic | Kernel::Narrow => {
+            Kernel::Cubic | Kernel::Narrow | Kernel::CrawfisMax => {
                 let rr = self.radius() as f64;
                 let n = 400;
                 let (mut m0, mut m2) = (0.0, 0.0);
@@ -149,7 +155,7 @@ impl Kernel {
     /// The footprint table, row-major, `FOOTPRINT_TABLE_SIZE`^2 texels, in voxel^-2. Computed once
     /// per kernel (a million profile evaluations) and shared.
     pub fn footprint_table(self) -> Vec<f32> {
-        static TABLES: KernelTables = [const { OnceLock::new() }; 3];
+        static TABLES: KernelTables = [const { OnceLock::new() }; 4];
         self.cached(&TABLES, Kernel::compute_footprint_table)
     }
 
@@ -158,7 +164,7 @@ impl Kernel {
     /// A radially symmetric kernel's footprint depends on r alone, so the footprint stage samples
     /// this (one pair load, no sampler; `radial_pairs`) rather than the 2D table (four texel fetches).
     pub fn radial_table(self) -> Vec<f32> {
-        static TABLES: KernelTables = [const { OnceLock::new() }; 3];
+        static TABLES: KernelTables = [const { OnceLock::new() }; 4];
         self.cached(&TABLES, Kernel::compute_radial_table)
     }
 
@@ -238,7 +244,7 @@ impl Kernel {
     /// S(r, zb) - S(r, za), and the slabs of one splat sum to its footprint. Same normaliser as
     /// `footprint_table`; computed once per kernel.
     pub fn slice_table(self) -> Vec<f32> {
-        static TABLES: KernelTables = [const { OnceLock::new() }; 3];
+        static TABLES: KernelTables = [const { OnceLock::new() }; 4];
         self.cached(&TABLES, Kernel::compute_slice_table)
     }
 
@@ -271,4 +277,147 @@ pub fn sample_radial(table: &[f32], s: f32) -> f32 {
     let i = (t as u32).min(n - 1);
     let a = table[i as usize];
     a + (table[i as usize + 1] - a) * (t - i as f32)
+}
+
+/// A radial profile in x = r / R of two cubic Hermite pieces: from 1 with zero slope at the centre
+/// to `value` with `slope` at `knot`, and on to 0 with zero slope at x = 1 (C1 throughout).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RadialSpline {
+    /// Where the pieces meet, in (0, 1).
+    pub knot: f64,
+    /// The profile there.
+    pub value: f64,
+    /// Its slope there (per unit x).
+    pub slope: f64,
+}
+
+impl RadialSpline {
+    /// The profile at x (0 from x = 1 on).
+    pub fn eval(&self, x: f64) -> f64 {
+        let hermite = |x0: f64, x1: f64, p0: f64, m0: f64, p1: f64, m1: f64| {
+            let d = x1 - x0;
+            let t = (x - x0) / d;
+            let (t2, t3) = (t * t, t * t * t);
+            (2.0 * t3 - 3.0 * t2 + 1.0) * p0
+                + (t3 - 2.0 * t2 + t) * d * m0
+                + (3.0 * t2 - 2.0 * t3) * p1
+                + (t3 - t2) * d * m1
+        };
+        match x {
+            x if x >= 1.0 => 0.0,
+            x if x <= self.knot => hermite(0.0, self.knot, 1.0, 0.0, self.value, self.slope),
+            _ => hermite(self.knot, 1.0, self.value, self.slope, 0.0, 0.0),
+        }
+    }
+}
+
+/// Support of `Kernel::CrawfisMax` in voxel spacings (Crawfis and Max's).
+pub const CRAWFIS_MAX_RADIUS: f64 = 1.6;
+
+/// `fit_crawfis_max`'s result, baked in (tests/units.rs fits it again and compares).
+pub const CRAWFIS_MAX: RadialSpline =
+    RadialSpline { knot: 0.18708572534168427, value: 0.8426488031131327, slope: -1.3164634908267445 };
+
+/// How far the footprints of a uniform unit lattice of radial kernels `h(r)` (r in voxels, support
+/// `radius`) seen along an axis are from summing to a constant: the RMS of their sum over the
+/// lattice cell, relative to its mean. Crawfis and Max chose their kernel to make this smallest.
+pub fn lattice_rms(h: impl Fn(f64) -> f64, radius: f64) -> f64 {
+    // The footprint f(rho) = integral of h along the ray, tabulated, linear in between.
+    const M: usize = 160;
+    let f: Vec<f64> = (0..=M)
+        .map(|k| {
+            let rho = k as f64 / M as f64 * radius;
+            let half = (radius * radius - rho * rho).max(0.0).sqrt();
+            simpson(-half, half, 64, |z| h((rho * rho + z * z).sqrt()))
+        })
+        .collect();
+    let at = |rho: f64| {
+        let t = rho / radius * M as f64;
+        let i = t as usize;
+        if i >= M {
+            return 0.0;
+        }
+        f[i] + (f[i + 1] - f[i]) * (t - i as f64)
+    };
+    // The lattice's symmetry: a quarter of the cell, sampled at cell centres.
+    const N: usize = 16;
+    let reach = radius.ceil() as i32 + 1;
+    let mut sums = Vec::with_capacity(N * N);
+    for a in 0..N {
+        for b in 0..N {
+            let (x, y) = ((a as f64 + 0.5) / N as f64 * 0.5, (b as f64 + 0.5) / N as f64 * 0.5);
+            let mut v = 0.0;
+            for i in -reach..=reach {
+                for j in -reach..=reach {
+                    v += at(((x - i as f64).powi(2) + (y - j as f64).powi(2)).sqrt());
+                }
+            }
+            sums.push(v);
+        }
+    }
+    let mean = sums.iter().sum::<f64>() / sums.len() as f64;
+    (sums.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / sums.len() as f64).sqrt() / mean
+}
+
+/// Crawfis and Max's kernel by their criterion: the `RadialSpline` of support 1.6 whose lattice
+/// of footprints sums with the smallest `lattice_rms`, non-negative everywhere (a negative lobe
+/// would be negative optical depth). Nelder-Mead over (knot, value, slope) from three starts, the
+/// Hermite cubic first (the variance has several local minima: starts nearer the edge end higher).
+pub fn fit_crawfis_max() -> RadialSpline {
+    let spline = |p: &[f64; 3]| RadialSpline { knot: p[0], value: p[1], slope: p[2] };
+    let cost = |p: &[f64; 3]| {
+        let s = spline(p);
+        let valid = (0.05..=0.95).contains(&s.knot) && (0..=200).all(|i| s.eval(i as f64 / 200.0) >= 0.0);
+        if !valid {
+            return f64::INFINITY;
+        }
+        lattice_rms(|r| s.eval(r / CRAWFIS_MAX_RADIUS), CRAWFIS_MAX_RADIUS)
+    };
+    // The Hermite cubic 1 - 3x^2 + 2x^3 at x = 0.5 (value 0.5, slope -1.5), and two others.
+    let fits = [[0.5, 0.5, -1.5], [0.35, 0.7, -1.5], [0.7, 0.15, -0.6]].map(|start| nelder_mead(start, &cost));
+    let best = fits.iter().min_by(|a, b| a.1.total_cmp(&b.1)).expect("three fits");
+    spline(&best.0)
+}
+
+/// Nelder-Mead's simplex search for the smallest `cost` from `start`: 400 steps, the best point
+/// and its cost.
+fn nelder_mead(start: [f64; 3], cost: &impl Fn(&[f64; 3]) -> f64) -> ([f64; 3], f64) {
+    let mut simplex: Vec<([f64; 3], f64)> = (0..4)
+        .map(|i| {
+            let mut p = start;
+            if i > 0 {
+                p[i - 1] += [0.1, 0.1, 0.3][i - 1];
+            }
+            (p, cost(&p))
+        })
+        .collect();
+    for _ in 0..400 {
+        simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let centroid: [f64; 3] = std::array::from_fn(|k| simplex[..3].iter().map(|s| s.0[k]).sum::<f64>() / 3.0);
+        let toward =
+            |t: f64| -> [f64; 3] { std::array::from_fn(|k| centroid[k] + t * (simplex[3].0[k] - centroid[k])) };
+        let r = toward(-1.0);
+        let fr = cost(&r);
+        if fr < simplex[0].1 {
+            let e = toward(-2.0);
+            let fe = cost(&e);
+            simplex[3] = if fe < fr { (e, fe) } else { (r, fr) };
+        } else if fr < simplex[2].1 {
+            simplex[3] = (r, fr);
+        } else {
+            let c = toward(0.5);
+            let fc = cost(&c);
+            if fc < simplex[3].1 {
+                simplex[3] = (c, fc);
+            } else {
+                let best = simplex[0].0;
+                for s in &mut simplex[1..] {
+                    s.0 = std::array::from_fn(|k| best[k] + 0.5 * (s.0[k] - best[k]));
+                    s.1 = cost(&s.0);
+                }
+            }
+        }
+    }
+    simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+    simplex[0]
 }

@@ -191,3 +191,33 @@ fn eye_and_perspective_spaces_agree_with_the_clip_transform() {
     };
     assert!((cam.pixels_per_unit() - 100.0).abs() < 1e-3);
 }
+
+/// Issue 26: the Crawfis–Max kernel is fitted here by their criterion (their coefficients are not
+/// at hand): the two-piece cubic of support 1.6 whose footprints sum over a unit lattice with the
+/// least variance. The fit reproduces the baked constants, they are a local minimum, the kernel
+/// is non-negative and falls monotonically, and it beats the Hermite cubic of the same support
+/// and the wider Gaussian at their own criterion.
+#[test]
+fn the_crawfis_max_kernel_is_the_least_variance_cubic() {
+    use voxsplat::kernel::{fit_crawfis_max, lattice_rms, RadialSpline, CRAWFIS_MAX, CRAWFIS_MAX_RADIUS};
+    let fit = fit_crawfis_max();
+    let rms = |s: &RadialSpline| lattice_rms(|r| s.eval(r / CRAWFIS_MAX_RADIUS), CRAWFIS_MAX_RADIUS);
+    let baked = rms(&CRAWFIS_MAX);
+    assert!((rms(&fit) - baked).abs() <= 1e-7, "refit {} against baked {baked}", rms(&fit));
+    for (a, b) in [(fit.knot, CRAWFIS_MAX.knot), (fit.value, CRAWFIS_MAX.value), (fit.slope, CRAWFIS_MAX.slope)] {
+        assert!((a - b).abs() < 1e-5, "{fit:?} against {CRAWFIS_MAX:?}");
+    }
+    for (dk, dv, ds) in
+        [(0.02, 0.0, 0.0), (-0.02, 0.0, 0.0), (0.0, 0.02, 0.0), (0.0, -0.02, 0.0), (0.0, 0.0, 0.05), (0.0, 0.0, -0.05)]
+    {
+        let s =
+            RadialSpline { knot: CRAWFIS_MAX.knot + dk, value: CRAWFIS_MAX.value + dv, slope: CRAWFIS_MAX.slope + ds };
+        assert!(rms(&s) > baked, "{s:?} sums flatter: {} against {baked}", rms(&s));
+    }
+    let h: Vec<f64> = (0..=100).map(|i| CRAWFIS_MAX.eval(i as f64 / 100.0)).collect();
+    assert!(h.windows(2).all(|w| w[1] <= w[0] + 1e-12) && h[100] == 0.0 && h.iter().all(|&v| v >= 0.0));
+    let of = |k: Kernel| lattice_rms(|r| k.profile(r), k.radius() as f64);
+    assert!(baked < of(Kernel::Gaussian) && baked * 5.0 < of(Kernel::Cubic), "{baked}");
+    assert_eq!(Kernel::CrawfisMax.radius(), 1.6);
+    assert_eq!("crawfis-max".parse::<Kernel>().unwrap(), Kernel::CrawfisMax);
+}

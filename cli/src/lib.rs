@@ -1,9 +1,10 @@
 //! The research harness around the voxsplat renderer: the benchmark matrix and its charts
 //! (`bench`), where methods fail (`stability`), the raster-rate sweep (`rates`), the peers'
-//! comparison (`peer`) and long runs (`soak`). The `voxsplat` command-line tool is this crate's
+//! comparison (`peer`), the reconstruction kernels (`kernels`) and long runs (`soak`). The `voxsplat` command-line tool is this crate's
 //! binary; the renderer itself is the `voxsplat` library, which needs none of this.
 pub mod bench;
 pub mod bricked;
+pub mod kernels;
 pub mod peer;
 pub mod rates;
 pub mod soak;

@@ -73,6 +73,22 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// The reconstruction kernels side by side (issue 26): sheet ripple, lattice RMS (Crawfis and
+    /// Max's criterion), error against the peers' truth and time; a markdown section on stdout.
+    Kernels {
+        /// Side of the peers' volume.
+        #[arg(long, default_value_t = 128)]
+        n: u32,
+        /// Image side.
+        #[arg(long, default_value_t = 512)]
+        size: u32,
+        /// Rounds of alternating frames.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Chart of error against ripple (the markdown links it as bench/FILE).
+        #[arg(long)]
+        chart: Option<PathBuf>,
+    },
     /// The bricked-volume study (issue 23): store sizes, dense against bricked frames, a TF change,
     /// hidden-brick culling and the 512³ bonsai against the 256³, alternating variants in one
     /// process; a markdown section on stdout. With --volume: one volume's load, store, frame and
@@ -355,10 +371,11 @@ struct RenderArgs {
     /// before it takes over (0: abrupt level changes).
     #[arg(long, value_parser = parse_finite, default_value = "0.75")]
     lod_band: f32,
-    /// Reconstruction kernel: Westover's Gaussian (sigma 0.6, radius 2), the Crawfis-Max-style cubic
-    /// (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: fewer fragments, sharper, flat
-    /// sheets ripple by 7.6%).
-    #[arg(long, default_value = "gaussian", value_parser = ["gaussian", "cubic", "narrow"])]
+    /// Reconstruction kernel: Westover's Gaussian (sigma 0.6, radius 2), the Hermite cubic of
+    /// Crawfis and Max's support (radius 1.6), a narrow Gaussian (sigma 0.5, radius 1.5: fewer
+    /// fragments, sharper, flat sheets ripple by 7.6%), or the piecewise cubic fitted by Crawfis and
+    /// Max's criterion (radius 1.6, least variance over a lattice: 0.37% ripple).
+    #[arg(long, default_value = "gaussian", value_parser = ["gaussian", "cubic", "narrow", "crawfis-max"])]
     kernel: String,
     /// Anti-aliasing of distant splats (chapter 3): none, Swan's d/k scaling, or an EWA low-pass.
     #[arg(long, default_value = "none", value_parser = ["none", "swan", "ewa"])]
@@ -908,6 +925,17 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Bench(a) => bench(a),
+        Command::Kernels { n, size, frames, chart } => {
+            if !(16..=512).contains(&n) || !(16..=4096).contains(&size) || frames == 0 {
+                return Err(Error::InvalidArgument("--n in 16..=512, --size in 16..=4096, --frames at least 1".into()));
+            }
+            let rows = voxsplat_cli::kernels::study(n, size, frames)?;
+            if let Some(c) = &chart {
+                voxsplat_cli::kernels::chart(&rows, c)?;
+            }
+            print!("{}", voxsplat_cli::kernels::markdown(&rows, n, size, chart.as_deref()));
+            Ok(())
+        }
         Command::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => {
             voxsplat_cli::bricked::scaling_chart(&csv, &svg)
         }
@@ -1084,11 +1112,13 @@ fn bench(a: BenchArgs) -> Result<()> {
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
         // The peer comparison is its own run (scripts/peers.sh); its section is kept when present.
         let peers_md = std::fs::read_to_string(a.out_dir.join("peers.md")).unwrap_or_default();
-        // So is the bricked-volume study (`voxsplat bricks`, run by scripts/results.sh).
+        // So are the bricked-volume study (`voxsplat bricks`) and the kernels' (`voxsplat kernels`),
+        // run by scripts/results.sh.
         let bricks_md = std::fs::read_to_string(a.out_dir.join("bricks.md")).unwrap_or_default();
+        let kernels_md = std::fs::read_to_string(a.out_dir.join("kernels.md")).unwrap_or_default();
         let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
         let motion_md = format!(
-            "{}\n{}\n{}\n{}\n{}\n{}",
+            "{}\n{}\n{}\n{}\n{}\n{}\n{}",
             voxsplat_cli::rates::rates_markdown(
                 &rates,
                 &roof_rates,
@@ -1098,7 +1128,8 @@ fn bench(a: BenchArgs) -> Result<()> {
             motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
             voxsplat_cli::stability::markdown(&stab, &chart_dir),
             peers_md,
-            bricks_md
+            bricks_md,
+            kernels_md
         );
         let md = results_markdown(&Report {
             device,

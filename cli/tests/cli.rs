@@ -432,3 +432,24 @@ fn bricked_volumes_take_a_budget_and_fall_back_where_they_must() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("stored") && text.contains("median frame"), "{text}");
 }
+
+/// `voxsplat kernels` (issue 26) lists every kernel with its ripple and error, and the fitted
+/// Crawfis-Max kernel ripples least.
+#[test]
+fn kernels_subcommand_compares_every_kernel() {
+    let chart = tmp("kernels.svg");
+    let out = voxsplat(&["kernels", "--n", "32", "--size", "64", "--frames", "1", "--chart", chart.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let ripple = |name: &str| -> f64 {
+        let line =
+            text.lines().find(|l| l.starts_with(&format!("| {name} |"))).unwrap_or_else(|| panic!("{name}: {text}"));
+        line.split('|').nth(4).unwrap().trim().trim_end_matches(" %").parse().unwrap()
+    };
+    let fitted = ripple("crawfis-max");
+    for other in ["gaussian", "cubic", "narrow"] {
+        assert!(fitted < ripple(other), "crawfis-max ripples {fitted} %, {other} {} %", ripple(other));
+    }
+    assert!(std::fs::read_to_string(&chart).unwrap().contains("<svg"));
+    assert_eq!(voxsplat(&["kernels", "--n", "4"]).status.code(), Some(2));
+}

@@ -21,7 +21,7 @@ proptest! {
         scene in pick(&["cube40", "cube40-attenuated", "plane", "empty", "solid40"]),
         composite in pick(&["splat", "sheet", "slab"]),
         raster in pick(&["auto", "graphics", "compute", "points"]),
-        kernel in pick(&["gaussian", "cubic", "narrow"]),
+        kernel in pick(&["gaussian", "cubic", "narrow", "crawfis-max"]),
         aa in pick(&["none", "swan", "ewa"]),
         order in pick(&["pbtf", "btf", "wbtf", "sorted"]),
         eye in prop::option::of((-150f32..150.0, -150f32..150.0, -150f32..150.0)),
