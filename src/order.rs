@@ -247,19 +247,7 @@ pub fn visibility_order(set: &SplatSet, camera: &Camera, kind: OrderKind, direct
 /// Pairs of 6-neighbour splats drawn in the wrong order with respect to the grid plane between
 /// them and the eye. `order` must be a permutation of the splats.
 pub fn count_violations(set: &SplatSet, camera: &Camera, order: &[u32], direction: Direction) -> Result<u64> {
-    if order.len() != set.len() {
-        return Err(Error::InvalidArgument(format!("order has {} entries for {} splats", order.len(), set.len())));
-    }
-    let mut pos = vec![u32::MAX; set.len()];
-    for (p, &s) in order.iter().enumerate() {
-        let slot = pos
-            .get_mut(s as usize)
-            .ok_or_else(|| Error::InvalidArgument(format!("order names splat {s} of {}", set.len())))?;
-        if *slot != u32::MAX {
-            return Err(Error::InvalidArgument(format!("order names splat {s} twice")));
-        }
-        *slot = p as u32;
-    }
+    let pos = positions(set, order)?;
     let viewer = Viewer::of(set, camera);
     let mut violations = 0u64;
     for (s, sp) in set.splats().iter().enumerate() {
@@ -280,6 +268,147 @@ pub fn count_violations(set: &SplatSet, camera: &Camera, order: &[u32], directio
         }
     }
     Ok(violations)
+}
+
+/// Each splat's place in `order`, which must be a permutation of the splats.
+fn positions(set: &SplatSet, order: &[u32]) -> Result<Vec<u32>> {
+    if order.len() != set.len() {
+        return Err(Error::InvalidArgument(format!("order has {} entries for {} splats", order.len(), set.len())));
+    }
+    let mut pos = vec![u32::MAX; set.len()];
+    for (p, &s) in order.iter().enumerate() {
+        let slot = pos
+            .get_mut(s as usize)
+            .ok_or_else(|| Error::InvalidArgument(format!("order names splat {s} of {}", set.len())))?;
+        if *slot != u32::MAX {
+            return Err(Error::InvalidArgument(format!("order names splat {s} twice")));
+        }
+        *slot = p as u32;
+    }
+    Ok(pos)
+}
+
+/// What the image-space validator found (`count_pixel_inversions`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct PixelInversions {
+    /// Pairs of splats covering one pixel drawn against their depth along its ray, over all pixels.
+    pub inversions: u64,
+    /// Pixels with at least one such pair.
+    pub pixels: u64,
+    /// The pairs among them whose depths along the ray differ by more than the kernel's diameter:
+    /// kernels that do not overlap there, so one truly hides the other (the overlapping-splat
+    /// problem of neighbours, which any per-splat order has, is not among them).
+    pub separated: u64,
+    /// Pixels some footprint covers.
+    pub covered: u64,
+}
+
+/// The image-space validator (issue 26): for each pixel, the splats whose footprints (`radius`
+/// voxel spacings, the kernel's) cover its centre, in draw order, and the pairs of them drawn
+/// against their exact depth along that pixel's ray (back to front: a nearer splat before a
+/// farther one). Unlike the 6-neighbour count, it tells WBTF from BTF, and it sees the
+/// overlapping-splat problem any per-splat order has (section 1.2.2.1).
+pub fn count_pixel_inversions(
+    set: &SplatSet,
+    camera: &Camera,
+    order: &[u32],
+    direction: Direction,
+    radius: f32,
+) -> Result<PixelInversions> {
+    positions(set, order)?;
+    camera.validate()?;
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let g = set.grid();
+    let world = radius as f64 * g.kernel_spacing() as f64;
+    let (eye, fwd) = (camera.eye.as_dvec3(), camera.forward().as_dvec3());
+    let (right, up) = (camera.right().as_dvec3(), camera.true_up().as_dvec3());
+    // Pixels per world unit on the view plane at unit depth (perspective) or everywhere (ortho).
+    let scale = match camera.projection {
+        crate::camera::Projection::Perspective { fov_y_deg } => {
+            h as f64 * 0.5 / (0.5 * (fov_y_deg as f64).to_radians()).tan()
+        }
+        crate::camera::Projection::Orthographic { height } => h as f64 / height as f64,
+    };
+    let persp = camera.is_perspective();
+    let mut depths: Vec<Vec<f64>> = vec![Vec::new(); w * h];
+    for &s in order {
+        let ijk = set.splats()[s as usize].ijk;
+        let p = g.position([ijk[0], ijk[1], ijk[2]]).as_dvec3() - eye;
+        let z = p.dot(fwd);
+        if !(z > camera.near as f64 && z < camera.far as f64) {
+            continue;
+        }
+        let k = if persp { scale / z } else { scale };
+        let (cx, cy) = (w as f64 * 0.5 + p.dot(right) * k, h as f64 * 0.5 - p.dot(up) * k);
+        let r = world * k;
+        let (x0, x1) = ((cx - r).floor().max(0.0) as usize, ((cx + r).ceil() as usize).min(w));
+        let (y0, y1) = ((cy - r).floor().max(0.0) as usize, ((cy + r).ceil() as usize).min(h));
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+                if dx * dx + dy * dy > r * r {
+                    continue;
+                }
+                // Depth along this pixel's ray: the ray through the pixel centre (perspective),
+                // or the view direction (orthographic).
+                let t = if persp {
+                    let ray = (fwd + right * ((x as f64 + 0.5 - w as f64 * 0.5) / scale)
+                        - up * ((y as f64 + 0.5 - h as f64 * 0.5) / scale))
+                        .normalize();
+                    p.dot(ray)
+                } else {
+                    z
+                };
+                depths[y * w + x].push(t);
+            }
+        }
+    }
+    let mut out = PixelInversions::default();
+    for d in &mut depths {
+        if d.is_empty() {
+            continue;
+        }
+        out.covered += 1;
+        // Back to front wants depths falling; count pairs that rise (front to back: the reverse).
+        if direction == Direction::FrontToBack {
+            d.iter_mut().for_each(|t| *t = -*t);
+        }
+        let n = rising_pairs(&mut d.clone(), 0.0);
+        out.separated += rising_pairs(d, 2.0 * world);
+        out.inversions += n;
+        out.pixels += u64::from(n > 0);
+    }
+    Ok(out)
+}
+
+/// Pairs i < j with v[j] - v[i] > gap (merge sort into falling order; `v` is reordered).
+fn rising_pairs(v: &mut [f64], gap: f64) -> u64 {
+    if v.len() < 2 {
+        return 0;
+    }
+    let mid = v.len() / 2;
+    let mut n = rising_pairs(&mut v[..mid], gap) + rising_pairs(&mut v[mid..], gap);
+    let (a, b) = (v[..mid].to_vec(), v[mid..].to_vec());
+    // Both halves fall: for each right element, the left ones more than `gap` below it are a
+    // suffix of the left half, which starts later as the right elements fall.
+    let mut i = 0;
+    for &y in &b {
+        while i < a.len() && a[i] >= y - gap {
+            i += 1;
+        }
+        n += (a.len() - i) as u64;
+    }
+    let (mut i, mut j) = (0, 0);
+    for slot in v.iter_mut() {
+        if j < b.len() && (i == a.len() || b[j] > a[i]) {
+            *slot = b[j];
+            j += 1;
+        } else {
+            *slot = a[i];
+            i += 1;
+        }
+    }
+    n
 }
 
 /// The validator over a sequence of cells of mixed sizes (levels of detail, issue 24): `cells`

@@ -199,3 +199,53 @@ fn two_level_pbtf_is_pbtf_for_voxel_bricks_and_one_brick() {
     }
     assert!(voxsplat::order::pbtf_bricked(&set, &Camera::framing(set.grid(), 8, 8), 0).is_err());
 }
+
+/// Issue 26: the image-space validator counts, per pixel, splats drawn against their depth along
+/// its ray. It is exact on a pair (every pixel both footprints cover counts once when the pair is
+/// reversed), and unlike the 6-neighbour count it tells WBTF from BTF: on the view of Figs
+/// 2.25/2.26 both have 6,136 neighbour violations, but not the same picture.
+#[test]
+fn the_image_space_validator_tells_wbtf_from_btf() {
+    use voxsplat::order::count_pixel_inversions;
+    let grid = voxsplat::Grid::centered([1, 1, 8], [1.0; 3]).unwrap();
+    let pair = SplatSet::from_fn(grid, |_, _, k| (k == 0 || k == 7).then_some([1.0, 1.0, 1.0, 0.5])).unwrap();
+    let cam = Camera {
+        eye: glam::Vec3::new(0.0, 0.0, 30.0),
+        target: glam::Vec3::ZERO,
+        up: glam::Vec3::Y,
+        projection: voxsplat::Projection::Orthographic { height: 8.0 },
+        near: 1.0,
+        far: 60.0,
+        width: 32,
+        height: 32,
+    };
+    // Back to front is the far splat (k = 0, at z = -3.5) first.
+    let right = count_pixel_inversions(&pair, &cam, &[0, 1], Direction::BackToFront, 2.0).unwrap();
+    let wrong = count_pixel_inversions(&pair, &cam, &[1, 0], Direction::BackToFront, 2.0).unwrap();
+    assert_eq!((right.inversions, right.pixels), (0, 0));
+    // Both footprints cover the same disc of radius 2 (8 px): every covered pixel inverts once.
+    assert!(wrong.covered > 150 && wrong.inversions == wrong.covered && wrong.pixels == wrong.covered, "{wrong:?}");
+    assert_eq!(wrong.separated, wrong.inversions, "7 voxels apart: more than a kernel diameter");
+    assert!(count_pixel_inversions(&pair, &cam, &[0, 0], Direction::BackToFront, 2.0).is_err());
+
+    let set = scene::build("cube60").unwrap();
+    let view = |eye: glam::Vec3, target: glam::Vec3| Camera {
+        eye,
+        target,
+        projection: voxsplat::Projection::Perspective { fov_y_deg: 75.0 },
+        width: 128,
+        height: 128,
+        ..Camera::framing(set.grid(), 128, 128)
+    };
+    let a = view(glam::Vec3::new(70.0, 20.0, 12.0), glam::Vec3::ZERO);
+    let count = |cam: &Camera, kind: OrderKind| {
+        let seq = visibility_order(&set, cam, kind, Direction::BackToFront);
+        let v = count_violations(&set, cam, &seq, Direction::BackToFront).unwrap();
+        (v, count_pixel_inversions(&set, cam, &seq, Direction::BackToFront, 2.0).unwrap())
+    };
+    let (btf, wbtf, sorted) = (count(&a, OrderKind::Btf), count(&a, OrderKind::Wbtf), count(&a, OrderKind::Sorted));
+    assert_eq!(btf.0, wbtf.0, "the neighbour count cannot tell them apart");
+    assert!(btf.1.inversions > 2 * wbtf.1.inversions, "btf {:?} wbtf {:?}", btf.1, wbtf.1);
+    // Drawn by exact distance to the eye: the fewest inversions, none between splats apart.
+    assert!(sorted.1.inversions * 10 < wbtf.1.inversions && sorted.1.separated == 0, "{:?}", sorted.1);
+}

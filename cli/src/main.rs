@@ -439,7 +439,9 @@ struct OrderArgs {
     /// Write the back-to-front sequence as `i,j,k,x,y,z` lines.
     #[arg(long)]
     dump: Option<PathBuf>,
-    /// Count 6-neighbour pairs drawn in the wrong order; prints `violations: N` last.
+    /// Count pairs drawn in the wrong order: in image space (splats covering a pixel drawn against
+    /// their depth along its ray, the default kernel's footprints; `pixel inversions: N`), then
+    /// 6-neighbours (prints `violations: N` last).
     #[arg(long)]
     check: bool,
 }
@@ -986,6 +988,12 @@ fn run(cli: Cli) -> Result<()> {
             }
             println!("splats: {}", seq.len());
             if a.check {
+                let radius = voxsplat::Kernel::default().radius();
+                let p = order::count_pixel_inversions(&set, &cam, &seq, Direction::BackToFront, radius)?;
+                println!(
+                    "pixel inversions: {} in {} of {} covered pixels, {} of them between kernels apart along the ray",
+                    p.inversions, p.pixels, p.covered, p.separated
+                );
                 let v = order::count_violations(&set, &cam, &seq, Direction::BackToFront)?;
                 println!("violations: {v}");
             }
