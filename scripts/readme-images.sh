@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 cargo build --release --quiet
 a=(--eye 70,20,12 --target 0,0,0)
 b=(--eye 20,40,50 --target -40,-10,-10)
-for o in btf pbtf; do
+for o in btf wbtf pbtf; do
   ./target/release/voxsplat render --scene cube60 "${a[@]}" --fov 75 --size 256x256 --order "$o" --out "docs/img/a-$o.png"
 done
 for o in wbtf pbtf; do
