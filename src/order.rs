@@ -208,6 +208,32 @@ fn nested(set: &SplatSet, camera: &Camera, axes: [usize; 3]) -> Vec<u32> {
     })
 }
 
+/// PBTF with the loops inside octant o (bit a: the high side of axis a) nested as `axes(o)`
+/// (outermost first), front to back: the seed's "or duals" freedom (any nesting is a visibility
+/// order inside an octant, each axis traversed outward from the eye). `pbtf` nests [2, 1, 0] in
+/// every octant; Westover-style choices (per view, `wbtf_axes`, or per octant) are what issue 26
+/// measures against the overlapping-splat seams.
+pub fn pbtf_nested(set: &SplatSet, split: [u32; 3], axes: impl Fn(u32) -> [usize; 3]) -> Vec<u32> {
+    let dims = set.grid().dims;
+    let outward = |a: usize, v: u32| -> u64 {
+        if v < split[a] {
+            (split[a] - 1 - v) as u64
+        } else {
+            (v - split[a]) as u64
+        }
+    };
+    let per_octant: Vec<[usize; 3]> = (0..8).map(&axes).collect();
+    by_key(set, |s| {
+        let ijk = set.splats()[s].ijk;
+        let octant = (0..3).map(|a| u32::from(ijk[a] >= split[a]) << a).sum::<u32>();
+        let axes = per_octant[octant as usize];
+        let (d1, d2) = (dims[axes[1]] as u64, dims[axes[2]] as u64);
+        let within = (outward(axes[0], ijk[axes[0]]) * d1 + outward(axes[1], ijk[axes[1]])) * d2
+            + outward(axes[2], ijk[axes[2]]);
+        (octant, within)
+    })
+}
+
 /// Westover's axis permutation: most perpendicular to the view plane outermost.
 pub fn wbtf_axes(camera: &Camera) -> [usize; 3] {
     let f = camera.forward().abs();

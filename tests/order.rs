@@ -249,3 +249,26 @@ fn the_image_space_validator_tells_wbtf_from_btf() {
     // Drawn by exact distance to the eye: the fewest inversions, none between splats apart.
     assert!(sorted.1.inversions * 10 < wbtf.1.inversions && sorted.1.separated == 0, "{:?}", sorted.1);
 }
+
+/// Issue 26: the nesting inside PBTF's octants is the seed's "or duals" freedom: `pbtf_nested`
+/// with k, j, i is `pbtf`, and any other nesting is a visibility order too (0 violations).
+#[test]
+fn pbtf_nesting_inside_octants_is_free() {
+    use voxsplat::order::pbtf_nested;
+    let mut rng = Rng(26);
+    for seed in 0..4 {
+        let set = random_sparse(seed, [13, 9, 11], 0.3);
+        for _ in 0..8 {
+            let cam = random_camera(&mut rng, set.grid(), ViewKind::Inside);
+            let split = pbtf_split(&set, &cam);
+            assert_eq!(pbtf_nested(&set, split, |_| [2, 1, 0]), pbtf(&set, split));
+            for axes in [[0, 1, 2], [1, 2, 0], voxsplat::order::wbtf_axes(&cam)] {
+                let seq = pbtf_nested(&set, split, |_| axes);
+                assert_eq!(count_violations(&set, &cam, &seq, Direction::FrontToBack).unwrap(), 0, "{axes:?}");
+            }
+            // A different nesting in every octant is one too.
+            let mixed = pbtf_nested(&set, split, |o| [[0, 1, 2], [2, 0, 1], [1, 0, 2]][o as usize % 3]);
+            assert_eq!(count_violations(&set, &cam, &mixed, Direction::FrontToBack).unwrap(), 0);
+        }
+    }
+}
