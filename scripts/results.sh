@@ -11,4 +11,5 @@ cd "$(dirname "$0")/.."
 cargo run --release --quiet -- bricks --large target/large/bonsai512.nrrd --lod-chart docs/bench/lod-peer256.svg > docs/bench/bricks.md
 ./scripts/bricks-vtk.sh >> docs/bench/bricks.md
 cargo run --release --quiet -- kernels --chart docs/bench/kernels.svg > docs/bench/kernels.md
+cargo run --release --quiet -- antialias > docs/bench/antialias.md
 cargo run --release --quiet -- bench --out-dir docs/bench --results docs/RESULTS.md "$@"

@@ -1,7 +1,8 @@
 //! The research harness around the voxsplat renderer: the benchmark matrix and its charts
-//! (`bench`), where methods fail (`stability`), the raster-rate sweep (`rates`), the peers'
+//! (`bench`), anti-aliasing on the seed's terrain and orthographic figures (`antialias`), where methods fail (`stability`), the raster-rate sweep (`rates`), the peers'
 //! comparison (`peer`), the reconstruction kernels (`kernels`) and long runs (`soak`). The `voxsplat` command-line tool is this crate's
 //! binary; the renderer itself is the `voxsplat` library, which needs none of this.
+pub mod antialias;
 pub mod bench;
 pub mod bricked;
 pub mod kernels;

@@ -73,6 +73,22 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Anti-aliasing on the seed's terrain and orthographic figures (Figs 3.7, 3.8, 5.3; issue 26):
+    /// none, Swan and EWA against a supersampled truth; a markdown section on stdout.
+    Antialias {
+        /// Image side (128: three quarters of the terrain's splats lie beyond k, as in Fig. 3.7).
+        #[arg(long, default_value_t = 128)]
+        size: u32,
+        /// Supersampling of the truth per axis.
+        #[arg(long, default_value_t = 4)]
+        factor: u32,
+        /// Frames of the camera move the shimmer is measured over.
+        #[arg(long, default_value_t = 24)]
+        dolly: usize,
+        /// Timed frames per mode.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+    },
     /// The reconstruction kernels side by side (issue 26): sheet ripple, lattice RMS (Crawfis and
     /// Max's criterion), error against the peers' truth and time; a markdown section on stdout.
     Kernels {
@@ -927,6 +943,16 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Bench(a) => bench(a),
+        Command::Antialias { size, factor, dolly, frames } => {
+            if !(16..=2048).contains(&size) || !(1..=16).contains(&factor) || dolly < 2 || frames == 0 {
+                return Err(Error::InvalidArgument(
+                    "--size in 16..=2048, --factor in 1..=16, --dolly at least 2, --frames at least 1".into(),
+                ));
+            }
+            let rows = voxsplat_cli::antialias::study(size, factor, dolly, frames)?;
+            print!("{}", voxsplat_cli::antialias::markdown(&rows, size, factor, dolly));
+            Ok(())
+        }
         Command::Kernels { n, size, frames, chart } => {
             if !(16..=512).contains(&n) || !(16..=4096).contains(&size) || frames == 0 {
                 return Err(Error::InvalidArgument("--n in 16..=512, --size in 16..=4096, --frames at least 1".into()));
@@ -1124,15 +1150,17 @@ fn bench(a: BenchArgs) -> Result<()> {
         // run by scripts/results.sh.
         let bricks_md = std::fs::read_to_string(a.out_dir.join("bricks.md")).unwrap_or_default();
         let kernels_md = std::fs::read_to_string(a.out_dir.join("kernels.md")).unwrap_or_default();
+        let aa_scenes_md = std::fs::read_to_string(a.out_dir.join("antialias.md")).unwrap_or_default();
         let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
         let motion_md = format!(
-            "{}\n{}\n{}\n{}\n{}\n{}\n{}",
+            "{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}",
             voxsplat_cli::rates::rates_markdown(
                 &rates,
                 &roof_rates,
                 &voxsplat_cli::bench::link(&chart_dir, "rates.svg")
             ),
             antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
+            aa_scenes_md,
             motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
             voxsplat_cli::stability::markdown(&stab, &chart_dir),
             peers_md,

@@ -453,3 +453,20 @@ fn kernels_subcommand_compares_every_kernel() {
     assert!(std::fs::read_to_string(&chart).unwrap().contains("<svg"));
     assert_eq!(voxsplat(&["kernels", "--n", "4"]).status.code(), Some(2));
 }
+
+/// `voxsplat antialias` (issue 26): the terrain and orthographic figures, every mode measured;
+/// the orthographic view lies wholly beyond k and anti-aliasing lowers its shimmer.
+#[test]
+fn antialias_subcommand_measures_the_terrain_and_orthographic_figures() {
+    let out = voxsplat(&["antialias", "--size", "48", "--factor", "2", "--dolly", "3", "--frames", "1"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<Vec<&str>> =
+        text.lines().filter(|l| l.starts_with("| Fig")).map(|l| l.split('|').map(str::trim).collect()).collect();
+    assert_eq!(rows.len(), 6, "{text}");
+    let ortho: Vec<&Vec<&str>> = rows.iter().filter(|r| r[1].contains("orthographic")).collect();
+    assert!(ortho.iter().all(|r| r[2] == "100 %"), "{text}");
+    let shimmer = |r: &Vec<&str>| r[6].parse::<f64>().unwrap();
+    assert!(shimmer(ortho[2]) < shimmer(ortho[0]), "EWA shimmers less than none: {text}");
+    assert_eq!(voxsplat(&["antialias", "--dolly", "1"]).status.code(), Some(2));
+}
