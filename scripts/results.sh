@@ -12,4 +12,5 @@ cargo run --release --quiet -- bricks --large target/large/bonsai512.nrrd --lod-
 ./scripts/bricks-vtk.sh >> docs/bench/bricks.md
 cargo run --release --quiet -- kernels --chart docs/bench/kernels.svg > docs/bench/kernels.md
 cargo run --release --quiet -- antialias > docs/bench/antialias.md
+cargo run --release --quiet -- motion-orders > docs/bench/motion-orders.md
 cargo run --release --quiet -- bench --out-dir docs/bench --results docs/RESULTS.md "$@"

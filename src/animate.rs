@@ -101,12 +101,16 @@ pub const ANIMATIONS: &[(&str, &str)] = &[
     ("rotating-box", "the 60^3 hollow cube turning 6 degrees a frame about y, orthographic (Fig. 4.5)"),
     (
         "rotating-terrain",
-        "the rmnp terrain turning 3 degrees a frame about its vertical axis, perspective (Figs 5.4-5.6)",
+        "the rmnp terrain turning 3 degrees a frame about its vertical axis, perspective (a perspective companion of Figs 5.4-5.6)",
+    ),
+    (
+        "rotating-terrain-ortho",
+        "the same turn seen orthographically, as Figs 5.4-5.6 are (the seed draws them with --order wbtf)",
     ),
 ];
 
 impl Animation {
-    /// A built-in animation by name (`rotating-box`, `rotating-terrain`).
+    /// A built-in animation by name (`ANIMATIONS`).
     pub fn builtin(name: &str) -> Result<Self> {
         match name {
             "rotating-box" => Self::from_toml(
@@ -136,6 +140,24 @@ impl Animation {
                 target = [0.0, 0.0, 0.0]
                 up = [0.0, 0.0, 1.0]
                 fov = 45.0
+                [[keyframe]]
+                frame = 0
+                rotate = [0.0, 0.0, 1.0, 0.0]
+                [[keyframe]]
+                frame = 40
+                rotate = [0.0, 0.0, 1.0, 120.0]
+                "#,
+            ),
+            "rotating-terrain-ortho" => Self::from_toml(
+                r#"
+                scene = "rmnp"
+                frames = 40
+                size = [256, 192]
+                [camera]
+                eye = [0.0, -190.0, 120.0]
+                target = [0.0, 0.0, 0.0]
+                up = [0.0, 0.0, 1.0]
+                ortho = 150.0
                 [[keyframe]]
                 frame = 0
                 rotate = [0.0, 0.0, 1.0, 0.0]

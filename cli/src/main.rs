@@ -89,6 +89,20 @@ enum Command {
         #[arg(long, default_value_t = 5)]
         frames: usize,
     },
+    /// Orders under motion and the terrain's motion blur (chapters 4-5; issue 26): PBTF, WBTF and
+    /// BTF against the sorted order on the built-in animations, and blurred splats against the
+    /// accumulation buffer on the orthographic terrain with WBTF; a markdown section on stdout.
+    MotionOrders {
+        /// First frame.
+        #[arg(long, default_value_t = 8)]
+        first: u32,
+        /// Frames after it.
+        #[arg(long, default_value_t = 12)]
+        frames: u32,
+        /// Timed rounds of the blur methods.
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
+    },
     /// The reconstruction kernels side by side (issue 26): sheet ripple, lattice RMS (Crawfis and
     /// Max's criterion), error against the peers' truth and time; a markdown section on stdout.
     Kernels {
@@ -953,6 +967,16 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", voxsplat_cli::antialias::markdown(&rows, size, factor, dolly));
             Ok(())
         }
+        Command::MotionOrders { first, frames, rounds } => {
+            if frames == 0 || first + frames > 24 || rounds == 0 {
+                return Err(Error::InvalidArgument(
+                    "--frames at least 1, --first + --frames at most 24, --rounds at least 1".into(),
+                ));
+            }
+            let (orders, blurs) = voxsplat_cli::motion_orders::study(first, frames, rounds)?;
+            print!("{}", voxsplat_cli::motion_orders::markdown(&orders, &blurs, first, frames));
+            Ok(())
+        }
         Command::Kernels { n, size, frames, chart } => {
             if !(16..=512).contains(&n) || !(16..=4096).contains(&size) || frames == 0 {
                 return Err(Error::InvalidArgument("--n in 16..=512, --size in 16..=4096, --frames at least 1".into()));
@@ -1151,9 +1175,10 @@ fn bench(a: BenchArgs) -> Result<()> {
         let bricks_md = std::fs::read_to_string(a.out_dir.join("bricks.md")).unwrap_or_default();
         let kernels_md = std::fs::read_to_string(a.out_dir.join("kernels.md")).unwrap_or_default();
         let aa_scenes_md = std::fs::read_to_string(a.out_dir.join("antialias.md")).unwrap_or_default();
+        let motion_orders_md = std::fs::read_to_string(a.out_dir.join("motion-orders.md")).unwrap_or_default();
         let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
         let motion_md = format!(
-            "{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}",
+            "{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}",
             voxsplat_cli::rates::rates_markdown(
                 &rates,
                 &roof_rates,
@@ -1162,6 +1187,7 @@ fn bench(a: BenchArgs) -> Result<()> {
             antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
             aa_scenes_md,
             motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
+            motion_orders_md,
             voxsplat_cli::stability::markdown(&stab, &chart_dir),
             peers_md,
             bricks_md,

@@ -470,3 +470,21 @@ fn antialias_subcommand_measures_the_terrain_and_orthographic_figures() {
     assert!(shimmer(ortho[2]) < shimmer(ortho[0]), "EWA shimmers less than none: {text}");
     assert_eq!(voxsplat(&["antialias", "--dolly", "1"]).status.code(), Some(2));
 }
+
+/// `voxsplat motion-orders` (issue 26): every order on every built-in animation, and the terrain's
+/// blur against the accumulation buffer; WBTF's nesting follows the sorted order more closely than
+/// BTF's on the orthographic box (the seed's reason to draw Fig. 4.5 with it).
+#[test]
+fn motion_orders_subcommand_measures_orders_and_terrain_blur() {
+    let out = voxsplat(&["motion-orders", "--first", "10", "--frames", "2", "--rounds", "1"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let psnr = |anim: &str, order: &str| -> f64 {
+        let line =
+            text.lines().find(|l| l.starts_with(&format!("| {anim} | {order} |"))).unwrap_or_else(|| panic!("{text}"));
+        line.split('|').nth(3).unwrap().trim().parse().unwrap()
+    };
+    assert!(psnr("rotating-box", "WBTF") > psnr("rotating-box", "BTF") + 10.0, "{text}");
+    assert!(text.contains("| blurred splats |") && text.contains("| accum:5 |"), "{text}");
+    assert_eq!(voxsplat(&["motion-orders", "--first", "20", "--frames", "10"]).status.code(), Some(2));
+}
