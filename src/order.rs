@@ -20,6 +20,11 @@ pub enum OrderKind {
     Pbtf,
     /// Reference: sorted by exact distance to the eye (to the view plane in orthographic views).
     Sorted,
+    /// PBTF with Westover's nesting in each octant (`octant_axes`; issue 26): the same octants and
+    /// outward traversal, the axis along which the eye sees the octant's middle farthest
+    /// outermost. WBTF exactly in orthographic views, close to it in perspective views from
+    /// outside the grid; computed on the host (`--order pbtf-octant`).
+    PbtfOctant,
 }
 
 impl std::str::FromStr for OrderKind {
@@ -30,7 +35,8 @@ impl std::str::FromStr for OrderKind {
             "wbtf" => Ok(Self::Wbtf),
             "pbtf" => Ok(Self::Pbtf),
             "sorted" => Ok(Self::Sorted),
-            _ => Err(Error::InvalidArgument(format!("unknown order '{s}' (btf, wbtf, pbtf, sorted)"))),
+            "pbtf-octant" => Ok(Self::PbtfOctant),
+            _ => Err(Error::InvalidArgument(format!("unknown order '{s}' (btf, wbtf, pbtf, sorted, pbtf-octant)"))),
         }
     }
 }
@@ -234,6 +240,24 @@ pub fn pbtf_nested(set: &SplatSet, split: [u32; 3], axes: impl Fn(u32) -> [usize
     })
 }
 
+/// Westover's nesting per PBTF octant: the axes ordered by how far the eye's view of the
+/// octant's middle runs along them, farthest outermost (in an orthographic view, `wbtf_axes` in
+/// every octant).
+pub fn octant_axes(set: &SplatSet, camera: &Camera, split: [u32; 3]) -> [[usize; 3]; 8] {
+    let dims = set.grid().dims;
+    let Viewer::Eye(eye) = Viewer::of(set, camera) else { return [wbtf_axes(camera); 8] };
+    std::array::from_fn(|o| {
+        let d: [f64; 3] = std::array::from_fn(|a| {
+            let s = split[a] as f64;
+            let mid = if o >> a & 1 == 0 { s * 0.5 } else { (s + dims[a] as f64) * 0.5 };
+            (mid - eye[a]).abs()
+        });
+        let mut axes = [0usize, 1, 2];
+        axes.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
+        axes
+    })
+}
+
 /// Westover's axis permutation: most perpendicular to the view plane outermost.
 pub fn wbtf_axes(camera: &Camera) -> [usize; 3] {
     let f = camera.forward().abs();
@@ -248,6 +272,11 @@ pub fn visibility_order(set: &SplatSet, camera: &Camera, kind: OrderKind, direct
         OrderKind::Pbtf => pbtf(set, pbtf_split(set, camera)),
         OrderKind::Btf => nested(set, camera, [2, 1, 0]),
         OrderKind::Wbtf => nested(set, camera, wbtf_axes(camera)),
+        OrderKind::PbtfOctant => {
+            let split = pbtf_split(set, camera);
+            let axes = octant_axes(set, camera, split);
+            pbtf_nested(set, split, |o| axes[o as usize])
+        }
         OrderKind::Sorted => {
             let g = *set.grid();
             let eye = camera.eye.as_dvec3();

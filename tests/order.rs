@@ -266,6 +266,12 @@ fn pbtf_nesting_inside_octants_is_free() {
                 let seq = pbtf_nested(&set, split, |_| axes);
                 assert_eq!(count_violations(&set, &cam, &seq, Direction::FrontToBack).unwrap(), 0, "{axes:?}");
             }
+            // Westover's nesting per octant (`--order pbtf-octant`), and in orthographic views.
+            for kind in [ViewKind::Inside, ViewKind::Outside, ViewKind::Orthographic] {
+                let cam = random_camera(&mut rng, set.grid(), kind);
+                let seq = visibility_order(&set, &cam, OrderKind::PbtfOctant, Direction::BackToFront);
+                assert_eq!(count_violations(&set, &cam, &seq, Direction::BackToFront).unwrap(), 0, "{kind:?}");
+            }
             // A different nesting in every octant is one too.
             let mixed = pbtf_nested(&set, split, |o| [[0, 1, 2], [2, 0, 1], [1, 0, 2]][o as usize % 3]);
             assert_eq!(count_violations(&set, &cam, &mixed, Direction::FrontToBack).unwrap(), 0);

@@ -1,7 +1,7 @@
 //! Issue 26 item 7: PBTF's loops inside each octant nested k, j, i (`order::pbtf`) against
 //! Westover's per-view choice (`order::wbtf_axes`), both visibility orders (the seed's "or
 //! duals"), scored by the image-space validator on the README's views and the rmnp fly-over, 256².
-use voxsplat::order::{count_pixel_inversions, pbtf_nested, pbtf_split, wbtf_axes, Viewer};
+use voxsplat::order::{count_pixel_inversions, pbtf_nested, pbtf_split, wbtf_axes};
 use voxsplat::{Camera, Direction, Projection};
 
 /// A nesting per octant.
@@ -26,24 +26,8 @@ fn main() -> voxsplat::Result<()> {
     println!("| view | nesting | pixel inversions | in pixels | apart |\n|---|---|---:|---:|---:|");
     for (name, set, cam) in views {
         let split = pbtf_split(set, &cam);
-        // Per octant: the axes ordered by how far the eye's view of the octant's middle runs
-        // along them (Westover's rule with the octant's own direction).
-        let Viewer::Eye(eye) = Viewer::of(set, &cam) else { unreachable!("perspective views") };
-        let dims = set.grid().dims;
-        let per_octant = |o: u32| {
-            let mid: [f64; 3] = std::array::from_fn(|a| {
-                let s = split[a] as f64;
-                if o >> a & 1 == 0 {
-                    s * 0.5
-                } else {
-                    (s + dims[a] as f64) * 0.5
-                }
-            });
-            let d: [f64; 3] = std::array::from_fn(|a| (mid[a] - eye[a]).abs());
-            let mut axes = [0usize, 1, 2];
-            axes.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
-            axes
-        };
+        let octants = voxsplat::order::octant_axes(set, &cam, split);
+        let per_octant = |o: u32| octants[o as usize];
         let view_axes = wbtf_axes(&cam);
         let choices: [(&str, Nesting); 3] = [
             ("k, j, i", &|_| [2, 1, 0]),

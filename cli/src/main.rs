@@ -335,7 +335,7 @@ struct SceneArgs {
     #[arg(long, value_parser = parse_finite, default_value = "0")]
     cell: f32,
     /// Visibility order.
-    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted"])]
+    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
     order: String,
     /// Run every stage on the CPU mirrors instead of Vulkan.
     #[arg(long)]
@@ -449,7 +449,7 @@ struct AnimateArgs {
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet"])]
     composite: String,
     /// Visibility order.
-    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted"])]
+    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
     order: String,
     /// Frame files: png or exr.
     #[arg(long, default_value = "png", value_parser = ["png", "exr"])]

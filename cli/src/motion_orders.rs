@@ -51,7 +51,7 @@ pub fn study(first: u32, frames: u32, rounds: usize) -> Result<(Vec<OrderRow>, V
                 .collect()
         };
         let sorted = run(&mut r, OrderKind::Sorted)?;
-        for order in [OrderKind::Pbtf, OrderKind::Wbtf, OrderKind::Btf] {
+        for order in [OrderKind::Pbtf, OrderKind::PbtfOctant, OrderKind::Wbtf, OrderKind::Btf] {
             let seq = run(&mut r, order)?;
             let mut psnr = 0.0;
             for (a, b) in seq.iter().zip(&sorted) {
@@ -114,7 +114,10 @@ pub fn markdown(orders: &[OrderRow], blurs: &[BlurRow], first: u32, frames: u32)
         first + frames
     );
     for r in orders {
-        let order = format!("{:?}", r.order).to_uppercase();
+        let order = match r.order {
+            OrderKind::PbtfOctant => "PBTF, Westover's nesting per octant".to_string(),
+            other => format!("{other:?}").to_uppercase(),
+        };
         let _ = writeln!(s, "| {} | {order} | {:.2} | {:.5} |", r.animation, r.static_psnr, r.temporal_rmse);
     }
     let _ = writeln!(
