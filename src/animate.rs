@@ -148,24 +148,14 @@ impl Animation {
                 rotate = [0.0, 0.0, 1.0, 120.0]
                 "#,
             ),
-            "rotating-terrain-ortho" => Self::from_toml(
-                r#"
-                scene = "rmnp"
-                frames = 40
-                size = [256, 192]
-                [camera]
-                eye = [0.0, -190.0, 120.0]
-                target = [0.0, 0.0, 0.0]
-                up = [0.0, 0.0, 1.0]
-                ortho = 150.0
-                [[keyframe]]
-                frame = 0
-                rotate = [0.0, 0.0, 1.0, 0.0]
-                [[keyframe]]
-                frame = 40
-                rotate = [0.0, 0.0, 1.0, 120.0]
-                "#,
-            ),
+            "rotating-terrain-ortho" => {
+                // The same turn seen orthographically (near and far as an orthographic file gets them).
+                let mut a = Self::builtin("rotating-terrain")?;
+                let dist = (a.camera.target - a.camera.eye).length();
+                (a.camera.projection, a.camera.near) = (Projection::Orthographic { height: 150.0 }, -4.0 * dist);
+                a.camera.validate()?;
+                Ok(a)
+            }
             other => Err(Error::InvalidArgument(format!(
                 "unknown animation '{other}'; built in: {}",
                 ANIMATIONS.iter().map(|a| a.0).collect::<Vec<_>>().join(", ")
