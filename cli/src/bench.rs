@@ -148,6 +148,8 @@ impl MatrixOptions {
             methods.push(splat(OrderKind::Pbtf, Composite::Sheet, kernel));
             methods.push(splat(OrderKind::Pbtf, Composite::Slab, kernel));
         }
+        // PBTF with Westover's nesting per octant (issue 26), a host order.
+        methods.push(splat(OrderKind::PbtfOctant, Composite::Splat, Kernel::Gaussian));
         for composite in [Composite::Splat, Composite::Sheet, Composite::Slab] {
             for raster in [Raster::Points, Raster::Compute] {
                 methods.push(rastered(composite, raster));
