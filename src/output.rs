@@ -147,22 +147,23 @@ pub fn write_gif(frames: &[ImageF32], path: &Path, delay_ms: u32) -> Result<()> 
 /// A PNG (or any format `image` guesses) as straight RGBA8, within `MAX_PIXELS` (a terrain's
 /// colour image).
 pub fn read_rgba8(path: &Path) -> Result<image::RgbaImage> {
+    Ok(decode(path)?.to_rgba8())
+}
+
+/// An input image decoded by `image` (format guessed from its bytes) within `MAX_IMAGE_SIDE` a
+/// side and `MAX_PIXELS` RGBA32F of memory.
+fn decode(path: &Path) -> Result<image::DynamicImage> {
     let name = path.display().to_string();
     let mut reader = image::ImageReader::open(path)
         .map_err(|e| Error::Io { path: name.clone(), source: e })?
         .with_guessed_format()
         .map_err(|e| Error::Io { path: name.clone(), source: e })?;
-    reader.limits(image_limits());
-    Ok(reader.decode().map_err(|e| Error::ImageRead { path: name, message: crate::error::clip_message(e) })?.to_rgba8())
-}
-
-/// Decoder limits for input images: `MAX_IMAGE_SIDE` a side, `MAX_PIXELS` RGBA32F in memory.
-fn image_limits() -> image::Limits {
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(crate::camera::MAX_IMAGE_SIDE);
     limits.max_image_height = Some(crate::camera::MAX_IMAGE_SIDE);
     limits.max_alloc = Some(crate::camera::MAX_PIXELS * 16);
-    limits
+    reader.limits(limits);
+    reader.decode().map_err(|e| Error::ImageRead { path: name, message: crate::error::clip_message(e) })
 }
 
 /// Read a PNG (straight alpha, 8 or 16 bit) or an EXR (premultiplied) as a premultiplied float
@@ -174,12 +175,7 @@ pub fn read_image(path: &Path) -> Result<ImageF32> {
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     match ext.as_deref() {
         Some("png") => {
-            let mut reader = image::ImageReader::open(path)
-                .map_err(|e| Error::Io { path: name.clone(), source: e })?
-                .with_guessed_format()
-                .map_err(|e| Error::Io { path: name.clone(), source: e })?;
-            reader.limits(image_limits());
-            let img = reader.decode().map_err(|e| bad(e.to_string()))?;
+            let img = decode(path)?;
             let (width, height) = (img.width(), img.height());
             let premultiplied = |p: [f32; 4]| [p[0] * p[3], p[1] * p[3], p[2] * p[3], p[3]];
             // Straight to premultiplied floats, without a whole RGBA32F copy in between.
