@@ -194,19 +194,14 @@ impl Kernel {
     pub fn sheet_ripple(self) -> f64 {
         let table = self.radial_table();
         let rr = self.radius() as f64;
-        let reach = rr.ceil() as i32 + 1;
         let n = 32;
         let (mut lo, mut hi, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
         for a in 0..n {
             for b in 0..n {
-                let (x, y) = (a as f64 / n as f64, b as f64 / n as f64);
-                let mut v = 0.0;
-                for i in -reach..=reach {
-                    for j in -reach..=reach {
-                        let (dx, dy) = ((x - i as f64) / rr, (y - j as f64) / rr);
-                        v += sample_radial(&table, (dx * dx + dy * dy) as f32) as f64;
-                    }
-                }
+                let v = lattice_sum(rr, a as f64 / n as f64, b as f64 / n as f64, |dx, dy| {
+                    let (u, v) = (dx / rr, dy / rr);
+                    sample_radial(&table, (u * u + v * v) as f32) as f64
+                });
                 lo = lo.min(v);
                 hi = hi.max(v);
                 sum += v;
@@ -318,6 +313,19 @@ pub const CRAWFIS_MAX_RADIUS: f64 = 1.6;
 pub const CRAWFIS_MAX: RadialSpline =
     RadialSpline { knot: 0.18708572534168427, value: 0.8426488031131327, slope: -1.3164634908267445 };
 
+/// The footprints of a unit lattice of kernels of support `radius` summed at (x, y) in the cell:
+/// `footprint(dx, dy)` at each lattice point's offset (voxels) within reach.
+fn lattice_sum(radius: f64, x: f64, y: f64, footprint: impl Fn(f64, f64) -> f64) -> f64 {
+    let reach = radius.ceil() as i32 + 1;
+    let mut v = 0.0;
+    for i in -reach..=reach {
+        for j in -reach..=reach {
+            v += footprint(x - i as f64, y - j as f64);
+        }
+    }
+    v
+}
+
 /// How far the footprints of a uniform unit lattice of radial kernels `h(r)` (r in voxels, support
 /// `radius`) seen along an axis are from summing to a constant: the RMS of their sum over the
 /// lattice cell, relative to its mean. Crawfis and Max chose their kernel to make this smallest.
@@ -341,18 +349,11 @@ pub fn lattice_rms(h: impl Fn(f64) -> f64, radius: f64) -> f64 {
     };
     // The lattice's symmetry: a quarter of the cell, sampled at cell centres.
     const N: usize = 16;
-    let reach = radius.ceil() as i32 + 1;
     let mut sums = Vec::with_capacity(N * N);
     for a in 0..N {
         for b in 0..N {
             let (x, y) = ((a as f64 + 0.5) / N as f64 * 0.5, (b as f64 + 0.5) / N as f64 * 0.5);
-            let mut v = 0.0;
-            for i in -reach..=reach {
-                for j in -reach..=reach {
-                    v += at(((x - i as f64).powi(2) + (y - j as f64).powi(2)).sqrt());
-                }
-            }
-            sums.push(v);
+            sums.push(lattice_sum(radius, x, y, |dx, dy| at((dx * dx + dy * dy).sqrt())));
         }
     }
     let mean = sums.iter().sum::<f64>() / sums.len() as f64;
