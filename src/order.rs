@@ -207,11 +207,21 @@ fn nested(set: &SplatSet, camera: &Camera, axes: [usize; 3]) -> Vec<u32> {
             (dims[a] - 1 - v) as u64
         }
     };
+    by_key(set, |s| nesting_key(set.splats()[s].ijk, dims, axes, rank))
+}
+
+/// A voxel's place in loops nested as `axes` (outermost first) over a grid of `dims`, each loop
+/// running by `rank(axis, index)`.
+fn nesting_key(ijk: [u32; 4], dims: [u32; 3], axes: [usize; 3], rank: impl Fn(usize, u32) -> u64) -> u64 {
     let (d1, d2) = (dims[axes[1]] as u64, dims[axes[2]] as u64);
-    by_key(set, |s| {
-        let ijk = set.splats()[s].ijk;
-        (rank(axes[0], ijk[axes[0]]) * d1 + rank(axes[1], ijk[axes[1]])) * d2 + rank(axes[2], ijk[axes[2]])
-    })
+    (rank(axes[0], ijk[axes[0]]) * d1 + rank(axes[1], ijk[axes[1]])) * d2 + rank(axes[2], ijk[axes[2]])
+}
+
+/// The three axes ordered by `d`, largest first (ties keep axis order).
+fn axes_by(d: [f64; 3]) -> [usize; 3] {
+    let mut axes = [0usize, 1, 2];
+    axes.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
+    axes
 }
 
 /// PBTF with the loops inside octant o (bit a: the high side of axis a) nested as `axes(o)`
@@ -232,11 +242,7 @@ pub fn pbtf_nested(set: &SplatSet, split: [u32; 3], axes: impl Fn(u32) -> [usize
     by_key(set, |s| {
         let ijk = set.splats()[s].ijk;
         let octant = (0..3).map(|a| u32::from(ijk[a] >= split[a]) << a).sum::<u32>();
-        let axes = per_octant[octant as usize];
-        let (d1, d2) = (dims[axes[1]] as u64, dims[axes[2]] as u64);
-        let within = (outward(axes[0], ijk[axes[0]]) * d1 + outward(axes[1], ijk[axes[1]])) * d2
-            + outward(axes[2], ijk[axes[2]]);
-        (octant, within)
+        (octant, nesting_key(ijk, dims, per_octant[octant as usize], outward))
     })
 }
 
@@ -247,23 +253,18 @@ pub fn octant_axes(set: &SplatSet, camera: &Camera, split: [u32; 3]) -> [[usize;
     let dims = set.grid().dims;
     let Viewer::Eye(eye) = Viewer::of(set, camera) else { return [wbtf_axes(camera); 8] };
     std::array::from_fn(|o| {
-        let d: [f64; 3] = std::array::from_fn(|a| {
+        axes_by(std::array::from_fn(|a| {
             let s = split[a] as f64;
             let mid = if o >> a & 1 == 0 { s * 0.5 } else { (s + dims[a] as f64) * 0.5 };
             (mid - eye[a]).abs()
-        });
-        let mut axes = [0usize, 1, 2];
-        axes.sort_by(|&a, &b| d[b].total_cmp(&d[a]));
-        axes
+        }))
     })
 }
 
 /// Westover's axis permutation: most perpendicular to the view plane outermost.
 pub fn wbtf_axes(camera: &Camera) -> [usize; 3] {
     let f = camera.forward().abs();
-    let mut axes = [0usize, 1, 2];
-    axes.sort_by(|&a, &b| f[b].partial_cmp(&f[a]).unwrap_or(std::cmp::Ordering::Equal));
-    axes
+    axes_by([f.x as f64, f.y as f64, f.z as f64])
 }
 
 /// The draw sequence of `kind` in `direction`.
@@ -377,13 +378,7 @@ pub fn count_pixel_inversions(
     let world = radius as f64 * g.kernel_spacing() as f64;
     let (eye, fwd) = (camera.eye.as_dvec3(), camera.forward().as_dvec3());
     let (right, up) = (camera.right().as_dvec3(), camera.true_up().as_dvec3());
-    // Pixels per world unit on the view plane at unit depth (perspective) or everywhere (ortho).
-    let scale = match camera.projection {
-        crate::camera::Projection::Perspective { fov_y_deg } => {
-            h as f64 * 0.5 / (0.5 * (fov_y_deg as f64).to_radians()).tan()
-        }
-        crate::camera::Projection::Orthographic { height } => h as f64 / height as f64,
-    };
+    let scale = camera.pixels_per_unit() as f64;
     let persp = camera.is_perspective();
     let mut depths: Vec<Vec<f64>> = vec![Vec::new(); w * h];
     for &s in order {
