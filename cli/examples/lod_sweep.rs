@@ -4,7 +4,6 @@
 //! with the variants alternating in one process.
 //!
 //! `cargo run --release -p voxsplat-cli --example lod_sweep -- FILE TF TRUTH.exr 1,0.1 2,1e30 ...`
-use std::time::Instant;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
 use voxsplat::{Camera, Direction, Error, Grid, Lod, Raster, RenderOptions, Renderer, RendererOptions};
@@ -36,24 +35,16 @@ fn main() -> voxsplat::Result<()> {
     for v in &variants {
         psnr.push(voxsplat::metrics::compare(&r.render(&cam, &options(v))?.image, &truth)?.psnr);
     }
-    let mut times = vec![Vec::new(); variants.len()];
-    for _ in 0..3 {
-        for (v, t) in variants.iter().zip(&mut times) {
-            let start = Instant::now();
-            r.render(&cam, &options(v))?;
-            t.push(start.elapsed().as_secs_f64() * 1e3);
-        }
-    }
-    for t in &mut times {
-        t.sort_by(f64::total_cmp);
-    }
+    let times = voxsplat_cli::bench::alternating_medians(variants.len(), 0, 3, |v| {
+        voxsplat_cli::bricked::frame_ms(&mut r, &cam, &options(&variants[v]))
+    })?;
     println!("| cut (pixels, error) | PSNR dB | median ms | × full detail |\n|---|---:|---:|---:|");
     for ((v, p), t) in variants.iter().zip(&psnr).zip(&times) {
         let bound = |x: f32| if x >= 1e29 { "off".to_string() } else { x.to_string() };
         let label = v.map_or("full detail".to_string(), |(px, e)| {
             format!("{} px, {}", bound(px), bound(e)).replace("off px", "off")
         });
-        println!("| {label} | {p:.2} | {:.0} | {:.2} |", t[1], t[1] / times[0][1]);
+        println!("| {label} | {p:.2} | {t:.0} | {:.2} |", t / times[0]);
     }
     Ok(())
 }

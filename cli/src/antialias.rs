@@ -3,8 +3,8 @@
 //! more than one voxel per pixel (Fig. 3.8: stripes128, every splat beyond k), measured as the
 //! grazing plane of Fig. 3.6 is: error against a supersampled truth brought down by a Lanczos-3
 //! low-pass, aliasing energy, shimmer along a slow camera move, and time, for none, Swan and EWA.
+use crate::bricked::frame_ms;
 use std::fmt::Write as _;
-use std::time::Instant;
 use voxsplat::truth::{supersampled_with, Downsample, TruthOptions};
 use voxsplat::{Antialias, Camera, ImageF32, Projection, RenderOptions, Renderer, RendererOptions, Result};
 
@@ -60,20 +60,12 @@ pub fn study(size: u32, factor: u32, dolly: usize, frames: usize) -> Result<Vec<
             o
         };
         // The modes alternate frame by frame (after a warm-up frame each).
-        let mut times = vec![Vec::new(); modes.len()];
-        for round in 0..=frames.max(1) {
-            for (mode, t) in modes.iter().zip(&mut times) {
-                let start = Instant::now();
-                r.render(&camera, &options(*mode))?;
-                if round > 0 {
-                    t.push(start.elapsed().as_secs_f64() * 1e3);
-                }
-            }
-        }
-        for (mode, mut times) in modes.into_iter().zip(times) {
+        let medians = crate::bench::alternating_medians(modes.len(), 1, frames, |m| {
+            frame_ms(&mut r, &camera, &options(modes[m]))
+        })?;
+        for (mode, median_ms) in modes.into_iter().zip(medians) {
             let o = options(mode);
             let image = r.render(&camera, &o)?.image;
-            times.sort_by(f64::total_cmp);
             let moved: Vec<ImageF32> = (0..dolly)
                 .map(|f| {
                     let c =
@@ -87,7 +79,7 @@ pub fn study(size: u32, factor: u32, dolly: usize, frames: usize) -> Result<Vec<
                 psnr: voxsplat::metrics::compare(&image, &truth)?.psnr,
                 aliasing: voxsplat::metrics::aliasing_energy(&image, &truth, |_| true).unwrap_or(f64::NAN),
                 shimmer: voxsplat::metrics::shimmer(&moved, |_, _| true).unwrap_or(f64::NAN),
-                median_ms: times[times.len() / 2],
+                median_ms,
                 beyond_k,
             });
         }

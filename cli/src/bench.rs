@@ -238,6 +238,27 @@ pub fn median(v: &mut [f64]) -> f64 {
     }
 }
 
+/// Medians of `rounds` timings per variant, the `variants` alternating frame by frame after
+/// `warmup` untimed rounds (times on these shared machines drift; alternating keeps the ratios
+/// fair): `run(v)` draws variant `v` and returns its time in ms.
+pub fn alternating_medians(
+    variants: usize,
+    warmup: usize,
+    rounds: usize,
+    mut run: impl FnMut(usize) -> Result<f64>,
+) -> Result<Vec<f64>> {
+    let mut times = vec![Vec::new(); variants];
+    for round in 0..warmup + rounds.max(1) {
+        for (v, t) in times.iter_mut().enumerate() {
+            let ms = run(v)?;
+            if round >= warmup {
+                t.push(ms);
+            }
+        }
+    }
+    Ok(times.iter_mut().map(|t| median(t)).collect())
+}
+
 /// The camera every benchmark uses for a scene.
 pub fn bench_camera(grid: &Grid, width: u32, height: u32) -> Camera {
     Camera::framing(grid, width, height)

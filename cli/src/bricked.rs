@@ -21,7 +21,8 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
-fn frame_ms(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Result<f64> {
+/// The wall time of one frame, ms.
+pub fn frame_ms(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Result<f64> {
     let t = Instant::now();
     r.render(cam, o)?;
     Ok(ms(t))

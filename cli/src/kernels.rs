@@ -1,9 +1,9 @@
 //! The kernel study (issue 26, the seed's section 1.2.3): every reconstruction kernel's ripple on
 //! a flat sheet, its support, and its error and time on the peers' scene against one truth that
 //! no kernel shapes (scalars integrated along the rays), charted error against ripple.
+use crate::bricked::frame_ms;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::time::Instant;
 use voxsplat::kernel::{lattice_rms, KERNELS};
 use voxsplat::{Error, Kernel, Raster, RenderOptions, Renderer, RendererOptions, Result};
 
@@ -36,27 +36,19 @@ pub fn study(n: u32, size: u32, rounds: usize) -> Result<Vec<KernelRow>> {
     for k in KERNELS {
         psnr.push(voxsplat::metrics::compare(&r.render(&camera, &options(k))?.image, &truth)?.psnr);
     }
-    let mut times = vec![Vec::new(); KERNELS.len()];
-    for _ in 0..rounds.max(1) {
-        for (k, t) in KERNELS.iter().zip(&mut times) {
-            let start = Instant::now();
-            r.render(&camera, &options(*k))?;
-            t.push(start.elapsed().as_secs_f64() * 1e3);
-        }
-    }
+    let medians = crate::bench::alternating_medians(KERNELS.len(), 0, rounds, |k| {
+        frame_ms(&mut r, &camera, &options(KERNELS[k]))
+    })?;
     Ok(KERNELS
         .iter()
         .zip(psnr)
-        .zip(times)
-        .map(|((&kernel, psnr), mut t)| {
-            t.sort_by(f64::total_cmp);
-            KernelRow {
-                kernel,
-                ripple: kernel.sheet_ripple(),
-                rms: lattice_rms(|r| kernel.profile(r), kernel.radius() as f64),
-                psnr,
-                median_ms: t[t.len() / 2],
-            }
+        .zip(medians)
+        .map(|((&kernel, psnr), median_ms)| KernelRow {
+            kernel,
+            ripple: kernel.sheet_ripple(),
+            rms: lattice_rms(|r| kernel.profile(r), kernel.radius() as f64),
+            psnr,
+            median_ms,
         })
         .collect())
 }

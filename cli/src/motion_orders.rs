@@ -101,23 +101,17 @@ pub fn study(first: u32, frames: u32, rounds: usize) -> Result<(Vec<OrderRow>, V
     let at = first + frames;
     let truth = render_frame_timed(&mut r, &anim, &grid, at, Blur::Accum(64), &o)?.0;
     let methods = [("still", Blur::None), ("blurred splats", Blur::Splat), ("accum:5", Blur::Accum(5))];
-    let mut times = vec![Vec::new(); methods.len()];
     let mut images = vec![None; methods.len()];
     // The methods alternate frame by frame (a warm-up round first); summed stage times.
-    for round in 0..=rounds.max(1) {
-        for (k, (_, blur)) in methods.iter().enumerate() {
-            let (img, ms) = render_frame_timed(&mut r, &anim, &grid, at, *blur, &o)?;
-            if round > 0 {
-                times[k].push(ms);
-            }
-            images[k] = Some(img);
-        }
-    }
+    let medians = crate::bench::alternating_medians(methods.len(), 1, rounds, |k| {
+        let (img, ms) = render_frame_timed(&mut r, &anim, &grid, at, methods[k].1, &o)?;
+        images[k] = Some(img);
+        Ok(ms)
+    })?;
     let mut blurs = Vec::new();
-    for (((name, _), mut t), img) in methods.iter().zip(times).zip(images) {
-        t.sort_by(f64::total_cmp);
+    for (((name, _), ms), img) in methods.iter().zip(medians).zip(images) {
         let img = img.expect("a round");
-        blurs.push(BlurRow { method: name, rmse: voxsplat::metrics::compare(&img, &truth)?.rmse, ms: t[t.len() / 2] });
+        blurs.push(BlurRow { method: name, rmse: voxsplat::metrics::compare(&img, &truth)?.rmse, ms });
     }
     Ok((orders, blurs))
 }
