@@ -8,25 +8,28 @@ use std::fmt::Write as _;
 use voxsplat::animate::{render_frame_timed, Animation, Blur};
 use voxsplat::{ImageF32, OrderKind, RenderOptions, Renderer, RendererOptions, Result};
 
-/// A perspective turn of the 60³ box whose eye stays level with the box (inside its y slab): PBTF
-/// splits at the eye's plane there, so its seams cross the moving faces, the case the seed avoided
-/// by drawing Fig. 4.5 with WBTF.
+/// The turn of `rotating-box` seen in perspective by an eye level with the box (inside its y
+/// slab): PBTF splits at the eye's plane there, so its seams cross the moving faces, the case the
+/// seed avoided by drawing Fig. 4.5 with WBTF.
 const SEAMS: &str = "rotating-box, perspective, eye level with it";
-const SEAMS_TOML: &str = r#"
-scene = "cube60"
-frames = 24
-size = [256, 256]
-[camera]
-eye = [70.0, 20.0, 12.0]
-target = [0.0, 0.0, 0.0]
-fov = 75.0
-[[keyframe]]
-frame = 0
-rotate = [0.0, 1.0, 0.0, 0.0]
-[[keyframe]]
-frame = 24
-rotate = [0.0, 1.0, 0.0, 144.0]
-"#;
+
+/// `SEAMS`: `rotating-box` with view A's eye, a 75° field and the near and far planes an
+/// animation file's perspective camera gets.
+fn seams() -> Result<Animation> {
+    let mut a = Animation::builtin("rotating-box")?;
+    let (eye, target) = (voxsplat::glam::Vec3::new(70.0, 20.0, 12.0), voxsplat::glam::Vec3::ZERO);
+    let dist = (target - eye).length();
+    a.camera = voxsplat::Camera {
+        eye,
+        target,
+        projection: voxsplat::Projection::Perspective { fov_y_deg: 75.0 },
+        near: 0.05 * dist,
+        far: 4.0 * dist.max(1.0),
+        ..a.camera
+    };
+    a.camera.validate()?;
+    Ok(a)
+}
 
 /// One order on one animation.
 pub struct OrderRow {
@@ -61,7 +64,7 @@ pub fn study(first: u32, frames: u32, rounds: usize) -> Result<(Vec<OrderRow>, V
     let mut r = Renderer::new(&RendererOptions::default())?;
     let mut orders = Vec::new();
     for name in ["rotating-box", "rotating-terrain", "rotating-terrain-ortho", SEAMS] {
-        let anim = if name == SEAMS { Animation::from_toml(SEAMS_TOML)? } else { Animation::builtin(name)? };
+        let anim = if name == SEAMS { seams()? } else { Animation::builtin(name)? };
         let set = voxsplat::scene::build(&anim.scene)?;
         let grid = *set.grid();
         r.set_scene(set)?;
