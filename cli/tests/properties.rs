@@ -1,8 +1,8 @@
 //! Property tests through the whole command-line render path (issue 25): random scenes, cameras,
 //! sizes and modes give either a frame of the asked size or a typed error (exit 2), never a panic
 //! and never a validation message.
+mod cmd;
 use proptest::prelude::*;
-use std::process::Command;
 
 fn pick(options: &'static [&'static str]) -> impl Strategy<Value = &'static str> {
     prop::sample::select(options)
@@ -42,7 +42,7 @@ proptest! {
         }
         args.push(if cpu { "--cpu" } else { "--validation" }.to_string());
         let _ = std::fs::remove_file(&out);
-        let run = Command::new(env!("CARGO_BIN_EXE_voxsplat")).args(&args).output().unwrap();
+        let run = cmd::voxsplat(&args.iter().map(String::as_str).collect::<Vec<_>>());
         let err = String::from_utf8_lossy(&run.stderr);
         prop_assert!(!err.contains("panicked") && !err.contains("validation"), "{args:?}: {err}");
         match run.status.code() {
