@@ -423,31 +423,36 @@ pub fn count_pixel_inversions(
         if direction == Direction::FrontToBack {
             d.iter_mut().for_each(|t| *t = -*t);
         }
-        let n = rising_pairs(&mut d.clone(), 0.0);
-        out.separated += rising_pairs(d, 2.0 * world);
+        let (n, apart) = rising_pairs(d, 2.0 * world);
+        out.separated += apart;
         out.inversions += n;
         out.pixels += u64::from(n > 0);
     }
     Ok(out)
 }
 
-/// Pairs i < j with v[j] - v[i] > gap (merge sort into falling order; `v` is reordered).
-fn rising_pairs(v: &mut [f64], gap: f64) -> u64 {
+/// Pairs i < j with v[j] > v[i], and those with v[j] - v[i] > gap, in one merge sort into
+/// falling order (`v` is reordered).
+fn rising_pairs(v: &mut [f64], gap: f64) -> (u64, u64) {
     if v.len() < 2 {
-        return 0;
+        return (0, 0);
     }
     let mid = v.len() / 2;
-    let mut n = rising_pairs(&mut v[..mid], gap) + rising_pairs(&mut v[mid..], gap);
+    let (l, r) = (rising_pairs(&mut v[..mid], gap), rising_pairs(&mut v[mid..], gap));
     let (a, b) = (v[..mid].to_vec(), v[mid..].to_vec());
-    // Both halves fall: for each right element, the left ones more than `gap` below it are a
+    // Both halves fall: for each right element, the left ones more than `g` below it are a
     // suffix of the left half, which starts later as the right elements fall.
-    let mut i = 0;
-    for &y in &b {
-        while i < a.len() && a[i] >= y - gap {
-            i += 1;
+    let across = |g: f64| {
+        let (mut i, mut n) = (0, 0u64);
+        for &y in &b {
+            while i < a.len() && a[i] >= y - g {
+                i += 1;
+            }
+            n += (a.len() - i) as u64;
         }
-        n += (a.len() - i) as u64;
-    }
+        n
+    };
+    let n = (l.0 + r.0 + across(0.0), l.1 + r.1 + across(gap));
     let (mut i, mut j) = (0, 0);
     for slot in v.iter_mut() {
         if j < b.len() && (i == a.len() || b[j] > a[i]) {
