@@ -268,16 +268,16 @@ pub fn study(
 }
 
 /// Load `path` as a bricked scene with the transfer-function preset `tf` and draw `frames` frames
-/// (after a warm-up) on the GPU within `budget_mib`: one line with the load time, the store, the
+/// (after a warm-up) on the GPU within `budget_bytes`: one line with the load time, the store, the
 /// median frame and the peak resident set (run one file per process for the memory target).
-pub fn one_volume(path: &Path, size: u32, budget_mib: u64, tf: &str, frames: usize) -> Result<String> {
+pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: usize) -> Result<String> {
     let tf = TransferFunction::preset(tf)?;
     let l = load(path, &tf)?;
     let rss_loaded = peak_rss_mib().unwrap_or(0.0);
     let grid = Grid::centered(l.scene.store.dims, l.scene.store.spacing)?;
     let cam = Camera::framing(&grid, size, size);
     let mut o = RendererOptions::default();
-    o.gpu_budget_bytes = budget_mib << 20;
+    o.gpu_budget_bytes = budget_bytes;
     let mut r = Renderer::new(&o)?;
     let (stored, bytes) = (l.scene.store.len(), l.scene.store.bytes());
     r.set_bricks(l.scene)?;

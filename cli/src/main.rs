@@ -1001,7 +1001,7 @@ fn run(cli: Cli) -> Result<()> {
                     voxsplat_cli::bricked::one_volume(
                         &v,
                         size,
-                        mib_bytes(gpu_budget_mib, "--gpu-budget-mib")? >> 20,
+                        mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?,
                         &tf,
                         frames
                     )?
