@@ -3,7 +3,8 @@
 // quad (or point sprite), as optical depth. Per-splat mode emits premultiplied colour and
 // alpha = 1 - exp(-tau) for over/under blending; sheet mode emits (rgb * tau, tau) for additive
 // summation; slab mode weighs by the kernel slice between the slab's faces instead of the whole
-// footprint. Mirror: cpu::footprint.
+// footprint; a motion-blurred footprint is weighed along its path (footprint_value). Mirror:
+// cpu::footprint.
 #include "types.glsl"
 
 layout(std430, binding = 5) readonly buffer Radial { vec2 radial[]; };  // Kernel::radial_pairs
@@ -16,19 +17,15 @@ layout(constant_id = 1) const uint POINTS = 0u;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) flat in vec4 in_emit;
-layout(location = 2) flat in float in_stretch;
+layout(location = 2) flat in vec3 in_sweep;  // motion stretch, bend, profile
 layout(location = 3) flat in vec2 in_slab;
 layout(location = 0) out vec4 out_color;
 
 void main() {
     vec2 uv = POINTS != 0u ? gl_PointCoord * 2.0 - 1.0 : in_uv;
-    float weight = footprint_weight(slices, SHEET_MODE == SHEET_MODE_SLAB, uv, in_stretch, in_slab);
-    float tau = in_emit.a * weight;
-    if (tau <= 0.0) discard;
-    if (SHEET_MODE != SHEET_MODE_SPLAT) {
-        out_color = vec4(in_emit.rgb * tau, tau);
-    } else {
-        float a = 1.0 - exp(-tau);
-        out_color = vec4(in_emit.rgb * a, a);
-    }
+    // Optical depth (sheets) or alpha (per splat).
+    float v = footprint_value(slices, SHEET_MODE == SHEET_MODE_SLAB, uv, in_sweep, in_slab, in_emit.a,
+                              SHEET_MODE == SHEET_MODE_SPLAT);
+    if (v <= 0.0) discard;
+    out_color = vec4(in_emit.rgb * v, v);
 }

@@ -60,7 +60,8 @@ void main() {
         for (int x = box.x; x <= box.z; ++x) {
             vec2 uv = quad_uv(inv, ivec2(x, y));
             if (abs(uv.x) > 1.0 || abs(uv.y) > 1.0) continue;
-            float tau = energy * footprint_weight(slices, slab, uv, p.axis_v.w, faces);
+            float tau = footprint_value(slices, slab, uv, vec3(p.axis_v.w, p.screen.y, frame.sweep.y), faces,
+                                        energy, false);
             if (tau <= 0.0) continue;
             uvec4 add = uvec4(fixed_point(p.emit.r * tau), fixed_point(p.emit.g * tau),
                               fixed_point(p.emit.b * tau), fixed_point(tau));

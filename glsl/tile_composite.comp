@@ -80,6 +80,7 @@ void main() {
     if (carry && begin >= list_end) return;
     uint end = min(list_end, begin + TILE_SEGMENT);
     const bool btf = BACK_TO_FRONT;
+    bool swept = MOTION_BLUR && frame.sweep.y != float(SWEEP_UNIFORM);
     const bool terminate = !btf && TERMINATE;
     // Pixels still open, counted by the lanes that opened or closed them (only their sum means
     // anything).
@@ -138,6 +139,7 @@ void main() {
             q.inv0.xyz = subgroupShuffle(mine.inv0.xyz, j);
             q.inv0.w = MOTION_BLUR ? subgroupShuffle(mine.inv0.w, j) : 0.0;
             q.inv1.xyz = subgroupShuffle(mine.inv1.xyz, j);
+            q.inv1.w = MOTION_BLUR ? subgroupShuffle(mine.inv1.w, j) : 0.0;
             q.inv2.xyz = subgroupShuffle(mine.inv2.xyz, j);
             uvec2 b = subgroupShuffle(box_packed, j);
             q.box = ivec4(b & 0xffffu, b >> 16);
@@ -145,7 +147,7 @@ void main() {
 #else
             uint e = tile_entries[k0];
             ScreenQuad q = quads_at(e);
-            if (!MOTION_BLUR) q.inv0.w = 0.0;
+            if (!MOTION_BLUR) q.inv0.w = q.inv1.w = 0.0;
 #endif
             // The box's pixels inside the tile, dealt to the lanes in turn: every lane works on
             // every step but the last (a lane per row or column would idle on rows or columns the
@@ -170,7 +172,7 @@ void main() {
                 uint at = (base + uint(r) * RASTER_TILE_W + uint(c)) & (TILE_PIXELS - 1u);
                 vec3 h = h0 + c * hx + r * hy;
                 vec2 uv = h.xy * (1.0 / h.z);
-                float s = footprint_r2(uv, MOTION_BLUR ? q.inv0.w : 0.0);
+                float s = footprint_r2(uv, MOTION_BLUR ? q.inv0.w : 0.0, MOTION_BLUR ? q.inv1.w : 0.0);
                 vec4 a = tile_acc[at];
                 // No test against the quad: beyond the footprint's disc (or its blur's capsule)
                 // the radial table is exactly 0, which leaves a pixel as it is, and every pixel
@@ -178,8 +180,10 @@ void main() {
                 // rejects a NaN there.
                 bool live = t < count && s < 1.0 && (!terminate || 1.0 - a.a > pc.occluded);
                 if (live) {
-                    float tau = q.emit.a * sample_radial(s);
-                    float alpha = 1.0 - exp(-tau);
+                    // A tapered or teardrop blur averages the moving footprint's alpha over time.
+                    float alpha = swept ? footprint_value(slices, false, uv, vec3(q.inv0.w, q.inv1.w, frame.sweep.y),
+                                                          vec2(0.0), q.emit.a, true)
+                                        : 1.0 - exp(-q.emit.a * sample_radial(s));
                     vec4 src = vec4(q.emit.rgb * alpha, alpha);
                     if (btf) {
                         a = src + (1.0 - alpha) * a;

@@ -4,7 +4,7 @@
 use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result};
 use crate::image::ImageF32;
-use crate::options::{Motion, RenderOptions};
+use crate::options::{BlurProfile, Motion, RenderOptions};
 use crate::volume::Grid;
 use crate::Renderer;
 use glam::{Mat4, Quat, Vec3};
@@ -100,6 +100,10 @@ pub struct Animation {
 pub const ANIMATIONS: &[(&str, &str)] = &[
     ("rotating-box", "the 60^3 hollow cube turning 6 degrees a frame about y, orthographic (Fig. 4.5)"),
     (
+        "spinning-box",
+        "the same cube turning 30 degrees a frame: paths whose arcs a straight blur misses (--blur splat:arc)",
+    ),
+    (
         "rotating-terrain",
         "the rmnp terrain turning 3 degrees a frame about its vertical axis, perspective (a perspective companion of Figs 5.4-5.6)",
     ),
@@ -130,6 +134,19 @@ impl Animation {
                 rotate = [0.0, 1.0, 0.0, 144.0]
                 "#,
             ),
+            "spinning-box" => {
+                // Keyframes 150 degrees apart: the turn between two keyframes is taken about the
+                // axis, not slerped the short way.
+                let mut toml = String::from(
+                    "scene = \"cube60\"\nframes = 24\nsize = [256, 256]\n[camera]\neye = [0.0, 45.0, 120.0]\n\
+                     target = [0.0, 0.0, 0.0]\northo = 110.0\n",
+                );
+                for k in 0..=5 {
+                    let frame = (5 * k).min(24);
+                    toml += &format!("[[keyframe]]\nframe = {frame}\nrotate = [0.0, 1.0, 0.0, {}]\n", 30 * frame);
+                }
+                Self::from_toml(&toml)
+            }
             "rotating-terrain" => Self::from_toml(
                 r#"
                 scene = "rmnp"
@@ -246,7 +263,7 @@ impl Animation {
             let t = i as f32;
             let times: Vec<f32> = match blur {
                 Blur::None => vec![t],
-                Blur::Splat => vec![t - self.shutter, t],
+                Blur::Splat(_) => vec![t - self.shutter, t - 0.5 * self.shutter, t],
                 Blur::Accum(n) => (0..n).map(|k| t - self.shutter + (k + 1) as f32 / n as f32 * self.shutter).collect(),
             };
             for tk in times {
@@ -323,18 +340,62 @@ impl Animation {
 pub enum Blur {
     /// Each frame drawn still.
     None,
-    /// Motion-blurred splats.
-    Splat,
+    /// Motion-blurred splats, of this shape.
+    Splat(SplatBlur),
     /// N sub-frames over the shutter interval, averaged.
     Accum(u32),
+}
+
+/// The shape of motion-blurred splats: `splat` is the seed's (straight, uniform); `splat:arc`,
+/// `splat:tapered`, `splat:arc+teardrop` and so on choose the path and the profile.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SplatBlur {
+    /// Bend each path through where its point was halfway through the shutter.
+    pub arc: bool,
+    /// How the weight spreads along the path.
+    pub profile: BlurProfile,
+}
+
+impl SplatBlur {
+    /// The `--blur` spelling.
+    pub fn name(self) -> String {
+        let profile = match self.profile {
+            BlurProfile::Uniform => None,
+            BlurProfile::Tapered => Some("tapered"),
+            BlurProfile::Teardrop => Some("teardrop"),
+        };
+        match (self.arc, profile) {
+            (false, None) => "splat".into(),
+            (true, None) => "splat:arc".into(),
+            (false, Some(p)) => format!("splat:{p}"),
+            (true, Some(p)) => format!("splat:arc+{p}"),
+        }
+    }
 }
 
 impl std::str::FromStr for Blur {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
+        if let Some(rest) = s.strip_prefix("splat").filter(|r| r.is_empty() || r.starts_with(':')) {
+            let mut shape = SplatBlur::default();
+            for part in rest.strip_prefix(':').into_iter().flat_map(|r| r.split('+')) {
+                match part {
+                    "arc" => shape.arc = true,
+                    "line" => shape.arc = false,
+                    p => {
+                        shape.profile = p.parse().map_err(|_| {
+                            Error::InvalidArgument(format!(
+                                "blur '{s}': splat takes ':' and a '+'-joined path (line, arc) and profile \
+                                 (uniform, tapered, teardrop), e.g. splat:arc+tapered"
+                            ))
+                        })?
+                    }
+                }
+            }
+            return Ok(Blur::Splat(shape));
+        }
         match s {
             "none" => Ok(Blur::None),
-            "splat" => Ok(Blur::Splat),
             _ => {
                 let n = s
                     .strip_prefix("accum:")
@@ -342,7 +403,7 @@ impl std::str::FromStr for Blur {
                     .filter(|n| (1..=MAX_SUBFRAMES).contains(n))
                     .ok_or_else(|| {
                         Error::InvalidArgument(format!(
-                            "blur '{s}': use none, splat or accum:N with N in 1..={MAX_SUBFRAMES}"
+                            "blur '{s}': use none, splat[:arc+tapered...] or accum:N with N in 1..={MAX_SUBFRAMES}"
                         ))
                     })?;
                 Ok(Blur::Accum(n))
@@ -380,9 +441,14 @@ pub fn render_frame_timed(
             let m = ms(&f);
             Ok((f.image, m))
         }
-        Blur::Splat => {
+        Blur::Splat(shape) => {
             let mut o = base.clone();
-            o.motion = Some(Motion { previous: anim.motion(grid, t - anim.shutter, t), delta_px: DEFAULT_DELTA_PX });
+            o.motion = Some(Motion {
+                previous: anim.motion(grid, t - anim.shutter, t),
+                middle: shape.arc.then(|| anim.motion(grid, t - 0.5 * anim.shutter, t)),
+                delta_px: DEFAULT_DELTA_PX,
+                profile: shape.profile,
+            });
             let f = r.render(&anim.object_camera(grid, t), &o)?;
             let m = ms(&f);
             Ok((f.image, m))

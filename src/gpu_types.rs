@@ -24,7 +24,8 @@ pub struct SplatParams {
     pub axis_v: [f32; 4],
     /// RGB colour; a = optical depth of the voxel (tau).
     pub emit: [f32; 4],
-    /// Eye-space depth z_e, eye distance d, footprint radius in pixels; w unused.
+    /// Eye-space depth z_e; the motion path's bend (its middle's offset across the chord along
+    /// `axis_v`, radius units; 0 = straight); footprint radius in pixels; anti-aliasing radius scale.
     pub screen: [f32; 4],
 }
 
@@ -33,7 +34,7 @@ pub struct SplatParams {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ScreenQuad {
     /// Rows of the inverse projective map, pixel centre -> homogeneous quad coordinates;
-    /// `inv[0][3]` is the motion stretch.
+    /// `inv[0][3]` is the motion stretch, `inv[1][3]` the motion bend.
     pub inv: [[f32; 4]; 3],
     /// Inclusive pixel box x0, y0, x1, y1 (empty when culled: x0 > x1).
     pub bx: [i32; 4],
@@ -60,6 +61,10 @@ pub struct Frame {
     pub motion: [[f32; 4]; 4],
     /// Motion blur: delta in pixels (0 = off), G (across-line integral over area), image width, height.
     pub blur: [f32; 4],
+    /// Arc paths: grid point -> where it was halfway through the shutter.
+    pub motion_mid: [[f32; 4]; 4],
+    /// Motion blur: 1 = arc path (0 = straight), the profile's code (`BlurProfile::code`), unused, unused.
+    pub sweep: [f32; 4],
 }
 
 /// Uniforms of `raycast.comp`.
@@ -186,7 +191,7 @@ const _: () = assert!(std::mem::size_of::<BrickPush>() == 16);
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
-const _: () = assert!(std::mem::size_of::<Frame>() == 288);
+const _: () = assert!(std::mem::size_of::<Frame>() == 368);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);

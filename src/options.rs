@@ -77,8 +77,58 @@ pub struct Motion {
     /// t_{i-1} relative to the eye at t_i: `(V_i M_i)^-1 V_{i-1} M_{i-1}` for object transforms M and
     /// view transforms V.
     pub previous: glam::Mat4,
+    /// Where every grid point was halfway through the shutter, mapped as `previous`: `Some` bends
+    /// each path through it (a parabola, the seed's future work: a turn's arc is no chord), `None`
+    /// keeps the seed's straight segment.
+    pub middle: Option<glam::Mat4>,
     /// Splats whose projected path is at most this many pixels are drawn unblurred (delta).
     pub delta_px: f32,
+    /// How the footprint's weight spreads along its path.
+    pub profile: BlurProfile,
+}
+
+impl Motion {
+    /// The seed's blur: a straight path, uniform weight.
+    pub fn straight(previous: glam::Mat4, delta_px: f32) -> Self {
+        Self { previous, middle: None, delta_px, profile: BlurProfile::Uniform }
+    }
+}
+
+/// How a motion-blurred footprint's weight spreads along its path (chapter 4's future work).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BlurProfile {
+    /// The seed's: the footprint swept along the path at uniform weight, energy scaled by Eq. 4.2.
+    #[default]
+    Uniform,
+    /// The footprint averaged over the shutter (brightest mid-path, tapering to each end); per
+    /// splat its alpha is averaged, as the accumulation buffer averages a lone splat's frames.
+    Tapered,
+    /// As `Tapered` with the time weighted towards t_i (2t): a clear head trailing off, the
+    /// teardrop the seed suggests for stills that show movement.
+    Teardrop,
+}
+
+impl BlurProfile {
+    /// The code `params.glsl` and the footprint stages read (`Frame::sweep[1]`, `SWEEP_*`).
+    pub fn code(self) -> f32 {
+        match self {
+            BlurProfile::Uniform => 0.0,
+            BlurProfile::Tapered => 1.0,
+            BlurProfile::Teardrop => 2.0,
+        }
+    }
+}
+
+impl std::str::FromStr for BlurProfile {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "uniform" => Ok(Self::Uniform),
+            "tapered" => Ok(Self::Tapered),
+            "teardrop" => Ok(Self::Teardrop),
+            _ => Err(Error::InvalidArgument(format!("unknown blur profile '{s}' (uniform, tapered, teardrop)"))),
+        }
+    }
 }
 
 /// Per-frame choices. `Default` gives PBTF, per-splat back-to-front compositing, the Gaussian.

@@ -90,6 +90,13 @@ pub fn make_frame(
             camera.width as f32,
             camera.height as f32,
         ],
+        motion_mid: motion.and_then(|m| m.middle).unwrap_or(glam::Mat4::IDENTITY).to_cols_array_2d(),
+        sweep: [
+            motion.is_some_and(|m| m.middle.is_some()) as u32 as f32,
+            motion.map(|m| m.profile.code()).unwrap_or(0.0),
+            0.0,
+            0.0,
+        ],
     }
 }
 

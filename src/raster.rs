@@ -86,6 +86,12 @@ pub const AUTO_COMPUTE_SUM_MAX_PX: f32 = 10.0;
 /// pixel centres.
 pub const AUTO_POINTS_MIN_PX: f32 = 2.0;
 
+/// Whether the frame blurs with chapter 4's future work (an arc path or a tapered or teardrop
+/// profile), which only the graphics pipeline draws.
+fn swept(opts: &RenderOptions) -> bool {
+    opts.motion.is_some_and(|m| m.middle.is_some() || m.profile != crate::BlurProfile::Uniform)
+}
+
 /// Resolve `opts.raster` for this frame; `Auto` becomes a concrete variant. Explicit choices are
 /// checked: points cannot stretch along a motion path nor exceed the device's point size.
 pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Device) -> Result<RasterChoice> {
@@ -106,7 +112,16 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
             }
             Ok(RasterChoice { raster: Raster::Points, reason: "requested".into() })
         }
+        Raster::Compute if swept(opts) => Err(Error::InvalidArgument(
+            "the compute rasters draw the seed's straight, uniform blur only (a bent or tapered footprint's \
+             per-pixel loops would pass llvmpipe's loop budget): use --raster graphics"
+                .into(),
+        )),
         Raster::Graphics | Raster::Compute => Ok(RasterChoice { raster: opts.raster, reason: "requested".into() }),
+        Raster::Auto if swept(opts) => Ok(RasterChoice {
+            raster: Raster::Graphics,
+            reason: "auto: a bent or tapered motion blur (graphics quads only)".into(),
+        }),
         Raster::Auto => {
             let limit = match opts.composite {
                 Composite::Splat => AUTO_COMPUTE_TILES_MAX_PX,

@@ -53,7 +53,7 @@ fn a_moving_splat_keeps_its_energy_over_area_a1_plus_lw() {
     let radius_px = Kernel::Gaussian.radius() as f64 * 4.0;
     for l_vox in [2.0f32, 5.0, 9.0] {
         // The voxel was l voxels to the left at t_{i-1}: l * 4 pixels of motion.
-        let m = Motion { previous: Mat4::from_translation(Vec3::new(-l_vox, 0.0, 0.0)), delta_px: 0.5 };
+        let m = Motion::straight(Mat4::from_translation(Vec3::new(-l_vox, 0.0, 0.0)), 0.5);
         let moved = optical_depths(&mut r, &cam, &sheet_with(Some(m)));
         let e2: f64 = moved.iter().sum();
         let peak2 = moved.iter().cloned().fold(0.0, f64::max);
@@ -76,14 +76,14 @@ fn no_blur_below_delta_or_along_the_eye_axis() {
     for (shift, delta) in
         [(Vec3::new(0.1, 0.0, 0.0), 0.5), (Vec3::new(0.0, 0.0, 7.0), 0.5), (Vec3::new(3.0, 0.0, 0.0), 20.0)]
     {
-        let m = Motion { previous: Mat4::from_translation(shift), delta_px: delta };
+        let m = Motion::straight(Mat4::from_translation(shift), delta);
         let mut o = sheet_with(Some(m));
         o.antialias = Antialias::None;
         let moved = r.render(&cam, &o).unwrap().image;
         assert_eq!(moved.pixels, still.pixels, "shift {shift} with delta {delta} px must not blur");
     }
     // Just above delta it does blur.
-    let m = Motion { previous: Mat4::from_translation(Vec3::new(3.0, 0.0, 0.0)), delta_px: 0.5 };
+    let m = Motion::straight(Mat4::from_translation(Vec3::new(3.0, 0.0, 0.0)), 0.5);
     assert_ne!(r.render(&cam, &sheet_with(Some(m))).unwrap().image.pixels, still.pixels);
 }
 
@@ -121,23 +121,42 @@ fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
     anim.camera.height = 128;
     let set = voxsplat::scene::build(&anim.scene).unwrap();
     let grid = *set.grid();
+    let mut spin = Animation::builtin("spinning-box").unwrap();
+    (spin.camera.width, spin.camera.height) = (128, 128);
     let mut gpu = common::gpu();
     let mut cpu = common::cpu();
-    gpu.set_scene(set.clone()).unwrap();
-    cpu.set_scene(set).unwrap();
     for composite in [Composite::Splat, Composite::Sheet] {
         let mut o = RenderOptions::default();
         o.composite = composite;
         // Both rasters that draw blurred splats (the tile compositor has a build for them).
         for raster in [Raster::Graphics, Raster::Compute] {
             o.raster = raster;
-            let g = render_frame(&mut gpu, &anim, &grid, 9, Blur::Splat, &o).unwrap();
-            let c = render_frame(&mut cpu, &anim, &grid, 9, Blur::Splat, &o).unwrap();
+            gpu.set_scene(set.clone()).unwrap();
+            cpu.set_scene(set.clone()).unwrap();
+            let g = render_frame(&mut gpu, &anim, &grid, 9, Blur::Splat(Default::default()), &o).unwrap();
+            let c = render_frame(&mut cpu, &anim, &grid, 9, Blur::Splat(Default::default()), &o).unwrap();
             let (max, mean) = common::assert_mirrors(&g, &c, &format!("{composite:?} {raster} blurred"));
             eprintln!("{composite:?} {raster} blurred: max |diff| {max:.2e}, mean over covered {mean:.2e}");
         }
+        // Chapter 4's future work on the fast turn, where arcs bend, through the graphics pipeline
+        // (`auto` picks it; the compute rasters refuse these shapes).
+        for blur in ["splat:arc+tapered", "splat:arc+teardrop", "splat:arc", "splat:tapered"] {
+            o.raster = if blur == "splat:arc" { Raster::Auto } else { Raster::Graphics };
+            let blur: Blur = blur.parse().unwrap();
+            gpu.set_scene(voxsplat::scene::build(&spin.scene).unwrap()).unwrap();
+            cpu.set_scene(voxsplat::scene::build(&spin.scene).unwrap()).unwrap();
+            let g = render_frame(&mut gpu, &spin, &grid, 9, blur, &o).unwrap();
+            let c = render_frame(&mut cpu, &spin, &grid, 9, blur, &o).unwrap();
+            let tag = format!("{composite:?} {} {blur:?}", o.raster);
+            let (max, mean) = common::assert_mirrors(&g, &c, &tag);
+            eprintln!("{tag}: max |diff| {max:.2e}, mean over covered {mean:.2e}");
+            o.raster = Raster::Compute;
+            let e = render_frame(&mut gpu, &spin, &grid, 9, blur, &o).unwrap_err().to_string();
+            assert!(e.contains("--raster graphics"), "{e}");
+        }
         o.raster = Raster::Auto;
-        let g = render_frame(&mut gpu, &anim, &grid, 9, Blur::Splat, &o).unwrap();
+        gpu.set_scene(set.clone()).unwrap();
+        let g = render_frame(&mut gpu, &anim, &grid, 9, Blur::Splat(Default::default()), &o).unwrap();
         // Blurred splats are closer to a 16-sub-frame accumulation than the still frame is.
         let truth = render_frame(&mut gpu, &anim, &grid, 9, Blur::Accum(16), &o).unwrap();
         let still = render_frame(&mut gpu, &anim, &grid, 9, Blur::None, &o).unwrap();
@@ -160,7 +179,7 @@ fn the_rotating_terrain_animation_blurs_the_real_dem() {
     r.set_scene(set).unwrap();
     let o = RenderOptions::default();
     let still = render_frame(&mut r, &anim, &grid, 10, Blur::None, &o).unwrap();
-    let blurred = render_frame(&mut r, &anim, &grid, 10, Blur::Splat, &o).unwrap();
+    let blurred = render_frame(&mut r, &anim, &grid, 10, Blur::Splat(Default::default()), &o).unwrap();
     assert!(still.pixels.iter().filter(|p| p[3] > 0.5).count() > 1000, "the terrain is in view");
     assert_ne!(still.pixels, blurred.pixels);
 }
@@ -213,4 +232,117 @@ fn animation_files_are_checked() {
     assert!(m.is_finite() && o.validate().is_ok());
     assert!(Animation::from_toml(&good.replace("frame = 0\n", "frame = 0\n        eye = [1.0, 2.0, 3.0]\n")).is_err());
     assert_eq!("accum:5".parse::<Blur>().unwrap(), Blur::Accum(5));
+}
+
+/// A lone opaque-ish voxel 6 voxels off the grid's centre (the rotation axis), seen down -z.
+fn off_centre_voxel() -> SplatSet {
+    let grid = Grid::centered([13, 1, 1], [1.0; 3]).unwrap();
+    SplatSet::from_fn(grid, |i, _, _| (i == 12).then_some([1.0, 0.8, 0.6, 0.9])).unwrap()
+}
+
+/// The voxel turned by `deg` about z seen by `cam`: the camera turned the other way.
+fn turned(cam: &Camera, deg: f32) -> Camera {
+    let up = Mat4::from_rotation_z(-deg.to_radians()).transform_vector3(Vec3::Y);
+    Camera { up, ..cam.clone() }
+}
+
+/// The frame at t_i of a voxel turning `deg` a frame about z, blurred with `profile` on an arc or
+/// straight path, and the accumulation of `n` sub-frames over the same shutter.
+fn spun(r: &mut voxsplat::Renderer, deg: f32, arc: bool, profile: voxsplat::BlurProfile) -> voxsplat::ImageF32 {
+    let mut o = RenderOptions::default();
+    o.raster = Raster::Graphics;
+    o.motion = Some(Motion {
+        previous: Mat4::from_rotation_z(-deg.to_radians()),
+        middle: arc.then(|| Mat4::from_rotation_z(-0.5 * deg.to_radians())),
+        delta_px: 0.5,
+        profile,
+    });
+    r.render(&ortho(), &o).unwrap().image
+}
+
+fn accumulated(r: &mut voxsplat::Renderer, deg: f32, n: u32) -> voxsplat::ImageF32 {
+    let mut o = RenderOptions::default();
+    o.raster = Raster::Graphics;
+    let mut acc = voxsplat::ImageF32::new(128, 128);
+    for k in 0..n {
+        // Sub-frame k at the middle of its slice of the shutter, turned back from t_i.
+        let back = deg * (1.0 - (k as f32 + 0.5) / n as f32);
+        let img = r.render(&turned(&ortho(), -back), &o).unwrap().image;
+        for (a, p) in acc.pixels.iter_mut().zip(&img.pixels) {
+            for c in 0..4 {
+                a[c] += p[c] / n as f32;
+            }
+        }
+    }
+    acc
+}
+
+#[test]
+fn tapered_arcs_follow_a_turning_splat_as_the_accumulation_buffer_does() {
+    use voxsplat::BlurProfile::{Tapered, Teardrop, Uniform};
+    let mut r = common::gpu();
+    r.set_scene(off_centre_voxel()).unwrap();
+    // 60 degrees a frame at 6 voxels: a path of 25 px whose chord misses the arc by 3.2 px.
+    let truth = accumulated(&mut r, 60.0, 256);
+    let err = |img: &voxsplat::ImageF32| voxsplat::metrics::compare(img, &truth).unwrap().rmse;
+    let seed = err(&spun(&mut r, 60.0, false, Uniform));
+    let tapered = err(&spun(&mut r, 60.0, false, Tapered));
+    let arc = err(&spun(&mut r, 60.0, true, Uniform));
+    let arc_tapered = err(&spun(&mut r, 60.0, true, Tapered));
+    eprintln!("rmse to accum:256: seed {seed:.5}, tapered {tapered:.5}, arc {arc:.5}, arc+tapered {arc_tapered:.5}");
+    assert!(arc < seed, "the arc alone follows the path better");
+    assert!(tapered < seed, "the taper alone weighs the path as time does");
+    assert!(arc_tapered * 4.0 < seed && arc_tapered * 2.0 < tapered && arc_tapered < arc);
+    // A teardrop's weight leans towards t_i: its centroid lies nearer the voxel's place now.
+    let centroid_angle = |img: &voxsplat::ImageF32| {
+        let (mut x, mut y) = (0.0f64, 0.0f64);
+        for (i, p) in img.pixels.iter().enumerate() {
+            let (px, py) = ((i % 128) as f64 - 63.5 - 0.52, (i / 128) as f64 - 63.5 - 0.28);
+            x += px * p[3] as f64;
+            y += py * p[3] as f64;
+        }
+        y.atan2(x).to_degrees()
+    };
+    let now = centroid_angle(&spun(&mut r, 0.0, false, Uniform));
+    let tear = (centroid_angle(&spun(&mut r, 60.0, true, Teardrop)) - now).abs();
+    let taper = (centroid_angle(&spun(&mut r, 60.0, true, Tapered)) - now).abs();
+    eprintln!("centroid behind t_i: teardrop {tear:.1} deg, tapered {taper:.1} deg");
+    assert!(taper > 20.0 && tear < 0.8 * taper, "teardrop {tear}, tapered {taper}");
+    assert_clean(&r);
+}
+
+#[test]
+fn a_tapered_splat_keeps_its_energy() {
+    let mut r = common::cpu();
+    r.set_scene(one_voxel()).unwrap();
+    let cam = ortho();
+    let e1: f64 = optical_depths(&mut r, &cam, &sheet_with(None)).iter().sum();
+    for profile in [voxsplat::BlurProfile::Tapered, voxsplat::BlurProfile::Teardrop] {
+        for l_vox in [2.0f32, 5.0, 9.0] {
+            let mut m = Motion::straight(Mat4::from_translation(Vec3::new(-l_vox, 0.0, 0.0)), 0.5);
+            m.profile = profile;
+            let e2: f64 = optical_depths(&mut r, &cam, &sheet_with(Some(m))).iter().sum();
+            assert!((e2 / e1 - 1.0).abs() < 0.01, "{profile:?} l {l_vox}: energy ratio {}", e2 / e1);
+        }
+    }
+}
+
+#[test]
+fn blur_shapes_parse_and_bad_ones_are_refused() {
+    use voxsplat::animate::SplatBlur;
+    use voxsplat::BlurProfile;
+    let shape = |s: &str| match s.parse::<Blur>().unwrap() {
+        Blur::Splat(b) => b,
+        other => panic!("{s}: {other:?}"),
+    };
+    assert_eq!(shape("splat"), SplatBlur::default());
+    assert_eq!(shape("splat:arc+tapered"), SplatBlur { arc: true, profile: BlurProfile::Tapered });
+    assert_eq!(shape("splat:teardrop"), SplatBlur { arc: false, profile: BlurProfile::Teardrop });
+    for s in ["splat:arc+tapered", "splat", "splat:teardrop", "splat:arc"] {
+        assert_eq!(shape(s).name(), s);
+    }
+    for bad in ["splat:", "splat:curvy", "splatter", "splat:arc+"] {
+        let e = bad.parse::<Blur>().unwrap_err().to_string();
+        assert!(e.contains(bad), "{bad}: {e}");
+    }
 }

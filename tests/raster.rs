@@ -282,7 +282,7 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
     let cam = Camera::framing(set.grid(), 64, 48);
     gpu.set_scene(set).unwrap();
     let mut o = opts(Composite::Splat, Raster::Points);
-    o.motion = Some(voxsplat::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
+    o.motion = Some(voxsplat::Motion::straight(glam::Mat4::IDENTITY, 1.0));
     assert!(matches!(gpu.render(&cam, &o), Err(Error::InvalidArgument(m)) if m.contains("motion")));
     // A voxel a hair in front of the eye: its footprint is thousands of pixels wide.
     let (set, mut close) = close_up();
@@ -305,7 +305,7 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
     let wide_points = Device { cpu: true, point_size_max: 256.0 };
     let pick = |set: &SplatSet, cam: &Camera, o: &RenderOptions, d: Device| choose(set, cam, o, d).unwrap();
     let mut blurred = opts(Composite::Splat, Raster::Auto);
-    blurred.motion = Some(voxsplat::Motion { previous: glam::Mat4::IDENTITY, delta_px: 1.0 });
+    blurred.motion = Some(voxsplat::Motion::straight(glam::Mat4::IDENTITY, 1.0));
 
     // Small footprints: the tile compositor (ahead of the sprites up to 15 px, docs/RESULTS.md).
     let c = pick(&set, &small, &opts(Composite::Splat, Raster::Auto), cpu);

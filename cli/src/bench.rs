@@ -1167,8 +1167,8 @@ pub fn motion_study(r: &mut Renderer, size: u32, frame: u32, frames: usize) -> R
     let mut rows = Vec::new();
     for (name, blur, o) in [
         ("still", Blur::None, &splat),
-        ("blurred splats", Blur::Splat, &splat),
-        ("blurred splats sheet", Blur::Splat, &sheet),
+        ("blurred splats", Blur::Splat(Default::default()), &splat),
+        ("blurred splats sheet", Blur::Splat(Default::default()), &sheet),
         ("accum:5", Blur::Accum(5), &splat),
     ] {
         let _ = render_frame_timed(r, &anim, &grid, frame, blur, o)?;

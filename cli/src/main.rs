@@ -442,7 +442,10 @@ struct AnimateArgs {
     /// A built-in animation (rotating-box) or a TOML file.
     #[arg(long, default_value = "rotating-box")]
     anim: String,
-    /// none, splat (motion-blurred splats) or accum:N (N sub-frames averaged).
+    /// none, splat (motion-blurred splats) or accum:N (N sub-frames averaged). Blurred splats
+    /// take a path and a profile: splat:arc bends each path through its halfway point,
+    /// splat:tapered averages the footprint over the shutter, splat:teardrop weights it towards
+    /// the frame's time; joined with '+', e.g. splat:arc+tapered.
     #[arg(long, default_value = "splat")]
     blur: String,
     /// Per-splat compositing or sheet summation.

@@ -5,8 +5,8 @@
 //! and how far their frame-to-frame change departs from the sorted order's (temporal error); and
 //! on the orthographic terrain drawn with WBTF, blurred splats against the accumulation buffer.
 use std::fmt::Write as _;
-use voxsplat::animate::{render_frame_timed, Animation, Blur};
-use voxsplat::{ImageF32, OrderKind, RenderOptions, Renderer, RendererOptions, Result};
+use voxsplat::animate::{render_frame_timed, Animation, Blur, SplatBlur};
+use voxsplat::{BlurProfile, ImageF32, OrderKind, Raster, RenderOptions, Renderer, RendererOptions, Result};
 
 /// The turn of `rotating-box` seen in perspective by an eye level with the box (inside its y
 /// slab): PBTF splits at the eye's plane there, so its seams cross the moving faces, the case the
@@ -41,11 +41,29 @@ pub struct OrderRow {
     pub temporal_rmse: f64,
 }
 
-/// One blur method on the orthographic terrain (WBTF).
+/// One blur method on one animation (WBTF) through one raster choice.
 pub struct BlurRow {
-    pub method: &'static str,
+    pub animation: &'static str,
+    pub method: String,
+    /// `auto` (a CPU device's default: the compute tile compositor for the seed's shape, graphics
+    /// quads for the others) or `graphics`.
+    pub raster: Raster,
     pub rmse: f64,
     pub ms: f64,
+}
+
+/// The blur methods compared: still, the seed's blurred splats, chapter 4's future work (arc
+/// paths, tapered and teardrop profiles, alone and together), and the accumulation buffer.
+fn blur_methods() -> Vec<(String, Blur)> {
+    let mut m = vec![("still".to_string(), Blur::None)];
+    for arc in [false, true] {
+        for profile in [BlurProfile::Uniform, BlurProfile::Tapered, BlurProfile::Teardrop] {
+            let shape = SplatBlur { arc, profile };
+            m.push((shape.name(), Blur::Splat(shape)));
+        }
+    }
+    m.push(("accum:5".to_string(), Blur::Accum(5)));
+    m
 }
 
 fn options(order: OrderKind) -> RenderOptions {
@@ -95,26 +113,35 @@ pub fn study(first: u32, frames: u32, rounds: usize) -> Result<(Vec<OrderRow>, V
             });
         }
     }
-    // Figs 5.4-5.6: the orthographic terrain, WBTF, against 64 sub-frames.
-    let anim = Animation::builtin("rotating-terrain-ortho")?;
-    let set = voxsplat::scene::build(&anim.scene)?;
-    let grid = *set.grid();
-    r.set_scene(set)?;
-    let o = options(OrderKind::Wbtf);
-    let at = first + frames;
-    let truth = render_frame_timed(&mut r, &anim, &grid, at, Blur::Accum(64), &o)?.0;
-    let methods = [("still", Blur::None), ("blurred splats", Blur::Splat), ("accum:5", Blur::Accum(5))];
-    let mut images = vec![None; methods.len()];
-    // The methods alternate frame by frame (a warm-up round first); summed stage times.
-    let medians = crate::bench::alternating_medians(methods.len(), 1, rounds, |k| {
-        let (img, ms) = render_frame_timed(&mut r, &anim, &grid, at, methods[k].1, &o)?;
-        images[k] = Some(img);
-        Ok(ms)
-    })?;
+    // Fig. 4.5's box, a faster turn whose arcs bend, and Figs 5.4-5.6's orthographic terrain, WBTF
+    // as the seed draws them, against 64 sub-frames; every method through the default raster choice
+    // and through graphics quads.
     let mut blurs = Vec::new();
-    for (((name, _), ms), img) in methods.iter().zip(medians).zip(images) {
-        let img = img.expect("a round");
-        blurs.push(BlurRow { method: name, rmse: voxsplat::metrics::compare(&img, &truth)?.rmse, ms });
+    let methods: Vec<(String, Blur, Raster)> = [Raster::Auto, Raster::Graphics]
+        .into_iter()
+        .flat_map(|raster| blur_methods().into_iter().map(move |(name, blur)| (name, blur, raster)))
+        .collect();
+    for name in ["rotating-box", "spinning-box", "rotating-terrain-ortho"] {
+        let anim = Animation::builtin(name)?;
+        let set = voxsplat::scene::build(&anim.scene)?;
+        let grid = *set.grid();
+        r.set_scene(set)?;
+        let at = first + frames;
+        let truth = render_frame_timed(&mut r, &anim, &grid, at, Blur::Accum(64), &options(OrderKind::Wbtf))?.0;
+        let mut images = vec![None; methods.len()];
+        // The methods alternate frame by frame (a warm-up round first); summed stage times.
+        let medians = crate::bench::alternating_medians(methods.len(), 1, rounds, |k| {
+            let mut o = options(OrderKind::Wbtf);
+            o.raster = methods[k].2;
+            let (img, ms) = render_frame_timed(&mut r, &anim, &grid, at, methods[k].1, &o)?;
+            images[k] = Some(img);
+            Ok(ms)
+        })?;
+        for (((method, _, raster), ms), img) in methods.iter().zip(medians).zip(images) {
+            let img = img.expect("a round");
+            let rmse = voxsplat::metrics::compare(&img, &truth)?.rmse;
+            blurs.push(BlurRow { animation: name, method: method.clone(), raster: *raster, rmse, ms });
+        }
     }
     Ok((orders, blurs))
 }
@@ -139,19 +166,30 @@ pub fn markdown(orders: &[OrderRow], blurs: &[BlurRow], first: u32, frames: u32)
     }
     let _ = writeln!(
         s,
-        "\nFigs 5.4-5.6 as the seed draws them: `rotating-terrain-ortho`, WBTF, frame {}, against 64 sub-frames \
-         (summed stage times, methods alternating, medians):\n\n| method | RMSE | ms |\n|---|---:|---:|",
+        "\nFig. 4.5's box, the same box turning 30° a frame (`spinning-box`) and Figs 5.4-5.6's orthographic terrain \
+         drawn with WBTF as the seed draws them, frame {}, against 64 sub-frames (summed stage times, all methods \
+         alternating, medians). `auto` is the default raster choice (on a CPU device the tile compositor for the \
+         seed's shape and for accum:5; graphics quads for the arc and tapered shapes, which only that pipeline draws); \
+         the last two columns are against accum:5 through the same raster choice (issue 26's target for blurred \
+         splats: error ≤ 1.5× at ≤ 0.5× the time):\n\n\
+         | animation | method | raster | RMSE | ms | error vs accum:5 | time vs accum:5 |\n|---|---|---|---:|---:|---:|---:|",
         first + frames
     );
     for b in blurs {
-        let _ = writeln!(s, "| {} | {:.5} | {:.1} |", b.method, b.rmse, b.ms);
-    }
-    if let [_, blurred, accum] = blurs {
+        let accum = blurs
+            .iter()
+            .find(|a| a.animation == b.animation && a.raster == b.raster && a.method == "accum:5")
+            .expect("accum:5 row");
         let _ = writeln!(
             s,
-            "\nBlurred splats: error {:.2}× accum:5's at {:.2}× its time (issue 26's target for item 5: ≤ 1.5× at ≤ 0.5×).",
-            blurred.rmse / accum.rmse,
-            blurred.ms / accum.ms
+            "| {} | {} | {} | {:.5} | {:.1} | {:.2}× | {:.2}× |",
+            b.animation,
+            b.method,
+            b.raster,
+            b.rmse,
+            b.ms,
+            b.rmse / accum.rmse,
+            b.ms / accum.ms
         );
     }
     s

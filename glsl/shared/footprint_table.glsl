@@ -45,21 +45,53 @@ float sample_radial(float s) {
     return e.x + e.y * (t - float(i));
 }
 
-// r² (radius units) at quad coordinates uv of a footprint stretched along u across its motion
-// segment (stretch, radius units; 0: round). Mirror: Weight::at in src/cpu/footprint.rs.
-float footprint_r2(vec2 uv, float stretch) {
-    float along = max(abs(uv.x) * (1.0 + stretch) - stretch, 0.0);
-    return along * along + uv.y * uv.y;
+#include "sweep.glsl"
+
+// Time samples of a tapered or teardrop footprint: a quarter radius apart along the path or
+// closer, at most MAX_SWEEP_SAMPLES.
+int sweep_samples(float stretch, float bend) {
+    return clamp(1 + int(ceil(4.0 * (2.0 * stretch + 2.0 * abs(bend)))), 2, MAX_SWEEP_SAMPLES);
 }
 
-// A footprint's weight at quad coordinates uv: the pre-integrated kernel across the motion segment
-// (stretch, radius units along u) or, for a slab, the kernel slice between its faces (radius units).
-// Mirror: Weight::at in src/cpu/footprint.rs.
-float footprint_weight(sampler2D slices, bool slab, vec2 uv, float stretch, vec2 faces) {
-    float s = footprint_r2(uv, stretch);
+// The kernel's weight at r² s: the whole pre-integrated footprint or, for a slab, the kernel
+// slice between its faces (radius units).
+float kernel_at(sampler2D slices, bool slab, float s, vec2 faces) {
     if (slab) {
         float r = sqrt(s);
         return sample_slice_table(slices, r, faces.y) - sample_slice_table(slices, r, faces.x);
     }
     return sample_radial(s);
+}
+
+// What a footprint of optical depth scale tau deposits at quad coordinates uv: its optical depth
+// (sheet modes: summed) or, with `opacity`, its alpha (per-splat compositing). `sweep` is the
+// motion (stretch, bend, profile). The uniform profile weighs the distance to the path (the
+// seed's footprint); the tapered and teardrop ones average the moving footprint over time
+// samples, and per splat they average its alpha, as the accumulation buffer averages the frames
+// of a lone splat. Mirror: footprint_value in src/cpu/footprint.rs.
+float footprint_value(sampler2D slices, bool slab, vec2 uv, vec3 sweep, vec2 faces, float tau, bool opacity) {
+    float stretch = sweep.x, bend = sweep.y;
+    uint profile = uint(sweep.z);
+    if (profile == SWEEP_UNIFORM || stretch == 0.0) {
+        float d = tau * kernel_at(slices, slab, footprint_r2(uv, stretch, bend), faces);
+        return opacity ? 1.0 - exp(-d) : d;
+    }
+    vec2 x = sweep_coords(uv, stretch, bend);
+    int n = sweep_samples(stretch, bend);
+    // The path's u coordinate is linear in t, so only the samples within a radius of x along u
+    // can reach it: t in (x.x + stretch -+ 1) / (2 stretch).
+    float lo = (x.x + stretch - 1.0) / (2.0 * stretch), hi = (x.x + stretch + 1.0) / (2.0 * stretch);
+    int k0 = max(int(ceil(lo * float(n) - 0.5)), 0), k1 = min(int(floor(hi * float(n) - 0.5)), n - 1);
+    float sum = 0.0;
+    for (int k = k0; k <= k1; ++k) {
+        float t = (float(k) + 0.5) / float(n);
+        vec2 e = x - sweep_point(stretch, bend, t);
+        float s = dot(e, e);
+        if (s >= 1.0) continue;
+        float d = tau * kernel_at(slices, slab, s, faces);
+        // Teardrop: weight 2t / n, rising to t_i (the weights sum to 1 either way).
+        float w = profile == SWEEP_TEARDROP ? 2.0 * t / float(n) : 1.0 / float(n);
+        sum += w * (opacity ? 1.0 - exp(-d) : d);
+    }
+    return sum;
 }

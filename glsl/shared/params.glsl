@@ -4,6 +4,8 @@
 // and brick_params (bricked volumes); the includer declares `frame`. Mirror:
 // cpu::splat_params::params_of.
 
+#include "sweep.glsl"
+
 const float MAX_OPACITY = 0.999;
 const float CULL_RADII = 1.5;
 
@@ -38,8 +40,10 @@ SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
     vec3 u = normalize(frame.right.xyz - dot(frame.right.xyz, w) * w);
     vec3 v = cross(w, u);
     // Chapter 4: stretch the footprint back along the projected path from t_{i-1} (Fig. 4.3), in
-    // the plane facing the eye ray at t_i (Fig. 4.4), when the path exceeds delta pixels.
+    // the plane facing the eye ray at t_i (Fig. 4.4), when the path exceeds delta pixels; an arc
+    // path also bends through where the point was halfway (its offset across the chord).
     float stretch = 0.0;
+    float bend = 0.0;
     vec3 quad_center = center;
     float energy = 1.0 / (scale * scale * grow * grow);
     if (frame.blur.x > 0.0 && visible) {
@@ -50,22 +54,34 @@ SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
         vec3 d = center - prev;
         vec3 dp = d - dot(d, w) * w;
         float len = length(dp);
-        if (c0.w > 0.0 && length(moved) > frame.blur.x && len > 1e-6 * radius) {
+        float moved_px = length(moved);
+        vec3 off = vec3(0.0);
+        if (frame.sweep.x > 0.5) {
+            vec3 mid = (frame.motion_mid * vec4(center, 1.0)).xyz;
+            vec4 cm = frame.view_proj * vec4(mid, 1.0);
+            vec2 bulge = (cm.xy / cm.w - 0.5 * (c0.xy / c0.w + c1.xy / c1.w)) * 0.5 * frame.blur.zw;
+            if (cm.w > 0.0) moved_px = max(moved_px, 2.0 * length(bulge));
+            vec3 m = mid - 0.5 * (center + prev);
+            off = m - dot(m, w) * w;
+        }
+        if (c0.w > 0.0 && moved_px > frame.blur.x && len > 1e-6 * radius) {
             u = dp / len;
             v = cross(w, u);
             stretch = 0.5 * len / radius;
+            bend = dot(off, v) / radius;
             quad_center = center - 0.5 * dp;
-            energy /= 1.0 + 2.0 * stretch * frame.blur.y;   // Eq. 4.2 with effective area and width
+            // Eq. 4.2 with effective area and width; the tapered and teardrop profiles average
+            // the footprint over time, which keeps its energy.
+            if (frame.sweep.y == float(SWEEP_UNIFORM)) energy /= 1.0 + sweep_length(stretch, bend) * frame.blur.y;
         }
     }
     SplatParams p;
     p.center = vec4(quad_center, visible && tau > 0.0 ? 1.0 : 0.0);
     p.axis_u = vec4(u * radius * (1.0 + stretch), energy);   // Eq. 3.13: energy x (k/d)^2
-    p.axis_v = vec4(v * radius, stretch);
+    p.axis_v = vec4(v * radius * (1.0 + abs(bend)), stretch);
     p.emit = vec4(rgb, tau);
-    float dist = length(center - frame.eye.xyz);
     float pixels = frame.eye.w > 0.5 ? radius * frame.up.w / max(depth, 1e-6) : radius * frame.up.w;
-    p.screen = vec4(depth, dist, pixels, scale);
+    p.screen = vec4(depth, bend, pixels, scale);
     return p;
 }
 

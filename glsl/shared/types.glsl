@@ -52,20 +52,21 @@ struct SplatParams {
     vec4 axis_v;  // second half-extent vector, perpendicular to axis_u and to the eye ray;
                   // w: motion stretch (half the blur length over the radius; 0 = not blurred)
     vec4 emit;    // rgb colour; a: optical depth of the voxel (tau)
-    vec4 screen;  // eye-space depth z_e (section 3.3.1, +z forward), eye distance d,
-                  // footprint radius in pixels, anti-aliasing radius scale
+    vec4 screen;  // eye-space depth z_e (section 3.3.1, +z forward); the motion path's bend (its
+                  // middle's offset across the chord along axis_v, radius units; 0 = straight);
+                  // footprint radius in pixels; anti-aliasing radius scale
 };
 
 // A footprint in screen space, written by tile_count for the later tile stages. 80 bytes.
 struct ScreenQuad {
     vec4 inv0;    // rows of the inverse projective map, pixel centre (x, y, 1) -> homogeneous
-    vec4 inv1;    // quad coordinates (u, v, 1); inv0.w: motion stretch
+    vec4 inv1;    // quad coordinates (u, v, 1); inv0.w: motion stretch; inv1.w: motion bend
     vec4 inv2;
     ivec4 box;    // inclusive pixel box x0, y0, x1, y1 (empty when culled: x0 > x1)
     vec4 emit;    // rgb; a: optical depth scale (tau x energy)
 };
 
-// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 288 bytes.
+// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 368 bytes.
 // Bound as a readonly storage buffer, not a uniform buffer: Mesa 22.3's lavapipe inlines uniform
 // values that steer branches and recompiles the shader for every dispatch, keeping each variant until
 // the pipeline dies (+0.2-0.7 MB of host memory per frame; docs/RELIABILITY.md).
@@ -84,7 +85,15 @@ struct Frame {
     mat4 motion;      // chapter 4: grid point -> where it was at t_{i-1}, relative to the eye at t_i
     vec4 blur;        // x: delta in pixels (0 = no motion blur); y: G, the footprint's across-line
                       // integral over its area (radius units); z, w: image width and height
+    mat4 motion_mid;  // arc paths: grid point -> where it was halfway through the shutter
+    vec4 sweep;       // x: 1 = arc path through motion_mid, 0 = straight; y: profile along the
+                      // path (SWEEP_*); z, w: unused
 };
+
+// Profiles of a motion-blurred footprint along its path (glsl/shared/footprint_table.glsl).
+const uint SWEEP_UNIFORM = 0u;   // the seed's: uniform weight over the swept capsule, Eq. 4.2
+const uint SWEEP_TAPERED = 1u;   // the time average of the moving footprint (brightest mid-path)
+const uint SWEEP_TEARDROP = 2u;  // weighted towards t_i, fading towards t_{i-1}
 
 #define AA_NONE 0.0
 #define AA_SWAN 1.0

@@ -77,7 +77,8 @@ pub(crate) fn entry<'a>(
     let mut weight = Weight::Footprint(inputs.table);
     let layer = if slab_mode {
         let slab = inputs.draw_list[2 * e as usize + 1];
-        let radius = Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length();
+        // The quad spans 1 + |bend| radii along axis_v.
+        let radius = Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length() / (1.0 + p.screen[1].abs());
         let near_face = push.slab_z0 + slab as f32 * push.slab_dz - p.screen[0];
         let faces = [near_face / radius, (near_face + push.slab_dz) / radius];
         weight = Weight::Slice(inputs.slice_table, faces);
@@ -121,10 +122,11 @@ pub fn footprint(
         let Some((splat, layer, weight)) = entry(inputs, push, e) else { continue };
         let Some(target) = layers.get_mut(layer) else { continue };
         let p = &inputs.params[splat];
+        let shading = Shading { sheet: push.sheet_mode != 0, blend, weight, sweep: Sweep::of(inputs.frame, p) };
         if points {
-            raster_point(p, push.sheet_mode != 0, blend, vp, weight, target);
+            raster_point(p, shading, vp, target);
         } else {
-            raster_quad(p, push.sheet_mode != 0, blend, vp, &inv, weight, target);
+            raster_quad(p, shading, vp, &inv, target);
         }
     }
 }
@@ -191,7 +193,7 @@ pub fn footprint_sum(inputs: &FootprintInputs<'_>, push: &FootprintPush, sums: &
                 if uv.x.abs() > 1.0 || uv.y.abs() > 1.0 {
                     continue;
                 }
-                let tau = energy * weight.at(uv.x, uv.y, p.axis_v[3]);
+                let tau = weight.value(uv, Sweep::of(inputs.frame, p), energy, false);
                 if tau <= 0.0 {
                     continue;
                 }
@@ -253,6 +255,77 @@ pub fn occluded(inputs: &FootprintInputs<'_>, p: &SplatParams, threshold: f32) -
     true
 }
 
+/// Segments of a bent motion path (`ARC_SEGMENTS` in `glsl/shared/sweep.glsl`).
+const ARC_SEGMENTS: u32 = 8;
+/// Most time samples of a tapered or teardrop footprint (`MAX_SWEEP_SAMPLES`).
+const MAX_SWEEP_SAMPLES: i32 = 64;
+
+/// A motion-blurred footprint's path and profile (`glsl/shared/sweep.glsl`): from t_{i-1} at
+/// (-stretch, 0) to t_i at (stretch, 0) through (0, bend), radius units about the quad's centre.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sweep {
+    pub stretch: f32,
+    pub bend: f32,
+    /// `BlurProfile::code`.
+    pub profile: f32,
+}
+
+impl Sweep {
+    /// A splat's sweep: its stretch and bend with the frame's profile.
+    pub fn of(frame: &Frame, p: &SplatParams) -> Self {
+        Self { stretch: p.axis_v[3], bend: p.screen[1], profile: frame.sweep[1] }
+    }
+}
+
+/// Mirror of `sweep_point`: the path's point at time t in [0, 1].
+pub fn sweep_point(stretch: f32, bend: f32, t: f32) -> Vec2 {
+    Vec2::new(stretch * (2.0 * t - 1.0), 4.0 * bend * t * (1.0 - t))
+}
+
+fn sweep_coords(uv: Vec2, stretch: f32, bend: f32) -> Vec2 {
+    Vec2::new(uv.x * (1.0 + stretch), uv.y * (1.0 + bend.abs()))
+}
+
+/// Mirror of `sweep_length`: the path's length in radius units.
+pub fn sweep_length(stretch: f32, bend: f32) -> f32 {
+    if bend == 0.0 {
+        return 2.0 * stretch;
+    }
+    let mut a = sweep_point(stretch, bend, 0.0);
+    let mut l = 0.0;
+    for k in 1..=ARC_SEGMENTS {
+        let b = sweep_point(stretch, bend, k as f32 / ARC_SEGMENTS as f32);
+        l += (b - a).length();
+        a = b;
+    }
+    l
+}
+
+/// Mirror of `footprint_r2`: r² at quad coordinates uv, the squared distance to the path.
+pub fn sweep_r2(uv: Vec2, stretch: f32, bend: f32) -> f32 {
+    let x = sweep_coords(uv, stretch, bend);
+    if bend == 0.0 {
+        let along = (x.x.abs() - stretch).max(0.0);
+        return along * along + x.y * x.y;
+    }
+    let mut best = 1e30f32;
+    let mut a = sweep_point(stretch, bend, 0.0);
+    for k in 1..=ARC_SEGMENTS {
+        let b = sweep_point(stretch, bend, k as f32 / ARC_SEGMENTS as f32);
+        let ab = b - a;
+        let h = ((x - a).dot(ab) / ab.dot(ab).max(1e-12)).clamp(0.0, 1.0);
+        let d = x - a - h * ab;
+        best = best.min(d.dot(d));
+        a = b;
+    }
+    best
+}
+
+/// Mirror of `sweep_samples`.
+fn sweep_samples(stretch: f32, bend: f32) -> i32 {
+    (1 + (4.0 * (2.0 * stretch + 2.0 * bend.abs())).ceil() as i32).clamp(2, MAX_SWEEP_SAMPLES)
+}
+
 /// What a fragment weighs: the whole pre-integrated footprint, or the slice between two slab
 /// faces (radius units, relative to the splat's centre).
 #[derive(Clone, Copy)]
@@ -262,10 +335,8 @@ pub(crate) enum Weight<'a> {
 }
 
 impl Weight<'_> {
-    /// Mirror of `footprint_weight` in `glsl/shared/footprint_table.glsl`.
-    fn at(self, u: f32, v: f32, stretch: f32) -> f32 {
-        let along = (u.abs() * (1.0 + stretch) - stretch).max(0.0);
-        let s = along * along + v * v;
+    /// Mirror of `kernel_at` in `glsl/shared/footprint_table.glsl`: the weight at r² s.
+    fn kernel_at(self, s: f32) -> f32 {
         match self {
             Weight::Footprint(table) => sample_radial(table, s),
             Weight::Slice(table, [za, zb]) => {
@@ -274,27 +345,62 @@ impl Weight<'_> {
             }
         }
     }
+
+    /// Mirror of `footprint_value`: the optical depth a footprint of scale `tau` deposits at quad
+    /// coordinates uv or, with `opacity`, its alpha.
+    fn value(self, uv: Vec2, sweep: Sweep, tau: f32, opacity: bool) -> f32 {
+        let Sweep { stretch, bend, profile } = sweep;
+        if profile == crate::BlurProfile::Uniform.code() || stretch == 0.0 {
+            let d = tau * self.kernel_at(sweep_r2(uv, stretch, bend));
+            return if opacity { 1.0 - (-d).exp() } else { d };
+        }
+        let x = sweep_coords(uv, stretch, bend);
+        let n = sweep_samples(stretch, bend);
+        let teardrop = profile == crate::BlurProfile::Teardrop.code();
+        // Only the samples within a radius of x along u (the path's u is linear in t).
+        let (lo, hi) = ((x.x + stretch - 1.0) / (2.0 * stretch), (x.x + stretch + 1.0) / (2.0 * stretch));
+        let k0 = ((lo * n as f32 - 0.5).ceil() as i32).max(0);
+        let k1 = ((hi * n as f32 - 0.5).floor() as i32).min(n - 1);
+        let mut sum = 0.0;
+        for k in k0..=k1 {
+            let t = (k as f32 + 0.5) / n as f32;
+            let e = x - sweep_point(stretch, bend, t);
+            let s = e.dot(e);
+            if s >= 1.0 {
+                continue;
+            }
+            let d = tau * self.kernel_at(s);
+            let w = if teardrop { 2.0 * t / n as f32 } else { 1.0 / n as f32 };
+            sum += w * if opacity { 1.0 - (-d).exp() } else { d };
+        }
+        sum
+    }
 }
 
-/// The whole footprint's weight at quad coordinates (u, v) with a motion stretch (the tile
-/// compositor's case).
-pub fn footprint_weight(table: &[f32], uv: Vec2, stretch: f32) -> f32 {
-    Weight::Footprint(table).at(uv.x, uv.y, stretch)
+/// The whole footprint's optical depth (or, with `opacity`, alpha) at quad coordinates uv for a
+/// footprint of scale `tau` (the tile compositor's case).
+pub fn footprint_value(table: &[f32], uv: Vec2, sweep: Sweep, tau: f32, opacity: bool) -> f32 {
+    Weight::Footprint(table).value(uv, sweep, tau, opacity)
+}
+
+/// What the fragment shader and the blend do with a footprint.
+#[derive(Clone, Copy)]
+struct Shading<'a> {
+    sheet: bool,
+    blend: Blend,
+    weight: Weight<'a>,
+    sweep: Sweep,
 }
 
 /// The fragment shader's output at quad coordinates (u, v), blended into `dst`.
-fn shade(p: &SplatParams, sheet: bool, blend: Blend, weight: Weight<'_>, u: f32, v: f32, dst: &mut [f32; 4]) {
-    let tau = p.emit[3] * p.axis_u[3] * weight.at(u, v, p.axis_v[3]);
-    if tau <= 0.0 {
+fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, dst: &mut [f32; 4]) {
+    // Optical depth (sheets) or alpha (per splat).
+    let a = s.weight.value(Vec2::new(u, v), s.sweep, p.emit[3] * p.axis_u[3], !s.sheet);
+    if a <= 0.0 {
         return;
     }
-    let src = if sheet {
-        [p.emit[0] * tau, p.emit[1] * tau, p.emit[2] * tau, tau]
-    } else {
-        let a = 1.0 - (-tau).exp();
-        [p.emit[0] * a, p.emit[1] * a, p.emit[2] * a, a]
-    };
-    match blend {
+    let src = [p.emit[0] * a, p.emit[1] * a, p.emit[2] * a, a];
+    match s.blend {
         Blend::Over => {
             let k = 1.0 - src[3];
             *dst = [0, 1, 2, 3].map(|i| src[i] + k * dst[i]);
@@ -309,7 +415,7 @@ fn shade(p: &SplatParams, sheet: bool, blend: Blend, weight: Weight<'_>, u: f32,
 
 /// A point sprite `2 * screen radius` pixels wide centred on the projected centre: the pixels whose
 /// centres fall inside it, with gl_PointCoord mapped to [-1, 1]².
-fn raster_point(p: &SplatParams, sheet: bool, blend: Blend, vp: Mat4, weight: Weight<'_>, target: &mut ImageF32) {
+fn raster_point(p: &SplatParams, shading: Shading<'_>, vp: Mat4, target: &mut ImageF32) {
     let clip = vp * Vec4::new(p.center[0], p.center[1], p.center[2], 1.0);
     if clip.w <= 0.0 {
         return;
@@ -328,20 +434,12 @@ fn raster_point(p: &SplatParams, sheet: bool, blend: Blend, vp: Mat4, weight: We
         for x in x0..=x1 {
             let (u, v) = ((x as f32 + 0.5 - sx) / half, (y as f32 + 0.5 - sy) / half);
             let dst = &mut target.pixels[(y as u32 * target.width + x as u32) as usize];
-            shade(p, sheet, blend, weight, u, v, dst);
+            shade(p, shading, u, v, dst);
         }
     }
 }
 
-fn raster_quad(
-    p: &SplatParams,
-    sheet: bool,
-    blend: Blend,
-    vp: Mat4,
-    inv: &DMat4,
-    weight: Weight<'_>,
-    target: &mut ImageF32,
-) {
+fn raster_quad(p: &SplatParams, shading: Shading<'_>, vp: Mat4, inv: &DMat4, target: &mut ImageF32) {
     let v3 = |v: [f32; 4]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
     let (c, au, av) = (v3(p.center), v3(p.axis_u), v3(p.axis_v));
     let (w, h) = (target.width as f64, target.height as f64);
@@ -382,7 +480,7 @@ fn raster_quad(
                 continue;
             }
             let dst = &mut target.pixels[(y as u32 * target.width + x as u32) as usize];
-            shade(p, sheet, blend, weight, u as f32, v as f32, dst);
+            shade(p, shading, u as f32, v as f32, dst);
         }
     }
 }

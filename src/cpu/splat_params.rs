@@ -1,5 +1,6 @@
 //! Mirror of `splat_params.comp` and of `glsl/shared/params.glsl`.
 use super::bindings::Bindings;
+use super::footprint::sweep_length;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{Frame, Splat, SplatParams};
@@ -55,6 +56,7 @@ pub fn params_at(frame: &Frame, at: Vec3, cell: f32, grow: f32, rgb: [f32; 3], t
     let mut u = (right - right.dot(w) * w).normalize();
     let mut v = w.cross(u);
     let mut stretch = 0.0f32;
+    let mut bend = 0.0f32;
     let mut quad_center = center;
     let mut energy = 1.0 / (scale * scale * grow * grow);
     if frame.blur[0] > 0.0 && visible {
@@ -69,12 +71,28 @@ pub fn params_at(frame: &Frame, at: Vec3, cell: f32, grow: f32, rgb: [f32; 3], t
         let d = center - prev;
         let dp = d - d.dot(w) * w;
         let len = dp.length();
-        if c0.w > 0.0 && moved.length() > frame.blur[0] && len > 1e-6 * radius {
+        let mut moved_px = moved.length();
+        let mut off = Vec3::ZERO;
+        if frame.sweep[0] > 0.5 {
+            let mid = (Mat4::from_cols_array_2d(&frame.motion_mid) * center.extend(1.0)).truncate();
+            let cm = vp * mid.extend(1.0);
+            let xy = |c: glam::Vec4| c.truncate().truncate() / c.w;
+            let bulge = (xy(cm) - 0.5 * (xy(c0) + xy(c1))) * 0.5 * Vec2::new(frame.blur[2], frame.blur[3]);
+            if cm.w > 0.0 {
+                moved_px = moved_px.max(2.0 * bulge.length());
+            }
+            let m = mid - 0.5 * (center + prev);
+            off = m - m.dot(w) * w;
+        }
+        if c0.w > 0.0 && moved_px > frame.blur[0] && len > 1e-6 * radius {
             u = dp / len;
             v = w.cross(u);
             stretch = 0.5 * len / radius;
+            bend = off.dot(v) / radius;
             quad_center = center - 0.5 * dp;
-            energy /= 1.0 + 2.0 * stretch * frame.blur[1];
+            if frame.sweep[1] == crate::BlurProfile::Uniform.code() {
+                energy /= 1.0 + sweep_length(stretch, bend) * frame.blur[1];
+            }
         }
     }
     SplatParams {
@@ -85,11 +103,16 @@ pub fn params_at(frame: &Frame, at: Vec3, cell: f32, grow: f32, rgb: [f32; 3], t
             u.z * radius * (1.0 + stretch),
             energy,
         ],
-        axis_v: [v.x * radius, v.y * radius, v.z * radius, stretch],
+        axis_v: [
+            v.x * radius * (1.0 + bend.abs()),
+            v.y * radius * (1.0 + bend.abs()),
+            v.z * radius * (1.0 + bend.abs()),
+            stretch,
+        ],
         emit: [rgb[0], rgb[1], rgb[2], tau],
         screen: [
             depth,
-            (center - eye).length(),
+            bend,
             if frame.eye[3] > 0.5 { radius * frame.up[3] / depth.max(1e-6) } else { radius * frame.up[3] },
             scale,
         ],

@@ -2,7 +2,7 @@
 //! `tile_offsets.comp`, `tile_scatter.comp` (a stable counting sort of the draw list into screen tiles, so every tile's
 //! list keeps the PBTF order) and `tile_composite.comp` (each tile composites its list per pixel,
 //! front to back with early termination or back to front).
-use super::footprint::{footprint_weight, screen_quad, FootprintInputs};
+use super::footprint::{footprint_value, screen_quad, FootprintInputs, Sweep};
 use super::ImageF32;
 use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
 use crate::dispatch::{Args, Res, Variant};
@@ -23,7 +23,7 @@ pub fn screen_record(frame: &Frame, p: &SplatParams) -> ScreenQuad {
     let (inv, bx) = screen_quad(frame, p).unwrap_or((Mat3::IDENTITY, IVec4::new(0, 0, -1, -1)));
     let row = |r: usize, w: f32| [inv.x_axis[r], inv.y_axis[r], inv.z_axis[r], w];
     ScreenQuad {
-        inv: [row(0, p.axis_v[3]), row(1, 0.0), row(2, 0.0)],
+        inv: [row(0, p.axis_v[3]), row(1, p.screen[1]), row(2, 0.0)],
         bx: bx.to_array(),
         emit: [p.emit[0], p.emit[1], p.emit[2], p.emit[3] * p.axis_u[3]],
     }
@@ -155,11 +155,11 @@ pub fn tile_composite(
             if uv.x.abs() > 1.0 || uv.y.abs() > 1.0 {
                 continue;
             }
-            let tau = q.emit[3] * footprint_weight(inputs.table, uv, q.inv[0][3]);
-            if tau <= 0.0 {
+            let sweep = Sweep { stretch: q.inv[0][3], bend: q.inv[1][3], profile: inputs.frame.sweep[1] };
+            let a = footprint_value(inputs.table, uv, sweep, q.emit[3], true);
+            if a <= 0.0 {
                 continue;
             }
-            let a = 1.0 - (-tau).exp();
             let src = [q.emit[0] * a, q.emit[1] * a, q.emit[2] * a, a];
             if btf {
                 acc = [0, 1, 2, 3].map(|c| src[c] + (1.0 - a) * acc[c]);
