@@ -243,7 +243,7 @@ fn off_centre_voxel() -> SplatSet {
 /// The voxel turned by `deg` about z seen by `cam`: the camera turned the other way.
 fn turned(cam: &Camera, deg: f32) -> Camera {
     let up = Mat4::from_rotation_z(-deg.to_radians()).transform_vector3(Vec3::Y);
-    Camera { up, ..cam.clone() }
+    Camera { up, ..*cam }
 }
 
 /// The frame at t_i of a voxel turning `deg` a frame about z, blurred with `profile` on an arc or
