@@ -5,16 +5,18 @@ use crate::truth::pixel_ray;
 use crate::volume::SplatSet;
 use glam::Mat4;
 
-/// Per pixel: 0 where the ray misses the sheet, 1 where it meets the sheet before k, 2 beyond k.
-/// For orthographic views every hit pixel is 1 or 2 by the pixels-per-voxel ratio. Only for grids
-/// one voxel thick in z (the checkerboard plane); other grids give all zeros.
+/// Per pixel: 0 where the ray meets no splat, 1 where the first it meets lies before k, 2 beyond
+/// k. For orthographic views every hit pixel is 1 or 2 by the pixels-per-voxel ratio. A grid one
+/// voxel thick in z (the checkerboard plane) is met exactly at its plane; any other grid (a
+/// terrain's columns, a volume) at its first non-empty voxel, marched in steps of half the
+/// smallest spacing.
 pub fn k_regions(set: &SplatSet, camera: &Camera) -> Vec<u8> {
     let g = set.grid();
+    if g.dims[2] != 1 {
+        return k_regions_marched(set, camera);
+    }
     let (w, h) = (camera.width, camera.height);
     let mut out = vec![0u8; (w * h) as usize];
-    if g.dims[2] != 1 {
-        return out;
-    }
     let s = g.kernel_spacing();
     let inv = Mat4::from_cols_array_2d(&camera.view_proj().to_cols_array_2d()).as_dmat4().inverse();
     let z = g.origin[2] as f64;
@@ -42,6 +44,54 @@ pub fn k_regions(set: &SplatSet, camera: &Camera) -> Vec<u8> {
                 None => ortho_beyond,
             };
             out[(y * w + x) as usize] = if beyond { 2 } else { 1 };
+        }
+    }
+    out
+}
+
+/// `k_regions` for grids more than one voxel thick: each pixel's ray marched to its first
+/// non-empty voxel. Grids of more than 2^30 cells give all zeros (the occupancy takes a bit a cell).
+fn k_regions_marched(set: &SplatSet, camera: &Camera) -> Vec<u8> {
+    let g = set.grid();
+    let (w, h) = (camera.width, camera.height);
+    let mut out = vec![0u8; (w * h) as usize];
+    let [nx, ny, nz] = g.dims.map(|d| d as usize);
+    let cells = nx * ny * nz;
+    if cells as u64 > 1 << 30 {
+        return out;
+    }
+    let mut occupied = vec![0u64; cells.div_ceil(64)];
+    for s in set.splats() {
+        let c = (s.ijk[2] as usize * ny + s.ijk[1] as usize) * nx + s.ijk[0] as usize;
+        occupied[c / 64] |= 1 << (c % 64);
+    }
+    let spacing = glam::DVec3::from(g.spacing.map(f64::from));
+    let origin = glam::DVec3::from(g.origin.map(f64::from));
+    let (lo, hi) = (origin - 0.5 * spacing, origin + (glam::DVec3::from(g.dims.map(f64::from)) - 0.5) * spacing);
+    let step = 0.5 * spacing.min_element();
+    let inv = camera.view_proj().as_dmat4().inverse();
+    let (eye, fwd) = (camera.eye.as_dvec3(), camera.forward().as_dvec3());
+    let k = camera.k(g.kernel_spacing()).map(f64::from);
+    let ortho_beyond = g.kernel_spacing() * camera.pixels_per_unit() < 1.0;
+    for y in 0..h {
+        for x in 0..w {
+            let (o, d, len) = pixel_ray(&inv, x, y, w, h);
+            let Some((t0, t1)) = crate::truth::slab(o, d, lo, hi, len) else { continue };
+            let mut t = t0;
+            while t <= t1 {
+                let p = o + d * t;
+                let ijk = ((p - origin) / spacing).round();
+                let inside = (0..3).all(|a| ijk[a] >= 0.0 && ijk[a] < g.dims[a] as f64);
+                if inside {
+                    let c = (ijk.z as usize * ny + ijk.y as usize) * nx + ijk.x as usize;
+                    if occupied[c / 64] >> (c % 64) & 1 == 1 {
+                        let beyond = k.map_or(ortho_beyond, |k| (p - eye).dot(fwd) > k);
+                        out[(y * w + x) as usize] = if beyond { 2 } else { 1 };
+                        break;
+                    }
+                }
+                t += step;
+            }
         }
     }
     out

@@ -168,3 +168,23 @@ fn aliasing_energy_counts_added_patterns_not_blur() {
     assert!(e > 0.05, "aliasing energy {e}");
     assert_eq!(aliasing_energy(&moire, &reference, |i| i < 2), None, "a box under 4 pixels");
 }
+
+#[test]
+fn the_k_line_falls_across_the_terrain_fly_over() {
+    // Fig. 3.7's view at its size: the near terrain (lower rows) before k, the far terrain beyond.
+    let set = scene::build("rmnp").unwrap();
+    let cam = Camera::flyover(set.grid(), 260, 179);
+    let regions = voxsplat::aa::k_regions(&set, &cam);
+    let rows = |class: u8| {
+        let ys: Vec<usize> = (0..regions.len()).filter(|&i| regions[i] == class).map(|i| i / 260).collect();
+        (ys.len(), ys.iter().sum::<usize>() as f64 / ys.len().max(1) as f64)
+    };
+    let ((before, y_before), (beyond, y_beyond)) = (rows(1), rows(2));
+    eprintln!("before k: {before} px (mean row {y_before:.1}); beyond: {beyond} px (mean row {y_beyond:.1})");
+    assert!(before > 500 && beyond > 500, "the view spans k");
+    // The image's first row is its top (Vulkan's y points down): the far terrain lies above.
+    assert!(y_beyond < y_before);
+    // A voxel raster the rays miss has no regions.
+    let empty = voxsplat::SplatSet::from_fn(*set.grid(), |_, _, _| None).unwrap();
+    assert!(voxsplat::aa::k_regions(&empty, &cam).iter().all(|&r| r == 0));
+}

@@ -11,6 +11,8 @@ use voxsplat::{Antialias, Camera, ImageF32, Projection, RenderOptions, Renderer,
 /// One mode on one figure's view.
 pub struct AaSceneRow {
     pub figure: &'static str,
+    /// Image width and height.
+    pub size: (u32, u32),
     pub mode: Antialias,
     pub psnr: f64,
     pub aliasing: f64,
@@ -20,17 +22,21 @@ pub struct AaSceneRow {
     pub beyond_k: f64,
 }
 
-/// The figures' scenes and views at `size`² (the camera moves half a voxel per frame for the
-/// shimmer: forward along the view in perspective, sideways in the orthographic view).
-fn views(size: u32) -> Result<Vec<(&'static str, voxsplat::SplatSet, Camera, glam::Vec3)>> {
+/// The seed's image sizes: Fig. 3.7 (and 5.3) 260 x 179, Fig. 3.8 290 x 290.
+pub const SEED_SIZES: [(u32, u32); 2] = [(260, 179), (290, 290)];
+
+/// The figures' scenes and views at the seed's sizes or `size`² (the camera moves half a voxel per
+/// frame for the shimmer: forward along the view in perspective, sideways in the orthographic view).
+fn views(size: Option<u32>) -> Result<Vec<(&'static str, voxsplat::SplatSet, Camera, glam::Vec3)>> {
+    let [(w0, h0), (w1, h1)] = size.map_or(SEED_SIZES, |s| [(s, s); 2]);
     let rmnp = voxsplat::scene::build("rmnp")?;
-    let fly = Camera::flyover(rmnp.grid(), size, size);
+    let fly = Camera::flyover(rmnp.grid(), w0, h0);
     let fly_step = fly.forward() * 0.5 * rmnp.grid().kernel_spacing();
     let stripes = voxsplat::scene::build("stripes128")?;
     let g = stripes.grid();
     // 1.5 voxels per pixel: every splat beyond k, as in Fig. 3.8.
-    let height = 1.5 * size as f32 * g.kernel_spacing();
-    let ortho = Camera { projection: Projection::Orthographic { height }, ..Camera::framing(g, size, size) };
+    let height = 1.5 * h1 as f32 * g.kernel_spacing();
+    let ortho = Camera { projection: Projection::Orthographic { height }, ..Camera::framing(g, w1, h1) };
     let side = ortho.right() * 0.5 * g.kernel_spacing();
     Ok(vec![
         ("Figs 3.7, 5.3: rmnp fly-over", rmnp, fly, fly_step),
@@ -40,7 +46,7 @@ fn views(size: u32) -> Result<Vec<(&'static str, voxsplat::SplatSet, Camera, gla
 
 /// Every mode on every view: `frames` timed renders each (median), a `dolly`-frame move for the
 /// shimmer, against a `factor`× supersampled truth.
-pub fn study(size: u32, factor: u32, dolly: usize, frames: usize) -> Result<Vec<AaSceneRow>> {
+pub fn study(size: Option<u32>, factor: u32, dolly: usize, frames: usize) -> Result<Vec<AaSceneRow>> {
     let mut r = Renderer::new(&RendererOptions::default())?;
     let mut rows = Vec::new();
     for (figure, set, camera, step) in views(size)? {
@@ -75,6 +81,7 @@ pub fn study(size: u32, factor: u32, dolly: usize, frames: usize) -> Result<Vec<
                 .collect::<Result<_>>()?;
             rows.push(AaSceneRow {
                 figure,
+                size: (camera.width, camera.height),
                 mode,
                 psnr: voxsplat::metrics::compare(&image, &truth)?.psnr,
                 aliasing: voxsplat::metrics::aliasing_energy(&image, &truth, |_| true).unwrap_or(f64::NAN),
@@ -88,22 +95,24 @@ pub fn study(size: u32, factor: u32, dolly: usize, frames: usize) -> Result<Vec<
 }
 
 /// The study's markdown section.
-pub fn markdown(rows: &[AaSceneRow], size: u32, factor: u32, dolly: usize) -> String {
+pub fn markdown(rows: &[AaSceneRow], factor: u32, dolly: usize) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
         "## Anti-aliasing on the terrain and orthographic figures (Figs 3.7, 3.8, 5.3)\n\n`voxsplat antialias`: \
-         {size}², per-splat PBTF, Gaussian; error against the truth supersampled {factor}×{factor} and brought down by a \
+         per-splat PBTF, Gaussian; error against the truth supersampled {factor}×{factor} and brought down by a \
          Lanczos-3 low-pass; aliasing energy over the frame (`metrics::aliasing_energy`); shimmer = mean frame-to-frame \
          RMSE along a {dolly}-frame move of half a voxel per frame (forward in the fly-over, sideways in the orthographic \
-         view); median of the timed frames, the modes alternating frame by frame.\n\n| figure | splats beyond k | mode | PSNR dB | aliasing energy | shimmer | \
-         median ms |\n|---|---:|---|---:|---:|---:|---:|"
+         view); median of the timed frames, the modes alternating frame by frame.\n\n| figure | image | splats beyond k | mode | PSNR dB | \
+         aliasing energy | shimmer | median ms |\n|---|---|---:|---|---:|---:|---:|---:|"
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {:.0} % | {} | {:.2} | {:.4} | {:.5} | {:.1} |",
+            "| {} | {}×{} | {:.0} % | {} | {:.2} | {:.4} | {:.5} | {:.1} |",
             r.figure,
+            r.size.0,
+            r.size.1,
             r.beyond_k * 100.0,
             format!("{:?}", r.mode).to_lowercase(),
             r.psnr,

@@ -76,9 +76,10 @@ enum Command {
     /// Anti-aliasing on the seed's terrain and orthographic figures (Figs 3.7, 3.8, 5.3; issue 26):
     /// none, Swan and EWA against a supersampled truth; a markdown section on stdout.
     Antialias {
-        /// Image side (128: three quarters of the terrain's splats lie beyond k, as in Fig. 3.7).
-        #[arg(long, default_value_t = 128)]
-        size: u32,
+        /// Square images of this side instead of the seed's sizes (Fig. 3.7 260x179, Fig. 3.8
+        /// 290x290; at 128 three quarters of the terrain's splats lie beyond k).
+        #[arg(long)]
+        size: Option<u32>,
         /// Supersampling of the truth per axis.
         #[arg(long, default_value_t = 4)]
         factor: u32,
@@ -410,7 +411,7 @@ struct RenderArgs {
     /// Anti-aliasing of distant splats (chapter 3): none, Swan's d/k scaling, or an EWA low-pass.
     #[arg(long, default_value = "none", value_parser = ["none", "swan", "ewa"])]
     aa: String,
-    /// Draw the line where eye distance equals k (single-sheet scenes such as `plane`).
+    /// Draw the line where the first splat each pixel meets lies at eye distance k (Figs 3.6, 3.7).
     #[arg(long)]
     k_line: bool,
     /// Traversal direction (default: back to front for splats, front to back for sheets).
@@ -770,7 +771,7 @@ fn run(cli: Cli) -> Result<()> {
                 let regions = voxsplat::aa::k_regions(&set_for_k, &cam);
                 if regions.iter().all(|&r| r == 0) {
                     return Err(Error::InvalidArgument(
-                        "--k-line needs a single-sheet scene in view (e.g. plane)".into(),
+                        "--k-line needs a scene in view".into(),
                     ));
                 }
                 voxsplat::aa::draw_k_line(&mut image, &regions);
@@ -961,13 +962,14 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Bench(a) => bench(a),
         Command::Antialias { size, factor, dolly, frames } => {
-            if !(16..=2048).contains(&size) || !(1..=16).contains(&factor) || dolly < 2 || frames == 0 {
+            if size.is_some_and(|s| !(16..=2048).contains(&s)) || !(1..=16).contains(&factor) || dolly < 2 || frames == 0
+            {
                 return Err(Error::InvalidArgument(
                     "--size in 16..=2048, --factor in 1..=16, --dolly at least 2, --frames at least 1".into(),
                 ));
             }
             let rows = voxsplat_cli::antialias::study(size, factor, dolly, frames)?;
-            print!("{}", voxsplat_cli::antialias::markdown(&rows, size, factor, dolly));
+            print!("{}", voxsplat_cli::antialias::markdown(&rows, factor, dolly));
             Ok(())
         }
         Command::MotionOrders { first, frames, rounds } => {

@@ -465,17 +465,17 @@ fn antialias_subcommand_measures_the_terrain_and_orthographic_figures() {
         text.lines().filter(|l| l.starts_with("| Fig")).map(|l| l.split('|').map(str::trim).collect()).collect();
     assert_eq!(rows.len(), 6, "{text}");
     let ortho: Vec<&Vec<&str>> = rows.iter().filter(|r| r[1].contains("orthographic")).collect();
-    assert!(ortho.iter().all(|r| r[2] == "100 %"), "{text}");
-    let shimmer = |r: &Vec<&str>| r[6].parse::<f64>().unwrap();
+    assert!(ortho.iter().all(|r| r[3] == "100 %" && r[2] == "48×48"), "{text}");
+    let shimmer = |r: &Vec<&str>| r[7].parse::<f64>().unwrap();
     assert!(shimmer(ortho[2]) < shimmer(ortho[0]), "EWA shimmers less than none: {text}");
     assert_eq!(voxsplat(&["antialias", "--dolly", "1"]).status.code(), Some(2));
 }
 
-/// `voxsplat motion-orders` (issue 26): every order on every built-in animation, and the terrain's
-/// blur against the accumulation buffer; WBTF's nesting follows the sorted order more closely than
+/// `voxsplat motion-orders` (issue 26): every order on every built-in animation, and the blur shapes
+/// against the accumulation buffer; WBTF's nesting follows the sorted order more closely than
 /// BTF's on the orthographic box (the seed's reason to draw Fig. 4.5 with it).
 #[test]
-fn motion_orders_subcommand_measures_orders_and_terrain_blur() {
+fn motion_orders_subcommand_measures_orders_and_blur_shapes() {
     let out = voxsplat(&["motion-orders", "--first", "10", "--frames", "2", "--rounds", "1"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
@@ -485,6 +485,18 @@ fn motion_orders_subcommand_measures_orders_and_terrain_blur() {
         line.split('|').nth(3).unwrap().trim().parse().unwrap()
     };
     assert!(psnr("rotating-box", "WBTF") > psnr("rotating-box", "BTF") + 10.0, "{text}");
-    assert!(text.contains("| blurred splats |") && text.contains("| accum:5 |"), "{text}");
+    // Blur shapes: every method through both raster choices on the three animations; on the fast
+    // turn the bent, tapered footprint is nearer the 64 sub-frames than the seed's.
+    let rmse = |anim: &str, method: &str, raster: &str| -> f64 {
+        let head = format!("| {anim} | {method} | {raster} |");
+        let line = text.lines().find(|l| l.starts_with(&head)).unwrap_or_else(|| panic!("{head}: {text}"));
+        line.split('|').nth(4).unwrap().trim().parse().unwrap()
+    };
+    for anim in ["rotating-box", "spinning-box", "rotating-terrain-ortho"] {
+        for raster in ["auto", "graphics"] {
+            assert!(rmse(anim, "accum:5", raster) < rmse(anim, "still", raster), "{text}");
+        }
+    }
+    assert!(rmse("spinning-box", "splat:arc+tapered", "graphics") < rmse("spinning-box", "splat", "graphics"), "{text}");
     assert_eq!(voxsplat(&["motion-orders", "--first", "20", "--frames", "10"]).status.code(), Some(2));
 }
