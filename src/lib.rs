@@ -179,6 +179,13 @@ impl Renderer {
 
     /// Make `set` the scene (uploaded to the device on the GPU backend).
     pub fn set_scene(&mut self, set: SplatSet) -> Result<()> {
+        if set.coordinates().is_some() {
+            return Err(Error::InvalidArgument(
+                "a rectilinear grid (per-axis coordinates) is ordered and validated by voxsplat::order but not \
+                 rendered yet: the stages place splats on a uniform grid"
+                    .into(),
+            ));
+        }
         self.install(Prepared::new(set))
     }
 

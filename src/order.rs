@@ -61,9 +61,27 @@ pub enum Viewer {
 }
 
 impl Viewer {
-    /// The viewer of `camera`, in `set`'s grid index coordinates.
+    /// The viewer of `camera`, in `set`'s grid index coordinates (through its per-axis
+    /// coordinates on a rectilinear grid: a perspective eye maps exactly; an orthographic
+    /// direction keeps its signs, which is all the orders and the validator read of it, scaled by
+    /// each axis's mean spacing).
     pub fn of(set: &SplatSet, camera: &Camera) -> Self {
-        Self::of_grid(set.grid(), camera)
+        let Some(c) = set.coordinates() else { return Self::of_grid(set.grid(), camera) };
+        if camera.is_perspective() {
+            let e = camera.eye.as_dvec3();
+            Viewer::Eye(DVec3::new(set.index_of(0, e.x), set.index_of(1, e.y), set.index_of(2, e.z)))
+        } else {
+            let mean = |a: usize| {
+                let v = &c[a];
+                if v.len() > 1 {
+                    (v[v.len() - 1] - v[0]) as f64 / (v.len() - 1) as f64
+                } else {
+                    set.grid().spacing[a] as f64
+                }
+            };
+            let f = camera.forward().as_dvec3();
+            Viewer::Toward(DVec3::new(f.x / mean(0), f.y / mean(1), f.z / mean(2)))
+        }
     }
 
     /// The viewer of `camera`, in `g`'s index coordinates.
@@ -279,13 +297,12 @@ pub fn visibility_order(set: &SplatSet, camera: &Camera, kind: OrderKind, direct
             pbtf_nested(set, split, |o| axes[o as usize])
         }
         OrderKind::Sorted => {
-            let g = *set.grid();
             let eye = camera.eye.as_dvec3();
             let fwd = camera.forward().as_dvec3();
             let persp = camera.is_perspective();
             by_key(set, |s| {
                 let ijk = set.splats()[s].ijk;
-                let p = g.position([ijk[0], ijk[1], ijk[2]]).as_dvec3();
+                let p = set.position([ijk[0], ijk[1], ijk[2]]).as_dvec3();
                 if persp {
                     (p - eye).length()
                 } else {
@@ -374,8 +391,7 @@ pub fn count_pixel_inversions(
     positions(set, order)?;
     camera.validate()?;
     let (w, h) = (camera.width as usize, camera.height as usize);
-    let g = set.grid();
-    let world = radius as f64 * g.kernel_spacing() as f64;
+    let world = radius as f64 * set.kernel_spacing() as f64;
     let (eye, fwd) = (camera.eye.as_dvec3(), camera.forward().as_dvec3());
     let (right, up) = (camera.right().as_dvec3(), camera.true_up().as_dvec3());
     let scale = camera.pixels_per_unit() as f64;
@@ -383,7 +399,7 @@ pub fn count_pixel_inversions(
     let mut depths: Vec<Vec<f64>> = vec![Vec::new(); w * h];
     for &s in order {
         let ijk = set.splats()[s as usize].ijk;
-        let p = g.position([ijk[0], ijk[1], ijk[2]]).as_dvec3() - eye;
+        let p = set.position([ijk[0], ijk[1], ijk[2]]).as_dvec3() - eye;
         let z = p.dot(fwd);
         if !(z > camera.near as f64 && z < camera.far as f64) {
             continue;

@@ -79,6 +79,8 @@ pub struct SplatSet {
     grid: Grid,
     row_start: Vec<u32>,
     splats: Vec<Splat>,
+    /// Per-axis voxel positions of a rectilinear grid (`with_coordinates`).
+    coords: Option<std::sync::Arc<[Vec<f32>; 3]>>,
 }
 
 impl SplatSet {
@@ -109,19 +111,95 @@ impl SplatSet {
             }
         }
         row_start.push(splats.len() as u32);
-        Ok(Self { grid, row_start, splats })
+        Ok(Self { grid, row_start, splats, coords: None })
     }
 
     /// No splats on `grid` (a bricked volume's stand-in: its splats are made per frame).
     pub fn empty(grid: Grid) -> Result<Self> {
         grid.validate()?;
         let rows = grid.dims[1] as usize * grid.dims[2] as usize + 1;
-        Ok(Self { grid, row_start: vec![0; rows], splats: Vec::new() })
+        Ok(Self { grid, row_start: vec![0; rows], splats: Vec::new(), coords: None })
     }
 
     /// The grid the splats sit on.
     pub fn grid(&self) -> &Grid {
         &self.grid
+    }
+
+    /// The same splats on a rectilinear grid whose spacing varies along each axis (chapter 2's
+    /// vectors U, V, W; e.g. CT slices at irregular positions): `coords[a][i]` is the world
+    /// coordinate of index `i` along axis `a`, one per voxel, finite and strictly increasing.
+    /// PBTF needs only the eye's cell, so the orders and validators of `crate::order` run on
+    /// such grids through [`SplatSet::index_of`]; the renderer refuses them (its stages place
+    /// splats on a uniform grid).
+    pub fn with_coordinates(mut self, coords: [Vec<f32>; 3]) -> Result<Self> {
+        for (a, c) in coords.iter().enumerate() {
+            let axis = ["x", "y", "z"][a];
+            if c.len() != self.grid.dims[a] as usize {
+                return Err(Error::InvalidArgument(format!(
+                    "{} {axis} coordinates for {} voxels along {axis}",
+                    c.len(),
+                    self.grid.dims[a]
+                )));
+            }
+            if let Some(bad) = c.iter().position(|v| !v.is_finite()) {
+                return Err(Error::InvalidArgument(format!("{axis} coordinate {bad} is not finite")));
+            }
+            if let Some(w) = c.windows(2).position(|w| w[1] <= w[0]) {
+                return Err(Error::InvalidArgument(format!(
+                    "{axis} coordinates must increase strictly: {} then {} at index {w}",
+                    c[w],
+                    c[w + 1]
+                )));
+            }
+        }
+        self.coords = Some(std::sync::Arc::new(coords));
+        Ok(self)
+    }
+
+    /// The per-axis coordinates of a rectilinear grid, if set.
+    pub fn coordinates(&self) -> Option<&[Vec<f32>; 3]> {
+        self.coords.as_deref()
+    }
+
+    /// World position of voxel `ijk`: the per-axis coordinates where set, else the grid's.
+    pub fn position(&self, ijk: [u32; 3]) -> Vec3 {
+        match &self.coords {
+            Some(c) => Vec3::new(c[0][ijk[0] as usize], c[1][ijk[1] as usize], c[2][ijk[2] as usize]),
+            None => self.grid.position(ijk),
+        }
+    }
+
+    /// The spacing footprints are scaled by: the grid's, or a rectilinear grid's widest gap.
+    pub fn kernel_spacing(&self) -> f32 {
+        match &self.coords {
+            Some(c) => {
+                let widest = c.iter().flat_map(|v| v.windows(2).map(|w| w[1] - w[0])).fold(0.0, f32::max);
+                if widest > 0.0 {
+                    widest
+                } else {
+                    self.grid.kernel_spacing()
+                }
+            }
+            None => self.grid.kernel_spacing(),
+        }
+    }
+
+    /// The index-space coordinate of world coordinate `x` along `axis`: linear between the voxel
+    /// positions (so the midpoint between two voxels maps to the half index between them, the grid
+    /// plane PBTF splits at) and beyond the ends with the end spacing.
+    pub fn index_of(&self, axis: usize, x: f64) -> f64 {
+        let Some(c) = &self.coords else {
+            return (x - self.grid.origin[axis] as f64) / self.grid.spacing[axis] as f64;
+        };
+        let c = &c[axis];
+        if c.len() == 1 {
+            return (x - c[0] as f64) / self.grid.spacing[axis] as f64;
+        }
+        // The segment [c[i], c[i + 1]] holding x (the first or last one beyond the ends).
+        let i = c.partition_point(|&v| (v as f64) <= x).clamp(1, c.len() - 1) - 1;
+        let (a, b) = (c[i] as f64, c[i + 1] as f64);
+        i as f64 + (x - a) / (b - a)
     }
     /// The splats, row by row (PBTF rows along x).
     pub fn splats(&self) -> &[Splat] {

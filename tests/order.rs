@@ -278,3 +278,61 @@ fn pbtf_nesting_inside_octants_is_free() {
         }
     }
 }
+
+/// Issue 26 item 6: PBTF on a rectilinear grid (chapter 2's U, V, W: spacing varying along each
+/// axis). The eye's cell comes from the per-axis coordinates; everything else is index space.
+#[test]
+fn pbtf_orders_rectilinear_grids_from_the_eyes_cell() {
+    use voxsplat::order::{count_pixel_inversions, count_violations, pbtf, pbtf_split, Direction};
+    let grid = voxsplat::Grid::centered([10, 9, 12], [1.0; 3]).unwrap();
+    let solid = voxsplat::SplatSet::from_fn(grid, |_, _, _| Some([1.0, 1.0, 1.0, 0.2])).unwrap();
+    // CT-like slices: z gaps from 0.25 to 3, x and y gently irregular.
+    let x: Vec<f32> = (0..10).map(|i| i as f32 * 1.2 + 0.1 * (i * i) as f32).collect();
+    let y: Vec<f32> = (0..9).map(|j| j as f32 + 0.3 * (j % 2) as f32).collect();
+    let z: Vec<f32> = (0..12).map(|k| [0.0, 0.25, 0.5, 3.5, 4.0, 7.0, 7.5, 8.0, 11.0, 11.25, 12.0, 15.0][k]).collect();
+    let rect = solid.clone().with_coordinates([x.clone(), y.clone(), z.clone()]).unwrap();
+    // An eye inside the grid, in z between slices 4 and 5 (world 4.0 and 7.0), past their midpoint.
+    let cam = Camera {
+        eye: glam::Vec3::new(6.0, 3.9, 5.8),
+        target: glam::Vec3::new(6.0, 20.0, 5.8),
+        up: glam::Vec3::Z,
+        projection: voxsplat::Projection::Perspective { fov_y_deg: 90.0 },
+        near: 0.01,
+        far: 100.0,
+        width: 64,
+        height: 64,
+    };
+    let split = pbtf_split(&rect, &cam);
+    // z 5.8 lies in slice 5's cell (from 5.5, the midpoint of slices 4 and 5 at 4.0 and 7.0): slices
+    // 0..=5 run downward from it.
+    assert_eq!(split[2], 6);
+    let order = pbtf(&rect, split);
+    assert_eq!(count_violations(&rect, &cam, &order, Direction::FrontToBack).unwrap(), 0);
+    // The uniform grid's reading of the same eye puts it in another cell, and its order breaks
+    // the rectilinear grid's visibility.
+    let uniform = pbtf(&solid, pbtf_split(&solid, &cam));
+    assert_ne!(pbtf_split(&solid, &cam), split);
+    let wrong = count_violations(&rect, &cam, &uniform, Direction::FrontToBack).unwrap();
+    assert!(wrong > 0, "the uniform split misorders the rectilinear grid");
+    // The image-space validator places splats at their coordinates too.
+    let btf = |o: &[u32]| o.iter().rev().cloned().collect::<Vec<u32>>();
+    let good = count_pixel_inversions(&rect, &cam, &btf(&order), Direction::BackToFront, 0.5).unwrap();
+    let bad = count_pixel_inversions(&rect, &cam, &btf(&uniform), Direction::BackToFront, 0.5).unwrap();
+    eprintln!("rectilinear: 6-neighbour violations 0 vs {wrong}; pixel inversions {good:?} vs {bad:?}");
+    assert!(good.inversions < bad.inversions);
+    // Bad coordinates are refused with the axis named; the renderer refuses the grid.
+    let e = solid.clone().with_coordinates([x.clone(), y.clone(), vec![0.0; 12]]).unwrap_err().to_string();
+    assert!(e.contains("z coordinates must increase"), "{e}");
+    let e = solid.clone().with_coordinates([x.clone(), y[..8].to_vec(), z.clone()]).unwrap_err().to_string();
+    assert!(e.contains("8 y coordinates for 9"), "{e}");
+    let mut nan = z.clone();
+    nan[3] = f32::NAN;
+    assert!(solid.with_coordinates([x, y, nan]).is_err());
+    let mut r = voxsplat::Renderer::new(&{
+        let mut o = voxsplat::RendererOptions::default();
+        o.backend = voxsplat::Backend::Cpu;
+        o
+    })
+    .unwrap();
+    assert!(r.set_scene(rect).unwrap_err().to_string().contains("rectilinear"));
+}

@@ -770,9 +770,7 @@ fn run(cli: Cli) -> Result<()> {
             if a.k_line {
                 let regions = voxsplat::aa::k_regions(&set_for_k, &cam);
                 if regions.iter().all(|&r| r == 0) {
-                    return Err(Error::InvalidArgument(
-                        "--k-line needs a scene in view".into(),
-                    ));
+                    return Err(Error::InvalidArgument("--k-line needs a scene in view".into()));
                 }
                 voxsplat::aa::draw_k_line(&mut image, &regions);
             }
@@ -962,7 +960,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Bench(a) => bench(a),
         Command::Antialias { size, factor, dolly, frames } => {
-            if size.is_some_and(|s| !(16..=2048).contains(&s)) || !(1..=16).contains(&factor) || dolly < 2 || frames == 0
+            if size.is_some_and(|s| !(16..=2048).contains(&s))
+                || !(1..=16).contains(&factor)
+                || dolly < 2
+                || frames == 0
             {
                 return Err(Error::InvalidArgument(
                     "--size in 16..=2048, --factor in 1..=16, --dolly at least 2, --frames at least 1".into(),

@@ -497,6 +497,9 @@ fn motion_orders_subcommand_measures_orders_and_blur_shapes() {
             assert!(rmse(anim, "accum:5", raster) < rmse(anim, "still", raster), "{text}");
         }
     }
-    assert!(rmse("spinning-box", "splat:arc+tapered", "graphics") < rmse("spinning-box", "splat", "graphics"), "{text}");
+    assert!(
+        rmse("spinning-box", "splat:arc+tapered", "graphics") < rmse("spinning-box", "splat", "graphics"),
+        "{text}"
+    );
     assert_eq!(voxsplat(&["motion-orders", "--first", "20", "--frames", "10"]).status.code(), Some(2));
 }
