@@ -25,6 +25,8 @@ pub enum Res {
     SliceTable,
     /// The scene: splats, PBTF rows, sheet ranks.
     Splats,
+    /// A rectilinear grid's voxel coordinates (`SplatSet::with_coordinates`).
+    Coords,
     /// Each PBTF row's first splat.
     RowStart,
     /// Each slice's rank among the non-empty slices, per axis (sheet batches index them).
@@ -144,6 +146,7 @@ impl Res {
                 | Res::Radial
                 | Res::SliceTable
                 | Res::Splats
+                | Res::Coords
                 | Res::RowStart
                 | Res::Ranks
                 | Res::Field

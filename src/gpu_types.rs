@@ -65,6 +65,8 @@ pub struct Frame {
     pub motion_mid: [[f32; 4]; 4],
     /// Motion blur: 1 = arc path (0 = straight), the profile's code (`BlurProfile::code`), unused, unused.
     pub sweep: [f32; 4],
+    /// x: 1 = a rectilinear grid (voxel positions from the `Coords` buffer); y, z, w: unused.
+    pub rect: [u32; 4],
 }
 
 /// Uniforms of `raycast.comp`.
@@ -191,7 +193,7 @@ const _: () = assert!(std::mem::size_of::<BrickPush>() == 16);
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
-const _: () = assert!(std::mem::size_of::<Frame>() == 368);
+const _: () = assert!(std::mem::size_of::<Frame>() == 384);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);

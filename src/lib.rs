@@ -179,13 +179,6 @@ impl Renderer {
 
     /// Make `set` the scene (uploaded to the device on the GPU backend).
     pub fn set_scene(&mut self, set: SplatSet) -> Result<()> {
-        if set.coordinates().is_some() {
-            return Err(Error::InvalidArgument(
-                "a rectilinear grid (per-axis coordinates) is ordered and validated by voxsplat::order but not \
-                 rendered yet: the stages place splats on a uniform grid"
-                    .into(),
-            ));
-        }
         self.install(Prepared::new(set))
     }
 
@@ -419,6 +412,9 @@ impl Renderer {
         }
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        if prep.set.coordinates().is_some() {
+            return Err(Error::Unsupported("the ray caster samples a uniform grid, not a rectilinear one".into()));
+        }
         if prep.bricks.is_some() {
             return Err(Error::Unsupported("the ray caster draws classified splat sets, not bricked volumes".into()));
         }

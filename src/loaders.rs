@@ -9,7 +9,9 @@ pub use crate::volume::{HeightGrid, ScalarVolume};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+mod positions;
 mod slices;
+pub use positions::{load_positions, MAX_POSITIONS_BYTES};
 pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).

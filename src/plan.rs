@@ -79,7 +79,7 @@ pub fn make_frame(
         right: v4(r, camera.far),
         up: v4(u, camera.pixels_per_unit()),
         origin: [g.origin[0], g.origin[1], g.origin[2], radius_vox],
-        spacing: [g.spacing[0], g.spacing[1], g.spacing[2], radius_vox * g.kernel_spacing()],
+        spacing: [g.spacing[0], g.spacing[1], g.spacing[2], radius_vox * set.kernel_spacing()],
         dims: [g.dims[0], g.dims[1], g.dims[2], set.len() as u32],
         split: [split[0], split[1], split[2], back_to_front as u32],
         aa: [antialias.code(), kernel.footprint_sigma() as f32, EWA_LOWPASS_PX, 0.0],
@@ -97,6 +97,7 @@ pub fn make_frame(
             0.0,
             0.0,
         ],
+        rect: [set.coordinates().is_some() as u32, 0, 0, 0],
     }
 }
 

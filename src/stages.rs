@@ -57,7 +57,7 @@ const fn d(blend: Blend, points: bool, pass: Pass, spec: &'static [u32]) -> Vari
 }
 
 const ORDER: &[Res] = &[Res::Frame, Res::Splats, Res::RowStart, Res::RowSplit, Res::Segments, Res::Order];
-const PARAMS: &[Res] = &[Res::Frame, Res::Splats, Res::Params, Res::ParamsHi];
+const PARAMS: &[Res] = &[Res::Frame, Res::Splats, Res::Params, Res::ParamsHi, Res::Coords];
 const SLAB: &[Res] = &[Res::Params, Res::SlabCounts, Res::SlabPairs, Res::SlabStart, Res::ParamsHi, Res::BrickVoxels];
 /// Slabs along the view; a bricked volume's axis-aligned sheets binned by voxel plane (`AXIS_SHEETS`).
 const SLAB_BUILDS: &[Variant] = &[v("", &[]), v("AXIS_SHEETS", &[])];

@@ -176,6 +176,9 @@ pub fn slab(origin: DVec3, dir: DVec3, lo: DVec3, hi: DVec3, t_max: f64) -> Opti
 /// The volumetric summation buffer image: premultiplied RGBA.
 pub fn volumetric_summation(set: &SplatSet, camera: &Camera, opts: &TruthOptions) -> Result<ImageF32> {
     camera.validate()?;
+    if set.coordinates().is_some() {
+        return Err(Error::Unsupported("the truth samples a uniform grid, not a rectilinear one".into()));
+    }
     if opts.oversampling < 4 {
         return Err(Error::InvalidArgument("the truth needs at least 4 samples per voxel".into()));
     }

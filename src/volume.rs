@@ -130,8 +130,10 @@ impl SplatSet {
     /// vectors U, V, W; e.g. CT slices at irregular positions): `coords[a][i]` is the world
     /// coordinate of index `i` along axis `a`, one per voxel, finite and strictly increasing.
     /// PBTF needs only the eye's cell, so the orders and validators of `crate::order` run on
-    /// such grids through [`SplatSet::index_of`]; the renderer refuses them (its stages place
-    /// splats on a uniform grid).
+    /// such grids through [`SplatSet::index_of`]; the per-splat stage places each splat at its
+    /// coordinates, sized for the widest gap and weighted by its cell's volume. The grid's origin
+    /// and spacing become the coordinates' first values and mean gaps. The ray casters and the
+    /// truths, which sample a uniform grid, refuse such sets.
     pub fn with_coordinates(mut self, coords: [Vec<f32>; 3]) -> Result<Self> {
         for (a, c) in coords.iter().enumerate() {
             let axis = ["x", "y", "z"][a];
@@ -153,6 +155,15 @@ impl SplatSet {
                 )));
             }
         }
+        // The grid spans the same box: its corners (framing, culling, slab ranges) are the
+        // coordinates' ends, its spacing the mean gap.
+        for (a, c) in coords.iter().enumerate() {
+            self.grid.origin[a] = c[0];
+            if c.len() > 1 {
+                self.grid.spacing[a] = (c[c.len() - 1] - c[0]) / (c.len() - 1) as f32;
+            }
+        }
+        self.grid.validate()?;
         self.coords = Some(std::sync::Arc::new(coords));
         Ok(self)
     }

@@ -120,7 +120,7 @@ fn tile_lists_keep_the_pbtf_order_and_hold_exactly_the_overlapping_splats() {
                 let order = gpu.pbtf_order(&cam, direction).unwrap();
                 let frame = voxsplat::plan::frame_for(&set, &cam, &o);
                 let mut params = vec![Default::default(); set.len()];
-                voxsplat::cpu::splat_params(&frame, set.splats(), &mut params);
+                voxsplat::cpu::splat_params(&frame, set.splats(), &[], &mut params);
                 let boxes: Vec<_> = params
                     .iter()
                     .map(|p| voxsplat::cpu::footprint::screen_quad(&frame, p).map(|(_, b)| b.to_array()))
@@ -358,7 +358,7 @@ fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tile
     let prep = Prepared::new(set.clone());
     let frame = frame_for(set, cam, o);
     let mut params = vec![Default::default(); set.len()];
-    voxsplat::cpu::splat_params(&frame, set.splats(), &mut params);
+    voxsplat::cpu::splat_params(&frame, set.splats(), &[], &mut params);
     let (draw, batches) = if o.composite == Composite::Sheet {
         let (axis, batches) = sheet_plan(&prep, cam, o.direction(), 1 << 16);
         (prep.slices[axis].1.clone(), batches)

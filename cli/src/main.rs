@@ -317,6 +317,11 @@ struct SceneArgs {
     /// Voxel spacing (overrides the file's).
     #[arg(long, value_parser = parse_vec3, requires = "volume")]
     spacing: Option<Vec3>,
+    /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's
+    /// world coordinate along that axis (e.g. irregular CT slices; an axis left out keeps the even
+    /// spacing). Draws the volume as host splats.
+    #[arg(long, requires = "volume")]
+    positions: Option<PathBuf>,
     /// Transfer function: a preset (ramp, ct, bonsai) or a TOML file.
     #[arg(long, default_value = "ramp")]
     tf: String,
@@ -611,7 +616,14 @@ fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::brick
 fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
     let set = if let Some(path) = &a.volume {
         let (vol, tf, shading) = load_volume_parts(a, path)?;
-        voxsplat::classify::classify(&vol, &tf, shading)?
+        let set = voxsplat::classify::classify(&vol, &tf, shading)?;
+        match &a.positions {
+            Some(p) => {
+                let coords = voxsplat::loaders::load_positions(p, set.grid())?;
+                set.with_coordinates(coords)?
+            }
+            None => set,
+        }
     } else if let Some(path) = &a.terrain {
         // (clap drops `requires = "volume"` when --terrain, which conflicts with it, is given.)
         if a.dims.is_some() || a.dtype.is_some() || a.big_endian || a.spacing.is_some() {
@@ -697,7 +709,12 @@ fn run(cli: Cli) -> Result<()> {
             let order = a.scene.order.parse::<OrderKind>()?;
             let composite = a.composite.parse::<Composite>()?;
             // A volume is a bricked store classified on the device unless a mode needs host splats.
-            let host_splats = a.scene.dense || order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line;
+            let host_splats = a.scene.dense
+                || order != OrderKind::Pbtf
+                || a.truth
+                || a.raycast.is_some()
+                || a.k_line
+                || a.scene.positions.is_some();
             let bricked = match &a.scene.volume {
                 Some(path) if !host_splats => Some(load_bricked(&a.scene, path)?),
                 _ => None,

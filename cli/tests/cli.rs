@@ -503,3 +503,49 @@ fn motion_orders_subcommand_measures_orders_and_blur_shapes() {
     );
     assert_eq!(voxsplat(&["motion-orders", "--first", "20", "--frames", "10"]).status.code(), Some(2));
 }
+
+/// `--positions` (issue 26 item 6): a raw volume on irregular z slices renders at them, and its
+/// order checks clean; wrong counts, non-finite values and unknown keys are refused.
+#[test]
+fn a_volume_renders_on_the_slice_positions_a_sidecar_gives() {
+    let (raw, pos) = (cmd::tmp_in("cli", "rect.raw"), cmd::tmp_in("cli", "rect.toml"));
+    // 16 x 16 x 8: a slab of value 200 in the middle slices.
+    let mut data = vec![0u8; 16 * 16 * 8];
+    for (n, v) in data.iter_mut().enumerate() {
+        let (x, y, z) = (n % 16, n / 16 % 16, n / 256);
+        if (4..12).contains(&x) && (4..12).contains(&y) && (2..6).contains(&z) {
+            *v = 200;
+        }
+    }
+    std::fs::write(&raw, &data).unwrap();
+    std::fs::write(&pos, "z = [0.0, 0.5, 1.0, 3.0, 5.0, 5.5, 6.0, 9.0]\n").unwrap();
+    let out = cmd::tmp_in("cli", "rect.png");
+    let base = ["--volume", raw.to_str().unwrap(), "--dims", "16,16,8", "--dtype", "u8"];
+    let with = |extra: &[&str]| {
+        let mut a = vec!["render"];
+        a.extend_from_slice(&base);
+        a.extend_from_slice(extra);
+        a.extend_from_slice(&["--size", "64x64", "--out", out.to_str().unwrap()]);
+        voxsplat(&a)
+    };
+    let ok = with(&["--positions", pos.to_str().unwrap()]);
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let mut check = vec!["order"];
+    check.extend_from_slice(&base);
+    check.extend_from_slice(&["--positions", pos.to_str().unwrap(), "--check", "--eye", "3,2,4", "--size", "64x64"]);
+    let o = voxsplat(&check);
+    let text = String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && text.contains("violations: 0"), "{text}");
+    for (bad, says) in [
+        ("z = [0.0, 1.0]\n", "2 z values for 8 voxels"),
+        ("z = [0.0, 0.5, 1.0, 3.0, nan, 5.5, 6.0, 9.0]\n", "not a finite coordinate"),
+        ("z = [0.0, 0.5, 1.0, 3.0, 2.0, 5.5, 6.0, 9.0]\n", "must increase strictly"),
+        ("w = [1.0]\n", "unknown field"),
+    ] {
+        std::fs::write(&pos, bad).unwrap();
+        let e = with(&["--positions", pos.to_str().unwrap()]);
+        let msg = String::from_utf8_lossy(&e.stderr);
+        assert_eq!(e.status.code(), Some(2), "{bad}: {msg}");
+        assert!(msg.contains(says), "{bad}: {msg}");
+    }
+}

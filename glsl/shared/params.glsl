@@ -28,8 +28,8 @@ float footprint_scale(float depth, float cell) {
 // A splat of `cell` voxels a side (a voxel, or a coarse cell of levels of detail: its kernel
 // `cell` times wider) at grid position `at`, of straight colour rgb and optical depth tau per cell;
 // `grow` widens it further with its energy scaled by 1 / grow^2 (levels of detail's morphing).
-SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
-    vec3 center = frame.origin.xyz + at * frame.spacing.xyz;
+// (params_at, below, places it on the uniform grid; this takes its world centre.)
+SplatParams params_world(vec3 center, float cell, float grow, vec3 rgb, float tau) {
     vec3 forward = frame.forward.xyz;
     float depth = dot(center - frame.eye.xyz, forward);
     float scale = footprint_scale(depth, cell);
@@ -83,6 +83,10 @@ SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
     float pixels = frame.eye.w > 0.5 ? radius * frame.up.w / max(depth, 1e-6) : radius * frame.up.w;
     p.screen = vec4(depth, bend, pixels, scale);
     return p;
+}
+
+SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
+    return params_world(frame.origin.xyz + at * frame.spacing.xyz, cell, grow, rgb, tau);
 }
 
 // Optical depth of one voxel-length of opacity a (clamped below 1). Mirror: volume::optical_depth.

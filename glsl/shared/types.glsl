@@ -66,7 +66,7 @@ struct ScreenQuad {
     vec4 emit;    // rgb; a: optical depth scale (tau x energy)
 };
 
-// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 368 bytes.
+// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 384 bytes.
 // Bound as a readonly storage buffer, not a uniform buffer: Mesa 22.3's lavapipe inlines uniform
 // values that steer branches and recompiles the shader for every dispatch, keeping each variant until
 // the pipeline dies (+0.2-0.7 MB of host memory per frame; docs/RELIABILITY.md).
@@ -88,6 +88,8 @@ struct Frame {
     mat4 motion_mid;  // arc paths: grid point -> where it was halfway through the shutter
     vec4 sweep;       // x: 1 = arc path through motion_mid, 0 = straight; y: profile along the
                       // path (SWEEP_*); z, w: unused
+    uvec4 rect;       // x: 1 = a rectilinear grid (voxel positions from splat_params' Coords
+                      // buffer); y, z, w: unused
 };
 
 // Profiles of a motion-blurred footprint along its path (glsl/shared/footprint_table.glsl).

@@ -45,9 +45,13 @@ pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
 /// (energy / grow²), of straight colour `rgb` and optical depth `tau` per cell.
 pub fn params_at(frame: &Frame, at: Vec3, cell: f32, grow: f32, rgb: [f32; 3], tau: f32) -> SplatParams {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-    let (eye, forward, right, origin, spacing) =
-        (v3(frame.eye), v3(frame.forward), v3(frame.right), v3(frame.origin), v3(frame.spacing));
-    let center = origin + at * spacing;
+    params_world(frame, v3(frame.origin) + at * v3(frame.spacing), cell, grow, rgb, tau)
+}
+
+/// Mirror of `params_world`: `params_at` with the splat's world centre given.
+pub fn params_world(frame: &Frame, center: Vec3, cell: f32, grow: f32, rgb: [f32; 3], tau: f32) -> SplatParams {
+    let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+    let (eye, forward, right) = (v3(frame.eye), v3(frame.forward), v3(frame.right));
     let depth = (center - eye).dot(forward);
     let scale = cell_footprint_scale(frame, depth, cell);
     let radius = grow * cell * frame.spacing[3] * scale;
@@ -119,15 +123,51 @@ pub fn params_at(frame: &Frame, at: Vec3, cell: f32, grow: f32, rgb: [f32; 3], t
     }
 }
 
-pub fn splat_params(frame: &Frame, splats: &[Splat], params: &mut [SplatParams]) {
+/// Mirror of `cell_extent` in `splat_params.comp`: voxel `i`'s extent along axis `a` of a
+/// rectilinear grid (`coords`: x, then y, then z coordinates).
+fn cell_extent(frame: &Frame, coords: &[f32], a: usize, i: u32) -> f32 {
+    let base = [0, frame.dims[0], frame.dims[0] + frame.dims[1]][a];
+    let n = frame.dims[a];
+    if n == 1 {
+        return frame.spacing[a];
+    }
+    let lo = coords[(base + i.saturating_sub(1)) as usize];
+    let hi = coords[(base + (i + 1).min(n - 1)) as usize];
+    if i == 0 || i == n - 1 {
+        hi - lo
+    } else {
+        0.5 * (hi - lo)
+    }
+}
+
+/// Mirror of `params_rect`: a rectilinear grid's splat at its coordinates, its optical depth
+/// weighted by its cell's volume over the widest gap's cube.
+pub fn params_rect(frame: &Frame, coords: &[f32], ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
+    let (nx, ny) = (frame.dims[0] as usize, frame.dims[1] as usize);
+    let center = Vec3::new(coords[ijk[0] as usize], coords[nx + ijk[1] as usize], coords[nx + ny + ijk[2] as usize]);
+    let ks = frame.spacing[3] / frame.origin[3];
+    let weight = cell_extent(frame, coords, 0, ijk[0]) / ks
+        * (cell_extent(frame, coords, 1, ijk[1]) / ks)
+        * (cell_extent(frame, coords, 2, ijk[2]) / ks);
+    params_world(frame, center, 1.0, 1.0, [color[0], color[1], color[2]], optical_depth(color[3]) * weight)
+}
+
+/// `coords`: a rectilinear grid's x, y, z coordinates, read when `frame.rect[0]` is 1.
+pub fn splat_params(frame: &Frame, splats: &[Splat], coords: &[f32], params: &mut [SplatParams]) {
     for (s, sp) in splats.iter().enumerate().take(frame.dims[3] as usize) {
-        params[s] = params_of(frame, [sp.ijk[0], sp.ijk[1], sp.ijk[2]], sp.color);
+        let ijk = [sp.ijk[0], sp.ijk[1], sp.ijk[2]];
+        params[s] = if frame.rect[0] != 0 {
+            params_rect(frame, coords, ijk, sp.color)
+        } else {
+            params_of(frame, ijk, sp.color)
+        };
     }
 }
 
 pub(crate) fn splat_params_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let mut params = b.take(Res::Params);
-    splat_params(&b.frame, b.prep.set.splats(), bytemuck::cast_slice_mut(&mut params));
+    let coords = b.prep.set.coordinates().map(|c| c.concat()).unwrap_or_default();
+    splat_params(&b.frame, b.prep.set.splats(), &coords, bytemuck::cast_slice_mut(&mut params));
     b.put(Res::Params, params);
     Ok(())
 }

@@ -21,6 +21,8 @@ use std::sync::Arc;
 /// A scene on the device.
 pub struct SceneBuffers {
     pub splats: Buffer,
+    /// A rectilinear grid's x, y, z coordinates (one unused float on a uniform grid).
+    pub coords: Buffer,
     pub row_start: Buffer,
     /// Slice-grouped draw lists of axes x, y, z.
     pub draw: [Buffer; 3],
@@ -142,6 +144,11 @@ impl Resources {
         let ctx = &self.ctx;
         self.scene = Some(SceneBuffers {
             splats: storage(ctx, "splats", bytemuck::cast_slice(set.splats()))?,
+            coords: storage(
+                ctx,
+                "coords",
+                bytemuck::cast_slice(&set.coordinates().map_or(vec![0.0f32], |c| c.concat())),
+            )?,
             row_start: storage(ctx, "row_start", bytemuck::cast_slice(set.row_start()))?,
             draw: [
                 storage(ctx, "slices x", bytemuck::cast_slice(&prep.slices[0].1))?,
@@ -234,6 +241,7 @@ impl Resources {
             Res::Frame => &self.frame,
             Res::Radial => &self.radial,
             Res::Splats => &scene()?.splats,
+            Res::Coords => &scene()?.coords,
             Res::RowStart => &scene()?.row_start,
             Res::Ranks => &scene()?.ranks,
             Res::BrickHeaders | Res::BrickMasks | Res::BrickRecords | Res::BrickIndex => {
@@ -355,6 +363,7 @@ impl Resources {
                 Res::Frame
                 | Res::Radial
                 | Res::Splats
+                | Res::Coords
                 | Res::RowStart
                 | Res::Ranks
                 | Res::BrickHeaders
