@@ -372,13 +372,21 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
         gpu.set_scene(set).unwrap();
         gpu.render(&cam, &o).unwrap().image
     };
+    // The ball on a uniform grid of the widest gap (1.0): footprints as wide as the rectilinear
+    // grid's, half the samples.
+    let coarse = Grid::centered([15, 15, 15], [1.0; 3]).unwrap();
+    let coarse = SplatSet::from_fn(coarse, |i, j, k| ball(coarse.position([i, j, k])).then_some([1.0, 0.6, 0.3, a]));
     let truth = render(reference);
     let drawn = render(rect.clone());
     let as_if_even = render(samples);
-    let near = voxsplat::metrics::compare(&drawn, &truth).unwrap().psnr;
-    let far = voxsplat::metrics::compare(&as_if_even, &truth).unwrap().psnr;
-    eprintln!("rectilinear vs the uniform ball: {near:.2} dB; the same samples evenly spaced: {far:.2} dB");
-    assert!(near > far + 3.0 && near > 25.0);
+    let widest = render(coarse.unwrap());
+    let psnr = |img: &voxsplat::ImageF32| voxsplat::metrics::compare(img, &truth).unwrap().psnr;
+    let (near, far, wide) = (psnr(&drawn), psnr(&as_if_even), psnr(&widest));
+    eprintln!(
+        "against the ball on the 0.5 grid: rectilinear {near:.2} dB; the same samples evenly spaced {far:.2} dB; \
+         the ball on a uniform 1.0 grid {wide:.2} dB"
+    );
+    assert!(near > far + 3.0 && near > 25.0 && near > wide - 1.0);
     common::assert_clean(&gpu);
     let mut cpu = common::cpu();
     cpu.set_scene(rect.clone()).unwrap();
