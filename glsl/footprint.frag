@@ -18,14 +18,28 @@ layout(constant_id = 1) const uint POINTS = 0u;
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) flat in vec4 in_emit;
 layout(location = 2) flat in vec3 in_sweep;  // motion stretch, bend, profile
+#ifndef SLOTS
 layout(location = 3) flat in vec2 in_slab;
+#endif
 layout(location = 0) out vec4 out_color;
+// variants: SLOTS
+#ifdef SLOTS
+// Pass::Slots: the second half of the shutter (out_color takes the first).
+layout(location = 1) out vec4 out_slot;
+#endif
 
 void main() {
     vec2 uv = POINTS != 0u ? gl_PointCoord * 2.0 - 1.0 : in_uv;
+#ifdef SLOTS
+    vec2 a = footprint_slots(uv, in_sweep, in_emit.a);
+    if (max(a.x, a.y) <= 0.0) discard;
+    out_color = vec4(in_emit.rgb * a.x, a.x);
+    out_slot = vec4(in_emit.rgb * a.y, a.y);
+#else
     // Optical depth (sheets) or alpha (per splat).
     float v = footprint_value(slices, SHEET_MODE == SHEET_MODE_SLAB, uv, in_sweep, in_slab, in_emit.a,
                               SHEET_MODE == SHEET_MODE_SPLAT);
     if (v <= 0.0) discard;
     out_color = vec4(in_emit.rgb * v, v);
+#endif
 }

@@ -4,6 +4,8 @@
 // of its sheet; in slab mode (image-aligned sheets) the draw list holds (splat, slab) pairs and each
 // pair goes to its slab's layer with the slab's faces relative to the splat. Mirror: cpu::footprint.
 #extension GL_ARB_shader_viewport_layer_array : require
+// The two-slot pass's pipelines load this stage's SLOTS build too (the same code).
+// variants: SLOTS
 #include "footprint.glsl"
 
 // 1: point sprites (one vertex per entry, indexed by gl_VertexIndex), 0: instanced quads.
@@ -12,7 +14,9 @@ layout(constant_id = 1) const uint POINTS = 0u;
 layout(location = 0) out vec2 out_uv;
 layout(location = 1) flat out vec4 out_emit;
 layout(location = 2) flat out vec3 out_sweep;  // motion stretch, bend, profile
+#ifndef SLOTS
 layout(location = 3) flat out vec2 out_slab;
+#endif
 
 void main() {
     uint entry = POINTS != 0u ? uint(gl_VertexIndex) : uint(gl_InstanceIndex);
@@ -33,5 +37,10 @@ void main() {
         vec3 pos = p.center.xyz + c.x * p.axis_u.xyz + c.y * p.axis_v.xyz;
         gl_Position = frame.view_proj * vec4(pos, 1.0);
     }
+#ifdef SLOTS
+    vec2 faces;  // per-splat compositing: no slab
+    gl_Layer = entry_layer(entry, splat, p, faces);
+#else
     gl_Layer = entry_layer(entry, splat, p, out_slab);
+#endif
 }

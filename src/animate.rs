@@ -363,6 +363,7 @@ impl SplatBlur {
             BlurProfile::Uniform => None,
             BlurProfile::Tapered => Some("tapered"),
             BlurProfile::Teardrop => Some("teardrop"),
+            BlurProfile::Slotted => Some("slotted"),
         };
         match (self.arc, profile) {
             (false, None) => "splat".into(),
@@ -386,7 +387,7 @@ impl std::str::FromStr for Blur {
                         shape.profile = p.parse().map_err(|_| {
                             Error::InvalidArgument(format!(
                                 "blur '{s}': splat takes ':' and a '+'-joined path (line, arc) and profile \
-                                 (uniform, tapered, teardrop), e.g. splat:arc+tapered"
+                                 (uniform, tapered, teardrop, slotted), e.g. splat:arc+tapered"
                             ))
                         })?
                     }

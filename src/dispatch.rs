@@ -226,6 +226,10 @@ pub enum Pass {
     Target,
     /// The summation layers (`Res::Sums`).
     Sheet,
+    /// Two time slots of a motion-blurred frame composited apart, each fragment writing both: the
+    /// raster target (`Res::Color`, the first half of the shutter) and the accumulation image
+    /// (`Res::Accum`, the second).
+    Slots,
 }
 
 /// A draw variant's fixed-function state.

@@ -106,6 +106,11 @@ pub enum BlurProfile {
     /// As `Tapered` with the time weighted towards t_i (2t): a clear head trailing off, the
     /// teardrop the seed suggests for stills that show movement.
     Teardrop,
+    /// `Tapered` in two time slots: each fragment writes the first and the second half of the
+    /// shutter to two images composited apart and averaged, so splats that cover a pixel in turn
+    /// are not mixed as if independent (one geometry pass; per-splat compositing through graphics
+    /// quads, dense splat sets).
+    Slotted,
 }
 
 impl BlurProfile {
@@ -115,6 +120,7 @@ impl BlurProfile {
             BlurProfile::Uniform => 0.0,
             BlurProfile::Tapered => 1.0,
             BlurProfile::Teardrop => 2.0,
+            BlurProfile::Slotted => 3.0,
         }
     }
 }
@@ -126,7 +132,10 @@ impl std::str::FromStr for BlurProfile {
             "uniform" => Ok(Self::Uniform),
             "tapered" => Ok(Self::Tapered),
             "teardrop" => Ok(Self::Teardrop),
-            _ => Err(Error::InvalidArgument(format!("unknown blur profile '{s}' (uniform, tapered, teardrop)"))),
+            "slotted" => Ok(Self::Slotted),
+            _ => {
+                Err(Error::InvalidArgument(format!("unknown blur profile '{s}' (uniform, tapered, teardrop, slotted)")))
+            }
         }
     }
 }
@@ -249,6 +258,11 @@ impl RenderOptions {
 
     /// Reject values no frame can use.
     pub fn validate(&self) -> Result<()> {
+        if self.motion.is_some_and(|m| m.profile == BlurProfile::Slotted) && self.composite != Composite::Splat {
+            return Err(Error::InvalidArgument(
+                "the slotted blur composites each half of the shutter per splat: use --composite splat".into(),
+            ));
+        }
         if !(0.0..1.0).contains(&self.early_termination) {
             return Err(Error::InvalidArgument(format!(
                 "early-termination transmittance {} must be in [0, 1)",

@@ -39,6 +39,15 @@ pub fn one_page(n: u32) -> usize {
     usize::from(n <= SPLAT_PAGE)
 }
 
+/// The two-slot footprint draw's variant (`Pass::Slots`, after the others in stages.rs).
+pub fn footprint_slots_variant(blend: Blend) -> usize {
+    if blend == Blend::Over {
+        10
+    } else {
+        11
+    }
+}
+
 /// The footprint draw's variant.
 pub fn footprint_variant(blend: Blend, points: bool, mode: u32) -> usize {
     match (blend, mode) {
@@ -94,7 +103,13 @@ pub struct Recorded {
 /// chosen), on `e`.
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
     camera.validate()?;
+    let slotted = opts.motion.is_some_and(|m| m.profile == crate::BlurProfile::Slotted);
     if let Some(scene) = &prep.bricks {
+        if slotted {
+            return Err(Error::Unsupported(
+                "the slotted blur draws dense splat sets; a bricked volume takes splat:tapered".into(),
+            ));
+        }
         return bricked::record_bricks(e, prep, scene, camera, opts);
     }
     let set = &prep.set;
@@ -136,9 +151,14 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
             return finish(e, Res::Accum, w, h, false);
         }
         let blend = if btf { Blend::Over } else { Blend::Under };
-        let variant = footprint_variant(blend, points, SHEET_MODE_SPLAT);
+        let slots = opts.motion.is_some_and(|m| m.profile == crate::BlurProfile::Slotted);
+        let variant =
+            if slots { footprint_slots_variant(blend) } else { footprint_variant(blend, points, SHEET_MODE_SPLAT) };
         let push = FootprintPush::default();
         e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
+        if slots {
+            return finish_slots(e, w, h);
+        }
         return finish(e, Res::Color, w, h, false);
     }
 
@@ -354,6 +374,19 @@ fn record_tiles(
 }
 
 /// Read the frame's image (and, after compute sheet sums, the status word) and the timings.
+/// The frame of a two-slot draw (`Pass::Slots`): the mean of its slots, the target and the
+/// accumulation image.
+fn finish_slots(e: &mut dyn Engine, w: u32, h: u32) -> Result<Recorded> {
+    let back = e.read(&[(Res::Color, image_words(w, h)), (Res::Accum, image_words(w, h))])?;
+    let pixels = back[0]
+        .chunks_exact(4)
+        .zip(back[1].chunks_exact(4))
+        .map(|(a, b)| [0, 1, 2, 3].map(|i| 0.5 * (f32::from_bits(a[i]) + f32::from_bits(b[i]))))
+        .collect();
+    let timings = e.finish()?;
+    Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings })
+}
+
 fn finish(e: &mut dyn Engine, image: Res, w: u32, h: u32, status: bool) -> Result<Recorded> {
     let mut what = vec![(image, image_words(w, h))];
     if status {

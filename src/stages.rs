@@ -53,7 +53,8 @@ const fn v(defines: &'static str, spec: &'static [u32]) -> Variant {
 }
 
 const fn d(blend: Blend, points: bool, pass: Pass, spec: &'static [u32]) -> Variant {
-    Variant { defines: "", spec, draw: Some(DrawState { blend, points, pass }) }
+    let defines = if matches!(pass, Pass::Slots) { "SLOTS" } else { "" };
+    Variant { defines, spec, draw: Some(DrawState { blend, points, pass }) }
 }
 
 const ORDER: &[Res] = &[Res::Frame, Res::Splats, Res::RowStart, Res::RowSplit, Res::Segments, Res::Order];
@@ -427,6 +428,8 @@ pub const STAGES: &[StageDesc] = &[
             d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_SLAB, 1]),
             d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_BINNED, 0]),
             d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_BINNED, 1]),
+            d(Blend::Over, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
+            d(Blend::Under, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
         ],
         mirror: crate::cpu::footprint::footprint_stage,
     },

@@ -140,7 +140,12 @@ fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
         }
         // Chapter 4's future work on the fast turn, where arcs bend, through the graphics pipeline
         // (`auto` picks it; the compute rasters refuse these shapes).
-        for blur in ["splat:arc+tapered", "splat:arc+teardrop", "splat:arc", "splat:tapered"] {
+        for blur in ["splat:arc+tapered", "splat:arc+teardrop", "splat:arc", "splat:tapered", "splat:arc+slotted"] {
+            if blur.ends_with("slotted") && composite != Composite::Splat {
+                let e = render_frame(&mut gpu, &spin, &grid, 9, blur.parse().unwrap(), &o).unwrap_err();
+                assert!(e.to_string().contains("--composite splat"), "{e}");
+                continue;
+            }
             o.raster = if blur == "splat:arc" { Raster::Auto } else { Raster::Graphics };
             let blur: Blur = blur.parse().unwrap();
             gpu.set_scene(voxsplat::scene::build(&spin.scene).unwrap()).unwrap();
@@ -345,4 +350,28 @@ fn blur_shapes_parse_and_bad_ones_are_refused() {
         let e = bad.parse::<Blur>().unwrap_err().to_string();
         assert!(e.contains(bad), "{bad}: {e}");
     }
+}
+
+/// Issue 26 item 5: two time slots composited apart follow the accumulation buffer on a whole
+/// scene, where one time-averaged footprint per splat mixes the layers that cover a pixel in turn.
+#[test]
+fn slotted_blur_follows_the_accumulation_buffer_on_the_turning_box() {
+    let mut anim = Animation::builtin("rotating-box").unwrap();
+    (anim.camera.width, anim.camera.height) = (128, 128);
+    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let grid = *set.grid();
+    let mut r = common::gpu();
+    r.set_scene(set).unwrap();
+    let mut o = RenderOptions::default();
+    o.order = voxsplat::OrderKind::Wbtf;
+    o.raster = Raster::Graphics;
+    let truth = render_frame(&mut r, &anim, &grid, 12, Blur::Accum(64), &o).unwrap();
+    let mut err = |b: &str| {
+        let img = render_frame(&mut r, &anim, &grid, 12, b.parse().unwrap(), &o).unwrap();
+        voxsplat::metrics::compare(&img, &truth).unwrap().rmse
+    };
+    let (seed, tapered, slotted, accum5) = (err("splat"), err("splat:tapered"), err("splat:slotted"), err("accum:5"));
+    eprintln!("rmse to accum:64: seed {seed:.5}, tapered {tapered:.5}, slotted {slotted:.5}, accum:5 {accum5:.5}");
+    assert!(tapered < seed && slotted * 2.0 < tapered && slotted < accum5);
+    assert_clean(&r);
 }

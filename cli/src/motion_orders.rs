@@ -57,7 +57,7 @@ pub struct BlurRow {
 fn blur_methods() -> Vec<(String, Blur)> {
     let mut m = vec![("still".to_string(), Blur::None)];
     for arc in [false, true] {
-        for profile in [BlurProfile::Uniform, BlurProfile::Tapered, BlurProfile::Teardrop] {
+        for profile in [BlurProfile::Uniform, BlurProfile::Tapered, BlurProfile::Teardrop, BlurProfile::Slotted] {
             let shape = SplatBlur { arc, profile };
             m.push((shape.name(), Blur::Splat(shape)));
         }

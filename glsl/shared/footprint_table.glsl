@@ -95,3 +95,32 @@ float footprint_value(sampler2D slices, bool slab, vec2 uv, vec3 sweep, vec2 fac
     }
     return sum;
 }
+
+// Two time slots (Pass::Slots): the alpha a footprint of scale tau deposits at uv in each half of
+// the shutter, averaged over that half's samples (those of footprint_value, rounded up to an even
+// count). Mirror: Weight::slots in src/cpu/footprint.rs.
+vec2 footprint_slots(vec2 uv, vec3 sweep, float tau) {
+    float stretch = sweep.x, bend = sweep.y;
+    if (stretch == 0.0) {
+        float a = 1.0 - exp(-tau * sample_radial(footprint_r2(uv, 0.0, 0.0)));
+        return vec2(a);
+    }
+    vec2 x = sweep_coords(uv, stretch, bend);
+    int n = 2 * ((sweep_samples(stretch, bend) + 1) / 2);
+    float lo = (x.x + stretch - 1.0) / (2.0 * stretch), hi = (x.x + stretch + 1.0) / (2.0 * stretch);
+    int k0 = max(int(ceil(lo * float(n) - 0.5)), 0), k1 = min(int(floor(hi * float(n) - 0.5)), n - 1);
+    vec2 sum = vec2(0.0);
+    for (int k = k0; k <= k1; ++k) {
+        float t = (float(k) + 0.5) / float(n);
+        vec2 e = x - sweep_point(stretch, bend, t);
+        float s = dot(e, e);
+        if (s >= 1.0) continue;
+        float a = 1.0 - exp(-tau * sample_radial(s));
+        if (2 * k < n) {
+            sum.x += a;
+        } else {
+            sum.y += a;
+        }
+    }
+    return sum * (2.0 / float(n));
+}

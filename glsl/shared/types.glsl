@@ -96,6 +96,7 @@ struct Frame {
 const uint SWEEP_UNIFORM = 0u;   // the seed's: uniform weight over the swept capsule, Eq. 4.2
 const uint SWEEP_TAPERED = 1u;   // the time average of the moving footprint (brightest mid-path)
 const uint SWEEP_TEARDROP = 2u;  // weighted towards t_i, fading towards t_{i-1}
+const uint SWEEP_SLOTTED = 3u;   // tapered, each half of the shutter composited apart (Pass::Slots)
 
 #define AA_NONE 0.0
 #define AA_SWAN 1.0

@@ -106,12 +106,15 @@ pub(crate) fn entry<'a>(
 }
 
 /// Draw `instances` draw-list entries starting at `first_instance` into `layers`, as instanced
-/// quads or, with `points`, as point sprites.
+/// quads or, with `points`, as point sprites; with `slots`, every fragment into the two layers
+/// (`Pass::Slots`: the halves of the shutter).
+#[allow(clippy::too_many_arguments)]
 pub fn footprint(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
     blend: Blend,
     points: bool,
+    slots: bool,
     first_instance: u32,
     instances: u32,
     layers: &mut [ImageF32],
@@ -120,9 +123,11 @@ pub fn footprint(
     let inv = vp.as_dmat4().inverse();
     for e in first_instance..first_instance + instances {
         let Some((splat, layer, weight)) = entry(inputs, push, e) else { continue };
-        let Some(target) = layers.get_mut(layer) else { continue };
+        let target = if slots { layers.get_mut(..2) } else { layers.get_mut(layer..=layer) };
+        let Some(target) = target else { continue };
         let p = &inputs.params[splat];
-        let shading = Shading { sheet: push.sheet_mode != 0, blend, weight, sweep: Sweep::of(inputs.frame, p) };
+        let sheet = push.sheet_mode != 0;
+        let shading = Shading { sheet, blend, weight, sweep: Sweep::of(inputs.frame, p), slots };
         if points {
             raster_point(p, shading, vp, target);
         } else {
@@ -377,6 +382,33 @@ impl Weight<'_> {
     }
 }
 
+/// Mirror of `footprint_slots`: the alpha a footprint of scale `tau` deposits at uv in each half
+/// of the shutter (`Pass::Slots`).
+fn footprint_slots(weight: Weight<'_>, uv: Vec2, sweep: Sweep, tau: f32) -> [f32; 2] {
+    let Sweep { stretch, bend, .. } = sweep;
+    if stretch == 0.0 {
+        let a = 1.0 - (-tau * weight.kernel_at(sweep_r2(uv, 0.0, 0.0))).exp();
+        return [a, a];
+    }
+    let x = sweep_coords(uv, stretch, bend);
+    let n = 2 * ((sweep_samples(stretch, bend) + 1) / 2);
+    let (lo, hi) = ((x.x + stretch - 1.0) / (2.0 * stretch), (x.x + stretch + 1.0) / (2.0 * stretch));
+    let k0 = ((lo * n as f32 - 0.5).ceil() as i32).max(0);
+    let k1 = ((hi * n as f32 - 0.5).floor() as i32).min(n - 1);
+    let mut sum = [0.0f32; 2];
+    for k in k0..=k1 {
+        let t = (k as f32 + 0.5) / n as f32;
+        let e = x - sweep_point(stretch, bend, t);
+        let s = e.dot(e);
+        if s >= 1.0 {
+            continue;
+        }
+        let a = 1.0 - (-tau * weight.kernel_at(s)).exp();
+        sum[usize::from(2 * k >= n)] += a;
+    }
+    sum.map(|v| v * (2.0 / n as f32))
+}
+
 /// The whole footprint's optical depth (or, with `opacity`, alpha) at quad coordinates uv for a
 /// footprint of scale `tau` (the tile compositor's case).
 pub fn footprint_value(table: &[f32], uv: Vec2, sweep: Sweep, tau: f32, opacity: bool) -> f32 {
@@ -390,17 +422,31 @@ struct Shading<'a> {
     blend: Blend,
     weight: Weight<'a>,
     sweep: Sweep,
+    /// Two time slots (`Pass::Slots`): one value per target.
+    slots: bool,
 }
 
-/// The fragment shader's output at quad coordinates (u, v), blended into `dst`.
-fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, dst: &mut [f32; 4]) {
-    // Optical depth (sheets) or alpha (per splat).
-    let a = s.weight.value(Vec2::new(u, v), s.sweep, p.emit[3] * p.axis_u[3], !s.sheet);
-    if a <= 0.0 {
+/// The fragment shader's output at quad coordinates (u, v), blended into the pixel at `at` of
+/// `targets` (one, or the two slots).
+fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF32], at: usize) {
+    let tau = p.emit[3] * p.axis_u[3];
+    // Optical depth (sheets) or alpha (per splat), per target.
+    let values = if s.slots {
+        footprint_slots(s.weight, Vec2::new(u, v), s.sweep, tau)
+    } else {
+        [s.weight.value(Vec2::new(u, v), s.sweep, tau, !s.sheet), 0.0]
+    };
+    if values[..targets.len()].iter().all(|&a| a <= 0.0) {
         return;
     }
-    let src = [p.emit[0] * a, p.emit[1] * a, p.emit[2] * a, a];
-    match s.blend {
+    for (target, &a) in targets.iter_mut().zip(&values) {
+        blend(s.blend, [p.emit[0] * a, p.emit[1] * a, p.emit[2] * a, a], &mut target.pixels[at]);
+    }
+}
+
+/// The fixed-function blend of premultiplied `src` into `dst`.
+fn blend(mode: Blend, src: [f32; 4], dst: &mut [f32; 4]) {
+    match mode {
         Blend::Over => {
             let k = 1.0 - src[3];
             *dst = [0, 1, 2, 3].map(|i| src[i] + k * dst[i]);
@@ -415,12 +461,13 @@ fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, dst: &mut [f32; 4]) {
 
 /// A point sprite `2 * screen radius` pixels wide centred on the projected centre: the pixels whose
 /// centres fall inside it, with gl_PointCoord mapped to [-1, 1]².
-fn raster_point(p: &SplatParams, shading: Shading<'_>, vp: Mat4, target: &mut ImageF32) {
+fn raster_point(p: &SplatParams, shading: Shading<'_>, vp: Mat4, targets: &mut [ImageF32]) {
+    let (width, height) = (targets[0].width, targets[0].height);
     let clip = vp * Vec4::new(p.center[0], p.center[1], p.center[2], 1.0);
     if clip.w <= 0.0 {
         return;
     }
-    let (w, h) = (target.width as f32, target.height as f32);
+    let (w, h) = (width as f32, height as f32);
     let (sx, sy) = ((clip.x / clip.w * 0.5 + 0.5) * w, (clip.y / clip.w * 0.5 + 0.5) * h);
     let half = p.screen[2];
     if half <= 0.0 {
@@ -433,16 +480,16 @@ fn raster_point(p: &SplatParams, shading: Shading<'_>, vp: Mat4, target: &mut Im
     for y in y0..=y1 {
         for x in x0..=x1 {
             let (u, v) = ((x as f32 + 0.5 - sx) / half, (y as f32 + 0.5 - sy) / half);
-            let dst = &mut target.pixels[(y as u32 * target.width + x as u32) as usize];
-            shade(p, shading, u, v, dst);
+            shade(p, shading, u, v, targets, (y as u32 * width + x as u32) as usize);
         }
     }
 }
 
-fn raster_quad(p: &SplatParams, shading: Shading<'_>, vp: Mat4, inv: &DMat4, target: &mut ImageF32) {
+fn raster_quad(p: &SplatParams, shading: Shading<'_>, vp: Mat4, inv: &DMat4, targets: &mut [ImageF32]) {
     let v3 = |v: [f32; 4]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
     let (c, au, av) = (v3(p.center), v3(p.axis_u), v3(p.axis_v));
-    let (w, h) = (target.width as f64, target.height as f64);
+    let width = targets[0].width;
+    let (w, h) = (width as f64, targets[0].height as f64);
     let (mut minx, mut maxx, mut miny, mut maxy) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for (cx, cy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
         let q = c + cx * au + cy * av;
@@ -479,8 +526,7 @@ fn raster_quad(p: &SplatParams, shading: Shading<'_>, vp: Mat4, inv: &DMat4, tar
             if u.abs() > 1.0 || v.abs() > 1.0 {
                 continue;
             }
-            let dst = &mut target.pixels[(y as u32 * target.width + x as u32) as usize];
-            shade(p, shading, u as f32, v as f32, dst);
+            shade(p, shading, u as f32, v as f32, targets, (y as u32 * width + x as u32) as usize);
         }
     }
 }
@@ -496,12 +542,18 @@ pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Re
         Pass::Target => vec![ImageF32::new(b.width, b.height)],
         Pass::Sheet if push.carry != 0 => std::mem::take(&mut b.sums),
         Pass::Sheet => vec![ImageF32::new(b.width, b.height); b.sums.len()],
+        Pass::Slots => vec![ImageF32::new(b.width, b.height); 2],
     };
     let inputs = b.inputs(d.list);
-    footprint(&inputs, &push, state.blend, state.points, d.groups[0], d.groups[1], &mut layers);
+    let slots = state.pass == Pass::Slots;
+    footprint(&inputs, &push, state.blend, state.points, slots, d.groups[0], d.groups[1], &mut layers);
     match state.pass {
         Pass::Target => b.color = layers.remove(0),
         Pass::Sheet => b.sums = layers,
+        Pass::Slots => {
+            b.accum = layers.pop().expect("two slots");
+            b.color = layers.pop().expect("two slots");
+        }
     }
     Ok(())
 }

@@ -180,6 +180,10 @@ fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3],
                             rec.begin_pass(pass, &target.sums_fb);
                             layouts[1] = IL::GENERAL;
                         }
+                        Pass::Slots => {
+                            rec.begin_pass(&gpu.pipes.slots_pass, &target.slots_fb);
+                            (layouts[0], layouts[2]) = (IL::TRANSFER_SRC_OPTIMAL, IL::TRANSFER_SRC_OPTIMAL);
+                        }
                     }
                     if count > 0 {
                         if state.points {

@@ -47,6 +47,9 @@ pub struct Pipelines {
     pub sheet_pass: RenderPass,
     /// The same, summing onto the layers (a later part of a bricked volume's sheet batch).
     pub sheet_load_pass: RenderPass,
+    /// Into the target and the accumulation image at once (`Pass::Slots`; both left in
+    /// TRANSFER_SRC for the readback).
+    pub slots_pass: RenderPass,
 }
 
 impl Pipelines {
@@ -55,11 +58,12 @@ impl Pipelines {
         let target_load_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::TRANSFER_SRC_OPTIMAL, true)?;
         let sheet_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::GENERAL, false)?;
         let sheet_load_pass = RenderPass::new(ctx, COLOR_FORMAT, IL::GENERAL, true)?;
+        let slots_pass = RenderPass::with_attachments(ctx, COLOR_FORMAT, 2, IL::TRANSFER_SRC_OPTIMAL, false)?;
         let mut stages = Vec::with_capacity(STAGES.len());
         for desc in STAGES.iter() {
-            stages.push(build(ctx, desc, &target_pass, &sheet_pass)?);
+            stages.push(build(ctx, desc, [&target_pass, &sheet_pass, &slots_pass])?);
         }
-        Ok(Self { stages, target_pass, target_load_pass, sheet_pass, sheet_load_pass })
+        Ok(Self { stages, target_pass, target_load_pass, sheet_pass, sheet_load_pass, slots_pass })
     }
 }
 
@@ -70,7 +74,7 @@ fn has(ctx: &Context, feature: Feature) -> bool {
     }
 }
 
-fn build(ctx: &Arc<Context>, desc: &StageDesc, target: &RenderPass, sheet: &RenderPass) -> Result<StagePipelines> {
+fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Result<StagePipelines> {
     let slots: Vec<Slot> = desc.bindings.iter().map(|&r| slot(r)).collect();
     let flags = match desc.kind {
         Kind::Compute => SS::COMPUTE,
@@ -96,8 +100,9 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, target: &RenderPass, sheet: &Rend
                 };
                 let primitive = if state.points { Primitive::Points } else { Primitive::Quads };
                 let pass = match state.pass {
-                    Pass::Target => target,
-                    Pass::Sheet => sheet,
+                    Pass::Target => passes[0],
+                    Pass::Sheet => passes[1],
+                    Pass::Slots => passes[2],
                 };
                 Pipeline::graphics(ctx, &layout, pass, vert, frag, blend, primitive, v.spec)?
             }

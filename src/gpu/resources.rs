@@ -45,6 +45,8 @@ pub struct Target {
     pub sums: Image,
     pub sums_fb: Framebuffer,
     pub accum: Image,
+    /// The target and the accumulation image as the two time slots' attachments.
+    pub slots_fb: Framebuffer,
 }
 
 pub struct Resources {
@@ -281,9 +283,10 @@ impl Resources {
             let usage = IU::COLOR_ATTACHMENT | IU::STORAGE | IU::TRANSFER_SRC;
             let sums = Image::new(ctx, "sheet sums", (width, height, layers), COLOR_FORMAT, usage, true)?;
             let sums_fb = Framebuffer::new(ctx, &pipes.sheet_pass, &sums)?;
-            let usage = IU::STORAGE | IU::TRANSFER_SRC | IU::TRANSFER_DST;
+            let usage = IU::STORAGE | IU::TRANSFER_SRC | IU::TRANSFER_DST | IU::COLOR_ATTACHMENT;
             let accum = Image::new(ctx, "accumulation", (width, height, 1), COLOR_FORMAT, usage, false)?;
-            self.target = Some(Target { width, height, layers, color, color_fb, sums, sums_fb, accum });
+            let slots_fb = Framebuffer::over(ctx, &pipes.slots_pass, &[&color, &accum])?;
+            self.target = Some(Target { width, height, layers, color, color_fb, sums, sums_fb, accum, slots_fb });
         }
         self.current_target()
     }

@@ -270,7 +270,7 @@ impl Pipeline {
     /// Instanced triangle-strip quads (4 vertices per instance) or a point list (one vertex per
     /// point), no vertex buffers, with the given blend. `specialization[i]` sets `constant_id = i`
     /// in both stages: a mode fixed per pipeline costs nothing at run time, where a branch on a push
-    /// constant makes llvmpipe pay for both sides.
+    /// constant makes llvmpipe pay for both sides. Every colour attachment of `pass` blends alike.
     #[allow(clippy::too_many_arguments)]
     pub fn graphics(
         ctx: &Arc<Context>,
@@ -334,7 +334,7 @@ impl Pipeline {
             ),
             Blend::Add => (vk::BlendFactor::ONE, vk::BlendFactor::ONE, vk::BlendFactor::ONE, vk::BlendFactor::ONE),
         };
-        let attachments = [vk::PipelineColorBlendAttachmentState::default()
+        let attachment = vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(true)
             .src_color_blend_factor(src_c)
             .dst_color_blend_factor(dst_c)
@@ -342,7 +342,8 @@ impl Pipeline {
             .src_alpha_blend_factor(src_a)
             .dst_alpha_blend_factor(dst_a)
             .alpha_blend_op(vk::BlendOp::ADD)
-            .color_write_mask(vk::ColorComponentFlags::RGBA)];
+            .color_write_mask(vk::ColorComponentFlags::RGBA);
+        let attachments = vec![attachment; pass.attachments as usize];
         let color_blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
@@ -388,25 +389,44 @@ pub enum Blend {
     Add,
 }
 
-/// A single-subpass render pass over one RGBA32F colour attachment, cleared on load (or loaded, to
-/// draw on). Its external dependencies order it after earlier compute/attachment work and before
-/// compute reads or copies.
+/// A single-subpass render pass over RGBA32F colour attachments (one, or several written by one
+/// fragment: time slots), cleared on load (or loaded, to draw on). Its external dependencies order
+/// it after earlier compute/attachment work and before compute reads or copies.
 pub struct RenderPass {
     ctx: Arc<Context>,
     pub(crate) raw: vk::RenderPass,
+    /// Colour attachments (at most `MAX_ATTACHMENTS`).
+    pub(crate) attachments: u32,
 }
+
+/// Most colour attachments a render pass here takes (`begin_pass` clears this many).
+pub const MAX_ATTACHMENTS: u32 = 4;
 
 impl RenderPass {
     /// A render pass over one `format` attachment, left in `final_layout`; `load`: drawing on what
     /// the attachment holds (in `final_layout`, where an earlier such pass left it), else cleared.
     /// Both kinds are compatible, so one framebuffer and one pipeline serve both.
     pub fn new(ctx: &Arc<Context>, format: vk::Format, final_layout: vk::ImageLayout, load: bool) -> Result<Self> {
+        Self::with_attachments(ctx, format, 1, final_layout, load)
+    }
+
+    /// As `new`, over `count` attachments alike (1..=`MAX_ATTACHMENTS`).
+    pub fn with_attachments(
+        ctx: &Arc<Context>,
+        format: vk::Format,
+        count: u32,
+        final_layout: vk::ImageLayout,
+        load: bool,
+    ) -> Result<Self> {
+        if !(1..=MAX_ATTACHMENTS).contains(&count) {
+            return Err(Error::InvalidArgument(format!("{count} colour attachments (1..={MAX_ATTACHMENTS})")));
+        }
         let (load_op, initial) = if load {
             (vk::AttachmentLoadOp::LOAD, final_layout)
         } else {
             (vk::AttachmentLoadOp::CLEAR, vk::ImageLayout::UNDEFINED)
         };
-        let attachments = [vk::AttachmentDescription::default()
+        let attachment = vk::AttachmentDescription::default()
             .format(format)
             .samples(vk::SampleCountFlags::TYPE_1)
             .load_op(load_op)
@@ -414,8 +434,11 @@ impl RenderPass {
             .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
             .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
             .initial_layout(initial)
-            .final_layout(final_layout)];
-        let color_refs = [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }];
+            .final_layout(final_layout);
+        let attachments = vec![attachment; count as usize];
+        let color_refs: Vec<vk::AttachmentReference> = (0..count)
+            .map(|attachment| vk::AttachmentReference { attachment, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL })
+            .collect();
         let subpasses = [vk::SubpassDescription::default()
             .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
             .color_attachments(&color_refs)];
@@ -451,7 +474,7 @@ impl RenderPass {
             .dependencies(&dependencies);
         // SAFETY: valid create info.
         let raw = unsafe { ctx.device.create_render_pass(&info, None) }.map_err(Error::vk("vkCreateRenderPass"))?;
-        Ok(Self { ctx: ctx.clone(), raw })
+        Ok(Self { ctx: ctx.clone(), raw, attachments: count })
     }
 }
 
@@ -473,14 +496,31 @@ pub struct Framebuffer {
 impl Framebuffer {
     /// A framebuffer over every layer of `image` for `pass`.
     pub fn new(ctx: &Arc<Context>, pass: &RenderPass, image: &Image) -> Result<Self> {
-        let views = [image.view];
+        Self::over(ctx, pass, &[image])
+    }
+
+    /// A framebuffer whose attachments are `images` in order (as many as `pass` has, all of one
+    /// size and layer count).
+    pub fn over(ctx: &Arc<Context>, pass: &RenderPass, images: &[&Image]) -> Result<Self> {
+        let first = images.first().ok_or_else(|| Error::InvalidArgument("a framebuffer without images".into()))?;
+        if images.len() != pass.attachments as usize
+            || images.iter().any(|i| (i.width, i.height, i.layers) != (first.width, first.height, first.layers))
+        {
+            return Err(Error::InvalidArgument(format!(
+                "{} images of mixed sizes for a pass of {} attachments",
+                images.len(),
+                pass.attachments
+            )));
+        }
+        let image = first;
+        let views: Vec<vk::ImageView> = images.iter().map(|i| i.view).collect();
         let info = vk::FramebufferCreateInfo::default()
             .render_pass(pass.raw)
             .attachments(&views)
             .width(image.width)
             .height(image.height)
             .layers(image.layers);
-        // SAFETY: view and pass are compatible (same format, one attachment).
+        // SAFETY: views and pass are compatible (same format, one view per attachment).
         let raw = unsafe { ctx.device.create_framebuffer(&info, None) }.map_err(Error::vk("vkCreateFramebuffer"))?;
         Ok(Self { ctx: ctx.clone(), raw, width: image.width, height: image.height })
     }

@@ -168,7 +168,8 @@ impl Recorder<'_> {
 
     /// Begin `pass` on `fb`, clearing it.
     pub fn begin_pass(&self, pass: &RenderPass, fb: &Framebuffer) {
-        let clear = [vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } }];
+        let clear = [vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
+            super::pipeline::MAX_ATTACHMENTS as usize];
         let area = vk::Rect2D {
             offset: vk::Offset2D { x: 0, y: 0 },
             extent: vk::Extent2D { width: fb.width, height: fb.height },
@@ -177,7 +178,7 @@ impl Recorder<'_> {
             .render_pass(pass.raw)
             .framebuffer(fb.raw)
             .render_area(area)
-            .clear_values(&clear);
+            .clear_values(&clear[..pass.attachments as usize]);
         let viewport = [vk::Viewport {
             x: 0.0,
             y: 0.0,
