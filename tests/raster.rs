@@ -381,7 +381,7 @@ fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tile
     };
     let mut layers = vec![ImageF32::new(cam.width, cam.height); sheets];
     let points = o.raster == Raster::Points;
-    footprint(&inputs, &push, Blend::Add, points, 0, push.count, &mut layers);
+    footprint(&inputs, &push, Blend::Add, points, false, 0, push.count, &mut layers);
     let tile = voxsplat::constants::COMPOSITE_TILE;
     let (tiles_x, n) = (cam.width.div_ceil(tile), tiles.len() / 2);
     let mut written = 0;
