@@ -1,3 +1,7 @@
+//! Issue 26 item 5: how many time slots a blurred frame needs. Each animation's frame 20 drawn as
+//! 1 to 4 sub-frames, each with arc+tapered splats over its share of the shutter (WBTF, graphics
+//! quads), against 64 sub-frames, as a multiple of accum:5's error. `splat:slotted` is the
+//! two-slot case in one geometry pass.
 use voxsplat::animate::{render_frame, Animation, Blur};
 use voxsplat::{BlurProfile, Motion, OrderKind, Raster, RenderOptions, Renderer, RendererOptions};
 fn main() -> voxsplat::Result<()> {

@@ -451,7 +451,8 @@ struct AnimateArgs {
     /// none, splat (motion-blurred splats) or accum:N (N sub-frames averaged). Blurred splats
     /// take a path and a profile: splat:arc bends each path through its halfway point,
     /// splat:tapered averages the footprint over the shutter, splat:teardrop weights it towards
-    /// the frame's time; joined with '+', e.g. splat:arc+tapered.
+    /// the frame's time, splat:slotted composites the two halves of the shutter apart (the
+    /// closest to accum:N); joined with '+', e.g. splat:arc+slotted.
     #[arg(long, default_value = "splat")]
     blur: String,
     /// Per-splat compositing or sheet summation.
