@@ -53,6 +53,14 @@ int sweep_samples(float stretch, float bend) {
     return clamp(1 + int(ceil(4.0 * (2.0 * stretch + 2.0 * abs(bend)))), 2, MAX_SWEEP_SAMPLES);
 }
 
+// The first and last of n time samples (t = (k + 0.5) / n) that can reach x: the path's u
+// coordinate is linear in t, so only those within a radius of x along u, t in
+// (x.x + stretch -+ 1) / (2 stretch). Mirror: sweep_window in src/cpu/footprint.rs.
+ivec2 sweep_window(vec2 x, float stretch, int n) {
+    float lo = (x.x + stretch - 1.0) / (2.0 * stretch), hi = (x.x + stretch + 1.0) / (2.0 * stretch);
+    return ivec2(max(int(ceil(lo * float(n) - 0.5)), 0), min(int(floor(hi * float(n) - 0.5)), n - 1));
+}
+
 // The kernel's weight at r² s: the whole pre-integrated footprint or, for a slab, the kernel
 // slice between its faces (radius units).
 float kernel_at(sampler2D slices, bool slab, float s, vec2 faces) {
@@ -78,12 +86,9 @@ float footprint_value(sampler2D slices, bool slab, vec2 uv, vec3 sweep, vec2 fac
     }
     vec2 x = sweep_coords(uv, stretch, bend);
     int n = sweep_samples(stretch, bend);
-    // The path's u coordinate is linear in t, so only the samples within a radius of x along u
-    // can reach it: t in (x.x + stretch -+ 1) / (2 stretch).
-    float lo = (x.x + stretch - 1.0) / (2.0 * stretch), hi = (x.x + stretch + 1.0) / (2.0 * stretch);
-    int k0 = max(int(ceil(lo * float(n) - 0.5)), 0), k1 = min(int(floor(hi * float(n) - 0.5)), n - 1);
+    ivec2 ks = sweep_window(x, stretch, n);
     float sum = 0.0;
-    for (int k = k0; k <= k1; ++k) {
+    for (int k = ks.x; k <= ks.y; ++k) {
         float t = (float(k) + 0.5) / float(n);
         vec2 e = x - sweep_point(stretch, bend, t);
         float s = dot(e, e);
@@ -107,10 +112,9 @@ vec2 footprint_slots(vec2 uv, vec3 sweep, float tau) {
     }
     vec2 x = sweep_coords(uv, stretch, bend);
     int n = 2 * ((sweep_samples(stretch, bend) + 1) / 2);
-    float lo = (x.x + stretch - 1.0) / (2.0 * stretch), hi = (x.x + stretch + 1.0) / (2.0 * stretch);
-    int k0 = max(int(ceil(lo * float(n) - 0.5)), 0), k1 = min(int(floor(hi * float(n) - 0.5)), n - 1);
+    ivec2 ks = sweep_window(x, stretch, n);
     vec2 sum = vec2(0.0);
-    for (int k = k0; k <= k1; ++k) {
+    for (int k = ks.x; k <= ks.y; ++k) {
         float t = (float(k) + 0.5) / float(n);
         vec2 e = x - sweep_point(stretch, bend, t);
         float s = dot(e, e);

@@ -331,6 +331,12 @@ fn sweep_samples(stretch: f32, bend: f32) -> i32 {
     (1 + (4.0 * (2.0 * stretch + 2.0 * bend.abs())).ceil() as i32).clamp(2, MAX_SWEEP_SAMPLES)
 }
 
+/// Mirror of `sweep_window`: the time samples (k of `n`) within a radius of x along u.
+fn sweep_window(x: Vec2, stretch: f32, n: i32) -> std::ops::RangeInclusive<i32> {
+    let (lo, hi) = ((x.x + stretch - 1.0) / (2.0 * stretch), (x.x + stretch + 1.0) / (2.0 * stretch));
+    ((lo * n as f32 - 0.5).ceil() as i32).max(0)..=((hi * n as f32 - 0.5).floor() as i32).min(n - 1)
+}
+
 /// What a fragment weighs: the whole pre-integrated footprint, or the slice between two slab
 /// faces (radius units, relative to the splat's centre).
 #[derive(Clone, Copy)]
@@ -362,12 +368,8 @@ impl Weight<'_> {
         let x = sweep_coords(uv, stretch, bend);
         let n = sweep_samples(stretch, bend);
         let teardrop = profile == crate::BlurProfile::Teardrop.code();
-        // Only the samples within a radius of x along u (the path's u is linear in t).
-        let (lo, hi) = ((x.x + stretch - 1.0) / (2.0 * stretch), (x.x + stretch + 1.0) / (2.0 * stretch));
-        let k0 = ((lo * n as f32 - 0.5).ceil() as i32).max(0);
-        let k1 = ((hi * n as f32 - 0.5).floor() as i32).min(n - 1);
         let mut sum = 0.0;
-        for k in k0..=k1 {
+        for k in sweep_window(x, stretch, n) {
             let t = (k as f32 + 0.5) / n as f32;
             let e = x - sweep_point(stretch, bend, t);
             let s = e.dot(e);
@@ -392,11 +394,8 @@ fn footprint_slots(weight: Weight<'_>, uv: Vec2, sweep: Sweep, tau: f32) -> [f32
     }
     let x = sweep_coords(uv, stretch, bend);
     let n = 2 * ((sweep_samples(stretch, bend) + 1) / 2);
-    let (lo, hi) = ((x.x + stretch - 1.0) / (2.0 * stretch), (x.x + stretch + 1.0) / (2.0 * stretch));
-    let k0 = ((lo * n as f32 - 0.5).ceil() as i32).max(0);
-    let k1 = ((hi * n as f32 - 0.5).floor() as i32).min(n - 1);
     let mut sum = [0.0f32; 2];
-    for k in k0..=k1 {
+    for k in sweep_window(x, stretch, n) {
         let t = (k as f32 + 0.5) / n as f32;
         let e = x - sweep_point(stretch, bend, t);
         let s = e.dot(e);
