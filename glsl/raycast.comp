@@ -51,6 +51,17 @@ void main() {
         t0 = max(t0, min(p, q));
         t1 = min(t1, max(p, q));
     }
+    // Clipping planes and crop box: the part of the ray inside all of them.
+    for (uint i = 0u; i < rc.image.w; ++i) {
+        float na = dot(rc.clip[i].xyz, a) + rc.clip[i].w, nd = dot(rc.clip[i].xyz, dir);
+        if (abs(nd) < 1e-30) {
+            if (na < 0.0) t1 = -1.0;
+        } else if (nd > 0.0) {
+            t0 = max(t0, -na / nd);
+        } else {
+            t1 = min(t1, -na / nd);
+        }
+    }
     vec3 col = vec3(0.0);
     float trans = 1.0;
     if (t1 > t0) {

@@ -75,6 +75,11 @@ pub const PYRAMID_PAGES: u32 = 4;
 /// Entries of the brick stages' transfer-function table: one per 16-bit stored value.
 pub const TF_ENTRIES: u32 = 1 << 16;
 
+/// Most clipping planes a frame takes besides its box crop.
+pub const MAX_CLIP_PLANES: usize = 6;
+/// Planes a frame holds: the clipping planes and the crop box's six faces.
+pub const CLIP_SLOTS: usize = MAX_CLIP_PLANES + 6;
+
 /// Macros injected into GLSL (name, value).
 pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
@@ -97,6 +102,7 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("TF_ENTRIES", TF_ENTRIES),
     ("RECORD_PAGE", RECORD_PAGE),
     ("PYRAMID_PAGE", PYRAMID_PAGE),
+    ("CLIP_SLOTS", CLIP_SLOTS as u32),
 ];
 
 /// Splats closer than this many radii to the near or far plane are culled (the quad's corners

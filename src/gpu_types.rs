@@ -65,8 +65,11 @@ pub struct Frame {
     pub motion_mid: [[f32; 4]; 4],
     /// Motion blur: 1 = arc path (0 = straight), the profile's code (`BlurProfile::code`), unused, unused.
     pub sweep: [f32; 4],
-    /// x: 1 = a rectilinear grid (voxel positions from the `Coords` buffer); y, z, w: unused.
+    /// x: 1 = a rectilinear grid (voxel positions from the `Coords` buffer); y: clipping planes
+    /// in use (`clip`); z, w: unused.
     pub rect: [u32; 4],
+    /// Clipping planes (n, d): a splat is drawn where n · centre + d >= 0 for every one in use.
+    pub clip: [[f32; 4]; crate::options::CLIP_SLOTS],
 }
 
 /// Uniforms of `raycast.comp`.
@@ -79,7 +82,10 @@ pub struct RaycastParams {
     pub origin: [f32; 4],
     pub inv_spacing: [f32; 4],
     pub dims: [u32; 4],
+    /// Width, height, empty-space brick side, clipping planes in use.
     pub image: [u32; 4],
+    /// Clipping planes (n, d): each ray is cut to where n · x + d >= 0 for every one in use.
+    pub clip: [[f32; 4]; crate::options::CLIP_SLOTS],
 }
 
 /// Push constants of the footprint stage in every raster variant (`footprint.vert` / `.frag`,
@@ -193,8 +199,8 @@ const _: () = assert!(std::mem::size_of::<BrickPush>() == 16);
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
-const _: () = assert!(std::mem::size_of::<Frame>() == 384);
+const _: () = assert!(std::mem::size_of::<Frame>() == 576);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
-const _: () = assert!(std::mem::size_of::<RaycastParams>() == 160);
+const _: () = assert!(std::mem::size_of::<RaycastParams>() == 352);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -66,7 +66,7 @@ pub use error::{Error, Result};
 pub use glam;
 pub use image::ImageF32;
 pub use kernel::Kernel;
-pub use options::{Antialias, BlurProfile, Composite, Lod, Motion, RenderOptions, Rendered, StageTime};
+pub use options::{Antialias, BlurProfile, Clip, Composite, Lod, Motion, RenderOptions, Rendered, StageTime};
 pub use order::{Direction, OrderKind};
 pub use raster::{Raster, RasterChoice};
 pub use volume::{Grid, SplatSet, Volume};

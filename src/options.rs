@@ -70,6 +70,77 @@ impl std::str::FromStr for Antialias {
     }
 }
 
+pub use crate::constants::{CLIP_SLOTS, MAX_CLIP_PLANES};
+
+/// Clipping in world space: up to `MAX_CLIP_PLANES` half-spaces `n · x + d >= 0` and a box crop.
+/// Splats whose centres lie outside any are not drawn (every splat mode, dense and bricked); the
+/// ray caster cuts each ray to the part inside all of them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Clip {
+    planes: [glam::Vec4; CLIP_SLOTS],
+    count: u32,
+}
+
+impl Clip {
+    /// `planes` as (n, d) with `n` any non-zero length (normalised here), and an optional crop
+    /// box (min, max corners). Refused: more than `MAX_CLIP_PLANES` planes, a zero or non-finite
+    /// normal, a non-finite offset, a box not finite or empty along an axis.
+    pub fn new(planes: &[glam::Vec4], crop: Option<[glam::Vec3; 2]>) -> Result<Self> {
+        if planes.len() > MAX_CLIP_PLANES {
+            return Err(Error::InvalidArgument(format!(
+                "{} clipping planes: at most {MAX_CLIP_PLANES} (and a box crop)",
+                planes.len()
+            )));
+        }
+        let mut clip = Self::default();
+        for (i, p) in planes.iter().enumerate() {
+            let n = p.truncate();
+            let len = n.length();
+            if !p.is_finite() || !len.is_normal() {
+                return Err(Error::InvalidArgument(format!(
+                    "clipping plane {i} ({}, {}, {}, {}): its normal must be finite and non-zero, its offset finite",
+                    p.x, p.y, p.z, p.w
+                )));
+            }
+            clip.push(*p / len);
+        }
+        if let Some([lo, hi]) = crop {
+            if !(lo.is_finite() && hi.is_finite()) || (0..3).any(|a| lo[a] >= hi[a]) {
+                return Err(Error::InvalidArgument(format!(
+                    "crop box {lo} to {hi}: its corners must be finite, the first below the second on every axis"
+                )));
+            }
+            for a in 0..3 {
+                let mut n = glam::Vec3::ZERO;
+                n[a] = 1.0;
+                clip.push(n.extend(-lo[a]));
+                clip.push((-n).extend(hi[a]));
+            }
+        }
+        Ok(clip)
+    }
+
+    fn push(&mut self, p: glam::Vec4) {
+        self.planes[self.count as usize] = p;
+        self.count += 1;
+    }
+
+    /// The planes in use (normalised).
+    pub fn planes(&self) -> &[glam::Vec4] {
+        &self.planes[..self.count as usize]
+    }
+
+    /// Whether world point `p` lies inside every plane.
+    pub fn keeps(&self, p: glam::Vec3) -> bool {
+        self.planes().iter().all(|q| q.truncate().dot(p) + q.w >= 0.0)
+    }
+
+    /// The planes as the GPU reads them (`Frame::clip`, `RaycastParams::clip`) and their count.
+    pub fn uniforms(&self) -> ([[f32; 4]; CLIP_SLOTS], u32) {
+        (self.planes.map(|p| p.to_array()), self.count)
+    }
+}
+
 /// Motion blur of one frame (chapter 4): where every grid point was at the previous time step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Motion {
@@ -154,6 +225,8 @@ pub struct RenderOptions {
     pub antialias: Antialias,
     /// Motion-blurred splats (chapter 4); `None` draws the frame still.
     pub motion: Option<Motion>,
+    /// Clipping planes and a crop box (none by default).
+    pub clip: Clip,
     /// `None`: back to front for per-splat compositing, front to back for sheets.
     pub direction: Option<Direction>,
     /// Memory allowed for one batch of sheet summation layers (RGBA32F each).
@@ -214,6 +287,7 @@ impl Default for RenderOptions {
             kernel: Kernel::Gaussian,
             antialias: Antialias::None,
             motion: None,
+            clip: Clip::default(),
             direction: None,
             sheet_budget_bytes: 256 << 20,
             slab_thickness: 1.0,

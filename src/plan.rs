@@ -98,6 +98,7 @@ pub fn make_frame(
             0.0,
         ],
         rect: [set.coordinates().is_some() as u32, 0, 0, 0],
+        clip: [[0.0; 4]; crate::options::CLIP_SLOTS],
     }
 }
 
@@ -105,7 +106,9 @@ pub fn make_frame(
 pub fn frame_for(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> Frame {
     let split = order::pbtf_split(set, camera);
     let btf = opts.direction() == Direction::BackToFront;
-    make_frame(set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf)
+    let mut frame = make_frame(set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
+    (frame.clip, frame.rect[1]) = opts.clip.uniforms();
+    frame
 }
 
 /// The uniforms the order stage alone needs (no anti-aliasing or motion).

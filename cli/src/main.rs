@@ -21,9 +21,9 @@ enum Command {
     /// List the built-in scenes.
     Scenes,
     /// Render a scene to a PNG (straight alpha) or EXR (premultiplied alpha).
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Write or check a visibility order (back to front).
-    Order(OrderArgs),
+    Order(Box<OrderArgs>),
     /// Describe a volume or height file: dims, spacing, value range, splats at the default
     /// classification and GPU bytes per splat.
     Info {
@@ -219,19 +219,24 @@ struct BenchArgs {
     no_scaling: bool,
 }
 
-fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
+/// `N` comma-separated finite numbers.
+fn parse_floats<const N: usize>(s: &str) -> std::result::Result<[f32; N], String> {
     let parts: Vec<&str> = s.split(',').collect();
-    if parts.len() != 3 {
-        return Err(format!("expected X,Y,Z, got '{s}'"));
+    if parts.len() != N {
+        return Err(format!("expected {N} comma-separated numbers, got '{s}'"));
     }
-    let mut v = [0.0f32; 3];
+    let mut v = [0.0f32; N];
     for (o, p) in v.iter_mut().zip(parts) {
         *o = p.trim().parse::<f32>().map_err(|_| format!("'{p}' is not a number"))?;
         if !o.is_finite() {
             return Err(format!("'{p}' is not finite"));
         }
     }
-    Ok(Vec3::from(v))
+    Ok(v)
+}
+
+fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
+    parse_floats::<3>(s).map(Vec3::from)
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -368,6 +373,13 @@ struct SceneArgs {
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
+    /// A clipping plane NX,NY,NZ,D in world space: what lies where NX x + NY y + NZ z + D < 0 is
+    /// not drawn (splat centres; the ray caster cuts its rays). Up to 6.
+    #[arg(long = "clip", value_parser = parse_floats::<4>, allow_hyphen_values = true)]
+    clip: Vec<[f32; 4]>,
+    /// A crop box X0,Y0,Z0,X1,Y1,Z1 in world space: only what lies inside is drawn.
+    #[arg(long, value_parser = parse_floats::<6>, allow_hyphen_values = true)]
+    crop: Option<[f32; 6]>,
     /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
     /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
@@ -741,6 +753,9 @@ fn run(cli: Cli) -> Result<()> {
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
             opts.render_scale = a.render_scale;
             opts.lod = a.lod.parse()?;
+            let planes: Vec<voxsplat::glam::Vec4> = a.clip.iter().map(|p| voxsplat::glam::Vec4::from(*p)).collect();
+            let crop = a.crop.map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])]);
+            opts.clip = voxsplat::Clip::new(&planes, crop)?;
             (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
             opts.validate()?;
             let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
@@ -769,6 +784,7 @@ fn run(cli: Cli) -> Result<()> {
                         let o = voxsplat::cpu::raycast::RaycastOptions {
                             step,
                             render_scale: a.render_scale,
+                            clip: opts.clip,
                             ..Default::default()
                         };
                         r.raycast(&cam, &o)?

@@ -549,3 +549,40 @@ fn a_volume_renders_on_the_slice_positions_a_sidecar_gives() {
         assert!(msg.contains(says), "{bad}: {msg}");
     }
 }
+
+/// `--clip` and `--crop` (issue 27 item 2): a cut draws less, a cut that keeps nothing draws
+/// nothing, and a degenerate plane or more than six are refused.
+#[test]
+fn clip_planes_and_crop_boxes_from_the_command_line() {
+    let out = tmp("clip.png");
+    let render = |extra: &[&str]| {
+        let mut a = vec!["render", "--scene", "cube40", "--size", "64x64", "--out", out.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        voxsplat(&a)
+    };
+    let alpha = || -> usize {
+        let img = voxsplat::output::read_image(&out).unwrap();
+        img.pixels.iter().filter(|p| p[3] > 0.0).count()
+    };
+    assert!(render(&[]).status.success());
+    let full = alpha();
+    assert!(render(&["--clip", "-1,0,0,0"]).status.success());
+    let half = alpha();
+    assert!(render(&["--crop", "-5,-5,-5,5,5,5"]).status.success());
+    let cropped = alpha();
+    assert!(half > 100 && half < full && cropped < full, "{full} {half} {cropped}");
+    assert!(render(&["--clip", "0,0,1,-1000", "--raycast", "0.5"]).status.success());
+    assert_eq!(alpha(), 0);
+    for (bad, says) in [
+        (vec!["--clip", "0,0,0,1"], "non-zero"),
+        (vec!["--crop", "1,1,1,0,2,2"], "below the second"),
+        (vec!["--clip", "1,0,0"], "expected 4"),
+    ] {
+        let o = render(&bad);
+        let msg = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {msg}");
+        assert!(msg.contains(says), "{bad:?}: {msg}");
+    }
+    let seven: Vec<&str> = (0..7).flat_map(|_| ["--clip", "1,0,0,0"]).collect();
+    assert!(String::from_utf8_lossy(&render(&seven).stderr).contains("at most 6"));
+}

@@ -412,6 +412,15 @@ bool outside_view(uvec3 b, float cell) {
         out_lo &= uvec4(q.x < -q.w, q.x > q.w, q.y < -q.w, q.y > q.w);
     }
     if (dmax < frame.forward.w || dmin > frame.right.w) return true;
+    // Clipping planes: the whole footprint box outside one of them.
+    for (uint i = 0u; i < frame.rect.y; ++i) {
+        bool out_all = true;
+        for (uint c = 0u; c < 8u; ++c) {
+            vec3 p = mix(lo, hi, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u));
+            out_all = out_all && dot(frame.clip[i].xyz, p) + frame.clip[i].w < 0.0;
+        }
+        if (out_all) return true;
+    }
     return front && any(notEqual(out_lo, uvec4(0u)));
 }
 

@@ -35,6 +35,10 @@ SplatParams params_world(vec3 center, float cell, float grow, vec3 rgb, float ta
     float scale = footprint_scale(depth, cell);
     float radius = grow * cell * frame.spacing.w * scale;
     bool visible = depth >= frame.forward.w + CULL_RADII * radius && depth <= frame.right.w - CULL_RADII * radius;
+    // Clipping planes and crop box: splats whose centres lie outside any are not drawn.
+    for (uint i = 0u; i < frame.rect.y; ++i) {
+        visible = visible && dot(frame.clip[i].xyz, center) + frame.clip[i].w >= 0.0;
+    }
     // The quad faces the eye->voxel ray (perspective) or the view direction (orthographic).
     vec3 w = frame.eye.w > 0.5 ? normalize(center - frame.eye.xyz) : forward;
     vec3 u = normalize(frame.right.xyz - dot(frame.right.xyz, w) * w);

@@ -66,7 +66,7 @@ struct ScreenQuad {
     vec4 emit;    // rgb; a: optical depth scale (tau x energy)
 };
 
-// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 384 bytes.
+// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 576 bytes.
 // Bound as a readonly storage buffer, not a uniform buffer: Mesa 22.3's lavapipe inlines uniform
 // values that steer branches and recompiles the shader for every dispatch, keeping each variant until
 // the pipeline dies (+0.2-0.7 MB of host memory per frame; docs/RELIABILITY.md).
@@ -89,7 +89,8 @@ struct Frame {
     vec4 sweep;       // x: 1 = arc path through motion_mid, 0 = straight; y: profile along the
                       // path (SWEEP_*); z, w: unused
     uvec4 rect;       // x: 1 = a rectilinear grid (voxel positions from splat_params' Coords
-                      // buffer); y, z, w: unused
+                      // buffer); y: clipping planes in use; z, w: unused
+    vec4 clip[CLIP_SLOTS];  // clipping planes (n, d): drawn where n . centre + d >= 0 for all
 };
 
 // Profiles of a motion-blurred footprint along its path (glsl/shared/footprint_table.glsl).
@@ -110,7 +111,8 @@ struct RaycastParams {
     vec4 origin;         // world position of voxel (0,0,0); w: 1 / kernel spacing (sigma = tau * w)
     vec4 inv_spacing;    // 1 / voxel spacing; w: unused
     uvec4 dims;          // nx, ny, nz; w: most steps per ray
-    uvec4 image;         // width, height; zw: unused
+    uvec4 image;         // width, height, empty-space brick side, clipping planes in use
+    vec4 clip[CLIP_SLOTS];  // clipping planes (n, d): each ray cut to where n . x + d >= 0 for all
 };
 
 #define SHEET_MODE_SPLAT 0u  // per-splat over / under compositing

@@ -179,6 +179,12 @@ impl BrickInputs<'_> {
         if dmax < f.forward[3] || dmin > f.right[3] {
             return true;
         }
+        // Mirror of the clipping-plane test.
+        let clipped =
+            f.clip[..f.rect[1] as usize].iter().any(|q| (0..8).all(|c| v3(*q).dot(corner(lo, hi, c)) + q[3] < 0.0));
+        if clipped {
+            return true;
+        }
         front && out.iter().any(|&o| o)
     }
 

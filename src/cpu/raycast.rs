@@ -27,6 +27,8 @@ pub struct RaycastOptions {
     /// Cast on a grid this fraction of the camera's size and resample (`crate::resample`; the
     /// inverse of an image sample distance). 1: full size.
     pub render_scale: f32,
+    /// Clipping planes and crop box: each ray is cut to the part inside them.
+    pub clip: crate::options::Clip,
 }
 
 /// Default brick side of the empty-space skipping.
@@ -91,7 +93,14 @@ fn skip_brick(rc: &RaycastParams, b: [i32; 3], nb: [i32; 3], a: Vec3, dir: Vec3,
 
 impl Default for RaycastOptions {
     fn default() -> Self {
-        Self { step: 0.5, min_transmittance: 1e-3, max_steps: 1 << 16, brick: DEFAULT_BRICK, render_scale: 1.0 }
+        Self {
+            step: 0.5,
+            min_transmittance: 1e-3,
+            max_steps: 1 << 16,
+            brick: DEFAULT_BRICK,
+            render_scale: 1.0,
+            clip: Default::default(),
+        }
     }
 }
 
@@ -110,7 +119,8 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
         origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
         inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
-        image: [camera.width, camera.height, opts.brick, 0],
+        image: [camera.width, camera.height, opts.brick, opts.clip.uniforms().1],
+        clip: opts.clip.uniforms().0,
     }
 }
 
@@ -157,6 +167,20 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                 let q = (hi[ax] - a[ax]) / dir[ax];
                 t0 = t0.max(p.min(q));
                 t1 = t1.min(p.max(q));
+            }
+            // Mirror of the clipping in raycast.comp.
+            for c in &rc.clip[..rc.image[3] as usize] {
+                let n = Vec3::new(c[0], c[1], c[2]);
+                let (na, nd) = (n.dot(a) + c[3], n.dot(dir));
+                if nd.abs() < 1e-30 {
+                    if na < 0.0 {
+                        t1 = -1.0;
+                    }
+                } else if nd > 0.0 {
+                    t0 = t0.max(-na / nd);
+                } else {
+                    t1 = t1.min(-na / nd);
+                }
             }
             let (mut col, mut trans) = ([0.0f32; 3], 1.0f32);
             if t1 > t0 {

@@ -55,7 +55,10 @@ pub fn params_world(frame: &Frame, center: Vec3, cell: f32, grow: f32, rgb: [f32
     let depth = (center - eye).dot(forward);
     let scale = cell_footprint_scale(frame, depth, cell);
     let radius = grow * cell * frame.spacing[3] * scale;
-    let visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
+    let mut visible = depth >= frame.forward[3] + CULL_RADII * radius && depth <= frame.right[3] - CULL_RADII * radius;
+    for q in &frame.clip[..frame.rect[1] as usize] {
+        visible = visible && Vec3::new(q[0], q[1], q[2]).dot(center) + q[3] >= 0.0;
+    }
     let w = if frame.eye[3] > 0.5 { (center - eye).normalize() } else { forward };
     let mut u = (right - right.dot(w) * w).normalize();
     let mut v = w.cross(u);

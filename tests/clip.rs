@@ -1,0 +1,105 @@
+//! Clipping planes and the crop box (issue 27 item 2): every splat mode and the ray caster, dense
+//! and bricked, GPU against the CPU mirrors; what they keep and drop; refused planes.
+mod common;
+use common::{assert_clean, blob, blob_tf as tf, diff};
+use glam::{Vec3, Vec4};
+use voxsplat::classify::classify;
+use voxsplat::cpu::raycast::RaycastOptions;
+use voxsplat::{scene, Camera, Clip, Composite, Raster, RenderOptions};
+
+fn with(clip: Clip, composite: Composite, raster: Raster) -> RenderOptions {
+    let mut o = RenderOptions::default();
+    (o.clip, o.composite, o.raster) = (clip, composite, raster);
+    o
+}
+
+fn covered(img: &voxsplat::ImageF32) -> usize {
+    common::covered(img)
+}
+
+#[test]
+fn clipping_drops_what_lies_outside_in_every_mode_and_the_gpu_equals_its_mirror() {
+    let set = scene::build("cube60").unwrap();
+    let cam = Camera::framing(set.grid(), 96, 96);
+    let half = Clip::new(&[Vec4::new(-1.0, 0.0, 0.0, 0.0)], None).unwrap();
+    let cropped =
+        Clip::new(&[Vec4::new(0.0, 1.0, 1.0, 5.0)], Some([Vec3::splat(-20.0), Vec3::new(25.0, 30.0, 30.0)])).unwrap();
+    let everything = Clip::new(&[Vec4::new(0.0, 0.0, 1.0, 1000.0)], None).unwrap();
+    let nothing = Clip::new(&[Vec4::new(0.0, 0.0, 1.0, -1000.0)], None).unwrap();
+    let (mut g, mut c) = (common::gpu(), common::cpu());
+    g.set_scene(set.clone()).unwrap();
+    c.set_scene(set).unwrap();
+    for (composite, raster) in [
+        (Composite::Splat, Raster::Compute),
+        (Composite::Splat, Raster::Graphics),
+        (Composite::Sheet, Raster::Graphics),
+        (Composite::Slab, Raster::Compute),
+    ] {
+        let full = g.render(&cam, &with(Clip::default(), composite, raster)).unwrap().image;
+        for (clip, what) in [(half, "half"), (cropped, "cropped")] {
+            let a = g.render(&cam, &with(clip, composite, raster)).unwrap().image;
+            let b = c.render(&cam, &with(clip, composite, raster)).unwrap().image;
+            common::assert_mirrors(&a, &b, &format!("{composite:?} {raster} {what}"));
+            assert!(covered(&a) > 500 && covered(&a) < covered(&full), "{composite:?} {raster} {what}: drops some");
+        }
+        let kept = g.render(&cam, &with(everything, composite, raster)).unwrap().image;
+        assert_eq!(kept.pixels, full.pixels, "{composite:?} {raster}: a plane keeping all changes nothing");
+        let gone = g.render(&cam, &with(nothing, composite, raster)).unwrap().image;
+        assert_eq!(covered(&gone), 0, "{composite:?} {raster}: a plane keeping nothing draws nothing");
+    }
+    // The ray caster cuts its rays to the same half-space.
+    for clip in [half, cropped] {
+        let o = RaycastOptions { clip, ..Default::default() };
+        let a = g.raycast(&cam, &o).unwrap().image;
+        let b = c.raycast(&cam, &o).unwrap().image;
+        let (most, mean) = diff(&a, &b);
+        assert!(most <= 2e-3 && mean <= 1e-4, "ray caster: GPU vs mirror {most} / {mean}");
+        let full = g.raycast(&cam, &RaycastOptions::default()).unwrap().image;
+        assert!(covered(&a) > 500 && covered(&a) < covered(&full));
+    }
+    let o = RaycastOptions { clip: nothing, ..Default::default() };
+    assert_eq!(covered(&g.raycast(&cam, &o).unwrap().image), 0);
+    assert_clean(&g);
+}
+
+#[test]
+fn a_clipped_bricked_volume_draws_the_clipped_dense_splats() {
+    let vol = blob([37, 29, 23]);
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let cam = Camera::framing(&grid, 96, 80);
+    // Through the middle, and a crop that leaves whole bricks out (the brick test culls them).
+    let clip =
+        Clip::new(&[Vec4::new(1.0, 0.5, 0.0, 2.0)], Some([Vec3::new(-30.0, -30.0, -4.0), Vec3::splat(30.0)])).unwrap();
+    let (mut g, mut c, mut dense) = (common::gpu(), common::cpu(), common::gpu());
+    g.set_volume(&vol, &tf(), None).unwrap();
+    c.set_volume(&vol, &tf(), None).unwrap();
+    dense.set_scene(classify(&vol, &tf(), None).unwrap()).unwrap();
+    for raster in [Raster::Compute, Raster::Graphics] {
+        let o = with(clip, Composite::Splat, raster);
+        let a = g.render(&cam, &o).unwrap().image;
+        let b = c.render(&cam, &o).unwrap().image;
+        common::assert_mirrors(&a, &b, &format!("bricked {raster}"));
+        let d = dense.render(&cam, &o).unwrap().image;
+        let (most, mean) = diff(&a, &d);
+        assert!(most <= 0.05 && mean <= 2e-3, "{raster}: bricked vs dense {most} / {mean}");
+        let full = g.render(&cam, &with(Clip::default(), Composite::Splat, raster)).unwrap().image;
+        assert!(covered(&a) > 200 && covered(&a) < covered(&full));
+    }
+    assert_clean(&g);
+}
+
+#[test]
+fn degenerate_planes_and_boxes_are_refused() {
+    let p = Vec4::new(1.0, 0.0, 0.0, 0.0);
+    let e = |r: voxsplat::Result<Clip>| r.unwrap_err().to_string();
+    assert!(e(Clip::new(&[p; 7], None)).contains("at most 6"));
+    assert!(e(Clip::new(&[Vec4::new(0.0, 0.0, 0.0, 1.0)], None)).contains("non-zero"));
+    assert!(e(Clip::new(&[Vec4::new(f32::NAN, 1.0, 0.0, 1.0)], None)).contains("finite"));
+    assert!(e(Clip::new(&[Vec4::new(1.0, 0.0, 0.0, f32::INFINITY)], None)).contains("finite"));
+    assert!(e(Clip::new(&[], Some([Vec3::ONE, Vec3::new(2.0, 0.5, 2.0)]))).contains("below the second"));
+    // Six planes and a box are taken; normals of any length are normalised.
+    let c = Clip::new(&[Vec4::new(0.0, 2.0, 0.0, 4.0); 6], Some([Vec3::ZERO, Vec3::ONE])).unwrap();
+    assert_eq!(c.planes().len(), 12);
+    assert_eq!(c.planes()[0], Vec4::new(0.0, 1.0, 0.0, 2.0));
+    assert!(c.keeps(Vec3::splat(0.5)) && !c.keeps(Vec3::new(0.5, 1.5, 0.5)));
+}
