@@ -69,7 +69,7 @@ pub struct Frame {
     /// in use (`clip`); z, w: unused.
     pub rect: [u32; 4],
     /// Clipping planes (n, d): a splat is drawn where n · centre + d >= 0 for every one in use.
-    pub clip: [[f32; 4]; crate::options::CLIP_SLOTS],
+    pub clip: [[f32; 4]; crate::constants::CLIP_SLOTS],
 }
 
 /// Uniforms of `raycast.comp`.
@@ -85,7 +85,7 @@ pub struct RaycastParams {
     /// Width, height, empty-space brick side, clipping planes in use.
     pub image: [u32; 4],
     /// Clipping planes (n, d): each ray is cut to where n · x + d >= 0 for every one in use.
-    pub clip: [[f32; 4]; crate::options::CLIP_SLOTS],
+    pub clip: [[f32; 4]; crate::constants::CLIP_SLOTS],
 }
 
 /// Push constants of the footprint stage in every raster variant (`footprint.vert` / `.frag`,
