@@ -330,9 +330,14 @@ impl RenderOptions {
         })
     }
 
+    /// Whether the frame blurs with two time slots (`BlurProfile::Slotted`).
+    pub(crate) fn slotted(&self) -> bool {
+        self.motion.is_some_and(|m| m.profile == BlurProfile::Slotted)
+    }
+
     /// Reject values no frame can use.
     pub fn validate(&self) -> Result<()> {
-        if self.motion.is_some_and(|m| m.profile == BlurProfile::Slotted) && self.composite != Composite::Splat {
+        if self.slotted() && self.composite != Composite::Splat {
             return Err(Error::InvalidArgument(
                 "the slotted blur composites each half of the shutter per splat: use --composite splat".into(),
             ));

@@ -61,27 +61,16 @@ pub enum Viewer {
 }
 
 impl Viewer {
-    /// The viewer of `camera`, in `set`'s grid index coordinates (through its per-axis
-    /// coordinates on a rectilinear grid: a perspective eye maps exactly; an orthographic
-    /// direction keeps its signs, which is all the orders and the validator read of it, scaled by
-    /// each axis's mean spacing).
+    /// The viewer of `camera`, in `set`'s grid index coordinates. On a rectilinear grid a
+    /// perspective eye maps through its per-axis coordinates; an orthographic direction keeps its
+    /// signs, all the orders and the validator read of it, scaled by the grid's spacing (the mean
+    /// gaps, `SplatSet::with_coordinates`).
     pub fn of(set: &SplatSet, camera: &Camera) -> Self {
-        let Some(c) = set.coordinates() else { return Self::of_grid(set.grid(), camera) };
-        if camera.is_perspective() {
-            let e = camera.eye.as_dvec3();
-            Viewer::Eye(DVec3::new(set.index_of(0, e.x), set.index_of(1, e.y), set.index_of(2, e.z)))
-        } else {
-            let mean = |a: usize| {
-                let v = &c[a];
-                if v.len() > 1 {
-                    (v[v.len() - 1] - v[0]) as f64 / (v.len() - 1) as f64
-                } else {
-                    set.grid().spacing[a] as f64
-                }
-            };
-            let f = camera.forward().as_dvec3();
-            Viewer::Toward(DVec3::new(f.x / mean(0), f.y / mean(1), f.z / mean(2)))
+        if set.coordinates().is_none() || !camera.is_perspective() {
+            return Self::of_grid(set.grid(), camera);
         }
+        let e = camera.eye.as_dvec3();
+        Viewer::Eye(DVec3::new(set.index_of(0, e.x), set.index_of(1, e.y), set.index_of(2, e.z)))
     }
 
     /// The viewer of `camera`, in `g`'s index coordinates.

@@ -103,7 +103,7 @@ pub struct Recorded {
 /// chosen), on `e`.
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
     camera.validate()?;
-    let slotted = opts.motion.is_some_and(|m| m.profile == crate::BlurProfile::Slotted);
+    let slotted = opts.slotted();
     if let Some(scene) = &prep.bricks {
         if slotted {
             return Err(Error::Unsupported(
@@ -148,18 +148,15 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, false)?;
-            return finish(e, Res::Accum, w, h, false);
+            return finish(e, &[Res::Accum], w, h, false);
         }
         let blend = if btf { Blend::Over } else { Blend::Under };
-        let slots = opts.motion.is_some_and(|m| m.profile == crate::BlurProfile::Slotted);
         let variant =
-            if slots { footprint_slots_variant(blend) } else { footprint_variant(blend, points, SHEET_MODE_SPLAT) };
+            if slotted { footprint_slots_variant(blend) } else { footprint_variant(blend, points, SHEET_MODE_SPLAT) };
         let push = FootprintPush::default();
         e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
-        if slots {
-            return finish_slots(e, w, h);
-        }
-        return finish(e, Res::Color, w, h, false);
+        let images: &[Res] = if slotted { &[Res::Color, Res::Accum] } else { &[Res::Color] };
+        return finish(e, images, w, h, false);
     }
 
     // Sheet and slab modes: summation layers in batches, composited in visiting order.
@@ -231,7 +228,7 @@ fn record_sheets(
         sum_sheets(e, list, b, opts, b.first_instance, b.instances, false)?;
         composite_sheets(e, list, b, opts, w, h)?;
     }
-    finish(e, Res::Accum, w, h, opts.raster == Raster::Compute)
+    finish(e, &[Res::Accum], w, h, opts.raster == Raster::Compute)
 }
 
 /// The sheet modes' images and per-frame state for `batches`; with `tiles_pass`, `sheet_tiles`
@@ -373,34 +370,36 @@ fn record_tiles(
     Ok(())
 }
 
-/// Read the frame's image (and, after compute sheet sums, the status word) and the timings.
-/// The frame of a two-slot draw (`Pass::Slots`): the mean of its slots, the target and the
-/// accumulation image.
-fn finish_slots(e: &mut dyn Engine, w: u32, h: u32) -> Result<Recorded> {
-    let back = e.read(&[(Res::Color, image_words(w, h)), (Res::Accum, image_words(w, h))])?;
-    let pixels = back[0]
-        .chunks_exact(4)
-        .zip(back[1].chunks_exact(4))
-        .map(|(a, b)| [0, 1, 2, 3].map(|i| 0.5 * (f32::from_bits(a[i]) + f32::from_bits(b[i]))))
-        .collect();
-    let timings = e.finish()?;
-    Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings })
-}
-
-fn finish(e: &mut dyn Engine, image: Res, w: u32, h: u32, status: bool) -> Result<Recorded> {
-    let mut what = vec![(image, image_words(w, h))];
+/// Read the frame's image, the mean of `images` (one, or the two time slots of `Pass::Slots`), and,
+/// after compute sheet sums, the status word; then the timings.
+fn finish(e: &mut dyn Engine, images: &[Res], w: u32, h: u32, status: bool) -> Result<Recorded> {
+    let mut what: Vec<(Res, usize)> = images.iter().map(|&r| (r, image_words(w, h))).collect();
     if status {
         what.push((Res::Status, 1));
     }
     let back = e.read(&what)?;
-    if status && back[1][0] & LOOP_BUDGET_SUMS != 0 {
+    let (layers, rest) = back.split_at(images.len());
+    if status && rest[0][0] & LOOP_BUDGET_SUMS != 0 {
         return Err(Error::TooLarge(
             "a footprint larger than about 240 x 240 pixels: the compute sheet sums ran out of llvmpipe's 65535 \
              loop iterations per invocation; draw this frame with --raster graphics or points"
                 .into(),
         ));
     }
-    let pixels = back[0].chunks_exact(4).map(|c| [0, 1, 2, 3].map(|i| f32::from_bits(c[i]))).collect();
+    let at = |l: &[u32], i: usize| f32::from_bits(l[i]);
+    let scale = 1.0 / images.len() as f32;
+    let pixels = (0..layers[0].len() / 4)
+        .map(|p| {
+            [0, 1, 2, 3].map(|c| {
+                let sum = layers[1..].iter().fold(at(&layers[0], 4 * p + c), |acc, l| acc + at(l, 4 * p + c));
+                if layers.len() > 1 {
+                    sum * scale
+                } else {
+                    sum
+                }
+            })
+        })
+        .collect();
     let timings = e.finish()?;
     Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings })
 }
@@ -434,5 +433,5 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
     e.upload(Res::RaycastParams, words)?;
     let groups = tile_groups(StageId::Raycast, w, h);
     e.run(&Dispatch::new(StageId::Raycast, 0, groups, List::Order, &[]))?;
-    finish(e, Res::Accum, w, h, false)
+    finish(e, &[Res::Accum], w, h, false)
 }

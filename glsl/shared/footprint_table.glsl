@@ -61,6 +61,14 @@ ivec2 sweep_window(vec2 x, float stretch, int n) {
     return ivec2(max(int(ceil(lo * float(n) - 0.5)), 0), min(int(floor(hi * float(n) - 0.5)), n - 1));
 }
 
+// Time sample k of n, t = (k + 0.5) / n, and r² from x to the path there. Mirror: sweep_sample in
+// src/cpu/footprint.rs.
+vec2 sweep_sample(vec2 x, float stretch, float bend, int k, int n) {
+    float t = (float(k) + 0.5) / float(n);
+    vec2 e = x - sweep_point(stretch, bend, t);
+    return vec2(t, dot(e, e));
+}
+
 // The kernel's weight at r² s: the whole pre-integrated footprint or, for a slab, the kernel
 // slice between its faces (radius units).
 float kernel_at(sampler2D slices, bool slab, float s, vec2 faces) {
@@ -89,9 +97,8 @@ float footprint_value(sampler2D slices, bool slab, vec2 uv, vec3 sweep, vec2 fac
     ivec2 ks = sweep_window(x, stretch, n);
     float sum = 0.0;
     for (int k = ks.x; k <= ks.y; ++k) {
-        float t = (float(k) + 0.5) / float(n);
-        vec2 e = x - sweep_point(stretch, bend, t);
-        float s = dot(e, e);
+        vec2 ts = sweep_sample(x, stretch, bend, k, n);
+        float t = ts.x, s = ts.y;
         if (s >= 1.0) continue;
         float d = tau * kernel_at(slices, slab, s, faces);
         // Teardrop: weight 2t / n, rising to t_i (the weights sum to 1 either way).
@@ -115,9 +122,8 @@ vec2 footprint_slots(vec2 uv, vec3 sweep, float tau) {
     ivec2 ks = sweep_window(x, stretch, n);
     vec2 sum = vec2(0.0);
     for (int k = ks.x; k <= ks.y; ++k) {
-        float t = (float(k) + 0.5) / float(n);
-        vec2 e = x - sweep_point(stretch, bend, t);
-        float s = dot(e, e);
+        vec2 ts = sweep_sample(x, stretch, bend, k, n);
+        float s = ts.y;
         if (s >= 1.0) continue;
         float a = 1.0 - exp(-tau * sample_radial(s));
         if (2 * k < n) {

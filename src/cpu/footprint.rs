@@ -337,6 +337,13 @@ fn sweep_window(x: Vec2, stretch: f32, n: i32) -> std::ops::RangeInclusive<i32> 
     ((lo * n as f32 - 0.5).ceil() as i32).max(0)..=((hi * n as f32 - 0.5).floor() as i32).min(n - 1)
 }
 
+/// Mirror of `sweep_sample`: time sample k of n and r² from x to the path there.
+fn sweep_sample(x: Vec2, stretch: f32, bend: f32, k: i32, n: i32) -> (f32, f32) {
+    let t = (k as f32 + 0.5) / n as f32;
+    let e = x - sweep_point(stretch, bend, t);
+    (t, e.dot(e))
+}
+
 /// What a fragment weighs: the whole pre-integrated footprint, or the slice between two slab
 /// faces (radius units, relative to the splat's centre).
 #[derive(Clone, Copy)]
@@ -370,9 +377,7 @@ impl Weight<'_> {
         let teardrop = profile == crate::BlurProfile::Teardrop.code();
         let mut sum = 0.0;
         for k in sweep_window(x, stretch, n) {
-            let t = (k as f32 + 0.5) / n as f32;
-            let e = x - sweep_point(stretch, bend, t);
-            let s = e.dot(e);
+            let (t, s) = sweep_sample(x, stretch, bend, k, n);
             if s >= 1.0 {
                 continue;
             }
@@ -396,9 +401,7 @@ fn footprint_slots(weight: Weight<'_>, uv: Vec2, sweep: Sweep, tau: f32) -> [f32
     let n = 2 * ((sweep_samples(stretch, bend) + 1) / 2);
     let mut sum = [0.0f32; 2];
     for k in sweep_window(x, stretch, n) {
-        let t = (k as f32 + 0.5) / n as f32;
-        let e = x - sweep_point(stretch, bend, t);
-        let s = e.dot(e);
+        let (_, s) = sweep_sample(x, stretch, bend, k, n);
         if s >= 1.0 {
             continue;
         }

@@ -112,6 +112,7 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
     let last = g.position([g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1]);
     let (lo, hi) = (o - s, last + s);
     let step = opts.step * s.min_element();
+    let (clip, clip_count) = opts.clip.uniforms();
     RaycastParams {
         inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
         box_min: [lo.x, lo.y, lo.z, step],
@@ -119,8 +120,8 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
         origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
         inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
-        image: [camera.width, camera.height, opts.brick, opts.clip.uniforms().1],
-        clip: opts.clip.uniforms().0,
+        image: [camera.width, camera.height, opts.brick, clip_count],
+        clip,
     }
 }
 
