@@ -142,6 +142,20 @@ pub struct SlabPush {
     pub pad: u32,
 }
 
+/// Push constants of `present.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PresentPush {
+    /// The background, premultiplied (zero: none).
+    pub background: [f32; 4],
+    pub width: u32,
+    pub height: u32,
+    /// Bit 0: the accumulation image, bit 1: the raster target; both: their mean (slotted blur).
+    pub sources: u32,
+    /// 1: write linear values, for a target that encodes them itself (sRGB, float).
+    pub linear: u32,
+}
+
 /// Push constants of `composite.comp`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -201,6 +215,7 @@ const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 576);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
+const _: () = assert!(std::mem::size_of::<PresentPush>() == 32);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 352);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -62,6 +62,7 @@ pub mod volume;
 
 pub use bisect::Bisect;
 pub use camera::{Camera, Projection};
+pub use cpu::present::TargetFormat;
 pub use error::{Error, Result};
 pub use glam;
 pub use image::ImageF32;
@@ -70,6 +71,15 @@ pub use options::{Antialias, BlurProfile, Clip, Composite, Lod, Motion, RenderOp
 pub use order::{Direction, OrderKind};
 pub use raster::{Raster, RasterChoice};
 pub use volume::{Grid, SplatSet, Volume};
+
+/// What a frame drawn into a host's image (`Renderer::render_to`) reports.
+#[derive(Clone, Debug)]
+pub struct Delivered {
+    /// Per-stage times, as `Rendered::timings`.
+    pub timings: Vec<StageTime>,
+    /// What `Raster::Auto` picked.
+    pub raster: RasterChoice,
+}
 
 use cpu_engine::CpuEngine;
 use plan::Prepared;
@@ -278,6 +288,60 @@ impl Renderer {
             (None, _) => record_frame(&mut cpu, prep, camera, &opts)?,
         };
         Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice) })
+    }
+
+    /// Draw a frame into the host's image `target` on the device, with no readback: the frame
+    /// waits on the target's wait semaphores before it writes the image, converts it to the image's
+    /// format (over `options.background`, sRGB encoded where the format says so: the bytes a PNG
+    /// of `render` holds), leaves it in the target's new layout and signals the target's signal
+    /// semaphores. It returns when the frame is complete (docs/EMBEDDING.md).
+    pub fn render_to(
+        &mut self,
+        camera: &Camera,
+        options: &RenderOptions,
+        target: &vk::HostTarget,
+    ) -> Result<Delivered> {
+        options.validate()?;
+        camera.validate()?;
+        if (camera.width, camera.height) != target.size() {
+            return Err(Error::InvalidArgument(format!(
+                "the camera's {} x {} frame does not fit the {} x {} target",
+                camera.width,
+                camera.height,
+                target.size().0,
+                target.size().1
+            )));
+        }
+        if options.render_scale != 1.0 {
+            return Err(Error::Unsupported("render_to draws at the target's size: render_scale needs render()".into()));
+        }
+        if self.bisect.is_some() {
+            return Err(Error::Unsupported("render_to with a bisect split: use render()".into()));
+        }
+        let (opts, choice) = self.choose(camera, options)?;
+        let prep =
+            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let gpu = self.gpu.as_mut().ok_or_else(|| Error::Unsupported("render_to needs the GPU backend".into()))?;
+        gpu.context().check_target(target.format())?;
+        let recorded = record_frame(&mut gpu.engine_to(prep, target), prep, camera, &opts)?;
+        Ok(Delivered { timings: recorded.timings, raster: choice })
+    }
+
+    /// The texels of a target after `render_to`, in its format (it needs `TRANSFER_SRC` usage).
+    pub fn read_target(&self, target: &vk::HostTarget) -> Result<Vec<u8>> {
+        self.device_context("reading a target")?.read_target(target)
+    }
+
+    /// An image on this renderer's device that `render_to` can draw into and `read_target` read.
+    pub fn target_image(&self, format: TargetFormat, width: u32, height: u32) -> Result<vk::TargetImage> {
+        vk::TargetImage::new(self.device_context("a target image")?, format, width, height)
+    }
+
+    fn device_context(&self, what: &str) -> Result<&Arc<vk::Context>> {
+        self.gpu
+            .as_ref()
+            .map(|g| g.context())
+            .ok_or_else(|| Error::Unsupported(format!("{what} needs the GPU backend")))
     }
 
     /// The options with the raster variant `Raster::Auto` resolved for this device and view.

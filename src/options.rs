@@ -267,6 +267,10 @@ pub struct RenderOptions {
     /// takes over, its splats move and widen toward that level's cells (geomorphing), so a level
     /// change is continuous in time and across brick faces. 0: abrupt changes.
     pub lod_band: f32,
+    /// Composite the frame over this straight RGBA colour on the device (`present.comp`) before it
+    /// is read back or written into a host image; alpha 1 gives an opaque frame, as a window shows
+    /// it. `None` (the default) leaves the premultiplied frame as drawn: transparent where empty.
+    pub background: Option<[f32; 4]>,
 }
 
 /// Levels of detail (`RenderOptions::lod`).
@@ -299,6 +303,7 @@ impl Default for RenderOptions {
             lod_pixels: 1.0,
             lod_error: DEFAULT_LOD_ERROR,
             lod_band: 0.75,
+            background: None,
         }
     }
 }
@@ -365,6 +370,11 @@ impl RenderOptions {
                 "the level-of-detail band {} must be in [0, 1]",
                 self.lod_band
             )));
+        }
+        if let Some(bg) = self.background {
+            if !bg.iter().all(|c| (0.0..=1.0).contains(c)) {
+                return Err(Error::InvalidArgument(format!("background {bg:?}: each channel must be in [0, 1]")));
+            }
         }
         if self.sheet_budget_bytes == 0 {
             return Err(Error::InvalidArgument("the sheet budget must be positive".into()));

@@ -148,7 +148,7 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
         }
         if compute {
             record_tiles(e, &frame, n, opts, w, h, false)?;
-            return finish(e, &[Res::Accum], w, h, false);
+            return finish(e, opts.background, &[Res::Accum], w, h, false);
         }
         let blend = if btf { Blend::Over } else { Blend::Under };
         let variant =
@@ -156,7 +156,7 @@ pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: 
         let push = FootprintPush::default();
         e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
         let images: &[Res] = if slotted { &[Res::Color, Res::Accum] } else { &[Res::Color] };
-        return finish(e, images, w, h, false);
+        return finish(e, opts.background, images, w, h, false);
     }
 
     // Sheet and slab modes: summation layers in batches, composited in visiting order.
@@ -228,7 +228,7 @@ fn record_sheets(
         sum_sheets(e, list, b, opts, b.first_instance, b.instances, false)?;
         composite_sheets(e, list, b, opts, w, h)?;
     }
-    finish(e, &[Res::Accum], w, h, opts.raster == Raster::Compute)
+    finish(e, opts.background, &[Res::Accum], w, h, opts.raster == Raster::Compute)
 }
 
 /// The sheet modes' images and per-frame state for `batches`; with `tiles_pass`, `sheet_tiles`
@@ -371,20 +371,43 @@ fn record_tiles(
 }
 
 /// Read the frame's image, the mean of `images` (one, or the two time slots of `Pass::Slots`), and,
-/// after compute sheet sums, the status word; then the timings.
-fn finish(e: &mut dyn Engine, images: &[Res], w: u32, h: u32, status: bool) -> Result<Recorded> {
+/// after compute sheet sums, the status word; then the timings. Over a background, or into a host's
+/// image (`Engine::target_linear`), `present` first makes the final image; a host's image then
+/// receives it on the device and nothing is read but the status word.
+fn finish(
+    e: &mut dyn Engine,
+    background: Option<[f32; 4]>,
+    images: &[Res],
+    w: u32,
+    h: u32,
+    status: bool,
+) -> Result<Recorded> {
+    let linear = e.target_linear();
+    let images = if background.is_some() || linear.is_some() {
+        let sources = images.iter().fold(0, |m, &r| m | if r == Res::Accum { 1 } else { 2 });
+        let push = crate::cpu::present::present_push(background, sources, linear.unwrap_or(false), w, h);
+        let groups = tile_groups(StageId::Present, w, h);
+        e.run(&Dispatch::new(StageId::Present, 0, groups, List::Order, bytemuck::bytes_of(&push)))?;
+        &[Res::Accum][..]
+    } else {
+        images
+    };
+    if linear.is_some() {
+        e.deliver()?;
+        if status {
+            check_status(e.read(&[(Res::Status, 1)])?[0][0])?;
+        }
+        let timings = e.finish()?;
+        return Ok(Recorded { image: ImageF32 { width: w, height: h, pixels: Vec::new() }, timings });
+    }
     let mut what: Vec<(Res, usize)> = images.iter().map(|&r| (r, image_words(w, h))).collect();
     if status {
         what.push((Res::Status, 1));
     }
     let back = e.read(&what)?;
     let (layers, rest) = back.split_at(images.len());
-    if status && rest[0][0] & LOOP_BUDGET_SUMS != 0 {
-        return Err(Error::TooLarge(
-            "a footprint larger than about 240 x 240 pixels: the compute sheet sums ran out of llvmpipe's 65535 \
-             loop iterations per invocation; draw this frame with --raster graphics or points"
-                .into(),
-        ));
+    if status {
+        check_status(rest[0][0])?;
     }
     let at = |l: &[u32], i: usize| f32::from_bits(l[i]);
     let scale = 1.0 / images.len() as f32;
@@ -402,6 +425,18 @@ fn finish(e: &mut dyn Engine, images: &[Res], w: u32, h: u32, status: bool) -> R
         .collect();
     let timings = e.finish()?;
     Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings })
+}
+
+/// The compute sheet sums' status word: a footprint too large for llvmpipe's loop budget.
+fn check_status(word: u32) -> Result<()> {
+    if word & LOOP_BUDGET_SUMS != 0 {
+        return Err(Error::TooLarge(
+            "a footprint larger than about 240 x 240 pixels: the compute sheet sums ran out of llvmpipe's 65535 \
+             loop iterations per invocation; draw this frame with --raster graphics or points"
+                .into(),
+        ));
+    }
+    Ok(())
 }
 
 /// THE recording of the reference ray caster (`raycast.comp` and its mirror): `prep` cast from
@@ -433,5 +468,5 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
     e.upload(Res::RaycastParams, words)?;
     let groups = tile_groups(StageId::Raycast, w, h);
     e.run(&Dispatch::new(StageId::Raycast, 0, groups, List::Order, &[]))?;
-    finish(e, &[Res::Accum], w, h, false)
+    finish(e, None, &[Res::Accum], w, h, false)
 }

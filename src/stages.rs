@@ -12,8 +12,8 @@ use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
 use crate::gpu_types::{
-    BrickPush, CompositePush, FootprintPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB,
-    SHEET_MODE_SPLAT,
+    BrickPush, CompositePush, FootprintPush, PresentPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_BINNED,
+    SHEET_MODE_SLAB, SHEET_MODE_SPLAT,
 };
 
 pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, List, Pass, Res, Variant, Workgroup};
@@ -471,6 +471,18 @@ pub const STAGES: &[StageDesc] = &[
         variants: ONE,
         mirror: crate::cpu::raycast::raycast_stage,
     },
+    StageDesc {
+        name: "present",
+        kind: Kind::Compute,
+        bindings: &[Res::Accum, Res::Color],
+        writes: &[Res::Accum],
+        push: std::mem::size_of::<PresentPush>() as u32,
+        workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
+        timing: "present",
+        device_build: None,
+        variants: ONE,
+        mirror: crate::cpu::present::present_stage,
+    },
 ];
 
 const _: () = assert!(StageId::ALL.len() == STAGES.len());
@@ -551,6 +563,7 @@ stage_ids!(
     FootprintSum,
     Composite,
     Raycast,
+    Present,
 );
 
 impl StageId {
@@ -627,6 +640,16 @@ pub trait Engine {
     fn host_time(&mut self, stage: &'static str, ms: f64);
     /// Finish the frame: the stage times.
     fn finish(&mut self) -> Result<Vec<StageTime>>;
+    /// When the frame goes into a host's image (`Renderer::render_to`): whether that image wants
+    /// linear values (it encodes sRGB itself, or stores floats). `None`: the frame is read back.
+    fn target_linear(&self) -> Option<bool> {
+        None
+    }
+    /// Copy the presented frame (the accumulation image) into the host's image, ordered by the
+    /// host's semaphores: only an engine with a target can.
+    fn deliver(&mut self) -> Result<()> {
+        Err(Error::Unsupported("only the Vulkan engine writes into a host's image".into()))
+    }
     /// The frame resources written so far (what a split hands over).
     fn live(&self) -> Vec<Res>;
     /// What the frame's plan must respect on this engine.

@@ -6,6 +6,7 @@ pub mod composite;
 pub mod footprint;
 pub mod lod;
 pub mod order;
+pub mod present;
 pub mod raycast;
 pub mod sheet_tiles;
 pub mod slab;
@@ -17,6 +18,7 @@ pub use brick::{brick_cull, brick_hidden, brick_order, brick_params, tile_occlus
 pub use composite::composite;
 pub use footprint::{footprint, footprint_sum, sample_table};
 pub use order::{order_count, order_scan, order_scatter};
+pub use present::present;
 pub use raycast::raycast;
 pub use sheet_tiles::sheet_tiles;
 pub use slab::{slab_count, slab_scan, slab_scatter};

@@ -10,7 +10,7 @@ use crate::kernel::Kernel;
 use crate::options::StageTime;
 use crate::plan::Prepared;
 use crate::stages::{Dispatch, Engine, Limits};
-use crate::vk::{Buffer, BufferUsageFlags as BU, Image, ImageLayout as IL, Recorder, Stage, Timer};
+use crate::vk::{Buffer, BufferUsageFlags as BU, HostTarget, Image, ImageLayout as IL, Recorder, Stage, Timer};
 use std::collections::BTreeSet;
 use std::time::Instant;
 
@@ -20,6 +20,8 @@ enum Cmd {
     Upload(Res, Buffer),
     /// Copy the first bytes of a resource to its readback buffer.
     Copy(Res, u64),
+    /// Blit the accumulation image into the host's image (`GpuEngine::target`).
+    Blit,
 }
 
 /// The Vulkan engine of one frame.
@@ -35,6 +37,8 @@ pub struct GpuEngine<'a> {
     layers: u32,
     /// Where the accumulation image, the summation layers and the raster target stand.
     layouts: [IL; 3],
+    /// The host's image the frame goes to (`Renderer::render_to`), if any.
+    target: Option<&'a HostTarget>,
 }
 
 impl<'a> GpuEngine<'a> {
@@ -50,7 +54,13 @@ impl<'a> GpuEngine<'a> {
             height: 0,
             layers: 1,
             layouts: [IL::UNDEFINED; 3],
+            target: None,
         }
+    }
+
+    /// An engine whose frame goes into the host's image `target` instead of being read back.
+    pub fn to_target(gpu: &'a mut Gpu, prep: &'a Prepared, target: &'a HostTarget) -> Self {
+        Self { target: Some(target), ..Self::new(gpu, prep) }
     }
 
     /// Submit the queued commands. On a GPU: one submission with a timestamp after each run of
@@ -94,12 +104,14 @@ impl<'a> GpuEngine<'a> {
         let gpu = &*self.gpu;
         let target = gpu.res.current_target()?;
         let mut per_run = vec![0.0f64; runs.len()];
+        // The submission holding the blit into the host's image carries the host's semaphores.
+        let synced = |cmds: &[&Cmd]| self.target.filter(|_| cmds.iter().any(|c| matches!(c, Cmd::Blit)));
         if host_timed {
             for (i, (_, cmds)) in runs.iter().enumerate() {
                 let t = Instant::now();
-                ctx.submit(|rec| {
+                ctx.submit_synced(synced(cmds), |rec| {
                     for cmd in cmds {
-                        record(rec, gpu, target, &mut layouts, cmd)?;
+                        record(rec, gpu, target, &mut layouts, cmd, self.target)?;
                     }
                     Ok(())
                 })?;
@@ -107,12 +119,13 @@ impl<'a> GpuEngine<'a> {
             }
         } else {
             let timer = &gpu.timer;
-            ctx.submit(|rec| {
+            let all: Vec<&Cmd> = runs.iter().flat_map(|(_, cmds)| cmds.iter().copied()).collect();
+            ctx.submit_synced(synced(&all), |rec| {
                 rec.reset_timer(timer);
                 rec.timestamp(timer, 0);
                 for (i, (_, cmds)) in runs.iter().enumerate() {
                     for cmd in cmds {
-                        record(rec, gpu, target, &mut layouts, cmd)?;
+                        record(rec, gpu, target, &mut layouts, cmd, self.target)?;
                     }
                     rec.timestamp(timer, i as u32 + 1);
                 }
@@ -148,7 +161,14 @@ fn image_of(target: &Target, res: Res) -> (&Image, usize) {
     }
 }
 
-fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3], cmd: &Cmd) -> Result<()> {
+fn record(
+    rec: &Recorder<'_>,
+    gpu: &Gpu,
+    target: &Target,
+    layouts: &mut [IL; 3],
+    cmd: &Cmd,
+    host: Option<&HostTarget>,
+) -> Result<()> {
     let res = &gpu.res;
     match cmd {
         Cmd::Run(d) => {
@@ -157,7 +177,7 @@ fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3],
             let (pipe, set) = (&stage.variants[d.variant], res.set(d.stage, d.args.list)?);
             match desc.kind {
                 Kind::Compute => {
-                    for &r in desc.bindings.iter().filter(|r| matches!(r, Res::Accum | Res::Sums)) {
+                    for &r in desc.bindings.iter().filter(|r| r.is_image()) {
                         let (image, i) = image_of(target, r);
                         to_layout(rec, image, &mut layouts[i], IL::GENERAL);
                     }
@@ -232,6 +252,12 @@ fn record(rec: &Recorder<'_>, gpu: &Gpu, target: &Target, layouts: &mut [IL; 3],
                 rec.copy_buffer(res.buffer(*r)?, back, *bytes);
             }
             rec.barrier(Stage::Transfer, Stage::Host);
+        }
+        Cmd::Blit => {
+            let host = host.ok_or_else(|| Error::InvalidArgument("a blit without a host target".into()))?;
+            rec.barrier(Stage::All, Stage::Transfer);
+            to_layout(rec, &target.accum, &mut layouts[0], IL::TRANSFER_SRC_OPTIMAL);
+            rec.blit_to_host(&target.accum, host);
         }
     }
     Ok(())
@@ -348,6 +374,18 @@ impl Engine for GpuEngine<'_> {
     fn finish(&mut self) -> Result<Vec<StageTime>> {
         self.flush()?;
         Ok(std::mem::take(&mut self.timings))
+    }
+
+    fn target_linear(&self) -> Option<bool> {
+        self.target.map(|t| t.format().linear())
+    }
+
+    fn deliver(&mut self) -> Result<()> {
+        if self.target.is_none() {
+            return Err(Error::InvalidArgument("this frame has no host target".into()));
+        }
+        self.pending.push(("present", Cmd::Blit));
+        Ok(())
     }
 
     fn live(&self) -> Vec<Res> {

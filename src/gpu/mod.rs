@@ -74,6 +74,11 @@ impl Gpu {
         exec::GpuEngine::new(self, prep)
     }
 
+    /// An engine for one frame of `prep` that goes into the host's image `target`.
+    pub fn engine_to<'a>(&'a mut self, prep: &'a Prepared, target: &'a crate::vk::HostTarget) -> exec::GpuEngine<'a> {
+        exec::GpuEngine::to_target(self, prep, target)
+    }
+
     /// The dense field as a 3D texture and its brick occupancy for `brick`, built once per scene
     /// (the host copy is dropped after the upload).
     pub(crate) fn upload_field(&mut self, prep: &Prepared, brick: u32) -> Result<()> {

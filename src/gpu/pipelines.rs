@@ -24,8 +24,7 @@ pub fn spirv(name: &str) -> Result<&'static [u8]> {
 fn slot(res: Res) -> Slot {
     match res {
         Res::SliceTable | Res::Field => Slot::Texture,
-        Res::Accum | Res::Sums => Slot::StorageImage,
-        Res::Color => Slot::Unused,
+        Res::Accum | Res::Sums | Res::Color => Slot::StorageImage,
         _ => Slot::Storage,
     }
 }

@@ -277,7 +277,8 @@ impl Resources {
             self.sets.clear();
             self.target = None;
             let ctx = &self.ctx;
-            let usage = IU::COLOR_ATTACHMENT | IU::TRANSFER_SRC;
+            // Storage too: `present.comp` reads it.
+            let usage = IU::COLOR_ATTACHMENT | IU::STORAGE | IU::TRANSFER_SRC;
             let color = Image::new(ctx, "color", (width, height, 1), COLOR_FORMAT, usage, false)?;
             let color_fb = Framebuffer::new(ctx, &pipes.target_pass, &color)?;
             let usage = IU::COLOR_ATTACHMENT | IU::STORAGE | IU::TRANSFER_SRC;
@@ -342,7 +343,7 @@ impl Resources {
                 },
                 Res::Accum => Bind::Image(&target.accum),
                 Res::Sums => Bind::Image(&target.sums),
-                Res::Color => Bind::None,
+                Res::Color => Bind::Image(&target.color),
                 Res::Params | Res::ParamsHi | Res::Quads | Res::QuadsHi => {
                     let base = if matches!(res, Res::Params | Res::ParamsHi) { Res::Params } else { Res::Quads };
                     let [lo, hi] = pages(frame_buf(base));

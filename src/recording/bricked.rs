@@ -221,7 +221,7 @@ pub(super) fn record_bricks(
             e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
         }
     }
-    finish(e, &[if compute { Res::Accum } else { Res::Color }], w, h, false)
+    finish(e, opts.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)
 }
 
 /// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
@@ -386,7 +386,7 @@ fn record_bricked_sheets(
         }
         composite_sheets(e, List::SlabPairs, g, opts, w, h)?;
     }
-    finish(e, &[Res::Accum], w, h, compute)
+    finish(e, opts.background, &[Res::Accum], w, h, compute)
 }
 
 /// Splats of a batch of visible bricks (entries: header, first position, first record, voxels).

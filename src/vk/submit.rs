@@ -7,8 +7,8 @@ use std::sync::atomic::Ordering;
 
 /// A command buffer being recorded (see `Context::submit`).
 pub struct Recorder<'a> {
-    ctx: &'a Context,
-    cmd: vk::CommandBuffer,
+    pub(super) ctx: &'a Context,
+    pub(super) cmd: vk::CommandBuffer,
 }
 
 /// Pipeline stages a barrier connects (a small vocabulary is all the pipeline needs).
@@ -256,6 +256,16 @@ impl Context {
     /// Record with `f`, submit, and wait on a fence. Everything `f` referenced must live until
     /// this returns, which the borrow of the recorder guarantees for resources passed by reference.
     pub fn submit<T>(&self, f: impl FnOnce(&Recorder<'_>) -> Result<T>) -> Result<T> {
+        self.submit_synced(None, f)
+    }
+
+    /// `submit`, waiting on the host's semaphores of `target` before any of its commands run and
+    /// signalling its others when they are done (the frame that writes into the host's image).
+    pub fn submit_synced<T>(
+        &self,
+        target: Option<&super::HostTarget>,
+        f: impl FnOnce(&Recorder<'_>) -> Result<T>,
+    ) -> Result<T> {
         if self.is_lost() {
             return Err(Error::DeviceLost("a submission after the device was lost".into()));
         }
@@ -265,13 +275,18 @@ impl Context {
         // SAFETY: valid device; the pool is destroyed below on every path.
         let pool =
             unsafe { self.device.create_command_pool(&pool_info, None) }.map_err(Error::vk("vkCreateCommandPool"))?;
-        let result = self.submit_in(pool, f);
+        let result = self.submit_in(pool, target, f);
         // SAFETY: submit_in waited on its fence (or never submitted) before returning.
         unsafe { self.device.destroy_command_pool(pool, None) };
         result
     }
 
-    fn submit_in<T>(&self, pool: vk::CommandPool, f: impl FnOnce(&Recorder<'_>) -> Result<T>) -> Result<T> {
+    fn submit_in<T>(
+        &self,
+        pool: vk::CommandPool,
+        target: Option<&super::HostTarget>,
+        f: impl FnOnce(&Recorder<'_>) -> Result<T>,
+    ) -> Result<T> {
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -293,7 +308,13 @@ impl Context {
         let fence = unsafe { self.device.create_fence(&vk::FenceCreateInfo::default(), None) }
             .map_err(Error::vk("vkCreateFence"))?;
         let cmds = [cmd];
-        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        let (wait, signal) = target.map(|t| (&t.wait[..], &t.signal[..])).unwrap_or((&[], &[]));
+        let stages = vec![vk::PipelineStageFlags::ALL_COMMANDS; wait.len()];
+        let submit = [vk::SubmitInfo::default()
+            .command_buffers(&cmds)
+            .wait_semaphores(wait)
+            .wait_dst_stage_mask(&stages)
+            .signal_semaphores(signal)];
         let submitted = {
             let queue = self.queue.lock().map_err(|_| Error::Unsupported("queue lock poisoned".into()))?;
             // SAFETY: the queue is externally synchronised by the mutex.

@@ -1,0 +1,256 @@
+//! A host's image as a frame's destination (`Renderer::render_to`): the image, its layouts and the
+//! semaphores that order the frame with the host's work; an image voxsplat owns for hosts (and
+//! tests) without one; semaphores; and reading any of them back.
+use super::{Buffer, Context, Image, Memory, Recorder};
+use crate::cpu::present::TargetFormat;
+use crate::error::{Error, Result};
+use ash::vk;
+use std::sync::Arc;
+
+/// The Vulkan format of a target format.
+pub fn vk_format(format: TargetFormat) -> vk::Format {
+    match format {
+        TargetFormat::Bgra8Srgb => vk::Format::B8G8R8A8_SRGB,
+        TargetFormat::Bgra8Unorm => vk::Format::B8G8R8A8_UNORM,
+        TargetFormat::Rgba8Srgb => vk::Format::R8G8B8A8_SRGB,
+        TargetFormat::Rgba8Unorm => vk::Format::R8G8B8A8_UNORM,
+        TargetFormat::Rgba16Float => vk::Format::R16G16B16A16_SFLOAT,
+    }
+}
+
+/// The target format of a Vulkan format, or a typed error naming the ones voxsplat writes.
+pub fn target_format(format: vk::Format) -> Result<TargetFormat> {
+    TargetFormat::ALL.into_iter().find(|&f| vk_format(f) == format).ok_or_else(|| {
+        Error::Unsupported(format!(
+            "render_to writes B8G8R8A8 or R8G8B8A8 (SRGB or UNORM) and R16G16B16A16_SFLOAT images, not {format:?}"
+        ))
+    })
+}
+
+/// Where a frame goes: a host's 2D image (one layer, one mip level), the layout it is in when the
+/// frame starts and the one to leave it in, the semaphores the frame waits on before it writes the
+/// image and those it signals when done.
+#[derive(Clone, Debug)]
+pub struct HostTarget {
+    pub(crate) image: vk::Image,
+    pub(crate) format: TargetFormat,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) old_layout: vk::ImageLayout,
+    pub(crate) new_layout: vk::ImageLayout,
+    pub(crate) wait: Vec<vk::Semaphore>,
+    pub(crate) signal: Vec<vk::Semaphore>,
+}
+
+impl HostTarget {
+    /// Describe a host's image. `old_layout` may be `UNDEFINED` (the frame overwrites it all, as
+    /// after a swapchain acquire); `new_layout` is, for example, `PRESENT_SRC_KHR` or
+    /// `SHADER_READ_ONLY_OPTIMAL`, and not `UNDEFINED`.
+    ///
+    /// # Safety
+    ///
+    /// `image` is a valid 2D image of `format` and `width` x `height` on the device voxsplat's
+    /// context uses, created with `TRANSFER_DST` usage (and `TRANSFER_SRC` to read it back), in
+    /// `old_layout` when each frame starts; the semaphores are valid binary semaphores of that
+    /// device, each `wait` one signalled or pending a signal when the frame is submitted, each
+    /// `signal` one unsignalled with no wait pending. All of them stay alive until the frame's
+    /// `render_to` returns (it waits for the frame's completion).
+    pub unsafe fn new(
+        image: vk::Image,
+        format: vk::Format,
+        (width, height): (u32, u32),
+        (old_layout, new_layout): (vk::ImageLayout, vk::ImageLayout),
+        wait: &[vk::Semaphore],
+        signal: &[vk::Semaphore],
+    ) -> Result<Self> {
+        let format = target_format(format)?;
+        if new_layout == vk::ImageLayout::UNDEFINED || new_layout == vk::ImageLayout::PREINITIALIZED {
+            return Err(Error::InvalidArgument(format!("a target cannot be left in layout {new_layout:?}")));
+        }
+        if width == 0 || height == 0 {
+            return Err(Error::InvalidArgument(format!("a target of {width} x {height} pixels")));
+        }
+        Ok(Self { image, format, width, height, old_layout, new_layout, wait: wait.to_vec(), signal: signal.to_vec() })
+    }
+
+    /// Its size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Its format.
+    pub fn format(&self) -> TargetFormat {
+        self.format
+    }
+
+    /// The layout the frame leaves it in.
+    pub fn layout(&self) -> vk::ImageLayout {
+        self.new_layout
+    }
+}
+
+/// An image voxsplat owns that frames can be rendered into (`Renderer::render_to`) and read back:
+/// for hosts that sample a texture rather than present a swapchain, and for tests.
+pub struct TargetImage {
+    image: Image,
+    format: TargetFormat,
+}
+
+impl TargetImage {
+    /// A `width` x `height` image of `format`, usable as a colour attachment, a sampled texture and
+    /// a transfer source and destination.
+    pub fn new(ctx: &Arc<Context>, format: TargetFormat, width: u32, height: u32) -> Result<Self> {
+        use vk::ImageUsageFlags as IU;
+        let usage = IU::TRANSFER_DST | IU::TRANSFER_SRC | IU::SAMPLED | IU::COLOR_ATTACHMENT;
+        let image = Image::new(ctx, "render_to target", (width, height, 1), vk_format(format), usage, false)?;
+        Ok(Self { image, format })
+    }
+
+    /// The raw handle, for a host that samples it.
+    pub fn raw(&self) -> vk::Image {
+        self.image.raw
+    }
+
+    /// This image as a frame's destination, from `old_layout` (`UNDEFINED` the first time) to
+    /// `new_layout`, without semaphores (the frame is complete when `render_to` returns).
+    pub fn target(&self, old_layout: vk::ImageLayout, new_layout: vk::ImageLayout) -> Result<HostTarget> {
+        let (w, h) = (self.image.width, self.image.height);
+        // SAFETY: voxsplat made the image with the needed usage; no semaphores.
+        unsafe { HostTarget::new(self.image.raw, vk_format(self.format), (w, h), (old_layout, new_layout), &[], &[]) }
+    }
+}
+
+/// A binary semaphore, destroyed in Drop (after the device is idle).
+pub struct Semaphore {
+    ctx: Arc<Context>,
+    raw: vk::Semaphore,
+}
+
+impl Semaphore {
+    /// A new unsignalled semaphore.
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        // SAFETY: valid device.
+        let raw = unsafe { ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
+            .map_err(Error::vk("vkCreateSemaphore"))?;
+        Ok(Self { ctx: ctx.clone(), raw })
+    }
+
+    /// The raw handle, for `HostTarget::new` or a host's present.
+    pub fn raw(&self) -> vk::Semaphore {
+        self.raw
+    }
+}
+
+impl Drop for Semaphore {
+    fn drop(&mut self) {
+        self.ctx.wait_idle();
+        // SAFETY: the device is idle, so no submission uses it.
+        unsafe { self.ctx.device.destroy_semaphore(self.raw, None) };
+    }
+}
+
+fn color_range() -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+/// A layout change of a host's image; the semaphore waits and the submission's own barriers order
+/// everything else, so every stage on both sides.
+fn host_barrier(rec: &Recorder<'_>, image: vk::Image, layouts: (vk::ImageLayout, vk::ImageLayout)) {
+    let all = vk::PipelineStageFlags::ALL_COMMANDS;
+    let b = [vk::ImageMemoryBarrier::default()
+        .old_layout(layouts.0)
+        .new_layout(layouts.1)
+        .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+        .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(color_range())];
+    // SAFETY: recording state; the host promised the image is valid and in `layouts.0`.
+    unsafe { rec.ctx.device.cmd_pipeline_barrier(rec.cmd, all, all, vk::DependencyFlags::empty(), &[], &[], &b) };
+}
+
+impl Recorder<'_> {
+    /// Blit `src` (in TRANSFER_SRC_OPTIMAL, the target's size) into the host's image, which the
+    /// blit converts to its format (sRGB encoding included), leaving it in its new layout.
+    pub fn blit_to_host(&self, src: &Image, to: &HostTarget) {
+        host_barrier(self, to.image, (to.old_layout, vk::ImageLayout::TRANSFER_DST_OPTIMAL));
+        let layers = vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let corner = vk::Offset3D { x: to.width as i32, y: to.height as i32, z: 1 };
+        let region = [vk::ImageBlit::default()
+            .src_subresource(layers)
+            .src_offsets([vk::Offset3D::default(), corner])
+            .dst_subresource(layers)
+            .dst_offsets([vk::Offset3D::default(), corner])];
+        // SAFETY: both images alive for the submission and in the layouts named.
+        unsafe {
+            self.ctx.device.cmd_blit_image(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                to.image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &region,
+                vk::Filter::NEAREST,
+            )
+        };
+        host_barrier(self, to.image, (vk::ImageLayout::TRANSFER_DST_OPTIMAL, to.new_layout));
+    }
+}
+
+impl Context {
+    /// Whether frames can be blitted from RGBA32F into images of `format`: refused with a typed error
+    /// when the device lacks the format's blit features.
+    pub fn check_target(&self, format: TargetFormat) -> Result<()> {
+        let feature = |f: vk::Format| {
+            // SAFETY: plain query on a valid physical device.
+            unsafe { self.instance.get_physical_device_format_properties(self.physical, f) }.optimal_tiling_features
+        };
+        let src = feature(vk::Format::R32G32B32A32_SFLOAT).contains(vk::FormatFeatureFlags::BLIT_SRC);
+        let dst = feature(vk_format(format)).contains(vk::FormatFeatureFlags::BLIT_DST);
+        if src && dst {
+            Ok(())
+        } else {
+            Err(Error::Unsupported(format!(
+                "{} cannot blit RGBA32F into {:?} images (BLIT_SRC {src}, BLIT_DST {dst})",
+                self.device_name(),
+                vk_format(format)
+            )))
+        }
+    }
+
+    /// The texels of a target after a frame (in its new layout, which stays), row by row in the
+    /// image's own format. The image needs `TRANSFER_SRC` usage.
+    pub fn read_target(self: &Arc<Self>, target: &HostTarget) -> Result<Vec<u8>> {
+        let bytes = target.width as u64 * target.height as u64 * target.format.texel_bytes() as u64;
+        let back = Buffer::new(self, "target readback", bytes, vk::BufferUsageFlags::TRANSFER_DST, Memory::Readback)?;
+        self.submit(|rec| {
+            let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+            host_barrier(rec, target.image, (target.new_layout, src));
+            let region = [vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D { width: target.width, height: target.height, depth: 1 })];
+            // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer holds every texel.
+            unsafe { rec.ctx.device.cmd_copy_image_to_buffer(rec.cmd, target.image, src, back.raw, &region) };
+            host_barrier(rec, target.image, (src, target.new_layout));
+            Ok(())
+        })?;
+        Ok(back.read()?.to_vec())
+    }
+}

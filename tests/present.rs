@@ -1,0 +1,192 @@
+//! Frames into a host's image (issue 27 item 1): `render_to` writes, on the device, the bytes the
+//! mirror of `present.comp` and of the blit says, in every swapchain format, over a background or
+//! transparent, in the modes whose final images differ (accumulation, raster target, two slots);
+//! semaphores order frames; bad targets are refused.
+mod common;
+use common::assert_clean;
+use voxsplat::cpu::present::{decode, encode, present_pixel, present_push};
+use voxsplat::vk::ImageLayout as IL;
+use voxsplat::{scene, Camera, Composite, Motion, Raster, RenderOptions, TargetFormat};
+
+fn options(composite: Composite, raster: Raster, background: Option<[f32; 4]>) -> RenderOptions {
+    let mut o = RenderOptions::default();
+    (o.composite, o.raster, o.background) = (composite, raster, background);
+    o
+}
+
+/// Largest difference between two images' texels, as values (8-bit steps are 1/255).
+fn most(format: TargetFormat, a: &[u8], b: &[u8]) -> f32 {
+    assert_eq!(a.len(), b.len());
+    let (a, b) = (decode(format, a).unwrap(), decode(format, b).unwrap());
+    // Compare in the stored encoding: an sRGB byte step is not a fixed linear step.
+    let stored = |p: [f32; 4]| {
+        if matches!(format, TargetFormat::Bgra8Srgb | TargetFormat::Rgba8Srgb) {
+            [0, 1, 2].map(|c| voxsplat::cpu::present::to_srgb(p[c])).into_iter().chain([p[3]]).collect::<Vec<_>>()
+        } else {
+            p.to_vec()
+        }
+    };
+    a.iter()
+        .zip(&b)
+        .flat_map(|(x, y)| stored(*x).into_iter().zip(stored(*y)).map(|(u, v)| (u - v).abs()))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn render_to_writes_what_the_mirror_says_in_every_format_and_mode() {
+    let set = scene::build("cube60").unwrap();
+    let cam = Camera::framing(set.grid(), 80, 64);
+    let mut g = common::gpu();
+    g.set_scene(set).unwrap();
+    let slotted = {
+        let mut o = options(Composite::Splat, Raster::Graphics, Some([0.1, 0.2, 0.3, 1.0]));
+        let mut m = Motion::straight(glam::Mat4::from_translation(glam::Vec3::new(6.0, 0.0, 0.0)), 0.5);
+        m.profile = voxsplat::BlurProfile::Slotted;
+        o.motion = Some(m);
+        o
+    };
+    let cases = [
+        ("tile compositor, opaque background", options(Composite::Splat, Raster::Compute, Some([0.1, 0.2, 0.3, 1.0]))),
+        ("quads, transparent", options(Composite::Splat, Raster::Graphics, None)),
+        (
+            "sheets, half-transparent background",
+            options(Composite::Sheet, Raster::Graphics, Some([1.0, 0.5, 0.0, 0.5])),
+        ),
+        ("slotted blur", slotted),
+    ];
+    for format in TargetFormat::ALL {
+        let image = g.target_image(format, cam.width, cam.height).unwrap();
+        for (i, (what, o)) in cases.iter().enumerate() {
+            let first = if i == 0 { IL::UNDEFINED } else { IL::SHADER_READ_ONLY_OPTIMAL };
+            let target = image.target(first, IL::SHADER_READ_ONLY_OPTIMAL).unwrap();
+            g.render_to(&cam, o, &target).unwrap();
+            let got = g.read_target(&target).unwrap();
+            // The mirror: the frame as render() reads it back without a background, presented on the
+            // host as present.comp does for this format, encoded as the blit does.
+            let mut plain = o.clone();
+            plain.background = None;
+            let frame = g.render(&cam, &plain).unwrap().image;
+            let push = present_push(o.background, 1, format.linear(), cam.width, cam.height);
+            let presented: Vec<[f32; 4]> = frame.pixels.iter().map(|&p| present_pixel(&push, p, [0.0; 4])).collect();
+            let want = encode(format, &presented);
+            let step = if format == TargetFormat::Rgba16Float { 2e-3 } else { 1.0 / 255.0 + 1e-6 };
+            let d = most(format, &got, &want);
+            assert!(d <= step, "{format:?}, {what}: {d} from the mirror");
+            let lit = presented.iter().filter(|p| p[0] + p[1] + p[2] > 0.05).count();
+            assert!(lit > 1000, "{format:?}, {what}: only {lit} pixels lit");
+        }
+    }
+    assert_clean(&g);
+}
+
+#[test]
+fn a_background_goes_through_present_on_both_engines_and_keeps_the_png_bytes() {
+    let set = scene::build("cube60").unwrap();
+    let cam = Camera::framing(set.grid(), 72, 72);
+    let (mut g, mut c) = (common::gpu(), common::cpu());
+    g.set_scene(set.clone()).unwrap();
+    c.set_scene(set).unwrap();
+    for (composite, raster) in [(Composite::Splat, Raster::Compute), (Composite::Splat, Raster::Graphics)] {
+        let o = options(composite, raster, Some([0.2, 0.4, 0.6, 1.0]));
+        let a = g.render(&cam, &o).unwrap().image;
+        let b = c.render(&cam, &o).unwrap().image;
+        common::assert_mirrors(&a, &b, &format!("{raster} over a background"));
+        assert!(a.pixels.iter().all(|p| (p[3] - 1.0).abs() < 1e-6), "an opaque background leaves alpha 1");
+        // An empty pixel is the background itself.
+        assert!(a.pixels[0].iter().zip([0.2, 0.4, 0.6, 1.0]).all(|(x, y)| (x - y).abs() < 1e-6), "{:?}", a.pixels[0]);
+    }
+    // The sRGB target gets the PNG's bytes back: render_to into B8G8R8A8_SRGB, decoded by hand.
+    let o = options(Composite::Splat, Raster::Graphics, Some([0.0, 0.0, 0.0, 1.0]));
+    let png = voxsplat::output::to_rgba8(&g.render(&cam, &o).unwrap().image);
+    let image = g.target_image(TargetFormat::Bgra8Srgb, cam.width, cam.height).unwrap();
+    let target = image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap();
+    g.render_to(&cam, &o, &target).unwrap();
+    let bgra = g.read_target(&target).unwrap();
+    let worst = png
+        .chunks_exact(4)
+        .zip(bgra.chunks_exact(4))
+        .map(|(p, t)| [p[0].abs_diff(t[2]), p[1].abs_diff(t[1]), p[2].abs_diff(t[0]), p[3].abs_diff(t[3])])
+        .flat_map(|d| d.into_iter())
+        .max()
+        .unwrap();
+    assert!(worst <= 1, "the sRGB target differs from the PNG by {worst} steps");
+    assert_clean(&g);
+}
+
+#[test]
+fn semaphores_order_frames_into_one_image() {
+    let set = scene::build("cube60").unwrap();
+    let cam = Camera::framing(set.grid(), 64, 64);
+    let mut g = common::gpu();
+    g.set_scene(set).unwrap();
+    let ctx = g.context().unwrap().clone();
+    let (a, b) = (voxsplat::vk::Semaphore::new(&ctx).unwrap(), voxsplat::vk::Semaphore::new(&ctx).unwrap());
+    let image = g.target_image(TargetFormat::Rgba8Unorm, 64, 64).unwrap();
+    let o = options(Composite::Splat, Raster::Graphics, Some([0.0, 0.0, 0.0, 1.0]));
+    let mut last = Vec::new();
+    // Each frame signals the semaphore the next one waits on, as a swapchain loop does.
+    for f in 0..4 {
+        let (wait, signal) = if f % 2 == 0 { (&b, &a) } else { (&a, &b) };
+        let waits: Vec<_> = if f == 0 { vec![] } else { vec![wait.raw()] };
+        let old = if f == 0 { IL::UNDEFINED } else { IL::GENERAL };
+        let raw = image.raw();
+        // SAFETY: the image and semaphores are voxsplat's, alive for the whole loop; each wait
+        // semaphore was signalled by the frame before.
+        let target = unsafe {
+            voxsplat::vk::HostTarget::new(
+                raw,
+                voxsplat::vk::vk_format(TargetFormat::Rgba8Unorm),
+                (64, 64),
+                (old, IL::GENERAL),
+                &waits,
+                &[signal.raw()],
+            )
+        }
+        .unwrap();
+        g.render_to(&Camera { eye: cam.eye + glam::Vec3::new(f as f32, 0.0, 0.0), ..cam }, &o, &target).unwrap();
+        last = g.read_target(&target).unwrap();
+    }
+    // The fourth frame signalled `b` with nobody waiting; a last frame waits on it so nothing dangles.
+    let target = unsafe {
+        voxsplat::vk::HostTarget::new(
+            image.raw(),
+            voxsplat::vk::vk_format(TargetFormat::Rgba8Unorm),
+            (64, 64),
+            (IL::GENERAL, IL::GENERAL),
+            &[b.raw()],
+            &[],
+        )
+    }
+    .unwrap();
+    let moved = Camera { eye: cam.eye + glam::Vec3::new(3.0, 0.0, 0.0), ..cam };
+    g.render_to(&moved, &o, &target).unwrap();
+    assert_eq!(g.read_target(&target).unwrap(), last, "the same camera gives the same bytes");
+    assert_clean(&g);
+}
+
+#[test]
+fn bad_targets_are_refused_with_typed_errors() {
+    let set = scene::build("cube60").unwrap();
+    let cam = Camera::framing(set.grid(), 64, 48);
+    let mut g = common::gpu();
+    g.set_scene(set.clone()).unwrap();
+    let image = g.target_image(TargetFormat::Rgba8Unorm, 32, 32).unwrap();
+    let target = image.target(IL::UNDEFINED, IL::GENERAL).unwrap();
+    let e = g.render_to(&cam, &RenderOptions::default(), &target).unwrap_err();
+    assert!(e.to_string().contains("does not fit"), "{e}");
+    let wrong = voxsplat::vk::target_format(voxsplat::vk::Format::R8_UNORM).unwrap_err();
+    assert!(wrong.to_string().contains("R16G16B16A16_SFLOAT"), "{wrong}");
+    assert!(image.target(IL::UNDEFINED, IL::UNDEFINED).is_err(), "a target left undefined");
+    let image = g.target_image(TargetFormat::Rgba8Unorm, 64, 48).unwrap();
+    let target = image.target(IL::UNDEFINED, IL::GENERAL).unwrap();
+    let mut scaled = RenderOptions::default();
+    scaled.render_scale = 0.5;
+    assert!(g.render_to(&cam, &scaled, &target).is_err(), "render_scale needs render()");
+    let mut bad = RenderOptions::default();
+    bad.background = Some([2.0, 0.0, 0.0, 1.0]);
+    assert!(g.render(&cam, &bad).unwrap_err().to_string().contains("background"));
+    let mut c = common::cpu();
+    c.set_scene(set).unwrap();
+    assert!(c.target_image(TargetFormat::Rgba8Unorm, 8, 8).is_err(), "no device, no target");
+    assert_clean(&g);
+}
