@@ -235,6 +235,21 @@ fn parse_floats<const N: usize>(s: &str) -> std::result::Result<[f32; N], String
     Ok(v)
 }
 
+fn parse_background(s: &str) -> std::result::Result<[f32; 4], String> {
+    let [r, g, b, a] = match s.split(',').count() {
+        3 => {
+            let [r, g, b] = parse_floats::<3>(s)?;
+            [r, g, b, 1.0]
+        }
+        _ => parse_floats::<4>(s)?,
+    };
+    if [r, g, b, a].iter().all(|c| (0.0..=1.0).contains(c)) {
+        Ok([r, g, b, a])
+    } else {
+        Err(format!("'{s}': each channel must be in [0, 1]"))
+    }
+}
+
 fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
     parse_floats::<3>(s).map(Vec3::from)
 }
@@ -380,6 +395,10 @@ struct RenderArgs {
     /// A crop box X0,Y0,Z0,X1,Y1,Z1 in world space: only what lies inside is drawn.
     #[arg(long, value_parser = parse_floats::<6>, allow_hyphen_values = true)]
     crop: Option<[f32; 6]>,
+    /// Composite the frame over this colour R,G,B[,A] (each in [0, 1]; A defaults to 1, opaque), as
+    /// a window shows it; without it the PNG is transparent where nothing was drawn.
+    #[arg(long, value_parser = parse_background)]
+    background: Option<[f32; 4]>,
     /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
     /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
@@ -756,6 +775,7 @@ fn run(cli: Cli) -> Result<()> {
             let planes: Vec<voxsplat::glam::Vec4> = a.clip.iter().map(|p| voxsplat::glam::Vec4::from(*p)).collect();
             let crop = a.crop.map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])]);
             opts.clip = voxsplat::Clip::new(&planes, crop)?;
+            opts.background = a.background;
             (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
             opts.validate()?;
             let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
@@ -801,6 +821,11 @@ fn run(cli: Cli) -> Result<()> {
                 f
             };
             let mut image = frame.image;
+            if let (Some(bg), true) = (a.background, a.truth || a.raycast.is_some()) {
+                // The reference renderers have no present stage: its mirror, on the host.
+                let push = voxsplat::cpu::present::present_push(Some(bg), 1, false, cam.width, cam.height);
+                voxsplat::cpu::present::present(&push, &mut image, &voxsplat::ImageF32::new(0, 0));
+            }
             if a.k_line {
                 let regions = voxsplat::aa::k_regions(&set_for_k, &cam);
                 if regions.iter().all(|&r| r == 0) {

@@ -586,3 +586,28 @@ fn clip_planes_and_crop_boxes_from_the_command_line() {
     let seven: Vec<&str> = (0..7).flat_map(|_| ["--clip", "1,0,0,0"]).collect();
     assert!(String::from_utf8_lossy(&render(&seven).stderr).contains("at most 6"));
 }
+
+/// `--background` (issue 27 item 1): the frame over a colour, opaque everywhere, the colour itself
+/// where nothing is drawn, on the splat path and on the ray caster (the present stage's mirror).
+#[test]
+fn a_background_fills_the_frame() {
+    let out = tmp("background.png");
+    let render = |extra: &[&str]| {
+        let mut a = vec!["render", "--scene", "cube40", "--size", "48x48", "--out", out.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        voxsplat(&a)
+    };
+    for extra in [&["--background", "0.2,0.4,0.6"][..], &["--background", "0.2,0.4,0.6,1", "--raycast", "0.5"]] {
+        let o = render(extra);
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        let img = voxsplat::output::read_image(&out).unwrap();
+        assert!(img.pixels.iter().all(|p| p[3] > 0.999), "{extra:?}: opaque everywhere");
+        let corner = img.pixels[0];
+        assert!((corner[2] - 0.6).abs() < 0.003 && (corner[0] - 0.2).abs() < 0.003, "{extra:?}: {corner:?}");
+        assert!(img.pixels.iter().any(|p| (p[2] - 0.6).abs() > 0.05), "{extra:?}: the cube shows");
+    }
+    for bad in ["1,2,3", "0,0", "0,0,0,0,0"] {
+        let o = render(&["--background", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+    }
+}
