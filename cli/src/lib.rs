@@ -7,6 +7,7 @@ pub mod bench;
 pub mod bricked;
 pub mod kernels;
 pub mod motion_orders;
+pub mod open;
 pub mod peer;
 pub mod rates;
 pub mod soak;

@@ -1,0 +1,370 @@
+//! What `voxsplat render` opens and how: the scene flags shared by the commands and the viewer
+//! example (`examples/viewer.rs`), their parsers, the camera they describe, and loading the scene
+//! as host splats or a bricked store classified on the device.
+use clap::Args;
+use glam::Vec3;
+use std::path::PathBuf;
+use voxsplat::{scene, Backend, Camera, Error, Projection, Renderer, RendererOptions, Result};
+
+/// `N` comma-separated finite numbers.
+pub fn parse_floats<const N: usize>(s: &str) -> std::result::Result<[f32; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!("expected {N} comma-separated numbers, got '{s}'"));
+    }
+    let mut v = [0.0f32; N];
+    for (o, p) in v.iter_mut().zip(parts) {
+        *o = p.trim().parse::<f32>().map_err(|_| format!("'{p}' is not a number"))?;
+        if !o.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(v)
+}
+
+pub fn parse_background(s: &str) -> std::result::Result<[f32; 4], String> {
+    let [r, g, b, a] = match s.split(',').count() {
+        3 => {
+            let [r, g, b] = parse_floats::<3>(s)?;
+            [r, g, b, 1.0]
+        }
+        _ => parse_floats::<4>(s)?,
+    };
+    if [r, g, b, a].iter().all(|c| (0.0..=1.0).contains(c)) {
+        Ok([r, g, b, a])
+    } else {
+        Err(format!("'{s}': each channel must be in [0, 1]"))
+    }
+}
+
+pub fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
+    parse_floats::<3>(s).map(Vec3::from)
+}
+
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH, got '{s}'"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width '{w}'"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height '{h}'"))?;
+    if w == 0 || h == 0 {
+        return Err("image size must be at least 1x1".into());
+    }
+    Ok((w, h))
+}
+
+pub fn parse_dims(s: &str) -> std::result::Result<[u32; 3], String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if v.len() != 3 {
+        return Err(format!("expected X,Y,Z, got '{s}'"));
+    }
+    let mut d = [0u32; 3];
+    for (o, p) in d.iter_mut().zip(v) {
+        *o = p.trim().parse().map_err(|_| format!("'{p}' is not a dimension"))?;
+        if *o == 0 {
+            return Err("dimensions must be positive".into());
+        }
+    }
+    Ok(d)
+}
+
+pub fn parse_finite(s: &str) -> std::result::Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("'{s}' is not finite"))
+    }
+}
+
+#[derive(Args)]
+pub struct SceneArgs {
+    /// Built-in scene name (see `voxsplat scenes`).
+    #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain"])]
+    pub scene: String,
+    /// Eye position (default: a three-quarter view framing the scene).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Look-at point (default: the scene's centre).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Up vector.
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0", allow_hyphen_values = true)]
+    pub up: Vec3,
+    /// Vertical field of view in degrees (perspective).
+    #[arg(long, value_parser = parse_finite, conflicts_with = "ortho", allow_hyphen_values = true)]
+    pub fov: Option<f32>,
+    /// Orthographic projection with this view height (world units).
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    pub ortho: Option<f32>,
+    /// Near plane distance (default: fitted to the scene).
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    pub near: Option<f32>,
+    /// Far plane distance (default: fitted to the scene).
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    pub far: Option<f32>,
+    /// Image size.
+    #[arg(long, value_parser = parse_size, default_value = "512x512")]
+    pub size: (u32, u32),
+    /// Preset view: auto (fly-over for terrain, VTK's camera for the peer scenes, framing otherwise),
+    /// a three-quarter framing, a grazing view across a single-sheet scene (Fig. 3.6), a terrain
+    /// fly-over (Figs 5.1-5.3), or the peers' VTK camera (issue 9).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover", "peer"])]
+    pub view: String,
+    /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, or raw with --dims and --dtype).
+    #[arg(long, conflicts_with = "terrain")]
+    pub volume: Option<PathBuf>,
+    /// Raw volume dimensions.
+    #[arg(long, value_parser = parse_dims, requires = "volume")]
+    pub dims: Option<[u32; 3]>,
+    /// Raw sample type.
+    #[arg(long, value_parser = ["u8", "u16", "i16", "f32"], requires = "volume")]
+    pub dtype: Option<String>,
+    /// Raw data is big-endian.
+    #[arg(long, requires = "volume")]
+    pub big_endian: bool,
+    /// Voxel spacing (overrides the file's).
+    #[arg(long, value_parser = parse_vec3, requires = "volume")]
+    pub spacing: Option<Vec3>,
+    /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's
+    /// world coordinate along that axis (e.g. irregular CT slices; an axis left out keeps the even
+    /// spacing). Draws the volume as host splats.
+    #[arg(long, requires = "volume")]
+    pub positions: Option<PathBuf>,
+    /// Transfer function: a preset (ramp, ct, bonsai) or a TOML file.
+    #[arg(long, default_value = "ramp")]
+    pub tf: String,
+    /// Phong shading with a headlight, applied to the voxels before splatting.
+    #[arg(long)]
+    pub shade: bool,
+    /// Render a height grid (16-bit PNG, GeoTIFF, or 2D .npy) as voxel columns.
+    #[arg(long)]
+    pub terrain: Option<PathBuf>,
+    /// Colour image for --terrain (default: hypsometric ramp with hillshade).
+    #[arg(long, requires = "terrain")]
+    pub color: Option<PathBuf>,
+    /// Vertical exaggeration for --terrain.
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    pub vscale: f32,
+    /// Horizontal cell size of --terrain, in height units (0: relief a sixth of the width).
+    #[arg(long, value_parser = parse_finite, default_value = "0")]
+    pub cell: f32,
+    /// Visibility order.
+    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
+    pub order: String,
+    /// Run every stage on the CPU mirrors instead of Vulkan.
+    #[arg(long)]
+    pub cpu: bool,
+    /// Enable the Khronos validation layer and report its messages.
+    #[arg(long)]
+    pub validation: bool,
+    /// Split each frame between Vulkan and the CPU mirrors at a stage, to find the stage that
+    /// departs from its mirror: gpu-until:STAGE (the device runs the stages before STAGE, the
+    /// mirrors the rest) or cpu-until:STAGE. Stages: see src/stages.rs.
+    #[arg(long, conflicts_with = "cpu")]
+    pub bisect: Option<voxsplat::Bisect>,
+    /// Classify --volume on the host into a splat set (as before the bricked store): needed by the
+    /// other orders, --truth, --raycast and --k-line, which pick it themselves. Without it a volume is a bricked store classified on the device.
+    #[arg(long)]
+    pub dense: bool,
+    /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
+    /// batches.
+    #[arg(long, default_value = "1024")]
+    pub gpu_budget_mib: u64,
+}
+
+pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
+    let (w, h) = a.size;
+    let view = match a.view.as_str() {
+        "auto" if a.terrain.is_some() || a.scene == "rmnp" => "flyover",
+        "auto" if voxsplat::peer::side_of(&a.scene).is_some() && a.volume.is_none() => "peer",
+        "auto" => "framing",
+        v => v,
+    };
+    let grazing = view == "grazing" || view == "flyover";
+    let mut cam = match view {
+        "grazing" => Camera::grazing(grid, w, h),
+        "flyover" => Camera::flyover(grid, w, h),
+        "peer" => {
+            if w != h {
+                return Err(Error::InvalidArgument("the peer view is square: use --size NxN".into()));
+            }
+            voxsplat::peer::camera(grid.dims[0], w)
+        }
+        _ => Camera::framing(grid, w, h),
+    };
+    let fitted_eye = cam.eye;
+    if let Some(t) = a.target {
+        cam.target = t;
+    }
+    if let Some(e) = a.eye {
+        cam.eye = e;
+    } else if a.target.is_some() {
+        cam.eye = cam.target + (fitted_eye - grid.center());
+    }
+    if !grazing || a.eye.is_some() {
+        cam.up = a.up;
+    }
+    if let Some(fov) = a.fov {
+        cam.projection = Projection::Perspective { fov_y_deg: fov };
+    }
+    if let Some(hgt) = a.ortho {
+        cam.projection = Projection::Orthographic { height: hgt };
+    }
+    // Fit near/far to the scene's bounding sphere seen from this eye unless given.
+    let d = (grid.center() - cam.eye).length();
+    let r = 0.5 * grid.diagonal() + 4.0 * grid.kernel_spacing();
+    let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d.max(1.0)) } else { d - r - 1.0 };
+    cam.near = a.near.unwrap_or(if grazing { cam.near } else { fit_near });
+    cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + r + 1.0 });
+    cam.validate()?;
+    Ok(cam)
+}
+
+pub type VolumeParts =
+    (voxsplat::volume::ScalarVolume, voxsplat::classify::TransferFunction, Option<voxsplat::classify::Shading>);
+
+/// The --tf preset or TOML file.
+pub fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFunction> {
+    load_tf(&a.tf)
+}
+
+/// A transfer-function preset by name, or a TOML file.
+pub fn load_tf(spec: &str) -> Result<voxsplat::classify::TransferFunction> {
+    if spec.ends_with(".toml") {
+        let text = std::fs::read_to_string(spec).map_err(|e| Error::Io { path: spec.to_string(), source: e })?;
+        voxsplat::classify::TransferFunction::from_toml(&text)
+    } else {
+        voxsplat::classify::TransferFunction::preset(spec)
+    }
+}
+
+/// The --dims, --dtype, --big-endian and --spacing hints for the --volume file.
+pub fn volume_hints(a: &SceneArgs) -> Result<voxsplat::loaders::VolumeHints> {
+    Ok(voxsplat::loaders::VolumeHints {
+        dims: a.dims,
+        dtype: a.dtype.as_deref().map(str::parse).transpose()?,
+        big_endian: a.big_endian,
+        spacing: a.spacing.map(|v| v.to_array()),
+    })
+}
+
+/// With --shade, a headlight along the view of a grid of `dims` x `spacing`.
+pub fn headlight(a: &SceneArgs, dims: [u32; 3], spacing: [f32; 3]) -> Option<voxsplat::classify::Shading> {
+    a.shade.then(|| {
+        let g = voxsplat::Grid::centered(dims, spacing).ok();
+        let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
+        voxsplat::classify::Shading::headlight(-dir)
+    })
+}
+
+/// The --volume file, its transfer function and shading.
+pub fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumeParts> {
+    let vol = voxsplat::loaders::load_volume(path, &volume_hints(a)?)?;
+    let tf = transfer_function(a)?;
+    let shading = headlight(a, vol.dims, vol.spacing);
+    Ok((vol, tf, shading))
+}
+
+/// The --volume file as a bricked scene, with a one-line report of the store.
+pub fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::bricks::BrickScene> {
+    let store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
+    let tf = transfer_function(a)?;
+    let shading = headlight(a, store.dims, store.spacing);
+    eprintln!(
+        "{} stored voxels in {} bricks of {}^3, {:.2} bytes per stored voxel on the GPU ({} x {} x {} grid)",
+        store.len(),
+        store.headers.len(),
+        voxsplat::bricks::BRICK,
+        store.bytes() as f64 / store.len().max(1) as f64,
+        store.dims[0],
+        store.dims[1],
+        store.dims[2]
+    );
+    voxsplat::bricks::BrickScene::new(store, tf, shading)
+}
+
+/// The splats named by --volume, --terrain or --scene, with a one-line report of what was loaded.
+pub fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
+    let set = if let Some(path) = &a.volume {
+        let (vol, tf, shading) = load_volume_parts(a, path)?;
+        let set = voxsplat::classify::classify(&vol, &tf, shading)?;
+        match &a.positions {
+            Some(p) => {
+                let coords = voxsplat::loaders::load_positions(p, set.grid())?;
+                set.with_coordinates(coords)?
+            }
+            None => set,
+        }
+    } else if let Some(path) = &a.terrain {
+        // (clap drops `requires = "volume"` when --terrain, which conflicts with it, is given.)
+        if a.dims.is_some() || a.dtype.is_some() || a.big_endian || a.spacing.is_some() {
+            return Err(Error::InvalidArgument(
+                "--dims, --dtype, --big-endian and --spacing describe --volume files, not --terrain".into(),
+            ));
+        }
+        let heights = voxsplat::loaders::load_heights(path)?;
+        let color = match &a.color {
+            Some(c) => Some(voxsplat::output::read_rgba8(c)?),
+            None => None,
+        };
+        let opts = voxsplat::terrain::TerrainOptions { cell: a.cell, vscale: a.vscale, color, ..Default::default() };
+        voxsplat::terrain::terrain_splats(&heights, &opts)?
+    } else {
+        scene::build(&a.scene)?
+    };
+    eprintln!(
+        "{} splats, {:.0} bytes per splat on the GPU ({} x {} x {} grid)",
+        set.len(),
+        voxsplat::gpu_bytes_per_splat(&set),
+        set.grid().dims[0],
+        set.grid().dims[1],
+        set.grid().dims[2]
+    );
+    Ok(set)
+}
+
+/// `mib` MiB in bytes: positive, and without wrapping past u64.
+pub fn mib_bytes(mib: u64, flag: &str) -> Result<u64> {
+    match mib.checked_mul(1 << 20) {
+        Some(b) if b > 0 => Ok(b),
+        Some(_) => Err(Error::InvalidArgument(format!("{flag} must be positive"))),
+        None => {
+            Err(Error::InvalidArgument(format!("{flag} {mib} overflows a byte count (at most {} MiB)", u64::MAX >> 20)))
+        }
+    }
+}
+
+pub fn renderer_of(a: &SceneArgs) -> Result<Renderer> {
+    let mut opts = RendererOptions::default();
+    opts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
+    opts.validation = a.validation;
+    opts.gpu_budget_bytes = mib_bytes(a.gpu_budget_mib, "--gpu-budget-mib")?;
+    let mut r = Renderer::new(&opts)?;
+    r.set_bisect(a.bisect)?;
+    Ok(r)
+}
+
+pub fn report_validation(r: &Renderer) -> Result<()> {
+    let n = r.validation_count();
+    if n > 0 {
+        for m in r.validation_messages() {
+            eprintln!("validation: {m}");
+        }
+        return Err(Error::Unsupported(format!("{n} validation message(s)")));
+    }
+    Ok(())
+}
+
+/// The scene `a` names: a --volume as a bricked store classified on the device unless
+/// `host_splats` (a mode that needs host splats), else host splats; with the grid's splat set
+/// (empty for a bricked store) for cameras and orders.
+pub fn open(a: &SceneArgs, host_splats: bool) -> Result<(Option<voxsplat::bricks::BrickScene>, voxsplat::SplatSet)> {
+    let bricked = match &a.volume {
+        Some(path) if !host_splats && !a.dense && a.positions.is_none() => Some(load_bricked(a, path)?),
+        _ => None,
+    };
+    let set = match &bricked {
+        Some(b) => voxsplat::SplatSet::empty(voxsplat::Grid::centered(b.store.dims, b.store.spacing)?)?,
+        None => load_scene(a)?,
+    };
+    Ok((bricked, set))
+}
