@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs what voxsplat needs on Debian 12 beyond Rust: lavapipe (Mesa's CPU Vulkan driver), the
 # Vulkan loader, the Khronos validation layers, and the static shaderc/glslang/SPIRV-Tools libraries
-# that build.rs links through .cargo/config.toml. Idempotent: does nothing when all are present.
+# that build.rs links through .cargo/config.toml; Xvfb and the X libraries winit opens, for the
+# windowed viewer's headless test (examples/viewer.rs). Idempotent: does nothing when all are present.
 set -euo pipefail
-pkgs=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools)
+pkgs=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools
+  xvfb xauth libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -6,10 +6,10 @@ use crate::error::{Error, Result};
 use crate::volume::ScalarVolume;
 use crate::volume::{Grid, SplatSet};
 use glam::Vec3;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Piecewise-linear colour and opacity over density normalised to [0, 1].
-#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransferFunction {
     /// (density in [0, 1], [r, g, b, opacity]) control points, in increasing density.
@@ -65,6 +65,11 @@ impl TransferFunction {
         let tf: Self = toml::from_str(text).map_err(|e| Error::InvalidArgument(format!("transfer function: {e}")))?;
         tf.validate()?;
         Ok(tf)
+    }
+
+    /// The TOML `from_toml` reads back (to save an edited transfer function).
+    pub fn to_toml(&self) -> Result<String> {
+        toml::to_string(self).map_err(|e| Error::InvalidArgument(format!("transfer function: {e}")))
     }
 
     /// Reject transfer functions no classification can use.
@@ -216,4 +221,18 @@ pub fn classify_field(
         }
         (c[3] > 0.0).then_some(c)
     })
+}
+
+#[cfg(test)]
+mod toml_tests {
+    use super::TransferFunction;
+
+    #[test]
+    fn a_transfer_function_survives_toml() {
+        let mut tf = TransferFunction::preset("ct").unwrap();
+        assert_eq!(TransferFunction::from_toml(&tf.to_toml().unwrap()).unwrap(), tf);
+        tf.range = Some((20.0, 300.5));
+        tf.gradient_weight = 0.5;
+        assert_eq!(TransferFunction::from_toml(&tf.to_toml().unwrap()).unwrap(), tf);
+    }
 }

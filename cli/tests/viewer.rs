@@ -1,0 +1,90 @@
+//! The embedding path end to end (issue 27 item 4): the windowed viewer (examples/viewer.rs) runs
+//! under Xvfb on lavapipe with the validation layer, owning its device and swapchain, for a scripted
+//! orbit and transfer-function edit; the frame it reads back from the swapchain image must match
+//! `voxsplat render` with the same camera and transfer function within 1/255.
+mod cmd;
+use cmd::{tmp_in, voxsplat};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The viewer beside the `voxsplat` binary (built by `cargo test`; built here when a single test
+/// target was asked for).
+fn viewer() -> PathBuf {
+    let bin = PathBuf::from(env!("CARGO_BIN_EXE_voxsplat"));
+    let dir = bin.parent().expect("target dir");
+    let path = dir.join("examples").join("viewer");
+    if !path.exists() {
+        let mut build = Command::new(env!("CARGO"));
+        build.args(["build", "-p", "voxsplat-cli", "--example", "viewer"]);
+        if dir.ends_with("release") {
+            build.arg("--release");
+        }
+        assert!(build.status().expect("cargo").success(), "building the viewer");
+    }
+    path
+}
+
+fn rgba(path: &Path) -> image::RgbaImage {
+    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
+}
+
+#[test]
+fn the_viewer_under_xvfb_shows_what_render_draws() {
+    let volume = "../../shared/data/stent/stent.nrrd";
+    let volume = Path::new(env!("CARGO_MANIFEST_DIR")).join(volume);
+    assert!(volume.exists(), "{} (../shared/data beside the clone)", volume.display());
+    let volume = volume.to_str().unwrap();
+    for (tag, extra) in [("srgb", None), ("unorm", Some("--unorm"))] {
+        let (shot, tf, reference) = (
+            tmp_in("viewer", &format!("{tag}.png")),
+            tmp_in("viewer", &format!("{tag}.toml")),
+            tmp_in("viewer", &format!("{tag}-ref.png")),
+        );
+        let mut run = Command::new("xvfb-run");
+        run.args(["-a", "-s", "-screen 0 640x480x24"]).arg(viewer());
+        run.args(["--volume", volume, "--tf", "ct", "--size", "192x160", "--frames", "6", "--orbit", "120"]);
+        run.args(["--tf-range", "100,1500", "--opacity", "0.8", "--validation"]);
+        run.arg("--screenshot").arg(&shot).arg("--save-tf").arg(&tf);
+        run.args(extra);
+        let out = run.output().expect("xvfb-run (scripts/setup.sh installs xvfb)");
+        let log = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{tag}: the viewer failed:\n{log}");
+        assert!(String::from_utf8_lossy(&out.stdout).contains("6 frames"), "{tag}: {log}");
+        let out = voxsplat(&[
+            "render",
+            "--volume",
+            volume,
+            "--tf",
+            tf.to_str().unwrap(),
+            "--size",
+            "192x160",
+            "--background",
+            "0,0,0",
+            "--validation",
+            "--out",
+            reference.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let (a, b) = (rgba(&shot), rgba(&reference));
+        assert_eq!(a.dimensions(), b.dimensions(), "{tag}");
+        let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+        let lit = b.pixels().filter(|p| p[0] as u32 + p[1] as u32 + p[2] as u32 > 30).count();
+        assert!(lit > 1000, "{tag}: the reference shows the stent ({lit} pixels lit)");
+        assert!(worst <= 1, "{tag}: the screenshot differs from render by {worst}/255");
+        // The edit took: the saved transfer function has the scripted window.
+        assert!(std::fs::read_to_string(&tf).unwrap().contains("range = [100.0, 1500.0]"), "{tag}");
+    }
+}
+
+#[test]
+fn the_viewer_refuses_what_render_refuses() {
+    let out = Command::new("xvfb-run")
+        .args(["-a"])
+        .arg(viewer())
+        .args(["--volume", "/nonexistent.nrrd", "--frames", "1"])
+        .output()
+        .expect("xvfb-run");
+    assert!(!out.status.success());
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(log.contains("viewer:") && log.contains("nonexistent"), "{log}");
+}
