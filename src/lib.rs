@@ -294,7 +294,8 @@ impl Renderer {
     /// waits on the target's wait semaphores before it writes the image, converts it to the image's
     /// format (over `options.background`, sRGB encoded where the format says so: the bytes a PNG
     /// of `render` holds), leaves it in the target's new layout and signals the target's signal
-    /// semaphores. It returns when the frame is complete (docs/EMBEDDING.md).
+    /// semaphores. It returns when the frame is complete (docs/EMBEDDING.md). A `render_scale`
+    /// below 1 draws the coarser grid and stretches it in the blit (linear filter).
     pub fn render_to(
         &mut self,
         camera: &Camera,
@@ -312,18 +313,20 @@ impl Renderer {
                 target.size().1
             )));
         }
-        if options.render_scale != 1.0 {
-            return Err(Error::Unsupported("render_to draws at the target's size: render_scale needs render()".into()));
-        }
         if self.bisect.is_some() {
             return Err(Error::Unsupported("render_to with a bisect split: use render()".into()));
         }
-        let (opts, choice) = self.choose(camera, options)?;
+        // Below scale 1 the frame is drawn on the coarser grid and the blit stretches it.
+        let scaled = options.render_scale != 1.0;
+        let low = resample::scaled_camera(camera, options.render_scale)?;
+        let mut full = options.clone();
+        full.render_scale = 1.0;
+        let (opts, choice) = self.choose(&low, &full)?;
         let prep =
             self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
         let gpu = self.gpu.as_mut().ok_or_else(|| Error::Unsupported("render_to needs the GPU backend".into()))?;
-        gpu.context().check_target(target.format())?;
-        let recorded = record_frame(&mut gpu.engine_to(prep, target), prep, camera, &opts)?;
+        gpu.context().check_target(target.format(), scaled)?;
+        let recorded = record_frame(&mut gpu.engine_to(prep, target), prep, &low, &opts)?;
         Ok(Delivered { timings: recorded.timings, raster: choice })
     }
 

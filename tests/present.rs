@@ -180,13 +180,42 @@ fn bad_targets_are_refused_with_typed_errors() {
     let image = g.target_image(TargetFormat::Rgba8Unorm, 64, 48).unwrap();
     let target = image.target(IL::UNDEFINED, IL::GENERAL).unwrap();
     let mut scaled = RenderOptions::default();
-    scaled.render_scale = 0.5;
-    assert!(g.render_to(&cam, &scaled, &target).is_err(), "render_scale needs render()");
+    scaled.render_scale = 0.01;
+    assert!(g.render_to(&cam, &scaled, &target).is_err(), "a render scale below the least");
     let mut bad = RenderOptions::default();
     bad.background = Some([2.0, 0.0, 0.0, 1.0]);
     assert!(g.render(&cam, &bad).unwrap_err().to_string().contains("background"));
     let mut c = common::cpu();
     c.set_scene(set).unwrap();
     assert!(c.target_image(TargetFormat::Rgba8Unorm, 8, 8).is_err(), "no device, no target");
+    assert_clean(&g);
+}
+
+#[test]
+fn a_render_scale_is_stretched_by_the_blit_as_render_resamples_it() {
+    let set = scene::build("cube60").unwrap();
+    let mut g = common::gpu();
+    g.set_scene(set.clone()).unwrap();
+    // 128 x 96 at 0.5: a 64 x 48 grid that covers the view exactly; 100 x 70 at 0.5: 35 rows and
+    // 50 columns (the blit's whole-pixel region is exact there too); 90 x 70: 45.0 -> 45 columns.
+    for (w, h) in [(128u32, 96u32), (100, 70), (90, 70)] {
+        let cam = Camera::framing(set.grid(), w, h);
+        let mut o = options(Composite::Splat, Raster::Compute, Some([0.0, 0.0, 0.0, 1.0]));
+        o.render_scale = 0.5;
+        let image = g.target_image(TargetFormat::Rgba8Unorm, w, h).unwrap();
+        let target = image.target(IL::UNDEFINED, IL::GENERAL).unwrap();
+        let d = g.render_to(&cam, &o, &target).unwrap();
+        assert_eq!(d.raster.raster, Raster::Compute);
+        let got = decode(TargetFormat::Rgba8Unorm, &g.read_target(&target).unwrap()).unwrap();
+        let want = g.render(&cam, &o).unwrap().image;
+        let errs: Vec<f32> =
+            got.iter().zip(&want.pixels).flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs())).collect();
+        let worst = errs.iter().copied().fold(0.0, f32::max);
+        let mean = errs.iter().sum::<f32>() / errs.len() as f32;
+        // The blit's linear filter is the host's bilinear resampling: one 8-bit rounding apart.
+        assert!(worst <= 1.0 / 255.0 + 1e-6 && mean <= 0.5 / 255.0, "{w}x{h}: worst {worst}, mean {mean}");
+        let lit = got.iter().filter(|p| p[0] + p[1] + p[2] > 0.05).count();
+        assert!(lit > (w * h / 8) as usize, "{w}x{h}: {lit} lit");
+    }
     assert_clean(&g);
 }

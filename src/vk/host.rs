@@ -177,8 +177,10 @@ fn host_barrier(rec: &Recorder<'_>, image: vk::Image, layouts: (vk::ImageLayout,
 }
 
 impl Recorder<'_> {
-    /// Blit `src` (in TRANSFER_SRC_OPTIMAL, the target's size) into the host's image, which the
-    /// blit converts to its format (sRGB encoding included), leaving it in its new layout.
+    /// Blit `src` (in TRANSFER_SRC_OPTIMAL) into the host's image, which the blit converts to its
+    /// format (sRGB encoding included), leaving it in its new layout. A smaller `src` (a render
+    /// scale: `resample::scaled_camera`'s grid, as tall as the view and centred) is stretched
+    /// with the linear filter over the columns the view covers, rounded to whole pixels.
     pub fn blit_to_host(&self, src: &Image, to: &HostTarget) {
         host_barrier(self, to.image, (to.old_layout, vk::ImageLayout::TRANSFER_DST_OPTIMAL));
         let layers = vk::ImageSubresourceLayers {
@@ -188,11 +190,18 @@ impl Recorder<'_> {
             layer_count: 1,
         };
         let corner = vk::Offset3D { x: to.width as i32, y: to.height as i32, z: 1 };
+        let same = (src.width, src.height) == (to.width, to.height);
+        let span = ((to.width as f64 * src.height as f64 / to.height as f64).round() as i32).clamp(1, src.width as i32);
+        let x0 = (src.width as i32 - span) / 2;
         let region = [vk::ImageBlit::default()
             .src_subresource(layers)
-            .src_offsets([vk::Offset3D::default(), corner])
+            .src_offsets([
+                vk::Offset3D { x: x0, y: 0, z: 0 },
+                vk::Offset3D { x: x0 + span, y: src.height as i32, z: 1 },
+            ])
             .dst_subresource(layers)
             .dst_offsets([vk::Offset3D::default(), corner])];
+        let filter = if same { vk::Filter::NEAREST } else { vk::Filter::LINEAR };
         // SAFETY: both images alive for the submission and in the layouts named.
         unsafe {
             self.ctx.device.cmd_blit_image(
@@ -202,7 +211,7 @@ impl Recorder<'_> {
                 to.image,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 &region,
-                vk::Filter::NEAREST,
+                filter,
             )
         };
         host_barrier(self, to.image, (vk::ImageLayout::TRANSFER_DST_OPTIMAL, to.new_layout));
@@ -210,22 +219,27 @@ impl Recorder<'_> {
 }
 
 impl Context {
-    /// Whether frames can be blitted from RGBA32F into images of `format`: refused with a typed error
-    /// when the device lacks the format's blit features.
-    pub fn check_target(&self, format: TargetFormat) -> Result<()> {
+    /// Whether frames can be blitted from RGBA32F into images of `format` (`scaled`: with the linear
+    /// filter): refused with a typed error when the device lacks the formats' features.
+    pub fn check_target(&self, format: TargetFormat, scaled: bool) -> Result<()> {
         let feature = |f: vk::Format| {
             // SAFETY: plain query on a valid physical device.
             unsafe { self.instance.get_physical_device_format_properties(self.physical, f) }.optimal_tiling_features
         };
-        let src = feature(vk::Format::R32G32B32A32_SFLOAT).contains(vk::FormatFeatureFlags::BLIT_SRC);
+        let mut needs = vk::FormatFeatureFlags::BLIT_SRC;
+        if scaled {
+            needs |= vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR;
+        }
+        let src = feature(vk::Format::R32G32B32A32_SFLOAT).contains(needs);
         let dst = feature(vk_format(format)).contains(vk::FormatFeatureFlags::BLIT_DST);
         if src && dst {
             Ok(())
         } else {
             Err(Error::Unsupported(format!(
-                "{} cannot blit RGBA32F into {:?} images (BLIT_SRC {src}, BLIT_DST {dst})",
+                "{} cannot blit RGBA32F into {:?} images (BLIT_SRC{} {src}, BLIT_DST {dst})",
                 self.device_name(),
-                vk_format(format)
+                vk_format(format),
+                if scaled { " with linear filtering" } else { "" }
             )))
         }
     }
