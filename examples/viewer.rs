@@ -7,8 +7,9 @@
 //! Mouse: left drag orbits, wheel zooms, middle drag (or ctrl + left) pans, right drag edits the
 //! transfer function's window (x: level, y: width), shift + left drag moves the clip plane.
 //! Keys: o order, c compositing, r raster, l levels of detail, [ ] opacity, p clip plane through the
-//! centre facing the eye, s save `viewer.png` and `viewer-tf.toml` and print the matching `render`
-//! command, q or Esc quit. The title shows the frame time and the modes.
+//! centre facing the eye, s save `viewer-tf.toml` and print the matching `render` command, q or Esc
+//! quit. The title shows the frame time and the modes. While a button is held, frames are drawn at
+//! `--interactive-scale` (0.5 by default) and stretched on the device; full size when let go.
 //!
 //! Headless runs (CI, under Xvfb): `--frames N` draws N frames of a scripted orbit ending at the
 //! command line's camera, applies `--tf-range` and `--opacity` halfway (the transfer-function
@@ -64,6 +65,16 @@ struct Args {
     raster: String,
     #[arg(long, default_value = "off", value_parser = ["off", "auto"])]
     lod: String,
+    /// The reconstruction kernel (as `render --kernel`).
+    #[arg(long, default_value = "gaussian")]
+    kernel: String,
+    /// Draw on a grid this fraction of the window's size, stretched by the device's blit.
+    #[arg(long, default_value = "1")]
+    render_scale: f32,
+    /// While a mouse button is held (orbit, pan, window/level, clip), draw at this scale at most:
+    /// interactive frames at a fraction of the cost, full detail when the mouse is let go. 1: off.
+    #[arg(long, default_value = "0.5")]
+    interactive_scale: f32,
     /// Swapchain present mode: fifo (vsync) or immediate/mailbox when the surface has them.
     #[arg(long, default_value = "fifo", value_parser = ["fifo", "mailbox", "immediate"])]
     present: String,
@@ -395,6 +406,10 @@ impl Viewer {
         options.raster = args.raster.parse::<Raster>()?;
         options.lod = args.lod.parse::<Lod>()?;
         options.order = args.scene.order.parse::<OrderKind>()?;
+        options.render_scale = args.render_scale;
+        options.kernel = args.kernel.parse()?;
+        voxsplat::resample::check_scale(args.interactive_scale)?;
+        options.validate()?;
         let indices = [
             ORDERS.iter().position(|o| *o == args.scene.order).unwrap_or(0),
             COMPOSITES.iter().position(|c| *c == args.composite).unwrap_or(0),
@@ -555,17 +570,22 @@ impl Viewer {
             )
         }?;
         let renderer = self.renderer.as_mut().expect("started");
+        let mut options = self.options.clone();
+        if self.buttons.iter().any(|&b| b) {
+            options.render_scale = options.render_scale.min(self.args.interactive_scale);
+        }
         let t = Instant::now();
-        let mut result = renderer.render_to(&cam, &self.options, &target);
+        let mut result = renderer.render_to(&cam, &options, &target);
         if let Err(e) = &result {
             // A mode this scene cannot draw: say so, go back to the defaults, and still fill the image
             // the acquire handed over (its semaphore must be waited on).
             self.message = e.to_string();
             let mut fallback = RenderOptions::default();
-            (fallback.background, fallback.clip) = (self.options.background, self.options.clip);
+            (fallback.background, fallback.clip, fallback.render_scale) =
+                (self.options.background, self.options.clip, self.options.render_scale);
             self.options = fallback;
             self.indices = [0; 3];
-            result = renderer.render_to(&cam, &self.options, &target);
+            result = renderer.render_to(&cam, &fallback_or(&self.options, options.render_scale), &target);
         }
         result?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
@@ -711,6 +731,13 @@ impl Viewer {
         }
         Ok(())
     }
+}
+
+/// `options` at `scale`.
+fn fallback_or(options: &RenderOptions, scale: f32) -> RenderOptions {
+    let mut o = options.clone();
+    o.render_scale = scale;
+    o
 }
 
 /// A PNG of a swapchain image's texels: its bytes are already the display values (sRGB formats
