@@ -35,6 +35,8 @@ mod gpu;
 #[doc(hidden)]
 pub mod gpu_types;
 pub mod image;
+#[doc = include_str!("../docs/EMBEDDING.md")]
+pub mod embedding {}
 pub mod kernel;
 #[cfg(feature = "io")]
 pub mod loaders;
