@@ -50,6 +50,9 @@ struct Args {
     /// Scripted edit: opacity scale.
     #[arg(long, default_value = "1")]
     opacity: f32,
+    /// Scripted key presses, one per frame from the first (e.g. "crlp"): the keyboard's path.
+    #[arg(long, default_value = "")]
+    keys: String,
     /// Save the last frame, read back from the swapchain image, as a PNG.
     #[arg(long)]
     screenshot: Option<PathBuf>,
@@ -495,6 +498,10 @@ impl Viewer {
 
     /// The scripted run: orbit to the command line's camera; the transfer-function edit halfway.
     fn script(&mut self) -> Result<()> {
+        if let Some(key) = self.args.keys.chars().nth(self.frame as usize) {
+            self.press(&key.to_string())?;
+            eprintln!("frame {}: key {key} {}", self.frame, self.message);
+        }
         let Some(n) = self.args.frames else { return Ok(()) };
         let left = n.saturating_sub(self.frame + 1) as f32 / n.max(1) as f32;
         self.view.yaw = (self.args.orbit * left).to_radians();
@@ -580,6 +587,7 @@ impl Viewer {
             // A mode this scene cannot draw: say so, go back to the defaults, and still fill the image
             // the acquire handed over (its semaphore must be waited on).
             self.message = e.to_string();
+            eprintln!("frame {}: {}; back to the default modes", self.frame, self.message);
             let mut fallback = RenderOptions::default();
             (fallback.background, fallback.clip, fallback.render_scale) =
                 (self.options.background, self.options.clip, self.options.render_scale);
@@ -628,36 +636,42 @@ impl Viewer {
     }
 
     fn key(&mut self, key: &Key, event_loop: &ActiveEventLoop) -> Result<()> {
-        self.message.clear();
         match key {
             Key::Named(NamedKey::Escape) => event_loop.exit(),
-            Key::Character(c) => match c.as_str() {
-                "q" => event_loop.exit(),
-                "o" => {
-                    self.indices[0] = (self.indices[0] + 1) % ORDERS.len();
-                    self.options.order = ORDERS[self.indices[0]].parse()?;
-                }
-                "c" => {
-                    self.indices[1] = (self.indices[1] + 1) % COMPOSITES.len();
-                    self.options.composite = COMPOSITES[self.indices[1]].parse()?;
-                }
-                "r" => {
-                    self.indices[2] = (self.indices[2] + 1) % RASTERS.len();
-                    self.options.raster = RASTERS[self.indices[2]].parse()?;
-                }
-                "l" => self.options.lod = if self.options.lod == Lod::Off { Lod::Auto } else { Lod::Off },
-                "[" => self.edit_tf(None, 0.8)?,
-                "]" => self.edit_tf(None, 1.25)?,
-                "p" => {
-                    self.clip_offset = match self.clip_offset {
-                        Some(_) => None,
-                        None => self.camera().map(|c| (c.forward(), 0.0)),
-                    };
-                    self.update_clip()?;
-                }
-                "s" => self.save()?,
-                _ => {}
-            },
+            Key::Character(c) if c.as_str() == "q" => event_loop.exit(),
+            Key::Character(c) => self.press(c.as_str())?,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// What a key does (besides quitting).
+    fn press(&mut self, key: &str) -> Result<()> {
+        self.message.clear();
+        match key {
+            "o" => {
+                self.indices[0] = (self.indices[0] + 1) % ORDERS.len();
+                self.options.order = ORDERS[self.indices[0]].parse()?;
+            }
+            "c" => {
+                self.indices[1] = (self.indices[1] + 1) % COMPOSITES.len();
+                self.options.composite = COMPOSITES[self.indices[1]].parse()?;
+            }
+            "r" => {
+                self.indices[2] = (self.indices[2] + 1) % RASTERS.len();
+                self.options.raster = RASTERS[self.indices[2]].parse()?;
+            }
+            "l" => self.options.lod = if self.options.lod == Lod::Off { Lod::Auto } else { Lod::Off },
+            "[" => self.edit_tf(None, 0.8)?,
+            "]" => self.edit_tf(None, 1.25)?,
+            "p" => {
+                self.clip_offset = match self.clip_offset {
+                    Some(_) => None,
+                    None => self.camera().map(|c| (c.forward(), 0.0)),
+                };
+                self.update_clip()?;
+            }
+            "s" => self.save()?,
             _ => {}
         }
         Ok(())

@@ -113,6 +113,19 @@ fn a_background_goes_through_present_on_both_engines_and_keeps_the_png_bytes() {
     assert_clean(&g);
 }
 
+/// A 64 x 64 RGBA8 target of voxsplat's `image`, with raw semaphores, as a host would pass them.
+fn rgba8_target(
+    image: &voxsplat::vk::TargetImage,
+    layouts: (IL, IL),
+    wait: &[voxsplat::vk::ash::vk::Semaphore],
+    signal: &[voxsplat::vk::ash::vk::Semaphore],
+) -> voxsplat::vk::HostTarget {
+    let format = voxsplat::vk::vk_format(TargetFormat::Rgba8Unorm);
+    // SAFETY: the image and semaphores are voxsplat's and outlive every frame that uses them; each
+    // wait semaphore was signalled by the frame before.
+    unsafe { voxsplat::vk::HostTarget::new(image.raw(), format, (64, 64), layouts, wait, signal) }.unwrap()
+}
+
 #[test]
 fn semaphores_order_frames_into_one_image() {
     let set = scene::build("cube60").unwrap();
@@ -129,35 +142,12 @@ fn semaphores_order_frames_into_one_image() {
         let (wait, signal) = if f % 2 == 0 { (&b, &a) } else { (&a, &b) };
         let waits: Vec<_> = if f == 0 { vec![] } else { vec![wait.raw()] };
         let old = if f == 0 { IL::UNDEFINED } else { IL::GENERAL };
-        let raw = image.raw();
-        // SAFETY: the image and semaphores are voxsplat's, alive for the whole loop; each wait
-        // semaphore was signalled by the frame before.
-        let target = unsafe {
-            voxsplat::vk::HostTarget::new(
-                raw,
-                voxsplat::vk::vk_format(TargetFormat::Rgba8Unorm),
-                (64, 64),
-                (old, IL::GENERAL),
-                &waits,
-                &[signal.raw()],
-            )
-        }
-        .unwrap();
+        let target = rgba8_target(&image, (old, IL::GENERAL), &waits, &[signal.raw()]);
         g.render_to(&Camera { eye: cam.eye + glam::Vec3::new(f as f32, 0.0, 0.0), ..cam }, &o, &target).unwrap();
         last = g.read_target(&target).unwrap();
     }
     // The fourth frame signalled `b` with nobody waiting; a last frame waits on it so nothing dangles.
-    let target = unsafe {
-        voxsplat::vk::HostTarget::new(
-            image.raw(),
-            voxsplat::vk::vk_format(TargetFormat::Rgba8Unorm),
-            (64, 64),
-            (IL::GENERAL, IL::GENERAL),
-            &[b.raw()],
-            &[],
-        )
-    }
-    .unwrap();
+    let target = rgba8_target(&image, (IL::GENERAL, IL::GENERAL), &[b.raw()], &[]);
     let moved = Camera { eye: cam.eye + glam::Vec3::new(3.0, 0.0, 0.0), ..cam };
     g.render_to(&moved, &o, &target).unwrap();
     assert_eq!(g.read_target(&target).unwrap(), last, "the same camera gives the same bytes");

@@ -88,3 +88,29 @@ fn the_viewer_refuses_what_render_refuses() {
     let log = String::from_utf8_lossy(&out.stderr);
     assert!(log.contains("viewer:") && log.contains("nonexistent"), "{log}");
 }
+
+/// The keyboard's path, scripted: every mode key on a dense scene and on a bricked volume (where
+/// the other orders are refused and the viewer falls back to the defaults), validation clean.
+#[test]
+fn every_key_draws_validation_clean() {
+    let stent = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/stent/stent.nrrd");
+    for (scene, keys) in [
+        (vec!["--scene", "cube40"], "ocrlp[]rrcoooo"),
+        (vec!["--volume", stent.to_str().unwrap(), "--tf", "ct"], "lpr[oc"),
+    ] {
+        let frames = (keys.len() + 1).to_string();
+        let out = Command::new("xvfb-run")
+            .args(["-a"])
+            .arg(viewer())
+            .args(&scene)
+            .args(["--size", "96x80", "--frames", &frames, "--keys", keys, "--validation"])
+            .output()
+            .expect("xvfb-run");
+        let log = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{scene:?}: {log}");
+        assert_eq!(log.matches(": key ").count(), keys.len(), "{scene:?}: {log}");
+        if scene[0] == "--volume" {
+            assert!(log.contains("back to the default modes"), "the bricked volume refuses WBTF: {log}");
+        }
+    }
+}

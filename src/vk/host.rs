@@ -252,16 +252,7 @@ impl Context {
         self.submit(|rec| {
             let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
             host_barrier(rec, target.image, (target.new_layout, src));
-            let region = [vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D { width: target.width, height: target.height, depth: 1 })];
-            // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer holds every texel.
-            unsafe { rec.ctx.device.cmd_copy_image_to_buffer(rec.cmd, target.image, src, back.raw, &region) };
+            rec.copy_raw_to_buffer(target.image, (target.width, target.height), src, &back);
             host_barrier(rec, target.image, (src, target.new_layout));
             Ok(())
         })?;

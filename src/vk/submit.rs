@@ -129,6 +129,17 @@ impl Recorder<'_> {
 
     /// Copy layer 0 of `image` (in `layout`) to `buffer`.
     pub fn copy_image_to_buffer(&self, image: &Image, layout: vk::ImageLayout, buffer: &Buffer) {
+        self.copy_raw_to_buffer(image.raw, (image.width, image.height), layout, buffer);
+    }
+
+    /// Copy layer 0 of a `width` x `height` image (ours or a host's, in `layout`) to `buffer`.
+    pub(super) fn copy_raw_to_buffer(
+        &self,
+        image: vk::Image,
+        (width, height): (u32, u32),
+        layout: vk::ImageLayout,
+        buffer: &Buffer,
+    ) {
         let region = [vk::BufferImageCopy::default()
             .image_subresource(vk::ImageSubresourceLayers {
                 aspect_mask: vk::ImageAspectFlags::COLOR,
@@ -136,9 +147,9 @@ impl Recorder<'_> {
                 base_array_layer: 0,
                 layer_count: 1,
             })
-            .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 })];
+            .image_extent(vk::Extent3D { width, height, depth: 1 })];
         // SAFETY: image in `layout` (GENERAL or TRANSFER_SRC); buffer large enough (checked by caller).
-        unsafe { self.ctx.device.cmd_copy_image_to_buffer(self.cmd, image.raw, layout, buffer.raw, &region) };
+        unsafe { self.ctx.device.cmd_copy_image_to_buffer(self.cmd, image, layout, buffer.raw, &region) };
     }
 
     fn bind(&self, pipeline: &Pipeline, layout: &Layout, set: &DescriptorSet, push: &[u8]) {
