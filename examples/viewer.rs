@@ -26,7 +26,7 @@ use voxsplat::glam::{Quat, Vec3, Vec4};
 use voxsplat::vk::ash::{self, vk};
 use voxsplat::vk::{Context, HostHandles, HostTarget, Semaphore};
 use voxsplat::{Camera, Clip, Composite, Error, Lod, OrderKind, Raster, RenderOptions, Renderer, Result};
-use voxsplat_cli::open::{camera_of, open, parse_background, transfer_function, SceneArgs};
+use voxsplat_cli::open::{camera_of, open, parse_background, SceneArgs};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -460,7 +460,7 @@ impl Viewer {
         match bricked {
             Some(b) => {
                 self.raw_range = b.store.range;
-                self.tf = Some(transfer_function(&self.args.scene)?);
+                self.tf = Some(b.transfer_function().clone());
                 renderer.set_bricks(b)?;
             }
             None => renderer.set_scene(set)?,

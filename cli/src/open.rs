@@ -165,6 +165,10 @@ pub struct SceneArgs {
     /// other orders, --truth, --raycast and --k-line, which pick it themselves. Without it a volume is a bricked store classified on the device.
     #[arg(long)]
     pub dense: bool,
+    /// Draw the peers' scene (--scene peer128 or peer256) as a bricked store classified on the
+    /// device, as a --volume is, with the peers' transfer function (levels of detail need it).
+    #[arg(long, conflicts_with_all = ["volume", "terrain", "dense"])]
+    pub bricked: bool,
     /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
     /// batches.
     #[arg(long, default_value = "1024")]
@@ -358,8 +362,20 @@ pub fn report_validation(r: &Renderer) -> Result<()> {
 /// `host_splats` (a mode that needs host splats), else host splats; with the grid's splat set
 /// (empty for a bricked store) for cameras and orders.
 pub fn open(a: &SceneArgs, host_splats: bool) -> Result<(Option<voxsplat::bricks::BrickScene>, voxsplat::SplatSet)> {
-    let bricked = match &a.volume {
-        Some(path) if !host_splats && !a.dense && a.positions.is_none() => Some(load_bricked(a, path)?),
+    let peer = voxsplat::peer::side_of(&a.scene).filter(|_| a.volume.is_none() && a.terrain.is_none());
+    if a.bricked && (peer.is_none() || host_splats) {
+        return Err(Error::InvalidArgument(
+            "--bricked draws --scene peer128 or peer256 per splat in PBTF order, without --truth, --raycast or --k-line"
+                .into(),
+        ));
+    }
+    let bricked = match (&a.volume, peer) {
+        (Some(path), _) if !host_splats && !a.dense && a.positions.is_none() => Some(load_bricked(a, path)?),
+        (None, Some(n)) if a.bricked => {
+            let store = voxsplat::bricks::BrickStore::build(&voxsplat::peer::volume(n)?)?;
+            eprintln!("{} stored voxels in {} bricks", store.len(), store.headers.len());
+            Some(voxsplat::bricks::BrickScene::new(store, voxsplat::peer::transfer_function(), None)?)
+        }
         _ => None,
     };
     let set = match &bricked {

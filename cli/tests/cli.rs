@@ -611,3 +611,28 @@ fn a_background_fills_the_frame() {
         assert_eq!(o.status.code(), Some(2), "{bad}");
     }
 }
+
+/// `--bricked` draws the peers' scene as a bricked store classified on the device: the frame the
+/// host-classified splats give (within 8-bit rounding); refused where it cannot apply.
+#[test]
+fn the_peer_scene_bricked_draws_the_dense_frame() {
+    let (dense, bricked) = (tmp("peer-dense.png"), tmp("peer-bricked.png"));
+    for (out, extra) in [(&dense, None), (&bricked, Some("--bricked"))] {
+        let mut a =
+            vec!["render", "--scene", "peer128", "--size", "64x64", "--validation", "--out", out.to_str().unwrap()];
+        a.extend(extra);
+        let o = voxsplat(&a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let (a, b) = (voxsplat::output::read_rgba8(&dense).unwrap(), voxsplat::output::read_rgba8(&bricked).unwrap());
+    let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max();
+    assert!(worst.unwrap() <= 1, "bricked vs dense: {worst:?}");
+    assert!(a.pixels().filter(|p| p[3] > 0).count() > 500);
+    for bad in [vec!["--scene", "cube40", "--bricked"], vec!["--scene", "peer128", "--bricked", "--raycast", "1"]] {
+        let mut a = vec!["render", "--size", "32x32", "--out", "/tmp/never.png"];
+        a.extend(bad.iter().copied());
+        let o = voxsplat(&a);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains("--bricked"), "{bad:?}");
+    }
+}
