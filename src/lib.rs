@@ -261,7 +261,12 @@ impl Renderer {
     }
 
     fn prepared(&self) -> Result<&Prepared> {
-        self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
+        Self::prepared_in(&self.scene)
+    }
+
+    /// The scene, from its field alone (so the GPU can be borrowed beside it).
+    fn prepared_in(scene: &Option<Prepared>) -> Result<&Prepared> {
+        scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
     }
 
     /// Draw a frame.
@@ -274,8 +279,7 @@ impl Renderer {
         }
         let (opts, choice) = self.choose(camera, options)?;
         let bisect = self.bisect;
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let prep = Self::prepared_in(&self.scene)?;
         let mut cpu = CpuEngine::new(prep).with_budget(self.budget_bytes);
         let recorded = match (&mut self.gpu, bisect) {
             (Some(g), None) => record_frame(&mut g.engine(prep), prep, camera, &opts)?,
@@ -324,8 +328,7 @@ impl Renderer {
         let mut full = options.clone();
         full.render_scale = 1.0;
         let (opts, choice) = self.choose(&low, &full)?;
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let prep = Self::prepared_in(&self.scene)?;
         let gpu = self.gpu.as_mut().ok_or_else(|| Error::Unsupported("render_to needs the GPU backend".into()))?;
         gpu.context().check_target(target.format(), scaled)?;
         let recorded = record_frame(&mut gpu.engine_to(prep, target), prep, &low, &opts)?;
@@ -343,10 +346,7 @@ impl Renderer {
     }
 
     fn device_context(&self, what: &str) -> Result<&Arc<vk::Context>> {
-        self.gpu
-            .as_ref()
-            .map(|g| g.context())
-            .ok_or_else(|| Error::Unsupported(format!("{what} needs the GPU backend")))
+        self.context().ok_or_else(|| Error::Unsupported(format!("{what} needs the GPU backend")))
     }
 
     /// The options with the raster variant `Raster::Auto` resolved for this device and view.
@@ -377,8 +377,7 @@ impl Renderer {
         options.validate()?;
         camera.validate()?;
         let (opts, _) = self.choose(camera, options)?;
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let prep = Self::prepared_in(&self.scene)?;
         let run = |e: &mut dyn Engine| -> Result<Vec<Vec<u32>>> {
             record_frame(&mut bisect::Stop::new(e, after), prep, camera, &opts)?;
             let what: Vec<_> = what.iter().map(|&r| (r, e.words(r))).collect();
@@ -479,8 +478,7 @@ impl Renderer {
             let full = cpu::raycast::RaycastOptions { render_scale: 1.0, ..*options };
             return resample::render_scaled(camera, options.render_scale, |low| self.raycast(low, &full));
         }
-        let prep =
-            self.scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))?;
+        let prep = Self::prepared_in(&self.scene)?;
         if prep.set.coordinates().is_some() {
             return Err(Error::Unsupported("the ray caster samples a uniform grid, not a rectilinear one".into()));
         }
