@@ -15,6 +15,8 @@ void main() {
     if (h >= bf.grid.w) return;
     uvec4 hd = headers[h];
     uvec3 b = brick_coords(hd.x);
+    // Outside this rank's box (sort-last): held for its neighbours' gradients only.
+    if (any(lessThan(b, bf.lo.xyz)) || any(greaterThanEqual(b, bf.hi.xyz))) return;
     if (tf_empty(hd.w & 0xffffu, hd.w >> 16u)) return;
     float morph;
     uint level = brick_level(h, b, morph);

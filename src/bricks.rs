@@ -102,30 +102,46 @@ impl BrickStore {
         background: f32,
         mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
-        let [nx, ny, nz] = dims;
-        if dims.iter().any(|&d| d == 0 || d > BRICK << 10) {
-            return Err(Error::InvalidArgument(format!(
-                "a bricked volume is 1 to {} voxels a side, not {dims:?}",
-                BRICK << 10
-            )));
-        }
-        let nb = dims.map(|d| d.div_ceil(BRICK));
-        let bricks = nb[0] as u64 * nb[1] as u64 * nb[2] as u64;
-        let voxels = nx as u64 * ny as u64 * nz as u64;
-        check_host_memory(
-            voxels * 4 + bricks * (4 + 16 + BRICK_VOXELS as u64 / 8),
-            &format!("a {dims:?} bricked store"),
-        )?;
+        check_dims(dims)?;
         let mut slab = Vec::new();
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-        for z0 in (0..nz).step_by(BRICK as usize) {
-            read(z0, BRICK.min(nz - z0), &mut slab)?;
+        for z0 in (0..dims[2]).step_by(BRICK as usize) {
+            read(z0, BRICK.min(dims[2] - z0), &mut slab)?;
             for &v in slab.iter().filter(|v| v.is_finite()) {
                 (lo, hi) = (lo.min(v), hi.max(v));
             }
         }
         let lo = lo.min(background);
         let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo)) } else { (0.0, 0.0) };
+        Self::from_region(dims, spacing, (lo, hi), [[0; 3], dims], read)
+    }
+
+    /// The store of the voxels in `region` (`lo..hi`, voxel coordinates) of a `dims` grid whose
+    /// values `range` normalises (the whole volume's: `from_slices` finds it), every other voxel
+    /// empty: `read(z0, count, out)` puts the region's part of slices `z0..z0 + count` (x fastest
+    /// over the region's width) in `out`. One pass, `BRICK` slices at a time. Sort-last rendering
+    /// builds each rank's box (and the layer of voxels around it) this way.
+    pub fn from_region(
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        range: (f32, f32),
+        region: [[u32; 3]; 2],
+        mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
+    ) -> Result<Self> {
+        check_dims(dims)?;
+        let [r0, r1] = region;
+        if (0..3).any(|a| r0[a] > r1[a] || r1[a] > dims[a]) {
+            return Err(Error::InvalidArgument(format!("the region {r0:?}..{r1:?} lies outside the {dims:?} grid")));
+        }
+        let nb = dims.map(|d| d.div_ceil(BRICK));
+        let bricks = nb[0] as u64 * nb[1] as u64 * nb[2] as u64;
+        let size = [0, 1, 2].map(|a| (r1[a] - r0[a]) as u64);
+        let voxels = size[0] * size[1] * size[2];
+        check_host_memory(
+            voxels * 4 + bricks * 4 + voxels.div_ceil(BRICK_VOXELS as u64) * (16 + BRICK_VOXELS as u64 / 8),
+            &format!("a {dims:?} bricked store"),
+        )?;
+        let (lo, hi) = range;
         // A constant volume has no background: its voxels are kept (the minimum would drop them
         // all, and a one-voxel opaque volume drew nothing) at quantised 0, which the TF classifies
         // as the dense path does (density 0 without a TF range, the value's own with one).
@@ -140,20 +156,28 @@ impl BrickStore {
             records: Vec::new(),
             index: vec![u32::MAX; bricks as usize],
         };
-        let plane = nx as usize * ny as usize;
-        for bz in 0..nb[2] {
-            read(bz * BRICK, BRICK.min(nz - bz * BRICK), &mut slab)?;
-            for by in 0..nb[1] {
-                for bx in 0..nb[0] {
+        if voxels == 0 {
+            return Ok(store);
+        }
+        let mut slab = Vec::new();
+        let (w, plane) = (size[0] as usize, (size[0] * size[1]) as usize);
+        let blo = r0.map(|c| c / BRICK);
+        let bhi = r1.map(|c| c.div_ceil(BRICK));
+        for bz in blo[2]..bhi[2] {
+            let z0 = (bz * BRICK).max(r0[2]);
+            read(z0, ((bz + 1) * BRICK).min(r1[2]) - z0, &mut slab)?;
+            for by in blo[1]..bhi[1] {
+                for bx in blo[0]..bhi[0] {
                     let first = store.records.len() as u32;
                     let mut mask = [0u64; BRICK_VOXELS / 64];
                     let (mut qmin, mut qmax) = (u32::MAX, 0u32);
                     for l in 0..BRICK_VOXELS as u32 {
-                        let (x, y, z) = (bx * BRICK + l % BRICK, by * BRICK + l / BRICK % BRICK, bz * BRICK + l / 64);
-                        if x >= nx || y >= ny || z >= nz {
+                        let v = [bx * BRICK + l % BRICK, by * BRICK + l / BRICK % BRICK, bz * BRICK + l / 64];
+                        if (0..3).any(|a| v[a] < r0[a] || v[a] >= r1[a]) {
                             continue;
                         }
-                        let v = slab[(z - bz * BRICK) as usize * plane + (x + nx * y) as usize];
+                        let at = (v[2] - z0) as usize * plane + (v[1] - r0[1]) as usize * w + (v[0] - r0[0]) as usize;
+                        let v = slab[at];
                         if !(v.is_finite() && (v > lo || constant)) {
                             continue;
                         }
@@ -273,6 +297,8 @@ pub struct BrickScene {
     /// Names this store under this classification (TF and shading): what a device's level-of-detail
     /// pyramid was built from (`Engine::tag`). Unique in the process.
     classification: u64,
+    /// The bricks drawn, `lo..hi` in brick coordinates (`set_part`).
+    part: [[u32; 3]; 2],
 }
 
 /// The next `BrickScene::classification` (0 is never one).
@@ -341,6 +367,22 @@ fn tf_table(tf: &TransferFunction, (a, b): (f32, f32)) -> Vec<u32> {
     color
 }
 
+/// Refuse a grid a bricked store cannot hold.
+fn check_dims(dims: [u32; 3]) -> Result<()> {
+    if dims.iter().any(|&d| d == 0 || d > BRICK << 10) {
+        return Err(Error::InvalidArgument(format!(
+            "a bricked volume is 1 to {} voxels a side, not {dims:?}",
+            BRICK << 10
+        )));
+    }
+    Ok(())
+}
+
+/// Bricks along x, y, z of `store`'s grid.
+fn store_bricks(store: &BrickStore) -> [u32; 3] {
+    store.dims.map(|d| d.div_ceil(BRICK))
+}
+
 /// Most non-empty bricks a scene holds (a brick's draw-order slot packs its header in 22 bits).
 pub const MAX_BRICKS: usize = 1 << 22;
 
@@ -373,14 +415,45 @@ impl BrickScene {
         tf.validate()?;
         let table = tf_table(&tf, remap(&store, &tf));
         Ok(Self {
-            store,
             tf,
             shading,
             table,
             drawn: std::sync::OnceLock::new(),
             gmax: std::sync::OnceLock::new(),
             classification: next_classification(),
+            part: [[0; 3], store_bricks(&store)],
+            store,
         })
+    }
+
+    /// Draw only the bricks `lo..hi` (brick coordinates): a rank's box in sort-last rendering
+    /// (`distributed`), whose store also holds the voxels around the box that its faces'
+    /// gradients read. The whole grid by default.
+    pub fn set_part(&mut self, lo: [u32; 3], hi: [u32; 3]) -> Result<()> {
+        let nb = store_bricks(&self.store);
+        if (0..3).any(|a| lo[a] > hi[a] || hi[a] > nb[a]) {
+            return Err(Error::InvalidArgument(format!("the part {lo:?}..{hi:?} lies outside the {nb:?} brick grid")));
+        }
+        self.part = [lo, hi];
+        self.gmax = std::sync::OnceLock::new();
+        Ok(())
+    }
+
+    /// The bricks drawn (`set_part`).
+    pub fn part(&self) -> [[u32; 3]; 2] {
+        self.part
+    }
+
+    /// The largest gradient magnitude, in stored units, over the drawn part (gradient weighting
+    /// divides by it).
+    pub fn gradient_max(&self) -> f32 {
+        self.gmax_stored()
+    }
+
+    /// Set the largest gradient magnitude (stored units): the whole volume's, when this scene
+    /// draws one part of it.
+    pub fn set_gradient_max(&mut self, g: f32) {
+        self.gmax = std::sync::OnceLock::from(g);
     }
 
     /// A scene of few colours (a built-in scene's splats) as a bricked volume, so the bricked path
@@ -477,6 +550,8 @@ impl BrickScene {
             light,
             shade,
             grad: [gmax, 0.0, 0.0, 0.0],
+            lo: [self.part[0][0], self.part[0][1], self.part[0][2], 0],
+            hi: [self.part[1][0], self.part[1][1], self.part[1][2], 0],
         }
     }
 
@@ -520,9 +595,10 @@ impl BrickScene {
             };
             let sp = s.spacing;
             let mut most = 0.0f32;
-            for bz in 0..nb[2] {
-                for by in 0..nb[1] {
-                    for bx in 0..nb[0] {
+            let [lo, hi] = self.part.map(|c| c.map(i64::from));
+            for bz in lo[2]..hi[2] {
+                for by in lo[1]..hi[1] {
+                    for bx in lo[0]..hi[0] {
                         let near =
                             (-1..=1).any(|dz| (-1..=1).any(|dy| (-1..=1).any(|dx| filled(bx + dx, by + dy, bz + dz))));
                         if !near {

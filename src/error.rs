@@ -50,6 +50,16 @@ pub enum Error {
         /// The decoder's message.
         message: String,
     },
+    /// An error on one rank of a distributed render, which every rank returns (`distributed`).
+    #[error("rank {rank} of {ranks}: {source}")]
+    OnRank {
+        /// The rank it happened on (the lowest, when several failed).
+        rank: u32,
+        /// The ranks rendering.
+        ranks: u32,
+        /// What went wrong there.
+        source: Box<Error>,
+    },
     /// Encoding an output image.
     #[error("cannot write image {path}: {message}")]
     Image {

@@ -191,6 +191,10 @@ pub struct BrickFrame {
     /// the largest cell spacing in pixels (0: off); z: their largest error; w: their morphing
     /// band, in octaves of projected size (0: none).
     pub grad: [f32; 4],
+    /// The bricks drawn, `lo <= b < hi` (w unused): a rank's box in sort-last rendering, else the
+    /// grid; the store may hold voxels outside it for the gradients at its faces.
+    pub lo: [u32; 4],
+    pub hi: [u32; 4],
 }
 
 /// Push constants of `brick_order.comp` and `brick_params.comp`: the batch's entries of the
@@ -208,7 +212,7 @@ pub struct BrickPush {
     pub occluded: f32,
 }
 
-const _: () = assert!(std::mem::size_of::<BrickFrame>() == 96);
+const _: () = assert!(std::mem::size_of::<BrickFrame>() == 128);
 const _: () = assert!(std::mem::size_of::<BrickPush>() == 16);
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);

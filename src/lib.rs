@@ -29,6 +29,7 @@ pub mod constants;
 pub mod cpu;
 pub mod cpu_engine;
 pub mod dispatch;
+pub mod distributed;
 mod error;
 mod gpu;
 /// `#[repr(C)]` mirrors of `glsl/shared/types.glsl` (public for tests and the mirrors).

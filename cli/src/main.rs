@@ -301,6 +301,10 @@ struct RenderArgs {
     /// Print per-stage times.
     #[arg(long)]
     timings: bool,
+    /// Under mpirun (a build with `--features mpi`): how the ranks' frames are composited,
+    /// direct-send, binary-swap (a power of two ranks) or auto (binary-swap from 4 ranks).
+    #[arg(long, default_value = "auto")]
+    compositing: String,
     /// Render the frame this many times and report each stage's median (the first frames pay
     /// one-off costs: allocation, shader compilation on some drivers).
     #[arg(long, default_value_t = 1, conflicts_with_all = ["raycast", "truth"])]
@@ -395,8 +399,6 @@ fn run(cli: Cli) -> Result<()> {
             let composite = a.composite.parse::<Composite>()?;
             // A volume is a bricked store classified on the device unless a mode needs host splats.
             let host_splats = order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line;
-            let (bricked, set) = open(&a.scene, host_splats)?;
-            let cam = camera_of(&a.scene, set.grid())?;
             let mut opts = RenderOptions::default();
             opts.order = order;
             opts.composite = composite;
@@ -419,6 +421,13 @@ fn run(cli: Cli) -> Result<()> {
             opts.background = a.background;
             (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
             opts.validate()?;
+            a.compositing.parse::<voxsplat::distributed::Scheme>()?;
+            #[cfg(feature = "mpi")]
+            if voxsplat::distributed::mpi::launched() {
+                return render_distributed(&a, &opts, host_splats);
+            }
+            let (bricked, set) = open(&a.scene, host_splats)?;
+            let cam = camera_of(&a.scene, set.grid())?;
             let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
             let r_bricked = bricked.is_some();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
@@ -922,6 +931,69 @@ fn pathdiff(target: &std::path::Path, base: &std::path::Path) -> String {
     let t = std::fs::canonicalize(target).unwrap_or_else(|_| target.to_path_buf());
     let b = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
     t.strip_prefix(&b).map(|p| p.display().to_string()).unwrap_or_else(|_| target.display().to_string())
+}
+
+/// `voxsplat render` under mpirun: the --volume file cut into one box per rank, each drawn by its
+/// rank, composited in the boxes' visibility order; rank 0 writes the image.
+#[cfg(feature = "mpi")]
+fn render_distributed(a: &RenderArgs, opts: &RenderOptions, host_splats: bool) -> Result<()> {
+    use voxsplat::distributed::mpi::{rsmpi, Distributed};
+    let universe =
+        rsmpi::initialize().ok_or_else(|| Error::Unsupported("MPI was initialised already or cannot be".into()))?;
+    let world = universe.world();
+    use rsmpi::traits::Communicator;
+    let rank = world.rank();
+    let Some(path) = a.scene.volume.as_ref().filter(|_| !host_splats && a.scene.positions.is_none()) else {
+        return Err(Error::Unsupported(
+            "under mpirun, render draws a --volume file as a bricked store per splat in PBTF order (no --truth, \
+             --raycast, --k-line, --positions or other orders)"
+                .into(),
+        ));
+    };
+    let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
+    let reader = voxsplat::distributed::open(path, &hints)?;
+    let spacing = hints.spacing.unwrap_or(reader.spacing);
+    let grid = voxsplat::Grid::centered(reader.dims, spacing)?;
+    drop(reader);
+    let cam = camera_of(&a.scene, &grid)?;
+    let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
+    let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing);
+    let r = renderer_of(&a.scene)?;
+    let scheme = a.compositing.parse()?;
+    let mut d = Distributed::load(world, r, path, &hints, tf, shading, scheme)?;
+    let stored = d.stored_per_rank();
+    let mut frames = Vec::new();
+    for _ in 0..a.repeat.max(1) {
+        frames.push(d.render(&cam, opts)?);
+    }
+    report_validation(d.renderer())?;
+    let peak = voxsplat::distributed::peak_rss_bytes();
+    if rank != 0 {
+        return Ok(());
+    }
+    let frames: Vec<_> = frames.into_iter().flatten().collect();
+    let Some(last) = frames.last() else { return Ok(()) };
+    voxsplat::output::write_image(&last.image, &a.out)?;
+    eprintln!(
+        "{} stored voxels on {} ranks ({}) by {} -> {}",
+        stored.iter().sum::<u64>(),
+        stored.len(),
+        stored.iter().map(u64::to_string).collect::<Vec<_>>().join(" + "),
+        d.scheme().name(),
+        a.out.display()
+    );
+    if a.timings {
+        for stage in ["render", "composite"] {
+            let mut ms: Vec<f64> =
+                frames.iter().flat_map(|f| f.timings.iter().filter(|t| t.stage == stage).map(|t| t.ms)).collect();
+            ms.sort_by(f64::total_cmp);
+            println!("{stage:<14} {:>9.3} ms", ms[ms.len() / 2]);
+        }
+        if let Some(p) = peak {
+            println!("{:<14} {:>9.1} MiB (rank 0)", "peak memory", p as f64 / (1 << 20) as f64);
+        }
+    }
+    Ok(())
 }
 
 fn main() -> ExitCode {

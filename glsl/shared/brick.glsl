@@ -14,6 +14,8 @@ struct BrickFrame {
     vec4 shade;    // ambient, diffuse, specular, shininess
     vec4 grad;     // x: the volume's largest gradient magnitude (gradient weighting); y: levels of
                    // detail, largest cell spacing in pixels (0: off); z: their largest error
+    uvec4 lo;      // the bricks drawn: lo <= b < hi (a rank's box in sort-last rendering; else the grid)
+    uvec4 hi;
 };
 
 layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };

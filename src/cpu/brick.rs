@@ -313,7 +313,8 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
     let store = inputs.store;
     for (h, hd) in store.headers.iter().enumerate() {
         let b = hd.coords();
-        if inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) {
+        let (lo, hi) = (inputs.bf.lo, inputs.bf.hi);
+        if (0..3).any(|a| b[a] < lo[a] || b[a] >= hi[a]) || inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) {
             continue;
         }
         let (level, morph) = inputs.brick_level(h as u32, b);

@@ -205,17 +205,68 @@ impl SliceReader {
         let n = plane * count as u64;
         self.bytes.resize((self.plane_bytes() * count as u64) as usize, 0);
         let at = self.offset + self.plane_bytes() * z0 as u64;
-        self.source.read_at(at, &mut self.bytes).map_err(|e| match e.kind() {
-            std::io::ErrorKind::UnexpectedEof => {
-                bad(&self.what, format!("data is truncated before slice {}", z0 + count))
+        let r = self.source.read_at(at, &mut self.bytes);
+        r.map_err(|e| read_error(&self.what, z0 + count, e))?;
+        self.decode(n, out)
+    }
+
+    /// The part `lo..hi` (x and y) of slices `z0..z0 + count` into `out`, x fastest over the
+    /// part: a file is read row by row at its offsets, only the part's bytes; a gzip stream is
+    /// inflated through (the slices whole, the part kept). Sort-last rendering reads a rank's box
+    /// this way.
+    pub fn read_part(&mut self, z0: u32, count: u32, lo: [u32; 2], hi: [u32; 2], out: &mut Vec<f32>) -> Result<()> {
+        let [nx, ny, _] = self.dims;
+        if lo[0] > hi[0] || lo[1] > hi[1] || hi[0] > nx || hi[1] > ny || z0 + count > self.dims[2] {
+            return Err(Error::InvalidArgument(format!(
+                "the part {lo:?}..{hi:?} of slices {z0}..{} lies outside {}'s {:?} grid",
+                z0 + count,
+                self.what,
+                self.dims
+            )));
+        }
+        let (w, h) = ((hi[0] - lo[0]) as usize, (hi[1] - lo[1]) as usize);
+        if let Source::Gzip { .. } = self.source {
+            let mut whole = Vec::new();
+            self.read(z0, count, &mut whole)?;
+            out.clear();
+            for z in 0..count as usize {
+                for y in lo[1] as usize..hi[1] as usize {
+                    let row = (z * ny as usize + y) * nx as usize;
+                    out.extend_from_slice(&whole[row + lo[0] as usize..row + hi[0] as usize]);
+                }
             }
-            std::io::ErrorKind::InvalidInput | std::io::ErrorKind::InvalidData => bad(&self.what, format!("gzip: {e}")),
-            _ => Error::Io { path: self.what.clone(), source: e },
-        })?;
+            return Ok(());
+        }
+        let size = self.dtype.size();
+        let row_bytes = w * size;
+        self.bytes.resize(count as usize * h * row_bytes, 0);
+        for z in 0..count as usize {
+            for y in 0..h {
+                let voxel = ((z0 as u64 + z as u64) * ny as u64 + lo[1] as u64 + y as u64) * nx as u64 + lo[0] as u64;
+                let at = self.offset + voxel * size as u64;
+                let row = (z * h + y) * row_bytes;
+                let r = self.source.read_at(at, &mut self.bytes[row..row + row_bytes]);
+                r.map_err(|e| read_error(&self.what, z0 + z as u32 + 1, e))?;
+            }
+        }
+        self.decode((count as usize * h * w) as u64, out)
+    }
+
+    /// `n` samples from the bytes read, rescaled and checked finite.
+    fn decode(&self, n: u64, out: &mut Vec<f32>) -> Result<()> {
         *out = decode(&self.bytes, n, self.dtype, self.big_endian, &self.what)?;
         if let Some(l) = &self.rescale {
             l.rescale(out);
         }
         super::check_finite(out, &self.what)
+    }
+}
+
+/// A failed read of the data up to slice `end` as a typed error.
+fn read_error(what: &str, end: u32, e: std::io::Error) -> Error {
+    match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => bad(what, format!("data is truncated before slice {end}")),
+        std::io::ErrorKind::InvalidInput | std::io::ErrorKind::InvalidData => bad(what, format!("gzip: {e}")),
+        _ => Error::Io { path: what.to_string(), source: e },
     }
 }
