@@ -299,6 +299,8 @@ pub struct BrickScene {
     classification: u64,
     /// The bricks drawn, `lo..hi` in brick coordinates (`set_part`).
     part: [[u32; 3]; 2],
+    /// The k-d tree that orders the bricks (`kdtree`).
+    tree: Vec<crate::kdtree::Node>,
 }
 
 /// The next `BrickScene::classification` (0 is never one).
@@ -422,6 +424,7 @@ impl BrickScene {
             gmax: std::sync::OnceLock::new(),
             classification: next_classification(),
             part: [[0; 3], store_bricks(&store)],
+            tree: crate::kdtree::build(store_bricks(&store), |id| store.index[id] != u32::MAX),
             store,
         })
     }
@@ -437,6 +440,34 @@ impl BrickScene {
         self.part = [lo, hi];
         self.gmax = std::sync::OnceLock::new();
         Ok(())
+    }
+
+    /// The k-d tree that orders the bricks: the store's own, or (`set_tree`) the whole volume's
+    /// when the store holds one rank's part of it.
+    pub fn tree(&self) -> &[crate::kdtree::Node] {
+        &self.tree
+    }
+
+    /// Order the bricks by `tree` (the whole volume's, `kdtree::build`), refused when it does not
+    /// cut this grid.
+    pub fn set_tree(&mut self, tree: Vec<crate::kdtree::Node>) -> Result<()> {
+        let nb = store_bricks(&self.store);
+        let bad = tree.iter().any(|n| {
+            let (axis, plane) = crate::kdtree::cut(n);
+            axis > 2 || plane == 0 || plane >= nb[axis] || [n[1], n[2]].iter().any(|&c| c != u32::MAX && c as usize >= tree.len())
+        });
+        if bad || tree.len() >= 1 << crate::kdtree::TREE_DEPTH {
+            return Err(Error::InvalidArgument(format!("a k-d tree of {} nodes that does not cut the {nb:?} brick grid", tree.len())));
+        }
+        self.tree = tree;
+        Ok(())
+    }
+
+    /// The brick index and, after it, the k-d tree: the device's `Res::BrickIndex`.
+    pub fn index_words(&self) -> Vec<u32> {
+        let mut w = self.store.index.clone();
+        w.extend(self.tree.iter().flatten());
+        w
     }
 
     /// The bricks drawn (`set_part`).
@@ -550,7 +581,7 @@ impl BrickScene {
             light,
             shade,
             grad: [gmax, 0.0, 0.0, 0.0],
-            lo: [self.part[0][0], self.part[0][1], self.part[0][2], 0],
+            lo: [self.part[0][0], self.part[0][1], self.part[0][2], self.tree.len() as u32],
             hi: [self.part[1][0], self.part[1][1], self.part[1][2], 0],
         }
     }

@@ -56,79 +56,80 @@ pub struct Split {
     pub end: u32,
 }
 
-/// The brick grid cut into one box per rank by a k-d tree.
+/// The brick grid cut into one box per rank: the top of the k-d tree that orders the bricks
+/// (`kdtree`), so a rank's bricks are consecutive in the one-process draw order.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Partition {
     /// Bricks along x, y, z.
     pub grid: [u32; 3],
-    /// Rank r's box.
+    /// Rank r's box (empty for a rank beyond the tree's leaves).
     pub boxes: Vec<BrickBox>,
-    /// The tree's inner nodes, parents before children.
+    /// The cut's inner nodes, parents before children.
     pub splits: Vec<Split>,
+    /// The whole tree (`kdtree::build`), which every rank's scene orders its bricks by.
+    pub tree: Vec<crate::kdtree::Node>,
+}
+
+/// A node of the cut: its tree node or, for a box, its leaf.
+#[derive(Clone, Copy)]
+struct Part {
+    node: u32,
+    depth: u32,
+    lo: [u32; 3],
+    hi: [u32; 3],
 }
 
 impl Partition {
-    /// Cut a grid of `grid` bricks into `ranks` boxes: each node's ranks split in halves (the lower
-    /// half rounded down), its box cut across its longest side where the non-empty bricks
-    /// (`occupied`, x fastest) divide in the same proportion. A box may hold no non-empty brick, or
-    /// no brick at all (more ranks than bricks along a side): its rank draws nothing and still
-    /// takes part.
+    /// Cut a grid of `grid` bricks, non-empty where `occupied` (x fastest), into `ranks` boxes:
+    /// the k-d tree's nodes, split shallowest first and left to right until there are `ranks`
+    /// (a power of two: one level of the tree, every box with the same share of non-empty
+    /// bricks; otherwise the first nodes of the next level are split). A box may hold no
+    /// non-empty brick, or, with more ranks than the tree has leaves, no brick: its rank draws
+    /// nothing and still takes part.
     pub fn new(grid: [u32; 3], occupied: &[bool], ranks: u32) -> Result<Self> {
         let n = grid.iter().map(|&g| g as usize).product::<usize>();
-        if ranks == 0 || occupied.len() != n {
+        if ranks == 0 || ranks > 1 << crate::kdtree::TREE_DEPTH || occupied.len() != n {
             return Err(Error::InvalidArgument(format!(
-                "a partition of {grid:?} bricks into {ranks} boxes needs {n} occupancy flags, not {}",
+                "a partition of {grid:?} bricks into {ranks} boxes (at most {}) needs {n} occupancy flags, not {}",
+                1 << crate::kdtree::TREE_DEPTH,
                 occupied.len()
             )));
         }
-        let mut p =
-            Partition { grid, boxes: vec![BrickBox { lo: [0; 3], hi: [0; 3] }; ranks as usize], splits: Vec::new() };
-        p.cut(BrickBox { lo: [0; 3], hi: grid }, 0, ranks, occupied);
+        let tree = crate::kdtree::build(grid, |id| occupied[id]);
+        let root = Part { node: if tree.is_empty() { crate::kdtree::LEAF } else { 0 }, depth: 0, lo: [0; 3], hi: grid };
+        // The cut, in tree order; each entry carries the inner nodes above it that it opened.
+        let mut cut = vec![root];
+        while (cut.len() as u32) < ranks {
+            let open = (0..cut.len()).filter(|&i| cut[i].node != crate::kdtree::LEAF).min_by_key(|&i| (cut[i].depth, i));
+            let Some(i) = open else { break };
+            let c = cut[i];
+            let node = tree[c.node as usize];
+            let (axis, plane) = crate::kdtree::cut(&node);
+            let (mut low, mut high) = (c, c);
+            (low.hi[axis], high.lo[axis]) = (plane, plane);
+            (low.node, high.node) = (node[1], node[2]);
+            (low.depth, high.depth) = (c.depth + 1, c.depth + 1);
+            cut.splice(i..=i, [low, high]);
+        }
+        let mut p = Partition { grid, boxes: Vec::new(), splits: Vec::new(), tree };
+        p.boxes = cut.iter().map(|c| BrickBox { lo: c.lo, hi: c.hi }).collect();
+        p.boxes.resize(ranks as usize, BrickBox { lo: [0; 3], hi: [0; 3] });
+        // The cut's inner nodes with their ranks: walk the tree down to the boxes.
+        let boxes = p.boxes.clone();
+        p.walk_splits(0, boxes.len().min(cut.len()) as u32, &boxes, if p.tree.is_empty() { None } else { Some(0) });
         Ok(p)
     }
 
-    fn cut(&mut self, b: BrickBox, first: u32, end: u32, occupied: &[bool]) {
-        if end - first == 1 {
-            self.boxes[first as usize] = b;
-            return;
-        }
-        let mid = first + (end - first) / 2;
-        let axis = (0..3).max_by_key(|&a| (b.hi[a] - b.lo[a], 2 - a)).unwrap_or(0);
-        // Non-empty bricks per layer along the axis.
-        let g = self.grid;
-        let mut layers = vec![0u64; (b.hi[axis] - b.lo[axis]) as usize];
-        for z in b.lo[2]..b.hi[2] {
-            for y in b.lo[1]..b.hi[1] {
-                for x in b.lo[0]..b.hi[0] {
-                    if occupied[(x + g[0] * (y + g[1] * z)) as usize] {
-                        layers[([x, y, z][axis] - b.lo[axis]) as usize] += 1;
-                    }
-                }
-            }
-        }
-        let total: u64 = layers.iter().sum();
-        let want = total as f64 * (mid - first) as f64 / (end - first) as f64;
-        // The plane whose lower side's count is nearest the wanted share (with no content: the
-        // side's share of the layers).
-        let (mut best, mut below) = (b.lo[axis], 0u64);
-        let mut best_miss = f64::INFINITY;
-        for (i, &c) in layers.iter().enumerate().chain(std::iter::once((layers.len(), &0))) {
-            let plane = b.lo[axis] + i as u32;
-            let miss = if total > 0 {
-                (below as f64 - want).abs()
-            } else {
-                (i as f64 - layers.len() as f64 * (mid - first) as f64 / (end - first) as f64).abs()
-            };
-            if miss < best_miss {
-                (best, best_miss) = (plane, miss);
-            }
-            below += c;
-        }
-        self.splits.push(Split { axis, plane: best, first, mid, end });
-        let (mut low, mut high) = (b, b);
-        (low.hi[axis], high.lo[axis]) = (best, best);
-        self.cut(low, first, mid, occupied);
-        self.cut(high, mid, end, occupied);
+    /// Record the inner nodes of the cut over boxes `first..end`, under tree node `node`.
+    fn walk_splits(&mut self, first: u32, end: u32, boxes: &[BrickBox], node: Option<u32>) {
+        let Some(n) = node.filter(|_| end - first > 1) else { return };
+        let t = self.tree[n as usize];
+        let (axis, plane) = crate::kdtree::cut(&t);
+        let mid = (first..end).find(|&r| boxes[r as usize].lo[axis] >= plane).unwrap_or(end);
+        self.splits.push(Split { axis, plane, first, mid, end });
+        let child = |c: u32| (c != crate::kdtree::LEAF).then_some(c);
+        self.walk_splits(first, mid, boxes, child(t[1]));
+        self.walk_splits(mid, end, boxes, child(t[2]));
     }
 
     /// The node splitting ranks `first..end`.
@@ -136,25 +137,23 @@ impl Partition {
         self.splits.iter().find(|s| s.first == first && s.end == end)
     }
 
-    /// Whether node `s`'s lower ranks lie nearer the eye than its upper ones, for the eye's brick
-    /// split `split` (`order::brick_split`: brick b lies on the eye's far side along an axis when
-    /// b >= split there, its lowest voxel does): the upper side is farther when its first brick
-    /// lies on the far side, as it does in a single process's PBTF.
+    /// Whether node `s`'s lower ranks lie nearer the eye (`kdtree::lower_in_front`).
     pub fn lower_in_front(s: &Split, split: [u32; 3]) -> bool {
         s.plane >= split[s.axis]
     }
 
     /// The ranks' boxes back to front for the eye's brick split: a visibility order of the boxes,
-    /// as PBTF is of the bricks.
+    /// the one the bricks are drawn in by one process. Ranks without a box come first.
     pub fn back_to_front(&self, split: [u32; 3]) -> Vec<u32> {
-        let mut out = Vec::with_capacity(self.boxes.len());
-        self.walk(0, self.boxes.len() as u32, split, &mut out);
+        let boxed = self.boxes.iter().rposition(|b| b.bricks() > 0).map_or(1, |i| i + 1) as u32;
+        let mut out: Vec<u32> = (boxed..self.boxes.len() as u32).collect();
+        self.walk(0, boxed, split, &mut out);
         out
     }
 
     fn walk(&self, first: u32, end: u32, split: [u32; 3], out: &mut Vec<u32>) {
         let Some(s) = self.node(first, end).copied() else {
-            out.push(first);
+            out.extend(first..end);
             return;
         };
         let (low, high) = ((s.first, s.mid), (s.mid, s.end));

@@ -191,8 +191,9 @@ pub struct BrickFrame {
     /// the largest cell spacing in pixels (0: off); z: their largest error; w: their morphing
     /// band, in octaves of projected size (0: none).
     pub grad: [f32; 4],
-    /// The bricks drawn, `lo <= b < hi` (w unused): a rank's box in sort-last rendering, else the
-    /// grid; the store may hold voxels outside it for the gradients at its faces.
+    /// The bricks drawn, `lo <= b < hi`: a rank's box in sort-last rendering, else the grid; the
+    /// store may hold voxels outside it for the gradients at its faces. lo.w: the k-d tree's
+    /// nodes, after the brick index (`kdtree`); hi.w unused.
     pub lo: [u32; 4],
     pub hi: [u32; 4],
 }

@@ -38,6 +38,7 @@ pub mod gpu_types;
 pub mod image;
 #[doc = include_str!("../docs/EMBEDDING.md")]
 pub mod embedding {}
+pub mod kdtree;
 pub mod kernel;
 #[cfg(feature = "io")]
 pub mod loaders;

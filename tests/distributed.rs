@@ -28,6 +28,7 @@ fn parts(r: &mut Renderer, path: &str, tf: &TransferFunction, ranks: u32, cam: &
         let store = distributed::load_part(&mut reader, spacing, scan.range(), b).unwrap();
         let mut scene = BrickScene::new(store, tf.clone(), None).unwrap();
         scene.set_part(b.lo, b.hi).unwrap();
+        scene.set_tree(p.tree.clone()).unwrap();
         r.set_bricks(scene).unwrap();
         images.push(r.render(cam, o).unwrap().image);
     }
@@ -50,8 +51,8 @@ fn boxes_composited_in_order_equal_the_whole() {
     let grid = Grid::centered(store.dims, store.spacing).unwrap();
     let outside = Camera::framing(&grid, 256, 256);
     let mut inside = outside;
-    inside.eye = grid.center() + Vec3::new(10.0, -20.0, 30.0);
-    inside.target = grid.center() + Vec3::new(-30.0, 40.0, -60.0);
+    inside.eye = grid.center() + Vec3::new(5.0, -10.0, 40.0);
+    inside.target = grid.center() + Vec3::new(0.0, 0.0, -100.0);
     let o = RenderOptions::default();
     for (name, cam) in [("outside", outside), ("inside", inside)] {
         r.set_bricks(BrickScene::new(store.clone(), tf.clone(), None).unwrap()).unwrap();
@@ -77,4 +78,44 @@ fn boxes_composited_in_order_equal_the_whole() {
         }
     }
     common::assert_clean(&r);
+}
+
+#[test]
+fn the_partition_is_the_top_of_the_brick_tree_balanced_by_non_empty_bricks() {
+    // Non-empty bricks in one corner octant of a 8 x 8 x 16 brick grid.
+    let grid = [8u32, 8, 16];
+    let occupied: Vec<bool> =
+        (0..8 * 8 * 16).map(|i| i % 8 < 4 && (i / 8) % 8 < 4 && i / 64 < 8).collect();
+    for ranks in [1u32, 2, 3, 4, 8] {
+        let p = Partition::new(grid, &occupied, ranks).unwrap();
+        assert_eq!(p.boxes.len(), ranks as usize);
+        let bricks: u64 = p.boxes.iter().map(|b| b.bricks()).sum();
+        assert_eq!(bricks, 8 * 8 * 16, "{ranks}: the boxes tile the grid");
+        let full = |b: &distributed::BrickBox| {
+            let mut n = 0;
+            for z in b.lo[2]..b.hi[2] {
+                for y in b.lo[1]..b.hi[1] {
+                    for x in b.lo[0]..b.hi[0] {
+                        n += occupied[(x + 8 * (y + 8 * z)) as usize] as u32;
+                    }
+                }
+            }
+            n
+        };
+        let counts: Vec<u32> = p.boxes.iter().map(full).collect();
+        if ranks.is_power_of_two() {
+            assert!(counts.iter().all(|&c| c == 128 / ranks), "{ranks}: balanced {counts:?}");
+        }
+        // Every eye: a back-to-front order of all ranks.
+        for split in [[0, 0, 0], [4, 4, 8], [8, 8, 16], [2, 7, 3]] {
+            let mut order = p.back_to_front(split);
+            order.sort();
+            assert_eq!(order, (0..ranks).collect::<Vec<_>>());
+        }
+    }
+    // More ranks than the grid has bricks: the extra boxes are empty and still ranked.
+    let p = Partition::new([2, 1, 1], &[true, false], 4).unwrap();
+    assert_eq!(p.boxes.iter().filter(|b| b.bricks() == 0).count(), 2);
+    assert_eq!(p.back_to_front([0, 0, 0]).len(), 4);
+    assert!(Partition::new([2, 1, 1], &[true], 2).is_err());
 }

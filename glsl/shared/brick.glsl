@@ -426,8 +426,28 @@ bool outside_view(uvec3 b, float cell) {
     return front && any(notEqual(out_lo, uvec4(0u)));
 }
 
-// Brick b's position in the draw order of the brick grid (PBTF; reversed back to front).
+// Brick b's position in the draw order of the brick grid: the k-d tree's (after the brick index;
+// kdtree.rs), front to back as dense_pbtf: every node's near side first, PBTF within its leaves'
+// boxes; reversed back to front.
+// Mirror: cpu::brick::tree_pbtf.
 uint brick_slot(uvec3 b) {
-    uint p = dense_pbtf(b, bf.grid.xyz, bf.split.xyz);
-    return frame.split.w != 0u ? bf.grid.x * bf.grid.y * bf.grid.z - 1u - p : p;
+    uint total = bf.grid.x * bf.grid.y * bf.grid.z;
+    uvec3 lo = uvec3(0u), hi = bf.grid.xyz;
+    uint p = 0u;
+    uint n = bf.lo.w > 0u ? 0u : 0xffffffffu;
+    while (n != 0xffffffffu) {
+        uint code = brick_index[total + 4u * n];
+        uint axis = code & 3u, plane = code >> 2u;
+        bool high = b[axis] >= plane;
+        if (high == (plane >= bf.split[axis])) {
+            uvec3 e = hi - lo;
+            e[axis] = high ? plane - lo[axis] : hi[axis] - plane;
+            p += e.x * e.y * e.z;
+        }
+        if (high) lo[axis] = plane; else hi[axis] = plane;
+        n = brick_index[total + 4u * n + (high ? 2u : 1u)];
+    }
+    uvec3 s = clamp(bf.split.xyz, lo, hi) - lo;
+    p += dense_pbtf(b - lo, hi - lo, s);
+    return frame.split.w != 0u ? total - 1u - p : p;
 }

@@ -30,6 +30,34 @@ pub fn dense_pbtf(c: [u32; 3], n: [u32; 3], s: [u32; 3]) -> u32 {
     base + (outward(c[2], s[2], sk) * nj + outward(c[1], s[1], sj)) * ni + outward(c[0], s[0], si)
 }
 
+/// Mirror of `tree_pbtf`: brick `b`'s position in the order of a `grid` of bricks that `tree`
+/// (`kdtree`) cuts, front to back as `dense_pbtf`: every node's near side first (for the eye's
+/// brick split `split`), PBTF within its leaves' boxes.
+pub fn tree_pbtf(tree: &[crate::kdtree::Node], grid: [u32; 3], split: [u32; 3], b: [u32; 3]) -> u32 {
+    let (mut lo, mut hi, mut p) = ([0u32; 3], grid, 0u32);
+    let mut n = if tree.is_empty() { crate::kdtree::LEAF } else { 0 };
+    while n != crate::kdtree::LEAF {
+        let node = &tree[n as usize];
+        let (axis, plane) = crate::kdtree::cut(node);
+        let high = b[axis] >= plane;
+        if high == crate::kdtree::lower_in_front(node, split) {
+            // b lies on the far side: after every brick of the near one (front to back, as PBTF).
+            let mut e = [0, 1, 2].map(|a| hi[a] - lo[a]);
+            e[axis] = if high { plane - lo[axis] } else { hi[axis] - plane };
+            p += e[0] * e[1] * e[2];
+        }
+        if high {
+            lo[axis] = plane;
+        } else {
+            hi[axis] = plane;
+        }
+        n = if high { node[2] } else { node[1] };
+    }
+    let size = [0, 1, 2].map(|a| hi[a] - lo[a]);
+    let s = [0, 1, 2].map(|a| split[a].clamp(lo[a], hi[a]) - lo[a]);
+    p + dense_pbtf([0, 1, 2].map(|a| b[a] - lo[a]), size, s)
+}
+
 /// What the brick stages read: the frame, its brick uniforms, the TF table and the store.
 pub struct BrickInputs<'a> {
     pub frame: &'a Frame,
@@ -42,6 +70,8 @@ pub struct BrickInputs<'a> {
     pub summary: &'a [[u32; 4]],
     /// Per brick its splats' morph this frame (`brick_cull`).
     pub morphs: &'a [f32],
+    /// The k-d tree that orders the bricks (`BrickScene::tree`).
+    pub tree: &'a [crate::kdtree::Node],
     /// A streamed store's pyramid holds one batch's bricks: per header its slot (STREAMED_STORE
     /// builds), or `None`: the pyramid is indexed by header.
     pub pyramid_slot: Option<&'a [u32]>,
@@ -191,7 +221,8 @@ impl BrickInputs<'_> {
     /// Mirror of `brick_slot`.
     fn brick_slot(&self, b: [u32; 3]) -> u32 {
         let g = self.bf.grid;
-        let p = dense_pbtf(b, [g[0], g[1], g[2]], [self.bf.split[0], self.bf.split[1], self.bf.split[2]]);
+        let split = [self.bf.split[0], self.bf.split[1], self.bf.split[2]];
+        let p = tree_pbtf(self.tree, [g[0], g[1], g[2]], split, b);
         if self.frame.split[3] != 0 {
             g[0] * g[1] * g[2] - 1 - p
         } else {
@@ -410,6 +441,7 @@ pub(crate) fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
         bf: bf[0],
         tf: b.get(Res::Tf),
         store: &scene.store,
+        tree: scene.tree(),
         pyramid: b.get(Res::Pyramid),
         summary: b.get(Res::LodSummary),
         morphs: b.get(Res::BrickMorph),

@@ -83,6 +83,7 @@ impl<C: Communicator> Distributed<C> {
         let built = load_part(&mut reader, spacing, whole.range(), &b).and_then(|store| {
             let mut scene = BrickScene::new(store, tf.clone(), shading)?;
             scene.set_part(b.lo, b.hi)?;
+            scene.set_tree(partition.tree.clone())?;
             Ok(scene)
         });
         let mut scene = agree(&comm, built)?;

@@ -173,7 +173,7 @@ impl Resources {
                             "brick records",
                             bytemuck::cast_slice(&words(if b.streams(budget) { &[] } else { &s.records })),
                         )?,
-                        storage(ctx, "brick index", bytemuck::cast_slice(&words(&s.index)))?,
+                        storage(ctx, "brick index", bytemuck::cast_slice(&words(&b.index_words())))?,
                     ])
                 }
                 None => None,

@@ -22,7 +22,7 @@ pub fn bricked_resident_bytes(scene: &BrickScene, budget: u64, width: u32, heigh
     } else {
         s.bytes()
     };
-    store + s.index.len() as u64 * (4 + 4 + 16) + width as u64 * height as u64 * 16 * 3
+    store + s.index.len() as u64 * (4 + 4 + 16) + scene.tree().len() as u64 * 16 + width as u64 * height as u64 * 16 * 3
 }
 
 /// The least budget that draws `scene` at `width` x `height`: resident data and one brick's splats
