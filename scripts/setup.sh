@@ -3,9 +3,13 @@
 # Vulkan loader, the Khronos validation layers, and the static shaderc/glslang/SPIRV-Tools libraries
 # that build.rs links through .cargo/config.toml; Xvfb and the X libraries winit opens, for the
 # windowed viewer's headless test (examples/viewer.rs). Idempotent: does nothing when all are present.
+# With --mpi, also OpenMPI and libclang: what `--features mpi` (sort-last rendering, rsmpi) builds
+# and runs with (docs/SCALE.md).
 set -euo pipefail
+mpi=()
+[ "${1:-}" = "--mpi" ] && mpi=(openmpi-bin libopenmpi-dev libclang-dev)
 pkgs=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools
-  xvfb xauth libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
+  xvfb xauth libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 "${mpi[@]}")
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

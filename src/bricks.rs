@@ -454,10 +454,16 @@ impl BrickScene {
         let nb = store_bricks(&self.store);
         let bad = tree.iter().any(|n| {
             let (axis, plane) = crate::kdtree::cut(n);
-            axis > 2 || plane == 0 || plane >= nb[axis] || [n[1], n[2]].iter().any(|&c| c != u32::MAX && c as usize >= tree.len())
+            axis > 2
+                || plane == 0
+                || plane >= nb[axis]
+                || [n[1], n[2]].iter().any(|&c| c != u32::MAX && c as usize >= tree.len())
         });
         if bad || tree.len() >= 1 << crate::kdtree::TREE_DEPTH {
-            return Err(Error::InvalidArgument(format!("a k-d tree of {} nodes that does not cut the {nb:?} brick grid", tree.len())));
+            return Err(Error::InvalidArgument(format!(
+                "a k-d tree of {} nodes that does not cut the {nb:?} brick grid",
+                tree.len()
+            )));
         }
         self.tree = tree;
         Ok(())

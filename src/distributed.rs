@@ -100,7 +100,8 @@ impl Partition {
         // The cut, in tree order; each entry carries the inner nodes above it that it opened.
         let mut cut = vec![root];
         while (cut.len() as u32) < ranks {
-            let open = (0..cut.len()).filter(|&i| cut[i].node != crate::kdtree::LEAF).min_by_key(|&i| (cut[i].depth, i));
+            let open =
+                (0..cut.len()).filter(|&i| cut[i].node != crate::kdtree::LEAF).min_by_key(|&i| (cut[i].depth, i));
             let Some(i) = open else { break };
             let c = cut[i];
             let node = tree[c.node as usize];
@@ -165,7 +166,7 @@ impl Partition {
 
 /// The eye's brick split (`order::brick_split`) for a grid: what orders the boxes.
 pub fn eye_split(grid: &Grid, camera: &Camera) -> Result<[u32; 3]> {
-    let set = SplatSet::empty(grid.clone())?;
+    let set = SplatSet::empty(*grid)?;
     Ok(crate::order::brick_split(&set, camera, BRICK))
 }
 

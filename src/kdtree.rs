@@ -23,7 +23,14 @@ pub fn build(grid: [u32; 3], occupied: impl Fn(usize) -> bool) -> Vec<Node> {
     nodes
 }
 
-fn split(nodes: &mut Vec<Node>, g: [u32; 3], lo: [u32; 3], hi: [u32; 3], depth: u32, occ: &dyn Fn(usize) -> bool) -> u32 {
+fn split(
+    nodes: &mut Vec<Node>,
+    g: [u32; 3],
+    lo: [u32; 3],
+    hi: [u32; 3],
+    depth: u32,
+    occ: &dyn Fn(usize) -> bool,
+) -> u32 {
     let axis = (0..3).max_by_key(|&a| (hi[a] - lo[a], 2 - a)).unwrap_or(0);
     if depth == TREE_DEPTH || hi[axis] - lo[axis] < 2 {
         return LEAF;

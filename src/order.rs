@@ -181,6 +181,46 @@ pub fn pbtf_bricked(set: &SplatSet, camera: &Camera, brick: u32) -> Result<Vec<u
     }))
 }
 
+/// A bricked volume's draw order, front to back (issue 28): the bricks as the k-d tree `tree`
+/// (`kdtree`) orders them, every node's near side first and PBTF within its leaves' boxes, and
+/// inside each brick its voxels in PBTF order. A CPU reference (a comparison sort on the path
+/// through the tree, then the two PBTF keys).
+pub fn tree_bricked(set: &SplatSet, camera: &Camera, brick: u32, tree: &[crate::kdtree::Node]) -> Result<Vec<u32>> {
+    if brick == 0 {
+        return Err(Error::InvalidArgument("the brick side must be at least one voxel".into()));
+    }
+    let voxel_split = pbtf_split(set, camera);
+    let split = brick_split(set, camera, brick);
+    let grid = set.grid().dims.map(|d| d.div_ceil(brick));
+    let outward = |v: u32, s: u32| if v < s { (0u64, (s - 1 - v) as u64) } else { (1, (v - s) as u64) };
+    let level = |ijk: [u32; 3], split: [u32; 3]| {
+        let [(si, ri), (sj, rj), (sk, rk)] = [0, 1, 2].map(|a| outward(ijk[a], split[a]));
+        (si | sj << 1 | sk << 2, rk, rj, ri)
+    };
+    // Per brick: the near (0) / far (1) turns down the tree, and the PBTF key in its leaf's box.
+    let brick_key = |b: [u32; 3]| {
+        let (mut lo, mut hi, mut path) = ([0u32; 3], grid, Vec::new());
+        let mut n = if tree.is_empty() { crate::kdtree::LEAF } else { 0 };
+        while n != crate::kdtree::LEAF {
+            let node = &tree[n as usize];
+            let (axis, plane) = crate::kdtree::cut(node);
+            let high = b[axis] >= plane;
+            path.push(u8::from(high == crate::kdtree::lower_in_front(node, split)));
+            if high {
+                lo[axis] = plane;
+            } else {
+                hi[axis] = plane;
+            }
+            n = node[1 + usize::from(high)];
+        }
+        (path, level(b, [0, 1, 2].map(|a| split[a].clamp(lo[a], hi[a]))))
+    };
+    Ok(by_key(set, |s| {
+        let [i, j, k, _] = set.splats()[s].ijk;
+        (brick_key([i / brick, j / brick, k / brick]), level([i, j, k], voxel_split))
+    }))
+}
+
 /// The eye's PBTF split of the grid of `brick`-voxel bricks over `set`'s grid (`brick` > 0).
 pub fn brick_split(set: &SplatSet, camera: &Camera, brick: u32) -> [u32; 3] {
     let dims = set.grid().dims;

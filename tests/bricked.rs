@@ -1,5 +1,5 @@
 //! Bricked volumes on the GPU path (issue 23): the brick stages (`brick_cull`, `brick_order`, `brick_params`)
-//! against their CPU mirrors, the two-level PBTF order they write against `order::pbtf_bricked`
+//! against their CPU mirrors, the order they write (bricks by the k-d tree, voxels by PBTF) against `order::tree_bricked`
 //! over a random view battery, streaming through a small budget, transfer-function changes, and
 //! bad budgets. Validation on: any message fails.
 mod common;
@@ -78,11 +78,14 @@ fn drawn_sequence(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32
 }
 
 #[test]
-fn the_two_level_order_is_pbtf_over_bricks_then_voxels_on_both_engines() {
+fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
     let vol = blob([37, 29, 23]);
     let store = BrickStore::build(&vol).unwrap();
     let set = store.classify(&tf(), None).unwrap();
     let grid = *set.grid();
+    let nb = store.dims.map(|d| d.div_ceil(BRICK));
+    let tree = voxsplat::kdtree::build(nb, |id| store.index[id] != u32::MAX);
+    assert!(tree.len() >= 3, "the tree cuts the bricks: {tree:?}");
     let (mut g, mut c) = (renderer(true, None), renderer(false, None));
     g.set_volume(&vol, &tf(), None).unwrap();
     c.set_volume(&vol, &tf(), None).unwrap();
@@ -104,7 +107,7 @@ fn the_two_level_order_is_pbtf_over_bricks_then_voxels_on_both_engines() {
                 let o = opts(Raster::Graphics, direction);
                 let got = drawn_sequence(&mut g, &cam, &o);
                 assert_eq!(got, drawn_sequence(&mut c, &cam, &o), "{kind:?} {v}: GPU vs mirror sequence");
-                let mut want: Vec<[u32; 3]> = voxsplat::order::pbtf_bricked(&set, &cam, BRICK)
+                let mut want: Vec<[u32; 3]> = voxsplat::order::tree_bricked(&set, &cam, BRICK, &tree)
                     .unwrap()
                     .iter()
                     .map(|&s| {
@@ -119,7 +122,7 @@ fn the_two_level_order_is_pbtf_over_bricks_then_voxels_on_both_engines() {
                 let kept: std::collections::HashSet<[u32; 3]> = got.iter().copied().collect();
                 want.retain(|v| kept.contains(v));
                 assert_eq!(got.len(), want.len(), "{kind:?} {v}: drawn voxels are the classified ones");
-                assert_eq!(got, want, "{kind:?} {v} {direction:?}: two-level PBTF");
+                assert_eq!(got, want, "{kind:?} {v} {direction:?}: tree order, then PBTF");
                 // And the order validator on what is drawn: no 6-neighbour pair against its plane.
                 let drawn = voxsplat::SplatSet::from_fn(grid, |i, j, k| {
                     kept.contains(&[i, j, k]).then_some([1.0, 1.0, 1.0, 0.5])

@@ -84,8 +84,7 @@ fn boxes_composited_in_order_equal_the_whole() {
 fn the_partition_is_the_top_of_the_brick_tree_balanced_by_non_empty_bricks() {
     // Non-empty bricks in one corner octant of a 8 x 8 x 16 brick grid.
     let grid = [8u32, 8, 16];
-    let occupied: Vec<bool> =
-        (0..8 * 8 * 16).map(|i| i % 8 < 4 && (i / 8) % 8 < 4 && i / 64 < 8).collect();
+    let occupied: Vec<bool> = (0..8 * 8 * 16).map(|i| i % 8 < 4 && (i / 8) % 8 < 4 && i / 64 < 8).collect();
     for ranks in [1u32, 2, 3, 4, 8] {
         let p = Partition::new(grid, &occupied, ranks).unwrap();
         assert_eq!(p.boxes.len(), ranks as usize);

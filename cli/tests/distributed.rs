@@ -1,0 +1,124 @@
+//! `voxsplat render` under mpirun (issue 28; a build with `--features mpi`): 1, 2 and 4 ranks on
+//! this machine (oversubscribed) draw the single-process frame, the eye outside the volume and
+//! inside it; ranks with empty boxes take part; a rank that cannot read its part makes every rank
+//! exit with the same error, not hang; the sheet modes are refused.
+#![cfg(feature = "mpi")]
+mod cmd;
+use cmd::voxsplat;
+use std::process::{Command, Output};
+
+const STENT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/stent/stent.nrrd");
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    cmd::tmp_in("distributed", name)
+}
+
+/// `mpirun -n RANKS voxsplat ARGS`, killed after two minutes (a hang fails the test).
+fn mpirun(ranks: u32, args: &[&str]) -> Output {
+    let mut c = Command::new("timeout");
+    c.args(["120", "mpirun", "--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string()]);
+    c.arg(env!("CARGO_BIN_EXE_voxsplat")).args(args);
+    c.output().expect("run mpirun (scripts/setup.sh --mpi installs OpenMPI)")
+}
+
+/// The largest difference of two EXR frames (`voxsplat compare`).
+fn max_abs(a: &std::path::Path, b: &std::path::Path) -> f64 {
+    let out = voxsplat(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    let line = text.lines().find(|l| l.starts_with("max_abs:")).unwrap_or_else(|| panic!("{text}"));
+    line.split_whitespace().nth(1).unwrap().parse().unwrap()
+}
+
+fn ok(out: &Output, what: &str) {
+    assert!(out.status.success(), "{what}: {}", String::from_utf8_lossy(&out.stderr));
+}
+
+#[test]
+fn one_two_and_four_ranks_draw_the_single_process_frame() {
+    let views: [(&str, &[&str]); 2] = [("outside", &[]), ("inside", &["--eye", "5,-10,40", "--target", "0,0,-100"])];
+    for (view, extra) in views {
+        let single = tmp(&format!("{view}-single.exr"));
+        let mut args = vec!["render", "--volume", STENT, "--tf", "ct", "--size", "192x192", "--validation"];
+        args.extend_from_slice(extra);
+        let mut a = args.clone();
+        a.extend(["--out", single.to_str().unwrap()]);
+        ok(&voxsplat(&a), "single process");
+        for (ranks, scheme) in [(1, "auto"), (2, "auto"), (4, "binary-swap"), (4, "direct-send")] {
+            let out = tmp(&format!("{view}-{ranks}-{scheme}.exr"));
+            let mut a = args.clone();
+            a.extend(["--compositing", scheme, "--out", out.to_str().unwrap()]);
+            let run = mpirun(ranks, &a);
+            ok(&run, &format!("{view}, {ranks} ranks, {scheme}"));
+            let err = String::from_utf8_lossy(&run.stderr);
+            assert!(err.contains(&format!("on {ranks} ranks")), "{err}");
+            let d = max_abs(&single, &out);
+            assert!(d <= 2e-3, "{view}, {ranks} ranks by {scheme}: {d} from the single-process frame");
+        }
+    }
+}
+
+#[test]
+fn ranks_whose_boxes_are_empty_take_part() {
+    // 8 x 8 x 16 voxels (two bricks along z), something only in the lower one: with four ranks,
+    // one box holds nothing and two have no brick at all.
+    let raw = tmp("half.raw");
+    let data: Vec<u8> = (0..8 * 8 * 16).map(|i| if i / 64 < 8 && (i % 8) > 1 { 200 } else { 0 }).collect();
+    std::fs::write(&raw, data).unwrap();
+    let args = [
+        "render",
+        "--volume",
+        raw.to_str().unwrap(),
+        "--dims",
+        "8,8,16",
+        "--dtype",
+        "u8",
+        "--tf",
+        "ramp",
+        "--size",
+        "64x64",
+    ];
+    let single = tmp("half-single.exr");
+    let mut a = args.to_vec();
+    a.extend(["--out", single.to_str().unwrap()]);
+    ok(&voxsplat(&a), "single process");
+    let out = tmp("half-4.exr");
+    let mut a = args.to_vec();
+    a.extend(["--out", out.to_str().unwrap(), "--validation"]);
+    let run = mpirun(4, &a);
+    ok(&run, "four ranks");
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains(" + 0 + 0"), "two ranks without voxels: {err}");
+    assert!(max_abs(&single, &out) <= 2e-3);
+}
+
+#[test]
+fn a_rank_that_cannot_read_its_part_stops_every_rank_with_the_same_error() {
+    // The stent's gzip stream cut short: the ranks that read its last slices fail, the others
+    // do not; all four report the first failing rank's error and exit.
+    let bytes = std::fs::read(STENT).unwrap();
+    let cut = tmp("cut.nrrd");
+    std::fs::write(&cut, &bytes[..bytes.len() * 3 / 5]).unwrap();
+    let out = tmp("cut.png");
+    let run =
+        mpirun(4, &["render", "--volume", cut.to_str().unwrap(), "--size", "64x64", "--out", out.to_str().unwrap()]);
+    assert!(!run.status.success() && run.status.code() != Some(124), "exits, does not hang: {:?}", run.status);
+    let err = String::from_utf8_lossy(&run.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(lines.len(), 4, "every rank reports: {err}");
+    assert!(lines.iter().all(|l| *l == lines[0]), "the same error: {lines:?}");
+    assert!(lines[0].contains("of 4") && lines[0].contains("truncated"), "{}", lines[0]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn sheet_modes_are_refused_across_ranks() {
+    let out = tmp("sheet.png");
+    let run = mpirun(
+        2,
+        &["render", "--volume", STENT, "--composite", "sheet", "--size", "64x64", "--out", out.to_str().unwrap()],
+    );
+    assert!(!run.status.success());
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains("per-splat frames") && err.contains("SCALE.md"), "{err}");
+}
