@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Mutation check (issue 25): plants six known bugs one at a time, runs the tests that should
+# Mutation check (issue 25): plants seven known bugs one at a time, runs the tests that should
 # catch each, and prints a markdown table; exits 1 when a bug survives (no test failed). Each
 # mutant costs a release rebuild of the library and its tests (about 1-3 minutes here); the last
 # result lives in docs/RELIABILITY.md. The tree is restored after every mutant, also on Ctrl-C.
-#   scripts/mutants.sh            all six
+#   scripts/mutants.sh            all seven
 #   scripts/mutants.sh octant     the ones whose name contains "octant"
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,6 +15,7 @@ MUTANTS=(
   "skip a stage (tile offsets)|src/recording.rs|        e.run(&Dispatch::new(StageId::TileOffsets, 0, [1, 1, 1], List::Order, bytes))?;|        let _ = StageId::TileOffsets;|--test raster"
   "wrong blend equation (alpha)|src/cpu/composite.rs|                        a + (1.0 - a) * acc[3],|                        a + acc[3],|--test gpu"
   "stale TF (no new classification)|src/bricks.rs|        self.classification = next_classification();\n        Ok(())|        Ok(())|--test lod"
+  "boxes composited nearest first|src/distributed.rs|        s.plane >= split[s.axis]|        s.plane < split[s.axis]|--features mpi -p voxsplat-cli --test distributed one_two"
 )
 filter=${1:-}
 backup=$(mktemp -d)

@@ -967,7 +967,8 @@ fn render_distributed(a: &RenderArgs, opts: &RenderOptions, host_splats: bool) -
         frames.push(d.render(&cam, opts)?);
     }
     report_validation(d.renderer())?;
-    let peak = voxsplat::distributed::peak_rss_bytes();
+    let store_bytes = d.gather(d.store_bytes());
+    let peaks = d.gather(voxsplat::distributed::peak_rss_bytes().unwrap_or(0));
     if rank != 0 {
         return Ok(());
     }
@@ -989,9 +990,9 @@ fn render_distributed(a: &RenderArgs, opts: &RenderOptions, host_splats: bool) -
             ms.sort_by(f64::total_cmp);
             println!("{stage:<14} {:>9.3} ms", ms[ms.len() / 2]);
         }
-        if let Some(p) = peak {
-            println!("{:<14} {:>9.1} MiB (rank 0)", "peak memory", p as f64 / (1 << 20) as f64);
-        }
+        let mib = |v: &[u64]| v.iter().map(|b| format!("{:.1}", *b as f64 / (1 << 20) as f64)).collect::<Vec<_>>();
+        println!("{:<14} {} MiB per rank", "store", mib(&store_bytes).join(" "));
+        println!("{:<14} {} MiB per rank", "peak memory", mib(&peaks).join(" "));
     }
     Ok(())
 }

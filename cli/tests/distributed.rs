@@ -59,6 +59,32 @@ fn one_two_and_four_ranks_draw_the_single_process_frame() {
 }
 
 #[test]
+fn every_per_splat_mode_draws_the_single_process_frame_on_four_ranks() {
+    // The compute tile raster, point sprites, levels of detail, shading (gradients across the
+    // boxes' faces read the voxel layer each rank holds around its box), back to front.
+    let modes: [&[&str]; 5] = [
+        &["--raster", "compute"],
+        &["--raster", "points", "--kernel", "narrow"],
+        &["--lod", "auto"],
+        &["--shade"],
+        &["--direction", "btf", "--raster", "graphics"],
+    ];
+    for (i, mode) in modes.iter().enumerate() {
+        let mut args = vec!["render", "--volume", STENT, "--tf", "ct", "--size", "160x160", "--validation"];
+        args.extend_from_slice(mode);
+        let (single, out) = (tmp(&format!("mode{i}-single.exr")), tmp(&format!("mode{i}-4.exr")));
+        let mut a = args.clone();
+        a.extend(["--out", single.to_str().unwrap()]);
+        ok(&voxsplat(&a), "single process");
+        let mut a = args.clone();
+        a.extend(["--out", out.to_str().unwrap()]);
+        ok(&mpirun(4, &a), &format!("{mode:?}"));
+        let d = max_abs(&single, &out);
+        assert!(d <= 2e-3, "{mode:?}: {d} from the single-process frame");
+    }
+}
+
+#[test]
 fn ranks_whose_boxes_are_empty_take_part() {
     // 8 x 8 x 16 voxels (two bricks along z), something only in the lower one: with four ranks,
     // one box holds nothing and two have no brick at all.

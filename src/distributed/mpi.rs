@@ -44,6 +44,7 @@ pub struct Distributed<C: Communicator> {
     grid: Grid,
     scheme: Scheme,
     stored: u64,
+    store_bytes: u64,
 }
 
 impl<C: Communicator> Distributed<C> {
@@ -92,10 +93,15 @@ impl<C: Communicator> Distributed<C> {
             comm.all_reduce_into(&scene.gradient_max(), &mut g, SystemOperation::max());
             scene.set_gradient_max(g);
         }
-        let stored = scene.store.len() as u64;
+        let (stored, store_bytes) = (scene.store.len() as u64, scene.store.bytes());
         let set = renderer.set_bricks(scene);
         agree(&comm, set)?;
-        Ok(Self { comm, renderer, partition, grid, scheme, stored })
+        Ok(Self { comm, renderer, partition, grid, scheme, stored, store_bytes })
+    }
+
+    /// Bytes of this rank's store (its box and the voxel layer around it; `BrickStore::bytes`).
+    pub fn store_bytes(&self) -> u64 {
+        self.store_bytes
     }
 
     /// The partition of the volume over the ranks.
@@ -120,7 +126,12 @@ impl<C: Communicator> Distributed<C> {
 
     /// Voxels stored on each rank (at rank 0; others get an empty list).
     pub fn stored_per_rank(&self) -> Vec<u64> {
-        gather_u64(&self.comm, self.stored)
+        self.gather(self.stored)
+    }
+
+    /// `v` from every rank, in rank order, at rank 0 (others get an empty list).
+    pub fn gather(&self, v: u64) -> Vec<u64> {
+        gather_u64(&self.comm, v)
     }
 
     /// Every rank calls this with the same camera and options: each draws its box (per-splat
