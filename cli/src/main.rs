@@ -950,23 +950,26 @@ fn render_distributed(a: &RenderArgs, opts: &RenderOptions, host_splats: bool) -
                 .into(),
         ));
     };
-    let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
-    let reader = voxsplat::distributed::open(path, &hints)?;
-    let spacing = hints.spacing.unwrap_or(reader.spacing);
-    let grid = voxsplat::Grid::centered(reader.dims, spacing)?;
-    drop(reader);
-    let cam = camera_of(&a.scene, &grid)?;
-    let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
-    let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing);
-    let r = renderer_of(&a.scene)?;
-    let scheme = a.compositing.parse()?;
+    // Whatever one rank alone may fail at (its view of the file, its device) is agreed on before
+    // the first collective, so no rank waits for one that has quit.
+    let setup = (|| {
+        let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
+        let reader = voxsplat::distributed::open(path, &hints)?;
+        let grid = voxsplat::Grid::centered(reader.dims, hints.spacing.unwrap_or(reader.spacing))?;
+        let cam = camera_of(&a.scene, &grid)?;
+        let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
+        let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing);
+        let scheme: voxsplat::distributed::Scheme = a.compositing.parse()?;
+        Ok((hints, cam, tf, shading, scheme, renderer_of(&a.scene)?))
+    })();
+    let (hints, cam, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
     let mut d = Distributed::load(world, r, path, &hints, tf, shading, scheme)?;
     let stored = d.stored_per_rank();
     let mut frames = Vec::new();
     for _ in 0..a.repeat.max(1) {
         frames.push(d.render(&cam, opts)?);
     }
-    report_validation(d.renderer())?;
+    d.agree(report_validation(d.renderer()))?;
     let store_bytes = d.gather(d.store_bytes());
     let peaks = d.gather(voxsplat::distributed::peak_rss_bytes().unwrap_or(0));
     if rank != 0 {

@@ -3,6 +3,24 @@
 //! direct-send or binary-swap, through MPI collectives and point-to-point messages; rank 0 holds
 //! the image. A failure on any rank (a file it cannot read, a device error) is agreed on before
 //! the next collective, so every rank returns the same error instead of waiting forever.
+//!
+//! Every rank runs the same program (started by `mpirun -n R`):
+//!
+//! ```no_run
+//! use voxsplat::distributed::{mpi::{rsmpi, Distributed}, Scheme};
+//! use voxsplat::{Camera, RenderOptions, Renderer, RendererOptions};
+//! let universe = rsmpi::initialize().expect("MPI initialised once");
+//! let renderer = Renderer::new(&RendererOptions::default())?;
+//! let tf = voxsplat::classify::TransferFunction::preset("ct")?;
+//! let path = std::path::Path::new("stent.nrrd");
+//! let mut d = Distributed::load(universe.world(), renderer, path, &Default::default(), tf, None, Scheme::Auto)?;
+//! let camera = Camera::framing(d.grid(), 512, 512);
+//! // Rank 0 gets the frame; every rank must call render with the same camera and options.
+//! if let Some(frame) = d.render(&camera, &RenderOptions::default())? {
+//!     voxsplat::output::write_image(&frame.image, std::path::Path::new("stent.png"))?;
+//! }
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use super::{eye_split, load_part, over_into, piece, scan, scan_layers, swap_range, BrickBox, Partition, Scan, Scheme};
 use crate::bricks::{BrickScene, BRICK};
 use crate::camera::Camera;
@@ -127,6 +145,12 @@ impl<C: Communicator> Distributed<C> {
     /// Voxels stored on each rank (at rank 0; others get an empty list).
     pub fn stored_per_rank(&self) -> Vec<u64> {
         self.gather(self.stored)
+    }
+
+    /// `local` agreed on across the ranks (`agree`): call it on a rank-local result before the
+    /// next collective.
+    pub fn agree<T>(&self, local: Result<T>) -> Result<T> {
+        agree(&self.comm, local)
     }
 
     /// `v` from every rank, in rank order, at rank 0 (others get an empty list).
