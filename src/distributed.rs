@@ -1,9 +1,10 @@
-//! Sort-last rendering (issue 28), the parts that need no transport: the k-d partition of a
-//! bricked volume's brick grid into one convex box per rank, balanced by non-empty bricks; the
-//! boxes' visibility order for an eye (PBTF one level up: at every split plane the far side
-//! first); the region a rank reads (its box and the layer of voxels its faces' gradients need);
-//! and the `over` of premultiplied images and the pixel pieces the compositing schemes exchange.
-//! The MPI side (feature `mpi`) is `distributed::mpi`.
+//! Sort-last rendering (issue 28), the parts that need no transport: the partition of a bricked
+//! volume's brick grid into one convex box per rank (the top of the k-d tree that orders the
+//! bricks, `kdtree`: balanced by non-empty bricks for a power of two); the boxes' visibility order
+//! for an eye (at every node of the tree the far side first); the scan that finds the whole
+//! volume's range and non-empty bricks; the region a rank reads (its box and the layer of voxels
+//! its faces' gradients need); and the `over` of premultiplied images and the pixel pieces the
+//! compositing schemes exchange. The MPI side (feature `mpi`) is `distributed::mpi`.
 use crate::bricks::BRICK;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -97,7 +98,7 @@ impl Partition {
         }
         let tree = crate::kdtree::build(grid, |id| occupied[id]);
         let root = Part { node: if tree.is_empty() { crate::kdtree::LEAF } else { 0 }, depth: 0, lo: [0; 3], hi: grid };
-        // The cut, in tree order; each entry carries the inner nodes above it that it opened.
+        // The cut, in tree order (left to right): open the shallowest node, leftmost first.
         let mut cut = vec![root];
         while (cut.len() as u32) < ranks {
             let open =

@@ -61,13 +61,15 @@ fn one_two_and_four_ranks_draw_the_single_process_frame() {
 #[test]
 fn every_per_splat_mode_draws_the_single_process_frame_on_four_ranks() {
     // The compute tile raster, point sprites, levels of detail, shading (gradients across the
-    // boxes' faces read the voxel layer each rank holds around its box), back to front.
-    let modes: [&[&str]; 5] = [
+    // boxes' faces read the voxel layer each rank holds around its box), back to front, a
+    // background laid under the composite at rank 0.
+    let modes: [&[&str]; 6] = [
         &["--raster", "compute"],
         &["--raster", "points", "--kernel", "narrow"],
         &["--lod", "auto"],
         &["--shade"],
         &["--direction", "btf", "--raster", "graphics"],
+        &["--background", "0.1,0.2,0.3"],
     ];
     for (i, mode) in modes.iter().enumerate() {
         let mut args = vec!["render", "--volume", STENT, "--tf", "ct", "--size", "160x160", "--validation"];
