@@ -937,11 +937,31 @@ fn pathdiff(target: &std::path::Path, base: &std::path::Path) -> String {
 /// rank, composited in the boxes' visibility order; rank 0 writes the image.
 #[cfg(feature = "mpi")]
 fn render_distributed(a: &RenderArgs, opts: &RenderOptions, host_splats: bool) -> Result<()> {
-    use voxsplat::distributed::mpi::{rsmpi, Distributed};
+    use voxsplat::distributed::mpi::rsmpi::{self, traits::CommunicatorCollectives};
     let universe =
         rsmpi::initialize().ok_or_else(|| Error::Unsupported("MPI was initialised already or cannot be".into()))?;
-    let world = universe.world();
-    use rsmpi::traits::Communicator;
+    let result = distributed_frames(a, opts, host_splats, universe.world());
+    if let Err(e @ Error::OnRank { .. }) = &result {
+        // Every rank holds this error: each reports it, and none exits (which makes mpirun stop
+        // the others) before all have.
+        let line = format!("error: {e}\n");
+        let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
+        universe.world().barrier();
+        drop(universe);
+        std::process::exit(2);
+    }
+    result
+}
+
+/// `render_distributed` on an initialised `world`.
+#[cfg(feature = "mpi")]
+fn distributed_frames(
+    a: &RenderArgs,
+    opts: &RenderOptions,
+    host_splats: bool,
+    world: voxsplat::distributed::mpi::rsmpi::topology::SimpleCommunicator,
+) -> Result<()> {
+    use voxsplat::distributed::mpi::{rsmpi::traits::Communicator, Distributed};
     let rank = world.rank();
     let Some(path) = a.scene.volume.as_ref().filter(|_| !host_splats && a.scene.positions.is_none()) else {
         return Err(Error::Unsupported(
@@ -1005,7 +1025,10 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // One write for the whole line: under mpirun the ranks share one stderr, and a line
+            // written in pieces interleaves with the other ranks'.
+            let line = format!("error: {e}\n");
+            let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
             ExitCode::from(2)
         }
     }
