@@ -424,7 +424,7 @@ impl BrickScene {
             gmax: std::sync::OnceLock::new(),
             classification: next_classification(),
             part: [[0; 3], store_bricks(&store)],
-            tree: crate::kdtree::build(store_bricks(&store), |id| store.index[id] != u32::MAX),
+            tree: crate::kdtree::build(store_bricks(&store), 1, |id| store.index[id] != u32::MAX),
             store,
         })
     }

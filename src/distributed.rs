@@ -1,6 +1,6 @@
 //! Sort-last rendering (issue 28), the parts that need no transport: the partition of a bricked
 //! volume's brick grid into one convex box per rank (the top of the k-d tree that orders the
-//! bricks, `kdtree`: balanced by non-empty bricks for a power of two); the boxes' visibility order
+//! bricks, `kdtree`, balanced by non-empty bricks); the boxes' visibility order
 //! for an eye (at every node of the tree the far side first); the scan that finds the whole
 //! volume's range and non-empty bricks; the region a rank reads (its box and the layer of voxels
 //! its faces' gradients need); and the `over` of premultiplied images and the pixel pieces the
@@ -71,22 +71,14 @@ pub struct Partition {
     pub tree: Vec<crate::kdtree::Node>,
 }
 
-/// A node of the cut: its tree node or, for a box, its leaf.
-#[derive(Clone, Copy)]
-struct Part {
-    node: u32,
-    depth: u32,
-    lo: [u32; 3],
-    hi: [u32; 3],
-}
-
 impl Partition {
-    /// Cut a grid of `grid` bricks, non-empty where `occupied` (x fastest), into `ranks` boxes:
-    /// the k-d tree's nodes, split shallowest first and left to right until there are `ranks`
-    /// (a power of two: one level of the tree, every box with the same share of non-empty
-    /// bricks; otherwise the first nodes of the next level are split). A box may hold no
-    /// non-empty brick, or, with more ranks than the tree has leaves, no brick: its rank draws
-    /// nothing and still takes part.
+    /// Cut a grid of `grid` bricks, non-empty where `occupied` (x fastest), into `ranks` boxes: the
+    /// k-d tree built for `ranks` (`kdtree::build`), whose nodes over one rank are the boxes, in
+    /// tree order; every box holds its share of the non-empty bricks (to a brick layer). For a
+    /// power of two the tree is the one a single process orders the bricks by, so the composite
+    /// equals its frame; for other counts it equals the frame of one process ordering by this
+    /// tree (`BrickScene::set_tree`). A box may hold no non-empty brick, or, with more ranks than
+    /// the grid has bricks to cut, no brick: its rank draws nothing and still takes part.
     pub fn new(grid: [u32; 3], occupied: &[bool], ranks: u32) -> Result<Self> {
         let n = grid.iter().map(|&g| g as usize).product::<usize>();
         if ranks == 0 || ranks > 1 << crate::kdtree::TREE_DEPTH || occupied.len() != n {
@@ -96,42 +88,29 @@ impl Partition {
                 occupied.len()
             )));
         }
-        let tree = crate::kdtree::build(grid, |id| occupied[id]);
-        let root = Part { node: if tree.is_empty() { crate::kdtree::LEAF } else { 0 }, depth: 0, lo: [0; 3], hi: grid };
-        // The cut, in tree order (left to right): open the shallowest node, leftmost first.
-        let mut cut = vec![root];
-        while (cut.len() as u32) < ranks {
-            let open =
-                (0..cut.len()).filter(|&i| cut[i].node != crate::kdtree::LEAF).min_by_key(|&i| (cut[i].depth, i));
-            let Some(i) = open else { break };
-            let c = cut[i];
-            let node = tree[c.node as usize];
-            let (axis, plane) = crate::kdtree::cut(&node);
-            let (mut low, mut high) = (c, c);
-            (low.hi[axis], high.lo[axis]) = (plane, plane);
-            (low.node, high.node) = (node[1], node[2]);
-            (low.depth, high.depth) = (c.depth + 1, c.depth + 1);
-            cut.splice(i..=i, [low, high]);
-        }
-        let mut p = Partition { grid, boxes: Vec::new(), splits: Vec::new(), tree };
-        p.boxes = cut.iter().map(|c| BrickBox { lo: c.lo, hi: c.hi }).collect();
-        p.boxes.resize(ranks as usize, BrickBox { lo: [0; 3], hi: [0; 3] });
-        // The cut's inner nodes with their ranks: walk the tree down to the boxes.
-        let boxes = p.boxes.clone();
-        p.walk_splits(0, boxes.len().min(cut.len()) as u32, &boxes, if p.tree.is_empty() { None } else { Some(0) });
+        let tree = crate::kdtree::build(grid, ranks, |id| occupied[id]);
+        let empty = BrickBox { lo: [0; 3], hi: [0; 3] };
+        let mut p = Partition { grid, boxes: vec![empty; ranks as usize], splits: Vec::new(), tree };
+        let root = if p.tree.is_empty() { crate::kdtree::LEAF } else { 0 };
+        p.walk_ranks(root, BrickBox { lo: [0; 3], hi: grid }, 0, ranks);
         Ok(p)
     }
 
-    /// Record the inner nodes of the cut over boxes `first..end`, under tree node `node`.
-    fn walk_splits(&mut self, first: u32, end: u32, boxes: &[BrickBox], node: Option<u32>) {
-        let Some(n) = node.filter(|_| end - first > 1) else { return };
-        let t = self.tree[n as usize];
+    /// Give ranks `first..end` the box `b` under tree node `node`: halves of them to its two
+    /// sides, as `kdtree::build` cut it (a leaf over several ranks: the first takes the box).
+    fn walk_ranks(&mut self, node: u32, b: BrickBox, first: u32, end: u32) {
+        if end - first == 1 || node == crate::kdtree::LEAF {
+            self.boxes[first as usize] = b;
+            return;
+        }
+        let t = self.tree[node as usize];
         let (axis, plane) = crate::kdtree::cut(&t);
-        let mid = (first..end).find(|&r| boxes[r as usize].lo[axis] >= plane).unwrap_or(end);
+        let mid = first + (end - first) / 2;
         self.splits.push(Split { axis, plane, first, mid, end });
-        let child = |c: u32| (c != crate::kdtree::LEAF).then_some(c);
-        self.walk_splits(first, mid, boxes, child(t[1]));
-        self.walk_splits(mid, end, boxes, child(t[2]));
+        let (mut low, mut high) = (b, b);
+        (low.hi[axis], high.lo[axis]) = (plane, plane);
+        self.walk_ranks(t[1], low, first, mid);
+        self.walk_ranks(t[2], high, mid, end);
     }
 
     /// The node splitting ranks `first..end`.
@@ -145,11 +124,10 @@ impl Partition {
     }
 
     /// The ranks' boxes back to front for the eye's brick split: a visibility order of the boxes,
-    /// the one the bricks are drawn in by one process. Ranks without a box come first.
+    /// the one the bricks are drawn in by one process (ranks without a box anywhere).
     pub fn back_to_front(&self, split: [u32; 3]) -> Vec<u32> {
-        let boxed = self.boxes.iter().rposition(|b| b.bricks() > 0).map_or(1, |i| i + 1) as u32;
-        let mut out: Vec<u32> = (boxed..self.boxes.len() as u32).collect();
-        self.walk(0, boxed, split, &mut out);
+        let mut out = Vec::with_capacity(self.boxes.len());
+        self.walk(0, self.boxes.len() as u32, split, &mut out);
         out
     }
 

@@ -84,7 +84,7 @@ fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
     let set = store.classify(&tf(), None).unwrap();
     let grid = *set.grid();
     let nb = store.dims.map(|d| d.div_ceil(BRICK));
-    let tree = voxsplat::kdtree::build(nb, |id| store.index[id] != u32::MAX);
+    let tree = voxsplat::kdtree::build(nb, 1, |id| store.index[id] != u32::MAX);
     assert!(tree.len() >= 3, "the tree cuts the bricks: {tree:?}");
     let (mut g, mut c) = (renderer(true, None), renderer(false, None));
     g.set_volume(&vol, &tf(), None).unwrap();

@@ -11,8 +11,16 @@ use voxsplat::{Camera, Grid, ImageF32, RenderOptions, Renderer};
 
 const STENT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/stent/stent.nrrd");
 
-/// The frame of `path` cut into `ranks` boxes, drawn box by box on `r` and composited.
-fn parts(r: &mut Renderer, path: &str, tf: &TransferFunction, ranks: u32, cam: &Camera, o: &RenderOptions) -> ImageF32 {
+/// The frame of `path` cut into `ranks` boxes, drawn box by box on `r` and composited, and the
+/// tree that ordered the bricks.
+fn parts(
+    r: &mut Renderer,
+    path: &str,
+    tf: &TransferFunction,
+    ranks: u32,
+    cam: &Camera,
+    o: &RenderOptions,
+) -> (ImageF32, Vec<voxsplat::kdtree::Node>) {
     let hints = Default::default();
     let mut reader = distributed::open(path.as_ref(), &hints).unwrap();
     let nb = reader.dims.map(|d| d.div_ceil(voxsplat::bricks::BRICK));
@@ -40,7 +48,7 @@ fn parts(r: &mut Renderer, path: &str, tf: &TransferFunction, ranks: u32, cam: &
     for (px, c) in out.pixels.iter_mut().zip(all.chunks_exact(4)) {
         *px = [c[0], c[1], c[2], c[3]];
     }
-    out
+    (out, p.tree)
 }
 
 #[test]
@@ -53,28 +61,28 @@ fn boxes_composited_in_order_equal_the_whole() {
     let mut inside = outside;
     inside.eye = grid.center() + Vec3::new(5.0, -10.0, 40.0);
     inside.target = grid.center() + Vec3::new(0.0, 0.0, -100.0);
+    (inside.near, inside.far) = (0.1, 1000.0);
     let o = RenderOptions::default();
     for (name, cam) in [("outside", outside), ("inside", inside)] {
         r.set_bricks(BrickScene::new(store.clone(), tf.clone(), None).unwrap()).unwrap();
         let whole = r.render(&cam, &o).unwrap().image;
+        assert!(common::covered(&whole) > 10_000, "{name}: the stent in view");
         for ranks in [1, 2, 3, 4] {
-            let img = parts(&mut r, STENT, &tf, ranks, &cam, &o);
+            let (img, tree) = parts(&mut r, STENT, &tf, ranks, &cam, &o);
             let (max, mean) = common::diff(&whole, &img);
-            let worst = whole
-                .pixels
-                .iter()
-                .zip(&img.pixels)
-                .enumerate()
-                .max_by(|a, b| {
-                    let d = |p: &[f32; 4], q: &[f32; 4]| (0..4).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max);
-                    d(a.1 .0, a.1 .1).total_cmp(&d(b.1 .0, b.1 .1))
-                })
-                .map(|(i, _)| (i as u32 % cam.width, i as u32 / cam.width));
-            eprintln!(
-                "{name} {ranks}: max {max:.2e} mean {mean:.2e} covered {} at {worst:?} split {:?}",
-                common::covered(&whole),
-                distributed::eye_split(&grid, &cam).unwrap()
-            );
+            eprintln!("{name}, {ranks} ranks: max {max:.2e} mean {mean:.2e} from the one-process frame");
+            if ranks.is_power_of_two() {
+                // The ranks' tree is the one-process tree.
+                assert!(max <= 2e-3, "{name}, {ranks} ranks: max {max} from the one-process frame");
+            } else {
+                // Three boxes of equal shares: a tree of their own, which one process draws alike.
+                let mut scene = BrickScene::new(store.clone(), tf.clone(), None).unwrap();
+                scene.set_tree(tree).unwrap();
+                r.set_bricks(scene).unwrap();
+                let same_tree = r.render(&cam, &o).unwrap().image;
+                let (max, _) = common::diff(&same_tree, &img);
+                assert!(max <= 2e-3, "{name}, {ranks} ranks: max {max} from one process on their tree");
+            }
         }
     }
     common::assert_clean(&r);
@@ -85,7 +93,7 @@ fn the_partition_is_the_top_of_the_brick_tree_balanced_by_non_empty_bricks() {
     // Non-empty bricks in one corner octant of a 8 x 8 x 16 brick grid.
     let grid = [8u32, 8, 16];
     let occupied: Vec<bool> = (0..8 * 8 * 16).map(|i| i % 8 < 4 && (i / 8) % 8 < 4 && i / 64 < 8).collect();
-    for ranks in [1u32, 2, 3, 4, 8] {
+    for ranks in [1u32, 2, 3, 4, 5, 8] {
         let p = Partition::new(grid, &occupied, ranks).unwrap();
         assert_eq!(p.boxes.len(), ranks as usize);
         let bricks: u64 = p.boxes.iter().map(|b| b.bricks()).sum();
@@ -102,8 +110,13 @@ fn the_partition_is_the_top_of_the_brick_tree_balanced_by_non_empty_bricks() {
             n
         };
         let counts: Vec<u32> = p.boxes.iter().map(full).collect();
+        // Each box its share of the 128 non-empty bricks, to within one layer of them.
+        let share = 128.0 / ranks as f64;
+        assert!(counts.iter().all(|&c| (c as f64 - share).abs() <= 16.0), "{ranks}: balanced {counts:?}");
         if ranks.is_power_of_two() {
             assert!(counts.iter().all(|&c| c == 128 / ranks), "{ranks}: balanced {counts:?}");
+            let one = voxsplat::kdtree::build(grid, 1, |id| occupied[id]);
+            assert_eq!(p.tree, one, "{ranks}: the one-process tree");
         }
         // Every eye: a back-to-front order of all ranks.
         for split in [[0, 0, 0], [4, 4, 8], [8, 8, 16], [2, 7, 3]] {
