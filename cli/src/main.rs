@@ -963,16 +963,16 @@ fn distributed_frames(
 ) -> Result<()> {
     use voxsplat::distributed::mpi::{rsmpi::traits::Communicator, Distributed};
     let rank = world.rank();
-    let Some(path) = a.scene.volume.as_ref().filter(|_| !host_splats && a.scene.positions.is_none()) else {
-        return Err(Error::Unsupported(
-            "under mpirun, render draws a --volume file as a bricked store per splat in PBTF order (no --truth, \
-             --raycast, --k-line, --positions or other orders)"
-                .into(),
-        ));
-    };
     // Whatever one rank alone may fail at (its view of the file, its device) is agreed on before
     // the first collective, so no rank waits for one that has quit.
     let setup = (|| {
+        let Some(path) = a.scene.volume.as_ref().filter(|_| !host_splats && a.scene.positions.is_none()) else {
+            return Err(Error::Unsupported(
+                "under mpirun, render draws a --volume file as a bricked store per splat in PBTF order (no --truth, \
+                 --raycast, --k-line, --positions or other orders)"
+                    .into(),
+            ));
+        };
         let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
         let reader = voxsplat::distributed::open(path, &hints)?;
         let grid = voxsplat::Grid::centered(reader.dims, hints.spacing.unwrap_or(reader.spacing))?;
@@ -980,9 +980,9 @@ fn distributed_frames(
         let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
         let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing);
         let scheme: voxsplat::distributed::Scheme = a.compositing.parse()?;
-        Ok((hints, cam, tf, shading, scheme, renderer_of(&a.scene)?))
+        Ok((path, hints, cam, tf, shading, scheme, renderer_of(&a.scene)?))
     })();
-    let (hints, cam, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
+    let (path, hints, cam, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
     let mut d = Distributed::load(world, r, path, &hints, tf, shading, scheme)?;
     let stored = d.stored_per_rank();
     let mut frames = Vec::new();

@@ -1,7 +1,8 @@
 //! `voxsplat render` under mpirun (issue 28; a build with `--features mpi`): 1, 2 and 4 ranks on
 //! this machine (oversubscribed) draw the single-process frame, the eye outside the volume and
 //! inside it; ranks with empty boxes take part; a rank that cannot read its part makes every rank
-//! exit with the same error, not hang; the sheet modes are refused.
+//! exit with the same error, not hang; the sheet modes and scenes without a file are refused on
+//! every rank.
 #![cfg(feature = "mpi")]
 mod cmd;
 use cmd::voxsplat;
@@ -143,13 +144,20 @@ fn a_rank_that_cannot_read_its_part_stops_every_rank_with_the_same_error() {
 }
 
 #[test]
-fn sheet_modes_are_refused_across_ranks() {
-    let out = tmp("sheet.png");
-    let run = mpirun(
-        2,
-        &["render", "--volume", STENT, "--composite", "sheet", "--size", "64x64", "--out", out.to_str().unwrap()],
-    );
-    assert!(!run.status.success());
-    let err = String::from_utf8_lossy(&run.stderr);
-    assert!(err.contains("per-splat frames") && err.contains("SCALE.md"), "{err}");
+fn what_cannot_be_split_is_refused_on_every_rank() {
+    let out = tmp("refused.png");
+    let o = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 2] = [
+        (&["render", "--volume", STENT, "--composite", "sheet", "--size", "64x64", "--out", o], "SCALE.md"),
+        (&["render", "--scene", "cube40", "--size", "64x64", "--out", o], "--volume file"),
+    ];
+    for (args, why) in cases {
+        let run = mpirun(2, args);
+        assert!(!run.status.success() && run.status.code() != Some(124), "{args:?}: {:?}", run.status);
+        let err = String::from_utf8_lossy(&run.stderr);
+        let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+        assert_eq!(lines.len(), 2, "{args:?}: both ranks report: {err}");
+        assert!(lines.iter().all(|l| *l == lines[0] && l.contains(why)), "{args:?}: {lines:?}");
+    }
+    assert!(!out.exists());
 }
