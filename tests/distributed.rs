@@ -40,14 +40,10 @@ fn parts(
         r.set_bricks(scene).unwrap();
         images.push(r.render(cam, o).unwrap().image);
     }
-    let flat: Vec<Vec<f32>> = images.iter().map(|i| i.pixels.iter().flatten().copied().collect()).collect();
-    let refs: Vec<&[f32]> = flat.iter().map(|v| v.as_slice()).collect();
+    let refs: Vec<&[f32]> = images.iter().map(|i| bytemuck::cast_slice(&i.pixels)).collect();
     let split = distributed::eye_split(&grid, cam).unwrap();
     let all = distributed::composite_all(&p, split, &refs);
-    let mut out = ImageF32::new(cam.width, cam.height);
-    for (px, c) in out.pixels.iter_mut().zip(all.chunks_exact(4)) {
-        *px = [c[0], c[1], c[2], c[3]];
-    }
+    let out = ImageF32 { width: cam.width, height: cam.height, pixels: bytemuck::cast_slice(&all).to_vec() };
     (out, p.tree)
 }
 

@@ -170,10 +170,11 @@ impl<C: Communicator> Distributed<C> {
         let t = Instant::now();
         let drawn = self.renderer.render(camera, &o);
         let local_ms = t.elapsed().as_secs_f64() * 1e3;
-        let frame = agree(&self.comm, drawn)?;
+        let mut frame = agree(&self.comm, drawn)?;
         let t = Instant::now();
         let split = eye_split(&self.grid, camera)?;
-        let pixels: Vec<f32> = frame.image.pixels.iter().flatten().copied().collect();
+        // The frame's own pixels, as the floats MPI moves: no copy.
+        let pixels: &mut [f32] = bytemuck::cast_slice_mut(&mut frame.image.pixels);
         let image = match self.scheme {
             Scheme::BinarySwap => binary_swap(&self.comm, &self.partition, split, pixels),
             _ => direct_send(&self.comm, &self.partition, split, pixels),
@@ -181,11 +182,8 @@ impl<C: Communicator> Distributed<C> {
         let composite_ms = t.elapsed().as_secs_f64() * 1e3;
         let mut slowest = 0.0f64;
         self.comm.all_reduce_into(&local_ms, &mut slowest, SystemOperation::max());
-        let Some(flat) = image else { return Ok(None) };
-        let mut image = ImageF32::new(camera.width, camera.height);
-        for (px, c) in image.pixels.iter_mut().zip(flat.chunks_exact(4)) {
-            *px = [c[0], c[1], c[2], c[3]];
-        }
+        let Some(pixels) = image else { return Ok(None) };
+        let mut image = ImageF32 { width: camera.width, height: camera.height, pixels };
         if opts.background.is_some() {
             let push = crate::cpu::present::present_push(opts.background, 1, false, camera.width, camera.height);
             crate::cpu::present::present(&push, &mut image, &ImageF32::new(0, 0));
@@ -306,7 +304,7 @@ fn spans(ranges: impl Iterator<Item = std::ops::Range<usize>>) -> (Vec<i32>, Vec
 
 /// Direct-send: piece i of every rank's frame goes to rank i (one all-to-all), which composites
 /// the R layers in box order; rank 0 gathers the pieces.
-fn direct_send<C: Communicator>(comm: &C, p: &Partition, split: [u32; 3], frame: Vec<f32>) -> Option<Vec<f32>> {
+fn direct_send<C: Communicator>(comm: &C, p: &Partition, split: [u32; 3], frame: &[f32]) -> Option<Vec<[f32; 4]>> {
     let (rank, ranks) = (comm.rank() as usize, comm.size() as usize);
     let pixels = frame.len() / 4;
     let (send_counts, send_displs) = spans((0..ranks).map(|i| piece(pixels, ranks, i)));
@@ -316,7 +314,7 @@ fn direct_send<C: Communicator>(comm: &C, p: &Partition, split: [u32; 3], frame:
     let recv_counts = vec![n as i32; ranks];
     let recv_displs: Vec<i32> = (0..ranks).map(|i| (i * n) as i32).collect();
     {
-        let send = Parts::new(&frame[..], &send_counts[..], &send_displs[..]);
+        let send = Parts::new(frame, &send_counts[..], &send_displs[..]);
         let mut recv = PartitionMut::new(&mut layers[..], &recv_counts[..], &recv_displs[..]);
         comm.all_to_all_varcount_into(&send, &mut recv);
     }
@@ -331,12 +329,11 @@ fn direct_send<C: Communicator>(comm: &C, p: &Partition, split: [u32; 3], frame:
 /// Binary-swap: in round k, ranks that differ in bit k (siblings under a k-d node) swap halves of
 /// what they hold and composite by which side of the node's plane is nearer the eye; after
 /// log2 R rounds each holds 1/R of the frame, which rank 0 gathers.
-fn binary_swap<C: Communicator>(comm: &C, p: &Partition, split: [u32; 3], mut frame: Vec<f32>) -> Option<Vec<f32>> {
+fn binary_swap<C: Communicator>(comm: &C, p: &Partition, split: [u32; 3], frame: &mut [f32]) -> Option<Vec<[f32; 4]>> {
     let (rank, ranks) = (comm.rank() as u32, comm.size() as u32);
     let pixels = frame.len() / 4;
     let rounds = ranks.trailing_zeros();
     for k in 0..rounds {
-        let held = swap_range(pixels, rank, k);
         let keep = swap_range(pixels, rank, k + 1);
         let give = swap_range(pixels, rank ^ (1 << k), k + 1);
         let mut got = vec![0f32; keep.len() * 4];
@@ -356,11 +353,9 @@ fn binary_swap<C: Communicator>(comm: &C, p: &Partition, split: [u32; 3], mut fr
         } else {
             over_into(&got, mine);
         }
-        debug_assert!(held.start <= keep.start && keep.end <= held.end);
     }
     let mine = swap_range(pixels, rank, rounds);
-    let part = frame[mine.start * 4..mine.end * 4].to_vec();
-    gather(comm, pixels, &part, |r| swap_range(pixels, r as u32, rounds))
+    gather(comm, pixels, &frame[mine.start * 4..mine.end * 4], |r| swap_range(pixels, r as u32, rounds))
 }
 
 /// Rank 0 gathers each rank's composited pixels `range(r)` into the frame.
@@ -369,15 +364,15 @@ fn gather<C: Communicator>(
     pixels: usize,
     part: &[f32],
     range: impl Fn(usize) -> std::ops::Range<usize>,
-) -> Option<Vec<f32>> {
+) -> Option<Vec<[f32; 4]>> {
     let root = comm.process_at_rank(0);
     if comm.rank() != 0 {
         root.gather_varcount_into(part);
         return None;
     }
-    let mut out = vec![0f32; pixels * 4];
+    let mut out = vec![[0f32; 4]; pixels];
     let (counts, displs) = spans((0..comm.size() as usize).map(range));
-    let mut recv = PartitionMut::new(&mut out[..], &counts[..], &displs[..]);
+    let mut recv = PartitionMut::new(bytemuck::cast_slice_mut::<_, f32>(&mut out), &counts[..], &displs[..]);
     root.gather_varcount_into_root(part, &mut recv);
     Some(out)
 }
