@@ -111,9 +111,7 @@ impl BrickStore {
                 (lo, hi) = (lo.min(v), hi.max(v));
             }
         }
-        let lo = lo.min(background);
-        let (lo, hi) = if lo.is_finite() { (lo, hi.max(lo)) } else { (0.0, 0.0) };
-        Self::from_region(dims, spacing, (lo, hi), [[0; 3], dims], read)
+        Self::from_region(dims, spacing, store_range(lo.min(background), hi), [[0; 3], dims], read)
     }
 
     /// The store of the voxels in `region` (`lo..hi`, voxel coordinates) of a `dims` grid whose
@@ -142,10 +140,9 @@ impl BrickStore {
             &format!("a {dims:?} bricked store"),
         )?;
         let (lo, hi) = range;
-        // A constant volume has no background: its voxels are kept (the minimum would drop them
-        // all, and a one-voxel opaque volume drew nothing) at quantised 0, which the TF classifies
-        // as the dense path does (density 0 without a TF range, the value's own with one).
-        let constant = hi <= lo;
+        // A constant volume has no background: its voxels are kept (`keeps`: the minimum would drop
+        // them all, and a one-voxel opaque volume drew nothing) at quantised 0, which the TF
+        // classifies as the dense path does (density 0 without a TF range, the value's own with one).
         let span = if hi > lo { hi - lo } else { 1.0 };
         let mut store = Self {
             dims,
@@ -178,7 +175,7 @@ impl BrickStore {
                         }
                         let at = (v[2] - z0) as usize * plane + (v[1] - r0[1]) as usize * w + (v[0] - r0[0]) as usize;
                         let v = slab[at];
-                        if !(v.is_finite() && (v > lo || constant)) {
+                        if !keeps(v, range) {
                             continue;
                         }
                         let q = ((v - lo) / span * Q).round().clamp(0.0, Q) as u32;
@@ -367,6 +364,22 @@ fn tf_table(tf: &TransferFunction, (a, b): (f32, f32)) -> Vec<u32> {
     color.extend(bits);
     color.extend(prefix);
     color
+}
+
+/// The range a store normalises by, from the smallest and largest finite values read (none read:
+/// (0, 0)).
+pub fn store_range(lo: f32, hi: f32) -> (f32, f32) {
+    if lo.is_finite() {
+        (lo, hi.max(lo))
+    } else {
+        (0.0, 0.0)
+    }
+}
+
+/// Whether a store normalised by `range` keeps value `v`: finite and above the minimum, or any
+/// finite value of a constant volume.
+pub fn keeps(v: f32, (lo, hi): (f32, f32)) -> bool {
+    v.is_finite() && (v > lo || hi <= lo)
 }
 
 /// Refuse a grid a bricked store cannot hold.

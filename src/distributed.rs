@@ -262,18 +262,14 @@ impl Scan {
 
     /// The range a bricked store normalises by (`BrickStore::from_slices`'s).
     pub fn range(&self) -> (f32, f32) {
-        if self.lo.is_finite() {
-            (self.lo, self.hi.max(self.lo))
-        } else {
-            (0.0, 0.0)
-        }
+        crate::bricks::store_range(self.lo, self.hi)
     }
 
     /// Per brick, whether the store keeps any of its voxels (above the minimum; every finite one
     /// of a constant volume).
     pub fn occupied(&self) -> Vec<bool> {
-        let (lo, hi) = self.range();
-        self.brick_max.iter().map(|&m| m.is_finite() && (m > lo || hi <= lo)).collect()
+        let range = self.range();
+        self.brick_max.iter().map(|&m| crate::bricks::keeps(m, range)).collect()
     }
 }
 
