@@ -26,7 +26,7 @@ use voxsplat::glam::{Quat, Vec3, Vec4};
 use voxsplat::vk::ash::{self, vk};
 use voxsplat::vk::{Context, HostHandles, HostTarget, Semaphore};
 use voxsplat::{Camera, Clip, Composite, Error, Lod, OrderKind, Raster, RenderOptions, Renderer, Result};
-use voxsplat_cli::open::{camera_of, open, parse_background, SceneArgs};
+use voxsplat_cli::open::{camera_of, content_of, open, parse_background, SceneArgs};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -457,6 +457,7 @@ impl Viewer {
         let mut renderer = Renderer::with_context(ctx.clone())?;
         let (bricked, set) = open(&self.args.scene, self.options.order != OrderKind::Pbtf)?;
         let grid = *set.grid();
+        let content = content_of(&self.args.scene, bricked.as_ref(), &set)?;
         match bricked {
             Some(b) => {
                 self.raw_range = b.store.range;
@@ -465,7 +466,7 @@ impl Viewer {
             }
             None => renderer.set_scene(set)?,
         }
-        self.base = Some(camera_of(&self.args.scene, &grid)?);
+        self.base = Some(camera_of(&self.args.scene, &grid, &content)?);
         self.radius = 0.5 * grid.diagonal() + 4.0 * grid.kernel_spacing();
         let size = window.inner_size();
         self.swapchain =

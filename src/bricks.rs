@@ -583,6 +583,24 @@ impl BrickScene {
         remap(&self.store, &self.tf)
     }
 
+    /// The box of stored voxels the transfer function gives some opacity (`None`: none does),
+    /// smallest and largest grid index: what a camera frames.
+    pub fn visible_bounds(&self) -> Option<[[u32; 3]; 2]> {
+        let ((a, b), (mut lo, mut hi)) = (self.remap(), ([u32::MAX; 3], [0u32; 3]));
+        for h in &self.store.headers {
+            let base = h.coords().map(|c| c * BRICK);
+            for &rec in &self.store.records[h.first as usize..(h.first + h.count) as usize] {
+                let d = a * (rec >> 16) as f32 / Q + b;
+                if d >= self.tf.threshold && self.tf.eval(d)[3] > 0.0 {
+                    let l = rec & 0x1ff;
+                    let v = [l % BRICK, l / BRICK % BRICK, l / (BRICK * BRICK)];
+                    (0..3).for_each(|x| (lo[x], hi[x]) = (lo[x].min(base[x] + v[x]), hi[x].max(base[x] + v[x])));
+                }
+            }
+        }
+        (lo[0] <= hi[0]).then_some([lo, hi])
+    }
+
     /// The brick stages' uniforms for a frame whose brick grid is split at `split`.
     pub fn uniforms(&self, split: [u32; 3]) -> BrickFrame {
         let nb = self.store.dims.map(|d| d.div_ceil(BRICK));

@@ -55,20 +55,27 @@ pub struct Camera {
 impl Camera {
     /// A three-quarter perspective view that frames `grid` at the given image size.
     pub fn framing(grid: &Grid, width: u32, height: u32) -> Self {
-        let center = grid.center();
-        let radius = 0.5 * grid.diagonal().max(1.0);
+        let top = grid.position([grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1]);
+        let dir = Vec3::new(0.55, 0.45, 1.0);
+        Self::framing_box(grid.position([0, 0, 0]), top, grid.kernel_spacing(), dir, Vec3::Y, width, height)
+    }
+
+    /// A perspective view along `-dir` with `up` that frames the box `lo..hi` (voxel centres) of a
+    /// grid whose kernel spacing is `kernel_spacing`, at the given image size.
+    pub fn framing_box(lo: Vec3, hi: Vec3, kernel_spacing: f32, dir: Vec3, up: Vec3, width: u32, height: u32) -> Self {
+        let center = lo.lerp(hi, 0.5);
+        let radius = 0.5 * (hi - lo).length().max(1.0);
         let fov = 35.0f32;
         // The nearest splats must clear the near plane by the cull margin (CULL_RADII of the widest
         // kernel's radius), or a grid a few voxels wide would frame its eye inside it and draw nothing.
         let reach = crate::constants::CULL_RADII
             * crate::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max)
-            * grid.kernel_spacing();
+            * kernel_spacing;
         let dist = (radius / (0.5 * fov.to_radians()).sin() * 1.05).max((radius + reach) / 0.98);
-        let dir = Vec3::new(0.55, 0.45, 1.0).normalize();
         Self {
-            eye: center + dir * dist,
+            eye: center + dir.normalize() * dist,
             target: center,
-            up: Vec3::Y,
+            up,
             projection: Projection::Perspective { fov_y_deg: fov },
             near: (dist - radius * 1.5).min(dist - radius - reach).max(dist * 0.01),
             far: (dist + radius * 1.5).max(dist + radius + reach),

@@ -45,6 +45,7 @@ pub mod loaders;
 pub mod metrics;
 pub mod options;
 pub mod order;
+pub mod orient;
 #[cfg(feature = "io")]
 pub mod output;
 pub mod peer;

@@ -9,8 +9,10 @@ pub use crate::volume::{HeightGrid, ScalarVolume};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+mod nrrd;
 mod positions;
 mod slices;
+use nrrd::{nrrd_header, NrrdHeader};
 pub use positions::{load_positions, MAX_POSITIONS_BYTES};
 pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
 
@@ -174,97 +176,19 @@ pub(crate) fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
     }
 }
 
-/// NRRD with an attached or detached header, raw or gzip encoding. `dir` resolves detached data
-/// files.
-/// An NRRD header's fields.
-struct NrrdHeader {
-    dtype: DType,
-    dims: [u64; 3],
-    voxels: u64,
-    encoding: String,
-    big_endian: bool,
-    spacing: [f32; 3],
-    data_file: Option<String>,
-    /// Offset of attached data.
-    data_start: usize,
-}
-
-/// Parse the header at the start of `bytes`, allowing at most `limit` voxels.
-fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHeader> {
-    if !bytes.starts_with(b"NRRD000") {
-        return Err(bad(what, "not an NRRD file (no NRRD000x magic)"));
-    }
-    // The header ends at the first blank line.
-    let end = bytes
-        .windows(2)
-        .position(|w| w == b"\n\n")
-        .map(|p| (p + 1, p + 2))
-        .or_else(|| bytes.windows(4).position(|w| w == b"\r\n\r\n").map(|p| (p + 2, p + 4)));
-    let (hdr_end, data_start) = match end {
-        Some(e) => e,
-        None => (bytes.len(), bytes.len()),
-    };
-    if hdr_end > 1 << 20 {
-        return Err(bad(what, "header longer than 1 MiB"));
-    }
-    let header = std::str::from_utf8(&bytes[..hdr_end]).map_err(|_| bad(what, "header is not text"))?;
-    let (mut dtype, mut dims, mut enc, mut endian_big, mut spacing, mut data_file) =
-        (None, None, None, false, [1.0f32; 3], None::<String>);
-    let mut dimension = None;
-    for line in header.lines().skip(1) {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let Some((key, value)) = line.split_once(':') else { continue };
-        let value = value.trim_start_matches('=').trim();
-        match key.trim() {
-            "type" => dtype = Some(value.parse::<DType>().map_err(|e| bad(what, e))?),
-            "dimension" => dimension = Some(value.parse::<u32>().map_err(|_| bad(what, "bad dimension"))?),
-            "sizes" => {
-                let v: std::result::Result<Vec<u64>, _> = value.split_whitespace().map(|t| t.parse::<u64>()).collect();
-                dims = Some(v.map_err(|_| bad(what, "bad sizes"))?);
-            }
-            "encoding" => enc = Some(value.to_string()),
-            "endian" => endian_big = value == "big",
-            "spacings" => {
-                let v: Vec<f32> = value.split_whitespace().filter_map(|t| t.parse().ok()).collect();
-                for (i, s) in v.iter().take(3).enumerate() {
-                    spacing[i] = *s;
-                }
-            }
-            "data file" | "datafile" => data_file = Some(value.to_string()),
-            _ => {}
-        }
-    }
-    let dtype = dtype.ok_or_else(|| bad(what, "no type field"))?;
-    let sizes = dims.ok_or_else(|| bad(what, "no sizes field"))?;
-    if sizes.is_empty() || sizes.len() > 3 || dimension.map(|d| d as usize != sizes.len()).unwrap_or(false) {
-        return Err(bad(what, "only 1 to 3 dimensional NRRD scalar volumes are supported"));
-    }
-    let mut d3 = [1u64; 3];
-    d3[..sizes.len()].copy_from_slice(&sizes);
-    let n = voxel_count_within(&d3, what, limit)?;
-    if d3.iter().any(|&d| d > crate::volume::MAX_DIM as u64) {
-        return Err(Error::TooLarge(format!("{what}: a dimension exceeds {}", crate::volume::MAX_DIM)));
-    }
-    check_spacing(spacing, what)?;
-    Ok(NrrdHeader {
+/// NRRD (attached or detached data, raw or gzip) as a dense volume.
+pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<ScalarVolume> {
+    let NrrdHeader {
         dtype,
         dims: d3,
         voxels: n,
-        encoding: enc.unwrap_or_else(|| "raw".into()),
+        encoding,
         big_endian: endian_big,
         spacing,
         data_file,
         data_start,
-    })
-}
-
-/// NRRD (attached or detached data, raw or gzip) as a dense volume.
-pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<ScalarVolume> {
-    let NrrdHeader { dtype, dims: d3, voxels: n, encoding, big_endian: endian_big, spacing, data_file, data_start } =
-        nrrd_header(bytes, what, MAX_VOXELS)?;
+        orientation,
+    } = nrrd_header(bytes, what, MAX_VOXELS)?;
     let enc = Some(encoding);
     let need = n * dtype.size() as u64;
     let payload: Vec<u8> = match &data_file {
@@ -284,8 +208,11 @@ pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<S
         "gzip" | "gz" => gunzip(&payload, need, what)?,
         other => return Err(bad(what, format!("unsupported encoding '{other}' (raw, gzip)"))),
     };
-    let values = decode(&data, n, dtype, endian_big, what)?;
+    let mut values = decode(&data, n, dtype, endian_big, what)?;
     check_finite(&values, what)?;
+    if orientation.is_some_and(|o| o.flip_x) {
+        nrrd::flip_rows(&mut values, d3[0] as usize);
+    }
     Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
 }
 
@@ -305,6 +232,9 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
     let mut values = decode(&data[l.offset as usize..], n, l.dtype, l.big_endian, what)?;
     l.rescale(&mut values);
     check_finite(&values, what)?;
+    if l.orientation.is_some_and(|o| o.flip_x) {
+        nrrd::flip_rows(&mut values, l.dims[0] as usize);
+    }
     Ok(ScalarVolume { dims: l.dims, spacing: l.spacing, values })
 }
 
@@ -316,6 +246,8 @@ pub(crate) struct NiftiLayout {
     pub offset: u64,
     pub big_endian: bool,
     pub spacing: [f32; 3],
+    /// Placement from the sform or qform.
+    pub orientation: Option<crate::orient::Orientation>,
     /// `scl_slope`, `scl_inter` when they change the values.
     scale: Option<(f32, f32)>,
 }
@@ -370,7 +302,10 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
         }
         *s = p.abs();
     }
+    let orientation = nrrd::nifti_orientation(&header, d3.map(|d| d as u32), what)?;
+    let spacing = orientation.map(|o| o.spacing()).unwrap_or(spacing);
     Ok(NiftiLayout {
+        orientation,
         dims: d3.map(|d| d as u32),
         dtype,
         offset: off as u64,
@@ -504,7 +439,30 @@ pub(crate) fn raw_layout(path: &Path, hints: &VolumeHints, what: &str) -> Result
     Ok((dims, dtype, hints.big_endian || side.big_endian, spacing))
 }
 
+/// The placement in patient space (RAS+) a NIfTI sform/qform or an NRRD anatomical `space` gives
+/// `path`, with `hints.spacing` applied; `None` for files without one (raw, npy, NRRD without a
+/// space, NIfTI with both codes 0). A sheared affine is `Error::Unsupported`.
+pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate::orient::Orientation>> {
+    let what = path.display().to_string();
+    let o = match SliceReader::open(path, hints)? {
+        Some(reader) => reader.orientation,
+        None if is_raw(path) || path.to_string_lossy().to_ascii_lowercase().ends_with(".npy") => None,
+        None => {
+            let mut head = Vec::new();
+            let file = std::fs::File::open(path).map_err(|e| Error::Io { path: what.clone(), source: e })?;
+            file.take(1 << 20).read_to_end(&mut head).map_err(|e| Error::Io { path: what.clone(), source: e })?;
+            nrrd_header(&head, &what, MAX_VOXELS)?.orientation
+        }
+    };
+    match (o, hints.spacing) {
+        (Some(o), Some(s)) => o.with_spacing(s).map(Some),
+        (o, _) => Ok(o),
+    }
+}
+
 /// Load a volume by its extension: `.nrrd`/`.nhdr`, `.nii`/`.nii.gz`, `.npy`, anything else raw.
+/// A file whose affine is left-handed comes back with its x axis reversed, so that its placement
+/// is a rotation (`Orientation::flip_x`, `load_orientation`); the `*_from_bytes` readers do the same.
 /// Only the bytes its header (or `hints`) says the data needs are read, slice by slice where the
 /// format allows (`SliceReader`), after the file is checked to hold them: a device or a file far
 /// larger than its header says is never read whole.

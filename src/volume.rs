@@ -168,6 +168,15 @@ impl SplatSet {
         Ok(self)
     }
 
+    /// The smallest and largest grid index of its splats (`None`: no splats): what a camera frames.
+    pub fn bounds(&self) -> Option<[[u32; 3]; 2]> {
+        let first = self.splats.first()?.ijk;
+        let start = [[first[0], first[1], first[2]]; 2];
+        Some(self.splats.iter().fold(start, |[lo, hi], s| {
+            [[0, 1, 2].map(|a| lo[a].min(s.ijk[a])), [0, 1, 2].map(|a| hi[a].max(s.ijk[a]))]
+        }))
+    }
+
     /// The per-axis coordinates of a rectilinear grid, if set.
     pub fn coordinates(&self) -> Option<&[Vec<f32>; 3]> {
         self.coords.as_deref()

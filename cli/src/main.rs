@@ -427,7 +427,8 @@ fn run(cli: Cli) -> Result<()> {
                 return render_distributed(&a, &opts, host_splats);
             }
             let (bricked, set) = open(&a.scene, host_splats)?;
-            let cam = camera_of(&a.scene, set.grid())?;
+            let content = content_of(&a.scene, bricked.as_ref(), &set)?;
+            let cam = camera_of(&a.scene, set.grid(), &content)?;
             let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
             let r_bricked = bricked.is_some();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
@@ -622,6 +623,15 @@ fn run(cli: Cli) -> Result<()> {
                     dtype: dtype.as_deref().map(str::parse).transpose()?,
                     ..Default::default()
                 };
+                match voxsplat::loaders::load_orientation(&file, &hints)? {
+                    Some(o) => println!(
+                        "orientation: {} (index axes i, j, k toward; world RAS+, grid centre at {:.2?}{})",
+                        o.code(),
+                        o.to_world(voxsplat::glam::Vec3::ZERO).to_array(),
+                        if o.flip_x { "; left-handed: x stored reversed" } else { "" }
+                    ),
+                    None => println!("orientation: none (no anatomical frame: --view framing)"),
+                }
                 // Past the dense loader (a file read slice by slice, of more than MAX_VOXELS): the store only.
                 if let Some(mut reader) = voxsplat::loaders::SliceReader::open(&file, &hints)? {
                     let voxels: u64 = reader.dims.iter().map(|&d| d as u64).product();
@@ -730,7 +740,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Order(a) => {
             let set = load_scene(&a.scene)?;
-            let cam = camera_of(&a.scene, set.grid())?;
+            let cam = camera_of(&a.scene, set.grid(), &content_of(&a.scene, None, &set)?)?;
             let kind = a.scene.order.parse::<OrderKind>()?;
             let seq = if kind == OrderKind::Pbtf && !a.scene.cpu {
                 let mut r = renderer_of(&a.scene)?;
@@ -976,9 +986,11 @@ fn distributed_frames(
         let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
         let reader = voxsplat::distributed::open(path, &hints)?;
         let grid = voxsplat::Grid::centered(reader.dims, hints.spacing.unwrap_or(reader.spacing))?;
-        let cam = camera_of(&a.scene, &grid)?;
+        let orientation = voxsplat_cli::open::orientation_of(&a.scene)?;
+        // Framed on the grid: the visible voxels are known only once the ranks have scanned the file.
+        let cam = camera_of(&a.scene, &grid, &voxsplat_cli::open::Content { orientation, bounds: None })?;
         let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
-        let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing);
+        let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing, orientation);
         let scheme: voxsplat::distributed::Scheme = a.compositing.parse()?;
         Ok((path, hints, cam, tf, shading, scheme, renderer_of(&a.scene)?))
     })();

@@ -4,6 +4,7 @@
 use clap::Args;
 use glam::Vec3;
 use std::path::PathBuf;
+use voxsplat::orient::Orientation;
 use voxsplat::{scene, Backend, Camera, Error, Projection, Renderer, RendererOptions, Result};
 
 /// `N` comma-separated finite numbers.
@@ -86,9 +87,9 @@ pub struct SceneArgs {
     /// Look-at point (default: the scene's centre).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub target: Option<Vec3>,
-    /// Up vector.
-    #[arg(long, value_parser = parse_vec3, default_value = "0,1,0", allow_hyphen_values = true)]
-    pub up: Vec3,
+    /// Up vector (default: +y; superior for data with an anatomical frame).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
     /// Vertical field of view in degrees (perspective).
     #[arg(long, value_parser = parse_finite, conflicts_with = "ortho", allow_hyphen_values = true)]
     pub fov: Option<f32>,
@@ -104,10 +105,15 @@ pub struct SceneArgs {
     /// Image size.
     #[arg(long, value_parser = parse_size, default_value = "512x512")]
     pub size: (u32, u32),
-    /// Preset view: auto (fly-over for terrain, VTK's camera for the peer scenes, framing otherwise),
-    /// a three-quarter framing, a grazing view across a single-sheet scene (Fig. 3.6), a terrain
-    /// fly-over (Figs 5.1-5.3), or the peers' VTK camera (issue 9).
-    #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover", "peer"])]
+    /// Preset view: auto (fly-over for terrain, VTK's camera for the peer scenes, the oblique
+    /// anatomical view for data with an anatomical frame, framing otherwise), a three-quarter
+    /// framing, a grazing view across a single-sheet scene (Fig. 3.6), a terrain fly-over
+    /// (Figs 5.1-5.3), the peers' VTK camera (issue 9), or an anatomical view of a volume whose file
+    /// places it in patient space (NIfTI sform/qform, NRRD space), superior up: anterior,
+    /// posterior, left, right, superior and inferior (anterior up), oblique (anterior, a little
+    /// right and above). Volumes are framed on the voxels the transfer function shows.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover", "peer",
+        "anterior", "posterior", "left", "right", "superior", "inferior", "oblique"])]
     pub view: String,
     /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, or raw with --dims and --dtype).
     #[arg(long, conflicts_with = "terrain")]
@@ -175,15 +181,62 @@ pub struct SceneArgs {
     pub gpu_budget_mib: u64,
 }
 
-pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
+/// What a camera frames beyond the grid: the file's placement in patient space, and the box of
+/// voxels the transfer function shows (grid indices).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Content {
+    /// The --volume file's placement (`None`: no anatomical frame; the grid's frame is the world).
+    pub orientation: Option<Orientation>,
+    /// Smallest and largest index of a visible voxel (`None`: frame the whole grid).
+    pub bounds: Option<[[u32; 3]; 2]>,
+}
+
+/// The --volume file's placement in patient space, if its header gives one.
+pub fn orientation_of(a: &SceneArgs) -> Result<Option<Orientation>> {
+    match &a.volume {
+        Some(path) if a.terrain.is_none() => voxsplat::loaders::load_orientation(path, &volume_hints(a)?),
+        _ => Ok(None),
+    }
+}
+
+/// The placement and visible box of an opened scene (`open`).
+pub fn content_of(
+    a: &SceneArgs,
+    bricked: Option<&voxsplat::bricks::BrickScene>,
+    set: &voxsplat::SplatSet,
+) -> Result<Content> {
+    let orientation = orientation_of(a)?;
+    let bounds = match bricked {
+        Some(b) => b.visible_bounds(),
+        None if a.volume.is_some() => set.bounds(),
+        None => None,
+    };
+    Ok(Content { orientation, bounds })
+}
+
+/// The camera `a` asks for, in the grid's frame (`Grid::centered`). With an anatomical frame,
+/// --eye, --target and --up are world (patient) coordinates, mapped into the grid's frame.
+pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Result<Camera> {
     let (w, h) = a.size;
+    let o = content.orientation;
     let view = match a.view.as_str() {
         "auto" if a.terrain.is_some() || a.scene == "rmnp" => "flyover",
         "auto" if voxsplat::peer::side_of(&a.scene).is_some() && a.volume.is_none() => "peer",
+        "auto" if o.is_some() => "oblique",
         "auto" => "framing",
         v => v,
     };
+    let anatomical = voxsplat::orient::VIEWS.contains(&view);
+    if anatomical && o.is_none() {
+        return Err(Error::InvalidArgument(format!(
+            "--view {view} names a side of the patient: it needs a volume whose file gives an anatomical frame \
+             (NIfTI sform/qform, NRRD space); use --view framing"
+        )));
+    }
     let grazing = view == "grazing" || view == "flyover";
+    let top = grid.dims.map(|d| d - 1);
+    let [lo, hi] = content.bounds.unwrap_or([[0; 3], top]).map(|c| grid.position(c));
+    let ks = grid.kernel_spacing();
     let mut cam = match view {
         "grazing" => Camera::grazing(grid, w, h),
         "flyover" => Camera::flyover(grid, w, h),
@@ -193,19 +246,29 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid) -> Result<Camera> {
             }
             voxsplat::peer::camera(grid.dims[0], w)
         }
-        _ => Camera::framing(grid, w, h),
+        v if anatomical => {
+            let o = o.expect("checked above");
+            let (dir, up) = v.parse::<voxsplat::orient::View>()?.directions();
+            Camera::framing_box(lo, hi, ks, o.dir_to_grid(dir), o.dir_to_grid(up), w, h)
+        }
+        _ => Camera::framing_box(lo, hi, ks, Vec3::new(0.55, 0.45, 1.0), Vec3::Y, w, h),
     };
+    let point = |p: Vec3| o.map_or(p, |o| o.to_grid(p));
+    let dir = |v: Vec3| o.map_or(v, |o| o.dir_to_grid(v));
     let fitted_eye = cam.eye;
+    let fitted_target = cam.target;
     if let Some(t) = a.target {
-        cam.target = t;
+        cam.target = point(t);
     }
     if let Some(e) = a.eye {
-        cam.eye = e;
+        cam.eye = point(e);
     } else if a.target.is_some() {
-        cam.eye = cam.target + (fitted_eye - grid.center());
+        cam.eye = cam.target + (fitted_eye - fitted_target);
     }
-    if !grazing || a.eye.is_some() {
-        cam.up = a.up;
+    match a.up {
+        Some(u) => cam.up = dir(u),
+        None if o.is_none() && (!grazing || a.eye.is_some()) => cam.up = Vec3::Y,
+        None => {}
     }
     if let Some(fov) = a.fov {
         cam.projection = Projection::Perspective { fov_y_deg: fov };
@@ -251,12 +314,19 @@ pub fn volume_hints(a: &SceneArgs) -> Result<voxsplat::loaders::VolumeHints> {
     })
 }
 
-/// With --shade, a headlight along the view of a grid of `dims` x `spacing`.
-pub fn headlight(a: &SceneArgs, dims: [u32; 3], spacing: [f32; 3]) -> Option<voxsplat::classify::Shading> {
+/// With --shade, a headlight along the view of a grid of `dims` x `spacing` (placed by
+/// `orientation`).
+pub fn headlight(
+    a: &SceneArgs,
+    dims: [u32; 3],
+    spacing: [f32; 3],
+    orientation: Option<Orientation>,
+) -> Option<voxsplat::classify::Shading> {
     a.shade.then(|| {
         let g = voxsplat::Grid::centered(dims, spacing).ok();
-        let dir = g.map(|g| -(camera_of(a, &g).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z))).unwrap_or(Vec3::Z);
-        voxsplat::classify::Shading::headlight(-dir)
+        let content = Content { orientation, bounds: None };
+        let forward = g.and_then(|g| camera_of(a, &g, &content).ok()).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z);
+        voxsplat::classify::Shading::headlight(forward)
     })
 }
 
@@ -264,7 +334,7 @@ pub fn headlight(a: &SceneArgs, dims: [u32; 3], spacing: [f32; 3]) -> Option<vox
 pub fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumeParts> {
     let vol = voxsplat::loaders::load_volume(path, &volume_hints(a)?)?;
     let tf = transfer_function(a)?;
-    let shading = headlight(a, vol.dims, vol.spacing);
+    let shading = headlight(a, vol.dims, vol.spacing, orientation_of(a)?);
     Ok((vol, tf, shading))
 }
 
@@ -272,7 +342,7 @@ pub fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<Volume
 pub fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::bricks::BrickScene> {
     let store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
     let tf = transfer_function(a)?;
-    let shading = headlight(a, store.dims, store.spacing);
+    let shading = headlight(a, store.dims, store.spacing, orientation_of(a)?);
     eprintln!(
         "{} stored voxels in {} bricks of {}^3, {:.2} bytes per stored voxel on the GPU ({} x {} x {} grid)",
         store.len(),

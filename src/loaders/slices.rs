@@ -70,6 +70,9 @@ pub struct SliceReader {
     pub dims: [u32; 3],
     /// Voxel spacing.
     pub spacing: [f32; 3],
+    /// Placement in patient space, when the header gives one; with `flip_x`, every read returns
+    /// rows reversed.
+    pub orientation: Option<crate::orient::Orientation>,
     dtype: DType,
     big_endian: bool,
     /// NIfTI value scaling.
@@ -85,6 +88,7 @@ struct Layout {
     spacing: [f32; 3],
     dtype: DType,
     big_endian: bool,
+    orientation: Option<crate::orient::Orientation>,
 }
 
 fn io_err(p: &Path) -> impl FnOnce(std::io::Error) -> Error {
@@ -132,12 +136,14 @@ impl SliceReader {
             None => (file, h.data_start as u64, path.to_path_buf()),
         };
         let (dims, spacing, dtype, big_endian) = (h.dims.map(|d| d as u32), h.spacing, h.dtype, h.big_endian);
+        let orientation = h.orientation;
         if gz {
             // The inflated data starts at its first byte.
-            let layout = Layout { offset: 0, dims, spacing, dtype, big_endian };
+            let layout = Layout { offset: 0, dims, spacing, dtype, big_endian, orientation };
             return Ok(Some(Self::new(Source::gzip(&data_path, offset)?, layout, what)));
         }
-        Self::from_file(file, &data_path, Layout { offset, dims, spacing, dtype, big_endian }, what).map(Some)
+        let layout = Layout { offset, dims, spacing, dtype, big_endian, orientation };
+        Self::from_file(file, &data_path, layout, what).map(Some)
     }
 
     /// A NIfTI-1 file, compressed or not.
@@ -154,8 +160,14 @@ impl SliceReader {
             (&mut file).take(348).read_to_end(&mut head).map_err(io_err(path))?;
         }
         let l = nifti_layout(&head, MAX_STREAMED_VOXELS, &what)?;
-        let layout =
-            Layout { offset: l.offset, dims: l.dims, spacing: l.spacing, dtype: l.dtype, big_endian: l.big_endian };
+        let layout = Layout {
+            offset: l.offset,
+            dims: l.dims,
+            spacing: l.spacing,
+            dtype: l.dtype,
+            big_endian: l.big_endian,
+            orientation: l.orientation,
+        };
         let mut reader = if gz {
             Self::new(Source::gzip(path, 0)?, layout, what)
         } else {
@@ -176,7 +188,8 @@ impl SliceReader {
         if len != need {
             return Err(bad(&what, format!("has {len} bytes; {dims:?} of {dtype:?} needs {need}")));
         }
-        Ok(Self::new(Source::File(file), Layout { offset: 0, dims, spacing, dtype, big_endian }, what))
+        let layout = Layout { offset: 0, dims, spacing, dtype, big_endian, orientation: None };
+        Ok(Self::new(Source::File(file), layout, what))
     }
 
     /// A file whose data (`layout`) it is checked to hold whole.
@@ -192,7 +205,8 @@ impl SliceReader {
 
     fn new(source: Source, l: Layout, what: String) -> Self {
         let (offset, dims, spacing, dtype, big_endian) = (l.offset, l.dims, l.spacing, l.dtype, l.big_endian);
-        Self { source, offset, dims, spacing, dtype, big_endian, rescale: None, what, bytes: Vec::new() }
+        let orientation = l.orientation;
+        Self { source, offset, dims, spacing, orientation, dtype, big_endian, rescale: None, what, bytes: Vec::new() }
     }
 
     fn plane_bytes(&self) -> u64 {
@@ -207,7 +221,15 @@ impl SliceReader {
         let at = self.offset + self.plane_bytes() * z0 as u64;
         let r = self.source.read_at(at, &mut self.bytes);
         r.map_err(|e| read_error(&self.what, z0 + count, e))?;
-        self.decode(n, out)
+        self.decode(n, out)?;
+        if self.flip_x() {
+            super::nrrd::flip_rows(out, self.dims[0] as usize);
+        }
+        Ok(())
+    }
+
+    fn flip_x(&self) -> bool {
+        self.orientation.is_some_and(|o| o.flip_x)
     }
 
     /// The part `lo..hi` (x and y) of slices `z0..z0 + count` into `out`, x fastest over the
@@ -240,16 +262,22 @@ impl SliceReader {
         let size = self.dtype.size();
         let row_bytes = w * size;
         self.bytes.resize(count as usize * h * row_bytes, 0);
+        // A reversed x reads the mirrored span of each file row, then reverses it.
+        let x0 = if self.flip_x() { nx - hi[0] } else { lo[0] };
         for z in 0..count as usize {
             for y in 0..h {
-                let voxel = ((z0 as u64 + z as u64) * ny as u64 + lo[1] as u64 + y as u64) * nx as u64 + lo[0] as u64;
+                let voxel = ((z0 as u64 + z as u64) * ny as u64 + lo[1] as u64 + y as u64) * nx as u64 + x0 as u64;
                 let at = self.offset + voxel * size as u64;
                 let row = (z * h + y) * row_bytes;
                 let r = self.source.read_at(at, &mut self.bytes[row..row + row_bytes]);
                 r.map_err(|e| read_error(&self.what, z0 + z as u32 + 1, e))?;
             }
         }
-        self.decode((count as usize * h * w) as u64, out)
+        self.decode((count as usize * h * w) as u64, out)?;
+        if self.flip_x() {
+            super::nrrd::flip_rows(out, w);
+        }
+        Ok(())
     }
 
     /// `n` samples from the bytes read, rescaled and checked finite.

@@ -1,0 +1,188 @@
+//! NRRD headers, and the placement in patient space that NIfTI and NRRD headers give.
+use super::{bad, check_spacing, voxel_count_within, DType};
+use crate::error::{Error, Result};
+use crate::orient::Orientation;
+use glam::{DMat4, DVec3, DVec4};
+
+/// An NRRD header's fields.
+pub(super) struct NrrdHeader {
+    pub dtype: DType,
+    pub dims: [u64; 3],
+    pub voxels: u64,
+    pub encoding: String,
+    pub big_endian: bool,
+    pub spacing: [f32; 3],
+    pub data_file: Option<String>,
+    /// Offset of attached data.
+    pub data_start: usize,
+    /// Placement from `space`, `space directions` and `space origin`, when the space is anatomical.
+    pub orientation: Option<Orientation>,
+}
+
+/// Parse the header at the start of `bytes`, allowing at most `limit` voxels.
+pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHeader> {
+    if !bytes.starts_with(b"NRRD000") {
+        return Err(bad(what, "not an NRRD file (no NRRD000x magic)"));
+    }
+    // The header ends at the first blank line.
+    let end = bytes
+        .windows(2)
+        .position(|w| w == b"\n\n")
+        .map(|p| (p + 1, p + 2))
+        .or_else(|| bytes.windows(4).position(|w| w == b"\r\n\r\n").map(|p| (p + 2, p + 4)));
+    let (hdr_end, data_start) = match end {
+        Some(e) => e,
+        None => (bytes.len(), bytes.len()),
+    };
+    if hdr_end > 1 << 20 {
+        return Err(bad(what, "header longer than 1 MiB"));
+    }
+    let header = std::str::from_utf8(&bytes[..hdr_end]).map_err(|_| bad(what, "header is not text"))?;
+    let (mut dtype, mut dims, mut enc, mut endian_big, mut spacing, mut data_file) =
+        (None, None, None, false, [1.0f32; 3], None::<String>);
+    let mut dimension = None;
+    let (mut space, mut directions, mut space_origin) = (None, None, None);
+    for line in header.lines().skip(1) {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let Some((key, value)) = line.split_once(':') else { continue };
+        let value = value.trim_start_matches('=').trim();
+        match key.trim() {
+            "type" => dtype = Some(value.parse::<DType>().map_err(|e| bad(what, e))?),
+            "dimension" => dimension = Some(value.parse::<u32>().map_err(|_| bad(what, "bad dimension"))?),
+            "sizes" => {
+                let v: std::result::Result<Vec<u64>, _> = value.split_whitespace().map(|t| t.parse::<u64>()).collect();
+                dims = Some(v.map_err(|_| bad(what, "bad sizes"))?);
+            }
+            "encoding" => enc = Some(value.to_string()),
+            "endian" => endian_big = value == "big",
+            "spacings" => {
+                let v: Vec<f32> = value.split_whitespace().filter_map(|t| t.parse().ok()).collect();
+                for (i, s) in v.iter().take(3).enumerate() {
+                    spacing[i] = *s;
+                }
+            }
+            "data file" | "datafile" => data_file = Some(value.to_string()),
+            "space" => space = Some(value.to_string()),
+            "space directions" => directions = Some(value.to_string()),
+            "space origin" => space_origin = Some(value.to_string()),
+            _ => {}
+        }
+    }
+    let dtype = dtype.ok_or_else(|| bad(what, "no type field"))?;
+    let sizes = dims.ok_or_else(|| bad(what, "no sizes field"))?;
+    if sizes.is_empty() || sizes.len() > 3 || dimension.map(|d| d as usize != sizes.len()).unwrap_or(false) {
+        return Err(bad(what, "only 1 to 3 dimensional NRRD scalar volumes are supported"));
+    }
+    let mut d3 = [1u64; 3];
+    d3[..sizes.len()].copy_from_slice(&sizes);
+    let n = voxel_count_within(&d3, what, limit)?;
+    if d3.iter().any(|&d| d > crate::volume::MAX_DIM as u64) {
+        return Err(Error::TooLarge(format!("{what}: a dimension exceeds {}", crate::volume::MAX_DIM)));
+    }
+    let orientation = match space {
+        Some(space) => nrrd_orientation(&space, directions.as_deref(), space_origin.as_deref(), d3, spacing, what)?,
+        None => None,
+    };
+    let spacing = orientation.map(|o| o.spacing()).unwrap_or(spacing);
+    check_spacing(spacing, what)?;
+    Ok(NrrdHeader {
+        dtype,
+        dims: d3,
+        voxels: n,
+        encoding: enc.unwrap_or_else(|| "raw".into()),
+        big_endian: endian_big,
+        spacing,
+        data_file,
+        data_start,
+        orientation,
+    })
+}
+
+
+/// The RAS+ placement an NRRD `space` (RAS, LAS or LPS, short or long names) with its directions
+/// and origin gives a `dims` grid; `None` for other spaces (no anatomical frame).
+fn nrrd_orientation(
+    space: &str,
+    directions: Option<&str>,
+    origin: Option<&str>,
+    dims: [u64; 3],
+    spacing: [f32; 3],
+    what: &str,
+) -> Result<Option<Orientation>> {
+    // World x and y signs turning the space into RAS+.
+    let flip = match space.to_ascii_lowercase().as_str() {
+        "ras" | "right-anterior-superior" => DVec3::new(1.0, 1.0, 1.0),
+        "las" | "left-anterior-superior" => DVec3::new(-1.0, 1.0, 1.0),
+        "lps" | "left-posterior-superior" => DVec3::new(-1.0, -1.0, 1.0),
+        _ => return Ok(None),
+    };
+    let mut cols = [DVec3::X * spacing[0] as f64, DVec3::Y * spacing[1] as f64, DVec3::Z * spacing[2] as f64];
+    if let Some(d) = directions {
+        let vectors: Vec<&str> = d.split_whitespace().filter(|t| *t != "none").collect();
+        if vectors.len() != 3 {
+            return Err(bad(what, format!("space directions '{d}': three vectors expected")));
+        }
+        for (c, v) in cols.iter_mut().zip(vectors) {
+            *c = nrrd_vector(v, what)?;
+        }
+    }
+    let o = match origin {
+        Some(o) => nrrd_vector(o, what)?,
+        None => DVec3::ZERO,
+    };
+    let [x, y, z] = cols.map(|c| (c * flip).extend(0.0));
+    let affine = DMat4::from_cols(x, y, z, (o * flip).extend(1.0));
+    Orientation::from_affine(affine, dims.map(|d| d as u32)).map(Some).map_err(|e| place_error(e, what))
+}
+
+/// An NRRD vector `(a,b,c)`.
+fn nrrd_vector(v: &str, what: &str) -> Result<DVec3> {
+    let inner = v.trim().strip_prefix('(').and_then(|v| v.strip_suffix(')'));
+    let parts: Option<Vec<f64>> = inner.map(|i| i.split(',').map(|t| t.trim().parse::<f64>().ok()).collect()).flatten();
+    match parts.as_deref() {
+        Some(&[a, b, c]) if [a, b, c].iter().all(|x| x.is_finite()) => Ok(DVec3::new(a, b, c)),
+        _ => Err(bad(what, format!("space vector '{v}' is not (x,y,z) of three finite numbers"))),
+    }
+}
+
+/// The file's name on a placement error.
+fn place_error(e: Error, what: &str) -> Error {
+    match e {
+        Error::InvalidArgument(m) => bad(what, m),
+        Error::Unsupported(m) => Error::Unsupported(format!("{what}: {m}")),
+        other => other,
+    }
+}
+
+/// The RAS+ placement a NIfTI-1 header gives: its sform when `sform_code` > 0, else its qform
+/// when `qform_code` > 0, else `None` (no frame: NIfTI's "method 1", spacing only).
+pub(super) fn nifti_orientation(h: &nifti::NiftiHeader, dims: [u32; 3], what: &str) -> Result<Option<Orientation>> {
+    let affine = if h.sform_code > 0 {
+        let [x, y, z] = [h.srow_x, h.srow_y, h.srow_z].map(|r| DVec4::from_array(r.map(f64::from)));
+        DMat4::from_cols(x, y, z, DVec4::W).transpose()
+    } else if h.qform_code > 0 {
+        let (b, c, d) = (h.quatern_b as f64, h.quatern_c as f64, h.quatern_d as f64);
+        let a = (1.0 - (b * b + c * c + d * d)).max(0.0).sqrt();
+        let qfac = if h.pixdim[0] < 0.0 { -1.0 } else { 1.0 };
+        let s = [h.pixdim[1] as f64, h.pixdim[2] as f64, qfac * h.pixdim[3] as f64];
+        let r = [
+            [a * a + b * b - c * c - d * d, 2.0 * (b * c - a * d), 2.0 * (b * d + a * c)],
+            [2.0 * (b * c + a * d), a * a + c * c - b * b - d * d, 2.0 * (c * d - a * b)],
+            [2.0 * (b * d - a * c), 2.0 * (c * d + a * b), a * a + d * d - c * c - b * b],
+        ];
+        let col = |j: usize| DVec4::new(r[0][j] * s[j], r[1][j] * s[j], r[2][j] * s[j], 0.0);
+        let t = DVec4::new(h.quatern_x as f64, h.quatern_y as f64, h.quatern_z as f64, 1.0);
+        DMat4::from_cols(col(0), col(1), col(2), t)
+    } else {
+        return Ok(None);
+    };
+    Orientation::from_affine(affine, dims).map(Some).map_err(|e| place_error(e, what))
+}
+
+/// Reverse each `nx`-sample row (a left-handed file's x, `Orientation::flip_x`).
+pub(super) fn flip_rows(values: &mut [f32], nx: usize) {
+    values.chunks_exact_mut(nx.max(1)).for_each(|r| r.reverse());
+}

@@ -1,0 +1,199 @@
+//! Where a file puts its grid in patient space, and the named anatomical views.
+//!
+//! World space for data with an anatomical frame is RAS+ in the file's units (NIfTI's convention:
+//! +x toward the patient's right, +y anterior, +z superior); NRRD's LPS and LAS spaces are turned
+//! into it. The renderer draws a grid in its own frame (`Grid::centered`: axis-aligned, centred on
+//! the origin); the file's affine, split into spacing, a rotation and the centre's world position,
+//! maps that frame into the world. A camera given in world space is mapped into the grid's frame by
+//! the inverse (`Orientation::camera_to_grid`): a rigid map of scene and camera together leaves the
+//! picture unchanged, and the visibility order is computed from the mapped eye (docs/MODEL.md).
+//! A left-handed affine (a reflection) cannot be undone by moving a camera, so its grid's x axis is
+//! stored reversed (`flip_x`): the loaders apply it, and the rotation left is proper.
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use glam::{DMat3, DMat4, DVec3, Vec3};
+
+/// Most an affine's axes may depart from perpendicular (cosine of the angle between two
+/// directions) and still be taken as a rotation: files store their directions in f32, and scanners
+/// round them.
+pub const MAX_SKEW: f64 = 1e-3;
+
+/// A grid's placement in patient space (RAS+), from its file's affine.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orientation {
+    /// Index -> world affine as the file gives it (columns i, j, k, then the translation).
+    pub affine: DMat4,
+    /// Grid frame -> world rotation (proper: determinant +1).
+    rotation: DMat3,
+    /// World position of the grid's centre.
+    center: DVec3,
+    /// The affine is left-handed: the grid's x axis is stored reversed (voxel i of the grid is
+    /// the file's nx - 1 - i).
+    pub flip_x: bool,
+    dims: [u32; 3],
+}
+
+impl Orientation {
+    /// The placement of a `dims` grid whose file maps index (i, j, k) to world `affine` (RAS+).
+    /// Refuses a singular, non-finite or sheared affine (Error::Unsupported names the angle).
+    pub fn from_affine(affine: DMat4, dims: [u32; 3]) -> Result<Self> {
+        let cols = [affine.x_axis.truncate(), affine.y_axis.truncate(), affine.z_axis.truncate()];
+        if !affine.is_finite() || cols.iter().any(|c| !(c.length() > 0.0)) {
+            return Err(Error::InvalidArgument(format!("index-to-world affine {affine:?} is singular or not finite")));
+        }
+        let dirs = cols.map(|c| c.normalize());
+        for (a, b) in [(0, 1), (0, 2), (1, 2)] {
+            let cos = dirs[a].dot(dirs[b]);
+            if cos.abs() > MAX_SKEW {
+                return Err(Error::Unsupported(format!(
+                    "the file's index axes {a} and {b} meet at {:.2} degrees (a sheared grid): only \
+                     rotations and reflections of a rectilinear grid are placed; resample the volume first",
+                    cos.clamp(-1.0, 1.0).acos().to_degrees()
+                )));
+            }
+        }
+        // The nearest rotation (or rotation-reflection) to the directions.
+        let m = orthonormalize(DMat3::from_cols(dirs[0], dirs[1], dirs[2]));
+        let flip_x = m.determinant() < 0.0;
+        let rotation = if flip_x { DMat3::from_cols(-m.x_axis, m.y_axis, m.z_axis) } else { m };
+        let mid = DVec3::new(dims[0] as f64 - 1.0, dims[1] as f64 - 1.0, dims[2] as f64 - 1.0) * 0.5;
+        let center = affine.transform_point3(mid);
+        Ok(Self { affine, rotation, center, flip_x, dims })
+    }
+
+    /// Voxel spacing along i, j, k: the lengths of the affine's columns.
+    pub fn spacing(&self) -> [f32; 3] {
+        [self.affine.x_axis, self.affine.y_axis, self.affine.z_axis].map(|c| c.truncate().length() as f32)
+    }
+
+    /// The same placement with the spacing replaced (`--spacing` overriding the file's).
+    pub fn with_spacing(&self, spacing: [f32; 3]) -> Result<Self> {
+        let s = self.spacing();
+        let mut a = self.affine;
+        a.x_axis *= DVec3::splat(spacing[0] as f64 / s[0] as f64).extend(1.0);
+        a.y_axis *= DVec3::splat(spacing[1] as f64 / s[1] as f64).extend(1.0);
+        a.z_axis *= DVec3::splat(spacing[2] as f64 / s[2] as f64).extend(1.0);
+        // Keep the file's voxel (0, 0, 0) where it was.
+        Self::from_affine(a, self.dims)
+    }
+
+    /// The anatomical direction each index axis points to, as in "RAS" (i toward the right, j
+    /// anterior, k superior) or "LPS": the dominant world axis of each column of the file's affine.
+    pub fn code(&self) -> String {
+        [self.affine.x_axis, self.affine.y_axis, self.affine.z_axis]
+            .iter()
+            .map(|c| {
+                let v = c.truncate();
+                let a = (0..3).max_by(|&p, &q| v[p].abs().total_cmp(&v[q].abs())).unwrap_or(0);
+                let positive = v[a] >= 0.0;
+                [["L", "R"], ["P", "A"], ["I", "S"]][a][positive as usize]
+            })
+            .collect()
+    }
+
+    /// World position of a point given in the grid's frame.
+    pub fn to_world(&self, p: Vec3) -> Vec3 {
+        (self.rotation * p.as_dvec3() + self.center).as_vec3()
+    }
+
+    /// The grid-frame position of world point `p`.
+    pub fn to_grid(&self, p: Vec3) -> Vec3 {
+        (self.rotation.transpose() * (p.as_dvec3() - self.center)).as_vec3()
+    }
+
+    /// A world direction in the grid's frame.
+    pub fn dir_to_grid(&self, v: Vec3) -> Vec3 {
+        (self.rotation.transpose() * v.as_dvec3()).as_vec3()
+    }
+
+    /// A grid-frame direction in the world.
+    pub fn dir_to_world(&self, v: Vec3) -> Vec3 {
+        (self.rotation * v.as_dvec3()).as_vec3()
+    }
+
+    /// `camera` (world space) as the grid's frame sees it: the same picture of the grid.
+    pub fn camera_to_grid(&self, camera: &Camera) -> Camera {
+        Camera {
+            eye: self.to_grid(camera.eye),
+            target: self.to_grid(camera.target),
+            up: self.dir_to_grid(camera.up),
+            ..*camera
+        }
+    }
+
+    /// `camera` (grid frame) in world space.
+    pub fn camera_to_world(&self, camera: &Camera) -> Camera {
+        Camera {
+            eye: self.to_world(camera.eye),
+            target: self.to_world(camera.target),
+            up: self.dir_to_world(camera.up),
+            ..*camera
+        }
+    }
+}
+
+/// The orthogonal matrix nearest `m` (a few Newton steps of the polar decomposition: `m` is already
+/// within MAX_SKEW of one).
+fn orthonormalize(mut m: DMat3) -> DMat3 {
+    for _ in 0..8 {
+        m = (m + m.inverse().transpose()) * 0.5;
+    }
+    m
+}
+
+/// Anatomical views of data with a frame (3D Slicer's names): where the eye is. Superior is up in
+/// the four side views; the superior and inferior views put anterior up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum View {
+    /// From the front.
+    Anterior,
+    /// From behind.
+    Posterior,
+    /// From the patient's left.
+    Left,
+    /// From the patient's right.
+    Right,
+    /// From above.
+    Superior,
+    /// From below.
+    Inferior,
+    /// From the front, a little to the patient's right and above (the default).
+    Oblique,
+}
+
+/// Every view's name, for help and errors.
+pub const VIEWS: &[&str] = &["anterior", "posterior", "left", "right", "superior", "inferior", "oblique"];
+
+impl std::str::FromStr for View {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Ok(match s {
+            "anterior" => View::Anterior,
+            "posterior" => View::Posterior,
+            "left" => View::Left,
+            "right" => View::Right,
+            "superior" => View::Superior,
+            "inferior" => View::Inferior,
+            "oblique" => View::Oblique,
+            other => {
+                return Err(Error::InvalidArgument(format!("unknown view '{other}' ({})", VIEWS.join(", "))))
+            }
+        })
+    }
+}
+
+impl View {
+    /// World (RAS+) direction from the object to the eye, and the up direction.
+    pub fn directions(self) -> (Vec3, Vec3) {
+        let (r, a, s) = (Vec3::X, Vec3::Y, Vec3::Z);
+        match self {
+            View::Anterior => (a, s),
+            View::Posterior => (-a, s),
+            View::Left => (-r, s),
+            View::Right => (r, s),
+            View::Superior => (s, a),
+            View::Inferior => (-s, a),
+            View::Oblique => ((a + 0.55 * r + 0.45 * s).normalize(), s),
+        }
+    }
+}
