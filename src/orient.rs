@@ -175,9 +175,7 @@ impl std::str::FromStr for View {
             "superior" => View::Superior,
             "inferior" => View::Inferior,
             "oblique" => View::Oblique,
-            other => {
-                return Err(Error::InvalidArgument(format!("unknown view '{other}' ({})", VIEWS.join(", "))))
-            }
+            other => return Err(Error::InvalidArgument(format!("unknown view '{other}' ({})", VIEWS.join(", ")))),
         })
     }
 }

@@ -101,7 +101,6 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
     })
 }
 
-
 /// The RAS+ placement an NRRD `space` (RAS, LAS or LPS, short or long names) with its directions
 /// and origin gives a `dims` grid; `None` for other spaces (no anatomical frame).
 fn nrrd_orientation(

@@ -211,3 +211,77 @@ pub fn assert_mirrors(g: &voxsplat::ImageF32, c: &voxsplat::ImageF32, tag: &str)
     assert!(max <= 2e-3 && mean <= 2e-4, "{tag}: GPU against mirror: max {max}, mean over {n} covered px {mean}");
     (max, mean)
 }
+
+/// Placement tests (issue 29): a small object with no symmetry, and NIfTI files that place it.
+pub const DIMS: [u32; 3] = [12, 10, 16];
+
+/// An object with no symmetry: a ball low in k, a bar along i high in k, a stub toward high j.
+pub fn object(i: i64, j: i64, k: i64) -> u8 {
+    let p = glam::DVec3::new(i as f64, j as f64, k as f64);
+    let ball = (p - glam::DVec3::new(5.0, 4.5, 4.0)).length() < 3.2;
+    let bar = (2..=10).contains(&i) && (3..=5).contains(&j) && (11..=13).contains(&k);
+    let stub = (4..=6).contains(&i) && (5..=8).contains(&j) && (7..=9).contains(&k);
+    if ball || bar {
+        200
+    } else if stub {
+        120
+    } else {
+        0
+    }
+}
+
+/// The file voxels of `dims` whose index `b` holds the object's voxel `map(b)`.
+pub fn samples(dims: [u32; 3], map: impl Fn([i64; 3]) -> [i64; 3]) -> Vec<u8> {
+    let mut v = Vec::new();
+    for k in 0..dims[2] as i64 {
+        for j in 0..dims[1] as i64 {
+            for i in 0..dims[0] as i64 {
+                let [a, b, c] = map([i, j, k]);
+                v.push(object(a, b, c));
+            }
+        }
+    }
+    v
+}
+
+/// A NIfTI-1 file of u8 samples with an sform (code 1) or, without one, a qform (code 1:
+/// quaternion b, c, d, offset, qfac).
+pub fn nifti(
+    dims: [u32; 3],
+    v: &[u8],
+    sform: Option<glam::DMat4>,
+    qform: Option<(glam::DQuat, glam::DVec3, f32)>,
+) -> Vec<u8> {
+    let mut h = vec![0u8; 352];
+    let put_f32 = |h: &mut Vec<u8>, at: usize, x: f32| h[at..at + 4].copy_from_slice(&x.to_le_bytes());
+    h[0..4].copy_from_slice(&348i32.to_le_bytes());
+    let dim: [i16; 8] = [3, dims[0] as i16, dims[1] as i16, dims[2] as i16, 1, 1, 1, 1];
+    for (i, d) in dim.iter().enumerate() {
+        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    h[70..72].copy_from_slice(&2i16.to_le_bytes()); // uint8
+    h[72..74].copy_from_slice(&8i16.to_le_bytes());
+    let qfac = qform.map(|q| q.2).unwrap_or(1.0);
+    for (i, p) in [qfac, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0].iter().enumerate() {
+        put_f32(&mut h, 76 + 4 * i, *p);
+    }
+    put_f32(&mut h, 108, 352.0);
+    if let Some((q, offset, _)) = qform {
+        h[252..254].copy_from_slice(&1i16.to_le_bytes());
+        let q = if q.w < 0.0 { -q } else { q };
+        for (n, x) in [q.x, q.y, q.z, offset.x, offset.y, offset.z].iter().enumerate() {
+            put_f32(&mut h, 256 + 4 * n, *x as f32);
+        }
+    }
+    if let Some(m) = sform {
+        h[254..256].copy_from_slice(&1i16.to_le_bytes());
+        for r in 0..3 {
+            for c in 0..4 {
+                put_f32(&mut h, 280 + 16 * r + 4 * c, m.col(c)[r] as f32);
+            }
+        }
+    }
+    h[344..348].copy_from_slice(b"n+1\0");
+    h.extend_from_slice(v);
+    h
+}
