@@ -1,6 +1,11 @@
-"""VTK's fixed-point CPU ray caster on a volume file, for the bricked-volume comparison (issue 23):
-the same file, transfer-function preset and view as `voxsplat render --volume FILE --tf TF` (the
-framing camera: src/camera.rs), 512x512 by default. Prints the median frame time.
+"""VTK's ray casters on a volume file, beside voxsplat: the same file, transfer-function preset and
+view as `voxsplat render --volume FILE --tf TF`, 512x512 by default. Prints the median frame time.
+The view is voxsplat's framing camera (src/camera.rs) unless --camera gives the line `voxsplat render`
+prints ("camera (grid frame): eye X,Y,Z target X,Y,Z up X,Y,Z fov F"): voxsplat's grid frame is
+centred on the grid, VTK's image starts at voxel (0, 0, 0), and both run the file's axes as stored
+(files whose affine is left-handed, which voxsplat stores x-reversed, are not taken).
+--mapper fixed: the fixed-point CPU ray caster (issue 23); gpu: vtkGPUVolumeRayCastMapper (llvmpipe
+through EGL here). --shade: VTK's gradient shading, as voxsplat's --shade.
 Usage: python vtk_file.py --file F.nrrd|F.nii.gz --tf bonsai|ramp|ct --frames 5 --out out.png
 """
 import argparse, math, statistics, sys, time
@@ -13,6 +18,9 @@ ap.add_argument("--size", type=int, default=512)
 ap.add_argument("--frames", type=int, default=5)
 ap.add_argument("--warmup", type=int, default=1)
 ap.add_argument("--out", default="vtk.png")
+ap.add_argument("--mapper", default="fixed", choices=["fixed", "gpu"])
+ap.add_argument("--camera", default=None, help="voxsplat's 'camera (grid frame)' line")
+ap.add_argument("--shade", action="store_true")
 a = ap.parse_args()
 
 # voxsplat's presets (src/classify.rs): density normalised over the data's range, RGB, opacity of
@@ -21,8 +29,8 @@ PRESETS = {
     "ramp": [(0.1, (0, 0, 0, 0)), (1.0, (1, 1, 1, 0.6))],
     "ct": [(0.0, (0, 0, 0, 0)), (0.12, (0, 0, 0, 0)), (0.2, (0.8, 0.3, 0.2, 0.03)), (0.45, (1, 0.9, 0.8, 0.6)),
            (1.0, (1, 1, 1, 0.95))],
-    "bonsai": [(0.0, (0, 0, 0, 0)), (0.15, (0, 0, 0, 0)), (0.25, (0.25, 0.6, 0.15, 0.35)), (0.45, (0.3, 0.55, 0.15, 0.6)),
-               (0.6, (0.55, 0.35, 0.15, 0.9)), (1.0, (0.7, 0.5, 0.3, 0.95))],
+    "bonsai": [(0.0, (0, 0, 0, 0)), (0.22, (0, 0, 0, 0)), (0.25, (0.22, 0.6, 0.12, 0.35)), (0.31, (0.25, 0.6, 0.15, 0.35)),
+               (0.36, (0.55, 0.33, 0.14, 0.9)), (1.0, (0.65, 0.42, 0.25, 0.95))],
 }
 
 t0 = time.perf_counter()
@@ -49,9 +57,19 @@ prop.SetColor(ctf)
 prop.SetScalarOpacity(otf)
 prop.SetScalarOpacityUnitDistance(max(sp))
 prop.SetInterpolationTypeToLinear()
-prop.ShadeOff()
+if a.shade:
+    prop.ShadeOn()
+    prop.SetAmbient(0.3)
+    prop.SetDiffuse(0.7)
+    prop.SetSpecular(0.25)
+    prop.SetSpecularPower(20.0)
+else:
+    prop.ShadeOff()
 
-mapper = vtk.vtkFixedPointVolumeRayCastMapper()
+if a.mapper == "gpu":
+    mapper = vtk.vtkGPUVolumeRayCastMapper()
+else:
+    mapper = vtk.vtkFixedPointVolumeRayCastMapper()
 mapper.SetAutoAdjustSampleDistances(0)
 mapper.SetInputData(img)
 mapper.SetBlendModeToComposite()
@@ -66,18 +84,30 @@ rw.SetOffScreenRendering(1)
 rw.AddRenderer(ren)
 rw.SetSize(a.size, a.size)
 
-# voxsplat's Camera::framing.
-ext = [(dims[i] - 1) * sp[i] for i in range(3)]
-c = [e / 2 for e in ext]
-radius = 0.5 * max(math.sqrt(sum(e * e for e in ext)), 1.0)
-dist = radius / math.sin(math.radians(17.5)) * 1.05
-d = (0.55, 0.45, 1.0)
-n = math.sqrt(sum(x * x for x in d))
 cam = ren.GetActiveCamera()
-cam.SetFocalPoint(*c)
-cam.SetPosition(*[c[i] + d[i] / n * dist for i in range(3)])
-cam.SetViewUp(0, 1, 0)
-cam.SetViewAngle(35.0)
+if a.camera:
+    # "camera (grid frame): eye X,Y,Z target X,Y,Z up X,Y,Z fov F": grid frame -> VTK's image frame.
+    f = a.camera.split()
+    vec = lambda k: [float(x) for x in f[f.index(k) + 1].split(",")]
+    org = img.GetOrigin()
+    shift = [org[i] + (dims[i] - 1) * sp[i] / 2 for i in range(3)]
+    eye, target, up = vec("eye"), vec("target"), vec("up")
+    cam.SetFocalPoint(*[target[i] + shift[i] for i in range(3)])
+    cam.SetPosition(*[eye[i] + shift[i] for i in range(3)])
+    cam.SetViewUp(*up)
+    cam.SetViewAngle(float(f[f.index("fov") + 1]))
+else:
+    # voxsplat's Camera::framing.
+    ext = [(dims[i] - 1) * sp[i] for i in range(3)]
+    c = [e / 2 for e in ext]
+    radius = 0.5 * max(math.sqrt(sum(e * e for e in ext)), 1.0)
+    dist = radius / math.sin(math.radians(17.5)) * 1.05
+    d = (0.55, 0.45, 1.0)
+    n = math.sqrt(sum(x * x for x in d))
+    cam.SetFocalPoint(*c)
+    cam.SetPosition(*[c[i] + d[i] / n * dist for i in range(3)])
+    cam.SetViewUp(0, 1, 0)
+    cam.SetViewAngle(35.0)
 ren.ResetCameraClippingRange()
 
 for i in range(a.warmup):
@@ -89,6 +119,11 @@ for i in range(a.frames):
     t = time.perf_counter()
     rw.Render()
     times.append(time.perf_counter() - t)
+if a.frames % 2 == 1:
+    # Back to the view asked for before the picture is taken.
+    cam.Azimuth(-0.5)
+    ren.ResetCameraClippingRange()
+    rw.Render()
 w2i = vtk.vtkWindowToImageFilter()
 w2i.SetInput(rw)
 w2i.Update()

@@ -29,7 +29,7 @@ pub struct TransferFunction {
 pub const TF_PRESETS: &[(&str, &str)] = &[
     ("ramp", "grey ramp, opacity rising from a tenth of the range"),
     ("ct", "CT: soft tissue faint red, contrast and bone opaque white"),
-    ("bonsai", "the bonsai CT: foliage green, trunk and pot brown"),
+    ("bonsai", "the bonsai CT: twigs green, trunk and pot brown, the base plate transparent"),
 ];
 
 impl TransferFunction {
@@ -45,13 +45,15 @@ impl TransferFunction {
                 (0.45, [1.0, 0.9, 0.8, 0.6]),
                 (1.0, [1.0, 1.0, 1.0, 0.95]),
             ])),
+            // The base plate the bonsai stands on (0.13-0.19) is left transparent; twigs (0.25-0.31)
+            // green; trunk, soil and pot brown (issue 29, tuned beside VTK: docs/RESULTS.md).
             "bonsai" => Ok(p(vec![
                 (0.0, [0.0, 0.0, 0.0, 0.0]),
-                (0.15, [0.0, 0.0, 0.0, 0.0]),
-                (0.25, [0.25, 0.6, 0.15, 0.35]),
-                (0.45, [0.3, 0.55, 0.15, 0.6]),
-                (0.6, [0.55, 0.35, 0.15, 0.9]),
-                (1.0, [0.7, 0.5, 0.3, 0.95]),
+                (0.22, [0.0, 0.0, 0.0, 0.0]),
+                (0.25, [0.22, 0.6, 0.12, 0.35]),
+                (0.31, [0.25, 0.6, 0.15, 0.35]),
+                (0.36, [0.55, 0.33, 0.14, 0.9]),
+                (1.0, [0.65, 0.42, 0.25, 0.95]),
             ])),
             other => Err(Error::InvalidArgument(format!(
                 "unknown transfer function '{other}' ({})",

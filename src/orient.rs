@@ -38,7 +38,7 @@ impl Orientation {
     /// Refuses a singular, non-finite or sheared affine (Error::Unsupported names the angle).
     pub fn from_affine(affine: DMat4, dims: [u32; 3]) -> Result<Self> {
         let cols = [affine.x_axis.truncate(), affine.y_axis.truncate(), affine.z_axis.truncate()];
-        if !affine.is_finite() || cols.iter().any(|c| !(c.length() > 0.0)) {
+        if !affine.is_finite() || cols.iter().any(|c| c.length() <= 0.0) {
             return Err(Error::InvalidArgument(format!("index-to-world affine {affine:?} is singular or not finite")));
         }
         let dirs = cols.map(|c| c.normalize());

@@ -429,6 +429,16 @@ fn run(cli: Cli) -> Result<()> {
             let (bricked, set) = open(&a.scene, host_splats)?;
             let content = content_of(&a.scene, bricked.as_ref(), &set)?;
             let cam = camera_of(&a.scene, set.grid(), &content)?;
+            if let voxsplat::Projection::Perspective { fov_y_deg } = cam.projection {
+                // Other renderers (scripts/vtk_file.py) take the same view from this line.
+                let v = |v: Vec3| format!("{:.4},{:.4},{:.4}", v.x, v.y, v.z);
+                eprintln!(
+                    "camera (grid frame): eye {} target {} up {} fov {fov_y_deg}",
+                    v(cam.eye),
+                    v(cam.target),
+                    v(cam.up)
+                );
+            }
             let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
             let r_bricked = bricked.is_some();
             let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
@@ -987,15 +997,17 @@ fn distributed_frames(
         let reader = voxsplat::distributed::open(path, &hints)?;
         let grid = voxsplat::Grid::centered(reader.dims, hints.spacing.unwrap_or(reader.spacing))?;
         let orientation = voxsplat_cli::open::orientation_of(&a.scene)?;
-        // Framed on the grid: the visible voxels are known only once the ranks have scanned the file.
-        let cam = camera_of(&a.scene, &grid, &voxsplat_cli::open::Content { orientation, bounds: None })?;
+        // Checked here; framed on the visible voxels once the ranks hold them.
+        camera_of(&a.scene, &grid, &voxsplat_cli::open::Content { orientation, bounds: None })?;
         let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
         let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing, orientation);
         let scheme: voxsplat::distributed::Scheme = a.compositing.parse()?;
-        Ok((path, hints, cam, tf, shading, scheme, renderer_of(&a.scene)?))
+        Ok((path, hints, grid, orientation, tf, shading, scheme, renderer_of(&a.scene)?))
     })();
-    let (path, hints, cam, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
+    let (path, hints, grid, orientation, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
     let mut d = Distributed::load(world, r, path, &hints, tf, shading, scheme)?;
+    let content = voxsplat_cli::open::Content { orientation, bounds: d.visible_bounds() };
+    let cam = d.agree(camera_of(&a.scene, &grid, &content))?;
     let stored = d.stored_per_rank();
     let mut frames = Vec::new();
     for _ in 0..a.repeat.max(1) {

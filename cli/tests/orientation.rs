@@ -19,7 +19,8 @@ fn affine(cols: [DVec3; 3], t: DVec3) -> DMat4 {
 /// k (RAS), and stored upside down with the affine flipped along k (superior at low k: RAI, a
 /// left-handed file).
 fn files() -> [std::path::PathBuf; 2] {
-    let tee = |i: u32, j: u32, k: u32| (k >= 12 && k <= 14 || (5..=6).contains(&i) && (4..=5).contains(&j)) as u8 * 200;
+    let tee =
+        |i: u32, j: u32, k: u32| ((12..=14).contains(&k) || (5..=6).contains(&i) && (4..=5).contains(&j)) as u8 * 200;
     let [nx, ny, nz] = DIMS;
     let stored = |flip: bool| {
         let mut v = Vec::new();

@@ -63,6 +63,7 @@ pub struct Distributed<C: Communicator> {
     scheme: Scheme,
     stored: u64,
     store_bytes: u64,
+    visible: Option<[[u32; 3]; 2]>,
 }
 
 impl<C: Communicator> Distributed<C> {
@@ -112,9 +113,21 @@ impl<C: Communicator> Distributed<C> {
             scene.set_gradient_max(g);
         }
         let (stored, store_bytes) = (scene.store.len() as u64, scene.store.bytes());
+        // The whole volume's visible box: each rank's (its box and the voxel layer around it).
+        let [lo, hi] = scene.visible_bounds().unwrap_or([[u32::MAX; 3], [0; 3]]);
+        let (mut wlo, mut whi) = ([0u32; 3], [0u32; 3]);
+        comm.all_reduce_into(&lo[..], &mut wlo[..], SystemOperation::min());
+        comm.all_reduce_into(&hi[..], &mut whi[..], SystemOperation::max());
+        let visible = (wlo[0] <= whi[0]).then_some([wlo, whi]);
         let set = renderer.set_bricks(scene);
         agree(&comm, set)?;
-        Ok(Self { comm, renderer, partition, grid, scheme, stored, store_bytes })
+        Ok(Self { comm, renderer, partition, grid, scheme, stored, store_bytes, visible })
+    }
+
+    /// The box of voxels the transfer function shows across every rank (`BrickScene::visible_bounds`
+    /// of the whole volume): what a camera frames.
+    pub fn visible_bounds(&self) -> Option<[[u32; 3]; 2]> {
+        self.visible
     }
 
     /// Bytes of this rank's store (its box and the voxel layer around it; `BrickStore::bytes`).

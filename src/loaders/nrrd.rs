@@ -140,7 +140,7 @@ fn nrrd_orientation(
 /// An NRRD vector `(a,b,c)`.
 fn nrrd_vector(v: &str, what: &str) -> Result<DVec3> {
     let inner = v.trim().strip_prefix('(').and_then(|v| v.strip_suffix(')'));
-    let parts: Option<Vec<f64>> = inner.map(|i| i.split(',').map(|t| t.trim().parse::<f64>().ok()).collect()).flatten();
+    let parts: Option<Vec<f64>> = inner.and_then(|i| i.split(',').map(|t| t.trim().parse::<f64>().ok()).collect());
     match parts.as_deref() {
         Some(&[a, b, c]) if [a, b, c].iter().all(|x| x.is_finite()) => Ok(DVec3::new(a, b, c)),
         _ => Err(bad(what, format!("space vector '{v}' is not (x,y,z) of three finite numbers"))),
