@@ -4,7 +4,8 @@
 # the same file, preset and view (voxsplat's default camera, handed to VTK: scripts/vtk_file.py
 # --camera), in one run, the two tools alternating file by file. voxsplat: `render --repeat 5
 # --timings` (default path, median of each stage, summed); VTK: median of 5 frames after a warm-up.
-# PSNR over the object (scripts/gallery.py). Writes docs/img/gallery/NAME.png (voxsplat left, VTK
+# PSNR over the object (scripts/gallery.py), and the luminance contrast over the object of each
+# voxsplat frame (std / mean; the shaded rows against the unshaded decide `SHADED_PRESETS`). Writes docs/img/gallery/NAME.png (voxsplat left, VTK
 # right, 256² each) and prints the markdown table README and docs/RESULTS.md carry.
 # The terrain (rmnp) is drawn by voxsplat alone: VTK has no voxel-column terrain to set beside it.
 set -euo pipefail
@@ -22,13 +23,13 @@ out=docs/img/gallery
 mkdir -p "$work" "$out"
 [ -f "$work/procedural256.nrrd" ] || ./target/release/voxsplat make-volume --procedural 256 --out "$work/procedural256.nrrd" >&2
 vs=./target/release/voxsplat
-echo "| data | preset, view | voxsplat ms | VTK GPU ray cast ms | VTK / voxsplat | PSNR over the object, dB |"
-echo "|---|---|---|---|---|---|"
+echo "| data | preset, view | voxsplat ms | VTK GPU ray cast ms | VTK / voxsplat | PSNR over the object, dB | contrast |"
+echo "|---|---|---|---|---|---|---|"
 while IFS='|' read -r name file tf shade; do
-  flags=()
-  [ "$shade" = shade ] && flags+=(--shade)
+  flags=(--no-shade)
+  [ "$shade" = shade ] && flags=(--shade)
   log=$("$vs" render --volume "$file" --tf "$tf" "${flags[@]}" --size 512x512 --repeat "$FRAMES" --timings \
-    --validation --out "$work/$name-voxsplat.png" 2>&1)
+    --out "$work/$name-voxsplat.png" 2>&1)
   cam=$(grep "camera (grid frame)" <<< "$log")
   if "$vs" info "$file" | grep "^orientation: none" >/dev/null; then view=framing; else view=oblique; fi
   ms=$(grep -E "^[a-z_]+ +[0-9.]+ ms" <<< "$log" | awk '{s += $2} END {printf "%.1f", s}')
@@ -38,16 +39,20 @@ while IFS='|' read -r name file tf shade; do
     --frames "$FRAMES" --out "$work/$name-vtk.png")
   vtk_ms=$(sed -E 's/.*median=([0-9.]+)s.*/\1/' <<< "$vtk" | awk '{printf "%.1f", $1 * 1000}')
   psnr=$("$VENV/bin/python" scripts/gallery.py "$work/$name-voxsplat.png" "$work/$name-vtk.png" "$out/$name.png" \
-    | sed -E 's/psnr=([0-9.inf]+).*/\1/')
+    | tr '\n' ' ')
+  contrast=$(sed -E 's/.*contrast=([0-9.]+).*/\1/' <<< "$psnr")
+  psnr=$(sed -E 's/psnr=([0-9.inf]+).*/\1/' <<< "$psnr")
   ratio=$(awk -v a="$vtk_ms" -v b="$ms" 'BEGIN {printf "%.2f", a / b}')
-  echo "| $name | $tf${shade:+, shaded}, $view | $ms | $vtk_ms | $ratio | $psnr |"
+  echo "| $name | $tf${shade:+, shaded}, $view | $ms | $vtk_ms | $ratio | $psnr | $contrast |"
 done <<ROWS
-bonsai|$DATA/bonsai/bonsai.nii.gz|bonsai|
+bonsai|$DATA/bonsai/bonsai.nii.gz|bonsai|shade
 heptane|$DATA/heptane/heptane.nii.gz|ramp|
 stent|$DATA/stent/stent.nrrd|ct|
 procedural|$work/procedural256.nrrd|ramp|
-bonsai-shaded|$DATA/bonsai/bonsai.nii.gz|bonsai|shade
+bonsai-flat|$DATA/bonsai/bonsai.nii.gz|bonsai|
 stent-shaded|$DATA/stent/stent.nrrd|ct|shade
+heptane-shaded|$DATA/heptane/heptane.nii.gz|ramp|shade
+procedural-shaded|$work/procedural256.nrrd|ramp|shade
 ROWS
 # The terrain, voxsplat alone (its default fly-over).
 t=$("$vs" render --terrain "$DATA/rmnp/rmnp-dem.tif" --color "$DATA/rmnp/rmnp-rgb.png" --size 512x512 \
@@ -59,4 +64,4 @@ im = Image.open(sys.argv[1]).convert("RGBA")
 bg = Image.new("RGBA", im.size, (0, 0, 0, 255))
 Image.alpha_composite(bg, im).convert("RGB").resize((256, 256), Image.LANCZOS).save(sys.argv[2], optimize=True)
 PY
-echo "| rmnp (terrain) | colour image, fly-over | $t | - | - | - |"
+echo "| rmnp (terrain) | colour image, fly-over | $t | - | - | - | - |"

@@ -138,9 +138,13 @@ pub struct SceneArgs {
     /// Transfer function: a preset (ramp, ct, bonsai) or a TOML file.
     #[arg(long, default_value = "ramp")]
     pub tf: String,
-    /// Phong shading with a headlight, applied to the voxels before splatting.
-    #[arg(long)]
+    /// Phong shading with a headlight, applied to the voxels before splatting (on by default for
+    /// the presets it measurably helps: `classify::SHADED_PRESETS`, bonsai).
+    #[arg(long, conflicts_with = "no_shade")]
     pub shade: bool,
+    /// No shading, even for a preset shaded by default.
+    #[arg(long)]
+    pub no_shade: bool,
     /// Render a height grid (16-bit PNG, GeoTIFF, or 2D .npy) as voxel columns.
     #[arg(long)]
     pub terrain: Option<PathBuf>,
@@ -322,7 +326,8 @@ pub fn headlight(
     spacing: [f32; 3],
     orientation: Option<Orientation>,
 ) -> Option<voxsplat::classify::Shading> {
-    a.shade.then(|| {
+    let by_default = voxsplat::classify::SHADED_PRESETS.contains(&a.tf.as_str());
+    (a.shade || by_default && !a.no_shade).then(|| {
         let g = voxsplat::Grid::centered(dims, spacing).ok();
         let content = Content { orientation, bounds: None };
         let forward = g.and_then(|g| camera_of(a, &g, &content).ok()).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z);
