@@ -5,9 +5,10 @@
 # --camera), in one run, the two tools alternating file by file. voxsplat: `render --repeat 5
 # --timings` (default path, median of each stage, summed); VTK: median of 5 frames after a warm-up.
 # PSNR over the object (scripts/gallery.py), and the luminance contrast over the object of each
-# voxsplat frame (std / mean; the shaded rows against the unshaded decide `SHADED_PRESETS`). Writes docs/img/gallery/NAME.png (voxsplat left, VTK
-# right, 256² each) and prints the markdown table README and docs/RESULTS.md carry.
-# The terrain (rmnp) is drawn by voxsplat alone: VTK has no voxel-column terrain to set beside it.
+# voxsplat frame (std / mean; the shaded rows against the unshaded decide `SHADED_PRESETS`).
+# Writes docs/img/gallery/NAME.png (voxsplat left, VTK right, 256² each) and prints the markdown
+# table README and docs/RESULTS.md carry.
+# The terrain (rmnp) beside VTK's textured surface of the same height grid (scripts/vtk_terrain.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV_VTK:-$HOME/.cache/peers/venv}
@@ -54,14 +55,16 @@ stent-shaded|$DATA/stent/stent.nrrd|ct|shade
 heptane-shaded|$DATA/heptane/heptane.nii.gz|ramp|shade
 procedural-shaded|$work/procedural256.nrrd|ramp|shade
 ROWS
-# The terrain, voxsplat alone (its default fly-over).
-t=$("$vs" render --terrain "$DATA/rmnp/rmnp-dem.tif" --color "$DATA/rmnp/rmnp-rgb.png" --size 512x512 \
-  --repeat "$FRAMES" --timings --out "$work/rmnp-voxsplat.png" 2>&1 | grep -E "^[a-z_]+ +[0-9.]+ ms" | awk '{s += $2} END {printf "%.1f", s}')
-"$VENV/bin/python" - "$work/rmnp-voxsplat.png" "$out/rmnp.png" <<'PY'
-import sys
-from PIL import Image
-im = Image.open(sys.argv[1]).convert("RGBA")
-bg = Image.new("RGBA", im.size, (0, 0, 0, 255))
-Image.alpha_composite(bg, im).convert("RGB").resize((256, 256), Image.LANCZOS).save(sys.argv[2], optimize=True)
-PY
-echo "| rmnp (terrain) | colour image, fly-over | $t | - | - | - | - |"
+# The terrain: voxsplat's voxel columns beside VTK's textured surface of the same heights and colours
+# (scripts/vtk_terrain.py), voxsplat's default fly-over.
+dem=$DATA/rmnp/rmnp-dem.tif
+rgb=$DATA/rmnp/rmnp-rgb.png
+log=$("$vs" render --terrain "$dem" --color "$rgb" --size 512x512 --repeat "$FRAMES" --timings \
+  --out "$work/rmnp-voxsplat.png" 2>&1)
+t=$(grep -E "^[a-z_]+ +[0-9.]+ ms" <<< "$log" | awk '{s += $2} END {printf "%.1f", s}')
+vtk=$("$VENV/bin/python" scripts/vtk_terrain.py --dem "$dem" --color "$rgb" --camera "$(grep "camera (grid frame)" <<< "$log")" \
+  --frames "$FRAMES" --out "$work/rmnp-vtk.png")
+vtk_ms=$(sed -E 's/.*median=([0-9.]+)s.*/\1/' <<< "$vtk" | awk '{printf "%.1f", $1 * 1000}')
+r=$("$VENV/bin/python" scripts/gallery.py "$work/rmnp-voxsplat.png" "$work/rmnp-vtk.png" "$out/rmnp.png")
+ratio=$(awk -v a="$vtk_ms" -v b="$t" 'BEGIN {printf "%.2f", a / b}')
+echo "| rmnp (terrain; VTK: a textured surface) | colour image, fly-over | $t | $vtk_ms | $ratio | $(sed -E 's/psnr=([0-9.inf]+).*/\1/' <<< "$r") | $(sed -E 's/.*contrast=([0-9.]+).*/\1/' <<< "$r") |"

@@ -195,10 +195,24 @@ pub struct Content {
     pub bounds: Option<[[u32; 3]; 2]>,
 }
 
-/// The --volume file's placement in patient space, if its header gives one.
+/// The --volume file's placement in patient space, if its header gives one. With --positions the
+/// positions file places the voxels instead (a left-handed file, stored x-reversed, is refused).
 pub fn orientation_of(a: &SceneArgs) -> Result<Option<Orientation>> {
     match &a.volume {
-        Some(path) if a.terrain.is_none() => voxsplat::loaders::load_orientation(path, &volume_hints(a)?),
+        Some(path) if a.terrain.is_none() => {
+            let o = voxsplat::loaders::load_orientation(path, &volume_hints(a)?)?;
+            if a.positions.is_some() {
+                if o.is_some_and(|o| o.flip_x) {
+                    return Err(Error::Unsupported(
+                        "--positions with a left-handed file (its x is stored reversed): give the positions in \
+                         a right-handed file's order"
+                            .into(),
+                    ));
+                }
+                return Ok(None);
+            }
+            Ok(o)
+        }
         _ => Ok(None),
     }
 }
