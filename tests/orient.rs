@@ -264,3 +264,50 @@ fn views_put_superior_up_and_face_their_side() {
     assert_eq!(View::Left.directions().0, -Vec3::X);
     assert!("sideways".parse::<View>().is_err());
 }
+
+#[test]
+fn the_validator_runs_on_oblique_grids() {
+    use voxsplat::order::{count_violations, visibility_order, Direction, OrderKind};
+    let tf = voxsplat::classify::TransferFunction {
+        points: vec![(0.3, [0.9, 0.6, 0.3, 0.0]), (1.0, [0.9, 0.6, 0.3, 0.6])],
+        gradient_weight: 0.0,
+        range: Some((0.0, 200.0)),
+        threshold: 0.0,
+    };
+    let v = samples(DIMS, |b| b);
+    let m = DMat3::from_quat(DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.6));
+    for (name, cols) in [("oblique", [m.x_axis, m.y_axis, m.z_axis]), ("mirrored", [-m.x_axis, m.y_axis, m.z_axis])] {
+        let a = affine(cols, T);
+        let path = write(&format!("validator-{name}.nii"), &nifti(DIMS, &v, Some(a), None));
+        let vol = load_volume(&path, &VolumeHints::default()).unwrap();
+        let o = load_orientation(&path, &VolumeHints::default()).unwrap().unwrap();
+        let set = voxsplat::classify::classify(&vol, &tf, None).unwrap();
+        let c = a.transform_point3(DVec3::new(5.5, 4.5, 7.5)).as_vec3();
+        // Close (the eye over the grid, where BTF fails under perspective) and far, from three sides.
+        for (dist, dir) in [(11.0, Vec3::new(0.2, 1.0, 0.3)), (11.0, Vec3::new(-1.0, 0.1, 0.4)), (40.0, Vec3::Z)] {
+            let eye = c + dir.normalize() * dist;
+            let up = if dir.cross(Vec3::Z).length() < 1e-3 { Vec3::Y } else { Vec3::Z };
+            let cam = Camera {
+                eye,
+                target: c,
+                up,
+                projection: Projection::Perspective { fov_y_deg: 60.0 },
+                near: 0.5,
+                far: 80.0,
+                width: 64,
+                height: 64,
+            };
+            let grid_cam = o.camera_to_grid(&cam);
+            let count = |k| {
+                let order = visibility_order(&set, &grid_cam, k, Direction::BackToFront);
+                count_violations(&set, &grid_cam, &order, Direction::BackToFront).unwrap()
+            };
+            let (pbtf, btf) = (count(OrderKind::Pbtf), count(OrderKind::Btf));
+            eprintln!("{name}, eye at {dist}: PBTF {pbtf} violations, BTF {btf}");
+            assert_eq!(pbtf, 0, "{name}: PBTF from {eye}");
+            if dist < 20.0 {
+                assert!(btf > 0, "{name}: the validator sees BTF fail from {eye}");
+            }
+        }
+    }
+}

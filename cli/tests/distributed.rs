@@ -5,6 +5,8 @@
 //! every rank.
 #![cfg(feature = "mpi")]
 mod cmd;
+#[path = "../../tests/common/mod.rs"]
+mod common;
 use cmd::voxsplat;
 use std::process::{Command, Output};
 
@@ -160,4 +162,34 @@ fn what_cannot_be_split_is_refused_on_every_rank() {
         assert!(lines.iter().all(|l| *l == lines[0] && l.contains(why)), "{args:?}: {lines:?}");
     }
     assert!(!out.exists());
+}
+
+#[test]
+fn ranks_read_a_left_handed_file_as_one_process_does() {
+    // Superior at low k (a negative k column): stored x-reversed on every path, each rank's box too.
+    // Longest along x, so the ranks' boxes split x and each reads the mirrored span of its rows.
+    let dims = [24, common::DIMS[1], common::DIMS[2]];
+    let nz = dims[2] as i64;
+    let v = common::samples(dims, |[i, j, k]| [i / 2, j, nz - 1 - k]);
+    let affine = glam::DMat4::from_cols(
+        glam::DVec4::X,
+        glam::DVec4::Y,
+        -glam::DVec4::Z,
+        glam::DVec4::new(0.0, 0.0, (nz - 1) as f64, 1.0),
+    );
+    let file = tmp("rai.nii");
+    std::fs::write(&file, common::nifti(dims, &v, Some(affine), None)).unwrap();
+    let args = ["render", "--volume", file.to_str().unwrap(), "--tf", "ramp", "--view", "anterior", "--size", "64x64"];
+    let single = tmp("rai-single.exr");
+    let mut a = args.to_vec();
+    a.extend(["--out", single.to_str().unwrap()]);
+    ok(&voxsplat(&a), "single process");
+    let out = tmp("rai-2.exr");
+    let mut a = args.to_vec();
+    a.extend(["--out", out.to_str().unwrap(), "--validation"]);
+    let run = mpirun(2, &a);
+    ok(&run, "two ranks");
+    assert!(String::from_utf8_lossy(&run.stderr).contains("on 2 ranks"));
+    let d = max_abs(&single, &out);
+    assert!(d <= 2e-3, "two ranks: {d} from the single-process frame");
 }
