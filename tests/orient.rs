@@ -182,14 +182,20 @@ fn covered_error(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> f64 {
     sum / n as f64
 }
 
-#[test]
-fn an_oblique_grid_renders_as_the_world_space_truth() {
-    let tf = voxsplat::classify::TransferFunction {
+/// One colour, opacity rising from 0.3 of the object's value range (0..200): the comparisons turn
+/// on shape and opacity, not on where classification happens.
+fn one_colour() -> voxsplat::classify::TransferFunction {
+    voxsplat::classify::TransferFunction {
         points: vec![(0.3, [0.9, 0.6, 0.3, 0.0]), (1.0, [0.9, 0.6, 0.3, 0.6])],
         gradient_weight: 0.0,
         range: Some((0.0, 200.0)),
         threshold: 0.0,
-    };
+    }
+}
+
+#[test]
+fn an_oblique_grid_renders_as_the_world_space_truth() {
+    let tf = one_colour();
     let v = samples(DIMS, |b| b);
     let mut r = common::gpu();
     // An anterior-oblique world camera on the object's centre, 96 px.
@@ -268,12 +274,7 @@ fn views_put_superior_up_and_face_their_side() {
 #[test]
 fn the_validator_runs_on_oblique_grids() {
     use voxsplat::order::{count_violations, visibility_order, Direction, OrderKind};
-    let tf = voxsplat::classify::TransferFunction {
-        points: vec![(0.3, [0.9, 0.6, 0.3, 0.0]), (1.0, [0.9, 0.6, 0.3, 0.6])],
-        gradient_weight: 0.0,
-        range: Some((0.0, 200.0)),
-        threshold: 0.0,
-    };
+    let tf = one_colour();
     let v = samples(DIMS, |b| b);
     let m = DMat3::from_quat(DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.6));
     for (name, cols) in [("oblique", [m.x_axis, m.y_axis, m.z_axis]), ("mirrored", [-m.x_axis, m.y_axis, m.z_axis])] {
