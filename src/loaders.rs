@@ -210,7 +210,7 @@ pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<S
     };
     let mut values = decode(&data, n, dtype, endian_big, what)?;
     check_finite(&values, what)?;
-    if orientation.is_some_and(|o| o.flip_x) {
+    if orientation.is_some_and(|o| o.flip_x()) {
         nrrd::flip_rows(&mut values, d3[0] as usize);
     }
     Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
@@ -232,7 +232,7 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
     let mut values = decode(&data[l.offset as usize..], n, l.dtype, l.big_endian, what)?;
     l.rescale(&mut values);
     check_finite(&values, what)?;
-    if l.orientation.is_some_and(|o| o.flip_x) {
+    if l.orientation.is_some_and(|o| o.flip_x()) {
         nrrd::flip_rows(&mut values, l.dims[0] as usize);
     }
     Ok(ScalarVolume { dims: l.dims, spacing: l.spacing, values })

@@ -21,15 +21,12 @@ pub const MAX_SKEW: f64 = 1e-3;
 /// A grid's placement in patient space (RAS+), from its file's affine.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Orientation {
-    /// Index -> world affine as the file gives it (columns i, j, k, then the translation).
-    pub affine: DMat4,
+    affine: DMat4,
     /// Grid frame -> world rotation (proper: determinant +1).
     rotation: DMat3,
     /// World position of the grid's centre.
     center: DVec3,
-    /// The affine is left-handed: the grid's x axis is stored reversed (voxel i of the grid is
-    /// the file's nx - 1 - i).
-    pub flip_x: bool,
+    flip_x: bool,
     dims: [u32; 3],
 }
 
@@ -59,6 +56,17 @@ impl Orientation {
         let mid = DVec3::new(dims[0] as f64 - 1.0, dims[1] as f64 - 1.0, dims[2] as f64 - 1.0) * 0.5;
         let center = affine.transform_point3(mid);
         Ok(Self { affine, rotation, center, flip_x, dims })
+    }
+
+    /// Index -> world affine as the file gives it (columns i, j, k, then the translation).
+    pub fn affine(&self) -> DMat4 {
+        self.affine
+    }
+
+    /// The affine is left-handed: the grid's x axis is stored reversed (voxel i of the grid is the
+    /// file's nx - 1 - i), which leaves the grid-to-world map a rotation.
+    pub fn flip_x(&self) -> bool {
+        self.flip_x
     }
 
     /// Voxel spacing along i, j, k: the lengths of the affine's columns.

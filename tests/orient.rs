@@ -29,7 +29,7 @@ fn assert_placed(path: &std::path::Path, code: &str, flip_x: bool) -> Orientatio
     let hints = VolumeHints::default();
     let vol = load_volume(path, &hints).unwrap();
     let o = load_orientation(path, &hints).unwrap().expect("a frame");
-    assert_eq!((o.code().as_str(), o.flip_x), (code, flip_x), "{}", path.display());
+    assert_eq!((o.code().as_str(), o.flip_x()), (code, flip_x), "{}", path.display());
     let grid = Grid::centered(vol.dims, vol.spacing).unwrap();
     let mut n = 0;
     for k in 0..vol.dims[2] {

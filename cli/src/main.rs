@@ -635,10 +635,11 @@ fn run(cli: Cli) -> Result<()> {
                 };
                 match voxsplat::loaders::load_orientation(&file, &hints)? {
                     Some(o) => println!(
-                        "orientation: {} (index axes i, j, k toward; world RAS+, grid centre at {:.2?}{})",
+                        "orientation: {} (i, j, k run toward {}; world RAS+, grid centre at {:.2?}{})",
                         o.code(),
+                        o.code().chars().map(String::from).collect::<Vec<_>>().join(", "),
                         o.to_world(voxsplat::glam::Vec3::ZERO).to_array(),
-                        if o.flip_x { "; left-handed: x stored reversed" } else { "" }
+                        if o.flip_x() { "; left-handed: x stored reversed" } else { "" }
                     ),
                     None => println!("orientation: none (no anatomical frame: --view framing)"),
                 }

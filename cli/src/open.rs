@@ -202,7 +202,7 @@ pub fn orientation_of(a: &SceneArgs) -> Result<Option<Orientation>> {
         Some(path) if a.terrain.is_none() => {
             let o = voxsplat::loaders::load_orientation(path, &volume_hints(a)?)?;
             if a.positions.is_some() {
-                if o.is_some_and(|o| o.flip_x) {
+                if o.is_some_and(|o| o.flip_x()) {
                     return Err(Error::Unsupported(
                         "--positions with a left-handed file (its x is stored reversed): give the positions in \
                          a right-handed file's order"

@@ -229,7 +229,7 @@ impl SliceReader {
     }
 
     fn flip_x(&self) -> bool {
-        self.orientation.is_some_and(|o| o.flip_x)
+        self.orientation.is_some_and(|o| o.flip_x())
     }
 
     /// The part `lo..hi` (x and y) of slices `z0..z0 + count` into `out`, x fastest over the
