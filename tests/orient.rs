@@ -105,6 +105,16 @@ fn sheared_and_broken_affines_are_typed_errors() {
     assert!(
         matches!(load_volume(&p, &VolumeHints::default()), Err(Error::InvalidArgument(m)) if m.contains("space vector"))
     );
+    let nan = affine([DVec3::X, DVec3::new(f64::NAN, 1.0, 0.0), DVec3::Z], T);
+    let p = write("nan.nii", &nifti(DIMS, &v, Some(nan), None));
+    assert!(matches!(load_orientation(&p, &VolumeHints::default()), Err(Error::InvalidArgument(_))));
+    let head = "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspace: LPS\nspace directions: none none none\nencoding: raw\n\n";
+    let mut bytes = head.as_bytes().to_vec();
+    bytes.extend_from_slice(&[0; 8]);
+    let p = write("none-directions.nrrd", &bytes);
+    assert!(
+        matches!(load_volume(&p, &VolumeHints::default()), Err(Error::InvalidArgument(m)) if m.contains("three vectors"))
+    );
     // No frame: NIfTI with both codes 0, an NRRD without a space.
     let p = write("none.nii", &nifti(DIMS, &v, None, None));
     assert!(load_orientation(&p, &VolumeHints::default()).unwrap().is_none());
@@ -311,4 +321,25 @@ fn the_validator_runs_on_oblique_grids() {
             }
         }
     }
+}
+
+#[test]
+fn a_spacing_override_scales_the_placement_about_the_first_voxel() {
+    let v = samples(DIMS, |b| b);
+    let m = DMat3::from_quat(DQuat::from_rotation_x(0.3));
+    let a = affine([m.x_axis, m.y_axis * 2.0, m.z_axis], T);
+    let p = write("spaced.nii", &nifti(DIMS, &v, Some(a), None));
+    let plain = load_orientation(&p, &VolumeHints::default()).unwrap().unwrap();
+    assert_eq!(plain.spacing(), [1.0, 2.0, 1.0]);
+    let hints = VolumeHints { spacing: Some([0.5, 0.5, 3.0]), ..Default::default() };
+    let o = load_orientation(&p, &hints).unwrap().unwrap();
+    for (s, t) in o.spacing().iter().zip([0.5, 0.5, 3.0]) {
+        assert!((s - t).abs() < 1e-6, "{:?}", o.spacing());
+    }
+    // Voxel (0, 0, 0) stays where the file put it; the axes keep their directions.
+    let vol = load_volume(&p, &hints).unwrap();
+    let grid = Grid::centered(vol.dims, vol.spacing).unwrap();
+    assert!((o.to_world(grid.position([0, 0, 0])).as_dvec3() - T).length() < 1e-4);
+    let step = o.to_world(grid.position([0, 1, 0])) - o.to_world(grid.position([0, 0, 0]));
+    assert!((step.as_dvec3() - m.y_axis * 0.5).length() < 1e-5, "{step}");
 }
