@@ -226,7 +226,8 @@ pub fn content_of(
     let orientation = orientation_of(a)?;
     let bounds = match bricked {
         Some(b) => b.visible_bounds(),
-        None if a.volume.is_some() => set.bounds(),
+        // (A rectilinear grid's voxels lie at its --positions: framed whole.)
+        None if a.volume.is_some() && a.positions.is_none() => set.bounds(),
         None => None,
     };
     Ok(Content { orientation, bounds })
@@ -255,17 +256,16 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
     let top = grid.dims.map(|d| d - 1);
     let [lo, hi] = content.bounds.unwrap_or([[0; 3], top]).map(|c| grid.position(c));
     let ks = grid.kernel_spacing();
-    let mut cam = match view {
-        "grazing" => Camera::grazing(grid, w, h),
-        "flyover" => Camera::flyover(grid, w, h),
-        "peer" => {
+    let mut cam = match (view, o) {
+        ("grazing", _) => Camera::grazing(grid, w, h),
+        ("flyover", _) => Camera::flyover(grid, w, h),
+        ("peer", _) => {
             if w != h {
                 return Err(Error::InvalidArgument("the peer view is square: use --size NxN".into()));
             }
             voxsplat::peer::camera(grid.dims[0], w)
         }
-        v if anatomical => {
-            let o = o.expect("checked above");
+        (v, Some(o)) if anatomical => {
             let (dir, up) = v.parse::<voxsplat::orient::View>()?.directions();
             Camera::framing_box(lo, hi, ks, o.dir_to_grid(dir), o.dir_to_grid(up), w, h)
         }
