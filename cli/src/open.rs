@@ -81,10 +81,11 @@ pub struct SceneArgs {
     /// Built-in scene name (see `voxsplat scenes`).
     #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain"])]
     pub scene: String,
-    /// Eye position (default: a three-quarter view framing the scene).
+    /// Eye position (default: the --view's; patient RAS coordinates for a file with an anatomical
+    /// frame, the grid's centred frame otherwise).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
-    /// Look-at point (default: the scene's centre).
+    /// Look-at point (default: the centre of what the view frames; coordinates as --eye's).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub target: Option<Vec3>,
     /// Up vector (default: +y; superior for data with an anatomical frame).
