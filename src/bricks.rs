@@ -169,7 +169,8 @@ impl BrickStore {
                     let mut mask = [0u64; BRICK_VOXELS / 64];
                     let (mut qmin, mut qmax) = (u32::MAX, 0u32);
                     for l in 0..BRICK_VOXELS as u32 {
-                        let v = [bx * BRICK + l % BRICK, by * BRICK + l / BRICK % BRICK, bz * BRICK + l / 64];
+                        let c = local_cell(l);
+                        let v = [bx * BRICK + c[0], by * BRICK + c[1], bz * BRICK + c[2]];
                         if (0..3).any(|a| v[a] < r0[a] || v[a] >= r1[a]) {
                             continue;
                         }
@@ -334,6 +335,11 @@ fn remap(store: &BrickStore, tf: &TransferFunction) -> (f32, f32) {
         }
         None => (1.0, 0.0),
     }
+}
+
+/// The (x, y, z) within its brick of local index `l` (x + 8y + 64z, a record's low 9 bits).
+pub fn local_cell(l: u32) -> [u32; 3] {
+    [l % BRICK, (l / BRICK) % BRICK, l / (BRICK * BRICK)]
 }
 
 /// Whether the TF table `table` (`BrickScene::tf_words`) extracts voxels of quantised value `q`
@@ -586,16 +592,13 @@ impl BrickScene {
     /// The box of stored voxels the transfer function gives some opacity (`None`: none does),
     /// smallest and largest grid index: what a camera frames.
     pub fn visible_bounds(&self) -> Option<[[u32; 3]; 2]> {
-        let ((a, b), (mut lo, mut hi)) = (self.remap(), ([u32::MAX; 3], [0u32; 3]));
+        let (mut lo, mut hi) = ([u32::MAX; 3], [0u32; 3]);
         for h in &self.store.headers {
             let base = h.coords().map(|c| c * BRICK);
-            for &rec in &self.store.records[h.first as usize..(h.first + h.count) as usize] {
-                let d = a * (rec >> 16) as f32 / Q + b;
-                if d >= self.tf.threshold && self.tf.eval(d)[3] > 0.0 {
-                    let l = rec & 0x1ff;
-                    let v = [l % BRICK, l / BRICK % BRICK, l / (BRICK * BRICK)];
-                    (0..3).for_each(|x| (lo[x], hi[x]) = (lo[x].min(base[x] + v[x]), hi[x].max(base[x] + v[x])));
-                }
+            let records = &self.store.records[h.first as usize..(h.first + h.count) as usize];
+            for &rec in records.iter().filter(|&&r| emits(&self.table, r >> 16)) {
+                let v = local_cell(rec & 511);
+                (0..3).for_each(|x| (lo[x], hi[x]) = (lo[x].min(base[x] + v[x]), hi[x].max(base[x] + v[x])));
             }
         }
         (lo[0] <= hi[0]).then_some([lo, hi])

@@ -5,7 +5,7 @@ use super::bindings::Bindings;
 use super::lod::level_count;
 use super::order::{outward, side_count};
 use super::splat_params::{cell_footprint_scale, optical_depth, params_at, CULL_RADII};
-use crate::bricks::{BrickStore, BRICK};
+use crate::bricks::{local_cell, BrickStore, BRICK};
 use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::{Error, Result};
@@ -331,10 +331,6 @@ pub fn voxel_ijk(v: [u32; 2]) -> [u32; 3] {
 /// Mirror of `voxel_level`: 0 for a voxel, l for a cell of 2^l voxels a side.
 pub fn voxel_level(v: [u32; 2]) -> u32 {
     v[1] >> 13 & 3
-}
-
-pub(crate) fn local_cell(l: u32) -> [u32; 3] {
-    [l % BRICK, (l / BRICK) % BRICK, l / (BRICK * BRICK)]
 }
 
 /// Pass 1: cull each non-empty brick or write its header and count at its draw-order slot

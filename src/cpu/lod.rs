@@ -2,10 +2,10 @@
 //! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
 //! `cell_color`).
 use super::bindings::Bindings;
-use super::brick::{inputs, inputs_for, local_cell, streamed, voxel_ijk, voxel_level, BrickInputs, VOXEL_MORPHS};
+use super::brick::{inputs, inputs_for, streamed, voxel_ijk, voxel_level, BrickInputs, VOXEL_MORPHS};
 use super::order::side_count;
 use super::splat_params::{optical_depth, params_at};
-use crate::bricks::BRICK;
+use crate::bricks::{local_cell, BRICK};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{BrickPush, SplatParams};
