@@ -221,11 +221,7 @@ impl SliceReader {
         let at = self.offset + self.plane_bytes() * z0 as u64;
         let r = self.source.read_at(at, &mut self.bytes);
         r.map_err(|e| read_error(&self.what, z0 + count, e))?;
-        self.decode(n, out)?;
-        if self.flip_x() {
-            super::nrrd::flip_rows(out, self.dims[0] as usize);
-        }
-        Ok(())
+        self.decode(n, self.dims[0] as usize, out)
     }
 
     fn flip_x(&self) -> bool {
@@ -273,20 +269,21 @@ impl SliceReader {
                 r.map_err(|e| read_error(&self.what, z0 + z as u32 + 1, e))?;
             }
         }
-        self.decode((count as usize * h * w) as u64, out)?;
-        if self.flip_x() {
-            super::nrrd::flip_rows(out, w);
-        }
-        Ok(())
+        self.decode((count as usize * h * w) as u64, w, out)
     }
 
-    /// `n` samples from the bytes read, rescaled and checked finite.
-    fn decode(&self, n: u64, out: &mut Vec<f32>) -> Result<()> {
+    /// `n` samples from the bytes read, in rows of `row` samples: rescaled, checked finite, and
+    /// each row reversed for a left-handed file (`Orientation::flip_x`).
+    fn decode(&self, n: u64, row: usize, out: &mut Vec<f32>) -> Result<()> {
         *out = decode(&self.bytes, n, self.dtype, self.big_endian, &self.what)?;
         if let Some(l) = &self.rescale {
             l.rescale(out);
         }
-        super::check_finite(out, &self.what)
+        super::check_finite(out, &self.what)?;
+        if self.flip_x() {
+            super::nrrd::flip_rows(out, row);
+        }
+        Ok(())
     }
 }
 
