@@ -446,7 +446,8 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
     let what = path.display().to_string();
     let o = match SliceReader::open(path, hints)? {
         Some(reader) => reader.orientation,
-        None if is_raw(path) || path.to_string_lossy().to_ascii_lowercase().ends_with(".npy") => None,
+        // Not streamed: an .npy (no frame), or an NRRD in another encoding (its header alone).
+        None if path.to_string_lossy().to_ascii_lowercase().ends_with(".npy") => None,
         None => {
             let mut head = Vec::new();
             let file = std::fs::File::open(path).map_err(|e| Error::Io { path: what.clone(), source: e })?;
