@@ -26,7 +26,7 @@ use voxsplat::glam::{Quat, Vec3, Vec4};
 use voxsplat::vk::ash::{self, vk};
 use voxsplat::vk::{Context, HostHandles, HostTarget, Semaphore};
 use voxsplat::{Camera, Clip, Composite, Error, Lod, OrderKind, Raster, RenderOptions, Renderer, Result};
-use voxsplat_cli::open::{camera_of, content_of, open, parse_background, SceneArgs};
+use voxsplat_cli::open::{camera_of, open, parse_background, SceneArgs};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -455,9 +455,8 @@ impl Viewer {
         // first); the queue is used from this thread only, never while voxsplat submits.
         let ctx = unsafe { Context::from_host(host.handles()) }?;
         let mut renderer = Renderer::with_context(ctx.clone())?;
-        let (bricked, set) = open(&self.args.scene, self.options.order != OrderKind::Pbtf)?;
+        let (bricked, set, content) = open(&self.args.scene, self.options.order != OrderKind::Pbtf)?;
         let grid = *set.grid();
-        let content = content_of(&self.args.scene, bricked.as_ref(), &set)?;
         match bricked {
             Some(b) => {
                 self.raw_range = b.store.range;

@@ -426,8 +426,7 @@ fn run(cli: Cli) -> Result<()> {
             if voxsplat::distributed::mpi::launched() {
                 return render_distributed(&a, &opts, host_splats);
             }
-            let (bricked, set) = open(&a.scene, host_splats)?;
-            let content = content_of(&a.scene, bricked.as_ref(), &set)?;
+            let (bricked, set, content) = open(&a.scene, host_splats)?;
             let cam = camera_of(&a.scene, set.grid(), &content)?;
             if let voxsplat::Projection::Perspective { fov_y_deg } = cam.projection {
                 // Other renderers (scripts/vtk_file.py) take the same view from this line.
@@ -750,8 +749,8 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Order(a) => {
-            let set = load_scene(&a.scene)?;
-            let cam = camera_of(&a.scene, set.grid(), &content_of(&a.scene, None, &set)?)?;
+            let (set, content) = load_scene(&a.scene)?;
+            let cam = camera_of(&a.scene, set.grid(), &content)?;
             let kind = a.scene.order.parse::<OrderKind>()?;
             let seq = if kind == OrderKind::Pbtf && !a.scene.cpu {
                 let mut r = renderer_of(&a.scene)?;

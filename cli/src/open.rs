@@ -218,22 +218,6 @@ pub fn orientation_of(a: &SceneArgs) -> Result<Option<Orientation>> {
     }
 }
 
-/// The placement and visible box of an opened scene (`open`).
-pub fn content_of(
-    a: &SceneArgs,
-    bricked: Option<&voxsplat::bricks::BrickScene>,
-    set: &voxsplat::SplatSet,
-) -> Result<Content> {
-    let orientation = orientation_of(a)?;
-    let bounds = match bricked {
-        Some(b) => b.visible_bounds(),
-        // (A rectilinear grid's voxels lie at its --positions: framed whole.)
-        None if a.volume.is_some() && a.positions.is_none() => set.bounds(),
-        None => None,
-    };
-    Ok(Content { orientation, bounds })
-}
-
 /// The camera `a` asks for, in the grid's frame (`Grid::centered`). With an anatomical frame,
 /// --eye, --target and --up are world (patient) coordinates, mapped into the grid's frame.
 pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Result<Camera> {
@@ -350,19 +334,29 @@ pub fn headlight(
     })
 }
 
-/// The --volume file, its transfer function and shading.
-pub fn load_volume_parts(a: &SceneArgs, path: &std::path::Path) -> Result<VolumeParts> {
+/// The --volume file, its transfer function and shading (a headlight along the view of the file
+/// placed by `orientation`, `orientation_of`'s).
+pub fn load_volume_parts(
+    a: &SceneArgs,
+    path: &std::path::Path,
+    orientation: Option<Orientation>,
+) -> Result<VolumeParts> {
     let vol = voxsplat::loaders::load_volume(path, &volume_hints(a)?)?;
     let tf = transfer_function(a)?;
-    let shading = headlight(a, vol.dims, vol.spacing, orientation_of(a)?);
+    let shading = headlight(a, vol.dims, vol.spacing, orientation);
     Ok((vol, tf, shading))
 }
 
-/// The --volume file as a bricked scene, with a one-line report of the store.
-pub fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::bricks::BrickScene> {
+/// The --volume file as a bricked scene (shaded as `load_volume_parts` shades), with a one-line
+/// report of the store.
+pub fn load_bricked(
+    a: &SceneArgs,
+    path: &std::path::Path,
+    orientation: Option<Orientation>,
+) -> Result<voxsplat::bricks::BrickScene> {
     let store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
     let tf = transfer_function(a)?;
-    let shading = headlight(a, store.dims, store.spacing, orientation_of(a)?);
+    let shading = headlight(a, store.dims, store.spacing, orientation);
     eprintln!(
         "{} stored voxels in {} bricks of {}^3, {:.2} bytes per stored voxel on the GPU ({} x {} x {} grid)",
         store.len(),
@@ -376,10 +370,13 @@ pub fn load_bricked(a: &SceneArgs, path: &std::path::Path) -> Result<voxsplat::b
     voxsplat::bricks::BrickScene::new(store, tf, shading)
 }
 
-/// The splats named by --volume, --terrain or --scene, with a one-line report of what was loaded.
-pub fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
+/// The splats named by --volume, --terrain or --scene, with a one-line report of what was loaded,
+/// and what a camera frames of them: a volume's placement and the voxels its transfer function
+/// shows (a rectilinear grid's voxels lie at its --positions: framed whole).
+pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
+    let orientation = orientation_of(a)?;
     let set = if let Some(path) = &a.volume {
-        let (vol, tf, shading) = load_volume_parts(a, path)?;
+        let (vol, tf, shading) = load_volume_parts(a, path, orientation)?;
         let set = voxsplat::classify::classify(&vol, &tf, shading)?;
         match &a.positions {
             Some(p) => {
@@ -413,7 +410,8 @@ pub fn load_scene(a: &SceneArgs) -> Result<voxsplat::SplatSet> {
         set.grid().dims[1],
         set.grid().dims[2]
     );
-    Ok(set)
+    let bounds = if a.volume.is_some() && a.positions.is_none() { set.bounds() } else { None };
+    Ok((set, Content { orientation, bounds }))
 }
 
 /// `mib` MiB in bytes: positive, and without wrapping past u64.
@@ -450,8 +448,11 @@ pub fn report_validation(r: &Renderer) -> Result<()> {
 
 /// The scene `a` names: a --volume as a bricked store classified on the device unless
 /// `host_splats` (a mode that needs host splats), else host splats; with the grid's splat set
-/// (empty for a bricked store) for cameras and orders.
-pub fn open(a: &SceneArgs, host_splats: bool) -> Result<(Option<voxsplat::bricks::BrickScene>, voxsplat::SplatSet)> {
+/// (empty for a bricked store) for cameras and orders, and what a camera frames (`Content`).
+pub fn open(
+    a: &SceneArgs,
+    host_splats: bool,
+) -> Result<(Option<voxsplat::bricks::BrickScene>, voxsplat::SplatSet, Content)> {
     let peer = voxsplat::peer::side_of(&a.scene).filter(|_| a.volume.is_none() && a.terrain.is_none());
     if a.bricked && (peer.is_none() || host_splats) {
         return Err(Error::InvalidArgument(
@@ -459,18 +460,19 @@ pub fn open(a: &SceneArgs, host_splats: bool) -> Result<(Option<voxsplat::bricks
                 .into(),
         ));
     }
-    let bricked = match (&a.volume, peer) {
-        (Some(path), _) if !host_splats && !a.dense && a.positions.is_none() => Some(load_bricked(a, path)?),
+    let (bricked, orientation) = match (&a.volume, peer) {
+        (Some(path), _) if !host_splats && !a.dense && a.positions.is_none() => {
+            let orientation = orientation_of(a)?;
+            (load_bricked(a, path, orientation)?, orientation)
+        }
         (None, Some(n)) if a.bricked => {
             let store = voxsplat::bricks::BrickStore::build(&voxsplat::peer::volume(n)?)?;
             eprintln!("{} stored voxels in {} bricks", store.len(), store.headers.len());
-            Some(voxsplat::bricks::BrickScene::new(store, voxsplat::peer::transfer_function(), None)?)
+            (voxsplat::bricks::BrickScene::new(store, voxsplat::peer::transfer_function(), None)?, None)
         }
-        _ => None,
+        _ => return load_scene(a).map(|(set, content)| (None, set, content)),
     };
-    let set = match &bricked {
-        Some(b) => voxsplat::SplatSet::empty(voxsplat::Grid::centered(b.store.dims, b.store.spacing)?)?,
-        None => load_scene(a)?,
-    };
-    Ok((bricked, set))
+    let set = voxsplat::SplatSet::empty(voxsplat::Grid::centered(bricked.store.dims, bricked.store.spacing)?)?;
+    let content = Content { orientation, bounds: bricked.visible_bounds() };
+    Ok((Some(bricked), set, content))
 }
