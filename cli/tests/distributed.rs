@@ -37,6 +37,22 @@ fn ok(out: &Output, what: &str) {
     assert!(out.status.success(), "{what}: {}", String::from_utf8_lossy(&out.stderr));
 }
 
+/// `voxsplat ARGS` in one process and under mpirun on `ranks` ranks (with validation), both
+/// succeeding: the ranks' run and the largest difference of the two frames.
+fn beside_one_process(args: &[&str], ranks: u32, tag: &str) -> (Output, f64) {
+    let single = tmp(&format!("{tag}-single.exr"));
+    let mut a = args.to_vec();
+    a.extend(["--out", single.to_str().unwrap()]);
+    ok(&voxsplat(&a), "single process");
+    let out = tmp(&format!("{tag}-{ranks}.exr"));
+    let mut a = args.to_vec();
+    a.extend(["--out", out.to_str().unwrap(), "--validation"]);
+    let run = mpirun(ranks, &a);
+    ok(&run, &format!("{ranks} ranks"));
+    let d = max_abs(&single, &out);
+    (run, d)
+}
+
 #[test]
 fn one_two_and_four_ranks_draw_the_single_process_frame() {
     let views: [(&str, &[&str]); 2] = [("outside", &[]), ("inside", &["--eye", "5,-10,40", "--target", "0,0,-100"])];
@@ -110,20 +126,12 @@ fn ranks_whose_boxes_are_empty_take_part() {
         "--size",
         "64x64",
     ];
-    let single = tmp("half-single.exr");
-    let mut a = args.to_vec();
-    a.extend(["--out", single.to_str().unwrap()]);
-    ok(&voxsplat(&a), "single process");
-    let out = tmp("half-4.exr");
-    let mut a = args.to_vec();
-    a.extend(["--out", out.to_str().unwrap(), "--validation"]);
-    let run = mpirun(4, &a);
-    ok(&run, "four ranks");
+    let (run, d) = beside_one_process(&args, 4, "half");
     let err = String::from_utf8_lossy(&run.stderr);
     let line = err.lines().find(|l| l.contains("stored voxels on 4 ranks")).unwrap_or_else(|| panic!("{err}"));
     let per_rank = &line[line.find('(').unwrap() + 1..line.find(')').unwrap()];
     assert_eq!(per_rank.split(" + ").filter(|n| *n == "0").count(), 2, "two ranks without a box: {line}");
-    assert!(max_abs(&single, &out) <= 2e-3);
+    assert!(d <= 2e-3);
 }
 
 #[test]
@@ -180,16 +188,7 @@ fn ranks_read_a_left_handed_file_as_one_process_does() {
     let file = tmp("rai.nii");
     std::fs::write(&file, common::nifti(dims, &v, Some(affine), None)).unwrap();
     let args = ["render", "--volume", file.to_str().unwrap(), "--tf", "ramp", "--view", "anterior", "--size", "64x64"];
-    let single = tmp("rai-single.exr");
-    let mut a = args.to_vec();
-    a.extend(["--out", single.to_str().unwrap()]);
-    ok(&voxsplat(&a), "single process");
-    let out = tmp("rai-2.exr");
-    let mut a = args.to_vec();
-    a.extend(["--out", out.to_str().unwrap(), "--validation"]);
-    let run = mpirun(2, &a);
-    ok(&run, "two ranks");
+    let (run, d) = beside_one_process(&args, 2, "rai");
     assert!(String::from_utf8_lossy(&run.stderr).contains("on 2 ranks"));
-    let d = max_abs(&single, &out);
     assert!(d <= 2e-3, "two ranks: {d} from the single-process frame");
 }
