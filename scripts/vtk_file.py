@@ -10,6 +10,7 @@ Usage: python vtk_file.py --file F.nrrd|F.nii.gz --tf bonsai|ramp|ct --frames 5 
 """
 import argparse, math, statistics, sys, time
 import vtk
+from vtk_common import set_camera, write_png
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--file", required=True)
@@ -86,16 +87,9 @@ rw.SetSize(a.size, a.size)
 
 cam = ren.GetActiveCamera()
 if a.camera:
-    # "camera (grid frame): eye X,Y,Z target X,Y,Z up X,Y,Z fov F": grid frame -> VTK's image frame.
-    f = a.camera.split()
-    vec = lambda k: [float(x) for x in f[f.index(k) + 1].split(",")]
+    # voxsplat's grid frame is centred on the grid; VTK's image starts at its origin.
     org = img.GetOrigin()
-    shift = [org[i] + (dims[i] - 1) * sp[i] / 2 for i in range(3)]
-    eye, target, up = vec("eye"), vec("target"), vec("up")
-    cam.SetFocalPoint(*[target[i] + shift[i] for i in range(3)])
-    cam.SetPosition(*[eye[i] + shift[i] for i in range(3)])
-    cam.SetViewUp(*up)
-    cam.SetViewAngle(float(f[f.index("fov") + 1]))
+    set_camera(cam, a.camera, [org[i] + (dims[i] - 1) * sp[i] / 2 for i in range(3)])
 else:
     # voxsplat's Camera::framing.
     ext = [(dims[i] - 1) * sp[i] for i in range(3)]
@@ -124,11 +118,5 @@ if a.frames % 2 == 1:
     cam.Azimuth(-0.5)
     ren.ResetCameraClippingRange()
     rw.Render()
-w2i = vtk.vtkWindowToImageFilter()
-w2i.SetInput(rw)
-w2i.Update()
-wr = vtk.vtkPNGWriter()
-wr.SetFileName(a.out)
-wr.SetInputConnection(w2i.GetOutputPort())
-wr.Write()
+write_png(rw, a.out)
 print(f"file={a.file} dims={dims} load={load_s:.3f}s median={statistics.median(times):.3f}s")

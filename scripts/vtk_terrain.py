@@ -8,6 +8,7 @@ frame time. Usage: python vtk_terrain.py --dem D.tif --color C.png --camera LINE
 import argparse, statistics, time
 import numpy as np
 import vtk
+from vtk_common import set_camera, write_png
 from PIL import Image
 from vtk.util import numpy_support
 
@@ -58,13 +59,8 @@ rw = vtk.vtkRenderWindow()
 rw.SetOffScreenRendering(1)
 rw.AddRenderer(ren)
 rw.SetSize(a.size, a.size)
-f = a.camera.split()
-vec = lambda k: [float(v) for v in f[f.index(k) + 1].split(",")]
 cam = ren.GetActiveCamera()
-cam.SetPosition(*vec("eye"))
-cam.SetFocalPoint(*vec("target"))
-cam.SetViewUp(*vec("up"))
-cam.SetViewAngle(float(f[f.index("fov") + 1]))
+set_camera(cam, a.camera)
 ren.ResetCameraClippingRange()
 rw.Render()
 times = []
@@ -72,11 +68,5 @@ for i in range(a.frames):
     t = time.perf_counter()
     rw.Render()
     times.append(time.perf_counter() - t)
-w2i = vtk.vtkWindowToImageFilter()
-w2i.SetInput(rw)
-w2i.Update()
-wr = vtk.vtkPNGWriter()
-wr.SetFileName(a.out)
-wr.SetInputConnection(w2i.GetOutputPort())
-wr.Write()
+write_png(rw, a.out)
 print(f"dem={a.dem} cells={w}x{rows} median={statistics.median(times):.4f}s")
