@@ -1,6 +1,17 @@
-"""What scripts/vtk_file.py and scripts/vtk_terrain.py share: voxsplat's camera line on a VTK
-camera, and the window written as PNG."""
+"""What scripts/vtk_file.py and scripts/vtk_terrain.py share: an off-screen window on black,
+voxsplat's camera line on a VTK camera, and the window written as PNG."""
 import vtk
+
+
+def offscreen(size):
+    """A renderer on black in an off-screen `size` x `size` window: (renderer, window)."""
+    ren = vtk.vtkRenderer()
+    ren.SetBackground(0, 0, 0)
+    rw = vtk.vtkRenderWindow()
+    rw.SetOffScreenRendering(1)
+    rw.AddRenderer(ren)
+    rw.SetSize(size, size)
+    return ren, rw
 
 
 def set_camera(cam, line, shift=(0.0, 0.0, 0.0)):

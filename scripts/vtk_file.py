@@ -10,7 +10,7 @@ Usage: python vtk_file.py --file F.nrrd|F.nii.gz --tf bonsai|ramp|ct --frames 5 
 """
 import argparse, math, statistics, sys, time
 import vtk
-from vtk_common import set_camera, write_png
+from vtk_common import offscreen, set_camera, write_png
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--file", required=True)
@@ -77,13 +77,8 @@ mapper.SetBlendModeToComposite()
 volume = vtk.vtkVolume()
 volume.SetMapper(mapper)
 volume.SetProperty(prop)
-ren = vtk.vtkRenderer()
+ren, rw = offscreen(a.size)
 ren.AddVolume(volume)
-ren.SetBackground(0, 0, 0)
-rw = vtk.vtkRenderWindow()
-rw.SetOffScreenRendering(1)
-rw.AddRenderer(ren)
-rw.SetSize(a.size, a.size)
 
 cam = ren.GetActiveCamera()
 if a.camera:

@@ -8,7 +8,7 @@ frame time. Usage: python vtk_terrain.py --dem D.tif --color C.png --camera LINE
 import argparse, statistics, time
 import numpy as np
 import vtk
-from vtk_common import set_camera, write_png
+from vtk_common import offscreen, set_camera, write_png
 from PIL import Image
 from vtk.util import numpy_support
 
@@ -52,13 +52,8 @@ mapper.SetColorModeToDirectScalars()
 actor = vtk.vtkActor()
 actor.SetMapper(mapper)
 actor.GetProperty().LightingOff()
-ren = vtk.vtkRenderer()
+ren, rw = offscreen(a.size)
 ren.AddActor(actor)
-ren.SetBackground(0, 0, 0)
-rw = vtk.vtkRenderWindow()
-rw.SetOffScreenRendering(1)
-rw.AddRenderer(ren)
-rw.SetSize(a.size, a.size)
 cam = ren.GetActiveCamera()
 set_camera(cam, a.camera)
 ren.ResetCameraClippingRange()
