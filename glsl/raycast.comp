@@ -13,11 +13,18 @@ layout(binding = 1) uniform sampler3D field;
 layout(binding = 2, rgba32f) uniform writeonly image2D out_image;
 layout(std430, binding = 3) readonly buffer Bricks { uint bricks[]; };  // 1: occupied
 
-// The first sample index past the empty brick `b` for a ray a + dir t sampled at t0 + (s + 0.5) step.
+// World offset d in index units: the inverse cell matrix (upper triangular) times d.
+vec3 to_index(vec3 d) {
+    vec3 s = rc.inv_spacing.xyz;
+    vec3 h = rc.inv_shear.xyz;
+    return vec3(d.x * s.x + d.y * h.x + d.z * h.y, d.y * s.y + d.z * h.z, d.z * s.z);
+}
+
+// The first sample index past the empty brick `b` for a ray a + dir t (index space) sampled at
+// t0 + (s + 0.5) step.
 uint skip_brick(ivec3 b, ivec3 nb, uint bs, vec3 a, vec3 dir, float t0, float step, uint s) {
-    vec3 size = float(bs) / rc.inv_spacing.xyz;
-    vec3 lo = rc.origin.xyz + vec3(b) * size;
-    vec3 hi = lo + size;
+    vec3 lo = vec3(b) * float(bs);
+    vec3 hi = lo + float(bs);
     float t_exit = 3.4e38;
     for (int ax = 0; ax < 3; ++ax) {
         // Edge bricks also hold the samples beyond the grid on their side.
@@ -38,16 +45,19 @@ void main() {
     vec3 d = b4.xyz / b4.w - a;
     float len = length(d);
     vec3 dir = d / len;
-    // Slab test against the sampled box.
+    // Slab test against the sampled box, in index space (a sheared grid's box is a parallelepiped
+    // in the world; t is the same along the ray in both).
+    vec3 ia = to_index(a - rc.origin.xyz);
+    vec3 idir = to_index(dir);
     float t0 = 0.0;
     float t1 = len;
     for (int ax = 0; ax < 3; ++ax) {
-        if (abs(dir[ax]) < 1e-30) {
-            if (a[ax] < rc.box_min[ax] || a[ax] > rc.box_max[ax]) t1 = -1.0;
+        if (abs(idir[ax]) < 1e-30) {
+            if (ia[ax] < rc.box_min[ax] || ia[ax] > rc.box_max[ax]) t1 = -1.0;
             continue;
         }
-        float p = (rc.box_min[ax] - a[ax]) / dir[ax];
-        float q = (rc.box_max[ax] - a[ax]) / dir[ax];
+        float p = (rc.box_min[ax] - ia[ax]) / idir[ax];
+        float q = (rc.box_max[ax] - ia[ax]) / idir[ax];
         t0 = max(t0, min(p, q));
         t1 = min(t1, max(p, q));
     }
@@ -72,11 +82,11 @@ void main() {
         ivec3 nb = (dims + int(bs) - 1) / max(int(bs), 1);
         for (uint s = 0u; s < n; ++s) {
             vec3 x = a + dir * (t0 + (float(s) + 0.5) * step);
-            vec3 u = (x - rc.origin.xyz) * rc.inv_spacing.xyz;
+            vec3 u = to_index(x - rc.origin.xyz);
             if (bs > 0u) {
                 ivec3 b = clamp(ivec3(floor(u / float(bs))), ivec3(0), nb - 1);
                 if (bricks[(b.z * nb.y + b.y) * nb.x + b.x] == 0u) {
-                    s = skip_brick(b, nb, bs, a, dir, t0, step, s) - 1u;
+                    s = skip_brick(b, nb, bs, ia, idir, t0, step, s) - 1u;
                     continue;
                 }
             }

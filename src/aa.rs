@@ -66,8 +66,8 @@ fn k_regions_marched(set: &SplatSet, camera: &Camera) -> Vec<u8> {
         occupied[c / 64] |= 1 << (c % 64);
     }
     let spacing = glam::DVec3::from(g.spacing.map(f64::from));
-    let origin = glam::DVec3::from(g.origin.map(f64::from));
-    let (lo, hi) = (origin - 0.5 * spacing, origin + (glam::DVec3::from(g.dims.map(f64::from)) - 0.5) * spacing);
+    let [lo, hi] = g.world_box(glam::Vec3::splat(-0.5), glam::Vec3::from(g.dims.map(|d| d as f32 - 0.5)));
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     // Half the smallest gap (a rectilinear grid's may be below its mean spacing).
     let smallest = set.coordinates().map_or(f64::MAX, |c| {
         c.iter().flat_map(|v| v.windows(2).map(|w| (w[1] - w[0]) as f64)).fold(f64::MAX, f64::min)
@@ -85,7 +85,7 @@ fn k_regions_marched(set: &SplatSet, camera: &Camera) -> Vec<u8> {
             while t <= t1 {
                 let p = o + d * t;
                 // Index space (through a rectilinear grid's coordinates where it has them).
-                let ijk = glam::DVec3::new(set.index_of(0, p.x), set.index_of(1, p.y), set.index_of(2, p.z)).round();
+                let ijk = set.index_point(p).round();
                 let inside = (0..3).all(|a| ijk[a] >= 0.0 && ijk[a] < g.dims[a] as f64);
                 if inside {
                     let c = (ijk.z as usize * ny + ijk.y as usize) * nx + ijk.x as usize;

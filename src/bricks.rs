@@ -51,8 +51,10 @@ impl BrickHeader {
 pub struct BrickStore {
     /// Voxels along x, y, z.
     pub dims: [u32; 3],
-    /// Voxel spacing.
+    /// Voxel spacing (the cell matrix's diagonal, `Grid::spacing`).
     pub spacing: [f32; 3],
+    /// A sheared grid's cell matrix above its diagonal (`Grid::shear`; zero when axis-aligned).
+    pub shear: [f32; 3],
     /// The raw values normalisation maps to [0, 1] (the volume's finite min and max).
     pub range: (f32, f32),
     /// Non-empty bricks, in brick order (x fastest).
@@ -135,7 +137,7 @@ impl BrickStore {
         let bricks = nb[0] as u64 * nb[1] as u64 * nb[2] as u64;
         let size = [0, 1, 2].map(|a| (r1[a] - r0[a]) as u64);
         let voxels = size[0] * size[1] * size[2];
-        check_host_memory(
+        crate::error::check_host_memory(
             voxels * 4 + bricks * 4 + voxels.div_ceil(BRICK_VOXELS as u64) * (16 + BRICK_VOXELS as u64 / 8),
             &format!("a {dims:?} bricked store"),
         )?;
@@ -147,6 +149,7 @@ impl BrickStore {
         let mut store = Self {
             dims,
             spacing,
+            shear: [0.0; 3],
             range: (lo, hi),
             headers: Vec::new(),
             masks: Vec::new(),
@@ -221,6 +224,11 @@ impl BrickStore {
         Ok(store)
     }
 
+    /// The grid the store's voxels lie on, centred on the origin.
+    pub fn grid(&self) -> Result<Grid> {
+        Grid::centered_sheared(self.dims, self.spacing, self.shear)
+    }
+
     /// Stored voxels.
     pub fn len(&self) -> usize {
         self.records.len()
@@ -273,8 +281,7 @@ impl BrickStore {
         let (tlo, thi) = tf.range.unwrap_or((lo, hi));
         let tspan = if thi > tlo { thi - tlo } else { 1.0 };
         let remap = |d: f32| if tf.range.is_some() { (lo + d * span - tlo) / tspan } else { d };
-        let grid = Grid::centered(self.dims, self.spacing)?;
-        classify_field(grid, self.spacing, tf, shading, |i, j, k| remap(self.value_at(i, j, k)))
+        classify_field(self.grid()?, tf, shading, |i, j, k| remap(self.value_at(i, j, k)))
     }
 }
 
@@ -305,23 +312,6 @@ pub struct BrickScene {
 fn next_classification() -> u64 {
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
     NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-}
-
-/// Refuse `bytes` of host memory for `what` when the host has less available (Linux's
-/// MemAvailable; elsewhere nothing is checked).
-pub fn check_host_memory(bytes: u64, what: &str) -> Result<()> {
-    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
-        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?.to_string();
-        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
-    });
-    match available {
-        Some(a) if bytes > a => Err(Error::TooLarge(format!(
-            "{what} may need {} MiB of host memory; {} MiB are available",
-            bytes >> 20,
-            a >> 20
-        ))),
-        _ => Ok(()),
-    }
 }
 
 /// (a, b): stored value d is `tf`'s density a d + b.
@@ -536,7 +526,7 @@ impl BrickScene {
             index.push(p);
         }
         let g = set.grid();
-        if g.origin != Grid::centered(g.dims, g.spacing)?.origin {
+        if g.origin != Grid::centered_sheared(g.dims, g.spacing, g.shear)?.origin {
             return Err(Error::InvalidArgument("a palette volume's grid must be centred on the origin".into()));
         }
         let n = palette.len().max(1) as f32;
@@ -555,7 +545,8 @@ impl BrickScene {
         }
         let tf = TransferFunction { points, gradient_weight: 0.0, range: Some((0.0, n)), threshold: 0.5 / n };
         let vol = ScalarVolume { dims: g.dims, spacing: g.spacing, values };
-        Self::new(BrickStore::build_over(&vol, 0.0)?, tf, None)
+        let store = BrickStore { shear: g.shear, ..BrickStore::build_over(&vol, 0.0)? };
+        Self::new(store, tf, None)
     }
 
     /// Classify with another transfer function and shading from the next frame on.

@@ -55,9 +55,9 @@ pub struct Camera {
 impl Camera {
     /// A three-quarter perspective view that frames `grid` at the given image size.
     pub fn framing(grid: &Grid, width: u32, height: u32) -> Self {
-        let top = grid.position([grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1]);
+        let [lo, hi] = grid.world_box(Vec3::ZERO, Vec3::from(grid.dims.map(|d| (d - 1) as f32)));
         let dir = Vec3::new(0.55, 0.45, 1.0);
-        Self::framing_box(grid.position([0, 0, 0]), top, grid.kernel_spacing(), dir, Vec3::Y, width, height)
+        Self::framing_box(lo, hi, grid.kernel_spacing(), dir, Vec3::Y, width, height)
     }
 
     /// A perspective view along `-dir` with `up` that frames the box `lo..hi` (voxel centres) of a

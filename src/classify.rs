@@ -149,8 +149,20 @@ impl Shading {
 
 /// Classify a loaded volume into splats. Gradients by central differences on the grid.
 pub fn classify(vol: &ScalarVolume, tf: &TransferFunction, shading: Option<Shading>) -> Result<SplatSet> {
+    classify_on(Grid::centered(vol.dims, vol.spacing)?, vol, tf, shading)
+}
+
+/// Classify `vol` on `grid` (its dimensions; a placed or sheared grid, `Orientation::grid`).
+pub fn classify_on(
+    grid: Grid,
+    vol: &ScalarVolume,
+    tf: &TransferFunction,
+    shading: Option<Shading>,
+) -> Result<SplatSet> {
+    if grid.dims != vol.dims {
+        return Err(Error::InvalidArgument(format!("a {:?} grid for a {:?} volume", grid.dims, vol.dims)));
+    }
     let [nx, ny, nz] = vol.dims;
-    let grid = Grid::centered(vol.dims, vol.spacing)?;
     let (lo, hi) = tf.range.unwrap_or_else(|| {
         vol.values
             .iter()
@@ -167,14 +179,13 @@ pub fn classify(vol: &ScalarVolume, tf: &TransferFunction, shading: Option<Shadi
             0.0
         }
     };
-    classify_field(grid, vol.spacing, tf, shading, at)
+    classify_field(grid, tf, shading, at)
 }
 
 /// Classify the normalised field `at` (indices clamped to the grid by `at` itself) on `grid`:
 /// the dense volume's classification (`classify`) and the bricked store's (`bricks`) share it.
 pub fn classify_field(
     grid: Grid,
-    spacing: [f32; 3],
     tf: &TransferFunction,
     shading: Option<Shading>,
     at: impl Fn(i64, i64, i64) -> f32,
@@ -183,11 +194,11 @@ pub fn classify_field(
     let [nx, ny, nz] = grid.dims;
     let grad = |i: u32, j: u32, k: u32| -> Vec3 {
         let (i, j, k) = (i as i64, j as i64, k as i64);
-        Vec3::new(
-            (at(i + 1, j, k) - at(i - 1, j, k)) / (2.0 * spacing[0]),
-            (at(i, j + 1, k) - at(i, j - 1, k)) / (2.0 * spacing[1]),
-            (at(i, j, k + 1) - at(i, j, k - 1)) / (2.0 * spacing[2]),
-        )
+        Vec3::from(grid.gradient([
+            at(i + 1, j, k) - at(i - 1, j, k),
+            at(i, j + 1, k) - at(i, j - 1, k),
+            at(i, j, k + 1) - at(i, j, k - 1),
+        ]))
     };
     let gmax = if tf.gradient_weight > 0.0 || shading.is_some() {
         let mut m = 0.0f32;

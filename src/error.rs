@@ -100,3 +100,20 @@ impl Error {
         }
     }
 }
+
+/// Refuse `bytes` of host memory for `what` when the host has less available (Linux's
+/// MemAvailable; elsewhere nothing is checked).
+pub fn check_host_memory(bytes: u64, what: &str) -> Result<()> {
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?.to_string();
+        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
+    });
+    match available {
+        Some(a) if bytes > a => Err(Error::TooLarge(format!(
+            "{what} may need {} MiB of host memory; {} MiB are available",
+            bytes >> 20,
+            a >> 20
+        ))),
+        _ => Ok(()),
+    }
+}

@@ -53,6 +53,8 @@ pub struct Frame {
     pub up: [f32; 4],
     pub origin: [f32; 4],
     pub spacing: [f32; 4],
+    /// The cell matrix above its diagonal (`Grid::shear`); w: unused.
+    pub shear: [f32; 4],
     pub dims: [u32; 4],
     pub split: [u32; 4],
     /// Anti-aliasing: mode (0 none, 1 Swan, 2 EWA), footprint std in voxels, EWA low-pass std in pixels.
@@ -81,6 +83,8 @@ pub struct RaycastParams {
     pub box_max: [f32; 4],
     pub origin: [f32; 4],
     pub inv_spacing: [f32; 4],
+    /// The inverse cell matrix above its diagonal (a sheared grid's; zero when axis-aligned).
+    pub inv_shear: [f32; 4],
     pub dims: [u32; 4],
     /// Width, height, empty-space brick side, clipping planes in use.
     pub image: [u32; 4],
@@ -218,9 +222,9 @@ const _: () = assert!(std::mem::size_of::<BrickPush>() == 16);
 const _: () = assert!(std::mem::size_of::<Splat>() == 32);
 const _: () = assert!(std::mem::size_of::<SplatParams>() == 80);
 const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
-const _: () = assert!(std::mem::size_of::<Frame>() == 576);
+const _: () = assert!(std::mem::size_of::<Frame>() == 592);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<PresentPush>() == 32);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
-const _: () = assert!(std::mem::size_of::<RaycastParams>() == 352);
+const _: () = assert!(std::mem::size_of::<RaycastParams>() == 368);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -441,7 +441,8 @@ pub(crate) fn raw_layout(path: &Path, hints: &VolumeHints, what: &str) -> Result
 
 /// The placement in patient space (RAS+) a NIfTI sform/qform or an NRRD anatomical `space` gives
 /// `path`, with `hints.spacing` applied; `None` for files without one (raw, npy, NRRD without a
-/// space, NIfTI with both codes 0). A sheared affine is `Error::Unsupported`.
+/// space, NIfTI with both codes 0). An affine whose axes meet within `orient::MAX_SHEAR` of
+/// parallel is `Error::Unsupported`; a less sheared one is placed (`Orientation::grid`).
 pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate::orient::Orientation>> {
     let what = path.display().to_string();
     let o = match SliceReader::open(path, hints)? {

@@ -69,19 +69,18 @@ impl Viewer {
         if set.coordinates().is_none() || !camera.is_perspective() {
             return Self::of_grid(set.grid(), camera);
         }
-        let e = camera.eye.as_dvec3();
-        Viewer::Eye(DVec3::new(set.index_of(0, e.x), set.index_of(1, e.y), set.index_of(2, e.z)))
+        Viewer::Eye(set.index_point(camera.eye.as_dvec3()))
     }
 
     /// The viewer of `camera`, in `g`'s index coordinates.
+    /// An affine map of grid and eye together keeps a visibility order (docs/MODEL.md), so a
+    /// sheared grid is ordered from the eye mapped by its inverse cell matrix.
     pub fn of_grid(g: &crate::volume::Grid, camera: &Camera) -> Self {
-        let o = DVec3::from(g.origin.map(f64::from));
-        let s = DVec3::from(g.spacing.map(f64::from));
         if camera.is_perspective() {
-            Viewer::Eye((camera.eye.as_dvec3() - o) / s)
+            Viewer::Eye(g.index_point(camera.eye.as_dvec3()))
         } else {
             // Index space scales each axis: directions scale by 1/spacing too.
-            Viewer::Toward(camera.forward().as_dvec3() / s)
+            Viewer::Toward(g.index_dir(camera.forward().as_dvec3()))
         }
     }
 

@@ -8,15 +8,23 @@
 //! the inverse (`Orientation::camera_to_grid`): a rigid map of scene and camera together leaves the
 //! picture unchanged, and the visibility order is computed from the mapped eye (docs/MODEL.md).
 //! A left-handed affine (a reflection) cannot be undone by moving a camera, so its grid's x axis is
-//! stored reversed (`flip_x`): the loaders apply it, and the rotation left is proper.
+//! stored reversed (`flip_x`): the loaders apply it, and the rotation left is proper. A sheared
+//! (oblique) affine, such as a CT's tilted gantry gives, is split as rotation times an upper
+//! triangular cell matrix (QR): the rotation moves the camera, the cell matrix places the voxels
+//! (`Orientation::grid`, `Grid::shear`).
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 
 /// Most an affine's axes may depart from perpendicular (cosine of the angle between two
 /// directions) and still be taken as a rotation: files store their directions in f32, and scanners
-/// round them.
+/// round them. Beyond it the grid is sheared.
 pub const MAX_SKEW: f64 = 1e-3;
+
+/// Most a sheared grid's axes may depart from perpendicular (cosine 0.95, about 18 degrees from
+/// parallel): a flatter cell is more likely a broken header than a scan, and its voxels' kernels,
+/// round in the world, would overlap many neighbours.
+pub const MAX_SHEAR: f64 = 0.95;
 
 /// A grid's placement in patient space (RAS+), from its file's affine.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,36 +34,71 @@ pub struct Orientation {
     rotation: DMat3,
     /// World position of the grid's centre.
     center: DVec3,
+    /// The cell matrix (upper triangular: the grid's spacing and shear): the affine's linear part
+    /// is `rotation * cell` (x reversed first when `flip_x`).
+    cell: DMat3,
     flip_x: bool,
     dims: [u32; 3],
 }
 
 impl Orientation {
     /// The placement of a `dims` grid whose file maps index (i, j, k) to world `affine` (RAS+).
-    /// Refuses a singular, non-finite or sheared affine (Error::Unsupported names the angle).
+    /// Refuses a singular or non-finite affine, and one whose axes meet at a grazing angle
+    /// (`MAX_SHEAR`: Error::Unsupported names the angle).
     pub fn from_affine(affine: DMat4, dims: [u32; 3]) -> Result<Self> {
         let cols = [affine.x_axis.truncate(), affine.y_axis.truncate(), affine.z_axis.truncate()];
         if !affine.is_finite() || cols.iter().any(|c| c.length() <= 0.0) {
             return Err(Error::InvalidArgument(format!("index-to-world affine {affine:?} is singular or not finite")));
         }
         let dirs = cols.map(|c| c.normalize());
+        let mut sheared = false;
         for (a, b) in [(0, 1), (0, 2), (1, 2)] {
             let cos = dirs[a].dot(dirs[b]);
-            if cos.abs() > MAX_SKEW {
+            if cos.abs() > MAX_SHEAR {
                 return Err(Error::Unsupported(format!(
-                    "the file's index axes {a} and {b} meet at {:.2} degrees (a sheared grid): only \
-                     rotations and reflections of a rectilinear grid are placed; resample the volume first",
-                    cos.clamp(-1.0, 1.0).acos().to_degrees()
+                    "the file's index axes {a} and {b} meet at {:.2} degrees: a grid sheared past {:.0} degrees \
+                     from square is not placed (a broken header?); resample the volume first",
+                    cos.clamp(-1.0, 1.0).acos().to_degrees(),
+                    90.0 - MAX_SHEAR.acos().to_degrees()
                 )));
             }
+            sheared |= cos.abs() > MAX_SKEW;
         }
-        // The nearest rotation (or rotation-reflection) to the directions.
-        let m = orthonormalize(DMat3::from_cols(dirs[0], dirs[1], dirs[2]));
-        let flip_x = m.determinant() < 0.0;
-        let rotation = if flip_x { DMat3::from_cols(-m.x_axis, m.y_axis, m.z_axis) } else { m };
+        let linear = DMat3::from_cols(cols[0], cols[1], cols[2]);
+        let flip_x = linear.determinant() < 0.0;
+        // x reversed: the grid's i runs along the file's -i.
+        let proper = if flip_x { DMat3::from_cols(-cols[0], cols[1], cols[2]) } else { linear };
+        let (rotation, cell) = if sheared {
+            qr(proper)
+        } else {
+            // The nearest rotation to the directions; the cell is the columns' lengths.
+            let x = if flip_x { -dirs[0] } else { dirs[0] };
+            let m = orthonormalize(DMat3::from_cols(x, dirs[1], dirs[2]));
+            (m, DMat3::from_diagonal(DVec3::new(cols[0].length(), cols[1].length(), cols[2].length())))
+        };
         let mid = DVec3::new(dims[0] as f64 - 1.0, dims[1] as f64 - 1.0, dims[2] as f64 - 1.0) * 0.5;
         let center = affine.transform_point3(mid);
-        Ok(Self { affine, rotation, center, flip_x, dims })
+        Ok(Self { affine, rotation, center, cell, flip_x, dims })
+    }
+
+    /// The grid this placement draws, in its own frame (centred on the origin): the cell matrix's
+    /// diagonal as spacing and what lies above it as shear (`Grid::shear`).
+    pub fn grid(&self) -> Result<crate::volume::Grid> {
+        let c = self.cell;
+        let spacing = [c.x_axis.x, c.y_axis.y, c.z_axis.z].map(|v| v as f32);
+        let shear = [c.y_axis.x, c.z_axis.x, c.z_axis.y].map(|v| v as f32);
+        crate::volume::Grid::centered_sheared(self.dims, spacing, shear)
+    }
+
+    /// The angles in degrees at which the grid's axes i and j, i and k, j and k meet in the world.
+    pub fn angles(&self) -> [f64; 3] {
+        let c = [self.cell.x_axis, self.cell.y_axis, self.cell.z_axis].map(|v| v.normalize());
+        [(0, 1), (0, 2), (1, 2)].map(|(a, b)| c[a].dot(c[b]).clamp(-1.0, 1.0).acos().to_degrees())
+    }
+
+    /// The grid is sheared: its axes are not perpendicular in the world.
+    pub fn is_sheared(&self) -> bool {
+        self.cell.y_axis.x != 0.0 || self.cell.z_axis.x != 0.0 || self.cell.z_axis.y != 0.0
     }
 
     /// Index -> world affine as the file gives it (columns i, j, k, then the translation).
@@ -138,6 +181,27 @@ impl Orientation {
             ..*camera
         }
     }
+}
+
+/// The grid a `dims` volume of voxel `spacing` is drawn on: its placement's (sheared where the
+/// file's affine is, `Orientation::grid`), else axis-aligned; centred on the origin either way.
+pub fn placed_grid(dims: [u32; 3], spacing: [f32; 3], placement: Option<&Orientation>) -> Result<crate::volume::Grid> {
+    match placement {
+        Some(o) if o.dims == dims => o.grid(),
+        Some(o) => Err(Error::InvalidArgument(format!("a placement of a {:?} grid for a {dims:?} volume", o.dims))),
+        None => crate::volume::Grid::centered(dims, spacing),
+    }
+}
+
+/// `m` = Q R with Q a rotation and R upper triangular with a positive diagonal (Gram-Schmidt on
+/// the columns; `m` has a positive determinant).
+fn qr(m: DMat3) -> (DMat3, DMat3) {
+    let q0 = m.x_axis.normalize();
+    let y = m.y_axis - q0 * q0.dot(m.y_axis);
+    let q1 = y.normalize();
+    let q2 = q0.cross(q1);
+    let q = DMat3::from_cols(q0, q1, q2);
+    (q, q.transpose() * m)
 }
 
 /// The orthogonal matrix nearest `m` (a few Newton steps of the polar decomposition: `m` is already

@@ -444,7 +444,9 @@ fn check_status(word: u32) -> Result<()> {
 pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RaycastOptions) -> Result<Recorded> {
     camera.validate()?;
     let params = crate::cpu::raycast::raycast_params(&prep.set, camera, opts);
-    let diagonal = glam::Vec3::from_slice(&params.box_max[..3]).distance(glam::Vec3::from_slice(&params.box_min[..3]));
+    let g = prep.set.grid();
+    let [lo, hi] = g.world_box(glam::Vec3::splat(-1.0), glam::Vec3::from(g.dims.map(|d| d as f32)));
+    let diagonal = hi.distance(lo);
     let steps = (diagonal / params.box_min[3]).ceil();
     if e.is_device() && steps > MAX_GPU_RAY_STEPS as f32 {
         return Err(Error::TooLarge(format!(

@@ -11,7 +11,7 @@ use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::volume::SplatSet;
 pub use crate::volume::{DenseField, MAX_DENSE_BYTES};
-use glam::{DMat4, DVec3, DVec4, Mat4};
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use rayon::prelude::*;
 
 /// How the continuous volume is rebuilt from the voxels.
@@ -186,16 +186,25 @@ pub fn volumetric_summation(set: &SplatSet, camera: &Camera, opts: &TruthOptions
     let g = *set.grid();
     let radius = opts.reconstruction.radius();
     let occ = field.occupancy(radius.ceil() as i64 + 1);
-    let origin = DVec3::from(g.origin.map(f64::from));
     let spacing = DVec3::from(g.spacing.map(f64::from));
+    let cell = g.cell_matrix();
     let ks = g.kernel_spacing() as f64;
-    // Kernel reach in world units, per axis.
-    let reach = match opts.reconstruction {
-        Reconstruction::Kernel(_) => DVec3::splat(radius * ks),
-        Reconstruction::Trilinear => spacing,
+    let last = DVec3::from(g.dims.map(|d| d as f64 - 1.0));
+    // The kernel's reach in index units per axis (a world ball's extent through the inverse cell
+    // matrix: its rows' lengths), and the world box sampled.
+    let inv_rows = cell.inverse().transpose();
+    let (r, [lo, hi]) = match opts.reconstruction {
+        Reconstruction::Kernel(_) => {
+            let reach = radius * ks;
+            let [lo, hi] = g.world_box(Vec3::ZERO, last.as_vec3());
+            let r = DVec3::new(inv_rows.x_axis.length(), inv_rows.y_axis.length(), inv_rows.z_axis.length()) * reach;
+            (r, [lo.as_dvec3() - reach, hi.as_dvec3() + reach])
+        }
+        Reconstruction::Trilinear => {
+            let [lo, hi] = g.world_box(Vec3::splat(-1.0), last.as_vec3() + 1.0);
+            (DVec3::ONE, [lo.as_dvec3(), hi.as_dvec3()])
+        }
     };
-    let last = origin + spacing * DVec3::new(g.dims[0] as f64 - 1.0, g.dims[1] as f64 - 1.0, g.dims[2] as f64 - 1.0);
-    let (lo, hi) = (origin - reach, last + reach);
     let step = spacing.min_element() / opts.oversampling as f64;
     let inv = Mat4::from_cols_array_2d(&camera.view_proj().to_cols_array_2d()).as_dmat4().inverse();
     let norm = match opts.reconstruction {
@@ -207,12 +216,11 @@ pub fn volumetric_summation(set: &SplatSet, camera: &Camera, opts: &TruthOptions
 
     // (sum c tau h, sum tau h) at a world point.
     let sample = |x: DVec3| -> [f64; 4] {
-        let u = (x - origin) / spacing;
+        let u = g.index_point(x);
         let c = [0, 1, 2].map(|a| u[a].round().clamp(0.0, (dims[a] - 1) as f64) as i64);
         if !occ[(c[0] + dims[0] * (c[1] + dims[1] * c[2])) as usize] {
             return [0.0; 4];
         }
-        let r = [0, 1, 2].map(|a| reach[a] / spacing[a]);
         let range =
             |a: usize| ((u[a] - r[a]).ceil().max(0.0) as i64, (u[a] + r[a]).floor().min((dims[a] - 1) as f64) as i64);
         let ((i0, i1), (j0, j1), (k0, k1)) = (range(0), range(1), range(2));
@@ -227,7 +235,7 @@ pub fn volumetric_summation(set: &SplatSet, camera: &Camera, opts: &TruthOptions
                     let d = DVec3::new(i as f64, j as f64, k as f64) - u;
                     let wgt = match opts.reconstruction {
                         Reconstruction::Kernel(kern) => {
-                            let r = (d * spacing).length() / ks;
+                            let r = (cell * d).length() / ks;
                             kern.profile(r) * norm
                         }
                         Reconstruction::Trilinear => {

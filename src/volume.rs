@@ -2,7 +2,7 @@
 //! voxels are stored, each keeping its grid index.
 use crate::error::{Error, Result};
 use crate::gpu_types::Splat;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 /// Most splats a scene may hold (32 bytes each on the GPU, plus order and parameters).
 pub const MAX_SPLATS: usize = 1 << 26;
@@ -11,24 +11,99 @@ pub const MAX_ROWS: u64 = 1 << 26;
 /// Largest extent of one axis.
 pub const MAX_DIM: u32 = 1 << 16;
 
-/// A rectilinear grid: dimensions, voxel spacing, and the world position of voxel (0, 0, 0).
+/// A regular grid: dimensions, the cell matrix (voxel spacing, and a sheared grid's shear), and
+/// the world position of voxel (0, 0, 0). Voxel (i, j, k) lies at `origin + U (i, j, k)` with
+/// U = [[sx, hxy, hxz], [0, sy, hyz], [0, 0, sz]]: upper triangular, so any index-to-world affine
+/// is a rotation of one (`Orientation::grid`), and an axis-aligned grid has a diagonal U.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
     /// Voxels along x, y, z.
     pub dims: [u32; 3],
-    /// Voxel spacing along x, y, z, in world units.
+    /// U's diagonal: the voxel spacing along x, y, z in world units (a sheared grid's distances
+    /// between its index planes).
     pub spacing: [f32; 3],
     /// World position of voxel (0, 0, 0).
     pub origin: [f32; 3],
+    /// U above its diagonal: how far x moves per step in j and in k, and y per step in k (zero
+    /// for an axis-aligned grid).
+    pub shear: [f32; 3],
 }
 
 impl Grid {
     /// A grid centred on the world origin.
     pub fn centered(dims: [u32; 3], spacing: [f32; 3]) -> Result<Self> {
-        let origin = [0, 1, 2].map(|a| -((dims[a].max(1) - 1) as f32) * 0.5 * spacing[a]);
-        let g = Self { dims, spacing, origin };
+        Self::centered_sheared(dims, spacing, [0.0; 3])
+    }
+
+    /// A sheared grid (`shear`: U above its diagonal) centred on the world origin.
+    pub fn centered_sheared(dims: [u32; 3], spacing: [f32; 3], shear: [f32; 3]) -> Result<Self> {
+        if shear.iter().any(|h| !h.is_finite()) {
+            return Err(Error::InvalidArgument(format!("grid shear {shear:?} must be finite")));
+        }
+        let mut g = Self { dims, spacing, origin: [0.0; 3], shear };
+        let mid = Vec3::from(dims.map(|d| (d.max(1) - 1) as f32)) * 0.5;
+        g.origin = (-g.offset(mid)).to_array();
         g.validate()?;
         Ok(g)
+    }
+
+    /// U `at`: the world offset of grid point `at` (index units) from voxel (0, 0, 0).
+    fn offset(&self, at: Vec3) -> Vec3 {
+        let (s, h) = (self.spacing, self.shear);
+        Vec3::new(at.x * s[0] + at.y * h[0] + at.z * h[1], at.y * s[1] + at.z * h[2], at.z * s[2])
+    }
+
+    /// World position of grid point `at` (index units; mirror of `grid_point` in
+    /// glsl/shared/params.glsl).
+    pub fn point(&self, at: Vec3) -> Vec3 {
+        Vec3::from(self.origin) + self.offset(at)
+    }
+
+    /// The world box holding every grid point of the index box `lo..=hi`.
+    pub fn world_box(&self, lo: Vec3, hi: Vec3) -> [Vec3; 2] {
+        let (a, b) = (self.offset(lo), self.offset(hi));
+        if self.shear == [0.0; 3] {
+            return [Vec3::from(self.origin) + a.min(b), Vec3::from(self.origin) + a.max(b)];
+        }
+        let corners =
+            (0..8).map(|c| self.offset(Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo)));
+        let (l, h) = corners.fold((Vec3::MAX, Vec3::MIN), |(l, h), p| (l.min(p), h.max(p)));
+        [Vec3::from(self.origin) + l, Vec3::from(self.origin) + h]
+    }
+
+    /// The index coordinates of world point `p` (U's inverse, by back substitution).
+    pub fn index_point(&self, p: DVec3) -> DVec3 {
+        self.index_dir(p - DVec3::from(self.origin.map(f64::from)))
+    }
+
+    /// A world direction (or offset) in index units.
+    pub fn index_dir(&self, d: DVec3) -> DVec3 {
+        let (s, h) = (DVec3::from(self.spacing.map(f64::from)), self.shear.map(f64::from));
+        let z = d.z / s.z;
+        let y = (d.y - h[2] * z) / s.y;
+        DVec3::new((d.x - h[0] * y - h[1] * z) / s.x, y, z)
+    }
+
+    /// The world gradient of a field whose central differences (value at index + 1 minus value
+    /// at index - 1) along i, j, k are `diff`: solves U^T g = diff / 2 (mirror of `gradient_at`
+    /// in glsl/shared/brick.glsl).
+    pub fn gradient(&self, diff: [f32; 3]) -> [f32; 3] {
+        let (s, h) = (self.spacing, self.shear);
+        let gx = diff[0] / (2.0 * s[0]);
+        let gy = (diff[1] - 2.0 * h[0] * gx) / (2.0 * s[1]);
+        let gz = (diff[2] - 2.0 * (h[1] * gx + h[2] * gy)) / (2.0 * s[2]);
+        [gx, gy, gz]
+    }
+
+    /// The cell matrix U (columns: the world steps along i, j, k).
+    pub fn cell_matrix(&self) -> glam::DMat3 {
+        let (s, h) = (self.spacing.map(f64::from), self.shear.map(f64::from));
+        glam::DMat3::from_cols(DVec3::new(s[0], 0.0, 0.0), DVec3::new(h[0], s[1], 0.0), DVec3::new(h[1], h[2], s[2]))
+    }
+
+    /// The grid is sheared (U not diagonal).
+    pub fn is_sheared(&self) -> bool {
+        self.shear != [0.0; 3]
     }
 
     /// Reject empty, overflowing or degenerate grids.
@@ -42,8 +117,8 @@ impl Grid {
                 self.spacing
             )));
         }
-        if self.origin.iter().any(|o| !o.is_finite()) {
-            return Err(Error::InvalidArgument("grid origin must be finite".into()));
+        if self.origin.iter().chain(&self.shear).any(|o| !o.is_finite()) {
+            return Err(Error::InvalidArgument("grid origin and shear must be finite".into()));
         }
         let rows = self.dims[1] as u64 * self.dims[2] as u64;
         if rows > MAX_ROWS {
@@ -54,7 +129,7 @@ impl Grid {
 
     /// World position of voxel `ijk`.
     pub fn position(&self, ijk: [u32; 3]) -> Vec3 {
-        Vec3::from(self.origin) + Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32) * Vec3::from(self.spacing)
+        self.point(Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32))
     }
 
     /// World centre of the grid.
@@ -67,7 +142,10 @@ impl Grid {
         (self.position([self.dims[0] - 1, self.dims[1] - 1, self.dims[2] - 1]) - self.position([0, 0, 0])).length()
     }
 
-    /// The spacing the footprint kernel is scaled by (the largest, so anisotropic grids have no holes).
+    /// The spacing the footprint kernel is scaled by (the largest, so anisotropic grids have no
+    /// holes). A sheared grid's too: every point lies within half a diagonal entry per axis of a
+    /// voxel (the nearest-plane bound), as on the axis-aligned grid of the same spacing, so its
+    /// kernels and their energy are that grid's and only their centres move.
     pub fn kernel_spacing(&self) -> f32 {
         self.spacing.iter().cloned().fold(0.0, f32::max)
     }
@@ -135,6 +213,9 @@ impl SplatSet {
     /// and spacing become the coordinates' first values and mean gaps. The ray casters and the
     /// truths, which sample a uniform grid, refuse such sets.
     pub fn with_coordinates(mut self, coords: [Vec<f32>; 3]) -> Result<Self> {
+        if self.grid.is_sheared() {
+            return Err(Error::Unsupported("per-axis coordinates on a sheared grid".into()));
+        }
         for (a, c) in coords.iter().enumerate() {
             let axis = ["x", "y", "z"][a];
             if c.len() != self.grid.dims[a] as usize {
@@ -202,6 +283,15 @@ impl SplatSet {
                 }
             }
             None => self.grid.kernel_spacing(),
+        }
+    }
+
+    /// The index coordinates of world point `p` (`index_of` per axis on a rectilinear grid; a
+    /// sheared grid's inverse cell matrix).
+    pub fn index_point(&self, p: DVec3) -> DVec3 {
+        match self.coords {
+            Some(_) => DVec3::new(self.index_of(0, p.x), self.index_of(1, p.y), self.index_of(2, p.z)),
+            None => self.grid.index_point(p),
         }
     }
 

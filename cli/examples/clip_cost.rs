@@ -7,14 +7,14 @@
 use glam::Vec4;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::{Camera, Clip, Direction, Grid, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{Camera, Clip, Direction, Raster, RenderOptions, Renderer, RendererOptions};
 
 fn main() -> voxsplat::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args.first().map_or("../shared/data/bonsai/bonsai.nii.gz", |s| s.as_str());
     let tf = args.get(1).map_or("bonsai", |s| s.as_str());
     let store = BrickStore::load(path.as_ref(), &Default::default())?;
-    let grid = Grid::centered(store.dims, store.spacing)?;
+    let grid = store.grid()?;
     let cam = Camera::framing(&grid, 512, 512);
     let mut r = Renderer::new(&RendererOptions::default())?;
     r.set_bricks(BrickScene::new(store, TransferFunction::preset(tf)?, None)?)?;

@@ -6,7 +6,7 @@
 //! `cargo run --release -p voxsplat-cli --example lod_sweep -- FILE TF TRUTH.exr 1,0.1 2,1e30 ...`
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::{Camera, Direction, Error, Grid, Lod, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
 
 fn main() -> voxsplat::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -20,7 +20,7 @@ fn main() -> voxsplat::Result<()> {
     }
     let truth = voxsplat::output::read_image(truth.as_ref())?;
     let store = BrickStore::load(path.as_ref(), &Default::default())?;
-    let cam = Camera::framing(&Grid::centered(store.dims, store.spacing)?, 512, 512);
+    let cam = Camera::framing(&store.grid()?, 512, 512);
     let mut r = Renderer::new(&RendererOptions::default())?;
     r.set_bricks(BrickScene::new(store, TransferFunction::preset(tf)?, None)?)?;
     let options = |v: &Option<(f32, f32)>| {

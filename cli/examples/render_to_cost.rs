@@ -8,7 +8,7 @@
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
 use voxsplat::vk::ImageLayout as IL;
-use voxsplat::{scene, Camera, Grid, RenderOptions, Renderer, RendererOptions, TargetFormat};
+use voxsplat::{scene, Camera, RenderOptions, Renderer, RendererOptions, TargetFormat};
 
 fn main() -> voxsplat::Result<()> {
     let mut options = RenderOptions::default();
@@ -18,7 +18,7 @@ fn main() -> voxsplat::Result<()> {
         let mut r = Renderer::new(&RendererOptions::default())?;
         let cam = if name == "bonsai" {
             let store = BrickStore::load("../shared/data/bonsai/bonsai.nii.gz".as_ref(), &Default::default())?;
-            let grid = Grid::centered(store.dims, store.spacing)?;
+            let grid = store.grid()?;
             r.set_bricks(BrickScene::new(store, TransferFunction::preset("bonsai")?, None)?)?;
             Camera::framing(&grid, 512, 512)
         } else {

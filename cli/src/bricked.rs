@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::{classify, TransferFunction};
-use voxsplat::{Camera, Direction, Error, Grid, Raster, RenderOptions, Renderer, RendererOptions, Result};
+use voxsplat::{Camera, Direction, Error, Raster, RenderOptions, Renderer, RendererOptions, Result};
 
 /// The process's peak resident set (VmHWM) in MiB, where /proc says (Linux).
 pub fn peak_rss_mib() -> Option<f64> {
@@ -65,7 +65,7 @@ pub fn study(
 ) -> Result<String> {
     let tf = TransferFunction::preset("bonsai")?;
     let small = load(bonsai, &tf)?;
-    let grid = Grid::centered(small.scene.store.dims, small.scene.store.spacing)?;
+    let grid = small.scene.store.grid()?;
     let cam = Camera::framing(&grid, size, size);
     let mut s = String::new();
     let _ = writeln!(s, "## Bricked volumes (issue 23)\n");
@@ -188,7 +188,7 @@ pub fn study(
     }
 
     if let Some(l) = large {
-        let lgrid = Grid::centered(l.scene.store.dims, l.scene.store.spacing)?;
+        let lgrid = l.scene.store.grid()?;
         let lcam = Camera::framing(&lgrid, size, size);
         let mut big = renderer()?;
         big.set_bricks(l.scene)?;
@@ -274,7 +274,7 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     let tf = TransferFunction::preset(tf)?;
     let l = load(path, &tf)?;
     let rss_loaded = peak_rss_mib().unwrap_or(0.0);
-    let grid = Grid::centered(l.scene.store.dims, l.scene.store.spacing)?;
+    let grid = l.scene.store.grid()?;
     let cam = Camera::framing(&grid, size, size);
     let mut o = RendererOptions::default();
     o.gpu_budget_bytes = budget_bytes;

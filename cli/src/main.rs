@@ -633,13 +633,21 @@ fn run(cli: Cli) -> Result<()> {
                     ..Default::default()
                 };
                 match voxsplat::loaders::load_orientation(&file, &hints)? {
-                    Some(o) => println!(
-                        "orientation: {} (i, j, k run toward {}; world RAS+, grid centre at {:.2?}{})",
-                        o.code(),
-                        o.code().chars().map(String::from).collect::<Vec<_>>().join(", "),
-                        o.to_world(voxsplat::glam::Vec3::ZERO).to_array(),
-                        if o.flip_x() { "; left-handed: x stored reversed" } else { "" }
-                    ),
+                    Some(o) => {
+                        let [ij, ik, jk] = o.angles();
+                        println!(
+                            "orientation: {} (i, j, k run toward {}; world RAS+, grid centre at {:.2?}{}{})",
+                            o.code(),
+                            o.code().chars().map(String::from).collect::<Vec<_>>().join(", "),
+                            o.to_world(voxsplat::glam::Vec3::ZERO).to_array(),
+                            if o.flip_x() { "; left-handed: x stored reversed" } else { "" },
+                            if o.is_sheared() {
+                                format!("; sheared: axes i-j at {ij:.1}, i-k at {ik:.1}, j-k at {jk:.1} degrees")
+                            } else {
+                                String::new()
+                            }
+                        )
+                    }
                     None => println!("orientation: none (no anatomical frame: --view framing)"),
                 }
                 // Past the dense loader (a file read slice by slice, of more than MAX_VOXELS): the store only.
@@ -995,8 +1003,9 @@ fn distributed_frames(
         };
         let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
         let reader = voxsplat::distributed::open(path, &hints)?;
-        let grid = voxsplat::Grid::centered(reader.dims, hints.spacing.unwrap_or(reader.spacing))?;
         let orientation = voxsplat_cli::open::orientation_of(&a.scene)?;
+        let spacing = hints.spacing.unwrap_or(reader.spacing);
+        let grid = voxsplat::orient::placed_grid(reader.dims, spacing, orientation.as_ref())?;
         // Checked here; framed on the visible voxels once the ranks hold them.
         camera_of(&a.scene, &grid, &voxsplat_cli::open::Content { orientation, bounds: None })?;
         let tf = voxsplat_cli::open::transfer_function(&a.scene)?;

@@ -239,7 +239,8 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
     }
     let grazing = view == "grazing" || view == "flyover";
     let top = grid.dims.map(|d| d - 1);
-    let [lo, hi] = content.bounds.unwrap_or([[0; 3], top]).map(|c| grid.position(c));
+    let [lo, hi] = content.bounds.unwrap_or([[0; 3], top]).map(|c| Vec3::from(c.map(|v| v as f32)));
+    let [lo, hi] = grid.world_box(lo, hi);
     let ks = grid.kernel_spacing();
     let mut cam = match (view, o) {
         ("grazing", _) => Camera::grazing(grid, w, h),
@@ -354,7 +355,9 @@ pub fn load_bricked(
     path: &std::path::Path,
     orientation: Option<Orientation>,
 ) -> Result<voxsplat::bricks::BrickScene> {
-    let store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
+    let mut store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
+    let grid = voxsplat::orient::placed_grid(store.dims, store.spacing, orientation.as_ref())?;
+    (store.spacing, store.shear) = (grid.spacing, grid.shear);
     let tf = transfer_function(a)?;
     let shading = headlight(a, store.dims, store.spacing, orientation);
     eprintln!(
@@ -377,7 +380,8 @@ pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
     let orientation = orientation_of(a)?;
     let set = if let Some(path) = &a.volume {
         let (vol, tf, shading) = load_volume_parts(a, path, orientation)?;
-        let set = voxsplat::classify::classify(&vol, &tf, shading)?;
+        let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
+        let set = voxsplat::classify::classify_on(grid, &vol, &tf, shading)?;
         match &a.positions {
             Some(p) => {
                 let coords = voxsplat::loaders::load_positions(p, set.grid())?;
@@ -472,7 +476,7 @@ pub fn open(
         }
         _ => return load_scene(a).map(|(set, content)| (None, set, content)),
     };
-    let set = voxsplat::SplatSet::empty(voxsplat::Grid::centered(bricked.store.dims, bricked.store.spacing)?)?;
+    let set = voxsplat::SplatSet::empty(bricked.store.grid()?)?;
     let content = Content { orientation, bounds: bricked.visible_bounds() };
     Ok((Some(bricked), set, content))
 }

@@ -20,6 +20,7 @@ struct BrickFrame {
 
 layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 1) readonly buffer BrickFrameBlock { BrickFrame bf; };
+#include "grid.glsl"
 // The transfer function tabulated per quantised value q (BrickScene::tf_words): straight RGBA,
 // whether q is extracted (a bit), and the extracted values below each 32-value word.
 layout(std430, binding = 2) readonly buffer Tf {
@@ -163,12 +164,15 @@ float density_at(ivec3 v) {
 }
 
 // Central-difference gradient of the density at voxel v, read through the store (classify_field).
+// A sheared grid's world gradient solves U^T g = diff / 2 (Grid::gradient).
 vec3 gradient_at(ivec3 v) {
     vec3 s = frame.spacing.xyz;
-    return vec3(
-        (density_at(v + ivec3(1, 0, 0)) - density_at(v - ivec3(1, 0, 0))) / (2.0 * s.x),
-        (density_at(v + ivec3(0, 1, 0)) - density_at(v - ivec3(0, 1, 0))) / (2.0 * s.y),
-        (density_at(v + ivec3(0, 0, 1)) - density_at(v - ivec3(0, 0, 1))) / (2.0 * s.z));
+    vec3 h = frame.shear.xyz;
+    float gx = (density_at(v + ivec3(1, 0, 0)) - density_at(v - ivec3(1, 0, 0))) / (2.0 * s.x);
+    float gy = (density_at(v + ivec3(0, 1, 0)) - density_at(v - ivec3(0, 1, 0)) - 2.0 * h.x * gx) / (2.0 * s.y);
+    float gz = (density_at(v + ivec3(0, 0, 1)) - density_at(v - ivec3(0, 0, 1)) - 2.0 * (h.y * gx + h.z * gy))
+        / (2.0 * s.z);
+    return vec3(gx, gy, gz);
 }
 
 // Headlight shading (two-sided) of colour rgb at a gradient g.
@@ -246,10 +250,18 @@ uvec3 level_split(uvec3 b, uint l) {
     return uvec3(clamp(global - ivec3(b * side), ivec3(0), ivec3(side)));
 }
 
-// The world box of brick b's voxel centres.
+// The world box of brick b's voxel centres (a sheared grid's: the box around its corners).
+// Mirror: Grid::world_box.
 void voxel_box(uvec3 b, out vec3 lo, out vec3 hi) {
-    lo = frame.origin.xyz + vec3(b * BRICK_SIDE) * frame.spacing.xyz;
-    hi = frame.origin.xyz + vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u) * frame.spacing.xyz;
+    vec3 first = vec3(b * BRICK_SIDE);
+    vec3 last = vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u);
+    lo = vec3(1e30);
+    hi = vec3(-1e30);
+    for (uint c = 0u; c < 8u; ++c) {
+        vec3 p = grid_point(mix(first, last, vec3(uvec3(c, c >> 1u, c >> 2u) & 1u)));
+        lo = min(lo, p);
+        hi = max(hi, p);
+    }
 }
 
 // Pixels per voxel spacing at eye-space depth `depth`.
@@ -280,7 +292,7 @@ uint morph_bit(uint h) {
 // their parent's centre made a flat slab's summed footprints ripple by 5 %, and a growth per brick
 // left 2 % steps at brick faces.
 float splat_growth(vec3 at, uint l) {
-    vec3 center = frame.origin.xyz + at * frame.spacing.xyz;
+    vec3 center = grid_point(at);
     float octaves = level_octaves(dot(center - frame.eye.xyz, frame.forward.xyz), l);
     return 1.0 + clamp((octaves - (1.0 - bf.grad.w)) / bf.grad.w, 0.0, 1.0);
 }

@@ -5,6 +5,7 @@
 // cpu::splat_params::params_of.
 
 #include "sweep.glsl"
+#include "grid.glsl"
 
 const float MAX_OPACITY = 0.999;
 const float CULL_RADII = 1.5;
@@ -90,7 +91,7 @@ SplatParams params_world(vec3 center, float cell, float grow, vec3 rgb, float ta
 }
 
 SplatParams params_at(vec3 at, float cell, float grow, vec3 rgb, float tau) {
-    return params_world(frame.origin.xyz + at * frame.spacing.xyz, cell, grow, rgb, tau);
+    return params_world(grid_point(at), cell, grow, rgb, tau);
 }
 
 // Optical depth of one voxel-length of opacity a (clamped below 1). Mirror: volume::optical_depth.

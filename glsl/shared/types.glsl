@@ -66,7 +66,7 @@ struct ScreenQuad {
     vec4 emit;    // rgb; a: optical depth scale (tau x energy)
 };
 
-// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 576 bytes.
+// Per-frame constants (vec4-only, so std140 = std430 and the Rust mirror is plain repr(C)). 592 bytes.
 // Bound as a readonly storage buffer, not a uniform buffer: Mesa 22.3's lavapipe inlines uniform
 // values that steer branches and recompiles the shader for every dispatch, keeping each variant until
 // the pipeline dies (+0.2-0.7 MB of host memory per frame; docs/RELIABILITY.md).
@@ -77,7 +77,8 @@ struct Frame {
     vec4 right;       // unit camera right; w: far distance
     vec4 up;          // unit camera up; w: D/p, pixels per world unit at unit depth (ortho: per unit)
     vec4 origin;      // world position of voxel (0,0,0); w: footprint radius in voxels
-    vec4 spacing;     // voxel spacing xyz; w: world footprint radius
+    vec4 spacing;     // voxel spacing xyz (the cell matrix's diagonal); w: world footprint radius
+    vec4 shear;       // a sheared grid's cell matrix above the diagonal: x per j, x per k, y per k
     uvec4 dims;       // nx, ny, nz; w: splat count
     uvec4 split;      // PBTF: voxels per axis on the low side of the eye; w: 1 = back-to-front
     vec4 aa;          // x: anti-aliasing mode (AA_*); y: footprint standard deviation in voxels;
@@ -103,13 +104,14 @@ const uint SWEEP_SLOTTED = 3u;   // tapered, each half of the shutter composited
 #define AA_SWAN 1.0
 #define AA_EWA 2.0
 
-// Uniforms of the ray caster. 160 bytes.
+// Uniforms of the ray caster. 176 bytes before the clipping planes.
 struct RaycastParams {
     mat4 inv_view_proj;  // clip -> world
-    vec4 box_min;        // world box sampled (voxel centres widened by one spacing); w: step length
+    vec4 box_min;        // index box sampled (voxel centres widened by one voxel); w: step length
     vec4 box_max;        // w: transmittance below which a ray stops (early ray termination)
     vec4 origin;         // world position of voxel (0,0,0); w: 1 / kernel spacing (sigma = tau * w)
-    vec4 inv_spacing;    // 1 / voxel spacing; w: unused
+    vec4 inv_spacing;    // the inverse cell matrix's diagonal (1 / voxel spacing); w: unused
+    vec4 inv_shear;      // the inverse cell matrix above its diagonal (a sheared grid's); w: unused
     uvec4 dims;          // nx, ny, nz; w: most steps per ray
     uvec4 image;         // width, height, empty-space brick side, clipping planes in use
     vec4 clip[CLIP_SLOTS];  // clipping planes (n, d): each ray cut to where n . x + d >= 0 for all

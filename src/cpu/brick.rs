@@ -4,7 +4,7 @@
 use super::bindings::Bindings;
 use super::lod::level_count;
 use super::order::{outward, side_count};
-use super::splat_params::{cell_footprint_scale, optical_depth, params_at, CULL_RADII};
+use super::splat_params::{cell_footprint_scale, frame_grid, optical_depth, params_at, CULL_RADII};
 use crate::bricks::{local_cell, BrickStore, BRICK};
 use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
 use crate::dispatch::{Args, Res, Variant};
@@ -113,13 +113,12 @@ impl BrickInputs<'_> {
 
     /// Mirror of `gradient_at`.
     pub(crate) fn gradient_at(&self, v: [i64; 3]) -> Vec3 {
-        let s = &self.frame.spacing;
         let [i, j, k] = v;
-        Vec3::new(
-            (self.density_at(i + 1, j, k) - self.density_at(i - 1, j, k)) / (2.0 * s[0]),
-            (self.density_at(i, j + 1, k) - self.density_at(i, j - 1, k)) / (2.0 * s[1]),
-            (self.density_at(i, j, k + 1) - self.density_at(i, j, k - 1)) / (2.0 * s[2]),
-        )
+        Vec3::from(frame_grid(self.frame).gradient([
+            self.density_at(i + 1, j, k) - self.density_at(i - 1, j, k),
+            self.density_at(i, j + 1, k) - self.density_at(i, j - 1, k),
+            self.density_at(i, j, k + 1) - self.density_at(i, j, k - 1),
+        ]))
     }
 
     /// Mirror of `shade`.
@@ -154,11 +153,10 @@ impl BrickInputs<'_> {
     /// Mirror of `voxel_box`: the world box of brick `b`'s voxel centres.
     pub(crate) fn voxel_box(&self, b: [u32; 3]) -> (Vec3, Vec3) {
         let f = self.frame;
-        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-        let (origin, spacing) = (v3(f.origin), v3(f.spacing));
         let first = Vec3::new((b[0] * BRICK) as f32, (b[1] * BRICK) as f32, (b[2] * BRICK) as f32);
         let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
-        (origin + first * spacing, origin + Vec3::from(last) * spacing)
+        let [lo, hi] = frame_grid(f).world_box(first, Vec3::from(last));
+        (lo, hi)
     }
 
     /// Mirror of `box_depths`: the depths along the view of the box's nearest and farthest corners.

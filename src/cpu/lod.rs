@@ -146,7 +146,7 @@ impl BrickInputs<'_> {
     pub fn splat_growth(&self, at: Vec3, l: u32) -> f32 {
         let (f, bf) = (self.frame, &self.bf);
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-        let center = v3(f.origin) + at * v3(f.spacing);
+        let center = super::splat_params::frame_grid(f).point(at);
         let octaves = self.level_octaves((center - v3(f.eye)).dot(v3(f.forward)), l);
         1.0 + ((octaves - (1.0 - bf.grad[3])) / bf.grad[3]).clamp(0.0, 1.0)
     }

@@ -62,13 +62,18 @@ pub fn brick_occupancy(field: &DenseField, brick: u32) -> ([u32; 3], Vec<u32>) {
     (nb.map(|n| n as u32), occ)
 }
 
+/// Mirror of `to_index` in `raycast.comp`: world offset `d` in index units.
+fn to_index(rc: &RaycastParams, d: Vec3) -> Vec3 {
+    let (s, h) = (rc.inv_spacing, rc.inv_shear);
+    Vec3::new(d.x * s[0] + d.y * h[0] + d.z * h[1], d.y * s[1] + d.z * h[2], d.z * s[2])
+}
+
 /// Mirror of `skip_brick` in `raycast.comp`.
 #[allow(clippy::too_many_arguments)]
 fn skip_brick(rc: &RaycastParams, b: [i32; 3], nb: [i32; 3], a: Vec3, dir: Vec3, t0: f32, offset: f32, s: u32) -> u32 {
     let bs = rc.image[2] as f32;
-    let size = Vec3::new(bs / rc.inv_spacing[0], bs / rc.inv_spacing[1], bs / rc.inv_spacing[2]);
-    let lo = Vec3::from_slice(&rc.origin[..3]) + Vec3::new(b[0] as f32, b[1] as f32, b[2] as f32) * size;
-    let hi = lo + size;
+    let lo = Vec3::new(b[0] as f32, b[1] as f32, b[2] as f32) * bs;
+    let hi = lo + bs;
     let mut t_exit = 3.4e38f32;
     for ax in 0..3 {
         if dir[ax] > 0.0 && b[ax] < nb[ax] - 1 {
@@ -109,16 +114,19 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
     let g = set.grid();
     let o = Vec3::from(g.origin);
     let s = Vec3::from(g.spacing);
-    let last = g.position([g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1]);
-    let (lo, hi) = (o - s, last + s);
+    let hi = Vec3::from(g.dims.map(|d| d as f32));
     let step = opts.step * s.min_element();
+    // The inverse of the cell matrix [[sx, a, b], [0, sy, c], [0, 0, sz]].
+    let [a, b, c] = g.shear;
+    let inv_shear = [-a / (s.x * s.y), (a * c - b * s.y) / (s.x * s.y * s.z), -c / (s.y * s.z)];
     let (clip, clip_count) = opts.clip.uniforms();
     RaycastParams {
         inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
-        box_min: [lo.x, lo.y, lo.z, step],
+        box_min: [-1.0, -1.0, -1.0, step],
         box_max: [hi.x, hi.y, hi.z, opts.min_transmittance],
         origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
         inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
+        inv_shear: [inv_shear[0], inv_shear[1], inv_shear[2], 0.0],
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
         image: [camera.width, camera.height, opts.brick, clip_count],
         clip,
@@ -145,7 +153,6 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
     let inv = Mat4::from_cols_array_2d(&rc.inv_view_proj);
     let (lo, hi) = (Vec3::from_slice(&rc.box_min[..3]), Vec3::from_slice(&rc.box_max[..3]));
     let origin = Vec3::from_slice(&rc.origin[..3]);
-    let inv_spacing = Vec3::from_slice(&rc.inv_spacing[..3]);
     let mut pixels = vec![[0.0f32; 4]; (w * h) as usize];
     pixels.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
@@ -156,16 +163,17 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
             let d = b4.truncate() / b4.w - a;
             let len = d.length();
             let dir = d / len;
+            let (ia, idir) = (to_index(rc, a - origin), to_index(rc, dir));
             let (mut t0, mut t1) = (0.0f32, len);
             for ax in 0..3 {
-                if dir[ax].abs() < 1e-30 {
-                    if a[ax] < lo[ax] || a[ax] > hi[ax] {
+                if idir[ax].abs() < 1e-30 {
+                    if ia[ax] < lo[ax] || ia[ax] > hi[ax] {
                         t1 = -1.0;
                     }
                     continue;
                 }
-                let p = (lo[ax] - a[ax]) / dir[ax];
-                let q = (hi[ax] - a[ax]) / dir[ax];
+                let p = (lo[ax] - ia[ax]) / idir[ax];
+                let q = (hi[ax] - ia[ax]) / idir[ax];
                 t0 = t0.max(p.min(q));
                 t1 = t1.min(p.max(q));
             }
@@ -196,11 +204,11 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                 let mut s = 0u32;
                 while s < n {
                     let p = a + dir * (t0 + (s as f32 + offset) * step);
-                    let u = (p - origin) * inv_spacing;
+                    let u = to_index(rc, p - origin);
                     if bs > 0 {
                         let b = [0, 1, 2].map(|ax| ((u[ax] / bs as f32).floor() as i32).clamp(0, nb[ax] - 1));
                         if bricks[((b[2] * nb[1] + b[1]) * nb[0] + b[0]) as usize] == 0 {
-                            s = skip_brick(rc, b, nb, a, dir, t0, offset, s);
+                            s = skip_brick(rc, b, nb, ia, idir, t0, offset, s);
                             continue;
                         }
                     }

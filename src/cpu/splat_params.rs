@@ -44,8 +44,20 @@ pub fn params_of(frame: &Frame, ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
 /// Mirror of `params_at`: a splat `cell` voxels a side at grid position `at`, widened by `grow`
 /// (energy / grow²), of straight colour `rgb` and optical depth `tau` per cell.
 pub fn params_at(frame: &Frame, at: Vec3, cell: f32, grow: f32, rgb: [f32; 3], tau: f32) -> SplatParams {
-    let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-    params_world(frame, v3(frame.origin) + at * v3(frame.spacing), cell, grow, rgb, tau)
+    params_world(frame, frame_grid(frame).point(at), cell, grow, rgb, tau)
+}
+
+/// The grid `frame` places voxels on (its origin, cell matrix and dimensions): the mirrors of
+/// `grid_point`, `voxel_box` and `gradient_at` are its `point`, `world_box` and `gradient`.
+pub fn frame_grid(frame: &Frame) -> crate::volume::Grid {
+    let v3 = |v: [f32; 4]| [v[0], v[1], v[2]];
+    let [nx, ny, nz, _] = frame.dims;
+    crate::volume::Grid {
+        dims: [nx, ny, nz],
+        spacing: v3(frame.spacing),
+        origin: v3(frame.origin),
+        shear: v3(frame.shear),
+    }
 }
 
 /// Mirror of `params_world`: `params_at` with the splat's world centre given.

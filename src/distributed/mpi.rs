@@ -98,9 +98,15 @@ impl<C: Communicator> Distributed<C> {
             }
             None => reader.spacing,
         };
-        let grid = Grid::centered(reader.dims, spacing)?;
+        // Placed as the file says (a sheared grid's shear; `load_orientation` applies hints the same way).
+        let placement = match (reader.orientation, hints.spacing) {
+            (Some(o), Some(s)) => Some(o.with_spacing(s)?),
+            (o, _) => o,
+        };
+        let grid = crate::orient::placed_grid(reader.dims, spacing, placement.as_ref())?;
         let b: BrickBox = partition.boxes[rank as usize];
-        let built = load_part(&mut reader, spacing, whole.range(), &b).and_then(|store| {
+        let built = load_part(&mut reader, spacing, whole.range(), &b).and_then(|mut store| {
+            (store.spacing, store.shear) = (grid.spacing, grid.shear);
             let mut scene = BrickScene::new(store, tf.clone(), shading)?;
             scene.set_part(b.lo, b.hi)?;
             scene.set_tree(partition.tree.clone())?;
