@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Mutation check (issue 25): plants eight known bugs one at a time, runs the tests that should
+# Mutation check (issue 25): plants nine known bugs one at a time, runs the tests that should
 # catch each, and prints a markdown table; exits 1 when a bug survives (no test failed). Each
 # mutant costs a release rebuild of the library and its tests (about 1-3 minutes here); the last
 # result lives in docs/RELIABILITY.md. The tree is restored after every mutant, also on Ctrl-C.
-#   scripts/mutants.sh            all eight
+#   scripts/mutants.sh            all nine
 #   scripts/mutants.sh octant     the ones whose name contains "octant"
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,6 +17,7 @@ MUTANTS=(
   "stale TF (no new classification)|src/bricks.rs|        self.classification = next_classification();\n        Ok(())|        Ok(())|--test lod"
   "boxes composited nearest first|src/distributed.rs|        s.plane >= split[s.axis]|        s.plane < split[s.axis]|--features mpi -p voxsplat-cli --test distributed one_two"
   "world eye into the grid frame by the rotation, not its inverse|src/orient.rs|(self.rotation.transpose() * (p.as_dvec3() - self.center)).as_vec3()|(self.rotation * (p.as_dvec3() - self.center)).as_vec3()|--test orient"
+  "a sheared grid's eye mapped into index space without the shear|src/volume.rs|        let y = (d.y - h[2] * z) / s.y;|        let y = d.y / s.y;|--test orient"
 )
 filter=${1:-}
 backup=$(mktemp -d)

@@ -173,22 +173,26 @@ fn what_cannot_be_split_is_refused_on_every_rank() {
 }
 
 #[test]
-fn ranks_read_a_left_handed_file_as_one_process_does() {
+fn ranks_read_a_left_handed_or_sheared_file_as_one_process_does() {
     // Superior at low k (a negative k column): stored x-reversed on every path, each rank's box too.
     // Longest along x, so the ranks' boxes split x and each reads the mirrored span of its rows.
     let dims = [24, common::DIMS[1], common::DIMS[2]];
     let nz = dims[2] as i64;
     let v = common::samples(dims, |[i, j, k]| [i / 2, j, nz - 1 - k]);
-    let affine = glam::DMat4::from_cols(
-        glam::DVec4::X,
-        glam::DVec4::Y,
-        -glam::DVec4::Z,
-        glam::DVec4::new(0.0, 0.0, (nz - 1) as f64, 1.0),
-    );
-    let file = tmp("rai.nii");
-    std::fs::write(&file, common::nifti(dims, &v, Some(affine), None)).unwrap();
-    let args = ["render", "--volume", file.to_str().unwrap(), "--tf", "ramp", "--view", "anterior", "--size", "64x64"];
-    let (run, d) = beside_one_process(&args, 2, "rai");
-    assert!(String::from_utf8_lossy(&run.stderr).contains("on 2 ranks"));
-    assert!(d <= 2e-3, "two ranks: {d} from the single-process frame");
+    // And the same with a 30-degree gantry tilt: each rank's store on the sheared grid.
+    for (name, tilt) in [("rai", 0.0), ("rai-tilted", 30f64.to_radians().tan())] {
+        let affine = glam::DMat4::from_cols(
+            glam::DVec4::X,
+            glam::DVec4::Y,
+            glam::DVec4::new(0.0, tilt, -1.0, 0.0),
+            glam::DVec4::new(0.0, 0.0, (nz - 1) as f64, 1.0),
+        );
+        let file = tmp(&format!("{name}.nii"));
+        std::fs::write(&file, common::nifti(dims, &v, Some(affine), None)).unwrap();
+        let args =
+            ["render", "--volume", file.to_str().unwrap(), "--tf", "ramp", "--view", "anterior", "--size", "64x64"];
+        let (run, d) = beside_one_process(&args, 2, name);
+        assert!(String::from_utf8_lossy(&run.stderr).contains("on 2 ranks"));
+        assert!(d <= 2e-3, "{name}, two ranks: {d} from the single-process frame");
+    }
 }

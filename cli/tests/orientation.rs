@@ -43,8 +43,12 @@ fn files() -> [std::path::PathBuf; 2] {
 }
 
 fn render(file: &std::path::Path, view: &str, out: &str) -> image::RgbaImage {
+    render_with(file, view, out, &[])
+}
+
+fn render_with(file: &std::path::Path, view: &str, out: &str, extra: &[&str]) -> image::RgbaImage {
     let path = tmp(out);
-    let o = voxsplat(&[
+    let mut args = vec![
         "render",
         "--volume",
         file.to_str().unwrap(),
@@ -57,7 +61,9 @@ fn render(file: &std::path::Path, view: &str, out: &str) -> image::RgbaImage {
         "--validation",
         "--out",
         path.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let o = voxsplat(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     image::open(&path).unwrap().to_rgba8()
 }
@@ -110,4 +116,46 @@ fn an_anatomical_view_of_data_without_a_frame_is_refused() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("anatomical frame") && !err.contains("panicked"), "{err}");
+}
+
+/// A column of voxels along k in a CT whose gantry is tilted 30 degrees: each slice lies 0.577
+/// units further anterior than the one below, so the column leans toward anterior in the world.
+#[test]
+fn a_tilted_gantry_leans_as_the_file_says() {
+    let [nx, ny, nz] = DIMS;
+    let mut v = Vec::new();
+    for _ in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                v.push(((5..=6).contains(&i) && (4..=5).contains(&j)) as u8 * 200);
+            }
+        }
+    }
+    let tilt = 30f64.to_radians().tan();
+    let path = tmp("tilted.nii");
+    std::fs::write(&path, nifti(DIMS, &v, Some(affine([DVec3::X, DVec3::Y, DVec3::new(0.0, tilt, 1.0)], DVec3::ZERO)), None))
+        .unwrap();
+    let o = voxsplat(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && text.contains("sheared: axes i-j at 90.0, i-k at 90.0, j-k at 60.0 degrees"), "{text}");
+    // From the patient's left anterior is to the image's left: the column's upper rows lie left
+    // of its lower ones, by the tilt (pixels per pixel: the view is square on the column).
+    for extra in [&[][..], &["--dense"][..]] {
+        let img = render_with(&path, "left", &format!("tilted{}.png", extra.len()), extra);
+        let centre = |rows: std::ops::Range<u32>| {
+            let (mut s, mut w) = (0.0, 0.0);
+            for y in rows {
+                for x in 0..img.width() {
+                    let a = img.get_pixel(x, y)[3] as f64;
+                    (s, w) = (s + x as f64 * a, w + a);
+                }
+            }
+            assert!(w > 0.0, "{extra:?}: the column is drawn");
+            s / w
+        };
+        let (rows, top, bottom) = (8..24u32, 24..40u32, 40..56u32);
+        let lean = (centre(bottom.clone()) - centre(rows.clone())) / 32.0;
+        eprintln!("{extra:?}: lean {lean:.3} px per px ({:.1}, {:.1}, {:.1})", centre(rows), centre(top), centre(bottom));
+        assert!((lean - tilt).abs() < 0.15, "{extra:?}: the column leans {lean} px per px, the file says {tilt}");
+    }
 }
