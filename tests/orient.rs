@@ -209,23 +209,6 @@ fn an_oblique_grid_renders_as_the_world_space_truth() {
     let tf = one_colour();
     let v = samples(DIMS, |b| b);
     let mut r = common::gpu();
-    // An anterior-oblique world camera on the object's centre, 96 px.
-    let centre = |a: DMat4| a.transform_point3(DVec3::new(5.5, 4.5, 7.5)).as_vec3();
-    let world_camera = |a: DMat4| {
-        let (dir, up) = View::Oblique.directions();
-        let c = centre(a);
-        let eye = c + dir * 40.0;
-        Camera {
-            eye,
-            target: c,
-            up,
-            projection: Projection::Perspective { fov_y_deg: 30.0 },
-            near: 20.0,
-            far: 60.0,
-            width: 96,
-            height: 96,
-        }
-    };
     let oblique = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.6);
     let rotated = {
         let m = DMat3::from_quat(oblique);
@@ -282,6 +265,28 @@ fn views_put_superior_up_and_face_their_side() {
     assert!("sideways".parse::<View>().is_err());
 }
 
+/// The validators' world cameras on the object `a` places: close (the eye over the grid, where BTF
+/// fails under perspective) and far, from three sides; with their distances.
+fn validator_cameras(a: DMat4) -> Vec<(f32, Camera)> {
+    let c = a.transform_point3(DVec3::new(5.5, 4.5, 7.5)).as_vec3();
+    [(11.0, Vec3::new(0.2, 1.0, 0.3)), (11.0, Vec3::new(-1.0, 0.1, 0.4)), (40.0, Vec3::Z)]
+        .map(|(dist, dir): (f32, Vec3)| {
+            let up = if dir.cross(Vec3::Z).length() < 1e-3 { Vec3::Y } else { Vec3::Z };
+            let cam = Camera {
+                eye: c + dir.normalize() * dist,
+                target: c,
+                up,
+                projection: Projection::Perspective { fov_y_deg: 60.0 },
+                near: 0.5,
+                far: 80.0,
+                width: 64,
+                height: 64,
+            };
+            (dist, cam)
+        })
+        .to_vec()
+}
+
 #[test]
 fn the_validator_runs_on_oblique_grids() {
     use voxsplat::order::{count_violations, visibility_order, Direction, OrderKind};
@@ -294,21 +299,8 @@ fn the_validator_runs_on_oblique_grids() {
         let vol = load_volume(&path, &VolumeHints::default()).unwrap();
         let o = load_orientation(&path, &VolumeHints::default()).unwrap().unwrap();
         let set = voxsplat::classify::classify(&vol, &tf, None).unwrap();
-        let c = a.transform_point3(DVec3::new(5.5, 4.5, 7.5)).as_vec3();
-        // Close (the eye over the grid, where BTF fails under perspective) and far, from three sides.
-        for (dist, dir) in [(11.0, Vec3::new(0.2, 1.0, 0.3)), (11.0, Vec3::new(-1.0, 0.1, 0.4)), (40.0, Vec3::Z)] {
-            let eye = c + dir.normalize() * dist;
-            let up = if dir.cross(Vec3::Z).length() < 1e-3 { Vec3::Y } else { Vec3::Z };
-            let cam = Camera {
-                eye,
-                target: c,
-                up,
-                projection: Projection::Perspective { fov_y_deg: 60.0 },
-                near: 0.5,
-                far: 80.0,
-                width: 64,
-                height: 64,
-            };
+        for (dist, cam) in validator_cameras(a) {
+            let eye = cam.eye;
             let grid_cam = o.camera_to_grid(&cam);
             let count = |k| {
                 let order = visibility_order(&set, &grid_cam, k, Direction::BackToFront);
@@ -480,21 +472,8 @@ fn the_validator_runs_on_sheared_grids() {
     for (name, a) in sheared_affines() {
         let (set, o, _) =
             sheared_scene(&write(&format!("validator-{name}.nii"), &nifti(DIMS, &v, Some(a), None)), true);
-        let c = a.transform_point3(DVec3::new(5.5, 4.5, 7.5)).as_vec3();
-        // Close (the eye over the grid, where BTF fails under perspective) and far, from three sides.
-        for (dist, dir) in [(11.0, Vec3::new(0.2, 1.0, 0.3)), (11.0, Vec3::new(-1.0, 0.1, 0.4)), (40.0, Vec3::Z)] {
-            let eye = c + dir.normalize() * dist;
-            let up = if dir.cross(Vec3::Z).length() < 1e-3 { Vec3::Y } else { Vec3::Z };
-            let cam = Camera {
-                eye,
-                target: c,
-                up,
-                projection: Projection::Perspective { fov_y_deg: 60.0 },
-                near: 0.5,
-                far: 80.0,
-                width: 64,
-                height: 64,
-            };
+        for (dist, cam) in validator_cameras(a) {
+            let eye = cam.eye;
             let grid_cam = o.camera_to_grid(&cam);
             let count = |k| {
                 let order = visibility_order(&set, &grid_cam, k, Direction::BackToFront);

@@ -133,11 +133,17 @@ fn a_tilted_gantry_leans_as_the_file_says() {
     }
     let tilt = 30f64.to_radians().tan();
     let path = tmp("tilted.nii");
-    std::fs::write(&path, nifti(DIMS, &v, Some(affine([DVec3::X, DVec3::Y, DVec3::new(0.0, tilt, 1.0)], DVec3::ZERO)), None))
-        .unwrap();
+    std::fs::write(
+        &path,
+        nifti(DIMS, &v, Some(affine([DVec3::X, DVec3::Y, DVec3::new(0.0, tilt, 1.0)], DVec3::ZERO)), None),
+    )
+    .unwrap();
     let o = voxsplat(&["info", path.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success() && text.contains("sheared: axes i-j at 90.0, i-k at 90.0, j-k at 60.0 degrees"), "{text}");
+    assert!(
+        o.status.success() && text.contains("sheared: axes i-j at 90.0, i-k at 90.0, j-k at 60.0 degrees"),
+        "{text}"
+    );
     // From the patient's left anterior is to the image's left: the column's upper rows lie left
     // of its lower ones, by the tilt (pixels per pixel: the view is square on the column).
     for extra in [&[][..], &["--dense"][..]] {
@@ -155,7 +161,12 @@ fn a_tilted_gantry_leans_as_the_file_says() {
         };
         let (rows, top, bottom) = (8..24u32, 24..40u32, 40..56u32);
         let lean = (centre(bottom.clone()) - centre(rows.clone())) / 32.0;
-        eprintln!("{extra:?}: lean {lean:.3} px per px ({:.1}, {:.1}, {:.1})", centre(rows), centre(top), centre(bottom));
+        eprintln!(
+            "{extra:?}: lean {lean:.3} px per px ({:.1}, {:.1}, {:.1})",
+            centre(rows),
+            centre(top),
+            centre(bottom)
+        );
         assert!((lean - tilt).abs() < 0.15, "{extra:?}: the column leans {lean} px per px, the file says {tilt}");
     }
 }
