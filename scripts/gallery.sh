@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The README's gallery (issue 29): every real dataset in ../shared/data and one procedural volume
+# The README's gallery (issue 29): every real dataset in ../shared/data, one procedural volume and
+# the T1 head phantom (make-volume --phantom; no brain MRI in ../shared/data)
 # at 512², voxsplat beside VTK's GPU ray caster (vtkGPUVolumeRayCastMapper on llvmpipe through EGL),
 # the same file, preset and view (voxsplat's default camera, handed to VTK: scripts/vtk_file.py
 # --camera), in one run, the two tools alternating file by file. voxsplat: `render --repeat 5
@@ -23,6 +24,8 @@ work=target/gallery
 out=docs/img/gallery
 mkdir -p "$work" "$out"
 [ -f "$work/procedural256.nrrd" ] || ./target/release/voxsplat make-volume --procedural 256 --out "$work/procedural256.nrrd" >&2
+# No brain MRI in ../shared/data: the mri preset is shown on the T1 head phantom.
+[ -f "$work/head256.nrrd" ] || ./target/release/voxsplat make-volume --phantom 256 --out "$work/head256.nrrd" >&2
 vs=./target/release/voxsplat
 echo "| data | preset, view | voxsplat ms | VTK GPU ray cast ms | VTK / voxsplat | PSNR over the object, dB | contrast |"
 echo "|---|---|---|---|---|---|---|"
@@ -50,10 +53,12 @@ bonsai|$DATA/bonsai/bonsai.nii.gz|bonsai|shade
 heptane|$DATA/heptane/heptane.nii.gz|ramp|
 stent|$DATA/stent/stent.nrrd|ct|
 procedural|$work/procedural256.nrrd|ramp|
+head-phantom|$work/head256.nrrd|mri|
 bonsai-flat|$DATA/bonsai/bonsai.nii.gz|bonsai|
 stent-shaded|$DATA/stent/stent.nrrd|ct|shade
 heptane-shaded|$DATA/heptane/heptane.nii.gz|ramp|shade
 procedural-shaded|$work/procedural256.nrrd|ramp|shade
+head-phantom-shaded|$work/head256.nrrd|mri|shade
 ROWS
 # The terrain: voxsplat's voxel columns beside VTK's textured surface of the same heights and colours
 # (scripts/vtk_terrain.py), voxsplat's default fly-over.

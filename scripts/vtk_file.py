@@ -6,7 +6,7 @@ centred on the grid, VTK's image starts at voxel (0, 0, 0), and both run the fil
 (files whose affine is left-handed, which voxsplat stores x-reversed, are not taken).
 --mapper fixed: the fixed-point CPU ray caster (issue 23); gpu: vtkGPUVolumeRayCastMapper (llvmpipe
 through EGL here). --shade: VTK's gradient shading, as voxsplat's --shade.
-Usage: python vtk_file.py --file F.nrrd|F.nii.gz --tf bonsai|ramp|ct --frames 5 --out out.png
+Usage: python vtk_file.py --file F.nrrd|F.nii.gz --tf bonsai|ramp|ct|mri --frames 5 --out out.png
 """
 import argparse, math, statistics, sys, time
 import vtk
@@ -32,6 +32,8 @@ PRESETS = {
            (1.0, (1, 1, 1, 0.95))],
     "bonsai": [(0.0, (0, 0, 0, 0)), (0.22, (0, 0, 0, 0)), (0.25, (0.22, 0.6, 0.12, 0.35)), (0.31, (0.25, 0.6, 0.15, 0.35)),
                (0.36, (0.55, 0.33, 0.14, 0.9)), (1.0, (0.65, 0.42, 0.25, 0.95))],
+    "mri": [(0.0, (0, 0, 0, 0)), (0.3, (0, 0, 0, 0)), (0.4, (0.85, 0.62, 0.5, 0.015)), (0.5, (0.85, 0.62, 0.5, 0.015)),
+            (0.6, (0.8, 0.5, 0.5, 0.12)), (0.85, (0.95, 0.9, 0.82, 0.5)), (1.0, (1, 0.97, 0.9, 0.8))],
 }
 
 t0 = time.perf_counter()

@@ -30,6 +30,7 @@ pub const TF_PRESETS: &[(&str, &str)] = &[
     ("ramp", "grey ramp, opacity rising from a tenth of the range"),
     ("ct", "CT: soft tissue faint red, contrast and bone opaque white"),
     ("bonsai", "the bonsai CT: twigs green, trunk and pot brown, the base plate transparent"),
+    ("mri", "T1-weighted MRI head: scalp a faint skin tone, grey matter rose, white matter opaque ivory"),
 ];
 
 /// Presets drawn with headlight shading by default: those where shading raised the luminance
@@ -38,7 +39,7 @@ pub const TF_PRESETS: &[(&str, &str)] = &[
 pub const SHADED_PRESETS: &[&str] = &["bonsai"];
 
 impl TransferFunction {
-    /// A named preset: `ramp`, `ct`, `bonsai` (see README).
+    /// A named preset: `ramp`, `ct`, `bonsai`, `mri` (see README).
     pub fn preset(name: &str) -> Result<Self> {
         let p = |points: Vec<(f32, [f32; 4])>| Self { points, gradient_weight: 0.0, range: None, threshold: 0.0 };
         match name {
@@ -59,6 +60,18 @@ impl TransferFunction {
                 (0.31, [0.25, 0.6, 0.15, 0.35]),
                 (0.36, [0.55, 0.33, 0.14, 0.9]),
                 (1.0, [0.65, 0.42, 0.25, 0.95]),
+            ])),
+            // T1 over the data's range: fluid and bone (below 0.25) transparent, scalp (~0.4) faint,
+            // grey matter (~0.6) translucent, white matter (~0.95) near opaque (issue 29, tuned on
+            // `make-volume --phantom` beside VTK: docs/RESULTS.md).
+            "mri" => Ok(p(vec![
+                (0.0, [0.0, 0.0, 0.0, 0.0]),
+                (0.3, [0.0, 0.0, 0.0, 0.0]),
+                (0.4, [0.85, 0.62, 0.5, 0.015]),
+                (0.5, [0.85, 0.62, 0.5, 0.015]),
+                (0.6, [0.8, 0.5, 0.5, 0.12]),
+                (0.85, [0.95, 0.9, 0.82, 0.5]),
+                (1.0, [1.0, 0.97, 0.9, 0.8]),
             ])),
             other => Err(Error::InvalidArgument(format!(
                 "unknown transfer function '{other}' ({})",

@@ -58,8 +58,8 @@ enum Command {
         validation: bool,
     },
     /// Make a large test volume (never committed): FILE upsampled by an integer factor (e.g. the
-    /// 512³ bonsai from the 256³ one), or a procedural field of side N (e.g. 1024³); written as
-    /// 8-bit NRRD slice by slice.
+    /// 512³ bonsai from the 256³ one), a procedural field of side N (e.g. 1024³), or a T1 MRI head
+    /// phantom of side N (placed in RAS); written as 8-bit NRRD slice by slice.
     MakeVolume {
         /// Upsample this volume file (any format `render --volume` reads)...
         #[arg(long, conflicts_with = "procedural")]
@@ -68,8 +68,12 @@ enum Command {
         #[arg(long, default_value_t = 2)]
         factor: u32,
         /// Or make the procedural field of this side.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "phantom")]
         procedural: Option<u32>,
+        /// Or make a T1-weighted MRI head phantom of this side (220 mm across, RAS; for the `mri`
+        /// preset: ../shared/data holds no brain MRI).
+        #[arg(long, conflicts_with = "from")]
+        phantom: Option<u32>,
         /// The NRRD file to write.
         #[arg(long)]
         out: PathBuf,
@@ -552,10 +556,14 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::MakeVolume { from, factor, procedural, out } => {
+        Command::MakeVolume { from, factor, procedural, phantom, out } => {
             let bar = indicatif::ProgressBar::new(0);
             let t = std::time::Instant::now();
-            let dims = match (from, procedural) {
+            let dims = match (from, procedural.or(phantom)) {
+                (None, Some(n)) if phantom.is_some() => {
+                    bar.set_length(n as u64);
+                    voxsplat_cli::volumes::head_phantom(n, &out, |z| bar.set_position(z as u64))?
+                }
                 (Some(file), None) => {
                     let vol = voxsplat::loaders::load_volume(&file, &Default::default())?;
                     bar.set_length(vol.dims[2] as u64 * factor as u64);
@@ -565,7 +573,7 @@ fn run(cli: Cli) -> Result<()> {
                     bar.set_length(n as u64);
                     voxsplat_cli::volumes::procedural(n, &out, |z| bar.set_position(z as u64))?
                 }
-                _ => return Err(Error::InvalidArgument("give --from FILE or --procedural N".into())),
+                _ => return Err(Error::InvalidArgument("give --from FILE, --procedural N or --phantom N".into())),
             };
             bar.finish_and_clear();
             println!(

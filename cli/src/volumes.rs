@@ -10,13 +10,33 @@ use voxsplat::{Error, Result};
 /// Most voxels along a side of a made volume.
 pub const MAX_SIDE: u32 = 4096;
 
-fn create(path: &Path, dims: [u32; 3], spacing: [f32; 3]) -> Result<std::io::BufWriter<std::fs::File>> {
+/// How a made volume's header places it: spacing alone, or in patient space (RAS, axis-aligned,
+/// centred on the world origin).
+#[derive(Clone, Copy)]
+enum Frame {
+    Spacing,
+    Ras,
+}
+
+fn create(path: &Path, dims: [u32; 3], spacing: [f32; 3], frame: Frame) -> Result<std::io::BufWriter<std::fs::File>> {
     let io = |e| Error::Io { path: path.display().to_string(), source: e };
     let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    let [sx, sy, sz] = spacing;
+    let place = match frame {
+        Frame::Spacing => format!("spacings: {sx} {sy} {sz}"),
+        Frame::Ras => {
+            let o = [0, 1, 2].map(|a| -0.5 * (dims[a] - 1) as f32 * spacing[a]);
+            format!(
+                "space: right-anterior-superior\nspace directions: ({sx},0,0) (0,{sy},0) (0,0,{sz})\n\
+                 space origin: ({},{},{})",
+                o[0], o[1], o[2]
+            )
+        }
+    };
     write!(
         out,
-        "NRRD0004\ntype: uint8\ndimension: 3\nsizes: {} {} {}\nspacings: {} {} {}\nencoding: raw\n\n",
-        dims[0], dims[1], dims[2], spacing[0], spacing[1], spacing[2]
+        "NRRD0004\ntype: uint8\ndimension: 3\nsizes: {} {} {}\n{place}\nencoding: raw\n\n",
+        dims[0], dims[1], dims[2]
     )
     .map_err(io)?;
     Ok(out)
@@ -28,6 +48,7 @@ fn write_slices(
     path: &Path,
     dims: [u32; 3],
     spacing: [f32; 3],
+    frame: Frame,
     slice: impl Fn(u32, &mut [u8]) + Sync,
     mut progress: impl FnMut(u32),
 ) -> Result<()> {
@@ -35,7 +56,7 @@ fn write_slices(
         return Err(Error::InvalidArgument(format!("volume sides must be in 1..={MAX_SIDE}, not {dims:?}")));
     }
     let io = |e| Error::Io { path: path.display().to_string(), source: e };
-    let mut out = create(path, dims, spacing)?;
+    let mut out = create(path, dims, spacing, frame)?;
     let area = dims[0] as usize * dims[1] as usize;
     let batch = 8u32;
     let mut buf = vec![0u8; area * batch as usize];
@@ -81,6 +102,7 @@ pub fn upsample(vol: &ScalarVolume, factor: u32, path: &Path, progress: impl FnM
         path,
         dims,
         spacing,
+        Frame::Spacing,
         |z, buf| {
             let (k0, k1, wk) = src(z, nz);
             for y in 0..dims[1] {
@@ -109,6 +131,7 @@ pub fn procedural(n: u32, path: &Path, progress: impl FnMut(u32)) -> Result<[u32
         path,
         dims,
         [1.0; 3],
+        Frame::Spacing,
         |z, buf| {
             let c = n as f32 * 0.5;
             for y in 0..n {
@@ -127,4 +150,92 @@ pub fn procedural(n: u32, path: &Path, progress: impl FnMut(u32)) -> Result<[u32
         progress,
     )?;
     Ok(dims)
+}
+
+/// T1-weighted intensities of the head phantom's tissues (of 255 = 1.0).
+const T1_WHITE: f32 = 0.72;
+const T1_GREY: f32 = 0.45;
+const T1_SKIN: f32 = 0.30;
+const T1_CSF: f32 = 0.12;
+const T1_BONE: f32 = 0.08;
+
+/// A T1-weighted MRI head phantom of side `n` (220 mm across, RAS+: i toward the patient's right,
+/// j anterior, k superior): scalp, a dark skull, cerebrospinal fluid, a folded grey-matter cortex
+/// over white matter, two ventricles and the fissure between the hemispheres, the eyes, and the
+/// neck; a little deterministic noise. Not a real scan (../shared/data has none): a stand-in to
+/// tune and check the `mri` preset on, whose tissue values are in T1's order (white matter
+/// brightest, then grey matter, scalp, fluid and bone darkest). Scalp fat, as bright as white
+/// matter in a real T1 scan, is left out: a one-dimensional transfer function cannot tell them
+/// apart.
+pub fn head_phantom(n: u32, path: &Path, progress: impl FnMut(u32)) -> Result<[u32; 3]> {
+    let dims = [n; 3];
+    let spacing = 220.0 / n as f32;
+    write_slices(
+        path,
+        dims,
+        [spacing; 3],
+        Frame::Ras,
+        |z, buf| {
+            for y in 0..n {
+                for x in 0..n {
+                    let p = [x, y, z].map(|v| (v as f32 + 0.5) / n as f32 * 2.0 - 1.0);
+                    let v = (t1_head(p) + 0.015 * noise(x, y, z)).clamp(0.0, 1.0);
+                    buf[(y * n + x) as usize] = (v * 255.0).round() as u8;
+                }
+            }
+        },
+        progress,
+    )?;
+    Ok(dims)
+}
+
+/// The ellipsoidal radius of `p` about `c` with radii `r` (1 on the surface).
+fn ellipsoid(p: [f32; 3], c: [f32; 3], r: [f32; 3]) -> f32 {
+    (0..3).map(|a| ((p[a] - c[a]) / r[a]).powi(2)).sum::<f32>().sqrt()
+}
+
+/// The phantom's T1 intensity at `p` (each axis -1..1: right, anterior, superior).
+fn t1_head(p: [f32; 3]) -> f32 {
+    let [x, y, z] = p;
+    let head = ellipsoid(p, [0.0, 0.0, 0.05], [0.68, 0.84, 0.82]);
+    let eye = ellipsoid([x.abs(), y, z], [0.3, 0.72, -0.12], [0.11, 0.1, 0.1]);
+    let neck = ((x / 0.4).powi(2) + ((y + 0.08) / 0.45).powi(2)).sqrt();
+    if eye < 1.0 {
+        return T1_CSF; // the vitreous: fluid
+    }
+    if head > 1.0 {
+        return if z < -0.55 && neck < 1.0 { T1_SKIN } else { 0.0 };
+    }
+    if head > 0.95 {
+        return T1_SKIN;
+    }
+    if head > 0.89 {
+        return T1_BONE;
+    }
+    // Below the brain: the skull base and the soft tissue of the face and neck.
+    if z < -0.38 + 0.25 * y.max(0.0) {
+        return if head > 0.8 { T1_BONE } else { T1_SKIN };
+    }
+    if head > 0.85 {
+        return T1_CSF;
+    }
+    let ventricle = ellipsoid([x.abs(), y, z], [0.1, 0.0, 0.12], [0.06, 0.3, 0.1]);
+    let fissure = x.abs() < 0.012 && z > -0.1;
+    if ventricle < 1.0 || fissure {
+        return T1_CSF;
+    }
+    // A cortex 4-8 % of the head's radius thick, folded into gyri.
+    let fold = (23.0 * x).sin() * (19.0 * y).sin() * (21.0 * z).sin();
+    if head > 0.76 + 0.04 * fold {
+        return T1_GREY;
+    }
+    T1_WHITE
+}
+
+/// Deterministic noise in -1..1 (a hash of the voxel).
+fn noise(x: u32, y: u32, z: u32) -> f32 {
+    let mut h = (x as u64) << 42 ^ (y as u64) << 21 ^ z as u64;
+    h = (h ^ (h >> 33)).wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h = (h ^ (h >> 33)).wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    ((h >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
 }
