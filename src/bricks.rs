@@ -229,6 +229,14 @@ impl BrickStore {
         Grid::centered_sheared(self.dims, self.spacing, self.shear)
     }
 
+    /// Lay the store on the grid its file's `placement` draws (a sheared grid's cell matrix,
+    /// `Orientation::grid`; the rotation moves the camera, `Orientation::camera_to_grid`).
+    pub fn place(&mut self, placement: &crate::orient::Orientation) -> Result<()> {
+        let g = crate::orient::placed_grid(self.dims, self.spacing, Some(placement))?;
+        (self.spacing, self.shear) = (g.spacing, g.shear);
+        Ok(())
+    }
+
     /// Stored voxels.
     pub fn len(&self) -> usize {
         self.records.len()

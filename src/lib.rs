@@ -212,7 +212,9 @@ impl Renderer {
     /// classification and the two-level PBTF order run on the device, so a volume of any size that
     /// fits host memory draws, streaming through the device budget when it must: per splat (PBTF),
     /// and in the sheet and slab modes. The other orders and the ray caster need
-    /// [`Renderer::set_scene`] with a classified set. The host keeps no copy of `volume`.
+    /// [`Renderer::set_scene`] with a classified set. The host keeps no copy of `volume`. The grid
+    /// is axis-aligned: a sheared file's store goes in through [`Renderer::set_bricks`] after
+    /// `bricks::BrickStore::place`.
     pub fn set_volume(
         &mut self,
         volume: &volume::ScalarVolume,

@@ -411,7 +411,7 @@ fn a_sheared_grid_renders_as_the_world_space_truth() {
         let e_rc = covered_error(&rc, &truth);
         // A bricked store on the same grid draws the dense classification's frame.
         let mut store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
-        (store.spacing, store.shear) = (set.grid().spacing, set.grid().shear);
+        store.place(&o).unwrap();
         let mut b = common::gpu();
         b.set_bricks(voxsplat::bricks::BrickScene::new(store, tf.clone(), None).unwrap()).unwrap();
         let (most, mean) = common::diff(&b.render(&cam, &RenderOptions::default()).unwrap().image, &frame);

@@ -356,8 +356,9 @@ pub fn load_bricked(
     orientation: Option<Orientation>,
 ) -> Result<voxsplat::bricks::BrickScene> {
     let mut store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
-    let grid = voxsplat::orient::placed_grid(store.dims, store.spacing, orientation.as_ref())?;
-    (store.spacing, store.shear) = (grid.spacing, grid.shear);
+    if let Some(o) = &orientation {
+        store.place(o)?;
+    }
     let tf = transfer_function(a)?;
     let shading = headlight(a, store.dims, store.spacing, orientation);
     eprintln!(

@@ -106,7 +106,9 @@ impl<C: Communicator> Distributed<C> {
         let grid = crate::orient::placed_grid(reader.dims, spacing, placement.as_ref())?;
         let b: BrickBox = partition.boxes[rank as usize];
         let built = load_part(&mut reader, spacing, whole.range(), &b).and_then(|mut store| {
-            (store.spacing, store.shear) = (grid.spacing, grid.shear);
+            if let Some(o) = &placement {
+                store.place(o)?;
+            }
             let mut scene = BrickScene::new(store, tf.clone(), shading)?;
             scene.set_part(b.lo, b.hi)?;
             scene.set_tree(partition.tree.clone())?;
