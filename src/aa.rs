@@ -12,7 +12,8 @@ use glam::Mat4;
 /// smallest spacing.
 pub fn k_regions(set: &SplatSet, camera: &Camera) -> Vec<u8> {
     let g = set.grid();
-    if g.dims[2] != 1 {
+    // One axis-aligned sheet is a plane of known z and box; others are marched.
+    if g.dims[2] != 1 || g.is_sheared() {
         return k_regions_marched(set, camera);
     }
     let (w, h) = (camera.width, camera.height);
