@@ -10,6 +10,32 @@ use voxsplat::{
 };
 use voxsplat_cli::open::*;
 
+/// `print!` and `println!` that end the process quietly when stdout is a closed pipe
+/// (`voxsplat info F | head`): the standard ones panic there.
+macro_rules! print {
+    ($($arg:tt)*) => {
+        stdout_or_exit(write!(std::io::stdout(), $($arg)*))
+    };
+}
+macro_rules! println {
+    ($($arg:tt)*) => {
+        stdout_or_exit(writeln!(std::io::stdout(), $($arg)*))
+    };
+}
+
+/// A write to stdout's outcome: a closed pipe ends the process with success (the reader has what
+/// it wanted), another error with a message and failure.
+fn stdout_or_exit(written: std::io::Result<()>) {
+    match written {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        Err(e) => {
+            eprintln!("error: writing to stdout: {e}");
+            std::process::exit(1)
+        }
+    }
+}
+
 #[derive(Parser)]
 #[command(name = "voxsplat", version, about = "Splatting renderer for discrete objects (Swan 1997) on Vulkan")]
 struct Cli {

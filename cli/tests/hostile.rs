@@ -115,3 +115,22 @@ fn an_animation_fails_before_writing_a_frame() {
     std::os::unix::fs::symlink("/dev/full", full.join("anim.gif")).unwrap();
     fails_with(&["animate", "--anim", short.to_str().unwrap(), "--out-dir", full.to_str().unwrap()], "No space left");
 }
+
+/// `voxsplat info FILE | head -1`: the reader closes the pipe early; the writer ends quietly with
+/// success instead of panicking ("failed printing to stdout: Broken pipe").
+#[test]
+fn a_closed_stdout_pipe_ends_quietly() {
+    use std::process::{Command, Stdio};
+    for args in [&["info", &data("bonsai/bonsai.nii.gz")][..], &["scenes"][..]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_voxsplat"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // closed before the first line is written
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success() && !err.contains("panicked"), "{args:?}: {:?} {err}", out.status);
+    }
+}
