@@ -125,9 +125,19 @@ pub struct Batch {
     pub push: FootprintPush,
 }
 
-/// The grid axis most perpendicular to the view plane: the axis-aligned sheets' normal.
-pub fn sheet_axis(camera: &Camera) -> usize {
-    let f = camera.forward().abs();
+/// The grid axis whose index planes face the view most: the axis-aligned sheets' normal. On a
+/// sheared grid the planes' own normals (the rows of the inverse cell matrix) decide, not the
+/// frame's axes: a plane of constant j leans with the shear.
+pub fn sheet_axis(grid: &crate::volume::Grid, camera: &Camera) -> usize {
+    let f = if grid.is_sheared() {
+        // |f . n_a| / |n_a| with n_a row a of U^-1: f . n_a is f in index units, along a.
+        let (along, rows) = (grid.index_dir(camera.forward().as_dvec3()), grid.cell_matrix().inverse().transpose());
+        glam::DVec3::new(along.x / rows.x_axis.length(), along.y / rows.y_axis.length(), along.z / rows.z_axis.length())
+            .abs()
+            .as_vec3()
+    } else {
+        camera.forward().abs()
+    };
     if f.x >= f.y && f.x >= f.z {
         0
     } else if f.y >= f.z {
@@ -141,7 +151,7 @@ pub fn sheet_axis(camera: &Camera) -> usize {
 /// order. Empty sheets are skipped; a batch never straddles the eye's plane, so its splats are one
 /// contiguous run of the slice-grouped draw list.
 pub fn sheet_plan(prep: &Prepared, camera: &Camera, direction: Direction, max_layers: u32) -> (usize, Vec<Batch>) {
-    let axis = sheet_axis(camera);
+    let axis = sheet_axis(prep.set.grid(), camera);
     let split = order::pbtf_split(&prep.set, camera)[axis];
     let base = prep.rank_offsets[axis];
     let push =

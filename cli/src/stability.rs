@@ -153,7 +153,7 @@ pub fn axis_switch_cameras(grid: &Grid, size: u32, frames: usize) -> (Vec<Camera
             }
         })
         .collect();
-    let switch = cams.windows(2).position(|w| sheet_axis(&w[0]) != sheet_axis(&w[1]));
+    let switch = cams.windows(2).position(|w| sheet_axis(grid, &w[0]) != sheet_axis(grid, &w[1]));
     (cams, switch)
 }
 

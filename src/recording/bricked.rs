@@ -297,7 +297,7 @@ fn record_bricked_sheets(
     let compute = opts.raster == Raster::Compute;
     let direction = opts.direction();
     let sheet = opts.composite == Composite::Sheet;
-    let axis = plan::sheet_axis(camera);
+    let axis = plan::sheet_axis(grid, camera);
     let layers = sheet_layers(e, opts, w, h);
     // The layers (and the compute raster's fixed-point copy) come out of the budget too.
     let layer_bytes = w as u64 * h as u64 * 16 * layers as u64 * (1 + compute as u64);
