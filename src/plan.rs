@@ -130,8 +130,9 @@ pub struct Batch {
 /// frame's axes: a plane of constant j leans with the shear.
 pub fn sheet_axis(grid: &crate::volume::Grid, camera: &Camera) -> usize {
     let f = if grid.is_sheared() {
-        // |f . n_a| / |n_a| with n_a row a of U^-1: f . n_a is f in index units, along a.
-        let (along, rows) = (grid.index_dir(camera.forward().as_dvec3()), grid.cell_matrix().inverse().transpose());
+        // |f . n_a| / |n_a| with n_a row a of U^-1 (so f . n_a is (U^-1 f)_a).
+        let inv = grid.cell_matrix().inverse();
+        let (along, rows) = (inv * camera.forward().as_dvec3(), inv.transpose());
         glam::DVec3::new(along.x / rows.x_axis.length(), along.y / rows.y_axis.length(), along.z / rows.z_axis.length())
             .abs()
             .as_vec3()

@@ -192,10 +192,9 @@ pub fn volumetric_summation(set: &SplatSet, camera: &Camera, opts: &TruthOptions
     let last = DVec3::from(g.dims.map(|d| d as f64 - 1.0));
     // The kernel's reach in index units per axis (a world ball's extent through the inverse cell
     // matrix: its rows' lengths), and the world box sampled.
-    let inv_rows = cell.inverse().transpose();
     let (r, [lo, hi]) = match opts.reconstruction {
         Reconstruction::Kernel(_) => {
-            let reach = radius * ks;
+            let (reach, inv_rows) = (radius * ks, cell.inverse().transpose());
             let [lo, hi] = g.world_box(Vec3::ZERO, last.as_vec3());
             let r = DVec3::new(inv_rows.x_axis.length(), inv_rows.y_axis.length(), inv_rows.z_axis.length()) * reach;
             (r, [lo.as_dvec3() - reach, hi.as_dvec3() + reach])

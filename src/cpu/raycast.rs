@@ -116,9 +116,9 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
     let s = Vec3::from(g.spacing);
     let hi = Vec3::from(g.dims.map(|d| d as f32));
     let step = opts.step * s.min_element();
-    // The inverse of the cell matrix [[sx, a, b], [0, sy, c], [0, 0, sz]].
-    let [a, b, c] = g.shear;
-    let inv_shear = [-a / (s.x * s.y), (a * c - b * s.y) / (s.x * s.y * s.z), -c / (s.y * s.z)];
+    // The inverse cell matrix, upper triangular as the cell matrix is.
+    let inv = g.cell_matrix().inverse();
+    let inv_shear = [inv.y_axis.x, inv.z_axis.x, inv.z_axis.y].map(|v| v as f32);
     let (clip, clip_count) = opts.clip.uniforms();
     RaycastParams {
         inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
