@@ -61,10 +61,6 @@ impl Grid {
 
     /// The world box holding every grid point of the index box `lo..=hi`.
     pub fn world_box(&self, lo: Vec3, hi: Vec3) -> [Vec3; 2] {
-        let (a, b) = (self.offset(lo), self.offset(hi));
-        if self.shear == [0.0; 3] {
-            return [Vec3::from(self.origin) + a.min(b), Vec3::from(self.origin) + a.max(b)];
-        }
         let corners =
             (0..8).map(|c| self.offset(Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo)));
         let (l, h) = corners.fold((Vec3::MAX, Vec3::MIN), |(l, h), p| (l.min(p), h.max(p)));
