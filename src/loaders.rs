@@ -456,10 +456,7 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
             nrrd_header(&head, &what, MAX_VOXELS)?.orientation
         }
     };
-    match (o, hints.spacing) {
-        (Some(o), Some(s)) => o.with_spacing(s).map(Some),
-        (o, _) => Ok(o),
-    }
+    crate::orient::respaced(o, hints.spacing)
 }
 
 /// Load a volume by its extension: `.nrrd`/`.nhdr`, `.nii`/`.nii.gz`, `.npy`, anything else raw.

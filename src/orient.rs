@@ -183,6 +183,15 @@ impl Orientation {
     }
 }
 
+/// `placement` with a voxel spacing given instead of the file's (`--spacing`,
+/// `Orientation::with_spacing`), where there are both.
+pub fn respaced(placement: Option<Orientation>, spacing: Option<[f32; 3]>) -> Result<Option<Orientation>> {
+    match (placement, spacing) {
+        (Some(o), Some(s)) => o.with_spacing(s).map(Some),
+        (o, _) => Ok(o),
+    }
+}
+
 /// The grid a `dims` volume of voxel `spacing` is drawn on: its placement's (sheared where the
 /// file's affine is, `Orientation::grid`), else axis-aligned; centred on the origin either way.
 pub fn placed_grid(dims: [u32; 3], spacing: [f32; 3], placement: Option<&Orientation>) -> Result<crate::volume::Grid> {

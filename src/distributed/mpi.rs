@@ -98,11 +98,8 @@ impl<C: Communicator> Distributed<C> {
             }
             None => reader.spacing,
         };
-        // Placed as the file says (a sheared grid's shear; `load_orientation` applies hints the same way).
-        let placement = match (reader.orientation, hints.spacing) {
-            (Some(o), Some(s)) => Some(o.with_spacing(s)?),
-            (o, _) => o,
-        };
+        // Placed as the file says (a sheared grid's shear), as `load_orientation` places it.
+        let placement = crate::orient::respaced(reader.orientation, hints.spacing)?;
         let grid = crate::orient::placed_grid(reader.dims, spacing, placement.as_ref())?;
         let b: BrickBox = partition.boxes[rank as usize];
         let built = load_part(&mut reader, spacing, whole.range(), &b).and_then(|mut store| {
