@@ -479,6 +479,33 @@ impl Renderer {
         if !(options.step.is_finite() && options.step > 0.0) {
             return Err(Error::InvalidArgument("ray caster step must be positive".into()));
         }
+        if !(0.0..1.0).contains(&options.min_transmittance) {
+            return Err(Error::InvalidArgument("the ray caster's stopping transmittance must be in [0, 1)".into()));
+        }
+        let k = options.supersample;
+        if k == 0 || k > cpu::raycast::MAX_SUPERSAMPLE {
+            return Err(Error::InvalidArgument(format!(
+                "rays per pixel along each axis must be in 1..={}, not {k}",
+                cpu::raycast::MAX_SUPERSAMPLE
+            )));
+        }
+        if k > 1 && options.render_scale != 1.0 {
+            return Err(Error::InvalidArgument(
+                "a supersampled ray cast is the full-size reference: drop the render scale".into(),
+            ));
+        }
+        if k > 1 {
+            // k x k rays per pixel: the view cast on a grid k times finer, each pixel the mean of
+            // its k x k rays (the finer grid's pixel centres sit on a regular grid inside it).
+            let fine = Camera { width: camera.width * k, height: camera.height * k, ..*camera };
+            fine.validate()?;
+            let one = cpu::raycast::RaycastOptions { supersample: 1, ..*options };
+            let mut out = self.raycast(&fine, &one)?;
+            let t = std::time::Instant::now();
+            out.image = truth::downsample(&out.image, k as usize, truth::Downsample::Box);
+            out.timings.push(StageTime { stage: "downsample", ms: t.elapsed().as_secs_f64() * 1e3 });
+            return Ok(out);
+        }
         if options.render_scale != 1.0 {
             let full = cpu::raycast::RaycastOptions { render_scale: 1.0, ..*options };
             return resample::render_scaled(camera, options.render_scale, |low| self.raycast(low, &full));

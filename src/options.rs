@@ -234,12 +234,13 @@ pub struct RenderOptions {
     /// Image-aligned slab thickness in voxel spacings (`Composite::Slab`): thinner is closer to the
     /// volume integral and costs more primitives (about 2R/Δ + 1 per splat).
     pub slab_thickness: f32,
-    /// Front-to-back early termination for the sheet modes (Mueller et al. 1999): after each batch,
-    /// footprints lying wholly over composite tiles whose remaining transmittance is at most this
-    /// are skipped. No pixel changes by more than this much. 0 (the default) turns it off; back to
-    /// front ignores it. It pays on opaque data (1.2-1.8x on `solid40`) and costs on translucent data,
-    /// where nothing is culled but batches are smaller (docs/RESULTS.md). The compute tile
-    /// compositor (`Raster::Compute` with `Composite::Splat`) stops each pixel at this transmittance.
+    /// Front-to-back early termination (Mueller et al. 1999): the compute tile compositor
+    /// (`Raster::Compute` with `Composite::Splat`) stops each pixel at this transmittance, a
+    /// bricked volume drops the bricks that earlier batches already hide, and the sheet modes
+    /// skip, after each batch, footprints lying wholly over composite tiles this transparent. No
+    /// pixel changes by more than this much. Default `DEFAULT_EARLY_TERMINATION` (a quarter of an
+    /// 8-bit step: a value changes by at most one step, in under 0.1 % of the bonsai's; docs/RESULTS.md);
+    /// 0 turns it off; back to front ignores it.
     pub early_termination: f32,
     /// Bricked volumes, front to back with early termination on the tile compositor: cut the
     /// frame into several batches and drop, before each later batch, the bricks the image so far
@@ -253,10 +254,11 @@ pub struct RenderOptions {
     /// where voxels cover several pixels and the kernel already blurs finer than the grid; the
     /// error it adds is measured against the full-size truth. 1 (the default) draws full size.
     pub render_scale: f32,
-    /// Levels of detail of a bricked volume drawn per splat (issue 24): `Auto` draws each brick
-    /// at the coarsest level of its prefiltered pyramid whose cells project to at most
-    /// `lod_pixels` pixels and whose error is at most `lod_error` (docs/MODEL.md). Off by default
-    /// until its targets hold (docs/RESULTS.md). Sheet and slab modes draw full detail.
+    /// Levels of detail of a bricked volume drawn per splat: `Auto` (the default) draws each
+    /// brick at the coarsest level of its prefiltered pyramid whose cells project to at most
+    /// `lod_pixels` pixels and whose error is at most `lod_error` (docs/MODEL.md): full detail
+    /// wherever voxels project to a pixel or more, fewer splats where they are smaller. Sheet and
+    /// slab modes and classified splat sets draw full detail.
     pub lod: Lod,
     /// Largest projected cell spacing, in pixels, of a coarse level (at the brick's nearest point).
     pub lod_pixels: f32,
@@ -277,9 +279,11 @@ pub struct RenderOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Lod {
     /// Every voxel is a splat.
-    #[default]
     Off,
-    /// Each brick at the coarsest level its projection and error allow.
+    /// Each brick of a bricked store drawn per splat at the coarsest level its projection and
+    /// error allow (the default). A classified splat set, and the sheet and slab modes, have no
+    /// levels: they draw every splat (the CLI refuses `--lod auto` there).
+    #[default]
     Auto,
 }
 
@@ -295,11 +299,11 @@ impl Default for RenderOptions {
             direction: None,
             sheet_budget_bytes: 256 << 20,
             slab_thickness: 1.0,
-            early_termination: 0.0,
+            early_termination: DEFAULT_EARLY_TERMINATION,
             cull_hidden_bricks: true,
             raster: Raster::Auto,
             render_scale: 1.0,
-            lod: Lod::Off,
+            lod: Lod::Auto,
             lod_pixels: 1.0,
             lod_error: DEFAULT_LOD_ERROR,
             lod_band: 0.75,
@@ -314,7 +318,7 @@ impl Default for RenderOptions {
 /// 0.16x), one run each.
 pub const DEFAULT_LOD_ERROR: f32 = 0.1;
 
-/// Suggested transmittance threshold of front-to-back early termination: a quarter of an 8-bit step.
+/// Default transmittance threshold of front-to-back early termination: a quarter of an 8-bit step.
 pub const DEFAULT_EARLY_TERMINATION: f32 = 1.0 / 1024.0;
 
 /// Most summation layers in one batch when front-to-back early termination is on.

@@ -152,7 +152,9 @@ fn early_termination_in_the_tile_compositor_changes_no_pixel_beyond_the_threshol
     gpu.set_scene(set.clone()).unwrap();
     cpu.set_scene(set).unwrap();
     for cam in [framed, close] {
-        let full = gpu.render(&cam, &opts(Composite::Splat, Raster::Compute)).unwrap().image;
+        let mut o = opts(Composite::Splat, Raster::Compute);
+        o.early_termination = 0.0;
+        let full = gpu.render(&cam, &o).unwrap().image;
         check_early_termination(&mut gpu, &mut cpu, &cam, &full);
     }
     assert_clean(&gpu);

@@ -288,7 +288,7 @@ fn render_method_at(r: &mut Renderer, m: &Method, camera: &Camera, render_scale:
         }
         Method::Bricked { lod } => {
             let mut o = RenderOptions::default();
-            (o.raster, o.render_scale) = (Raster::Compute, render_scale);
+            (o.raster, o.render_scale, o.lod) = (Raster::Compute, render_scale, voxsplat::Lod::Off);
             if let Some((pixels, error)) = *lod {
                 (o.lod, o.lod_pixels, o.lod_error) = (voxsplat::Lod::Auto, pixels, error);
             }

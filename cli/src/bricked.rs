@@ -51,6 +51,8 @@ fn renderer() -> Result<Renderer> {
 fn opts(early_termination: f32) -> RenderOptions {
     let mut o = RenderOptions::default();
     (o.raster, o.direction, o.early_termination) = (Raster::Compute, Some(Direction::FrontToBack), early_termination);
+    // Full detail unless a variant asks for levels of detail.
+    o.lod = voxsplat::Lod::Off;
     o
 }
 
@@ -396,7 +398,7 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     bricked.set_bricks(BrickScene::new(BrickStore::build(&vol)?, tf, None)?)?;
     drop(vol);
     let mut o = RenderOptions::default();
-    o.raster = Raster::Compute;
+    (o.raster, o.lod) = (Raster::Compute, voxsplat::Lod::Off);
     let mut variants: Vec<(String, bool, RenderOptions)> =
         vec![("dense classified splats".into(), true, o.clone()), ("bricked, full detail".into(), false, o.clone())];
     let unbounded = crate::bench::LOD_UNBOUNDED;

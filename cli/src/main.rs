@@ -269,9 +269,10 @@ struct RenderArgs {
     /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
     composite: String,
-    /// Front-to-back sheet modes: skip footprints over tiles whose remaining transmittance is at
-    /// most this (0 = off; 0.001 suits opaque data). No pixel changes by more than this.
-    #[arg(long, value_parser = parse_finite, default_value = "0")]
+    /// Front to back, stop drawing where what is drawn already lets at most this much light
+    /// through (0 = off; the default, a quarter of an 8-bit step, changes a value by at most one
+    /// step). No pixel changes by more than this.
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_EARLY_TERMINATION)]
     early_termination: f32,
     /// Bricked volumes: keep the bricks that earlier batches hide (front to back, early
     /// termination), to measure what dropping them saves.
@@ -290,10 +291,11 @@ struct RenderArgs {
     /// faster where voxels cover several pixels; the added error is in docs/RESULTS.md (peers).
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     render_scale: f32,
-    /// Levels of detail of a bricked --volume drawn per splat: off, or auto (each brick at the
-    /// coarsest prefiltered level within --lod-pixels and --lod-error; docs/MODEL.md).
-    #[arg(long, default_value = "off")]
-    lod: String,
+    /// Levels of detail of a volume drawn per splat: auto (the default: where voxels project
+    /// smaller than --lod-pixels, groups of them drawn as one prefiltered splat, within
+    /// --lod-error; docs/MODEL.md) or off (every voxel a splat).
+    #[arg(long, value_parser = ["off", "auto"])]
+    lod: Option<String>,
     /// Largest projected cell spacing of a coarse level, in pixels.
     #[arg(long, value_parser = parse_finite, default_value = "1")]
     lod_pixels: f32,
@@ -325,6 +327,14 @@ struct RenderArgs {
     /// Render with the ray caster at this step (in voxel spacings) instead of splatting.
     #[arg(long, value_parser = parse_finite, conflicts_with = "truth")]
     raycast: Option<f32>,
+    /// With --raycast: cast K x K rays per pixel and average them (the converged reference that
+    /// levels of detail and anti-aliasing are scored against; 4 with --raycast 0.25 is the one
+    /// docs/MODEL.md checks).
+    #[arg(long, default_value_t = 1, requires = "raycast")]
+    supersample: u32,
+    /// With --raycast: transmittance below which a ray stops.
+    #[arg(long, value_parser = parse_finite, requires = "raycast")]
+    raycast_stop: Option<f32>,
     /// Render the volumetric-summation truth (CPU, f64) with --kernel's reconstruction.
     #[arg(long)]
     truth: bool,
@@ -444,7 +454,7 @@ fn run(cli: Cli) -> Result<()> {
             opts.cull_hidden_bricks = !a.keep_hidden_bricks;
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
             opts.render_scale = a.render_scale;
-            opts.lod = a.lod.parse()?;
+            opts.lod = a.lod.as_deref().unwrap_or("auto").parse()?;
             let planes: Vec<voxsplat::glam::Vec4> = a.clip.iter().map(|p| voxsplat::glam::Vec4::from(*p)).collect();
             let crop = a.crop.map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])]);
             opts.clip = voxsplat::Clip::new(&planes, crop)?;
@@ -457,6 +467,13 @@ fn run(cli: Cli) -> Result<()> {
                 return render_distributed(&a, &opts, host_splats);
             }
             let (bricked, set, content) = open(&a.scene, host_splats)?;
+            if a.lod.as_deref() == Some("auto") && (bricked.is_none() || composite != Composite::Splat) {
+                return Err(Error::InvalidArgument(
+                    "--lod auto: levels of detail are drawn per splat (--composite splat) from a volume's bricked store; \
+                     this scene is a classified splat set (a built-in scene, --dense, another order, --truth, --raycast)"
+                        .into(),
+                ));
+            }
             let cam = camera_of(&a.scene, set.grid(), &content)?;
             if let voxsplat::Projection::Perspective { fov_y_deg } = cam.projection {
                 // Other renderers (scripts/vtk_file.py) take the same view from this line.
@@ -491,12 +508,16 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 let f = match a.raycast {
                     Some(step) => {
-                        let o = voxsplat::cpu::raycast::RaycastOptions {
+                        let mut o = voxsplat::cpu::raycast::RaycastOptions {
                             step,
                             render_scale: a.render_scale,
                             clip: opts.clip,
+                            supersample: a.supersample,
                             ..Default::default()
                         };
+                        if let Some(stop) = a.raycast_stop {
+                            o.min_transmittance = stop;
+                        }
                         r.raycast(&cam, &o)?
                     }
                     None => {
@@ -592,8 +613,11 @@ fn run(cli: Cli) -> Result<()> {
                 }
                 (Some(file), None) => {
                     let vol = voxsplat::loaders::load_volume(&file, &Default::default())?;
+                    let placement = voxsplat::loaders::load_orientation(&file, &Default::default())?;
                     bar.set_length(vol.dims[2] as u64 * factor as u64);
-                    voxsplat_cli::volumes::upsample(&vol, factor, &out, |z| bar.set_position(z as u64))?
+                    voxsplat_cli::volumes::upsample(&vol, factor, placement.as_ref(), &out, |z| {
+                        bar.set_position(z as u64)
+                    })?
                 }
                 (None, Some(n)) => {
                     bar.set_length(n as u64);

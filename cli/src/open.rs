@@ -172,14 +172,12 @@ pub struct SceneArgs {
     /// mirrors the rest) or cpu-until:STAGE. Stages: see src/stages.rs.
     #[arg(long, conflicts_with = "cpu")]
     pub bisect: Option<voxsplat::Bisect>,
-    /// Classify --volume on the host into a splat set (as before the bricked store): needed by the
-    /// other orders, --truth, --raycast and --k-line, which pick it themselves. Without it a volume is a bricked store classified on the device.
+    /// Classify a --volume, or the peers' scene (--scene peer128, peer256), on the host into a
+    /// splat set: needed by the other orders, --truth, --raycast and --k-line, which pick it
+    /// themselves. Without it a volume is a bricked store classified on the device (levels of
+    /// detail need it).
     #[arg(long)]
     pub dense: bool,
-    /// Draw the peers' scene (--scene peer128 or peer256) as a bricked store classified on the
-    /// device, as a --volume is, with the peers' transfer function (levels of detail need it).
-    #[arg(long, conflicts_with_all = ["volume", "terrain", "dense"])]
-    pub bricked: bool,
     /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
     /// batches.
     #[arg(long, default_value = "1024")]
@@ -459,9 +457,10 @@ pub fn open(
     host_splats: bool,
 ) -> Result<(Option<voxsplat::bricks::BrickScene>, voxsplat::SplatSet, Content)> {
     let peer = voxsplat::peer::side_of(&a.scene).filter(|_| a.volume.is_none() && a.terrain.is_none());
-    if a.bricked && (peer.is_none() || host_splats) {
+    if a.dense && a.volume.is_none() && peer.is_none() {
         return Err(Error::InvalidArgument(
-            "--bricked draws --scene peer128 or peer256 per splat in PBTF order, without --truth, --raycast or --k-line"
+            "--dense classifies a --volume or the peers' scene (--scene peer128, peer256) on the host; this scene is \
+             already a classified splat set"
                 .into(),
         ));
     }
@@ -470,7 +469,7 @@ pub fn open(
             let orientation = orientation_of(a)?;
             (load_bricked(a, path, orientation)?, orientation)
         }
-        (None, Some(n)) if a.bricked => {
+        (None, Some(n)) if !host_splats && !a.dense => {
             let store = voxsplat::bricks::BrickStore::build(&voxsplat::peer::volume(n)?)?;
             eprintln!("{} stored voxels in {} bricks", store.len(), store.headers.len());
             (voxsplat::bricks::BrickScene::new(store, voxsplat::peer::transfer_function(), None)?, None)

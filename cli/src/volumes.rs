@@ -16,6 +16,8 @@ pub const MAX_SIDE: u32 = 4096;
 enum Frame {
     Spacing,
     Ras,
+    /// Index -> world (RAS+) affine: columns i, j, k and the origin.
+    Affine(glam::DMat4),
 }
 
 fn create(path: &Path, dims: [u32; 3], spacing: [f32; 3], frame: Frame) -> Result<std::io::BufWriter<std::fs::File>> {
@@ -30,6 +32,16 @@ fn create(path: &Path, dims: [u32; 3], spacing: [f32; 3], frame: Frame) -> Resul
                 "space: right-anterior-superior\nspace directions: ({sx},0,0) (0,{sy},0) (0,0,{sz})\n\
                  space origin: ({},{},{})",
                 o[0], o[1], o[2]
+            )
+        }
+        Frame::Affine(a) => {
+            let v = |c: glam::DVec4| format!("({},{},{})", c.x, c.y, c.z);
+            format!(
+                "space: right-anterior-superior\nspace directions: {} {} {}\nspace origin: {}",
+                v(a.x_axis),
+                v(a.y_axis),
+                v(a.z_axis),
+                v(a.w_axis)
             )
         }
     };
@@ -70,8 +82,15 @@ fn write_slices(
 }
 
 /// `vol` upsampled `factor` times along each axis by trilinear interpolation (sample centres
-/// aligned), its values mapped from [min, max] to 0..=255.
-pub fn upsample(vol: &ScalarVolume, factor: u32, path: &Path, progress: impl FnMut(u32)) -> Result<[u32; 3]> {
+/// aligned), its values mapped from [min, max] to 0..=255. `placement`: the source file's, which
+/// the output keeps (the same object in the same place, so the same view frames both).
+pub fn upsample(
+    vol: &ScalarVolume,
+    factor: u32,
+    placement: Option<&voxsplat::orient::Orientation>,
+    path: &Path,
+    progress: impl FnMut(u32),
+) -> Result<[u32; 3]> {
     if !(1..=8).contains(&factor) {
         return Err(Error::InvalidArgument(format!("upsampling factor {factor} must be in 1..=8")));
     }
@@ -98,11 +117,27 @@ pub fn upsample(vol: &ScalarVolume, factor: u32, path: &Path, progress: impl FnM
         (i0, (i0 + 1).min(n as usize - 1), t - i0 as f32)
     };
     let spacing = vol.spacing.map(|s| s / factor as f32);
+    let frame = match placement {
+        None => Frame::Spacing,
+        Some(o) => {
+            // The affine of the stored grid (a left-handed file is stored with x reversed), then
+            // of the output's: its sample o sits at source index (o + 0.5) / factor - 0.5.
+            let mut a = o.affine();
+            if o.flip_x() {
+                a.w_axis += a.x_axis * (nx as f64 - 1.0);
+                a.x_axis = -a.x_axis;
+            }
+            let f = factor as f64;
+            let first = 0.5 / f - 0.5;
+            let origin = a.w_axis + (a.x_axis + a.y_axis + a.z_axis) * first;
+            Frame::Affine(glam::DMat4::from_cols(a.x_axis / f, a.y_axis / f, a.z_axis / f, origin))
+        }
+    };
     write_slices(
         path,
         dims,
         spacing,
-        Frame::Spacing,
+        frame,
         |z, buf| {
             let (k0, k1, wk) = src(z, nz);
             for y in 0..dims[1] {

@@ -397,6 +397,56 @@ fn make_volume_writes_readable_large_test_volumes() {
     }
 }
 
+/// `make-volume --from` keeps the source's placement: the upsampled volume shows its object in the
+/// same place of the world, so one view frames both (a left-handed, sheared file here). Before, the
+/// output had spacing alone and the 512³ bonsai was framed from another view than the 256³ one.
+#[test]
+fn an_upsampled_volume_keeps_its_placement() {
+    let (nx, ny, nz) = (6usize, 5usize, 4usize);
+    let mut data = vec![0u8; nx * ny * nz];
+    data[1 + nx * (2 + ny * 2)] = 255;
+    let src = tmp("placed.nrrd");
+    let mut bytes = format!(
+        "NRRD0004\ntype: uint8\ndimension: 3\nsizes: {nx} {ny} {nz}\nspace: right-anterior-superior\n\
+         space directions: (-1,0,0) (0,2,0) (0,0.5,3)\nspace origin: (10,20,30)\nencoding: raw\n\n"
+    )
+    .into_bytes();
+    bytes.extend_from_slice(&data);
+    std::fs::write(&src, bytes).unwrap();
+    let up = tmp("placed2x.nrrd");
+    let out = voxsplat(&["make-volume", "--from", src.to_str().unwrap(), "--factor", "2", "--out", up.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let place = |p: &std::path::Path| voxsplat::loaders::load_orientation(p, &Default::default()).unwrap().unwrap();
+    let (a, b) = (place(&src), place(&up));
+    // The bright voxel's world position, and the value-weighted centroid of the upsampled copy
+    // (trilinear spreads it evenly about its centre): both through the files' own affines.
+    let world = |o: &voxsplat::orient::Orientation, i: f64, j: f64, k: f64| {
+        o.affine().transform_point3(glam::DVec3::new(i, j, k))
+    };
+    let want = world(&a, 1.0, 2.0, 2.0);
+    let v = voxsplat::loaders::load_volume(&up, &Default::default()).unwrap();
+    let [ux, uy, uz] = v.dims.map(|d| d as usize);
+    let (mut sum, mut weight) = (glam::DVec3::ZERO, 0.0);
+    for k in 0..uz {
+        for j in 0..uy {
+            for i in 0..ux {
+                let w = v.values[i + ux * (j + uy * k)] as f64;
+                // The loader stores a left-handed file with x reversed.
+                let fi = if b.flip_x() { ux - 1 - i } else { i };
+                sum += world(&b, fi as f64, j as f64, k as f64) * w;
+                weight += w;
+            }
+        }
+    }
+    let got = sum / weight;
+    assert!((got - want).length() < 1e-3, "the upsampled object sits at {got:?}, the source's at {want:?}");
+    // Written in the order the loader stores it (x reversed from the left-handed file), so the
+    // output's affine is right-handed; the angles between its axes are the source's.
+    assert!(a.flip_x() && !b.flip_x());
+    let (aa, ba) = (a.angles(), b.angles());
+    assert!((0..3).all(|i| (aa[i] - ba[i]).abs() < 1e-9), "{aa:?} {ba:?}");
+}
+
 /// A bricked volume through the CLI: a budget below the store and one brick of splats names the
 /// minimum, a zero budget is refused, the other orders fall back to host-classified splats, the
 /// sheet modes draw the bricks, and
@@ -612,27 +662,47 @@ fn a_background_fills_the_frame() {
     }
 }
 
-/// `--bricked` draws the peers' scene as a bricked store classified on the device: the frame the
-/// host-classified splats give (within 8-bit rounding); refused where it cannot apply.
+/// The peers' scene is drawn as a bricked store classified on the device by default, as a
+/// --volume is (`--dense` classifies it on the host): the two frames agree within 8-bit rounding.
+/// Levels of detail and `--dense` are refused where they cannot apply, not silently ignored.
 #[test]
 fn the_peer_scene_bricked_draws_the_dense_frame() {
-    let (dense, bricked) = (tmp("peer-dense.png"), tmp("peer-bricked.png"));
-    for (out, extra) in [(&dense, None), (&bricked, Some("--bricked"))] {
+    let (dense, bricked, lod) = (tmp("peer-dense.png"), tmp("peer-bricked.png"), tmp("peer-lod.png"));
+    for (out, extra) in [(&dense, vec!["--dense"]), (&bricked, vec!["--lod", "off"]), (&lod, vec![])] {
         let mut a =
             vec!["render", "--scene", "peer128", "--size", "64x64", "--validation", "--out", out.to_str().unwrap()];
-        a.extend(extra);
+        a.extend(extra.iter().copied());
         let o = voxsplat(&a);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let stored = String::from_utf8_lossy(&o.stderr).contains("bricks");
+        assert_eq!(stored, extra != ["--dense"], "{}", String::from_utf8_lossy(&o.stderr));
     }
-    let (a, b) = (voxsplat::output::read_rgba8(&dense).unwrap(), voxsplat::output::read_rgba8(&bricked).unwrap());
+    let read = |p: &std::path::PathBuf| voxsplat::output::read_rgba8(p).unwrap();
+    let (a, b) = (read(&dense), read(&bricked));
     let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max();
     assert!(worst.unwrap() <= 1, "bricked vs dense: {worst:?}");
     assert!(a.pixels().filter(|p| p[3] > 0).count() > 500);
-    for bad in [vec!["--scene", "cube40", "--bricked"], vec!["--scene", "peer128", "--bricked", "--raycast", "1"]] {
+    // The default, levels of detail: at 64x64 the peers' voxels project below a pixel, so some
+    // bricks draw coarser cells; the frame stays within the 40 dB the defaults keep.
+    // PNG stores straight colour: compared premultiplied, as the frames are drawn.
+    let c = read(&lod);
+    let pm = |p: &image::Rgba<u8>| {
+        let a = p.0[3] as f64 / 255.0;
+        [p.0[0] as f64 * a, p.0[1] as f64 * a, p.0[2] as f64 * a, p.0[3] as f64]
+    };
+    let d2: f64 = c.pixels().zip(b.pixels()).map(|(x, y)| (0..4).map(|i| (pm(x)[i] - pm(y)[i]).powi(2)).sum::<f64>()).sum();
+    let psnr = 10.0 * (255.0f64.powi(2) / (d2 / c.as_raw().len() as f64)).log10();
+    assert!(c != b && psnr >= 40.0, "levels of detail against full detail: {psnr:.2} dB");
+    for (bad, names) in [
+        (vec!["--scene", "cube40", "--lod", "auto"], "--lod auto"),
+        (vec!["--scene", "peer128", "--dense", "--lod", "auto"], "--lod auto"),
+        (vec!["--scene", "peer128", "--composite", "sheet", "--lod", "auto"], "--lod auto"),
+        (vec!["--scene", "cube40", "--dense"], "--dense"),
+    ] {
         let mut a = vec!["render", "--size", "32x32", "--out", "/tmp/never.png"];
         a.extend(bad.iter().copied());
         let o = voxsplat(&a);
         assert_eq!(o.status.code(), Some(2), "{bad:?}");
-        assert!(String::from_utf8_lossy(&o.stderr).contains("--bricked"), "{bad:?}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains(names), "{bad:?}: {}", String::from_utf8_lossy(&o.stderr));
     }
 }

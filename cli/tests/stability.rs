@@ -208,6 +208,7 @@ fn early_termination_stays_within_its_threshold_and_matches_the_mirror() {
     for composite in [Composite::Sheet, Composite::Slab] {
         let mut o = RenderOptions::default();
         o.composite = composite;
+        o.early_termination = 0.0;
         let full = gpu.render(&cam, &o).unwrap().image;
         for threshold in [1.0 / 1024.0, 0.3] {
             o.early_termination = threshold;

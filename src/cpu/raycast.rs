@@ -29,7 +29,14 @@ pub struct RaycastOptions {
     pub render_scale: f32,
     /// Clipping planes and crop box: each ray is cut to the part inside them.
     pub clip: crate::options::Clip,
+    /// Rays per pixel along each axis (1 to `MAX_SUPERSAMPLE`): `k`×`k` rays on a regular grid
+    /// inside each pixel, averaged (a box filter over the pixel's area). The converged reference
+    /// that levels of detail and anti-aliasing are scored against (docs/MODEL.md, "The reference").
+    pub supersample: u32,
 }
+
+/// Most rays per pixel along each axis of a supersampled cast.
+pub const MAX_SUPERSAMPLE: u32 = 16;
 
 /// Default brick side of the empty-space skipping.
 pub const DEFAULT_BRICK: u32 = 8;
@@ -105,6 +112,7 @@ impl Default for RaycastOptions {
             brick: DEFAULT_BRICK,
             render_scale: 1.0,
             clip: Default::default(),
+            supersample: 1,
         }
     }
 }
