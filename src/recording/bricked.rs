@@ -170,7 +170,7 @@ pub(super) fn record_bricks(
         && opts.early_termination > 0.0;
     let capacity = if cull_hidden {
         let total: u32 = slot_words.iter().map(|&w| slot_entry(w).2).sum();
-        MAX_GPU_SPLATS.min(total.div_ceil(std::env::var("VOXSPLAT_WAVES").ok().and_then(|v| v.parse().ok()).unwrap_or(HIDDEN_BATCHES)).max(std::env::var("VOXSPLAT_WAVEMIN").ok().and_then(|v| v.parse().ok()).unwrap_or(HIDDEN_BATCH_MIN)))
+        MAX_GPU_SPLATS.min(total.div_ceil(HIDDEN_BATCHES).max(HIDDEN_BATCH_MIN))
     } else {
         MAX_GPU_SPLATS
     };
