@@ -66,10 +66,11 @@ struct Args {
     composite: String,
     #[arg(long, default_value = "auto")]
     raster: String,
-    #[arg(long, default_value = "off", value_parser = ["off", "auto"])]
+    /// Levels of detail (as `render --lod`; `l` toggles them).
+    #[arg(long, default_value = "auto", value_parser = ["off", "auto"])]
     lod: String,
     /// The reconstruction kernel (as `render --kernel`).
-    #[arg(long, default_value = "gaussian")]
+    #[arg(long, default_value = "crawfis-max")]
     kernel: String,
     /// Draw on a grid this fraction of the window's size, stretched by the device's blit.
     #[arg(long, default_value = "1")]

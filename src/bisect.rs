@@ -56,6 +56,11 @@ impl<'a> Split<'a> {
                 continue;
             }
             let words = self.first.words(res);
+            if words == 0 {
+                // Bound by a stage but never filled this frame (a levels-of-detail buffer a
+                // resident store does not use): nothing to move.
+                continue;
+            }
             let data = self.first.read(&[(res, words)]).map_err(|e| cannot(self.at, res, e))?;
             if !res.is_image() {
                 self.second.ensure(res, words as u64 * 4)?;

@@ -13,7 +13,6 @@ use std::sync::OnceLock;
 /// The reconstruction kernel, pre-integrated along the ray into a footprint.
 pub enum Kernel {
     /// Westover's Gaussian, sigma = 0.6 voxel, truncated at radius 2.
-    #[default]
     Gaussian,
     /// The Hermite cubic with Crawfis and Max's support, radius 1.6 voxel: h(r) = 1 - 3x^2 + 2x^3
     /// with x = r / 1.6 (zero value and slope at the edge); their fitted kernel is `CrawfisMax`.
@@ -28,6 +27,11 @@ pub enum Kernel {
     /// Crawfis and Max's criterion with their support (radius 1.6): the piecewise cubic
     /// (`CRAWFIS_MAX`, two C1 Hermite pieces) whose footprints sum over a unit lattice with the
     /// smallest variance, fitted here (`fit_crawfis_max`) since their coefficients are not at hand.
+    /// The default: against the supersampled ray-cast reference it errs less than the Gaussian
+    /// on every gallery file (42 against 38 dB on the bonsai and the stent: the Gaussian blurs
+    /// more than trilinear interpolation does), its footprints are 64 % of the Gaussian's area,
+    /// and a flat sheet of its voxels ripples least (0.37 %; docs/RESULTS.md).
+    #[default]
     CrawfisMax,
 }
 

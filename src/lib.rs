@@ -72,7 +72,9 @@ pub use error::{Error, Result};
 pub use glam;
 pub use image::ImageF32;
 pub use kernel::Kernel;
-pub use options::{Antialias, BlurProfile, Clip, Composite, Lod, Motion, RenderOptions, Rendered, StageTime};
+pub use options::{
+    Antialias, BlurProfile, Clip, Composite, FrameStats, Lod, Motion, RenderOptions, Rendered, StageTime,
+};
 pub use order::{Direction, OrderKind};
 pub use raster::{Raster, RasterChoice};
 pub use volume::{Grid, SplatSet, Volume};
@@ -298,7 +300,7 @@ impl Renderer {
             }
             (None, _) => record_frame(&mut cpu, prep, camera, &opts)?,
         };
-        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice) })
+        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats: recorded.stats })
     }
 
     /// Draw a frame into the host's image `target` on the device, with no readback: the frame
@@ -521,7 +523,7 @@ impl Renderer {
             Some(g) => recording::record_raycast(&mut g.engine(prep), prep, camera, options)?,
             None => recording::record_raycast(&mut CpuEngine::new(prep), prep, camera, options)?,
         };
-        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: None })
+        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: None, stats: recorded.stats })
     }
 
     /// Validation messages counted so far (always 0 without validation or on the CPU).

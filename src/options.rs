@@ -417,6 +417,25 @@ pub struct Rendered {
     pub timings: Vec<StageTime>,
     /// The footprint stage's raster variant and why (`None` for the ray caster and the truth).
     pub raster: Option<RasterChoice>,
+    /// What the frame drew and culled (a bricked volume's; zero elsewhere).
+    pub stats: FrameStats,
+}
+
+/// What a bricked volume's frame drew and what it left out, and why (`Rendered::stats`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Non-empty bricks in the store.
+    pub bricks: u32,
+    /// Bricks left after culling those outside the view or empty under the transfer function.
+    pub bricks_visible: u32,
+    /// Visible bricks the level-of-detail cut drew coarser than their voxels.
+    pub bricks_coarse: u32,
+    /// Visible bricks dropped because what earlier waves drew already hides them.
+    pub bricks_hidden: u32,
+    /// Splats drawn: voxels and coarse cells.
+    pub splats: u64,
+    /// Batches (waves) the visible bricks were drawn in, front to back.
+    pub waves: u32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

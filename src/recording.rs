@@ -97,6 +97,8 @@ pub struct Recorded {
     pub image: ImageF32,
     /// Per-stage times.
     pub timings: Vec<StageTime>,
+    /// What a bricked volume's frame drew and culled.
+    pub stats: crate::options::FrameStats,
 }
 
 /// THE recording of a frame: `prep` drawn from `camera` with `opts` (whose raster is already
@@ -398,7 +400,11 @@ fn finish(
             check_status(e.read(&[(Res::Status, 1)])?[0][0])?;
         }
         let timings = e.finish()?;
-        return Ok(Recorded { image: ImageF32 { width: w, height: h, pixels: Vec::new() }, timings });
+        return Ok(Recorded {
+            image: ImageF32 { width: w, height: h, pixels: Vec::new() },
+            timings,
+            stats: Default::default(),
+        });
     }
     let mut what: Vec<(Res, usize)> = images.iter().map(|&r| (r, image_words(w, h))).collect();
     if status {
@@ -424,7 +430,7 @@ fn finish(
         })
         .collect();
     let timings = e.finish()?;
-    Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings })
+    Ok(Recorded { image: ImageF32 { width: w, height: h, pixels }, timings, stats: Default::default() })
 }
 
 /// The compute sheet sums' status word: a footprint too large for llvmpipe's loop budget.

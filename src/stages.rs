@@ -196,7 +196,8 @@ pub const STAGES: &[StageDesc] = &[
         name: "brick_cull",
         kind: Kind::Compute,
         bindings: BRICK,
-        writes: &[Res::BrickSlots],
+        // With levels of detail it also writes each brick's morph (a bisect split moves it).
+        writes: &[Res::BrickSlots, Res::BrickMorph],
         push: 0,
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "bricks",

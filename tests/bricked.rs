@@ -9,7 +9,7 @@ use voxsplat::classify::{classify, Shading, TransferFunction};
 use voxsplat::gpu_types::SplatParams;
 use voxsplat::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
-use voxsplat::{Camera, Direction, Error, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
 
 fn renderer(gpu: bool, budget: Option<u64>) -> Renderer {
     let mut r = if gpu { common::gpu() } else { common::cpu() };
@@ -233,21 +233,31 @@ fn dropping_hidden_bricks_front_to_back_changes_nothing_and_drops_some() {
     let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
     // Opaque material: most bricks lie behind the front ones.
     let opaque = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.95])], ..tf() };
-    for gpu in [true, false] {
-        let mut r = renderer(gpu, None);
-        r.set_volume(&vol, &opaque, None).unwrap();
-        let mut o = compute(Direction::FrontToBack);
-        o.early_termination = 1.0 / 1024.0;
-        let culled = r.render(&cam, &o).unwrap().image;
-        let hidden = r.probe(&cam, &o, StageId::BrickHidden, &[Res::BrickHidden]).unwrap();
-        let dropped = hidden[0].iter().filter(|&&h| h == 1).count();
-        assert!(dropped > 10, "gpu {gpu}: {dropped} bricks dropped in the second batch");
-        o.cull_hidden_bricks = false;
-        let kept = r.render(&cam, &o).unwrap().image;
-        assert!(kept.pixels.iter().any(|p| p[3] > 0.5));
-        assert!(culled.pixels == kept.pixels, "gpu {gpu}: dropping hidden bricks changed the frame");
-        if gpu {
-            assert_clean(&r);
+    // At full detail, and with levels of detail (the default: at 96² most bricks draw coarser
+    // cells, so the frame holds fewer splats and its first wave more of the bricks).
+    for (lod, least) in [(Lod::Off, 10), (Lod::Auto, 3)] {
+        for gpu in [true, false] {
+            let mut r = renderer(gpu, None);
+            r.set_volume(&vol, &opaque, None).unwrap();
+            let mut o = compute(Direction::FrontToBack);
+            (o.early_termination, o.lod) = (1.0 / 1024.0, lod);
+            let culled = r.render(&cam, &o).unwrap();
+            let hidden = r.probe(&cam, &o, StageId::BrickHidden, &[Res::BrickHidden]).unwrap();
+            let dropped = hidden[0].iter().filter(|&&h| h == 1).count();
+            assert!(dropped > least, "gpu {gpu} {lod:?}: {dropped} bricks dropped in the second batch");
+            assert!(culled.stats.bricks_hidden as usize >= dropped, "gpu {gpu} {lod:?}: {:?}", culled.stats);
+            o.cull_hidden_bricks = false;
+            let kept = r.render(&cam, &o).unwrap();
+            assert!(kept.image.pixels.iter().any(|p| p[3] > 0.5));
+            assert_eq!(kept.stats.bricks_hidden, 0);
+            // The same bricks visible; the hidden ones' splats drawn only when kept.
+            assert_eq!(kept.stats.bricks_visible, culled.stats.bricks_visible);
+            assert!(kept.stats.splats > culled.stats.splats, "{:?} {:?}", kept.stats, culled.stats);
+            let culled = culled.image;
+            assert!(culled.pixels == kept.image.pixels, "gpu {gpu} {lod:?}: dropping hidden bricks changed the frame");
+            if gpu {
+                assert_clean(&r);
+            }
         }
     }
 }
@@ -329,7 +339,10 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
         streamed.set_volume(&vol, &tf(), None).unwrap();
         for raster in [Raster::Compute, Raster::Graphics] {
             for direction in [Direction::FrontToBack, Direction::BackToFront] {
-                let o = opts(raster, direction);
+                // Full detail: the budget is the full-detail minimum (levels of detail streamed
+                // are tests/lod.rs's).
+                let mut o = opts(raster, direction);
+                o.lod = Lod::Off;
                 let a = resident.render(&cam, &o).unwrap().image;
                 assert!(a.pixels.iter().any(|p| p[3] > 0.1));
                 let b = streamed.render(&cam, &o).unwrap().image;
@@ -337,7 +350,7 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
             }
         }
         let mut et = opts(Raster::Compute, Direction::FrontToBack);
-        et.early_termination = 1.0 / 1024.0;
+        (et.early_termination, et.lod) = (1.0 / 1024.0, Lod::Off);
         let a = resident.render(&cam, &et).unwrap().image;
         assert!(a.pixels == streamed.render(&cam, &et).unwrap().image.pixels, "gpu {gpu}: hidden bricks, streamed");
         streamed.set_transfer_function(&tf(), Some(Shading::headlight(cam.forward()))).unwrap();

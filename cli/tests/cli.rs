@@ -414,7 +414,8 @@ fn an_upsampled_volume_keeps_its_placement() {
     bytes.extend_from_slice(&data);
     std::fs::write(&src, bytes).unwrap();
     let up = tmp("placed2x.nrrd");
-    let out = voxsplat(&["make-volume", "--from", src.to_str().unwrap(), "--factor", "2", "--out", up.to_str().unwrap()]);
+    let out =
+        voxsplat(&["make-volume", "--from", src.to_str().unwrap(), "--factor", "2", "--out", up.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let place = |p: &std::path::Path| voxsplat::loaders::load_orientation(p, &Default::default()).unwrap().unwrap();
     let (a, b) = (place(&src), place(&up));
@@ -690,7 +691,8 @@ fn the_peer_scene_bricked_draws_the_dense_frame() {
         let a = p.0[3] as f64 / 255.0;
         [p.0[0] as f64 * a, p.0[1] as f64 * a, p.0[2] as f64 * a, p.0[3] as f64]
     };
-    let d2: f64 = c.pixels().zip(b.pixels()).map(|(x, y)| (0..4).map(|i| (pm(x)[i] - pm(y)[i]).powi(2)).sum::<f64>()).sum();
+    let d2: f64 =
+        c.pixels().zip(b.pixels()).map(|(x, y)| (0..4).map(|i| (pm(x)[i] - pm(y)[i]).powi(2)).sum::<f64>()).sum();
     let psnr = 10.0 * (255.0f64.powi(2) / (d2 / c.as_raw().len() as f64)).log10();
     assert!(c != b && psnr >= 40.0, "levels of detail against full detail: {psnr:.2} dB");
     for (bad, names) in [

@@ -4,6 +4,7 @@ use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
 use crate::constants::{MAX_GPU_SPLATS, PYRAMID_PAGE, PYRAMID_PAGES};
 use crate::cpu::lod::{pyramid_bytes, LOD_BUFFERS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
+use crate::options::FrameStats;
 
 /// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
 /// voxel (8), and for the tile compositor its screen quad (80) and about four tile entries (the
@@ -98,9 +99,18 @@ pub(super) fn record_bricks(
     let pyramid = if lod { pyramid_bytes(lod_buffers, headers) + batch_pyramid } else { 0 };
     let least = bricked_min_budget(scene, budget, w, h) + pyramid;
     if budget < least {
+        let levels = if lod {
+            format!(
+                ", its levels-of-detail pyramid ({} MiB; levels of detail off draw without it, from {} MiB)",
+                pyramid.div_ceil(1 << 20),
+                (least - pyramid).div_ceil(1 << 20)
+            )
+        } else {
+            String::new()
+        };
         return Err(Error::TooLarge(format!(
-            "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB) and one brick of splats at \
-             {w}x{h}: the minimum is {} MiB",
+            "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB){levels} and one brick of splats \
+             at {w}x{h}: the minimum is {} MiB",
             budget >> 20,
             scene.store.bytes() >> 20,
             least.div_ceil(1 << 20)
@@ -174,12 +184,20 @@ pub(super) fn record_bricks(
     } else {
         MAX_GPU_SPLATS
     };
+    let mut stats = FrameStats { bricks: bf.grid[3], ..Default::default() };
+    for &w in slot_words.iter().filter(|&&w| w != 0) {
+        let (_, level, n) = slot_entry(w);
+        stats.bricks_visible += 1;
+        stats.bricks_coarse += u32::from(level > 0);
+        stats.splats += n as u64;
+    }
     // The visible bricks in draw order, cut between bricks into batches.
     let visible = slot_words.into_iter().filter(|&w| w != 0).map(|w| {
         let (header, level, n) = slot_entry(w);
         [header, 0, 0, n | level << 16]
     });
     let batches = cut.batches(scene, visible, capacity, available);
+    stats.waves = batches.len() as u32;
     e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
     let most_entries = batches.iter().map(Vec::len).max().unwrap_or(0).max(1) as u64;
     e.ensure(Res::BrickList, most_entries * 16)?;
@@ -189,7 +207,9 @@ pub(super) fn record_bricks(
         e.ensure(Res::BrickHidden, most_entries * 4)?;
     }
     if sheets {
-        return record_bricked_sheets(e, prep, scene, camera, opts, &frame, batches.concat(), cut);
+        let mut recorded = record_bricked_sheets(e, prep, scene, camera, opts, &frame, batches.concat(), cut)?;
+        recorded.stats = stats;
+        return Ok(recorded);
     }
     if !compute {
         e.layers(1)?;
@@ -204,8 +224,11 @@ pub(super) fn record_bricks(
             e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
             let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
             // The bricks left, their positions (and streamed records) laid out again.
+            let before = batch_splats(&batch);
             let kept = batch.into_iter().zip(hidden).filter(|(_, h)| *h == 0).map(|(l, _)| l);
             batch = cut.batches(scene, kept, u32::MAX, u64::MAX).swap_remove(0);
+            stats.bricks_hidden += count - batch.len() as u32;
+            stats.splats -= (before - batch_splats(&batch)) as u64;
         }
         let n = batch_splats(&batch);
         if !batch.is_empty() {
@@ -221,7 +244,9 @@ pub(super) fn record_bricks(
             e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
         }
     }
-    finish(e, opts.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)
+    let mut recorded = finish(e, opts.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)?;
+    recorded.stats = stats;
+    Ok(recorded)
 }
 
 /// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
