@@ -53,14 +53,17 @@ for spec in "../shared/data/bonsai/bonsai.nii.gz|bonsai" "$LARGE/bonsai512.nrrd|
     psnr="$(p "$WORK/cost-$name.exr"), $(p "$WORK/cost-prev-$name.exr")"
   fi
   echo "| $name ($tf) | $stored | $vtk_ms | $ms | $ratio | $prev_ms | $psnr |"
-  stages+=("$name|$stored|$log" "$name, previous defaults|$stored|$prev")
+  printf '%s\n' "$log" > "$WORK/log-$name.txt"
+  printf '%s\n' "$prev" > "$WORK/log-prev-$name.txt"
+  stages+=("$name|$stored|$WORK/log-$name.txt" "$name, previous defaults|$stored|$WORK/log-prev-$name.txt")
 done
 # Where the time goes: each stage's median, per stored voxel and per splat drawn.
 echo
 echo "| file, settings | splats drawn (bricks: visible, coarser, hidden; waves) | stage: ms, ns per stored voxel, ns per splat drawn |"
 echo "|---|---|---|"
 for s in "${stages[@]}"; do
-  IFS='|' read -r label stored log <<< "$s"
+  IFS='|' read -r label stored file <<< "$s"
+  log=$(cat "$file")
   drawn=$(sed -nE 's/^drawn: ([0-9]+) splats from ([0-9]+) of [0-9]+ bricks \(([0-9]+) drawn coarser, ([0-9]+) hidden.*, ([0-9]+) waves/\1|\2, \3, \4; \5/p' <<< "$log")
   splats=${drawn%%|*}
   cells=$(grep -E "^[a-z_]+ +[0-9.]+ ms$" <<< "$log" | awk -v v="$stored" -v n="$splats" \

@@ -304,13 +304,20 @@ impl Default for RenderOptions {
             raster: Raster::Auto,
             render_scale: 1.0,
             lod: Lod::Auto,
-            lod_pixels: 1.0,
+            lod_pixels: DEFAULT_LOD_PIXELS,
             lod_error: DEFAULT_LOD_ERROR,
             lod_band: 0.75,
             background: None,
         }
     }
 }
+
+/// Default `RenderOptions::lod_pixels`: against the supersampled reference (docs/MODEL.md), at
+/// 512² from the default view, the 512³ bonsai's frame costs 0.43x the 1-px cut's at 44.35 dB
+/// (1 px: 44.56 dB; its level-1 cells project to 0.8-1.5 px, so at 1 px almost none coarsens), and
+/// the 256³ gallery files stay at or above 42.2 dB (heptane and the procedural field lose 1.8 dB, to
+/// 50.3 and 50.8; their splats widen over the morph band, up to 1.2x the time; docs/RESULTS.md).
+pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 
 /// Default `RenderOptions::lod_error`: the bound that keeps levels of detail at 1 px above 40 dB on
 /// the 512³ bonsai (45.2 dB against the ray-cast truth, 0.58x full detail's frame; 0.25 gave 39.3 dB

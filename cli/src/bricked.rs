@@ -110,7 +110,7 @@ pub fn study(
     let m = voxsplat::metrics::compare(&a, &b)?;
     frame_ms(&mut bricked, &cam, &o)?;
     let mut with_lod = o.clone();
-    with_lod.lod = voxsplat::Lod::Auto;
+    (with_lod.lod, with_lod.lod_pixels) = (voxsplat::Lod::Auto, 1.0);
     frame_ms(&mut bricked, &cam, &with_lod)?;
     let (mut t_dense, mut t_bricked, mut t_tf) = (Vec::new(), Vec::new(), Vec::new());
     let (mut t_lod, mut t_tf_lod) = (Vec::new(), Vec::new());
@@ -286,7 +286,7 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     // Full detail and levels of detail (1 px), alternating frame by frame after a warm-up each.
     let full = opts(0.0);
     let mut lod = full.clone();
-    lod.lod = voxsplat::Lod::Auto;
+    (lod.lod, lod.lod_pixels) = (voxsplat::Lod::Auto, 1.0);
     let reference = r.render(&cam, &full)?.image;
     let psnr = voxsplat::metrics::compare(&r.render(&cam, &lod)?.image, &reference)?.psnr;
     let (mut times, mut lod_times) = (Vec::new(), Vec::new());

@@ -297,7 +297,7 @@ struct RenderArgs {
     #[arg(long, value_parser = ["off", "auto"])]
     lod: Option<String>,
     /// Largest projected cell spacing of a coarse level, in pixels.
-    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
     lod_pixels: f32,
     /// Largest error of a coarse level (opacity per voxel length, summed down the levels).
     #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]

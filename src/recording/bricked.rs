@@ -215,9 +215,13 @@ pub(super) fn record_bricks(
         e.layers(1)?;
     }
     let words = |b: &[[u32; 4]]| b.iter().flatten().copied().collect::<Vec<u32>>();
-    for (i, mut batch) in batches.into_iter().enumerate() {
+    let mut batches = batches;
+    let mut i = 0;
+    while i < batches.len() {
+        let mut batch = std::mem::take(&mut batches[i]);
         if cull_hidden && i > 0 && !batch.is_empty() {
             let count = batch.len() as u32;
+            e.ensure(Res::BrickHidden, count as u64 * 4)?;
             e.upload(Res::BrickList, &words(&batch))?;
             e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, &[]))?;
             let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
@@ -229,6 +233,15 @@ pub(super) fn record_bricks(
             batch = cut.batches(scene, kept, u32::MAX, u64::MAX).swap_remove(0);
             stats.bricks_hidden += count - batch.len() as u32;
             stats.splats -= (before - batch_splats(&batch)) as u64;
+            if batch.len() as u32 == count && i + 1 < batches.len() {
+                // Nothing hidden yet (translucent data): waves would only add passes, so the
+                // rest goes in as few batches as the budget allows.
+                let rest: Vec<[u32; 4]> = batch.into_iter().chain(batches.drain(i + 1..).flatten()).collect();
+                let merged = cut.batches(scene, rest, MAX_GPU_SPLATS, available);
+                batches.truncate(i);
+                batches.extend(merged);
+                batch = std::mem::take(&mut batches[i]);
+            }
         }
         let n = batch_splats(&batch);
         if !batch.is_empty() {
@@ -243,7 +256,9 @@ pub(super) fn record_bricks(
             let push = FootprintPush { carry: u32::from(i > 0), ..Default::default() };
             e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
         }
+        i += 1;
     }
+    stats.waves = batches.len() as u32;
     let mut recorded = finish(e, opts.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)?;
     recorded.stats = stats;
     Ok(recorded)
