@@ -104,7 +104,9 @@ fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
                 continue;
             }
             for direction in [Direction::FrontToBack, Direction::BackToFront] {
-                let o = opts(Raster::Graphics, direction);
+                // Voxels, at full detail (the mixed-level order is tests/lod.rs's).
+                let mut o = opts(Raster::Graphics, direction);
+                o.lod = Lod::Off;
                 let got = drawn_sequence(&mut g, &cam, &o);
                 assert_eq!(got, drawn_sequence(&mut c, &cam, &o), "{kind:?} {v}: GPU vs mirror sequence");
                 let mut want: Vec<[u32; 3]> = voxsplat::order::tree_bricked(&set, &cam, BRICK, &tree)
@@ -233,9 +235,10 @@ fn dropping_hidden_bricks_front_to_back_changes_nothing_and_drops_some() {
     let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
     // Opaque material: most bricks lie behind the front ones.
     let opaque = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.95])], ..tf() };
-    // At full detail, and with levels of detail (the default: at 96² most bricks draw coarser
-    // cells, so the frame holds fewer splats and its first wave more of the bricks).
-    for (lod, least) in [(Lod::Off, 10), (Lod::Auto, 3)] {
+    // At full detail, and with levels of detail (the default; at 192², since at 96² most bricks
+    // draw coarser cells and the frame's splats fit one wave).
+    for (lod, least, size) in [(Lod::Off, 10, 96), (Lod::Auto, 3, 192)] {
+        let cam = Camera { width: size, height: size, ..cam };
         for gpu in [true, false] {
             let mut r = renderer(gpu, None);
             r.set_volume(&vol, &opaque, None).unwrap();
@@ -258,6 +261,35 @@ fn dropping_hidden_bricks_front_to_back_changes_nothing_and_drops_some() {
             if gpu {
                 assert_clean(&r);
             }
+        }
+    }
+}
+
+/// Front to back with early termination (the default), a translucent volume hides nothing from
+/// the second wave on: the rest is drawn in one more batch, not in the remaining waves, and the
+/// frame is the one drawn without dropping bricks (itself one batch: the waves are cut only to drop
+/// bricks). Opaque material keeps its waves (`dropping_hidden_bricks_...`).
+#[test]
+fn waves_stop_where_nothing_is_hidden() {
+    let vol = blob([120, 100, 90]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
+    let faint = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.02])], ..tf() };
+    for gpu in [true, false] {
+        let mut r = renderer(gpu, None);
+        r.set_volume(&vol, &faint, None).unwrap();
+        let mut o = compute(Direction::FrontToBack);
+        o.lod = Lod::Off;
+        let waved = r.render(&cam, &o).unwrap();
+        assert_eq!(waved.stats.bricks_hidden, 0, "gpu {gpu}: {:?}", waved.stats);
+        assert_eq!(waved.stats.waves, 2, "gpu {gpu}: the first wave, then the rest at once: {:?}", waved.stats);
+        o.cull_hidden_bricks = false;
+        let one = r.render(&cam, &o).unwrap();
+        assert_eq!(one.stats.waves, 1, "gpu {gpu}: {:?}", one.stats);
+        assert_eq!(one.stats.splats, waved.stats.splats);
+        let (most, _) = diff(&one.image, &waved.image);
+        assert!(most < 1e-5, "gpu {gpu}: {most}");
+        if gpu {
+            assert_clean(&r);
         }
     }
 }
