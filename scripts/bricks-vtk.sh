@@ -28,9 +28,9 @@ length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat br
 own process per file), 512², 5 frames after a warm-up, medians. voxsplat alternates full detail
 with levels of detail (`--lod auto`, 1 px; PSNR against its own full detail): the fifth column is
 issue 24's moonshot, LOD frame time against VTK's. The last column holds both frames' PSNR against a
-converged truth, the CPU ray caster at 0.25-voxel steps (`render --raycast 0.25 --cpu`: trilinear
-scalars through the same transfer function), for the files the dense loaders take (at most 2²⁸
-voxels; not the 1024³).
+converged truth, the supersampled reference (`render --raycast 0.25 --supersample 4 --raycast-stop
+1e-4 --cpu`: 4 x 4 rays per pixel, trilinear scalars through the same transfer function;
+docs/MODEL.md), for the files the dense loaders take (at most 2²⁸ voxels; not the 1024³).
 
 TEXT
 csv=docs/bench/bricks-scaling.csv
@@ -53,7 +53,8 @@ for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/pro
   truth="-"
   if [ "$voxels" -le 268435456 ]; then
     t=target/truth-$(basename "$f").exr
-    ./target/release/voxsplat render --volume "$f" --tf $tf --size 512x512 --raycast 0.25 --cpu --out "$t" >/dev/null
+    ./target/release/voxsplat render --volume "$f" --tf $tf --size 512x512 --raycast 0.25 --supersample 4 \
+      --raycast-stop 1e-4 --cpu --out "$t" >/dev/null
     psnr=()
     for lod in off auto; do
       ./target/release/voxsplat render --volume "$f" --tf $tf --size 512x512 --raster compute --direction ftb \
