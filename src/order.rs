@@ -20,7 +20,7 @@ pub enum OrderKind {
     Pbtf,
     /// Reference: sorted by exact distance to the eye (to the view plane in orthographic views).
     Sorted,
-    /// PBTF with Westover's nesting in each octant (`octant_axes`; issue 26): the same octants and
+    /// PBTF with Westover's nesting in each octant (`octant_axes`): the same octants and
     /// outward traversal, the axis along which the eye sees the octant's middle farthest
     /// outermost. WBTF exactly in orthographic views, close to it in perspective views from
     /// outside the grid; computed on the host (`--order pbtf-octant`).
@@ -158,7 +158,7 @@ pub fn pbtf(set: &SplatSet, split: [u32; 3]) -> Vec<u32> {
     out
 }
 
-/// Two-level PBTF, front to back, over bricks of `brick`³ voxels (issue 23; docs/MODEL.md,
+/// Two-level PBTF, front to back, over bricks of `brick`³ voxels (docs/MODEL.md,
 /// "Two-level PBTF"): the bricks in PBTF order over the brick grid, and inside each brick its voxels
 /// in PBTF order, both split at the eye's cell. A CPU reference (a comparison sort on the two-level
 /// key); `brick` 1 and a brick covering the grid both give `pbtf` itself.
@@ -180,7 +180,7 @@ pub fn pbtf_bricked(set: &SplatSet, camera: &Camera, brick: u32) -> Result<Vec<u
     }))
 }
 
-/// A bricked volume's draw order, front to back (issue 28): the bricks as the k-d tree `tree`
+/// A bricked volume's draw order, front to back: the bricks as the k-d tree `tree`
 /// (`kdtree`) orders them, every node's near side first and PBTF within its leaves' boxes, and
 /// inside each brick its voxels in PBTF order. A CPU reference (a comparison sort on the path
 /// through the tree, then the two PBTF keys).
@@ -273,7 +273,7 @@ fn axes_by(d: [f64; 3]) -> [usize; 3] {
 /// PBTF with the loops inside octant o (bit a: the high side of axis a) nested as `axes(o)`
 /// (outermost first), front to back: the seed's "or duals" freedom (any nesting is a visibility
 /// order inside an octant, each axis traversed outward from the eye). `pbtf` nests [2, 1, 0] in
-/// every octant; Westover-style choices (per view, `wbtf_axes`, or per octant) are what issue 26
+/// every octant; Westover-style choices (per view, `wbtf_axes`, or per octant) are what this project
 /// measures against the overlapping-splat seams.
 pub fn pbtf_nested(set: &SplatSet, split: [u32; 3], axes: impl Fn(u32) -> [usize; 3]) -> Vec<u32> {
     let dims = set.grid().dims;
@@ -404,7 +404,7 @@ pub struct PixelInversions {
     pub covered: u64,
 }
 
-/// The image-space validator (issue 26): for each pixel, the splats whose footprints (`radius`
+/// The image-space validator: for each pixel, the splats whose footprints (`radius`
 /// voxel spacings, the kernel's) cover its centre, in draw order, and the pairs of them drawn
 /// against their exact depth along that pixel's ray (back to front: a nearer splat before a
 /// farther one). Unlike the 6-neighbour count, it tells WBTF from BTF, and it sees the
@@ -510,7 +510,7 @@ fn rising_pairs(v: &mut [f64], gap: f64) -> (u64, u64) {
     n
 }
 
-/// The validator over a sequence of cells of mixed sizes (levels of detail, issue 24): `cells`
+/// The validator over a sequence of cells of mixed sizes (levels of detail): `cells`
 /// in draw order, each (i, j, k, side), the cube of `side` voxels a side from voxel (i, j, k),
 /// clipped to `grid`. Counts pairs of 6-neighbour voxels in different cells whose cells are drawn
 /// in the wrong order with respect to the grid plane between them and the eye (the plane between

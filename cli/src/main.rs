@@ -104,7 +104,7 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Anti-aliasing on the seed's terrain and orthographic figures (Figs 3.7, 3.8, 5.3; issue 26):
+    /// Anti-aliasing on the seed's terrain and orthographic figures (Figs 3.7, 3.8, 5.3):
     /// none, Swan and EWA against a supersampled truth; a markdown section on stdout.
     Antialias {
         /// Square images of this side instead of the seed's sizes (Fig. 3.7 260x179, Fig. 3.8
@@ -121,7 +121,7 @@ enum Command {
         #[arg(long, default_value_t = 5)]
         frames: usize,
     },
-    /// Orders under motion and the terrain's motion blur (chapters 4-5; issue 26): PBTF, WBTF and
+    /// Orders under motion and the terrain's motion blur (chapters 4-5): PBTF, WBTF and
     /// BTF against the sorted order on the built-in animations, and blurred splats against the
     /// accumulation buffer on the orthographic terrain with WBTF; a markdown section on stdout.
     MotionOrders {
@@ -135,7 +135,7 @@ enum Command {
         #[arg(long, default_value_t = 5)]
         rounds: usize,
     },
-    /// The reconstruction kernels side by side (issue 26): sheet ripple, lattice RMS (Crawfis and
+    /// The reconstruction kernels side by side: sheet ripple, lattice RMS (Crawfis and
     /// Max's criterion), error against the peers' truth and time; a markdown section on stdout.
     Kernels {
         /// Side of the peers' volume.
@@ -151,7 +151,7 @@ enum Command {
         #[arg(long)]
         chart: Option<PathBuf>,
     },
-    /// The bricked-volume study (issue 23): store sizes, dense against bricked frames, a TF change,
+    /// The bricked-volume study: store sizes, dense against bricked frames, a TF change,
     /// hidden-brick culling and the 512³ bonsai against the 256³, alternating variants in one
     /// process; a markdown section on stdout. With --volume: one volume's load, store, frame and
     /// peak resident set (one file per process, for the memory target).
@@ -188,7 +188,7 @@ enum Command {
         #[arg(long)]
         chart_out: Option<PathBuf>,
     },
-    /// Render the peers' scene (../shared/peers, issue 9) with every voxsplat mode: median frame
+    /// Render the peers' scene (../shared/peers) with every voxsplat mode: median frame
     /// times as CSV on stdout, images into --out-dir; `scripts/peers.sh` runs it beside VTK.
     Peer {
         /// Volume side (the peers use 128 and 256).

@@ -109,7 +109,7 @@ pub struct SceneArgs {
     /// Preset view: auto (fly-over for terrain, VTK's camera for the peer scenes, the oblique
     /// anatomical view for data with an anatomical frame, framing otherwise), a three-quarter
     /// framing, a grazing view across a single-sheet scene (Fig. 3.6), a terrain fly-over
-    /// (Figs 5.1-5.3), the peers' VTK camera (issue 9), or an anatomical view of a volume whose file
+    /// (Figs 5.1-5.3), the peers' VTK camera, or an anatomical view of a volume whose file
     /// places it in patient space (NIfTI sform/qform, NRRD space), superior up: anterior,
     /// posterior, left, right, superior and inferior (anterior up), oblique (anterior, a little
     /// right and above). Volumes are framed on the voxels the transfer function shows.
