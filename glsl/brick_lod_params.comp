@@ -2,8 +2,8 @@
 // variants: PAGED_RECORDS STREAMED_STORE
 // Levels of detail, beside brick_params (which makes the voxels' splats and skips coarse cells): a
 // lane per coarse splat of the batch (lod_splats: their positions, listed by the host), its
-// parameters from its pyramid cell: prefiltered colour shaded at the cell's gradient, optical depth
-// per cell, a splat 2^l voxels wide at the middle of its voxels inside the grid, grown toward the
+// parameters from its pyramid cell seen along the view (its directional prefilter: colour shaded
+// at that view's normal, optical depth per cell), a splat 2^l voxels wide at the middle of its voxels inside the grid, grown toward the
 // next level when its brick morphs. Mirror: cpu::lod::brick_lod_params.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
@@ -29,7 +29,9 @@ void main() {
     vec3 at = vec3(ijk) + 0.5 * (vec3(min(uvec3(1u << level), frame.dims.xyz - ijk)) - 1.0);
     float grow = (v.y & VOXEL_MORPHS) != 0u ? splat_growth(at, level) : 1.0;
     vec3 normal;
-    vec4 c = cell_color(h, v.y >> 16u, normal);
+    vec3 centre = grid_point(at);
+    vec3 view = grid_direction(frame.eye.w > 0.5 ? centre - frame.eye.xyz : frame.forward.xyz);
+    vec4 c = cell_color(h, v.y >> 16u, view, normal);
     if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
     params_store(s, params_at(at, float(1u << level), grow, c.rgb, c.a));
 }

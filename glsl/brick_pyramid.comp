@@ -1,19 +1,18 @@
 #version 450
 // variants: PAGED_RECORDS STREAMED_STORE
-// Levels of detail (issue 24), built when the classification changes: one workgroup per
-// non-empty brick, a lane per level-1 cell reading its 8 voxels through the occupancy mask. Its
-// voxels are classified (TF and gradient weighting; shading waits for the
-// frame's light) into optical depth per voxel length tau, tau-weighted colour and tau-weighted
-// gradient; levels 1..3 sum them over 2x2x2 children, so a coarse cell holds its children's
-// extinction and extinction-weighted colour (Swan's energy argument, at build time: its splat is
-// 2^l times wider and carries 2^l times the mean optical depth per voxel). Each cell's error is
-// how far its children depart from it (Laur-Hanrahan): the largest over its children of their own
-// error plus the difference of opacity per voxel length, or of colour weighted by the child's
-// opacity. Writes the pyramid cells and each brick's summary (brick.glsl). A streamed store
-// (STREAMED_STORE) builds the pyramids of one batch's bricks from its records, a workgroup per
-// entry of brick_list from pc.first, into the entries' slots or, when the pyramid is resident,
-// the bricks' own (pyramid_slot). Mirror:
-// cpu::lod::brick_pyramid.
+// Levels of detail, built when the classification changes: one workgroup per non-empty brick, a
+// lane per level-1 cell reading its 8 voxels through the occupancy mask. Its voxels are classified
+// (TF and gradient weighting; shading waits for the frame's light) and summed over 2x2x2 children
+// into levels 1..3: optical depth, tau-weighted colour and gradient (sign-aligned). Each cell keeps
+// its opacity along the three axes (brick.glsl): its children composited in pairs along the axis
+// and averaged across it, so a coarse cell covers, seen along each axis, what its children cover.
+// Its splat is 2^l times wider and carries the optical depth through the cell. Each cell's error is how far its children
+// depart from it (Laur-Hanrahan): the largest over its children of their own error plus the
+// difference of opacity per voxel length, or of colour weighted by the child's opacity. Writes
+// the pyramid cells and each brick's summary (brick.glsl). A streamed store (STREAMED_STORE)
+// builds the pyramids of one batch's bricks from its records, a workgroup per entry of
+// brick_list from pc.first, into the entries' slots or, when the pyramid is resident, the bricks'
+// own (pyramid_slot). Mirror: cpu::lod::brick_pyramid.
 layout(local_size_x = BRICK_LANES) in;
 #include "brick.glsl"
 
@@ -24,12 +23,14 @@ layout(push_constant) uniform Push {
     float occluded;
 } pc;
 
-// Levels 1..3 at level_offset(l): sums over the cell's voxels.
+// Levels 1..3 at level_offset(l): sums over the cell's voxels (optical depth, tau-weighted colour,
+// tau-weighted gradient sign-aligned), its error, and its opacity along x, y and z (at 3 i + axis).
 shared float tau_l[LOD_CELLS];
 shared vec3 col_l[LOD_CELLS];
 shared vec3 grad_l[LOD_CELLS];
 shared float err_l[LOD_CELLS];
-// The optical depth per cell length each cell stores (drawn when > 0).
+shared float axis_l[3u * LOD_CELLS];
+// The optical depth per cell length each cell stores along x (drawn when > 0).
 shared float stored_l[LOD_CELLS];
 // Drawn voxels per level-1 cell.
 shared uint drawn_1[64];
@@ -55,20 +56,46 @@ uint child(uint l, uvec3 c, uint n, uint d) {
     return l == 1u ? i : level_offset(l - 1u) + i;
 }
 
-// Store level l's cell i (sums t, col, g; error err) and its pyramid words at `slot`.
-void put_cell(uint slot, uint l, uint i, float t, vec3 col, vec3 g, float err) {
-    float voxels = float(1u << (3u * l));
-    vec3 straight = t > 0.0 ? col / t : vec3(0.0);
+// g turned to agree with `with` (shading is two-sided, so a normal's sign is free; the opposite
+// gradients of a thin shell's two faces would otherwise cancel).
+vec3 aligned(vec3 g, vec3 with) {
+    return dot(g, with) < 0.0 ? -g : g;
+}
+
+// The opacity along `axis` of a cell whose children have opacities a (along that axis): its four
+// columns of two children composited, then averaged across (the same from either side).
+float axis_opacity(float a[8], uint axis) {
+    float sum = 0.0;
+    for (uint p = 0u; p < 4u; ++p) {
+        // Insert a 0 bit along the axis into p's two bits: the low child of the column.
+        uint low = (p & ((1u << axis) - 1u)) | ((p >> axis) << (axis + 1u));
+        sum += 1.0 - (1.0 - a[low]) * (1.0 - a[low | (1u << axis)]);
+    }
+    return 0.25 * sum;
+}
+
+uint unorm10(float v) {
+    return uint(floor(clamp(v, 0.0, 1.0) * 1023.0 + 0.5));
+}
+
+// Cell i: its sums (t, col, g), error and axis opacities (for the level above), and its pyramid
+// words at `slot`.
+void put_cell(uint slot, uint i, float t, vec3 col, vec3 g, float err, vec3 axes) {
     tau_l[i] = t;
     col_l[i] = col;
     grad_l[i] = g;
     err_l[i] = err;
-    // Optical depth per cell length: 2^l voxel lengths of the mean per voxel.
-    stored_l[i] = t / voxels * float(1u << l);
+    uint codes[3];
+    for (uint a = 0u; a < 3u; ++a) {
+        axis_l[3u * i + a] = axes[a];
+        codes[a] = tau_code(-log(1.0 - min(axes[a], 0.9999999)));
+    }
+    stored_l[i] = tau_decode(codes[0]);
+    vec3 straight = t > 0.0 ? col / t : vec3(0.0);
     uint base = (slot * LOD_CELLS + i) * CELL_WORDS;
-    pyramid_put(base, floatBitsToUint(stored_l[i]));
-    pyramid_put(base + 1u, packUnorm2x16(straight.rg));
-    pyramid_put(base + 2u, (packUnorm2x16(vec2(straight.b, 0.0)) & 0xffffu) | (pack_normal(g) << 16u));
+    pyramid_put(base, codes[0] | (codes[1] << 16u));
+    pyramid_put(base + 1u, codes[2] | (pack_normal(g) << 16u));
+    pyramid_put(base + 2u, unorm10(straight.r) | (unorm10(straight.g) << 10u) | (unorm10(straight.b) << 20u));
 }
 
 // The error of a cell of mean opacity a and colour straight against a child (sums tk, ck; error
@@ -112,6 +139,7 @@ void main() {
         uvec3 cc = uvec3(c % 4u, (c / 4u) % 4u, c / 16u);
         float tk[8];
         vec3 ck[8];
+        float ak[8];
         float t = 0.0;
         vec3 col = vec3(0.0);
         vec3 g = vec3(0.0);
@@ -130,10 +158,11 @@ void main() {
                     vec4 cl = classify_voxel(v, q, false);
                     tk[d] = optical_depth(cl.a);
                     ck[d] = cl.rgb * tk[d];
-                    if (shaded) g += gradient_at(v) * tk[d];
+                    if (shaded) g += aligned(gradient_at(v) * tk[d], g);
                     drawn += tk[d] > 0.0 ? 1u : 0u;
                 }
             }
+            ak[d] = 1.0 - exp(-tk[d]);
             t += tk[d];
             col += ck[d];
         }
@@ -141,7 +170,8 @@ void main() {
         vec3 straight = t > 0.0 ? col / t : vec3(0.0);
         float err = 0.0;
         for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0));
-        put_cell(slot, 1u, c, t, col, g, err);
+        vec3 axes = vec3(axis_opacity(ak, 0u), axis_opacity(ak, 1u), axis_opacity(ak, 2u));
+        put_cell(slot, c, t, col, g, err, axes);
         drawn_1[c] = drawn;
     }
     barrier();
@@ -158,7 +188,7 @@ void main() {
                 uint k = child(l, cc, n, d);
                 t += tau_l[k];
                 col += col_l[k];
-                g += grad_l[k];
+                g += aligned(grad_l[k], g);
             }
             float a = 1.0 - exp(-t / voxels);
             vec3 straight = t > 0.0 ? col / t : vec3(0.0);
@@ -167,7 +197,13 @@ void main() {
                 uint k = child(l, cc, n, d);
                 err = max(err, child_error(a, straight, tau_l[k], col_l[k], err_l[k], voxels / 8.0));
             }
-            put_cell(slot, l, level_offset(l) + c, t, col, g, err);
+            vec3 axes;
+            for (uint x = 0u; x < 3u; ++x) {
+                float ak[8];
+                for (uint d = 0u; d < 8u; ++d) ak[d] = axis_l[3u * child(l, cc, n, d) + x];
+                axes[x] = axis_opacity(ak, x);
+            }
+            put_cell(slot, level_offset(l) + c, t, col, g, err, axes);
         }
         barrier();
     }

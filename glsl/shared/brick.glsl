@@ -198,11 +198,16 @@ vec4 classify_voxel(ivec3 v, uint q, bool shaded) {
     return c;
 }
 
-// Levels of detail (issue 24): per header a pyramid of LOD_CELLS cells, levels 1..3 of a brick
-// (64 + 8 + 1 cells of 2^l voxels a side), each 3 words: its optical depth per cell length (f32),
-// red | green << 16 (unorm16), blue | octahedral normal << 16 (unorm16, snorm 8 + 8); and a summary:
-// x: drawn cells of level 1 | level 2 << 8 | level 3 << 12 | drawn voxels << 16; yzw: the largest
-// error of levels 1..3.
+// Levels of detail: per header a pyramid of LOD_CELLS cells, levels 1..3 of a brick (64 + 8 + 1
+// cells of 2^l voxels a side). A cell is prefiltered along the six axis directions (as voxel cone
+// tracing's anisotropic cells are): seen along each, its columns are composited front to back and
+// their opacities averaged across, so a half-covered cell keeps half its coverage and a thin sheet
+// covers what it covers from each side. The opacity along an axis is the same from either side,
+// so a cell keeps three (brick_pyramid), and one colour and normal over the six directions. Words:
+// tau_code along x | along y << 16 (optical depth per cell length), along z | octahedral normal
+// << 16 (snorm 8 + 8), straight colour (unorm 10:10:10).
+// A summary per brick: x: drawn cells of level 1 | level 2 << 8 | level 3 << 12 | drawn voxels
+// << 16; yzw: the largest error of levels 1..3.
 // Built by brick_pyramid when the classification changes. Mirror: cpu::lod.
 // Up to 4 storage bindings of PYRAMID_PAGE words (one binding may not pass maxStorageBufferRange).
 layout(std430, binding = 24) buffer Pyramid { uint pyramid_0[]; };
@@ -322,9 +327,22 @@ uint pyramid_index(uint h) {
 #endif
 }
 
-// Cell i of header h's pyramid: optical depth per cell length, straight colour, gradient direction.
+// A cell's optical depth in 16 bits: an f32's exponent from 2^-23 to 2^7 and 11 bits of mantissa,
+// rounded; 0 for none. Integer steps, so the mirror (cpu::lod::tau_code) packs the same bits.
+uint tau_code(float t) {
+    if (!(t >= 1.1920929e-7)) return 0u;
+    uint b = floatBitsToUint(min(t, 255.0));
+    return ((b + 0x800u) >> 12u) - (103u << 11u);
+}
+
+float tau_decode(uint code) {
+    return code == 0u ? 0.0 : uintBitsToFloat((code + (103u << 11u)) << 12u);
+}
+
+// Cell i of header h's pyramid: its optical depth per cell length along x (0 when it draws
+// nothing; every axis's is 0 together).
 float cell_tau(uint h, uint i) {
-    return uintBitsToFloat(pyramid_word((pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS));
+    return tau_decode(pyramid_word((pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS) & 0xffffu);
 }
 
 // Octahedral normals fold the lower hemisphere with the signs of x and y, 0 counted positive.
@@ -332,15 +350,28 @@ vec2 sign_not_zero(vec2 v) {
     return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);
 }
 
-vec4 cell_color(uint h, uint i, out vec3 normal) {
-    uint base = (pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS;
-    vec2 rg = unpackUnorm2x16(pyramid_word(base + 1u));
-    uint w = pyramid_word(base + 2u);
-    vec2 oct = unpackSnorm4x8(w >> 16u).xy;
+// The direction of octahedral bytes w (0 for NO_NORMAL).
+vec3 unpack_normal(uint w) {
+    if (w == NO_NORMAL) return vec3(0.0);
+    vec2 oct = unpackSnorm4x8(w).xy;
     vec3 n = vec3(oct, 1.0 - abs(oct.x) - abs(oct.y));
     if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
-    normal = w >> 16u == NO_NORMAL ? vec3(0.0) : normalize(n);
-    return vec4(rg, unpackUnorm2x16(w).x, uintBitsToFloat(pyramid_word(base)));
+    return normalize(n);
+}
+
+// Cell i of header h seen along `view` (index space): the opacities along the three axes weighted
+// by the squares of the view's components; returns straight colour and optical depth per cell
+// length.
+vec4 cell_color(uint h, uint i, vec3 view, out vec3 normal) {
+    uint base = (pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS;
+    uint xy = pyramid_word(base);
+    uint zn = pyramid_word(base + 1u);
+    uint c = pyramid_word(base + 2u);
+    vec3 w = view * view / max(dot(view, view), 1e-30);
+    vec3 tau = vec3(tau_decode(xy & 0xffffu), tau_decode(xy >> 16u), tau_decode(zn & 0xffffu));
+    float trans = dot(w, exp(-min(tau, vec3(80.0))));
+    normal = unpack_normal(zn >> 16u);
+    return vec4(vec3(uvec3(c, c >> 10u, c >> 20u) & 1023u) / 1023.0, -log(max(trans, 1e-30)));
 }
 
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)

@@ -1,4 +1,4 @@
-//! Levels of detail over a bricked volume (issue 24): mirror of `brick_pyramid.comp` and of the
+//! Levels of detail over a bricked volume: mirror of `brick_pyramid.comp` and of the
 //! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
 //! `cell_color`).
 use super::bindings::Bindings;
@@ -13,7 +13,7 @@ use glam::Vec3;
 
 /// Cells of levels 1-3 in a brick's pyramid (64 + 8 + 1).
 pub const LOD_CELLS: usize = 73;
-/// Words per pyramid cell.
+/// Words per pyramid cell: the optical depth along each axis, the normal, the colour (`brick.glsl`).
 pub const CELL_WORDS: usize = 3;
 /// Coarse levels (level l: cells of 2^l voxels a side).
 pub const LOD_LEVELS: u32 = 3;
@@ -55,8 +55,28 @@ fn snorm8(v: f32) -> u32 {
     ((v.clamp(-1.0, 1.0) * 127.0).round() as i32 as u32) & 0xff
 }
 
-fn unorm16(v: f32) -> u32 {
-    (v.clamp(0.0, 1.0) * 65535.0).round() as u32
+/// Mirror of `unorm10` (brick_pyramid.comp).
+fn unorm10(v: f32) -> u32 {
+    (v.clamp(0.0, 1.0) * 1023.0 + 0.5).floor() as u32
+}
+
+/// Mirror of `tau_code`: a cell's optical depth in 16 bits (exponent 2^-23..2^7, 11 bits of
+/// mantissa, rounded; 0 for none).
+pub fn tau_code(t: f32) -> u32 {
+    if !(t >= 1.192_092_9e-7) {
+        return 0;
+    }
+    let b = t.min(255.0).to_bits();
+    ((b + 0x800) >> 12) - (103 << 11)
+}
+
+/// Mirror of `tau_decode`.
+pub fn tau_decode(code: u32) -> f32 {
+    if code == 0 {
+        0.0
+    } else {
+        f32::from_bits((code + (103 << 11)) << 12)
+    }
 }
 
 /// Mirror of `sign_not_zero` (one component).
@@ -83,26 +103,35 @@ fn pack_normal(g: Vec3) -> u32 {
     snorm8(ox) | snorm8(oy) << 8
 }
 
-/// Mirror of `cell_color`: cell `i` of header `h`: straight colour, optical depth per cell
-/// length, and its gradient direction (zero when it has none).
-pub fn cell_color(pyramid: &[u32], h: u32, i: u32) -> ([f32; 4], Vec3) {
-    let base = (h as usize * LOD_CELLS + i as usize) * CELL_WORDS;
-    let un = |w: u32| (w & 0xffff) as f32 / 65535.0;
-    let w = pyramid[base + 2];
+/// Mirror of `unpack_normal`.
+fn unpack_normal(w: u32) -> Vec3 {
+    if w == NO_NORMAL {
+        return Vec3::ZERO;
+    }
     let sn = |b: u32| ((b & 0xff) as u8 as i8 as f32 / 127.0).max(-1.0);
-    let (ox, oy) = (sn(w >> 16), sn(w >> 24));
+    let (ox, oy) = (sn(w), sn(w >> 8));
     let mut n = Vec3::new(ox, oy, 1.0 - ox.abs() - oy.abs());
     if n.z < 0.0 {
         (n.x, n.y) = ((1.0 - oy.abs()) * sign_not_zero(ox), (1.0 - ox.abs()) * sign_not_zero(oy));
     }
-    let normal = if w >> 16 == NO_NORMAL { Vec3::ZERO } else { n.normalize() };
-    let rgba = [un(pyramid[base + 1]), un(pyramid[base + 1] >> 16), un(w), f32::from_bits(pyramid[base])];
-    (rgba, normal)
+    n.normalize()
 }
 
-/// Mirror of `cell_tau`.
+/// Mirror of `cell_color`: cell `i` of header `h` seen along `view` (index space): straight
+/// colour, optical depth per cell length, and its normal (zero when it has none).
+pub fn cell_color(pyramid: &[u32], h: u32, i: u32, view: Vec3) -> ([f32; 4], Vec3) {
+    let base = (h as usize * LOD_CELLS + i as usize) * CELL_WORDS;
+    let (xy, zn, c) = (pyramid[base], pyramid[base + 1], pyramid[base + 2]);
+    let w = view * view / view.dot(view).max(1e-30);
+    let tau = Vec3::new(tau_decode(xy & 0xffff), tau_decode(xy >> 16), tau_decode(zn & 0xffff));
+    let trans = w.dot((-tau.min(Vec3::splat(80.0))).exp());
+    let rgb = [c & 1023, c >> 10 & 1023, c >> 20 & 1023].map(|q| q as f32 / 1023.0);
+    ([rgb[0], rgb[1], rgb[2], -trans.max(1e-30).ln()], unpack_normal(zn >> 16))
+}
+
+/// Mirror of `cell_tau`: the optical depth per cell length along x.
 pub fn cell_tau(pyramid: &[u32], h: u32, i: u32) -> f32 {
-    f32::from_bits(pyramid[(h as usize * LOD_CELLS + i as usize) * CELL_WORDS])
+    tau_decode(pyramid[(h as usize * LOD_CELLS + i as usize) * CELL_WORDS] & 0xffff)
 }
 
 /// Mirror of `level_count`.
@@ -184,13 +213,35 @@ impl BrickInputs<'_> {
     }
 }
 
-/// Per-level sums of a brick's cells: optical depth, tau-weighted colour and gradient, error.
+/// Per-level sums of a brick's cells: optical depth, tau-weighted colour and gradient
+/// (sign-aligned), error, and its opacity along x, y and z (a voxel's: its opacity).
 #[derive(Clone, Copy, Default)]
 struct Sums {
     tau: f32,
     col: Vec3,
     grad: Vec3,
     err: f32,
+    axes: [f32; 3],
+}
+
+/// Mirror of `aligned`: `g` turned to agree with `with`.
+fn aligned(g: Vec3, with: Vec3) -> Vec3 {
+    if g.dot(with) < 0.0 {
+        -g
+    } else {
+        g
+    }
+}
+
+/// Mirror of `axis_opacity`: the opacity along `axis` of a cell whose children have opacities
+/// `a` along it.
+fn axis_opacity(a: [f32; 8], axis: usize) -> f32 {
+    let mut sum = 0.0;
+    for p in 0..4usize {
+        let low = (p & ((1 << axis) - 1)) | ((p >> axis) << (axis + 1));
+        sum += 1.0 - (1.0 - a[low]) * (1.0 - a[low | 1 << axis]);
+    }
+    0.25 * sum
 }
 
 /// A streamed store's batch for `brick_pyramid`: brick_list, the push's range of it (its `splats`
@@ -239,7 +290,8 @@ pub fn brick_pyramid(
             let c = inputs.classify_voxel(v, rec >> 16, false);
             let t = optical_depth(c[3]);
             let grad = if shaded { inputs.gradient_at(v) * t } else { Vec3::ZERO };
-            fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0 };
+            let a = 1.0 - (-t).exp();
+            fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0, axes: [a; 3] };
         }
         let mut cells = [Sums::default(); LOD_CELLS];
         let mut stored = [0f32; LOD_CELLS];
@@ -261,7 +313,7 @@ pub fn brick_pyramid(
                 });
                 let (mut t, mut col, mut g) = (0.0f32, Vec3::ZERO, Vec3::ZERO);
                 for k in &children {
-                    (t, col, g) = (t + k.tau, col + k.col, g + k.grad);
+                    (t, col, g) = (t + k.tau, col + k.col, g + aligned(k.grad, g));
                 }
                 let a = 1.0 - (-t / voxels).exp();
                 let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
@@ -272,13 +324,16 @@ pub fn brick_pyramid(
                     let dc = (sk - straight).abs();
                     err = err.max(k.err + (ak - a).abs().max(ak * dc.x.max(dc.y.max(dc.z))));
                 }
+                let axes = [0, 1, 2].map(|x| axis_opacity(children.map(|k| k.axes[x]), x));
                 let i = level_offset(l) as usize + c as usize;
-                cells[i] = Sums { tau: t, col, grad: g, err };
-                stored[i] = t / voxels * (1u32 << l) as f32;
+                cells[i] = Sums { tau: t, col, grad: g, err, axes };
+                // Mirror of `put_cell`.
+                let codes = axes.map(|a| tau_code(-(1.0 - a.min(0.999_999_9)).ln()));
+                stored[i] = tau_decode(codes[0]);
                 let base = (slot * LOD_CELLS + i) * CELL_WORDS;
-                pyramid[base] = stored[i].to_bits();
-                pyramid[base + 1] = unorm16(straight.x) | unorm16(straight.y) << 16;
-                pyramid[base + 2] = unorm16(straight.z) | pack_normal(g) << 16;
+                pyramid[base] = codes[0] | codes[1] << 16;
+                pyramid[base + 1] = codes[2] | pack_normal(g) << 16;
+                pyramid[base + 2] = unorm10(straight.x) | unorm10(straight.y) << 10 | unorm10(straight.z) << 20;
             }
         }
         let mut s = [fine.iter().filter(|f| f.tau > 0.0).count() as u32 * (1 << 16), 0, 0, 0];
@@ -363,7 +418,14 @@ pub fn brick_lod_params(
             [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
         );
         let grow = if v[1] & VOXEL_MORPHS != 0 { inputs.splat_growth(at, level) } else { 1.0 };
-        let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16);
+        let (f, grid) = (inputs.frame, super::splat_params::frame_grid(inputs.frame));
+        let view = if f.eye[3] > 0.5 {
+            grid.point(at) - Vec3::new(f.eye[0], f.eye[1], f.eye[2])
+        } else {
+            Vec3::new(f.forward[0], f.forward[1], f.forward[2])
+        };
+        let view = grid.index_dir(view.as_dvec3()).as_vec3();
+        let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16, view);
         if shaded {
             inputs.shade(&mut c, normal);
         }
