@@ -95,6 +95,9 @@ impl Engine for Split<'_> {
     fn upload(&mut self, res: Res, data: &[u32]) -> Result<()> {
         self.active().upload(res, data)
     }
+    fn upload_regions(&mut self, res: Res, data: &[u32], regions: &[[u64; 3]]) -> Result<()> {
+        self.active().upload_regions(res, data, regions)
+    }
     fn run(&mut self, d: &Dispatch) -> Result<()> {
         if !self.switched && d.stage == self.at {
             self.switch()?;
@@ -194,6 +197,12 @@ impl Engine for Stop<'_> {
             return Ok(());
         }
         self.inner.upload(res, data)
+    }
+    fn upload_regions(&mut self, res: Res, data: &[u32], regions: &[[u64; 3]]) -> Result<()> {
+        if self.done {
+            return Ok(());
+        }
+        self.inner.upload_regions(res, data, regions)
     }
     fn run(&mut self, d: &Dispatch) -> Result<()> {
         if d.stage == self.after {

@@ -314,6 +314,8 @@ pub struct BrickScene {
     part: [[u32; 3]; 2],
     /// The k-d tree that orders the bricks (`kdtree`).
     tree: Vec<crate::kdtree::Node>,
+    /// Which bricks' records a device holds when the store streams (`RecordCache`).
+    pub(crate) records_cache: crate::residency::CacheCell,
 }
 
 /// The next `BrickScene::classification` (0 is never one).
@@ -440,6 +442,7 @@ impl BrickScene {
             drawn: std::sync::OnceLock::new(),
             gmax: std::sync::OnceLock::new(),
             classification: next_classification(),
+            records_cache: Default::default(),
             part: [[0; 3], store_bricks(&store)],
             tree: crate::kdtree::build(store_bricks(&store), 1, |id| store.index[id] != u32::MAX),
             store,

@@ -114,6 +114,19 @@ impl Engine for CpuEngine<'_> {
         Ok(())
     }
 
+    fn upload_regions(&mut self, res: Res, data: &[u32], regions: &[[u64; 3]]) -> Result<()> {
+        self.live.insert(res);
+        let buf = self.b.bufs.entry(res).or_default();
+        for &[src, dst, words] in regions {
+            let (src, dst, n) = (src as usize, dst as usize, words as usize);
+            let (Some(from), Some(to)) = (data.get(src..src + n), buf.get_mut(dst..dst + n)) else {
+                return Err(Error::InvalidArgument(format!("an upload region outside {res:?} or its data")));
+            };
+            to.copy_from_slice(from);
+        }
+        Ok(())
+    }
+
     fn run(&mut self, d: &Dispatch) -> Result<()> {
         let t = Instant::now();
         let desc = d.stage.desc();

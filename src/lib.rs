@@ -55,6 +55,7 @@ pub mod plan;
 pub mod raster;
 pub mod recording;
 pub mod resample;
+mod residency;
 pub mod scene;
 pub mod slab;
 pub mod stages;

@@ -443,6 +443,10 @@ pub struct FrameStats {
     pub splats: u64,
     /// Batches (waves) the visible bricks were drawn in, front to back.
     pub waves: u32,
+    /// Bytes of brick records uploaded: a streamed store's bricks its record cache lacked.
+    pub bytes_uploaded: u64,
+    /// Bytes of brick records its record cache holds after the frame (whole-brick slots).
+    pub records_resident: u64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -626,6 +626,9 @@ pub trait Engine {
     fn fill(&mut self, res: Res, range: Option<(u64, u64)>, value: u32) -> Result<()>;
     /// Write host data into `res` from its start.
     fn upload(&mut self, res: Res, data: &[u32]) -> Result<()>;
+    /// Write `words` words of `data` from word `src` into `res` at word `dst`, for each region
+    /// `[src, dst, words]`, keeping the rest of `res` (which already holds them: `ensure`).
+    fn upload_regions(&mut self, res: Res, data: &[u32], regions: &[[u64; 3]]) -> Result<()>;
     /// Run (or queue) one stage dispatch.
     fn run(&mut self, dispatch: &Dispatch) -> Result<()>;
     /// Finish the work so far and read the first `words` 32-bit words of each resource.

@@ -507,3 +507,49 @@ fn a_built_in_scene_as_a_palette_volume_classifies_back_to_its_splats() {
     assert!(matches!(err, voxsplat::Error::InvalidArgument(_)), "{err}");
     assert!(err.to_string().contains("more than 64 colours"), "{err}");
 }
+
+/// A streamed store keeps the records it used on the device (`RecordCache`): the same view again
+/// uploads none, a turned view only those its cache lacks, and the frames are the resident
+/// store's bit for bit. (The CPU engine keeps nothing between frames: it uploads every frame.)
+#[test]
+fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
+    let vol = blob([120, 110, 100]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    let mut turned = cam;
+    turned.eye = cam.target + glam::Quat::from_rotation_y(0.35) * (cam.eye - cam.target);
+    for gpu in [true, false] {
+        let mut resident = renderer(gpu, None);
+        resident.set_volume(&vol, &tf(), None).unwrap();
+        let records = resident.volume().unwrap().store.records.len() as u64 * 4;
+        let budget = 2 * records - 1;
+        let mut streamed = renderer(gpu, Some(budget));
+        streamed.set_volume(&vol, &tf(), None).unwrap();
+        assert!(streamed.volume().unwrap().streams(budget), "the store streams");
+        // Levels of detail (the error bound lifted) keep the far bricks coarse: their cells need
+        // no records, and the near bricks' fit the cache.
+        let mut o = compute(Direction::FrontToBack);
+        (o.lod_pixels, o.lod_error) = (1.0, 100.0);
+        let first = streamed.render(&cam, &o).unwrap();
+        let again = streamed.render(&cam, &o).unwrap();
+        let want = resident.render(&cam, &o).unwrap().image;
+        assert!(want.pixels == first.image.pixels, "gpu {gpu}: the streamed frame is not the resident store's");
+        assert!(want.pixels == again.image.pixels, "gpu {gpu}: the cached frame is not the resident store's");
+        let t = streamed.render(&turned, &o).unwrap();
+        assert!(resident.render(&turned, &o).unwrap().image.pixels == t.image.pixels, "gpu {gpu}: turned");
+        if gpu {
+            let st = again.stats;
+            assert!(first.stats.bytes_uploaded > 0 && st.records_resident > 0, "{:?}", first.stats);
+            assert!(st.bricks_visible > st.bricks_coarse, "some bricks draw their voxels: {st:?}");
+            assert_eq!(st.bytes_uploaded, 0, "the same view again uploads nothing ({st:?})");
+            // Every fine brick's records, were none cached.
+            let fine = |s: &voxsplat::FrameStats| (s.bricks_visible - s.bricks_coarse) as u64;
+            assert!(
+                t.stats.bytes_uploaded * 2 < fine(&t.stats) * st.records_resident / fine(&st),
+                "a 20-degree turn re-uploads {} bytes ({:?})",
+                t.stats.bytes_uploaded,
+                t.stats
+            );
+            assert_clean(&streamed);
+        }
+    }
+}

@@ -309,6 +309,52 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     ))
 }
 
+/// Orbit `path` (preset `tf`) in `steps` equal steps about its framing camera's up axis at the
+/// default settings within `budget_bytes`: per frame its time, splats, and the bytes of brick
+/// records it uploaded against those the record cache holds after it (a streamed store); then the
+/// largest fraction after the first frame. A markdown table on stdout.
+pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, steps: u32) -> Result<String> {
+    if !(1..=3600).contains(&steps) {
+        return Err(Error::InvalidArgument(format!("--orbit {steps}: between 1 and 3600 steps")));
+    }
+    let tf = TransferFunction::preset(tf)?;
+    let l = load(path, &tf)?;
+    let grid = l.scene.store.grid()?;
+    let cam = Camera::framing(&grid, size, size);
+    let mut o = RendererOptions::default();
+    o.gpu_budget_bytes = budget_bytes;
+    let mut r = Renderer::new(&o)?;
+    r.set_bricks(l.scene)?;
+    let opts = RenderOptions::default();
+    let mut out = String::from(
+        "| frame | degrees | ms | splats | record MiB uploaded | record MiB held | uploaded / held |\n|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let mut worst = 0.0f64;
+    for i in 0..steps {
+        let angle = i as f32 * std::f32::consts::TAU / steps as f32;
+        let mut c = cam;
+        c.eye = cam.target + glam::Quat::from_axis_angle(cam.up.normalize(), angle) * (cam.eye - cam.target);
+        let t = Instant::now();
+        let st = r.render(&c, &opts)?.stats;
+        let (up, held) = (st.bytes_uploaded as f64, st.records_resident as f64);
+        let fraction = if held > 0.0 { up / held } else { 0.0 };
+        if i > 0 {
+            worst = worst.max(fraction);
+        }
+        out += &format!(
+            "| {i} | {:.0} | {:.0} | {} | {:.1} | {:.1} | {:.3} |\n",
+            angle.to_degrees(),
+            ms(t),
+            st.splats,
+            up / 1048576.0,
+            held / 1048576.0,
+            fraction
+        );
+    }
+    out += &format!("\nlargest upload after the first frame: {:.1} % of the records held\n", worst * 100.0);
+    Ok(out)
+}
+
 /// Rows `voxels,vtk_ms,voxsplat_ms` of the bricked-volume scaling CSV (`scripts/bricks-vtk.sh`),
 /// after a header line.
 pub fn read_scaling_csv(csv: &Path) -> Result<Vec<(f64, f64, f64)>> {

@@ -177,6 +177,11 @@ enum Command {
         /// Transfer-function preset for --volume.
         #[arg(long, default_value = "ramp")]
         tf: String,
+        /// With --volume: orbit it in this many steps at the default settings, one line per
+        /// frame with the bytes of brick records it uploaded (a store that streams through the
+        /// budget keeps the records it used in a cache on the device).
+        #[arg(long, requires = "volume")]
+        orbit: Option<u32>,
         /// Chart of the levels-of-detail study on peer256 (its markdown links it as bench/FILE).
         #[arg(long)]
         lod_chart: Option<PathBuf>,
@@ -570,6 +575,13 @@ fn run(cli: Cli) -> Result<()> {
                         st.splats, st.bricks_visible, st.bricks, st.bricks_coarse, st.bricks_hidden, st.waves
                     );
                 }
+                if st.records_resident > 0 {
+                    println!(
+                        "brick records: {:.1} MiB uploaded, {:.1} MiB held on the device",
+                        st.bytes_uploaded as f64 / 1048576.0,
+                        st.records_resident as f64 / 1048576.0
+                    );
+                }
                 if !wall.is_empty() {
                     let n = wall.len();
                     // Not a stage line: scripts sum those.
@@ -813,9 +825,14 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => {
             voxsplat_cli::bricked::scaling_chart(&csv, &svg)
         }
-        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, lod_chart, .. } => {
+        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, orbit, lod_chart, .. } => {
             if frames < 1 || size < 16 {
                 return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
+            }
+            if let (Some(v), Some(steps)) = (&volume, orbit) {
+                let budget = mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?;
+                print!("{}", voxsplat_cli::bricked::orbit(v, size, budget, &tf, steps)?);
+                return Ok(());
             }
             match volume {
                 Some(v) => println!(

@@ -63,7 +63,8 @@ fn unorm10(v: f32) -> u32 {
 /// Mirror of `tau_code`: a cell's optical depth in 16 bits (exponent 2^-23..2^7, 11 bits of
 /// mantissa, rounded; 0 for none).
 pub fn tau_code(t: f32) -> u32 {
-    if !(t >= 1.192_092_9e-7) {
+    // NaN too.
+    if t.partial_cmp(&1.192_092_9e-7).is_none_or(|o| o == std::cmp::Ordering::Less) {
         return 0;
     }
     let b = t.min(255.0).to_bits();

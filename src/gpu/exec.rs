@@ -18,6 +18,8 @@ enum Cmd {
     Run(Dispatch),
     Fill(Res, Option<(u64, u64)>, u32),
     Upload(Res, Buffer),
+    /// Copy regions (source, destination, size in bytes) of a staging buffer into a resource.
+    UploadRegions(Res, Buffer, Vec<[u64; 3]>),
     /// Copy the first bytes of a resource to its readback buffer.
     Copy(Res, u64),
     /// Blit the accumulation image into the host's image (`GpuEngine::target`).
@@ -241,6 +243,10 @@ fn record(
             }
             rec.barrier(Stage::Transfer, Stage::All);
         }
+        Cmd::UploadRegions(r, staging, regions) => {
+            rec.copy_buffer_regions(staging, res.buffer(*r)?, regions);
+            rec.barrier(Stage::Transfer, Stage::All);
+        }
         Cmd::Copy(r, bytes) => {
             let back = res.readback(*r)?;
             rec.barrier(Stage::All, Stage::Transfer);
@@ -322,6 +328,22 @@ impl Engine for GpuEngine<'_> {
         let staging =
             Buffer::with_data(&self.gpu.ctx, &format!("{res:?} upload"), bytemuck::cast_slice(data), BU::TRANSFER_SRC)?;
         self.pending.push(("", Cmd::Upload(res, staging)));
+        Ok(())
+    }
+
+    fn upload_regions(&mut self, res: Res, data: &[u32], regions: &[[u64; 3]]) -> Result<()> {
+        self.live.insert(res);
+        let size = self.gpu.res.buffer(res)?.size();
+        let bytes: Vec<[u64; 3]> = regions.iter().map(|r| r.map(|w| w * 4)).collect();
+        if bytes.iter().any(|&[src, dst, n]| src + n > data.len() as u64 * 4 || dst + n > size) {
+            return Err(Error::InvalidArgument(format!("an upload region outside {res:?} or its data")));
+        }
+        if bytes.iter().all(|r| r[2] == 0) {
+            return Ok(());
+        }
+        let staging =
+            Buffer::with_data(&self.gpu.ctx, &format!("{res:?} upload"), bytemuck::cast_slice(data), BU::TRANSFER_SRC)?;
+        self.pending.push(("", Cmd::UploadRegions(res, staging, bytes)));
         Ok(())
     }
 

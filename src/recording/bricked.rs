@@ -5,6 +5,9 @@ use crate::bricks::{slot_entry, BrickScene, BRICK};
 use crate::constants::{MAX_GPU_SPLATS, PYRAMID_PAGE, PYRAMID_PAGES};
 use crate::cpu::lod::{pyramid_bytes, LOD_BUFFERS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
 use crate::options::FrameStats;
+use crate::residency::{RecordCache, SLOT_WORDS};
+use std::cell::Cell;
+use std::sync::Mutex;
 
 /// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
 /// voxel (8), and for the tile compositor its screen quad (80) and about four tile entries (the
@@ -117,6 +120,18 @@ pub(super) fn record_bricks(
         )));
     }
     let available = budget - bricked_resident_bytes(scene, budget, w, h) - pyramid;
+    let range = e.limits().max_storage_range;
+    // A streamed store's records live in a cache of whole-brick slots across frames (half of
+    // what the batches leave, one binding at most): a batch uploads only the bricks it lacks.
+    let (available, cache_slots) = if streamed {
+        let slot = SLOT_WORDS * 4;
+        let brick = (BRICK as u64).pow(3) * BATCH_BYTES_PER_SPLAT;
+        let most = (range / slot).min(headers as u64).min(u32::MAX as u64).max(1);
+        let slots = (available.saturating_sub(brick) / 2 / slot).clamp(1, most);
+        (available - slots * slot, slots as u32)
+    } else {
+        (available, 0)
+    };
     let frame = plan::frame_for(&prep.set, camera, opts);
     let mut bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
     if lod {
@@ -128,8 +143,21 @@ pub(super) fn record_bricks(
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
-    let range = e.limits().max_storage_range;
-    let cut = Cut { streamed, build, available, pyramid: batch_pyramid, range };
+    let cut = Cut {
+        streamed,
+        build,
+        available,
+        pyramid: batch_pyramid,
+        range,
+        cache: &scene.records_cache.0,
+        cache_slots,
+        uploaded: Cell::new(0),
+    };
+    if streamed {
+        e.ensure(Res::BatchRecords, cache_slots as u64 * SLOT_WORDS * 4)?;
+        let tag = cut.lock_cache().open(e.tag(Res::BatchRecords), cache_slots);
+        e.set_tag(Res::BatchRecords, tag);
+    }
     if lod {
         for &(res, per_brick) in lod_buffers {
             e.ensure(res, headers as u64 * per_brick)?;
@@ -148,6 +176,7 @@ pub(super) fn record_bricks(
                     let push = BrickPush { count: batch.len() as u32, splats: u32::from(!per_batch), ..all };
                     build_pyramids(e, build, &push)?;
                 }
+                cut.lock_cache().forget();
                 e.set_tag(Res::LodSummary, id);
             }
             // Per batch it holds batches' pyramids, not the store's.
@@ -207,7 +236,9 @@ pub(super) fn record_bricks(
         e.ensure(Res::BrickHidden, most_entries * 4)?;
     }
     if sheets {
-        let mut recorded = record_bricked_sheets(e, prep, scene, camera, opts, &frame, batches.concat(), cut)?;
+        let mut recorded = record_bricked_sheets(e, prep, scene, camera, opts, &frame, batches.concat(), &cut)?;
+        stats.bytes_uploaded = cut.uploaded.get();
+        stats.records_resident = cut.held_bytes();
         recorded.stats = stats;
         return Ok(recorded);
     }
@@ -259,6 +290,8 @@ pub(super) fn record_bricks(
         i += 1;
     }
     stats.waves = batches.len() as u32;
+    stats.bytes_uploaded = cut.uploaded.get();
+    stats.records_resident = cut.held_bytes();
     let mut recorded = finish(e, opts.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)?;
     recorded.stats = stats;
     Ok(recorded)
@@ -267,16 +300,35 @@ pub(super) fn record_bricks(
 /// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
 /// brick stages' build, the budget's bytes for batches, and each entry's pyramid bytes (a streamed
 /// store's levels of detail with pyramids built per batch, whose coarse entries need their records).
-struct Cut {
+struct Cut<'a> {
     streamed: bool,
     build: usize,
     available: u64,
     pyramid: u64,
     /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
     range: u64,
+    /// A streamed store's record cache (`RecordCache`), its slots, and the record bytes uploaded
+    /// so far this frame.
+    cache: &'a Mutex<RecordCache>,
+    cache_slots: u32,
+    uploaded: Cell<u64>,
 }
 
-impl Cut {
+impl Cut<'_> {
+    /// Bytes of the record cache's slots that hold a brick (0 when the store is resident).
+    fn held_bytes(&self) -> u64 {
+        if self.streamed {
+            self.lock_cache().held() as u64 * SLOT_WORDS * 4
+        } else {
+            0
+        }
+    }
+
+    /// The record cache (a poisoned lock: a panic elsewhere left it; its slots are still valid).
+    fn lock_cache(&self) -> std::sync::MutexGuard<'_, RecordCache> {
+        self.cache.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
     /// `entries` (header, -, -, voxels) cut, in their order, into batches of at most `capacity`
     /// splats within `available` bytes (header, first position in its batch, first record: in the
     /// store, or in the batch's records when they stream; voxels).
@@ -288,23 +340,27 @@ impl Cut {
         available: u64,
     ) -> Vec<Vec<[u32; 4]>> {
         let mut batches: Vec<Vec<[u32; 4]>> = vec![Vec::new()];
-        let (mut filled, mut records, mut bytes) = (0u32, 0u32, 0u64);
+        let (mut filled, mut slots, mut bytes) = (0u32, 0u32, 0u64);
         for [header, _, _, w] in entries {
             let n = w & 0xffff;
             let hd = &scene.store.headers[header as usize];
-            let recs = if self.uploads(w) { hd.count } else { 0 };
+            // A streamed brick's records take a slot of the cache, which holds the batch's.
+            let slot = u32::from(self.uploads(w));
             let per_splat = BATCH_BYTES_PER_SPLAT + if w >> 16 != 0 { LOD_SPLAT_BYTES } else { 0 };
-            let cost = n as u64 * per_splat + recs as u64 * 4 + self.pyramid;
+            let cost = n as u64 * per_splat + self.pyramid;
             let entries = batches.last().map_or(0, |b| b.len()) as u64 + 1;
-            let binding = (entries * 16).max(entries * self.pyramid).max((records + recs) as u64 * 4);
+            let binding = (entries * 16).max(entries * self.pyramid);
             let open = batches.last().is_some_and(|b| !b.is_empty());
-            if open && (filled + n > capacity || bytes + cost > available || binding > self.range) {
+            let full = slots + slot > self.cache_slots;
+            if open && (filled + n > capacity || bytes + cost > available || binding > self.range || full) {
                 batches.push(Vec::new());
-                (filled, records, bytes) = (0, 0, 0);
+                (filled, slots, bytes) = (0, 0, 0);
             }
-            let first = if self.streamed { records } else { hd.first };
+            // A streamed brick's first record is its slot's, known when the batch is placed
+            // (`upload_batch`).
+            let first = if self.streamed { 0 } else { hd.first };
             batches.last_mut().expect("one batch at least").push([header, filled, first, w]);
-            (filled, records, bytes) = (filled + n, records + recs, bytes + cost);
+            (filled, slots, bytes) = (filled + n, slots + slot, bytes + cost);
         }
         batches
     }
@@ -330,7 +386,7 @@ fn record_bricked_sheets(
     opts: &RenderOptions,
     frame: &Frame,
     visible: Vec<[u32; 4]>,
-    cut: Cut,
+    cut: &Cut,
 ) -> Result<Recorded> {
     let (w, h) = (camera.width, camera.height);
     let grid = prep.set.grid();
@@ -371,7 +427,7 @@ fn record_bricked_sheets(
         let part = &parts[0];
         let n = batch_splats(part);
         if n > 0 {
-            record_brick_batch(e, scene, part, &cut)?;
+            record_brick_batch(e, scene, part, cut)?;
         }
         let pc = geometry(n)?;
         let starts = record_slab_bins(e, &pc, variant)?;
@@ -418,7 +474,7 @@ fn record_bricked_sheets(
         for (k, part) in cut.batches(scene, near, MAX_GPU_SPLATS, available).iter().enumerate() {
             let n = batch_splats(part);
             if n > 0 {
-                record_brick_batch(e, scene, part, &cut)?;
+                record_brick_batch(e, scene, part, cut)?;
             }
             let starts = record_slab_bins(e, &geometry(n)?, variant)?;
             let (first, end) = (starts[p0 as usize], starts[p1 as usize + 1]);
@@ -488,9 +544,10 @@ fn build_pyramids(e: &mut dyn Engine, build: usize, push: &BrickPush) -> Result<
     e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(push)))
 }
 
-/// A streamed store's batch on the device: its bricks' records in `batch`'s order (the entries'
-/// first records count in it; `Cut::uploads`), `list` (the same entries in any order), and room
-/// for their pyramids when each batch builds its own.
+/// A streamed store's batch on the device: the records of its bricks that read them (`Cut::uploads`)
+/// placed in the record cache, uploading those it lacks; `list` (the same entries in any order)
+/// with each such entry's first record at its slot; and room for their pyramids when each batch
+/// builds its own.
 fn upload_batch(
     e: &mut dyn Engine,
     scene: &BrickScene,
@@ -499,17 +556,22 @@ fn upload_batch(
     cut: &Cut,
 ) -> Result<()> {
     let s = &scene.store;
-    let recs: Vec<u32> = batch
-        .iter()
-        .filter(|l| cut.uploads(l[3]))
-        .flat_map(|l| {
-            let hd = &s.headers[l[0] as usize];
-            s.records[hd.first as usize..(hd.first + hd.count) as usize].iter().copied()
-        })
-        .collect();
+    let readers: Vec<u32> = batch.iter().filter(|l| cut.uploads(l[3])).map(|l| l[0]).collect();
+    let (slots, new) = cut.lock_cache().place(&readers)?;
+    let (mut data, mut regions) = (Vec::new(), Vec::with_capacity(new.len()));
+    for (i, slot) in new {
+        let hd = &s.headers[readers[i] as usize];
+        regions.push([data.len() as u64, slot as u64 * SLOT_WORDS, hd.count as u64]);
+        data.extend_from_slice(&s.records[hd.first as usize..(hd.first + hd.count) as usize]);
+    }
+    e.upload_regions(Res::BatchRecords, &data, &regions)?;
+    cut.uploaded.set(cut.uploaded.get() + data.len() as u64 * 4);
+    let first: std::collections::HashMap<u32, u32> =
+        readers.iter().zip(&slots).map(|(&h, &slot)| (h, slot * SLOT_WORDS as u32)).collect();
+    let list: Vec<[u32; 4]> =
+        list.iter().map(|&[h, pos, f, w]| [h, pos, first.get(&h).copied().unwrap_or(f), w]).collect();
     e.ensure(Res::BrickList, list.len().max(1) as u64 * 16)?;
-    e.upload(Res::BrickList, bytemuck::cast_slice(list))?;
-    e.upload(Res::BatchRecords, &recs)?;
+    e.upload(Res::BrickList, bytemuck::cast_slice(&list))?;
     if cut.pyramid > 0 {
         e.ensure(Res::Pyramid, list.len().max(1) as u64 * cut.pyramid)?;
     }

@@ -127,6 +127,20 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_copy_buffer(self.cmd, src.raw, dst.raw, &region) };
     }
 
+    /// Copy `regions` (source offset, destination offset, size, in bytes) of `src` into `dst`.
+    pub fn copy_buffer_regions(&self, src: &Buffer, dst: &Buffer, regions: &[[u64; 3]]) {
+        let regions: Vec<vk::BufferCopy> = regions
+            .iter()
+            .filter(|r| r[2] > 0 && r[0] + r[2] <= src.size() && r[1] + r[2] <= dst.size())
+            .map(|&[src_offset, dst_offset, size]| vk::BufferCopy { src_offset, dst_offset, size })
+            .collect();
+        if regions.is_empty() {
+            return;
+        }
+        // SAFETY: both buffers alive for the submission; every region within both (filtered).
+        unsafe { self.ctx.device.cmd_copy_buffer(self.cmd, src.raw, dst.raw, &regions) };
+    }
+
     /// Copy layer 0 of `image` (in `layout`) to `buffer`.
     pub fn copy_image_to_buffer(&self, image: &Image, layout: vk::ImageLayout, buffer: &Buffer) {
         self.copy_raw_to_buffer(image.raw, (image.width, image.height), layout, buffer);
