@@ -80,7 +80,7 @@ uint unorm10(float v) {
 
 // Cell i: its sums (t, col, g), error and axis opacities (for the level above), and its pyramid
 // words at `slot`.
-void put_cell(uint slot, uint i, float t, vec3 col, vec3 g, float err, vec3 axes) {
+void put_cell(uint slot, uint h, uint i, float t, vec3 col, vec3 g, float err, vec3 axes) {
     tau_l[i] = t;
     col_l[i] = col;
     grad_l[i] = g;
@@ -92,10 +92,13 @@ void put_cell(uint slot, uint i, float t, vec3 col, vec3 g, float err, vec3 axes
     }
     stored_l[i] = tau_decode(codes[0]);
     vec3 straight = t > 0.0 ? col / t : vec3(0.0);
-    uint base = (slot * LOD_CELLS + i) * CELL_WORDS;
-    pyramid_put(base, codes[0] | (codes[1] << 16u));
-    pyramid_put(base + 1u, codes[2] | (pack_normal(g) << 16u));
-    pyramid_put(base + 2u, unorm10(straight.r) | (unorm10(straight.g) << 10u) | (unorm10(straight.b) << 20u));
+    uint words[3] = uint[3](codes[0] | (codes[1] << 16u), codes[2] | (pack_normal(g) << 16u),
+                            unorm10(straight.r) | (unorm10(straight.g) << 10u) | (unorm10(straight.b) << 20u));
+    // Level 1 into the pyramid's slot, levels 2 and 3 into the brick's resident summary.
+    for (uint k = 0u; k < 3u; ++k) {
+        if (i < SLOT_CELLS) pyramid_put((slot * SLOT_CELLS + i) * CELL_WORDS + k, words[k]);
+        else lod_words[h * SUMMARY_WORDS + 4u + (i - SLOT_CELLS) * CELL_WORDS + k] = words[k];
+    }
 }
 
 // The error of a cell of mean opacity a and colour straight against a child (sums tk, ck; error
@@ -171,7 +174,7 @@ void main() {
         float err = 0.0;
         for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0));
         vec3 axes = vec3(axis_opacity(ak, 0u), axis_opacity(ak, 1u), axis_opacity(ak, 2u));
-        put_cell(slot, c, t, col, g, err, axes);
+        put_cell(slot, h, c, t, col, g, err, axes);
         drawn_1[c] = drawn;
     }
     barrier();
@@ -203,7 +206,7 @@ void main() {
                 for (uint d = 0u; d < 8u; ++d) ak[d] = axis_l[3u * child(l, cc, n, d) + x];
                 axes[x] = axis_opacity(ak, x);
             }
-            put_cell(slot, level_offset(l) + c, t, col, g, err, axes);
+            put_cell(slot, h, level_offset(l) + c, t, col, g, err, axes);
         }
         barrier();
     }
@@ -222,7 +225,7 @@ void main() {
             s.x |= drawn << (l == 1u ? 0u : (l == 2u ? 8u : 12u));
             s[l] = floatBitsToUint(most);
         }
-        lod_summary[h] = s;
+        for (uint k = 0u; k < 4u; ++k) lod_words[h * SUMMARY_WORDS + k] = s[k];
 #ifdef STREAMED_STORE
         pyramid_slot[h] = slot;
 #endif

@@ -489,7 +489,7 @@ fn coarse_cells_cover_what_their_voxels_cover_along_each_axis() {
         cells.push(r.probe(&cam, &o, StageId::BrickPyramid, &[Res::Pyramid]).unwrap().remove(0));
     }
     // 64 bricks, all holding rods.
-    let words = 64 * voxsplat::cpu::lod::LOD_CELLS * voxsplat::cpu::lod::CELL_WORDS;
+    let words = 64 * voxsplat::cpu::lod::SLOT_CELLS * voxsplat::cpu::lod::CELL_WORDS;
     assert!(cells[0][..words] == cells[1][..words], "GPU vs mirror pyramid");
     let alpha = |code: u32| 1.0 - (-voxsplat::cpu::lod::tau_decode(code)).exp();
     let pyramid = &cells[0];

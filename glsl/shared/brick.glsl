@@ -206,8 +206,11 @@ vec4 classify_voxel(ivec3 v, uint q, bool shaded) {
 // so a cell keeps three (brick_pyramid), and one colour and normal over the six directions. Words:
 // tau_code along x | along y << 16 (optical depth per cell length), along z | octahedral normal
 // << 16 (snorm 8 + 8), straight colour (unorm 10:10:10).
-// A summary per brick: x: drawn cells of level 1 | level 2 << 8 | level 3 << 12 | drawn voxels
-// << 16; yzw: the largest error of levels 1..3.
+// Level 1 (64 cells) lives in the pyramid's slot of the brick; levels 2 and 3 (9 cells), with a
+// summary, in the brick's SUMMARY_WORDS of LodSummary, which stays resident whatever the budget,
+// so a brick drawn at level 2 or 3 never needs its records: words 0..3, x: drawn cells of level 1
+// | level 2 << 8 | level 3 << 12 | drawn voxels << 16, yzw: the largest error of levels 1..3;
+// words 4..30: the 9 cells.
 // Built by brick_pyramid when the classification changes. Mirror: cpu::lod.
 // Up to 4 storage bindings of PYRAMID_PAGE words (one binding may not pass maxStorageBufferRange).
 layout(std430, binding = 24) buffer Pyramid { uint pyramid_0[]; };
@@ -236,8 +239,16 @@ void pyramid_put(uint i, uint v) {
 }
 // A batch's coarse splats' positions (brick_lod_params).
 layout(std430, binding = 31) readonly buffer LodSplats { uint lod_splats[]; };
-layout(std430, binding = 25) buffer LodSummary { uvec4 lod_summary[]; };
+layout(std430, binding = 25) buffer LodSummary { uint lod_words[]; };
 const uint LOD_CELLS = 73u;
+// Cells in a brick's pyramid slot (level 1), and words per brick of LodSummary.
+const uint SLOT_CELLS = 64u;
+const uint SUMMARY_WORDS = 32u;
+
+uvec4 lod_summary(uint h) {
+    uint b = h * SUMMARY_WORDS;
+    return uvec4(lod_words[b], lod_words[b + 1u], lod_words[b + 2u], lod_words[b + 3u]);
+}
 const uint CELL_WORDS = 3u;
 // The octahedral bytes of a zero gradient (-128 is never written for a unit vector).
 const uint NO_NORMAL = 0x8080u;
@@ -304,7 +315,7 @@ float splat_growth(vec3 at, uint l) {
 
 // Drawn cells of level l in header h's brick (level 0: its drawn voxels).
 uint level_count(uint h, uint l) {
-    uint x = lod_summary[h].x;
+    uint x = lod_words[h * SUMMARY_WORDS];
     if (l == 0u) return x >> 16u;
     return l == 1u ? x & 255u : (l == 2u ? (x >> 8u) & 15u : (x >> 12u) & 1u);
 }
@@ -339,10 +350,17 @@ float tau_decode(uint code) {
     return code == 0u ? 0.0 : uintBitsToFloat((code + (103u << 11u)) << 12u);
 }
 
+// Word k of cell i (level_offset) of header h's pyramid: level 1 in its pyramid slot, levels 2
+// and 3 in its summary.
+uint cell_word(uint h, uint i, uint k) {
+    if (i < SLOT_CELLS) return pyramid_word((pyramid_index(h) * SLOT_CELLS + i) * CELL_WORDS + k);
+    return lod_words[h * SUMMARY_WORDS + 4u + (i - SLOT_CELLS) * CELL_WORDS + k];
+}
+
 // Cell i of header h's pyramid: its optical depth per cell length along x (0 when it draws
 // nothing; every axis's is 0 together).
 float cell_tau(uint h, uint i) {
-    return tau_decode(pyramid_word((pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS) & 0xffffu);
+    return tau_decode(cell_word(h, i, 0u) & 0xffffu);
 }
 
 // Octahedral normals fold the lower hemisphere with the signs of x and y, 0 counted positive.
@@ -363,10 +381,9 @@ vec3 unpack_normal(uint w) {
 // by the squares of the view's components; returns straight colour and optical depth per cell
 // length.
 vec4 cell_color(uint h, uint i, vec3 view, out vec3 normal) {
-    uint base = (pyramid_index(h) * LOD_CELLS + i) * CELL_WORDS;
-    uint xy = pyramid_word(base);
-    uint zn = pyramid_word(base + 1u);
-    uint c = pyramid_word(base + 2u);
+    uint xy = cell_word(h, i, 0u);
+    uint zn = cell_word(h, i, 1u);
+    uint c = cell_word(h, i, 2u);
     vec3 w = view * view / max(dot(view, view), 1e-30);
     vec3 tau = vec3(tau_decode(xy & 0xffffu), tau_decode(xy >> 16u), tau_decode(zn & 0xffffu));
     float trans = dot(w, exp(-min(tau, vec3(80.0))));
@@ -407,7 +424,7 @@ uint brick_level(uint h, uvec3 b, out float morph) {
     voxel_box(b, lo, hi);
     vec2 depths = box_depths(lo, hi);
     float px = voxel_pixels(depths.x);
-    uvec4 s = lod_summary[h];
+    uvec4 s = lod_summary(h);
     uint level = 0u;
     for (uint l = 1u; l <= 3u; ++l) {
         if (px * float(1u << l) > bf.grad.y || uintBitsToFloat(s[l]) > bf.grad.z) break;

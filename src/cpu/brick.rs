@@ -67,7 +67,7 @@ pub struct BrickInputs<'a> {
     pub store: &'a BrickStore,
     /// Levels of detail: the pyramid cells and per-brick summaries (empty when off).
     pub pyramid: &'a [u32],
-    pub summary: &'a [[u32; 4]],
+    pub summary: &'a [u32],
     /// Per brick its splats' morph this frame (`brick_cull`).
     pub morphs: &'a [f32],
     /// The k-d tree that orders the bricks (`BrickScene::tree`).

@@ -20,21 +20,29 @@ pub const LOD_LEVELS: u32 = 3;
 /// The octahedral bytes of a zero gradient.
 const NO_NORMAL: u32 = 0x8080;
 
-/// Bytes of one brick's pyramid cells.
-pub const PYRAMID_BYTES: u64 = (LOD_CELLS * CELL_WORDS * 4) as u64;
+/// Cells of a brick's pyramid slot (level 1); levels 2 and 3 live in its summary.
+pub const SLOT_CELLS: usize = 64;
+/// Words per brick of the summary: 4 of summary, the 9 cells of levels 2 and 3, one spare.
+pub const SUMMARY_WORDS: usize = 32;
+/// Bytes of one brick's pyramid slot.
+pub const PYRAMID_BYTES: u64 = (SLOT_CELLS * CELL_WORDS * 4) as u64;
+/// Bytes of one brick's summary (resident whatever the budget).
+pub const SUMMARY_BYTES: u64 = SUMMARY_WORDS as u64 * 4;
 
 /// The buffers levels of detail add, and their bytes per non-empty brick: the pyramid's cells, its
 /// summary, this frame's morph.
-pub const LOD_BUFFERS: &[(Res, u64)] = &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, 16), (Res::BrickMorph, 4)];
+pub const LOD_BUFFERS: &[(Res, u64)] =
+    &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, SUMMARY_BYTES), (Res::BrickMorph, 4)];
 
 /// The same for a store whose records stream, its pyramid resident: and each brick's slot
 /// (its own header).
 pub const SLOTTED_LOD_BUFFERS: &[(Res, u64)] =
-    &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, 16), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
+    &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, SUMMARY_BYTES), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
 
 /// The same for a streamed store whose pyramid holds one batch's bricks (`PYRAMID_BYTES` per
 /// entry of the batch): the summary, the morph, and each brick's slot in the batch.
-pub const STREAMED_LOD_BUFFERS: &[(Res, u64)] = &[(Res::LodSummary, 16), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
+pub const STREAMED_LOD_BUFFERS: &[(Res, u64)] =
+    &[(Res::LodSummary, SUMMARY_BYTES), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
 
 /// Resident device bytes of `buffers` for `bricks` non-empty bricks.
 pub fn pyramid_bytes(buffers: &[(Res, u64)], bricks: usize) -> u64 {
@@ -118,26 +126,39 @@ fn unpack_normal(w: u32) -> Vec3 {
     n.normalize()
 }
 
-/// Mirror of `cell_color`: cell `i` of header `h` seen along `view` (index space): straight
-/// colour, optical depth per cell length, and its normal (zero when it has none).
-pub fn cell_color(pyramid: &[u32], h: u32, i: u32, view: Vec3) -> ([f32; 4], Vec3) {
-    let base = (h as usize * LOD_CELLS + i as usize) * CELL_WORDS;
-    let (xy, zn, c) = (pyramid[base], pyramid[base + 1], pyramid[base + 2]);
-    let w = view * view / view.dot(view).max(1e-30);
-    let tau = Vec3::new(tau_decode(xy & 0xffff), tau_decode(xy >> 16), tau_decode(zn & 0xffff));
-    let trans = w.dot((-tau.min(Vec3::splat(80.0))).exp());
-    let rgb = [c & 1023, c >> 10 & 1023, c >> 20 & 1023].map(|q| q as f32 / 1023.0);
-    ([rgb[0], rgb[1], rgb[2], -trans.max(1e-30).ln()], unpack_normal(zn >> 16))
+/// Mirror of `cell_word`: word `k` of cell `i` of the brick of header `h` whose pyramid slot is
+/// `slot`: level 1 in `pyramid`, levels 2 and 3 in `summary`.
+pub fn cell_word(pyramid: &[u32], summary: &[u32], slot: u32, h: u32, i: u32, k: usize) -> u32 {
+    let i = i as usize;
+    if i < SLOT_CELLS {
+        pyramid[(slot as usize * SLOT_CELLS + i) * CELL_WORDS + k]
+    } else {
+        summary[h as usize * SUMMARY_WORDS + 4 + (i - SLOT_CELLS) * CELL_WORDS + k]
+    }
 }
 
-/// Mirror of `cell_tau`: the optical depth per cell length along x.
-pub fn cell_tau(pyramid: &[u32], h: u32, i: u32) -> f32 {
-    tau_decode(pyramid[(h as usize * LOD_CELLS + i as usize) * CELL_WORDS] & 0xffff)
+impl BrickInputs<'_> {
+    /// Mirror of `cell_color`: cell `i` of header `h` seen along `view` (index space): straight
+    /// colour, optical depth per cell length, and its normal (zero when it has none).
+    pub fn cell_color(&self, h: u32, i: u32, view: Vec3) -> ([f32; 4], Vec3) {
+        let word = |k| cell_word(self.pyramid, self.summary, self.pyramid_index(h), h, i, k);
+        let (xy, zn, c) = (word(0), word(1), word(2));
+        let w = view * view / view.dot(view).max(1e-30);
+        let tau = Vec3::new(tau_decode(xy & 0xffff), tau_decode(xy >> 16), tau_decode(zn & 0xffff));
+        let trans = w.dot((-tau.min(Vec3::splat(80.0))).exp());
+        let rgb = [c & 1023, c >> 10 & 1023, c >> 20 & 1023].map(|q| q as f32 / 1023.0);
+        ([rgb[0], rgb[1], rgb[2], -trans.max(1e-30).ln()], unpack_normal(zn >> 16))
+    }
+
+    /// Mirror of `cell_tau`: the optical depth per cell length along x.
+    pub fn cell_tau(&self, h: u32, i: u32) -> f32 {
+        tau_decode(cell_word(self.pyramid, self.summary, self.pyramid_index(h), h, i, 0) & 0xffff)
+    }
 }
 
 /// Mirror of `level_count`.
-pub fn level_count(summary: &[[u32; 4]], h: u32, l: u32) -> u32 {
-    let x = summary[h as usize][0];
+pub fn level_count(summary: &[u32], h: u32, l: u32) -> u32 {
+    let x = summary[h as usize * SUMMARY_WORDS];
     match l {
         0 => x >> 16,
         1 => x & 255,
@@ -191,7 +212,8 @@ impl BrickInputs<'_> {
         let (lo, hi) = self.voxel_box(b);
         let (near, far) = self.box_depths(lo, hi);
         let px = self.voxel_pixels(near);
-        let s = self.summary[h as usize];
+        let at = h as usize * SUMMARY_WORDS;
+        let s = &self.summary[at..at + 4];
         let mut level = 0;
         for l in 1..=LOD_LEVELS {
             if px * (1u32 << l) as f32 > bf.grad[1] || f32::from_bits(s[l as usize]) > bf.grad[2] {
@@ -260,7 +282,7 @@ pub fn brick_pyramid(
     inputs: &BrickInputs<'_>,
     batch: Option<PyramidBatch<'_>>,
     pyramid: &mut [u32],
-    summary: &mut [[u32; 4]],
+    summary: &mut [u32],
 ) {
     let store = inputs.store;
     let shaded = inputs.bf.light[3] > 0.5;
@@ -331,10 +353,18 @@ pub fn brick_pyramid(
                 // Mirror of `put_cell`.
                 let codes = axes.map(|a| tau_code(-(1.0 - a.min(0.999_999_9)).ln()));
                 stored[i] = tau_decode(codes[0]);
-                let base = (slot * LOD_CELLS + i) * CELL_WORDS;
-                pyramid[base] = codes[0] | codes[1] << 16;
-                pyramid[base + 1] = codes[2] | pack_normal(g) << 16;
-                pyramid[base + 2] = unorm10(straight.x) | unorm10(straight.y) << 10 | unorm10(straight.z) << 20;
+                let words = [
+                    codes[0] | codes[1] << 16,
+                    codes[2] | pack_normal(g) << 16,
+                    unorm10(straight.x) | unorm10(straight.y) << 10 | unorm10(straight.z) << 20,
+                ];
+                // Level 1 into the pyramid's slot, levels 2 and 3 into the brick's summary.
+                let at = if i < SLOT_CELLS {
+                    &mut pyramid[(slot * SLOT_CELLS + i) * CELL_WORDS..][..CELL_WORDS]
+                } else {
+                    &mut summary[h * SUMMARY_WORDS + 4 + (i - SLOT_CELLS) * CELL_WORDS..][..CELL_WORDS]
+                };
+                at.copy_from_slice(&words);
             }
         }
         let mut s = [fine.iter().filter(|f| f.tau > 0.0).count() as u32 * (1 << 16), 0, 0, 0];
@@ -346,7 +376,7 @@ pub fn brick_pyramid(
             s[0] |= drawn << [0, 8, 12][l as usize - 1];
             s[l as usize] = most.to_bits();
         }
-        summary[h] = s;
+        summary[h * SUMMARY_WORDS..][..4].copy_from_slice(&s);
         if let Some(slots) = slots.as_deref_mut() {
             slots[h] = slot as u32;
         }
@@ -384,9 +414,7 @@ pub fn brick_cells(
                         let cc =
                             [axis(side[0], split[0], ti), axis(side[1], split[1], tj), axis(side[2], split[2], tk)];
                         let c = cc[0] + n * (cc[1] + n * cc[2]);
-                        if cell_tau(inputs.pyramid, inputs.pyramid_index(entry[0]), off + c).partial_cmp(&0.0)
-                            != Some(std::cmp::Ordering::Greater)
-                        {
+                        if inputs.cell_tau(entry[0], off + c).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                             continue;
                         }
                         let pos = entry[1] + if inputs.frame.split[3] != 0 { total - 1 - rank } else { rank };
@@ -426,7 +454,7 @@ pub fn brick_lod_params(
             Vec3::new(f.forward[0], f.forward[1], f.forward[2])
         };
         let view = grid.index_dir(view.as_dvec3()).as_vec3();
-        let (mut c, normal) = cell_color(inputs.pyramid, inputs.pyramid_index(h), v[1] >> 16, view);
+        let (mut c, normal) = inputs.cell_color(h, v[1] >> 16, view);
         if shaded {
             inputs.shade(&mut c, normal);
         }
@@ -463,7 +491,7 @@ pub(crate) fn brick_cells_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) 
 
 pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut pyramid, mut summary) = (b.take(Res::Pyramid), b.take(Res::LodSummary));
-    let summary_words = bytemuck::cast_slice_mut(&mut summary);
+    let summary_words = &mut summary[..];
     if streamed(v) {
         let mut slots = b.take(Res::PyramidSlot);
         let batch = Some(PyramidBatch { list: b.get(Res::BrickList), push: args.push_as(), slots: &mut slots });

@@ -365,9 +365,10 @@ impl Cut<'_> {
         batches
     }
 
-    /// Whether an entry (splats | level << 16) uploads its brick's records.
+    /// Whether an entry (splats | level << 16) uploads its brick's records: its voxels, or with
+    /// per-batch pyramids its level-1 cells (levels 2 and 3 stay resident in the summaries).
     fn uploads(&self, w: u32) -> bool {
-        self.streamed && (w >> 16 == 0 || self.pyramid > 0)
+        self.streamed && (w >> 16 == 0 || (self.pyramid > 0 && w >> 16 == 1))
     }
 }
 
@@ -500,9 +501,11 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, n as u64 * 4)?;
     e.ensure(Res::BrickVoxels, n as u64 * 8)?;
-    // Voxel bricks first (brick_order's workgroups), then coarse ones (brick_cells' lanes): each
-    // entry names its own first position, so the list's order is free.
-    let (fine, coarse): (Vec<[u32; 4]>, Vec<[u32; 4]>) = batch.iter().partition(|l| l[3] >> 16 == 0);
+    // Voxel bricks first (brick_order's workgroups), then coarse ones (brick_cells' lanes), level 1
+    // before levels 2 and 3 (per-batch pyramids build level 1's only): each entry names its own
+    // first position, so the list's order is free.
+    let (fine, mut coarse): (Vec<[u32; 4]>, Vec<[u32; 4]>) = batch.iter().partition(|l| l[3] >> 16 == 0);
+    coarse.sort_by_key(|l| u32::from(l[3] >> 16 > 1));
     let listed: Vec<[u32; 4]> = fine.iter().chain(&coarse).copied().collect();
     if streamed {
         upload_batch(e, scene, batch, &listed, cut)?;
@@ -516,9 +519,10 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     }
     if !coarse.is_empty() {
         let cells = BrickPush { first: fine.len() as u32, count: coarse.len() as u32, ..push };
-        if cut.pyramid > 0 {
-            // The coarse bricks' pyramids, into their entries' slots.
-            build_pyramids(e, build, &BrickPush { splats: 0, ..cells })?;
+        let level_1 = coarse.iter().filter(|l| l[3] >> 16 == 1).count() as u32;
+        if cut.pyramid > 0 && level_1 > 0 {
+            // The level-1 bricks' pyramids, into their entries' slots.
+            build_pyramids(e, build, &BrickPush { count: level_1, splats: 0, ..cells })?;
         }
         let groups = groups_1d(coarse.len() as u32);
         let variant = usize::from(streamed);
