@@ -504,3 +504,50 @@ fn coarse_cells_cover_what_their_voxels_cover_along_each_axis() {
     }
     assert_clean(&g);
 }
+
+/// Dropping hidden bricks between waves over mixed levels, the eye outside and inside the volume:
+/// the frame is the one drawn without dropping any, bit for bit, and some views drop bricks. (The
+/// culled sequence is the full one less whole bricks, so the cell validator's verdict on the full
+/// sequence, `mixed_level_sequences_pass_the_cell_validator_on_both_engines`, holds for it.)
+#[test]
+fn hidden_bricks_dropped_over_mixed_levels_change_no_pixel_eye_inside_too() {
+    let vol = blob([96, 80, 72]);
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let opaque = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.95])], ..tf() };
+    let mut rng = Rng(4343);
+    for gpu in [true, false] {
+        let mut r = if gpu { common::gpu() } else { common::cpu() };
+        r.set_volume(&vol, &opaque, None).unwrap();
+        let (mut views, mut dropping, mut mixed) = (0, 0, 0);
+        for kind in [ViewKind::Outside, ViewKind::Inside] {
+            for v in 0..4 {
+                let mut cam = random_camera(&mut rng, &grid, kind);
+                (cam.width, cam.height) = (160, 160);
+                if cam.validate().is_err() {
+                    continue;
+                }
+                let mut o = lod(Raster::Compute, Direction::FrontToBack, [1.5, 3.0][v % 2]);
+                (o.early_termination, o.lod_error) = (1.0 / 1024.0, 0.1);
+                let culled = r.render(&cam, &o).unwrap();
+                o.cull_hidden_bricks = false;
+                let kept = r.render(&cam, &o).unwrap();
+                assert!(
+                    culled.image.pixels == kept.image.pixels,
+                    "gpu {gpu} {kind:?} {v}: dropping hidden bricks changed the frame ({:?})",
+                    culled.stats
+                );
+                let st = culled.stats;
+                views += 1;
+                dropping += usize::from(st.bricks_hidden > 0);
+                mixed += usize::from(st.bricks_coarse > 0 && st.bricks_coarse < st.bricks_visible);
+            }
+        }
+        assert!(
+            views >= 6 && dropping >= 2 && mixed >= 2,
+            "gpu {gpu}: {views} views, {dropping} dropped bricks, {mixed} mixed"
+        );
+        if gpu {
+            assert_clean(&r);
+        }
+    }
+}
