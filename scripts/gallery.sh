@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The README's gallery (issue 29): every real dataset in ../shared/data, one procedural volume and
+# The gallery (docs/GALLERY.md): every real dataset in ../shared/data, one procedural volume and
 # the T1 head phantom (make-volume --phantom; no brain MRI in ../shared/data)
 # at 512², voxsplat beside VTK's GPU ray caster (vtkGPUVolumeRayCastMapper on llvmpipe through EGL),
 # the same file, preset and view (voxsplat's default camera, handed to VTK: scripts/vtk_file.py
@@ -8,7 +8,7 @@
 # PSNR over the object (scripts/gallery.py), and the luminance contrast over the object of each
 # voxsplat frame (std / mean; the shaded rows against the unshaded decide `SHADED_PRESETS`).
 # Writes docs/img/gallery/NAME.png (voxsplat left, VTK right, 256² each) and prints the markdown
-# table README and docs/RESULTS.md carry.
+# table docs/GALLERY.md and docs/RESULTS.md carry.
 # The terrain (rmnp) beside VTK's textured surface of the same height grid (scripts/vtk_terrain.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Renders the README's pictures: the 60^3 cube of Figs 2.25-2.27 from close perspective views where
+# Renders the pictures of docs/GALLERY.md: the 60^3 cube of Figs 2.25-2.27 from close perspective views where
 # BTF (view A) and WBTF (view B) draw back-face rows over front-face rows, beside PBTF.
 set -euo pipefail
 cd "$(dirname "$0")/.."

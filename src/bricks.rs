@@ -1,4 +1,4 @@
-//! The bricked, compact store of a scalar volume (issue 23, first piece; host side only so far):
+//! The bricked, compact store of a scalar volume (host side):
 //! the grid cut into bricks of `BRICK`³ voxels, each non-empty brick a 16-byte header and a 64-byte
 //! occupancy mask, each candidate voxel (value above the volume's minimum) a 4-byte record of its
 //! position in the brick and its value quantised to 16 bits. Empty voxels are not stored: their

@@ -35,11 +35,11 @@ pub const TF_PRESETS: &[(&str, &str)] = &[
 
 /// Presets drawn with headlight shading by default: those where shading raised the luminance
 /// contrast over the object by at least a fifth on the gallery's views (bonsai +45 %; ct on the
-/// stent +4 %, ramp on heptane +5 %: left unshaded; docs/RESULTS.md, issue 29).
+/// stent +4 %, ramp on heptane +5 %: left unshaded; docs/RESULTS.md).
 pub const SHADED_PRESETS: &[&str] = &["bonsai"];
 
 impl TransferFunction {
-    /// A named preset: `ramp`, `ct`, `bonsai`, `mri` (see README).
+    /// A named preset: `ramp`, `ct`, `bonsai`, `mri` (docs/CLI.md).
     pub fn preset(name: &str) -> Result<Self> {
         let p = |points: Vec<(f32, [f32; 4])>| Self { points, gradient_weight: 0.0, range: None, threshold: 0.0 };
         match name {

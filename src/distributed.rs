@@ -1,4 +1,4 @@
-//! Sort-last rendering (issue 28), the parts that need no transport: the partition of a bricked
+//! Sort-last rendering, the parts that need no transport: the partition of a bricked
 //! volume's brick grid into one convex box per rank (the top of the k-d tree that orders the
 //! bricks, `kdtree`, balanced by non-empty bricks); the boxes' visibility order
 //! for an eye (at every node of the tree the far side first); the scan that finds the whole

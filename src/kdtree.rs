@@ -1,4 +1,4 @@
-//! The k-d tree over a bricked volume's brick grid (issue 28): each node cuts its box across its
+//! The k-d tree over a bricked volume's brick grid: each node cuts its box across its
 //! longest side where its non-empty bricks divide in halves (or, over sort-last ranks, in their
 //! proportion), down to `TREE_DEPTH` levels. Drawn at every node near side first (or far side first, back to front), it orders the bricks (PBTF
 //! within its leaves' boxes: a visibility order, as PBTF's is); its top levels are the boxes of

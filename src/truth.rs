@@ -280,7 +280,7 @@ pub fn volumetric_summation(set: &SplatSet, camera: &Camera, opts: &TruthOptions
 }
 
 /// Ray integration that interpolates the *scalar* and classifies every sample, as VTK's ray
-/// casters do (issue 9; docs/MODEL.md "One truth for the peers"). `volume` sits on voxsplat's
+/// casters do (docs/MODEL.md "One truth for the peers"). `volume` sits on voxsplat's
 /// centred grid; samples every `step` voxel spacings between the entry and exit of the box of voxel
 /// centres; per sample the transfer function's opacity, given per unit length, becomes
 /// `1 - (1 - a)^step` and colour is composited front to back. Premultiplied RGBA, in f64.

@@ -1,4 +1,4 @@
-//! The core's layout stays as README's "Layout" section draws it: no module imports another that
+//! The core's layout stays as docs/DEVELOPING.md's "Layout" section draws it: no module imports another that
 //! (through others) imports it back, the maths reaches into no executor, and no source file grows
 //! past ~700 lines.
 use std::collections::{BTreeMap, BTreeSet};

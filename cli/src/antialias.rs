@@ -1,4 +1,4 @@
-//! Chapter 3's anti-aliasing on the seed's other figures (issue 26 item 3): the terrain seen in
+//! Chapter 3's anti-aliasing on the seed's other figures: the terrain seen in
 //! perspective (Figs 3.7 and 5.3: the rmnp fly-over) and a dense volume seen orthographically at
 //! more than one voxel per pixel (Fig. 3.8: stripes128, every splat beyond k), measured as the
 //! grazing plane of Fig. 3.6 is: error against a supersampled truth brought down by a Lanczos-3

@@ -1,4 +1,4 @@
-//! The bricked-volume study (issue 23): what a volume costs as a bricked store and what a frame
+//! The bricked-volume study: what a volume costs as a bricked store and what a frame
 //! costs from it, alternating the variants frame by frame in one process (`voxsplat bricks`).
 //! Prints a markdown section for docs/RESULTS.md.
 use crate::bench::median;
@@ -428,7 +428,7 @@ pub fn scaling_chart(csv: &Path, out: &Path) -> Result<()> {
 /// The error bounds of the levels-of-detail curve on peer256.
 const LOD_CURVE_ERRORS: [f32; 5] = [0.003, 0.01, 0.02, 0.05, 0.25];
 
-/// Levels of detail on the peers' volume (issue 24's peer256 target): `n`³ at `size`², the peers'
+/// Levels of detail on the peers' volume (the peer256 target): `n`³ at `size`², the peers'
 /// camera and transfer function, the bricked store at full detail and with levels of detail over
 /// an error sweep (the LOD curve), against the peers' truth (scalar ray integration, step 0.25
 /// voxel), alternated frame by frame over `frames` rounds; the dense classified splats beside them.

@@ -1,4 +1,4 @@
-//! The kernel study (issue 26, the seed's section 1.2.3): every reconstruction kernel's ripple on
+//! The kernel study (the seed's section 1.2.3): every reconstruction kernel's ripple on
 //! a flat sheet, its support, and its error and time on the peers' scene against one truth that
 //! no kernel shapes (scalars integrated along the rays), charted error against ripple.
 use crate::bricked::frame_ms;

@@ -1,4 +1,4 @@
-//! Chapter 4's order choice and chapter 5's terrain blur (issue 26 item 4). The seed draws its
+//! Chapter 4's order choice and chapter 5's terrain blur. The seed draws its
 //! moving object (Fig. 4.5) and the turning terrain (Figs 5.4-5.6) with WBTF, because PBTF's seams
 //! lie on planes through the eye and march across a moving object from frame to frame. Measured
 //! here per animation: each order's still frames against the exactly sorted order's (static error)

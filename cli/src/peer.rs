@@ -1,4 +1,4 @@
-//! The peers' comparison (issue 9): every voxsplat mode timed on the shared scene of
+//! The peers' comparison: every voxsplat mode timed on the shared scene of
 //! `voxsplat::peer`.
 use voxsplat::peer::{camera, transfer_function, volume};
 use voxsplat::Result;

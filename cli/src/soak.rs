@@ -1,5 +1,5 @@
 //! Long runs: render many frames with changing scenes, cameras and modes and watch host memory and
-//! GPU allocations (issue 7). The scene/mode sequence repeats every `CYCLE` frames, so after warm-up
+//! GPU allocations. The scene/mode sequence repeats every `CYCLE` frames, so after warm-up
 //! the allocator's report at the start of each cycle must not grow.
 use voxsplat::camera::Camera;
 use voxsplat::kernel::KERNELS;

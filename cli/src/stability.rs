@@ -1,4 +1,4 @@
-//! Where methods fail (section 1.2.2.3; issue 8), reproduced as animations and views with numbers:
+//! Where methods fail (section 1.2.2.3), reproduced as animations and views with numbers:
 //! (a) the axis-aligned sheet buffer's pop when its sheet axis switches (Figs 1.9, 1.16);
 //! (b) brightening against screen splat density in perspective (Fig. 1.17);
 //! (c) per-splat compositing's dependence on the order of overlapping splats (Figs 1.13, 1.14);

@@ -1,4 +1,4 @@
-//! Large test volumes, made rather than committed (issue 23): a volume upsampled by an integer
+//! Large test volumes, made rather than committed: a volume upsampled by an integer
 //! factor (the 512³ bonsai from the 256³ one) and a procedural field of any side (1024³: a billion
 //! voxels). Written as attached raw 8-bit NRRD, slice by slice: the output is never held in memory.
 use rayon::prelude::*;

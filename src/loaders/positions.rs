@@ -1,4 +1,4 @@
-//! Voxel positions of a rectilinear grid (issue 26 item 6): a TOML sidecar whose `x`, `y`, `z`
+//! Voxel positions of a rectilinear grid: a TOML sidecar whose `x`, `y`, `z`
 //! arrays give the world coordinate of every voxel along that axis (e.g. a CT series' slice
 //! positions, which a header's one spacing cannot hold). An axis left out keeps the grid's even
 //! spacing.

@@ -1,4 +1,4 @@
-//! A bricked volume's frame (issue 23): culling and listing the visible bricks, batches under the
+//! A bricked volume's frame: culling and listing the visible bricks, batches under the
 //! device budget, and the per-splat, sheet and slab modes over them. Part of THE recording.
 use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
@@ -36,7 +36,7 @@ pub fn bricked_min_budget(scene: &BrickScene, budget: u64, width: u32, height: u
     bricked_resident_bytes(scene, budget, width, height) + brick
 }
 
-/// A bricked volume's frame (issue 23): `brick_cull` culls whole bricks on the device (outside
+/// A bricked volume's frame: `brick_cull` culls whole bricks on the device (outside
 /// the view, or empty under the transfer function) and counts the rest's voxels at their slots in
 /// the brick grid's PBTF order; the host lists the visible bricks in that order and cuts batches
 /// that fit the budget; per batch `brick_order` writes their voxels in two-level PBTF order,
