@@ -1,5 +1,5 @@
 //! What a streamed bricked store keeps on the device across frames: its bricks' records, in a
-//! cache of whole-brick slots with least-recently-used eviction (`RecordCache`).
+//! cache of whole-brick slots (`RecordCache`).
 use crate::error::{Error, Result};
 
 /// A tag no other cache has had (0 is never one).

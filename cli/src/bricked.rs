@@ -269,6 +269,16 @@ pub fn study(
     Ok(s)
 }
 
+/// A GPU renderer within `budget_bytes` holding `scene`, and its framing camera at `size`².
+fn framed(scene: voxsplat::bricks::BrickScene, size: u32, budget_bytes: u64) -> Result<(Renderer, Camera)> {
+    let cam = Camera::framing(&scene.store.grid()?, size, size);
+    let mut o = RendererOptions::default();
+    o.gpu_budget_bytes = budget_bytes;
+    let mut r = Renderer::new(&o)?;
+    r.set_bricks(scene)?;
+    Ok((r, cam))
+}
+
 /// Load `path` as a bricked scene with the transfer-function preset `tf` and draw `frames` frames
 /// (after a warm-up) on the GPU within `budget_bytes`: one line with the load time, the store, the
 /// median frame and the peak resident set (run one file per process for the memory target).
@@ -276,13 +286,8 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     let tf = TransferFunction::preset(tf)?;
     let l = load(path, &tf)?;
     let rss_loaded = peak_rss_mib().unwrap_or(0.0);
-    let grid = l.scene.store.grid()?;
-    let cam = Camera::framing(&grid, size, size);
-    let mut o = RendererOptions::default();
-    o.gpu_budget_bytes = budget_bytes;
-    let mut r = Renderer::new(&o)?;
     let (stored, bytes) = (l.scene.store.len(), l.scene.store.bytes());
-    r.set_bricks(l.scene)?;
+    let (mut r, cam) = framed(l.scene, size, budget_bytes)?;
     // Full detail and levels of detail (1 px), alternating frame by frame after a warm-up each.
     let full = opts(0.0);
     let mut lod = full.clone();
@@ -318,13 +323,7 @@ pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, steps: u32) ->
         return Err(Error::InvalidArgument(format!("--orbit {steps}: between 1 and 3600 steps")));
     }
     let tf = TransferFunction::preset(tf)?;
-    let l = load(path, &tf)?;
-    let grid = l.scene.store.grid()?;
-    let cam = Camera::framing(&grid, size, size);
-    let mut o = RendererOptions::default();
-    o.gpu_budget_bytes = budget_bytes;
-    let mut r = Renderer::new(&o)?;
-    r.set_bricks(l.scene)?;
+    let (mut r, cam) = framed(load(path, &tf)?.scene, size, budget_bytes)?;
     let opts = RenderOptions::default();
     let mut out = String::from(
         "| frame | degrees | ms | splats | record MiB uploaded | record MiB held | uploaded / held |\n|---:|---:|---:|---:|---:|---:|---:|\n",

@@ -439,6 +439,7 @@ pub fn brick_lod_params(
     params: &mut [SplatParams],
 ) {
     let (shaded, dims) = (inputs.bf.light[3] > 0.5, inputs.frame.dims);
+    let (f, grid) = (inputs.frame, super::splat_params::frame_grid(inputs.frame));
     for &s in &lod_splats[..push.splats as usize] {
         let v = voxels[s as usize];
         let (ijk, level) = (voxel_ijk(v), voxel_level(v));
@@ -447,7 +448,6 @@ pub fn brick_lod_params(
             [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
         );
         let grow = if v[1] & VOXEL_MORPHS != 0 { inputs.splat_growth(at, level) } else { 1.0 };
-        let (f, grid) = (inputs.frame, super::splat_params::frame_grid(inputs.frame));
         let view = if f.eye[3] > 0.5 {
             grid.point(at) - Vec3::new(f.eye[0], f.eye[1], f.eye[2])
         } else {
@@ -491,14 +491,13 @@ pub(crate) fn brick_cells_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) 
 
 pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut pyramid, mut summary) = (b.take(Res::Pyramid), b.take(Res::LodSummary));
-    let summary_words = &mut summary[..];
     if streamed(v) {
         let mut slots = b.take(Res::PyramidSlot);
         let batch = Some(PyramidBatch { list: b.get(Res::BrickList), push: args.push_as(), slots: &mut slots });
-        brick_pyramid(&inputs(b)?, batch, &mut pyramid, summary_words);
+        brick_pyramid(&inputs(b)?, batch, &mut pyramid, &mut summary);
         b.put(Res::PyramidSlot, slots);
     } else {
-        brick_pyramid(&inputs(b)?, None, &mut pyramid, summary_words);
+        brick_pyramid(&inputs(b)?, None, &mut pyramid, &mut summary);
     }
     b.put(Res::Pyramid, pyramid);
     b.put(Res::LodSummary, summary);

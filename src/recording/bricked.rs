@@ -150,7 +150,6 @@ pub(super) fn record_bricks(
         pyramid: batch_pyramid,
         range,
         cache: &scene.records_cache.0,
-        cache_slots,
         uploaded: Cell::new(0),
     };
     if streamed {
@@ -307,10 +306,9 @@ struct Cut<'a> {
     pyramid: u64,
     /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
     range: u64,
-    /// A streamed store's record cache (`RecordCache`), its slots, and the record bytes uploaded
-    /// so far this frame.
+    /// A streamed store's record cache (`RecordCache`; opened with its slots this frame), and the
+    /// record bytes uploaded so far this frame.
     cache: &'a Mutex<RecordCache>,
-    cache_slots: u32,
     uploaded: Cell<u64>,
 }
 
@@ -340,6 +338,7 @@ impl Cut<'_> {
         available: u64,
     ) -> Vec<Vec<[u32; 4]>> {
         let mut batches: Vec<Vec<[u32; 4]>> = vec![Vec::new()];
+        let cache_slots = if self.streamed { self.lock_cache().slots() } else { 0 };
         let (mut filled, mut slots, mut bytes) = (0u32, 0u32, 0u64);
         for [header, _, _, w] in entries {
             let n = w & 0xffff;
@@ -351,7 +350,7 @@ impl Cut<'_> {
             let entries = batches.last().map_or(0, |b| b.len()) as u64 + 1;
             let binding = (entries * 16).max(entries * self.pyramid);
             let open = batches.last().is_some_and(|b| !b.is_empty());
-            let full = slots + slot > self.cache_slots;
+            let full = slots + slot > cache_slots;
             if open && (filled + n > capacity || bytes + cost > available || binding > self.range || full) {
                 batches.push(Vec::new());
                 (filled, slots, bytes) = (0, 0, 0);
