@@ -4,7 +4,8 @@
 // brick_list. A brick drawn at level l > 0 writes its pyramid's drawn cells, visiting the brick's
 // cells of 2^l voxels in PBTF order (split like the brick grid: level_split), each as (lowest
 // voxel, level, cell) at the brick's first position + its rank: the two-level order with cells for
-// voxels, no sort. Voxel bricks are brick_order's. A streamed store's pyramid holds the batch's
+// voxels, no sort; a node above the brick (level 3 + its tree level) writes its one cell. Voxel
+// bricks are brick_order's. A streamed store's pyramid holds the batch's
 // bricks (STREAMED_STORE: pyramid_index). Mirror: cpu::lod::brick_cells.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
@@ -30,6 +31,14 @@ void main() {
     uint level = entry.w >> 16u;
     if (level == 0u) return;
     uvec3 b = brick_coords(headers[entry.x].x);
+    if (level > 3u) {
+        // A node above the brick: one splat at its lowest voxel, its tree level in the first word.
+        uint k = level - 3u;
+        uvec3 ijk = ((b >> k) << k) * BRICK_SIDE;
+        voxels[entry.y] = uvec2(ijk.x | (k << 13u) | (ijk.y << 16u), ijk.z | (3u << 13u));
+        order_out[entry.y] = entry.y;
+        return;
+    }
     uint n = BRICK_SIDE >> level;
     uint off = level_offset(level);
     uint morphs = morph_bit(entry.x);

@@ -21,7 +21,9 @@ const int MAX_BRICK_TILES = 256;
 bool hidden(uint h, uint level, uvec3 b) {
     vec3 lo;
     vec3 hi;
-    footprint_box(b, float(1u << level) * (1.0 + (bf.grad.y > 0.0 ? brick_morph[h] : 0.0)), lo, hi);
+    // A node above the brick (level 3 + its tree level) does not morph.
+    uint k = level > 3u ? level - 3u : 0u;
+    footprint_box(b, k, float(1u << level) * (1.0 + (bf.grad.y > 0.0 ? brick_morph[h] : 0.0)), lo, hi);
     vec2 size = frame.blur.zw;
     vec2 slo = vec2(1e30);
     vec2 shi = vec2(-1e30);

@@ -23,7 +23,6 @@ void main() {
     uvec2 v = voxels[s];
     uvec3 ijk = voxel_ijk(v);
     uint level = voxel_level(v);
-    uint h = header_of(ijk);
     // The middle of its voxels inside the grid (a cell the grid's end cuts would otherwise sit up
     // to 3.5 voxels off a thin sheet).
     vec3 at = vec3(ijk) + 0.5 * (vec3(min(uvec3(1u << level), frame.dims.xyz - ijk)) - 1.0);
@@ -31,7 +30,9 @@ void main() {
     vec3 normal;
     vec3 centre = grid_point(at);
     vec3 view = grid_direction(frame.eye.w > 0.5 ? centre - frame.eye.xyz : frame.forward.xyz);
-    vec4 c = cell_color(h, v.y >> 16u, view, normal);
+    // A node above the brick (level > 3) from its words after the summaries.
+    vec4 c = level > 3u ? node_color(level - 3u, ijk >> level, view, normal)
+                        : cell_color(header_of(ijk), v.y >> 16u, view, normal);
     if (bf.light.w > 0.5) c.rgb = shade(c.rgb, normal);
     params_store(s, params_at(at, float(1u << level), grow, c.rgb, c.a));
 }

@@ -38,44 +38,12 @@ shared uint drawn_1[64];
 shared uint mask_w[MASK_WORDS];
 shared uint mask_below[MASK_WORDS];
 
-// Octahedral bytes (snorm 8 + 8) of gradient g, NO_NORMAL when it is zero.
-uint pack_normal(vec3 g) {
-    float len = abs(g.x) + abs(g.y) + abs(g.z);
-    if (!(len > 0.0)) return NO_NORMAL;
-    vec3 n = g / len;
-    vec2 o = n.xy;
-    if (n.z < 0.0) o = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
-    return packSnorm4x8(vec4(o, 0.0, 0.0)) & 0xffffu;
-}
-
 // Child d (0..7) of cell c (side n) of level l, as an index into level l - 1's sums.
 uint child(uint l, uvec3 c, uint n, uint d) {
     uvec3 k = 2u * c + (uvec3(d, d >> 1u, d >> 2u) & 1u);
     uint m = 2u * n;
     uint i = k.x + m * (k.y + m * k.z);
     return l == 1u ? i : level_offset(l - 1u) + i;
-}
-
-// g turned to agree with `with` (shading is two-sided, so a normal's sign is free; the opposite
-// gradients of a thin shell's two faces would otherwise cancel).
-vec3 aligned(vec3 g, vec3 with) {
-    return dot(g, with) < 0.0 ? -g : g;
-}
-
-// The opacity along `axis` of a cell whose children have opacities a (along that axis): its four
-// columns of two children composited, then averaged across (the same from either side).
-float axis_opacity(float a[8], uint axis) {
-    float sum = 0.0;
-    for (uint p = 0u; p < 4u; ++p) {
-        // Insert a 0 bit along the axis into p's two bits: the low child of the column.
-        uint low = (p & ((1u << axis) - 1u)) | ((p >> axis) << (axis + 1u));
-        sum += 1.0 - (1.0 - a[low]) * (1.0 - a[low | (1u << axis)]);
-    }
-    return 0.25 * sum;
-}
-
-uint unorm10(float v) {
-    return uint(floor(clamp(v, 0.0, 1.0) * 1023.0 + 0.5));
 }
 
 // Cell i: its sums (t, col, g), error and axis opacities (for the level above), and its pyramid
@@ -99,15 +67,8 @@ void put_cell(uint slot, uint h, uint i, float t, vec3 col, vec3 g, float err, v
         if (i < SLOT_CELLS) pyramid_put((slot * SLOT_CELLS + i) * CELL_WORDS + k, words[k]);
         else lod_words[h * SUMMARY_WORDS + 4u + (i - SLOT_CELLS) * CELL_WORDS + k] = words[k];
     }
-}
-
-// The error of a cell of mean opacity a and colour straight against a child (sums tk, ck; error
-// ek) of `voxels` voxels.
-float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float voxels) {
-    float ak = 1.0 - exp(-tk / voxels);
-    vec3 sk = tk > 0.0 ? ck / tk : vec3(0.0);
-    vec3 dc = abs(sk - straight);
-    return ek + max(abs(ak - a), ak * max(dc.x, max(dc.y, dc.z)));
+    // The one level-3 cell's optical depth: the nodes above the brick sum it (brick_nodes).
+    if (i == LOD_CELLS - 1u) lod_words[h * SUMMARY_WORDS + SUMMARY_WORDS - 1u] = floatBitsToUint(t);
 }
 
 void main() {

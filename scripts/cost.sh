@@ -64,7 +64,7 @@ echo "|---|---|---|"
 for s in "${stages[@]}"; do
   IFS='|' read -r label stored file <<< "$s"
   log=$(cat "$file")
-  drawn=$(sed -nE 's/^drawn: ([0-9]+) splats from ([0-9]+) of [0-9]+ bricks \(([0-9]+) drawn coarser, ([0-9]+) hidden.*, ([0-9]+) waves/\1|\2, \3, \4; \5/p' <<< "$log")
+  drawn=$(sed -nE 's/^drawn: ([0-9]+) splats from ([0-9]+) of [0-9]+ bricks \(([0-9]+) drawn coarser, [0-9]+ of them nodes of several bricks, ([0-9]+) hidden.*, ([0-9]+) waves/\1|\2, \3, \4; \5/p' <<< "$log")
   splats=${drawn%%|*}
   cells=$(grep -E "^[a-z_]+ +[0-9.]+ ms$" <<< "$log" | awk -v v="$stored" -v n="$splats" \
     '{printf "%s%s %.0f, %.0f, %.0f", sep, $1, $2, $2 * 1e6 / v, $2 * 1e6 / n; sep = "; "}')

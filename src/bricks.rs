@@ -409,14 +409,14 @@ pub const MAX_BRICKS: usize = 1 << 22;
 
 /// A brick's draw-order slot word (`brick_cull`: header << 10 | code) as (header, level of
 /// detail, splats): the code is the count at level 0 (1-512), 512 + the count at level 1 (1-64),
-/// 576 + the count at level 2 (1-8), 585 at level 3. Mirror of brick.glsl's `slot_code`.
+/// 576 + the count at level 2 (1-8), 585 at level 3, 585 + k for a node k levels above. Mirror of `slot_code`.
 pub fn slot_entry(word: u32) -> (u32, u32, u32) {
     let c = word & 1023;
     let (level, count) = match c {
         0..=512 => (0, c),
         513..=576 => (1, c - 512),
         577..=584 => (2, c - 576),
-        _ => (3, 1),
+        _ => (c - 582, 1),
     };
     (word >> 10, level, count)
 }

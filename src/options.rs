@@ -437,6 +437,9 @@ pub struct FrameStats {
     pub bricks_visible: u32,
     /// Visible bricks the level-of-detail cut drew coarser than their voxels.
     pub bricks_coarse: u32,
+    /// Of those, nodes above the brick: one cell drawn for 2^k bricks a side, listed at the first
+    /// of its bricks that draws (the others are not counted as visible).
+    pub nodes: u32,
     /// Visible bricks dropped because what earlier waves drew already hides them.
     pub bricks_hidden: u32,
     /// Splats drawn: voxels and coarse cells.

@@ -571,8 +571,9 @@ fn run(cli: Cli) -> Result<()> {
                 let st = frame.stats;
                 if st.bricks > 0 {
                     println!(
-                        "drawn: {} splats from {} of {} bricks ({} drawn coarser, {} hidden by nearer ones), {} waves",
-                        st.splats, st.bricks_visible, st.bricks, st.bricks_coarse, st.bricks_hidden, st.waves
+                        "drawn: {} splats from {} of {} bricks ({} drawn coarser, {} of them nodes of several bricks, {} \
+                         hidden by nearer ones), {} waves",
+                        st.splats, st.bricks_visible, st.bricks, st.bricks_coarse, st.nodes, st.bricks_hidden, st.waves
                     );
                 }
                 if st.records_resident > 0 {

@@ -15,7 +15,7 @@ struct BrickFrame {
     vec4 grad;     // x: the volume's largest gradient magnitude (gradient weighting); y: levels of
                    // detail, largest cell spacing in pixels (0: off); z: their largest error
     uvec4 lo;      // the bricks drawn: lo <= b < hi (a rank's box in sort-last rendering; else the grid)
-    uvec4 hi;
+    uvec4 hi;      // w: levels of detail's node levels above the brick (0: none; brick_nodes)
 };
 
 layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
@@ -266,11 +266,12 @@ uvec3 level_split(uvec3 b, uint l) {
     return uvec3(clamp(global - ivec3(b * side), ivec3(0), ivec3(side)));
 }
 
-// The world box of brick b's voxel centres (a sheared grid's: the box around its corners).
-// Mirror: Grid::world_box.
-void voxel_box(uvec3 b, out vec3 lo, out vec3 hi) {
-    vec3 first = vec3(b * BRICK_SIDE);
-    vec3 last = vec3(min(b * BRICK_SIDE + BRICK_SIDE, frame.dims.xyz) - 1u);
+// The world box of the voxel centres of brick b's node of tree level k (k = 0: the brick; a
+// sheared grid's: the box around its corners). Mirror: Grid::world_box.
+void voxel_box(uvec3 b, uint k, out vec3 lo, out vec3 hi) {
+    uvec3 first_voxel = ((b >> k) << k) * BRICK_SIDE;
+    vec3 first = vec3(first_voxel);
+    vec3 last = vec3(min(first_voxel + (BRICK_SIDE << k), frame.dims.xyz) - 1u);
     lo = vec3(1e30);
     hi = vec3(-1e30);
     for (uint c = 0u; c < 8u; ++c) {
@@ -320,9 +321,10 @@ uint level_count(uint h, uint l) {
     return l == 1u ? x & 255u : (l == 2u ? (x >> 8u) & 15u : (x >> 12u) & 1u);
 }
 
-// A brick's slot code for n splats at level l, in 10 bits (bricks::slot_entry decodes it).
+// A brick's slot code for n splats at level l, in 10 bits (bricks::slot_entry decodes it); a node
+// above the brick (l > 3, one splat) 585 + its tree level.
 uint slot_code(uint l, uint n) {
-    return l == 0u ? n : (l == 1u ? 512u + n : (l == 2u ? 576u + n : 585u));
+    return l == 0u ? n : (l == 1u ? 512u + n : (l == 2u ? 576u + n : 582u + l));
 }
 
 // A streamed store's pyramid holds a batch's bricks (brick_pyramid's STREAMED_STORE build): per
@@ -377,18 +379,95 @@ vec3 unpack_normal(uint w) {
     return normalize(n);
 }
 
-// Cell i of header h seen along `view` (index space): the opacities along the three axes weighted
-// by the squares of the view's components; returns straight colour and optical depth per cell
-// length.
-vec4 cell_color(uint h, uint i, vec3 view, out vec3 normal) {
-    uint xy = cell_word(h, i, 0u);
-    uint zn = cell_word(h, i, 1u);
-    uint c = cell_word(h, i, 2u);
+// A cell (words xy, zn, c) seen along `view` (index space): the opacities along the three axes
+// weighted by the squares of the view's components; returns straight colour and optical depth per
+// cell length.
+vec4 cell_seen(uint xy, uint zn, uint c, vec3 view, out vec3 normal) {
     vec3 w = view * view / max(dot(view, view), 1e-30);
     vec3 tau = vec3(tau_decode(xy & 0xffffu), tau_decode(xy >> 16u), tau_decode(zn & 0xffffu));
     float trans = dot(w, exp(-min(tau, vec3(80.0))));
     normal = unpack_normal(zn >> 16u);
     return vec4(vec3(uvec3(c, c >> 10u, c >> 20u) & 1023u) / 1023.0, -log(max(trans, 1e-30)));
+}
+
+// Cell i of header h seen along `view` (cell_seen).
+vec4 cell_color(uint h, uint i, vec3 view, out vec3 normal) {
+    return cell_seen(cell_word(h, i, 0u), cell_word(h, i, 1u), cell_word(h, i, 2u), view, normal);
+}
+
+// Octahedral bytes (snorm 8 + 8) of gradient g, NO_NORMAL when it is zero.
+uint pack_normal(vec3 g) {
+    float len = abs(g.x) + abs(g.y) + abs(g.z);
+    if (!(len > 0.0)) return NO_NORMAL;
+    vec3 n = g / len;
+    vec2 o = n.xy;
+    if (n.z < 0.0) o = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
+    return packSnorm4x8(vec4(o, 0.0, 0.0)) & 0xffffu;
+}
+
+// g turned to agree with `with` (shading is two-sided, so a normal's sign is free; the opposite
+// gradients of a thin shell's two faces would otherwise cancel).
+vec3 aligned(vec3 g, vec3 with) {
+    return dot(g, with) < 0.0 ? -g : g;
+}
+
+// The opacity along `axis` of a cell whose children have opacities a (along that axis): its four
+// columns of two children composited, then averaged across (the same from either side).
+float axis_opacity(float a[8], uint axis) {
+    float sum = 0.0;
+    for (uint p = 0u; p < 4u; ++p) {
+        // Insert a 0 bit along the axis into p's two bits: the low child of the column.
+        uint low = (p & ((1u << axis) - 1u)) | ((p >> axis) << (axis + 1u));
+        sum += 1.0 - (1.0 - a[low]) * (1.0 - a[low | (1u << axis)]);
+    }
+    return 0.25 * sum;
+}
+
+uint unorm10(float v) {
+    return uint(floor(clamp(v, 0.0, 1.0) * 1023.0 + 0.5));
+}
+
+// The error of a cell of mean opacity a and colour straight against a child (sums tk, ck; error
+// ek) of `voxels` voxels.
+float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float voxels) {
+    float ak = 1.0 - exp(-tk / voxels);
+    vec3 sk = tk > 0.0 ? ck / tk : vec3(0.0);
+    vec3 dc = abs(sk - straight);
+    return ek + max(abs(ak - a), ak * max(dc.x, max(dc.y, dc.z)));
+}
+
+
+// Levels of detail above the brick: a node of tree level k (1..bf.hi.w) covers 2^k bricks a side
+// and is one cell 2^(3+k) voxels a side, prefiltered from its 8 children as brick_pyramid's
+// levels are (brick_nodes). NODE_WORDS per node, after the bricks' summaries in LodSummary, level
+// by level, each level's nodes x fastest: the cell's 3 words, its error, its optical depth, and the
+// first header below it whose cell draws (the brick that draws the node; 0xffffffff: none).
+const uint NODE_WORDS = 6u;
+// A node's cell projects to at most this many pixels (and the bound): wider, its one footprint
+// blurs the silhouette of what it stands for (a uniform cube at 8 x 8 pixels drawn with 1.5-pixel
+// nodes covered 20 % more than at full detail). Mirror: cpu::brick_nodes::NODE_PIXELS.
+const float NODE_PIXELS = 1.0;
+
+// Nodes along x, y, z at tree level k.
+uvec3 node_grid(uint k) {
+    return (bf.grid.xyz + (1u << k) - 1u) >> k;
+}
+
+// Word w of node n (node coordinates) of tree level k.
+uint node_word(uint k, uvec3 n, uint w) {
+    uint base = max(bf.grid.w, 1u) * SUMMARY_WORDS;
+    for (uint j = 1u; j < k; ++j) {
+        uvec3 g = node_grid(j);
+        base += g.x * g.y * g.z * NODE_WORDS;
+    }
+    uvec3 g = node_grid(k);
+    return base + (n.x + g.x * (n.y + g.y * n.z)) * NODE_WORDS + w;
+}
+
+// Node n of tree level k seen along `view` (cell_seen).
+vec4 node_color(uint k, uvec3 n, vec3 view, out vec3 normal) {
+    uint w = node_word(k, n, 0u);
+    return cell_seen(lod_words[w], lod_words[w + 1u], lod_words[w + 2u], view, normal);
 }
 
 PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
@@ -411,23 +490,32 @@ float cull_reach(float depth, float cell) {
     return CULL_RADII * cell * frame.spacing.w * footprint_scale(max(depth, 1e-6), cell);
 }
 
+// A coarse cell's error as the picture sees it, the cell projecting to `size` pixels: its
+// departure from its children is detail at half its size, which the pixel's filter averages away
+// as the cell shrinks below a pixel (weighted by the square of its size there).
+float seen_error(float err, float size) {
+    float s = min(size, 1.0);
+    return err * s;
+}
+
 // Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
 // bf.grad.y pixels at the brick's nearest depth, whose error is at most bf.grad.z (0: off) and
 // whose splats keep clear of the near and far planes;
 // `morph`: 1 when its splats may morph toward the next level (allowed there too, and some of its
-// splats within the band; splat_growth).
-uint brick_level(uint h, uvec3 b, out float morph) {
+// splats within the band; splat_growth); `px`: pixels per voxel spacing at its nearest depth.
+uint brick_level(uint h, uvec3 b, out float morph, out float px) {
     morph = 0.0;
+    px = 0.0;
     if (bf.grad.y <= 0.0) return 0u;
     vec3 lo;
     vec3 hi;
-    voxel_box(b, lo, hi);
+    voxel_box(b, 0u, lo, hi);
     vec2 depths = box_depths(lo, hi);
-    float px = voxel_pixels(depths.x);
+    px = voxel_pixels(depths.x);
     uvec4 s = lod_summary(h);
     uint level = 0u;
     for (uint l = 1u; l <= 3u; ++l) {
-        if (px * float(1u << l) > bf.grad.y || uintBitsToFloat(s[l]) > bf.grad.z) break;
+        if (px * float(1u << l) > bf.grad.y || seen_error(uintBitsToFloat(s[l]), px * float(1u << l)) > bf.grad.z) break;
         // Splats within CULL_RADII radii of the near or far plane are dropped (params_at): no level
         // whose wider splats (morphed: up to twice) would be dropped where the brick reaches a plane.
         float cell = float(1u << l);
@@ -438,28 +526,57 @@ uint brick_level(uint h, uvec3 b, out float morph) {
     }
     // Its splats grow (splat_growth) only within the band, which its farthest reaches first.
     float octaves = level_octaves(depths.y, level);
-    if (level < 3u && bf.grad.w > 0.0 && uintBitsToFloat(s[level + 1u]) <= bf.grad.z && octaves > 1.0 - bf.grad.w)
+    float next = seen_error(uintBitsToFloat(s[min(level + 1u, 3u)]), px * float(2u << level));
+    if (level < 3u && bf.grad.w > 0.0 && next <= bf.grad.z && octaves > 1.0 - bf.grad.w)
         morph = 1.0;
     return level;
 }
 
-// The world box holding every footprint of brick b drawn with cells `cell` voxels a side: its voxel
-// centres' box widened by the footprint reach at its far side (anti-aliasing widens with depth).
-void footprint_box(uvec3 b, float cell, out vec3 lo, out vec3 hi) {
-    voxel_box(b, lo, hi);
+// The tree level of the node above brick b that draws it this frame (0: none, the brick draws
+// itself): the highest whose one cell projects to at most bf.grad.y pixels at the node's nearest
+// depth, whose error is at most bf.grad.z, whose splat keeps clear of the near and far planes and
+// which lies inside the drawn bricks. Every brick of a node tests the same nodes from the top, so
+// all find the same one. `px`: brick_level's; a node's nearest depth is at most its brick's, so
+// where the brick's own one cell projects wider than the bound no node can pass.
+uint node_level(uvec3 b, float px) {
+    if (bf.grad.y <= 0.0 || px * float(BRICK_SIDE) > min(bf.grad.y, NODE_PIXELS)) return 0u;
+    for (uint k = bf.hi.w; k >= 1u; --k) {
+        uvec3 n0 = (b >> k) << k;
+        uvec3 n1 = min(n0 + (1u << k), bf.grid.xyz);
+        if (any(lessThan(n0, bf.lo.xyz)) || any(greaterThan(n1, bf.hi.xyz))) continue;
+        vec3 lo;
+        vec3 hi;
+        voxel_box(b, k, lo, hi);
+        vec2 depths = box_depths(lo, hi);
+        float cell = float(BRICK_SIDE << k);
+        float size = voxel_pixels(depths.x) * cell;
+        if (size > min(bf.grad.y, NODE_PIXELS) || seen_error(uintBitsToFloat(lod_words[node_word(k, b >> k, 3u)]), size) > bf.grad.z) continue;
+        float near_reach = 2.0 * cull_reach(depths.x, cell);
+        float far_reach = 2.0 * cull_reach(depths.y, cell);
+        if (depths.x < frame.forward.w + near_reach || depths.y > frame.right.w - far_reach) continue;
+        return k;
+    }
+    return 0u;
+}
+
+// The world box holding every footprint of brick b's node of tree level k (0: the brick) drawn
+// with cells `cell` voxels a side: its voxel centres' box widened by the footprint reach at its far
+// side (anti-aliasing widens with depth).
+void footprint_box(uvec3 b, uint k, float cell, out vec3 lo, out vec3 hi) {
+    voxel_box(b, k, lo, hi);
     float reach = cull_reach(box_depths(lo, hi).y, cell);
     lo -= reach;
     hi += reach;
 }
 
-// Whether brick b's footprints all miss the view: its footprint box lies beyond the near or far
-// plane, or wholly outside one side plane. Not with motion blur (a blurred quad reaches back along
-// its path).
-bool outside_view(uvec3 b, float cell) {
+// Whether the footprints of brick b's node of tree level k (0: the brick) all miss the view: its
+// footprint box lies beyond the near or far plane, or wholly outside one side plane. Not with
+// motion blur (a blurred quad reaches back along its path).
+bool outside_view(uvec3 b, uint k, float cell) {
     if (frame.blur.x > 0.0) return false;
     vec3 lo;
     vec3 hi;
-    footprint_box(b, cell, lo, hi);
+    footprint_box(b, k, cell, lo, hi);
     float dmin = 1e30;
     float dmax = -1e30;
     bool front = true;

@@ -122,20 +122,21 @@ struct RaycastParams {
 #define SHEET_MODE_SLAB 2u   // image-aligned sheets (slabs)
 #define SHEET_MODE_BINNED 3u // axis-aligned sheets binned on the device: (splat, sheet) pairs
 
-// A bricked batch's voxel as brick_order writes it (i | j << 16, k | level << 13 | VOXEL_MORPHS |
-// stored value or pyramid cell << 16): its grid index (a coarse cell's lowest voxel). Mirror:
-// cpu::brick::voxel_ijk.
+// A bricked batch's voxel as brick_order writes it (i | node level << 13 | j << 16, k | level << 13
+// | VOXEL_MORPHS | stored value or pyramid cell << 16): its grid index (a coarse cell's lowest
+// voxel; 13 bits each). Mirror: cpu::brick::voxel_ijk.
 uvec3 voxel_ijk(uvec2 v) {
-    return uvec3(v.x & 0xffffu, v.x >> 16u, v.y & 0x1fffu);
+    return uvec3(v.x & 0x1fffu, (v.x >> 16u) & 0x1fffu, v.y & 0x1fffu);
 }
 
 // Set in a bricked voxel of a brick that morphs toward its next level (levels of detail): its
 // splat grows (splat_growth), and brick_params reads no brick state for the others.
 const uint VOXEL_MORPHS = 0x8000u;
 
-// Its level of detail (0: a voxel; l: a cell of 2^l voxels a side). Mirror: cpu::brick::voxel_level.
+// Its level of detail (0: a voxel; l: a cell of 2^l voxels a side; a node k levels above the brick
+// is level 3 + k, its k in the first word). Mirror: cpu::brick::voxel_level.
 uint voxel_level(uvec2 v) {
-    return (v.y >> 13u) & 3u;
+    return ((v.y >> 13u) & 3u) + ((v.x >> 13u) & 7u);
 }
 
 #define KERNEL_GAUSSIAN 0u

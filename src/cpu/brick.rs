@@ -150,11 +150,13 @@ impl BrickInputs<'_> {
         c
     }
 
-    /// Mirror of `voxel_box`: the world box of brick `b`'s voxel centres.
-    pub(crate) fn voxel_box(&self, b: [u32; 3]) -> (Vec3, Vec3) {
+    /// Mirror of `voxel_box`: the world box of the voxel centres of brick `b`'s node of tree
+    /// level `k` (0: the brick).
+    pub(crate) fn voxel_box(&self, b: [u32; 3], k: u32) -> (Vec3, Vec3) {
         let f = self.frame;
-        let first = Vec3::new((b[0] * BRICK) as f32, (b[1] * BRICK) as f32, (b[2] * BRICK) as f32);
-        let last = [0, 1, 2].map(|a| ((b[a] * BRICK + BRICK).min(f.dims[a]) - 1) as f32);
+        let first_voxel = b.map(|c| (c >> k << k) * BRICK);
+        let first = Vec3::from(first_voxel.map(|c| c as f32));
+        let last = [0, 1, 2].map(|a| ((first_voxel[a] + (BRICK << k)).min(f.dims[a]) - 1) as f32);
         let [lo, hi] = frame_grid(f).world_box(first, Vec3::from(last));
         (lo, hi)
     }
@@ -175,21 +177,21 @@ impl BrickInputs<'_> {
     }
 
     /// Mirror of `footprint_box`.
-    fn footprint_box(&self, b: [u32; 3], cell: f32) -> (Vec3, Vec3) {
-        let (lo, hi) = self.voxel_box(b);
+    fn footprint_box(&self, b: [u32; 3], k: u32, cell: f32) -> (Vec3, Vec3) {
+        let (lo, hi) = self.voxel_box(b, k);
         let reach = self.cull_reach(self.box_depths(lo, hi).1, cell);
         (lo - Vec3::splat(reach), hi + Vec3::splat(reach))
     }
 
     /// Mirror of `outside_view`.
-    fn outside_view(&self, b: [u32; 3], cell: f32) -> bool {
+    fn outside_view(&self, b: [u32; 3], k: u32, cell: f32) -> bool {
         let f = self.frame;
         if f.blur[0] > 0.0 {
             return false;
         }
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         let (eye, forward) = (v3(f.eye), v3(f.forward));
-        let (lo, hi) = self.footprint_box(b, cell);
+        let (lo, hi) = self.footprint_box(b, k, cell);
         let vp = Mat4::from_cols_array_2d(&f.view_proj);
         let (mut dmin, mut dmax, mut front) = (1e30f32, -1e30f32, true);
         let mut out = [true; 4];
@@ -273,7 +275,8 @@ pub fn brick_hidden(
     let tiles_x = (size.x / tile).ceil() as i64;
     let is_hidden = |h: u32, level: u32, b: [u32; 3]| {
         let morph = if inputs.bf.grad[1] > 0.0 { inputs.morphs[h as usize] } else { 0.0 };
-        let (lo, hi) = inputs.footprint_box(b, (1u32 << level) as f32 * (1.0 + morph));
+        let k = level.saturating_sub(3);
+        let (lo, hi) = inputs.footprint_box(b, k, (1u32 << level) as f32 * (1.0 + morph));
         let (mut slo, mut shi) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
         for c in 0..8 {
             let q: Vec4 = vp * corner(lo, hi, c).extend(1.0);
@@ -302,7 +305,7 @@ pub fn slot_code(l: u32, n: u32) -> u32 {
         0 => n,
         1 => 512 + n,
         2 => 576 + n,
-        _ => 585,
+        _ => 582 + l,
     }
 }
 
@@ -323,12 +326,13 @@ impl BrickInputs<'_> {
 
 /// Mirror of `voxel_ijk` (types.glsl): the grid index of a voxel as `brick_order` writes it.
 pub fn voxel_ijk(v: [u32; 2]) -> [u32; 3] {
-    [v[0] & 0xffff, v[0] >> 16, v[1] & 0x1fff]
+    [v[0] & 0x1fff, v[0] >> 16 & 0x1fff, v[1] & 0x1fff]
 }
 
-/// Mirror of `voxel_level`: 0 for a voxel, l for a cell of 2^l voxels a side.
+/// Mirror of `voxel_level`: 0 for a voxel, l for a cell of 2^l voxels a side (a node k levels
+/// above the brick: 3 + k).
 pub fn voxel_level(v: [u32; 2]) -> u32 {
-    v[1] >> 13 & 3
+    (v[1] >> 13 & 3) + (v[0] >> 13 & 7)
 }
 
 /// Pass 1: cull each non-empty brick or write its header and count at its draw-order slot
@@ -342,8 +346,21 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
         if (0..3).any(|a| b[a] < lo[a] || b[a] >= hi[a]) || inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) {
             continue;
         }
-        let (level, morph) = inputs.brick_level(h as u32, b);
-        if inputs.outside_view(b, (1u32 << level) as f32 * (1.0 + morph)) {
+        let (level, morph, px) = inputs.brick_level(h as u32, b);
+        let k = inputs.node_level(b, px);
+        if k > 0 {
+            // Mirror of the node branch: the node's first drawing brick draws it.
+            morphs[h] = 0.0;
+            let w = inputs.node_of(k, b);
+            if w[5] == h as u32
+                && super::lod::tau_decode(w[0] & 0xffff) > 0.0
+                && !inputs.outside_view(b, k, (BRICK << k) as f32)
+            {
+                slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(3 + k, 1);
+            }
+            continue;
+        }
+        if inputs.outside_view(b, 0, (1u32 << level) as f32 * (1.0 + morph)) {
             continue;
         }
         let drawn = match counts {

@@ -18,7 +18,7 @@ pub const CELL_WORDS: usize = 3;
 /// Coarse levels (level l: cells of 2^l voxels a side).
 pub const LOD_LEVELS: u32 = 3;
 /// The octahedral bytes of a zero gradient.
-const NO_NORMAL: u32 = 0x8080;
+pub(crate) const NO_NORMAL: u32 = 0x8080;
 
 /// Cells of a brick's pyramid slot (level 1); levels 2 and 3 live in its summary.
 pub const SLOT_CELLS: usize = 64;
@@ -64,7 +64,7 @@ fn snorm8(v: f32) -> u32 {
 }
 
 /// Mirror of `unorm10` (brick_pyramid.comp).
-fn unorm10(v: f32) -> u32 {
+pub(crate) fn unorm10(v: f32) -> u32 {
     (v.clamp(0.0, 1.0) * 1023.0 + 0.5).floor() as u32
 }
 
@@ -98,7 +98,7 @@ fn sign_not_zero(v: f32) -> f32 {
 }
 
 /// Mirror of `pack_normal`: octahedral bytes of gradient `g`.
-fn pack_normal(g: Vec3) -> u32 {
+pub(crate) fn pack_normal(g: Vec3) -> u32 {
     let len = g.x.abs() + g.y.abs() + g.z.abs();
     if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return NO_NORMAL;
@@ -113,7 +113,7 @@ fn pack_normal(g: Vec3) -> u32 {
 }
 
 /// Mirror of `unpack_normal`.
-fn unpack_normal(w: u32) -> Vec3 {
+pub(crate) fn unpack_normal(w: u32) -> Vec3 {
     if w == NO_NORMAL {
         return Vec3::ZERO;
     }
@@ -137,17 +137,21 @@ pub fn cell_word(pyramid: &[u32], summary: &[u32], slot: u32, h: u32, i: u32, k:
     }
 }
 
+/// Mirror of `cell_seen`: a cell (words `xy`, `zn`, `c`) seen along `view` (index space):
+/// straight colour, optical depth per cell length, and its normal (zero when it has none).
+pub(crate) fn cell_seen(xy: u32, zn: u32, c: u32, view: Vec3) -> ([f32; 4], Vec3) {
+    let w = view * view / view.dot(view).max(1e-30);
+    let tau = Vec3::new(tau_decode(xy & 0xffff), tau_decode(xy >> 16), tau_decode(zn & 0xffff));
+    let trans = w.dot((-tau.min(Vec3::splat(80.0))).exp());
+    let rgb = [c & 1023, c >> 10 & 1023, c >> 20 & 1023].map(|q| q as f32 / 1023.0);
+    ([rgb[0], rgb[1], rgb[2], -trans.max(1e-30).ln()], unpack_normal(zn >> 16))
+}
+
 impl BrickInputs<'_> {
-    /// Mirror of `cell_color`: cell `i` of header `h` seen along `view` (index space): straight
-    /// colour, optical depth per cell length, and its normal (zero when it has none).
+    /// Mirror of `cell_color`: cell `i` of header `h` seen along `view` (`cell_seen`).
     pub fn cell_color(&self, h: u32, i: u32, view: Vec3) -> ([f32; 4], Vec3) {
         let word = |k| cell_word(self.pyramid, self.summary, self.pyramid_index(h), h, i, k);
-        let (xy, zn, c) = (word(0), word(1), word(2));
-        let w = view * view / view.dot(view).max(1e-30);
-        let tau = Vec3::new(tau_decode(xy & 0xffff), tau_decode(xy >> 16), tau_decode(zn & 0xffff));
-        let trans = w.dot((-tau.min(Vec3::splat(80.0))).exp());
-        let rgb = [c & 1023, c >> 10 & 1023, c >> 20 & 1023].map(|q| q as f32 / 1023.0);
-        ([rgb[0], rgb[1], rgb[2], -trans.max(1e-30).ln()], unpack_normal(zn >> 16))
+        cell_seen(word(0), word(1), word(2), view)
     }
 
     /// Mirror of `cell_tau`: the optical depth per cell length along x.
@@ -167,6 +171,13 @@ pub fn level_count(summary: &[u32], h: u32, l: u32) -> u32 {
     }
 }
 
+/// Mirror of `seen_error`: a coarse cell's error as the picture sees it, the cell projecting to
+/// `size` pixels (its detail is averaged away by the pixel's filter below a pixel).
+pub fn seen_error(err: f32, size: f32) -> f32 {
+    let s = size.min(1.0);
+    err * s
+}
+
 /// Mirror of `level_split`: the eye's PBTF split of level `l`'s cells inside brick `b`.
 pub fn level_split(split: [u32; 4], b: [u32; 3], l: u32) -> [u32; 3] {
     let side = BRICK >> l;
@@ -178,7 +189,7 @@ pub fn level_split(split: [u32; 4], b: [u32; 3], l: u32) -> [u32; 3] {
 
 impl BrickInputs<'_> {
     /// Mirror of `voxel_pixels`.
-    fn voxel_pixels(&self, depth: f32) -> f32 {
+    pub(crate) fn voxel_pixels(&self, depth: f32) -> f32 {
         let f = self.frame;
         let voxel = f.spacing[3] / f.origin[3];
         if f.eye[3] > 0.5 {
@@ -202,21 +213,22 @@ impl BrickInputs<'_> {
         1.0 + ((octaves - (1.0 - bf.grad[3])) / bf.grad[3]).clamp(0.0, 1.0)
     }
 
-    /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame, and 1 when
-    /// its splats may morph toward the next.
-    pub fn brick_level(&self, h: u32, b: [u32; 3]) -> (u32, f32) {
+    /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame, 1 when its
+    /// splats may morph toward the next, and pixels per voxel spacing at its nearest depth.
+    pub fn brick_level(&self, h: u32, b: [u32; 3]) -> (u32, f32, f32) {
         let (f, bf) = (self.frame, &self.bf);
         if bf.grad[1] <= 0.0 {
-            return (0, 0.0);
+            return (0, 0.0, 0.0);
         }
-        let (lo, hi) = self.voxel_box(b);
+        let (lo, hi) = self.voxel_box(b, 0);
         let (near, far) = self.box_depths(lo, hi);
         let px = self.voxel_pixels(near);
         let at = h as usize * SUMMARY_WORDS;
         let s = &self.summary[at..at + 4];
         let mut level = 0;
         for l in 1..=LOD_LEVELS {
-            if px * (1u32 << l) as f32 > bf.grad[1] || f32::from_bits(s[l as usize]) > bf.grad[2] {
+            let size = px * (1u32 << l) as f32;
+            if size > bf.grad[1] || seen_error(f32::from_bits(s[l as usize]), size) > bf.grad[2] {
                 break;
             }
             let cell = (1u32 << l) as f32;
@@ -230,9 +242,9 @@ impl BrickInputs<'_> {
         let octaves = self.level_octaves(far, level);
         let morph = level < 3
             && bf.grad[3] > 0.0
-            && f32::from_bits(s[level as usize + 1]) <= bf.grad[2]
+            && seen_error(f32::from_bits(s[level as usize + 1]), px * (2u32 << level) as f32) <= bf.grad[2]
             && octaves > 1.0 - bf.grad[3];
-        (level, if morph { 1.0 } else { 0.0 })
+        (level, if morph { 1.0 } else { 0.0 }, px)
     }
 }
 
@@ -248,7 +260,7 @@ struct Sums {
 }
 
 /// Mirror of `aligned`: `g` turned to agree with `with`.
-fn aligned(g: Vec3, with: Vec3) -> Vec3 {
+pub(crate) fn aligned(g: Vec3, with: Vec3) -> Vec3 {
     if g.dot(with) < 0.0 {
         -g
     } else {
@@ -258,7 +270,7 @@ fn aligned(g: Vec3, with: Vec3) -> Vec3 {
 
 /// Mirror of `axis_opacity`: the opacity along `axis` of a cell whose children have opacities
 /// `a` along it.
-fn axis_opacity(a: [f32; 8], axis: usize) -> f32 {
+pub(crate) fn axis_opacity(a: [f32; 8], axis: usize) -> f32 {
     let mut sum = 0.0;
     for p in 0..4usize {
         let low = (p & ((1 << axis) - 1)) | ((p >> axis) << (axis + 1));
@@ -365,6 +377,9 @@ pub fn brick_pyramid(
                     &mut summary[h * SUMMARY_WORDS + 4 + (i - SLOT_CELLS) * CELL_WORDS..][..CELL_WORDS]
                 };
                 at.copy_from_slice(&words);
+                if i == LOD_CELLS - 1 {
+                    summary[h * SUMMARY_WORDS + SUMMARY_WORDS - 1] = t.to_bits();
+                }
             }
         }
         let mut s = [fine.iter().filter(|f| f.tau > 0.0).count() as u32 * (1 << 16), 0, 0, 0];
@@ -398,6 +413,14 @@ pub fn brick_cells(
             continue;
         }
         let b = inputs.store.headers[entry[0] as usize].coords();
+        if level > LOD_LEVELS {
+            // Mirror of the node branch.
+            let k = level - LOD_LEVELS;
+            let ijk = b.map(|c| (c >> k << k) * BRICK);
+            voxels[entry[1] as usize] = [ijk[0] | k << 13 | ijk[1] << 16, ijk[2] | LOD_LEVELS << 13];
+            order[entry[1] as usize] = entry[1];
+            continue;
+        }
         let n = BRICK >> level;
         let off = level_offset(level);
         let split = level_split(inputs.frame.split, b, level);
@@ -443,7 +466,6 @@ pub fn brick_lod_params(
     for &s in &lod_splats[..push.splats as usize] {
         let v = voxels[s as usize];
         let (ijk, level) = (voxel_ijk(v), voxel_level(v));
-        let h = inputs.store.header_of(ijk);
         let at = Vec3::from_array(
             [0, 1, 2].map(|a| ijk[a] as f32 + 0.5 * ((1u32 << level).min(dims[a] - ijk[a]) as f32 - 1.0)),
         );
@@ -454,7 +476,11 @@ pub fn brick_lod_params(
             Vec3::new(f.forward[0], f.forward[1], f.forward[2])
         };
         let view = grid.index_dir(view.as_dvec3()).as_vec3();
-        let (mut c, normal) = inputs.cell_color(h, v[1] >> 16, view);
+        let (mut c, normal) = if level > LOD_LEVELS {
+            inputs.node_color(level - LOD_LEVELS, ijk.map(|c| c >> level), view)
+        } else {
+            inputs.cell_color(inputs.store.header_of(ijk), v[1] >> 16, view)
+        };
         if shaded {
             inputs.shade(&mut c, normal);
         }

@@ -2,6 +2,7 @@
 //! loop like the shaders and reading the same `#[repr(C)]` structs.
 pub mod bindings;
 pub mod brick;
+pub mod brick_nodes;
 pub mod composite;
 pub mod footprint;
 pub mod lod;

@@ -3,7 +3,10 @@
 use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
 use crate::constants::{MAX_GPU_SPLATS, PYRAMID_PAGE, PYRAMID_PAGES};
-use crate::cpu::lod::{pyramid_bytes, LOD_BUFFERS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
+use crate::cpu::brick_nodes::{node_grid, node_levels, node_words};
+use crate::cpu::lod::{
+    pyramid_bytes, LOD_BUFFERS, LOD_LEVELS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS,
+};
 use crate::options::FrameStats;
 use crate::residency::{RecordCache, SLOT_WORDS};
 use std::cell::Cell;
@@ -99,7 +102,11 @@ pub(super) fn record_bricks(
     };
     let per_batch = lod && lod_buffers == STREAMED_LOD_BUFFERS;
     let batch_pyramid = if per_batch { PYRAMID_BYTES } else { 0 };
-    let pyramid = if lod { pyramid_bytes(lod_buffers, headers) + batch_pyramid } else { 0 };
+    // The nodes above the brick, after the summaries (resident with them).
+    let grid = scene.store.dims.map(|d| d.div_ceil(BRICK));
+    let node_levels = if lod { node_levels(grid, headers) } else { 0 };
+    let node_bytes = node_words(grid, node_levels) * 4;
+    let pyramid = if lod { pyramid_bytes(lod_buffers, headers) + batch_pyramid + node_bytes } else { 0 };
     let least = bricked_min_budget(scene, budget, w, h) + pyramid;
     if budget < least {
         let levels = if lod {
@@ -136,6 +143,7 @@ pub(super) fn record_bricks(
     let mut bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
     if lod {
         (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, opts.lod_error, opts.lod_band);
+        bf.hi[3] = node_levels;
     }
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
     // The brick stages' build: one page of store records, the paged reader, or streamed records.
@@ -159,7 +167,8 @@ pub(super) fn record_bricks(
     }
     if lod {
         for &(res, per_brick) in lod_buffers {
-            e.ensure(res, headers as u64 * per_brick)?;
+            let nodes = if res == Res::LodSummary { node_bytes } else { 0 };
+            e.ensure(res, headers as u64 * per_brick + nodes)?;
         }
         let id = scene.classification();
         let all = BrickPush { first: 0, count: bf.grid[3], splats: 0, occluded: 0.0 };
@@ -176,12 +185,14 @@ pub(super) fn record_bricks(
                     build_pyramids(e, build, &push)?;
                 }
                 cut.lock_cache().forget();
+                build_nodes(e, grid, node_levels)?;
                 e.set_tag(Res::LodSummary, id);
             }
             // Per batch it holds batches' pyramids, not the store's.
             e.set_tag(Res::Pyramid, if per_batch { 0 } else { id });
         } else if !built && bf.grid[3] > 0 {
             build_pyramids(e, build, &all)?;
+            build_nodes(e, grid, node_levels)?;
             e.set_tag(Res::Pyramid, id);
             e.set_tag(Res::LodSummary, id);
         }
@@ -217,6 +228,7 @@ pub(super) fn record_bricks(
         let (_, level, n) = slot_entry(w);
         stats.bricks_visible += 1;
         stats.bricks_coarse += u32::from(level > 0);
+        stats.nodes += u32::from(level > LOD_LEVELS);
         stats.splats += n as u64;
     }
     // The visible bricks in draw order, cut between bricks into batches.
@@ -545,6 +557,16 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
 fn build_pyramids(e: &mut dyn Engine, build: usize, push: &BrickPush) -> Result<()> {
     let groups = plan::groups_per_item(push.count);
     e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(push)))
+}
+
+/// `brick_nodes` over tree levels 1..=`levels` of a `grid` of bricks, each from the one below.
+fn build_nodes(e: &mut dyn Engine, grid: [u32; 3], levels: u32) -> Result<()> {
+    for k in 1..=levels {
+        let count = node_grid(grid, k).iter().product::<u32>();
+        let push = BrickPush { first: k, count, splats: 0, occluded: 0.0 };
+        e.run(&Dispatch::new(StageId::BrickNodes, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
+    }
+    Ok(())
 }
 
 /// A streamed store's batch on the device: the records of its bricks that read them (`Cut::uploads`)

@@ -1,0 +1,180 @@
+//! Levels of detail above the brick: mirror of `brick_nodes.comp` and of the node helpers of
+//! `glsl/shared/brick.glsl` (`node_grid`, `node_word`, `node_color`, `node_level`), and the host's
+//! choice of how many node levels a grid gets.
+use super::bindings::Bindings;
+use super::brick::{inputs, BrickInputs};
+use super::lod::{
+    aligned, axis_opacity, cell_seen, pack_normal, seen_error, tau_code, tau_decode, unorm10, unpack_normal,
+    CELL_WORDS, LOD_CELLS, NO_NORMAL, SLOT_CELLS, SUMMARY_WORDS,
+};
+use crate::bricks::BRICK;
+use crate::dispatch::{Args, Res, Variant};
+use crate::error::Result;
+use crate::gpu_types::BrickPush;
+use glam::Vec3;
+
+/// Words per node: the cell's 3, its error, its optical depth, the brick that draws it.
+pub const NODE_WORDS: usize = 6;
+/// Most tree levels above the brick (a voxel's level field holds 3 + 7).
+pub const NODE_LEVELS: u32 = 7;
+/// Mirror of `NODE_PIXELS`: a node's cell projects to at most this many pixels (and the bound).
+pub const NODE_PIXELS: f32 = 1.0;
+/// The nodes may take this many bytes, or the bricks' summaries' bytes where those are more: a
+/// sparse store in a large grid would otherwise hold far more nodes than bricks.
+const NODE_BYTES_FLOOR: u64 = 4 << 20;
+
+/// Mirror of `node_grid`: nodes along x, y, z at tree level `k` of a `grid` of bricks.
+pub fn node_grid(grid: [u32; 3], k: u32) -> [u32; 3] {
+    grid.map(|g| (g + (1 << k) - 1) >> k)
+}
+
+/// Words of the node levels 1..=`levels` of a `grid` of bricks.
+pub fn node_words(grid: [u32; 3], levels: u32) -> u64 {
+    (1..=levels).map(|k| node_grid(grid, k).iter().map(|&n| n as u64).product::<u64>() * NODE_WORDS as u64).sum()
+}
+
+/// The node levels a `grid` of bricks with `headers` non-empty bricks gets: up to one root node,
+/// at most `NODE_LEVELS`, and none when even the first would pass the nodes' share of memory.
+pub fn node_levels(grid: [u32; 3], headers: usize) -> u32 {
+    let most = grid.iter().copied().max().unwrap_or(1);
+    let levels = (0..NODE_LEVELS).find(|&k| 1u32 << k >= most).unwrap_or(NODE_LEVELS);
+    let cap = (headers as u64 * SUMMARY_WORDS as u64 * 4).max(NODE_BYTES_FLOOR);
+    if node_words(grid, levels) * 4 > cap {
+        0
+    } else {
+        levels
+    }
+}
+
+impl BrickInputs<'_> {
+    /// Mirror of `node_word`: the index of word 0 of brick `b`'s node at tree level `k` in the
+    /// summary buffer.
+    fn node_at(&self, k: u32, n: [u32; 3]) -> usize {
+        let grid = [self.bf.grid[0], self.bf.grid[1], self.bf.grid[2]];
+        let base = self.bf.grid[3].max(1) as u64 * SUMMARY_WORDS as u64 + node_words(grid, k - 1);
+        let g = node_grid(grid, k);
+        (base + (n[0] + g[0] * (n[1] + g[1] * n[2])) as u64 * NODE_WORDS as u64) as usize
+    }
+
+    /// The words of brick `b`'s node at tree level `k`.
+    pub(crate) fn node_of(&self, k: u32, b: [u32; 3]) -> &[u32] {
+        &self.summary[self.node_at(k, b.map(|c| c >> k))..][..NODE_WORDS]
+    }
+
+    /// Mirror of `node_color`: node `n` (node coordinates) of tree level `k` seen along `view`.
+    pub fn node_color(&self, k: u32, n: [u32; 3], view: Vec3) -> ([f32; 4], Vec3) {
+        let w = &self.summary[self.node_at(k, n)..];
+        cell_seen(w[0], w[1], w[2], view)
+    }
+
+    /// Mirror of `node_level`: the tree level of the node that draws brick `b` this frame (0:
+    /// none), `px` being `brick_level`'s pixels per voxel spacing at the brick's nearest depth.
+    pub fn node_level(&self, b: [u32; 3], px: f32) -> u32 {
+        let (f, bf) = (self.frame, &self.bf);
+        let bound = bf.grad[1].min(NODE_PIXELS);
+        if bf.grad[1] <= 0.0 || px * BRICK as f32 > bound {
+            return 0;
+        }
+        for k in (1..=bf.hi[3]).rev() {
+            let n0 = b.map(|c| c >> k << k);
+            let n1 = [0, 1, 2].map(|a| (n0[a] + (1 << k)).min(bf.grid[a]));
+            if (0..3).any(|a| n0[a] < bf.lo[a] || n1[a] > bf.hi[a]) {
+                continue;
+            }
+            let (lo, hi) = self.voxel_box(b, k);
+            let (near, far) = self.box_depths(lo, hi);
+            let cell = (BRICK << k) as f32;
+            let size = self.voxel_pixels(near) * cell;
+            if size > bound || seen_error(f32::from_bits(self.node_of(k, b)[3]), size) > bf.grad[2] {
+                continue;
+            }
+            if near < f.forward[3] + 2.0 * self.cull_reach(near, cell)
+                || far > f.right[3] - 2.0 * self.cull_reach(far, cell)
+            {
+                continue;
+            }
+            return k;
+        }
+        0
+    }
+}
+
+/// Mirror of `brick_nodes.comp`: the nodes of tree level `push.first` from their children (the
+/// bricks' level-3 cells in `summary`, or the level below's nodes), written after the summaries.
+pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u32]) {
+    let k = push.first;
+    let bf = &inputs.bf;
+    let grid = [bf.grid[0], bf.grid[1], bf.grid[2]];
+    let (g, below) = (node_grid(grid, k), node_grid(grid, k - 1));
+    let voxels = (1u32 << (3 * (3 + k))) as f32;
+    let at = |k: u32, n: [u32; 3]| {
+        let base = bf.grid[3].max(1) as u64 * SUMMARY_WORDS as u64 + node_words(grid, k - 1);
+        let g = node_grid(grid, k);
+        (base + (n[0] + g[0] * (n[1] + g[1] * n[2])) as u64 * NODE_WORDS as u64) as usize
+    };
+    for i in 0..push.count {
+        let n = [i % g[0], (i / g[0]) % g[1], i / (g[0] * g[1])];
+        let (mut t, mut col, mut grad, mut rep) = (0.0f32, Vec3::ZERO, Vec3::ZERO, u32::MAX);
+        let (mut tk, mut ck, mut ek, mut ak) = ([0f32; 8], [Vec3::ZERO; 8], [0f32; 8], [[0f32; 8]; 3]);
+        for d in 0..8u32 {
+            let c = [0, 1, 2].map(|a| 2 * n[a] + (d >> a & 1));
+            let (mut words, mut e, mut tc, mut r) = ([0, NO_NORMAL << 16, 0], 0.0f32, 0.0f32, u32::MAX);
+            if (0..3).all(|a| c[a] < below[a]) {
+                if k == 1 {
+                    let h = inputs.store.index[(c[0] + grid[0] * (c[1] + grid[1] * c[2])) as usize];
+                    if h != u32::MAX {
+                        let s = h as usize * SUMMARY_WORDS;
+                        let cell = s + 4 + (LOD_CELLS - 1 - SLOT_CELLS) * CELL_WORDS;
+                        words = [summary[cell], summary[cell + 1], summary[cell + 2]];
+                        (e, tc, r) =
+                            (f32::from_bits(summary[s + 3]), f32::from_bits(summary[s + SUMMARY_WORDS - 1]), h);
+                    }
+                } else {
+                    let w = at(k - 1, c);
+                    words = [summary[w], summary[w + 1], summary[w + 2]];
+                    (e, tc, r) = (f32::from_bits(summary[w + 3]), f32::from_bits(summary[w + 4]), summary[w + 5]);
+                }
+            }
+            if words[0] & 0xffff != 0 {
+                rep = rep.min(r);
+            }
+            let straight = Vec3::from([words[2], words[2] >> 10, words[2] >> 20].map(|q| (q & 1023) as f32 / 1023.0));
+            let d = d as usize;
+            (tk[d], ck[d], ek[d]) = (tc, straight * tc, e);
+            let codes = [words[0] & 0xffff, words[0] >> 16, words[1] & 0xffff];
+            for x in 0..3 {
+                ak[x][d] = 1.0 - (-tau_decode(codes[x])).exp();
+            }
+            t += tc;
+            col += ck[d];
+            grad += aligned(unpack_normal(words[1] >> 16) * tc, grad);
+        }
+        let a = 1.0 - (-t / voxels).exp();
+        let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
+        let mut err = 0.0f32;
+        for d in 0..8 {
+            // Mirror of `child_error`.
+            let akd = 1.0 - (-tk[d] / (voxels / 8.0)).exp();
+            let sk = if tk[d] > 0.0 { ck[d] / tk[d] } else { Vec3::ZERO };
+            let dc = (sk - straight).abs();
+            err = err.max(ek[d] + (akd - a).abs().max(akd * dc.x.max(dc.y.max(dc.z))));
+        }
+        let codes = [0, 1, 2].map(|x| tau_code(-(1.0 - axis_opacity(ak[x], x).min(0.999_999_9)).ln()));
+        let w = at(k, n);
+        summary[w..w + NODE_WORDS].copy_from_slice(&[
+            codes[0] | codes[1] << 16,
+            codes[2] | pack_normal(grad) << 16,
+            unorm10(straight.x) | unorm10(straight.y) << 10 | unorm10(straight.z) << 20,
+            err.to_bits(),
+            t.to_bits(),
+            rep,
+        ]);
+    }
+}
+
+pub(crate) fn brick_nodes_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+    let mut summary = b.take(Res::LodSummary);
+    brick_nodes(&inputs(b)?, &args.push_as(), &mut summary);
+    b.put(Res::LodSummary, summary);
+    Ok(())
+}
