@@ -3,7 +3,7 @@
 // Bricks, pass 1 (issue 23): one lane per non-empty brick. A brick outside the view, or whose
 // value range the transfer function leaves empty, is culled whole; otherwise it counts the voxels
 // the TF extracts (with levels of detail, brick_pyramid counted every level's splats, and the
-// brick takes its level's; a brick under a node drawn whole (node_level) is left to the node, which
+// brick takes its level's; a brick under a node drawn whole (brick_node_cut) is left to the node, which
 // the first brick below it whose cell draws writes at its own position, as level 3 + the node's
 // tree level), and writes header << 10 | slot_code(level, count) at its position in
 // the PBTF order of the brick grid (the host then lists the visible bricks in draw order and cuts
@@ -21,9 +21,8 @@ void main() {
     if (any(lessThan(b, bf.lo.xyz)) || any(greaterThanEqual(b, bf.hi.xyz))) return;
     if (tf_empty(hd.w & 0xffffu, hd.w >> 16u)) return;
     float morph;
-    float px;
-    uint level = brick_level(h, b, morph, px);
-    uint k = node_level(b, px);
+    uint level = brick_level(h, b, morph);
+    uint k = bf.grad.y > 0.0 && bf.hi.w > 0u ? lod_words[cut_word(b >> 1u)] : 0u;
     if (k > 0u) {
         brick_morph[h] = 0.0;
         uint w = node_word(k, b >> k, 0u);

@@ -6,7 +6,8 @@
 // tau-weighted colour, sign-aligned normal, and the error (Laur-Hanrahan) of the largest over the
 // children of their own error plus their departure from the node. So a node is one cell
 // 2^(3+k) voxels a side, and a frame's cut (node_level) can draw a whole subtree as one splat.
-// Each node also keeps the first header below it whose cell draws: that brick draws the node.
+// Each node also keeps the first header below it whose cell draws (that brick draws the node), and
+// whether it may be drawn at all: inside the drawn bricks, its bricks consecutive in their order.
 // Mirror: cpu::brick_nodes::brick_nodes.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
@@ -86,4 +87,8 @@ void main() {
     lod_words[w + 3u] = floatBitsToUint(err);
     lod_words[w + 4u] = floatBitsToUint(t);
     lod_words[w + 5u] = rep;
+    uvec3 n0 = n << k;
+    uvec3 n1 = min(n0 + (1u << k), bf.grid.xyz);
+    bool inside = all(greaterThanEqual(n0, bf.lo.xyz)) && all(lessThanEqual(n1, bf.hi.xyz));
+    lod_words[w + 6u] = inside && consecutive(n0, n1) ? 1u : 0u;
 }

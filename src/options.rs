@@ -269,6 +269,11 @@ pub struct RenderOptions {
     /// takes over, its splats move and widen toward that level's cells (geomorphing), so a level
     /// change is continuous in time and across brick faces. 0: abrupt changes.
     pub lod_band: f32,
+    /// Levels of detail above the brick (off by default): a node of 2^k bricks a side whose one
+    /// prefiltered cell projects to at most a pixel is drawn as that one splat (docs/MODEL.md).
+    /// Measured on lavapipe it halves the splats of a 1024³ volume at 32², but the cut over the
+    /// nodes costs about what it saves from 64² up (docs/RESULTS.md, "Nodes above the brick").
+    pub lod_nodes: bool,
     /// Composite the frame over this straight RGBA colour on the device (`present.comp`) before it
     /// is read back or written into a host image; alpha 1 gives an opaque frame, as a window shows
     /// it. `None` (the default) leaves the premultiplied frame as drawn: transparent where empty.
@@ -307,6 +312,7 @@ impl Default for RenderOptions {
             lod_pixels: DEFAULT_LOD_PIXELS,
             lod_error: DEFAULT_LOD_ERROR,
             lod_band: 0.75,
+            lod_nodes: false,
             background: None,
         }
     }
@@ -381,6 +387,12 @@ impl RenderOptions {
                 "the level-of-detail band {} must be in [0, 1]",
                 self.lod_band
             )));
+        }
+        if self.lod_nodes && self.lod != Lod::Auto {
+            return Err(Error::InvalidArgument(
+                "levels of detail above the brick (lod_nodes) are part of the level-of-detail cut: it needs lod = Auto"
+                    .into(),
+            ));
         }
         if let Some(bg) = self.background {
             if !bg.iter().all(|c| (0.0..=1.0).contains(c)) {

@@ -317,7 +317,10 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
     let mut cam = Camera::framing(&grid, 48, 48);
     cam.eye = grid.center() + glam::Vec3::new(30.0, 40.0, 900.0);
     cam.far = 2000.0;
-    let o = compute(Direction::FrontToBack);
+    // Full detail: this far, levels of detail would draw the bricks from their pyramids, which
+    // read no records.
+    let mut o = compute(Direction::FrontToBack);
+    o.lod = voxsplat::Lod::Off;
     let what = [Res::BrickSlots, Res::BrickVoxels];
     let (mut g, mut c) = (renderer(true, None), renderer(false, None));
     g.set_bricks(scene.clone()).unwrap();

@@ -440,9 +440,10 @@ float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float vox
 // Levels of detail above the brick: a node of tree level k (1..bf.hi.w) covers 2^k bricks a side
 // and is one cell 2^(3+k) voxels a side, prefiltered from its 8 children as brick_pyramid's
 // levels are (brick_nodes). NODE_WORDS per node, after the bricks' summaries in LodSummary, level
-// by level, each level's nodes x fastest: the cell's 3 words, its error, its optical depth, and the
-// first header below it whose cell draws (the brick that draws the node; 0xffffffff: none).
-const uint NODE_WORDS = 6u;
+// by level, each level's nodes x fastest: the cell's 3 words, its error, its optical depth, the
+// first header below it whose cell draws (the brick that draws the node; 0xffffffff: none), and 1
+// when it may be drawn at all (inside the drawn bricks, its bricks consecutive: consecutive).
+const uint NODE_WORDS = 7u;
 // A node's cell projects to at most this many pixels (and the bound): wider, its one footprint
 // blurs the silhouette of what it stands for (a uniform cube at 8 x 8 pixels drawn with 1.5-pixel
 // nodes covered 20 % more than at full detail). Mirror: cpu::brick_nodes::NODE_PIXELS.
@@ -462,6 +463,13 @@ uint node_word(uint k, uvec3 n, uint w) {
     }
     uvec3 g = node_grid(k);
     return base + (n.x + g.x * (n.y + g.y * n.z)) * NODE_WORDS + w;
+}
+
+// This frame's cut over the nodes (brick_node_cut), per level-1 node after the nodes: the tree
+// level of the node that draws its bricks, 0 for none.
+uint cut_word(uvec3 n1) {
+    uvec3 g = node_grid(1u);
+    return node_word(bf.hi.w + 1u, uvec3(0u), 0u) + n1.x + g.x * (n1.y + g.y * n1.z);
 }
 
 // Node n of tree level k seen along `view` (cell_seen).
@@ -502,16 +510,15 @@ float seen_error(float err, float size) {
 // bf.grad.y pixels at the brick's nearest depth, whose error is at most bf.grad.z (0: off) and
 // whose splats keep clear of the near and far planes;
 // `morph`: 1 when its splats may morph toward the next level (allowed there too, and some of its
-// splats within the band; splat_growth); `px`: pixels per voxel spacing at its nearest depth.
-uint brick_level(uint h, uvec3 b, out float morph, out float px) {
+// splats within the band; splat_growth).
+uint brick_level(uint h, uvec3 b, out float morph) {
     morph = 0.0;
-    px = 0.0;
     if (bf.grad.y <= 0.0) return 0u;
     vec3 lo;
     vec3 hi;
     voxel_box(b, 0u, lo, hi);
     vec2 depths = box_depths(lo, hi);
-    px = voxel_pixels(depths.x);
+    float px = voxel_pixels(depths.x);
     uvec4 s = lod_summary(h);
     uint level = 0u;
     for (uint l = 1u; l <= 3u; ++l) {
@@ -532,25 +539,56 @@ uint brick_level(uint h, uvec3 b, out float morph, out float px) {
     return level;
 }
 
-// The tree level of the node above brick b that draws it this frame (0: none, the brick draws
-// itself): the highest whose one cell projects to at most bf.grad.y pixels at the node's nearest
-// depth, whose error is at most bf.grad.z, whose splat keeps clear of the near and far planes and
-// which lies inside the drawn bricks. Every brick of a node tests the same nodes from the top, so
-// all find the same one. `px`: brick_level's; a node's nearest depth is at most its brick's, so
-// where the brick's own one cell projects wider than the bound no node can pass.
+// Whether the bricks of the aligned block n0..n1 (clipped to the grid) are consecutive in the
+// brick order (brick_slot): the block is one of the k-d tree's boxes or lies inside one of its
+// leaves (an octree there); a block the tree cuts is not. Only then can one splat at one of its
+// bricks' places stand for them all in a visibility order. Mirror: cpu::brick_nodes::consecutive.
+bool consecutive(uvec3 n0, uvec3 n1) {
+    uint total = bf.grid.x * bf.grid.y * bf.grid.z;
+    uvec3 lo = uvec3(0u), hi = bf.grid.xyz;
+    uint n = bf.lo.w > 0u ? 0u : 0xffffffffu;
+    for (;;) {
+        if (all(equal(lo, n0)) && all(equal(hi, n1))) return true;
+        // Inside a leaf: an aligned block, consecutive in its octree order.
+        if (n == 0xffffffffu) return all(greaterThanEqual(n0, lo)) && all(lessThanEqual(n1, hi));
+        uint code = brick_index[total + 4u * n];
+        uint axis = code & 3u, plane = code >> 2u;
+        if (plane <= n0[axis]) {
+            lo[axis] = plane;
+            n = brick_index[total + 4u * n + 2u];
+        } else if (plane >= n1[axis]) {
+            hi[axis] = plane;
+            n = brick_index[total + 4u * n + 1u];
+        } else {
+            return false;
+        }
+    }
+    return false;
+}
+
+// The tree level of the node above brick b (or any brick of b's level-1 node) that draws it this
+// frame, 0 for none: the highest whose one cell projects to at most min(bf.grad.y, NODE_PIXELS)
+// pixels at the node's nearest depth, whose seen error is at most bf.grad.z, whose splat keeps
+// clear of the near and far planes and which may be drawn at all (brick_nodes: inside the drawn
+// bricks, its bricks consecutive in their order). `px`: pixels per voxel spacing at the nearest depth of b's level-1
+// node, which bounds every node above it from below (their nearest depths are no farther), so the
+// cheap tests come first. Run per level-1 node (brick_node_cut).
 uint node_level(uvec3 b, float px) {
-    if (bf.grad.y <= 0.0 || px * float(BRICK_SIDE) > min(bf.grad.y, NODE_PIXELS)) return 0u;
+    float bound = min(bf.grad.y, NODE_PIXELS);
+    if (bf.grad.y <= 0.0 || px * float(2u * BRICK_SIDE) > bound) return 0u;
     for (uint k = bf.hi.w; k >= 1u; --k) {
-        uvec3 n0 = (b >> k) << k;
-        uvec3 n1 = min(n0 + (1u << k), bf.grid.xyz);
-        if (any(lessThan(n0, bf.lo.xyz)) || any(greaterThan(n1, bf.hi.xyz))) continue;
+        // Cheap tests first: the brick's own pixels per voxel bound the node's from below.
+        float cell = float(BRICK_SIDE << k);
+        if (px * cell > bound) continue;
+        float err = uintBitsToFloat(lod_words[node_word(k, b >> k, 3u)]);
+        if (seen_error(err, px * cell) > bf.grad.z) continue;
+        if (lod_words[node_word(k, b >> k, 6u)] == 0u) continue;
         vec3 lo;
         vec3 hi;
         voxel_box(b, k, lo, hi);
         vec2 depths = box_depths(lo, hi);
-        float cell = float(BRICK_SIDE << k);
         float size = voxel_pixels(depths.x) * cell;
-        if (size > min(bf.grad.y, NODE_PIXELS) || seen_error(uintBitsToFloat(lod_words[node_word(k, b >> k, 3u)]), size) > bf.grad.z) continue;
+        if (size > bound || seen_error(err, size) > bf.grad.z) continue;
         float near_reach = 2.0 * cull_reach(depths.x, cell);
         float far_reach = 2.0 * cull_reach(depths.y, cell);
         if (depths.x < frame.forward.w + near_reach || depths.y > frame.right.w - far_reach) continue;
@@ -603,9 +641,42 @@ bool outside_view(uvec3 b, uint k, float cell) {
     return front && any(notEqual(out_lo, uvec4(0u)));
 }
 
+// Brick b's position among the bricks of the box lo..hi visited front to back as an octree of
+// aligned blocks (2^l bricks a side at multiples of 2^l, clipped to the box), from the smallest
+// holding the box: at each block its 8 children in PBTF order for the eye's brick split s
+// (dense_pbtf over 2 x 2 x 2, a child on the low side when its lowest brick is). A visibility order
+// for the same reason PBTF is (two 6-adjacent bricks are ordered by the children their lowest
+// common block splits them into, across the plane between them), in which every aligned block
+// inside the box is consecutive, so a node above the brick can stand at any of its bricks' places.
+// Mirror: cpu::brick::octree_pbtf.
+uint octree_pbtf(uvec3 b, uvec3 lo, uvec3 hi, uvec3 s) {
+    uint l = 0u;
+    while (any(notEqual(lo >> l, (hi - 1u) >> l))) l++;
+    uvec3 o = (lo >> l) << l;
+    uint p = 0u;
+    for (; l > 0u; --l) {
+        uint half_side = 1u << (l - 1u);
+        uvec3 cs = uvec3(clamp((ivec3(s) - ivec3(o) + int(half_side) - 1) / int(half_side), 0, 2));
+        uvec3 mine = uvec3(greaterThanEqual(b, o + half_side));
+        uint rank = dense_pbtf(mine, uvec3(2u), cs);
+        for (uint d = 0u; d < 8u; ++d) {
+            uvec3 c = uvec3(d, d >> 1u, d >> 2u) & 1u;
+            if (dense_pbtf(c, uvec3(2u), cs) >= rank) continue;
+            uvec3 clo = max(o + c * half_side, lo);
+            uvec3 chi = min(o + (c + 1u) * half_side, hi);
+            if (all(lessThan(clo, chi))) {
+                uvec3 e = chi - clo;
+                p += e.x * e.y * e.z;
+            }
+        }
+        o += mine * half_side;
+    }
+    return p;
+}
+
 // Brick b's position in the draw order of the brick grid: the k-d tree's (after the brick index;
-// kdtree.rs), front to back as dense_pbtf: every node's near side first, PBTF within its leaves'
-// boxes; reversed back to front.
+// kdtree.rs), front to back: every node's near side first, its leaves' boxes as octrees
+// (octree_pbtf); reversed back to front.
 // Mirror: cpu::brick::tree_pbtf.
 uint brick_slot(uvec3 b) {
     uint total = bf.grid.x * bf.grid.y * bf.grid.z;
@@ -624,7 +695,6 @@ uint brick_slot(uvec3 b) {
         if (high) lo[axis] = plane; else hi[axis] = plane;
         n = brick_index[total + 4u * n + (high ? 2u : 1u)];
     }
-    uvec3 s = clamp(bf.split.xyz, lo, hi) - lo;
-    p += dense_pbtf(b - lo, hi - lo, s);
+    p += octree_pbtf(b, lo, hi, bf.split.xyz);
     return frame.split.w != 0u ? total - 1u - p : p;
 }

@@ -31,8 +31,8 @@ pub fn dense_pbtf(c: [u32; 3], n: [u32; 3], s: [u32; 3]) -> u32 {
 }
 
 /// Mirror of `tree_pbtf`: brick `b`'s position in the order of a `grid` of bricks that `tree`
-/// (`kdtree`) cuts, front to back as `dense_pbtf`: every node's near side first (for the eye's
-/// brick split `split`), PBTF within its leaves' boxes.
+/// (`kdtree`) cuts, front to back: every node's near side first (for the eye's brick split
+/// `split`), its leaves' boxes as octrees (`octree_pbtf`).
 pub fn tree_pbtf(tree: &[crate::kdtree::Node], grid: [u32; 3], split: [u32; 3], b: [u32; 3]) -> u32 {
     let (mut lo, mut hi, mut p) = ([0u32; 3], grid, 0u32);
     let mut n = if tree.is_empty() { crate::kdtree::LEAF } else { 0 };
@@ -53,9 +53,38 @@ pub fn tree_pbtf(tree: &[crate::kdtree::Node], grid: [u32; 3], split: [u32; 3], 
         }
         n = if high { node[2] } else { node[1] };
     }
-    let size = [0, 1, 2].map(|a| hi[a] - lo[a]);
-    let s = [0, 1, 2].map(|a| split[a].clamp(lo[a], hi[a]) - lo[a]);
-    p + dense_pbtf([0, 1, 2].map(|a| b[a] - lo[a]), size, s)
+    p + octree_pbtf(b, lo, hi, split)
+}
+
+/// Mirror of `octree_pbtf`: brick `b`'s position among the bricks of the box `lo..hi` visited front
+/// to back as an octree of aligned blocks, each block's children in PBTF order for the split.
+pub fn octree_pbtf(b: [u32; 3], lo: [u32; 3], hi: [u32; 3], s: [u32; 3]) -> u32 {
+    let mut l = 0;
+    while (0..3).any(|a| lo[a] >> l != (hi[a] - 1) >> l) {
+        l += 1;
+    }
+    let mut o = lo.map(|c| c >> l << l);
+    let mut p = 0;
+    while l > 0 {
+        let half = 1u32 << (l - 1);
+        let cs = [0, 1, 2].map(|a| ((s[a] as i64 - o[a] as i64 + half as i64 - 1) / half as i64).clamp(0, 2) as u32);
+        let mine = [0, 1, 2].map(|a| u32::from(b[a] >= o[a] + half));
+        let rank = dense_pbtf(mine, [2; 3], cs);
+        for d in 0..8u32 {
+            let c = [d & 1, d >> 1 & 1, d >> 2 & 1];
+            if dense_pbtf(c, [2; 3], cs) >= rank {
+                continue;
+            }
+            let clo = [0, 1, 2].map(|a| (o[a] + c[a] * half).max(lo[a]));
+            let chi = [0, 1, 2].map(|a| (o[a] + (c[a] + 1) * half).min(hi[a]));
+            if (0..3).all(|a| clo[a] < chi[a]) {
+                p += (0..3).map(|a| chi[a] - clo[a]).product::<u32>();
+            }
+        }
+        o = [0, 1, 2].map(|a| o[a] + mine[a] * half);
+        l -= 1;
+    }
+    p
 }
 
 /// What the brick stages read: the frame, its brick uniforms, the TF table and the store.
@@ -346,8 +375,8 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
         if (0..3).any(|a| b[a] < lo[a] || b[a] >= hi[a]) || inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) {
             continue;
         }
-        let (level, morph, px) = inputs.brick_level(h as u32, b);
-        let k = inputs.node_level(b, px);
+        let (level, morph) = inputs.brick_level(h as u32, b);
+        let k = inputs.node_cut(b);
         if k > 0 {
             // Mirror of the node branch: the node's first drawing brick draws it.
             morphs[h] = 0.0;

@@ -13,8 +13,9 @@ use crate::error::Result;
 use crate::gpu_types::BrickPush;
 use glam::Vec3;
 
-/// Words per node: the cell's 3, its error, its optical depth, the brick that draws it.
-pub const NODE_WORDS: usize = 6;
+/// Words per node: the cell's 3, its error, its optical depth, the brick that draws it, and 1
+/// when it may be drawn at all.
+pub const NODE_WORDS: usize = 7;
 /// Most tree levels above the brick (a voxel's level field holds 3 + 7).
 pub const NODE_LEVELS: u32 = 7;
 /// Mirror of `NODE_PIXELS`: a node's cell projects to at most this many pixels (and the bound).
@@ -46,6 +47,33 @@ pub fn node_levels(grid: [u32; 3], headers: usize) -> u32 {
     }
 }
 
+/// Mirror of `consecutive`: whether the bricks of the aligned block `n0..n1` of a `grid` of bricks
+/// are consecutive in the order `tree` gives them (the block is one of the tree's boxes, or lies
+/// inside one of its leaves).
+pub fn consecutive(tree: &[crate::kdtree::Node], grid: [u32; 3], n0: [u32; 3], n1: [u32; 3]) -> bool {
+    let (mut lo, mut hi) = ([0u32; 3], grid);
+    let mut n = if tree.is_empty() { crate::kdtree::LEAF } else { 0 };
+    loop {
+        if lo == n0 && hi == n1 {
+            return true;
+        }
+        if n == crate::kdtree::LEAF {
+            return (0..3).all(|a| n0[a] >= lo[a] && n1[a] <= hi[a]);
+        }
+        let node = &tree[n as usize];
+        let (axis, plane) = crate::kdtree::cut(node);
+        if plane <= n0[axis] {
+            lo[axis] = plane;
+            n = node[2];
+        } else if plane >= n1[axis] {
+            hi[axis] = plane;
+            n = node[1];
+        } else {
+            return false;
+        }
+    }
+}
+
 impl BrickInputs<'_> {
     /// Mirror of `node_word`: the index of word 0 of brick `b`'s node at tree level `k` in the
     /// summary buffer.
@@ -61,31 +89,54 @@ impl BrickInputs<'_> {
         &self.summary[self.node_at(k, b.map(|c| c >> k))..][..NODE_WORDS]
     }
 
+    /// Mirror of `cut_word`: the index of level-1 node `n1`'s cut word.
+    fn cut_at(&self, n1: [u32; 3]) -> usize {
+        let grid = [self.bf.grid[0], self.bf.grid[1], self.bf.grid[2]];
+        let g = node_grid(grid, 1);
+        let base = self.bf.grid[3].max(1) as u64 * SUMMARY_WORDS as u64 + node_words(grid, self.bf.hi[3]);
+        (base + (n1[0] + g[0] * (n1[1] + g[1] * n1[2])) as u64) as usize
+    }
+
+    /// This frame's tree level of the node that draws brick `b` (`brick_cull`'s read of the cut).
+    pub(crate) fn node_cut(&self, b: [u32; 3]) -> u32 {
+        if self.bf.grad[1] > 0.0 && self.bf.hi[3] > 0 {
+            self.summary[self.cut_at(b.map(|c| c >> 1))]
+        } else {
+            0
+        }
+    }
+
     /// Mirror of `node_color`: node `n` (node coordinates) of tree level `k` seen along `view`.
     pub fn node_color(&self, k: u32, n: [u32; 3], view: Vec3) -> ([f32; 4], Vec3) {
         let w = &self.summary[self.node_at(k, n)..];
         cell_seen(w[0], w[1], w[2], view)
     }
 
-    /// Mirror of `node_level`: the tree level of the node that draws brick `b` this frame (0:
-    /// none), `px` being `brick_level`'s pixels per voxel spacing at the brick's nearest depth.
+    /// Mirror of `node_level`: the tree level of the node that draws brick `b`'s level-1 node this
+    /// frame (0: none), `px` being pixels per voxel spacing at that level-1 node's nearest depth.
     pub fn node_level(&self, b: [u32; 3], px: f32) -> u32 {
         let (f, bf) = (self.frame, &self.bf);
         let bound = bf.grad[1].min(NODE_PIXELS);
-        if bf.grad[1] <= 0.0 || px * BRICK as f32 > bound {
+        if bf.grad[1] <= 0.0 || px * (2 * BRICK) as f32 > bound {
             return 0;
         }
         for k in (1..=bf.hi[3]).rev() {
-            let n0 = b.map(|c| c >> k << k);
-            let n1 = [0, 1, 2].map(|a| (n0[a] + (1 << k)).min(bf.grid[a]));
-            if (0..3).any(|a| n0[a] < bf.lo[a] || n1[a] > bf.hi[a]) {
+            // Cheap tests first: the brick's own pixels per voxel bound the node's from below.
+            let cell = (BRICK << k) as f32;
+            if px * cell > bound {
+                continue;
+            }
+            let err = f32::from_bits(self.node_of(k, b)[3]);
+            if seen_error(err, px * cell) > bf.grad[2] {
+                continue;
+            }
+            if self.node_of(k, b)[6] == 0 {
                 continue;
             }
             let (lo, hi) = self.voxel_box(b, k);
             let (near, far) = self.box_depths(lo, hi);
-            let cell = (BRICK << k) as f32;
             let size = self.voxel_pixels(near) * cell;
-            if size > bound || seen_error(f32::from_bits(self.node_of(k, b)[3]), size) > bf.grad[2] {
+            if size > bound || seen_error(err, size) > bf.grad[2] {
                 continue;
             }
             if near < f.forward[3] + 2.0 * self.cull_reach(near, cell)
@@ -112,6 +163,8 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
         let g = node_grid(grid, k);
         (base + (n[0] + g[0] * (n[1] + g[1] * n[2])) as u64 * NODE_WORDS as u64) as usize
     };
+    let n1 = |n: [u32; 3]| [0, 1, 2].map(|a| ((n[a] << k) + (1 << k)).min(grid[a]));
+    let inside = |n: [u32; 3]| (0..3).all(|a| n[a] << k >= bf.lo[a] && n1(n)[a] <= bf.hi[a]);
     for i in 0..push.count {
         let n = [i % g[0], (i / g[0]) % g[1], i / (g[0] * g[1])];
         let (mut t, mut col, mut grad, mut rep) = (0.0f32, Vec3::ZERO, Vec3::ZERO, u32::MAX);
@@ -168,8 +221,49 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
             err.to_bits(),
             t.to_bits(),
             rep,
+            u32::from(inside(n) && consecutive(inputs.tree, grid, n.map(|c| c << k), n1(n))),
         ]);
     }
+}
+
+/// Mirror of `brick_node_cut.comp`: per level-1 node, the tree level of the node that draws its
+/// bricks this frame, as (index of its cut word in the summary buffer, level).
+pub fn brick_node_cut(inputs: &BrickInputs<'_>) -> Vec<(usize, u32)> {
+    let bf = &inputs.bf;
+    let g = node_grid([bf.grid[0], bf.grid[1], bf.grid[2]], 1);
+    let mut cut = Vec::with_capacity((g[0] * g[1] * g[2]) as usize);
+    for i in 0..g[0] * g[1] * g[2] {
+        let n = [i % g[0], (i / g[0]) % g[1], i / (g[0] * g[1])];
+        let b = n.map(|c| c << 1);
+        // A level-1 node whose bricks draw nothing: no node above it draws them either.
+        let k = if inputs.node_of(1, b)[5] == u32::MAX {
+            0
+        } else {
+            let (lo, hi) = inputs.voxel_box(b, 1);
+            inputs.node_level(b, inputs.voxel_pixels(inputs.box_depths(lo, hi).0))
+        };
+        cut.push((inputs.cut_at(n), k));
+    }
+    cut
+}
+
+/// Words of a `grid` of bricks' nodes over `levels` tree levels and of its frame's cut (one per
+/// level-1 node), after the summaries.
+pub fn node_and_cut_words(grid: [u32; 3], levels: u32) -> u64 {
+    if levels == 0 {
+        return 0;
+    }
+    node_words(grid, levels) + node_grid(grid, 1).iter().map(|&n| n as u64).product::<u64>()
+}
+
+pub(crate) fn brick_node_cut_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+    let cut = brick_node_cut(&inputs(b)?);
+    let mut summary = b.take(Res::LodSummary);
+    for (at, k) in cut {
+        summary[at] = k;
+    }
+    b.put(Res::LodSummary, summary);
+    Ok(())
 }
 
 pub(crate) fn brick_nodes_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {

@@ -213,12 +213,12 @@ impl BrickInputs<'_> {
         1.0 + ((octaves - (1.0 - bf.grad[3])) / bf.grad[3]).clamp(0.0, 1.0)
     }
 
-    /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame, 1 when its
-    /// splats may morph toward the next, and pixels per voxel spacing at its nearest depth.
-    pub fn brick_level(&self, h: u32, b: [u32; 3]) -> (u32, f32, f32) {
+    /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame, and 1 when
+    /// its splats may morph toward the next.
+    pub fn brick_level(&self, h: u32, b: [u32; 3]) -> (u32, f32) {
         let (f, bf) = (self.frame, &self.bf);
         if bf.grad[1] <= 0.0 {
-            return (0, 0.0, 0.0);
+            return (0, 0.0);
         }
         let (lo, hi) = self.voxel_box(b, 0);
         let (near, far) = self.box_depths(lo, hi);
@@ -244,7 +244,7 @@ impl BrickInputs<'_> {
             && bf.grad[3] > 0.0
             && seen_error(f32::from_bits(s[level as usize + 1]), px * (2u32 << level) as f32) <= bf.grad[2]
             && octaves > 1.0 - bf.grad[3];
-        (level, if morph { 1.0 } else { 0.0 }, px)
+        (level, if morph { 1.0 } else { 0.0 })
     }
 }
 

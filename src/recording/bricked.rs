@@ -3,7 +3,7 @@
 use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
 use crate::constants::{MAX_GPU_SPLATS, PYRAMID_PAGE, PYRAMID_PAGES};
-use crate::cpu::brick_nodes::{node_grid, node_levels, node_words};
+use crate::cpu::brick_nodes::{node_and_cut_words, node_grid, node_levels};
 use crate::cpu::lod::{
     pyramid_bytes, LOD_BUFFERS, LOD_LEVELS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS,
 };
@@ -104,8 +104,8 @@ pub(super) fn record_bricks(
     let batch_pyramid = if per_batch { PYRAMID_BYTES } else { 0 };
     // The nodes above the brick, after the summaries (resident with them).
     let grid = scene.store.dims.map(|d| d.div_ceil(BRICK));
-    let node_levels = if lod { node_levels(grid, headers) } else { 0 };
-    let node_bytes = node_words(grid, node_levels) * 4;
+    let node_levels = if lod && opts.lod_nodes { node_levels(grid, headers) } else { 0 };
+    let node_bytes = node_and_cut_words(grid, node_levels) * 4;
     let pyramid = if lod { pyramid_bytes(lod_buffers, headers) + batch_pyramid + node_bytes } else { 0 };
     let least = bricked_min_budget(scene, budget, w, h) + pyramid;
     if budget < least {
@@ -204,6 +204,10 @@ pub(super) fn record_bricks(
     }
     e.ensure(Res::BrickSlots, slots as u64 * 4)?;
     e.fill(Res::BrickSlots, None, 0)?;
+    if bf.grid[3] > 0 && node_levels > 0 {
+        let count = node_grid(grid, 1).iter().product::<u32>();
+        e.run(&Dispatch::new(StageId::BrickNodeCut, 0, groups_1d(count), List::Order, &[]))?;
+    }
     if bf.grid[3] > 0 {
         e.run(&Dispatch::new(StageId::BrickCull, build, groups_1d(bf.grid[3]), List::Order, &[]))?;
     }
