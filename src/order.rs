@@ -181,8 +181,8 @@ pub fn pbtf_bricked(set: &SplatSet, camera: &Camera, brick: u32) -> Result<Vec<u
 }
 
 /// A bricked volume's draw order, front to back: the bricks as the k-d tree `tree`
-/// (`kdtree`) orders them, every node's near side first and PBTF within its leaves' boxes, and
-/// inside each brick its voxels in PBTF order. A CPU reference (a comparison sort on the path
+/// (`kdtree`) orders them, every node's near side first and its leaves' boxes as octrees of aligned
+/// blocks (each block's children by PBTF), and inside each brick its voxels in PBTF order. A CPU reference (a comparison sort on the path
 /// through the tree, then the two PBTF keys).
 pub fn tree_bricked(set: &SplatSet, camera: &Camera, brick: u32, tree: &[crate::kdtree::Node]) -> Result<Vec<u32>> {
     if brick == 0 {
@@ -212,7 +212,25 @@ pub fn tree_bricked(set: &SplatSet, camera: &Camera, brick: u32, tree: &[crate::
             }
             n = node[1 + usize::from(high)];
         }
-        (path, level(b, [0, 1, 2].map(|a| split[a].clamp(lo[a], hi[a]))))
+        // Inside the leaf an octree of aligned blocks from the smallest holding its box: per
+        // block, the child holding b by PBTF over its 2 x 2 x 2 children (a child on the eye's low
+        // side when its lowest brick is).
+        let mut l = 0;
+        while (0..3).any(|a| lo[a] >> l != (hi[a] - 1) >> l) {
+            l += 1;
+        }
+        let mut o = lo.map(|c| c >> l << l);
+        let mut blocks = Vec::new();
+        while l > 0 {
+            let half = 1u32 << (l - 1);
+            let cs =
+                [0, 1, 2].map(|a| ((split[a] as i64 - o[a] as i64 + half as i64 - 1) / half as i64).clamp(0, 2) as u32);
+            let mine = [0, 1, 2].map(|a| u32::from(b[a] >= o[a] + half));
+            blocks.push(level(mine, cs));
+            o = [0, 1, 2].map(|a| o[a] + mine[a] * half);
+            l -= 1;
+        }
+        (path, blocks)
     };
     Ok(by_key(set, |s| {
         let [i, j, k, _] = set.splats()[s].ijk;

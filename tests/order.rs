@@ -395,3 +395,63 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
     // What samples a uniform grid refuses the set.
     assert!(voxsplat::truth::volumetric_summation(&rect, &cam, &Default::default()).is_err());
 }
+
+/// A k-d leaf's bricks as an octree of aligned blocks (`octree_pbtf`, what the device's brick
+/// slots use inside a leaf): over random boxes (aligned or not) and eye splits (inside, on block
+/// planes, outside), the positions are a permutation of the box's bricks, every aligned block
+/// inside the box takes consecutive positions (so a node above the brick may stand at any of its
+/// bricks' places), and every 6-adjacent pair is ordered as PBTF orders it: the brick on the eye's
+/// side first, or the low-side one first where the split runs between them.
+#[test]
+fn octree_order_in_a_leaf_is_a_visibility_order_with_consecutive_blocks() {
+    use voxsplat::cpu::brick::octree_pbtf;
+    let mut rng = Rng(777);
+    let mut below = |n: u32| (rng.next_u64() % n as u64) as u32;
+    for _ in 0..200 {
+        let lo = [0, 1, 2].map(|_| below(20));
+        let hi = [0, 1, 2].map(|a| lo[a] + 1 + below(13));
+        let s = [0, 1, 2].map(|a| match below(4) {
+            0 => 0,
+            1 => hi[a] + 3,
+            2 => (lo[a] + hi[a]) / 2 / 4 * 4,
+            _ => lo[a] + below(hi[a] - lo[a] + 1),
+        });
+        let n = (0..3).map(|a| (hi[a] - lo[a]) as usize).product::<usize>();
+        let mut pos = std::collections::HashMap::new();
+        for z in lo[2]..hi[2] {
+            for y in lo[1]..hi[1] {
+                for x in lo[0]..hi[0] {
+                    pos.insert([x, y, z], octree_pbtf([x, y, z], lo, hi, s));
+                }
+            }
+        }
+        let order: Vec<u32> = pos.values().copied().collect();
+        assert!(is_permutation(&order, n), "{lo:?}..{hi:?} split {s:?}: not a permutation");
+        for (b, &p) in &pos {
+            for a in 0..3 {
+                let mut c = *b;
+                c[a] += 1;
+                if let Some(&q) = pos.get(&c) {
+                    // b is c's low neighbour: c first where c lies on the eye's low side.
+                    assert_eq!(q < p, c[a] < s[a], "{lo:?}..{hi:?} split {s:?}: {b:?} against {c:?}");
+                }
+            }
+        }
+        for k in 1..4u32 {
+            for (b, _) in pos.iter().filter(|(b, _)| b.iter().all(|&c| c % (1 << k) == 0)) {
+                let inside = (0..3).all(|a| b[a] >= lo[a] && b[a] + (1 << k) <= hi[a]);
+                if !inside {
+                    continue;
+                }
+                let mut block: Vec<u32> =
+                    pos.iter().filter(|(c, _)| (0..3).all(|a| c[a] >> k == b[a] >> k)).map(|(_, &p)| p).collect();
+                block.sort_unstable();
+                assert_eq!(
+                    block.last().unwrap() - block[0] + 1,
+                    block.len() as u32,
+                    "{b:?} block of {k}: not consecutive"
+                );
+            }
+        }
+    }
+}

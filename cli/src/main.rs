@@ -471,6 +471,12 @@ fn run(cli: Cli) -> Result<()> {
             opts.clip = voxsplat::Clip::new(&planes, crop)?;
             opts.background = a.background;
             (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
+            if a.lod_nodes && opts.lod == voxsplat::Lod::Off {
+                return Err(Error::InvalidArgument(
+                    "--lod-nodes draws levels of detail above the brick: it needs --lod auto (the default), not --lod off"
+                        .into(),
+                ));
+            }
             opts.lod_nodes = a.lod_nodes;
             opts.validate()?;
             a.compositing.parse::<voxsplat::distributed::Scheme>()?;

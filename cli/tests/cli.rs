@@ -696,6 +696,8 @@ fn the_peer_scene_bricked_draws_the_dense_frame() {
         (vec!["--scene", "peer128", "--dense", "--lod", "auto"], "--lod auto"),
         (vec!["--scene", "peer128", "--composite", "sheet", "--lod", "auto"], "--lod auto"),
         (vec!["--scene", "cube40", "--dense"], "--dense"),
+        (vec!["--scene", "cube40", "--lod-nodes"], "--lod-nodes"),
+        (vec!["--scene", "peer128", "--lod", "off", "--lod-nodes"], "--lod-nodes"),
     ] {
         let mut a = vec!["render", "--size", "32x32", "--out", "/tmp/never.png"];
         a.extend(bad.iter().copied());

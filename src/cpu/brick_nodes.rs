@@ -4,8 +4,8 @@
 use super::bindings::Bindings;
 use super::brick::{inputs, BrickInputs};
 use super::lod::{
-    aligned, axis_opacity, cell_seen, pack_normal, seen_error, tau_code, tau_decode, unorm10, unpack_normal,
-    CELL_WORDS, LOD_CELLS, NO_NORMAL, SLOT_CELLS, SUMMARY_WORDS,
+    aligned, axis_opacity, cell_seen, child_error, pack_normal, seen_error, tau_code, tau_decode, unorm10,
+    unpack_normal, CELL_WORDS, LOD_CELLS, NO_NORMAL, SLOT_CELLS, SUMMARY_WORDS,
 };
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
@@ -158,11 +158,6 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
     let grid = [bf.grid[0], bf.grid[1], bf.grid[2]];
     let (g, below) = (node_grid(grid, k), node_grid(grid, k - 1));
     let voxels = (1u32 << (3 * (3 + k))) as f32;
-    let at = |k: u32, n: [u32; 3]| {
-        let base = bf.grid[3].max(1) as u64 * SUMMARY_WORDS as u64 + node_words(grid, k - 1);
-        let g = node_grid(grid, k);
-        (base + (n[0] + g[0] * (n[1] + g[1] * n[2])) as u64 * NODE_WORDS as u64) as usize
-    };
     let n1 = |n: [u32; 3]| [0, 1, 2].map(|a| ((n[a] << k) + (1 << k)).min(grid[a]));
     let inside = |n: [u32; 3]| (0..3).all(|a| n[a] << k >= bf.lo[a] && n1(n)[a] <= bf.hi[a]);
     for i in 0..push.count {
@@ -183,7 +178,7 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
                             (f32::from_bits(summary[s + 3]), f32::from_bits(summary[s + SUMMARY_WORDS - 1]), h);
                     }
                 } else {
-                    let w = at(k - 1, c);
+                    let w = inputs.node_at(k - 1, c);
                     words = [summary[w], summary[w + 1], summary[w + 2]];
                     (e, tc, r) = (f32::from_bits(summary[w + 3]), f32::from_bits(summary[w + 4]), summary[w + 5]);
                 }
@@ -206,14 +201,10 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
         let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
         let mut err = 0.0f32;
         for d in 0..8 {
-            // Mirror of `child_error`.
-            let akd = 1.0 - (-tk[d] / (voxels / 8.0)).exp();
-            let sk = if tk[d] > 0.0 { ck[d] / tk[d] } else { Vec3::ZERO };
-            let dc = (sk - straight).abs();
-            err = err.max(ek[d] + (akd - a).abs().max(akd * dc.x.max(dc.y.max(dc.z))));
+            err = err.max(child_error(a, straight, tk[d], ck[d], ek[d], voxels / 8.0));
         }
         let codes = [0, 1, 2].map(|x| tau_code(-(1.0 - axis_opacity(ak[x], x).min(0.999_999_9)).ln()));
-        let w = at(k, n);
+        let w = inputs.node_at(k, n);
         summary[w..w + NODE_WORDS].copy_from_slice(&[
             codes[0] | codes[1] << 16,
             codes[2] | pack_normal(grad) << 16,

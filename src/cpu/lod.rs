@@ -279,6 +279,15 @@ pub(crate) fn axis_opacity(a: [f32; 8], axis: usize) -> f32 {
     0.25 * sum
 }
 
+/// Mirror of `child_error`: the error of a cell of mean opacity `a` and colour `straight` against
+/// a child (sums `tk`, `ck`; error `ek`) of `voxels` voxels.
+pub(crate) fn child_error(a: f32, straight: Vec3, tk: f32, ck: Vec3, ek: f32, voxels: f32) -> f32 {
+    let ak = 1.0 - (-tk / voxels).exp();
+    let sk = if tk > 0.0 { ck / tk } else { Vec3::ZERO };
+    let dc = (sk - straight).abs();
+    ek + (ak - a).abs().max(ak * dc.x.max(dc.y.max(dc.z)))
+}
+
 /// A streamed store's batch for `brick_pyramid`: brick_list, the push's range of it (its `splats`
 /// not 0: each brick into its own header's slot, a resident pyramid), and per header its slot
 /// (written).
@@ -354,10 +363,7 @@ pub fn brick_pyramid(
                 let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
                 let mut err = 0.0f32;
                 for k in &children {
-                    let ak = 1.0 - (-k.tau * 8.0 / voxels).exp();
-                    let sk = if k.tau > 0.0 { k.col / k.tau } else { Vec3::ZERO };
-                    let dc = (sk - straight).abs();
-                    err = err.max(k.err + (ak - a).abs().max(ak * dc.x.max(dc.y.max(dc.z))));
+                    err = err.max(child_error(a, straight, k.tau, k.col, k.err, voxels / 8.0));
                 }
                 let axes = [0, 1, 2].map(|x| axis_opacity(children.map(|k| k.axes[x]), x));
                 let i = level_offset(l) as usize + c as usize;
