@@ -3,11 +3,11 @@
 // Bricks, pass 1 (issue 23): one lane per non-empty brick. A brick outside the view, or whose
 // value range the transfer function leaves empty, is culled whole; otherwise it counts the voxels
 // the TF extracts (with levels of detail, brick_pyramid counted every level's splats, and the
-// brick takes its level's; a brick under a node drawn whole (brick_node_cut) is left to the node, which
-// the first brick below it whose cell draws writes at its own position, as level 3 + the node's
-// tree level), and writes header << 10 | slot_code(level, count) at its position in
-// the PBTF order of the brick grid (the host then lists the visible bricks in draw order and cuts
-// batches within the memory budget: recording.rs). Mirror: cpu::brick::brick_cull.
+// brick takes its level's; a brick under a node drawn whole (brick_node_cut) is left to the node,
+// which the first brick below it whose cell draws writes at its own position, as level 3 + the
+// node's tree level), and writes header << 10 | slot_code(level, count) at its position in the
+// brick order (brick_slot; the host then lists the visible bricks in draw order and cuts batches
+// within the memory budget: recording.rs). Mirror: cpu::brick::brick_cull.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
 #include "linear.glsl"
