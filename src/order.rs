@@ -212,30 +212,56 @@ pub fn tree_bricked(set: &SplatSet, camera: &Camera, brick: u32, tree: &[crate::
             }
             n = node[1 + usize::from(high)];
         }
-        // Inside the leaf an octree of aligned blocks from the smallest holding its box: per
-        // block, the child holding b by PBTF over its 2 x 2 x 2 children (a child on the eye's low
-        // side when its lowest brick is).
-        let mut l = 0;
-        while (0..3).any(|a| lo[a] >> l != (hi[a] - 1) >> l) {
-            l += 1;
-        }
-        let mut o = lo.map(|c| c >> l << l);
-        let mut blocks = Vec::new();
-        while l > 0 {
-            let half = 1u32 << (l - 1);
-            let cs =
-                [0, 1, 2].map(|a| ((split[a] as i64 - o[a] as i64 + half as i64 - 1) / half as i64).clamp(0, 2) as u32);
-            let mine = [0, 1, 2].map(|a| u32::from(b[a] >= o[a] + half));
-            blocks.push(level(mine, cs));
-            o = [0, 1, 2].map(|a| o[a] + mine[a] * half);
-            l -= 1;
-        }
+        // Inside the leaf, per block of its octree the child holding b by PBTF over the block's
+        // 2 x 2 x 2 children.
+        let blocks: Vec<_> = octree_descent(b, lo, hi, split).map(|step| level(step.child, step.split)).collect();
         (path, blocks)
     };
     Ok(by_key(set, |s| {
         let [i, j, k, _] = set.splats()[s].ijk;
         (brick_key([i / brick, j / brick, k / brick]), level([i, j, k], voxel_split))
     }))
+}
+
+/// One block on the way down a k-d leaf's octree to a brick (`octree_descent`).
+pub struct OctreeStep {
+    /// The block's lowest brick.
+    pub origin: [u32; 3],
+    /// Its children's side, in bricks.
+    pub half: u32,
+    /// Per axis, how many of its two children lie on the eye's low side (0, 1 or 2): the PBTF
+    /// split of its 2 x 2 x 2 children (a child is on the low side when its lowest brick is).
+    pub split: [u32; 3],
+    /// The child holding the brick: 1 per axis where it is the high one.
+    pub child: [u32; 3],
+}
+
+/// The blocks from the smallest aligned block (2^l bricks a side at multiples of 2^l) holding
+/// the box `lo..hi` of bricks down to brick `b`, for the eye's brick split `split`: the order of a
+/// k-d leaf's bricks, each block's children by PBTF (`tree_bricked`; `cpu::brick::octree_pbtf`
+/// counts the bricks before `b` along it, as brick.glsl's `octree_pbtf` does).
+pub fn octree_descent(b: [u32; 3], lo: [u32; 3], hi: [u32; 3], split: [u32; 3]) -> impl Iterator<Item = OctreeStep> {
+    let mut l = 0;
+    while (0..3).any(|a| lo[a] >> l != (hi[a] - 1) >> l) {
+        l += 1;
+    }
+    let mut origin = lo.map(|c| c >> l << l);
+    std::iter::from_fn(move || {
+        if l == 0 {
+            return None;
+        }
+        let half = 1u32 << (l - 1);
+        let below = |a: usize| (split[a] as i64 - origin[a] as i64 + half as i64 - 1) / half as i64;
+        let step = OctreeStep {
+            origin,
+            half,
+            split: [0, 1, 2].map(|a| below(a).clamp(0, 2) as u32),
+            child: [0, 1, 2].map(|a| u32::from(b[a] >= origin[a] + half)),
+        };
+        origin = [0, 1, 2].map(|a| origin[a] + step.child[a] * half);
+        l -= 1;
+        Some(step)
+    })
 }
 
 /// The eye's PBTF split of the grid of `brick`-voxel bricks over `set`'s grid (`brick` > 0).

@@ -580,9 +580,9 @@ uint node_level(uvec3 b, float px) {
         // Cheap tests first: the brick's own pixels per voxel bound the node's from below.
         float cell = float(BRICK_SIDE << k);
         if (px * cell > bound) continue;
-        float err = uintBitsToFloat(lod_words[node_word(k, b >> k, 3u)]);
-        if (seen_error(err, px * cell) > bf.grad.z) continue;
-        if (lod_words[node_word(k, b >> k, 6u)] == 0u) continue;
+        uint w = node_word(k, b >> k, 0u);
+        float err = uintBitsToFloat(lod_words[w + 3u]);
+        if (seen_error(err, px * cell) > bf.grad.z || lod_words[w + 6u] == 0u) continue;
         vec3 lo;
         vec3 hi;
         voxel_box(b, k, lo, hi);

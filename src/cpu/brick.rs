@@ -57,22 +57,16 @@ pub fn tree_pbtf(tree: &[crate::kdtree::Node], grid: [u32; 3], split: [u32; 3], 
 }
 
 /// Mirror of `octree_pbtf`: brick `b`'s position among the bricks of the box `lo..hi` visited front
-/// to back as an octree of aligned blocks, each block's children in PBTF order for the split.
+/// to back as an octree of aligned blocks (`order::octree_descent`): per block on the way down, the
+/// bricks of the box in its children drawn before the one holding `b`.
 pub fn octree_pbtf(b: [u32; 3], lo: [u32; 3], hi: [u32; 3], s: [u32; 3]) -> u32 {
-    let mut l = 0;
-    while (0..3).any(|a| lo[a] >> l != (hi[a] - 1) >> l) {
-        l += 1;
-    }
-    let mut o = lo.map(|c| c >> l << l);
     let mut p = 0;
-    while l > 0 {
-        let half = 1u32 << (l - 1);
-        let cs = [0, 1, 2].map(|a| ((s[a] as i64 - o[a] as i64 + half as i64 - 1) / half as i64).clamp(0, 2) as u32);
-        let mine = [0, 1, 2].map(|a| u32::from(b[a] >= o[a] + half));
-        let rank = dense_pbtf(mine, [2; 3], cs);
+    for step in crate::order::octree_descent(b, lo, hi, s) {
+        let (o, half) = (step.origin, step.half);
+        let rank = dense_pbtf(step.child, [2; 3], step.split);
         for d in 0..8u32 {
             let c = [d & 1, d >> 1 & 1, d >> 2 & 1];
-            if dense_pbtf(c, [2; 3], cs) >= rank {
+            if dense_pbtf(c, [2; 3], step.split) >= rank {
                 continue;
             }
             let clo = [0, 1, 2].map(|a| (o[a] + c[a] * half).max(lo[a]));
@@ -81,8 +75,6 @@ pub fn octree_pbtf(b: [u32; 3], lo: [u32; 3], hi: [u32; 3], s: [u32; 3]) -> u32 
                 p += (0..3).map(|a| chi[a] - clo[a]).product::<u32>();
             }
         }
-        o = [0, 1, 2].map(|a| o[a] + mine[a] * half);
-        l -= 1;
     }
     p
 }

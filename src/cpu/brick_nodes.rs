@@ -35,7 +35,7 @@ pub fn node_words(grid: [u32; 3], levels: u32) -> u64 {
 }
 
 /// The node levels a `grid` of bricks with `headers` non-empty bricks gets: up to one root node,
-/// at most `NODE_LEVELS`, and none when even the first would pass the nodes' share of memory.
+/// at most `NODE_LEVELS`, and none when those would pass the nodes' share of memory.
 pub fn node_levels(grid: [u32; 3], headers: usize) -> u32 {
     let most = grid.iter().copied().max().unwrap_or(1);
     let levels = (0..NODE_LEVELS).find(|&k| 1u32 << k >= most).unwrap_or(NODE_LEVELS);
@@ -75,8 +75,8 @@ pub fn consecutive(tree: &[crate::kdtree::Node], grid: [u32; 3], n0: [u32; 3], n
 }
 
 impl BrickInputs<'_> {
-    /// Mirror of `node_word`: the index of word 0 of brick `b`'s node at tree level `k` in the
-    /// summary buffer.
+    /// Mirror of `node_word`: the index of word 0 of node `n` (node coordinates) at tree level `k`
+    /// in the summary buffer.
     fn node_at(&self, k: u32, n: [u32; 3]) -> usize {
         let grid = [self.bf.grid[0], self.bf.grid[1], self.bf.grid[2]];
         let base = self.bf.grid[3].max(1) as u64 * SUMMARY_WORDS as u64 + node_words(grid, k - 1);
@@ -89,12 +89,11 @@ impl BrickInputs<'_> {
         &self.summary[self.node_at(k, b.map(|c| c >> k))..][..NODE_WORDS]
     }
 
-    /// Mirror of `cut_word`: the index of level-1 node `n1`'s cut word.
+    /// Mirror of `cut_word`: the index of level-1 node `n1`'s cut word (one per level-1 node, where
+    /// a level past the last would start).
     fn cut_at(&self, n1: [u32; 3]) -> usize {
-        let grid = [self.bf.grid[0], self.bf.grid[1], self.bf.grid[2]];
-        let g = node_grid(grid, 1);
-        let base = self.bf.grid[3].max(1) as u64 * SUMMARY_WORDS as u64 + node_words(grid, self.bf.hi[3]);
-        (base + (n1[0] + g[0] * (n1[1] + g[1] * n1[2])) as u64) as usize
+        let g = node_grid([self.bf.grid[0], self.bf.grid[1], self.bf.grid[2]], 1);
+        self.node_at(self.bf.hi[3] + 1, [0; 3]) + (n1[0] + g[0] * (n1[1] + g[1] * n1[2])) as usize
     }
 
     /// This frame's tree level of the node that draws brick `b` (`brick_cull`'s read of the cut).
@@ -126,11 +125,9 @@ impl BrickInputs<'_> {
             if px * cell > bound {
                 continue;
             }
-            let err = f32::from_bits(self.node_of(k, b)[3]);
-            if seen_error(err, px * cell) > bf.grad[2] {
-                continue;
-            }
-            if self.node_of(k, b)[6] == 0 {
+            let node = self.node_of(k, b);
+            let err = f32::from_bits(node[3]);
+            if seen_error(err, px * cell) > bf.grad[2] || node[6] == 0 {
                 continue;
             }
             let (lo, hi) = self.voxel_box(b, k);
