@@ -1,24 +1,25 @@
 #version 450
-// Bricks, between batches drawn front to back with early termination (issue 23): per brick of the
-// next batch, whether its footprints' screen box lies wholly over composite tiles whose
-// transmittance is at most the termination threshold (tile_occlusion). The tile compositor would
-// stop every pixel such a brick reaches before its first splat, so dropping it changes nothing:
-// the tile compositor's early termination extended to whole bricks. Mirror: cpu::brick::brick_hidden.
+// Bricks, between waves drawn front to back with early termination: per entry of the next wave,
+// whether its footprints' screen box covers no open pixel of the occlusion map (tile_occlusion;
+// occlusion.glsl), that is, lies wholly over pixels with at most the termination threshold of
+// transmittance left. The tile compositor would stop every pixel such a brick (or node) reaches
+// before its first splat, so dropping it changes nothing: the compositor's early termination moved
+// before the brick's voxels are ordered, classified or binned. Mirror: cpu::brick_hidden.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "brick.glsl"
 #include "linear.glsl"
+#include "occlusion.glsl"
 
 layout(push_constant) uniform Push {
     uint first;      // the batch's first entry of brick_list
     uint count;      // its entries
     uint splats;     // its splats
-    float occluded;  // the early-termination threshold
+    float occluded;  // the early-termination threshold (tile_occlusion's map is built for it)
 } pc;
 
-// Most composite tiles a brick may span and still be tested (larger ones are always drawn).
-const int MAX_BRICK_TILES = 256;
-
 bool hidden(uint h, uint level, uvec3 b) {
+    // A blurred quad reaches back along its path, past the footprint box.
+    if (frame.blur.x > 0.0) return false;
     vec3 lo;
     vec3 hi;
     // A node above the brick (level 3 + its tree level) does not morph.
@@ -34,16 +35,10 @@ bool hidden(uint h, uint level, uvec3 b) {
         slo = min(slo, s);
         shi = max(shi, s);
     }
-    ivec2 tiles = ivec2(ceil(size / float(COMPOSITE_TILE)));
-    ivec2 t0 = ivec2(floor(clamp(slo - 1.0, vec2(0.0), size - 1.0) / float(COMPOSITE_TILE)));
-    ivec2 t1 = ivec2(floor(clamp(shi + 1.0, vec2(0.0), size - 1.0) / float(COMPOSITE_TILE)));
-    if ((t1.x - t0.x + 1) * (t1.y - t0.y + 1) > MAX_BRICK_TILES) return false;
-    for (int y = t0.y; y <= t1.y; ++y) {
-        for (int x = t0.x; x <= t1.x; ++x) {
-            if (occlusion[y * tiles.x + x] > pc.occluded) return false;
-        }
-    }
-    return true;
+    // A pixel's margin: the footprints' pixel boxes (screen_quad) lie inside.
+    vec2 a = floor(clamp(slo - 1.0, vec2(0.0), size - 1.0));
+    vec2 z = floor(clamp(shi + 1.0, vec2(0.0), size - 1.0));
+    return box_hidden(ivec4(a, z));
 }
 
 void main() {

@@ -106,7 +106,7 @@ pub enum Res {
     BrickList,
     /// A batch's voxels in draw order: (i | j << 16, k | stored value << 16).
     BrickVoxels,
-    /// Per brick of the next batch, 1 when hidden (front to back, early termination).
+    /// Per entry of the next wave, 1 when hidden (front to back, early termination).
     BrickHidden,
     /// A streamed store's records for one batch (the store stays on the host).
     BatchRecords,

@@ -282,12 +282,12 @@ pub const STAGES: &[StageDesc] = &[
         kind: Kind::Compute,
         bindings: &[Res::Frame, Res::Accum, Res::Occlusion],
         writes: &[Res::Occlusion],
-        push: 0,
+        push: std::mem::size_of::<BrickPush>() as u32,
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "bricks",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::brick::tile_occlusion_stage,
+        mirror: crate::cpu::tile_occlusion::tile_occlusion_stage,
     },
     StageDesc {
         name: "brick_hidden",
@@ -299,7 +299,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "bricks",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::brick::brick_hidden_stage,
+        mirror: crate::cpu::brick_hidden::brick_hidden_stage,
     },
     StageDesc {
         name: "slab_count",

@@ -81,9 +81,9 @@ layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]
 layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
 // The batch's voxels in draw order: i | j << 16, k | stored value << 16.
 layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
-// Per composite tile, the largest transmittance left (tile_occlusion).
+// The occlusion map after the waves drawn so far (tile_occlusion; occlusion.glsl).
 layout(std430, binding = 13) readonly buffer Occlusion { float occlusion[]; };
-// Per brick of the next batch, 1 when it is hidden (brick_hidden).
+// Per entry of the next wave, 1 when it is hidden (brick_hidden).
 layout(std430, binding = 21) writeonly buffer Hidden { uint hidden_out[]; };
 
 const float Q_MAX = 65535.0;

@@ -6,11 +6,10 @@ use super::lod::level_count;
 use super::order::{outward, side_count};
 use super::splat_params::{cell_footprint_scale, frame_grid, optical_depth, params_at, CULL_RADII};
 use crate::bricks::{local_cell, BrickStore, BRICK};
-use crate::constants::{COMPOSITE_TILE, TF_ENTRIES};
+use crate::constants::TF_ENTRIES;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::{Error, Result};
 use crate::gpu_types::{BrickFrame, BrickPush, Frame, SplatParams};
-use crate::image::ImageF32;
 use glam::{Mat4, Vec3, Vec4};
 
 const CELL_WORDS: usize = (BRICK * BRICK * BRICK / 32) as usize;
@@ -198,7 +197,7 @@ impl BrickInputs<'_> {
     }
 
     /// Mirror of `footprint_box`.
-    fn footprint_box(&self, b: [u32; 3], k: u32, cell: f32) -> (Vec3, Vec3) {
+    pub(crate) fn footprint_box(&self, b: [u32; 3], k: u32, cell: f32) -> (Vec3, Vec3) {
         let (lo, hi) = self.voxel_box(b, k);
         let reach = self.cull_reach(self.box_depths(lo, hi).1, cell);
         (lo - Vec3::splat(reach), hi + Vec3::splat(reach))
@@ -259,65 +258,6 @@ pub(crate) fn corner(lo: Vec3, hi: Vec3, c: u32) -> Vec3 {
         if c >> 1 & 1 == 1 { hi.y } else { lo.y },
         if c >> 2 & 1 == 1 { hi.z } else { lo.z },
     )
-}
-
-/// Most composite tiles a brick may span and still be tested by `brick_hidden`.
-const MAX_BRICK_TILES: f32 = 256.0;
-
-/// Mirror of `tile_occlusion.comp`: per composite tile, the largest transmittance left in `accum`.
-pub fn tile_occlusion(accum: &ImageF32, occlusion: &mut [u32]) {
-    let (w, h) = (accum.width, accum.height);
-    let tiles_x = w.div_ceil(COMPOSITE_TILE);
-    for t in 0..(tiles_x * h.div_ceil(COMPOSITE_TILE)) {
-        let (x0, y0) = ((t % tiles_x) * COMPOSITE_TILE, (t / tiles_x) * COMPOSITE_TILE);
-        let mut most = 0.0f32;
-        for y in y0..(y0 + COMPOSITE_TILE).min(h) {
-            for x in x0..(x0 + COMPOSITE_TILE).min(w) {
-                most = most.max(1.0 - accum.pixels[(y * w + x) as usize][3]);
-            }
-        }
-        occlusion[t as usize] = most.to_bits();
-    }
-}
-
-/// Mirror of `brick_hidden.comp`: per brick of the batch, 1 when its footprints lie wholly over
-/// composite tiles with at most `push.occluded` transmittance left.
-pub fn brick_hidden(
-    inputs: &BrickInputs<'_>,
-    list: &[[u32; 4]],
-    push: &BrickPush,
-    occlusion: &[f32],
-    hidden: &mut [u32],
-) {
-    let f = inputs.frame;
-    let vp = Mat4::from_cols_array_2d(&f.view_proj);
-    let size = glam::Vec2::new(f.blur[2], f.blur[3]);
-    let tile = COMPOSITE_TILE as f32;
-    let tiles_x = (size.x / tile).ceil() as i64;
-    let is_hidden = |h: u32, level: u32, b: [u32; 3]| {
-        let morph = if inputs.bf.grad[1] > 0.0 { inputs.morphs[h as usize] } else { 0.0 };
-        let k = level.saturating_sub(3);
-        let (lo, hi) = inputs.footprint_box(b, k, (1u32 << level) as f32 * (1.0 + morph));
-        let (mut slo, mut shi) = (glam::Vec2::splat(1e30), glam::Vec2::splat(-1e30));
-        for c in 0..8 {
-            let q: Vec4 = vp * corner(lo, hi, c).extend(1.0);
-            if q.w <= 0.0 {
-                return false;
-            }
-            let s = (glam::Vec2::new(q.x, q.y) / q.w * 0.5 + 0.5) * size;
-            (slo, shi) = (slo.min(s), shi.max(s));
-        }
-        let t = |v: glam::Vec2| (v.clamp(glam::Vec2::ZERO, size - 1.0) / tile).floor();
-        let (t0, t1) = (t(slo - 1.0), t(shi + 1.0));
-        if (t1.x - t0.x + 1.0) * (t1.y - t0.y + 1.0) > MAX_BRICK_TILES {
-            return false;
-        }
-        (t0.y as i64..=t1.y as i64)
-            .all(|y| (t0.x as i64..=t1.x as i64).all(|x| occlusion[(y * tiles_x + x) as usize] <= push.occluded))
-    };
-    for (e, entry) in list[push.first as usize..(push.first + push.count) as usize].iter().enumerate() {
-        hidden[e] = u32::from(is_hidden(entry[0], entry[3] >> 16, inputs.store.headers[entry[0] as usize].coords()));
-    }
 }
 
 /// Mirror of `slot_code`: a brick's slot code for `n` splats at level `l` (`bricks::slot_entry`).
@@ -525,19 +465,5 @@ pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant)
     let mut params = b.take(Res::Params);
     brick_params(&inputs_for(b, v)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
     b.put(Res::Params, params);
-    Ok(())
-}
-
-pub(crate) fn tile_occlusion_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
-    let mut occlusion = b.take(Res::Occlusion);
-    tile_occlusion(&b.accum, &mut occlusion);
-    b.put(Res::Occlusion, occlusion);
-    Ok(())
-}
-
-pub(crate) fn brick_hidden_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
-    let mut hidden = b.take(Res::BrickHidden);
-    brick_hidden(&inputs(b)?, b.get(Res::BrickList), &args.push_as(), b.get(Res::Occlusion), &mut hidden);
-    b.put(Res::BrickHidden, hidden);
     Ok(())
 }
