@@ -13,16 +13,75 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct TransferFunction {
     /// (density in [0, 1], [r, g, b, opacity]) control points, in increasing density.
+    #[serde(deserialize_with = "strict::points")]
     pub points: Vec<(f32, [f32; 4])>,
     /// Opacity × (|∇ρ| / max |∇ρ|)^gradient_weight; 0 disables the weighting.
     #[serde(default)]
     pub gradient_weight: f32,
     /// Densities mapped to 0 and 1 (default: the data's minimum and maximum).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::range")]
     pub range: Option<(f32, f32)>,
     /// Extraction threshold: voxels whose normalised density is below it are never extracted.
     #[serde(default)]
     pub threshold: f32,
+}
+
+/// Deserializers that refuse what a loose tuple would drop: a colour of more or fewer than four
+/// components, a point or a range with a third element.
+mod strict {
+    use serde::de::{self, Deserializer, IgnoredAny, SeqAccess, Visitor};
+    use std::fmt;
+
+    /// `[a, b]` of exactly two elements.
+    fn pair<'de, D: Deserializer<'de>, A: de::Deserialize<'de>, B: de::Deserialize<'de>>(
+        d: D,
+        what: &'static str,
+    ) -> Result<(A, B), D::Error> {
+        struct Pair<A, B>(&'static str, std::marker::PhantomData<(A, B)>);
+        impl<'de, A: de::Deserialize<'de>, B: de::Deserialize<'de>> Visitor<'de> for Pair<A, B> {
+            type Value = (A, B);
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str(self.0)
+            }
+            fn visit_seq<S: SeqAccess<'de>>(self, mut s: S) -> Result<(A, B), S::Error> {
+                let a = s.next_element()?.ok_or_else(|| de::Error::invalid_length(0, &self))?;
+                let b = s.next_element()?.ok_or_else(|| de::Error::invalid_length(1, &self))?;
+                if s.next_element::<IgnoredAny>()?.is_some() {
+                    return Err(de::Error::invalid_length(3, &self));
+                }
+                Ok((a, b))
+            }
+        }
+        d.deserialize_seq(Pair(what, std::marker::PhantomData))
+    }
+
+    struct Point((f32, [f32; 4]));
+    impl<'de> de::Deserialize<'de> for Point {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            let (density, c): (f32, Vec<f32>) = pair(d, "a point [density, [r, g, b, opacity]]")?;
+            let c: [f32; 4] = c.try_into().map_err(|c: Vec<f32>| {
+                de::Error::invalid_length(c.len(), &"a colour of 4 components [r, g, b, opacity]")
+            })?;
+            Ok(Point((density, c)))
+        }
+    }
+
+    pub fn points<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(f32, [f32; 4])>, D::Error> {
+        let points: Vec<Point> = de::Deserialize::deserialize(d)?;
+        Ok(points.into_iter().map(|p| p.0).collect())
+    }
+
+    struct Range((f32, f32));
+    impl<'de> de::Deserialize<'de> for Range {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            pair(d, "a range [low, high]").map(Range)
+        }
+    }
+
+    pub fn range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<(f32, f32)>, D::Error> {
+        let r: Option<Range> = de::Deserialize::deserialize(d)?;
+        Ok(r.map(|r| r.0))
+    }
 }
 
 /// Named transfer functions: (name, description).

@@ -518,6 +518,17 @@ pub(crate) fn check_finite(values: &[f32], what: &str) -> Result<()> {
     }
 }
 
+/// Most bytes of a text file the library reads whole: a transfer function (4,096 points at most)
+/// or an animation's keyframes.
+pub const MAX_TEXT_BYTES: u64 = 1 << 20;
+
+/// A text file (transfer function, animation) read whole, refused past `MAX_TEXT_BYTES` before it
+/// is parsed, or when it is not UTF-8.
+pub fn read_text(path: &Path, what: &str) -> Result<String> {
+    let bytes = read_bounded(path, MAX_TEXT_BYTES, what)?;
+    String::from_utf8(bytes).map_err(|_| bad(what, "not UTF-8 text"))
+}
+
 /// The whole of `path`, refused without reading it when it holds more than `limit` bytes (and
 /// never reading more than `limit` + 1 from a device or pipe that does not say its length).
 fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>> {

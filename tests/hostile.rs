@@ -258,3 +258,40 @@ fn banded_ssim_is_the_whole_image_ssim() {
     let whole = voxsplat::metrics::ssim(&alpha(&a), &alpha(&b), w, h);
     assert!((m.ssim_alpha - whole).abs() < 1e-12, "{} against {whole}", m.ssim_alpha);
 }
+
+/// Issue 44: a transfer function's points and range take exactly the components they name; a
+/// colour of five, a point or a range of three elements is refused, not cut short.
+#[test]
+fn transfer_function_points_take_no_extra_components() {
+    let ok = TransferFunction::from_toml("points = [[0.1, [0, 0, 0, 0]], [1.0, [1, 1, 1, 0.5]]]\nrange = [0.0, 2.0]")
+        .unwrap();
+    assert_eq!(ok.points[1], (1.0, [1.0, 1.0, 1.0, 0.5]));
+    assert_eq!(ok.range, Some((0.0, 2.0)));
+    for (text, needle) in [
+        ("points = [[0.1, [0, 0, 0, 0, 0]]]", "4 components"),
+        ("points = [[0.1, [0, 0, 0]]]", "4 components"),
+        ("points = [[0.1, [0, 0, 0, 0], 3]]", "a point [density"),
+        ("points = [[0.1]]", "a point [density"),
+        ("points = [[0.1, [0, 0, 0, 0]]]\nrange = [0.0, 1.0, 2.0]", "a range [low, high]"),
+    ] {
+        let e = TransferFunction::from_toml(text).unwrap_err();
+        assert!(matches!(e, Error::InvalidArgument(_)) && e.to_string().contains(needle), "{text}: {e}");
+    }
+}
+
+/// Issue 44: a transfer-function or animation file past `MAX_TEXT_BYTES` is refused from its
+/// length, before a byte of it is parsed (a 2 M-point file took 3.2 GB and 10 s to be refused).
+#[test]
+fn text_files_are_refused_past_their_size_cap() {
+    use voxsplat::loaders::{read_text, MAX_TEXT_BYTES};
+    let big = dir().join("big-tf.toml");
+    let f = std::fs::File::create(&big).unwrap();
+    f.set_len(MAX_TEXT_BYTES + 1).unwrap();
+    let t = std::time::Instant::now();
+    let e = read_text(&big, "big-tf.toml").unwrap_err();
+    assert!(matches!(e, Error::TooLarge(_)) && e.to_string().contains("more than"), "{e}");
+    assert!(t.elapsed().as_secs_f64() < 1.0);
+    let bad = dir().join("latin1.toml");
+    std::fs::write(&bad, b"points = [[0.1, [0, 0, 0, 0]]] # caf\xe9").unwrap();
+    assert!(read_text(&bad, "latin1.toml").unwrap_err().to_string().contains("UTF-8"));
+}

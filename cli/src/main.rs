@@ -425,15 +425,25 @@ fn print_store(store: &voxsplat::bricks::BrickStore) {
 }
 
 /// The last frame with every stage's time replaced by its median over `frames`.
-fn median_timings(mut frames: Vec<voxsplat::Rendered>) -> voxsplat::Rendered {
-    let mut last = frames.pop().expect("at least one frame");
+/// The last of `frames` with each stage's median time over all of them, keeping one image at a
+/// time (`--repeat` would otherwise hold every frame).
+fn median_timings(frames: impl Iterator<Item = Result<voxsplat::Rendered>>) -> Result<voxsplat::Rendered> {
+    let mut earlier: Vec<Vec<voxsplat::StageTime>> = Vec::new();
+    let mut last: Option<voxsplat::Rendered> = None;
+    for f in frames {
+        let f = f?;
+        if let Some(prev) = last.replace(f) {
+            earlier.push(prev.timings);
+        }
+    }
+    let mut last = last.expect("at least one frame");
     for t in &mut last.timings {
         let mut v: Vec<f64> =
-            frames.iter().flat_map(|f| f.timings.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
+            earlier.iter().flat_map(|ts| ts.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
         v.push(t.ms);
         t.ms = voxsplat_cli::bench::median(&mut v);
     }
-    last
+    Ok(last)
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -548,15 +558,12 @@ fn run(cli: Cli) -> Result<()> {
                         }
                         r.raycast(&cam, &o)?
                     }
-                    None => {
-                        let mut frames = Vec::new();
-                        for _ in 0..a.repeat.max(1) {
-                            let t = std::time::Instant::now();
-                            frames.push(r.render(&cam, &opts)?);
-                            wall.push(t.elapsed().as_secs_f64() * 1e3);
-                        }
-                        median_timings(frames)
-                    }
+                    None => median_timings((0..a.repeat.max(1)).map(|_| {
+                        let t = std::time::Instant::now();
+                        let f = r.render(&cam, &opts);
+                        wall.push(t.elapsed().as_secs_f64() * 1e3);
+                        f
+                    }))?,
                 };
                 report_validation(&r)?;
                 f
@@ -603,6 +610,9 @@ fn run(cli: Cli) -> Result<()> {
                     let n = wall.len();
                     // Not a stage line: scripts sum those.
                     println!("frame, wall:   {:>9.3} ms (median of {n})", voxsplat_cli::bench::median(&mut wall));
+                }
+                if let Some(mib) = voxsplat_cli::bricked::peak_rss_mib() {
+                    println!("host memory, peak: {mib:.0} MiB resident");
                 }
             }
             Ok(())
@@ -911,7 +921,7 @@ fn run(cli: Cli) -> Result<()> {
 fn animate(a: AnimateArgs) -> Result<()> {
     use voxsplat::animate::{render_frame, Animation, Blur};
     let anim = if a.anim.ends_with(".toml") {
-        let text = std::fs::read_to_string(&a.anim).map_err(|e| Error::Io { path: a.anim.clone(), source: e })?;
+        let text = voxsplat::loaders::read_text(std::path::Path::new(&a.anim), &a.anim)?;
         Animation::from_toml(&text)?
     } else {
         Animation::builtin(&a.anim)?

@@ -299,7 +299,7 @@ pub fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFu
 /// A transfer-function preset by name, or a TOML file.
 pub fn load_tf(spec: &str) -> Result<voxsplat::classify::TransferFunction> {
     if spec.ends_with(".toml") {
-        let text = std::fs::read_to_string(spec).map_err(|e| Error::Io { path: spec.to_string(), source: e })?;
+        let text = voxsplat::loaders::read_text(std::path::Path::new(spec), spec)?;
         voxsplat::classify::TransferFunction::from_toml(&text)
     } else {
         voxsplat::classify::TransferFunction::preset(spec)

@@ -134,3 +134,22 @@ fn a_closed_stdout_pipe_ends_quietly() {
         assert!(out.status.success() && !err.contains("panicked"), "{args:?}: {:?} {err}", out.status);
     }
 }
+
+/// Peak resident memory, as `render --timings` reports it.
+fn peak_mib(args: &[&str]) -> f64 {
+    let out = voxsplat(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    let line = text.lines().find(|l| l.starts_with("host memory, peak:")).expect("a peak memory line");
+    line.split_whitespace().nth(3).and_then(|v| v.parse().ok()).expect("MiB")
+}
+
+/// `--repeat N` keeps one frame at a time (each 4 MiB at 512²), not all N.
+#[test]
+fn repeated_frames_are_not_all_kept() {
+    let out = tmp("repeat.png");
+    let base = ["render", "--scene", "cube40", "--size", "512x512", "--timings", "--out", out.to_str().unwrap()];
+    let one = peak_mib(&[&base[..], &["--repeat", "2"]].concat());
+    let many = peak_mib(&[&base[..], &["--repeat", "30"]].concat());
+    assert!(many < one + 40.0, "30 frames peak at {many} MiB against {one} MiB for 2");
+}
