@@ -467,7 +467,7 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
 /// larger than its header says is never read whole.
 pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
     let what = path.display().to_string();
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+    let name = lower_name(path);
     let mut v = if let Some(mut reader) = SliceReader::open(path, hints)? {
         voxel_count(&reader.dims.map(u64::from), &what)?;
         let mut values = Vec::new();
@@ -491,9 +491,15 @@ pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
     Ok(v)
 }
 
+/// `path`'s file name in ASCII lower case, read lossily: a name that is not UTF-8 keeps its
+/// extension (it was taken for raw data).
+pub(crate) fn lower_name(path: &Path) -> String {
+    path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default()
+}
+
 /// Whether `path` is raw data by its name (anything but NRRD, NIfTI and npy).
 pub fn is_raw(path: &Path) -> bool {
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+    let name = lower_name(path);
     ![".nrrd", ".nhdr", ".nii", ".nii.gz", ".npy"].iter().any(|e| name.ends_with(e))
 }
 
@@ -607,7 +613,7 @@ pub fn load_heights(path: &Path) -> Result<HeightGrid> {
 
 fn load_height_file(path: &Path) -> Result<HeightGrid> {
     let what = path.display().to_string();
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+    let name = lower_name(path);
     if name.ends_with(".npy") {
         let (shape, heights) = npy_from_bytes(&read_npy(path, &what)?, &what)?;
         if shape.len() != 2 {

@@ -295,3 +295,18 @@ fn text_files_are_refused_past_their_size_cap() {
     std::fs::write(&bad, b"points = [[0.1, [0, 0, 0, 0]]] # caf\xe9").unwrap();
     assert!(read_text(&bad, "latin1.toml").unwrap_err().to_string().contains("UTF-8"));
 }
+
+/// Issue 44: a file name that is not UTF-8 keeps its extension: an NRRD is read as NRRD, not
+/// taken for raw data ("needs --dims").
+#[test]
+fn a_file_name_that_is_not_utf8_is_read_by_its_extension() {
+    use std::os::unix::ffi::OsStrExt;
+    let head = "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 3 4\nencoding: raw\n\n";
+    let mut bytes = head.as_bytes().to_vec();
+    bytes.extend((0..24).map(|i| i as u8));
+    let p = dir().join(std::ffi::OsStr::from_bytes(b"caf\xe9.nrrd"));
+    std::fs::write(&p, &bytes).unwrap();
+    let v = load_volume(&p, &VolumeHints::default()).unwrap();
+    assert_eq!(v.dims, [2, 3, 4]);
+    assert_eq!(v.values[23], 23.0);
+}

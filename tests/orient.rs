@@ -116,6 +116,17 @@ fn flattened_and_broken_affines_are_typed_errors() {
     assert!(
         matches!(load_volume(&p, &VolumeHints::default()), Err(Error::InvalidArgument(m)) if m.contains("three vectors"))
     );
+    // Issue 44: a qform quaternion whose b^2 + c^2 + d^2 passes 1 is no rotation (it was read as
+    // one, "SSA"); one past 1 by float32 rounding only is the half turn it rounds from.
+    let q = glam::DQuat::from_xyzw(2.0, 2.0, 2.0, 0.0);
+    let p = write("qform-222.nii", &nifti(DIMS, &v, None, Some((q, T, 1.0))));
+    match load_orientation(&p, &VolumeHints::default()) {
+        Err(Error::InvalidArgument(m)) => assert!(m.contains("not a rotation"), "{m}"),
+        other => panic!("qform (2, 2, 2): {other:?}"),
+    }
+    let q = glam::DQuat::from_xyzw(1.000_000_2, 0.0, 0.0, 0.0);
+    let p = write("qform-rounded.nii", &nifti(DIMS, &v, None, Some((q, T, 1.0))));
+    assert!(load_orientation(&p, &VolumeHints::default()).unwrap().is_some());
     // No frame: NIfTI with both codes 0, an NRRD without a space.
     let p = write("none.nii", &nifti(DIMS, &v, None, None));
     assert!(load_orientation(&p, &VolumeHints::default()).unwrap().is_none());

@@ -163,7 +163,21 @@ pub(super) fn nifti_orientation(h: &nifti::NiftiHeader, dims: [u32; 3], what: &s
         let [x, y, z] = [h.srow_x, h.srow_y, h.srow_z].map(|r| DVec4::from_array(r.map(f64::from)));
         DMat4::from_cols(x, y, z, DVec4::W).transpose()
     } else if h.qform_code > 0 {
-        let (b, c, d) = (h.quatern_b as f64, h.quatern_c as f64, h.quatern_d as f64);
+        let (mut b, mut c, mut d) = (h.quatern_b as f64, h.quatern_c as f64, h.quatern_d as f64);
+        // A unit quaternion's b^2 + c^2 + d^2 is at most 1: past float32 rounding of 1 it is no
+        // rotation (nibabel refuses it too); up to that, normalised as niftilib does (a = 0).
+        let norm = b * b + c * c + d * d;
+        if !(norm <= 1.0 + 1e-5) {
+            return Err(bad(
+                what,
+                format!(
+                    "qform quaternion (b, c, d) = ({b}, {c}, {d}) has b²+c²+d² = {norm}, more than 1: not a rotation"
+                ),
+            ));
+        }
+        if norm > 1.0 {
+            (b, c, d) = (b / norm.sqrt(), c / norm.sqrt(), d / norm.sqrt());
+        }
         let a = (1.0 - (b * b + c * c + d * d)).max(0.0).sqrt();
         let qfac = if h.pixdim[0] < 0.0 { -1.0 } else { 1.0 };
         let s = [h.pixdim[1] as f64, h.pixdim[2] as f64, qfac * h.pixdim[3] as f64];

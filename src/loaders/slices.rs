@@ -102,7 +102,7 @@ impl SliceReader {
     /// (a raw file's dims and type); sizes are checked against `MAX_STREAMED_VOXELS` and the
     /// data's length before anything is read.
     pub fn open(path: &Path, hints: &VolumeHints) -> Result<Option<Self>> {
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("").to_ascii_lowercase();
+        let name = super::lower_name(path);
         super::check_raw_hints(path, hints)?;
         if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
             Self::nrrd(path)
