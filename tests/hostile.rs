@@ -310,3 +310,35 @@ fn a_file_name_that_is_not_utf8_is_read_by_its_extension() {
     assert_eq!(v.dims, [2, 3, 4]);
     assert_eq!(v.values[23], 23.0);
 }
+
+/// Issue 44: NRRD fields that move or split the data are refused by name, not read past: `byte
+/// skip` and `line skip` (the skipped bytes were read as data), `data file: LIST`, and an `endian`
+/// other than little or big. Through both readers: the whole-file one and the streamed slices.
+#[test]
+fn nrrd_skips_lists_and_odd_endians_are_refused_by_name() {
+    let body = |extra: &str| {
+        let mut b =
+            format!("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n{extra}\n\n").into_bytes();
+        b.extend_from_slice(&[7; 16]);
+        b
+    };
+    for (extra, needle) in [
+        ("byte skip: 8", "byte skip: 8"),
+        ("byte skip: -1", "byte skip: -1"),
+        ("line skip: 2", "line skip: 2"),
+        ("data file: LIST", "names several data files"),
+        ("data file: slice%03d.raw 0 9 1", "names several data files"),
+        ("endian: middle", "little or big"),
+    ] {
+        let p = dir().join(format!("skip-{}.nrrd", extra.replace([' ', ':', '%'], "_")));
+        std::fs::write(&p, body(extra)).unwrap();
+        let e = load_volume(&p, &VolumeHints::default()).unwrap_err();
+        assert!(e.to_string().contains(needle), "{extra}: {e}");
+        let e = voxsplat::loaders::SliceReader::open(&p, &VolumeHints::default()).map(|_| ()).unwrap_err();
+        assert!(e.to_string().contains(needle), "{extra} (streamed): {e}");
+    }
+    // A zero skip is the default, and read as such.
+    let p = dir().join("skip-zero.nrrd");
+    std::fs::write(&p, body("byte skip: 0\nline skip: 0")).unwrap();
+    assert_eq!(load_volume(&p, &VolumeHints::default()).unwrap().values, vec![7.0; 8]);
+}

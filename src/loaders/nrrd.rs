@@ -57,14 +57,37 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
                 dims = Some(v.map_err(|_| bad(what, "bad sizes"))?);
             }
             "encoding" => enc = Some(value.to_string()),
-            "endian" => endian_big = value == "big",
+            "endian" => {
+                endian_big = match value {
+                    "big" => true,
+                    "little" => false,
+                    other => return Err(bad(what, format!("endian '{other}': little or big expected"))),
+                }
+            }
+            // Skipped lines or bytes before the data: not read (the data would shift and be read
+            // wrong), so refused by name.
+            "line skip" | "lineskip" | "byte skip" | "byteskip" if value != "0" => {
+                return Err(Error::Unsupported(format!(
+                    "{what}: NRRD '{}: {value}' (data after skipped lines or bytes) is not supported; \
+                     write the data without the skip",
+                    key.trim()
+                )));
+            }
             "spacings" => {
                 let v: Vec<f32> = value.split_whitespace().filter_map(|t| t.parse().ok()).collect();
                 for (i, s) in v.iter().take(3).enumerate() {
                     spacing[i] = *s;
                 }
             }
-            "data file" | "datafile" => data_file = Some(value.to_string()),
+            "data file" | "datafile" => {
+                // One detached file; a LIST or a numbered format names several.
+                if value.starts_with("LIST") || value.split_whitespace().count() > 1 {
+                    return Err(Error::Unsupported(format!(
+                        "{what}: NRRD 'data file: {value}' names several data files; one is supported"
+                    )));
+                }
+                data_file = Some(value.to_string())
+            }
             "space" => space = Some(value.to_string()),
             "space directions" => directions = Some(value.to_string()),
             "space origin" => space_origin = Some(value.to_string()),
