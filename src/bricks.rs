@@ -145,7 +145,8 @@ impl BrickStore {
         // A constant volume has no background: its voxels are kept (`keeps`: the minimum would drop
         // them all, and a one-voxel opaque volume drew nothing) at quantised 0, which the TF
         // classifies as the dense path does (density 0 without a TF range, the value's own with one).
-        let span = if hi > lo { hi - lo } else { 1.0 };
+        // In f64: the span of an f32 range may pass f32's largest value.
+        let span = if hi > lo { hi as f64 - lo as f64 } else { 1.0 };
         let mut store = Self {
             dims,
             spacing,
@@ -182,7 +183,7 @@ impl BrickStore {
                         if !keeps(v, range) {
                             continue;
                         }
-                        let q = ((v - lo) / span * Q).round().clamp(0.0, Q) as u32;
+                        let q = ((v as f64 - lo as f64) / span * Q as f64).round().clamp(0.0, Q as f64) as u32;
                         mask[l as usize / 64] |= 1 << (l % 64);
                         store.records.push(l | q << 16);
                         (qmin, qmax) = (qmin.min(q), qmax.max(q));
@@ -283,12 +284,9 @@ impl BrickStore {
     /// Classify the stored volume (as `classify::classify` does a dense one), reading every value
     /// and gradient through the store.
     pub fn classify(&self, tf: &TransferFunction, shading: Option<Shading>) -> Result<SplatSet> {
-        let (lo, hi) = self.range;
-        let span = if hi > lo { hi - lo } else { 1.0 };
+        let (a, b) = remap(self, tf);
         // The transfer function's own range, if it sets one, re-maps the stored normalisation.
-        let (tlo, thi) = tf.range.unwrap_or((lo, hi));
-        let tspan = if thi > tlo { thi - tlo } else { 1.0 };
-        let remap = |d: f32| if tf.range.is_some() { (lo + d * span - tlo) / tspan } else { d };
+        let remap = |d: f32| if tf.range.is_some() { a * d + b } else { d };
         classify_field(self.grid()?, tf, shading, |i, j, k| remap(self.value_at(i, j, k)))
     }
 }
@@ -326,12 +324,14 @@ fn next_classification() -> u64 {
 
 /// (a, b): stored value d is `tf`'s density a d + b.
 fn remap(store: &BrickStore, tf: &TransferFunction) -> (f32, f32) {
-    let (lo, hi) = store.range;
+    // In f64: the spans of f32 ranges may pass f32's largest value.
+    let (lo, hi) = (store.range.0 as f64, store.range.1 as f64);
     let span = if hi > lo { hi - lo } else { 1.0 };
     match tf.range {
         Some((tlo, thi)) => {
+            let (tlo, thi) = (tlo as f64, thi as f64);
             let tspan = if thi > tlo { thi - tlo } else { 1.0 };
-            (span / tspan, (lo - tlo) / tspan)
+            ((span / tspan) as f32, ((lo - tlo) / tspan) as f32)
         }
         None => (1.0, 0.0),
     }

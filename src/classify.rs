@@ -241,12 +241,13 @@ pub fn classify_on(
             .filter(|v| v.is_finite())
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)))
     });
-    let span = if hi > lo { hi - lo } else { 1.0 };
+    // In f64: the span of an f32 range may pass f32's largest value.
+    let span = if hi > lo { hi as f64 - lo as f64 } else { 1.0 };
     let at = |i: i64, j: i64, k: i64| -> f32 {
         let (i, j, k) = (i.clamp(0, nx as i64 - 1), j.clamp(0, ny as i64 - 1), k.clamp(0, nz as i64 - 1));
         let v = vol.values[(i + nx as i64 * (j + ny as i64 * k)) as usize];
         if v.is_finite() {
-            (v - lo) / span
+            ((v as f64 - lo as f64) / span) as f32
         } else {
             0.0
         }

@@ -309,7 +309,7 @@ pub fn ray_integrate_scalars(
     let (lo_v, hi_v) = tf.range.unwrap_or_else(|| {
         volume.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)))
     });
-    let span = if hi_v > lo_v { (hi_v - lo_v) as f64 } else { 1.0 };
+    let span = if hi_v > lo_v { hi_v as f64 - lo_v as f64 } else { 1.0 };
     let dt = step * spacing.min_element();
     let at = |i: usize, j: usize, k: usize| volume.values[i + nx * (j + ny * k)] as f64;
     let sample = |p: DVec3| -> f64 {

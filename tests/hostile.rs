@@ -342,3 +342,36 @@ fn nrrd_skips_lists_and_odd_endians_are_refused_by_name() {
     std::fs::write(&p, body("byte skip: 0\nline skip: 0")).unwrap();
     assert_eq!(load_volume(&p, &VolumeHints::default()).unwrap().values, vec![7.0; 8]);
 }
+
+/// Issue 44: a float volume whose range spans more than f32's largest value (max − min
+/// overflowed to infinity: every voxel normalised to 0) is drawn, dense and bricked, on the GPU
+/// and the mirrors; so is a TF range as wide.
+#[test]
+fn ranges_wider_than_f32_normalise_in_f64() {
+    let mut values = vec![-1e38f32; 27];
+    values[13] = 3e38;
+    let vol = ScalarVolume { dims: [3, 3, 3], spacing: [1.0; 3], values };
+    // Opaque only at the top of the range: the one hot voxel.
+    let tf = TransferFunction::from_toml("points = [[0.0, [0, 0, 0, 0]], [0.9, [0, 0, 0, 0]], [1.0, [1, 1, 1, 1]]]")
+        .unwrap();
+    let cam = Camera::framing(&Grid::centered(vol.dims, vol.spacing).unwrap(), 48, 48);
+    let splats = voxsplat::classify::classify(&vol, &tf, None).unwrap();
+    assert_eq!(splats.len(), 1, "the hot voxel, classified");
+    for mut r in [gpu(), cpu()] {
+        r.set_scene(splats.clone()).unwrap();
+        assert!(covered(&r.render(&cam, &RenderOptions::default()).unwrap().image) > 20);
+        r.set_bricks(BrickScene::new(BrickStore::build(&vol).unwrap(), tf.clone(), None).unwrap()).unwrap();
+        let bricked = r.render(&cam, &RenderOptions::default()).unwrap();
+        assert_eq!(bricked.stats.splats, 1, "{:?}", bricked.stats);
+        assert!(covered(&bricked.image) > 20);
+        assert_clean(&r);
+    }
+    // A TF range of [-3e38, 3e38] over ordinary values: they sit at its middle, drawn.
+    let ordinary = ScalarVolume { dims: [3, 3, 3], spacing: [1.0; 3], values: vec![5.0; 27] };
+    let wide = TransferFunction::from_toml("points = [[0.0, [0, 0, 0, 0]], [0.4, [0, 0, 0, 0]], [0.5, [1, 1, 1, 1]], [1.0, [1, 1, 1, 1]]]\nrange = [-3e38, 3e38]").unwrap();
+    let set = voxsplat::classify::classify(&ordinary, &wide, None).unwrap();
+    assert_eq!(set.len(), 27);
+    let mut r = cpu();
+    r.set_bricks(BrickScene::new(BrickStore::build(&ordinary).unwrap(), wide, None).unwrap()).unwrap();
+    assert!(covered(&r.render(&cam, &RenderOptions::default()).unwrap().image) > 100);
+}
