@@ -205,7 +205,7 @@ impl Animation {
             if !finite {
                 return Err(Error::InvalidArgument("keyframe values must be finite".into()));
             }
-            if k.rotate[3] != 0.0 && Vec3::from_slice(&k.rotate[..3]).length() < 1e-6 {
+            if k.rotate[3] != 0.0 && unit_axis(&k.rotate).is_none() {
                 return Err(Error::InvalidArgument("a keyframe rotates about a zero axis".into()));
             }
         }
@@ -280,13 +280,9 @@ impl Animation {
     /// The object's transform at time `t` (in frames): rotation about the grid centre, slerped
     /// between keyframes, and linearly interpolated translation.
     pub fn model(&self, grid: &Grid, t: f32) -> Mat4 {
-        let rot = |k: &Keyframe| {
-            let axis = Vec3::from_slice(&k.rotate[..3]);
-            if k.rotate[3] == 0.0 || axis.length() < 1e-6 {
-                Quat::IDENTITY
-            } else {
-                Quat::from_axis_angle(axis.normalize(), k.rotate[3].to_radians())
-            }
+        let rot = |k: &Keyframe| match unit_axis(&k.rotate) {
+            Some(axis) if k.rotate[3] != 0.0 => Quat::from_axis_angle(axis, k.rotate[3].to_radians()),
+            _ => Quat::IDENTITY,
         };
         let ks = &self.keyframes;
         let (q, tr) = match ks.iter().position(|k| k.frame > t) {
@@ -301,7 +297,7 @@ impl Animation {
                 let qb = rot(b);
                 let q = if (b.rotate[3] - a.rotate[3]).abs() < 180.0 && a.rotate[..3] == b.rotate[..3] {
                     Quat::from_axis_angle(
-                        Vec3::from_slice(&a.rotate[..3]).try_normalize().unwrap_or(Vec3::Y),
+                        unit_axis(&a.rotate).unwrap_or(Vec3::Y),
                         (a.rotate[3] + (b.rotate[3] - a.rotate[3]) * s).to_radians(),
                     )
                 } else {
@@ -482,4 +478,14 @@ pub fn render_frame_timed(
             Ok((a, total))
         }
     }
+}
+
+/// A keyframe's rotation axis (`rotate[..3]`) as a unit vector, its length taken in f64 so that a
+/// huge axis (1e30: its f32 length overflows) keeps its direction; `None` for an axis shorter than
+/// 1e-6.
+fn unit_axis(rotate: &[f32; 4]) -> Option<Vec3> {
+    let a = rotate[..3].iter().map(|&v| v as f64);
+    let len = a.clone().map(|v| v * v).sum::<f64>().sqrt();
+    (len >= 1e-6 && len.is_finite())
+        .then(|| Vec3::from_slice(&rotate[..3].iter().map(|&v| (v as f64 / len) as f32).collect::<Vec<_>>()))
 }

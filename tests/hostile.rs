@@ -375,3 +375,23 @@ fn ranges_wider_than_f32_normalise_in_f64() {
     r.set_bricks(BrickScene::new(BrickStore::build(&ordinary).unwrap(), wide, None).unwrap()).unwrap();
     assert!(covered(&r.render(&cam, &RenderOptions::default()).unwrap().image) > 100);
 }
+
+/// Issue 44: a keyframe's rotation axis of 1e30 (its f32 length overflows) turns the object as
+/// the unit axis does; it was dropped, the frames standing still.
+#[test]
+fn a_huge_rotation_axis_keeps_its_direction() {
+    let anim = |axis: &str| {
+        let text = format!(
+            "scene = \"cube40\"\nframes = 9\n[camera]\neye = [0.0, 0.0, 100.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[keyframe]]\nframe = 0\nrotate = [{axis}, 0.0]\n[[keyframe]]\nframe = 8\nrotate = [{axis}, 90.0]\n"
+        );
+        voxsplat::animate::Animation::from_toml(&text).unwrap()
+    };
+    let grid = *voxsplat::scene::build("cube40").unwrap().grid();
+    let (huge, unit) = (anim("1e30, 0.0, 0.0"), anim("1.0, 0.0, 0.0"));
+    for t in [0.0, 2.0, 4.0, 8.0] {
+        let (a, b) = (huge.model(&grid, t), unit.model(&grid, t));
+        assert!(a.abs_diff_eq(b, 1e-5), "t {t}: {a:?} against {b:?}");
+    }
+    assert!(!huge.model(&grid, 4.0).abs_diff_eq(huge.model(&grid, 0.0), 1e-3), "frame 4 turns");
+}
