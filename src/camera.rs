@@ -250,6 +250,14 @@ impl Camera {
             grid.dims[2] as f32 * grid.spacing[2],
         );
         let eye = c + Vec3::new(0.1 * ext.x, -0.75 * ext.y, 0.5 * ext.z + 0.25 * ext.y);
+        // A grid a few cells wide would put the eye within its splats' cull margin (CULL_RADII of
+        // the widest kernel) and draw nothing: the eye stays outside the bounding sphere widened
+        // by it.
+        let reach = crate::constants::CULL_RADII
+            * crate::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max)
+            * grid.kernel_spacing();
+        let least = 0.5 * ext.length() + 2.0 * reach;
+        let eye = if (eye - c).length() < least { c + (eye - c).normalize() * least } else { eye };
         let target = c + Vec3::new(0.0, 0.15 * ext.y, -0.2 * ext.z);
         let d = (target - eye).length();
         Self {

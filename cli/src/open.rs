@@ -278,9 +278,23 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
     if let Some(hgt) = a.ortho {
         cam.projection = Projection::Orthographic { height: hgt };
     }
-    // Fit near/far to the scene's bounding sphere seen from this eye unless given.
+    // Fit near/far to the scene's bounding sphere seen from this eye unless given, widened by the
+    // splats' cull margin: CULL_RADII of the widest kernel, grown by anti-aliasing where a voxel
+    // spacing projects below a pixel (far or small: every splat would fall in the margin and the
+    // frame be empty).
     let d = (grid.center() - cam.eye).length();
-    let r = 0.5 * grid.diagonal() + 4.0 * grid.kernel_spacing();
+    let ppv = match cam.projection {
+        Projection::Perspective { fov_y_deg } => {
+            grid.kernel_spacing() * h as f32
+                / (2.0 * (0.5 * fov_y_deg.to_radians()).tan() * (d - 0.5 * grid.diagonal()).max(1e-6))
+        }
+        Projection::Orthographic { height } => grid.kernel_spacing() * h as f32 / height,
+    };
+    // The widest anti-aliasing scale either method gives at that size (footprint_scale).
+    let aa_scale = (1.0 + (1.5 / ppv.max(1e-6)).powi(2)).sqrt().max(1.0 / ppv.max(1e-6)).max(1.0);
+    let widest = voxsplat::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max);
+    let reach = voxsplat::constants::CULL_RADII * widest * grid.kernel_spacing() * aa_scale;
+    let r = 0.5 * grid.diagonal() + (4.0 * grid.kernel_spacing()).max(reach);
     let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d.max(1.0)) } else { d - r - 1.0 };
     cam.near = a.near.unwrap_or(if grazing { cam.near } else { fit_near });
     cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + r + 1.0 });

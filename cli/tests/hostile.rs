@@ -153,3 +153,47 @@ fn repeated_frames_are_not_all_kept() {
     let many = peak_mib(&[&base[..], &["--repeat", "30"]].concat());
     assert!(many < one + 40.0, "30 frames peak at {many} MiB against {one} MiB for 2");
 }
+
+/// Pixels with any coverage in an image the CLI wrote.
+fn covered(path: &std::path::Path) -> usize {
+    voxsplat::output::read_image(path).unwrap().pixels.iter().filter(|p| p[3] > 0.0).count()
+}
+
+/// Issue 44: what anti-aliasing widens is not culled whole. A cube seen from far away, or at a
+/// 4 x 4 image, drew nothing with `--aa swan|ewa` (every widened splat fell within the cull margin
+/// of the fitted near and far planes); a 2 x 2 terrain drew nothing (the fly-over's eye sat within
+/// the margin of its splats). On the GPU and `--cpu`.
+#[test]
+fn far_small_and_tiny_scenes_are_drawn() {
+    let out = tmp("far.exr");
+    let o = out.to_str().unwrap();
+    for cpu in [false, true] {
+        let c: &[&str] = if cpu { &["--cpu"] } else { &[] };
+        for aa in ["none", "swan", "ewa"] {
+            for args in [
+                &["--scene", "cube60", "--size", "256x256", "--eye", "3200,2600,5800"][..],
+                &["--scene", "cube60", "--size", "4x4"][..],
+            ] {
+                let run = voxsplat(&[&["render", "--aa", aa, "--out", o][..], args, c].concat());
+                assert!(run.status.success(), "{args:?} {aa}: {}", String::from_utf8_lossy(&run.stderr));
+                assert!(covered(&out) > 0, "{args:?} --aa {aa} cpu {cpu}: an empty frame");
+            }
+        }
+        // The smallest terrain a height grid may be: 2 x 2 cells.
+        voxsplat::output::write_image(
+            &voxsplat::ImageF32 {
+                width: 2,
+                height: 2,
+                pixels: vec![[0.1, 0.1, 0.1, 1.0], [0.2; 4], [0.3; 4], [0.4; 4]],
+            },
+            &tmp("dem-2x2.png"),
+        )
+        .unwrap();
+        let run = voxsplat(
+            &[&["render", "--terrain", tmp("dem-2x2.png").to_str().unwrap(), "--size", "64x64", "--out", o][..], c]
+                .concat(),
+        );
+        assert!(run.status.success(), "2x2 terrain: {}", String::from_utf8_lossy(&run.stderr));
+        assert!(covered(&out) > 100, "2x2 terrain cpu {cpu}: {} px", covered(&out));
+    }
+}
