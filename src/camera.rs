@@ -64,7 +64,8 @@ impl Camera {
     /// grid whose kernel spacing is `kernel_spacing`, at the given image size.
     pub fn framing_box(lo: Vec3, hi: Vec3, kernel_spacing: f32, dir: Vec3, up: Vec3, width: u32, height: u32) -> Self {
         let center = lo.lerp(hi, 0.5);
-        let radius = 0.5 * (hi - lo).length().max(1.0);
+        // A floor of one kernel spacing (a one-voxel grid), not one unit: spacings in metres are common.
+        let radius = 0.5 * (hi - lo).length().max(kernel_spacing);
         let fov = 35.0f32;
         // The nearest splats must clear the near plane by the cull margin (CULL_RADII of the widest
         // kernel's radius), or a grid a few voxels wide would frame its eye inside it and draw nothing.
@@ -105,7 +106,8 @@ impl Camera {
             )));
         }
         let view = self.target - self.eye;
-        if view.length() < 1e-6 * (1.0 + self.eye.length()) {
+        // Relative to where they are, not in units: a scene in metres may be 1e-7 across.
+        if view.length() <= 1e-6 * self.eye.length().max(self.target.length()) {
             return bad("eye and target coincide");
         }
         if self.up.length() < 1e-12 || view.normalize().cross(self.up.normalize()).length() < 1e-4 {

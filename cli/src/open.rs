@@ -295,9 +295,10 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
     let widest = voxsplat::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max);
     let reach = voxsplat::constants::CULL_RADII * widest * grid.kernel_spacing() * aa_scale;
     let r = 0.5 * grid.diagonal() + (4.0 * grid.kernel_spacing()).max(reach);
-    let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d.max(1.0)) } else { d - r - 1.0 };
+    // Margins relative to the scene, not in units: spacings in metres (1e-4 and below) are common.
+    let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d) } else { d - 1.5 * r };
     cam.near = a.near.unwrap_or(if grazing { cam.near } else { fit_near });
-    cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + r + 1.0 });
+    cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + 1.5 * r });
     cam.validate()?;
     Ok(cam)
 }

@@ -197,3 +197,22 @@ fn far_small_and_tiny_scenes_are_drawn() {
         assert!(covered(&out) > 100, "2x2 terrain cpu {cpu}: {} px", covered(&out));
     }
 }
+
+/// Issue 44: spacing in metres draws the object as spacing in millimetres does (1e-4 drew an
+/// empty frame, 1e-3 drew it at a fifth of its size: the framing had a floor of one unit), down
+/// to 1e-9.
+#[test]
+fn metre_scale_spacing_frames_the_object_as_any_other() {
+    let out = tmp("metres.exr");
+    let o = out.to_str().unwrap();
+    let bonsai = data("bonsai/bonsai.nii.gz");
+    let mut pixels = Vec::new();
+    for sp in ["1,1,1", "0.001,0.001,0.001", "0.0001,0.0001,0.0001", "1e-9,1e-9,1e-9"] {
+        let run = voxsplat(&["render", "--volume", &bonsai, "--spacing", sp, "--size", "96x96", "--out", o]);
+        assert!(run.status.success(), "{sp}: {}", String::from_utf8_lossy(&run.stderr));
+        pixels.push(covered(&out));
+    }
+    for (p, sp) in pixels.iter().zip(["1", "1e-3", "1e-4", "1e-9"]) {
+        assert!(p.abs_diff(pixels[0]) * 20 < pixels[0], "spacing {sp}: {p} px against {} at 1", pixels[0]);
+    }
+}
