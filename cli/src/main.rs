@@ -283,9 +283,9 @@ struct RenderArgs {
     /// termination), to measure what dropping them saves.
     #[arg(long)]
     keep_hidden_bricks: bool,
-    /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25).
-    #[arg(long, value_parser = parse_finite, default_value = "1")]
-    slab_thickness: f32,
+    /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25) [default: 1].
+    #[arg(long, value_parser = parse_finite)]
+    slab_thickness: Option<f32>,
     /// How footprints become pixels: instanced quads (graphics), point sprites (points), compute
     /// shaders (tile compositing / fixed-point sheet sums), or auto (on a CPU device: compute for
     /// small footprints, else point sprites where they fit, else graphics; graphics on hardware; it
@@ -470,7 +470,14 @@ fn run(cli: Cli) -> Result<()> {
                     .as_deref()
                     .map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
             opts.sheet_budget_bytes = mib_bytes(a.sheet_budget_mib, "--sheet-budget-mib")?;
-            opts.slab_thickness = a.slab_thickness;
+            if let Some(t) = a.slab_thickness {
+                if composite != Composite::Slab {
+                    return Err(Error::InvalidArgument(
+                        "--slab-thickness sets the slabs of --composite slab; this frame draws no slabs".into(),
+                    ));
+                }
+                opts.slab_thickness = t;
+            }
             opts.early_termination = a.early_termination;
             opts.cull_hidden_bricks = !a.keep_hidden_bricks;
             opts.raster = a.raster.parse::<voxsplat::Raster>()?;
@@ -664,6 +671,13 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::MakeVolume { from, factor, procedural, phantom, out } => {
+            // It writes NRRD (raw data, attached): a name that says otherwise would mislead.
+            if !out.to_string_lossy().to_ascii_lowercase().ends_with(".nrrd") {
+                return Err(Error::InvalidArgument(format!(
+                    "make-volume writes NRRD: name the output .nrrd, not {}",
+                    out.display()
+                )));
+            }
             let bar = indicatif::ProgressBar::new(0);
             let t = std::time::Instant::now();
             let dims = match (from, procedural.or(phantom)) {

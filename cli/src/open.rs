@@ -136,9 +136,10 @@ pub struct SceneArgs {
     /// spacing). Draws the volume as host splats.
     #[arg(long, requires = "volume")]
     pub positions: Option<PathBuf>,
-    /// Transfer function: a preset (ramp, ct, bonsai) or a TOML file.
-    #[arg(long, default_value = "ramp")]
-    pub tf: String,
+    /// Transfer function for --volume: a preset (ramp, ct, bonsai, mri) or a TOML file [default:
+    /// ramp].
+    #[arg(long)]
+    pub tf: Option<String>,
     /// Phong shading with a headlight, applied to the voxels before splatting (on by default for
     /// the presets it measurably helps: `classify::SHADED_PRESETS`, bonsai).
     #[arg(long, conflicts_with = "no_shade")]
@@ -308,7 +309,7 @@ pub type VolumeParts =
 
 /// The --tf preset or TOML file.
 pub fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFunction> {
-    load_tf(&a.tf)
+    load_tf(a.tf.as_deref().unwrap_or("ramp"))
 }
 
 /// A transfer-function preset by name, or a TOML file.
@@ -339,7 +340,7 @@ pub fn headlight(
     spacing: [f32; 3],
     orientation: Option<Orientation>,
 ) -> Option<voxsplat::classify::Shading> {
-    let by_default = voxsplat::classify::SHADED_PRESETS.contains(&a.tf.as_str());
+    let by_default = voxsplat::classify::SHADED_PRESETS.contains(&a.tf.as_deref().unwrap_or("ramp"));
     (a.shade || by_default && !a.no_shade).then(|| {
         let g = voxsplat::Grid::centered(dims, spacing).ok();
         let content = Content { orientation, bounds: None };
@@ -410,6 +411,11 @@ pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
                 "--dims, --dtype, --big-endian and --spacing describe --volume files, not --terrain".into(),
             ));
         }
+        if a.tf.is_some() {
+            return Err(Error::InvalidArgument(
+                "--tf colours a --volume; a --terrain is coloured by its height or by --color".into(),
+            ));
+        }
         let heights = voxsplat::loaders::load_heights(path)?;
         let color = match &a.color {
             Some(c) => Some(voxsplat::output::read_rgba8(c)?),
@@ -418,6 +424,7 @@ pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
         let opts = voxsplat::terrain::TerrainOptions { cell: a.cell, vscale: a.vscale, color, ..Default::default() };
         voxsplat::terrain::terrain_splats(&heights, &opts)?
     } else {
+        refuse_volume_flags(a)?;
         scene::build(&a.scene)?
     };
     eprintln!(
@@ -464,6 +471,25 @@ pub fn report_validation(r: &Renderer) -> Result<()> {
     Ok(())
 }
 
+/// A built-in scene has its own colours and grid: what describes a --volume would be ignored.
+fn refuse_volume_flags(a: &SceneArgs) -> Result<()> {
+    let given = [
+        (a.tf.is_some(), "--tf"),
+        (a.spacing.is_some(), "--spacing"),
+        (a.positions.is_some(), "--positions"),
+        (a.dims.is_some(), "--dims"),
+        (a.dtype.is_some(), "--dtype"),
+        (a.big_endian, "--big-endian"),
+    ];
+    match given.iter().find(|g| g.0) {
+        Some((_, flag)) => Err(Error::InvalidArgument(format!(
+            "{flag} describes a --volume file; the built-in scene '{}' has its own colours and grid",
+            a.scene
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// The scene `a` names: a --volume as a bricked store classified on the device unless
 /// `host_splats` (a mode that needs host splats), else host splats; with the grid's splat set
 /// (empty for a bricked store) for cameras and orders, and what a camera frames (`Content`).
@@ -485,6 +511,7 @@ pub fn open(
             (load_bricked(a, path, orientation)?, orientation)
         }
         (None, Some(n)) if !host_splats && !a.dense => {
+            refuse_volume_flags(a)?;
             let store = voxsplat::bricks::BrickStore::build(&voxsplat::peer::volume(n)?)?;
             eprintln!("{} stored voxels in {} bricks", store.len(), store.headers.len());
             (voxsplat::bricks::BrickScene::new(store, voxsplat::peer::transfer_function(), None)?, None)

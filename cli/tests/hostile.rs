@@ -216,3 +216,33 @@ fn metre_scale_spacing_frames_the_object_as_any_other() {
         assert!(p.abs_diff(pixels[0]) * 20 < pixels[0], "spacing {sp}: {p} px against {} at 1", pixels[0]);
     }
 }
+
+/// Issue 44: flags that cannot apply are refused, not silently ignored: what describes a --volume
+/// file given with a built-in scene or a terrain, --slab-thickness without slabs, and make-volume
+/// writing NRRD bytes under another extension.
+#[test]
+fn flags_that_cannot_apply_are_refused() {
+    let out = tmp("flags.png");
+    let o = out.to_str().unwrap();
+    let stent = data("stent/stent.nrrd");
+    let dem = data("rmnp/rmnp-dem.tif");
+    for (args, needle) in [
+        (vec!["render", "--scene", "cube60", "--spacing", "2,2,2"], "--spacing describes a --volume"),
+        (vec!["render", "--scene", "cube60", "--tf", "ct"], "--tf describes a --volume"),
+        (vec!["render", "--scene", "cube60", "--tf", "/nonexistent.toml"], "--tf describes a --volume"),
+        (vec!["render", "--scene", "peer128", "--tf", "ct"], "--tf describes a --volume"),
+        (vec!["render", "--terrain", &dem, "--tf", "ct"], "--tf colours a --volume"),
+        (vec!["render", "--scene", "cube60", "--slab-thickness", "2"], "draws no slabs"),
+    ] {
+        fails_with(&[&args[..], &["--size", "32x32", "--out", o]].concat(), needle);
+    }
+    fails_with(&["make-volume", "--procedural", "8", "--out", o], "name the output .nrrd");
+    // What does apply still runs.
+    for args in [
+        vec!["render", "--volume", &stent, "--tf", "ct"],
+        vec!["render", "--scene", "cube60", "--composite", "slab", "--slab-thickness", "2"],
+    ] {
+        let run = voxsplat(&[&args[..], &["--size", "32x32", "--out", o]].concat());
+        assert!(run.status.success(), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
+    }
+}
