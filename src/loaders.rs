@@ -169,12 +169,19 @@ pub fn raw_from_bytes(
 }
 
 pub(crate) fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
-    if s.iter().all(|v| v.is_finite() && *v > 0.0) {
-        Ok(())
-    } else {
-        Err(bad(what, format!("spacing {s:?} must be finite and positive")))
+    if !s.iter().all(|v| v.is_finite() && *v > 0.0) {
+        return Err(bad(what, format!("spacing {s:?} must be finite and positive")));
     }
+    // A grid of MAX_DIM voxels must stay within the 1e15 units a camera resolves.
+    if s.iter().any(|&v| v > MAX_SPACING) {
+        return Err(bad(what, format!("spacing {s:?} is past {MAX_SPACING:e} units a voxel: the grid would pass the 1e15 units a camera resolves")));
+    }
+    Ok(())
 }
+
+/// The largest voxel spacing a file may give: 2^16 voxels of it span 1e15 units, the most a camera
+/// resolves.
+const MAX_SPACING: f32 = 1e10;
 
 /// NRRD (attached or detached data, raw or gzip) as a dense volume.
 pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<ScalarVolume> {
@@ -266,11 +273,7 @@ impl NiftiLayout {
 /// The layout of the NIfTI-1 file whose first bytes are `head` (at least the 348-byte header),
 /// its voxel count checked against `limit`.
 pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiLayout> {
-    if head.len() < 348 {
-        return Err(bad(what, "shorter than a NIfTI-1 header"));
-    }
-    let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&head[..348]))
-        .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
+    let header = nifti1_header(head, what)?;
     let dim = nifti_dims(&header, what)?;
     if dim.is_empty() || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
         return Err(bad(what, "only 3D NIfTI volumes (or 4D with one frame) are supported"));
@@ -326,12 +329,25 @@ fn gunzip_prefix(bytes: &[u8], n: u64, what: &str) -> Result<Vec<u8>> {
 }
 
 /// Bytes a NIfTI-1 file needs (offset + data), from its checked header.
-fn nifti_size(head: &[u8], what: &str) -> Result<u64> {
+/// A NIfTI-1 header from the first 348 bytes of `head`; a NIfTI-2 file (540-byte header) is
+/// refused by name.
+fn nifti1_header(head: &[u8], what: &str) -> Result<nifti::NiftiHeader> {
+    let sizeof_hdr =
+        head.get(..4).map(|b| [u32::from_le_bytes(b.try_into().unwrap()), u32::from_be_bytes(b.try_into().unwrap())]);
+    if sizeof_hdr.is_some_and(|s| s.contains(&540)) {
+        return Err(Error::Unsupported(format!(
+            "{what}: a NIfTI-2 file (540-byte header); NIfTI-1 is read (nibabel: nib.Nifti1Image(img.dataobj, img.affine, img.header))"
+        )));
+    }
     if head.len() < 348 {
         return Err(bad(what, "shorter than a NIfTI-1 header"));
     }
-    let header = nifti::NiftiHeader::from_reader(std::io::Cursor::new(&head[..348]))
-        .map_err(|e| bad(what, format!("NIfTI header: {e}")))?;
+    nifti::NiftiHeader::from_reader(std::io::Cursor::new(&head[..348]))
+        .map_err(|e| bad(what, format!("NIfTI header: {e}")))
+}
+
+fn nifti_size(head: &[u8], what: &str) -> Result<u64> {
+    let header = nifti1_header(head, what)?;
     let n = voxel_count(&nifti_dims(&header, what)?, what)?;
     let size = (header.bitpix.max(8) as u64) / 8;
     let off = header.vox_offset;
@@ -396,7 +412,20 @@ pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> 
         (npyz::TypeChar::Int, 2) => read_all::<i16>(npy, what)?.into_iter().map(f32::from).collect(),
         (npyz::TypeChar::Float, 4) => read_all::<f32>(npy, what)?,
         (npyz::TypeChar::Float, 8) => read_all::<f64>(npy, what)?.into_iter().map(|v| v as f32).collect(),
-        (c, s) => return Err(bad(what, format!("unsupported npy type {c:?}{s}"))),
+        (c, s) => {
+            let kind = match c {
+                npyz::TypeChar::Uint => "uint",
+                npyz::TypeChar::Int => "int",
+                npyz::TypeChar::Float => "float",
+                npyz::TypeChar::Complex => "complex",
+                npyz::TypeChar::Bool => "bool",
+                _ => "other",
+            };
+            return Err(Error::Unsupported(format!(
+                "{what}: npy type {kind}{} is not read (uint8, uint16, int16, float32 and float64 are)",
+                s * 8
+            )));
+        }
     };
     if values.len() as u64 != n {
         return Err(bad(what, "data is truncated"));
@@ -647,14 +676,24 @@ pub fn tiff_heights(bytes: &[u8], what: &str) -> Result<HeightGrid> {
     let (w, h) = dec.dimensions().map_err(|e| bad(what, format!("tiff: {e}")))?;
     voxel_count(&[w as u64, h as u64], what)?;
     use tiff::decoder::DecodingResult as D;
-    let heights: Vec<f32> = match dec.read_image().map_err(|e| bad(what, format!("tiff: {e}")))? {
+    const READ: &str = "uint8, uint16, int16, uint32, float32 and float64 single-channel heights are read";
+    let heights: Vec<f32> = match dec.read_image().map_err(|e| bad(what, format!("tiff: {e} ({READ})")))? {
         D::U8(v) => v.into_iter().map(f32::from).collect(),
         D::U16(v) => v.into_iter().map(f32::from).collect(),
         D::I16(v) => v.into_iter().map(f32::from).collect(),
         D::U32(v) => v.into_iter().map(|x| x as f32).collect(),
         D::F32(v) => v,
         D::F64(v) => v.into_iter().map(|x| x as f32).collect(),
-        _ => return Err(bad(what, "unsupported TIFF sample type")),
+        other => {
+            let kind = match other {
+                D::I8(_) => "int8",
+                D::I32(_) => "int32",
+                D::U64(_) => "uint64",
+                D::I64(_) => "int64",
+                _ => "this sample type",
+            };
+            return Err(bad(what, format!("TIFF samples of {kind} are not read ({READ})")));
+        }
     };
     if heights.len() as u64 != w as u64 * h as u64 {
         return Err(bad(what, "TIFF is not a single-channel height grid"));

@@ -94,15 +94,15 @@ impl Clip {
         }
         let mut clip = Self::default();
         for (i, p) in planes.iter().enumerate() {
-            let n = p.truncate();
-            let len = n.length();
-            if !p.is_finite() || !len.is_normal() {
+            // The length in f64: a normal of 1e30 is a direction, though its f32 length overflows.
+            let len = p.truncate().as_dvec3().length();
+            if !p.is_finite() || !(len > 0.0 && len.is_finite()) {
                 return Err(Error::InvalidArgument(format!(
                     "clipping plane {i} ({}, {}, {}, {}): its normal must be finite and non-zero, its offset finite",
                     p.x, p.y, p.z, p.w
                 )));
             }
-            clip.push(*p / len);
+            clip.push((p.as_dvec4() / len).as_vec4());
         }
         if let Some([lo, hi]) = crop {
             if !(lo.is_finite() && hi.is_finite()) || (0..3).any(|a| lo[a] >= hi[a]) {

@@ -395,3 +395,38 @@ fn a_huge_rotation_axis_keeps_its_direction() {
     }
     assert!(!huge.model(&grid, 4.0).abs_diff_eq(huge.model(&grid, 0.0), 1e-3), "frame 4 turns");
 }
+
+/// Issue 44: messages that name the real cause. A NIfTI-2 file ("Invalid NIfTI-1 file"), an npy of
+/// uint64 ("Uint8"), an NRRD header longer than 1 MiB ("no type field" from the streamed reader),
+/// a spacing of 1e30 (an invalid camera later on), a clipping plane whose normal is 1e30 long (a
+/// direction: "normal must be finite" before).
+#[test]
+fn refusals_name_the_real_cause() {
+    let mut two = vec![0u8; 560];
+    two[..4].copy_from_slice(&540u32.to_le_bytes());
+    two[4..8].copy_from_slice(b"n+2\0");
+    let p = dir().join("two.nii");
+    std::fs::write(&p, &two).unwrap();
+    let e = load_volume(&p, &VolumeHints::default()).unwrap_err();
+    assert!(matches!(e, Error::Unsupported(_)) && e.to_string().contains("NIfTI-2"), "{e}");
+    let e = npy_from_bytes(&common::npy(&[2, 2, 2], "<u8", &[0u8; 64]), "u64.npy").unwrap_err();
+    assert!(e.to_string().contains("uint64") && e.to_string().contains("float32"), "{e}");
+    let mut long = b"NRRD0004\ntype: uint8\n".to_vec();
+    long.extend(std::iter::repeat_n(b"# comment\n".iter().copied(), 120_000).flatten());
+    long.extend_from_slice(b"dimension: 3\nsizes: 2 2 2\nencoding: raw\n\n");
+    long.extend_from_slice(&[1; 8]);
+    let p = dir().join("long-comment.nrrd");
+    std::fs::write(&p, &long).unwrap();
+    let e = load_volume(&p, &VolumeHints::default()).unwrap_err();
+    assert!(e.to_string().contains("longer than 1 MiB"), "{e}");
+    let e = voxsplat::loaders::SliceReader::open(&p, &VolumeHints::default()).map(|_| ()).unwrap_err();
+    assert!(e.to_string().contains("longer than 1 MiB"), "streamed: {e}");
+    let p = dir().join("huge-spacing.nrrd");
+    let mut b = b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 1e30 1 1\nencoding: raw\n\n".to_vec();
+    b.extend_from_slice(&[1; 8]);
+    std::fs::write(&p, &b).unwrap();
+    let e = load_volume(&p, &VolumeHints::default()).unwrap_err();
+    assert!(e.to_string().contains("past 1e10 units a voxel"), "{e}");
+    voxsplat::Clip::new(&[glam::Vec4::new(1e30, 0.0, 0.0, 0.0)], None).unwrap();
+    assert!(voxsplat::Clip::new(&[glam::Vec4::new(0.0, 0.0, 0.0, 1.0)], None).is_err());
+}

@@ -32,6 +32,8 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
         .or_else(|| bytes.windows(4).position(|w| w == b"\r\n\r\n").map(|p| (p + 2, p + 4)));
     let (hdr_end, data_start) = match end {
         Some(e) => e,
+        // (A reader passes at most the first MiB: a longer header has no end in it.)
+        None if bytes.len() >= 1 << 20 => return Err(bad(what, "header longer than 1 MiB (no blank line ends it)")),
         None => (bytes.len(), bytes.len()),
     };
     if hdr_end > 1 << 20 {
