@@ -101,9 +101,30 @@ impl Error {
     }
 }
 
-/// Refuse `bytes` of host memory for `what` when the host has less available (Linux's
-/// MemAvailable; elsewhere nothing is checked).
+/// The process's host-memory budget in bytes (`set_host_budget`); `u64::MAX`: none set.
+static HOST_BUDGET: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(u64::MAX);
+
+/// Cap the host memory that allocations sized by a file's header or a caller's request may take
+/// (`check_host_memory`), below what the host has available; `None` lifts the cap.
+pub fn set_host_budget(bytes: Option<u64>) {
+    HOST_BUDGET.store(bytes.unwrap_or(u64::MAX), std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The host-memory budget `set_host_budget` set, if any.
+pub fn host_budget() -> Option<u64> {
+    Some(HOST_BUDGET.load(std::sync::atomic::Ordering::Relaxed)).filter(|&b| b != u64::MAX)
+}
+
+/// Refuse `bytes` of host memory for `what` past the host budget (`set_host_budget`) or when the
+/// host has less available (Linux's MemAvailable; elsewhere only the budget is checked).
 pub fn check_host_memory(bytes: u64, what: &str) -> Result<()> {
+    if let Some(b) = host_budget().filter(|&b| bytes > b) {
+        return Err(Error::TooLarge(format!(
+            "{what} may need {} MiB of host memory, past the host budget of {} MiB",
+            bytes >> 20,
+            b >> 20
+        )));
+    }
     let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
         let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?.to_string();
         line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)

@@ -69,7 +69,7 @@ pub mod volume;
 pub use bisect::Bisect;
 pub use camera::{Camera, Projection};
 pub use cpu::present::TargetFormat;
-pub use error::{Error, Result};
+pub use error::{host_budget, set_host_budget, Error, Result};
 pub use glam;
 pub use image::ImageF32;
 pub use kernel::Kernel;
@@ -281,6 +281,7 @@ impl Renderer {
     pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
         options.validate()?;
         camera.validate()?;
+        check_frame_memory(camera)?;
         if options.render_scale != 1.0 {
             let full = RenderOptions { render_scale: 1.0, ..options.clone() };
             return resample::render_scaled(camera, options.render_scale, |low| self.render(low, &full));
@@ -479,6 +480,7 @@ impl Renderer {
     /// The ray caster: `raycast.comp` on the GPU, or its CPU mirror.
     pub fn raycast(&mut self, camera: &Camera, options: &cpu::raycast::RaycastOptions) -> Result<Rendered> {
         camera.validate()?;
+        check_frame_memory(camera)?;
         if !(options.step.is_finite() && options.step > 0.0) {
             return Err(Error::InvalidArgument("ray caster step must be positive".into()));
         }
@@ -579,4 +581,18 @@ pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
 #[doc(hidden)]
 pub fn spirv_builds() -> &'static [(&'static str, &'static [u8])] {
     gpu::pipelines::SPIRV
+}
+
+/// Host bytes a frame takes per pixel at most: the image (f32 RGBA), its read-back copy, the CPU
+/// engine's accumulators and the 8-bit copy an output format writes (an 8192² frame took 4.4 GB).
+const FRAME_HOST_BYTES_PER_PIXEL: u64 = 72;
+
+/// Refuse a frame whose host memory would pass the host budget or what the host has available,
+/// before anything of it is allocated.
+fn check_frame_memory(camera: &Camera) -> Result<()> {
+    let pixels = camera.width as u64 * camera.height as u64;
+    error::check_host_memory(
+        pixels * FRAME_HOST_BYTES_PER_PIXEL,
+        &format!("a {}x{} frame", camera.width, camera.height),
+    )
 }

@@ -101,6 +101,7 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
     if (bytes.len() as u64) < need {
         return Err(bad(what, format!("data is truncated: {} bytes for {need}", bytes.len())));
     }
+    crate::error::check_host_memory(n * 4, &format!("{what}'s {n} samples"))?;
     let b = &bytes[..need as usize];
     let v = match dtype {
         DType::U8 => b.iter().map(|&x| x as f32).collect(),
@@ -133,6 +134,8 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
 
 /// Inflate gzip data, refusing to produce more than `limit` bytes.
 pub fn gunzip(bytes: &[u8], limit: u64, what: &str) -> Result<Vec<u8>> {
+    // `limit` is what the header says the data takes: a small file may inflate to all of it.
+    crate::error::check_host_memory(limit, &format!("{what} inflated"))?;
     let mut out = Vec::new();
     flate2::read::MultiGzDecoder::new(bytes)
         .take(limit + 1)

@@ -41,6 +41,11 @@ fn stdout_or_exit(written: std::io::Result<()>) {
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Host memory, in MiB, that what a file's header or a flag sizes may take (volumes, frames,
+    /// terrains, the store): past it the command stops with an error before allocating [default:
+    /// what the host has available].
+    #[arg(long, global = true)]
+    host_budget_mib: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -1192,6 +1197,9 @@ fn distributed_frames(
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(mib) = cli.host_budget_mib {
+        voxsplat::set_host_budget(Some(mib.saturating_mul(1 << 20)));
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

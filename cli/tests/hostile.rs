@@ -246,3 +246,38 @@ fn flags_that_cannot_apply_are_refused() {
         assert!(run.status.success(), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
     }
 }
+
+/// Issue 44: `--host-budget-mib` bounds what a header or a flag sizes, refused before it is
+/// allocated: an 8192² frame (it took 4.4 GB), a volume's samples and its store, a terrain's
+/// columns. Within the budget the same commands run.
+#[test]
+fn the_host_budget_refuses_before_allocating() {
+    let out = tmp("budget.png");
+    let o = out.to_str().unwrap();
+    let bonsai = data("bonsai/bonsai.nii.gz");
+    let dem = data("rmnp/rmnp-dem.tif");
+    for (args, needle) in [
+        (vec!["render", "--scene", "cube40", "--size", "8192x8192", "--out", o], "a 8192x8192 frame may need"),
+        (vec!["render", "--volume", &bonsai, "--size", "32x32", "--out", o], "past the host budget of 40 MiB"),
+        (
+            vec!["render", "--volume", &bonsai, "--dense", "--size", "32x32", "--out", o],
+            "past the host budget of 40 MiB",
+        ),
+        (vec!["info", &bonsai], "past the host budget of 40 MiB"),
+        // rmnp at 50x relief: 1.2 M column voxels.
+        (
+            vec!["render", "--terrain", &dem, "--vscale", "50", "--size", "32x32", "--out", o],
+            "terrain's 1222732 splats",
+        ),
+    ] {
+        let t = std::time::Instant::now();
+        fails_with(&[&args[..], &["--host-budget-mib", "40"][..]].concat(), needle);
+        assert!(t.elapsed().as_secs_f64() < 20.0, "{args:?}");
+    }
+    for args in
+        [vec!["render", "--scene", "cube40", "--size", "64x64"], vec!["render", "--terrain", &dem, "--size", "32x32"]]
+    {
+        let run = voxsplat(&[&args[..], &["--host-budget-mib", "400", "--out", o][..]].concat());
+        assert!(run.status.success(), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
+    }
+}
