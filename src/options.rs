@@ -96,7 +96,7 @@ impl Clip {
         for (i, p) in planes.iter().enumerate() {
             // The length in f64: a normal of 1e30 is a direction, though its f32 length overflows.
             let len = p.truncate().as_dvec3().length();
-            if !p.is_finite() || !(len > 0.0 && len.is_finite()) {
+            if !(p.is_finite() && len > 0.0 && len.is_finite()) {
                 return Err(Error::InvalidArgument(format!(
                     "clipping plane {i} ({}, {}, {}, {}): its normal must be finite and non-zero, its offset finite",
                     p.x, p.y, p.z, p.w

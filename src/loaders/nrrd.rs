@@ -192,7 +192,7 @@ pub(super) fn nifti_orientation(h: &nifti::NiftiHeader, dims: [u32; 3], what: &s
         // A unit quaternion's b^2 + c^2 + d^2 is at most 1: past float32 rounding of 1 it is no
         // rotation (nibabel refuses it too); up to that, normalised as niftilib does (a = 0).
         let norm = b * b + c * c + d * d;
-        if !(norm <= 1.0 + 1e-5) {
+        if norm.is_nan() || norm > 1.0 + 1e-5 {
             return Err(bad(
                 what,
                 format!(
