@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Mutation check (issue 25): plants nine known bugs one at a time, runs the tests that should
+# Mutation check (issues 25, 44): plants fourteen known bugs one at a time, runs the tests that should
 # catch each, and prints a markdown table; exits 1 when a bug survives (no test failed). Each
 # mutant costs a release rebuild of the library and its tests (about 1-3 minutes here); the last
 # result lives in docs/RELIABILITY.md. The tree is restored after every mutant, also on Ctrl-C.
-#   scripts/mutants.sh            all nine
+#   scripts/mutants.sh            all fourteen
 #   scripts/mutants.sh octant     the ones whose name contains "octant"
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,6 +18,11 @@ MUTANTS=(
   "boxes composited nearest first|src/distributed.rs|        s.plane >= split[s.axis]|        s.plane < split[s.axis]|--features mpi -p voxsplat-cli --test distributed one_two"
   "world eye into the grid frame by the rotation, not its inverse|src/orient.rs|(self.rotation.transpose() * (p.as_dvec3() - self.center)).as_vec3()|(self.rotation * (p.as_dvec3() - self.center)).as_vec3()|--test orient"
   "a sheared grid's eye mapped into index space without the shear|src/volume.rs|        let y = (d.y - h[2] * z) / s.y;|        let y = d.y / s.y;|--test orient"
+  "the occlusion map's box mask shifted a pixel|src/cpu/tile_occlusion.rs|let row = ((1u32 << (zx - ax + 1)) - 1) << ax;|let row = ((1u32 << (zx - ax + 1)) - 1) << ax >> 1;|--test bricked the_occlusion_map"
+  "motion-blurred frames drop hidden bricks|src/cpu/brick_hidden.rs|        if f.blur[0] > 0.0 {|        if f.blur[0] > 1e30 {|--test bricked motion_blurred"
+  "a value range's span in f32 (overflows)|src/classify.rs|let span = if hi > lo { hi as f64 - lo as f64 } else { 1.0 };|let span = if hi > lo { (hi - lo) as f64 } else { 1.0 };|--test hostile ranges_wider"
+  "NRRD byte skip read as data|src/loaders/nrrd.rs|if value != \"0\" =>|if false =>|--test hostile nrrd_skips"
+  "a TF point's third element dropped|src/classify.rs|if s.next_element::<IgnoredAny>()?.is_some() {|if false && s.next_element::<IgnoredAny>()?.is_some() {|--test hostile transfer_function_points"
 )
 filter=${1:-}
 backup=$(mktemp -d)
