@@ -375,7 +375,16 @@ impl std::str::FromStr for Blur {
     fn from_str(s: &str) -> Result<Self> {
         if let Some(rest) = s.strip_prefix("splat").filter(|r| r.is_empty() || r.starts_with(':')) {
             let mut shape = SplatBlur::default();
+            let (mut path, mut profile) = (None, None);
             for part in rest.strip_prefix(':').into_iter().flat_map(|r| r.split('+')) {
+                // One path and one profile: a second would silently replace the first.
+                let slot = if matches!(part, "arc" | "line") { &mut path } else { &mut profile };
+                if let Some(first) = slot.replace(part) {
+                    return Err(Error::InvalidArgument(format!(
+                        "blur '{s}': '{first}' and '{part}' both given; a splat blur takes one path (line, arc) \
+                         and one profile (uniform, tapered, teardrop, slotted)"
+                    )));
+                }
                 match part {
                     "arc" => shape.arc = true,
                     "line" => shape.arc = false,

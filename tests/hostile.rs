@@ -430,3 +430,17 @@ fn refusals_name_the_real_cause() {
     voxsplat::Clip::new(&[glam::Vec4::new(1e30, 0.0, 0.0, 0.0)], None).unwrap();
     assert!(voxsplat::Clip::new(&[glam::Vec4::new(0.0, 0.0, 0.0, 1.0)], None).is_err());
 }
+
+/// Issue 44: a splat blur takes one path and one profile; `splat:arc+slotted+tapered+teardrop`
+/// kept the last profile silently.
+#[test]
+fn a_blur_takes_one_path_and_one_profile() {
+    use voxsplat::animate::Blur;
+    for bad in ["splat:arc+slotted+tapered+teardrop", "splat:tapered+teardrop", "splat:arc+line"] {
+        let e = bad.parse::<Blur>().unwrap_err();
+        assert!(e.to_string().contains("both given"), "{bad}: {e}");
+    }
+    for good in ["splat", "splat:arc", "splat:arc+tapered", "splat:teardrop+line", "none", "accum:4"] {
+        good.parse::<Blur>().unwrap();
+    }
+}
