@@ -273,6 +273,12 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
         None if o.is_none() && (!grazing || a.eye.is_some()) => cam.up = Vec3::Y,
         None => {}
     }
+    // Looking along the up it was not told: another up, as a viewer would pick (the view was
+    // refused as "up is parallel").
+    let view = (cam.target - cam.eye).normalize_or_zero();
+    if a.up.is_none() && view.cross(cam.up.normalize_or_zero()).length() < 1e-4 {
+        cam.up = if view.cross(Vec3::Z).length() >= 1e-3 { Vec3::Z } else { Vec3::X };
+    }
     if let Some(fov) = a.fov {
         cam.projection = Projection::Perspective { fov_y_deg: fov };
     }

@@ -281,3 +281,25 @@ fn the_host_budget_refuses_before_allocating() {
         assert!(run.status.success(), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
     }
 }
+
+/// Issue 44: an eye straight above or below the target, with no --up, gets another up, as a viewer
+/// picks one (it was refused: "up is parallel"); an --up given along the view is still refused.
+#[test]
+fn a_view_along_the_default_up_picks_another() {
+    let out = tmp("topdown.png");
+    let o = out.to_str().unwrap();
+    for eye in ["0,200,0", "0,-200,0"] {
+        let run = voxsplat(&[
+            "render", "--scene", "cube40", "--eye", eye, "--target", "0,0,0", "--size", "48x48", "--out", o,
+        ]);
+        assert!(run.status.success(), "{eye}: {}", String::from_utf8_lossy(&run.stderr));
+        assert!(covered(&out) > 100, "{eye}");
+    }
+    fails_with(
+        &[
+            "render", "--scene", "cube40", "--eye", "0,200,0", "--target", "0,0,0", "--up", "0,1,0", "--size", "48x48",
+            "--out", o,
+        ],
+        "parallel",
+    );
+}

@@ -1,6 +1,6 @@
 //! Mirror of `tile_occlusion.comp` and of `glsl/shared/occlusion.glsl`: the occlusion map a bricked
 //! frame drawn front to back builds after each wave, and the test of a pixel box against it that
-//! `brick_hidden` makes for whole bricks and for their voxels.
+//! `brick_hidden` makes for each brick (or node) of the next wave.
 use super::bindings::Bindings;
 use crate::constants::COMPOSITE_TILE;
 use crate::dispatch::{Args, Res, Variant};
@@ -8,6 +8,9 @@ use crate::error::Result;
 use crate::gpu_types::{BrickPush, Frame};
 use crate::image::ImageF32;
 use glam::IVec4;
+
+// A tile's open pixels are one bit each in two words.
+const _: () = assert!(COMPOSITE_TILE * COMPOSITE_TILE == 64);
 
 /// Most composite tiles a box may span and still be tested (larger ones are always drawn).
 const MAX_BOX_TILES: i32 = 256;

@@ -2,7 +2,8 @@
 //! arrays give the world coordinate of every voxel along that axis (e.g. a CT series' slice
 //! positions, which a header's one spacing cannot hold). An axis left out keeps the grid's even
 //! spacing.
-use super::{bad, read_bounded};
+use super::bad;
+use super::bounded::read_bounded;
 use crate::error::Result;
 use crate::volume::Grid;
 use std::path::Path;
