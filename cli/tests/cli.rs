@@ -462,6 +462,9 @@ fn bricked_volumes_take_a_budget_and_fall_back_where_they_must() {
     let out = voxsplat(&[&big[..], &["--gpu-budget-mib", "1"]].concat());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("GPU budget of 1 MiB") && err.contains("the minimum is"), "{err}");
+    // Issue 44: the store streams at that budget, and the message says so (it said it could not
+    // hold the store, then named a minimum below the store's size).
+    assert!(err.contains("cannot stream this volume's bricked store"), "{err}");
     let out = voxsplat(&[&base[..], &["--gpu-budget-mib", "0"]].concat());
     assert!(
         !out.status.success() && String::from_utf8_lossy(&out.stderr).contains("--gpu-budget-mib must be positive")

@@ -119,11 +119,20 @@ pub(super) fn record_bricks(
         } else {
             String::new()
         };
+        // A store streamed at this budget keeps its records on the host: the minimum is what stays
+        // resident, below the store's size (it said "cannot hold the store", then named less).
+        let store = if streamed {
+            format!(
+                "stream this volume's bricked store ({} MiB, its records kept on the host at this budget): its \
+                 headers and summaries",
+                scene.store.bytes() >> 20
+            )
+        } else {
+            format!("hold this volume's bricked store ({} MiB)", scene.store.bytes() >> 20)
+        };
         return Err(Error::TooLarge(format!(
-            "a GPU budget of {} MiB cannot hold this volume's bricked store ({} MiB){levels} and one brick of splats \
-             at {w}x{h}: the minimum is {} MiB",
+            "a GPU budget of {} MiB cannot {store}{levels} and one brick of splats at {w}x{h}: the minimum is {} MiB",
             budget >> 20,
-            scene.store.bytes() >> 20,
             least.div_ceil(1 << 20)
         )));
     }
