@@ -493,8 +493,7 @@ pub fn render_frame_timed(
 /// huge axis (1e30: its f32 length overflows) keeps its direction; `None` for an axis shorter than
 /// 1e-6.
 fn unit_axis(rotate: &[f32; 4]) -> Option<Vec3> {
-    let a = rotate[..3].iter().map(|&v| v as f64);
-    let len = a.clone().map(|v| v * v).sum::<f64>().sqrt();
-    (len >= 1e-6 && len.is_finite())
-        .then(|| Vec3::from_slice(&rotate[..3].iter().map(|&v| (v as f64 / len) as f32).collect::<Vec<_>>()))
+    let axis = Vec3::from_slice(&rotate[..3]).as_dvec3();
+    let len = axis.length();
+    (len >= 1e-6 && len.is_finite()).then(|| (axis / len).as_vec3())
 }

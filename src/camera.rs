@@ -60,6 +60,15 @@ impl Camera {
         Self::framing_box(lo, hi, grid.kernel_spacing(), dir, Vec3::Y, width, height)
     }
 
+    /// How far from the near and far planes a splat's centre must lie not to be culled, before
+    /// anti-aliasing widens it: CULL_RADII of the widest kernel's radius, for a grid of
+    /// `kernel_spacing`.
+    pub fn cull_margin(kernel_spacing: f32) -> f32 {
+        crate::constants::CULL_RADII
+            * crate::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max)
+            * kernel_spacing
+    }
+
     /// A perspective view along `-dir` with `up` that frames the box `lo..hi` (voxel centres) of a
     /// grid whose kernel spacing is `kernel_spacing`, at the given image size.
     pub fn framing_box(lo: Vec3, hi: Vec3, kernel_spacing: f32, dir: Vec3, up: Vec3, width: u32, height: u32) -> Self {
@@ -67,11 +76,9 @@ impl Camera {
         // A floor of one kernel spacing (a one-voxel grid), not one unit: spacings in metres are common.
         let radius = 0.5 * (hi - lo).length().max(kernel_spacing);
         let fov = 35.0f32;
-        // The nearest splats must clear the near plane by the cull margin (CULL_RADII of the widest
-        // kernel's radius), or a grid a few voxels wide would frame its eye inside it and draw nothing.
-        let reach = crate::constants::CULL_RADII
-            * crate::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max)
-            * kernel_spacing;
+        // The nearest splats must clear the near plane by the cull margin, or a grid a few voxels
+        // wide would frame its eye inside it and draw nothing.
+        let reach = Self::cull_margin(kernel_spacing);
         let dist = (radius / (0.5 * fov.to_radians()).sin() * 1.05).max((radius + reach) / 0.98);
         Self {
             eye: center + dir.normalize() * dist,
@@ -252,13 +259,9 @@ impl Camera {
             grid.dims[2] as f32 * grid.spacing[2],
         );
         let eye = c + Vec3::new(0.1 * ext.x, -0.75 * ext.y, 0.5 * ext.z + 0.25 * ext.y);
-        // A grid a few cells wide would put the eye within its splats' cull margin (CULL_RADII of
-        // the widest kernel) and draw nothing: the eye stays outside the bounding sphere widened
-        // by it.
-        let reach = crate::constants::CULL_RADII
-            * crate::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max)
-            * grid.kernel_spacing();
-        let least = 0.5 * ext.length() + 2.0 * reach;
+        // A grid a few cells wide would put the eye within its splats' cull margin and draw
+        // nothing: the eye stays outside the bounding sphere widened by it.
+        let least = 0.5 * ext.length() + 2.0 * Self::cull_margin(grid.kernel_spacing());
         let eye = if (eye - c).length() < least { c + (eye - c).normalize() * least } else { eye };
         let target = c + Vec3::new(0.0, 0.15 * ext.y, -0.2 * ext.z);
         let d = (target - eye).length();

@@ -286,7 +286,7 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
         cam.projection = Projection::Orthographic { height: hgt };
     }
     // Fit near/far to the scene's bounding sphere seen from this eye unless given, widened by the
-    // splats' cull margin: CULL_RADII of the widest kernel, grown by anti-aliasing where a voxel
+    // splats' cull margin (`Camera::cull_margin`), grown by anti-aliasing where a voxel
     // spacing projects below a pixel (far or small: every splat would fall in the margin and the
     // frame be empty).
     let d = (grid.center() - cam.eye).length();
@@ -299,8 +299,7 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
     };
     // The widest anti-aliasing scale either method gives at that size (footprint_scale).
     let aa_scale = (1.0 + (1.5 / ppv.max(1e-6)).powi(2)).sqrt().max(1.0 / ppv.max(1e-6)).max(1.0);
-    let widest = voxsplat::kernel::KERNELS.iter().map(|k| k.radius()).fold(0.0, f32::max);
-    let reach = voxsplat::constants::CULL_RADII * widest * grid.kernel_spacing() * aa_scale;
+    let reach = Camera::cull_margin(grid.kernel_spacing()) * aa_scale;
     let r = 0.5 * grid.diagonal() + (4.0 * grid.kernel_spacing()).max(reach);
     // Margins relative to the scene, not in units: spacings in metres (1e-4 and below) are common.
     let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d) } else { d - 1.5 * r };
@@ -315,7 +314,12 @@ pub type VolumeParts =
 
 /// The --tf preset or TOML file.
 pub fn transfer_function(a: &SceneArgs) -> Result<voxsplat::classify::TransferFunction> {
-    load_tf(a.tf.as_deref().unwrap_or("ramp"))
+    load_tf(tf_spec(a))
+}
+
+/// What --tf names, `ramp` when it is not given.
+fn tf_spec(a: &SceneArgs) -> &str {
+    a.tf.as_deref().unwrap_or("ramp")
 }
 
 /// A transfer-function preset by name, or a TOML file.
@@ -346,7 +350,7 @@ pub fn headlight(
     spacing: [f32; 3],
     orientation: Option<Orientation>,
 ) -> Option<voxsplat::classify::Shading> {
-    let by_default = voxsplat::classify::SHADED_PRESETS.contains(&a.tf.as_deref().unwrap_or("ramp"));
+    let by_default = voxsplat::classify::SHADED_PRESETS.contains(&tf_spec(a));
     (a.shade || by_default && !a.no_shade).then(|| {
         let g = voxsplat::Grid::centered(dims, spacing).ok();
         let content = Content { orientation, bounds: None };

@@ -281,10 +281,11 @@ pub(super) fn record_bricks(
             let count = batch.len() as u32;
             e.ensure(Res::BrickHidden, count as u64 * 4)?;
             e.upload(Res::BrickList, &words(&batch))?;
-            let map = BrickPush { first: 0, count: 0, splats: 0, occluded: opts.early_termination };
-            e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, bytemuck::bytes_of(&map)))?;
+            // One push for both: the map is built for the threshold the bricks are tested at.
             let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
-            e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
+            let bytes = bytemuck::bytes_of(&push);
+            e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, bytes))?;
+            e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytes))?;
             let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
             // The bricks left, their positions (and streamed records) laid out again.
             let before = batch_splats(&batch);
