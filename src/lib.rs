@@ -363,6 +363,7 @@ impl Renderer {
         let prep = self.prepared()?;
         let device = match &self.gpu {
             Some(g) => {
+                gpu::resources::Resources::check_splat_cap(prep)?;
                 raster::Device { cpu: g.context().is_cpu_device(), point_size_max: g.context().point_size_max() }
             }
             None => raster::Device { cpu: true, point_size_max: f32::INFINITY },

@@ -444,3 +444,21 @@ fn a_blur_takes_one_path_and_one_profile() {
         good.parse::<Blur>().unwrap();
     }
 }
+
+/// Issue 44: a classified set past the GPU path's splat cap is refused for splat frames only; the
+/// ray caster, which draws no splats, casts it on the device (it refused the set outright).
+#[test]
+fn a_set_past_the_splat_cap_is_still_ray_cast() {
+    let n = 150; // 3,375,000 voxels, past MAX_GPU_SPLATS
+    assert!(n * n * n > voxsplat::constants::MAX_GPU_SPLATS);
+    let grid = Grid::centered([n; 3], [1.0; 3]).unwrap();
+    let set = voxsplat::SplatSet::from_fn(grid.clone(), |_, _, _| Some([0.8, 0.6, 0.4, 0.02])).unwrap();
+    let cam = Camera::framing(&grid, 24, 24);
+    let mut g = gpu();
+    g.set_scene(set).unwrap();
+    let e = g.render(&cam, &RenderOptions::default()).unwrap_err();
+    assert!(matches!(e, Error::TooLarge(_)) && e.to_string().contains("cast rays"), "{e}");
+    let image = g.raycast(&cam, &RaycastOptions { step: 1.0, ..Default::default() }).unwrap().image;
+    assert!(covered(&image) > 24 * 24 / 4, "the ray cast drew {} pixels", covered(&image));
+    assert_clean(&g);
+}

@@ -125,13 +125,15 @@ impl Resources {
         self.tags.clear();
         self.scene = None;
         let set = &prep.set;
-        if set.len() > MAX_GPU_SPLATS as usize {
-            return Err(Error::TooLarge(format!(
-                "{} splats: the GPU path takes at most {MAX_GPU_SPLATS} (two {SPLAT_PAGE}-record pages of 80-byte \
-                 per-splat parameters; one storage binding is limited to maxStorageBufferRange). Classify fewer \
-                 voxels as non-empty or use the CPU backend (--cpu)",
-                set.len()
-            )));
+        // A set past the splat cap is only ray cast on the device (splat frames refuse it,
+        // `check_splat_cap`): its splat arrays stay on the host, one-element stand-ins bound.
+        let splats = set.len() <= MAX_GPU_SPLATS as usize;
+        fn or_one(splats: bool, words: &[u32]) -> &[u32] {
+            if splats {
+                words
+            } else {
+                &[0; 8]
+            }
         }
         if let Some(b) = prep.bricks.as_ref().filter(|b| !b.streams(budget)) {
             let most = RECORD_PAGE as u64 * RECORD_PAGES as u64;
@@ -145,19 +147,19 @@ impl Resources {
         }
         let ctx = &self.ctx;
         self.scene = Some(SceneBuffers {
-            splats: storage(ctx, "splats", bytemuck::cast_slice(set.splats()))?,
+            splats: storage(ctx, "splats", bytemuck::cast_slice(or_one(splats, bytemuck::cast_slice(set.splats()))))?,
             coords: storage(
                 ctx,
                 "coords",
                 bytemuck::cast_slice(&set.coordinates().map_or(vec![0.0f32], |c| c.concat())),
             )?,
-            row_start: storage(ctx, "row_start", bytemuck::cast_slice(set.row_start()))?,
+            row_start: storage(ctx, "row_start", bytemuck::cast_slice(or_one(splats, set.row_start())))?,
             draw: [
-                storage(ctx, "slices x", bytemuck::cast_slice(&prep.slices[0].1))?,
-                storage(ctx, "slices y", bytemuck::cast_slice(&prep.slices[1].1))?,
-                storage(ctx, "slices z", bytemuck::cast_slice(&prep.slices[2].1))?,
+                storage(ctx, "slices x", bytemuck::cast_slice(or_one(splats, &prep.slices[0].1)))?,
+                storage(ctx, "slices y", bytemuck::cast_slice(or_one(splats, &prep.slices[1].1)))?,
+                storage(ctx, "slices z", bytemuck::cast_slice(or_one(splats, &prep.slices[2].1)))?,
             ],
-            ranks: storage(ctx, "sheet ranks", bytemuck::cast_slice(&prep.ranks))?,
+            ranks: storage(ctx, "sheet ranks", bytemuck::cast_slice(or_one(splats, &prep.ranks)))?,
             field: None,
             bricks: None,
             store: match &prep.bricks {
@@ -179,6 +181,19 @@ impl Resources {
                 None => None,
             },
         });
+        Ok(())
+    }
+
+    /// Refuse a splat frame of a set past the GPU path's splat cap (it may still be ray cast).
+    pub fn check_splat_cap(prep: &Prepared) -> Result<()> {
+        let n = prep.set.len();
+        if prep.bricks.is_none() && n > MAX_GPU_SPLATS as usize {
+            return Err(Error::TooLarge(format!(
+                "{n} splats: the GPU path takes at most {MAX_GPU_SPLATS} (two {SPLAT_PAGE}-record pages of 80-byte \
+                 per-splat parameters; one storage binding is limited to maxStorageBufferRange). Classify fewer \
+                 voxels as non-empty, draw the volume as a bricked store, use the CPU backend (--cpu) or cast rays"
+            )));
+        }
         Ok(())
     }
 
