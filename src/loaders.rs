@@ -16,7 +16,7 @@ mod slices;
 use bounded::read_bounded;
 pub use bounded::{read_text, MAX_TEXT_BYTES};
 use nrrd::{nrrd_header, NrrdHeader};
-pub use positions::{load_positions, MAX_POSITIONS_BYTES};
+pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
 pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).

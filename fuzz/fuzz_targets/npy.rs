@@ -1,4 +1,3 @@
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    let _ = voxsplat::loaders::npy_from_bytes(data, "fuzz");
-});
+include!("../bodies.rs");
+libfuzzer_sys::fuzz_target!(|data: &[u8]| npy(data));

@@ -1,4 +1,3 @@
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    let _ = voxsplat::loaders::nrrd_from_bytes(data, None, "fuzz");
-});
+include!("../bodies.rs");
+libfuzzer_sys::fuzz_target!(|data: &[u8]| nrrd(data));

@@ -25,6 +25,12 @@ pub fn load_positions(path: &Path, grid: &Grid) -> Result<[Vec<f32>; 3]> {
     let what = path.display().to_string();
     let bytes = read_bounded(path, MAX_POSITIONS_BYTES, &what)?;
     let text = std::str::from_utf8(&bytes).map_err(|_| bad(&what, "positions: not UTF-8 text"))?;
+    positions_from_text(text, grid, &what)
+}
+
+/// `load_positions` of a positions file's text (`what` names it in errors).
+pub fn positions_from_text(text: &str, grid: &Grid, what: &str) -> Result<[Vec<f32>; 3]> {
+    let what = what.to_string();
     let file: PositionsFile = toml::from_str(text).map_err(|e| bad(&what, format!("positions: {}", e.message())))?;
     let mut out: [Vec<f32>; 3] = Default::default();
     for (a, given) in [file.x, file.y, file.z].into_iter().enumerate() {

@@ -1,0 +1,101 @@
+// The fuzz targets' bodies, one function per target (fuzz_targets/NAME.rs calls NAME), included
+// by the targets and by tests/fuzz_corpus.rs, which replays the committed corpus in CI.
+
+/// NRRD files read whole (`nrrd_from_bytes`; attached data only).
+pub fn nrrd(data: &[u8]) {
+    let _ = voxsplat::loaders::nrrd_from_bytes(data, None, "fuzz");
+}
+
+/// NIfTI-1 files read whole, plain or gzip (`nifti_from_bytes`).
+pub fn nifti(data: &[u8]) {
+    let _ = voxsplat::loaders::nifti_from_bytes(data, "fuzz");
+}
+
+/// `.npy` arrays (`npy_from_bytes`).
+pub fn npy(data: &[u8]) {
+    let _ = voxsplat::loaders::npy_from_bytes(data, "fuzz");
+}
+
+/// TIFF height grids (`tiff_heights`).
+pub fn tiff(data: &[u8]) {
+    let _ = voxsplat::loaders::tiff_heights(data, "fuzz");
+}
+
+/// Raw samples: the first byte picks the sample type and byte order; the rest is the payload of a
+/// 4 x 3 x 2 grid.
+pub fn raw(data: &[u8]) {
+    use voxsplat::loaders::{raw_from_bytes, DType};
+    if let Some((&t, rest)) = data.split_first() {
+        let dtype = [DType::U8, DType::U16, DType::I16, DType::F32][t as usize % 4];
+        let _ = raw_from_bytes(rest, [4, 3, 2], dtype, t & 4 != 0, [1.0; 3], "fuzz");
+    }
+}
+
+/// The streamed loader a volume file renders from (`BrickStore::load`: NRRD, NIfTI, gzip inflated
+/// as it is read) and the dense loader, through a file: the first byte picks the file's kind, the
+/// rest is the file. The host budget bounds what a header may make them allocate.
+pub fn slices(data: &[u8]) {
+    let Some((&kind, rest)) = data.split_first() else { return };
+    voxsplat::set_host_budget(Some(256 << 20));
+    let ext = ["nrrd", "nii", "nii.gz"][kind as usize % 3];
+    let path = std::env::temp_dir().join(format!("voxsplat-fuzz-slices-{}.{ext}", std::process::id()));
+    if std::fs::write(&path, rest).is_ok() {
+        let hints = voxsplat::loaders::VolumeHints::default();
+        let _ = voxsplat::bricks::BrickStore::load(&path, &hints);
+        let _ = voxsplat::loaders::load_volume(&path, &hints);
+    }
+}
+
+/// Terrain height files through `load_heights`: the first byte picks PNG, TIFF or npy, the rest is
+/// the file.
+pub fn heights(data: &[u8]) {
+    let Some((&kind, rest)) = data.split_first() else { return };
+    voxsplat::set_host_budget(Some(256 << 20));
+    let ext = ["png", "tif", "npy"][kind as usize % 3];
+    let path = std::env::temp_dir().join(format!("voxsplat-fuzz-heights-{}.{ext}", std::process::id()));
+    if std::fs::write(&path, rest).is_ok() {
+        let _ = voxsplat::loaders::load_heights(&path);
+    }
+}
+
+/// Transfer-function files (`render --tf`).
+pub fn tf(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        if let Ok(tf) = voxsplat::classify::TransferFunction::from_toml(text) {
+            // What parses must evaluate to finite colours.
+            for d in [-1.0, 0.0, 0.25, 0.5, 1.0, 2.0] {
+                assert!(tf.eval(d).iter().all(|c| c.is_finite()), "{text:?} at {d}");
+            }
+        }
+    }
+}
+
+/// Animation files (`animate --file`).
+pub fn animation(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        if let Ok(a) = voxsplat::animate::Animation::from_toml(text) {
+            // What parses gives a valid camera at every frame.
+            for t in [0.0, 0.5, a.frames as f32 * 0.5, a.frames as f32] {
+                let _ = a.camera_at(t).validate();
+            }
+        }
+    }
+}
+
+/// Rectilinear positions files (`--positions`) for a 4 x 3 x 2 grid.
+pub fn positions(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        let grid = voxsplat::Grid::centered([4, 3, 2], [1.0; 3]).unwrap();
+        if let Ok(coords) = voxsplat::loaders::positions_from_text(text, &grid, "fuzz") {
+            let set = voxsplat::SplatSet::from_fn(grid, |_, _, _| Some([1.0; 4])).unwrap();
+            let _ = set.with_coordinates(coords);
+        }
+    }
+}
+
+/// Raw files' TOML sidecars (dims, type, byte order, spacing).
+pub fn sidecar(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        let _ = voxsplat::loaders::sidecar_hints(text, "fuzz");
+    }
+}

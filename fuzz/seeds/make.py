@@ -1,0 +1,87 @@
+"""Writes the fuzz targets' seed files into fuzz/seeds/<target>/ (committed; run it to remake them).
+
+Small valid files of each format, made by independent writers where there is one (nibabel for
+NIfTI, tifffile for TIFF, numpy for npy, PIL for PNG); the slices and heights targets take a first
+byte that picks the file's kind (see their sources).
+"""
+import gzip, io, os, sys
+import numpy as np
+
+root = os.path.dirname(os.path.abspath(__file__))
+
+
+def put(target, name, data, prefix="seed-"):
+    """A seed the loader reads (`seed-`), or one it must refuse with an error (`refused-`)."""
+    d = os.path.join(root, target)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, prefix + name), "wb") as f:
+        f.write(data)
+
+
+vol = (np.arange(4 * 3 * 2, dtype=np.uint8) * 9).reshape(2, 3, 4)  # z, y, x
+nrrd_raw = (b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 3 2\nspacings: 1 1 2\nencoding: raw\n\n"
+            + vol.tobytes())
+nrrd_gz = (b"NRRD0005\n# a comment\ntype: short\ndimension: 3\nsizes: 4 3 2\nendian: little\n"
+           b"space: right-anterior-superior\nspace directions: (1,0,0) (0,1,0) (0,0.5,1.5)\n"
+           b"space origin: (0,0,0)\nencoding: gzip\n\n" + gzip.compress(vol.astype("<i2").tobytes()))
+nrrd_skip = (b"NRRD0004\ntype: float\ndimension: 3\nsizes: 4 3 2\nendian: big\nbyte skip: 4\nline skip: 0\n"
+             b"encoding: raw\n\n" + b"\0\0\0\0" + vol.astype(">f4").tobytes())
+put("nrrd", "raw.nrrd", nrrd_raw)
+put("nrrd", "gzip.nrrd", nrrd_gz)
+put("nrrd", "skip.nrrd", nrrd_skip, "refused-")  # byte skip is refused by name
+
+try:
+    import nibabel as nib
+    img = nib.Nifti1Image(vol.transpose(2, 1, 0).astype(np.int16), np.diag([1.0, 1.0, 2.0, 1.0]))
+    img.header.set_qform(np.diag([1.0, 1.0, 2.0, 1.0]), code=1)
+    nii = img.to_bytes()
+    put("nifti", "plain.nii", nii)
+    put("nifti", "plain.nii.gz", gzip.compress(nii))
+    img2 = nib.Nifti1Image(vol.transpose(2, 1, 0).astype(np.float32), np.eye(4))
+    img2.header.set_slope_inter(2.0, -1.0)
+    put("nifti", "scaled.nii", img2.to_bytes())
+except ImportError:
+    sys.exit("nibabel is needed for the NIfTI seeds (pip install nibabel)")
+
+for dt in ["<u1", "<u2", "<i2", "<f4", ">f8"]:
+    buf = io.BytesIO()
+    np.save(buf, vol.astype(dt))
+    put("npy", f"{dt[1:]}.npy", buf.getvalue())
+
+import tifffile
+for dt in ["uint8", "uint16", "int16", "float32"]:
+    buf = io.BytesIO()
+    tifffile.imwrite(buf, (np.arange(12).reshape(3, 4) * 7).astype(dt))
+    put("tiff", f"{dt}.tif", buf.getvalue())
+
+put("raw", "u8", bytes([0]) + vol.tobytes())
+put("raw", "f32", bytes([3]) + vol.astype("<f4").tobytes())
+
+# slices: the first byte picks nrrd, nii, nii.gz (see fuzz_targets/slices.rs).
+put("slices", "raw.nrrd", b"\0" + nrrd_raw)
+put("slices", "gzip.nrrd", b"\0" + nrrd_gz)
+put("slices", "skip.nrrd", b"\0" + nrrd_skip, "refused-")
+put("slices", "plain.nii", b"\1" + nii)
+put("slices", "plain.nii.gz", b"\2" + gzip.compress(nii))
+
+# heights: the first byte picks png, tif, npy (see fuzz_targets/heights.rs).
+from PIL import Image
+buf = io.BytesIO()
+Image.fromarray((np.arange(12).reshape(3, 4) * 5000).astype(np.uint16)).save(buf, format="PNG")
+put("heights", "u16.png", b"\0" + buf.getvalue())
+buf = io.BytesIO()
+tifffile.imwrite(buf, np.arange(12, dtype=np.float32).reshape(3, 4))
+put("heights", "f32.tif", b"\1" + buf.getvalue())
+buf = io.BytesIO()
+np.save(buf, np.arange(12, dtype=np.float32).reshape(3, 4))
+put("heights", "f32.npy", b"\2" + buf.getvalue())
+
+put("tf", "points.toml", b'points = [[0.0, [0, 0, 0, 0]], [0.3, [1, 0.5, 0.2, 0.4]], [1.0, [1, 1, 1, 1]]]\n'
+    b'range = [-10.0, 300.0]\n')
+put("tf", "preset.toml", b'points = [[0.1, [0.2, 0.4, 1, 0]], [0.9, [1, 1, 0.8, 0.9]]]\n')
+put("animation", "keys.toml", b'scene = "cube60"\nframes = 24\nshutter = 1.0\nsize = [64, 64]\n[camera]\n'
+    b'eye = [0.0, 45.0, 120.0]\ntarget = [0.0, 0.0, 0.0]\northo = 110.0\n[[keyframe]]\nframe = 0\n'
+    b'rotate = [0.0, 1.0, 0.0, 0.0]\n[[keyframe]]\nframe = 24\nrotate = [0.0, 1.0, 0.0, 144.0]\n'
+    b'eye = [1.0, 40.0, 100.0]\ntarget = [0.0, 1.0, 0.0]\n')
+put("positions", "xz.toml", b"x = [0.0, 1.0, 2.5, 4.0]\nz = [0, 3]\n")
+put("sidecar", "raw.toml", b'dims = [4, 3, 2]\ndtype = "uint16"\nendian = "big"\nspacing = [1.0, 1.0, 2.0]\n')

@@ -1,0 +1,93 @@
+//! The fuzz corpus replayed through the fuzz targets' own bodies: the seeds (fuzz/seeds/TARGET) and
+//! every input a fuzzer kept or crashed on once (fuzz/corpus/TARGET; scripts/fuzz.sh grows and
+//! minimises it; both committed) run here on each CI build, without the sanitizer, so a loader that
+//! panics on one again fails the suite.
+use std::path::Path;
+include!("../fuzz/bodies.rs");
+
+const TARGETS: &[(&str, fn(&[u8]))] = &[
+    ("nrrd", nrrd),
+    ("nifti", nifti),
+    ("npy", npy),
+    ("tiff", tiff),
+    ("raw", raw),
+    ("slices", slices),
+    ("heights", heights),
+    ("tf", tf),
+    ("animation", animation),
+    ("positions", positions),
+    ("sidecar", sidecar),
+];
+
+/// The seeds of `target` (which must exist), then its corpus.
+fn inputs(target: &str) -> Vec<std::path::PathBuf> {
+    let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz");
+    let list = |dir: &Path| -> Vec<_> {
+        let mut files: Vec<_> = std::fs::read_dir(dir).map_or(vec![], |d| d.map(|e| e.unwrap().path()).collect());
+        files.sort();
+        files
+    };
+    let seeds = list(&fuzz.join("seeds").join(target));
+    assert!(!seeds.is_empty(), "fuzz/seeds/{target} is empty");
+    seeds.into_iter().chain(list(&fuzz.join("corpus").join(target))).collect()
+}
+
+#[test]
+fn every_fuzz_target_replays_its_corpus_without_a_panic() {
+    for &(target, body) in TARGETS {
+        for f in &inputs(target) {
+            let data = std::fs::read(f).unwrap();
+            if std::panic::catch_unwind(|| body(&data)).is_err() {
+                panic!("fuzz target {target} panicked on {}", f.display());
+            }
+        }
+    }
+}
+
+/// The seeds (fuzz/seeds/make.py, written by independent writers) are files the loaders read (a
+/// corpus of files every loader refuses would fuzz only the first check), and the `refused-` ones
+/// are refused with an error.
+#[test]
+fn the_volume_seeds_load() {
+    use voxsplat::loaders::{nifti_from_bytes, npy_from_bytes, nrrd_from_bytes, tiff_heights};
+    for target in ["nrrd", "nifti", "npy", "tiff"] {
+        for f in inputs(target).iter().filter(|f| {
+            let name = f.file_name().unwrap().to_string_lossy().into_owned();
+            name.starts_with("seed-") || name.starts_with("refused-")
+        }) {
+            let data = std::fs::read(f).unwrap();
+            let what = f.display().to_string();
+            let ok = match target {
+                "nrrd" => nrrd_from_bytes(&data, None, &what).map(|v| v.values.len()),
+                "nifti" => nifti_from_bytes(&data, &what).map(|v| v.values.len()),
+                "npy" => npy_from_bytes(&data, &what).map(|v| v.1.len()),
+                _ => tiff_heights(&data, &what).map(|h| h.heights.len()),
+            };
+            if what.contains("refused-") {
+                assert!(ok.is_err(), "{what} loaded");
+                continue;
+            }
+            assert_eq!(ok.unwrap_or_else(|e| panic!("{what}: {e}")), if target == "tiff" { 12 } else { 24 }, "{what}");
+        }
+    }
+}
+
+/// The streamed loader's seeds (first byte: the file's kind, as `slices` reads it) load as stores.
+#[test]
+fn the_streamed_seeds_load_as_stores() {
+    for f in inputs("slices") {
+        let data = std::fs::read(&f).unwrap();
+        let ext = ["nrrd", "nii", "nii.gz"][data[0] as usize % 3];
+        let path = std::env::temp_dir().join(format!("voxsplat-corpus-{}.{ext}", std::process::id()));
+        std::fs::write(&path, &data[1..]).unwrap();
+        let store = voxsplat::bricks::BrickStore::load(&path, &Default::default());
+        std::fs::remove_file(&path).unwrap();
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        match (name.starts_with("seed-"), store) {
+            (true, Ok(s)) => assert_eq!(s.dims, [4, 3, 2], "{name}"),
+            (true, Err(e)) => panic!("{name}: {e}"),
+            (false, Ok(_)) if name.starts_with("refused-") => panic!("{name} loaded"),
+            _ => {}
+        }
+    }
+}
