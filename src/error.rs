@@ -104,32 +104,56 @@ impl Error {
 /// The process's host-memory budget in bytes (`set_host_budget`); `u64::MAX`: none set.
 static HOST_BUDGET: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(u64::MAX);
 
+/// The share of physical memory the host budget takes when none is set: 3/4, which leaves the
+/// rest to the system and to what the budget does not size (the device's driver, buffers).
+pub const DEFAULT_HOST_SHARE: (u64, u64) = (3, 4);
+
 /// Cap the host memory that allocations sized by a file's header or a caller's request may take
-/// (`check_host_memory`), below what the host has available; `None` lifts the cap.
+/// (`check_host_memory`), below what the host has available; `None` restores the default
+/// (`DEFAULT_HOST_SHARE` of physical memory).
 pub fn set_host_budget(bytes: Option<u64>) {
     HOST_BUDGET.store(bytes.unwrap_or(u64::MAX), std::sync::atomic::Ordering::Relaxed);
 }
 
-/// The host-memory budget `set_host_budget` set, if any.
+/// The host-memory budget in force: the one `set_host_budget` set, else `DEFAULT_HOST_SHARE` of
+/// the host's physical memory (Linux's MemTotal; `None` where the host does not say).
 pub fn host_budget() -> Option<u64> {
-    Some(HOST_BUDGET.load(std::sync::atomic::Ordering::Relaxed)).filter(|&b| b != u64::MAX)
+    let set = HOST_BUDGET.load(std::sync::atomic::Ordering::Relaxed);
+    if set != u64::MAX {
+        return Some(set);
+    }
+    physical_memory().map(|m| m / DEFAULT_HOST_SHARE.1 * DEFAULT_HOST_SHARE.0)
 }
 
-/// Refuse `bytes` of host memory for `what` past the host budget (`set_host_budget`) or when the
+/// Physical memory in bytes, read once (Linux's MemTotal).
+fn physical_memory() -> Option<u64> {
+    static TOTAL: std::sync::OnceLock<Option<u64>> = std::sync::OnceLock::new();
+    *TOTAL.get_or_init(|| meminfo("MemTotal:"))
+}
+
+/// A /proc/meminfo field in bytes.
+fn meminfo(field: &str) -> Option<u64> {
+    let m = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = m.lines().find(|l| l.starts_with(field))?;
+    line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
+}
+
+/// Refuse `bytes` of host memory for `what` past the host budget (`host_budget`) or when the
 /// host has less available (Linux's MemAvailable; elsewhere only the budget is checked).
 pub fn check_host_memory(bytes: u64, what: &str) -> Result<()> {
     if let Some(b) = host_budget().filter(|&b| bytes > b) {
+        let whose = if HOST_BUDGET.load(std::sync::atomic::Ordering::Relaxed) == u64::MAX {
+            " (the default: three quarters of physical memory)"
+        } else {
+            ""
+        };
         return Err(Error::TooLarge(format!(
-            "{what} may need {} MiB of host memory, past the host budget of {} MiB",
+            "{what} may need {} MiB of host memory, past the host budget of {} MiB{whose}",
             bytes >> 20,
             b >> 20
         )));
     }
-    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
-        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?.to_string();
-        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
-    });
-    match available {
+    match meminfo("MemAvailable:") {
         Some(a) if bytes > a => Err(Error::TooLarge(format!(
             "{what} may need {} MiB of host memory; {} MiB are available",
             bytes >> 20,

@@ -462,3 +462,22 @@ fn a_set_past_the_splat_cap_is_still_ray_cast() {
     assert!(covered(&image) > 24 * 24 / 4, "the ray cast drew {} pixels", covered(&image));
     assert_clean(&g);
 }
+
+/// Issue 44: with no budget set, the host budget is three quarters of physical memory (it was
+/// only what the host had available, so one request could take the machine's last free byte).
+#[test]
+fn the_host_budget_defaults_to_a_share_of_physical_memory() {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap();
+    let kb = |field: &str| -> u64 {
+        let line = meminfo.lines().find(|l| l.starts_with(field)).unwrap();
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    let total = kb("MemTotal:") * 1024;
+    assert_eq!(voxsplat::host_budget(), Some(total / 4 * 3));
+    // A store whose records alone take 90 % of physical memory: refused by the budget before a
+    // slice is read.
+    let z = (total / 10 * 9 / 4).div_ceil(4096 * 4096) as u32;
+    let read = |_: u32, _: u32, _: &mut Vec<f32>| -> voxsplat::Result<()> { panic!("a slice was read") };
+    let e = BrickStore::from_region([4096, 4096, z], [1.0; 3], (0.0, 1.0), [[0; 3], [4096, 4096, z]], read).unwrap_err();
+    assert!(e.to_string().contains("past the host budget") && e.to_string().contains("three quarters"), "{e}");
+}

@@ -42,8 +42,8 @@ struct Cli {
     #[command(subcommand)]
     command: Command,
     /// Host memory, in MiB, that what a file's header or a flag sizes may take (volumes, frames,
-    /// terrains, the store): past it the command stops with an error before allocating [default:
-    /// what the host has available].
+    /// terrains, the store): past it the command stops with an error before allocating, as it does
+    /// past what the host has available [default: three quarters of physical memory].
     #[arg(long, global = true)]
     host_budget_mib: Option<u64>,
 }
