@@ -188,3 +188,33 @@ fn the_k_line_falls_across_the_terrain_fly_over() {
     let empty = voxsplat::SplatSet::from_fn(*set.grid(), |_, _, _| None).unwrap();
     assert!(voxsplat::aa::k_regions(&empty, &cam).iter().all(|&r| r == 0));
 }
+
+/// Issue 44: in a frame of a few pixels, or near the near plane, anti-aliasing's widening no longer
+/// culls the splat it widens: the cull margin was CULL_RADII widened radii, and a radius widened to
+/// a pixel grows with depth, so a small frame drew nothing at any distance (EWA at 8 x 8, 62°: a
+/// voxel 4 units away, alpha 0). The widening now stops short of the planes; the energy holds.
+#[test]
+fn anti_aliasing_never_culls_the_splat_it_widens() {
+    let set = one_voxel(0.3);
+    let (mut c, mut g) = (common::cpu(), common::gpu());
+    c.set_scene(set.clone()).unwrap();
+    g.set_scene(set.clone()).unwrap();
+    // Beyond the unwidened cull margin (3 units here), which still holds.
+    let margin = Camera::cull_margin(set.grid().kernel_spacing());
+    for (size, fov, beyond) in [(8, 62.0, 0.5), (4, 35.0, 0.6), (2, 30.0, 3.0), (16, 40.0, 0.2), (3, 20.0, 8.0)] {
+        let mut cam = looking_at(set.grid().center(), margin + beyond, size);
+        (cam.projection, cam.near) = (Projection::Perspective { fov_y_deg: fov }, 0.01);
+        let none = c.render(&cam, &RenderOptions::default()).unwrap().image;
+        let sum = |img: &voxsplat::ImageF32| img.pixels.iter().map(|p| p[3]).sum::<f32>();
+        assert!(sum(&none) > 0.05, "{size}: nothing drawn without anti-aliasing ({})", sum(&none));
+        for aa in [Antialias::Swan, Antialias::Ewa] {
+            let mut o = RenderOptions::default();
+            o.antialias = aa;
+            let img = c.render(&cam, &o).unwrap().image;
+            let ratio = sum(&img) / sum(&none);
+            assert!((0.8..1.25).contains(&ratio), "{aa:?} at {size}x{size}, {fov}°: coverage {ratio} of --aa none's");
+            common::assert_mirrors(&g.render(&cam, &o).unwrap().image, &img, &format!("{aa:?} {size}"));
+        }
+    }
+    common::assert_clean(&g);
+}

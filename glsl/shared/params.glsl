@@ -33,9 +33,15 @@ float footprint_scale(float depth, float cell) {
 SplatParams params_world(vec3 center, float cell, float grow, vec3 rgb, float tau) {
     vec3 forward = frame.forward.xyz;
     float depth = dot(center - frame.eye.xyz, forward);
-    float scale = footprint_scale(depth, cell);
-    float radius = grow * cell * frame.spacing.w * scale;
-    bool visible = depth >= frame.forward.w + CULL_RADII * radius && depth <= frame.right.w - CULL_RADII * radius;
+    // The splat's own kernel keeps CULL_RADII radii clear of the near and far planes, or it is
+    // culled. Anti-aliasing's widening (a low-pass on the screen) stops where its quad would
+    // reach a plane: near a plane, or in a frame of a few pixels, a splat is low-passed less
+    // rather than culled (a widened cull margin grew with depth and drew such frames empty).
+    float base = grow * cell * frame.spacing.w;
+    float room = min(depth - frame.forward.w, frame.right.w - depth) / (CULL_RADII * base);
+    bool visible = room >= 1.0;
+    float scale = clamp(footprint_scale(depth, cell), 1.0, max(room, 1.0));
+    float radius = base * scale;
     // Clipping planes and crop box: splats whose centres lie outside any are not drawn.
     for (uint i = 0u; i < frame.rect.y; ++i) {
         visible = visible && dot(frame.clip[i].xyz, center) + frame.clip[i].w >= 0.0;
