@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Mutation check (issues 25, 44): plants fourteen known bugs one at a time, runs the tests that should
+# Mutation check (issues 25, 44): plants seventeen known bugs one at a time, runs the tests that should
 # catch each, and prints a markdown table; exits 1 when a bug survives (no test failed). Each
 # mutant costs a release rebuild of the library and its tests (about 1-3 minutes here); the last
 # result lives in docs/RELIABILITY.md. The tree is restored after every mutant, also on Ctrl-C.
-#   scripts/mutants.sh            all fourteen
+#   scripts/mutants.sh            all seventeen
 #   scripts/mutants.sh octant     the ones whose name contains "octant"
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,6 +23,9 @@ MUTANTS=(
   "a value range's span in f32 (overflows)|src/classify.rs|let span = if hi > lo { hi as f64 - lo as f64 } else { 1.0 };|let span = if hi > lo { (hi - lo) as f64 } else { 1.0 };|--test hostile ranges_wider"
   "NRRD byte skip read as data|src/loaders/nrrd.rs|if value != \"0\" =>|if false =>|--test hostile nrrd_skips"
   "a TF point's third element dropped|src/classify.rs|if s.next_element::<IgnoredAny>()?.is_some() {|if false && s.next_element::<IgnoredAny>()?.is_some() {|--test hostile transfer_function_points"
+  "a partial brick stored as uniform|src/bricks/build.rs|if count as usize == BRICK_VOXELS && qmin == qmax {|if qmin == qmax {|--test bricks uniform"
+  "the cull margin widened by anti-aliasing|src/cpu/splat_params.rs|let mut visible = room >= 1.0;|let mut visible = room >= cell_footprint_scale(frame, depth, cell);|--test aa anti_aliasing_never"
+  "a slab's depth profile widened by anti-aliasing|src/cpu/footprint.rs|/ (1.0 + p.screen[1].abs()) / p.screen[3];|/ (1.0 + p.screen[1].abs());|--test aa slab_mode"
 )
 filter=${1:-}
 backup=$(mktemp -d)

@@ -17,6 +17,9 @@ use crate::gpu_types::BrickFrame;
 use crate::volume::{Grid, ScalarVolume, SplatSet};
 use bytemuck::{Pod, Zeroable};
 
+mod build;
+pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
+
 /// Voxels along each side of a brick.
 pub const BRICK: u32 = crate::constants::BRICK_SIDE;
 const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
@@ -69,142 +72,6 @@ pub struct BrickStore {
 }
 
 impl BrickStore {
-    /// Cut `vol` into bricks, keeping every voxel whose value lies above the minimum.
-    pub fn build(vol: &ScalarVolume) -> Result<Self> {
-        Self::build_over(vol, f32::INFINITY)
-    }
-
-    /// `build`, with the empty value at most `background` (`from_slices_over`).
-    fn build_over(vol: &ScalarVolume, background: f32) -> Result<Self> {
-        let plane = vol.dims[0] as usize * vol.dims[1] as usize;
-        Self::from_slices_over(vol.dims, vol.spacing, background, |z0, count, out| {
-            out.clear();
-            out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + count) as usize * plane]);
-            Ok(())
-        })
-    }
-
-    /// Build the store from z-slices without holding the volume: `read(z0, count, out)` puts
-    /// slices `z0..z0 + count` (x fastest) in `out`. Two passes: the value range, then the bricks,
-    /// `BRICK` slices at a time. Refused before any large allocation when the store could exceed
-    /// the host's available memory.
-    pub fn from_slices(
-        dims: [u32; 3],
-        spacing: [f32; 3],
-        read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
-    ) -> Result<Self> {
-        Self::from_slices_over(dims, spacing, f32::INFINITY, read)
-    }
-
-    /// `from_slices`, with the empty value at most `background` (a volume with no empty voxel
-    /// keeps its minimum).
-    fn from_slices_over(
-        dims: [u32; 3],
-        spacing: [f32; 3],
-        background: f32,
-        mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
-    ) -> Result<Self> {
-        check_dims(dims)?;
-        let mut slab = Vec::new();
-        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-        for z0 in (0..dims[2]).step_by(BRICK as usize) {
-            read(z0, BRICK.min(dims[2] - z0), &mut slab)?;
-            for &v in slab.iter().filter(|v| v.is_finite()) {
-                (lo, hi) = (lo.min(v), hi.max(v));
-            }
-        }
-        Self::from_region(dims, spacing, store_range(lo.min(background), hi), [[0; 3], dims], read)
-    }
-
-    /// The store of the voxels in `region` (`lo..hi`, voxel coordinates) of a `dims` grid whose
-    /// values `range` normalises (the whole volume's: `from_slices` finds it), every other voxel
-    /// empty: `read(z0, count, out)` puts the region's part of slices `z0..z0 + count` (x fastest
-    /// over the region's width) in `out`. One pass, `BRICK` slices at a time. Sort-last rendering
-    /// builds each rank's box (and the layer of voxels around it) this way.
-    pub fn from_region(
-        dims: [u32; 3],
-        spacing: [f32; 3],
-        range: (f32, f32),
-        region: [[u32; 3]; 2],
-        mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
-    ) -> Result<Self> {
-        check_dims(dims)?;
-        let [r0, r1] = region;
-        if (0..3).any(|a| r0[a] > r1[a] || r1[a] > dims[a]) {
-            return Err(Error::InvalidArgument(format!("the region {r0:?}..{r1:?} lies outside the {dims:?} grid")));
-        }
-        let nb = dims.map(|d| d.div_ceil(BRICK));
-        let bricks = nb[0] as u64 * nb[1] as u64 * nb[2] as u64;
-        let size = [0, 1, 2].map(|a| (r1[a] - r0[a]) as u64);
-        let voxels = size[0] * size[1] * size[2];
-        crate::error::check_host_memory(
-            voxels * 4 + bricks * 4 + voxels.div_ceil(BRICK_VOXELS as u64) * (16 + BRICK_VOXELS as u64 / 8),
-            &format!("a {dims:?} bricked store"),
-        )?;
-        let (lo, hi) = range;
-        // A constant volume has no background: its voxels are kept (`keeps`: the minimum would drop
-        // them all, and a one-voxel opaque volume drew nothing) at quantised 0, which the TF
-        // classifies as the dense path does (density 0 without a TF range, the value's own with one).
-        // In f64: the span of an f32 range may pass f32's largest value.
-        let span = if hi > lo { hi as f64 - lo as f64 } else { 1.0 };
-        let mut store = Self {
-            dims,
-            spacing,
-            shear: [0.0; 3],
-            range: (lo, hi),
-            headers: Vec::new(),
-            masks: Vec::new(),
-            records: Vec::new(),
-            index: vec![u32::MAX; bricks as usize],
-        };
-        if voxels == 0 {
-            return Ok(store);
-        }
-        let mut slab = Vec::new();
-        let (w, plane) = (size[0] as usize, (size[0] * size[1]) as usize);
-        let blo = r0.map(|c| c / BRICK);
-        let bhi = r1.map(|c| c.div_ceil(BRICK));
-        for bz in blo[2]..bhi[2] {
-            let z0 = (bz * BRICK).max(r0[2]);
-            read(z0, ((bz + 1) * BRICK).min(r1[2]) - z0, &mut slab)?;
-            for by in blo[1]..bhi[1] {
-                for bx in blo[0]..bhi[0] {
-                    let first = store.records.len() as u32;
-                    let mut mask = [0u64; BRICK_VOXELS / 64];
-                    let (mut qmin, mut qmax) = (u32::MAX, 0u32);
-                    for l in 0..BRICK_VOXELS as u32 {
-                        let c = local_cell(l);
-                        let v = [bx * BRICK + c[0], by * BRICK + c[1], bz * BRICK + c[2]];
-                        if (0..3).any(|a| v[a] < r0[a] || v[a] >= r1[a]) {
-                            continue;
-                        }
-                        let at = (v[2] - z0) as usize * plane + (v[1] - r0[1]) as usize * w + (v[0] - r0[0]) as usize;
-                        let v = slab[at];
-                        if !keeps(v, range) {
-                            continue;
-                        }
-                        let q = ((v as f64 - lo as f64) / span * Q as f64).round().clamp(0.0, Q as f64) as u32;
-                        mask[l as usize / 64] |= 1 << (l % 64);
-                        store.records.push(l | q << 16);
-                        (qmin, qmax) = (qmin.min(q), qmax.max(q));
-                    }
-                    let count = store.records.len() as u32 - first;
-                    if count > 0 {
-                        store.index[(bx + nb[0] * (by + nb[1] * bz)) as usize] = store.headers.len() as u32;
-                        store.headers.push(BrickHeader {
-                            brick: bx | by << 10 | bz << 20,
-                            first,
-                            count,
-                            range: qmin | qmax << 16,
-                        });
-                        store.masks.push(mask);
-                    }
-                }
-            }
-        }
-        Ok(store)
-    }
-
     /// Load a volume file as a store (`hints` as `loaders::load_volume` takes them): NRRD (raw
     /// or gzip), NIfTI and raw files stream slice by slice (gzip inflated as it is read), never
     /// held whole (volumes past the dense loader's `MAX_VOXELS` too); an `.npy` is loaded, cut
@@ -238,14 +105,14 @@ impl BrickStore {
         Ok(())
     }
 
-    /// Stored voxels.
+    /// Stored voxels (a uniform brick's too, which have no records).
     pub fn len(&self) -> usize {
-        self.records.len()
+        self.headers.iter().map(|h| h.count as usize).sum()
     }
 
     /// Whether no voxel is stored.
     pub fn is_empty(&self) -> bool {
-        self.records.is_empty()
+        self.headers.is_empty()
     }
 
     /// Bytes the store takes on a device: headers, masks and records.
@@ -277,7 +144,7 @@ impl BrickStore {
         // The record's rank among the brick's: stored voxels below it in local index order.
         let below = mask[..l / 64].iter().map(|w| w.count_ones()).sum::<u32>()
             + (mask[l / 64] & ((1u64 << (l % 64)) - 1)).count_ones();
-        let rec = self.records[(self.headers[h as usize].first + below) as usize];
+        let rec = record_at(&self.records, self.headers[h as usize].first + below);
         (rec >> 16) as f32 / Q
     }
 
@@ -370,33 +237,6 @@ fn tf_table(tf: &TransferFunction, (a, b): (f32, f32)) -> Vec<u32> {
     color.extend(bits);
     color.extend(prefix);
     color
-}
-
-/// The range a store normalises by, from the smallest and largest finite values read (none read:
-/// (0, 0)).
-pub fn store_range(lo: f32, hi: f32) -> (f32, f32) {
-    if lo.is_finite() {
-        (lo, hi.max(lo))
-    } else {
-        (0.0, 0.0)
-    }
-}
-
-/// Whether a store normalised by `range` keeps value `v`: finite and above the minimum, or any
-/// finite value of a constant volume.
-pub fn keeps(v: f32, (lo, hi): (f32, f32)) -> bool {
-    v.is_finite() && (v > lo || hi <= lo)
-}
-
-/// Refuse a grid a bricked store cannot hold.
-fn check_dims(dims: [u32; 3]) -> Result<()> {
-    if dims.iter().any(|&d| d == 0 || d > BRICK << 10) {
-        return Err(Error::InvalidArgument(format!(
-            "a bricked volume is 1 to {} voxels a side, not {dims:?}",
-            BRICK << 10
-        )));
-    }
-    Ok(())
 }
 
 /// Bricks along x, y, z of `store`'s grid.
@@ -597,8 +437,7 @@ impl BrickScene {
         let (mut lo, mut hi) = ([u32::MAX; 3], [0u32; 3]);
         for h in &self.store.headers {
             let base = h.coords().map(|c| c * BRICK);
-            let records = &self.store.records[h.first as usize..(h.first + h.count) as usize];
-            for &rec in records.iter().filter(|&&r| emits(&self.table, r >> 16)) {
+            for &rec in self.store.brick_records(h).iter().filter(|&&r| emits(&self.table, r >> 16)) {
                 let v = local_cell(rec & 511);
                 (0..3).for_each(|x| (lo[x], hi[x]) = (lo[x].min(base[x] + v[x]), hi[x].max(base[x] + v[x])));
             }
@@ -646,9 +485,9 @@ impl BrickScene {
     pub fn drawn_counts(&self) -> &[u32] {
         self.drawn.get_or_init(|| {
             let s = &self.store;
-            let drawn = |h: &BrickHeader| {
-                let records = &s.records[h.first as usize..(h.first + h.count) as usize];
-                records.iter().filter(|&&r| emits(&self.table, r >> 16)).count() as u32
+            let drawn = |h: &BrickHeader| match h.is_uniform() {
+                true => h.count * emits(&self.table, h.range & 0xffff) as u32,
+                false => s.brick_records(h).iter().filter(|&&r| emits(&self.table, r >> 16)).count() as u32,
             };
             s.headers.iter().map(drawn).collect()
         })

@@ -396,6 +396,10 @@ pub fn sidecar_hints(text: &str, what: &str) -> Result<VolumeHints> {
 
 /// `.npy` arrays of 2 or 3 dimensions (C order: the last axis is x), through `npyz`.
 pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> {
+    let end = npy_header_end(bytes, what)?;
+    if end > bytes.len() {
+        return Err(bad(what, format!("npy: a header of {end} bytes in {} bytes", bytes.len())));
+    }
     let npy = npyz::NpyFile::new(bytes).map_err(|e| bad(what, format!("npy: {e}")))?;
     let shape = npy.shape().to_vec();
     if shape.len() < 2 || shape.len() > 3 {
@@ -565,25 +569,32 @@ fn npy_header(file: &mut std::fs::File, what: &str) -> Result<(Vec<u8>, Vec<u64>
     let io = |e| Error::Io { path: what.to_string(), source: e };
     let mut head = Vec::with_capacity(12);
     let got = file.take(12).read_to_end(&mut head).map_err(io)?;
-    if got < 10 || !head.starts_with(b"\x93NUMPY") {
-        return Err(bad(what, "npy: not an .npy file (no \\x93NUMPY magic)"));
-    }
-    // Version 1 stores the header's length in 2 bytes, versions 2 and 3 in 4.
-    let (len, start) = match head[6] {
-        1 => (u16::from_le_bytes([head[8], head[9]]) as usize, 10),
-        2 | 3 if got == 12 => (u32::from_le_bytes([head[8], head[9], head[10], head[11]]) as usize, 12),
-        v => return Err(bad(what, format!("npy: unsupported format version {v}"))),
-    };
-    if len > 1 << 20 || start + len < got {
-        return Err(bad(what, format!("npy: a header of {len} bytes")));
-    }
-    file.take((start + len - got) as u64).read_to_end(&mut head).map_err(io)?;
+    let end = npy_header_end(&head, what)?;
+    file.take((end - got) as u64).read_to_end(&mut head).map_err(io)?;
     let npy = npyz::NpyFile::new(&head[..]).map_err(|e| bad(what, format!("npy: {e}")))?;
     let shape = npy.shape().to_vec();
     let n = voxel_count(&shape, what)?;
     let npyz::DType::Plain(ts) = npy.dtype() else { return Err(bad(what, "structured npy arrays are not supported")) };
     let need = n.checked_mul(ts.size_field()).ok_or_else(|| bad(what, "size overflows"))?;
     Ok((head, shape, need))
+}
+
+/// Where an `.npy` header that starts `head` (its first 12 bytes at least) ends: refused past 1 MiB
+/// (npyz allocates what the length field says before it reads a byte).
+fn npy_header_end(head: &[u8], what: &str) -> Result<usize> {
+    if head.len() < 10 || !head.starts_with(b"\x93NUMPY") {
+        return Err(bad(what, "npy: not an .npy file (no \\x93NUMPY magic)"));
+    }
+    // Version 1 stores the header's length in 2 bytes, versions 2 and 3 in 4.
+    let (len, start) = match head[6] {
+        1 => (u16::from_le_bytes([head[8], head[9]]) as usize, 10),
+        2 | 3 if head.len() >= 12 => (u32::from_le_bytes([head[8], head[9], head[10], head[11]]) as usize, 12),
+        v => return Err(bad(what, format!("npy: unsupported format version {v}"))),
+    };
+    if len > 1 << 20 || start + len < head.len().min(12) {
+        return Err(bad(what, format!("npy: a header of {len} bytes")));
+    }
+    Ok(start + len)
 }
 
 /// The shape an `.npy` file's header gives (its data unread): rank 2 is a height grid, 3 a volume.

@@ -623,3 +623,50 @@ fn motion_blurred_frames_drop_no_hidden_brick() {
         }
     }
 }
+
+/// Issue 44: uniform bricks (no records; their value in the header) draw on the device as their
+/// mirrors and the dense classification draw them, resident or streamed, with levels of detail
+/// and without.
+#[test]
+fn uniform_bricks_draw_as_their_voxels_do() {
+    let vol = common::flat_blocks([64, 56, 72]);
+    let tf = TransferFunction {
+        points: vec![(0.05, [0.0; 4]), (0.3, [0.9, 0.5, 0.2, 0.2]), (1.0, [1.0, 1.0, 0.9, 0.6])],
+        gradient_weight: 0.0,
+        range: None,
+        threshold: 0.0,
+    };
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let cam = Camera::framing(&grid, 72, 64);
+    let mut dense = renderer(true, None);
+    dense.set_scene(classify(&vol, &tf, None).unwrap()).unwrap();
+    let mut whole = renderer(true, None);
+    whole.set_volume(&vol, &tf, None).unwrap();
+    let scene = whole.volume().unwrap();
+    assert!(scene.store.headers.iter().filter(|h| h.is_uniform()).count() >= 12);
+    let least = voxsplat::recording::bricked_min_budget(scene, u64::MAX, 72, 64);
+    let most = scene.store.records.len() as u64 * 8; // streams below twice the records
+    assert!(least < most, "{least} {most}");
+    let budget = (least + most) / 2;
+    assert!(scene.streams(budget), "the store streams at {budget} bytes");
+    for stream in [false, true] {
+        let b = stream.then_some(budget);
+        let (mut g, mut c) = (renderer(true, b), renderer(false, b));
+        g.set_volume(&vol, &tf, None).unwrap();
+        c.set_volume(&vol, &tf, None).unwrap();
+        for lod in [Lod::Off, Lod::Auto] {
+            let mut o = compute(Direction::FrontToBack);
+            o.lod = lod;
+            let a = g.render(&cam, &o).unwrap().image;
+            assert!(a.pixels.iter().filter(|p| p[3] > 0.1).count() > 500, "stream {stream} {lod:?}: something drawn");
+            let (most, mean) = diff(&a, &c.render(&cam, &o).unwrap().image);
+            assert!(most <= 2e-3 && mean <= 1e-5, "stream {stream} {lod:?}: GPU vs mirror {most} / {mean}");
+            if lod == Lod::Off {
+                let (most, mean) = diff(&a, &dense.render(&cam, &o).unwrap().image);
+                assert!(most <= 0.05 && mean <= 2e-3, "stream {stream}: bricked vs dense {most} / {mean}");
+            }
+        }
+        assert_clean(&g);
+    }
+    assert_clean(&dense);
+}

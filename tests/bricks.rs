@@ -234,3 +234,42 @@ fn a_gzip_nrrd_streams_into_the_same_store() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 44: a full brick whose voxels hold one value stores no records, only its header (a
+/// constant 512³ volume took 4 bytes a voxel), and every value still comes back through it.
+#[test]
+fn uniform_bricks_store_no_records_and_every_value_comes_back() {
+    let vol = common::flat_blocks([37, 29, 40]);
+    let store = BrickStore::build(&vol).unwrap();
+    let uniform: Vec<_> = store.headers.iter().filter(|h| h.is_uniform()).collect();
+    assert!(uniform.len() >= 12, "{} uniform bricks", uniform.len());
+    let dims = vol.dims;
+    let mut stored = 0;
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let v = vol.values[(i + dims[0] * (j + dims[1] * k)) as usize];
+                let want = (v - store.range.0) / (store.range.1 - store.range.0);
+                stored += usize::from(v > 0.0);
+                let got = store.value_at(i as i64, j as i64, k as i64);
+                assert!((got - want).abs() <= 0.5 / 65535.0 + 1e-7, "({i},{j},{k}): {got} for {want}");
+            }
+        }
+    }
+    assert_eq!(store.len(), stored);
+    assert_eq!(store.records.len(), stored - uniform.len() * 512, "a uniform brick stores no record");
+    for h in &uniform {
+        let records = store.brick_records(h);
+        assert_eq!(records.len(), 512);
+        let q = h.range & 0xFFFF;
+        assert_eq!(h.range >> 16, q);
+        assert!(records.iter().enumerate().all(|(l, &r)| r == l as u32 | q << 16));
+    }
+    // A constant volume: every brick uniform where it is full, records only in the partial ones.
+    for (dims, records) in [([16, 24, 8], 0), ([17, 16, 8], 16 * 8)] {
+        let n = (dims[0] * dims[1] * dims[2]) as usize;
+        let store = BrickStore::build(&ScalarVolume { dims, spacing: [1.0; 3], values: vec![3.0; n] }).unwrap();
+        assert_eq!((store.len(), store.records.len()), (n, records), "{dims:?}");
+        assert_eq!(store.value_at(5, 5, 5), 0.0);
+    }
+}

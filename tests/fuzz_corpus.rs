@@ -5,7 +5,10 @@
 use std::path::Path;
 include!("../fuzz/bodies.rs");
 
-const TARGETS: &[(&str, fn(&[u8]))] = &[
+/// A fuzz target's body.
+type Body = fn(&[u8]);
+
+const TARGETS: &[(&str, Body)] = &[
     ("nrrd", nrrd),
     ("nifti", nifti),
     ("npy", npy),

@@ -452,7 +452,7 @@ fn a_set_past_the_splat_cap_is_still_ray_cast() {
     let n = 150; // 3,375,000 voxels, past MAX_GPU_SPLATS
     assert!(n * n * n > voxsplat::constants::MAX_GPU_SPLATS);
     let grid = Grid::centered([n; 3], [1.0; 3]).unwrap();
-    let set = voxsplat::SplatSet::from_fn(grid.clone(), |_, _, _| Some([0.8, 0.6, 0.4, 0.02])).unwrap();
+    let set = voxsplat::SplatSet::from_fn(grid, |_, _, _| Some([0.8, 0.6, 0.4, 0.02])).unwrap();
     let cam = Camera::framing(&grid, 24, 24);
     let mut g = gpu();
     g.set_scene(set).unwrap();
@@ -474,10 +474,22 @@ fn the_host_budget_defaults_to_a_share_of_physical_memory() {
     };
     let total = kb("MemTotal:") * 1024;
     assert_eq!(voxsplat::host_budget(), Some(total / 4 * 3));
-    // A store whose records alone take 90 % of physical memory: refused by the budget before a
-    // slice is read.
-    let z = (total / 10 * 9 / 4).div_ceil(4096 * 4096) as u32;
-    let read = |_: u32, _: u32, _: &mut Vec<f32>| -> voxsplat::Result<()> { panic!("a slice was read") };
-    let e = BrickStore::from_region([4096, 4096, z], [1.0; 3], (0.0, 1.0), [[0; 3], [4096, 4096, z]], read).unwrap_err();
+    // A gzip stream allowed to inflate to 90 % of physical memory: refused before a byte is read.
+    let e = voxsplat::loaders::gunzip(&[], total / 10 * 9, "a test's stream").unwrap_err();
     assert!(e.to_string().contains("past the host budget") && e.to_string().contains("three quarters"), "{e}");
+}
+
+/// Issue 44, found by fuzzing (fuzz/corpus/npy/oom-f5235dbe...): an `.npy` read from bytes whose
+/// version-3 header length says 3.6 GB made npyz allocate that before reading a byte; the length is
+/// checked against the bytes first, as the file path checks it.
+#[test]
+fn an_npy_header_length_past_its_bytes_is_refused_before_allocating() {
+    let mut bytes = b"\x93NUMPY\x03\x00".to_vec();
+    bytes.extend_from_slice(&0xd97b_0076u32.to_le_bytes());
+    bytes.extend_from_slice(b"{'descr': '<i2', 'fortran_order': False, 'shape': (2, 2), }");
+    let e = npy_from_bytes(&bytes, "bomb.npy").unwrap_err();
+    assert!(e.to_string().contains("npy: a header of"), "{e}");
+    // A header that ends inside the bytes still reads.
+    let ok = common::npy(&[2, 2], "<i2", &[1, 0, 2, 0, 3, 0, 4, 0]);
+    assert_eq!(npy_from_bytes(&ok, "ok.npy").unwrap().1, vec![1.0, 2.0, 3.0, 4.0]);
 }

@@ -9,6 +9,7 @@
 //! - with anti-aliasing (Swan's, EWA) a splat smaller than a pixel spreads its energy over the
 //!   pixel, each fainter, as a box-filtered ray cast (`SUPERSAMPLE`² rays per pixel) averages it:
 //!   the frame's coverage, its alpha summed over the pixels, is at least half the ray cast's.
+//!
 //! The scene projects to 2-64 pixels across, so far views are in; the eye stays beyond the cull
 //! margin (`Camera::cull_margin`: splats nearer the eye than that are not drawn), and the near and
 //! far planes clear of the scene. What this catches: a frame drawn empty or cut away (metre-scale

@@ -39,7 +39,7 @@ layout(std430, binding = 23) readonly buffer BrickCounts { uint brick_counts[]; 
 // Stores of more than RECORD_PAGE records bind them as up to 8 pages (one storage binding may not
 // pass maxStorageBufferRange); PAGED_RECORDS builds read through the pages.
 #if defined(STREAMED_STORE)
-uint record_at(uint i) {
+uint stored_record(uint i) {
     return batch_records[i];
 }
 #elif defined(PAGED_RECORDS)
@@ -50,7 +50,7 @@ layout(std430, binding = 17) readonly buffer Records4 { uint records_4[]; };
 layout(std430, binding = 18) readonly buffer Records5 { uint records_5[]; };
 layout(std430, binding = 19) readonly buffer Records6 { uint records_6[]; };
 layout(std430, binding = 20) readonly buffer Records7 { uint records_7[]; };
-uint record_at(uint i) {
+uint stored_record(uint i) {
     uint j = i % RECORD_PAGE;
     switch (i / RECORD_PAGE) {
         case 0u: return records_0[j];
@@ -64,10 +64,17 @@ uint record_at(uint i) {
     }
 }
 #else
-uint record_at(uint i) {
+uint stored_record(uint i) {
     return records_0[i];
 }
 #endif
+// A uniform brick (a full brick whose voxels hold one value; src/bricks/build.rs) stores no
+// records: its first record is UNIFORM_RECORDS | value << 9, and record first + r is r | value << 16.
+const uint UNIFORM_RECORDS = 0x80000000u;
+uint record_at(uint i) {
+    if ((i & UNIFORM_RECORDS) != 0u) return (i & 511u) | (((i >> 9u) & 0xffffu) << 16u);
+    return stored_record(i);
+}
 // Brick id (x + nx (y + ny z)) -> header, or 0xffffffff when the brick stores nothing.
 layout(std430, binding = 6) readonly buffer BrickIndex { uint brick_index[]; };
 // Per brick-grid position in draw order: header << 10 | voxels drawn, 0 when culled.

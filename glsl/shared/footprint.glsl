@@ -79,7 +79,10 @@ int entry_layer(uint e, uint splat, SplatParams p, out vec2 faces) {
     faces = vec2(0.0);
     if (SHEET_MODE == SHEET_MODE_SLAB) {
         uint slab = draw_list[2u * e + 1u];
-        float radius = length(p.axis_v.xyz) / (1.0 + abs(p.screen.y));  // the quad spans 1 + |bend| radii
+        // The quad spans 1 + |bend| radii; in depth the kernel keeps its own radius (anti-aliasing
+        // widens it on the screen by p.screen.w: its depth profile widened as well put most of its
+        // weight outside the slabs, and small far frames in slab mode lost it).
+        float radius = length(p.axis_v.xyz) / (1.0 + abs(p.screen.y)) / p.screen.w;
         float near_face = pc.slab_z0 + float(slab) * pc.slab_dz - p.screen.x;
         faces = vec2(near_face, near_face + pc.slab_dz) / radius;
         return pc.rank_dir > 0 ? int(slab - pc.rank_base) : int(pc.rank_base - slab);

@@ -29,7 +29,8 @@ bool slab_range(uint s, SplatParams p, out uint first, out uint last) {
     first = voxel_ijk(voxels[s])[pc.axis];
     last = first;
 #else
-    float r = length(p.axis_v.xyz) * 1.0001;
+    // The kernel's depth extent: anti-aliasing widens it on the screen only (p.screen.w).
+    float r = length(p.axis_v.xyz) / p.screen.w * 1.0001;
     first = slab_of(p.screen.x - r);
     last = slab_of(p.screen.x + r);
 #endif

@@ -327,10 +327,7 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
         let drawn = match counts {
             _ if inputs.bf.grad[1] > 0.0 => level_count(inputs.summary, h as u32, level),
             Some(c) => c[h],
-            None => {
-                let records = &store.records[hd.first as usize..(hd.first + hd.count) as usize];
-                records.iter().filter(|&&r| inputs.emits(r >> 16)).count() as u32
-            }
+            None => store.brick_records(hd).iter().filter(|&&r| inputs.emits(r >> 16)).count() as u32,
         };
         if drawn > 0 {
             slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(level, drawn);
@@ -362,7 +359,7 @@ pub fn brick_order(
         }
         let morphs = inputs.morph_bit(entry[0]);
         let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
-        let records = &records[entry[2] as usize..(entry[2] + hd.count) as usize];
+        let records = &*BrickStore::records_of(records, entry[2], &hd);
         let mut cells = [0u32; CELL_WORDS];
         let position = |rec: u32| dense_pbtf(local_cell(rec & 511), [BRICK; 3], split);
         for &rec in records {

@@ -77,8 +77,9 @@ pub(crate) fn entry<'a>(
     let mut weight = Weight::Footprint(inputs.table);
     let layer = if slab_mode {
         let slab = inputs.draw_list[2 * e as usize + 1];
-        // The quad spans 1 + |bend| radii along axis_v.
-        let radius = Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length() / (1.0 + p.screen[1].abs());
+        // The quad spans 1 + |bend| radii along axis_v; in depth the kernel keeps its own radius.
+        let radius =
+            Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length() / (1.0 + p.screen[1].abs()) / p.screen[3];
         let near_face = push.slab_z0 + slab as f32 * push.slab_dz - p.screen[0];
         let faces = [near_face / radius, (near_face + push.slab_dz) / radius];
         weight = Weight::Slice(inputs.slice_table, faces);

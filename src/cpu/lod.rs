@@ -324,7 +324,7 @@ pub fn brick_pyramid(
         let hd = &store.headers[h];
         let b = hd.coords();
         fine.fill(Sums::default());
-        for &rec in &store.records[hd.first as usize..(hd.first + hd.count) as usize] {
+        for &rec in store.brick_records(hd).iter() {
             if !inputs.emits(rec >> 16) {
                 continue;
             }

@@ -29,7 +29,8 @@ pub fn slab_range(pc: &SlabPush, s: usize, p: &SplatParams, voxels: Option<&[[u3
         let sheet = super::brick::voxel_ijk(v[s])[pc.axis as usize];
         return Some((sheet, sheet));
     }
-    let r = Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length() * 1.0001;
+    // The kernel's depth extent: anti-aliasing widens it on the screen only.
+    let r = Vec3::new(p.axis_v[0], p.axis_v[1], p.axis_v[2]).length() / p.screen[3] * 1.0001;
     Some((slab_of(pc, p.screen[0] - r), slab_of(pc, p.screen[0] + r)))
 }
 

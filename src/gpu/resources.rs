@@ -137,11 +137,11 @@ impl Resources {
         }
         if let Some(b) = prep.bricks.as_ref().filter(|b| !b.streams(budget)) {
             let most = RECORD_PAGE as u64 * RECORD_PAGES as u64;
-            if b.store.len() as u64 > most {
+            if b.store.records.len() as u64 > most {
                 return Err(Error::TooLarge(format!(
                     "a bricked store of {} voxels: the GPU path binds at most {most} ({RECORD_PAGES} storage bindings \
                      of {RECORD_PAGE} records)",
-                    b.store.len()
+                    b.store.records.len()
                 )));
             }
         }

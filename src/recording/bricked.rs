@@ -88,10 +88,19 @@ pub(super) fn record_bricks(
     let most_cells = PYRAMID_PAGE as u64 * 4 * PYRAMID_PAGES as u64;
     let fits = headers as u64 * PYRAMID_BYTES <= most_cells;
     if lod && !streamed && !fits {
+        // Streaming needs records to stream (a store of uniform bricks has few or none).
+        let records = scene.store.records.len() as u64 * 4;
+        let stream = if records > 0 {
+            format!(
+                "a GPU budget under {} MiB streams the store's records and builds the pyramid batch by batch, or ",
+                (2 * records) >> 20
+            )
+        } else {
+            String::new()
+        };
         return Err(Error::TooLarge(format!(
             "levels of detail: the pyramid of {headers} bricks takes {} MiB, more than the {} MiB its {PYRAMID_PAGES} \
-             storage bindings hold; a GPU budget under twice the store's records streams them, and the pyramid then \
-             builds batch by batch",
+             storage bindings hold; {stream}levels of detail off (--lod off) draw every voxel instead",
             (headers as u64 * PYRAMID_BYTES) >> 20,
             most_cells >> 20
         )));
@@ -157,7 +166,7 @@ pub(super) fn record_bricks(
     }
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
     // The brick stages' build: one page of store records, the paged reader, or streamed records.
-    let build = if streamed { 2 } else { usize::from(scene.store.len() > RECORD_PAGE as usize) };
+    let build = if streamed { 2 } else { usize::from(scene.store.records.len() > RECORD_PAGE as usize) };
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
@@ -389,7 +398,8 @@ impl Cut<'_> {
             }
             // A streamed brick's first record is its slot's, known when the batch is placed
             // (`upload_batch`).
-            let first = if self.streamed { 0 } else { hd.first };
+            // A uniform brick has no records to stream: its first says its value (`record_at`).
+            let first = if self.streamed && !hd.is_uniform() { 0 } else { hd.first };
             batches.last_mut().expect("one batch at least").push([header, filled, first, w]);
             (filled, slots, bytes) = (filled + n, slots + slot, bytes + cost);
         }
@@ -601,7 +611,8 @@ fn upload_batch(
     cut: &Cut,
 ) -> Result<()> {
     let s = &scene.store;
-    let readers: Vec<u32> = batch.iter().filter(|l| cut.uploads(l[3])).map(|l| l[0]).collect();
+    let readers: Vec<u32> =
+        batch.iter().filter(|l| cut.uploads(l[3]) && !s.headers[l[0] as usize].is_uniform()).map(|l| l[0]).collect();
     let (slots, new) = cut.lock_cache().place(&readers)?;
     let (mut data, mut regions) = (Vec::new(), Vec::with_capacity(new.len()));
     for (i, slot) in new {

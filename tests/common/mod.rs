@@ -163,6 +163,29 @@ pub fn blob(dims: [u32; 3]) -> voxsplat::volume::ScalarVolume {
     voxsplat::volume::ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
 }
 
+/// A volume with flat regions: empty space (its minimum), a block at one value, and noise.
+pub fn flat_blocks(dims: [u32; 3]) -> voxsplat::volume::ScalarVolume {
+    let mut rng = Rng(44);
+    let mut values = Vec::new();
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let inside = |lo: u32, hi: u32, v: u32| (lo..hi).contains(&v);
+                values.push(
+                    if inside(3, dims[0] - 2, i) && inside(2, dims[1] - 3, j) && inside(1, 2 * dims[2] / 3, k) {
+                        50.0 // a flat block: its full bricks are uniform
+                    } else if k >= 2 * dims[2] / 3 + 2 && i > 4 {
+                        10.0 + 80.0 * rng.f32()
+                    } else {
+                        0.0
+                    },
+                );
+            }
+        }
+    }
+    voxsplat::volume::ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
+}
+
 /// The bricked tests' transfer function for `blob`.
 pub fn blob_tf() -> voxsplat::classify::TransferFunction {
     voxsplat::classify::TransferFunction {
