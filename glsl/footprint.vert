@@ -37,6 +37,9 @@ void main() {
         vec3 pos = p.center.xyz + c.x * p.axis_u.xyz + c.y * p.axis_v.xyz;
         gl_Position = frame.view_proj * vec4(pos, 1.0);
     }
+    // No depth test reads it: halfway through the clip volume, so that no corner of a quad that
+    // anti-aliasing widened past the far plane is clipped (the compute raster clips none either).
+    if (p.center.w != 0.0) gl_Position.z = 0.5 * gl_Position.w;
 #ifdef SLOTS
     vec2 faces;  // per-splat compositing: no slab
     gl_Layer = entry_layer(entry, splat, p, faces);

@@ -24,7 +24,7 @@ MUTANTS=(
   "NRRD byte skip read as data|src/loaders/nrrd.rs|if value != \"0\" =>|if false =>|--test hostile nrrd_skips"
   "a TF point's third element dropped|src/classify.rs|if s.next_element::<IgnoredAny>()?.is_some() {|if false && s.next_element::<IgnoredAny>()?.is_some() {|--test hostile transfer_function_points"
   "a partial brick stored as uniform|src/bricks/build.rs|if count as usize == BRICK_VOXELS && qmin == qmax {|if qmin == qmax {|--test bricks uniform"
-  "the cull margin widened by anti-aliasing|src/cpu/splat_params.rs|let mut visible = room >= 1.0;|let mut visible = room >= cell_footprint_scale(frame, depth, cell);|--test aa anti_aliasing_never"
+  "the cull margin widened by anti-aliasing|src/cpu/splat_params.rs|let mut visible = clear >= CULL_RADII * base;|let mut visible = clear >= CULL_RADII * base * cell_footprint_scale(frame, depth, cell);|--test aa anti_aliasing_never"
   "a slab's depth profile widened by anti-aliasing|src/cpu/footprint.rs|/ (1.0 + p.screen[1].abs()) / p.screen[3];|/ (1.0 + p.screen[1].abs());|--test aa slab_mode"
 )
 filter=${1:-}

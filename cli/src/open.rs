@@ -286,21 +286,9 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
         cam.projection = Projection::Orthographic { height: hgt };
     }
     // Fit near/far to the scene's bounding sphere seen from this eye unless given, widened by the
-    // splats' cull margin (`Camera::cull_margin`), grown by anti-aliasing where a voxel spacing
-    // projects below a pixel: the library stops a widened splat short of the planes, so planes
-    // as tight as the scene would keep far or small frames from being low-passed to the pixel.
+    // splats' cull margin (`Camera::cull_margin`; what anti-aliasing widens is never culled).
     let d = (grid.center() - cam.eye).length();
-    let ppv = match cam.projection {
-        Projection::Perspective { fov_y_deg } => {
-            grid.kernel_spacing() * h as f32
-                / (2.0 * (0.5 * fov_y_deg.to_radians()).tan() * (d - 0.5 * grid.diagonal()).max(1e-6))
-        }
-        Projection::Orthographic { height } => grid.kernel_spacing() * h as f32 / height,
-    };
-    // The widest anti-aliasing scale either method gives at that size (footprint_scale).
-    let aa_scale = (1.0 + (1.5 / ppv.max(1e-6)).powi(2)).sqrt().max(1.0 / ppv.max(1e-6)).max(1.0);
-    let reach = Camera::cull_margin(grid.kernel_spacing()) * aa_scale;
-    let r = 0.5 * grid.diagonal() + (4.0 * grid.kernel_spacing()).max(reach);
+    let r = 0.5 * grid.diagonal() + (4.0 * grid.kernel_spacing()).max(Camera::cull_margin(grid.kernel_spacing()));
     // Margins relative to the scene, not in units: spacings in metres (1e-4 and below) are common.
     let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d) } else { d - 1.5 * r };
     cam.near = a.near.unwrap_or(if grazing { cam.near } else { fit_near });

@@ -34,13 +34,15 @@ SplatParams params_world(vec3 center, float cell, float grow, vec3 rgb, float ta
     vec3 forward = frame.forward.xyz;
     float depth = dot(center - frame.eye.xyz, forward);
     // The splat's own kernel keeps CULL_RADII radii clear of the near and far planes, or it is
-    // culled. Anti-aliasing's widening (a low-pass on the screen) stops where its quad would
-    // reach a plane: near a plane, or in a frame of a few pixels, a splat is low-passed less
-    // rather than culled (a widened cull margin grew with depth and drew such frames empty).
+    // culled. Anti-aliasing's widening (a low-pass on the screen) is not: a widened cull margin
+    // grew with depth and drew small frames empty. Nothing clips a widened quad at the planes
+    // (footprint.vert flattens its depth); in perspective it stops short of the eye, behind which
+    // a corner does not project (only frames a few pixels high reach that).
     float base = grow * cell * frame.spacing.w;
-    float room = min(depth - frame.forward.w, frame.right.w - depth) / (CULL_RADII * base);
-    bool visible = room >= 1.0;
-    float scale = clamp(footprint_scale(depth, cell), 1.0, max(room, 1.0));
+    float clear = min(depth - frame.forward.w, frame.right.w - depth);
+    bool visible = clear >= CULL_RADII * base;
+    float eye_room = frame.eye.w > 0.5 ? depth / (CULL_RADII * base) : 1e30;
+    float scale = clamp(footprint_scale(depth, cell), 1.0, max(eye_room, 1.0));
     float radius = base * scale;
     // Clipping planes and crop box: splats whose centres lie outside any are not drawn.
     for (uint i = 0u; i < frame.rect.y; ++i) {

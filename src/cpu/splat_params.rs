@@ -65,11 +65,12 @@ pub fn params_world(frame: &Frame, center: Vec3, cell: f32, grow: f32, rgb: [f32
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right) = (v3(frame.eye), v3(frame.forward), v3(frame.right));
     let depth = (center - eye).dot(forward);
-    // The kernel clear of the near and far planes; the widening capped where it would reach one.
+    // The kernel clear of the near and far planes; the widening, in perspective, short of the eye.
     let base = grow * cell * frame.spacing[3];
-    let room = (depth - frame.forward[3]).min(frame.right[3] - depth) / (CULL_RADII * base);
-    let mut visible = room >= 1.0;
-    let scale = cell_footprint_scale(frame, depth, cell).clamp(1.0, room.max(1.0));
+    let clear = (depth - frame.forward[3]).min(frame.right[3] - depth);
+    let mut visible = clear >= CULL_RADII * base;
+    let eye_room = if frame.eye[3] > 0.5 { depth / (CULL_RADII * base) } else { 1e30 };
+    let scale = cell_footprint_scale(frame, depth, cell).clamp(1.0, eye_room.max(1.0));
     let radius = base * scale;
     for q in &frame.clip[..frame.rect[1] as usize] {
         visible = visible && Vec3::new(q[0], q[1], q[2]).dot(center) + q[3] >= 0.0;
