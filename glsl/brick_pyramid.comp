@@ -87,6 +87,23 @@ void main() {
     uvec4 hd = headers[h];
     uvec3 b = brick_coords(hd.x);
     uint lane = gl_LocalInvocationID.x;
+    // A brick whose value range the transfer function leaves empty: every cell of its pyramid and
+    // its summary are zero, written without reading a voxel (the full pass writes the same words;
+    // brick_cull never draws the brick, the nodes above sum its zeros). The whole workgroup leaves.
+    uint qlo = hd.w & 0xffffu;
+    uint qhi = hd.w >> 16u;
+    if (emitted_below(qhi) + (emits(qhi) ? 1u : 0u) == emitted_below(qlo)) {
+        for (uint i = lane; i < LOD_CELLS; i += BRICK_LANES) {
+            put_cell(slot, h, i, 0.0, vec3(0.0), vec3(0.0), 0.0, vec3(0.0));
+        }
+        if (lane == 0u) {
+            for (uint k = 0u; k < 4u; ++k) lod_words[h * SUMMARY_WORDS + k] = 0u;
+#ifdef STREAMED_STORE
+            pyramid_slot[h] = slot;
+#endif
+        }
+        return;
+    }
     if (lane < MASK_WORDS) mask_w[lane] = masks[h * MASK_WORDS + lane];
     barrier();
     if (lane == 0u) {
