@@ -503,11 +503,23 @@ fn an_npy_header_that_is_not_numpy_s_dict_is_refused_before_it_is_parsed() {
         (format!("{{'descr': {}1.5", "{".repeat(40)), "nested deeper"),
         ("{'descr': '<f4', 'fortran_order': False, 'shape': [2, 2], }".to_string(), "'['"),
         ("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 2), } \x7f".to_string(), "\\x7f"),
+        // npyz multiplies the shape out unchecked (a panic in a debug build).
+        (
+            "{'descr': '>f8', 'fortran_order': False, 'shape': (23333333333333333,333333, 3, 2), }".to_string(),
+            "overflows",
+        ),
     ] {
         let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
         bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
         bytes.extend_from_slice(header.as_bytes());
         let e = npy_from_bytes(&bytes, "odd.npy").unwrap_err();
+        assert!(e.to_string().contains(needle), "{header:?}: {e}");
+        // Read from a file (a volume, or terrain heights), the whole header is checked too.
+        let path = dir().join("odd.npy");
+        std::fs::write(&path, &bytes).unwrap();
+        let e = voxsplat::loaders::load_heights(&path).unwrap_err();
+        assert!(e.to_string().contains(needle), "{header:?}: {e}");
+        let e = load_volume(&path, &VolumeHints::default()).unwrap_err();
         assert!(e.to_string().contains(needle), "{header:?}: {e}");
     }
 }

@@ -9,10 +9,11 @@ use std::path::Path;
 
 /// `.npy` arrays of 2 or 3 dimensions (C order: the last axis is x), through `npyz`.
 pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> {
-    let end = npy_header_end(bytes, what)?;
+    let (start, end) = npy_header_span(bytes, what)?;
     if end > bytes.len() {
         return Err(bad(what, format!("npy: a header of {end} bytes in {} bytes", bytes.len())));
     }
+    check_dict(&bytes[start..end], what)?;
     let npy = npyz::NpyFile::new(bytes).map_err(|e| bad(what, format!("npy: {e}")))?;
     let shape = npy.shape().to_vec();
     if shape.len() < 2 || shape.len() > 3 {
@@ -67,8 +68,12 @@ fn npy_header(file: &mut std::fs::File, what: &str) -> Result<(Vec<u8>, Vec<u64>
     let io = |e| Error::Io { path: what.to_string(), source: e };
     let mut head = Vec::with_capacity(12);
     let got = file.take(12).read_to_end(&mut head).map_err(io)?;
-    let end = npy_header_end(&head, what)?;
+    let (start, end) = npy_header_span(&head, what)?;
     file.take((end - got) as u64).read_to_end(&mut head).map_err(io)?;
+    if head.len() < end {
+        return Err(bad(what, format!("npy: a header of {end} bytes in a file of {}", head.len())));
+    }
+    check_dict(&head[start..end], what)?;
     let npy = npyz::NpyFile::new(&head[..]).map_err(|e| bad(what, format!("npy: {e}")))?;
     let shape = npy.shape().to_vec();
     let n = voxel_count(&shape, what)?;
@@ -77,9 +82,9 @@ fn npy_header(file: &mut std::fs::File, what: &str) -> Result<(Vec<u8>, Vec<u64>
     Ok((head, shape, need))
 }
 
-/// Where an `.npy` header that starts `head` (its first 12 bytes at least) ends: refused past 1 MiB
-/// (npyz allocates what the length field says before it reads a byte).
-fn npy_header_end(head: &[u8], what: &str) -> Result<usize> {
+/// Where the dict of an `.npy` header that starts `head` (its first 12 bytes at least) starts and
+/// ends: refused past 1 MiB (npyz allocates what the length field says before it reads a byte).
+fn npy_header_span(head: &[u8], what: &str) -> Result<(usize, usize)> {
     if head.len() < 10 || !head.starts_with(b"\x93NUMPY") {
         return Err(bad(what, "npy: not an .npy file (no \\x93NUMPY magic)"));
     }
@@ -92,10 +97,7 @@ fn npy_header_end(head: &[u8], what: &str) -> Result<usize> {
     if len > 1 << 20 || start + len < head.len().min(12) {
         return Err(bad(what, format!("npy: a header of {len} bytes")));
     }
-    if let Some(text) = head.get(start..(start + len).min(head.len())) {
-        check_dict(text, what)?;
-    }
-    Ok(start + len)
+    Ok((start, start + len))
 }
 
 /// Refuse an `.npy` header that is not the plain dict numpy writes (`{'descr': '<f4',
@@ -115,6 +117,15 @@ fn check_dict(text: &[u8], what: &str) -> Result<()> {
         }
         if depth > 2 {
             return Err(bad(what, "npy: a header nested deeper than the dict numpy writes"));
+        }
+    }
+    // The shape's size in checked arithmetic (npyz multiplies it out unchecked).
+    let text = String::from_utf8_lossy(text);
+    if let Some(dims) = text.split("shape").nth(1).and_then(|t| t.split('(').nth(1)).and_then(|t| t.split(')').next()) {
+        let mut n = 1u64;
+        for d in dims.split(',').map(|d| d.trim().trim_end_matches('L')).filter(|d| !d.is_empty()) {
+            let d: u64 = d.parse().map_err(|_| bad(what, format!("npy: a shape of ({dims})")))?;
+            n = n.checked_mul(d).ok_or_else(|| bad(what, format!("npy: a shape of ({dims}) overflows")))?;
         }
     }
     Ok(())
