@@ -72,9 +72,11 @@ pub enum Error {
 
 /// Longest message a decoder may put in an error: a corrupt file can make a decoder describe
 /// itself at length (one flipped bit in a TIFF gave 315,815 bytes).
+#[cfg(feature = "io")]
 const MAX_MESSAGE: usize = 400;
 
 /// `message`, cut at `MAX_MESSAGE` bytes with a note of how much was left out.
+#[cfg(feature = "io")]
 pub(crate) fn clip_message(message: impl std::fmt::Display) -> String {
     let mut m = message.to_string();
     if m.len() > MAX_MESSAGE {
