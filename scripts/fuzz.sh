@@ -7,7 +7,8 @@
 # executions, crashes and corpus size per target; docs/RELIABILITY.md records a run. An input that
 # runs past 10 s, or past 2 GB, counts as a crash.
 #   scripts/fuzz.sh [RUNS]          FUZZ_TARGETS="nrrd tf" scripts/fuzz.sh 1000   (a subset)
-# A crash leaves its input in fuzz/artifacts/TARGET; copy it into fuzz/corpus/TARGET once fixed, and
+# A crash leaves its input in fuzz/artifacts/TARGET; copy it into fuzz/seeds/TARGET as found-NAME once
+# fixed (the corpus is minimised and may drop it), and
 # tests/fuzz_corpus.rs replays it on every CI run. fuzz/seeds/make.py rewrites the seed files.
 # cargo-fuzz needs nightly features: on a stable-only machine RUSTC_BOOTSTRAP=1 enables them.
 set -euo pipefail

@@ -479,7 +479,7 @@ fn the_host_budget_defaults_to_a_share_of_physical_memory() {
     assert!(e.to_string().contains("past the host budget") && e.to_string().contains("three quarters"), "{e}");
 }
 
-/// Issue 44, found by fuzzing (fuzz/corpus/npy/oom-f5235dbe...): an `.npy` read from bytes whose
+/// Issue 44, found by fuzzing (fuzz/seeds/npy/found-oom-f5235dbe...): an `.npy` read from bytes whose
 /// version-3 header length says 3.6 GB made npyz allocate that before reading a byte; the length is
 /// checked against the bytes first, as the file path checks it.
 #[test]
