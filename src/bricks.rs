@@ -437,9 +437,19 @@ impl BrickScene {
         let (mut lo, mut hi) = ([u32::MAX; 3], [0u32; 3]);
         for h in &self.store.headers {
             let base = h.coords().map(|c| c * BRICK);
+            let mut take = |v: [u32; 3]| {
+                (0..3).for_each(|x| (lo[x], hi[x]) = (lo[x].min(base[x] + v[x]), hi[x].max(base[x] + v[x])))
+            };
+            if h.is_uniform() {
+                // Every voxel of a full brick, without making its records: its two far corners.
+                if emits(&self.table, h.range & 0xffff) {
+                    take([0; 3]);
+                    take([BRICK - 1; 3]);
+                }
+                continue;
+            }
             for &rec in self.store.brick_records(h).iter().filter(|&&r| emits(&self.table, r >> 16)) {
-                let v = local_cell(rec & 511);
-                (0..3).for_each(|x| (lo[x], hi[x]) = (lo[x].min(base[x] + v[x]), hi[x].max(base[x] + v[x])));
+                take(local_cell(rec & 511));
             }
         }
         (lo[0] <= hi[0]).then_some([lo, hi])
@@ -485,11 +495,7 @@ impl BrickScene {
     pub fn drawn_counts(&self) -> &[u32] {
         self.drawn.get_or_init(|| {
             let s = &self.store;
-            let drawn = |h: &BrickHeader| match h.is_uniform() {
-                true => h.count * emits(&self.table, h.range & 0xffff) as u32,
-                false => s.brick_records(h).iter().filter(|&&r| emits(&self.table, r >> 16)).count() as u32,
-            };
-            s.headers.iter().map(drawn).collect()
+            s.headers.iter().map(|h| s.drawn_in(h, |q| emits(&self.table, q))).collect()
         })
     }
 

@@ -258,6 +258,14 @@ fn uniform_bricks_store_no_records_and_every_value_comes_back() {
     }
     assert_eq!(store.len(), stored);
     assert_eq!(store.records.len(), stored - uniform.len() * 512, "a uniform brick stores no record");
+    // What the scene frames and draws, taken from uniform bricks' values, is what classifying
+    // the store voxel by voxel gives.
+    for tf in [common::blob_tf(), voxsplat::classify::TransferFunction::preset("ramp").unwrap()] {
+        let set = store.classify(&tf, None).unwrap();
+        let scene = voxsplat::bricks::BrickScene::new(store.clone(), tf, None).unwrap();
+        assert_eq!(scene.visible_bounds(), set.bounds());
+        assert_eq!(scene.drawn_counts().iter().sum::<u32>() as usize, set.len());
+    }
     for h in &uniform {
         let records = store.brick_records(h);
         assert_eq!(records.len(), 512);
@@ -271,5 +279,11 @@ fn uniform_bricks_store_no_records_and_every_value_comes_back() {
         let store = BrickStore::build(&ScalarVolume { dims, spacing: [1.0; 3], values: vec![3.0; n] }).unwrap();
         assert_eq!((store.len(), store.records.len()), (n, records), "{dims:?}");
         assert_eq!(store.value_at(5, 5, 5), 0.0);
+        // Seen through a TF range that makes the value visible, every voxel is framed and drawn.
+        let mut tf = voxsplat::classify::TransferFunction::preset("ramp").unwrap();
+        tf.range = Some((0.0, 6.0));
+        let scene = voxsplat::bricks::BrickScene::new(store, tf, None).unwrap();
+        assert_eq!(scene.visible_bounds(), Some([[0; 3], dims.map(|d| d - 1)]), "{dims:?}");
+        assert_eq!(scene.drawn_counts().iter().sum::<u32>() as usize, n, "{dims:?}");
     }
 }

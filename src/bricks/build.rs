@@ -43,6 +43,15 @@ impl BrickStore {
         Self::records_of(&self.records, hd.first, hd)
     }
 
+    /// Voxels of brick `hd` whose quantised value `emits` extracts: a uniform brick's from its
+    /// one value, without making its records.
+    pub fn drawn_in(&self, hd: &BrickHeader, emits: impl Fn(u32) -> bool) -> u32 {
+        if hd.is_uniform() {
+            return if emits(hd.range & 0xffff) { hd.count } else { 0 };
+        }
+        self.brick_records(hd).iter().filter(|&&r| emits(r >> 16)).count() as u32
+    }
+
     /// Cut `vol` into bricks, keeping every voxel whose value lies above the minimum.
     pub fn build(vol: &ScalarVolume) -> Result<Self> {
         Self::build_over(vol, f32::INFINITY)

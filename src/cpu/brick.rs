@@ -327,7 +327,7 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
         let drawn = match counts {
             _ if inputs.bf.grad[1] > 0.0 => level_count(inputs.summary, h as u32, level),
             Some(c) => c[h],
-            None => store.brick_records(hd).iter().filter(|&&r| inputs.emits(r >> 16)).count() as u32,
+            None => store.drawn_in(hd, |q| inputs.emits(q)),
         };
         if drawn > 0 {
             slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(level, drawn);
