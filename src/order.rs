@@ -264,6 +264,17 @@ pub fn octree_descent(b: [u32; 3], lo: [u32; 3], hi: [u32; 3], split: [u32; 3]) 
     })
 }
 
+/// Brick `b`'s shell in the front-to-back shell order of a brick grid whose eye's PBTF split is
+/// `split` (`brick_split`): its distance toward the eye in bricks, summed over the axes (0 for the
+/// bricks at the eye). A ray from a brick to the eye moves toward the split along every axis, so
+/// whatever lies in front of a brick lies in a lower shell and bricks of one shell hide none of
+/// each other: bricks sorted by shell, ties in a valid order (the k-d tree's), are a valid
+/// visibility order. Its prefixes are thin shells around the eye that cover the picture, where
+/// the tree's are slabs along its first cut (docs/MODEL.md, "Hidden bricks").
+pub fn brick_shell(b: [u32; 3], split: [u32; 3]) -> u32 {
+    (0..3).map(|a| if b[a] < split[a] { split[a] - 1 - b[a] } else { b[a] - split[a] }).sum()
+}
+
 /// The eye's PBTF split of the grid of `brick`-voxel bricks over `set`'s grid (`brick` > 0).
 pub fn brick_split(set: &SplatSet, camera: &Camera, brick: u32) -> [u32; 3] {
     let dims = set.grid().dims;

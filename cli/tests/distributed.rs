@@ -58,7 +58,21 @@ fn one_two_and_four_ranks_draw_the_single_process_frame() {
     let views: [(&str, &[&str]); 2] = [("outside", &[]), ("inside", &["--eye", "5,-10,40", "--target", "0,0,-100"])];
     for (view, extra) in views {
         let single = tmp(&format!("{view}-single.exr"));
-        let mut args = vec!["render", "--volume", STENT, "--tf", "ct", "--size", "192x192", "--validation"];
+        // Sort-last composites the ranks' boxes in the k-d tree's order: the single-process frame
+        // it equals draws its bricks in that order, without early termination (with it, front to
+        // back, a frame draws them in shells around the eye, which interleave the boxes).
+        let mut args = vec![
+            "render",
+            "--volume",
+            STENT,
+            "--tf",
+            "ct",
+            "--size",
+            "192x192",
+            "--validation",
+            "--early-termination",
+            "0",
+        ];
         args.extend_from_slice(extra);
         let mut a = args.clone();
         a.extend(["--out", single.to_str().unwrap()]);
@@ -189,8 +203,20 @@ fn ranks_read_a_left_handed_or_sheared_file_as_one_process_does() {
         );
         let file = tmp(&format!("{name}.nii"));
         std::fs::write(&file, common::nifti(dims, &v, Some(affine), None)).unwrap();
-        let args =
-            ["render", "--volume", file.to_str().unwrap(), "--tf", "ramp", "--view", "anterior", "--size", "64x64"];
+        // In the tree's order, as the ranks composite (see above).
+        let args = [
+            "render",
+            "--volume",
+            file.to_str().unwrap(),
+            "--tf",
+            "ramp",
+            "--view",
+            "anterior",
+            "--size",
+            "64x64",
+            "--early-termination",
+            "0",
+        ];
         let (run, d) = beside_one_process(&args, 2, name);
         assert!(String::from_utf8_lossy(&run.stderr).contains("on 2 ranks"));
         assert!(d <= 2e-3, "{name}, two ranks: {d} from the single-process frame");

@@ -235,11 +235,8 @@ pub(super) fn record_bricks(
     let compute = opts.raster == Raster::Compute;
     // Front to back with early termination, later batches drop the bricks that what is drawn
     // already hides: cut the frame into a few batches even when it fits one.
-    let cull_hidden = compute
-        && !sheets
-        && opts.cull_hidden_bricks
-        && opts.direction() == Direction::FrontToBack
-        && opts.early_termination > 0.0;
+    let terminating = compute && !sheets && opts.direction() == Direction::FrontToBack && opts.early_termination > 0.0;
+    let cull_hidden = terminating && opts.cull_hidden_bricks;
     let capacity = if cull_hidden {
         let total: u32 = slot_words.iter().map(|&w| slot_entry(w).2).sum();
         // Two bricks' splats more than the share: batches are cut between bricks, and the last
@@ -257,10 +254,22 @@ pub(super) fn record_bricks(
         stats.splats += n as u64;
     }
     // The visible bricks in draw order, cut between bricks into batches.
-    let visible = slot_words.into_iter().filter(|&w| w != 0).map(|w| {
-        let (header, level, n) = slot_entry(w);
-        [header, 0, 0, n | level << 16]
-    });
+    let mut visible: Vec<[u32; 4]> = slot_words
+        .into_iter()
+        .filter(|&w| w != 0)
+        .map(|w| {
+            let (header, level, n) = slot_entry(w);
+            [header, 0, 0, n | level << 16]
+        })
+        .collect();
+    if terminating && node_levels == 0 {
+        // Waves in shells (`brick_shell`): each covers the picture, so the next finds more hidden
+        // than behind the tree's slabs (the 512³ bonsai draws 2.38 M splats against 3.16 M). Kept
+        // with the hidden bricks too (`cull_hidden_bricks` off), so the two draw the same frame. A
+        // node stands for bricks consecutive in the tree's order: with nodes the waves keep it.
+        let split = crate::order::brick_split(&prep.set, camera, BRICK);
+        visible.sort_by_key(|l| crate::order::brick_shell(scene.store.headers[l[0] as usize].coords(), split));
+    }
     let batches = cut.batches(scene, visible, capacity, available);
     stats.waves = batches.len() as u32;
     e.host_time("brick_list", t.elapsed().as_secs_f64() * 1e3);
