@@ -14,6 +14,7 @@
 // brick_list from pc.first, into the entries' slots or, when the pyramid is resident, the bricks'
 // own (pyramid_slot). Mirror: cpu::lod::brick_pyramid.
 layout(local_size_x = BRICK_LANES) in;
+#define MASK_SUMS
 #include "brick.glsl"
 
 layout(push_constant) uniform Push {
@@ -36,7 +37,7 @@ shared float stored_l[LOD_CELLS];
 shared uint drawn_1[64];
 // The brick's occupancy mask and the stored voxels below each of its words.
 shared uint mask_w[MASK_WORDS];
-shared uint mask_below[MASK_WORDS];
+shared uint below_w[MASK_WORDS];
 
 // Child d (0..7) of cell c (side n) of level l, as an index into level l - 1's sums.
 uint child(uint l, uvec3 c, uint n, uint d) {
@@ -104,12 +105,12 @@ void main() {
         }
         return;
     }
-    if (lane < MASK_WORDS) mask_w[lane] = masks[h * MASK_WORDS + lane];
+    if (lane < MASK_WORDS) mask_w[lane] = masks[h * MASK_STRIDE + lane];
     barrier();
     if (lane == 0u) {
         uint below = 0u;
         for (uint w = 0u; w < MASK_WORDS; ++w) {
-            mask_below[w] = below;
+            below_w[w] = below;
             below += uint(bitCount(mask_w[w]));
         }
     }
@@ -132,7 +133,7 @@ void main() {
             ck[d] = vec3(0.0);
             uint word = mask_w[l / 32u];
             if (((word >> (l % 32u)) & 1u) != 0u) {
-                uint rank = mask_below[l / 32u] + uint(bitCount(word & ((1u << (l % 32u)) - 1u)));
+                uint rank = below_w[l / 32u] + uint(bitCount(word & ((1u << (l % 32u)) - 1u)));
                 uint q = record_at(first + rank) >> 16u;
                 if (emits(q)) {
                     ivec3 v = ivec3(b * BRICK_SIDE + k);

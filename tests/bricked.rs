@@ -413,7 +413,9 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
 #[test]
 fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
     let vol = blob([61, 53, 47]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    // 64², so the images leave the streamed store's resident part (headers, masks with their
+    // counts, index) and a brick of splats room under twice its records.
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 64);
     for gpu in [true, false] {
         let mut resident = renderer(gpu, None);
         resident.set_volume(&vol, &tf(), None).unwrap();
@@ -422,7 +424,7 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
         // Under twice the records, the store streams; above the streamed minimum, it draws.
         let budget = 2 * records - 1;
         assert!(scene.streams(budget));
-        let least = voxsplat::recording::bricked_min_budget(scene, budget, 80, 80);
+        let least = voxsplat::recording::bricked_min_budget(scene, budget, 64, 64);
         assert!(least < budget, "{least} < {budget}");
         let mut streamed = renderer(gpu, Some(budget));
         streamed.set_volume(&vol, &tf(), None).unwrap();

@@ -58,6 +58,40 @@ fn every_value_comes_back_through_the_store() {
     assert!(BrickStore::build(&too_wide).is_err());
 }
 
+/// The masks as the device reads them: per brick its 16 mask words, then per word the stored voxels
+/// before it, so `stored_at` finds a voxel's record with one count and one popcount.
+#[test]
+fn the_device_masks_count_the_stored_voxels_before_each_word() {
+    let mut rng = Rng(71);
+    let dims = [21u32, 17, 13];
+    let values: Vec<f32> =
+        (0..dims.iter().product::<u32>()).map(|_| if rng.f32() < 0.4 { 0.0 } else { rng.f32() }).collect();
+    let store = BrickStore::build(&ScalarVolume { dims, spacing: [1.0; 3], values }).unwrap();
+    let words = store.mask_words();
+    assert_eq!(words.len(), store.masks.len() * 24);
+    for (h, m) in store.masks.iter().enumerate() {
+        let mask: &[u32] = bytemuck::cast_slice(m);
+        let brick = &words[h * 24..h * 24 + 24];
+        assert_eq!(&brick[..16], mask, "brick {h}: its mask words");
+        // Two 16-bit counts to a word, the even word's low.
+        let below = |w: usize| brick[16 + w / 2] >> (16 * (w % 2)) & 0xffff;
+        for w in 0..16 {
+            let before: u32 = mask[..w].iter().map(|x| x.count_ones()).sum();
+            assert_eq!(below(w), before, "brick {h}, word {w}");
+        }
+        // Every stored voxel's rank: the records below it in local index order.
+        let mut rank = 0;
+        for l in 0..512usize {
+            if mask[l / 32] >> (l % 32) & 1 == 1 {
+                let got = below(l / 32) + (mask[l / 32] & ((1u32 << (l % 32)) - 1)).count_ones();
+                assert_eq!(got, rank, "brick {h}, voxel {l}");
+                rank += 1;
+            }
+        }
+        assert!(rank > 0, "brick {h} stores a voxel");
+    }
+}
+
 #[test]
 fn real_volumes_take_under_8_bytes_a_voxel_and_classify_alike_through_the_store() {
     let data = voxsplat::loaders::data_dir();

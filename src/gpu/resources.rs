@@ -169,7 +169,7 @@ impl Resources {
                     let words = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
                     Some([
                         storage(ctx, "brick headers", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.headers))))?,
-                        storage(ctx, "brick masks", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.masks))))?,
+                        storage(ctx, "brick masks", bytemuck::cast_slice(&words(&s.mask_words())))?,
                         storage(
                             ctx,
                             "brick records",
