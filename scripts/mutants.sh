@@ -26,6 +26,8 @@ MUTANTS=(
   "a partial brick stored as uniform|src/bricks/build.rs|if count as usize == BRICK_VOXELS && qmin == qmax {|if qmin == qmax {|--test bricks uniform"
   "the cull margin widened by anti-aliasing|src/cpu/splat_params.rs|let mut visible = clear >= CULL_RADII * base;|let mut visible = clear >= CULL_RADII * base * cell_footprint_scale(frame, depth, cell);|--test aa anti_aliasing_never"
   "a slab's depth profile widened by anti-aliasing|src/cpu/footprint.rs|/ (1.0 + p.screen[1].abs()) / p.screen[3];|/ (1.0 + p.screen[1].abs());|--test aa slab_mode"
+  "shells counted away from the eye on its low side|src/order.rs|if b[a] < split[a] { split[a] - 1 - b[a] } else|if b[a] < split[a] { b[a] } else|--test bricked waves_front"
+  "a mask word's count taken past it|src/bricks.rs|below[i] = below[i - 1] + words[i - 1].count_ones();|below[i] = below[i - 1] + words[i].count_ones();|--test bricked gpu_frames_match"
 )
 filter=${1:-}
 backup=$(mktemp -d)
