@@ -268,7 +268,7 @@ pub(super) fn record_bricks(
         // with the hidden bricks too (`cull_hidden_bricks` off), so the two draw the same frame. A
         // node stands for bricks consecutive in the tree's order: with nodes the waves keep it.
         let split = crate::order::brick_split(&prep.set, camera, BRICK);
-        visible.sort_by_key(|l| crate::order::brick_shell(scene.store.headers[l[0] as usize].coords(), split));
+        visible.sort_by_cached_key(|l| crate::order::brick_shell(scene.store.headers[l[0] as usize].coords(), split));
     }
     let batches = cut.batches(scene, visible, capacity, available);
     stats.waves = batches.len() as u32;
