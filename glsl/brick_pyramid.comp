@@ -91,9 +91,7 @@ void main() {
     // A brick whose value range the transfer function leaves empty: every cell of its pyramid and
     // its summary are zero, written without reading a voxel (the full pass writes the same words;
     // brick_cull never draws the brick, the nodes above sum its zeros). The whole workgroup leaves.
-    uint qlo = hd.w & 0xffffu;
-    uint qhi = hd.w >> 16u;
-    if (emitted_below(qhi) + (emits(qhi) ? 1u : 0u) == emitted_below(qlo)) {
+    if (tf_empty(hd.w & 0xffffu, hd.w >> 16u)) {
         for (uint i = lane; i < LOD_CELLS; i += BRICK_LANES) {
             put_cell(slot, h, i, 0.0, vec3(0.0), vec3(0.0), 0.0, vec3(0.0));
         }
