@@ -159,7 +159,8 @@ pub(super) fn record_bricks(
         (available, 0)
     };
     let frame = plan::frame_for(&prep.set, camera, opts);
-    let mut bf = scene.uniforms(crate::order::brick_split(&prep.set, camera, BRICK));
+    let split = crate::order::brick_split(&prep.set, camera, BRICK);
+    let mut bf = scene.uniforms(split);
     if lod {
         (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, opts.lod_error, opts.lod_band);
         bf.hi[3] = node_levels;
@@ -267,7 +268,6 @@ pub(super) fn record_bricks(
         // than behind the tree's slabs (the 512³ bonsai draws 2.38 M splats against 3.16 M). Kept
         // with the hidden bricks too (`cull_hidden_bricks` off), so the two draw the same frame. A
         // node stands for bricks consecutive in the tree's order: with nodes the waves keep it.
-        let split = crate::order::brick_split(&prep.set, camera, BRICK);
         visible.sort_by_cached_key(|l| crate::order::brick_shell(scene.store.headers[l[0] as usize].coords(), split));
     }
     let batches = cut.batches(scene, visible, capacity, available);
