@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Mutation check (issues 25, 44): plants seventeen known bugs one at a time, runs the tests that should
+# Mutation check (issues 25, 44): plants twenty-one known bugs one at a time, runs the tests that should
 # catch each, and prints a markdown table; exits 1 when a bug survives (no test failed). Each
 # mutant costs a release rebuild of the library and its tests (about 1-3 minutes here); the last
 # result lives in docs/RELIABILITY.md. The tree is restored after every mutant, also on Ctrl-C.
-#   scripts/mutants.sh            all seventeen
+#   scripts/mutants.sh            all twenty-one
 #   scripts/mutants.sh octant     the ones whose name contains "octant"
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,6 +28,8 @@ MUTANTS=(
   "a slab's depth profile widened by anti-aliasing|src/cpu/footprint.rs|/ (1.0 + p.screen[1].abs()) / p.screen[3];|/ (1.0 + p.screen[1].abs());|--test aa slab_mode"
   "shells counted away from the eye on its low side|src/order.rs|if b[a] < split[a] { split[a] - 1 - b[a] } else|if b[a] < split[a] { b[a] } else|--test bricked waves_front"
   "a mask word's count taken past it|src/bricks.rs|below[i] = below[i - 1] + words[i - 1].count_ones();|below[i] = below[i - 1] + words[i].count_ones();|--test bricked gpu_frames_match"
+  "a voxel's stored differences one-sided|src/bricks/gradients.rs|                hi[a] += 1;|                hi[a] += 0;|--test bricks every_stored_voxel"
+  "a voxel's differences read a record on, on the device|glsl/shared/brick.glsl|    uint i = gradients[h] + 2u * below;|    uint i = gradients[h] + 2u * below + 2u;|--test bricked gpu_frames_match"
 )
 filter=${1:-}
 backup=$(mktemp -d)

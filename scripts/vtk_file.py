@@ -22,6 +22,7 @@ ap.add_argument("--out", default="vtk.png")
 ap.add_argument("--mapper", default="fixed", choices=["fixed", "gpu"])
 ap.add_argument("--camera", default=None, help="voxsplat's 'camera (grid frame)' line")
 ap.add_argument("--shade", action="store_true")
+ap.add_argument("--sample-distance", type=float, default=None, help="ray step in world units (VTK's default: 1)")
 a = ap.parse_args()
 
 # voxsplat's presets (src/classify.rs): density normalised over the data's range, RGB, opacity of
@@ -74,6 +75,8 @@ if a.mapper == "gpu":
 else:
     mapper = vtk.vtkFixedPointVolumeRayCastMapper()
 mapper.SetAutoAdjustSampleDistances(0)
+if a.sample_distance:
+    mapper.SetSampleDistance(a.sample_distance)
 mapper.SetInputData(img)
 mapper.SetBlendModeToComposite()
 volume = vtk.vtkVolume()

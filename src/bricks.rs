@@ -19,7 +19,9 @@ use crate::volume::{Grid, ScalarVolume, SplatSet};
 use bytemuck::{Pod, Zeroable};
 
 mod build;
+mod gradients;
 pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
+pub use gradients::{pack_differences, unpack_differences, DIFFERENCE_WORDS};
 
 /// Voxels along each side of a brick.
 pub const BRICK: u32 = crate::constants::BRICK_SIDE;
@@ -236,6 +238,18 @@ pub fn local_cell(l: u32) -> [u32; 3] {
 /// (glsl/shared/brick.glsl's `emits`).
 pub fn emits(table: &[u32], q: u32) -> bool {
     table[4 * crate::constants::TF_ENTRIES as usize + (q >> 5) as usize] >> (q & 31) & 1 != 0
+}
+
+/// Whether the TF table `table` extracts any quantised value in `lo..=hi` (a brick of that range
+/// draws a voxel; `!tf_empty` in glsl/shared/brick.glsl).
+pub fn draws_any(table: &[u32], lo: u32, hi: u32) -> bool {
+    let bits = 4 * crate::constants::TF_ENTRIES as usize;
+    let prefix = bits + crate::constants::TF_ENTRIES as usize / 32;
+    let below = |q: u32| {
+        let w = (q >> 5) as usize;
+        table[prefix + w] + if q & 31 == 0 { 0 } else { (table[bits + w] & ((1u32 << (q & 31)) - 1)).count_ones() }
+    };
+    below(hi + 1) != below(lo)
 }
 
 /// `tf` tabulated per quantised value (see `BrickScene::tf_words`): the classification of a
@@ -498,6 +512,18 @@ impl BrickScene {
             lo: [self.part[0][0], self.part[0][1], self.part[0][2], self.tree.len() as u32],
             hi: [self.part[1][0], self.part[1][1], self.part[1][2], 0],
         }
+    }
+
+    /// The store's `gradient_words` (`Res::BrickGradients`) for the bricks the transfer function
+    /// draws: made when a device lacks them for this classification, and not kept (4 bytes a
+    /// stored voxel).
+    pub fn gradient_words(&self) -> Vec<u32> {
+        self.store.gradient_words(|hd| draws_any(&self.table, hd.range & 0xffff, hd.range >> 16))
+    }
+
+    /// Whether a frame classifies with gradients: shaded, or gradient-weighted opacity.
+    pub fn reads_gradients(&self) -> bool {
+        self.shading.is_some() || self.tf.gradient_weight > 0.0
     }
 
     /// The TF buffer (`Res::Tf`, glsl/shared/brick.glsl): per quantised value q its straight

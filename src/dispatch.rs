@@ -108,6 +108,9 @@ pub enum Res {
     BrickVoxels,
     /// Per entry of the next wave, 1 when hidden (front to back, early termination).
     BrickHidden,
+    /// Per stored voxel its packed central differences (`BrickStore::gradient_words`): what a
+    /// shaded or gradient-weighted frame's `brick_params` reads (its `GRADIENTS` build).
+    BrickGradients,
     /// A streamed store's records for one batch (the store stays on the host).
     BatchRecords,
     /// A streamed store's drawn voxels per brick under the current TF (counted on the host).
@@ -138,6 +141,20 @@ pub enum Res {
 }
 
 impl Res {
+    /// `list` with `from` replaced by `to`: a stage's bindings that differ from its family's in
+    /// one place.
+    pub const fn replaced<const N: usize>(list: [Res; N], from: Res, to: Res) -> [Res; N] {
+        let mut out = list;
+        let mut i = 0;
+        while i < N {
+            if list[i] as u32 == from as u32 {
+                out[i] = to;
+            }
+            i += 1;
+        }
+        out
+    }
+
     /// Made before any frame (renderer or scene) and never changed by a stage.
     pub fn is_constant(self) -> bool {
         matches!(

@@ -85,7 +85,7 @@ const FOOTPRINT: &[Res] = &[
     Res::Status,
 ];
 /// glsl/shared/brick.glsl's bindings, shared by the brick stages.
-const BRICK: &[Res] = &[
+const BRICK: &[Res; 32] = &[
     Res::Frame,
     Res::BrickFrame,
     Res::Tf,
@@ -119,9 +119,15 @@ const BRICK: &[Res] = &[
     Res::Pyramid3,
     Res::LodSplats,
 ];
+/// `brick_params`' bindings: its `GRADIENTS` build's input in `brick_hidden`'s output's place
+/// (the brick stages' list is at lavapipe's 32 storage buffers a stage).
+const BRICK_PARAMS: &[Res] = &Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients);
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
 const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
+/// `RECORD_PAGED`'s, and one page of records with the voxels' differences read from
+/// `Res::BrickGradients` (`recording::record_bricks` picks it for shaded or gradient-weighted frames).
+const PARAMS_BUILDS: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[]), v("GRADIENTS", &[])];
 /// A resident pyramid, or a streamed store's batch of pyramids (`brick_cells`).
 const PYRAMID_STREAMED: &[Variant] = &[v("", &[]), v("STREAMED_STORE", &[])];
 const ONE: &[Variant] = &[v("", &[])];
@@ -256,13 +262,13 @@ pub const STAGES: &[StageDesc] = &[
     StageDesc {
         name: "brick_params",
         kind: Kind::Compute,
-        bindings: BRICK,
+        bindings: BRICK_PARAMS,
         writes: &[Res::Params],
         push: std::mem::size_of::<BrickPush>() as u32,
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: RECORD_PAGED,
+        variants: PARAMS_BUILDS,
         mirror: crate::cpu::brick::brick_params_stage,
     },
     StageDesc {

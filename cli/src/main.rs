@@ -419,13 +419,15 @@ fn print_store(store: &voxsplat::bricks::BrickStore) {
     let pyramid = voxsplat::cpu::lod::pyramid_bytes(voxsplat::cpu::lod::LOD_BUFFERS, store.headers.len());
     println!(
         "bricked store: {} stored voxels in {} bricks of {}^3, {} bytes on the GPU, {:.2} bytes per stored voxel \
-         ({:.2} with the levels-of-detail pyramid of --lod auto)",
+         ({:.2} with the levels-of-detail pyramid of --lod auto; shaded or gradient-weighted frames add {:.2} for \
+         each voxel's central differences)",
         store.len(),
         store.headers.len(),
         voxsplat::bricks::BRICK,
         store.bytes(),
         per_voxel(store.bytes()),
-        per_voxel(store.bytes() + pyramid)
+        per_voxel(store.bytes() + pyramid),
+        per_voxel(store.gradient_len() * 4)
     );
 }
 

@@ -95,8 +95,14 @@ layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
 layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
 // The occlusion map after the waves drawn so far (tile_occlusion; occlusion.glsl).
 layout(std430, binding = 13) readonly buffer Occlusion { float occlusion[]; };
+#ifdef GRADIENTS
+// Per header its first word, then per stored voxel its packed central differences
+// (BrickStore::gradient_words): brick_params' GRADIENTS build, in brick_hidden's place.
+layout(std430, binding = 21) readonly buffer Gradients { uint gradients[]; };
+#else
 // Per entry of the next wave, 1 when it is hidden (brick_hidden).
 layout(std430, binding = 21) writeonly buffer Hidden { uint hidden_out[]; };
+#endif
 
 const float Q_MAX = 65535.0;
 const uint MASK_WORDS = BRICK_SIDE * BRICK_SIDE * BRICK_SIDE / 32u;
@@ -187,17 +193,41 @@ float density_at(ivec3 v) {
     return stored_at(v) * bf.tf.x + bf.tf.y;
 }
 
-// Central-difference gradient of the density at voxel v, read through the store (classify_field).
-// A sheared grid's world gradient solves U^T g = diff / 2 (Grid::gradient).
-vec3 gradient_at(ivec3 v) {
+// The world gradient of the density from its central differences d along the grid's axes: a
+// sheared grid's solves U^T g = d / 2 (Grid::gradient).
+vec3 gradient_from(vec3 d) {
     vec3 s = frame.spacing.xyz;
     vec3 h = frame.shear.xyz;
-    float gx = (density_at(v + ivec3(1, 0, 0)) - density_at(v - ivec3(1, 0, 0))) / (2.0 * s.x);
-    float gy = (density_at(v + ivec3(0, 1, 0)) - density_at(v - ivec3(0, 1, 0)) - 2.0 * h.x * gx) / (2.0 * s.y);
-    float gz = (density_at(v + ivec3(0, 0, 1)) - density_at(v - ivec3(0, 0, 1)) - 2.0 * (h.y * gx + h.z * gy))
-        / (2.0 * s.z);
+    float gx = d.x / (2.0 * s.x);
+    float gy = (d.y - 2.0 * h.x * gx) / (2.0 * s.y);
+    float gz = (d.z - 2.0 * (h.y * gx + h.z * gy)) / (2.0 * s.z);
     return vec3(gx, gy, gz);
 }
+
+// Central-difference gradient of the density at voxel v, read through the store (classify_field).
+vec3 gradient_at(ivec3 v) {
+    return gradient_from(vec3(density_at(v + ivec3(1, 0, 0)) - density_at(v - ivec3(1, 0, 0)),
+                              density_at(v + ivec3(0, 1, 0)) - density_at(v - ivec3(0, 1, 0)),
+                              density_at(v + ivec3(0, 0, 1)) - density_at(v - ivec3(0, 0, 1))));
+}
+
+#ifdef GRADIENTS
+// The density's central differences at stored voxel v, from its two packed words (each difference
+// plus 65536 in 17 bits: pack_differences): one lookup of the voxel's rank instead of six
+// neighbours'. Mirror: BrickInputs::stored_differences.
+vec3 stored_differences(ivec3 v) {
+    uvec3 c = uvec3(v);
+    uint h = header_of(c);
+    uvec3 lc = c % BRICK_SIDE;
+    uint l = lc.x + BRICK_SIDE * (lc.y + BRICK_SIDE * lc.z);
+    uint word = masks[h * MASK_STRIDE + l / 32u];
+    uint below = uint(bitCount(word & ((1u << (l % 32u)) - 1u))) + mask_below(h, l / 32u);
+    uint i = gradients[h] + 2u * below;
+    uvec2 w = uvec2(gradients[i], gradients[i + 1u]);
+    ivec3 d = ivec3(uvec3(w.x & 0x1ffffu, (w.x >> 17u) | ((w.y & 3u) << 15u), w.y >> 2u)) - 65536;
+    return vec3(d) * (bf.tf.x / Q_MAX);
+}
+#endif
 
 // Headlight shading (two-sided) of colour rgb at a gradient g.
 vec3 shade(vec3 rgb, vec3 g) {
@@ -215,7 +245,11 @@ vec4 classify_voxel(ivec3 v, uint q, bool shaded) {
     vec4 c = tf_color[q];
     bool weighted = bf.tf.w > 0.0;
     if (weighted || shaded) {
+#ifdef GRADIENTS
+        vec3 g = gradient_from(stored_differences(v));
+#else
         vec3 g = gradient_at(v);
+#endif
         if (weighted) c.a *= pow(length(g) / bf.grad.x, bf.tf.w);
         if (shaded) c.rgb = shade(c.rgb, g);
     }

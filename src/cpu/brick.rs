@@ -95,6 +95,8 @@ pub struct BrickInputs<'a> {
     /// A streamed store's pyramid holds one batch's bricks: per header its slot (STREAMED_STORE
     /// builds), or `None`: the pyramid is indexed by header.
     pub pyramid_slot: Option<&'a [u32]>,
+    /// `BrickStore::gradient_words` (GRADIENTS builds), or `None`: gradients read through the store.
+    pub gradients: Option<&'a [u32]>,
 }
 
 impl BrickInputs<'_> {
@@ -141,6 +143,18 @@ impl BrickInputs<'_> {
         ]))
     }
 
+    /// Mirror of `stored_differences`: voxel `v`'s packed central differences of the density.
+    fn stored_differences(&self, words: &[u32], v: [i64; 3]) -> [f32; 3] {
+        let c = v.map(|c| c as u32);
+        let h = self.store.header_of(c);
+        let mask = &self.store.masks[h as usize];
+        let l = (c[0] % BRICK + BRICK * (c[1] % BRICK) + BRICK * BRICK * (c[2] % BRICK)) as usize;
+        let below = mask[..l / 64].iter().map(|w| w.count_ones()).sum::<u32>()
+            + (mask[l / 64] & ((1u64 << (l % 64)) - 1)).count_ones();
+        let i = (words[h as usize] + crate::bricks::DIFFERENCE_WORDS * below) as usize;
+        crate::bricks::unpack_differences([words[i], words[i + 1]], self.bf.tf[0] / 65535.0)
+    }
+
     /// Mirror of `shade`.
     pub(crate) fn shade(&self, c: &mut [f32; 4], g: Vec3) {
         let len = g.length();
@@ -159,7 +173,10 @@ impl BrickInputs<'_> {
         let mut c = [0, 1, 2, 3].map(|i| f32::from_bits(self.tf[4 * q as usize + i]));
         let weighted = self.bf.tf[3] > 0.0;
         if weighted || shaded {
-            let g = self.gradient_at(v);
+            let g = match self.gradients {
+                Some(words) => Vec3::from(frame_grid(self.frame).gradient(self.stored_differences(words, v))),
+                None => self.gradient_at(v),
+            };
             if weighted {
                 c[3] *= (g.length() / self.bf.grad[0]).powf(self.bf.tf[3]);
             }
@@ -414,6 +431,7 @@ pub(crate) fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
         pyramid: b.get(Res::Pyramid),
         summary: b.get(Res::LodSummary),
         morphs: b.get(Res::BrickMorph),
+        gradients: None,
         pyramid_slot: None,
     })
 }
@@ -423,6 +441,9 @@ pub(crate) fn inputs_for<'a>(b: &'a Bindings<'_>, v: &Variant) -> Result<BrickIn
     let mut i = inputs(b)?;
     if streamed(v) {
         i.pyramid_slot = Some(b.get(Res::PyramidSlot));
+    }
+    if v.defines.contains("GRADIENTS") {
+        i.gradients = Some(b.get(Res::BrickGradients));
     }
     Ok(i)
 }

@@ -158,6 +158,13 @@ pub(super) fn record_bricks(
     } else {
         (available, 0)
     };
+    // A shaded or gradient-weighted frame of a resident store in one page reads each voxel's
+    // differences (`BrickStore::gradient_words`, made once) where they fit what the store leaves:
+    // one lookup a splat instead of six neighbours'.
+    let gradient_bytes = scene.store.gradient_len() * 4;
+    let gradients =
+        build_of(scene, streamed) == 0 && scene.reads_gradients() && gradient_bytes <= range.min(available / 2);
+    let available = if gradients { available - gradient_bytes } else { available };
     let frame = plan::frame_for(&prep.set, camera, opts);
     let split = crate::order::brick_split(&prep.set, camera, BRICK);
     let mut bf = scene.uniforms(split);
@@ -167,13 +174,25 @@ pub(super) fn record_bricks(
     }
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
     // The brick stages' build: one page of store records, the paged reader, or streamed records.
-    let build = if streamed { 2 } else { usize::from(scene.store.records.len() > RECORD_PAGE as usize) };
+    let build = build_of(scene, streamed);
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
+    if gradients {
+        e.ensure(Res::BrickGradients, gradient_bytes)?;
+        let id = scene.classification();
+        if e.tag(Res::BrickGradients) != id {
+            // Made on the first frame of a classification that reads them (the 512³ bonsai: ~0.4 s).
+            let t = Instant::now();
+            e.upload(Res::BrickGradients, &scene.gradient_words())?;
+            e.host_time("gradients", t.elapsed().as_secs_f64() * 1e3);
+            e.set_tag(Res::BrickGradients, id);
+        }
+    }
     let cut = Cut {
         streamed,
         build,
+        params_build: if gradients { PARAMS_GRADIENTS } else { build },
         available,
         pyramid: batch_pyramid,
         range,
@@ -352,6 +371,8 @@ pub(super) fn record_bricks(
 struct Cut<'a> {
     streamed: bool,
     build: usize,
+    /// `brick_params`' build: `build`, or `PARAMS_GRADIENTS`.
+    params_build: usize,
     available: u64,
     pyramid: u64,
     /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
@@ -578,7 +599,13 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         let variant = usize::from(streamed);
         e.run(&Dispatch::new(StageId::BrickCells, variant, groups, List::Order, bytemuck::bytes_of(&cells)))?;
     }
-    e.run(&Dispatch::new(StageId::BrickParams, build, groups_1d(n), List::Order, bytemuck::bytes_of(&push)))?;
+    e.run(&Dispatch::new(
+        StageId::BrickParams,
+        cut.params_build,
+        groups_1d(n),
+        List::Order,
+        bytemuck::bytes_of(&push),
+    ))?;
     // The coarse splats' positions, for brick_lod_params' lanes.
     let lod_splats: Vec<u32> = coarse.iter().flat_map(|l| l[1]..l[1] + (l[3] & 0xffff)).collect();
     if !lod_splats.is_empty() {
@@ -642,6 +669,19 @@ fn upload_batch(
     }
     Ok(())
 }
+
+/// The brick stages' build: one page of store records (0), the paged reader (1), or streamed
+/// records (2).
+fn build_of(scene: &BrickScene, streamed: bool) -> usize {
+    if streamed {
+        2
+    } else {
+        usize::from(scene.store.records.len() > RECORD_PAGE as usize)
+    }
+}
+
+/// `brick_params`' build that reads `Res::BrickGradients` (stages.rs, `PARAMS_BUILDS`).
+const PARAMS_GRADIENTS: usize = 3;
 
 /// Most bytes of one batch of a streamed store's one-time pyramid build.
 const SUMMARY_BATCH_BYTES: u64 = 64 << 20;
