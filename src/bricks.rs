@@ -21,7 +21,7 @@ use bytemuck::{Pod, Zeroable};
 mod build;
 mod gradients;
 pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
-pub use gradients::{pack_differences, unpack_differences, DIFFERENCE_WORDS};
+pub use gradients::{pack_differences, unpack_differences};
 
 /// Voxels along each side of a brick.
 pub const BRICK: u32 = crate::constants::BRICK_SIDE;
@@ -517,7 +517,7 @@ impl BrickScene {
     /// The store's `gradient_words` (`Res::BrickGradients`) for the bricks the transfer function
     /// draws: made when a device lacks them for this classification, and not kept (4 bytes a
     /// stored voxel).
-    pub fn gradient_words(&self) -> Vec<u32> {
+    pub fn gradient_words(&self) -> [Vec<u32>; 2] {
         self.store.gradient_words(|hd| draws_any(&self.table, hd.range & 0xffff, hd.range >> 16))
     }
 

@@ -108,9 +108,12 @@ pub enum Res {
     BrickVoxels,
     /// Per entry of the next wave, 1 when hidden (front to back, early termination).
     BrickHidden,
-    /// Per stored voxel its packed central differences (`BrickStore::gradient_words`): what a
-    /// shaded or gradient-weighted frame's `brick_params` reads (its `GRADIENTS` build).
+    /// Per stored voxel the first word of its packed central differences
+    /// (`BrickStore::gradient_words`): what a shaded or gradient-weighted frame's `brick_params`
+    /// reads (its `GRADIENTS` build).
     BrickGradients,
+    /// The second words of `BrickGradients`.
+    BrickGradientsHi,
     /// A streamed store's records for one batch (the store stays on the host).
     BatchRecords,
     /// A streamed store's drawn voxels per brick under the current TF (counted on the host).

@@ -4,6 +4,7 @@
 //! starts and the loop-budget word), the engine finishes the work so far; the recording is still
 //! written once, for every engine.
 mod bricked;
+mod gradients;
 use crate::camera::Camera;
 use crate::constants::{
     COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, RECORD_PAGE, SPLAT_PAGE, TILE_BIN_WORKGROUP,

@@ -119,9 +119,10 @@ const BRICK: &[Res; 32] = &[
     Res::Pyramid3,
     Res::LodSplats,
 ];
-/// `brick_params`' bindings: its `GRADIENTS` build's input in `brick_hidden`'s output's place
-/// (the brick stages' list is at lavapipe's 32 storage buffers a stage).
-const BRICK_PARAMS: &[Res] = &Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients);
+/// `brick_params`' bindings: its `GRADIENTS` build's inputs in `brick_hidden`'s places (the brick
+/// stages' list is at lavapipe's 32 storage buffers a stage).
+const BRICK_PARAMS: &[Res] =
+    &Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi);
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
 const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];

@@ -724,3 +724,52 @@ fn uniform_bricks_draw_as_their_voxels_do() {
     }
     assert_clean(&dense);
 }
+
+/// A shaded or gradient-weighted frame reads each voxel's precomputed differences where both
+/// buffers fit half of what the store leaves of the budget, and its neighbours through the store
+/// where they do not: the same gradients either way (the differences are exact), on both engines.
+#[test]
+fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
+    let vol = blob([61, 53, 47]);
+    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    let shading = Some(Shading::headlight(cam.forward()));
+    let mut weighted = tf();
+    weighted.gradient_weight = 0.5;
+    let mut o = compute(Direction::FrontToBack);
+    o.lod = Lod::Off;
+    let made = |r: &voxsplat::Rendered| r.timings.iter().any(|t| t.stage == "gradients");
+    for (tf, what) in [(tf(), "shaded"), (weighted, "weighted")] {
+        let mut frames = Vec::new();
+        for gpu in [true, false] {
+            let mut whole = renderer(gpu, None);
+            whole.set_volume(&vol, &tf, shading).unwrap();
+            let scene = whole.volume().unwrap();
+            // Just under four times one buffer's bytes left by the store: they do not fit.
+            let bytes = scene.store.gradient_len() * 4;
+            let budget = voxsplat::recording::bricked_resident_bytes(scene, u64::MAX, 80, 80) + 4 * bytes - 4;
+            assert!(!scene.streams(budget), "the store stays resident");
+            let mut tight = renderer(gpu, Some(budget));
+            tight.set_volume(&vol, &tf, shading).unwrap();
+            let a = whole.render(&cam, &o).unwrap();
+            let b = tight.render(&cam, &o).unwrap();
+            assert!(made(&a) && !made(&b), "{what} gpu {gpu}: precomputed, then through the store");
+            // The device keeps them for the classification (the CPU engine keeps nothing across frames).
+            assert!(!gpu || !made(&whole.render(&cam, &o).unwrap()), "{what}: made once per classification");
+            assert!(a.image.pixels.iter().any(|p| p[3] > 0.1), "{what}: something drawn");
+            let (most, mean) = diff(&a.image, &b.image);
+            assert!(most <= 1e-5 && mean <= 1e-7, "{what} gpu {gpu}: precomputed vs through the store {most} / {mean}");
+            if gpu {
+                assert_clean(&whole);
+                assert_clean(&tight);
+            }
+            frames.push((a.image, b.image));
+        }
+        for i in 0..2 {
+            let (most, mean) = diff(
+                if i == 0 { &frames[0].0 } else { &frames[0].1 },
+                if i == 0 { &frames[1].0 } else { &frames[1].1 },
+            );
+            assert!(most <= 2e-3 && mean <= 1e-5, "{what} build {i}: GPU vs mirror {most} / {mean}");
+        }
+    }
+}

@@ -325,10 +325,10 @@ fn uniform_bricks_store_no_records_and_every_value_comes_back() {
 /// Each stored voxel's precomputed central differences (what a shaded frame's `brick_params`
 /// reads in place of six neighbours) are exactly the store's own, voxel by voxel: across brick
 /// faces, at the clamped grid edges, in partial and uniform bricks. The device finds a voxel's
-/// words as `brick_params` does: the header's first word plus two per record before it.
+/// two words as `brick_params` does: the header's first word plus the records before it.
 #[test]
 fn every_stored_voxel_keeps_the_stores_central_differences() {
-    use voxsplat::bricks::{unpack_differences, DIFFERENCE_WORDS};
+    use voxsplat::bricks::unpack_differences;
     let mut rng = Rng(41);
     let noisy = {
         let dims = [21, 17, 11];
@@ -338,8 +338,9 @@ fn every_stored_voxel_keeps_the_stores_central_differences() {
     };
     for vol in [common::blob([37, 29, 23]), common::flat_blocks([37, 29, 40]), noisy] {
         let store = BrickStore::build(&vol).unwrap();
-        let words = store.gradient_words(|_| true);
-        assert_eq!(words.len() as u64, store.gradient_len());
+        let [words, hi] = store.gradient_words(|_| true);
+        assert_eq!((words.len() as u64, hi.len()), (store.gradient_len(), words.len()));
+        assert_eq!(words[..store.headers.len()], hi[..store.headers.len()]);
         let q = |i: i64, j: i64, k: i64| (store.value_at(i, j, k) * 65535.0).round() as i32;
         let (mut checked, mut across) = (0, 0);
         for (h, hd) in store.headers.iter().enumerate() {
@@ -351,8 +352,8 @@ fn every_stored_voxel_keeps_the_stores_central_differences() {
                 let [i, j, k] = [0, 1, 2].map(|a| base[a] + local[a] as i64);
                 let want =
                     [q(i + 1, j, k) - q(i - 1, j, k), q(i, j + 1, k) - q(i, j - 1, k), q(i, j, k + 1) - q(i, j, k - 1)];
-                let at = (words[h] + DIFFERENCE_WORDS * rank as u32) as usize;
-                let got = unpack_differences([words[at], words[at + 1]], 1.0);
+                let at = (words[h] + rank as u32) as usize;
+                let got = unpack_differences([words[at], hi[at]], 1.0);
                 assert_eq!(got, want.map(|d| d as f32), "({i},{j},{k})");
                 checked += 1;
                 across += usize::from(local.iter().any(|&c| c == 0 || c == BRICK - 1) && want != [0; 3]);
@@ -363,9 +364,9 @@ fn every_stored_voxel_keeps_the_stores_central_differences() {
     }
     // A brick the predicate leaves out keeps zeros (the transfer function draws none of it).
     let store = BrickStore::build(&common::blob([37, 29, 23])).unwrap();
-    let words = store.gradient_words(|hd| hd.coords() != [1, 1, 1]);
+    let [words, hi] = store.gradient_words(|hd| hd.coords() != [1, 1, 1]);
     let h = store.headers.iter().position(|hd| hd.coords() == [1, 1, 1]).unwrap();
-    let (at, n) = (words[h] as usize, (DIFFERENCE_WORDS * store.headers[h].count) as usize);
-    assert!(n > 0 && words[at..at + n].iter().all(|&w| w == 0));
-    assert_ne!(store.gradient_words(|_| true)[at..at + n], words[at..at + n]);
+    let (at, n) = (words[h] as usize, store.headers[h].count as usize);
+    assert!(n > 0 && words[at..at + n].iter().chain(&hi[at..at + n]).all(|&w| w == 0));
+    assert_ne!(store.gradient_words(|_| true)[0][at..at + n], words[at..at + n]);
 }

@@ -427,7 +427,7 @@ fn print_store(store: &voxsplat::bricks::BrickStore) {
         store.bytes(),
         per_voxel(store.bytes()),
         per_voxel(store.bytes() + pyramid),
-        per_voxel(store.gradient_len() * 4)
+        per_voxel(store.gradient_len() * 8)
     );
 }
 

@@ -93,12 +93,16 @@ layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]
 layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
 // The batch's voxels in draw order: i | j << 16, k | stored value << 16.
 layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
+#ifndef GRADIENTS
 // The occlusion map after the waves drawn so far (tile_occlusion; occlusion.glsl).
 layout(std430, binding = 13) readonly buffer Occlusion { float occlusion[]; };
+#endif
 #ifdef GRADIENTS
-// Per header its first word, then per stored voxel its packed central differences
-// (BrickStore::gradient_words): brick_params' GRADIENTS build, in brick_hidden's place.
+// Per header its first word, then per stored voxel the first and second words of its packed
+// central differences (BrickStore::gradient_words): brick_params' GRADIENTS build, in the places
+// of brick_hidden's output and input (two bindings: each within maxStorageBufferRange).
 layout(std430, binding = 21) readonly buffer Gradients { uint gradients[]; };
+layout(std430, binding = 13) readonly buffer GradientsHi { uint gradients_hi[]; };
 #else
 // Per entry of the next wave, 1 when it is hidden (brick_hidden).
 layout(std430, binding = 21) writeonly buffer Hidden { uint hidden_out[]; };
@@ -222,8 +226,8 @@ vec3 stored_differences(ivec3 v) {
     uint l = lc.x + BRICK_SIDE * (lc.y + BRICK_SIDE * lc.z);
     uint word = masks[h * MASK_STRIDE + l / 32u];
     uint below = uint(bitCount(word & ((1u << (l % 32u)) - 1u))) + mask_below(h, l / 32u);
-    uint i = gradients[h] + 2u * below;
-    uvec2 w = uvec2(gradients[i], gradients[i + 1u]);
+    uint i = gradients[h] + below;
+    uvec2 w = uvec2(gradients[i], gradients_hi[i]);
     ivec3 d = ivec3(uvec3(w.x & 0x1ffffu, (w.x >> 17u) | ((w.y & 3u) << 15u), w.y >> 2u)) - 65536;
     return vec3(d) * (bf.tf.x / Q_MAX);
 }

@@ -6,9 +6,6 @@
 use super::{BrickHeader, BrickStore, BRICK, BRICK_VOXELS};
 use rayon::prelude::*;
 
-/// Words a voxel's differences take.
-pub const DIFFERENCE_WORDS: u32 = 2;
-
 /// Packs the central differences `d` of quantised values (each within ±65535), exactly: each plus
 /// 65536 in 17 bits, x in bits 0-16 of the first word, y in its bits 17-31 and the second's 0-1,
 /// z in the second's 2-18.
@@ -25,36 +22,41 @@ pub fn unpack_differences(w: [u32; 2], scale: f32) -> [f32; 3] {
 }
 
 impl BrickStore {
-    /// `Res::BrickGradients`: per header the index of its first word, then per brick, in the
-    /// order of its records (local index order; all 512 voxels of a uniform brick), each voxel's
-    /// two words of packed central differences of the quantised values around it (`pack_differences`; indices
-    /// clamped to the grid, 0 where nothing is stored, as `value_at` reads them). Bricks that
-    /// `draws` leaves out (the transfer function draws none of their values) keep zeros.
-    pub fn gradient_words(&self, draws: impl Fn(&BrickHeader) -> bool + Sync) -> Vec<u32> {
-        let mut words = vec![0u32; self.gradient_len() as usize];
-        let (first, mut rest) = words.split_at_mut(self.headers.len());
-        // Each brick's slice of the output, so the bricks fill theirs in parallel.
-        let mut slices = Vec::with_capacity(self.headers.len());
+    /// `Res::BrickGradients` and `BrickGradientsHi`: each per header the index of its first word,
+    /// then per brick, in the order of its records (local index order; all 512 voxels of a uniform
+    /// brick), the first (second) word of each voxel's packed central differences of the quantised
+    /// values around it (`pack_differences`; indices clamped to the grid, 0 where nothing is
+    /// stored, as `value_at` reads them). Bricks that `draws` leaves out (the transfer function
+    /// draws none of their values) keep zeros.
+    pub fn gradient_words(&self, draws: impl Fn(&BrickHeader) -> bool + Sync) -> [Vec<u32>; 2] {
+        let n = self.gradient_len() as usize;
+        let (mut lo, mut hi) = (vec![0u32; n], vec![0u32; n]);
         let mut at = self.headers.len() as u32;
-        for (hd, f) in self.headers.iter().zip(first.iter_mut()) {
-            *f = at;
-            at += DIFFERENCE_WORDS * hd.count;
-            let (mine, tail) = std::mem::take(&mut rest).split_at_mut((DIFFERENCE_WORDS * hd.count) as usize);
-            rest = tail;
-            slices.push((hd, mine));
+        for (hd, f) in self.headers.iter().zip(lo.iter_mut().zip(hi.iter_mut())) {
+            (*f.0, *f.1) = (at, at);
+            at += hd.count;
         }
-        slices.into_par_iter().filter(|(hd, _)| draws(hd)).for_each(|(hd, out)| self.brick_differences(hd, out));
-        words
+        // Each brick's slices of the output, so the bricks fill theirs in parallel.
+        let (mut rest_lo, mut rest_hi) = (&mut lo[self.headers.len()..], &mut hi[self.headers.len()..]);
+        let mut slices = Vec::with_capacity(self.headers.len());
+        for hd in &self.headers {
+            let (a, tail_lo) = std::mem::take(&mut rest_lo).split_at_mut(hd.count as usize);
+            let (b, tail_hi) = std::mem::take(&mut rest_hi).split_at_mut(hd.count as usize);
+            (rest_lo, rest_hi) = (tail_lo, tail_hi);
+            slices.push((hd, a, b));
+        }
+        slices.into_par_iter().filter(|(hd, ..)| draws(hd)).for_each(|(hd, a, b)| self.brick_differences(hd, a, b));
+        [lo, hi]
     }
 
-    /// The length of `gradient_words`, without making it.
+    /// The length of each of `gradient_words`' two, without making them.
     pub fn gradient_len(&self) -> u64 {
-        self.headers.len() as u64 + DIFFERENCE_WORDS as u64 * self.headers.iter().map(|h| h.count as u64).sum::<u64>()
+        self.headers.len() as u64 + self.headers.iter().map(|h| h.count as u64).sum::<u64>()
     }
 
     /// Brick `hd`'s voxels' packed differences, into `out`: its own values from a dense copy,
     /// its face neighbours' from copies of the layer next to it.
-    fn brick_differences(&self, hd: &BrickHeader, out: &mut [u32]) {
+    fn brick_differences(&self, hd: &BrickHeader, lo: &mut [u32], hi: &mut [u32]) {
         const B: i64 = BRICK as i64;
         let mut dense = [0i32; BRICK_VOXELS];
         let records = self.brick_records(hd);
@@ -101,15 +103,15 @@ impl BrickStore {
                 }
             }
         };
-        for (o, r) in out.chunks_exact_mut(DIFFERENCE_WORDS as usize).zip(records.iter()) {
+        for ((a_out, b_out), r) in lo.iter_mut().zip(hi.iter_mut()).zip(records.iter()) {
             let [x, y, z] = super::local_cell(r & 511).map(|c| c as i64);
             let v = [base[0] + x, base[1] + y, base[2] + z];
-            o.copy_from_slice(&pack_differences([0, 1, 2].map(|a| {
-                let (mut lo, mut hi) = (v, v);
-                lo[a] -= 1;
-                hi[a] += 1;
-                q(hi) - q(lo)
-            })));
+            [*a_out, *b_out] = pack_differences([0, 1, 2].map(|a| {
+                let (mut down, mut up) = (v, v);
+                down[a] -= 1;
+                up[a] += 1;
+                q(up) - q(down)
+            }));
         }
     }
 }

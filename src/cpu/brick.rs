@@ -96,7 +96,7 @@ pub struct BrickInputs<'a> {
     /// builds), or `None`: the pyramid is indexed by header.
     pub pyramid_slot: Option<&'a [u32]>,
     /// `BrickStore::gradient_words` (GRADIENTS builds), or `None`: gradients read through the store.
-    pub gradients: Option<&'a [u32]>,
+    pub gradients: Option<(&'a [u32], &'a [u32])>,
 }
 
 impl BrickInputs<'_> {
@@ -144,15 +144,15 @@ impl BrickInputs<'_> {
     }
 
     /// Mirror of `stored_differences`: voxel `v`'s packed central differences of the density.
-    fn stored_differences(&self, words: &[u32], v: [i64; 3]) -> [f32; 3] {
+    fn stored_differences(&self, words: (&[u32], &[u32]), v: [i64; 3]) -> [f32; 3] {
         let c = v.map(|c| c as u32);
         let h = self.store.header_of(c);
         let mask = &self.store.masks[h as usize];
         let l = (c[0] % BRICK + BRICK * (c[1] % BRICK) + BRICK * BRICK * (c[2] % BRICK)) as usize;
         let below = mask[..l / 64].iter().map(|w| w.count_ones()).sum::<u32>()
             + (mask[l / 64] & ((1u64 << (l % 64)) - 1)).count_ones();
-        let i = (words[h as usize] + crate::bricks::DIFFERENCE_WORDS * below) as usize;
-        crate::bricks::unpack_differences([words[i], words[i + 1]], self.bf.tf[0] / 65535.0)
+        let i = (words.0[h as usize] + below) as usize;
+        crate::bricks::unpack_differences([words.0[i], words.1[i]], self.bf.tf[0] / 65535.0)
     }
 
     /// Mirror of `shade`.
@@ -443,7 +443,7 @@ pub(crate) fn inputs_for<'a>(b: &'a Bindings<'_>, v: &Variant) -> Result<BrickIn
         i.pyramid_slot = Some(b.get(Res::PyramidSlot));
     }
     if v.defines.contains("GRADIENTS") {
-        i.gradients = Some(b.get(Res::BrickGradients));
+        i.gradients = Some((b.get(Res::BrickGradients), b.get(Res::BrickGradientsHi)));
     }
     Ok(i)
 }

@@ -158,13 +158,8 @@ pub(super) fn record_bricks(
     } else {
         (available, 0)
     };
-    // A shaded or gradient-weighted frame of a resident store in one page reads each voxel's
-    // differences (`BrickStore::gradient_words`, made once) where they fit what the store leaves:
-    // one lookup a splat instead of six neighbours'.
-    let gradient_bytes = scene.store.gradient_len() * 4;
-    let gradients =
-        build_of(scene, streamed) == 0 && scene.reads_gradients() && gradient_bytes <= range.min(available / 2);
-    let available = if gradients { available - gradient_bytes } else { available };
+    let gradients = super::gradients::fit(scene, build_of(scene, streamed), range, available);
+    let available = available - gradients.unwrap_or(0);
     let frame = plan::frame_for(&prep.set, camera, opts);
     let split = crate::order::brick_split(&prep.set, camera, BRICK);
     let mut bf = scene.uniforms(split);
@@ -178,21 +173,13 @@ pub(super) fn record_bricks(
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
-    if gradients {
-        e.ensure(Res::BrickGradients, gradient_bytes)?;
-        let id = scene.classification();
-        if e.tag(Res::BrickGradients) != id {
-            // Made on the first frame of a classification that reads them (the 512³ bonsai: ~0.4 s).
-            let t = Instant::now();
-            e.upload(Res::BrickGradients, &scene.gradient_words())?;
-            e.host_time("gradients", t.elapsed().as_secs_f64() * 1e3);
-            e.set_tag(Res::BrickGradients, id);
-        }
+    if let Some(bytes) = gradients {
+        super::gradients::upload(e, scene, bytes)?;
     }
     let cut = Cut {
         streamed,
         build,
-        params_build: if gradients { PARAMS_GRADIENTS } else { build },
+        params_build: if gradients.is_some() { super::gradients::PARAMS_GRADIENTS } else { build },
         available,
         pyramid: batch_pyramid,
         range,
@@ -679,9 +666,6 @@ fn build_of(scene: &BrickScene, streamed: bool) -> usize {
         usize::from(scene.store.records.len() > RECORD_PAGE as usize)
     }
 }
-
-/// `brick_params`' build that reads `Res::BrickGradients` (stages.rs, `PARAMS_BUILDS`).
-const PARAMS_GRADIENTS: usize = 3;
 
 /// Most bytes of one batch of a streamed store's one-time pyramid build.
 const SUMMARY_BATCH_BYTES: u64 = 64 << 20;

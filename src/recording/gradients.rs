@@ -1,0 +1,34 @@
+//! A shaded or gradient-weighted bricked frame's voxel differences (`BrickStore::gradient_words`):
+//! `brick_params` reads one voxel's two words instead of its six neighbours through the store.
+use super::*;
+use crate::bricks::BrickScene;
+
+/// `brick_params`' build that reads `Res::BrickGradients` (stages.rs, `PARAMS_BUILDS`).
+pub(super) const PARAMS_GRADIENTS: usize = 3;
+
+/// The bytes the two buffers take when this frame reads them: it classifies with gradients, its
+/// store is resident in one page (`build` 0), each fits a binding and both fit half of what the
+/// store leaves of the budget (`available`). `None`: neighbours are read through the store.
+pub(super) fn fit(scene: &BrickScene, build: usize, range: u64, available: u64) -> Option<u64> {
+    let bytes = scene.store.gradient_len() * 4;
+    (build == 0 && scene.reads_gradients() && bytes <= range.min(available / 4)).then_some(2 * bytes)
+}
+
+/// Make the two buffers hold this classification's differences (`bytes`: both), made on its first
+/// frame (the 512³ bonsai: ~0.4 s, the `gradients` time).
+pub(super) fn upload(e: &mut dyn Engine, scene: &BrickScene, bytes: u64) -> Result<()> {
+    let res = [Res::BrickGradients, Res::BrickGradientsHi];
+    let id = scene.classification();
+    for r in res {
+        e.ensure(r, bytes / 2)?;
+    }
+    if res.iter().any(|&r| e.tag(r) != id) {
+        let t = std::time::Instant::now();
+        for (r, words) in res.into_iter().zip(scene.gradient_words()) {
+            e.upload(r, &words)?;
+            e.set_tag(r, id);
+        }
+        e.host_time("gradients", t.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(())
+}
