@@ -3,7 +3,7 @@
 //! (each a brick lookup, a mask word, its count and a record: 55 % of that stage on the shaded
 //! bonsai, docs/RESULTS.md). The differences are of quantised values (exact: 8 bytes a voxel, the
 //! neighbours' lookups gave what the store holds), so only the density remap scales them.
-use super::{BrickHeader, BrickStore, BRICK, BRICK_VOXELS};
+use super::{BrickHeader, BrickStore, BRICK};
 use rayon::prelude::*;
 
 /// Packs the central differences `d` of quantised values (each within ±65535), exactly: each plus
@@ -54,20 +54,20 @@ impl BrickStore {
         self.headers.len() as u64 + self.headers.iter().map(|h| h.count as u64).sum::<u64>()
     }
 
-    /// Brick `hd`'s voxels' packed differences, into `out`: its own values from a dense copy,
-    /// its face neighbours' from copies of the layer next to it.
+    /// Brick `hd`'s voxels' packed differences, into `lo` and `hi`: its values and the layers of
+    /// its face neighbours next to it in a dense block one voxel wider on each side, the grid's
+    /// edges clamped as `value_at` clamps them.
     fn brick_differences(&self, hd: &BrickHeader, lo: &mut [u32], hi: &mut [u32]) {
-        const B: i64 = BRICK as i64;
-        let mut dense = [0i32; BRICK_VOXELS];
+        const A: usize = BRICK as usize + 2;
+        // Local (x, y, z), each in -1..=BRICK, in the block.
+        let at = |l: [i64; 3]| ((l[0] + 1) + A as i64 * ((l[1] + 1) + A as i64 * (l[2] + 1))) as usize;
+        let mut block = [0i32; A * A * A];
         let records = self.brick_records(hd);
         for r in records.iter() {
-            dense[(r & 511) as usize] = (r >> 16) as i32;
+            block[at(super::local_cell(r & 511).map(|c| c as i64))] = (r >> 16) as i32;
         }
         let b = hd.coords();
         let nb = self.dims.map(|d| d.div_ceil(BRICK));
-        // Face 2a + side: the neighbour's layer along axis a below (side 0) or above (1), by the
-        // other two local coordinates (x before y before z).
-        let mut faces = [[0i32; (BRICK * BRICK) as usize]; 6];
         for a in 0..3 {
             for side in 0..2 {
                 let mut n = b;
@@ -83,35 +83,39 @@ impl BrickStore {
                 for r in self.brick_records(&self.headers[h as usize]).iter() {
                     let c = super::local_cell(r & 511);
                     if c[a] == layer {
-                        let (u, w) = other_axes(a);
-                        faces[2 * a + side][(c[u] + BRICK * c[w]) as usize] = (r >> 16) as i32;
+                        let mut l = c.map(|c| c as i64);
+                        l[a] = if side == 0 { -1 } else { BRICK as i64 };
+                        block[at(l)] = (r >> 16) as i32;
                     }
                 }
             }
         }
-        let base = b.map(|c| (c * BRICK) as i64);
-        let last = self.dims.map(|d| d as i64 - 1);
-        // The quantised value at voxel v, indices clamped to the grid: one step from the brick at
-        // most, so outside it along one axis only.
-        let q = |v: [i64; 3]| -> i32 {
-            let l = [0, 1, 2].map(|a| v[a].clamp(0, last[a]) - base[a]);
-            match (0..3).find(|&a| !(0..B).contains(&l[a])) {
-                None => dense[(l[0] + B * (l[1] + B * l[2])) as usize],
-                Some(a) => {
-                    let (u, w) = other_axes(a);
-                    faces[2 * a + usize::from(l[a] >= B)][(l[u] + B * l[w]) as usize]
+        // The grid's edges: the layer past the first (last) voxel along an axis holds its values.
+        for a in 0..3 {
+            let base = (b[a] * BRICK) as i64;
+            let valid = (self.dims[a] as i64 - base).min(BRICK as i64);
+            let mut copy = |from: i64, to: i64| {
+                let (u, w) = other_axes(a);
+                for j in 0..BRICK as i64 {
+                    for i in 0..BRICK as i64 {
+                        let (mut f, mut t) = ([0; 3], [0; 3]);
+                        (f[a], f[u], f[w]) = (from, i, j);
+                        (t[a], t[u], t[w]) = (to, i, j);
+                        block[at(t)] = block[at(f)];
+                    }
                 }
+            };
+            if base == 0 {
+                copy(0, -1);
             }
-        };
+            if base + valid == self.dims[a] as i64 {
+                copy(valid - 1, valid);
+            }
+        }
+        let steps = [1, A, A * A];
         for ((a_out, b_out), r) in lo.iter_mut().zip(hi.iter_mut()).zip(records.iter()) {
-            let [x, y, z] = super::local_cell(r & 511).map(|c| c as i64);
-            let v = [base[0] + x, base[1] + y, base[2] + z];
-            [*a_out, *b_out] = pack_differences([0, 1, 2].map(|a| {
-                let (mut down, mut up) = (v, v);
-                down[a] -= 1;
-                up[a] += 1;
-                q(up) - q(down)
-            }));
+            let i = at(super::local_cell(r & 511).map(|c| c as i64));
+            [*a_out, *b_out] = pack_differences(steps.map(|s| block[i + s] - block[i - s]));
         }
     }
 }

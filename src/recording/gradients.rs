@@ -15,7 +15,7 @@ pub(super) fn fit(scene: &BrickScene, build: usize, range: u64, available: u64) 
 }
 
 /// Make the two buffers hold this classification's differences (`bytes`: both), made on its first
-/// frame (the 512³ bonsai: ~0.4 s, the `gradients` time).
+/// frame (the 512³ bonsai: ~0.2 s, the `gradients` time).
 pub(super) fn upload(e: &mut dyn Engine, scene: &BrickScene, bytes: u64) -> Result<()> {
     let res = [Res::BrickGradients, Res::BrickGradientsHi];
     let id = scene.classification();
