@@ -5,7 +5,8 @@ prints ("camera (grid frame): eye X,Y,Z target X,Y,Z up X,Y,Z fov F"): voxsplat'
 centred on the grid, VTK's image starts at voxel (0, 0, 0), and both run the file's axes as stored
 (files whose affine is left-handed, which voxsplat stores x-reversed, are not taken).
 --mapper fixed: the fixed-point CPU ray caster (issue 23); gpu: vtkGPUVolumeRayCastMapper (llvmpipe
-through EGL here). --shade: VTK's gradient shading, as voxsplat's --shade.
+through EGL here). --shade: VTK's gradient shading, as voxsplat's --shade. --sample-distance D:
+the ray step in world units (VTK's default 1, a voxel at spacing 1; the PNG has no alpha).
 Usage: python vtk_file.py --file F.nrrd|F.nii.gz --tf bonsai|ramp|ct|mri --frames 5 --out out.png
 """
 import argparse, math, statistics, sys, time
