@@ -1,5 +1,5 @@
 #version 450
-// variants: PAGED_RECORDS STREAMED_STORE
+// variants: PAGED_RECORDS STREAMED_STORE GRADIENTS
 // Levels of detail, built when the classification changes: one workgroup per non-empty brick, a
 // lane per level-1 cell reading its 8 voxels through the occupancy mask. Its voxels are classified
 // (TF and gradient weighting; shading waits for the frame's light) and summed over 2x2x2 children
@@ -138,7 +138,13 @@ void main() {
                     vec4 cl = classify_voxel(v, q, false);
                     tk[d] = optical_depth(cl.a);
                     ck[d] = cl.rgb * tk[d];
+#ifdef GRADIENTS
+                    // Each voxel's differences, made once (BrickStore::gradient_words): half the
+                    // shaded pyramid's time read its neighbours through the store.
+                    if (shaded) g += aligned(gradient_from(differences_at(h, rank)) * tk[d], g);
+#else
                     if (shaded) g += aligned(gradient_at(v) * tk[d], g);
+#endif
                     drawn += tk[d] > 0.0 ? 1u : 0u;
                 }
             }

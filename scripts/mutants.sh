@@ -29,7 +29,7 @@ MUTANTS=(
   "shells counted away from the eye on its low side|src/order.rs|if b[a] < split[a] { split[a] - 1 - b[a] } else|if b[a] < split[a] { b[a] } else|--test bricked waves_front"
   "a mask word's count taken past it|src/bricks.rs|below[i] = below[i - 1] + words[i - 1].count_ones();|below[i] = below[i - 1] + words[i].count_ones();|--test bricked gpu_frames_match"
   "a voxel's stored differences one-sided|src/bricks/gradients.rs|block[i + s] - block[i - s]|block[i + s] - block[i]|--test bricks every_stored_voxel"
-  "a voxel's differences read a record on, on the device|glsl/shared/brick.glsl|    uint i = gradients[h] + below;|    uint i = gradients[h] + below + 1u;|--test bricked gpu_frames_match"
+  "a voxel's differences read a record on, on the device|glsl/shared/brick.glsl|    uint i = gradients[h] + rank;|    uint i = gradients[h] + rank + 1u;|--test bricked gpu_frames_match"
 )
 filter=${1:-}
 backup=$(mktemp -d)

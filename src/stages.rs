@@ -119,16 +119,17 @@ const BRICK: &[Res; 32] = &[
     Res::Pyramid3,
     Res::LodSplats,
 ];
-/// `brick_params`' bindings: its `GRADIENTS` build's inputs in `brick_hidden`'s places (the brick
-/// stages' list is at lavapipe's 32 storage buffers a stage).
-const BRICK_PARAMS: &[Res] =
+/// `brick_params`' and `brick_pyramid`'s bindings: their `GRADIENTS` builds' inputs in
+/// `brick_hidden`'s places (the brick stages' list is at lavapipe's 32 storage buffers a stage).
+const BRICK_GRADIENTS: &[Res] =
     &Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi);
 /// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
 /// (`recording::record_bricks` picks).
 const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
 /// `RECORD_PAGED`'s, and one page of records with the voxels' differences read from
 /// `Res::BrickGradients` (`recording::record_bricks` picks it for shaded or gradient-weighted frames).
-const PARAMS_BUILDS: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[]), v("GRADIENTS", &[])];
+const GRADIENT_BUILDS: &[Variant] =
+    &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[]), v("GRADIENTS", &[])];
 /// A resident pyramid, or a streamed store's batch of pyramids (`brick_cells`).
 const PYRAMID_STREAMED: &[Variant] = &[v("", &[]), v("STREAMED_STORE", &[])];
 const ONE: &[Variant] = &[v("", &[])];
@@ -190,13 +191,13 @@ pub const STAGES: &[StageDesc] = &[
     StageDesc {
         name: "brick_pyramid",
         kind: Kind::Compute,
-        bindings: BRICK,
+        bindings: BRICK_GRADIENTS,
         writes: &[Res::Pyramid, Res::LodSummary, Res::PyramidSlot],
         push: std::mem::size_of::<BrickPush>() as u32,
         workgroup: Workgroup::PerItem(BRICK_LANES),
         timing: "lod",
         device_build: None,
-        variants: RECORD_PAGED,
+        variants: GRADIENT_BUILDS,
         mirror: crate::cpu::lod::brick_pyramid_stage,
     },
     StageDesc {
@@ -263,13 +264,13 @@ pub const STAGES: &[StageDesc] = &[
     StageDesc {
         name: "brick_params",
         kind: Kind::Compute,
-        bindings: BRICK_PARAMS,
+        bindings: BRICK_GRADIENTS,
         writes: &[Res::Params],
         push: std::mem::size_of::<BrickPush>() as u32,
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: PARAMS_BUILDS,
+        variants: GRADIENT_BUILDS,
         mirror: crate::cpu::brick::brick_params_stage,
     },
     StageDesc {

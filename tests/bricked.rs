@@ -727,7 +727,8 @@ fn uniform_bricks_draw_as_their_voxels_do() {
 
 /// A shaded or gradient-weighted frame reads each voxel's precomputed differences where both
 /// buffers fit half of what the store leaves of the budget, and its neighbours through the store
-/// where they do not: the same gradients either way (the differences are exact), on both engines.
+/// where they do not: the same gradients either way (the differences are exact), on both engines,
+/// in the voxels' splats and in the coarse cells' normals (`brick_pyramid`).
 #[test]
 fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
     let vol = blob([61, 53, 47]);
@@ -735,8 +736,11 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
     let shading = Some(Shading::headlight(cam.forward()));
     let mut weighted = tf();
     weighted.gradient_weight = 0.5;
-    let mut o = compute(Direction::FrontToBack);
-    o.lod = Lod::Off;
+    let mut fine = compute(Direction::FrontToBack);
+    fine.lod = Lod::Off;
+    // Cells up to 4 px: the far bricks drawn coarser, from the pyramid.
+    let mut coarse = compute(Direction::FrontToBack);
+    coarse.lod_pixels = 4.0;
     let made = |r: &voxsplat::Rendered| r.timings.iter().any(|t| t.stage == "gradients");
     for (tf, what) in [(tf(), "shaded"), (weighted, "weighted")] {
         let mut frames = Vec::new();
@@ -744,32 +748,48 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
             let mut whole = renderer(gpu, None);
             whole.set_volume(&vol, &tf, shading).unwrap();
             let scene = whole.volume().unwrap();
-            // Just under four times one buffer's bytes left by the store: they do not fit.
+            // Just under four times one buffer's bytes left by the store (and the pyramid, with
+            // levels of detail): they do not fit.
             let bytes = scene.store.gradient_len() * 4;
-            let budget = voxsplat::recording::bricked_resident_bytes(scene, u64::MAX, 80, 80) + 4 * bytes - 4;
-            assert!(!scene.streams(budget), "the store stays resident");
-            let mut tight = renderer(gpu, Some(budget));
-            tight.set_volume(&vol, &tf, shading).unwrap();
-            let a = whole.render(&cam, &o).unwrap();
-            let b = tight.render(&cam, &o).unwrap();
-            assert!(made(&a) && !made(&b), "{what} gpu {gpu}: precomputed, then through the store");
-            // The device keeps them for the classification (the CPU engine keeps nothing across frames).
-            assert!(!gpu || !made(&whole.render(&cam, &o).unwrap()), "{what}: made once per classification");
-            assert!(a.image.pixels.iter().any(|p| p[3] > 0.1), "{what}: something drawn");
-            let (most, mean) = diff(&a.image, &b.image);
-            assert!(most <= 1e-5 && mean <= 1e-7, "{what} gpu {gpu}: precomputed vs through the store {most} / {mean}");
+            let pyramid = voxsplat::cpu::lod::pyramid_bytes(voxsplat::cpu::lod::LOD_BUFFERS, scene.store.headers.len());
+            let resident = voxsplat::recording::bricked_resident_bytes(scene, u64::MAX, 80, 80);
+            assert!(!scene.streams(resident + 4 * bytes), "the store stays resident");
+            for (o, which, held) in [(&fine, "full detail", 0), (&coarse, "coarse cells", pyramid)] {
+                let budget = resident + held + 4 * bytes - 4;
+                let mut tight = renderer(gpu, Some(budget));
+                tight.set_volume(&vol, &tf, shading).unwrap();
+                let a = whole.render(&cam, o).unwrap();
+                let b = tight.render(&cam, o).unwrap();
+                // The first frame makes them; the tight budget reads through the store.
+                assert!(o.lod == Lod::Auto || made(&a), "{what} gpu {gpu}: precomputed");
+                assert!(!made(&b), "{what} {which} gpu {gpu}: through the store");
+                assert!(a.image.pixels.iter().any(|p| p[3] > 0.1), "{what}: something drawn");
+                if o.lod == Lod::Auto {
+                    assert!(a.stats.bricks_coarse > 0, "{what}: coarse bricks drawn");
+                }
+                let (most, mean) = diff(&a.image, &b.image);
+                assert!(
+                    most <= 1e-5 && mean <= 1e-7,
+                    "{what} {which} gpu {gpu}: precomputed vs through the store {most} / {mean}"
+                );
+                frames.push((a.image, b.image));
+                if gpu {
+                    assert_clean(&tight);
+                }
+            }
+            // The device keeps them for the classification (the CPU engine keeps nothing across
+            // frames, so it makes them for each).
+            assert!(!gpu || !made(&whole.render(&cam, &fine).unwrap()), "{what}: made once per classification");
             if gpu {
                 assert_clean(&whole);
-                assert_clean(&tight);
             }
-            frames.push((a.image, b.image));
         }
-        for i in 0..2 {
-            let (most, mean) = diff(
-                if i == 0 { &frames[0].0 } else { &frames[0].1 },
-                if i == 0 { &frames[1].0 } else { &frames[1].1 },
-            );
-            assert!(most <= 2e-3 && mean <= 1e-5, "{what} build {i}: GPU vs mirror {most} / {mean}");
+        // Made on the first frame: the GPU's frames, then the mirrors', in the same order.
+        for (g, c) in frames[..2].iter().zip(&frames[2..]) {
+            for (x, y) in [(&g.0, &c.0), (&g.1, &c.1)] {
+                let (most, mean) = diff(x, y);
+                assert!(most <= 2e-3 && mean <= 1e-5, "{what}: GPU vs mirror {most} / {mean}");
+            }
         }
     }
 }

@@ -216,20 +216,24 @@ vec3 gradient_at(ivec3 v) {
 }
 
 #ifdef GRADIENTS
-// The density's central differences at stored voxel v, from its two packed words (each difference
-// plus 65536 in 17 bits: pack_differences): one lookup of the voxel's rank instead of six
-// neighbours'. Mirror: BrickInputs::stored_differences.
+// The density's central differences at the stored voxel of rank `rank` in header h's brick, from
+// its two packed words (each difference plus 65536 in 17 bits: pack_differences). Mirror:
+// BrickInputs::differences_at.
+vec3 differences_at(uint h, uint rank) {
+    uint i = gradients[h] + rank;
+    uvec2 w = uvec2(gradients[i], gradients_hi[i]);
+    ivec3 d = ivec3(uvec3(w.x & 0x1ffffu, (w.x >> 17u) | ((w.y & 3u) << 15u), w.y >> 2u)) - 65536;
+    return vec3(d) * (bf.tf.x / Q_MAX);
+}
+
+// The same at stored voxel v: one lookup of the voxel's rank instead of six neighbours'.
 vec3 stored_differences(ivec3 v) {
     uvec3 c = uvec3(v);
     uint h = header_of(c);
     uvec3 lc = c % BRICK_SIDE;
     uint l = lc.x + BRICK_SIDE * (lc.y + BRICK_SIDE * lc.z);
     uint word = masks[h * MASK_STRIDE + l / 32u];
-    uint below = uint(bitCount(word & ((1u << (l % 32u)) - 1u))) + mask_below(h, l / 32u);
-    uint i = gradients[h] + below;
-    uvec2 w = uvec2(gradients[i], gradients_hi[i]);
-    ivec3 d = ivec3(uvec3(w.x & 0x1ffffu, (w.x >> 17u) | ((w.y & 3u) << 15u), w.y >> 2u)) - 65536;
-    return vec3(d) * (bf.tf.x / Q_MAX);
+    return differences_at(h, uint(bitCount(word & ((1u << (l % 32u)) - 1u))) + mask_below(h, l / 32u));
 }
 #endif
 

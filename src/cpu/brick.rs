@@ -143,16 +143,32 @@ impl BrickInputs<'_> {
         ]))
     }
 
-    /// Mirror of `stored_differences`: voxel `v`'s packed central differences of the density.
-    fn stored_differences(&self, words: (&[u32], &[u32]), v: [i64; 3]) -> [f32; 3] {
+    /// Mirror of `differences_at`: the density's central differences at header `h`'s stored voxel
+    /// of rank `rank`.
+    fn differences_at(&self, words: (&[u32], &[u32]), h: u32, rank: u32) -> Vec3 {
+        let i = (words.0[h as usize] + rank) as usize;
+        let d = crate::bricks::unpack_differences([words.0[i], words.1[i]], self.bf.tf[0] / 65535.0);
+        Vec3::from(frame_grid(self.frame).gradient(d))
+    }
+
+    /// Mirror of `stored_differences`: the same at stored voxel `v`.
+    fn stored_differences(&self, words: (&[u32], &[u32]), v: [i64; 3]) -> Vec3 {
         let c = v.map(|c| c as u32);
         let h = self.store.header_of(c);
         let mask = &self.store.masks[h as usize];
         let l = (c[0] % BRICK + BRICK * (c[1] % BRICK) + BRICK * BRICK * (c[2] % BRICK)) as usize;
         let below = mask[..l / 64].iter().map(|w| w.count_ones()).sum::<u32>()
             + (mask[l / 64] & ((1u64 << (l % 64)) - 1)).count_ones();
-        let i = (words.0[h as usize] + below) as usize;
-        crate::bricks::unpack_differences([words.0[i], words.1[i]], self.bf.tf[0] / 65535.0)
+        self.differences_at(words, h, below)
+    }
+
+    /// The world gradient at stored voxel `v`, of rank `rank` in header `h`'s brick: from its
+    /// differences (GRADIENTS builds) or its neighbours through the store.
+    pub(crate) fn voxel_gradient(&self, v: [i64; 3], h: u32, rank: u32) -> Vec3 {
+        match self.gradients {
+            Some(words) => self.differences_at(words, h, rank),
+            None => self.gradient_at(v),
+        }
     }
 
     /// Mirror of `shade`.
@@ -174,7 +190,7 @@ impl BrickInputs<'_> {
         let weighted = self.bf.tf[3] > 0.0;
         if weighted || shaded {
             let g = match self.gradients {
-                Some(words) => Vec3::from(frame_grid(self.frame).gradient(self.stored_differences(words, v))),
+                Some(words) => self.stored_differences(words, v),
                 None => self.gradient_at(v),
             };
             if weighted {

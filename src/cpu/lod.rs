@@ -324,7 +324,7 @@ pub fn brick_pyramid(
         let hd = &store.headers[h];
         let b = hd.coords();
         fine.fill(Sums::default());
-        for &rec in store.brick_records(hd).iter() {
+        for (rank, &rec) in store.brick_records(hd).iter().enumerate() {
             if !inputs.emits(rec >> 16) {
                 continue;
             }
@@ -333,7 +333,7 @@ pub fn brick_pyramid(
             let v = [0, 1, 2].map(|a| (b[a] * BRICK + lc[a]) as i64);
             let c = inputs.classify_voxel(v, rec >> 16, false);
             let t = optical_depth(c[3]);
-            let grad = if shaded { inputs.gradient_at(v) * t } else { Vec3::ZERO };
+            let grad = if shaded { inputs.voxel_gradient(v, h as u32, rank as u32) * t } else { Vec3::ZERO };
             let a = 1.0 - (-t).exp();
             fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0, axes: [a; 3] };
         }
@@ -529,7 +529,7 @@ pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant
         brick_pyramid(&inputs(b)?, batch, &mut pyramid, &mut summary);
         b.put(Res::PyramidSlot, slots);
     } else {
-        brick_pyramid(&inputs(b)?, None, &mut pyramid, &mut summary);
+        brick_pyramid(&super::brick::inputs_for(b, v)?, None, &mut pyramid, &mut summary);
     }
     b.put(Res::Pyramid, pyramid);
     b.put(Res::LodSummary, summary);

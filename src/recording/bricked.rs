@@ -179,7 +179,7 @@ pub(super) fn record_bricks(
     let cut = Cut {
         streamed,
         build,
-        params_build: if gradients.is_some() { super::gradients::PARAMS_GRADIENTS } else { build },
+        gradient_build: if gradients.is_some() { super::gradients::BUILD } else { build },
         available,
         pyramid: batch_pyramid,
         range,
@@ -217,7 +217,7 @@ pub(super) fn record_bricks(
             // Per batch it holds batches' pyramids, not the store's.
             e.set_tag(Res::Pyramid, if per_batch { 0 } else { id });
         } else if !built && bf.grid[3] > 0 {
-            build_pyramids(e, build, &all)?;
+            build_pyramids(e, cut.gradient_build, &all)?;
             build_nodes(e, grid, node_levels)?;
             e.set_tag(Res::Pyramid, id);
             e.set_tag(Res::LodSummary, id);
@@ -358,8 +358,8 @@ pub(super) fn record_bricks(
 struct Cut<'a> {
     streamed: bool,
     build: usize,
-    /// `brick_params`' build: `build`, or `PARAMS_GRADIENTS`.
-    params_build: usize,
+    /// `brick_params`' and a resident pyramid's build: `build`, or `gradients::BUILD`.
+    gradient_build: usize,
     available: u64,
     pyramid: u64,
     /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
@@ -588,7 +588,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     }
     e.run(&Dispatch::new(
         StageId::BrickParams,
-        cut.params_build,
+        cut.gradient_build,
         groups_1d(n),
         List::Order,
         bytemuck::bytes_of(&push),

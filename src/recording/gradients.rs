@@ -1,10 +1,12 @@
 //! A shaded or gradient-weighted bricked frame's voxel differences (`BrickStore::gradient_words`):
-//! `brick_params` reads one voxel's two words instead of its six neighbours through the store.
+//! `brick_params` and `brick_pyramid` read one voxel's two words instead of its six neighbours
+//! through the store.
 use super::*;
 use crate::bricks::BrickScene;
 
-/// `brick_params`' build that reads `Res::BrickGradients` (stages.rs, `PARAMS_BUILDS`).
-pub(super) const PARAMS_GRADIENTS: usize = 3;
+/// The build of `brick_params` and `brick_pyramid` that reads `Res::BrickGradients` (stages.rs,
+/// `GRADIENT_BUILDS`).
+pub(super) const BUILD: usize = 3;
 
 /// The bytes the two buffers take when this frame reads them: it classifies with gradients, its
 /// store is resident in one page (`build` 0), each fits a binding and both fit half of what the
