@@ -166,11 +166,16 @@ impl BrickStore {
         if mask[l / 64] >> (l % 64) & 1 == 0 {
             return 0.0;
         }
-        // The record's rank among the brick's: stored voxels below it in local index order.
-        let below = mask[..l / 64].iter().map(|w| w.count_ones()).sum::<u32>()
-            + (mask[l / 64] & ((1u64 << (l % 64)) - 1)).count_ones();
-        let rec = record_at(&self.records, self.headers[h as usize].first + below);
+        let rec = record_at(&self.records, self.headers[h as usize].first + self.stored_below(h, l));
         (rec >> 16) as f32 / Q
+    }
+
+    /// The rank of local voxel `l`'s record among header `h`'s: the brick's stored voxels below it
+    /// in local index order.
+    pub fn stored_below(&self, h: u32, l: usize) -> u32 {
+        let mask = &self.masks[h as usize];
+        mask[..l / 64].iter().map(|w| w.count_ones()).sum::<u32>()
+            + (mask[l / 64] & ((1u64 << (l % 64)) - 1)).count_ones()
     }
 
     /// Classify the stored volume (as `classify::classify` does a dense one), reading every value
@@ -241,7 +246,7 @@ pub fn emits(table: &[u32], q: u32) -> bool {
 }
 
 /// Whether the TF table `table` extracts any quantised value in `lo..=hi` (a brick of that range
-/// draws a voxel; `!tf_empty` in glsl/shared/brick.glsl).
+/// draws a voxel; `!tf_empty` in glsl/shared/brick.glsl, counting with `emitted_below`).
 pub fn draws_any(table: &[u32], lo: u32, hi: u32) -> bool {
     let bits = 4 * crate::constants::TF_ENTRIES as usize;
     let prefix = bits + crate::constants::TF_ENTRIES as usize / 32;
@@ -515,7 +520,7 @@ impl BrickScene {
     }
 
     /// The store's `gradient_words` (`Res::BrickGradients`) for the bricks the transfer function
-    /// draws: made when a device lacks them for this classification, and not kept (4 bytes a
+    /// draws: made when a device lacks them for this classification, and not kept (8 bytes a
     /// stored voxel).
     pub fn gradient_words(&self) -> [Vec<u32>; 2] {
         self.store.gradient_words(|hd| draws_any(&self.table, hd.range & 0xffff, hd.range >> 16))

@@ -6,7 +6,6 @@ use super::lod::level_count;
 use super::order::{outward, side_count};
 use super::splat_params::{cell_footprint_scale, frame_grid, optical_depth, params_at, CULL_RADII};
 use crate::bricks::{local_cell, BrickStore, BRICK};
-use crate::constants::TF_ENTRIES;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::{Error, Result};
 use crate::gpu_types::{BrickFrame, BrickPush, Frame, SplatParams};
@@ -106,27 +105,15 @@ impl BrickInputs<'_> {
     }
 }
 
-const TF_BITS: usize = 4 * TF_ENTRIES as usize;
-const TF_PREFIX: usize = TF_BITS + TF_ENTRIES as usize / 32;
-
 impl BrickInputs<'_> {
     /// Mirror of `emits`.
     pub(crate) fn emits(&self, q: u32) -> bool {
         crate::bricks::emits(self.tf, q)
     }
 
-    /// Mirror of `emitted_below`.
-    fn emitted_below(&self, q: u32) -> u32 {
-        let w = (q >> 5) as usize;
-        if q & 31 == 0 {
-            return self.tf[TF_PREFIX + w];
-        }
-        self.tf[TF_PREFIX + w] + (self.tf[TF_BITS + w] & ((1u32 << (q & 31)) - 1)).count_ones()
-    }
-
     /// Mirror of `tf_empty`.
     pub fn tf_empty(&self, lo: u32, hi: u32) -> bool {
-        self.emitted_below(hi + 1) == self.emitted_below(lo)
+        !crate::bricks::draws_any(self.tf, lo, hi)
     }
 
     fn density_at(&self, i: i64, j: i64, k: i64) -> f32 {
@@ -155,11 +142,8 @@ impl BrickInputs<'_> {
     fn stored_differences(&self, words: (&[u32], &[u32]), v: [i64; 3]) -> Vec3 {
         let c = v.map(|c| c as u32);
         let h = self.store.header_of(c);
-        let mask = &self.store.masks[h as usize];
         let l = (c[0] % BRICK + BRICK * (c[1] % BRICK) + BRICK * BRICK * (c[2] % BRICK)) as usize;
-        let below = mask[..l / 64].iter().map(|w| w.count_ones()).sum::<u32>()
-            + (mask[l / 64] & ((1u64 << (l % 64)) - 1)).count_ones();
-        self.differences_at(words, h, below)
+        self.differences_at(words, h, self.store.stored_below(h, l))
     }
 
     /// The world gradient at stored voxel `v`, of rank `rank` in header `h`'s brick: from its

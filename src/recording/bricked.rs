@@ -158,7 +158,9 @@ pub(super) fn record_bricks(
     } else {
         (available, 0)
     };
-    let gradients = super::gradients::fit(scene, build_of(scene, streamed), range, available);
+    // The brick stages' build: one page of store records, the paged reader, or streamed records.
+    let build = if streamed { 2 } else { usize::from(scene.store.records.len() > RECORD_PAGE as usize) };
+    let gradients = super::gradients::fit(scene, build, range, available);
     let available = available - gradients.unwrap_or(0);
     let frame = plan::frame_for(&prep.set, camera, opts);
     let split = crate::order::brick_split(&prep.set, camera, BRICK);
@@ -168,8 +170,6 @@ pub(super) fn record_bricks(
         bf.hi[3] = node_levels;
     }
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
-    // The brick stages' build: one page of store records, the paged reader, or streamed records.
-    let build = build_of(scene, streamed);
     e.begin(&frame, opts.kernel, w, h)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
@@ -655,16 +655,6 @@ fn upload_batch(
         e.ensure(Res::Pyramid, list.len().max(1) as u64 * cut.pyramid)?;
     }
     Ok(())
-}
-
-/// The brick stages' build: one page of store records (0), the paged reader (1), or streamed
-/// records (2).
-fn build_of(scene: &BrickScene, streamed: bool) -> usize {
-    if streamed {
-        2
-    } else {
-        usize::from(scene.store.records.len() > RECORD_PAGE as usize)
-    }
 }
 
 /// Most bytes of one batch of a streamed store's one-time pyramid build.
