@@ -75,7 +75,7 @@ impl BrickStore {
                     continue;
                 }
                 n[a] = if side == 0 { n[a] - 1 } else { n[a] + 1 };
-                let h = self.index[(n[0] + nb[0] * (n[1] + nb[1] * n[2])) as usize];
+                let h = self.header_of(n.map(|c| c * BRICK));
                 if h == u32::MAX {
                     continue;
                 }
