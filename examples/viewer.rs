@@ -1,7 +1,7 @@
 //! A windowed viewer that embeds voxsplat as a host program would: the example owns the window
 //! (winit), the Vulkan instance, device, queue and swapchain (ash), and voxsplat adopts its device
 //! (`Context::from_host`) and draws each frame straight into the acquired swapchain image
-//! (`Renderer::render_to`), ordered by the example's semaphores. See docs/EMBEDDING.md.
+//! (`Renderer::render_to`), ordered by the example's semaphores. See docs/guide/embedding.md.
 //!
 //! It opens whatever `voxsplat render` opens (`--volume`, `--terrain`, `--scene` and their flags).
 //! Mouse: left drag orbits, wheel zooms, middle drag (or ctrl + left) pans, right drag edits the

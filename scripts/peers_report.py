@@ -1,4 +1,4 @@
-"""Tables and image strips for scripts/peers.sh (issue 9).
+"""Tables and image strips for scripts/peers.sh.
 usage: peers_report.py OUT_DIR DOCS_BENCH_DIR "128 256"
 Every image is composited over black (VTK's background) as 8-bit RGB and scored over the object's
 pixels (where the truth's alpha or VTK's fine reference is non-zero) against voxsplat's ray
@@ -66,7 +66,7 @@ for row in csv.reader(open(os.path.join(out, "times.csv"))):
     if len(row) == 4 and row[3]:
         times.setdefault((row[0], row[2]), []).append(float(row[3]))
 
-md = ["## Side by side with the peers (issue 9)", "",
+md = ["## Side by side with the peers", "",
       "The shared scene of `../shared/peers` (uint8 shell + blobs, piecewise-linear TF, opacity per unit "
       "length, VTK's camera: focal point at the centre, position c + (1.2, 0.8, 1.6)·n, view-up +y, 30°), "
       "512×512, rendered in one run by `scripts/peers.sh`: VTK's fixed-point CPU ray caster and GPU ray "
@@ -145,7 +145,7 @@ for n in sizes:
             ms, l, p = min(pool)
             r = vtk["vtk fixed"] / ms
             md.append(f"- Fastest splatting mode {title}: **{l}** ({ms:.1f} ms, {p:.1f} dB), **{r:.2f}×** VTK "
-                      f"fixed-point (issue 10 target: faster than it, {'met' if r >= 1 else 'missed'}).")
+                      f"fixed-point (the target: faster than it, {'met' if r >= 1 else 'missed'}).")
     # VTK fixed point along its own speed-accuracy curve: for each of its settings, the fastest
     # splatting mode at least as accurate, and which voxsplat rows one of its settings beats on both.
     fixed_rows = [(l, ms, p) for (l, ms, p) in rows if l.startswith("vtk fixed")]
@@ -167,13 +167,13 @@ for n in sizes:
     md.append("")
 open(os.path.join(docs, "peers.md"), "w").write("\n".join(md) + "\n")
 
-# Splice the section into docs/RESULTS.md (replacing an earlier one); `voxsplat bench --results`
+# Splice the section into docs/RESULTS.md (replacing an earlier one); `voxsplat lab matrix --results`
 # includes docs/bench/peers.md the same way when it regenerates the page.
 results = os.path.join(os.path.dirname(os.path.abspath(docs)), "RESULTS.md")
 if os.path.exists(results):
     page = open(results).read()
     section = "\n".join(md) + "\n"
-    head = "## Side by side with the peers (issue 9)"
+    head = "## Side by side with the peers"
     if head in page:
         start = page.index(head)
         nxt = page.find("\n## ", start + len(head))

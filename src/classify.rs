@@ -98,7 +98,7 @@ pub const TF_PRESETS: &[(&str, &str)] = &[
 pub const SHADED_PRESETS: &[&str] = &["bonsai"];
 
 impl TransferFunction {
-    /// A named preset: `ramp`, `ct`, `bonsai`, `mri` (docs/CLI.md).
+    /// A named preset: `ramp`, `ct`, `bonsai`, `mri` (docs/guide/cli.md).
     pub fn preset(name: &str) -> Result<Self> {
         let p = |points: Vec<(f32, [f32; 4])>| Self { points, gradient_weight: 0.0, range: None, threshold: 0.0 };
         match name {
@@ -111,7 +111,7 @@ impl TransferFunction {
                 (1.0, [1.0, 1.0, 1.0, 0.95]),
             ])),
             // The base plate the bonsai stands on (0.13-0.19) is left transparent; twigs (0.25-0.31)
-            // green; trunk, soil and pot brown (issue 29, tuned beside VTK: docs/RESULTS.md).
+            // green; trunk, soil and pot brown (tuned beside VTK: docs/log/2026-11-24-orientation-framing-presets-gallery.md).
             "bonsai" => Ok(p(vec![
                 (0.0, [0.0, 0.0, 0.0, 0.0]),
                 (0.22, [0.0, 0.0, 0.0, 0.0]),
@@ -122,7 +122,7 @@ impl TransferFunction {
             ])),
             // T1 over the data's range: fluid and bone (below 0.25) transparent, scalp (~0.4) faint,
             // grey matter (~0.6) translucent, white matter (~0.95) near opaque (issue 29, tuned on
-            // `make-volume --phantom` beside VTK: docs/RESULTS.md).
+            // `make-volume --phantom` beside VTK: docs/log/2026-11-24-orientation-framing-presets-gallery.md).
             "mri" => Ok(p(vec![
                 (0.0, [0.0, 0.0, 0.0, 0.0]),
                 (0.3, [0.0, 0.0, 0.0, 0.0]),

@@ -36,8 +36,12 @@ mod gpu;
 #[doc(hidden)]
 pub mod gpu_types;
 pub mod image;
-#[doc = include_str!("../docs/EMBEDDING.md")]
+#[doc = include_str!("../docs/guide/embedding.md")]
 pub mod embedding {}
+// The README's Rust example compiles (a doc test; cli/tests/readme.rs runs its commands).
+#[cfg(all(doctest, feature = "io"))]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
 pub mod kdtree;
 pub mod kernel;
 #[cfg(feature = "io")]
@@ -309,7 +313,7 @@ impl Renderer {
     /// waits on the target's wait semaphores before it writes the image, converts it to the image's
     /// format (over `options.background`, sRGB encoded where the format says so: the bytes a PNG
     /// of `render` holds), leaves it in the target's new layout and signals the target's signal
-    /// semaphores. It returns when the frame is complete (docs/EMBEDDING.md). A `render_scale`
+    /// semaphores. It returns when the frame is complete (docs/guide/embedding.md). A `render_scale`
     /// below 1 draws the coarser grid and stretches it in the blit (linear filter).
     pub fn render_to(
         &mut self,

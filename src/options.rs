@@ -272,7 +272,7 @@ pub struct RenderOptions {
     /// Levels of detail above the brick (off by default): a node of 2^k bricks a side whose one
     /// prefiltered cell projects to at most a pixel is drawn as that one splat (docs/MODEL.md).
     /// Measured on lavapipe it halves the splats of a 1024³ volume at 32², but the cut over the
-    /// nodes costs about what it saves from 64² up (docs/RESULTS.md, "Thumbnails").
+    /// nodes costs about what it saves from 64² up (docs/log/2026-11-28-thumbnails-and-nodes.md).
     pub lod_nodes: bool,
     /// Composite the frame over this straight RGBA colour on the device (`present.comp`) before it
     /// is read back or written into a host image; alpha 1 gives an opaque frame, as a window shows

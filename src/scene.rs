@@ -22,7 +22,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("plane", "single-sheet 498x398x1 checkerboard of 10x10 black/white squares (Fig. 3.6)"),
     ("stripes128", "dense 128^3 ball with 3-voxel colour stripes, semi-transparent: finer than the pixels in small views (Fig. 3.8)"),
     ("empty", "an 8^3 grid with no non-empty voxel"),
-    ("peer128", "the peers' synthetic 128^3 volume and transfer function (../shared/peers, issue 9)"),
+    ("peer128", "the peers' synthetic 128^3 volume and transfer function (../shared/peers: VTK and taichi render the same scene)"),
     ("peer256", "the same at 256^3"),
     ("bonsai", "data: CT of a bonsai, 256^3 NIfTI (shared/data/bonsai), 'bonsai' transfer function"),
     ("stent", "data: CT of a stented aorta, 128x128x256 NRRD (shared/data/stent), 'ct' transfer function"),

@@ -619,7 +619,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
         let st = a.stats;
         assert_eq!(st, b.stats, "{size}: GPU vs mirror statistics");
         // What the nodes cover against full detail is measured, not bounded, here: at 3-8 pixels
-        // the footprints' anti-aliasing dominates (docs/RESULTS.md, "Thumbnails").
+        // the footprints' anti-aliasing dominates (docs/log/2026-11-28-thumbnails-and-nodes.md).
         let f = g.render(&cam, &full).unwrap().image;
         let coverage = |i: &voxsplat::ImageF32| i.pixels.iter().map(|p| p[3] as f64).sum::<f64>();
         eprintln!("{size}: coverage {:.3} of full detail's ({st:?})", coverage(&a.image) / coverage(&f));

@@ -1,5 +1,5 @@
 //! Criterion wall-time benchmark of whole frames for the methods of the quick matrix; the full
-//! matrix with errors, roofline and scaling is `voxsplat bench` (bodies in `voxsplat::bench`).
+//! matrix with errors, roofline and scaling is `voxsplat lab matrix` (bodies in `voxsplat::bench`).
 use criterion::{criterion_group, criterion_main, Criterion};
 use voxsplat::{Renderer, RendererOptions};
 use voxsplat_cli::bench::{bench_camera, time_method, MatrixOptions};

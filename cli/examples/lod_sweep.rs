@@ -1,4 +1,4 @@
-//! The levels-of-detail sweep behind issue 24's notes in docs/results-notes.md: one bricked volume
+//! The levels-of-detail sweep behind docs/log/2026-11-24-levels-of-detail-targets.md: one bricked volume
 //! at 512² (the framing view), full detail and each `pixels,error` cut, PSNR against a truth image
 //! (e.g. `voxsplat render --volume F --raycast 0.25 --cpu`), then median frame times of three rounds
 //! with the variants alternating in one process.

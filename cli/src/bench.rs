@@ -1,4 +1,4 @@
-//! Benchmark bodies shared by `benches/render.rs` and `voxsplat bench`: the method matrix (time
+//! Benchmark bodies shared by `benches/render.rs` and `voxsplat lab matrix`: the method matrix (time
 //! from GPU timestamps, error against the truth), the roofline, and scaling; CSV, SVG charts and
 //! docs/RESULTS.md. Medians over frames after warm-up.
 use std::fmt::Write as _;
@@ -1123,8 +1123,8 @@ pub fn antialias_markdown(rows: &[AaRow], size: u32, factor: u32, dolly: usize) 
             let met = db >= 3.0 && sh <= 0.5;
             let _ = writeln!(
                 s,
-                "- **{} vs none beyond k:** {db:+.2} dB, shimmer × {sh:.2}, aliasing energy × {:.2}, time × {:.2} (issue \
-                 24's target: ≥ +3 dB, ≤ × 0.5): {}.",
+                "- **{} vs none beyond k:** {db:+.2} dB, shimmer × {sh:.2}, aliasing energy × {:.2}, time × {:.2} (the \
+                 target: ≥ +3 dB, ≤ × 0.5): {}.",
                 x.method,
                 x.aliasing / none.aliasing,
                 x.time_ms / none.time_ms,

@@ -1,5 +1,5 @@
 //! The bricked-volume study: what a volume costs as a bricked store and what a frame
-//! costs from it, alternating the variants frame by frame in one process (`voxsplat bricks`).
+//! costs from it, alternating the variants frame by frame in one process (`voxsplat lab bricks`).
 //! Prints a markdown section for docs/RESULTS.md.
 use crate::bench::median;
 use std::fmt::Write as _;
@@ -70,10 +70,10 @@ pub fn study(
     let grid = small.scene.store.grid()?;
     let cam = Camera::framing(&grid, size, size);
     let mut s = String::new();
-    let _ = writeln!(s, "## Bricked volumes (issue 23)\n");
+    let _ = writeln!(s, "## Bricked volumes\n");
     let _ = writeln!(
         s,
-        "`voxsplat bricks`, one process, {size}², the framing view, tile compositor front to back; every \
+        "`voxsplat lab bricks`, one process, {size}², the framing view, tile compositor front to back; every \
          variant of a pair alternates frame by frame, {frames} rounds after a warm-up frame; medians.\n"
     );
     let _ = writeln!(s, "| volume | voxels | stored | bricks | GPU bytes / stored voxel | load + bricks ms |");
@@ -412,7 +412,7 @@ pub fn bricks_panel(
     Ok(())
 }
 
-/// The bricked-volume scaling chart (`voxsplat bricks --chart`) from `read_scaling_csv`'s file.
+/// The bricked-volume scaling chart (`voxsplat lab bricks --chart`) from `read_scaling_csv`'s file.
 pub fn scaling_chart(csv: &Path, out: &Path) -> Result<()> {
     use plotters::prelude::*;
     let rows = read_scaling_csv(csv)?;
@@ -474,7 +474,7 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "\n### Levels of detail on peer{n} (issue 24)\n\nThe peers' volume, camera and transfer function, {size}², tile \
+        "\n### Levels of detail on peer{n}\n\nThe peers' volume, camera and transfer function, {size}², tile \
          compositor; PSNR against the peers' truth (scalar ray integration, step 0.25 voxel); every variant alternates \
          frame by frame, {frames} rounds after a warm-up; medians.\n"
     );

@@ -36,8 +36,15 @@ fn stdout_or_exit(written: std::io::Result<()>) {
     }
 }
 
+// After the macros above, which the studies' printing uses too.
+mod lab;
+
 #[derive(Parser)]
-#[command(name = "voxsplat", version, about = "Splatting renderer for discrete objects (Swan 1997) on Vulkan")]
+#[command(
+    name = "voxsplat",
+    version,
+    about = "Render volumes (CT, MRI, microscopy, simulation fields) and terrain by splatting, on Vulkan"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -77,20 +84,9 @@ enum Command {
     },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
     Animate(AnimateArgs),
-    /// Render many frames with changing scenes, cameras and modes; report host memory and GPU
-    /// allocations per cycle (they must stay flat after warm-up).
-    Soak {
-        #[arg(long, default_value_t = 1000)]
-        frames: usize,
-        #[arg(long, default_value_t = 96)]
-        size: u32,
-        /// Enable the validation layer and count its messages.
-        #[arg(long)]
-        validation: bool,
-    },
-    /// Make a large test volume (never committed): FILE upsampled by an integer factor (e.g. the
-    /// 512³ bonsai from the 256³ one), a procedural field of side N (e.g. 1024³), or a T1 MRI head
-    /// phantom of side N (placed in RAS); written as 8-bit NRRD slice by slice.
+    /// Make a test volume: a file upsampled by an integer factor (e.g. a 512³ bonsai from the 256³
+    /// one), a procedural field of side N (e.g. 1024³), or a T1 MRI head phantom of side N (placed
+    /// in RAS); written as 8-bit NRRD slice by slice, so it may be larger than memory.
     MakeVolume {
         /// Upsample this volume file (any format `render --volume` reads)...
         #[arg(long, conflicts_with = "procedural")]
@@ -109,127 +105,6 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Anti-aliasing on the seed's terrain and orthographic figures (Figs 3.7, 3.8, 5.3):
-    /// none, Swan and EWA against a supersampled truth; a markdown section on stdout.
-    Antialias {
-        /// Square images of this side instead of the seed's sizes (Fig. 3.7 260x179, Fig. 3.8
-        /// 290x290; at 128 three quarters of the terrain's splats lie beyond k).
-        #[arg(long)]
-        size: Option<u32>,
-        /// Supersampling of the truth per axis.
-        #[arg(long, default_value_t = 4)]
-        factor: u32,
-        /// Frames of the camera move the shimmer is measured over.
-        #[arg(long, default_value_t = 24)]
-        dolly: usize,
-        /// Timed frames per mode.
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-    },
-    /// Orders under motion and the terrain's motion blur (chapters 4-5): PBTF, WBTF and
-    /// BTF against the sorted order on the built-in animations, and blurred splats against the
-    /// accumulation buffer on the orthographic terrain with WBTF; a markdown section on stdout.
-    MotionOrders {
-        /// First frame.
-        #[arg(long, default_value_t = 8)]
-        first: u32,
-        /// Frames after it.
-        #[arg(long, default_value_t = 12)]
-        frames: u32,
-        /// Timed rounds of the blur methods.
-        #[arg(long, default_value_t = 5)]
-        rounds: usize,
-    },
-    /// The reconstruction kernels side by side: sheet ripple, lattice RMS (Crawfis and
-    /// Max's criterion), error against the peers' truth and time; a markdown section on stdout.
-    Kernels {
-        /// Side of the peers' volume.
-        #[arg(long, default_value_t = 128)]
-        n: u32,
-        /// Image side.
-        #[arg(long, default_value_t = 512)]
-        size: u32,
-        /// Rounds of alternating frames.
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-        /// Chart of error against ripple (the markdown links it as bench/FILE).
-        #[arg(long)]
-        chart: Option<PathBuf>,
-    },
-    /// The bricked-volume study: store sizes, dense against bricked frames, a TF change,
-    /// hidden-brick culling and the 512³ bonsai against the 256³, alternating variants in one
-    /// process; a markdown section on stdout. With --volume: one volume's load, store, frame and
-    /// peak resident set (one file per process, for the memory target).
-    Bricks {
-        /// The 256³ bonsai.
-        #[arg(long, default_value = "../shared/data/bonsai/bonsai.nii.gz")]
-        bonsai: PathBuf,
-        /// Its 2x upsampling (scripts/large-volumes.sh), if made.
-        #[arg(long)]
-        large: Option<PathBuf>,
-        /// Image side.
-        #[arg(long, default_value_t = 512)]
-        size: u32,
-        /// Rounds of alternating frames.
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-        /// Measure this one volume instead.
-        #[arg(long)]
-        volume: Option<PathBuf>,
-        /// Device-memory budget for --volume, MiB.
-        #[arg(long, default_value_t = 1024)]
-        gpu_budget_mib: u64,
-        /// Transfer-function preset for --volume.
-        #[arg(long, default_value = "ramp")]
-        tf: String,
-        /// With --volume: orbit it in this many steps at the default settings, one line per
-        /// frame with the bytes of brick records it uploaded (a store that streams through the
-        /// budget keeps the records it used in a cache on the device).
-        #[arg(long, requires = "volume")]
-        orbit: Option<u32>,
-        /// Chart of the levels-of-detail study on peer256 (its markdown links it as bench/FILE).
-        #[arg(long)]
-        lod_chart: Option<PathBuf>,
-        /// Draw the scaling chart from this CSV (voxels,vtk_ms,voxsplat_ms; scripts/bricks-vtk.sh)
-        /// into --chart-out instead.
-        #[arg(long, requires = "chart_out")]
-        chart: Option<PathBuf>,
-        /// The chart's SVG.
-        #[arg(long)]
-        chart_out: Option<PathBuf>,
-    },
-    /// Render the peers' scene (../shared/peers) with every voxsplat mode: median frame
-    /// times as CSV on stdout, images into --out-dir; `scripts/peers.sh` runs it beside VTK.
-    Peer {
-        /// Volume side (the peers use 128 and 256).
-        #[arg(long, default_value_t = 128)]
-        n: u32,
-        #[arg(long, default_value_t = 512)]
-        size: u32,
-        #[arg(long, default_value_t = 2)]
-        warmup: usize,
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-        #[arg(long, default_value = "peers-out")]
-        out_dir: PathBuf,
-        /// Also write the references: ray integration of the interpolated scalar (VTK's model) at
-        /// this step, and the pre-classified volumetric truth.
-        #[arg(long, value_parser = parse_finite)]
-        truth_step: Option<f32>,
-    },
-    /// Splat rate of every raster variant against footprint size (the bench's raster sweep): a
-    /// sheet of N x N voxels head-on, footprints exactly S px wide; CSV on stdout.
-    Rates {
-        /// Voxels per side of the sheet.
-        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(4..=2048))]
-        n: u32,
-        /// Footprint quad sides in pixels, comma-separated.
-        #[arg(long, default_value = "3,5,7,11,15", value_delimiter = ',', value_parser = parse_finite)]
-        sizes: Vec<f32>,
-        /// Timed frames per variant (median; one warm-up first).
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-    },
     /// Print error metrics of image A against reference B (PNG or EXR).
     Compare {
         /// The image to score.
@@ -237,27 +112,13 @@ enum Command {
         /// The reference.
         b: PathBuf,
     },
-    /// Time the benchmark cases (cube60 and the plane at 512x512): per-stage medians.
-    Bench(BenchArgs),
-}
-
-#[derive(Args)]
-struct BenchArgs {
-    /// A small matrix (two scenes at 128x128) that CI can afford.
-    #[arg(long)]
-    quick: bool,
-    /// Measured frames per configuration (at least 5; after warm-up).
-    #[arg(long)]
-    frames: Option<usize>,
-    /// Where the CSV files and SVG charts go.
-    #[arg(long, default_value = "bench-out")]
-    out_dir: PathBuf,
-    /// Also write the results page (e.g. docs/RESULTS.md), linking the charts in --out-dir.
-    #[arg(long)]
-    results: Option<PathBuf>,
-    /// Skip the scaling series.
-    #[arg(long)]
-    no_scaling: bool,
+    /// Studies that measure the renderer (for its developers): the timing matrix and the results
+    /// page, anti-aliasing, orders under motion, kernels, bricked volumes, the peers' scene,
+    /// raster rates, long runs. `voxsplat lab --help` lists them.
+    Lab {
+        #[command(subcommand)]
+        study: lab::Study,
+    },
 }
 
 #[derive(Args)]
@@ -334,7 +195,8 @@ struct RenderArgs {
     /// Draw the line where the first splat each pixel meets lies at eye distance k (Figs 3.6, 3.7).
     #[arg(long)]
     k_line: bool,
-    /// Traversal direction (default: back to front for splats, front to back for sheets).
+    /// Order of drawing: front to back (the default, which lets early termination stop), or back to
+    /// front (the default where per-splat footprints go through the graphics or point pipelines).
     #[arg(long, value_parser = ["ftb", "btf"])]
     direction: Option<String>,
     /// Memory budget for one batch of sheet summation layers, in MiB.
@@ -372,7 +234,8 @@ struct RenderArgs {
 
 #[derive(Args)]
 struct AnimateArgs {
-    /// A built-in animation (rotating-box) or a TOML file.
+    /// A built-in animation (rotating-box, spinning-box, rotating-terrain, rotating-terrain-ortho)
+    /// or a TOML file.
     #[arg(long, default_value = "rotating-box")]
     anim: String,
     /// none, splat (motion-blurred splats) or accum:N (N sub-frames averaged). Blurred splats
@@ -632,51 +495,6 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Animate(a) => animate(a),
-        Command::Rates { n, sizes, frames } => {
-            if frames < 1 {
-                return Err(Error::InvalidArgument("--frames must be at least 1".into()));
-            }
-            let mut r = Renderer::new(&RendererOptions::default())?;
-            eprintln!("device: {}", r.device_name());
-            let pts = voxsplat_cli::rates::raster_rates(&mut r, n, &sizes, frames, |m| eprintln!("{m}"))?;
-            print!("{}", voxsplat_cli::rates::rates_csv(&pts));
-            Ok(())
-        }
-        Command::Peer { n, size, warmup, frames, out_dir, truth_step } => {
-            if frames < 5 {
-                return Err(Error::InvalidArgument("--frames must be at least 5".into()));
-            }
-            std::fs::create_dir_all(&out_dir)
-                .map_err(|e| Error::Io { path: out_dir.display().to_string(), source: e })?;
-            let cam = voxsplat::peer::camera(n, size);
-            if let Some(step) = truth_step {
-                let t = std::time::Instant::now();
-                let vol = voxsplat::peer::volume(n)?;
-                let img = voxsplat::truth::ray_integrate_scalars(
-                    &vol,
-                    &voxsplat::peer::transfer_function(),
-                    &cam,
-                    step as f64,
-                )?;
-                voxsplat::output::write_image(&img, &out_dir.join(format!("truth-scalar-{n}.png")))?;
-                let set = voxsplat::classify::classify(&vol, &voxsplat::peer::transfer_function(), None)?;
-                let opts = voxsplat::truth::TruthOptions {
-                    reconstruction: voxsplat::truth::Reconstruction::Trilinear,
-                    ..Default::default()
-                };
-                let img = voxsplat::truth::volumetric_summation(&set, &cam, &opts)?;
-                voxsplat::output::write_image(&img, &out_dir.join(format!("truth-classified-{n}.png")))?;
-                eprintln!("references in {:.1} s", t.elapsed().as_secs_f64());
-            }
-            let mut r = Renderer::new(&RendererOptions::default())?;
-            println!("label,median_ms");
-            for run in voxsplat_cli::peer::time_variants(&mut r, n, size, warmup, frames)? {
-                println!("{},{:.2}", run.label, run.median_ms);
-                let file = format!("voxsplat-{}-{n}.png", run.label.replace(' ', "-"));
-                voxsplat::output::write_image(&run.image, &out_dir.join(file))?;
-            }
-            Ok(())
-        }
         Command::MakeVolume { from, factor, procedural, phantom, out } => {
             // It writes NRRD (raw data, attached): a name that says otherwise would mislead.
             if !out.to_string_lossy().to_ascii_lowercase().ends_with(".nrrd") {
@@ -715,31 +533,6 @@ fn run(cli: Cli) -> Result<()> {
                 out.display(),
                 t.elapsed().as_secs_f64()
             );
-            Ok(())
-        }
-        Command::Soak { frames, size, validation } => {
-            if frames == 0 || size == 0 {
-                return Err(Error::InvalidArgument("--frames and --size must be positive".into()));
-            }
-            let mut ro = RendererOptions::default();
-            ro.validation = validation;
-            let mut r = Renderer::new(&ro)?;
-            let bar = indicatif::ProgressBar::new(frames as u64);
-            let rep = voxsplat_cli::soak::soak(&mut r, frames, size, |_| bar.inc(1))?;
-            bar.finish_and_clear();
-            println!("frames: {}", rep.frames);
-            println!("cycle,rss_mib,gpu_allocations,gpu_bytes");
-            for (i, (rss, (n, b))) in rep.rss.iter().zip(&rep.gpu).enumerate() {
-                println!("{i},{:.1},{n},{b}", *rss as f64 / (1u64 << 20) as f64);
-            }
-            let growth = rep.rss_growth() as f64 / (1u64 << 20) as f64;
-            println!("rss peak growth after warm-up: {growth:.1} MiB over {} frames", rep.growth_span_frames());
-            let step = rep.rss_median_step() as f64 / (1u64 << 20) as f64;
-            println!(
-                "rss median step per cycle after warm-up: {step:.2} MiB ({} frames per cycle)",
-                voxsplat_cli::soak::CYCLE
-            );
-            println!("validation messages: {}", rep.validation_messages);
             Ok(())
         }
         Command::Info { file, dims, dtype, tf, vscale, cell } => {
@@ -834,72 +627,7 @@ fn run(cli: Cli) -> Result<()> {
             println!("ssim_alpha: {:.5}", m.ssim_alpha);
             Ok(())
         }
-        Command::Bench(a) => bench(a),
-        Command::Antialias { size, factor, dolly, frames } => {
-            if size.is_some_and(|s| !(16..=2048).contains(&s))
-                || !(1..=16).contains(&factor)
-                || dolly < 2
-                || frames == 0
-            {
-                return Err(Error::InvalidArgument(
-                    "--size in 16..=2048, --factor in 1..=16, --dolly at least 2, --frames at least 1".into(),
-                ));
-            }
-            let rows = voxsplat_cli::antialias::study(size, factor, dolly, frames)?;
-            print!("{}", voxsplat_cli::antialias::markdown(&rows, factor, dolly));
-            Ok(())
-        }
-        Command::MotionOrders { first, frames, rounds } => {
-            if frames == 0 || first + frames > 24 || rounds == 0 {
-                return Err(Error::InvalidArgument(
-                    "--frames at least 1, --first + --frames at most 24, --rounds at least 1".into(),
-                ));
-            }
-            let (orders, blurs) = voxsplat_cli::motion_orders::study(first, frames, rounds)?;
-            print!("{}", voxsplat_cli::motion_orders::markdown(&orders, &blurs, first, frames));
-            Ok(())
-        }
-        Command::Kernels { n, size, frames, chart } => {
-            if !(16..=512).contains(&n) || !(16..=4096).contains(&size) || frames == 0 {
-                return Err(Error::InvalidArgument("--n in 16..=512, --size in 16..=4096, --frames at least 1".into()));
-            }
-            let rows = voxsplat_cli::kernels::study(n, size, frames)?;
-            if let Some(c) = &chart {
-                voxsplat_cli::kernels::chart(&rows, c)?;
-            }
-            print!("{}", voxsplat_cli::kernels::markdown(&rows, n, size, chart.as_deref()));
-            Ok(())
-        }
-        Command::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => {
-            voxsplat_cli::bricked::scaling_chart(&csv, &svg)
-        }
-        Command::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, orbit, lod_chart, .. } => {
-            if frames < 1 || size < 16 {
-                return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
-            }
-            if let (Some(v), Some(steps)) = (&volume, orbit) {
-                let budget = mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?;
-                print!("{}", voxsplat_cli::bricked::orbit(v, size, budget, &tf, steps)?);
-                return Ok(());
-            }
-            match volume {
-                Some(v) => println!(
-                    "{}",
-                    voxsplat_cli::bricked::one_volume(
-                        &v,
-                        size,
-                        mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?,
-                        &tf,
-                        frames
-                    )?
-                ),
-                None => print!(
-                    "{}",
-                    voxsplat_cli::bricked::study(&bonsai, large.as_deref(), size, frames, lod_chart.as_deref())?
-                ),
-            }
-            Ok(())
-        }
+        Command::Lab { study } => lab::run(study),
         Command::Order(a) => {
             let (set, content) = load_scene(&a.scene)?;
             let cam = camera_of(&a.scene, set.grid(), &content)?;
@@ -973,136 +701,6 @@ fn animate(a: AnimateArgs) -> Result<()> {
     gif.finish()?;
     eprintln!("{} frames -> {}", anim.frames, a.out_dir.display());
     Ok(())
-}
-
-fn bench(a: BenchArgs) -> Result<()> {
-    use voxsplat_cli::bench::*;
-    let mut m = if a.quick { MatrixOptions::quick() } else { MatrixOptions::full() };
-    if let Some(f) = a.frames {
-        if f < 5 {
-            return Err(Error::InvalidArgument("--frames must be at least 5".into()));
-        }
-        m.frames = f;
-    }
-    let io = |p: &std::path::Path| {
-        let p = p.display().to_string();
-        move |e| Error::Io { path: p, source: e }
-    };
-    std::fs::create_dir_all(&a.out_dir).map_err(io(&a.out_dir))?;
-    let mut r = Renderer::new(&RendererOptions::default())?;
-    let device = r.device_name();
-    eprintln!("device: {device}");
-    let bar = indicatif::ProgressBar::new((m.scenes.len() * m.methods.len()) as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {elapsed} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let mut rows = run_matrix(&mut r, &m, |done, _, label| {
-        bar.set_position(done as u64);
-        bar.set_message(label.to_string());
-    })?;
-    bar.finish_and_clear();
-    let (aa_size, aa_factor, aa_dolly) = if a.quick { (96, 4, 8) } else { (256, 8, 60) };
-    let aa = antialias_study(&mut r, aa_size, aa_factor, aa_dolly, m.frames, |msg| eprintln!("{msg}"))?;
-    rows.extend(antialias_rows(&aa, aa_size));
-    eprintln!("motion blur...");
-    let (mb_size, mb_frame) = if a.quick { (96, 9) } else { (256, 12) };
-    let mb = motion_study(&mut r, mb_size, mb_frame, m.frames)?;
-    rows.extend(motion_rows(&mb, mb_size));
-    let mb_images = write_motion_images(&mb, &a.out_dir)?;
-    let stab = voxsplat_cli::stability::run(&mut r, a.quick, |msg| eprintln!("{msg}"))?;
-    voxsplat_cli::stability::write_outputs(&stab, &a.out_dir)?;
-    write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
-    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
-    scenes.dedup();
-    for sc in &scenes {
-        chart_svg(&rows, sc, &a.out_dir.join(format!("chart-{sc}.svg")))?;
-    }
-    eprintln!("roofline...");
-    let (w, h) = (m.width.max(256), m.height.max(256));
-    let sizes: &[u32] = if a.quick { &[3, 7] } else { &[3, 7, 15, 31] };
-    let frags = if a.quick { 1 << 20 } else { 8 << 20 };
-    let roof = roofline(&mut r, w, h, sizes, frags, 5)?;
-    let (rate_n, rate_sizes): (u32, &[f32]) =
-        if a.quick { (48, &[3.0, 7.0]) } else { (256, &[3.0, 5.0, 7.0, 11.0, 15.0]) };
-    let rates =
-        voxsplat_cli::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames.clamp(3, 5), |msg| eprintln!("{msg}"))?;
-    voxsplat_cli::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
-    voxsplat_cli::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
-    let scale = if a.no_scaling {
-        Vec::new()
-    } else {
-        let (cubes, images): (&[u32], &[u32]) =
-            if a.quick { (&[22, 46], &[128, 256]) } else { (&[22, 46, 100, 146], &[128, 256, 512, 1024, 2048]) };
-        let s = scaling(&mut r, cubes, images, 5, |msg| eprintln!("{msg}"))?;
-        write_scaling_csv(&s, &a.out_dir.join("scaling.csv"))?;
-        // The bricked volumes' series (scripts/bricks-vtk.sh, run first by scripts/results.sh).
-        let bricks = a.out_dir.join("bricks-scaling.csv");
-        let bricks = bricks.exists().then(|| voxsplat_cli::bricked::read_scaling_csv(&bricks)).transpose()?;
-        scaling_svg(&s, bricks.as_deref(), &a.out_dir.join("scaling.svg"))?;
-        s
-    };
-    if let Some(path) = &a.results {
-        let commit = std::process::Command::new("git")
-            .args(["rev-parse", "--short", "HEAD"])
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-            .unwrap_or_else(|| "unknown".into());
-        let base = path.parent().unwrap_or(std::path::Path::new("."));
-        let chart_dir = pathdiff(&a.out_dir, base);
-        let notes_path = base.join("results-notes.md");
-        let notes = std::fs::read_to_string(&notes_path).ok();
-        let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
-        // The peer comparison is its own run (scripts/peers.sh); its section is kept when present.
-        let peers_md = std::fs::read_to_string(a.out_dir.join("peers.md")).unwrap_or_default();
-        // So are the bricked-volume study (`voxsplat bricks`) and the kernels' (`voxsplat kernels`),
-        // run by scripts/results.sh.
-        let bricks_md = std::fs::read_to_string(a.out_dir.join("bricks.md")).unwrap_or_default();
-        let kernels_md = std::fs::read_to_string(a.out_dir.join("kernels.md")).unwrap_or_default();
-        let aa_scenes_md = std::fs::read_to_string(a.out_dir.join("antialias.md")).unwrap_or_default();
-        let motion_orders_md = std::fs::read_to_string(a.out_dir.join("motion-orders.md")).unwrap_or_default();
-        let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
-        let motion_md = format!(
-            "{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}",
-            voxsplat_cli::rates::rates_markdown(
-                &rates,
-                &roof_rates,
-                &voxsplat_cli::bench::link(&chart_dir, "rates.svg")
-            ),
-            antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
-            aa_scenes_md,
-            motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
-            motion_orders_md,
-            voxsplat_cli::stability::markdown(&stab, &chart_dir),
-            peers_md,
-            bricks_md,
-            kernels_md
-        );
-        let md = results_markdown(&Report {
-            device,
-            commit,
-            command: format!("voxsplat {cmd}"),
-            rows: &rows,
-            roofline: Some(&roof),
-            scaling: &scale,
-            chart_dir,
-            notes,
-            antialias: Some(motion_md),
-        })?;
-        std::fs::write(path, md).map_err(io(path))?;
-        eprintln!("wrote {}", path.display());
-    }
-    print!("{}", std::fs::read_to_string(a.out_dir.join("matrix.csv")).map_err(io(&a.out_dir))?);
-    Ok(())
-}
-
-/// `target` relative to `base` when it lies below it, else as given.
-fn pathdiff(target: &std::path::Path, base: &std::path::Path) -> String {
-    let t = std::fs::canonicalize(target).unwrap_or_else(|_| target.to_path_buf());
-    let b = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
-    t.strip_prefix(&b).map(|p| p.display().to_string()).unwrap_or_else(|_| target.display().to_string())
 }
 
 /// `voxsplat render` under mpirun: the --volume file cut into one box per rank, each drawn by its

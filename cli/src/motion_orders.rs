@@ -151,7 +151,7 @@ pub fn markdown(orders: &[OrderRow], blurs: &[BlurRow], first: u32, frames: u32)
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "## Orders under motion, blur shapes (chapters 4 and 5)\n\n`voxsplat motion-orders`: still frames {first} to {} \
+        "## Orders under motion, blur shapes (chapters 4 and 5)\n\n`voxsplat lab motion-orders`: still frames {first} to {} \
          of each built-in animation; static error = mean PSNR against the exactly sorted order's frames; temporal error = \
          mean RMSE of each frame-to-frame change against the sorted order's change (what the order adds to the motion).\n\n\
          | animation | order | static PSNR dB | temporal RMSE |\n|---|---|---:|---:|",
@@ -170,7 +170,7 @@ pub fn markdown(orders: &[OrderRow], blurs: &[BlurRow], first: u32, frames: u32)
          drawn with WBTF as the seed draws them, frame {}, against 64 sub-frames (summed stage times, all methods \
          alternating, medians). `auto` is the default raster choice (on a CPU device the tile compositor for the \
          seed's shape and for accum:5; graphics quads for the arc and tapered shapes, which only that pipeline draws); \
-         the last two columns are against accum:5 through the same raster choice (issue 26's target for blurred \
+         the last two columns are against accum:5 through the same raster choice (the target for blurred \
          splats: error ≤ 1.5× at ≤ 0.5× the time):\n\n\
          | animation | method | raster | RMSE | ms | error vs accum:5 | time vs accum:5 |\n|---|---|---|---:|---:|---:|---:|",
         first + frames

@@ -141,7 +141,7 @@ pub struct SceneArgs {
     #[arg(long)]
     pub tf: Option<String>,
     /// Phong shading with a headlight, applied to the voxels before splatting (on by default for
-    /// the presets it measurably helps: `classify::SHADED_PRESETS`, bonsai).
+    /// the presets it measurably helps: bonsai).
     #[arg(long, conflicts_with = "no_shade")]
     pub shade: bool,
     /// No shading, even for a preset shaded by default.

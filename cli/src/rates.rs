@@ -1,4 +1,4 @@
-//! The raster-rate sweep of `voxsplat bench`: splats per second of every raster variant
+//! The raster-rate sweep of `voxsplat lab matrix`: splats per second of every raster variant
 //! against footprint size, each with its error against the truth, beside the raster roofline.
 //!
 //! Scene: one sheet of n x n voxels (a checkerboard at opacity 0.3) seen head-on through an
@@ -222,7 +222,7 @@ pub fn rates_svg(points: &[RatePoint], path: &Path) -> Result<()> {
 /// roofline (`quads_per_s` of `bench::roofline` at the same sizes, when measured).
 pub fn rates_markdown(points: &[RatePoint], roofline: &[(u32, f64)], chart: &str) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "## Raster variants (issue 10)\n\n![splat rate vs footprint]({chart})\n");
+    let _ = writeln!(s, "## Raster variants\n\n![splat rate vs footprint]({chart})\n");
     let _ = writeln!(
         s,
         "One sheet of {} voxels, head-on and orthographic, footprint quads exactly N px wide; rate = splats \

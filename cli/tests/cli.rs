@@ -171,8 +171,15 @@ const QUICK_RMSE_CEILINGS: &[(&str, &str, f64)] = &[
 fn quick_bench_writes_valid_csv_and_svg() {
     let dir = tmp("bench");
     let results = dir.join("RESULTS.md");
-    let out =
-        voxsplat(&["bench", "--quick", "--out-dir", dir.to_str().unwrap(), "--results", results.to_str().unwrap()]);
+    let out = voxsplat(&[
+        "lab",
+        "matrix",
+        "--quick",
+        "--out-dir",
+        dir.to_str().unwrap(),
+        "--results",
+        results.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = std::fs::read_to_string(dir.join("matrix.csv")).unwrap();
     let mut lines = csv.lines();
@@ -295,13 +302,13 @@ fn compare_prints_metrics_and_rejects_bad_files() {
     }
 }
 
-/// `voxsplat peer` times every mode on the peers' scene and writes their images; bad sizes are
+/// `voxsplat lab peer` times every mode on the peers' scene and writes their images; bad sizes are
 /// typed errors.
 #[test]
 fn peer_subcommand_times_every_mode() {
     let dir = tmp("peer");
     let d = dir.to_str().unwrap();
-    let out = voxsplat(&["peer", "--n", "24", "--size", "48", "--frames", "5", "--warmup", "1", "--out-dir", d]);
+    let out = voxsplat(&["lab", "peer", "--n", "24", "--size", "48", "--frames", "5", "--warmup", "1", "--out-dir", d]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<&str> = csv.lines().skip(1).collect();
@@ -316,7 +323,7 @@ fn peer_subcommand_times_every_mode() {
         assert!(ms.parse::<f64>().unwrap() > 0.0, "{r}");
         assert!(dir.join(format!("voxsplat-{}-24.png", label.replace(' ', "-"))).exists(), "{label}");
     }
-    for args in [["peer", "--n", "1"], ["peer", "--frames", "2"]] {
+    for args in [["lab", "peer", "--n", "1"], ["lab", "peer", "--frames", "2"]] {
         let out = voxsplat(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         assert!(String::from_utf8_lossy(&out.stderr).contains("error"));
@@ -482,17 +489,18 @@ fn bricked_volumes_take_a_budget_and_fall_back_where_they_must() {
         out.status.success() && err.contains("stored voxels in") && err.contains("bytes per stored voxel"),
         "{err}"
     );
-    let out = voxsplat(&["bricks", "--volume", stent, "--tf", "ct", "--size", "32", "--frames", "1"]);
+    let out = voxsplat(&["lab", "bricks", "--volume", stent, "--tf", "ct", "--size", "32", "--frames", "1"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("stored") && text.contains("median frame"), "{text}");
 }
 
-/// `voxsplat kernels` (issue 26) lists every kernel with its ripple and error, and the fitted
+/// `voxsplat lab kernels` lists every kernel with its ripple and error, and the fitted
 /// Crawfis-Max kernel ripples least.
 #[test]
 fn kernels_subcommand_compares_every_kernel() {
     let chart = tmp("kernels.svg");
-    let out = voxsplat(&["kernels", "--n", "32", "--size", "64", "--frames", "1", "--chart", chart.to_str().unwrap()]);
+    let out =
+        voxsplat(&["lab", "kernels", "--n", "32", "--size", "64", "--frames", "1", "--chart", chart.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
     let ripple = |name: &str| -> f64 {
@@ -505,14 +513,14 @@ fn kernels_subcommand_compares_every_kernel() {
         assert!(fitted < ripple(other), "crawfis-max ripples {fitted} %, {other} {} %", ripple(other));
     }
     assert!(std::fs::read_to_string(&chart).unwrap().contains("<svg"));
-    assert_eq!(voxsplat(&["kernels", "--n", "4"]).status.code(), Some(2));
+    assert_eq!(voxsplat(&["lab", "kernels", "--n", "4"]).status.code(), Some(2));
 }
 
-/// `voxsplat antialias` (issue 26): the terrain and orthographic figures, every mode measured;
+/// `voxsplat lab antialias`: the terrain and orthographic figures, every mode measured;
 /// the orthographic view lies wholly beyond k and anti-aliasing lowers its shimmer.
 #[test]
 fn antialias_subcommand_measures_the_terrain_and_orthographic_figures() {
-    let out = voxsplat(&["antialias", "--size", "48", "--factor", "2", "--dolly", "3", "--frames", "1"]);
+    let out = voxsplat(&["lab", "antialias", "--size", "48", "--factor", "2", "--dolly", "3", "--frames", "1"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<Vec<&str>> =
@@ -522,15 +530,15 @@ fn antialias_subcommand_measures_the_terrain_and_orthographic_figures() {
     assert!(ortho.iter().all(|r| r[3] == "100 %" && r[2] == "48×48"), "{text}");
     let shimmer = |r: &Vec<&str>| r[7].parse::<f64>().unwrap();
     assert!(shimmer(ortho[2]) < shimmer(ortho[0]), "EWA shimmers less than none: {text}");
-    assert_eq!(voxsplat(&["antialias", "--dolly", "1"]).status.code(), Some(2));
+    assert_eq!(voxsplat(&["lab", "antialias", "--dolly", "1"]).status.code(), Some(2));
 }
 
-/// `voxsplat motion-orders` (issue 26): every order on every built-in animation, and the blur shapes
+/// `voxsplat lab motion-orders`: every order on every built-in animation, and the blur shapes
 /// against the accumulation buffer; WBTF's nesting follows the sorted order more closely than
 /// BTF's on the orthographic box (the seed's reason to draw Fig. 4.5 with it).
 #[test]
 fn motion_orders_subcommand_measures_orders_and_blur_shapes() {
-    let out = voxsplat(&["motion-orders", "--first", "10", "--frames", "2", "--rounds", "1"]);
+    let out = voxsplat(&["lab", "motion-orders", "--first", "10", "--frames", "2", "--rounds", "1"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
     let psnr = |anim: &str, order: &str| -> f64 {
@@ -555,7 +563,7 @@ fn motion_orders_subcommand_measures_orders_and_blur_shapes() {
         rmse("spinning-box", "splat:arc+tapered", "graphics") < rmse("spinning-box", "splat", "graphics"),
         "{text}"
     );
-    assert_eq!(voxsplat(&["motion-orders", "--first", "20", "--frames", "10"]).status.code(), Some(2));
+    assert_eq!(voxsplat(&["lab", "motion-orders", "--first", "20", "--frames", "10"]).status.code(), Some(2));
 }
 
 /// `--positions` (issue 26 item 6): a raw volume on irregular z slices renders at them, and its

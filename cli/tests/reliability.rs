@@ -29,11 +29,11 @@ fn a_100_frame_soak_keeps_gpu_allocations_flat() {
 #[test]
 fn a_120_frame_soak_keeps_host_memory_flat() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_voxsplat"))
-        .args(["soak", "--frames", "120", "--size", "64", "--validation"])
+        .args(["lab", "soak", "--frames", "120", "--size", "64", "--validation"])
         .env("MALLOC_MMAP_THRESHOLD_", "131072")
         .env("MALLOC_ARENA_MAX", "1")
         .output()
-        .expect("run voxsplat soak");
+        .expect("run voxsplat lab soak");
     let text = String::from_utf8_lossy(&out.stdout);
     eprintln!("{text}{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success());
