@@ -108,3 +108,6 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
 /// Splats closer than this many radii to the near or far plane are culled (the quad's corners
 /// must stay in front of the eye; 1.5 > sqrt 2); the framing view keeps the nearest voxels clear.
 pub const CULL_RADII: f32 = 1.5;
+
+/// The default device-memory budget of a frame: 1 GiB, as on a mid-range GPU (lavapipe too).
+pub const DEFAULT_GPU_BUDGET: u64 = 1 << 30;

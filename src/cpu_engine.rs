@@ -7,11 +7,12 @@ use crate::gpu_types::Frame;
 use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
+// Where they live now; kept here for the paths callers already use.
+pub use crate::constants::DEFAULT_GPU_BUDGET;
+pub use crate::options::add_time;
 use crate::plan::Prepared;
 use crate::stages::{Dispatch, Engine, Limits};
 
-/// The default device-memory budget of a frame: 1 GiB, as on a mid-range GPU (lavapipe too).
-pub const DEFAULT_GPU_BUDGET: u64 = 1 << 30;
 use std::collections::BTreeSet;
 use std::time::Instant;
 
@@ -40,14 +41,6 @@ impl<'a> CpuEngine<'a> {
     pub fn with_budget(mut self, bytes: u64) -> Self {
         self.budget_bytes = bytes;
         self
-    }
-}
-
-/// Add `ms` to the stage named `stage` (first-seen order).
-pub fn add_time(timings: &mut Vec<StageTime>, stage: &'static str, ms: f64) {
-    match timings.iter_mut().find(|t| t.stage == stage) {
-        Some(t) => t.ms += ms,
-        None => timings.push(StageTime { stage, ms }),
     }
 }
 
@@ -191,7 +184,7 @@ impl Engine for CpuEngine<'_> {
 
     fn prepare_field(&mut self, brick: u32) -> Result<()> {
         let field = self.b.prep.dense_field()?;
-        self.b.bricks = crate::cpu::raycast::brick_occupancy(field, brick.max(1)).1;
+        self.b.bricks = field.brick_occupancy(brick.max(1)).1;
         Ok(())
     }
 }

@@ -72,13 +72,14 @@ pub mod volume;
 
 pub use bisect::Bisect;
 pub use camera::{Camera, Projection};
-pub use cpu::present::TargetFormat;
 pub use error::{host_budget, set_host_budget, Error, Result};
 pub use glam;
 pub use image::ImageF32;
+pub use image::TargetFormat;
 pub use kernel::Kernel;
 pub use options::{
-    Antialias, BlurProfile, Clip, Composite, FrameStats, Lod, Motion, RenderOptions, Rendered, StageTime,
+    Antialias, BlurProfile, Clip, Composite, FrameStats, Lod, Motion, RaycastOptions, RenderOptions, Rendered,
+    StageTime,
 };
 pub use order::{Direction, OrderKind};
 pub use raster::{Raster, RasterChoice};
@@ -483,7 +484,7 @@ impl Renderer {
     }
 
     /// The ray caster: `raycast.comp` on the GPU, or its CPU mirror.
-    pub fn raycast(&mut self, camera: &Camera, options: &cpu::raycast::RaycastOptions) -> Result<Rendered> {
+    pub fn raycast(&mut self, camera: &Camera, options: &RaycastOptions) -> Result<Rendered> {
         camera.validate()?;
         check_frame_memory(camera)?;
         if !(options.step.is_finite() && options.step > 0.0) {
@@ -493,10 +494,10 @@ impl Renderer {
             return Err(Error::InvalidArgument("the ray caster's stopping transmittance must be in [0, 1)".into()));
         }
         let k = options.supersample;
-        if k == 0 || k > cpu::raycast::MAX_SUPERSAMPLE {
+        if k == 0 || k > options::MAX_SUPERSAMPLE {
             return Err(Error::InvalidArgument(format!(
                 "rays per pixel along each axis must be in 1..={}, not {k}",
-                cpu::raycast::MAX_SUPERSAMPLE
+                options::MAX_SUPERSAMPLE
             )));
         }
         if k > 1 && options.render_scale != 1.0 {
@@ -509,7 +510,7 @@ impl Renderer {
             // its k x k rays (the finer grid's pixel centres sit on a regular grid inside it).
             let fine = Camera { width: camera.width * k, height: camera.height * k, ..*camera };
             fine.validate()?;
-            let one = cpu::raycast::RaycastOptions { supersample: 1, ..*options };
+            let one = RaycastOptions { supersample: 1, ..*options };
             let mut out = self.raycast(&fine, &one)?;
             let t = std::time::Instant::now();
             out.image = truth::downsample(&out.image, k as usize, truth::Downsample::Box);
@@ -517,7 +518,7 @@ impl Renderer {
             return Ok(out);
         }
         if options.render_scale != 1.0 {
-            let full = cpu::raycast::RaycastOptions { render_scale: 1.0, ..*options };
+            let full = RaycastOptions { render_scale: 1.0, ..*options };
             return resample::render_scaled(camera, options.render_scale, |low| self.raycast(low, &full));
         }
         let prep = Self::prepared_in(&self.scene)?;

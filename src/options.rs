@@ -427,6 +427,57 @@ pub struct StageTime {
     pub ms: f64,
 }
 
+/// Add `ms` to the stage named `stage` (first-seen order).
+pub fn add_time(timings: &mut Vec<StageTime>, stage: &'static str, ms: f64) {
+    match timings.iter_mut().find(|t| t.stage == stage) {
+        Some(t) => t.ms += ms,
+        None => timings.push(StageTime { stage, ms }),
+    }
+}
+
+/// Ray caster settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RaycastOptions {
+    /// Step length in voxel spacings.
+    pub step: f32,
+    /// Transmittance below which a ray stops.
+    pub min_transmittance: f32,
+    /// Most samples per ray.
+    pub max_steps: u32,
+    /// Empty-space skipping over bricks of this many voxels per side (0: off). Exact: only samples
+    /// that read nothing but empty voxels are skipped.
+    pub brick: u32,
+    /// Cast on a grid this fraction of the camera's size and resample (`crate::resample`; the
+    /// inverse of an image sample distance). 1: full size.
+    pub render_scale: f32,
+    /// Clipping planes and crop box: each ray is cut to the part inside them.
+    pub clip: crate::options::Clip,
+    /// Rays per pixel along each axis (1 to `MAX_SUPERSAMPLE`): `k`×`k` rays on a regular grid
+    /// inside each pixel, averaged (a box filter over the pixel's area). The converged reference
+    /// that levels of detail and anti-aliasing are scored against (docs/MODEL.md, "The reference").
+    pub supersample: u32,
+}
+
+/// Most rays per pixel along each axis of a supersampled cast.
+pub const MAX_SUPERSAMPLE: u32 = 16;
+
+/// Default brick side of the empty-space skipping.
+pub const DEFAULT_BRICK: u32 = 8;
+
+impl Default for RaycastOptions {
+    fn default() -> Self {
+        Self {
+            step: 0.5,
+            min_transmittance: 1e-3,
+            max_steps: 1 << 16,
+            brick: DEFAULT_BRICK,
+            render_scale: 1.0,
+            clip: Default::default(),
+            supersample: 1,
+        }
+    }
+}
+
 /// A rendered frame: premultiplied RGBA32F, row 0 at the top.
 #[derive(Clone, Debug)]
 pub struct Rendered {

@@ -4,9 +4,9 @@
 use crate::camera::Camera;
 use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE_H, RASTER_TILE_W, TILE_CHUNK, WORKGROUP_SIZE};
 use crate::error::Result;
-use crate::gpu_types::{CompositePush, FootprintPush, Frame, SHEET_MODE_AXIS, SHEET_MODE_BINNED};
+use crate::gpu_types::{CompositePush, FootprintPush, Frame, RaycastParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED};
 use crate::kernel::Kernel;
-use crate::options::{Antialias, Motion, RenderOptions, EWA_LOWPASS_PX};
+use crate::options::{Antialias, Motion, RaycastOptions, RenderOptions, EWA_LOWPASS_PX};
 use crate::order::{self, Direction};
 use crate::volume::SplatSet;
 use glam::Vec3;
@@ -303,3 +303,27 @@ pub fn set_early_termination(opts: &RenderOptions, batches: &mut [Batch]) {
 
 /// Most cells of the tile x chunk count matrix (4 bytes each: 64 MiB).
 pub const MAX_TILE_CELLS: u64 = 1 << 24;
+
+/// The ray caster's uniforms, read by the GPU stage and its mirror.
+pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) -> RaycastParams {
+    let g = set.grid();
+    let o = Vec3::from(g.origin);
+    let s = Vec3::from(g.spacing);
+    let hi = Vec3::from(g.dims.map(|d| d as f32));
+    let step = opts.step * s.min_element();
+    // The inverse cell matrix, upper triangular as the cell matrix is.
+    let inv = g.cell_matrix().inverse();
+    let inv_shear = [inv.y_axis.x, inv.z_axis.x, inv.z_axis.y].map(|v| v as f32);
+    let (clip, clip_count) = opts.clip.uniforms();
+    RaycastParams {
+        inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
+        box_min: [-1.0, -1.0, -1.0, step],
+        box_max: [hi.x, hi.y, hi.z, opts.min_transmittance],
+        origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
+        inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
+        inv_shear: [inv_shear[0], inv_shear[1], inv_shear[2], 0.0],
+        dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
+        image: [camera.width, camera.height, opts.brick, clip_count],
+        clip,
+    }
+}

@@ -10,14 +10,14 @@ use crate::constants::{
     COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, RECORD_PAGE, SPLAT_PAGE, TILE_BIN_WORKGROUP,
     TILE_SEGMENT,
 };
-use crate::cpu::footprint::Blend;
-use crate::cpu::raycast::RaycastOptions;
+use crate::dispatch::Blend;
 use crate::error::{Error, Result};
 use crate::gpu_types::{
     BrickPush, FootprintPush, Frame, ScreenQuad, SlabPush, SplatParams, SHEET_MODE_BINNED, SHEET_MODE_SLAB,
     SHEET_MODE_SPLAT,
 };
 use crate::image::ImageF32;
+use crate::options::RaycastOptions;
 use crate::options::{Composite, Lod, RenderOptions, StageTime};
 use crate::order::{Direction, OrderKind};
 use crate::plan::{self, groups_1d, Prepared};
@@ -450,7 +450,7 @@ fn check_status(word: u32) -> Result<()> {
 /// `camera` with `opts` (at full size: the caller resamples a render scale).
 pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RaycastOptions) -> Result<Recorded> {
     camera.validate()?;
-    let params = crate::cpu::raycast::raycast_params(&prep.set, camera, opts);
+    let params = crate::plan::raycast_params(&prep.set, camera, opts);
     let g = prep.set.grid();
     let [lo, hi] = g.world_box(glam::Vec3::splat(-1.0), glam::Vec3::from(g.dims.map(|d| d as f32)));
     let diagonal = hi.distance(lo);

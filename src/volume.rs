@@ -448,6 +448,36 @@ pub struct DenseField {
 }
 
 impl DenseField {
+    /// Which bricks of `brick`³ voxels hold a voxel with optical depth, looking one voxel beyond each
+    /// face (the trilinear support of every sample inside the brick): (bricks per axis, flags). The
+    /// ray caster's empty-space skipping reads them (`raycast`, both engines).
+    pub fn brick_occupancy(&self, brick: u32) -> ([u32; 3], Vec<u32>) {
+        let field = self;
+        let b = brick.max(1) as i64;
+        let nb = field.dims.map(|d| (d as i64 + b - 1) / b);
+        let mut occ = vec![0u32; (nb[0] * nb[1] * nb[2]) as usize];
+        for k in 0..field.dims[2] as i64 {
+            for j in 0..field.dims[1] as i64 {
+                for i in 0..field.dims[0] as i64 {
+                    if field.at(i, j, k)[3] <= 0.0 {
+                        continue;
+                    }
+                    // Mark every brick whose widened range [bB - 1, (b+1)B + 1] holds (i, j, k).
+                    let range = |c: i64, n: i64| ((c - 1).div_euclid(b).max(0), ((c + 1).div_euclid(b)).min(n - 1));
+                    let (rx, ry, rz) = (range(i, nb[0]), range(j, nb[1]), range(k, nb[2]));
+                    for bz in rz.0..=rz.1 {
+                        for by in ry.0..=ry.1 {
+                            for bx in rx.0..=rx.1 {
+                                occ[((bz * nb[1] + by) * nb[0] + bx) as usize] = 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        (nb.map(|n| n as u32), occ)
+    }
+
     /// The non-empty voxels of `set` on their grid (refused past `MAX_DENSE_BYTES`).
     pub fn new(set: &SplatSet) -> Result<Self> {
         let [nx, ny, nz] = set.grid().dims;

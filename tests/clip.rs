@@ -4,7 +4,7 @@ mod common;
 use common::{assert_clean, blob, blob_tf as tf, diff};
 use glam::{Vec3, Vec4};
 use voxsplat::classify::classify;
-use voxsplat::cpu::raycast::RaycastOptions;
+use voxsplat::RaycastOptions;
 use voxsplat::{scene, Camera, Clip, Composite, Raster, RenderOptions};
 
 fn with(clip: Clip, composite: Composite, raster: Raster) -> RenderOptions {

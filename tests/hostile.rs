@@ -5,9 +5,9 @@ use common::{assert_clean, cpu, gpu};
 use std::path::{Path, PathBuf};
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::cpu::raycast::RaycastOptions;
 use voxsplat::loaders::{load_volume, npy_from_bytes, DType, VolumeHints};
 use voxsplat::volume::ScalarVolume;
+use voxsplat::RaycastOptions;
 use voxsplat::{Camera, Error, Grid, ImageF32, Projection, Raster, RenderOptions};
 
 fn dir() -> PathBuf {

@@ -146,7 +146,7 @@ fn gpu_rays_past_the_loop_budget_are_refused() {
     let mut g = gpu();
     g.set_scene(set).unwrap();
     // A ~70-voxel diagonal at a 0.001-voxel step: 70 000 samples.
-    let mut o = voxsplat::cpu::raycast::RaycastOptions { step: 0.001, ..Default::default() };
+    let mut o = voxsplat::RaycastOptions { step: 0.001, ..Default::default() };
     let m = too_large(g.raycast(&cam, &o));
     assert!(m.contains(&MAX_GPU_RAY_STEPS.to_string()), "{m}");
     o.step = 0.002;

@@ -89,3 +89,233 @@ fn no_core_source_file_passes_700_lines() {
         }
     }
 }
+
+/// Every `.rs` file under `root`.
+fn rust_files(root: &Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+/// The paths a `use` tree or path expression at the start of `s` names: `a::{b, c::d}` ->
+/// [a, b], [a, c, d]. Segments run while they are identifiers; a group is read to its brace.
+fn path_tree(s: &str) -> Vec<Vec<String>> {
+    fn tree(s: &[char], i: &mut usize, prefix: Vec<String>, out: &mut Vec<Vec<String>>) {
+        let mut path = prefix;
+        loop {
+            while *i < s.len() && s[*i] == ' ' {
+                *i += 1;
+            }
+            if *i < s.len() && s[*i] == '{' {
+                *i += 1;
+                loop {
+                    tree(s, i, path.clone(), out);
+                    while *i < s.len() && s[*i] == ' ' {
+                        *i += 1;
+                    }
+                    match s.get(*i) {
+                        Some(',') => *i += 1,
+                        Some('}') => {
+                            *i += 1;
+                            return;
+                        }
+                        _ => return,
+                    }
+                    while *i < s.len() && s[*i] == ' ' {
+                        *i += 1;
+                    }
+                    if s.get(*i) == Some(&'}') {
+                        *i += 1;
+                        return;
+                    }
+                }
+            }
+            let start = *i;
+            while *i < s.len() && (s[*i].is_ascii_alphanumeric() || s[*i] == '_' || s[*i] == '*') {
+                *i += 1;
+            }
+            if *i > start {
+                path.push(s[start..*i].iter().collect());
+            }
+            if s.get(*i) == Some(&':') && s.get(*i + 1) == Some(&':') {
+                *i += 2;
+                continue;
+            }
+            // Skip `as name`.
+            out.push(path);
+            return;
+        }
+    }
+    let chars: Vec<char> = s.chars().collect();
+    let mut out = Vec::new();
+    tree(&chars, &mut 0, Vec::new(), &mut out);
+    out
+}
+
+/// File -> the files its code names, the file-level import graph of one crate's `src` (comments
+/// and test modules left out): `crate::a::b`, `super::x`, a child module's `x::`, and for the
+/// CLI's binary `voxsplat_cli::a`. A path names the file of its longest module prefix. A file's
+/// own ancestors are not counted (a module and the files it declares are one unit: `use super::`
+/// into the parent, `pub use child::Item` out of it); every other edge is. The binary's modules
+/// (`main.rs` and what it declares) are keyed apart as "bin:".
+fn file_graph(root: &Path, lib_name: Option<&str>) -> BTreeMap<String, BTreeSet<String>> {
+    let files = rust_files(root);
+    let bin_files: BTreeSet<String> = match std::fs::read_to_string(root.join("main.rs")) {
+        Ok(main) => main
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("mod ").map(|m| m.trim_end_matches(';').to_string()))
+            .chain(["main".to_string()])
+            .collect(),
+        Err(_) => BTreeSet::new(),
+    };
+    // File key and module path (`src/cpu/mod.rs` -> "cpu/mod", [cpu]).
+    let module = |f: &Path| -> (String, bool, Vec<String>) {
+        let rel = f.strip_prefix(root).unwrap().with_extension("").to_str().unwrap().to_string();
+        if bin_files.contains(&rel) {
+            let m = if rel == "main" { vec![] } else { vec![rel.clone()] };
+            return (format!("bin:{rel}"), true, m);
+        }
+        let mut parts: Vec<String> = rel.split('/').map(str::to_string).collect();
+        if matches!(parts.last().map(String::as_str), Some("mod" | "lib")) {
+            parts.pop();
+        }
+        (rel, false, parts)
+    };
+    let mut lib_mods: BTreeMap<Vec<String>, String> = BTreeMap::new();
+    let mut bin_mods: BTreeMap<Vec<String>, String> = BTreeMap::new();
+    for f in &files {
+        let (k, bin, m) = module(f);
+        if bin { &mut bin_mods } else { &mut lib_mods }.insert(m, k);
+    }
+    let resolve = |mods: &BTreeMap<Vec<String>, String>, path: &[String]| -> Option<(Vec<String>, String)> {
+        (0..=path.len()).rev().find_map(|n| mods.get(&path[..n]).map(|k| (path[..n].to_vec(), k.clone())))
+    };
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for f in &files {
+        let (k, bin, me) = module(f);
+        let mods = if bin { &bin_mods } else { &lib_mods };
+        // The code on one line: comments and test modules out.
+        let mut code = String::new();
+        let mut skip_to: Option<i32> = None;
+        let mut depth = 0i32;
+        let mut inline = Vec::new();
+        let mut test_next = false;
+        for line in std::fs::read_to_string(f).unwrap().lines() {
+            let c = line.split("//").next().unwrap();
+            let opens_mod = c.trim_start().trim_start_matches("pub ").starts_with("mod ") && c.contains('{');
+            if skip_to.is_none() && test_next && opens_mod {
+                skip_to = Some(depth);
+            }
+            test_next = c.contains("#[cfg(test)]") || (test_next && c.trim().starts_with("#["));
+            if skip_to.is_none() && opens_mod {
+                inline.push(depth);
+                code.push_str(" \u{1} ");
+            }
+            depth += c.matches('{').count() as i32 - c.matches('}').count() as i32;
+            if skip_to.is_none() {
+                code.push_str(c);
+                code.push(' ');
+            }
+            if skip_to.is_some_and(|d| depth <= d) {
+                skip_to = None;
+            }
+            while inline.last().is_some_and(|&d| depth <= d) {
+                inline.pop();
+                code.push_str(" \u{2} ");
+            }
+        }
+        let children: BTreeSet<String> = mods
+            .keys()
+            .filter(|m| m.len() == me.len() + 1 && m.starts_with(&me))
+            .map(|m| m.last().unwrap().clone())
+            .collect();
+        let uses = graph.entry(k.clone()).or_default();
+        let mut in_inline = 0;
+        let bytes: Vec<char> = code.chars().collect();
+        let text: String = bytes.iter().collect();
+        let mut i = 0;
+        while i < bytes.len() {
+            match bytes[i] {
+                '\u{1}' => in_inline += 1,
+                '\u{2}' => in_inline -= 1,
+                _ => {}
+            }
+            let boundary =
+                i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == '_' || bytes[i - 1] == ':');
+            if !boundary || !(bytes[i].is_ascii_lowercase() || bytes[i] == '_') {
+                i += 1;
+                continue;
+            }
+            let rest: String = bytes[i..].iter().take(400).collect();
+            let mut hit = |prefix: &str, base: Vec<String>, table: &BTreeMap<Vec<String>, String>| -> bool {
+                let Some(after) = rest.strip_prefix(prefix) else { return false };
+                for p in path_tree(after) {
+                    let mut full = base.clone();
+                    full.extend(p);
+                    if let Some((m, t)) = resolve(table, &full) {
+                        let ancestor = std::ptr::eq(table, mods) && me.starts_with(&m);
+                        if !ancestor && t != k {
+                            uses.insert(t);
+                        }
+                    }
+                }
+                true
+            };
+            let parent = me[..me.len().saturating_sub(1)].to_vec();
+            let _ = hit("crate::", vec![], mods)
+                || (in_inline == 0 && hit("super::", parent, mods))
+                || lib_name.is_some_and(|l| hit(&format!("{l}::"), vec![], &lib_mods))
+                || children.iter().any(|c| hit(&format!("{c}::"), [me.clone(), vec![c.clone()]].concat(), mods));
+            i += 1;
+        }
+        let _ = text;
+    }
+    graph
+}
+
+/// The files of `graph` on an import loop.
+fn file_loops(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
+    graph.keys().filter(|f| reaches(graph, f, f)).cloned().collect()
+}
+
+#[test]
+fn no_file_imports_a_file_that_imports_it_back() {
+    let core = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), None);
+    let cli = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("cli/src"), Some("voxsplat_cli"));
+    assert!(core.len() > 60 && cli.len() > 10, "files found: {} and {}", core.len(), cli.len());
+    let show = |g: &BTreeMap<String, BTreeSet<String>>, on: &[String]| -> String {
+        on.iter()
+            .map(|f| format!("\n  {f} -> {:?}", g[f].iter().filter(|t| on.contains(t)).collect::<Vec<_>>()))
+            .collect()
+    };
+    let (a, b) = (file_loops(&core), file_loops(&cli));
+    assert!(a.is_empty() && b.is_empty(), "files on an import loop:{}{}", show(&core, &a), show(&cli, &b));
+}
+
+#[test]
+fn no_cli_source_file_passes_700_lines() {
+    for p in rust_files(&Path::new(env!("CARGO_MANIFEST_DIR")).join("cli/src")) {
+        let lines = std::fs::read_to_string(&p).unwrap().lines().count();
+        assert!(lines <= 700, "{} has {lines} lines", p.display());
+    }
+}
+
+#[test]
+fn the_vulkan_engine_imports_no_mirror() {
+    let core = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), None);
+    for (file, uses) in core.iter().filter(|(f, _)| f.starts_with("gpu/") || f.starts_with("vk/")) {
+        let mirrors: Vec<_> = uses.iter().filter(|t| t.starts_with("cpu/") || *t == "cpu_engine").collect();
+        assert!(mirrors.is_empty(), "{file} imports the CPU mirrors {mirrors:?}");
+    }
+}

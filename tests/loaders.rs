@@ -3,10 +3,10 @@
 mod common;
 use common::Rng;
 use std::io::Write;
-use voxsplat::cpu::raycast::RaycastOptions;
 use voxsplat::loaders::{nifti_from_bytes, npy_from_bytes, nrrd_from_bytes, raw_from_bytes, tiff_heights, DType};
 use voxsplat::order::{count_violations, visibility_order};
 use voxsplat::terrain::{terrain_splats, TerrainOptions};
+use voxsplat::RaycastOptions;
 use voxsplat::{Camera, Direction, OrderKind};
 
 const DIMS: [u32; 3] = [7, 5, 4];

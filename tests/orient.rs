@@ -402,7 +402,7 @@ fn a_sheared_grid_renders_as_the_world_space_truth() {
         (o.camera_to_grid(&world_camera(aligned)), world_truth(&v, DIMS, aligned, &tf, &world_camera(aligned)));
     g.set_scene(set).unwrap();
     let base = covered_error(&g.render(&cam, &RenderOptions::default()).unwrap().image, &truth);
-    let raycast = voxsplat::cpu::raycast::RaycastOptions { step: 0.25, ..Default::default() };
+    let raycast = voxsplat::RaycastOptions { step: 0.25, ..Default::default() };
     let base_rc = covered_error(&g.raycast(&cam, &raycast).unwrap().image, &truth);
     eprintln!("axis-aligned: splats {base:.4}, ray cast {base_rc:.4}");
     for (name, a) in sheared_affines() {

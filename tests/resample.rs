@@ -2,9 +2,9 @@
 //! is the backend's own frame of `scaled_camera`, resampled; close to the full-size frame where
 //! voxels cover several pixels; bad scales are typed errors.
 mod common;
-use voxsplat::cpu::raycast::RaycastOptions;
 use voxsplat::resample::{scaled_camera, upsample};
 use voxsplat::ImageF32;
+use voxsplat::RaycastOptions;
 use voxsplat::{classify, peer, scene, Camera, Error, Kernel, Raster, RenderOptions, Renderer};
 
 fn opts(raster: Raster, kernel: Kernel, scale: f32) -> RenderOptions {

@@ -78,7 +78,7 @@ fn ray_caster_converges_to_the_truth_as_its_step_shrinks() {
     let mut last = f64::INFINITY;
     for step in [1.0f32, 0.5, 0.25, 0.125, 0.0625] {
         let rc = raycast_params(&set, &cam, &RaycastOptions { step, min_transmittance: 0.0, ..Default::default() });
-        let (_, bricks) = voxsplat::cpu::raycast::brick_occupancy(&field, rc.image[2]);
+        let (_, bricks) = field.brick_occupancy(rc.image[2]);
         let img = raycast(&rc, &field, &bricks, None);
         let e = compare(&img, &truth).unwrap().rmse;
         eprintln!("step {step}: rmse {e:.3e}");

@@ -273,9 +273,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
             print!("{}", voxsplat_cli::kernels::markdown(&rows, n, size, chart.as_deref()));
             Ok(())
         }
-        Study::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => {
-            voxsplat_cli::bricked::scaling_chart(&csv, &svg)
-        }
+        Study::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => voxsplat_cli::bench::scaling_chart(&csv, &svg),
         Study::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, orbit, lod_chart, .. } => {
             if frames < 1 || size < 16 {
                 return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
@@ -370,7 +368,7 @@ fn matrix(a: MatrixArgs) -> Result<()> {
         write_scaling_csv(&s, &a.out_dir.join("scaling.csv"))?;
         // The bricked volumes' series (scripts/bricks-vtk.sh, run first by scripts/results.sh).
         let bricks = a.out_dir.join("bricks-scaling.csv");
-        let bricks = bricks.exists().then(|| voxsplat_cli::bricked::read_scaling_csv(&bricks)).transpose()?;
+        let bricks = bricks.exists().then(|| voxsplat_cli::bench::read_scaling_csv(&bricks)).transpose()?;
         scaling_svg(&s, bricks.as_deref(), &a.out_dir.join("scaling.svg"))?;
         s
     };

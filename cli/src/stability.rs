@@ -6,7 +6,6 @@
 use crate::bench::median;
 use glam::{Quat, Vec3};
 use voxsplat::camera::{Camera, Projection};
-use voxsplat::cpu::raycast::RaycastOptions;
 use voxsplat::image::ImageF32;
 use voxsplat::metrics::{compare, frame_changes, temporal_of};
 use voxsplat::options::{Composite, RenderOptions, Rendered};
@@ -16,6 +15,7 @@ use voxsplat::raster::Raster;
 use voxsplat::scene::close_view;
 use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use voxsplat::volume::{Grid, SplatSet};
+use voxsplat::RaycastOptions;
 use voxsplat::Result;
 use voxsplat::{scene, Renderer};
 

@@ -25,11 +25,11 @@ use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 use std::sync::Mutex;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::cpu::raycast::RaycastOptions;
 use voxsplat::glam::Vec3;
 use voxsplat::options::{Antialias, Composite, Lod};
 use voxsplat::order::OrderKind;
 use voxsplat::volume::ScalarVolume;
+use voxsplat::RaycastOptions;
 use voxsplat::{
     Backend, Camera, Grid, ImageF32, Kernel, Projection, Raster, RenderOptions, Renderer, RendererOptions, SplatSet,
 };

@@ -5,9 +5,9 @@ mod cmd;
 mod common;
 use cmd::voxsplat;
 use voxsplat::classify::TransferFunction;
-use voxsplat::cpu::raycast::RaycastOptions;
 use voxsplat::glam::Vec3;
 use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};
+use voxsplat::RaycastOptions;
 use voxsplat::{Camera, Projection};
 
 /// 1.2x the measured RMSE of the `mri` preset's splats on the 64³ phantom against the CPU

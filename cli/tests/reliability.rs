@@ -117,7 +117,7 @@ fn device_loss_is_an_error_that_sticks_and_the_renderer_drops_cleanly() {
     let mut sheet = RenderOptions::default();
     sheet.composite = Composite::Sheet;
     assert!(matches!(r.render(&cam, &sheet), Err(voxsplat::Error::DeviceLost(_))));
-    let rc = voxsplat::cpu::raycast::RaycastOptions::default();
+    let rc = voxsplat::RaycastOptions::default();
     assert!(matches!(r.raycast(&cam, &rc), Err(voxsplat::Error::DeviceLost(_))));
     common::assert_clean(&r);
     drop(ctx);

@@ -1,11 +1,9 @@
 //! What the mirrors read and write: host copies of the resources the GPU binds, by name.
 use crate::dispatch::{List, Res};
-use crate::gpu_types::Frame;
+use crate::gpu_types::{Frame, Splat, SplatParams};
 use crate::image::ImageF32;
 use crate::plan::Prepared;
 use std::collections::HashMap;
-
-use super::footprint::FootprintInputs;
 
 /// What a mirror reads and writes: the scene, the frame's uniforms and tables, and the frame's
 /// resources by name (buffers as 32-bit words, images as `ImageF32`).
@@ -102,4 +100,20 @@ impl<'a> Bindings<'a> {
             _ => self.sums.iter_mut().collect(),
         }
     }
+}
+
+/// The footprint stages' inputs, as bound on the GPU (the draw call's and the tile stages').
+#[derive(Clone, Copy)]
+pub struct FootprintInputs<'a> {
+    pub frame: &'a Frame,
+    pub params: &'a [SplatParams],
+    pub draw_list: &'a [u32],
+    pub splats: &'a [Splat],
+    pub sheet_rank: &'a [u32],
+    /// The radial footprint table (`Kernel::radial_table`).
+    pub table: &'a [f32],
+    /// The kernel-slice table (slab mode).
+    pub slice_table: &'a [f32],
+    /// Largest transmittance left per composite tile (early termination; empty when off).
+    pub occlusion: &'a [f32],
 }

@@ -2,7 +2,7 @@
 //! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer (levels of
 //! detail: `cpu::lod`).
 use super::bindings::Bindings;
-use super::lod::level_count;
+use super::brick_words::level_count;
 use super::order::{outward, side_count};
 use super::splat_params::{cell_footprint_scale, frame_grid, optical_depth, params_at, CULL_RADII};
 use crate::bricks::{local_cell, BrickStore, BRICK};
@@ -331,7 +331,7 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
             morphs[h] = 0.0;
             let w = inputs.node_of(k, b);
             if w[5] == h as u32
-                && super::lod::tau_decode(w[0] & 0xffff) > 0.0
+                && super::brick_words::tau_decode(w[0] & 0xffff) > 0.0
                 && !inputs.outside_view(b, k, (BRICK << k) as f32)
             {
                 slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(3 + k, 1);

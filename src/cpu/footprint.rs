@@ -8,11 +8,12 @@ use super::ImageF32;
 use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
 use crate::dispatch::{Args, Pass, Res, Variant};
 use crate::error::Result;
-use crate::gpu_types::{FootprintPush, Frame, Splat, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB};
+use crate::gpu_types::{FootprintPush, Frame, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB};
 pub use crate::kernel::sample_radial;
 use glam::{DMat4, DVec3, DVec4, IVec4, Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use super::bindings::Bindings;
+pub use super::bindings::FootprintInputs;
 
 pub use crate::dispatch::Blend;
 
@@ -42,22 +43,6 @@ pub fn sample_slice_table(table: &[f32], r: f32, z: f32) -> f32 {
     let top = at(x0, y0) + (at(x0 + 1, y0) - at(x0, y0)) * wx;
     let bottom = at(x0, y0 + 1) + (at(x0 + 1, y0 + 1) - at(x0, y0 + 1)) * wx;
     top + (bottom - top) * wy
-}
-
-/// The draw call's inputs, as bound on the GPU.
-#[derive(Clone, Copy)]
-pub struct FootprintInputs<'a> {
-    pub frame: &'a Frame,
-    pub params: &'a [SplatParams],
-    pub draw_list: &'a [u32],
-    pub splats: &'a [Splat],
-    pub sheet_rank: &'a [u32],
-    /// The radial footprint table (`Kernel::radial_table`).
-    pub table: &'a [f32],
-    /// The kernel-slice table (slab mode).
-    pub slice_table: &'a [f32],
-    /// Largest transmittance left per composite tile (early termination; empty when off).
-    pub occlusion: &'a [f32],
 }
 
 /// Mirror of `entry_splat` + `entry_layer` in `glsl/shared/footprint.glsl`: draw-list entry `e`'s

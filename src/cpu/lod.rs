@@ -1,8 +1,9 @@
 //! Levels of detail over a bricked volume: mirror of `brick_pyramid.comp` and of the
 //! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
-//! `cell_color`).
+//! `cell_color`; the word codecs the brick mirrors share are in brick_words.rs).
 use super::bindings::Bindings;
 use super::brick::{inputs, inputs_for, streamed, voxel_ijk, voxel_level, BrickInputs, VOXEL_MORPHS};
+pub use super::brick_words::{level_count, tau_code, tau_decode, SUMMARY_WORDS};
 use super::order::side_count;
 use super::splat_params::{optical_depth, params_at};
 use crate::bricks::{local_cell, BRICK};
@@ -22,8 +23,6 @@ pub(crate) const NO_NORMAL: u32 = 0x8080;
 
 /// Cells of a brick's pyramid slot (level 1); levels 2 and 3 live in its summary.
 pub const SLOT_CELLS: usize = 64;
-/// Words per brick of the summary: 4 of summary, the 9 cells of levels 2 and 3, one spare.
-pub const SUMMARY_WORDS: usize = 32;
 /// Bytes of one brick's pyramid slot.
 pub const PYRAMID_BYTES: u64 = (SLOT_CELLS * CELL_WORDS * 4) as u64;
 /// Bytes of one brick's summary (resident whatever the budget).
@@ -66,26 +65,6 @@ fn snorm8(v: f32) -> u32 {
 /// Mirror of `unorm10` (brick_pyramid.comp).
 pub(crate) fn unorm10(v: f32) -> u32 {
     (v.clamp(0.0, 1.0) * 1023.0 + 0.5).floor() as u32
-}
-
-/// Mirror of `tau_code`: a cell's optical depth in 16 bits (exponent 2^-23..2^7, 11 bits of
-/// mantissa, rounded; 0 for none).
-pub fn tau_code(t: f32) -> u32 {
-    // NaN too.
-    if t.partial_cmp(&1.192_092_9e-7).is_none_or(|o| o == std::cmp::Ordering::Less) {
-        return 0;
-    }
-    let b = t.min(255.0).to_bits();
-    ((b + 0x800) >> 12) - (103 << 11)
-}
-
-/// Mirror of `tau_decode`.
-pub fn tau_decode(code: u32) -> f32 {
-    if code == 0 {
-        0.0
-    } else {
-        f32::from_bits((code + (103 << 11)) << 12)
-    }
 }
 
 /// Mirror of `sign_not_zero` (one component).
@@ -157,17 +136,6 @@ impl BrickInputs<'_> {
     /// Mirror of `cell_tau`: the optical depth per cell length along x.
     pub fn cell_tau(&self, h: u32, i: u32) -> f32 {
         tau_decode(cell_word(self.pyramid, self.summary, self.pyramid_index(h), h, i, 0) & 0xffff)
-    }
-}
-
-/// Mirror of `level_count`.
-pub fn level_count(summary: &[u32], h: u32, l: u32) -> u32 {
-    let x = summary[h as usize * SUMMARY_WORDS];
-    match l {
-        0 => x >> 16,
-        1 => x & 255,
-        2 => x >> 8 & 15,
-        _ => x >> 12 & 1,
     }
 }
 

@@ -4,6 +4,7 @@ pub mod bindings;
 pub mod brick;
 pub mod brick_hidden;
 pub mod brick_nodes;
+pub mod brick_words;
 pub mod composite;
 pub mod footprint;
 pub mod lod;

@@ -5,54 +5,7 @@ use super::ImageF32;
 use crate::dispatch::{Args, Variant};
 use crate::error::{Error, Result};
 use crate::gpu_types::PresentPush;
-
-/// The formats `Renderer::render_to` writes: the usual swapchain ones.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum TargetFormat {
-    /// `B8G8R8A8_SRGB`: the device encodes; voxsplat writes linear values.
-    Bgra8Srgb,
-    /// `B8G8R8A8_UNORM`: the frame's values as a PNG of it holds them.
-    Bgra8Unorm,
-    /// `R8G8B8A8_SRGB`.
-    Rgba8Srgb,
-    /// `R8G8B8A8_UNORM`.
-    Rgba8Unorm,
-    /// `R16G16B16A16_SFLOAT`: linear values (an extended-sRGB-linear swapchain, or a host texture).
-    Rgba16Float,
-}
-
-impl TargetFormat {
-    /// Every format, for tests and listings.
-    pub const ALL: [TargetFormat; 5] = [
-        TargetFormat::Bgra8Srgb,
-        TargetFormat::Bgra8Unorm,
-        TargetFormat::Rgba8Srgb,
-        TargetFormat::Rgba8Unorm,
-        TargetFormat::Rgba16Float,
-    ];
-
-    /// Whether the target wants linear values: it encodes them itself (sRGB) or stores them (float).
-    pub fn linear(self) -> bool {
-        !matches!(self, TargetFormat::Bgra8Unorm | TargetFormat::Rgba8Unorm)
-    }
-
-    /// Bytes per texel.
-    pub fn texel_bytes(self) -> usize {
-        if self == TargetFormat::Rgba16Float {
-            8
-        } else {
-            4
-        }
-    }
-
-    fn bgra(self) -> bool {
-        matches!(self, TargetFormat::Bgra8Srgb | TargetFormat::Bgra8Unorm)
-    }
-
-    fn srgb(self) -> bool {
-        matches!(self, TargetFormat::Bgra8Srgb | TargetFormat::Rgba8Srgb)
-    }
-}
+pub use crate::image::TargetFormat;
 
 /// The sRGB curve's inverse (IEC 61966-2-1), as `present.comp` applies it.
 pub fn to_linear(c: f32) -> f32 {

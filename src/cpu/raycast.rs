@@ -1,73 +1,17 @@
 //! Mirror of `raycast.comp`, in the shader's f32 arithmetic, with an optional per-pixel jitter of
 //! the first sample (CPU only) for supersampled references.
 use super::ImageF32;
-use crate::camera::Camera;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::RaycastParams;
 
 use super::bindings::Bindings;
+// Settled by the plan, read by both engines; kept here for the paths callers already use.
+pub use crate::options::{RaycastOptions, DEFAULT_BRICK, MAX_SUPERSAMPLE};
+pub use crate::plan::raycast_params;
 use crate::volume::DenseField;
-use crate::volume::SplatSet;
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
-
-/// Ray caster settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RaycastOptions {
-    /// Step length in voxel spacings.
-    pub step: f32,
-    /// Transmittance below which a ray stops.
-    pub min_transmittance: f32,
-    /// Most samples per ray.
-    pub max_steps: u32,
-    /// Empty-space skipping over bricks of this many voxels per side (0: off). Exact: only samples
-    /// that read nothing but empty voxels are skipped.
-    pub brick: u32,
-    /// Cast on a grid this fraction of the camera's size and resample (`crate::resample`; the
-    /// inverse of an image sample distance). 1: full size.
-    pub render_scale: f32,
-    /// Clipping planes and crop box: each ray is cut to the part inside them.
-    pub clip: crate::options::Clip,
-    /// Rays per pixel along each axis (1 to `MAX_SUPERSAMPLE`): `k`×`k` rays on a regular grid
-    /// inside each pixel, averaged (a box filter over the pixel's area). The converged reference
-    /// that levels of detail and anti-aliasing are scored against (docs/MODEL.md, "The reference").
-    pub supersample: u32,
-}
-
-/// Most rays per pixel along each axis of a supersampled cast.
-pub const MAX_SUPERSAMPLE: u32 = 16;
-
-/// Default brick side of the empty-space skipping.
-pub const DEFAULT_BRICK: u32 = 8;
-
-/// Which bricks of `brick`³ voxels hold a voxel with optical depth, looking one voxel beyond each
-/// face (the trilinear support of every sample inside the brick): (bricks per axis, flags).
-pub fn brick_occupancy(field: &DenseField, brick: u32) -> ([u32; 3], Vec<u32>) {
-    let b = brick.max(1) as i64;
-    let nb = field.dims.map(|d| (d as i64 + b - 1) / b);
-    let mut occ = vec![0u32; (nb[0] * nb[1] * nb[2]) as usize];
-    for k in 0..field.dims[2] as i64 {
-        for j in 0..field.dims[1] as i64 {
-            for i in 0..field.dims[0] as i64 {
-                if field.at(i, j, k)[3] <= 0.0 {
-                    continue;
-                }
-                // Mark every brick whose widened range [bB - 1, (b+1)B + 1] holds (i, j, k).
-                let range = |c: i64, n: i64| ((c - 1).div_euclid(b).max(0), ((c + 1).div_euclid(b)).min(n - 1));
-                let (rx, ry, rz) = (range(i, nb[0]), range(j, nb[1]), range(k, nb[2]));
-                for bz in rz.0..=rz.1 {
-                    for by in ry.0..=ry.1 {
-                        for bx in rx.0..=rx.1 {
-                            occ[((bz * nb[1] + by) * nb[0] + bx) as usize] = 1;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    (nb.map(|n| n as u32), occ)
-}
 
 /// Mirror of `to_index` in `raycast.comp`: world offset `d` in index units.
 fn to_index(rc: &RaycastParams, d: Vec3) -> Vec3 {
@@ -103,44 +47,6 @@ fn skip_brick(rc: &RaycastParams, b: [i32; 3], nb: [i32; 3], a: Vec3, dir: Vec3,
     }
 }
 
-impl Default for RaycastOptions {
-    fn default() -> Self {
-        Self {
-            step: 0.5,
-            min_transmittance: 1e-3,
-            max_steps: 1 << 16,
-            brick: DEFAULT_BRICK,
-            render_scale: 1.0,
-            clip: Default::default(),
-            supersample: 1,
-        }
-    }
-}
-
-/// The uniforms shared by the GPU stage and this mirror.
-pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) -> RaycastParams {
-    let g = set.grid();
-    let o = Vec3::from(g.origin);
-    let s = Vec3::from(g.spacing);
-    let hi = Vec3::from(g.dims.map(|d| d as f32));
-    let step = opts.step * s.min_element();
-    // The inverse cell matrix, upper triangular as the cell matrix is.
-    let inv = g.cell_matrix().inverse();
-    let inv_shear = [inv.y_axis.x, inv.z_axis.x, inv.z_axis.y].map(|v| v as f32);
-    let (clip, clip_count) = opts.clip.uniforms();
-    RaycastParams {
-        inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
-        box_min: [-1.0, -1.0, -1.0, step],
-        box_max: [hi.x, hi.y, hi.z, opts.min_transmittance],
-        origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
-        inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
-        inv_shear: [inv_shear[0], inv_shear[1], inv_shear[2], 0.0],
-        dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
-        image: [camera.width, camera.height, opts.brick, clip_count],
-        clip,
-    }
-}
-
 /// Mirror of `trilinear` in `glsl/shared/trilinear.glsl`.
 pub fn trilinear(field: &DenseField, u: Vec3) -> [f32; 4] {
     let b = u.floor();
@@ -155,7 +61,7 @@ pub fn trilinear(field: &DenseField, u: Vec3) -> [f32; 4] {
 }
 
 /// `jitter`: `Some(seed)` offsets each pixel's samples by a hashed fraction of a step.
-/// `bricks`: `brick_occupancy(field, rc.image[2])` when skipping is on.
+/// `bricks`: `field.brick_occupancy(rc.image[2])` when skipping is on.
 pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: Option<u64>) -> ImageF32 {
     let (w, h) = (rc.image[0], rc.image[1]);
     let inv = Mat4::from_cols_array_2d(&rc.inv_view_proj);

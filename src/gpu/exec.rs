@@ -2,11 +2,11 @@
 //! recording reads something back, then go in one submission; each stage is timed.
 use super::resources::Target;
 use super::Gpu;
-use crate::cpu_engine::add_time;
 use crate::dispatch::{Kind, Pass, Res};
 use crate::error::{Error, Result};
 use crate::gpu_types::Frame;
 use crate::kernel::Kernel;
+use crate::options::add_time;
 use crate::options::StageTime;
 use crate::plan::Prepared;
 use crate::stages::{Dispatch, Engine, Limits};

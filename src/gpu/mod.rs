@@ -57,7 +57,7 @@ impl Gpu {
             roofline_composite: Pipeline::compute(&ctx, composite_layout, spirv("roofline.comp")?)?,
             roofline_layout,
         };
-        let budget_bytes = crate::cpu_engine::DEFAULT_GPU_BUDGET;
+        let budget_bytes = crate::constants::DEFAULT_GPU_BUDGET;
         Ok(Self { res: Resources::new(&ctx)?, timer: Timer::new(&ctx, 16)?, pipes, extra, ctx, budget_bytes })
     }
 
@@ -91,7 +91,7 @@ impl Gpu {
         let scene = self.res.scene_mut()?;
         let dense = DenseField::new(&prep.set)?;
         if need_bricks {
-            let (_, occ) = crate::cpu::raycast::brick_occupancy(&dense, brick.max(1));
+            let (_, occ) = dense.brick_occupancy(brick.max(1));
             scene.bricks = None;
             let buf = Buffer::with_data(&self.ctx, "raycast bricks", bytemuck::cast_slice(&occ), BU::STORAGE_BUFFER)?;
             scene.bricks = Some((brick, buf));

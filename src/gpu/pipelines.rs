@@ -93,9 +93,9 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Resu
                 let vert = spirv(&format!("{}.vert{suffix}", desc.name))?;
                 let frag = spirv(&format!("{}.frag{suffix}", desc.name))?;
                 let blend = match state.blend {
-                    crate::cpu::footprint::Blend::Over => Blend::Over,
-                    crate::cpu::footprint::Blend::Under => Blend::Under,
-                    crate::cpu::footprint::Blend::Add => Blend::Add,
+                    crate::dispatch::Blend::Over => Blend::Over,
+                    crate::dispatch::Blend::Under => Blend::Under,
+                    crate::dispatch::Blend::Add => Blend::Add,
                 };
                 let primitive = if state.points { Primitive::Points } else { Primitive::Quads };
                 let pass = match state.pass {

@@ -2,8 +2,8 @@
 //! semaphores that order the frame with the host's work; an image voxsplat owns for hosts (and
 //! tests) without one; semaphores; and reading any of them back.
 use super::{Buffer, Context, Image, Memory, Recorder};
-use crate::cpu::present::TargetFormat;
 use crate::error::{Error, Result};
+use crate::image::TargetFormat;
 use ash::vk;
 use std::sync::Arc;
 

@@ -1,0 +1,389 @@
+//! `voxsplat render`: one frame of a built-in scene, a volume file or a terrain, to PNG or EXR;
+//! under mpirun (feature `mpi`), one box of the volume per rank.
+use super::*;
+
+#[derive(Args)]
+pub(crate) struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// A clipping plane NX,NY,NZ,D in world space: what lies where NX x + NY y + NZ z + D < 0 is
+    /// not drawn (splat centres; the ray caster cuts its rays). Up to 6.
+    #[arg(long = "clip", value_parser = parse_floats::<4>, allow_hyphen_values = true)]
+    clip: Vec<[f32; 4]>,
+    /// A crop box X0,Y0,Z0,X1,Y1,Z1 in world space: only what lies inside is drawn.
+    #[arg(long, value_parser = parse_floats::<6>, allow_hyphen_values = true)]
+    crop: Option<[f32; 6]>,
+    /// Composite the frame over this colour R,G,B[,A] (each in [0, 1]; A defaults to 1, opaque), as
+    /// a window shows it; without it the PNG is transparent where nothing was drawn.
+    #[arg(long, value_parser = parse_background)]
+    background: Option<[f32; 4]>,
+    /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
+    /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
+    #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
+    composite: String,
+    /// Front to back, stop drawing where what is drawn already lets at most this much light
+    /// through (0 = off; the default, a quarter of an 8-bit step, changes a value by at most one
+    /// step). No pixel changes by more than this.
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_EARLY_TERMINATION)]
+    early_termination: f32,
+    /// Bricked volumes: keep the bricks that earlier batches hide (front to back, early
+    /// termination), to measure what dropping them saves.
+    #[arg(long)]
+    keep_hidden_bricks: bool,
+    /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25) [default: 1].
+    #[arg(long, value_parser = parse_finite)]
+    slab_thickness: Option<f32>,
+    /// How footprints become pixels: instanced quads (graphics), point sprites (points), compute
+    /// shaders (tile compositing / fixed-point sheet sums), or auto (on a CPU device: compute for
+    /// small footprints, else point sprites where they fit, else graphics; graphics on hardware; it
+    /// prints what it picked).
+    #[arg(long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"])]
+    raster: String,
+    /// Draw on a grid this fraction of --size and resample it bilinearly to full size (1/16 to 1):
+    /// faster where voxels cover several pixels; the added error is in docs/RESULTS.md (peers).
+    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    render_scale: f32,
+    /// Levels of detail of a volume drawn per splat: auto (the default: where voxels project
+    /// smaller than --lod-pixels, groups of them drawn as one prefiltered splat, within
+    /// --lod-error; docs/MODEL.md) or off (every voxel a splat).
+    #[arg(long, value_parser = ["off", "auto"])]
+    lod: Option<String>,
+    /// Largest projected cell spacing of a coarse level, in pixels.
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
+    lod_pixels: f32,
+    /// Largest error of a coarse level (opacity per voxel length, summed down the levels).
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
+    lod_error: f32,
+    /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
+    /// before it takes over (0: abrupt level changes).
+    #[arg(long, value_parser = parse_finite, default_value = "0.75")]
+    lod_band: f32,
+    /// Levels of detail above the brick too: a block of bricks seen within a pixel drawn as one
+    /// prefiltered splat (fewer splats for a large volume seen small; off by default: on this
+    /// machine kind it pays only at thumbnail sizes).
+    #[arg(long)]
+    lod_nodes: bool,
+    /// Reconstruction kernel: the piecewise cubic fitted by Crawfis and Max's criterion (the
+    /// default: radius 1.6, flat sheets stay flat to 0.37 %, closest to the ray-cast picture but for
+    /// narrow), Westover's Gaussian (sigma 0.6, radius 2: softer), the Hermite cubic of Crawfis and
+    /// Max's support (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: sharpest and
+    /// fewest fragments, but flat sheets ripple by 7.6 %).
+    #[arg(long, default_value = "crawfis-max", value_parser = ["gaussian", "cubic", "narrow", "crawfis-max"])]
+    kernel: String,
+    /// Anti-aliasing of distant splats (chapter 3): none, Swan's d/k scaling, or an EWA low-pass.
+    #[arg(long, default_value = "none", value_parser = ["none", "swan", "ewa"])]
+    aa: String,
+    /// Draw the line where the first splat each pixel meets lies at eye distance k (Figs 3.6, 3.7).
+    #[arg(long)]
+    k_line: bool,
+    /// Order of drawing: front to back (the default, which lets early termination stop), or back to
+    /// front (the default where per-splat footprints go through the graphics or point pipelines).
+    #[arg(long, value_parser = ["ftb", "btf"])]
+    direction: Option<String>,
+    /// Memory budget for one batch of sheet summation layers, in MiB.
+    #[arg(long, default_value_t = 256)]
+    sheet_budget_mib: u64,
+    /// Render with the ray caster at this step (in voxel spacings) instead of splatting.
+    #[arg(long, value_parser = parse_finite, conflicts_with = "truth")]
+    raycast: Option<f32>,
+    /// With --raycast: cast K x K rays per pixel and average them (the converged reference that
+    /// levels of detail and anti-aliasing are scored against; 4 with --raycast 0.25 is the one
+    /// docs/MODEL.md checks).
+    #[arg(long, default_value_t = 1, requires = "raycast")]
+    supersample: u32,
+    /// With --raycast: transmittance below which a ray stops.
+    #[arg(long, value_parser = parse_finite, requires = "raycast")]
+    raycast_stop: Option<f32>,
+    /// Render the volumetric-summation truth (CPU, f64) with --kernel's reconstruction.
+    #[arg(long)]
+    truth: bool,
+    /// Print per-stage times.
+    #[arg(long)]
+    timings: bool,
+    /// Under mpirun (a build with `--features mpi`): how the ranks' frames are composited,
+    /// direct-send, binary-swap (a power of two ranks) or auto (binary-swap from 4 ranks).
+    #[arg(long, default_value = "auto")]
+    compositing: String,
+    /// Render the frame this many times and report each stage's median (the first frames pay
+    /// one-off costs: allocation, shader compilation on some drivers).
+    #[arg(long, default_value_t = 1, conflicts_with_all = ["raycast", "truth"])]
+    repeat: u32,
+    /// Output file, .png or .exr.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Runs `voxsplat render`.
+pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
+    voxsplat::output::ImageFormat::of(&a.out)?;
+    let order = a.scene.order.parse::<OrderKind>()?;
+    let composite = a.composite.parse::<Composite>()?;
+    // A volume is a bricked store classified on the device unless a mode needs host splats.
+    let host_splats = order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line;
+    let mut opts = RenderOptions::default();
+    opts.order = order;
+    opts.composite = composite;
+    opts.kernel = a.kernel.parse::<Kernel>()?;
+    opts.antialias = a.aa.parse::<voxsplat::Antialias>()?;
+    opts.direction =
+        a.direction.as_deref().map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
+    opts.sheet_budget_bytes = mib_bytes(a.sheet_budget_mib, "--sheet-budget-mib")?;
+    if let Some(t) = a.slab_thickness {
+        if composite != Composite::Slab {
+            return Err(Error::InvalidArgument(
+                "--slab-thickness sets the slabs of --composite slab; this frame draws no slabs".into(),
+            ));
+        }
+        opts.slab_thickness = t;
+    }
+    opts.early_termination = a.early_termination;
+    opts.cull_hidden_bricks = !a.keep_hidden_bricks;
+    opts.raster = a.raster.parse::<voxsplat::Raster>()?;
+    opts.render_scale = a.render_scale;
+    opts.lod = a.lod.as_deref().unwrap_or("auto").parse()?;
+    let planes: Vec<voxsplat::glam::Vec4> = a.clip.iter().map(|p| voxsplat::glam::Vec4::from(*p)).collect();
+    let crop = a.crop.map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])]);
+    opts.clip = voxsplat::Clip::new(&planes, crop)?;
+    opts.background = a.background;
+    (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
+    if a.lod_nodes && opts.lod == voxsplat::Lod::Off {
+        return Err(Error::InvalidArgument(
+            "--lod-nodes draws levels of detail above the brick: it needs --lod auto (the default), not --lod off"
+                .into(),
+        ));
+    }
+    opts.lod_nodes = a.lod_nodes;
+    opts.validate()?;
+    a.compositing.parse::<voxsplat::distributed::Scheme>()?;
+    #[cfg(feature = "mpi")]
+    if voxsplat::distributed::mpi::launched() {
+        return render_distributed(&a, &opts, host_splats);
+    }
+    let (bricked, set, content) = open(&a.scene, host_splats)?;
+    let asked =
+        if a.lod_nodes { Some("--lod-nodes") } else { a.lod.as_deref().filter(|l| *l == "auto").map(|_| "--lod auto") };
+    if let Some(flag) = asked.filter(|_| bricked.is_none() || composite != Composite::Splat) {
+        return Err(Error::InvalidArgument(format!(
+            "{flag}: levels of detail are drawn per splat (--composite splat) from a volume's bricked store; \
+             this scene is a classified splat set (a built-in scene, --dense, another order, --truth, --raycast)"
+        )));
+    }
+    let cam = camera_of(&a.scene, set.grid(), &content)?;
+    if let voxsplat::Projection::Perspective { fov_y_deg } = cam.projection {
+        // Other renderers (scripts/vtk_file.py) take the same view from this line.
+        let v = |v: Vec3| format!("{:.4},{:.4},{:.4}", v.x, v.y, v.z);
+        eprintln!("camera (grid frame): eye {} target {} up {} fov {fov_y_deg}", v(cam.eye), v(cam.target), v(cam.up));
+    }
+    let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
+    let r_bricked = bricked.is_some();
+    let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
+    if a.truth && a.render_scale != 1.0 {
+        return Err(Error::InvalidArgument("--truth is the full-size reference: drop --render-scale".into()));
+    }
+    let mut wall = Vec::new();
+    let frame = if a.truth {
+        let t = std::time::Instant::now();
+        let opts = voxsplat::truth::TruthOptions {
+            reconstruction: voxsplat::truth::Reconstruction::Kernel(opts.kernel),
+            ..Default::default()
+        };
+        let image = voxsplat::truth::volumetric_summation(&set, &cam, &opts)?;
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        voxsplat::Rendered {
+            image,
+            timings: vec![voxsplat::StageTime { stage: "truth", ms }],
+            raster: None,
+            stats: Default::default(),
+        }
+    } else {
+        let mut r = renderer_of(&a.scene)?;
+        match bricked {
+            Some(b) => r.set_bricks(b)?,
+            None => r.set_scene(set)?,
+        }
+        let f = match a.raycast {
+            Some(step) => {
+                let mut o = voxsplat::RaycastOptions {
+                    step,
+                    render_scale: a.render_scale,
+                    clip: opts.clip,
+                    supersample: a.supersample,
+                    ..Default::default()
+                };
+                if let Some(stop) = a.raycast_stop {
+                    o.min_transmittance = stop;
+                }
+                r.raycast(&cam, &o)?
+            }
+            None => median_timings((0..a.repeat.max(1)).map(|_| {
+                let t = std::time::Instant::now();
+                let f = r.render(&cam, &opts);
+                wall.push(t.elapsed().as_secs_f64() * 1e3);
+                f
+            }))?,
+        };
+        report_validation(&r)?;
+        f
+    };
+    let mut image = frame.image;
+    if let (Some(bg), true) = (a.background, a.truth || a.raycast.is_some()) {
+        // The reference renderers have no present stage: its mirror, on the host.
+        let push = voxsplat::cpu::present::present_push(Some(bg), 1, false, cam.width, cam.height);
+        voxsplat::cpu::present::present(&push, &mut image, &voxsplat::ImageF32::new(0, 0));
+    }
+    if a.k_line {
+        let regions = voxsplat::aa::k_regions(&set_for_k, &cam);
+        if regions.iter().all(|&r| r == 0) {
+            return Err(Error::InvalidArgument("--k-line needs a scene in view".into()));
+        }
+        voxsplat::aa::draw_k_line(&mut image, &regions);
+    }
+    voxsplat::output::write_image(&image, &a.out)?;
+    let what = if r_bricked { "stored voxels" } else { "splats" };
+    eprintln!("{splats} {what} -> {}", a.out.display());
+    if let Some(c) = &frame.raster {
+        eprintln!("raster: {} ({})", c.raster, c.reason);
+    }
+    if a.timings {
+        for t in &frame.timings {
+            println!("{:<14} {:>9.3} ms", t.stage, t.ms);
+        }
+        let st = frame.stats;
+        if st.bricks > 0 {
+            println!(
+                "drawn: {} splats from {} of {} bricks ({} drawn coarser, {} of them nodes of several bricks, {} \
+                 hidden by nearer ones), {} waves",
+                st.splats, st.bricks_visible, st.bricks, st.bricks_coarse, st.nodes, st.bricks_hidden, st.waves
+            );
+        }
+        if st.records_resident > 0 {
+            println!(
+                "brick records: {:.1} MiB uploaded, {:.1} MiB held on the device",
+                st.bytes_uploaded as f64 / 1048576.0,
+                st.records_resident as f64 / 1048576.0
+            );
+        }
+        if !wall.is_empty() {
+            let n = wall.len();
+            // Not a stage line: scripts sum those.
+            println!("frame, wall:   {:>9.3} ms (median of {n})", voxsplat_cli::bench::median(&mut wall));
+        }
+        if let Some(mib) = voxsplat_cli::bricked::peak_rss_mib() {
+            println!("host memory, peak: {mib:.0} MiB resident");
+        }
+    }
+    Ok(())
+}
+
+/// The last of `frames` with each stage's median time over all of them, keeping one image at a
+/// time (`--repeat` would otherwise hold every frame).
+fn median_timings(frames: impl Iterator<Item = Result<voxsplat::Rendered>>) -> Result<voxsplat::Rendered> {
+    let mut earlier: Vec<Vec<voxsplat::StageTime>> = Vec::new();
+    let mut last: Option<voxsplat::Rendered> = None;
+    for f in frames {
+        let f = f?;
+        if let Some(prev) = last.replace(f) {
+            earlier.push(prev.timings);
+        }
+    }
+    let mut last = last.expect("at least one frame");
+    for t in &mut last.timings {
+        let mut v: Vec<f64> =
+            earlier.iter().flat_map(|ts| ts.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
+        v.push(t.ms);
+        t.ms = voxsplat_cli::bench::median(&mut v);
+    }
+    Ok(last)
+}
+
+/// `voxsplat render` under mpirun: the --volume file cut into one box per rank, each drawn by its
+/// rank, composited in the boxes' visibility order; rank 0 writes the image.
+#[cfg(feature = "mpi")]
+fn render_distributed(a: &RenderArgs, opts: &RenderOptions, host_splats: bool) -> Result<()> {
+    use voxsplat::distributed::mpi::rsmpi::{self, traits::CommunicatorCollectives};
+    let universe =
+        rsmpi::initialize().ok_or_else(|| Error::Unsupported("MPI was initialised already or cannot be".into()))?;
+    let result = distributed_frames(a, opts, host_splats, universe.world());
+    if let Err(e @ Error::OnRank { .. }) = &result {
+        // Every rank holds this error: each reports it, and none exits (which makes mpirun stop
+        // the others) before all have.
+        let line = format!("error: {e}\n");
+        let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
+        universe.world().barrier();
+        drop(universe);
+        std::process::exit(2);
+    }
+    result
+}
+
+/// `render_distributed` on an initialised `world`.
+#[cfg(feature = "mpi")]
+fn distributed_frames(
+    a: &RenderArgs,
+    opts: &RenderOptions,
+    host_splats: bool,
+    world: voxsplat::distributed::mpi::rsmpi::topology::SimpleCommunicator,
+) -> Result<()> {
+    use voxsplat::distributed::mpi::{rsmpi::traits::Communicator, Distributed};
+    let rank = world.rank();
+    // Whatever one rank alone may fail at (its view of the file, its device) is agreed on before
+    // the first collective, so no rank waits for one that has quit.
+    let setup = (|| {
+        let Some(path) = a.scene.volume.as_ref().filter(|_| !host_splats && a.scene.positions.is_none()) else {
+            return Err(Error::Unsupported(
+                "under mpirun, render draws a --volume file as a bricked store per splat in PBTF order (no --truth, \
+                 --raycast, --k-line, --positions or other orders)"
+                    .into(),
+            ));
+        };
+        let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
+        let reader = voxsplat::distributed::open(path, &hints)?;
+        let orientation = voxsplat_cli::open::orientation_of(&a.scene)?;
+        let spacing = hints.spacing.unwrap_or(reader.spacing);
+        let grid = voxsplat::orient::placed_grid(reader.dims, spacing, orientation.as_ref())?;
+        // Checked here; framed on the visible voxels once the ranks hold them.
+        camera_of(&a.scene, &grid, &voxsplat_cli::open::Content { orientation, bounds: None })?;
+        let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
+        let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing, orientation);
+        let scheme: voxsplat::distributed::Scheme = a.compositing.parse()?;
+        Ok((path, hints, grid, orientation, tf, shading, scheme, renderer_of(&a.scene)?))
+    })();
+    let (path, hints, grid, orientation, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
+    let mut d = Distributed::load(world, r, path, &hints, tf, shading, scheme)?;
+    let content = voxsplat_cli::open::Content { orientation, bounds: d.visible_bounds() };
+    let cam = d.agree(camera_of(&a.scene, &grid, &content))?;
+    let stored = d.stored_per_rank();
+    let mut frames = Vec::new();
+    for _ in 0..a.repeat.max(1) {
+        frames.push(d.render(&cam, opts)?);
+    }
+    d.agree(report_validation(d.renderer()))?;
+    let store_bytes = d.gather(d.store_bytes());
+    let peaks = d.gather(voxsplat::distributed::peak_rss_bytes().unwrap_or(0));
+    if rank != 0 {
+        return Ok(());
+    }
+    let frames: Vec<_> = frames.into_iter().flatten().collect();
+    let Some(last) = frames.last() else { return Ok(()) };
+    voxsplat::output::write_image(&last.image, &a.out)?;
+    eprintln!(
+        "{} stored voxels on {} ranks ({}) by {} -> {}",
+        stored.iter().sum::<u64>(),
+        stored.len(),
+        stored.iter().map(u64::to_string).collect::<Vec<_>>().join(" + "),
+        d.scheme().name(),
+        a.out.display()
+    );
+    if a.timings {
+        for stage in ["render", "composite"] {
+            let mut ms: Vec<f64> =
+                frames.iter().flat_map(|f| f.timings.iter().filter(|t| t.stage == stage).map(|t| t.ms)).collect();
+            ms.sort_by(f64::total_cmp);
+            println!("{stage:<14} {:>9.3} ms", ms[ms.len() / 2]);
+        }
+        let mib = |v: &[u64]| v.iter().map(|b| format!("{:.1}", *b as f64 / (1 << 20) as f64)).collect::<Vec<_>>();
+        println!("{:<14} {} MiB per rank", "store", mib(&store_bytes).join(" "));
+        println!("{:<14} {} MiB per rank", "peak memory", mib(&peaks).join(" "));
+    }
+    Ok(())
+}
