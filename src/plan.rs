@@ -11,6 +11,9 @@ use crate::order::{self, Direction};
 use crate::volume::SplatSet;
 use glam::Vec3;
 
+mod layout;
+pub use layout::*;
+
 /// A scene ready to draw: the splat rows plus, per axis, the splats grouped by slice and each
 /// slice's rank among non-empty slices (what the sheet batches index).
 pub struct Prepared {

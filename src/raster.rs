@@ -60,7 +60,7 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
     let centre = sum / 8.0;
     let diameter = |depth: f32| {
         let depth = depth.max(camera.near);
-        let scale = crate::cpu::splat_params::footprint_scale(&frame, depth);
+        let scale = crate::plan::footprint_scale(&frame, depth);
         let radius = frame.spacing[3] * scale;
         let ppu = frame.up[3];
         2.0 * if camera.is_perspective() { radius * ppu / depth } else { radius * ppu }

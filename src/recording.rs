@@ -327,7 +327,7 @@ fn record_tiles(
     h: u32,
     carry: bool,
 ) -> Result<()> {
-    let (tx, ty) = crate::cpu::tile::tile_grid(frame);
+    let (tx, ty) = crate::plan::tile_grid(frame);
     let tiles = tx as u64 * ty as u64;
     let mut push = FootprintPush { carry: carry as u32, ..plan::tile_push(opts, n, w, h) };
     let most = (crate::raster::MAX_TILE_CELLS / tiles.max(1)).min(push.count.max(1) as u64) as u32;
@@ -388,7 +388,7 @@ fn finish(
     let linear = e.target_linear();
     let images = if background.is_some() || linear.is_some() {
         let sources = images.iter().fold(0, |m, &r| m | if r == Res::Accum { 1 } else { 2 });
-        let push = crate::cpu::present::present_push(background, sources, linear.unwrap_or(false), w, h);
+        let push = crate::plan::present_push(background, sources, linear.unwrap_or(false), w, h);
         let groups = tile_groups(StageId::Present, w, h);
         e.run(&Dispatch::new(StageId::Present, 0, groups, List::Order, bytemuck::bytes_of(&push)))?;
         &[Res::Accum][..]

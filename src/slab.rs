@@ -15,10 +15,10 @@
 //! slab geometry from the grid's bounds (O(1)) and reads back the slabs' first pairs (one u32 per
 //! slab) to size the pair buffer and cut the batches.
 use crate::constants::SLAB_CHUNK;
-use crate::cpu::splat_params::footprint_scale;
 use crate::error::{Error, Result};
 use crate::gpu_types::{FootprintPush, Frame, SlabPush, SHEET_MODE_SLAB};
 use crate::order::Direction;
+use crate::plan::footprint_scale;
 use crate::plan::Batch;
 use crate::volume::Grid;
 use glam::Vec3;

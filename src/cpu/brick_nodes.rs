@@ -2,6 +2,7 @@
 //! `glsl/shared/brick.glsl` (`node_grid`, `node_word`, `node_color`, `node_level`), and the host's
 //! choice of how many node levels a grid gets.
 use super::bindings::Bindings;
+// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use super::brick::{inputs, BrickInputs};
 use super::lod::{
     aligned, axis_opacity, cell_seen, child_error, pack_normal, seen_error, tau_code, tau_decode, unorm10,
@@ -11,41 +12,10 @@ use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::BrickPush;
+pub use crate::plan::{
+    node_and_cut_words, node_grid, node_levels, node_words, NODE_BYTES_FLOOR, NODE_LEVELS, NODE_PIXELS, NODE_WORDS,
+};
 use glam::Vec3;
-
-/// Words per node: the cell's 3, its error, its optical depth, the brick that draws it, and 1
-/// when it may be drawn at all.
-pub const NODE_WORDS: usize = 7;
-/// Most tree levels above the brick (a voxel's level field holds 3 + 7).
-pub const NODE_LEVELS: u32 = 7;
-/// Mirror of `NODE_PIXELS`: a node's cell projects to at most this many pixels (and the bound).
-pub const NODE_PIXELS: f32 = 1.0;
-/// The nodes may take this many bytes, or the bricks' summaries' bytes where those are more: a
-/// sparse store in a large grid would otherwise hold far more nodes than bricks.
-const NODE_BYTES_FLOOR: u64 = 4 << 20;
-
-/// Mirror of `node_grid`: nodes along x, y, z at tree level `k` of a `grid` of bricks.
-pub fn node_grid(grid: [u32; 3], k: u32) -> [u32; 3] {
-    grid.map(|g| (g + (1 << k) - 1) >> k)
-}
-
-/// Words of the node levels 1..=`levels` of a `grid` of bricks.
-pub fn node_words(grid: [u32; 3], levels: u32) -> u64 {
-    (1..=levels).map(|k| node_grid(grid, k).iter().map(|&n| n as u64).product::<u64>() * NODE_WORDS as u64).sum()
-}
-
-/// The node levels a `grid` of bricks with `headers` non-empty bricks gets: up to one root node,
-/// at most `NODE_LEVELS`, and none when those would pass the nodes' share of memory.
-pub fn node_levels(grid: [u32; 3], headers: usize) -> u32 {
-    let most = grid.iter().copied().max().unwrap_or(1);
-    let levels = (0..NODE_LEVELS).find(|&k| 1u32 << k >= most).unwrap_or(NODE_LEVELS);
-    let cap = (headers as u64 * SUMMARY_WORDS as u64 * 4).max(NODE_BYTES_FLOOR);
-    if node_words(grid, levels) * 4 > cap {
-        0
-    } else {
-        levels
-    }
-}
 
 /// Mirror of `consecutive`: whether the bricks of the aligned block `n0..n1` of a `grid` of bricks
 /// are consecutive in the order `tree` gives them (the block is one of the tree's boxes, or lies
@@ -233,15 +203,6 @@ pub fn brick_node_cut(inputs: &BrickInputs<'_>) -> Vec<(usize, u32)> {
         cut.push((inputs.cut_at(n), k));
     }
     cut
-}
-
-/// Words of a `grid` of bricks' nodes over `levels` tree levels and of its frame's cut (one per
-/// level-1 node), after the summaries.
-pub fn node_and_cut_words(grid: [u32; 3], levels: u32) -> u64 {
-    if levels == 0 {
-        return 0;
-    }
-    node_words(grid, levels) + node_grid(grid, 1).iter().map(|&n| n as u64).product::<u64>()
 }
 
 pub(crate) fn brick_node_cut_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {

@@ -2,6 +2,7 @@
 //! pyramid helpers of `glsl/shared/brick.glsl` (`level_split`, `brick_level`, `level_count`,
 //! `cell_color`; the word codecs the brick mirrors share are in brick_words.rs).
 use super::bindings::Bindings;
+// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use super::brick::{inputs, inputs_for, streamed, voxel_ijk, voxel_level, BrickInputs, VOXEL_MORPHS};
 pub use super::brick_words::{level_count, tau_code, tau_decode, SUMMARY_WORDS};
 use super::order::side_count;
@@ -10,43 +11,12 @@ use crate::bricks::{local_cell, BRICK};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{BrickPush, SplatParams};
+pub(crate) use crate::plan::NO_NORMAL;
+pub use crate::plan::{
+    pyramid_bytes, CELL_WORDS, LOD_BUFFERS, LOD_CELLS, LOD_LEVELS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, SLOT_CELLS,
+    STREAMED_LOD_BUFFERS, SUMMARY_BYTES,
+};
 use glam::Vec3;
-
-/// Cells of levels 1-3 in a brick's pyramid (64 + 8 + 1).
-pub const LOD_CELLS: usize = 73;
-/// Words per pyramid cell: the optical depth along each axis, the normal, the colour (`brick.glsl`).
-pub const CELL_WORDS: usize = 3;
-/// Coarse levels (level l: cells of 2^l voxels a side).
-pub const LOD_LEVELS: u32 = 3;
-/// The octahedral bytes of a zero gradient.
-pub(crate) const NO_NORMAL: u32 = 0x8080;
-
-/// Cells of a brick's pyramid slot (level 1); levels 2 and 3 live in its summary.
-pub const SLOT_CELLS: usize = 64;
-/// Bytes of one brick's pyramid slot.
-pub const PYRAMID_BYTES: u64 = (SLOT_CELLS * CELL_WORDS * 4) as u64;
-/// Bytes of one brick's summary (resident whatever the budget).
-pub const SUMMARY_BYTES: u64 = SUMMARY_WORDS as u64 * 4;
-
-/// The buffers levels of detail add, and their bytes per non-empty brick: the pyramid's cells, its
-/// summary, this frame's morph.
-pub const LOD_BUFFERS: &[(Res, u64)] =
-    &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, SUMMARY_BYTES), (Res::BrickMorph, 4)];
-
-/// The same for a store whose records stream, its pyramid resident: and each brick's slot
-/// (its own header).
-pub const SLOTTED_LOD_BUFFERS: &[(Res, u64)] =
-    &[(Res::Pyramid, PYRAMID_BYTES), (Res::LodSummary, SUMMARY_BYTES), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
-
-/// The same for a streamed store whose pyramid holds one batch's bricks (`PYRAMID_BYTES` per
-/// entry of the batch): the summary, the morph, and each brick's slot in the batch.
-pub const STREAMED_LOD_BUFFERS: &[(Res, u64)] =
-    &[(Res::LodSummary, SUMMARY_BYTES), (Res::BrickMorph, 4), (Res::PyramidSlot, 4)];
-
-/// Resident device bytes of `buffers` for `bricks` non-empty bricks.
-pub fn pyramid_bytes(buffers: &[(Res, u64)], bricks: usize) -> u64 {
-    bricks as u64 * buffers.iter().map(|(_, per)| per).sum::<u64>()
-}
 
 /// First cell of level `l` (1..3) in a brick's pyramid.
 pub fn level_offset(l: u32) -> u32 {

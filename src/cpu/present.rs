@@ -6,6 +6,8 @@ use crate::dispatch::{Args, Variant};
 use crate::error::{Error, Result};
 use crate::gpu_types::PresentPush;
 pub use crate::image::TargetFormat;
+// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
+pub use crate::plan::present_push;
 
 /// The sRGB curve's inverse (IEC 61966-2-1), as `present.comp` applies it.
 pub fn to_linear(c: f32) -> f32 {
@@ -23,13 +25,6 @@ pub fn to_srgb(c: f32) -> f32 {
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     }
-}
-
-/// The push constants of a frame whose final images are `sources` (bit 0 accumulation, bit 1 the
-/// raster target), over a straight-alpha `background`, for a target that wants linear values or not.
-pub fn present_push(background: Option<[f32; 4]>, sources: u32, linear: bool, width: u32, height: u32) -> PresentPush {
-    let bg = background.map(|[r, g, b, a]| [r * a, g * a, b * a, a]).unwrap_or([0.0; 4]);
-    PresentPush { background: bg, width, height, sources, linear: linear as u32 }
 }
 
 /// One pixel: the mean of its sources, over the background, clamped, linear if asked (the

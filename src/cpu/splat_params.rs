@@ -1,38 +1,17 @@
 //! Mirror of `splat_params.comp` and of `glsl/shared/params.glsl`.
 use super::bindings::Bindings;
+// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use super::footprint::sweep_length;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{Frame, Splat, SplatParams};
+pub use crate::plan::{cell_footprint_scale, footprint_scale, AA_EWA, AA_NONE, AA_SWAN};
 use glam::{Mat4, Vec2, Vec3};
 
 pub use crate::constants::CULL_RADII;
 pub use crate::volume::MAX_OPACITY;
 
 pub use crate::volume::optical_depth;
-
-pub const AA_NONE: f32 = 0.0;
-pub const AA_SWAN: f32 = 1.0;
-pub const AA_EWA: f32 = 2.0;
-
-/// The anti-aliasing radius scale at eye-space `depth` (1 before k; Eq. 3.9 or the EWA low-pass).
-pub fn footprint_scale(frame: &Frame, depth: f32) -> f32 {
-    cell_footprint_scale(frame, depth, 1.0)
-}
-
-/// Mirror of `footprint_scale` in params.glsl: the scale of a splat `cell` voxels a side.
-pub fn cell_footprint_scale(frame: &Frame, depth: f32, cell: f32) -> f32 {
-    let voxel = cell * frame.spacing[3] / frame.origin[3];
-    let ppv = if frame.eye[3] > 0.5 { voxel * frame.up[3] / depth.max(1e-6) } else { voxel * frame.up[3] };
-    if frame.aa[0] == AA_SWAN {
-        (1.0 / ppv).max(1.0)
-    } else if frame.aa[0] == AA_EWA {
-        let lp = frame.aa[2] / (frame.aa[1] * ppv);
-        (1.0 + lp * lp).sqrt()
-    } else {
-        1.0
-    }
-}
 
 /// Mirror of `params_of` in `glsl/shared/params.glsl`: a splat's parameters from its grid index
 /// and colour (the dense path's `splat_params` and the bricks' `brick_params` share it).

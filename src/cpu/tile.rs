@@ -12,11 +12,8 @@ use glam::{IVec4, Mat3, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::bindings::Bindings;
-
-/// Tiles across and down an image of the frame's size.
-pub fn tile_grid(frame: &Frame) -> (u32, u32) {
-    ((frame.blur[2] as u32).div_ceil(RASTER_TILE_W), (frame.blur[3] as u32).div_ceil(RASTER_TILE_H))
-}
+// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
+pub use crate::plan::tile_grid;
 
 /// Mirror of `screen_record` in `glsl/shared/tiles.glsl`.
 pub fn screen_record(frame: &Frame, p: &SplatParams) -> ScreenQuad {

@@ -2,11 +2,13 @@
 //! frame drawn front to back builds after each wave, and the test of a pixel box against it that
 //! `brick_hidden` makes for each brick (or node) of the next wave.
 use super::bindings::Bindings;
+// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use crate::constants::COMPOSITE_TILE;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{BrickPush, Frame};
 use crate::image::ImageF32;
+pub use crate::plan::{occlusion_len, tile_counts};
 use glam::IVec4;
 
 // A tile's open pixels are one bit each in two words.
@@ -14,18 +16,6 @@ const _: () = assert!(COMPOSITE_TILE * COMPOSITE_TILE == 64);
 
 /// Most composite tiles a box may span and still be tested (larger ones are always drawn).
 const MAX_BOX_TILES: i32 = 256;
-
-/// Composite tiles across and in all of a `w` x `h` image.
-fn tile_counts(w: u32, h: u32) -> (u32, u32) {
-    let tiles_x = w.div_ceil(COMPOSITE_TILE);
-    (tiles_x, tiles_x * h.div_ceil(COMPOSITE_TILE))
-}
-
-/// Entries of the occlusion map of a `w` x `h` frame: per composite tile its largest
-/// transmittance left, then two words per tile (its open pixels, one bit each).
-pub fn occlusion_len(w: u32, h: u32) -> u64 {
-    3 * tile_counts(w, h).1 as u64
-}
 
 /// Per composite tile the largest transmittance left in `accum`, then per tile the mask of its
 /// pixels with more than `occluded` left (bit (y % 8) * 8 + x % 8; rows 0-3 in the first word).

@@ -3,12 +3,11 @@
 use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
 use crate::constants::{MAX_GPU_SPLATS, PYRAMID_PAGE, PYRAMID_PAGES};
-use crate::cpu::brick_nodes::{node_and_cut_words, node_grid, node_levels};
-use crate::cpu::lod::{
-    pyramid_bytes, LOD_BUFFERS, LOD_LEVELS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS,
-};
-use crate::cpu::tile_occlusion::occlusion_len;
 use crate::options::FrameStats;
+use crate::plan::{
+    node_and_cut_words, node_grid, node_levels, occlusion_len, pyramid_bytes, LOD_BUFFERS, LOD_LEVELS, PYRAMID_BYTES,
+    SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS,
+};
 use crate::residency::{RecordCache, SLOT_WORDS};
 use std::cell::Cell;
 use std::sync::Mutex;
