@@ -97,3 +97,31 @@ fn the_readme_stays_short_and_names_no_issue_numbers() {
         assert!(!named, "README line {} names an issue number: {l}", i + 1);
     }
 }
+
+/// The guide's TOML examples are what the readers read: a transfer function (the first block)
+/// and an animation (the one naming a scene).
+#[test]
+fn the_guides_toml_examples_parse() {
+    let guide = include_str!("../../docs/guide/cli.md");
+    let mut blocks = Vec::new();
+    let mut block: Option<String> = None;
+    for line in guide.lines() {
+        match (&mut block, line.trim_start().strip_prefix("```")) {
+            (None, Some("toml")) => block = Some(String::new()),
+            (Some(b), Some(_)) => {
+                blocks.push(std::mem::take(b));
+                block = None;
+            }
+            (Some(b), None) => {
+                b.push_str(line);
+                b.push('\n');
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(blocks.len(), 2, "the guide's TOML blocks: {blocks:?}");
+    let tf = voxsplat::classify::TransferFunction::from_toml(&blocks[0]).unwrap();
+    assert_eq!((tf.points.len(), tf.range), (3, Some((0.0, 4095.0))));
+    let anim = voxsplat::animate::Animation::from_toml(&blocks[1]).unwrap();
+    assert_eq!(anim.frames, 24);
+}
