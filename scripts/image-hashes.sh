@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Renders a fixed matrix of 115 frames through the CLI (every order, compositing mode, raster
+# Renders a fixed matrix of 123 frames through the CLI (every order, compositing mode, raster
 # variant and kernel on both backends, AA, early termination, budgets, render scale, the ray caster,
-# the truth and four motion-blurred animations) and prints a hash of each frame's exact RGBA32F
-# pixels (cli/examples/pixel_hash.rs). Run it with the binaries before and after a refactor and diff
+# the truth, four motion-blurred animations, and eight bricked volumes from ../shared/data) and
+# prints a hash of each frame's exact RGBA32F pixels (cli/examples/pixel_hash.rs). Run it with the binaries before and after a refactor and diff
 # the outputs: a change that changes no image changes no hash. (Issue 22 ran it at every commit.)
 # Usage: scripts/image-hashes.sh [VOXSPLAT_BINARY] > hashes.txt
 set -euo pipefail
@@ -50,6 +50,21 @@ for be in gpu cpu; do
   run $be-plane-grazing-sheet --scene plane --view grazing --size 128x96 "${cpu[@]}" --composite sheet --raster compute
 done
 run truth-cube40 --scene cube40 --size 64x48 --truth
+# Bricked volumes from ../shared/data (or $VOXSPLAT_DATA): levels of detail with their nodes, waves
+# of hidden bricks, precomputed gradients, a store streamed through a small budget, the CPU mirrors.
+data=${VOXSPLAT_DATA:-../shared/data}
+if [ -d "$data/bonsai" ]; then
+  b=(--volume "$data/bonsai/bonsai.nii.gz" --tf bonsai)
+  st=(--volume "$data/stent/stent.nrrd" --tf ct)
+  run bricked-bonsai "${b[@]}" --size 128x128
+  run bricked-bonsai-lod-off "${b[@]}" --size 128x128 --lod off
+  run bricked-bonsai-nodes "${b[@]}" --lod-nodes --size 48x48
+  run bricked-bonsai-flat "${b[@]}" --size 128x128 --no-shade --early-termination 0
+  run bricked-stent "${st[@]}" --size 128x128
+  run bricked-stent-streamed "${st[@]}" --size 128x128 --gpu-budget-mib 4
+  run bricked-stent-cpu "${st[@]}" --size 64x64 --cpu
+  run bricked-heptane --volume "$data/heptane/heptane.nii.gz" --tf ramp --size 96x96
+fi
 for blur in splat accum:3; do
   for comp in splat sheet; do
     d="$out/anim-$blur-$comp"

@@ -52,7 +52,6 @@ pub mod order;
 pub mod orient;
 #[cfg(feature = "io")]
 pub mod output;
-pub mod peer;
 /// Per-frame planning without a device (public for tests and the harness).
 #[doc(hidden)]
 pub mod plan;
@@ -61,6 +60,8 @@ pub mod recording;
 pub mod resample;
 mod residency;
 pub mod scene;
+// The peers' scene is a built-in scene (`scene::peer`); its old path stays.
+pub use scene::peer;
 pub mod slab;
 pub mod stages;
 #[cfg(feature = "io")]

@@ -5,6 +5,8 @@ use crate::kernel::Kernel;
 use crate::volume::{Grid, SplatSet};
 use glam::Vec3;
 
+pub mod peer;
+
 /// Opacity of one voxel-length of the built-in materials.
 pub const SCENE_OPACITY: f32 = 0.95;
 const RED: [f32; 3] = [0.85, 0.1, 0.1];
@@ -71,8 +73,8 @@ pub fn build(name: &str) -> Result<SplatSet> {
         }
         "empty" => SplatSet::from_fn(Grid::centered([8, 8, 8], [1.0; 3])?, |_, _, _| None),
         "peer128" | "peer256" => {
-            let n = crate::peer::side_of(name).expect("matched above");
-            crate::classify::classify(&crate::peer::volume(n)?, &crate::peer::transfer_function(), None)
+            let n = peer::side_of(name).expect("matched above");
+            crate::classify::classify(&peer::volume(n)?, &peer::transfer_function(), None)
         }
         #[cfg(feature = "io")]
         "bonsai" | "stent" => {

@@ -1,4 +1,4 @@
-//! The peers' shared scene (`../shared/peers/common/scene.py`): the same uint8 volume,
+//! The peers' shared scene, built in as `peer128` and `peer256` (`../shared/peers/common/scene.py`): the same uint8 volume,
 //! transfer function and camera that the VTK and taichi scripts render, so voxsplat's images line
 //! up with theirs pixel for pixel.
 //!
