@@ -1,6 +1,7 @@
 //! The layout stays as docs/DEVELOPING.md's "Layout" section draws it: no module, and no file of the
 //! core or the CLI, imports another that (through others) imports it back; the maths reaches into
-//! no executor; the Vulkan engine, the recording and the plan import no CPU mirror; and no source
+//! no executor; the Vulkan engine, the recording and the plan import no CPU mirror; the formats
+//! (loaders, scenes, terrain, classification, output, orientation) import no study; and no source
 //! file of the core or the CLI grows past 700 lines.
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -298,4 +299,19 @@ fn the_vulkan_engine_the_recording_and_the_plan_import_no_mirror() {
         let mirrors: Vec<_> = uses.iter().filter(|t| t.starts_with("cpu/") || *t == "cpu_engine").collect();
         assert!(mirrors.is_empty(), "{file} imports the CPU mirrors {mirrors:?}");
     }
+}
+
+#[test]
+fn the_formats_import_no_study() {
+    let core = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), None);
+    let formats = ["loaders", "scene", "terrain", "classify", "output", "orient"];
+    let studies = ["truth", "metrics", "aa", "animate", "distributed", "bisect"];
+    let mut checked = 0;
+    for (file, uses) in core.iter().filter(|(f, _)| formats.iter().any(|m| f == m || f.starts_with(&format!("{m}/")))) {
+        let reached: Vec<_> =
+            uses.iter().filter(|t| studies.iter().any(|s| t == s || t.starts_with(&format!("{s}/")))).collect();
+        assert!(reached.is_empty(), "{file} imports the studies {reached:?}");
+        checked += 1;
+    }
+    assert!(checked >= 10, "format files found: {checked}");
 }
