@@ -14,7 +14,6 @@
 //! (`glsl/brick_*.comp`) cull bricks, classify voxels and order them in two-level PBTF each frame.
 use crate::classify::{classify_field, Shading, TransferFunction};
 use crate::error::{Error, Result};
-use crate::gpu_types::BrickFrame;
 use crate::volume::{Grid, ScalarVolume, SplatSet};
 use bytemuck::{Pod, Zeroable};
 
@@ -497,28 +496,6 @@ impl BrickScene {
         (lo[0] <= hi[0]).then_some([lo, hi])
     }
 
-    /// The brick stages' uniforms for a frame whose brick grid is split at `split`.
-    pub fn uniforms(&self, split: [u32; 3]) -> BrickFrame {
-        let nb = self.store.dims.map(|d| d.div_ceil(BRICK));
-        let (a, b) = self.remap();
-        let weight = self.tf.gradient_weight;
-        let gmax = if weight > 0.0 { (a * self.gmax_stored()).max(1e-12) } else { 1.0 };
-        let (light, shade) = match self.shading {
-            Some(s) => ([s.light.x, s.light.y, s.light.z, 1.0], [s.ambient, s.diffuse, s.specular, s.shininess]),
-            None => ([0.0; 4], [0.0; 4]),
-        };
-        BrickFrame {
-            grid: [nb[0], nb[1], nb[2], self.store.headers.len() as u32],
-            split: [split[0], split[1], split[2], 0],
-            tf: [a, b, 0.0, weight],
-            light,
-            shade,
-            grad: [gmax, 0.0, 0.0, 0.0],
-            lo: [self.part[0][0], self.part[0][1], self.part[0][2], self.tree.len() as u32],
-            hi: [self.part[1][0], self.part[1][1], self.part[1][2], 0],
-        }
-    }
-
     /// The store's `gradient_words` (`Res::BrickGradients`) for the bricks the transfer function
     /// draws: made when a device lacks them for this classification, and not kept (8 bytes a
     /// stored voxel).
@@ -555,7 +532,7 @@ impl BrickScene {
 
     /// The largest central-difference gradient magnitude over the grid, in stored units: only
     /// voxels in or next to a non-empty brick can have one.
-    fn gmax_stored(&self) -> f32 {
+    pub(crate) fn gmax_stored(&self) -> f32 {
         *self.gmax.get_or_init(|| {
             let s = &self.store;
             let nb = s.dims.map(|d| d.div_ceil(BRICK) as i64);

@@ -1,10 +1,13 @@
 //! Per-frame decisions made without a device: the frame uniforms, sheet batches, push constants
 //! and workgroup counts the recording (`crate::stages`) hands to either engine; and `Prepared`, a
 //! scene's per-axis slice lists.
+use crate::bricks::{BrickScene, BRICK};
 use crate::camera::Camera;
 use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE_H, RASTER_TILE_W, TILE_CHUNK, WORKGROUP_SIZE};
 use crate::error::Result;
-use crate::gpu_types::{CompositePush, FootprintPush, Frame, RaycastParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED};
+use crate::gpu_types::{
+    BrickFrame, CompositePush, FootprintPush, Frame, RaycastParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED,
+};
 use crate::kernel::Kernel;
 use crate::options::{Antialias, Motion, RaycastOptions, RenderOptions, EWA_LOWPASS_PX};
 use crate::order::{self, Direction};
@@ -328,5 +331,28 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
         image: [camera.width, camera.height, opts.brick, clip_count],
         clip,
+    }
+}
+
+/// The brick stages' uniforms for a frame of `scene` whose brick grid is split at `split`.
+pub fn brick_frame(scene: &BrickScene, split: [u32; 3]) -> BrickFrame {
+    let part = scene.part();
+    let nb = scene.store.dims.map(|d| d.div_ceil(BRICK));
+    let (a, b) = scene.remap();
+    let weight = scene.transfer_function().gradient_weight;
+    let gmax = if weight > 0.0 { (a * scene.gmax_stored()).max(1e-12) } else { 1.0 };
+    let (light, shade) = match scene.shading() {
+        Some(s) => ([s.light.x, s.light.y, s.light.z, 1.0], [s.ambient, s.diffuse, s.specular, s.shininess]),
+        None => ([0.0; 4], [0.0; 4]),
+    };
+    BrickFrame {
+        grid: [nb[0], nb[1], nb[2], scene.store.headers.len() as u32],
+        split: [split[0], split[1], split[2], 0],
+        tf: [a, b, 0.0, weight],
+        light,
+        shade,
+        grad: [gmax, 0.0, 0.0, 0.0],
+        lo: [part[0][0], part[0][1], part[0][2], scene.tree().len() as u32],
+        hi: [part[1][0], part[1][1], part[1][2], 0],
     }
 }

@@ -1,6 +1,7 @@
 //! The layout stays as docs/DEVELOPING.md's "Layout" section draws it: no module, and no file of the
 //! core or the CLI, imports another that (through others) imports it back; the maths reaches into
-//! no executor; the Vulkan engine, the recording and the plan import no CPU mirror; the formats
+//! no executor, nor (but for `SplatSet`'s records) the GPU layout; the Vulkan engine, the
+//! recording and the plan import no CPU mirror; the formats
 //! (loaders, scenes, terrain, classification, output, orientation) import no study; and no source
 //! file of the core or the CLI grows past 700 lines.
 use std::collections::{BTreeMap, BTreeSet};
@@ -314,4 +315,22 @@ fn the_formats_import_no_study() {
         checked += 1;
     }
     assert!(checked >= 10, "format files found: {checked}");
+}
+
+/// The maths (camera, kernel, order, the volume and its bricks) imports no GPU layout. One
+/// exception is left, named here so that it cannot grow: `SplatSet` holds its voxels as the GPU's
+/// `Splat` records, uploaded as they are.
+#[test]
+fn the_maths_imports_no_gpu_layout() {
+    let core = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), None);
+    let maths = ["camera", "kernel", "order", "volume", "bricks"];
+    let allowed = [("volume", "gpu_types")];
+    let mut checked = 0;
+    for (file, uses) in core.iter().filter(|(f, _)| maths.iter().any(|m| f == m || f.starts_with(&format!("{m}/")))) {
+        for t in uses.iter().filter(|t| *t == "gpu_types" || t.starts_with("gpu/") || t.starts_with("vk/")) {
+            assert!(allowed.contains(&(file.as_str(), t.as_str())), "{file} imports the GPU layout ({t})");
+        }
+        checked += 1;
+    }
+    assert!(checked >= 7, "maths files found: {checked}");
 }

@@ -163,7 +163,7 @@ pub(super) fn record_bricks(
     let available = available - gradients.unwrap_or(0);
     let frame = plan::frame_for(&prep.set, camera, opts);
     let split = crate::order::brick_split(&prep.set, camera, BRICK);
-    let mut bf = scene.uniforms(split);
+    let mut bf = crate::plan::brick_frame(scene, split);
     if lod {
         (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, opts.lod_error, opts.lod_band);
         bf.hi[3] = node_levels;
