@@ -148,7 +148,7 @@ struct AnimateArgs {
     /// Where the frames and anim.gif go.
     #[arg(long, default_value = "anim-out")]
     out_dir: PathBuf,
-    /// Run on the CPU mirrors.
+    /// Render on the CPU instead of the Vulkan device (slower; the same frames to within rounding).
     #[arg(long)]
     cpu: bool,
 }

@@ -162,7 +162,8 @@ pub struct SceneArgs {
     /// Visibility order.
     #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
     pub order: String,
-    /// Run every stage on the CPU mirrors instead of Vulkan.
+    /// Render on the CPU instead of the Vulkan device: every GPU step has a CPU twin that computes
+    /// the same picture to within rounding (slower; for checking a device).
     #[arg(long)]
     pub cpu: bool,
     /// Enable the Khronos validation layer and report its messages.

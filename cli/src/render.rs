@@ -26,8 +26,8 @@ pub(crate) struct RenderArgs {
     /// step). No pixel changes by more than this.
     #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_EARLY_TERMINATION)]
     early_termination: f32,
-    /// Bricked volumes: keep the bricks that earlier batches hide (front to back, early
-    /// termination), to measure what dropping them saves.
+    /// Bricked volumes: also draw the bricks that nearer ones already hide (slower; pixels move by
+    /// at most --early-termination; for measuring what dropping them saves).
     #[arg(long)]
     keep_hidden_bricks: bool,
     /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25) [default: 1].
