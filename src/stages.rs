@@ -150,7 +150,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::order::order_count_stage,
+        mirror: crate::cpu::order_count::order_count_stage,
     },
     StageDesc {
         name: "order_scan",
@@ -162,7 +162,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::order::order_scan_stage,
+        mirror: crate::cpu::order_scan::order_scan_stage,
     },
     StageDesc {
         name: "order_scatter",
@@ -174,7 +174,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::order::order_scatter_stage,
+        mirror: crate::cpu::order_scatter::order_scatter_stage,
     },
     StageDesc {
         name: "splat_params",
@@ -198,7 +198,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "lod",
         device_build: None,
         variants: GRADIENT_BUILDS,
-        mirror: crate::cpu::lod::brick_pyramid_stage,
+        mirror: crate::cpu::brick_pyramid::brick_pyramid_stage,
     },
     StageDesc {
         name: "brick_nodes",
@@ -222,7 +222,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "bricks",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::brick_nodes::brick_node_cut_stage,
+        mirror: crate::cpu::brick_node_cut::brick_node_cut_stage,
     },
     StageDesc {
         name: "brick_cull",
@@ -235,7 +235,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "bricks",
         device_build: None,
         variants: RECORD_PAGED,
-        mirror: crate::cpu::brick::brick_cull_stage,
+        mirror: crate::cpu::brick_cull::brick_cull_stage,
     },
     StageDesc {
         name: "brick_order",
@@ -247,7 +247,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: RECORD_PAGED,
-        mirror: crate::cpu::brick::brick_order_stage,
+        mirror: crate::cpu::brick_order::brick_order_stage,
     },
     StageDesc {
         name: "brick_cells",
@@ -259,7 +259,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: PYRAMID_STREAMED,
-        mirror: crate::cpu::lod::brick_cells_stage,
+        mirror: crate::cpu::brick_cells::brick_cells_stage,
     },
     StageDesc {
         name: "brick_params",
@@ -271,7 +271,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "splat_params",
         device_build: None,
         variants: GRADIENT_BUILDS,
-        mirror: crate::cpu::brick::brick_params_stage,
+        mirror: crate::cpu::brick_params::brick_params_stage,
     },
     StageDesc {
         name: "brick_lod_params",
@@ -283,7 +283,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "splat_params",
         device_build: None,
         variants: RECORD_PAGED,
-        mirror: crate::cpu::lod::brick_lod_params_stage,
+        mirror: crate::cpu::brick_lod_params::brick_lod_params_stage,
     },
     StageDesc {
         name: "tile_occlusion",
@@ -319,7 +319,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "slab_bins",
         device_build: None,
         variants: SLAB_BUILDS,
-        mirror: crate::cpu::slab::slab_count_stage,
+        mirror: crate::cpu::slab_count::slab_count_stage,
     },
     StageDesc {
         name: "slab_scan",
@@ -331,7 +331,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "slab_bins",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::slab::slab_scan_stage,
+        mirror: crate::cpu::slab_scan::slab_scan_stage,
     },
     StageDesc {
         name: "slab_scatter",
@@ -343,7 +343,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "slab_bins",
         device_build: None,
         variants: SLAB_BUILDS,
-        mirror: crate::cpu::slab::slab_scatter_stage,
+        mirror: crate::cpu::slab_scatter::slab_scatter_stage,
     },
     StageDesc {
         name: "tile_count",
@@ -355,7 +355,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: PAGED,
-        mirror: crate::cpu::tile::tile_count_stage,
+        mirror: crate::cpu::tile_count::tile_count_stage,
     },
     StageDesc {
         name: "tile_scan",
@@ -367,7 +367,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::tile::tile_scan_stage,
+        mirror: crate::cpu::tile_scan::tile_scan_stage,
     },
     StageDesc {
         name: "tile_offsets",
@@ -379,7 +379,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::tile::tile_offsets_stage,
+        mirror: crate::cpu::tile_offsets::tile_offsets_stage,
     },
     StageDesc {
         name: "tile_scatter",
@@ -391,7 +391,7 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: PAGED,
-        mirror: crate::cpu::tile::tile_scatter_stage,
+        mirror: crate::cpu::tile_scatter::tile_scatter_stage,
     },
     StageDesc {
         name: "tile_composite",
@@ -418,7 +418,7 @@ pub const STAGES: &[StageDesc] = &[
             v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 0]),
             v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 1]),
         ],
-        mirror: crate::cpu::tile::tile_composite_stage,
+        mirror: crate::cpu::tile_composite::tile_composite_stage,
     },
     StageDesc {
         name: "sheet_tiles",
@@ -477,7 +477,7 @@ pub const STAGES: &[StageDesc] = &[
         device_build: Some((Feature::Int64Atomics, "SUM64")),
         // Indexed by `sheet_mode - 1`.
         variants: &[v("", &[SHEET_MODE_AXIS]), v("", &[SHEET_MODE_SLAB]), v("", &[SHEET_MODE_BINNED])],
-        mirror: crate::cpu::footprint::footprint_sum_stage,
+        mirror: crate::cpu::footprint_sum::footprint_sum_stage,
     },
     StageDesc {
         name: "composite",

@@ -334,3 +334,26 @@ fn the_maths_imports_no_gpu_layout() {
     }
     assert!(checked >= 7, "maths files found: {checked}");
 }
+
+/// One name, four places: every stage of the table has its shader (`glsl/<name>.comp`, or `.vert`
+/// and `.frag` for a draw) and its mirror file (`src/cpu/<name>.rs`, defining `<name>_stage`),
+/// and the table's row names that mirror.
+#[test]
+fn every_stage_has_its_shader_and_a_mirror_file_of_its_name() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let table = std::fs::read_to_string(root.join("src/stages.rs")).unwrap();
+    assert!(voxsplat::stages::STAGES.len() >= 26);
+    for desc in voxsplat::stages::STAGES {
+        let name = desc.name;
+        let comp = root.join(format!("glsl/{name}.comp")).exists();
+        let draw = root.join(format!("glsl/{name}.vert")).exists() && root.join(format!("glsl/{name}.frag")).exists();
+        assert!(comp || draw, "{name}: no glsl/{name}.comp (or .vert and .frag)");
+        let mirror = std::fs::read_to_string(root.join(format!("src/cpu/{name}.rs")))
+            .unwrap_or_else(|_| panic!("{name}: no mirror file src/cpu/{name}.rs"));
+        assert!(mirror.contains(&format!("fn {name}_stage(")), "src/cpu/{name}.rs defines no {name}_stage");
+        assert!(
+            table.contains(&format!("crate::cpu::{name}::{name}_stage")),
+            "stages.rs names another mirror for {name}"
+        );
+    }
+}

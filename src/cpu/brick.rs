@@ -1,17 +1,16 @@
-//! Mirrors of `brick_cull.comp`, `brick_order.comp` and `brick_params.comp`, and of `glsl/shared/brick.glsl`'s
-//! helpers, over the scene's `BrickStore` and the frame's `BrickFrame` and TF buffer (levels of
-//! detail: `cpu::lod`).
+//! Helpers of the brick stages' mirrors (`brick_cull.rs`, `brick_order.rs`, `brick_params.rs`, and
+//! the levels of detail's): `glsl/shared/brick.glsl`'s helpers over the scene's `BrickStore`, the
+//! frame's `BrickFrame` and TF buffer (`BrickInputs`).
 use super::bindings::Bindings;
-use super::brick_words::level_count;
 use super::order::{outward, side_count};
-use super::splat_params::{cell_footprint_scale, frame_grid, optical_depth, params_at, CULL_RADII};
-use crate::bricks::{local_cell, BrickStore, BRICK};
-use crate::dispatch::{Args, Res, Variant};
+use super::splat_params::{cell_footprint_scale, frame_grid, CULL_RADII};
+use crate::bricks::{BrickStore, BRICK};
+use crate::dispatch::{Res, Variant};
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickFrame, BrickPush, Frame, SplatParams};
+use crate::gpu_types::{BrickFrame, Frame};
 use glam::{Mat4, Vec3, Vec4};
 
-const CELL_WORDS: usize = (BRICK * BRICK * BRICK / 32) as usize;
+pub(crate) const CELL_WORDS: usize = (BRICK * BRICK * BRICK / 32) as usize;
 
 /// Mirror of `dense_pbtf`: cell `c`'s position in the PBTF sequence of a dense `n`-cell grid split
 /// at `s`.
@@ -116,7 +115,7 @@ impl BrickInputs<'_> {
         !crate::bricks::draws_any(self.tf, lo, hi)
     }
 
-    fn density_at(&self, i: i64, j: i64, k: i64) -> f32 {
+    pub(crate) fn density_at(&self, i: i64, j: i64, k: i64) -> f32 {
         self.store.value_at(i, j, k) * self.bf.tf[0] + self.bf.tf[1]
     }
 
@@ -132,14 +131,14 @@ impl BrickInputs<'_> {
 
     /// Mirror of `differences_at`: the density's central differences at header `h`'s stored voxel
     /// of rank `rank`.
-    fn differences_at(&self, words: (&[u32], &[u32]), h: u32, rank: u32) -> Vec3 {
+    pub(crate) fn differences_at(&self, words: (&[u32], &[u32]), h: u32, rank: u32) -> Vec3 {
         let i = (words.0[h as usize] + rank) as usize;
         let d = crate::bricks::unpack_differences([words.0[i], words.1[i]], self.bf.tf[0] / 65535.0);
         Vec3::from(frame_grid(self.frame).gradient(d))
     }
 
     /// Mirror of `stored_differences`: the same at stored voxel `v`.
-    fn stored_differences(&self, words: (&[u32], &[u32]), v: [i64; 3]) -> Vec3 {
+    pub(crate) fn stored_differences(&self, words: (&[u32], &[u32]), v: [i64; 3]) -> Vec3 {
         let c = v.map(|c| c as u32);
         let h = self.store.header_of(c);
         let l = (c[0] % BRICK + BRICK * (c[1] % BRICK) + BRICK * BRICK * (c[2] % BRICK)) as usize;
@@ -221,7 +220,7 @@ impl BrickInputs<'_> {
     }
 
     /// Mirror of `outside_view`.
-    fn outside_view(&self, b: [u32; 3], k: u32, cell: f32) -> bool {
+    pub(crate) fn outside_view(&self, b: [u32; 3], k: u32, cell: f32) -> bool {
         let f = self.frame;
         if f.blur[0] > 0.0 {
             return false;
@@ -256,7 +255,7 @@ impl BrickInputs<'_> {
     }
 
     /// Mirror of `brick_slot`.
-    fn brick_slot(&self, b: [u32; 3]) -> u32 {
+    pub(crate) fn brick_slot(&self, b: [u32; 3]) -> u32 {
         let g = self.bf.grid;
         let split = [self.bf.split[0], self.bf.split[1], self.bf.split[2]];
         let p = tree_pbtf(self.tree, [g[0], g[1], g[2]], split, b);
@@ -313,112 +312,6 @@ pub fn voxel_level(v: [u32; 2]) -> u32 {
     (v[1] >> 13 & 3) + (v[0] >> 13 & 7)
 }
 
-/// Pass 1: cull each non-empty brick or write its header and count at its draw-order slot
-/// (`counts`: a streamed store's drawn voxels per brick, counted on the host), and with levels of
-/// detail its splats' morph.
-pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut [u32], morphs: &mut [f32]) {
-    let store = inputs.store;
-    for (h, hd) in store.headers.iter().enumerate() {
-        let b = hd.coords();
-        let (lo, hi) = (inputs.bf.lo, inputs.bf.hi);
-        if (0..3).any(|a| b[a] < lo[a] || b[a] >= hi[a]) || inputs.tf_empty(hd.range & 0xffff, hd.range >> 16) {
-            continue;
-        }
-        let (level, morph) = inputs.brick_level(h as u32, b);
-        let k = inputs.node_cut(b);
-        if k > 0 {
-            // Mirror of the node branch: the node's first drawing brick draws it.
-            morphs[h] = 0.0;
-            let w = inputs.node_of(k, b);
-            if w[5] == h as u32
-                && super::brick_words::tau_decode(w[0] & 0xffff) > 0.0
-                && !inputs.outside_view(b, k, (BRICK << k) as f32)
-            {
-                slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(3 + k, 1);
-            }
-            continue;
-        }
-        if inputs.outside_view(b, 0, (1u32 << level) as f32 * (1.0 + morph)) {
-            continue;
-        }
-        let drawn = match counts {
-            _ if inputs.bf.grad[1] > 0.0 => level_count(inputs.summary, h as u32, level),
-            Some(c) => c[h],
-            None => store.drawn_in(hd, |q| inputs.emits(q)),
-        };
-        if drawn > 0 {
-            slots[inputs.brick_slot(b) as usize] = (h as u32) << 10 | slot_code(level, drawn);
-        }
-        if inputs.bf.grad[1] > 0.0 {
-            morphs[h] = morph;
-        }
-    }
-}
-
-/// Pass 2: the batch's voxels (grid index, stored value) in two-level PBTF order from each
-/// brick's first position; each brick's records from its entry's first record in `records` (the
-/// store's, or the batch's when the store streams).
-pub fn brick_order(
-    inputs: &BrickInputs<'_>,
-    list: &[[u32; 4]],
-    records: &[u32],
-    push: &BrickPush,
-    voxels: &mut [[u32; 2]],
-    order: &mut [u32],
-) {
-    let (store, frame) = (inputs.store, inputs.frame);
-    for entry in &list[push.first as usize..(push.first + push.count) as usize] {
-        let hd = store.headers[entry[0] as usize];
-        let b = hd.coords();
-        // Coarse bricks are brick_cells'.
-        if entry[3] >> 16 != 0 {
-            continue;
-        }
-        let morphs = inputs.morph_bit(entry[0]);
-        let split = [0, 1, 2].map(|a| (frame.split[a] as i64 - (b[a] * BRICK) as i64).clamp(0, BRICK as i64) as u32);
-        let records = &*BrickStore::records_of(records, entry[2], &hd);
-        let mut cells = [0u32; CELL_WORDS];
-        let position = |rec: u32| dense_pbtf(local_cell(rec & 511), [BRICK; 3], split);
-        for &rec in records {
-            if inputs.emits(rec >> 16) {
-                let p = position(rec);
-                cells[p as usize / 32] |= 1 << (p % 32);
-            }
-        }
-        let mut below = [0u32; CELL_WORDS + 1];
-        for w in 0..CELL_WORDS {
-            below[w + 1] = below[w] + cells[w].count_ones();
-        }
-        let total = below[CELL_WORDS];
-        for &rec in records.iter().filter(|&&rec| inputs.emits(rec >> 16)) {
-            let p = position(rec);
-            let rank = below[p as usize / 32] + (cells[p as usize / 32] & ((1u32 << (p % 32)) - 1)).count_ones();
-            let rank = if frame.split[3] != 0 { total - 1 - rank } else { rank };
-            let pos = (entry[1] + rank) as usize;
-            let lc = local_cell(rec & 511);
-            let ijk = [0, 1, 2].map(|a| b[a] * BRICK + lc[a]);
-            voxels[pos] = [ijk[0] | ijk[1] << 16, ijk[2] | morphs | (rec & 0xffff_0000)];
-            order[pos] = pos as u32;
-        }
-    }
-}
-
-/// Pass 3: per splat of the batch, classify its voxel and make its parameters, grown when its
-/// brick morphs (coarse cells are `brick_lod_params`').
-pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
-    let shaded = inputs.bf.light[3] > 0.5;
-    for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
-        if voxel_level(*v) != 0 {
-            continue;
-        }
-        let ijk = voxel_ijk(*v);
-        let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
-        let at = Vec3::from_array(ijk.map(|c| c as f32));
-        let grow = if v[1] & VOXEL_MORPHS != 0 { inputs.splat_growth(at, 0) } else { 1.0 };
-        params[s] = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
-    }
-}
-
 pub(crate) fn inputs<'a>(b: &'a Bindings<'_>) -> Result<BrickInputs<'a>> {
     let scene = b.prep.bricks.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
     let bf: &[BrickFrame] = b.get(Res::BrickFrame);
@@ -451,37 +344,4 @@ pub(crate) fn inputs_for<'a>(b: &'a Bindings<'_>, v: &Variant) -> Result<BrickIn
 /// Whether a brick stage's build reads streamed records.
 pub(crate) fn streamed(v: &Variant) -> bool {
     v.defines.contains("STREAMED_STORE")
-}
-
-pub(crate) fn brick_cull_stage(b: &mut Bindings<'_>, _: &Args, v: &Variant) -> Result<()> {
-    let (mut slots, mut morphs) = (b.take(Res::BrickSlots), b.take(Res::BrickMorph));
-    let counts = streamed(v).then(|| b.get::<u32>(Res::BrickCounts));
-    brick_cull(&inputs(b)?, counts, &mut slots, bytemuck::cast_slice_mut(&mut morphs));
-    b.put(Res::BrickSlots, slots);
-    b.put(Res::BrickMorph, morphs);
-    Ok(())
-}
-
-pub(crate) fn brick_order_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
-    let (mut voxels, mut order) = (b.take(Res::BrickVoxels), b.take(Res::Order));
-    let inputs = inputs(b)?;
-    let records = if streamed(v) { b.get(Res::BatchRecords) } else { &inputs.store.records[..] };
-    brick_order(
-        &inputs,
-        b.get(Res::BrickList),
-        records,
-        &args.push_as(),
-        bytemuck::cast_slice_mut(&mut voxels),
-        &mut order,
-    );
-    b.put(Res::BrickVoxels, voxels);
-    b.put(Res::Order, order);
-    Ok(())
-}
-
-pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
-    let mut params = b.take(Res::Params);
-    brick_params(&inputs_for(b, v)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
-    b.put(Res::Params, params);
-    Ok(())
 }

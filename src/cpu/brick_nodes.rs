@@ -1,6 +1,6 @@
-//! Levels of detail above the brick: mirror of `brick_nodes.comp` and of the node helpers of
-//! `glsl/shared/brick.glsl` (`node_grid`, `node_word`, `node_color`, `node_level`), and the host's
-//! choice of how many node levels a grid gets.
+//! Levels of detail above the brick: mirror of `brick_nodes.comp`, and of the node helpers of
+//! `glsl/shared/brick.glsl` (`node_word`, `node_color`, `node_level`) that `brick_node_cut.rs`
+//! reads too.
 use super::bindings::Bindings;
 // Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use super::brick::{inputs, BrickInputs};
@@ -47,7 +47,7 @@ pub fn consecutive(tree: &[crate::kdtree::Node], grid: [u32; 3], n0: [u32; 3], n
 impl BrickInputs<'_> {
     /// Mirror of `node_word`: the index of word 0 of node `n` (node coordinates) at tree level `k`
     /// in the summary buffer.
-    fn node_at(&self, k: u32, n: [u32; 3]) -> usize {
+    pub(crate) fn node_at(&self, k: u32, n: [u32; 3]) -> usize {
         let grid = [self.bf.grid[0], self.bf.grid[1], self.bf.grid[2]];
         let base = self.bf.grid[3].max(1) as u64 * SUMMARY_WORDS as u64 + node_words(grid, k - 1);
         let g = node_grid(grid, k);
@@ -61,7 +61,7 @@ impl BrickInputs<'_> {
 
     /// Mirror of `cut_word`: the index of level-1 node `n1`'s cut word (one per level-1 node, where
     /// a level past the last would start).
-    fn cut_at(&self, n1: [u32; 3]) -> usize {
+    pub(crate) fn cut_at(&self, n1: [u32; 3]) -> usize {
         let g = node_grid([self.bf.grid[0], self.bf.grid[1], self.bf.grid[2]], 1);
         self.node_at(self.bf.hi[3] + 1, [0; 3]) + (n1[0] + g[0] * (n1[1] + g[1] * n1[2])) as usize
     }
@@ -182,37 +182,6 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
             u32::from(inside(n) && consecutive(inputs.tree, grid, n.map(|c| c << k), n1(n))),
         ]);
     }
-}
-
-/// Mirror of `brick_node_cut.comp`: per level-1 node, the tree level of the node that draws its
-/// bricks this frame, as (index of its cut word in the summary buffer, level).
-pub fn brick_node_cut(inputs: &BrickInputs<'_>) -> Vec<(usize, u32)> {
-    let bf = &inputs.bf;
-    let g = node_grid([bf.grid[0], bf.grid[1], bf.grid[2]], 1);
-    let mut cut = Vec::with_capacity((g[0] * g[1] * g[2]) as usize);
-    for i in 0..g[0] * g[1] * g[2] {
-        let n = [i % g[0], (i / g[0]) % g[1], i / (g[0] * g[1])];
-        let b = n.map(|c| c << 1);
-        // A level-1 node whose bricks draw nothing: no node above it draws them either.
-        let k = if inputs.node_of(1, b)[5] == u32::MAX {
-            0
-        } else {
-            let (lo, hi) = inputs.voxel_box(b, 1);
-            inputs.node_level(b, inputs.voxel_pixels(inputs.box_depths(lo, hi).0))
-        };
-        cut.push((inputs.cut_at(n), k));
-    }
-    cut
-}
-
-pub(crate) fn brick_node_cut_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
-    let cut = brick_node_cut(&inputs(b)?);
-    let mut summary = b.take(Res::LodSummary);
-    for (at, k) in cut {
-        summary[at] = k;
-    }
-    b.put(Res::LodSummary, summary);
-    Ok(())
 }
 
 pub(crate) fn brick_nodes_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {

@@ -2,11 +2,11 @@
 //! `footprint.frag` and the fixed-function blend: each splat's eye-facing quad is rasterised by
 //! intersecting every covered pixel's ray with the quad's plane (what perspective-correct
 //! interpolation computes on the GPU), or its point sprite by the point rule; weighted by the
-//! footprint table; blended. `footprint_sum` mirrors `footprint_sum.comp` (fixed-point sums through
-//! the projective map of `screen_quad`).
+//! footprint table; blended. Its helpers (the footprint tables, `screen_quad`, the motion-blur
+//! sweeps) serve `footprint_sum.rs`, `sheet_tiles.rs` and the tile compositor's mirrors too.
 use super::ImageF32;
 use crate::constants::{FOOTPRINT_TABLE_SIZE, SUM_FIXED_SCALE};
-use crate::dispatch::{Args, Pass, Res, Variant};
+use crate::dispatch::{Args, Pass, Variant};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, Frame, SplatParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB};
 pub use crate::kernel::sample_radial;
@@ -163,42 +163,8 @@ pub fn quad_uv(inv: &Mat3, x: i32, y: i32) -> Vec2 {
 }
 
 /// Mirror of `fixed_point` in `footprint_sum.comp`.
-fn fixed_point(v: f32) -> u32 {
+pub(crate) fn fixed_point(v: f32) -> u32 {
     (v.min(64.0) * SUM_FIXED_SCALE as f32 + 0.5) as u32
-}
-
-/// Mirror of `footprint_sum.comp` (its SUM64 build): add `push.count` entries from `push.first` to
-/// the fixed-point layers `sums` (layer-major rows of width x 4 channels), channels (r, g) and
-/// (b, tau) added as one 64-bit word each, wrapping as the GPU's atomics do (the 32-bit build
-/// differs only where a channel's sum wraps, which `SUM_FIXED_SCALE` keeps out of reach).
-pub fn footprint_sum(inputs: &FootprintInputs<'_>, push: &FootprintPush, sums: &mut [u32]) {
-    let (width, height) = (inputs.frame.blur[2] as usize, inputs.frame.blur[3] as usize);
-    for e in push.first..push.first + push.count {
-        let Some((splat, layer, weight)) = entry(inputs, push, e) else { continue };
-        let p = &inputs.params[splat];
-        let Some((inv, bx)) = screen_quad(inputs.frame, p) else { continue };
-        let energy = p.emit[3] * p.axis_u[3];
-        for y in bx.y..=bx.w {
-            for x in bx.x..=bx.z {
-                let uv = quad_uv(&inv, x, y);
-                if uv.x.abs() > 1.0 || uv.y.abs() > 1.0 {
-                    continue;
-                }
-                let tau = weight.value(uv, Sweep::of(inputs.frame, p), energy, false);
-                if tau <= 0.0 {
-                    continue;
-                }
-                let idx = 4 * ((layer * height + y as usize) * width + x as usize);
-                let Some(px) = sums.get_mut(idx..idx + 4) else { continue };
-                let add = [p.emit[0] * tau, p.emit[1] * tau, p.emit[2] * tau, tau].map(fixed_point);
-                for (pair, add) in px.chunks_exact_mut(2).zip(add.chunks_exact(2)) {
-                    let word =
-                        (pair[0] as u64 | (pair[1] as u64) << 32).wrapping_add(add[0] as u64 | (add[1] as u64) << 32);
-                    (pair[0], pair[1]) = (word as u32, (word >> 32) as u32);
-                }
-            }
-        }
-    }
 }
 
 /// Mirror of the fixed-point read in `composite.comp` (SUMS_FIXED): one layer as floats.
@@ -247,9 +213,9 @@ pub fn occluded(inputs: &FootprintInputs<'_>, p: &SplatParams, threshold: f32) -
 }
 
 /// Segments of a bent motion path (`ARC_SEGMENTS` in `glsl/shared/sweep.glsl`).
-const ARC_SEGMENTS: u32 = 8;
+pub(crate) const ARC_SEGMENTS: u32 = 8;
 /// Most time samples of a tapered or teardrop footprint (`MAX_SWEEP_SAMPLES`).
-const MAX_SWEEP_SAMPLES: i32 = 64;
+pub(crate) const MAX_SWEEP_SAMPLES: i32 = 64;
 
 /// A motion-blurred footprint's path and profile (`glsl/shared/sweep.glsl`): from t_{i-1} at
 /// (-stretch, 0) to t_i at (stretch, 0) through (0, bend), radius units about the quad's centre.
@@ -273,7 +239,7 @@ pub fn sweep_point(stretch: f32, bend: f32, t: f32) -> Vec2 {
     Vec2::new(stretch * (2.0 * t - 1.0), 4.0 * bend * t * (1.0 - t))
 }
 
-fn sweep_coords(uv: Vec2, stretch: f32, bend: f32) -> Vec2 {
+pub(crate) fn sweep_coords(uv: Vec2, stretch: f32, bend: f32) -> Vec2 {
     Vec2::new(uv.x * (1.0 + stretch), uv.y * (1.0 + bend.abs()))
 }
 
@@ -313,18 +279,18 @@ pub fn sweep_r2(uv: Vec2, stretch: f32, bend: f32) -> f32 {
 }
 
 /// Mirror of `sweep_samples`.
-fn sweep_samples(stretch: f32, bend: f32) -> i32 {
+pub(crate) fn sweep_samples(stretch: f32, bend: f32) -> i32 {
     (1 + (4.0 * (2.0 * stretch + 2.0 * bend.abs())).ceil() as i32).clamp(2, MAX_SWEEP_SAMPLES)
 }
 
 /// Mirror of `sweep_window`: the time samples (k of `n`) within a radius of x along u.
-fn sweep_window(x: Vec2, stretch: f32, n: i32) -> std::ops::RangeInclusive<i32> {
+pub(crate) fn sweep_window(x: Vec2, stretch: f32, n: i32) -> std::ops::RangeInclusive<i32> {
     let (lo, hi) = ((x.x + stretch - 1.0) / (2.0 * stretch), (x.x + stretch + 1.0) / (2.0 * stretch));
     ((lo * n as f32 - 0.5).ceil() as i32).max(0)..=((hi * n as f32 - 0.5).floor() as i32).min(n - 1)
 }
 
 /// Mirror of `sweep_sample`: time sample k of n and r² from x to the path there.
-fn sweep_sample(x: Vec2, stretch: f32, bend: f32, k: i32, n: i32) -> (f32, f32) {
+pub(crate) fn sweep_sample(x: Vec2, stretch: f32, bend: f32, k: i32, n: i32) -> (f32, f32) {
     let t = (k as f32 + 0.5) / n as f32;
     let e = x - sweep_point(stretch, bend, t);
     (t, e.dot(e))
@@ -340,7 +306,7 @@ pub(crate) enum Weight<'a> {
 
 impl Weight<'_> {
     /// Mirror of `kernel_at` in `glsl/shared/footprint_table.glsl`: the weight at r² s.
-    fn kernel_at(self, s: f32) -> f32 {
+    pub(crate) fn kernel_at(self, s: f32) -> f32 {
         match self {
             Weight::Footprint(table) => sample_radial(table, s),
             Weight::Slice(table, [za, zb]) => {
@@ -352,7 +318,7 @@ impl Weight<'_> {
 
     /// Mirror of `footprint_value`: the optical depth a footprint of scale `tau` deposits at quad
     /// coordinates uv or, with `opacity`, its alpha.
-    fn value(self, uv: Vec2, sweep: Sweep, tau: f32, opacity: bool) -> f32 {
+    pub(crate) fn value(self, uv: Vec2, sweep: Sweep, tau: f32, opacity: bool) -> f32 {
         let Sweep { stretch, bend, profile } = sweep;
         if profile == crate::BlurProfile::Uniform.code() || stretch == 0.0 {
             let d = tau * self.kernel_at(sweep_r2(uv, stretch, bend));
@@ -377,7 +343,7 @@ impl Weight<'_> {
 
 /// Mirror of `footprint_slots`: the alpha a footprint of scale `tau` deposits at uv in each half
 /// of the shutter (`Pass::Slots`).
-fn footprint_slots(weight: Weight<'_>, uv: Vec2, sweep: Sweep, tau: f32) -> [f32; 2] {
+pub(crate) fn footprint_slots(weight: Weight<'_>, uv: Vec2, sweep: Sweep, tau: f32) -> [f32; 2] {
     let Sweep { stretch, bend, .. } = sweep;
     if stretch == 0.0 {
         let a = 1.0 - (-tau * weight.kernel_at(sweep_r2(uv, 0.0, 0.0))).exp();
@@ -405,7 +371,7 @@ pub fn footprint_value(table: &[f32], uv: Vec2, sweep: Sweep, tau: f32, opacity:
 
 /// What the fragment shader and the blend do with a footprint.
 #[derive(Clone, Copy)]
-struct Shading<'a> {
+pub(crate) struct Shading<'a> {
     sheet: bool,
     blend: Blend,
     weight: Weight<'a>,
@@ -416,7 +382,7 @@ struct Shading<'a> {
 
 /// The fragment shader's output at quad coordinates (u, v), blended into the pixel at `at` of
 /// `targets` (one, or the two slots).
-fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF32], at: usize) {
+pub(crate) fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF32], at: usize) {
     let tau = p.emit[3] * p.axis_u[3];
     // Optical depth (sheets) or alpha (per splat), per target.
     let values = if s.slots {
@@ -433,7 +399,7 @@ fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF3
 }
 
 /// The fixed-function blend of premultiplied `src` into `dst`.
-fn blend(mode: Blend, src: [f32; 4], dst: &mut [f32; 4]) {
+pub(crate) fn blend(mode: Blend, src: [f32; 4], dst: &mut [f32; 4]) {
     match mode {
         Blend::Over => {
             let k = 1.0 - src[3];
@@ -449,7 +415,7 @@ fn blend(mode: Blend, src: [f32; 4], dst: &mut [f32; 4]) {
 
 /// A point sprite `2 * screen radius` pixels wide centred on the projected centre: the pixels whose
 /// centres fall inside it, with gl_PointCoord mapped to [-1, 1]².
-fn raster_point(p: &SplatParams, shading: Shading<'_>, vp: Mat4, targets: &mut [ImageF32]) {
+pub(crate) fn raster_point(p: &SplatParams, shading: Shading<'_>, vp: Mat4, targets: &mut [ImageF32]) {
     let (width, height) = (targets[0].width, targets[0].height);
     let clip = vp * Vec4::new(p.center[0], p.center[1], p.center[2], 1.0);
     if clip.w <= 0.0 {
@@ -473,7 +439,7 @@ fn raster_point(p: &SplatParams, shading: Shading<'_>, vp: Mat4, targets: &mut [
     }
 }
 
-fn raster_quad(p: &SplatParams, shading: Shading<'_>, vp: Mat4, inv: &DMat4, targets: &mut [ImageF32]) {
+pub(crate) fn raster_quad(p: &SplatParams, shading: Shading<'_>, vp: Mat4, inv: &DMat4, targets: &mut [ImageF32]) {
     let v3 = |v: [f32; 4]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
     let (c, au, av) = (v3(p.center), v3(p.axis_u), v3(p.axis_v));
     let width = targets[0].width;
@@ -543,12 +509,5 @@ pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Re
             b.color = layers.pop().expect("two slots");
         }
     }
-    Ok(())
-}
-
-pub(crate) fn footprint_sum_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
-    let mut sums = b.take(Res::Fixed);
-    footprint_sum(&b.inputs(d.list), &d.push_as(), &mut sums);
-    b.put(Res::Fixed, sums);
     Ok(())
 }

@@ -1,0 +1,31 @@
+//! Mirror of `glsl/brick_params.comp` (the `brick_params` stage); shared helpers in `brick.rs`.
+use super::bindings::Bindings;
+use super::brick::*;
+use super::splat_params::{optical_depth, params_at};
+use crate::dispatch::{Args, Res, Variant};
+use crate::error::Result;
+use crate::gpu_types::{BrickPush, SplatParams};
+use glam::Vec3;
+
+/// Pass 3: per splat of the batch, classify its voxel and make its parameters, grown when its
+/// brick morphs (coarse cells are `brick_lod_params`').
+pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], params: &mut [SplatParams]) {
+    let shaded = inputs.bf.light[3] > 0.5;
+    for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
+        if voxel_level(*v) != 0 {
+            continue;
+        }
+        let ijk = voxel_ijk(*v);
+        let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
+        let at = Vec3::from_array(ijk.map(|c| c as f32));
+        let grow = if v[1] & VOXEL_MORPHS != 0 { inputs.splat_growth(at, 0) } else { 1.0 };
+        params[s] = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
+    }
+}
+
+pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+    let mut params = b.take(Res::Params);
+    brick_params(&inputs_for(b, v)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
+    b.put(Res::Params, params);
+    Ok(())
+}

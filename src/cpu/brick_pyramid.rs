@@ -1,0 +1,142 @@
+//! Mirror of `glsl/brick_pyramid.comp` (the `brick_pyramid` stage); shared helpers in `lod.rs`.
+use super::bindings::Bindings;
+use super::brick::{inputs, streamed, BrickInputs};
+use super::lod::*;
+use super::splat_params::optical_depth;
+use crate::bricks::{local_cell, BRICK};
+use crate::dispatch::{Args, Res, Variant};
+use crate::error::Result;
+use glam::Vec3;
+
+/// Per-level sums of a brick's cells: optical depth, tau-weighted colour and gradient
+/// (sign-aligned), error, and its opacity along x, y and z (a voxel's: its opacity).
+#[derive(Clone, Copy, Default)]
+struct Sums {
+    tau: f32,
+    col: Vec3,
+    grad: Vec3,
+    err: f32,
+    axes: [f32; 3],
+}
+
+/// Mirror of `brick_pyramid.comp`: every non-empty brick's pyramid cells and summary, or with
+/// `batch` (a streamed store) the batch range's bricks' into their entries' slots.
+pub fn brick_pyramid(
+    inputs: &BrickInputs<'_>,
+    batch: Option<PyramidBatch<'_>>,
+    pyramid: &mut [u32],
+    summary: &mut [u32],
+) {
+    let store = inputs.store;
+    let shaded = inputs.bf.light[3] > 0.5;
+    let mut fine = vec![Sums::default(); (BRICK * BRICK * BRICK) as usize];
+    // (header, slot) of the bricks to build.
+    let (bricks, mut slots): (Vec<(usize, usize)>, _) = match batch {
+        Some(PyramidBatch { list, push, slots }) => {
+            let range = push.first as usize..(push.first + push.count) as usize;
+            let by_header = push.splats != 0;
+            (
+                range.map(|e| (list[e][0] as usize, if by_header { list[e][0] as usize } else { e })).collect(),
+                Some(slots),
+            )
+        }
+        None => ((0..store.headers.len()).map(|h| (h, h)).collect(), None),
+    };
+    for (h, slot) in bricks {
+        let hd = &store.headers[h];
+        let b = hd.coords();
+        fine.fill(Sums::default());
+        for (rank, &rec) in store.brick_records(hd).iter().enumerate() {
+            if !inputs.emits(rec >> 16) {
+                continue;
+            }
+            let l = rec & 511;
+            let lc = local_cell(l);
+            let v = [0, 1, 2].map(|a| (b[a] * BRICK + lc[a]) as i64);
+            let c = inputs.classify_voxel(v, rec >> 16, false);
+            let t = optical_depth(c[3]);
+            let grad = if shaded { inputs.voxel_gradient(v, h as u32, rank as u32) * t } else { Vec3::ZERO };
+            let a = 1.0 - (-t).exp();
+            fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0, axes: [a; 3] };
+        }
+        let mut cells = [Sums::default(); LOD_CELLS];
+        let mut stored = [0f32; LOD_CELLS];
+        for l in 1..=LOD_LEVELS {
+            let n = BRICK >> l;
+            let voxels = (1u32 << (3 * l)) as f32;
+            for c in 0..n * n * n {
+                let cc = [c % n, (c / n) % n, c / (n * n)];
+                let children: [Sums; 8] = std::array::from_fn(|d| {
+                    let d = d as u32;
+                    let k = [0, 1, 2].map(|a| 2 * cc[a] + (d >> a & 1));
+                    let m = 2 * n;
+                    let i = (k[0] + m * (k[1] + m * k[2])) as usize;
+                    if l == 1 {
+                        fine[i]
+                    } else {
+                        cells[level_offset(l - 1) as usize + i]
+                    }
+                });
+                let (mut t, mut col, mut g) = (0.0f32, Vec3::ZERO, Vec3::ZERO);
+                for k in &children {
+                    (t, col, g) = (t + k.tau, col + k.col, g + aligned(k.grad, g));
+                }
+                let a = 1.0 - (-t / voxels).exp();
+                let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
+                let mut err = 0.0f32;
+                for k in &children {
+                    err = err.max(child_error(a, straight, k.tau, k.col, k.err, voxels / 8.0));
+                }
+                let axes = [0, 1, 2].map(|x| axis_opacity(children.map(|k| k.axes[x]), x));
+                let i = level_offset(l) as usize + c as usize;
+                cells[i] = Sums { tau: t, col, grad: g, err, axes };
+                // Mirror of `put_cell`.
+                let codes = axes.map(|a| tau_code(-(1.0 - a.min(0.999_999_9)).ln()));
+                stored[i] = tau_decode(codes[0]);
+                let words = [
+                    codes[0] | codes[1] << 16,
+                    codes[2] | pack_normal(g) << 16,
+                    unorm10(straight.x) | unorm10(straight.y) << 10 | unorm10(straight.z) << 20,
+                ];
+                // Level 1 into the pyramid's slot, levels 2 and 3 into the brick's summary.
+                let at = if i < SLOT_CELLS {
+                    &mut pyramid[(slot * SLOT_CELLS + i) * CELL_WORDS..][..CELL_WORDS]
+                } else {
+                    &mut summary[h * SUMMARY_WORDS + 4 + (i - SLOT_CELLS) * CELL_WORDS..][..CELL_WORDS]
+                };
+                at.copy_from_slice(&words);
+                if i == LOD_CELLS - 1 {
+                    summary[h * SUMMARY_WORDS + SUMMARY_WORDS - 1] = t.to_bits();
+                }
+            }
+        }
+        let mut s = [fine.iter().filter(|f| f.tau > 0.0).count() as u32 * (1 << 16), 0, 0, 0];
+        for l in 1..=LOD_LEVELS {
+            let n = BRICK >> l;
+            let range = level_offset(l) as usize..(level_offset(l) + n * n * n) as usize;
+            let drawn = stored[range.clone()].iter().filter(|&&t| t > 0.0).count() as u32;
+            let most = cells[range].iter().map(|c| c.err).fold(0.0f32, f32::max);
+            s[0] |= drawn << [0, 8, 12][l as usize - 1];
+            s[l as usize] = most.to_bits();
+        }
+        summary[h * SUMMARY_WORDS..][..4].copy_from_slice(&s);
+        if let Some(slots) = slots.as_deref_mut() {
+            slots[h] = slot as u32;
+        }
+    }
+}
+
+pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+    let (mut pyramid, mut summary) = (b.take(Res::Pyramid), b.take(Res::LodSummary));
+    if streamed(v) {
+        let mut slots = b.take(Res::PyramidSlot);
+        let batch = Some(PyramidBatch { list: b.get(Res::BrickList), push: args.push_as(), slots: &mut slots });
+        brick_pyramid(&inputs(b)?, batch, &mut pyramid, &mut summary);
+        b.put(Res::PyramidSlot, slots);
+    } else {
+        brick_pyramid(&super::brick::inputs_for(b, v)?, None, &mut pyramid, &mut summary);
+    }
+    b.put(Res::Pyramid, pyramid);
+    b.put(Res::LodSummary, summary);
+    Ok(())
+}

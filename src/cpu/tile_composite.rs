@@ -1,0 +1,77 @@
+//! Mirror of `glsl/tile_composite.comp` (the `tile_composite` stage); shared helpers in `tile.rs`.
+use super::bindings::Bindings;
+use super::footprint::{footprint_value, FootprintInputs, Sweep};
+use super::tile::*;
+use super::ImageF32;
+use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
+use crate::dispatch::{Args, Res, Variant};
+use crate::error::Result;
+use crate::gpu_types::{FootprintPush, ScreenQuad};
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+/// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it
+/// unless `push.carry` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
+/// order, whichever GPU lane composites it.
+pub fn tile_composite(
+    inputs: &FootprintInputs<'_>,
+    push: &FootprintPush,
+    quads: &[ScreenQuad],
+    tile_start: &[u32],
+    entries: &[u32],
+    image: &mut ImageF32,
+) {
+    let tiles_x = tile_grid(inputs.frame).0;
+    let btf = push.back_to_front != 0;
+    let terminate = !btf && push.occluded > 0.0;
+    let width = image.width;
+    image.pixels.par_iter_mut().enumerate().for_each(|(i, px)| {
+        let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
+        let tile = ((y as u32 / RASTER_TILE_H) * tiles_x + x as u32 / RASTER_TILE_W) as usize;
+        // Segment `push.first`: TILE_SEGMENT entries of the list, carrying the pixel across segments.
+        let list_end = tile_start[tile + 1] as usize;
+        let begin = tile_start[tile] as usize + (push.first * TILE_SEGMENT) as usize;
+        let carry = push.first > 0 || push.carry != 0;
+        if carry && begin >= list_end {
+            return;
+        }
+        let end = list_end.min(begin + TILE_SEGMENT as usize);
+        let mut acc = if carry { *px } else { [0.0f32; 4] };
+        for &splat in &entries[begin..end] {
+            if terminate && 1.0 - acc[3] <= push.occluded {
+                break;
+            }
+            let q = &quads[splat as usize];
+            if x < q.bx[0] || x > q.bx[2] || y < q.bx[1] || y > q.bx[3] {
+                continue;
+            }
+            let p = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 1.0);
+            let row = |r: usize| Vec3::new(q.inv[r][0], q.inv[r][1], q.inv[r][2]).dot(p);
+            let uv = Vec2::new(row(0), row(1)) / row(2);
+            if uv.x.abs() > 1.0 || uv.y.abs() > 1.0 {
+                continue;
+            }
+            let sweep = Sweep { stretch: q.inv[0][3], bend: q.inv[1][3], profile: inputs.frame.sweep[1] };
+            let a = footprint_value(inputs.table, uv, sweep, q.emit[3], true);
+            if a <= 0.0 {
+                continue;
+            }
+            let src = [q.emit[0] * a, q.emit[1] * a, q.emit[2] * a, a];
+            if btf {
+                acc = [0, 1, 2, 3].map(|c| src[c] + (1.0 - a) * acc[c]);
+            } else {
+                let r = 1.0 - acc[3];
+                acc = [0, 1, 2, 3].map(|c| acc[c] + r * src[c]);
+            }
+        }
+        *px = acc;
+    });
+}
+
+pub(crate) fn tile_composite_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+    let mut image = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
+    let (inputs, push) = (b.inputs(d.list), d.push_as());
+    tile_composite(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);
+    b.accum = image;
+    Ok(())
+}
