@@ -138,10 +138,36 @@ const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];
 const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
 const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
 
-/// The stages, indexed by [`StageId`].
-pub const STAGES: &[StageDesc] = &[
-    StageDesc {
-        name: "order_count",
+/// Every stage, declared once: `name => Id { fields }` makes its id (`StageId::Id`), its row of
+/// [`STAGES`] with `name` (`glsl/<name>.comp`, or `.vert` + `.frag`), and its CPU mirror
+/// `cpu::<name>::stage`, so that a stage without its mirror file fails to compile. Rows are in id
+/// order; `Id` must be `name` in UpperCamelCase (checked below).
+macro_rules! stages {
+    ($($name:ident => $id:ident { $($field:ident: $value:expr),* $(,)? }),* $(,)?) => {
+        /// A stage: its row of [`STAGES`] ([`StageId::desc`]).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[allow(missing_docs)]
+        pub enum StageId {
+            $($id),*
+        }
+
+        impl StageId {
+            /// Every stage, in table order.
+            pub const ALL: &'static [StageId] = &[$(StageId::$id),*];
+            const NAMES: &'static [&'static str] = &[$(stringify!($id)),*];
+        }
+
+        /// The stages, indexed by [`StageId`].
+        pub const STAGES: &[StageDesc] = &[$(StageDesc {
+            name: stringify!($name),
+            $($field: $value,)*
+            mirror: crate::cpu::$name::stage,
+        }),*];
+    };
+}
+
+stages! {
+    order_count => OrderCount {
         kind: Kind::Compute,
         bindings: ORDER,
         writes: &[Res::RowSplit, Res::Segments],
@@ -150,10 +176,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::order_count::order_count_stage,
     },
-    StageDesc {
-        name: "order_scan",
+    order_scan => OrderScan {
         kind: Kind::Compute,
         bindings: ORDER,
         writes: &[Res::Segments],
@@ -162,10 +186,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::order_scan::order_scan_stage,
     },
-    StageDesc {
-        name: "order_scatter",
+    order_scatter => OrderScatter {
         kind: Kind::Compute,
         bindings: ORDER,
         writes: &[Res::Order],
@@ -174,10 +196,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::order_scatter::order_scatter_stage,
     },
-    StageDesc {
-        name: "splat_params",
+    splat_params => SplatParams {
         kind: Kind::Compute,
         bindings: PARAMS,
         writes: &[Res::Params],
@@ -186,10 +206,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "splat_params",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::splat_params::splat_params_stage,
     },
-    StageDesc {
-        name: "brick_pyramid",
+    brick_pyramid => BrickPyramid {
         kind: Kind::Compute,
         bindings: BRICK_GRADIENTS,
         writes: &[Res::Pyramid, Res::LodSummary, Res::PyramidSlot],
@@ -198,10 +216,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "lod",
         device_build: None,
         variants: GRADIENT_BUILDS,
-        mirror: crate::cpu::brick_pyramid::brick_pyramid_stage,
     },
-    StageDesc {
-        name: "brick_nodes",
+    brick_nodes => BrickNodes {
         kind: Kind::Compute,
         bindings: BRICK,
         writes: &[Res::LodSummary],
@@ -210,10 +226,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "lod",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::brick_nodes::brick_nodes_stage,
     },
-    StageDesc {
-        name: "brick_node_cut",
+    brick_node_cut => BrickNodeCut {
         kind: Kind::Compute,
         bindings: BRICK,
         writes: &[Res::LodSummary],
@@ -222,10 +236,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "bricks",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::brick_node_cut::brick_node_cut_stage,
     },
-    StageDesc {
-        name: "brick_cull",
+    brick_cull => BrickCull {
         kind: Kind::Compute,
         bindings: BRICK,
         // With levels of detail it also writes each brick's morph (a bisect split moves it).
@@ -235,10 +247,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "bricks",
         device_build: None,
         variants: RECORD_PAGED,
-        mirror: crate::cpu::brick_cull::brick_cull_stage,
     },
-    StageDesc {
-        name: "brick_order",
+    brick_order => BrickOrder {
         kind: Kind::Compute,
         bindings: BRICK,
         writes: &[Res::BrickVoxels, Res::Order],
@@ -247,10 +257,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: RECORD_PAGED,
-        mirror: crate::cpu::brick_order::brick_order_stage,
     },
-    StageDesc {
-        name: "brick_cells",
+    brick_cells => BrickCells {
         kind: Kind::Compute,
         bindings: BRICK,
         writes: &[Res::BrickVoxels, Res::Order],
@@ -259,10 +267,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "order",
         device_build: None,
         variants: PYRAMID_STREAMED,
-        mirror: crate::cpu::brick_cells::brick_cells_stage,
     },
-    StageDesc {
-        name: "brick_params",
+    brick_params => BrickParams {
         kind: Kind::Compute,
         bindings: BRICK_GRADIENTS,
         writes: &[Res::Params],
@@ -271,10 +277,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "splat_params",
         device_build: None,
         variants: GRADIENT_BUILDS,
-        mirror: crate::cpu::brick_params::brick_params_stage,
     },
-    StageDesc {
-        name: "brick_lod_params",
+    brick_lod_params => BrickLodParams {
         kind: Kind::Compute,
         bindings: BRICK,
         writes: &[Res::Params],
@@ -283,10 +287,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "splat_params",
         device_build: None,
         variants: RECORD_PAGED,
-        mirror: crate::cpu::brick_lod_params::brick_lod_params_stage,
     },
-    StageDesc {
-        name: "tile_occlusion",
+    tile_occlusion => TileOcclusion {
         kind: Kind::Compute,
         bindings: &[Res::Frame, Res::Accum, Res::Occlusion],
         writes: &[Res::Occlusion],
@@ -295,10 +297,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "bricks",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::tile_occlusion::tile_occlusion_stage,
     },
-    StageDesc {
-        name: "brick_hidden",
+    brick_hidden => BrickHidden {
         kind: Kind::Compute,
         bindings: BRICK,
         writes: &[Res::BrickHidden],
@@ -307,10 +307,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "bricks",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::brick_hidden::brick_hidden_stage,
     },
-    StageDesc {
-        name: "slab_count",
+    slab_count => SlabCount {
         kind: Kind::Compute,
         bindings: SLAB,
         writes: &[Res::SlabCounts],
@@ -319,10 +317,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "slab_bins",
         device_build: None,
         variants: SLAB_BUILDS,
-        mirror: crate::cpu::slab_count::slab_count_stage,
     },
-    StageDesc {
-        name: "slab_scan",
+    slab_scan => SlabScan {
         kind: Kind::Compute,
         bindings: SLAB,
         writes: &[Res::SlabCounts, Res::SlabStart],
@@ -331,10 +327,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "slab_bins",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::slab_scan::slab_scan_stage,
     },
-    StageDesc {
-        name: "slab_scatter",
+    slab_scatter => SlabScatter {
         kind: Kind::Compute,
         bindings: SLAB,
         writes: &[Res::SlabCounts, Res::SlabPairs],
@@ -343,10 +337,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "slab_bins",
         device_build: None,
         variants: SLAB_BUILDS,
-        mirror: crate::cpu::slab_scatter::slab_scatter_stage,
     },
-    StageDesc {
-        name: "tile_count",
+    tile_count => TileCount {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
         writes: &[Res::TileCounts, Res::Quads, Res::Status],
@@ -355,10 +347,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: PAGED,
-        mirror: crate::cpu::tile_count::tile_count_stage,
     },
-    StageDesc {
-        name: "tile_scan",
+    tile_scan => TileScan {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
         writes: &[Res::TileCounts, Res::TileStart],
@@ -367,10 +357,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::tile_scan::tile_scan_stage,
     },
-    StageDesc {
-        name: "tile_offsets",
+    tile_offsets => TileOffsets {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
         writes: &[Res::TileStart],
@@ -379,10 +367,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::tile_offsets::tile_offsets_stage,
     },
-    StageDesc {
-        name: "tile_scatter",
+    tile_scatter => TileScatter {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
         writes: &[Res::TileCounts, Res::TileEntries],
@@ -391,10 +377,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "tile_bins",
         device_build: None,
         variants: PAGED,
-        mirror: crate::cpu::tile_scatter::tile_scatter_stage,
     },
-    StageDesc {
-        name: "tile_composite",
+    tile_composite => TileComposite {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
         writes: &[Res::Accum],
@@ -418,10 +402,8 @@ pub const STAGES: &[StageDesc] = &[
             v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 0]),
             v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 1]),
         ],
-        mirror: crate::cpu::tile_composite::tile_composite_stage,
     },
-    StageDesc {
-        name: "sheet_tiles",
+    sheet_tiles => SheetTiles {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
         writes: &[Res::SheetTiles],
@@ -438,10 +420,8 @@ pub const STAGES: &[StageDesc] = &[
             v("", &[SHEET_MODE_BINNED, 0]),
             v("", &[SHEET_MODE_BINNED, 1]),
         ],
-        mirror: crate::cpu::sheet_tiles::sheet_tiles_stage,
     },
-    StageDesc {
-        name: "footprint",
+    footprint => Footprint {
         kind: Kind::Draw,
         bindings: FOOTPRINT,
         writes: &[Res::Color, Res::Sums],
@@ -464,10 +444,8 @@ pub const STAGES: &[StageDesc] = &[
             d(Blend::Over, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
             d(Blend::Under, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
         ],
-        mirror: crate::cpu::footprint::footprint_stage,
     },
-    StageDesc {
-        name: "footprint_sum",
+    footprint_sum => FootprintSum {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
         writes: &[Res::Fixed, Res::Status],
@@ -477,10 +455,8 @@ pub const STAGES: &[StageDesc] = &[
         device_build: Some((Feature::Int64Atomics, "SUM64")),
         // Indexed by `sheet_mode - 1`.
         variants: &[v("", &[SHEET_MODE_AXIS]), v("", &[SHEET_MODE_SLAB]), v("", &[SHEET_MODE_BINNED])],
-        mirror: crate::cpu::footprint_sum::footprint_sum_stage,
     },
-    StageDesc {
-        name: "composite",
+    composite => Composite {
         kind: Kind::Compute,
         bindings: COMPOSITE,
         writes: &[Res::Accum, Res::Occlusion],
@@ -490,10 +466,8 @@ pub const STAGES: &[StageDesc] = &[
         device_build: None,
         // Float layers (the summation image), fixed-point layers (`Res::Fixed`).
         variants: &[v("", &[]), v("", &[1])],
-        mirror: crate::cpu::composite::composite_stage,
     },
-    StageDesc {
-        name: "raycast",
+    raycast => Raycast {
         kind: Kind::Compute,
         bindings: &[Res::RaycastParams, Res::Field, Res::Accum, Res::Bricks],
         writes: &[Res::Accum],
@@ -502,10 +476,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "raycast",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::raycast::raycast_stage,
     },
-    StageDesc {
-        name: "present",
+    present => Present {
         kind: Kind::Compute,
         bindings: &[Res::Accum, Res::Color],
         writes: &[Res::Accum],
@@ -514,9 +486,8 @@ pub const STAGES: &[StageDesc] = &[
         timing: "present",
         device_build: None,
         variants: ONE,
-        mirror: crate::cpu::present::present_stage,
     },
-];
+}
 
 const _: () = assert!(StageId::ALL.len() == STAGES.len());
 const _: () = {
@@ -551,55 +522,6 @@ const fn camel_is_snake(camel: &[u8], snake: &[u8]) -> bool {
     }
     j == snake.len()
 }
-
-/// The stage ids, in the table's order: one name per row, `UpperCamel` of the row's `name`.
-macro_rules! stage_ids {
-    ($($id:ident),* $(,)?) => {
-        /// A stage: its row of [`STAGES`] ([`StageId::desc`]).
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-        #[allow(missing_docs)]
-        pub enum StageId {
-            $($id),*
-        }
-
-        impl StageId {
-            /// Every stage, in table order.
-            pub const ALL: &'static [StageId] = &[$(StageId::$id),*];
-            const NAMES: &'static [&'static str] = &[$(stringify!($id)),*];
-        }
-    };
-}
-
-stage_ids!(
-    OrderCount,
-    OrderScan,
-    OrderScatter,
-    SplatParams,
-    BrickPyramid,
-    BrickNodes,
-    BrickNodeCut,
-    BrickCull,
-    BrickOrder,
-    BrickCells,
-    BrickParams,
-    BrickLodParams,
-    TileOcclusion,
-    BrickHidden,
-    SlabCount,
-    SlabScan,
-    SlabScatter,
-    TileCount,
-    TileScan,
-    TileOffsets,
-    TileScatter,
-    TileComposite,
-    SheetTiles,
-    Footprint,
-    FootprintSum,
-    Composite,
-    Raycast,
-    Present,
-);
 
 impl StageId {
     /// Its row of the table.

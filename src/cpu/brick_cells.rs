@@ -62,7 +62,7 @@ pub fn brick_cells(
     }
 }
 
-pub(crate) fn brick_cells_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut voxels, mut order) = (b.take(Res::BrickVoxels), b.take(Res::Order));
     brick_cells(
         &inputs_for(b, v)?,

@@ -48,7 +48,7 @@ pub fn brick_cull(inputs: &BrickInputs<'_>, counts: Option<&[u32]>, slots: &mut 
     }
 }
 
-pub(crate) fn brick_cull_stage(b: &mut Bindings<'_>, _: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, v: &Variant) -> Result<()> {
     let (mut slots, mut morphs) = (b.take(Res::BrickSlots), b.take(Res::BrickMorph));
     let counts = streamed(v).then(|| b.get::<u32>(Res::BrickCounts));
     brick_cull(&inputs(b)?, counts, &mut slots, bytemuck::cast_slice_mut(&mut morphs));

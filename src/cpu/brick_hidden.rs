@@ -46,7 +46,7 @@ pub fn brick_hidden(
     }
 }
 
-pub(crate) fn brick_hidden_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
     let mut hidden = b.take(Res::BrickHidden);
     brick_hidden(&inputs(b)?, b.get(Res::BrickList), &args.push_as(), b.get(Res::Occlusion), &mut hidden);
     b.put(Res::BrickHidden, hidden);

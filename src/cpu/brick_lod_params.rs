@@ -44,7 +44,7 @@ pub fn brick_lod_params(
     }
 }
 
-pub(crate) fn brick_lod_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let mut params = b.take(Res::Params);
     brick_lod_params(
         &inputs_for(b, v)?,

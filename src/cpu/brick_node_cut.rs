@@ -26,7 +26,7 @@ pub fn brick_node_cut(inputs: &BrickInputs<'_>) -> Vec<(usize, u32)> {
     cut
 }
 
-pub(crate) fn brick_node_cut_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let cut = brick_node_cut(&inputs(b)?);
     let mut summary = b.take(Res::LodSummary);
     for (at, k) in cut {

@@ -184,7 +184,7 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
     }
 }
 
-pub(crate) fn brick_nodes_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
     let mut summary = b.take(Res::LodSummary);
     brick_nodes(&inputs(b)?, &args.push_as(), &mut summary);
     b.put(Res::LodSummary, summary);

@@ -54,7 +54,7 @@ pub fn brick_order(
     }
 }
 
-pub(crate) fn brick_order_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut voxels, mut order) = (b.take(Res::BrickVoxels), b.take(Res::Order));
     let inputs = inputs(b)?;
     let records = if streamed(v) { b.get(Res::BatchRecords) } else { &inputs.store.records[..] };

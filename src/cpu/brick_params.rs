@@ -23,7 +23,7 @@ pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 
     }
 }
 
-pub(crate) fn brick_params_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let mut params = b.take(Res::Params);
     brick_params(&inputs_for(b, v)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
     b.put(Res::Params, params);

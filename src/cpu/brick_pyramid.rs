@@ -126,7 +126,7 @@ pub fn brick_pyramid(
     }
 }
 
-pub(crate) fn brick_pyramid_stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let (mut pyramid, mut summary) = (b.take(Res::Pyramid), b.take(Res::LodSummary));
     if streamed(v) {
         let mut slots = b.take(Res::PyramidSlot);

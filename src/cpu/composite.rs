@@ -73,7 +73,7 @@ pub fn composite(
     }
 }
 
-pub(crate) fn composite_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let push: CompositePush = d.push_as();
     let mut occlusion = b.take(Res::Occlusion);
     let mut accum = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));

@@ -488,7 +488,7 @@ pub(crate) fn raster_quad(p: &SplatParams, shading: Shading<'_>, vp: Mat4, inv: 
 /// The draw: the raster target or the summation layers are cleared (the render pass's load) and
 /// the footprints drawn into them; a later part of a bricked frame (`carry` 1) draws on them as
 /// they are.
-pub(crate) fn footprint_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let state = v.draw.expect("footprint variants are draws");
     let push: FootprintPush = d.push_as();
     let mut layers = match state.pass {

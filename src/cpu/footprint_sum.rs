@@ -39,7 +39,7 @@ pub fn footprint_sum(inputs: &FootprintInputs<'_>, push: &FootprintPush, sums: &
     }
 }
 
-pub(crate) fn footprint_sum_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut sums = b.take(Res::Fixed);
     footprint_sum(&b.inputs(d.list), &d.push_as(), &mut sums);
     b.put(Res::Fixed, sums);

@@ -27,7 +27,7 @@ pub fn order_count(frame: &Frame, splats: &[Splat], row_start: &[u32], row_split
     }
 }
 
-pub(crate) fn order_count_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let (mut row_split, mut segments) = (b.take(Res::RowSplit), b.take(Res::Segments));
     let set = &b.prep.set;
     order_count(&b.frame, set.splats(), set.row_start(), &mut row_split, &mut segments);

@@ -15,7 +15,7 @@ pub fn order_scan(frame: &Frame, segments: &mut [u32]) {
     }
 }
 
-pub(crate) fn order_scan_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let mut segments = b.take(Res::Segments);
     order_scan(&b.frame, &mut segments);
     b.put(Res::Segments, segments);

@@ -31,7 +31,7 @@ pub fn order_scatter(
     }
 }
 
-pub(crate) fn order_scatter_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let mut out = b.take(Res::Order);
     let set = &b.prep.set;
     order_scatter(&b.frame, set.splats(), set.row_start(), b.get(Res::RowSplit), b.get(Res::Segments), &mut out);

@@ -58,7 +58,7 @@ pub fn present(push: &PresentPush, accum: &mut ImageF32, color: &ImageF32) {
 }
 
 /// The stage table's entry point.
-pub fn present_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
     let push = args.push_as::<PresentPush>();
     if push.sources & 1 == 0 {
         // The accumulation image is written whole: start it from nothing, as the device does.

@@ -154,7 +154,7 @@ fn hash01(seed: u64, x: u64, y: u64) -> f32 {
     ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
 }
 
-pub(crate) fn raycast_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let rc: RaycastParams = bytemuck::pod_read_unaligned(bytemuck::cast_slice(b.get::<u32>(Res::RaycastParams)));
     let field = b.prep.dense_field()?;
     b.accum = raycast(&rc, field, &b.bricks, None);

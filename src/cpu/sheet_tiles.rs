@@ -51,7 +51,7 @@ pub fn sheet_tiles(inputs: &FootprintInputs<'_>, push: &FootprintPush, points: b
     }
 }
 
-pub(crate) fn sheet_tiles_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let mut tiles = b.take(Res::SheetTiles);
     sheet_tiles(&b.inputs(d.list), &d.push_as(), v.spec.get(1) == Some(&1), &mut tiles);
     b.put(Res::SheetTiles, tiles);

@@ -20,7 +20,7 @@ pub fn slab_count(pc: &SlabPush, params: &[SplatParams], voxels: Option<&[[u32; 
     }
 }
 
-pub(crate) fn slab_count_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let mut counts = b.take(Res::SlabCounts);
     slab_count(&d.push_as(), b.get(Res::Params), sheet_voxels(b, v), &mut counts);
     b.put(Res::SlabCounts, counts);

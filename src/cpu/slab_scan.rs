@@ -17,7 +17,7 @@ pub fn slab_scan(pc: &SlabPush, counts: &mut [u32], slab_start: &mut [u32]) {
     slab_start[pc.slabs as usize] = carry;
 }
 
-pub(crate) fn slab_scan_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut start) = (b.take(Res::SlabCounts), b.take(Res::SlabStart));
     slab_scan(&d.push_as(), &mut counts, &mut start);
     b.put(Res::SlabCounts, counts);

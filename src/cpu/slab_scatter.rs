@@ -27,7 +27,7 @@ pub fn slab_scatter(
     }
 }
 
-pub(crate) fn slab_scatter_stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let (mut counts, mut pairs) = (b.take(Res::SlabCounts), b.take(Res::SlabPairs));
     slab_scatter(&d.push_as(), b.get(Res::Params), sheet_voxels(b, v), &mut counts, &mut pairs);
     b.put(Res::SlabCounts, counts);

@@ -162,7 +162,7 @@ pub fn splat_params(frame: &Frame, splats: &[Splat], coords: &[f32], params: &mu
     }
 }
 
-pub(crate) fn splat_params_stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let mut params = b.take(Res::Params);
     let coords = b.prep.set.coordinates().map(|c| c.concat()).unwrap_or_default();
     splat_params(&b.frame, b.prep.set.splats(), &coords, bytemuck::cast_slice_mut(&mut params));

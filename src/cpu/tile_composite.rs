@@ -68,7 +68,7 @@ pub fn tile_composite(
     });
 }
 
-pub(crate) fn tile_composite_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut image = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
     let (inputs, push) = (b.inputs(d.list), d.push_as());
     tile_composite(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);

@@ -19,7 +19,7 @@ pub fn tile_count(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &m
     }
 }
 
-pub(crate) fn tile_count_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut quads) = (b.take(Res::TileCounts), b.take(Res::Quads));
     tile_count(&b.inputs(d.list), &d.push_as(), &mut counts, bytemuck::cast_slice_mut(&mut quads));
     b.put(Res::TileCounts, counts);

@@ -75,7 +75,7 @@ pub fn box_hidden(frame: &Frame, occlusion: &[u32], bx: IVec4) -> bool {
     true
 }
 
-pub(crate) fn tile_occlusion_stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()> {
     let mut occlusion = b.take(Res::Occlusion);
     let push: BrickPush = args.push_as();
     tile_occlusion(&b.accum, push.occluded, &mut occlusion);

@@ -18,7 +18,7 @@ pub fn tile_offsets(inputs: &FootprintInputs<'_>, tile_start: &mut [u32]) {
     tile_start[tiles] = carry;
 }
 
-pub(crate) fn tile_offsets_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut start = b.take(Res::TileStart);
     tile_offsets(&b.inputs(d.list), &mut start);
     b.put(Res::TileStart, start);

@@ -21,7 +21,7 @@ pub fn tile_scan(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mu
     }
 }
 
-pub(crate) fn tile_scan_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut start) = (b.take(Res::TileCounts), b.take(Res::TileStart));
     tile_scan(&b.inputs(d.list), &d.push_as(), &mut counts, &mut start);
     b.put(Res::TileCounts, counts);

@@ -27,7 +27,7 @@ pub fn tile_scatter(
     }
 }
 
-pub(crate) fn tile_scatter_stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let (mut counts, mut entries) = (b.take(Res::TileCounts), b.take(Res::TileEntries));
     let (inputs, push) = (b.inputs(d.list), d.push_as());
     tile_scatter(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), &mut counts, &mut entries);
