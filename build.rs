@@ -1,4 +1,5 @@
-//! The GPU stages' SPIR-V, and `OUT_DIR/spirv_table.rs`, the table the pipelines look builds up in.
+//! The GPU stages' SPIR-V, and `OUT_DIR/shaders.rs`: per shader a module of its builds, which the
+//! stage table names (`src/shaders.rs`).
 //!
 //! With the `shaderc` feature (development and CI): every GLSL stage in `glsl/` is compiled to
 //! OUT_DIR, with `glsl/shared/` as the include directory and the constants of `src/constants.rs`
@@ -22,15 +23,52 @@ fn main() {
     #[cfg(not(feature = "shaderc"))]
     let (dir, built) = (manifest.join("glsl/spirv"), shipped(&manifest.join("glsl/spirv")));
     let _ = &manifest;
-    let mut table = String::from("/// Every SPIR-V build, by name (`<stage>.<ext>[.<DEFINES>]`).\n");
-    table += "pub static SPIRV: &[(&str, &[u8])] = &[\n";
-    for name in &built {
+    std::fs::write(out.join("shaders.rs"), shader_modules(&dir, &built)).unwrap();
+}
+
+/// `src/shaders.rs`'s body: per shader a module named after it, with one constant per stage kind
+/// (`COMP`, `VERT`, `FRAG`: its builds as `(defines, SPIR-V)`) and `SHADERS`, the handle the stage
+/// table names (a stage whose shader is missing does not compile); and `SPIRV`, every build by
+/// name (`<stage>.<ext>[.<DEFINES>]`) for the check against the shipped copies.
+fn shader_modules(dir: &Path, built: &[String]) -> String {
+    use std::collections::BTreeMap;
+    // Per shader, per stage kind (`comp`, `vert`, `frag`): its builds as (defines, file).
+    type Builds<'a> = BTreeMap<&'a str, Vec<(&'a str, &'a str)>>;
+    let mut by: BTreeMap<&str, Builds> = BTreeMap::new();
+    for name in built {
         let stem = name.strip_suffix(".spv").unwrap();
-        let path = dir.join(name);
-        table += &format!("    ({stem:?}, include_bytes!({:?})),\n", path.display().to_string());
+        let mut parts = stem.splitn(3, '.');
+        let (shader, ext) = (parts.next().unwrap(), parts.next().unwrap());
+        by.entry(shader).or_default().entry(ext).or_default().push((parts.next().unwrap_or(""), name));
     }
-    table += "];\n";
-    std::fs::write(out.join("spirv_table.rs"), table).unwrap();
+    let mut s = String::new();
+    let mut flat = String::from("/// Every SPIR-V build, by name (`<stage>.<ext>[.<DEFINES>]`).\n");
+    flat += "pub static SPIRV: &[(&str, &[u8])] = &[\n";
+    for (shader, exts) in &by {
+        s += &format!("/// `glsl/{shader}.*`'s builds.\npub mod {shader} {{\n");
+        for (ext, builds) in exts {
+            let konst = ext.to_uppercase();
+            s += &format!("    /// `{shader}.{ext}`'s builds: (defines, SPIR-V).\n");
+            s += &format!("    pub const {konst}: &[(&str, &[u8])] = &[\n");
+            for (i, (defines, file)) in builds.iter().enumerate() {
+                let path = dir.join(file).display().to_string();
+                s += &format!("        ({defines:?}, include_bytes!({path:?})),\n");
+                let dot = if defines.is_empty() { String::new() } else { format!(".{defines}") };
+                flat += &format!("    (\"{shader}.{ext}{dot}\", {shader}::{konst}[{i}].1),\n");
+            }
+            s += "    ];\n";
+        }
+        let handle = match (exts.contains_key("comp"), exts.contains_key("vert") && exts.contains_key("frag")) {
+            (true, false) => "super::Shaders::Compute(COMP)".to_string(),
+            (false, true) => "super::Shaders::Draw(VERT, FRAG)".to_string(),
+            _ => "super::Shaders::Other".to_string(),
+        };
+        s += &format!(
+            "    /// The handle the stage table names.\n    pub const SHADERS: super::Shaders = {handle};\n}}\n"
+        );
+    }
+    flat += "];\n";
+    s + &flat
 }
 
 /// The shipped builds' file names, sorted.

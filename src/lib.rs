@@ -60,6 +60,9 @@ pub mod recording;
 pub mod resample;
 mod residency;
 pub mod scene;
+/// Every shader's SPIR-V builds, by shader (public for the stage table and tests).
+#[doc(hidden)]
+pub mod shaders;
 // The peers' scene is a built-in scene (`scene::peer`); its old path stays.
 pub use scene::peer;
 pub mod slab;
@@ -587,7 +590,7 @@ pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
 /// feature, else the copies shipped in `glsl/spirv/` (tests/spirv.rs keeps the two equal).
 #[doc(hidden)]
 pub fn spirv_builds() -> &'static [(&'static str, &'static [u8])] {
-    gpu::pipelines::SPIRV
+    shaders::SPIRV
 }
 
 /// Host bytes a frame takes per pixel at most: the image (f32 RGBA), its read-back copy, the CPU

@@ -46,6 +46,8 @@ pub struct StageDesc {
     pub variants: &'static [Variant],
     /// The CPU mirror's entry point.
     pub mirror: Mirror,
+    /// Its shaders' builds (`glsl/<name>.*`).
+    pub shaders: crate::shaders::Shaders,
 }
 
 const fn v(defines: &'static str, spec: &'static [u32]) -> Variant {
@@ -139,8 +141,9 @@ const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
 const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
 
 /// Every stage, declared once: `name => Id { fields }` makes its id (`StageId::Id`), its row of
-/// [`STAGES`] with `name` (`glsl/<name>.comp`, or `.vert` + `.frag`), and its CPU mirror
-/// `cpu::<name>::stage`, so that a stage without its mirror file fails to compile. Rows are in id
+/// [`STAGES`] with `name`, its CPU mirror `cpu::<name>::stage` and its shaders' handle
+/// `shaders::<name>::SHADERS` (`glsl/<name>.comp`, or `.vert` + `.frag`), so that a stage without
+/// its mirror file or its shader fails to compile. Rows are in id
 /// order; `Id` must be `name` in UpperCamelCase (checked below).
 macro_rules! stages {
     ($($name:ident => $id:ident { $($field:ident: $value:expr),* $(,)? }),* $(,)?) => {
@@ -162,6 +165,7 @@ macro_rules! stages {
             name: stringify!($name),
             $($field: $value,)*
             mirror: crate::cpu::$name::stage,
+            shaders: crate::shaders::$name::SHADERS,
         }),*];
     };
 }

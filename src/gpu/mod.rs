@@ -9,13 +9,14 @@ use crate::constants::COMPOSITE_TILE;
 use crate::error::Result;
 use crate::gpu_types::CompositePush;
 use crate::plan::Prepared;
+use crate::shaders::spirv_build;
 use crate::stages::{List, Res, StageId};
 use crate::vk::{
     Bind, Blend, Buffer, BufferUsageFlags as BU, Context, Format, Image, ImageLayout as IL, ImageUsageFlags as IU,
     Layout, Pipeline, Primitive, ShaderStageFlags as SS, Slot, Stage, Timer,
 };
 use crate::volume::DenseField;
-use pipelines::{spirv, Pipelines};
+use pipelines::Pipelines;
 use resources::Resources;
 use std::sync::Arc;
 use std::time::Instant;
@@ -48,13 +49,17 @@ impl Gpu {
                 &ctx,
                 &roofline_layout,
                 &pipes.target_pass,
-                spirv("roofline.vert")?,
-                spirv("roofline.frag")?,
+                spirv_build(crate::shaders::roofline::VERT, "", "roofline")?,
+                spirv_build(crate::shaders::roofline::FRAG, "", "roofline")?,
                 Blend::Add,
                 Primitive::Quads,
                 &[],
             )?,
-            roofline_composite: Pipeline::compute(&ctx, composite_layout, spirv("roofline.comp")?)?,
+            roofline_composite: Pipeline::compute(
+                &ctx,
+                composite_layout,
+                spirv_build(crate::shaders::roofline::COMP, "", "roofline")?,
+            )?,
             roofline_layout,
         };
         let budget_bytes = crate::constants::DEFAULT_GPU_BUDGET;

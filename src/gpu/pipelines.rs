@@ -1,24 +1,14 @@
 //! Every stage's descriptor layout and pipelines, built from the stage table.
 use crate::error::{Error, Result};
+use crate::shaders::{spirv_build, Shaders};
 use crate::stages::{Feature, Kind, Pass, Res, StageDesc, STAGES};
 use crate::vk::{
     Blend, Context, Format, ImageLayout as IL, Layout, Pipeline, Primitive, RenderPass, ShaderStageFlags as SS, Slot,
 };
 use std::sync::Arc;
 
-include!(concat!(env!("OUT_DIR"), "/spirv_table.rs"));
-
 /// The attachments' format (RGBA32F, blendable on lavapipe).
 pub const COLOR_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
-
-/// A SPIR-V build by name (`<stage>.<ext>[.<DEFINES>]`).
-pub fn spirv(name: &str) -> Result<&'static [u8]> {
-    SPIRV
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, b)| *b)
-        .ok_or_else(|| Error::Unsupported(format!("no SPIR-V build named {name}")))
-}
 
 /// What binding slot a resource takes.
 fn slot(res: Res) -> Slot {
@@ -84,14 +74,14 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Resu
     let mut variants = Vec::with_capacity(desc.variants.len());
     for v in desc.variants {
         let defines: Vec<&str> = device.into_iter().chain((!v.defines.is_empty()).then_some(v.defines)).collect();
-        let suffix = if defines.is_empty() { String::new() } else { format!(".{}", defines.join("+")) };
-        let pipe = match (desc.kind, v.draw) {
-            (Kind::Compute, _) => {
-                Pipeline::compute_specialized(ctx, &layout, spirv(&format!("{}.comp{suffix}", desc.name))?, v.spec)?
+        let defines = defines.join("+");
+        let pipe = match (desc.kind, v.draw, desc.shaders) {
+            (Kind::Compute, _, Shaders::Compute(comp)) => {
+                Pipeline::compute_specialized(ctx, &layout, spirv_build(comp, &defines, desc.name)?, v.spec)?
             }
-            (Kind::Draw, Some(state)) => {
-                let vert = spirv(&format!("{}.vert{suffix}", desc.name))?;
-                let frag = spirv(&format!("{}.frag{suffix}", desc.name))?;
+            (Kind::Draw, Some(state), Shaders::Draw(vert, frag)) => {
+                let vert = spirv_build(vert, &defines, desc.name)?;
+                let frag = spirv_build(frag, &defines, desc.name)?;
                 let blend = match state.blend {
                     crate::dispatch::Blend::Over => Blend::Over,
                     crate::dispatch::Blend::Under => Blend::Under,
@@ -105,9 +95,10 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Resu
                 };
                 Pipeline::graphics(ctx, &layout, pass, vert, frag, blend, primitive, v.spec)?
             }
-            (Kind::Draw, None) => {
+            (Kind::Draw, None, _) => {
                 return Err(Error::Unsupported(format!("{}: a draw variant without raster state", desc.name)))
             }
+            _ => return Err(Error::Unsupported(format!("{}: its shaders are not of its kind", desc.name))),
         };
         variants.push(pipe);
     }
