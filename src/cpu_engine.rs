@@ -1,15 +1,13 @@
 //! The CPU engine: runs a frame's recording (`crate::recording`) on the mirrors, each dispatch
 //! through its stage's `mirror` entry in the stage table, over `cpu::bindings::Bindings`.
+use crate::constants::DEFAULT_GPU_BUDGET;
 use crate::cpu::bindings::Bindings;
 use crate::dispatch::Res;
 use crate::error::{Error, Result};
 use crate::gpu_types::Frame;
 use crate::image::ImageF32;
 use crate::kernel::Kernel;
-use crate::options::StageTime;
-// Where they live now; kept here for the paths callers already use.
-pub use crate::constants::DEFAULT_GPU_BUDGET;
-pub use crate::options::add_time;
+use crate::options::{add_time, StageTime};
 use crate::plan::Prepared;
 use crate::stages::{Dispatch, Engine, Limits};
 

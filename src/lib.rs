@@ -136,7 +136,7 @@ impl Default for RendererOptions {
             backend: Backend::Gpu,
             validation: false,
             device_name: None,
-            gpu_budget_bytes: cpu_engine::DEFAULT_GPU_BUDGET,
+            gpu_budget_bytes: constants::DEFAULT_GPU_BUDGET,
         }
     }
 }
@@ -186,7 +186,7 @@ impl Renderer {
 
     /// A renderer on a host program's Vulkan device (see [`vk::Context::from_host`]).
     pub fn with_context(ctx: Arc<vk::Context>) -> Result<Self> {
-        let budget_bytes = cpu_engine::DEFAULT_GPU_BUDGET;
+        let budget_bytes = constants::DEFAULT_GPU_BUDGET;
         Ok(Self { gpu: Some(gpu::Gpu::new(ctx)?), scene: None, bisect: None, budget_bytes })
     }
 
@@ -418,7 +418,7 @@ impl Renderer {
         opts.composite = Composite::Splat;
         let got = self.probe(camera, &opts, StageId::TileScatter, &[Res::TileStart, Res::TileEntries])?;
         let frame = plan::frame_for(&self.prepared()?.set, camera, &opts);
-        let (tx, ty) = cpu::tile::tile_grid(&frame);
+        let (tx, ty) = plan::tile_grid(&frame);
         let tiles = tx as usize * ty as usize;
         let starts = got[0][..tiles + 1].to_vec();
         let entries = got[1][..starts[tiles] as usize].to_vec();

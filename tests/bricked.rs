@@ -385,7 +385,7 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
     let count = a[0].iter().zip(&b[0]).filter(|(x, y)| x != y).count();
     assert_eq!(count, 0, "brick_cull's counts differ at {count} slots, first {differ:?}");
     // The first batch's splats: the bricks in slot order up to the batch capacity.
-    let budget = voxsplat::cpu_engine::DEFAULT_GPU_BUDGET;
+    let budget = voxsplat::constants::DEFAULT_GPU_BUDGET;
     let resident = voxsplat::recording::bricked_resident_bytes(g.volume().unwrap(), budget, 48, 48);
     let capacity = ((budget - resident) / voxsplat::recording::BATCH_BYTES_PER_SPLAT)
         .min(voxsplat::constants::MAX_GPU_SPLATS as u64) as u32;
@@ -619,7 +619,8 @@ fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
 /// that leave partial tiles at the edges, boxes small and large, inside and across the border.
 #[test]
 fn the_occlusion_map_answers_a_box_as_its_pixels_do() {
-    use voxsplat::cpu::tile_occlusion::{box_hidden, occlusion_len, tile_occlusion};
+    use voxsplat::cpu::tile_occlusion::{box_hidden, tile_occlusion};
+    use voxsplat::plan::occlusion_len;
     let threshold = 1.0 / 1024.0;
     let mut rng = Rng(0x6f63_636c);
     let (mut hidden, mut open) = (0, 0);
@@ -751,7 +752,7 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
             // Just under four times one buffer's bytes left by the store (and the pyramid, with
             // levels of detail): they do not fit.
             let bytes = scene.store.gradient_len() * 4;
-            let pyramid = voxsplat::cpu::lod::pyramid_bytes(voxsplat::cpu::lod::LOD_BUFFERS, scene.store.headers.len());
+            let pyramid = voxsplat::plan::pyramid_bytes(voxsplat::plan::LOD_BUFFERS, scene.store.headers.len());
             let resident = voxsplat::recording::bricked_resident_bytes(scene, u64::MAX, 80, 80);
             assert!(!scene.streams(resident + 4 * bytes), "the store stays resident");
             for (o, which, held) in [(&fine, "full detail", 0), (&coarse, "coarse cells", pyramid)] {

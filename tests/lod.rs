@@ -5,7 +5,7 @@
 mod common;
 use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 use voxsplat::classify::{Shading, TransferFunction};
-use voxsplat::cpu::lod::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
+use voxsplat::plan::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
 use voxsplat::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
 use voxsplat::{Camera, Direction, Lod, Raster, RenderOptions, Renderer};
@@ -494,7 +494,7 @@ fn coarse_cells_cover_what_their_voxels_cover_along_each_axis() {
         cells.push(r.probe(&cam, &o, StageId::BrickPyramid, &[Res::Pyramid]).unwrap().remove(0));
     }
     // 64 bricks, all holding rods.
-    let words = 64 * voxsplat::cpu::lod::SLOT_CELLS * voxsplat::cpu::lod::CELL_WORDS;
+    let words = 64 * voxsplat::plan::SLOT_CELLS * voxsplat::plan::CELL_WORDS;
     assert!(cells[0][..words] == cells[1][..words], "GPU vs mirror pyramid");
     let alpha = |code: u32| 1.0 - (-voxsplat::cpu::lod::tau_decode(code)).exp();
     let pyramid = &cells[0];
@@ -590,8 +590,8 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
             .into();
         // The nodes, after the bricks' summaries (whose float sums differ from the mirror's in the
         // last bits: exp and log): packed fields within a step, sums within 1e-4, the brick exact.
-        let at = 512 * voxsplat::cpu::lod::SUMMARY_WORDS;
-        let words = voxsplat::cpu::brick_nodes::NODE_WORDS;
+        let at = 512 * voxsplat::plan::SUMMARY_WORDS;
+        let words = voxsplat::plan::NODE_WORDS;
         let fields = |w: u32, i: usize| match i {
             0 | 1 => vec![w & 0xffff, w >> 16],
             2 => vec![w & 1023, w >> 10 & 1023, w >> 20 & 1023],
@@ -603,7 +603,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
             _ => fields(a, i).iter().zip(fields(b, i)).all(|(x, y)| x.abs_diff(y) <= 1),
         };
         // 4³ + 2³ + 1 nodes over the 8³ bricks.
-        let n = voxsplat::cpu::brick_nodes::node_words([8; 3], 3) as usize;
+        let n = voxsplat::plan::node_words([8; 3], 3) as usize;
         assert_eq!(n, 73 * words);
         for (i, (x, y)) in nodes[0][at..at + n].iter().zip(&nodes[1][at..at + n]).enumerate() {
             assert!(

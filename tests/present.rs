@@ -4,7 +4,8 @@
 //! semaphores order frames; bad targets are refused.
 mod common;
 use common::assert_clean;
-use voxsplat::cpu::present::{decode, encode, present_pixel, present_push};
+use voxsplat::cpu::present::{decode, encode, present_pixel};
+use voxsplat::plan::present_push;
 use voxsplat::vk::ImageLayout as IL;
 use voxsplat::{scene, Camera, Composite, Motion, Raster, RenderOptions, TargetFormat};
 

@@ -125,7 +125,7 @@ fn tile_lists_keep_the_pbtf_order_and_hold_exactly_the_overlapping_splats() {
                     .iter()
                     .map(|p| voxsplat::cpu::footprint::screen_quad(&frame, p).map(|(_, b)| b.to_array()))
                     .collect();
-                let tiles_x = voxsplat::cpu::tile::tile_grid(&frame).0;
+                let tiles_x = voxsplat::plan::tile_grid(&frame).0;
                 check_tile_lists(&order, &boxes, tiles_x, &start, &entries);
                 assert!(!entries.is_empty() || boxes.iter().all(Option::is_none), "{kind:?}: something binned");
             }

@@ -3,10 +3,12 @@
 mod common;
 use common::assert_clean;
 use glam::Vec3;
-use voxsplat::cpu::raycast::{raycast, raycast_params, RaycastOptions};
+use voxsplat::cpu::raycast::raycast;
 use voxsplat::metrics::{compare, temporal};
+use voxsplat::plan::raycast_params;
 use voxsplat::truth::{volumetric_summation, DenseField, Reconstruction, TruthOptions};
 use voxsplat::ImageF32;
+use voxsplat::RaycastOptions;
 use voxsplat::{scene, Camera, Grid, Kernel, Projection, SplatSet};
 
 fn ortho_down_z(center: Vec3, size: u32) -> Camera {

@@ -170,7 +170,7 @@ struct OrderArgs {
 /// `info`'s line about the bricked store.
 fn print_store(store: &voxsplat::bricks::BrickStore) {
     let per_voxel = |bytes: u64| bytes as f64 / store.len().max(1) as f64;
-    let pyramid = voxsplat::cpu::lod::pyramid_bytes(voxsplat::cpu::lod::LOD_BUFFERS, store.headers.len());
+    let pyramid = voxsplat::plan::pyramid_bytes(voxsplat::plan::LOD_BUFFERS, store.headers.len());
     println!(
         "bricked store: {} stored voxels in {} bricks of {}^3, {} bytes on the GPU, {:.2} bytes per stored voxel \
          ({:.2} with the levels-of-detail pyramid of --lod auto; shaded or gradient-weighted frames add {:.2} for \

@@ -228,7 +228,7 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     let mut image = frame.image;
     if let (Some(bg), true) = (a.background, a.truth || a.raycast.is_some()) {
         // The reference renderers have no present stage: its mirror, on the host.
-        let push = voxsplat::cpu::present::present_push(Some(bg), 1, false, cam.width, cam.height);
+        let push = voxsplat::plan::present_push(Some(bg), 1, false, cam.width, cam.height);
         voxsplat::cpu::present::present(&push, &mut image, &voxsplat::ImageF32::new(0, 0));
     }
     if a.k_line {

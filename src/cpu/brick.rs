@@ -3,11 +3,12 @@
 //! frame's `BrickFrame` and TF buffer (`BrickInputs`).
 use super::bindings::Bindings;
 use super::order::{outward, side_count};
-use super::splat_params::{cell_footprint_scale, frame_grid, CULL_RADII};
+use super::splat_params::{frame_grid, CULL_RADII};
 use crate::bricks::{BrickStore, BRICK};
 use crate::dispatch::{Res, Variant};
 use crate::error::{Error, Result};
 use crate::gpu_types::{BrickFrame, Frame};
+use crate::plan::cell_footprint_scale;
 use glam::{Mat4, Vec3, Vec4};
 
 pub(crate) const CELL_WORDS: usize = (BRICK * BRICK * BRICK / 32) as usize;

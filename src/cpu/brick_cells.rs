@@ -7,6 +7,7 @@ use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::BrickPush;
+use crate::plan::LOD_LEVELS;
 
 /// Mirror of `brick_cells.comp`: each coarse brick of the batch writes its level's drawn cells in
 /// PBTF order over the brick's cells.

@@ -1,11 +1,11 @@
 //! Mirror of `glsl/brick_lod_params.comp` (the `brick_lod_params` stage); shared helpers in `lod.rs`.
 use super::bindings::Bindings;
 use super::brick::{inputs_for, voxel_ijk, voxel_level, BrickInputs, VOXEL_MORPHS};
-use super::lod::*;
 use super::splat_params::params_at;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{BrickPush, SplatParams};
+use crate::plan::LOD_LEVELS;
 use glam::Vec3;
 
 /// Mirror of `brick_lod_params.comp`: the parameters of the coarse splats at positions

@@ -1,9 +1,9 @@
 //! Mirror of `glsl/brick_node_cut.comp` (the `brick_node_cut` stage); shared helpers in `brick_nodes.rs`.
 use super::bindings::Bindings;
 use super::brick::{inputs, BrickInputs};
-use super::brick_nodes::*;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
+use crate::plan::node_grid;
 
 /// Mirror of `brick_node_cut.comp`: per level-1 node, the tree level of the node that draws its
 /// bricks this frame, as (index of its cut word in the summary buffer, level).

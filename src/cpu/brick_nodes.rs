@@ -2,19 +2,18 @@
 //! `glsl/shared/brick.glsl` (`node_word`, `node_color`, `node_level`) that `brick_node_cut.rs`
 //! reads too.
 use super::bindings::Bindings;
-// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use super::brick::{inputs, BrickInputs};
 use super::lod::{
     aligned, axis_opacity, cell_seen, child_error, pack_normal, seen_error, tau_code, tau_decode, unorm10,
-    unpack_normal, CELL_WORDS, LOD_CELLS, NO_NORMAL, SLOT_CELLS, SUMMARY_WORDS,
+    unpack_normal,
 };
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::BrickPush;
-pub use crate::plan::{
-    node_and_cut_words, node_grid, node_levels, node_words, NODE_BYTES_FLOOR, NODE_LEVELS, NODE_PIXELS, NODE_WORDS,
-};
+use crate::plan::SUMMARY_WORDS;
+use crate::plan::{node_grid, node_words, NODE_PIXELS, NODE_WORDS};
+use crate::plan::{CELL_WORDS, LOD_CELLS, NO_NORMAL, SLOT_CELLS};
 use glam::Vec3;
 
 /// Mirror of `consecutive`: whether the bricks of the aligned block `n0..n1` of a `grid` of bricks

@@ -6,6 +6,8 @@ use super::splat_params::optical_depth;
 use crate::bricks::{local_cell, BRICK};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
+use crate::plan::SUMMARY_WORDS;
+use crate::plan::{CELL_WORDS, LOD_CELLS, LOD_LEVELS, SLOT_CELLS};
 use glam::Vec3;
 
 /// Per-level sums of a brick's cells: optical depth, tau-weighted colour and gradient

@@ -1,6 +1,6 @@
 //! Mirrors of `glsl/shared/brick.glsl`'s word codecs that the brick stages (brick.rs) and the
 //! pyramid (lod.rs) both read: a summary's level counts and a cell's 16-bit optical depth.
-pub use crate::plan::SUMMARY_WORDS;
+use crate::plan::SUMMARY_WORDS;
 
 /// Mirror of `tau_code`: a cell's optical depth in 16 bits (exponent 2^-23..2^7, 11 bits of
 /// mantissa, rounded; 0 for none).

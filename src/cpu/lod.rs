@@ -2,16 +2,13 @@
 //! `brick_lod_params.rs`, `brick_nodes.rs`): `glsl/shared/brick.glsl`'s pyramid helpers
 //! (`level_split`, `brick_level`, `cell_color`; the word codecs the brick mirrors share are in
 //! brick_words.rs).
-// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use super::brick::BrickInputs;
-pub use super::brick_words::{level_count, tau_code, tau_decode, SUMMARY_WORDS};
+pub use super::brick_words::{level_count, tau_code, tau_decode};
 use crate::bricks::BRICK;
 use crate::gpu_types::BrickPush;
-pub(crate) use crate::plan::NO_NORMAL;
-pub use crate::plan::{
-    pyramid_bytes, CELL_WORDS, LOD_BUFFERS, LOD_CELLS, LOD_LEVELS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, SLOT_CELLS,
-    STREAMED_LOD_BUFFERS, SUMMARY_BYTES,
-};
+use crate::plan::NO_NORMAL;
+use crate::plan::SUMMARY_WORDS;
+use crate::plan::{CELL_WORDS, LOD_LEVELS, SLOT_CELLS};
 use glam::Vec3;
 
 /// First cell of level `l` (1..3) in a brick's pyramid.

@@ -6,8 +6,6 @@ use crate::dispatch::{Args, Variant};
 use crate::error::{Error, Result};
 use crate::gpu_types::PresentPush;
 pub use crate::image::TargetFormat;
-// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
-pub use crate::plan::present_push;
 
 /// The sRGB curve's inverse (IEC 61966-2-1), as `present.comp` applies it.
 pub fn to_linear(c: f32) -> f32 {
@@ -144,6 +142,7 @@ pub fn decode(format: TargetFormat, bytes: &[u8]) -> Result<Vec<[f32; 4]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::plan::present_push;
 
     #[test]
     fn halves_round_trip_and_round_to_nearest() {

@@ -6,9 +6,6 @@ use crate::error::Result;
 use crate::gpu_types::RaycastParams;
 
 use super::bindings::Bindings;
-// Settled by the plan, read by both engines; kept here for the paths callers already use.
-pub use crate::options::{RaycastOptions, DEFAULT_BRICK, MAX_SUPERSAMPLE};
-pub use crate::plan::raycast_params;
 use crate::volume::DenseField;
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;

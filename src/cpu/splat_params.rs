@@ -1,11 +1,10 @@
 //! Mirror of `splat_params.comp` and of `glsl/shared/params.glsl`.
 use super::bindings::Bindings;
-// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use super::footprint::sweep_length;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{Frame, Splat, SplatParams};
-pub use crate::plan::{cell_footprint_scale, footprint_scale, AA_EWA, AA_NONE, AA_SWAN};
+use crate::plan::cell_footprint_scale;
 use glam::{Mat4, Vec2, Vec3};
 
 pub use crate::constants::CULL_RADII;

@@ -3,10 +3,8 @@
 use super::footprint::screen_quad;
 use crate::constants::{RASTER_TILE_H, RASTER_TILE_W};
 use crate::gpu_types::{FootprintPush, Frame, ScreenQuad, SplatParams};
+use crate::plan::tile_grid;
 use glam::{IVec4, Mat3};
-
-// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
-pub use crate::plan::tile_grid;
 
 /// Mirror of `screen_record` in `glsl/shared/tiles.glsl`.
 pub fn screen_record(frame: &Frame, p: &SplatParams) -> ScreenQuad {

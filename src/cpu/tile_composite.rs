@@ -1,12 +1,12 @@
 //! Mirror of `glsl/tile_composite.comp` (the `tile_composite` stage); shared helpers in `tile.rs`.
 use super::bindings::Bindings;
 use super::footprint::{footprint_value, FootprintInputs, Sweep};
-use super::tile::*;
 use super::ImageF32;
 use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, ScreenQuad};
+use crate::plan::tile_grid;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 

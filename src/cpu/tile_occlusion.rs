@@ -2,13 +2,12 @@
 //! frame drawn front to back builds after each wave, and the test of a pixel box against it that
 //! `brick_hidden` makes for each brick (or node) of the next wave.
 use super::bindings::Bindings;
-// Decided by the plan (plan/layout.rs), read here too; kept here for the paths callers already use.
 use crate::constants::COMPOSITE_TILE;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{BrickPush, Frame};
 use crate::image::ImageF32;
-pub use crate::plan::{occlusion_len, tile_counts};
+use crate::plan::tile_counts;
 use glam::IVec4;
 
 // A tile's open pixels are one bit each in two words.

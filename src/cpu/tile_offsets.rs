@@ -1,9 +1,9 @@
 //! Mirror of `glsl/tile_offsets.comp` (the `tile_offsets` stage); shared helpers in `tile.rs`.
 use super::bindings::Bindings;
 use super::footprint::FootprintInputs;
-use super::tile::*;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
+use crate::plan::tile_grid;
 
 /// Exclusive prefix sum of the tiles' totals; `tile_start[tiles]` gets the total.
 pub fn tile_offsets(inputs: &FootprintInputs<'_>, tile_start: &mut [u32]) {

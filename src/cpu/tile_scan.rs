@@ -1,10 +1,10 @@
 //! Mirror of `glsl/tile_scan.comp` (the `tile_scan` stage); shared helpers in `tile.rs`.
 use super::bindings::Bindings;
 use super::footprint::FootprintInputs;
-use super::tile::*;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::FootprintPush;
+use crate::plan::tile_grid;
 
 /// Each tile's row of the count matrix becomes offsets within the tile; `tile_start[t]` its total.
 pub fn tile_scan(inputs: &FootprintInputs<'_>, push: &FootprintPush, counts: &mut [u32], tile_start: &mut [u32]) {

@@ -203,7 +203,7 @@ impl<C: Communicator> Distributed<C> {
         let Some(pixels) = image else { return Ok(None) };
         let mut image = ImageF32 { width: camera.width, height: camera.height, pixels };
         if opts.background.is_some() {
-            let push = crate::cpu::present::present_push(opts.background, 1, false, camera.width, camera.height);
+            let push = crate::plan::present_push(opts.background, 1, false, camera.width, camera.height);
             crate::cpu::present::present(&push, &mut image, &ImageF32::new(0, 0));
         }
         let mut timings =
