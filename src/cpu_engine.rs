@@ -121,7 +121,7 @@ impl Engine for CpuEngine<'_> {
     fn run(&mut self, d: &Dispatch) -> Result<()> {
         let t = Instant::now();
         let desc = d.stage.desc();
-        (desc.mirror)(&mut self.b, &d.args, &desc.variants[d.variant])?;
+        (desc.mirror)(&mut self.b, &d.args, d.variant())?;
         self.live.extend(desc.writes.iter().copied());
         add_time(&mut self.timings, desc.timing, t.elapsed().as_secs_f64() * 1e3);
         Ok(())

@@ -307,3 +307,16 @@ impl Args {
         bytemuck::pod_read_unaligned(&self.push)
     }
 }
+
+/// What an engine can hold, which the frame's plan must respect.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Most layers of the summation image.
+    pub max_layers: u32,
+    /// Largest storage binding in bytes (the fixed-point layers are one).
+    pub max_storage_range: u64,
+    /// Device memory a frame may hold (`RendererOptions::gpu_budget_bytes`): a bricked volume's
+    /// splats stream through it in batches. The CPU engine keeps the same budget, so it cuts the
+    /// same batches.
+    pub budget_bytes: u64,
+}

@@ -20,6 +20,7 @@ pub mod aa;
 pub mod animate;
 pub mod bisect;
 pub mod bricks;
+pub mod builds;
 pub mod camera;
 pub mod classify;
 /// Constants shared with the shaders (injected into GLSL as macros by build.rs).
@@ -65,7 +66,6 @@ pub mod scene;
 pub mod shaders;
 // The peers' scene is a built-in scene (`scene::peer`); its old path stays.
 pub use scene::peer;
-pub mod slab;
 pub mod stages;
 #[cfg(feature = "io")]
 pub mod terrain;
@@ -314,6 +314,24 @@ impl Renderer {
         Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats: recorded.stats })
     }
 
+    /// The frame's plan: every decision `render` would make for this frame before it touches the
+    /// device (the raster path, the order, the sheet batches, a bricked volume's budget split and
+    /// levels of detail), for printing and testing. Under a render scale, the coarse frame's.
+    pub fn plan(&mut self, camera: &Camera, options: &RenderOptions) -> Result<plan::FramePlan> {
+        options.validate()?;
+        camera.validate()?;
+        let camera =
+            if options.render_scale != 1.0 { resample::scaled_camera(camera, options.render_scale)? } else { *camera };
+        let options = RenderOptions { render_scale: 1.0, ..options.clone() };
+        let (opts, _) = self.choose(&camera, &options)?;
+        let prep = Self::prepared_in(&self.scene)?;
+        let limits = match &mut self.gpu {
+            Some(g) => g.engine(prep).limits(),
+            None => CpuEngine::new(prep).with_budget(self.budget_bytes).limits(),
+        };
+        plan::frame(prep, &camera, &opts, &limits)
+    }
+
     /// Draw a frame into the host's image `target` on the device, with no readback: the frame
     /// waits on the target's wait semaphores before it writes the image, converts it to the image's
     /// format (over `options.background`, sRGB encoded where the format says so: the bytes a PNG
@@ -461,7 +479,7 @@ impl Renderer {
         let opts = RenderOptions { composite: Composite::Slab, render_scale: 1.0, ..options.clone() };
         let set = &self.prepared()?.set;
         let frame = plan::frame_for(set, camera, &opts);
-        let pc = slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, opts.direction())?;
+        let pc = plan::slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, opts.direction())?;
         let got = self.probe(camera, &opts, StageId::SlabScatter, &[Res::SlabStart, Res::SlabPairs])?;
         let pairs = got[0][pc.slabs as usize] as usize * 2;
         Ok(got[1][..pairs].to_vec())

@@ -3,7 +3,7 @@
 //! scene's per-axis slice lists.
 use crate::bricks::{BrickScene, BRICK};
 use crate::camera::Camera;
-use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, RASTER_TILE_H, RASTER_TILE_W, TILE_CHUNK, WORKGROUP_SIZE};
+use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, WORKGROUP_SIZE};
 use crate::error::Result;
 use crate::gpu_types::{
     BrickFrame, CompositePush, FootprintPush, Frame, RaycastParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED,
@@ -14,8 +14,15 @@ use crate::order::{self, Direction};
 use crate::volume::SplatSet;
 use glam::Vec3;
 
+mod bricked;
+mod frame;
 mod layout;
+mod pass;
+pub mod slab;
+pub use bricked::{bricked_min_budget, bricked_resident_bytes, BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT};
+pub use frame::{frame, Draw, FramePlan, OrderSource, SplatRaster};
 pub use layout::*;
+pub use pass::{sheet_layers, sheet_pass, SheetPass, TileRule};
 
 /// A scene ready to draw: the splat rows plus, per axis, the splats grouped by slice and each
 /// slice's rank among non-empty slices (what the sheet batches index).
@@ -229,22 +236,6 @@ fn sheet_batches(
     batches
 }
 
-/// Push constants of the tile binning and compositing stages for a draw list of `n` entries on a
-/// `width` x `height` image: chunks of `TILE_CHUNK` entries, fewer (and longer) where the count
-/// matrix would pass `MAX_TILE_CELLS`.
-pub fn tile_push(opts: &RenderOptions, n: u32, width: u32, height: u32) -> FootprintPush {
-    let btf = opts.direction() == Direction::BackToFront;
-    let tiles = (width.div_ceil(RASTER_TILE_W) as u64 * height.div_ceil(RASTER_TILE_H) as u64).max(1);
-    let most = (MAX_TILE_CELLS / tiles).max(1);
-    FootprintPush {
-        count: n,
-        chunks: (n.div_ceil(TILE_CHUNK) as u64).clamp(1, most) as u32,
-        back_to_front: btf as u32,
-        occluded: if btf { 0.0 } else { opts.early_termination },
-        ..Default::default()
-    }
-}
-
 /// Push constants of `sheet_tiles.comp` for a frame's sheet batches: every entry of the sheet
 /// list from 0, layers numbered by global sheet (rank base 0, direction +1), no occlusion culling.
 pub fn sheet_tiles_push(batches: &[Batch], first: &Batch) -> FootprintPush {
@@ -297,14 +288,6 @@ pub fn groups_1d(n: u32) -> [u32; 3] {
 pub fn groups_per_item(n: u32) -> [u32; 3] {
     let g = n.max(1);
     [g.min(MAX_GROUPS_X), g.div_ceil(MAX_GROUPS_X), 1]
-}
-
-/// Put the early-termination threshold in the batches' push constants (front to back only).
-pub fn set_early_termination(opts: &RenderOptions, batches: &mut [Batch]) {
-    let on = opts.direction() == Direction::FrontToBack && opts.early_termination > 0.0;
-    for b in batches {
-        b.push.occluded = if on { opts.early_termination } else { 0.0 };
-    }
 }
 
 /// Most cells of the tile x chunk count matrix (4 bytes each: 64 MiB).

@@ -5,27 +5,19 @@
 //! written once, for every engine.
 mod bricked;
 mod gradients;
+use crate::builds::{CompositeLayers, Footprint, Only, SheetTiles, SlabBins};
 use crate::camera::Camera;
 use crate::constants::{
-    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, RECORD_PAGE, SPLAT_PAGE, TILE_BIN_WORKGROUP,
-    TILE_SEGMENT,
+    COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, TILE_SEGMENT,
 };
-use crate::dispatch::Blend;
 use crate::error::{Error, Result};
-use crate::gpu_types::{
-    BrickPush, FootprintPush, Frame, ScreenQuad, SlabPush, SplatParams, SHEET_MODE_BINNED, SHEET_MODE_SLAB,
-    SHEET_MODE_SPLAT,
-};
+use crate::gpu_types::{BrickPush, FootprintPush, Frame, ScreenQuad, SlabPush, SplatParams};
 use crate::image::ImageF32;
 use crate::options::RaycastOptions;
-use crate::options::{Composite, Lod, RenderOptions, StageTime};
-use crate::order::{Direction, OrderKind};
-use crate::plan::{self, groups_1d, Prepared};
-use crate::raster::Raster;
+use crate::options::{RenderOptions, StageTime};
+use crate::plan::{self, groups_1d, Draw, FramePlan, OrderSource, Prepared, SheetPass, SplatRaster, TileRule};
 use crate::stages::{Dispatch, Engine, List, Res, StageId, Workgroup};
-pub use bricked::{
-    bricked_min_budget, bricked_resident_bytes, BATCH_BYTES_PER_SPLAT, HIDDEN_BATCHES, HIDDEN_BATCH_MIN,
-};
+pub use bricked::{HIDDEN_BATCHES, HIDDEN_BATCH_MIN};
 use std::time::Instant;
 
 /// Bits of the status word (binding 17): a binning invocation, or a footprint-sum invocation, made
@@ -33,46 +25,6 @@ use std::time::Instant;
 pub const LOOP_BUDGET_BINNING: u32 = 1;
 /// See `LOOP_BUDGET_BINNING`.
 pub const LOOP_BUDGET_SUMS: u32 = 2;
-
-/// 1 where a scene of `n` splats fits one page of splat records (the `ONE_PAGE` builds read only
-/// that page: llvmpipe runs both sides of the paged reader's branch), else 0.
-pub fn one_page(n: u32) -> usize {
-    usize::from(n <= SPLAT_PAGE)
-}
-
-/// The two-slot footprint draw's variant (`Pass::Slots`, after the others in stages.rs).
-pub fn footprint_slots_variant(blend: Blend) -> usize {
-    if blend == Blend::Over {
-        10
-    } else {
-        11
-    }
-}
-
-/// The footprint draw's variant.
-pub fn footprint_variant(blend: Blend, points: bool, mode: u32) -> usize {
-    match (blend, mode) {
-        (Blend::Add, m) if m == SHEET_MODE_BINNED => 8 + points as usize,
-        (Blend::Over, _) => 4 * points as usize,
-        (Blend::Under, _) => 1 + 4 * points as usize,
-        (Blend::Add, m) if m == SHEET_MODE_SLAB => 3 + 4 * points as usize,
-        (Blend::Add, _) => 2 + 4 * points as usize,
-    }
-}
-
-/// The tile compositor's variant for a scene of `n` splats, the frame's push constants and
-/// whether it is motion-blurred.
-pub fn tile_composite_variant(n: u32, push: &FootprintPush, blur: bool) -> usize {
-    let btf = push.back_to_front != 0;
-    let mode = if btf {
-        0
-    } else if push.occluded > 0.0 {
-        2
-    } else {
-        1
-    };
-    (one_page(n) * 3 + mode) * 2 + usize::from(blur)
-}
 
 /// Workgroups of the tile binning passes that walk the draw list chunk by chunk.
 fn tile_chunk_groups(push: &FootprintPush) -> [u32; 3] {
@@ -103,149 +55,149 @@ pub struct Recorded {
 }
 
 /// THE recording of a frame: `prep` drawn from `camera` with `opts` (whose raster is already
-/// chosen), on `e`.
+/// chosen), on `e`: its plan (`plan::frame`), then the plan recorded.
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
-    camera.validate()?;
-    let slotted = opts.slotted();
-    if let Some(scene) = &prep.bricks {
-        if slotted {
-            return Err(Error::Unsupported(
-                "the slotted blur draws dense splat sets; a bricked volume takes splat:tapered".into(),
-            ));
-        }
-        return bricked::record_bricks(e, prep, scene, camera, opts);
-    }
-    let set = &prep.set;
-    let (w, h) = (camera.width, camera.height);
-    let direction = opts.direction();
-    let btf = direction == Direction::BackToFront;
-    let frame = plan::frame_for(set, camera, opts);
-    let n = set.len() as u32;
-    let rows = (set.row_start().len() - 1) as u32;
-    let compute = opts.raster == Raster::Compute;
-    let points = opts.raster == Raster::Points;
-    e.begin(&frame, opts.kernel, w, h)?;
-    e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
-    let params = || Dispatch::new(StageId::SplatParams, 0, groups_1d(n), List::Order, &[]);
-
-    if opts.composite == Composite::Splat {
-        e.layers(1)?;
-        e.ensure(Res::Order, n as u64 * 4)?;
-        if opts.order == OrderKind::Pbtf {
-            if n > 0 {
-                e.ensure(Res::RowSplit, rows as u64 * 4)?;
-                e.ensure(Res::Segments, rows as u64 * 8)?;
-                e.run(&Dispatch::new(StageId::OrderCount, 0, groups_1d(rows), List::Order, &[]))?;
-                e.run(&Dispatch::new(StageId::OrderScan, 0, [1, 1, 1], List::Order, &[]))?;
-                e.run(&Dispatch::new(StageId::OrderScatter, 0, groups_1d(n), List::Order, &[]))?;
-            }
-        } else {
-            let t = Instant::now();
-            let order = crate::order::visibility_order(set, camera, opts.order, direction);
-            e.upload(Res::Order, &order)?;
-            let stage = if e.is_device() { "order_cpu" } else { "order" };
-            e.host_time(stage, t.elapsed().as_secs_f64() * 1e3);
-        }
-        if n > 0 {
-            e.run(&params())?;
-        }
-        if compute {
-            record_tiles(e, &frame, n, opts, w, h, false)?;
-            return finish(e, opts.background, &[Res::Accum], w, h, false);
-        }
-        let blend = if btf { Blend::Over } else { Blend::Under };
-        let variant =
-            if slotted { footprint_slots_variant(blend) } else { footprint_variant(blend, points, SHEET_MODE_SPLAT) };
-        let push = FootprintPush::default();
-        e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
-        let images: &[Res] = if slotted { &[Res::Color, Res::Accum] } else { &[Res::Color] };
-        return finish(e, opts.background, images, w, h, false);
-    }
-
-    // Sheet and slab modes: summation layers in batches, composited in visiting order.
-    let layers = sheet_layers(e, opts, w, h);
-    let (list, batches) = if opts.composite == Composite::Sheet {
-        if n > 0 {
-            e.run(&params())?;
-        }
-        let (axis, batches) = plan::sheet_plan(prep, camera, direction, layers);
-        (List::Slices(axis as u8), batches)
-    } else {
-        let pc = crate::slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, direction)?;
-        if n > 0 {
-            e.run(&params())?;
-        }
-        let starts = record_slab_bins(e, &pc, 0)?;
-        (List::SlabPairs, crate::slab::slab_batches(&pc, &starts, layers)?)
-    };
-    record_sheets(e, list, batches, opts, w, h)
+    let plan = plan::frame(prep, camera, opts, &e.limits())?;
+    record_plan(e, prep, &plan)
 }
 
-/// The slab binning stages (`variant` 1: a bricked batch's axis-aligned sheets) over the splats'
+/// A frame's plan recorded on `e`: the plan and the counts the device reads back decide every
+/// dispatch.
+pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Result<Recorded> {
+    let set = &prep.set;
+    let (w, h) = (plan.width, plan.height);
+    let frame = &plan.frame;
+    let n = set.len() as u32;
+    match &plan.draw {
+        Draw::Bricked(b) => {
+            let scene = prep
+                .bricks
+                .as_ref()
+                .ok_or_else(|| Error::InvalidArgument("a bricked plan for a dense scene".into()))?;
+            bricked::record_bricks(e, prep, scene, plan, b)
+        }
+        Draw::Splats { rows, order, raster, .. } => {
+            e.begin(frame, plan.kernel, w, h)?;
+            e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+            e.layers(1)?;
+            e.ensure(Res::Order, n as u64 * 4)?;
+            match order {
+                OrderSource::Pbtf => {
+                    if n > 0 {
+                        e.ensure(Res::RowSplit, *rows as u64 * 4)?;
+                        e.ensure(Res::Segments, *rows as u64 * 8)?;
+                        e.run(&Dispatch::new(StageId::OrderCount, Only, groups_1d(*rows), List::Order, &[])?)?;
+                        e.run(&Dispatch::new(StageId::OrderScan, Only, [1, 1, 1], List::Order, &[])?)?;
+                        e.run(&Dispatch::new(StageId::OrderScatter, Only, groups_1d(n), List::Order, &[])?)?;
+                    }
+                }
+                &OrderSource::Host(kind) => {
+                    let t = Instant::now();
+                    let order = crate::order::visibility_order(set, &plan.camera, kind, plan.direction);
+                    e.upload(Res::Order, &order)?;
+                    let stage = if e.is_device() { "order_cpu" } else { "order" };
+                    e.host_time(stage, t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+            if n > 0 {
+                record_params(e, n)?;
+            }
+            match raster {
+                SplatRaster::Tiles(rule) => {
+                    record_tiles(e, frame, rule, w, h, false)?;
+                    finish(e, plan.background, &[Res::Accum], w, h, false)
+                }
+                &SplatRaster::Draw(build) => {
+                    let push = FootprintPush::default();
+                    e.run(&Dispatch::new(
+                        StageId::Footprint,
+                        build,
+                        [0, n, 0],
+                        List::Order,
+                        bytemuck::bytes_of(&push),
+                    )?)?;
+                    let slotted = matches!(build, Footprint::Slots(_));
+                    let images: &[Res] = if slotted { &[Res::Color, Res::Accum] } else { &[Res::Color] };
+                    finish(e, plan.background, images, w, h, false)
+                }
+            }
+        }
+        Draw::Sheets { pass, .. } => {
+            e.begin(frame, plan.kernel, w, h)?;
+            e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+            if n > 0 {
+                record_params(e, n)?;
+            }
+            record_sheets(e, pass, pass.batches.clone(), plan.background, w, h)
+        }
+        Draw::Slabs { geometry, pass, .. } => {
+            e.begin(frame, plan.kernel, w, h)?;
+            e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+            if n > 0 {
+                record_params(e, n)?;
+            }
+            let starts = record_slab_bins(e, geometry, SlabBins::Slabs)?;
+            let batches = pass.terminated(crate::plan::slab::slab_batches(geometry, &starts, pass.layers)?);
+            record_sheets(e, pass, batches, plan.background, w, h)
+        }
+    }
+}
+
+/// `splat_params` over a dense set's `n` splats.
+fn record_params(e: &mut dyn Engine, n: u32) -> Result<()> {
+    e.run(&Dispatch::new(StageId::SplatParams, Only, groups_1d(n), List::Order, &[])?)
+}
+
+/// The slab binning stages (`SlabBins::AxisSheets`: a bricked batch's axis-aligned sheets) over the splats'
 /// parameters: (splat, slab) pairs grouped by slab in visiting order (`Res::SlabPairs`). Returns
 /// each slab's first pair (slabs + 1 entries, read back to cut the batches).
-fn record_slab_bins(e: &mut dyn Engine, pc: &SlabPush, variant: usize) -> Result<Vec<u32>> {
+fn record_slab_bins(e: &mut dyn Engine, pc: &SlabPush, bins: SlabBins) -> Result<Vec<u32>> {
     let push = bytemuck::bytes_of(pc);
     e.ensure(Res::SlabCounts, pc.slabs as u64 * pc.chunks as u64 * 4)?;
     e.ensure(Res::SlabStart, (pc.slabs as u64 + 1) * 4)?;
-    e.run(&Dispatch::new(StageId::SlabCount, variant, groups_1d(pc.chunks), List::Order, push))?;
-    e.run(&Dispatch::new(StageId::SlabScan, 0, [1, 1, 1], List::Order, push))?;
+    e.run(&Dispatch::new(StageId::SlabCount, bins, groups_1d(pc.chunks), List::Order, push)?)?;
+    e.run(&Dispatch::new(StageId::SlabScan, Only, [1, 1, 1], List::Order, push)?)?;
     let starts = e.read(&[(Res::SlabStart, pc.slabs as usize + 1)])?.remove(0);
     let total = starts[pc.slabs as usize] as u64;
-    if total > crate::slab::MAX_SLAB_PAIRS {
-        let limit = crate::slab::MAX_SLAB_PAIRS;
+    if total > crate::plan::slab::MAX_SLAB_PAIRS {
+        let limit = crate::plan::slab::MAX_SLAB_PAIRS;
         return Err(Error::TooLarge(format!("{total} splat-slab pairs (limit {limit}): use thicker slabs")));
     }
     e.ensure(Res::SlabPairs, total * 8)?;
-    e.run(&Dispatch::new(StageId::SlabScatter, variant, groups_1d(pc.chunks), List::Order, push))?;
+    e.run(&Dispatch::new(StageId::SlabScatter, bins, groups_1d(pc.chunks), List::Order, push)?)?;
     Ok(starts)
-}
-
-/// Summation layers a sheet batch may use at `w` x `h`: the options' memory budget, the device's
-/// layer limit and, for the fixed-point layers (one storage binding), its range.
-fn sheet_layers(e: &dyn Engine, opts: &RenderOptions, w: u32, h: u32) -> u32 {
-    let limits = e.limits();
-    let layers = opts.batch_layers(w, h).min(limits.max_layers.max(1));
-    let layer_bytes = w as u64 * h as u64 * 16;
-    if opts.raster == Raster::Compute {
-        layers.min((limits.max_storage_range / layer_bytes.max(1)).clamp(1, u32::MAX as u64) as u32)
-    } else {
-        layers
-    }
 }
 
 /// Sheet and slab modes after binning: each batch's sheets summed into layers (footprint draws
 /// or, with the compute raster, fixed-point sums), then composited onto the frame in visiting order.
 fn record_sheets(
     e: &mut dyn Engine,
-    list: List,
-    mut batches: Vec<plan::Batch>,
-    opts: &RenderOptions,
+    pass: &SheetPass,
+    batches: Vec<plan::Batch>,
+    background: Option<[f32; 4]>,
     w: u32,
     h: u32,
 ) -> Result<Recorded> {
-    plan::set_early_termination(opts, &mut batches);
     let tiles_pass = plan::sheet_tiles_pay(&batches, w, h);
-    begin_sheets(e, list, &batches, opts, w, h, tiles_pass)?;
+    begin_sheets(e, pass, &batches, w, h, tiles_pass)?;
     for b in &batches {
-        sum_sheets(e, list, b, opts, b.first_instance, b.instances, false)?;
-        composite_sheets(e, list, b, opts, w, h)?;
+        sum_sheets(e, pass, b, b.first_instance, b.instances, false)?;
+        composite_sheets(e, pass, b, w, h)?;
     }
-    finish(e, opts.background, &[Res::Accum], w, h, opts.raster == Raster::Compute)
+    finish(e, background, &[Res::Accum], w, h, pass.compute)
 }
 
 /// The sheet modes' images and per-frame state for `batches`; with `tiles_pass`, `sheet_tiles`
 /// finds each composite tile's sheet range over the batches' whole list.
 fn begin_sheets(
     e: &mut dyn Engine,
-    list: List,
+    pass: &SheetPass,
     batches: &[plan::Batch],
-    opts: &RenderOptions,
     w: u32,
     h: u32,
     tiles_pass: bool,
 ) -> Result<()> {
-    let compute = opts.raster == Raster::Compute;
+    let compute = pass.compute;
     // Allocate only as many layers as the largest batch needs.
     let layers = batches.iter().map(|b| b.layers).max().unwrap_or(1);
     e.layers(layers)?;
@@ -269,9 +221,9 @@ fn begin_sheets(
             // No sheet reaches any tile until the pass says so.
             halves(e, [u32::MAX, 0])?;
             let push = plan::sheet_tiles_push(batches, first);
-            let variant = 2 * (first.push.sheet_mode as usize - 1) + (opts.raster == Raster::Points) as usize;
+            let build = SheetTiles { mode: SheetPass::mode(first)?, points: pass.points };
             let groups = groups_1d(push.count);
-            e.run(&Dispatch::new(StageId::SheetTiles, variant, groups, list, bytemuck::bytes_of(&push)))
+            e.run(&Dispatch::new(StageId::SheetTiles, build, groups, pass.list, bytemuck::bytes_of(&push))?)
         }
     }
 }
@@ -280,57 +232,43 @@ fn begin_sheets(
 /// earlier part of the batch summed (a bricked volume streamed in parts), else onto cleared layers.
 fn sum_sheets(
     e: &mut dyn Engine,
-    list: List,
+    pass: &SheetPass,
     b: &plan::Batch,
-    opts: &RenderOptions,
     first: u32,
     count: u32,
     carry: bool,
 ) -> Result<()> {
-    let push = FootprintPush { first, count, carry: carry as u32, ..b.push };
-    if opts.raster == Raster::Compute {
+    let (list, push) = (pass.list, FootprintPush { first, count, carry: carry as u32, ..b.push });
+    if pass.compute {
         if !carry {
             e.fill(Res::Fixed, None, 0)?;
         }
-        let variant = b.push.sheet_mode as usize - 1;
-        e.run(&Dispatch::new(StageId::FootprintSum, variant, groups_1d(count), list, bytemuck::bytes_of(&push)))
+        let mode = SheetPass::mode(b)?;
+        e.run(&Dispatch::new(StageId::FootprintSum, mode, groups_1d(count), list, bytemuck::bytes_of(&push))?)
     } else {
-        let variant = footprint_variant(Blend::Add, opts.raster == Raster::Points, b.push.sheet_mode);
-        e.run(&Dispatch::new(StageId::Footprint, variant, [first, count, 0], list, bytemuck::bytes_of(&push)))
+        let build = pass.footprint(b)?;
+        e.run(&Dispatch::new(StageId::Footprint, build, [first, count, 0], list, bytemuck::bytes_of(&push))?)
     }
 }
 
 /// Composite batch `b`'s layers onto the frame.
-fn composite_sheets(
-    e: &mut dyn Engine,
-    list: List,
-    b: &plan::Batch,
-    opts: &RenderOptions,
-    w: u32,
-    h: u32,
-) -> Result<()> {
-    let compute = opts.raster == Raster::Compute;
-    let push = plan::composite_push(b, opts.direction() == Direction::BackToFront, w, h);
+fn composite_sheets(e: &mut dyn Engine, pass: &SheetPass, b: &plan::Batch, w: u32, h: u32) -> Result<()> {
+    let compute = pass.compute;
+    let push = plan::composite_push(b, pass.back_to_front, w, h);
     let groups = tile_groups(StageId::Composite, w, h);
-    e.run(&Dispatch::new(StageId::Composite, compute as usize, groups, list, bytemuck::bytes_of(&push)))
+    let layers = if compute { CompositeLayers::Fixed } else { CompositeLayers::Float };
+    e.run(&Dispatch::new(StageId::Composite, layers, groups, pass.list, bytemuck::bytes_of(&push))?)
 }
 
 /// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
 /// shorter chunks when an invocation ran out of llvmpipe's loop budget), then composite each
 /// tile's list `TILE_SEGMENT` entries per dispatch.
-fn record_tiles(
-    e: &mut dyn Engine,
-    frame: &Frame,
-    n: u32,
-    opts: &RenderOptions,
-    w: u32,
-    h: u32,
-    carry: bool,
-) -> Result<()> {
+fn record_tiles(e: &mut dyn Engine, frame: &Frame, rule: &TileRule, w: u32, h: u32, carry: bool) -> Result<()> {
     let (tx, ty) = crate::plan::tile_grid(frame);
     let tiles = tx as u64 * ty as u64;
-    let mut push = FootprintPush { carry: carry as u32, ..plan::tile_push(opts, n, w, h) };
-    let most = (crate::raster::MAX_TILE_CELLS / tiles.max(1)).min(push.count.max(1) as u64) as u32;
+    let n = rule.push.count;
+    let mut push = FootprintPush { carry: carry as u32, ..rule.push };
+    let most = rule.most_chunks;
     e.ensure(Res::Quads, n as u64 * std::mem::size_of::<ScreenQuad>() as u64)?;
     e.ensure(Res::TileStart, (tiles + 1) * 4)?;
     e.ensure(Res::Status, 4)?;
@@ -340,9 +278,9 @@ fn record_tiles(
         e.fill(Res::TileCounts, None, 0)?;
         e.fill(Res::Status, None, 0)?;
         let bytes = bytemuck::bytes_of(&push);
-        e.run(&Dispatch::new(StageId::TileCount, one_page(n), tile_chunk_groups(&push), List::Order, bytes))?;
-        e.run(&Dispatch::new(StageId::TileScan, 0, groups_1d(tiles as u32), List::Order, bytes))?;
-        e.run(&Dispatch::new(StageId::TileOffsets, 0, [1, 1, 1], List::Order, bytes))?;
+        e.run(&Dispatch::new(StageId::TileCount, rule.pages, tile_chunk_groups(&push), List::Order, bytes)?)?;
+        e.run(&Dispatch::new(StageId::TileScan, Only, groups_1d(tiles as u32), List::Order, bytes)?)?;
+        e.run(&Dispatch::new(StageId::TileOffsets, Only, [1, 1, 1], List::Order, bytes)?)?;
         let mut back = e.read(&[(Res::TileStart, tiles as usize + 1), (Res::Status, 1)])?;
         let spent = back[1][0] & LOOP_BUDGET_BINNING != 0;
         crate::raster::check_tile_entries(back[0][tiles as usize] as u64)?;
@@ -363,12 +301,12 @@ fn record_tiles(
     let longest = starts.windows(2).map(|w| w[1].saturating_sub(w[0])).max().unwrap_or(0);
     e.ensure(Res::TileEntries, total * 4)?;
     let bytes = bytemuck::bytes_of(&push);
-    e.run(&Dispatch::new(StageId::TileScatter, one_page(n), tile_chunk_groups(&push), List::Order, bytes))?;
-    let variant = tile_composite_variant(n, &push, opts.motion.is_some());
+    e.run(&Dispatch::new(StageId::TileScatter, rule.pages, tile_chunk_groups(&push), List::Order, bytes)?)?;
+    let build = rule.composite;
     for segment in 0..longest.div_ceil(TILE_SEGMENT).max(1) {
         let push = FootprintPush { first: segment, ..push };
         let groups = tile_groups(StageId::TileComposite, w, h);
-        e.run(&Dispatch::new(StageId::TileComposite, variant, groups, List::Order, bytemuck::bytes_of(&push)))?;
+        e.run(&Dispatch::new(StageId::TileComposite, build, groups, List::Order, bytemuck::bytes_of(&push))?)?;
     }
     Ok(())
 }
@@ -390,7 +328,7 @@ fn finish(
         let sources = images.iter().fold(0, |m, &r| m | if r == Res::Accum { 1 } else { 2 });
         let push = crate::plan::present_push(background, sources, linear.unwrap_or(false), w, h);
         let groups = tile_groups(StageId::Present, w, h);
-        e.run(&Dispatch::new(StageId::Present, 0, groups, List::Order, bytemuck::bytes_of(&push)))?;
+        e.run(&Dispatch::new(StageId::Present, Only, groups, List::Order, bytemuck::bytes_of(&push))?)?;
         &[Res::Accum][..]
     } else {
         images
@@ -476,6 +414,6 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
     e.ensure(Res::RaycastParams, words.len() as u64 * 4)?;
     e.upload(Res::RaycastParams, words)?;
     let groups = tile_groups(StageId::Raycast, w, h);
-    e.run(&Dispatch::new(StageId::Raycast, 0, groups, List::Order, &[]))?;
+    e.run(&Dispatch::new(StageId::Raycast, Only, groups, List::Order, &[])?)?;
     finish(e, None, &[Res::Accum], w, h, false)
 }

@@ -8,15 +8,13 @@
 //! (`crate::cpu_engine`), or a split of the two (`crate::bisect`). Adding a stage is its shader,
 //! its mirror, its row here and its line in the recording. The types they share are in
 //! `crate::dispatch`, below both this table and the mirrors it names.
+use crate::builds::{self, Build, Table};
 use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, WORKGROUP_SIZE};
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
-use crate::gpu_types::{
-    BrickPush, CompositePush, FootprintPush, PresentPush, SlabPush, SHEET_MODE_AXIS, SHEET_MODE_BINNED,
-    SHEET_MODE_SLAB, SHEET_MODE_SPLAT,
-};
+use crate::gpu_types::{BrickPush, CompositePush, FootprintPush, PresentPush, SlabPush};
 
-pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, List, Pass, Res, Variant, Workgroup};
+pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, Limits, List, Pass, Res, Variant, Workgroup};
 use crate::gpu_types::Frame;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
@@ -42,28 +40,17 @@ pub struct StageDesc {
     pub timing: &'static str,
     /// A build chosen by a device capability, when the device has it.
     pub device_build: Option<(Feature, &'static str)>,
-    /// Its builds; a dispatch names one by index.
-    pub variants: &'static [Variant],
+    /// Its builds: a dispatch names one by value (`crate::builds`).
+    pub builds: &'static Table,
     /// The CPU mirror's entry point.
     pub mirror: Mirror,
     /// Its shaders' builds (`glsl/<name>.*`).
     pub shaders: crate::shaders::Shaders,
 }
 
-const fn v(defines: &'static str, spec: &'static [u32]) -> Variant {
-    Variant { defines, spec, draw: None }
-}
-
-const fn d(blend: Blend, points: bool, pass: Pass, spec: &'static [u32]) -> Variant {
-    let defines = if matches!(pass, Pass::Slots) { "SLOTS" } else { "" };
-    Variant { defines, spec, draw: Some(DrawState { blend, points, pass }) }
-}
-
 const ORDER: &[Res] = &[Res::Frame, Res::Splats, Res::RowStart, Res::RowSplit, Res::Segments, Res::Order];
 const PARAMS: &[Res] = &[Res::Frame, Res::Splats, Res::Params, Res::ParamsHi, Res::Coords];
 const SLAB: &[Res] = &[Res::Params, Res::SlabCounts, Res::SlabPairs, Res::SlabStart, Res::ParamsHi, Res::BrickVoxels];
-/// Slabs along the view; a bricked volume's axis-aligned sheets binned by voxel plane (`AXIS_SHEETS`).
-const SLAB_BUILDS: &[Variant] = &[v("", &[]), v("AXIS_SHEETS", &[])];
 const COMPOSITE: &[Res] = &[Res::Sums, Res::Accum, Res::Occlusion, Res::Fixed, Res::SheetTiles];
 /// glsl/shared/footprint.glsl's bindings, shared by every footprint-reading stage.
 const FOOTPRINT: &[Res] = &[
@@ -125,18 +112,6 @@ const BRICK: &[Res; 32] = &[
 /// `brick_hidden`'s places (the brick stages' list is at lavapipe's 32 storage buffers a stage).
 const BRICK_GRADIENTS: &[Res] =
     &Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi);
-/// The store's records in one page, in up to `RECORD_PAGES`, or streamed batch by batch
-/// (`recording::record_bricks` picks).
-const RECORD_PAGED: &[Variant] = &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[])];
-/// `RECORD_PAGED`'s, and one page of records with the voxels' differences read from
-/// `Res::BrickGradients` (`recording::record_bricks` picks it for shaded or gradient-weighted frames).
-const GRADIENT_BUILDS: &[Variant] =
-    &[v("", &[]), v("PAGED_RECORDS", &[]), v("STREAMED_STORE", &[]), v("GRADIENTS", &[])];
-/// A resident pyramid, or a streamed store's batch of pyramids (`brick_cells`).
-const PYRAMID_STREAMED: &[Variant] = &[v("", &[]), v("STREAMED_STORE", &[])];
-const ONE: &[Variant] = &[v("", &[])];
-/// Two pages of splat records, and one (`ONE_PAGE`, types.glsl): see [`one_page`].
-const PAGED: &[Variant] = &[v("", &[]), v("ONE_PAGE", &[])];
 const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
 const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
 
@@ -179,7 +154,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "order",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     order_scan => OrderScan {
         kind: Kind::Compute,
@@ -189,7 +164,7 @@ stages! {
         workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
         timing: "order",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     order_scatter => OrderScatter {
         kind: Kind::Compute,
@@ -199,7 +174,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "order",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     splat_params => SplatParams {
         kind: Kind::Compute,
@@ -209,7 +184,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     brick_pyramid => BrickPyramid {
         kind: Kind::Compute,
@@ -219,7 +194,7 @@ stages! {
         workgroup: Workgroup::PerItem(BRICK_LANES),
         timing: "lod",
         device_build: None,
-        variants: GRADIENT_BUILDS,
+        builds: &builds::RECORDS_OR_GRADIENTS,
     },
     brick_nodes => BrickNodes {
         kind: Kind::Compute,
@@ -229,7 +204,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "lod",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     brick_node_cut => BrickNodeCut {
         kind: Kind::Compute,
@@ -239,7 +214,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "bricks",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     brick_cull => BrickCull {
         kind: Kind::Compute,
@@ -250,7 +225,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "bricks",
         device_build: None,
-        variants: RECORD_PAGED,
+        builds: &builds::RECORDS,
     },
     brick_order => BrickOrder {
         kind: Kind::Compute,
@@ -260,7 +235,7 @@ stages! {
         workgroup: Workgroup::PerItem(BRICK_LANES),
         timing: "order",
         device_build: None,
-        variants: RECORD_PAGED,
+        builds: &builds::RECORDS,
     },
     brick_cells => BrickCells {
         kind: Kind::Compute,
@@ -270,7 +245,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "order",
         device_build: None,
-        variants: PYRAMID_STREAMED,
+        builds: &builds::PYRAMIDS,
     },
     brick_params => BrickParams {
         kind: Kind::Compute,
@@ -280,7 +255,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: GRADIENT_BUILDS,
+        builds: &builds::RECORDS_OR_GRADIENTS,
     },
     brick_lod_params => BrickLodParams {
         kind: Kind::Compute,
@@ -290,7 +265,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        variants: RECORD_PAGED,
+        builds: &builds::RECORDS,
     },
     tile_occlusion => TileOcclusion {
         kind: Kind::Compute,
@@ -300,7 +275,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "bricks",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     brick_hidden => BrickHidden {
         kind: Kind::Compute,
@@ -310,7 +285,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "bricks",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     slab_count => SlabCount {
         kind: Kind::Compute,
@@ -320,7 +295,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "slab_bins",
         device_build: None,
-        variants: SLAB_BUILDS,
+        builds: &builds::SLAB_BINS,
     },
     slab_scan => SlabScan {
         kind: Kind::Compute,
@@ -330,7 +305,7 @@ stages! {
         workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
         timing: "slab_bins",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     slab_scatter => SlabScatter {
         kind: Kind::Compute,
@@ -340,7 +315,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "slab_bins",
         device_build: None,
-        variants: SLAB_BUILDS,
+        builds: &builds::SLAB_BINS,
     },
     tile_count => TileCount {
         kind: Kind::Compute,
@@ -350,7 +325,7 @@ stages! {
         workgroup: Workgroup::Linear(TILE_BIN_WORKGROUP),
         timing: "tile_bins",
         device_build: None,
-        variants: PAGED,
+        builds: &builds::PAGES,
     },
     tile_scan => TileScan {
         kind: Kind::Compute,
@@ -360,7 +335,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "tile_bins",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     tile_offsets => TileOffsets {
         kind: Kind::Compute,
@@ -370,7 +345,7 @@ stages! {
         workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
         timing: "tile_bins",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     tile_scatter => TileScatter {
         kind: Kind::Compute,
@@ -380,7 +355,7 @@ stages! {
         workgroup: Workgroup::Linear(TILE_BIN_WORKGROUP),
         timing: "tile_bins",
         device_build: None,
-        variants: PAGED,
+        builds: &builds::PAGES,
     },
     tile_composite => TileComposite {
         kind: Kind::Compute,
@@ -390,22 +365,7 @@ stages! {
         workgroup: Workgroup::Tile(RASTER_TILE_W, RASTER_TILE_H),
         timing: "footprint",
         device_build: Some((Feature::SubgroupShuffle, "SHUFFLE")),
-        // [paged, one page] x [back to front, front to back, front to back terminating] x
-        // [still, motion-blurred]: see `tile_composite_variant`.
-        variants: &[
-            v("", &[SHEET_MODE_SPLAT, 1, 0, 0]),
-            v("", &[SHEET_MODE_SPLAT, 1, 0, 1]),
-            v("", &[SHEET_MODE_SPLAT, 0, 0, 0]),
-            v("", &[SHEET_MODE_SPLAT, 0, 0, 1]),
-            v("", &[SHEET_MODE_SPLAT, 0, 1, 0]),
-            v("", &[SHEET_MODE_SPLAT, 0, 1, 1]),
-            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 1, 0, 0]),
-            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 1, 0, 1]),
-            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 0, 0]),
-            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 0, 1]),
-            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 0]),
-            v("ONE_PAGE", &[SHEET_MODE_SPLAT, 0, 1, 1]),
-        ],
+        builds: &builds::TILE_COMPOSITE,
     },
     sheet_tiles => SheetTiles {
         kind: Kind::Compute,
@@ -415,15 +375,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "sheet_tiles",
         device_build: None,
-        // [axis, slab, binned] x [quads or compute sums, points].
-        variants: &[
-            v("", &[SHEET_MODE_AXIS, 0]),
-            v("", &[SHEET_MODE_AXIS, 1]),
-            v("", &[SHEET_MODE_SLAB, 0]),
-            v("", &[SHEET_MODE_SLAB, 1]),
-            v("", &[SHEET_MODE_BINNED, 0]),
-            v("", &[SHEET_MODE_BINNED, 1]),
-        ],
+        builds: &builds::SHEET_TILES,
     },
     footprint => Footprint {
         kind: Kind::Draw,
@@ -433,21 +385,7 @@ stages! {
         workgroup: Workgroup::Instances,
         timing: "footprint",
         device_build: None,
-        // See `footprint_variant`.
-        variants: &[
-            d(Blend::Over, false, Pass::Target, &[SHEET_MODE_SPLAT, 0]),
-            d(Blend::Under, false, Pass::Target, &[SHEET_MODE_SPLAT, 0]),
-            d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_AXIS, 0]),
-            d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_SLAB, 0]),
-            d(Blend::Over, true, Pass::Target, &[SHEET_MODE_SPLAT, 1]),
-            d(Blend::Under, true, Pass::Target, &[SHEET_MODE_SPLAT, 1]),
-            d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_AXIS, 1]),
-            d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_SLAB, 1]),
-            d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_BINNED, 0]),
-            d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_BINNED, 1]),
-            d(Blend::Over, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
-            d(Blend::Under, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
-        ],
+        builds: &builds::FOOTPRINT,
     },
     footprint_sum => FootprintSum {
         kind: Kind::Compute,
@@ -457,8 +395,7 @@ stages! {
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "footprint",
         device_build: Some((Feature::Int64Atomics, "SUM64")),
-        // Indexed by `sheet_mode - 1`.
-        variants: &[v("", &[SHEET_MODE_AXIS]), v("", &[SHEET_MODE_SLAB]), v("", &[SHEET_MODE_BINNED])],
+        builds: &builds::SHEET_MODES,
     },
     composite => Composite {
         kind: Kind::Compute,
@@ -468,8 +405,7 @@ stages! {
         workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
         timing: "composite",
         device_build: None,
-        // Float layers (the summation image), fixed-point layers (`Res::Fixed`).
-        variants: &[v("", &[]), v("", &[1])],
+        builds: &builds::COMPOSITE_LAYERS,
     },
     raycast => Raycast {
         kind: Kind::Compute,
@@ -479,7 +415,7 @@ stages! {
         workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
         timing: "raycast",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
     present => Present {
         kind: Kind::Compute,
@@ -489,7 +425,7 @@ stages! {
         workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
         timing: "present",
         device_build: None,
-        variants: ONE,
+        builds: &builds::ONLY,
     },
 }
 
@@ -547,31 +483,37 @@ impl StageId {
 pub struct Dispatch {
     /// The stage.
     pub stage: StageId,
-    /// Index into the stage's `variants`.
+    /// The build.
+    pub build: Build,
+    /// Where `build` sits in the stage's table (its pipeline, its mirror's variant).
     pub variant: usize,
     /// Workgroups, draw list and push constants.
     pub args: Args,
 }
 
 impl Dispatch {
-    /// A dispatch of `stage`'s build `variant` (push: the stage's push-constant struct's bytes).
-    pub fn new(stage: StageId, variant: usize, groups: [u32; 3], list: List, push: &[u8]) -> Self {
-        debug_assert_eq!(push.len() as u32, stage.desc().push, "{}: push size", stage.desc().name);
-        Self { stage, variant, args: Args { groups, list, push: push.to_vec() } }
+    /// A dispatch of `stage`'s `build` (push: the stage's push-constant struct's bytes). Refused
+    /// when the stage has no such build or its push constants are of another size.
+    pub fn new(stage: StageId, build: impl Into<Build>, groups: [u32; 3], list: List, push: &[u8]) -> Result<Self> {
+        let (desc, build) = (stage.desc(), build.into());
+        let variant = desc.builds.index(build).ok_or_else(|| {
+            Error::Unsupported(format!("{}: no build {build:?} (its builds: {:?})", desc.name, desc.builds.builds))
+        })?;
+        if push.len() as u32 != desc.push {
+            return Err(Error::InvalidArgument(format!(
+                "{}: {} bytes of push constants, not {}",
+                desc.name,
+                push.len(),
+                desc.push
+            )));
+        }
+        Ok(Self { stage, build, variant, args: Args { groups, list, push: push.to_vec() } })
     }
-}
 
-/// What an engine can hold, which the frame's plan must respect.
-#[derive(Clone, Copy, Debug)]
-pub struct Limits {
-    /// Most layers of the summation image.
-    pub max_layers: u32,
-    /// Largest storage binding in bytes (the fixed-point layers are one).
-    pub max_storage_range: u64,
-    /// Device memory a frame may hold (`RendererOptions::gpu_budget_bytes`): a bricked volume's
-    /// splats stream through it in batches. The CPU engine keeps the same budget, so it cuts the
-    /// same batches.
-    pub budget_bytes: u64,
+    /// What the stage's mirror and pipeline are made of for this build.
+    pub fn variant(&self) -> &'static Variant {
+        &self.stage.desc().builds.variants[self.variant]
+    }
 }
 
 /// Runs a recording: the Vulkan device, the CPU mirrors, or a split of the two.

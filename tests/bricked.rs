@@ -154,9 +154,9 @@ fn streaming_through_a_small_budget_draws_the_same_frame() {
         whole.set_volume(&vol, &tf(), None).unwrap();
         let scene = whole.volume().unwrap();
         // Room for about a fifth of the splats in each batch.
-        let least = voxsplat::recording::bricked_min_budget(scene, u64::MAX, 80, 80);
+        let least = voxsplat::plan::bricked_min_budget(scene, u64::MAX, 80, 80);
         let splats = scene.store.len() as u64;
-        let budget = least + splats / 5 * voxsplat::recording::BATCH_BYTES_PER_SPLAT;
+        let budget = least + splats / 5 * voxsplat::plan::BATCH_BYTES_PER_SPLAT;
         assert!(!scene.streams(budget), "the store stays resident");
         let mut streamed = renderer(gpu, Some(budget));
         streamed.set_volume(&vol, &tf(), None).unwrap();
@@ -386,8 +386,8 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
     assert_eq!(count, 0, "brick_cull's counts differ at {count} slots, first {differ:?}");
     // The first batch's splats: the bricks in slot order up to the batch capacity.
     let budget = voxsplat::constants::DEFAULT_GPU_BUDGET;
-    let resident = voxsplat::recording::bricked_resident_bytes(g.volume().unwrap(), budget, 48, 48);
-    let capacity = ((budget - resident) / voxsplat::recording::BATCH_BYTES_PER_SPLAT)
+    let resident = voxsplat::plan::bricked_resident_bytes(g.volume().unwrap(), budget, 48, 48);
+    let capacity = ((budget - resident) / voxsplat::plan::BATCH_BYTES_PER_SPLAT)
         .min(voxsplat::constants::MAX_GPU_SPLATS as u64) as u32;
     let mut first = 0;
     for w in a[0].iter().filter(|&&w| w != 0) {
@@ -424,7 +424,7 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
         // Under twice the records, the store streams; above the streamed minimum, it draws.
         let budget = 2 * records - 1;
         assert!(scene.streams(budget));
-        let least = voxsplat::recording::bricked_min_budget(scene, budget, 64, 64);
+        let least = voxsplat::plan::bricked_min_budget(scene, budget, 64, 64);
         assert!(least < budget, "{least} < {budget}");
         let mut streamed = renderer(gpu, Some(budget));
         streamed.set_volume(&vol, &tf(), None).unwrap();
@@ -512,9 +512,9 @@ fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classificat
     for gpu in [true, false] {
         let mut whole = renderer(gpu, None);
         whole.set_volume(&vol, &tf(), None).unwrap();
-        let least = voxsplat::recording::bricked_min_budget(whole.volume().unwrap(), u64::MAX, 96, 80);
+        let least = voxsplat::plan::bricked_min_budget(whole.volume().unwrap(), u64::MAX, 96, 80);
         let splats = whole.volume().unwrap().store.len() as u64;
-        let budget = least + 2 * sheet_budget + splats / 6 * voxsplat::recording::BATCH_BYTES_PER_SPLAT;
+        let budget = least + 2 * sheet_budget + splats / 6 * voxsplat::plan::BATCH_BYTES_PER_SPLAT;
         let mut small = renderer(gpu, Some(budget));
         small.set_volume(&vol, &tf(), None).unwrap();
         for composite in [Composite::Sheet, Composite::Slab] {
@@ -699,7 +699,7 @@ fn uniform_bricks_draw_as_their_voxels_do() {
     whole.set_volume(&vol, &tf, None).unwrap();
     let scene = whole.volume().unwrap();
     assert!(scene.store.headers.iter().filter(|h| h.is_uniform()).count() >= 12);
-    let least = voxsplat::recording::bricked_min_budget(scene, u64::MAX, 72, 64);
+    let least = voxsplat::plan::bricked_min_budget(scene, u64::MAX, 72, 64);
     let most = scene.store.records.len() as u64 * 8; // streams below twice the records
     assert!(least < most, "{least} {most}");
     let budget = (least + most) / 2;
@@ -753,7 +753,7 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
             // levels of detail): they do not fit.
             let bytes = scene.store.gradient_len() * 4;
             let pyramid = voxsplat::plan::pyramid_bytes(voxsplat::plan::LOD_BUFFERS, scene.store.headers.len());
-            let resident = voxsplat::recording::bricked_resident_bytes(scene, u64::MAX, 80, 80);
+            let resident = voxsplat::plan::bricked_resident_bytes(scene, u64::MAX, 80, 80);
             assert!(!scene.streams(resident + 4 * bytes), "the store stays resident");
             for (o, which, held) in [(&fine, "full detail", 0), (&coarse, "coarse cells", pyramid)] {
                 let budget = resident + held + 4 * bytes - 4;

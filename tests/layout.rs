@@ -354,3 +354,26 @@ fn every_stage_has_its_shader_and_a_mirror_file_of_its_name() {
         assert!(table.contains(&format!("\n    {name} => ")), "stages.rs declares no row for {name}");
     }
 }
+
+/// Plan first, then record: past `record_frame` (which makes the plan), no function of the
+/// recording takes the render options; it reads the plan and the counts the device reads back.
+#[test]
+fn the_recording_reads_the_plan_not_the_options() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = vec![root.join("recording.rs")];
+    files.extend(rust_files(&root.join("recording")));
+    assert!(files.len() >= 3, "{files:?}");
+    let mut functions = 0;
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (i, _) in text.match_indices("fn ") {
+            let signature = &text[i..i + text[i..].find('{').unwrap_or(text.len() - i)];
+            let name = signature[3..].split(|c: char| !c.is_alphanumeric() && c != '_').next().unwrap();
+            functions += 1;
+            if signature.contains("RenderOptions") {
+                assert_eq!(name, "record_frame", "{}: `{name}` takes the render options", f.display());
+            }
+        }
+    }
+    assert!(functions > 20, "functions read: {functions}");
+}

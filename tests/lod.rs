@@ -363,17 +363,17 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
         // summaries, each batch building its coarse bricks' pyramids.
         let scene = resident.volume().unwrap();
         let headers = scene.store.headers.len();
-        let per_batch = voxsplat::recording::bricked_min_budget(scene, records, SIDE, SIDE)
+        let per_batch = voxsplat::plan::bricked_min_budget(scene, records, SIDE, SIDE)
             + pyramid_bytes(STREAMED_LOD_BUFFERS, headers)
             + 64 * PYRAMID_BYTES;
         // The resident pyramid built in one batch, and in several (room for it and under all
         // the records).
         let slotted = pyramid_bytes(SLOTTED_LOD_BUFFERS, headers);
-        let several = voxsplat::recording::bricked_resident_bytes(scene, 2 * records - 1, SIDE, SIDE) + 2 * slotted;
+        let several = voxsplat::plan::bricked_resident_bytes(scene, 2 * records - 1, SIDE, SIDE) + 2 * slotted;
         assert!(slotted < records, "the pyramid and a batch leave less room than the records take");
         let budgets = [2 * records - 1, several, per_batch];
         for (k, &budget) in budgets.iter().enumerate() {
-            let room = budget - voxsplat::recording::bricked_resident_bytes(scene, budget, SIDE, SIDE);
+            let room = budget - voxsplat::plan::bricked_resident_bytes(scene, budget, SIDE, SIDE);
             assert!(scene.streams(budget));
             assert_eq!(slotted <= room / 2, k < 2, "{budget}");
         }

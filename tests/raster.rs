@@ -365,7 +365,8 @@ fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tile
         let (axis, batches) = sheet_plan(&prep, cam, o.direction(), 1 << 16);
         (prep.slices[axis].1.clone(), batches)
     } else {
-        let pc = voxsplat::slab::slab_geometry(&frame, set.grid(), set.len(), o.slab_thickness, o.direction()).unwrap();
+        let pc = voxsplat::plan::slab::slab_geometry(&frame, set.grid(), set.len(), o.slab_thickness, o.direction())
+            .unwrap();
         slab_bins(&pc, &params)
     };
     let push = sheet_tiles_push(&batches, &batches[0]);
@@ -463,7 +464,7 @@ fn slab_bins(
     let mut start = vec![0u32; pc.slabs as usize + 1];
     voxsplat::cpu::slab_count(pc, params, None, &mut counts);
     voxsplat::cpu::slab_scan(pc, &mut counts, &mut start);
-    let batches = voxsplat::slab::slab_batches(pc, &start, 1 << 16).unwrap();
+    let batches = voxsplat::plan::slab::slab_batches(pc, &start, 1 << 16).unwrap();
     let mut pairs = vec![0u32; 2 * start[pc.slabs as usize] as usize];
     voxsplat::cpu::slab_scatter(pc, params, None, &mut counts, &mut pairs);
     (pairs, batches)

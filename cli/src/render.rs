@@ -108,14 +108,21 @@ pub(crate) struct RenderArgs {
     /// one-off costs: allocation, shader compilation on some drivers).
     #[arg(long, default_value_t = 1, conflicts_with_all = ["raycast", "truth"])]
     repeat: u32,
+    /// Print what the frame would draw and how (the raster, the order, the sheet batches, a
+    /// volume's memory split and levels of detail) instead of rendering it.
+    #[arg(long, conflicts_with_all = ["raycast", "truth", "out", "k_line", "repeat", "timings"])]
+    plan: bool,
     /// Output file, .png or .exr.
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(long, required_unless_present = "plan")]
+    out: Option<PathBuf>,
 }
 
 /// Runs `voxsplat render`.
 pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
-    voxsplat::output::ImageFormat::of(&a.out)?;
+    let out = a.out.clone().unwrap_or_default();
+    if !a.plan {
+        voxsplat::output::ImageFormat::of(&out)?;
+    }
     let order = a.scene.order.parse::<OrderKind>()?;
     let composite = a.composite.parse::<Composite>()?;
     // A volume is a bricked store classified on the device unless a mode needs host splats.
@@ -157,6 +164,9 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     a.compositing.parse::<voxsplat::distributed::Scheme>()?;
     #[cfg(feature = "mpi")]
     if voxsplat::distributed::mpi::launched() {
+        if a.plan {
+            return Err(Error::InvalidArgument("--plan prints one renderer's plan: run it without mpirun".into()));
+        }
         return render_distributed(&a, &opts, host_splats);
     }
     let (bricked, set, content) = open(&a.scene, host_splats)?;
@@ -179,6 +189,15 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
     if a.truth && a.render_scale != 1.0 {
         return Err(Error::InvalidArgument("--truth is the full-size reference: drop --render-scale".into()));
+    }
+    if a.plan {
+        let mut r = renderer_of(&a.scene)?;
+        match bricked {
+            Some(b) => r.set_bricks(b)?,
+            None => r.set_scene(set)?,
+        }
+        print!("{}", r.plan(&cam, &opts)?);
+        return report_validation(&r);
     }
     let mut wall = Vec::new();
     let frame = if a.truth {
@@ -238,9 +257,9 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         }
         voxsplat::aa::draw_k_line(&mut image, &regions);
     }
-    voxsplat::output::write_image(&image, &a.out)?;
+    voxsplat::output::write_image(&image, &out)?;
     let what = if r_bricked { "stored voxels" } else { "splats" };
-    eprintln!("{splats} {what} -> {}", a.out.display());
+    eprintln!("{splats} {what} -> {}", out.display());
     if let Some(c) = &frame.raster {
         eprintln!("raster: {} ({})", c.raster, c.reason);
     }
@@ -365,14 +384,15 @@ fn distributed_frames(
     }
     let frames: Vec<_> = frames.into_iter().flatten().collect();
     let Some(last) = frames.last() else { return Ok(()) };
-    voxsplat::output::write_image(&last.image, &a.out)?;
+    let out = a.out.clone().unwrap_or_default();
+    voxsplat::output::write_image(&last.image, &out)?;
     eprintln!(
         "{} stored voxels on {} ranks ({}) by {} -> {}",
         stored.iter().sum::<u64>(),
         stored.len(),
         stored.iter().map(u64::to_string).collect::<Vec<_>>().join(" + "),
         d.scheme().name(),
-        a.out.display()
+        out.display()
     );
     if a.timings {
         for stage in ["render", "composite"] {

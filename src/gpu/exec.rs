@@ -187,7 +187,7 @@ fn record(
                     rec.barrier(Stage::Compute, Stage::All);
                 }
                 Kind::Draw => {
-                    let state = desc.variants[d.variant].draw.expect("draw variants carry raster state");
+                    let state = d.variant().draw.expect("draw variants carry raster state");
                     let (first, count) = (d.args.groups[0], d.args.groups[1]);
                     let carry = d.args.push_as::<crate::gpu_types::FootprintPush>().carry != 0;
                     match state.pass {

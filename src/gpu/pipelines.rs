@@ -71,8 +71,8 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Resu
     };
     let layout = Layout::new(ctx, &slots, flags, desc.push)?;
     let device = desc.device_build.filter(|(f, _)| has(ctx, *f)).map(|(_, d)| d);
-    let mut variants = Vec::with_capacity(desc.variants.len());
-    for v in desc.variants {
+    let mut variants = Vec::with_capacity(desc.builds.variants.len());
+    for v in desc.builds.variants {
         let defines: Vec<&str> = device.into_iter().chain((!v.defines.is_empty()).then_some(v.defines)).collect();
         let defines = defines.join("+");
         let pipe = match (desc.kind, v.draw, desc.shaders) {

@@ -2,42 +2,17 @@
 //! device budget, and the per-splat, sheet and slab modes over them. Part of THE recording.
 use super::*;
 use crate::bricks::{slot_entry, BrickScene, BRICK};
-use crate::constants::{MAX_GPU_SPLATS, PYRAMID_PAGE, PYRAMID_PAGES};
+use crate::builds::{Pyramids, Records};
+use crate::constants::MAX_GPU_SPLATS;
 use crate::options::FrameStats;
-use crate::plan::{
-    node_and_cut_words, node_grid, node_levels, occlusion_len, pyramid_bytes, LOD_BUFFERS, LOD_LEVELS, PYRAMID_BYTES,
-    SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS,
-};
+use crate::plan::{node_grid, occlusion_len, LOD_LEVELS};
+use crate::plan::{BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT};
 use crate::residency::{RecordCache, SLOT_WORDS};
 use std::cell::Cell;
 use std::sync::Mutex;
 
-/// Device bytes a bricked frame holds per splat of a batch: its parameters (80), order entry and
-/// voxel (8), and for the tile compositor its screen quad (80) and about four tile entries (the
-/// sheet modes' (splat, slab) pairs fit in the last two).
-pub const BATCH_BYTES_PER_SPLAT: u64 = 80 + 4 + 8 + 80 + 16;
 /// And per coarse splat (levels of detail), its position in `Res::LodSplats`.
 const LOD_SPLAT_BYTES: u64 = 4;
-
-/// What a bricked frame keeps resident besides its batches under `budget`: the store (without its
-/// records when they stream, `BrickScene::streams`; then the per-brick counts), the brick index,
-/// the draw-order slots and visible list, and the images.
-pub fn bricked_resident_bytes(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
-    let s = &scene.store;
-    let store = if scene.streams(budget) {
-        s.bytes() - s.records.len() as u64 * 4 + s.headers.len() as u64 * 4
-    } else {
-        s.bytes()
-    };
-    store + s.index.len() as u64 * (4 + 4 + 16) + scene.tree().len() as u64 * 16 + width as u64 * height as u64 * 16 * 3
-}
-
-/// The least budget that draws `scene` at `width` x `height`: resident data and one brick's splats
-/// (and records, when they stream).
-pub fn bricked_min_budget(scene: &BrickScene, budget: u64, width: u32, height: u32) -> u64 {
-    let brick = (BRICK as u64).pow(3) * (BATCH_BYTES_PER_SPLAT + 4 * scene.streams(budget) as u64);
-    bricked_resident_bytes(scene, budget, width, height) + brick
-}
 
 /// A bricked volume's frame: `brick_cull` culls whole bricks on the device (outside
 /// the view, or empty under the transfer function) and counts the rest's voxels at their slots in
@@ -53,146 +28,38 @@ pub(super) fn record_bricks(
     e: &mut dyn Engine,
     prep: &Prepared,
     scene: &BrickScene,
-    camera: &Camera,
-    opts: &RenderOptions,
+    plan: &FramePlan,
+    b: &BrickedPlan,
 ) -> Result<Recorded> {
-    let sheets = opts.composite != Composite::Splat;
-    if !sheets && opts.order != OrderKind::Pbtf {
-        return Err(Error::Unsupported(
-            "a bricked volume is drawn per splat in PBTF order; the other orders need a classified splat set".into(),
-        ));
-    }
-    let (w, h) = (camera.width, camera.height);
-    let budget = e.limits().budget_bytes;
-    let streamed = scene.streams(budget);
-    if streamed && (scene.shading().is_some() || scene.transfer_function().gradient_weight > 0.0) {
-        return Err(Error::Unsupported(format!(
-            "this volume's store ({} MiB) streams through the {} MiB GPU budget, and gradients (shading, gradient \
-             weighting) read neighbouring bricks that a batch does not hold: a budget of at least {} MiB keeps it \
-             resident",
-            scene.store.bytes() >> 20,
-            budget >> 20,
-            (scene.store.records.len() as u64 * 8).div_ceil(1 << 20) + 1
-        )));
-    }
-    // Levels of detail, per splat: the pyramid is built from the records on the device when the
-    // classification changes (a streamed store's batch by batch: its coarse bricks then need no
-    // records). When a streamed store's pyramid would take more than half of what the budget
-    // leaves, only the bricks' summaries stay, and each batch rebuilds its coarse bricks' pyramids.
-    let lod = opts.lod == Lod::Auto && !sheets;
+    let (w, h) = (plan.width, plan.height);
+    let (streamed, lod, per_batch, available) = (b.streamed, b.lod, b.per_batch, b.available);
+    let (grid, node_levels, split, bf) = (b.grid, b.node_levels, b.split, &b.brick_frame);
     let headers = scene.store.headers.len().max(1);
-    let room = budget.saturating_sub(bricked_resident_bytes(scene, budget, w, h));
-    let slotted = pyramid_bytes(SLOTTED_LOD_BUFFERS, headers);
-    // The pyramid binds as up to PYRAMID_PAGES storage ranges.
-    let most_cells = PYRAMID_PAGE as u64 * 4 * PYRAMID_PAGES as u64;
-    let fits = headers as u64 * PYRAMID_BYTES <= most_cells;
-    if lod && !streamed && !fits {
-        // Streaming needs records to stream (a store of uniform bricks has few or none).
-        let records = scene.store.records.len() as u64 * 4;
-        let stream = if records > 0 {
-            format!(
-                "a GPU budget under {} MiB streams the store's records and builds the pyramid batch by batch, or ",
-                (2 * records) >> 20
-            )
-        } else {
-            String::new()
-        };
-        return Err(Error::TooLarge(format!(
-            "levels of detail: the pyramid of {headers} bricks takes {} MiB, more than the {} MiB its {PYRAMID_PAGES} \
-             storage bindings hold; {stream}levels of detail off (--lod off) draw every voxel instead",
-            (headers as u64 * PYRAMID_BYTES) >> 20,
-            most_cells >> 20
-        )));
-    }
-    let lod_buffers = match (streamed, fits && slotted <= room / 2) {
-        (false, _) => LOD_BUFFERS,
-        (true, true) => SLOTTED_LOD_BUFFERS,
-        (true, false) => STREAMED_LOD_BUFFERS,
-    };
-    let per_batch = lod && lod_buffers == STREAMED_LOD_BUFFERS;
-    let batch_pyramid = if per_batch { PYRAMID_BYTES } else { 0 };
-    // The nodes above the brick, after the summaries (resident with them).
-    let grid = scene.store.dims.map(|d| d.div_ceil(BRICK));
-    let node_levels = if lod && opts.lod_nodes { node_levels(grid, headers) } else { 0 };
-    let node_bytes = node_and_cut_words(grid, node_levels) * 4;
-    let pyramid = if lod { pyramid_bytes(lod_buffers, headers) + batch_pyramid + node_bytes } else { 0 };
-    let least = bricked_min_budget(scene, budget, w, h) + pyramid;
-    if budget < least {
-        let levels = if lod {
-            format!(
-                ", its levels-of-detail pyramid ({} MiB; levels of detail off draw without it, from {} MiB)",
-                pyramid.div_ceil(1 << 20),
-                (least - pyramid).div_ceil(1 << 20)
-            )
-        } else {
-            String::new()
-        };
-        // A store streamed at this budget keeps its records on the host: the minimum is what stays
-        // resident, below the store's size (it said "cannot hold the store", then named less).
-        let store = if streamed {
-            format!(
-                "stream this volume's bricked store ({} MiB, its records kept on the host at this budget): its \
-                 headers and summaries",
-                scene.store.bytes() >> 20
-            )
-        } else {
-            format!("hold this volume's bricked store ({} MiB)", scene.store.bytes() >> 20)
-        };
-        return Err(Error::TooLarge(format!(
-            "a GPU budget of {} MiB cannot {store}{levels} and one brick of splats at {w}x{h}: the minimum is {} MiB",
-            budget >> 20,
-            least.div_ceil(1 << 20)
-        )));
-    }
-    let available = budget - bricked_resident_bytes(scene, budget, w, h) - pyramid;
-    let range = e.limits().max_storage_range;
-    // A streamed store's records live in a cache of whole-brick slots across frames (half of
-    // what the batches leave, one binding at most): a batch uploads only the bricks it lacks.
-    let (available, cache_slots) = if streamed {
-        let slot = SLOT_WORDS * 4;
-        let brick = (BRICK as u64).pow(3) * BATCH_BYTES_PER_SPLAT;
-        let most = (range / slot).min(headers as u64).min(u32::MAX as u64).max(1);
-        let slots = (available.saturating_sub(brick) / 2 / slot).clamp(1, most);
-        (available - slots * slot, slots as u32)
-    } else {
-        (available, 0)
-    };
-    // The brick stages' build: one page of store records, the paged reader, or streamed records.
-    let build = if streamed { 2 } else { usize::from(scene.store.records.len() > RECORD_PAGE as usize) };
-    let gradients = super::gradients::fit(scene, build, range, available);
-    let available = available - gradients.unwrap_or(0);
-    let frame = plan::frame_for(&prep.set, camera, opts);
-    let split = crate::order::brick_split(&prep.set, camera, BRICK);
-    let mut bf = crate::plan::brick_frame(scene, split);
-    if lod {
-        (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, opts.lod_error, opts.lod_band);
-        bf.hi[3] = node_levels;
-    }
+    let frame = &plan.frame;
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
-    e.begin(&frame, opts.kernel, w, h)?;
-    e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(&bf)))?;
+    e.begin(frame, plan.kernel, w, h)?;
+    e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
-    if let Some(bytes) = gradients {
+    if let Some(bytes) = b.gradients {
         super::gradients::upload(e, scene, bytes)?;
     }
     let cut = Cut {
         streamed,
-        build,
-        gradient_build: if gradients.is_some() { super::gradients::BUILD } else { build },
-        available,
-        pyramid: batch_pyramid,
-        range,
+        build: b.build,
+        gradient_build: b.gradient_build,
+        pyramid: b.batch_pyramid,
+        range: b.range,
         cache: &scene.records_cache.0,
         uploaded: Cell::new(0),
     };
     if streamed {
-        e.ensure(Res::BatchRecords, cache_slots as u64 * SLOT_WORDS * 4)?;
-        let tag = cut.lock_cache().open(e.tag(Res::BatchRecords), cache_slots);
+        e.ensure(Res::BatchRecords, b.cache_slots as u64 * SLOT_WORDS * 4)?;
+        let tag = cut.lock_cache().open(e.tag(Res::BatchRecords), b.cache_slots);
         e.set_tag(Res::BatchRecords, tag);
     }
     if lod {
-        for &(res, per_brick) in lod_buffers {
-            let nodes = if res == Res::LodSummary { node_bytes } else { 0 };
+        for &(res, per_brick) in b.lod_buffers {
+            let nodes = if res == Res::LodSummary { b.node_bytes } else { 0 };
             e.ensure(res, headers as u64 * per_brick + nodes)?;
         }
         let id = scene.classification();
@@ -207,7 +74,7 @@ pub(super) fn record_bricks(
                 for batch in cut.batches(scene, every, u32::MAX, available.min(SUMMARY_BATCH_BYTES)) {
                     upload_batch(e, scene, &batch, &batch, &cut)?;
                     let push = BrickPush { count: batch.len() as u32, splats: u32::from(!per_batch), ..all };
-                    build_pyramids(e, build, &push)?;
+                    build_pyramids(e, b.build, &push)?;
                 }
                 cut.lock_cache().forget();
                 build_nodes(e, grid, node_levels)?;
@@ -231,18 +98,14 @@ pub(super) fn record_bricks(
     e.fill(Res::BrickSlots, None, 0)?;
     if bf.grid[3] > 0 && node_levels > 0 {
         let count = node_grid(grid, 1).iter().product::<u32>();
-        e.run(&Dispatch::new(StageId::BrickNodeCut, 0, groups_1d(count), List::Order, &[]))?;
+        e.run(&Dispatch::new(StageId::BrickNodeCut, Only, groups_1d(count), List::Order, &[])?)?;
     }
     if bf.grid[3] > 0 {
-        e.run(&Dispatch::new(StageId::BrickCull, build, groups_1d(bf.grid[3]), List::Order, &[]))?;
+        e.run(&Dispatch::new(StageId::BrickCull, b.build, groups_1d(bf.grid[3]), List::Order, &[])?)?;
     }
     let slot_words = e.read(&[(Res::BrickSlots, slots)])?.remove(0);
     let t = Instant::now();
-    let compute = opts.raster == Raster::Compute;
-    // Front to back with early termination, later batches drop the bricks that what is drawn
-    // already hides: cut the frame into a few batches even when it fits one.
-    let terminating = compute && !sheets && opts.direction() == Direction::FrontToBack && opts.early_termination > 0.0;
-    let cull_hidden = terminating && opts.cull_hidden_bricks;
+    let (compute, terminating, cull_hidden) = (b.compute, b.terminating, b.cull_hidden);
     let capacity = if cull_hidden {
         let total: u32 = slot_words.iter().map(|&w| slot_entry(w).2).sum();
         // Two bricks' splats more than the share: batches are cut between bricks, and the last
@@ -285,8 +148,8 @@ pub(super) fn record_bricks(
         e.ensure(Res::Occlusion, occlusion_len(w, h) * 4)?;
         e.ensure(Res::BrickHidden, most_entries * 4)?;
     }
-    if sheets {
-        let mut recorded = record_bricked_sheets(e, prep, scene, camera, opts, &frame, batches.concat(), &cut)?;
+    if let Some(sheets) = &b.sheets {
+        let mut recorded = record_bricked_sheets(e, prep, scene, plan, sheets, batches.concat(), &cut)?;
         stats.bytes_uploaded = cut.uploaded.get();
         stats.records_resident = cut.held_bytes();
         recorded.stats = stats;
@@ -305,10 +168,10 @@ pub(super) fn record_bricks(
             e.ensure(Res::BrickHidden, count as u64 * 4)?;
             e.upload(Res::BrickList, &words(&batch))?;
             // One push for both: the map is built for the threshold the bricks are tested at.
-            let push = BrickPush { first: 0, count, splats: 0, occluded: opts.early_termination };
+            let push = BrickPush { first: 0, count, splats: 0, occluded: b.early_termination };
             let bytes = bytemuck::bytes_of(&push);
-            e.run(&Dispatch::new(StageId::TileOcclusion, 0, groups_1d(tiles), List::Order, bytes))?;
-            e.run(&Dispatch::new(StageId::BrickHidden, 0, groups_1d(count), List::Order, bytes))?;
+            e.run(&Dispatch::new(StageId::TileOcclusion, Only, groups_1d(tiles), List::Order, bytes)?)?;
+            e.run(&Dispatch::new(StageId::BrickHidden, Only, groups_1d(count), List::Order, bytes)?)?;
             let hidden = e.read(&[(Res::BrickHidden, count as usize)])?.remove(0);
             // The bricks left, their positions (and streamed records) laid out again.
             let before = batch_splats(&batch);
@@ -333,20 +196,19 @@ pub(super) fn record_bricks(
             record_brick_batch(e, scene, &batch, &cut)?;
         }
         if compute {
-            record_tiles(e, &frame, n, opts, w, h, i > 0)?;
+            record_tiles(e, frame, &b.tile_rule(n, w, h, plan.direction), w, h, i > 0)?;
         } else {
-            let blend = if opts.direction() == Direction::BackToFront { Blend::Over } else { Blend::Under };
-            let variant = footprint_variant(blend, opts.raster == Raster::Points, SHEET_MODE_SPLAT);
+            let build = b.footprint;
             // A later batch draws on the target (the LOAD pass).
             let push = FootprintPush { carry: u32::from(i > 0), ..Default::default() };
-            e.run(&Dispatch::new(StageId::Footprint, variant, [0, n, 0], List::Order, bytemuck::bytes_of(&push)))?;
+            e.run(&Dispatch::new(StageId::Footprint, build, [0, n, 0], List::Order, bytemuck::bytes_of(&push))?)?;
         }
         i += 1;
     }
     stats.waves = batches.len() as u32;
     stats.bytes_uploaded = cut.uploaded.get();
     stats.records_resident = cut.held_bytes();
-    let mut recorded = finish(e, opts.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)?;
+    let mut recorded = finish(e, plan.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)?;
     recorded.stats = stats;
     Ok(recorded)
 }
@@ -356,10 +218,9 @@ pub(super) fn record_bricks(
 /// store's levels of detail with pyramids built per batch, whose coarse entries need their records).
 struct Cut<'a> {
     streamed: bool,
-    build: usize,
-    /// `brick_params`' and a resident pyramid's build: `build`, or `gradients::BUILD`.
-    gradient_build: usize,
-    available: u64,
+    build: Records,
+    /// `brick_params`' and a resident pyramid's build: `build`, or `Records::Gradients`.
+    gradient_build: Records,
     pyramid: u64,
     /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
     range: u64,
@@ -435,50 +296,33 @@ impl Cut<'_> {
 /// sheets (in visiting order), the bricks that reach its sheets are made, binned and summed part
 /// by part into its layers (each part carrying on from the layers the earlier left), then the
 /// batch is composited; a brick spanning two batches of sheets is made twice.
-#[allow(clippy::too_many_arguments)]
 fn record_bricked_sheets(
     e: &mut dyn Engine,
     prep: &Prepared,
     scene: &BrickScene,
-    camera: &Camera,
-    opts: &RenderOptions,
-    frame: &Frame,
+    plan: &FramePlan,
+    s: &BrickedSheets,
     visible: Vec<[u32; 4]>,
     cut: &Cut,
 ) -> Result<Recorded> {
-    let (w, h) = (camera.width, camera.height);
+    let (w, h, frame, direction) = (plan.width, plan.height, &plan.frame, plan.direction);
     let grid = prep.set.grid();
-    let compute = opts.raster == Raster::Compute;
-    let direction = opts.direction();
-    let sheet = opts.composite == Composite::Sheet;
-    let axis = plan::sheet_axis(grid, camera);
-    let layers = sheet_layers(e, opts, w, h);
-    // The layers (and the compute raster's fixed-point copy) come out of the budget too.
-    let layer_bytes = w as u64 * h as u64 * 16 * layers as u64 * (1 + compute as u64);
-    let brick_bytes = (BRICK as u64).pow(3) * BATCH_BYTES_PER_SPLAT;
-    let Some(available) = cut.available.checked_sub(layer_bytes).filter(|&a| a >= brick_bytes) else {
-        return Err(Error::TooLarge(format!(
-            "the {} MiB GPU budget cannot hold this volume's store, {layers} summation layers of {w}x{h} and one \
-             brick of splats: raise it by {} MiB or lower --sheet-budget-mib",
-            e.limits().budget_bytes >> 20,
-            (layer_bytes + brick_bytes).saturating_sub(cut.available).div_ceil(1 << 20)
-        )));
-    };
+    let (sheet, axis, pass, available) = (s.axis_sheets, s.axis, &s.pass, s.available);
     let geometry = |n: u32| {
         if sheet {
-            crate::slab::sheet_geometry(grid, n, axis)
+            crate::plan::slab::sheet_geometry(grid, n, axis)
         } else {
-            crate::slab::slab_geometry(frame, grid, n as usize, opts.slab_thickness, direction)
+            crate::plan::slab::slab_geometry(frame, grid, n as usize, s.slab_thickness, direction)
         }
     };
-    let variant = sheet as usize;
-    let split = crate::order::pbtf_split(&prep.set, camera)[axis];
-    let plan_of = |pc: &SlabPush, starts: &[u32]| {
-        if sheet {
-            Ok(plan::binned_sheet_plan(starts, axis, split, direction, layers))
+    let binning = if sheet { SlabBins::AxisSheets } else { SlabBins::Slabs };
+    let plan_of = |pc: &SlabPush, starts: &[u32]| -> Result<Vec<plan::Batch>> {
+        let batches = if sheet {
+            plan::binned_sheet_plan(starts, axis, s.split, direction, pass.layers)
         } else {
-            crate::slab::slab_batches(pc, starts, layers)
-        }
+            crate::plan::slab::slab_batches(pc, starts, pass.layers)?
+        };
+        Ok(pass.terminated(batches))
     };
     let parts = cut.batches(scene, visible.iter().copied(), MAX_GPU_SPLATS, available);
     if parts.len() == 1 {
@@ -488,8 +332,8 @@ fn record_bricked_sheets(
             record_brick_batch(e, scene, part, cut)?;
         }
         let pc = geometry(n)?;
-        let starts = record_slab_bins(e, &pc, variant)?;
-        return record_sheets(e, List::SlabPairs, plan_of(&pc, &starts)?, opts, w, h);
+        let starts = record_slab_bins(e, &pc, binning)?;
+        return record_sheets(e, pass, plan_of(&pc, &starts)?, plan.background, w, h);
     }
     // Each brick's bins (sheets or slabs, in index order) and each bin's reach (bricks), in
     // visiting position order for the slabs, index order for the sheets, as the binning writes.
@@ -505,7 +349,7 @@ fn record_bricked_sheets(
             if sheet {
                 (lo[axis], hi[axis])
             } else {
-                crate::slab::box_slabs(&pc, frame, grid, lo, hi)
+                crate::plan::slab::box_slabs(&pc, frame, grid, lo, hi)
             }
         })
         .collect();
@@ -518,9 +362,8 @@ fn record_bricked_sheets(
     for i in 0..bins {
         starts[i + 1] += starts[i];
     }
-    let mut groups = plan_of(&pc, &starts)?;
-    plan::set_early_termination(opts, &mut groups);
-    begin_sheets(e, List::SlabPairs, &groups, opts, w, h, false)?;
+    let groups = plan_of(&pc, &starts)?;
+    begin_sheets(e, pass, &groups, w, h, false)?;
     for g in &groups {
         let (lo, hi) = if g.push.rank_dir > 0 {
             (g.push.rank_base, g.push.rank_base + g.layers - 1)
@@ -534,13 +377,13 @@ fn record_bricked_sheets(
             if n > 0 {
                 record_brick_batch(e, scene, part, cut)?;
             }
-            let starts = record_slab_bins(e, &geometry(n)?, variant)?;
+            let starts = record_slab_bins(e, &geometry(n)?, binning)?;
             let (first, end) = (starts[p0 as usize], starts[p1 as usize + 1]);
-            sum_sheets(e, List::SlabPairs, g, opts, first, end - first, k > 0)?;
+            sum_sheets(e, pass, g, first, end - first, k > 0)?;
         }
-        composite_sheets(e, List::SlabPairs, g, opts, w, h)?;
+        composite_sheets(e, pass, g, w, h)?;
     }
-    finish(e, opts.background, &[Res::Accum], w, h, compute)
+    finish(e, plan.background, &[Res::Accum], w, h, pass.compute)
 }
 
 /// Splats of a batch of visible bricks (entries: header, first position, first record, voxels).
@@ -572,7 +415,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     let push = BrickPush { first: 0, count: fine.len() as u32, splats: n, occluded: 0.0 };
     if !fine.is_empty() {
         let groups = plan::groups_per_item(fine.len() as u32);
-        e.run(&Dispatch::new(StageId::BrickOrder, build, groups, List::Order, bytemuck::bytes_of(&push)))?;
+        e.run(&Dispatch::new(StageId::BrickOrder, build, groups, List::Order, bytemuck::bytes_of(&push))?)?;
     }
     if !coarse.is_empty() {
         let cells = BrickPush { first: fine.len() as u32, count: coarse.len() as u32, ..push };
@@ -582,8 +425,8 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
             build_pyramids(e, build, &BrickPush { count: level_1, splats: 0, ..cells })?;
         }
         let groups = groups_1d(coarse.len() as u32);
-        let variant = usize::from(streamed);
-        e.run(&Dispatch::new(StageId::BrickCells, variant, groups, List::Order, bytemuck::bytes_of(&cells)))?;
+        let pyramids = if streamed { Pyramids::Streamed } else { Pyramids::Resident };
+        e.run(&Dispatch::new(StageId::BrickCells, pyramids, groups, List::Order, bytemuck::bytes_of(&cells))?)?;
     }
     e.run(&Dispatch::new(
         StageId::BrickParams,
@@ -591,7 +434,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         groups_1d(n),
         List::Order,
         bytemuck::bytes_of(&push),
-    ))?;
+    )?)?;
     // The coarse splats' positions, for brick_lod_params' lanes.
     let lod_splats: Vec<u32> = coarse.iter().flat_map(|l| l[1]..l[1] + (l[3] & 0xffff)).collect();
     if !lod_splats.is_empty() {
@@ -599,16 +442,16 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         e.upload(Res::LodSplats, &lod_splats)?;
         let cells = BrickPush { splats: lod_splats.len() as u32, ..push };
         let groups = groups_1d(cells.splats);
-        e.run(&Dispatch::new(StageId::BrickLodParams, build, groups, List::Order, bytemuck::bytes_of(&cells)))?;
+        e.run(&Dispatch::new(StageId::BrickLodParams, build, groups, List::Order, bytemuck::bytes_of(&cells))?)?;
     }
     Ok(())
 }
 
 /// `brick_pyramid` over `push.count` bricks (a resident store's all; a streamed store's batch entries
 /// from `push.first`, into their own slots when `push.splats` is not 0).
-fn build_pyramids(e: &mut dyn Engine, build: usize, push: &BrickPush) -> Result<()> {
+fn build_pyramids(e: &mut dyn Engine, build: Records, push: &BrickPush) -> Result<()> {
     let groups = plan::groups_per_item(push.count);
-    e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(push)))
+    e.run(&Dispatch::new(StageId::BrickPyramid, build, groups, List::Order, bytemuck::bytes_of(push))?)
 }
 
 /// `brick_nodes` over tree levels 1..=`levels` of a `grid` of bricks, each from the one below.
@@ -616,7 +459,7 @@ fn build_nodes(e: &mut dyn Engine, grid: [u32; 3], levels: u32) -> Result<()> {
     for k in 1..=levels {
         let count = node_grid(grid, k).iter().product::<u32>();
         let push = BrickPush { first: k, count, splats: 0, occluded: 0.0 };
-        e.run(&Dispatch::new(StageId::BrickNodes, 0, groups_1d(count), List::Order, bytemuck::bytes_of(&push)))?;
+        e.run(&Dispatch::new(StageId::BrickNodes, Only, groups_1d(count), List::Order, bytemuck::bytes_of(&push))?)?;
     }
     Ok(())
 }

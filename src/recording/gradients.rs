@@ -4,18 +4,6 @@
 use super::*;
 use crate::bricks::BrickScene;
 
-/// The build of `brick_params` and `brick_pyramid` that reads `Res::BrickGradients` (stages.rs,
-/// `GRADIENT_BUILDS`).
-pub(super) const BUILD: usize = 3;
-
-/// The bytes the two buffers take when this frame reads them: it classifies with gradients, its
-/// store is resident in one page (`build` 0), each fits a binding and both fit half of what the
-/// store leaves of the budget (`available`). `None`: neighbours are read through the store.
-pub(super) fn fit(scene: &BrickScene, build: usize, range: u64, available: u64) -> Option<u64> {
-    let bytes = scene.store.gradient_len() * 4;
-    (build == 0 && scene.reads_gradients() && bytes <= range.min(available / 4)).then_some(2 * bytes)
-}
-
 /// Make the two buffers hold this classification's differences (`bytes`: both), made on its first
 /// frame (the 512³ bonsai: ~0.2 s, the `gradients` time).
 pub(super) fn upload(e: &mut dyn Engine, scene: &BrickScene, bytes: u64) -> Result<()> {

@@ -14,12 +14,11 @@
 //! (`slab_count`, `slab_scan`, `slab_scatter`, mirrored in `cpu::slab`). The host only fixes the
 //! slab geometry from the grid's bounds (O(1)) and reads back the slabs' first pairs (one u32 per
 //! slab) to size the pair buffer and cut the batches.
+use super::{footprint_scale, Batch};
 use crate::constants::SLAB_CHUNK;
 use crate::error::{Error, Result};
 use crate::gpu_types::{FootprintPush, Frame, SlabPush, SHEET_MODE_SLAB};
 use crate::order::Direction;
-use crate::plan::footprint_scale;
-use crate::plan::Batch;
 use crate::volume::Grid;
 use glam::Vec3;
 

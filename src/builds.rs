@@ -1,0 +1,375 @@
+//! Every stage's builds, by name. A stage's row in `crate::stages` names one [`Table`]; its
+//! values, in order, are the builds the engines make (the Vulkan engine one pipeline each, the
+//! CPU engine the mirror's [`Variant`]). A dispatch names a [`Build`] value, never an index:
+//! `Dispatch::new` finds the value in the stage's table and refuses one the stage lacks.
+use crate::dispatch::{Blend, DrawState, Pass, Variant};
+use crate::gpu_types::{SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+
+/// A stage's builds: the values a dispatch may name and, in the same order, what each is made of.
+#[derive(Debug)]
+pub struct Table {
+    /// The builds, in pipeline order.
+    pub builds: &'static [Build],
+    /// Each build's defines, specialization constants and draw state.
+    pub variants: &'static [Variant],
+}
+
+impl Table {
+    /// Where `build` sits in the table, if the stage has it.
+    pub fn index(&self, build: Build) -> Option<usize> {
+        self.builds.iter().position(|&b| b == build)
+    }
+}
+
+/// One build of some stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Build {
+    /// The stage's one build.
+    Only,
+    /// A brick stage's reading of the store's records.
+    Records(Records),
+    /// `brick_cells`: a resident pyramid or a streamed batch's.
+    Pyramids(Pyramids),
+    /// The slab binning stages' grouping.
+    SlabBins(SlabBins),
+    /// The tile binning stages' pages of splat records.
+    Pages(Pages),
+    /// The compute tile compositor.
+    TileComposite(TileComposite),
+    /// `sheet_tiles`.
+    SheetTiles(SheetTiles),
+    /// The footprint draw.
+    Footprint(Footprint),
+    /// `footprint_sum`: the sheets it sums.
+    SheetMode(SheetMode),
+    /// `composite`: the layers it reads.
+    CompositeLayers(CompositeLayers),
+}
+
+/// The stage's only build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Only;
+
+/// How a brick stage reads the store's records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Records {
+    /// One page of records (`RECORD_PAGE`).
+    OnePage,
+    /// Up to `RECORD_PAGES` pages (`PAGED_RECORDS`).
+    Paged,
+    /// A streamed store: the batch's records only (`STREAMED_STORE`).
+    Streamed,
+    /// One page, with the voxels' differences read from `Res::BrickGradients` (`GRADIENTS`):
+    /// `brick_params` and `brick_pyramid` only.
+    Gradients,
+}
+
+impl Records {
+    /// The reading of a store of `records` words, or of a streamed one.
+    pub fn of(streamed: bool, records: usize) -> Records {
+        if streamed {
+            Records::Streamed
+        } else if records > crate::constants::RECORD_PAGE as usize {
+            Records::Paged
+        } else {
+            Records::OnePage
+        }
+    }
+}
+
+/// `brick_cells`' pyramid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pyramids {
+    /// The store's resident pyramid.
+    Resident,
+    /// A streamed store's batch of pyramids (`STREAMED_STORE`).
+    Streamed,
+}
+
+/// What the slab binning stages group.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlabBins {
+    /// Slabs along the view.
+    Slabs,
+    /// A bricked batch's axis-aligned sheets, by voxel plane (`AXIS_SHEETS`).
+    AxisSheets,
+}
+
+/// The pages of splat records a tile stage reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pages {
+    /// Both pages (the paged reader).
+    Two,
+    /// Only the first (`ONE_PAGE`: llvmpipe runs both sides of the paged reader's branch).
+    One,
+}
+
+impl Pages {
+    /// The pages a scene of `n` splats needs.
+    pub fn of(n: u32) -> Pages {
+        if n <= crate::constants::SPLAT_PAGE {
+            Pages::One
+        } else {
+            Pages::Two
+        }
+    }
+}
+
+/// The tile compositor's walk along each tile's list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TileOrder {
+    /// Back to front.
+    BackToFront,
+    /// Front to back.
+    FrontToBack,
+    /// Front to back, ending a tile's walk once it is opaque.
+    Terminating,
+}
+
+/// A build of the compute tile compositor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileComposite {
+    /// The splat records it reads.
+    pub pages: Pages,
+    /// Its walk.
+    pub order: TileOrder,
+    /// Motion-blurred footprints.
+    pub blur: bool,
+}
+
+/// The sheets a sheet stage works on (`SHEET_MODE_*`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SheetMode {
+    /// Axis-aligned voxel slices.
+    Axis,
+    /// Slabs along the view.
+    Slab,
+    /// A bricked batch's binned slices.
+    Binned,
+}
+
+impl SheetMode {
+    /// The mode a `FootprintPush::sheet_mode` word names (`None`: per-splat, or no mode).
+    pub fn from_word(word: u32) -> Option<SheetMode> {
+        match word {
+            SHEET_MODE_AXIS => Some(SheetMode::Axis),
+            SHEET_MODE_SLAB => Some(SheetMode::Slab),
+            SHEET_MODE_BINNED => Some(SheetMode::Binned),
+            _ => None,
+        }
+    }
+}
+
+/// A build of `sheet_tiles`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SheetTiles {
+    /// The sheets.
+    pub mode: SheetMode,
+    /// Point sprites' footprints (else quads', or the compute sums').
+    pub points: bool,
+}
+
+/// A build of the footprint draw.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Footprint {
+    /// Per-splat compositing into the raster target, `Over` or `Under`.
+    Ordered {
+        /// Back to front (`Over`) or front to back (`Under`).
+        blend: Blend,
+        /// Point sprites rather than quads.
+        points: bool,
+    },
+    /// Summed into the sheet layers.
+    Sheet {
+        /// The sheets.
+        mode: SheetMode,
+        /// Point sprites rather than quads.
+        points: bool,
+    },
+    /// A motion-blurred frame's two time slots (`SLOTS`), `Over` or `Under`.
+    Slots(Blend),
+}
+
+/// The layers `composite` reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CompositeLayers {
+    /// The float summation image.
+    Float,
+    /// The compute raster's fixed-point layers (`Res::Fixed`).
+    Fixed,
+}
+
+macro_rules! into_build {
+    ($($ty:ident),*) => {$(
+        impl From<$ty> for Build {
+            fn from(b: $ty) -> Build {
+                Build::$ty(b)
+            }
+        }
+    )*};
+}
+into_build!(Records, Pyramids, SlabBins, Pages, TileComposite, SheetTiles, Footprint, SheetMode, CompositeLayers);
+
+impl From<Only> for Build {
+    fn from(_: Only) -> Build {
+        Build::Only
+    }
+}
+
+const fn v(defines: &'static str, spec: &'static [u32]) -> Variant {
+    Variant { defines, spec, draw: None }
+}
+
+const fn d(blend: Blend, points: bool, pass: Pass, spec: &'static [u32]) -> Variant {
+    let defines = if matches!(pass, Pass::Slots) { "SLOTS" } else { "" };
+    Variant { defines, spec, draw: Some(DrawState { blend, points, pass }) }
+}
+
+/// A table from `(build, variant)` pairs, so each build sits beside what it is made of.
+macro_rules! table {
+    ($($build:expr => $variant:expr),* $(,)?) => {
+        Table { builds: &[$($build),*], variants: &[$($variant),*] }
+    };
+}
+
+/// Stages with one build.
+pub const ONLY: Table = table! { Build::Only => v("", &[]) };
+
+/// The brick stages that read the store's records.
+pub const RECORDS: Table = table! {
+    Build::Records(Records::OnePage) => v("", &[]),
+    Build::Records(Records::Paged) => v("PAGED_RECORDS", &[]),
+    Build::Records(Records::Streamed) => v("STREAMED_STORE", &[]),
+};
+
+/// `brick_params` and `brick_pyramid`: [`RECORDS`], and one page with precomputed differences.
+pub const RECORDS_OR_GRADIENTS: Table = table! {
+    Build::Records(Records::OnePage) => v("", &[]),
+    Build::Records(Records::Paged) => v("PAGED_RECORDS", &[]),
+    Build::Records(Records::Streamed) => v("STREAMED_STORE", &[]),
+    Build::Records(Records::Gradients) => v("GRADIENTS", &[]),
+};
+
+/// `brick_cells`.
+pub const PYRAMIDS: Table = table! {
+    Build::Pyramids(Pyramids::Resident) => v("", &[]),
+    Build::Pyramids(Pyramids::Streamed) => v("STREAMED_STORE", &[]),
+};
+
+/// `slab_count` and `slab_scatter`.
+pub const SLAB_BINS: Table = table! {
+    Build::SlabBins(SlabBins::Slabs) => v("", &[]),
+    Build::SlabBins(SlabBins::AxisSheets) => v("AXIS_SHEETS", &[]),
+};
+
+/// `tile_count` and `tile_scatter`.
+pub const PAGES: Table = table! {
+    Build::Pages(Pages::Two) => v("", &[]),
+    Build::Pages(Pages::One) => v("ONE_PAGE", &[]),
+};
+
+const fn tc(pages: Pages, order: TileOrder, blur: bool) -> Build {
+    Build::TileComposite(TileComposite { pages, order, blur })
+}
+
+const fn tc_variant(pages: Pages, order: TileOrder, blur: bool) -> Variant {
+    let defines = if matches!(pages, Pages::One) { "ONE_PAGE" } else { "" };
+    // Spec: sheet mode, back to front, terminating, blurred.
+    let spec: &'static [u32] = match (order, blur) {
+        (TileOrder::BackToFront, false) => &[SHEET_MODE_SPLAT, 1, 0, 0],
+        (TileOrder::BackToFront, true) => &[SHEET_MODE_SPLAT, 1, 0, 1],
+        (TileOrder::FrontToBack, false) => &[SHEET_MODE_SPLAT, 0, 0, 0],
+        (TileOrder::FrontToBack, true) => &[SHEET_MODE_SPLAT, 0, 0, 1],
+        (TileOrder::Terminating, false) => &[SHEET_MODE_SPLAT, 0, 1, 0],
+        (TileOrder::Terminating, true) => &[SHEET_MODE_SPLAT, 0, 1, 1],
+    };
+    v(defines, spec)
+}
+
+macro_rules! tile_composite {
+    ($(($p:ident, $o:ident, $b:expr)),* $(,)?) => {
+        table! { $(tc(Pages::$p, TileOrder::$o, $b) => tc_variant(Pages::$p, TileOrder::$o, $b)),* }
+    };
+}
+
+/// The compute tile compositor: pages x walk x blur.
+pub const TILE_COMPOSITE: Table = tile_composite![
+    (Two, BackToFront, false),
+    (Two, BackToFront, true),
+    (Two, FrontToBack, false),
+    (Two, FrontToBack, true),
+    (Two, Terminating, false),
+    (Two, Terminating, true),
+    (One, BackToFront, false),
+    (One, BackToFront, true),
+    (One, FrontToBack, false),
+    (One, FrontToBack, true),
+    (One, Terminating, false),
+    (One, Terminating, true),
+];
+
+const fn st(mode: SheetMode, points: bool) -> Build {
+    Build::SheetTiles(SheetTiles { mode, points })
+}
+
+/// `sheet_tiles`: sheets x (quads or compute sums, points).
+pub const SHEET_TILES: Table = table! {
+    st(SheetMode::Axis, false) => v("", &[SHEET_MODE_AXIS, 0]),
+    st(SheetMode::Axis, true) => v("", &[SHEET_MODE_AXIS, 1]),
+    st(SheetMode::Slab, false) => v("", &[SHEET_MODE_SLAB, 0]),
+    st(SheetMode::Slab, true) => v("", &[SHEET_MODE_SLAB, 1]),
+    st(SheetMode::Binned, false) => v("", &[SHEET_MODE_BINNED, 0]),
+    st(SheetMode::Binned, true) => v("", &[SHEET_MODE_BINNED, 1]),
+};
+
+const fn ordered(blend: Blend, points: bool) -> Build {
+    Build::Footprint(Footprint::Ordered { blend, points })
+}
+
+const fn sheet(mode: SheetMode, points: bool) -> Build {
+    Build::Footprint(Footprint::Sheet { mode, points })
+}
+
+/// The footprint draw: ordered into the target, summed into sheets, or two time slots.
+pub const FOOTPRINT: Table = table! {
+    ordered(Blend::Over, false) => d(Blend::Over, false, Pass::Target, &[SHEET_MODE_SPLAT, 0]),
+    ordered(Blend::Under, false) => d(Blend::Under, false, Pass::Target, &[SHEET_MODE_SPLAT, 0]),
+    sheet(SheetMode::Axis, false) => d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_AXIS, 0]),
+    sheet(SheetMode::Slab, false) => d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_SLAB, 0]),
+    ordered(Blend::Over, true) => d(Blend::Over, true, Pass::Target, &[SHEET_MODE_SPLAT, 1]),
+    ordered(Blend::Under, true) => d(Blend::Under, true, Pass::Target, &[SHEET_MODE_SPLAT, 1]),
+    sheet(SheetMode::Axis, true) => d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_AXIS, 1]),
+    sheet(SheetMode::Slab, true) => d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_SLAB, 1]),
+    sheet(SheetMode::Binned, false) => d(Blend::Add, false, Pass::Sheet, &[SHEET_MODE_BINNED, 0]),
+    sheet(SheetMode::Binned, true) => d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_BINNED, 1]),
+    Build::Footprint(Footprint::Slots(Blend::Over)) => d(Blend::Over, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
+    Build::Footprint(Footprint::Slots(Blend::Under)) => d(Blend::Under, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
+};
+
+/// `footprint_sum`: the sheets it sums.
+pub const SHEET_MODES: Table = table! {
+    Build::SheetMode(SheetMode::Axis) => v("", &[SHEET_MODE_AXIS]),
+    Build::SheetMode(SheetMode::Slab) => v("", &[SHEET_MODE_SLAB]),
+    Build::SheetMode(SheetMode::Binned) => v("", &[SHEET_MODE_BINNED]),
+};
+
+/// `composite`: float layers, or the compute raster's fixed-point ones.
+pub const COMPOSITE_LAYERS: Table = table! {
+    Build::CompositeLayers(CompositeLayers::Float) => v("", &[]),
+    Build::CompositeLayers(CompositeLayers::Fixed) => v("", &[1]),
+};
+
+/// Every table, for the checks that each build is its own row.
+pub const TABLES: &[&Table] = &[
+    &ONLY,
+    &RECORDS,
+    &RECORDS_OR_GRADIENTS,
+    &PYRAMIDS,
+    &SLAB_BINS,
+    &PAGES,
+    &TILE_COMPOSITE,
+    &SHEET_TILES,
+    &FOOTPRINT,
+    &SHEET_MODES,
+    &COMPOSITE_LAYERS,
+];

@@ -1,0 +1,212 @@
+//! THE frame's plan: every per-frame decision that needs nothing from the device, made once by
+//! [`frame`] from (scene, camera, options, the engine's limits). The recording
+//! (`crate::recording`) reads only the plan and the counts the device reads back, so a plan can be
+//! printed (`voxsplat render --plan`), tested and diffed without a device.
+use super::bricked::BrickedPlan;
+use super::pass::{sheet_pass, SheetPass, TileRule};
+use super::{slab, Prepared};
+use crate::builds::{Footprint, Pages, TileOrder};
+use crate::camera::Camera;
+use crate::dispatch::{Blend, Limits, List};
+use crate::error::{Error, Result};
+use crate::gpu_types::{Frame, SlabPush};
+use crate::kernel::Kernel;
+use crate::options::Raster;
+use crate::options::{Composite, RenderOptions};
+use crate::order::{Direction, OrderKind};
+use std::fmt;
+
+/// A frame's decisions.
+#[derive(Clone, Debug)]
+pub struct FramePlan {
+    /// The uniforms every stage reads.
+    pub frame: Frame,
+    /// The camera (a host-computed order reads it).
+    pub camera: Camera,
+    /// The footprint kernel (its tables are uploaded when the frame begins).
+    pub kernel: Kernel,
+    /// The image's size.
+    pub width: u32,
+    /// See `width`.
+    pub height: u32,
+    /// Visiting order.
+    pub direction: Direction,
+    /// The straight-alpha background the frame is presented over, if any.
+    pub background: Option<[f32; 4]>,
+    /// What the frame draws and how.
+    pub draw: Draw,
+}
+
+/// How the frame draws.
+#[derive(Clone, Debug)]
+pub enum Draw {
+    /// Per-splat compositing of a dense splat set.
+    Splats {
+        /// Splats in the scene.
+        splats: u32,
+        /// PBTF rows (the order stages' invocations).
+        rows: u32,
+        /// Where the draw order comes from.
+        order: OrderSource,
+        /// How the footprints reach the image.
+        raster: SplatRaster,
+    },
+    /// Axis-aligned sheets: batches known before the frame.
+    Sheets {
+        /// Splats in the scene.
+        splats: u32,
+        /// The sheets' normal axis.
+        axis: usize,
+        /// The batches and how they are summed.
+        pass: SheetPass,
+    },
+    /// Image-aligned slabs: the batches are cut once the binning's counts are read back.
+    Slabs {
+        /// Splats in the scene.
+        splats: u32,
+        /// Where the slabs lie (the binning's push constants).
+        geometry: SlabPush,
+        /// How the batches are summed (`batches` empty until the counts are back).
+        pass: SheetPass,
+    },
+    /// A bricked volume: its splats made per frame, batch by batch through the budget.
+    Bricked(Box<BrickedPlan>),
+}
+
+/// Where the per-splat draw order comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OrderSource {
+    /// The PBTF order stages on the engine.
+    Pbtf,
+    /// Computed on the host (the other orders) and uploaded.
+    Host(OrderKind),
+}
+
+/// How per-splat footprints reach the image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SplatRaster {
+    /// The compute tile compositor.
+    Tiles(TileRule),
+    /// The footprint draw.
+    Draw(Footprint),
+}
+
+/// THE plan of a frame: `prep` drawn from `camera` with `opts` (whose raster is already chosen)
+/// on an engine with `limits`.
+pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Limits) -> Result<FramePlan> {
+    camera.validate()?;
+    let (width, height) = (camera.width, camera.height);
+    let direction = opts.direction();
+    let slotted = opts.slotted();
+    let plan = |frame, draw| FramePlan {
+        frame,
+        camera: *camera,
+        kernel: opts.kernel,
+        width,
+        height,
+        direction,
+        background: opts.background,
+        draw,
+    };
+    if let Some(scene) = &prep.bricks {
+        if slotted {
+            return Err(Error::Unsupported(
+                "the slotted blur draws dense splat sets; a bricked volume takes splat:tapered".into(),
+            ));
+        }
+        let (frame, bricked) = super::bricked::plan(prep, scene, camera, opts, limits)?;
+        return Ok(plan(frame, Draw::Bricked(Box::new(bricked))));
+    }
+    let set = &prep.set;
+    let frame = super::frame_for(set, camera, opts);
+    let splats = set.len() as u32;
+    let draw = match opts.composite {
+        Composite::Splat => {
+            let order = if opts.order == OrderKind::Pbtf { OrderSource::Pbtf } else { OrderSource::Host(opts.order) };
+            let raster = if opts.raster == Raster::Compute {
+                let blur = opts.motion.is_some();
+                SplatRaster::Tiles(TileRule::plan(splats, width, height, direction, opts.early_termination, blur))
+            } else {
+                let blend = if direction == Direction::BackToFront { Blend::Over } else { Blend::Under };
+                let points = opts.raster == Raster::Points;
+                SplatRaster::Draw(if slotted { Footprint::Slots(blend) } else { Footprint::Ordered { blend, points } })
+            };
+            Draw::Splats { splats, rows: (set.row_start().len() - 1) as u32, order, raster }
+        }
+        Composite::Sheet => {
+            let mut pass = sheet_pass(opts, limits, List::Order, width, height);
+            let (axis, batches) = super::sheet_plan(prep, camera, direction, pass.layers);
+            pass.list = List::Slices(axis as u8);
+            pass.batches = pass.terminated(batches);
+            Draw::Sheets { splats, axis, pass }
+        }
+        Composite::Slab => {
+            let geometry = slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, direction)?;
+            Draw::Slabs { splats, geometry, pass: sheet_pass(opts, limits, List::SlabPairs, width, height) }
+        }
+    };
+    Ok(plan(frame, draw))
+}
+
+impl fmt::Display for FramePlan {
+    /// A few lines: the draw, the order, the raster or sums, batches and layers; for a bricked
+    /// volume its records, levels of detail and budget split.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "image      {}x{}, kernel {:?}, {:?}", self.width, self.height, self.kernel, self.direction)?;
+        match &self.draw {
+            Draw::Splats { splats, order, raster, .. } => {
+                writeln!(f, "draw       {splats} splats, composited per splat")?;
+                match order {
+                    OrderSource::Pbtf => writeln!(f, "order      PBTF on the engine")?,
+                    OrderSource::Host(k) => writeln!(f, "order      {k:?}, on the host")?,
+                }
+                match raster {
+                    SplatRaster::Tiles(t) => {
+                        let walk = match t.composite.order {
+                            TileOrder::BackToFront => "back to front",
+                            TileOrder::FrontToBack => "front to back",
+                            TileOrder::Terminating => "front to back, ending opaque tiles",
+                        };
+                        let pages = if t.pages == Pages::One { "one page" } else { "two pages" };
+                        writeln!(
+                            f,
+                            "raster     compute tiles, {walk}; binned in {} chunks (at most {}); {pages} of splat records",
+                            t.push.chunks, t.most_chunks
+                        )?
+                    }
+                    SplatRaster::Draw(b) => writeln!(f, "raster     footprint draw {b:?}")?,
+                }
+            }
+            Draw::Sheets { splats, axis, pass } => {
+                writeln!(f, "draw       {splats} splats in axis-aligned sheets along axis {axis}")?;
+                write_pass(f, pass)?;
+            }
+            Draw::Slabs { splats, geometry, pass } => {
+                writeln!(f, "draw       {splats} splats in {} image-aligned slabs", geometry.slabs)?;
+                write_pass(f, pass)?;
+            }
+            Draw::Bricked(b) => write!(f, "{b}")?,
+        }
+        Ok(())
+    }
+}
+
+fn write_pass(f: &mut fmt::Formatter<'_>, pass: &SheetPass) -> fmt::Result {
+    let sums = if pass.compute {
+        "compute fixed-point sums"
+    } else if pass.points {
+        "point-sprite sums"
+    } else {
+        "quad sums"
+    };
+    let batches = if pass.batches.is_empty() && pass.list == List::SlabPairs {
+        "cut after the binning".to_string()
+    } else {
+        pass.batches.len().to_string()
+    };
+    writeln!(f, "sums       {sums}; up to {} layers a batch; batches {batches}", pass.layers)?;
+    if pass.early_termination > 0.0 {
+        writeln!(f, "terminate  tiles below {} transmittance", pass.early_termination)?;
+    }
+    Ok(())
+}
