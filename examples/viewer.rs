@@ -412,7 +412,7 @@ impl Viewer {
         options.order = args.scene.order.parse::<OrderKind>()?;
         options.render_scale = args.render_scale;
         options.kernel = args.kernel.parse()?;
-        voxsplat::resample::check_scale(args.interactive_scale)?;
+        voxsplat::low_level::resample::check_scale(args.interactive_scale)?;
         options.validate()?;
         let indices = [
             ORDERS.iter().position(|o| *o == args.scene.order).unwrap_or(0),

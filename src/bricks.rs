@@ -55,6 +55,17 @@ impl BrickHeader {
 }
 
 /// A scalar volume as bricks of compact records.
+///
+/// ```
+/// use voxsplat::bricks::BrickStore;
+/// use voxsplat::volume::ScalarVolume;
+/// // A 32³ ramp: bricks of 8³ voxels, each with its summary and occupancy mask.
+/// let values = (0..32 * 32 * 32).map(|i| (i % 32) as f32 / 31.0).collect();
+/// let volume = ScalarVolume { dims: [32; 3], spacing: [1.0; 3], values };
+/// let store = BrickStore::build(&volume)?;
+/// assert_eq!(store.headers.len(), 64);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct BrickStore {
     /// Voxels along x, y, z.

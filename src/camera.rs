@@ -33,6 +33,18 @@ pub enum Projection {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 /// A view of the scene: eye, target and up in world units, projection, clip planes and image size.
+///
+/// ```
+/// use voxsplat::{glam::Vec3, Camera, Grid};
+/// let grid = Grid::centered([64, 64, 32], [1.0, 1.0, 2.0])?;
+/// // The default three-quarter view, then the same camera moved to look down the z axis.
+/// let mut camera = Camera::framing(&grid, 512, 512);
+/// let distance = camera.eye.distance(camera.target);
+/// camera.eye = camera.target + Vec3::Z * distance;
+/// camera.up = Vec3::Y;
+/// camera.validate()?;
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 pub struct Camera {
     /// Where the eye is.
     pub eye: Vec3,

@@ -9,6 +9,15 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// Piecewise-linear colour and opacity over density normalised to [0, 1].
+///
+/// ```
+/// use voxsplat::classify::TransferFunction;
+/// let ct = TransferFunction::preset("ct")?;
+/// // Or points of (value in [0, 1], straight RGBA), as `voxsplat render --tf FILE` reads them.
+/// let own = TransferFunction::from_toml("points = [[0.2, [1, 0.5, 0, 0]], [0.8, [1, 1, 1, 0.6]]]")?;
+/// assert!(own.eval(0.8)[3] > ct.eval(0.0)[3]);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransferFunction {

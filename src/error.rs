@@ -1,6 +1,18 @@
 use ash::vk;
 
 /// Everything that can go wrong, split by concern so callers can tell their input from the device.
+///
+/// ```
+/// use voxsplat::{Camera, Error, Grid};
+/// let grid = Grid::centered([8; 3], [1.0; 3])?;
+/// let mut camera = Camera::framing(&grid, 64, 64);
+/// camera.target = camera.eye; // no view direction
+/// match camera.validate() {
+///     Err(Error::InvalidCamera(why)) => eprintln!("fix the camera: {why}"),
+///     other => panic!("{other:?}"),
+/// }
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {

@@ -1,5 +1,7 @@
 //! `#[repr(C)]` mirrors of the structs in `glsl/shared/types.glsl`. Keep in sync with that header;
 //! the size asserts catch drift.
+// Each field's meaning is documented once, beside its GLSL twin in glsl/shared/types.glsl.
+#![allow(missing_docs)]
 use bytemuck::{Pod, Zeroable};
 
 /// One extracted (non-empty) voxel.
@@ -46,16 +48,25 @@ pub struct ScreenQuad {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Frame {
+    /// World to clip space.
     pub view_proj: [[f32; 4]; 4],
+    /// The eye; w: 1 for a perspective camera.
     pub eye: [f32; 4],
+    /// The view direction; w: near plane.
     pub forward: [f32; 4],
+    /// The camera's right; w: far plane.
     pub right: [f32; 4],
+    /// The camera's true up; w: pixels per world unit at unit depth.
     pub up: [f32; 4],
+    /// The grid's origin; w: the kernel's radius in voxels.
     pub origin: [f32; 4],
+    /// The grid's spacing; w: the kernel's world radius.
     pub spacing: [f32; 4],
     /// The cell matrix above its diagonal (`Grid::shear`); w: unused.
     pub shear: [f32; 4],
+    /// The grid's dims; w: splats.
     pub dims: [u32; 4],
+    /// The PBTF split per axis; w: 1 back to front.
     pub split: [u32; 4],
     /// Anti-aliasing: mode (0 none, 1 Swan, 2 EWA), footprint std in voxels, EWA low-pass std in pixels.
     pub aa: [f32; 4],
@@ -78,13 +89,19 @@ pub struct Frame {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RaycastParams {
+    /// Clip to world space.
     pub inv_view_proj: [[f32; 4]; 4],
+    /// The volume's box in voxel coordinates, low corner; w: the step in world units.
     pub box_min: [f32; 4],
+    /// Its high corner; w: the transmittance below which a ray stops.
     pub box_max: [f32; 4],
+    /// The grid's origin; w: 1 / the kernel spacing.
     pub origin: [f32; 4],
+    /// 1 / the grid's spacing.
     pub inv_spacing: [f32; 4],
     /// The inverse cell matrix above its diagonal (a sheared grid's; zero when axis-aligned).
     pub inv_shear: [f32; 4],
+    /// The grid's dims; w: most steps per ray.
     pub dims: [u32; 4],
     /// Width, height, empty-space brick side, clipping planes in use.
     pub image: [u32; 4],

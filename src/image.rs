@@ -1,6 +1,14 @@
 //! The output image, and the formats of a host's image it can be drawn into.
 
 /// An RGBA32F image, row 0 at the top. Colour is premultiplied by alpha.
+///
+/// ```
+/// use voxsplat::ImageF32;
+/// // Premultiplied RGBA per pixel, row by row.
+/// let mut image = ImageF32::new(4, 2);
+/// image.pixels[0] = [0.5, 0.0, 0.0, 0.5];
+/// assert_eq!(image.pixels.len(), 8);
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageF32 {
     /// Pixels across.
@@ -64,4 +72,76 @@ impl TargetFormat {
     pub(crate) fn srgb(self) -> bool {
         matches!(self, TargetFormat::Bgra8Srgb | TargetFormat::Rgba8Srgb)
     }
+}
+
+/// How a supersampled reference is brought down to the camera's pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Downsample {
+    /// The mean of each pixel's samples: lets through much of what lies above the pixels' Nyquist
+    /// frequency.
+    #[default]
+    Box,
+    /// A Lanczos-3 low-pass at the pixels' Nyquist frequency (windowed sinc, three pixels each
+    /// side, weights normalised where the image ends): the reconstruction filter anti-aliasing is
+    /// measured against.
+    Lanczos3,
+}
+
+/// `img` brought down `f`× along each axis by `filter`, separably (rows, then columns).
+pub fn downsample(img: &ImageF32, f: usize, filter: Downsample) -> ImageF32 {
+    let (w, h) = (img.width as usize / f, img.height as usize / f);
+    let big_w = img.width as usize;
+    // Per output index, its (sample index, weight) taps along one axis of n samples.
+    let taps = |n: usize, out: usize| -> Vec<Vec<(usize, f32)>> {
+        (0..out)
+            .map(|x| match filter {
+                Downsample::Box => (x * f..x * f + f).map(|i| (i, 1.0 / f as f32)).collect(),
+                Downsample::Lanczos3 => {
+                    let c = (x as f64 + 0.5) * f as f64;
+                    let lo = (c - 3.0 * f as f64).floor().max(0.0) as usize;
+                    let hi = ((c + 3.0 * f as f64).ceil() as usize).min(n);
+                    let t: Vec<(usize, f64)> =
+                        (lo..hi).map(|i| (i, lanczos3((i as f64 + 0.5 - c) / f as f64))).collect();
+                    let sum: f64 = t.iter().map(|p| p.1).sum();
+                    t.into_iter().map(|(i, wt)| (i, (wt / sum) as f32)).collect()
+                }
+            })
+            .collect()
+    };
+    let (tx, ty) = (taps(big_w, w), taps(img.height as usize, h));
+    let mut rows = vec![[0.0f32; 4]; w * img.height as usize];
+    for y in 0..img.height as usize {
+        for (x, t) in tx.iter().enumerate() {
+            let mut acc = [0.0f32; 4];
+            for &(i, wt) in t {
+                let p = img.pixels[y * big_w + i];
+                (0..4).for_each(|c| acc[c] += wt * p[c]);
+            }
+            rows[y * w + x] = acc;
+        }
+    }
+    let mut out = ImageF32::new(w as u32, h as u32);
+    for (y, t) in ty.iter().enumerate() {
+        for x in 0..w {
+            let mut acc = [0.0f32; 4];
+            for &(j, wt) in t {
+                let p = rows[j * w + x];
+                (0..4).for_each(|c| acc[c] += wt * p[c]);
+            }
+            out.pixels[y * w + x] = acc;
+        }
+    }
+    out
+}
+
+/// The Lanczos-3 kernel: sinc(x) sinc(x / 3) for |x| < 3.
+fn lanczos3(x: f64) -> f64 {
+    if x.abs() >= 3.0 {
+        return 0.0;
+    }
+    if x.abs() < 1e-9 {
+        return 1.0;
+    }
+    let px = std::f64::consts::PI * x;
+    3.0 * px.sin() * (px / 3.0).sin() / (px * px)
 }

@@ -16,59 +16,52 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
+#[cfg(feature = "lab")]
 pub mod aa;
 pub mod animate;
-pub mod bisect;
+mod bisect;
 pub mod bricks;
-pub mod builds;
+mod builds;
 pub mod camera;
 pub mod classify;
-/// Constants shared with the shaders (injected into GLSL as macros by build.rs).
-pub mod constants;
-/// The CPU mirrors of the GPU stages (public for tests and the harness; see `stages`).
-#[doc(hidden)]
-pub mod cpu;
-pub mod cpu_engine;
-pub mod dispatch;
+mod constants;
+mod cpu;
+mod cpu_engine;
+mod dispatch;
 pub mod distributed;
-mod error;
-mod gpu;
-/// `#[repr(C)]` mirrors of `glsl/shared/types.glsl` (public for tests and the mirrors).
-#[doc(hidden)]
-pub mod gpu_types;
-pub mod image;
 #[doc = include_str!("../docs/guide/embedding.md")]
 pub mod embedding {}
+mod error;
+mod gpu;
+mod gpu_types;
+pub mod image;
 // The README's Rust example compiles (a doc test; cli/tests/readme.rs runs its commands).
 #[cfg(all(doctest, feature = "io"))]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
-pub mod kdtree;
+mod kdtree;
 pub mod kernel;
 #[cfg(feature = "io")]
 pub mod loaders;
+pub mod low_level;
+#[cfg(feature = "lab")]
 pub mod metrics;
 pub mod options;
 pub mod order;
 pub mod orient;
 #[cfg(feature = "io")]
 pub mod output;
-/// Per-frame planning without a device (public for tests and the harness).
-#[doc(hidden)]
-pub mod plan;
-pub mod raster;
-pub mod recording;
-pub mod resample;
+mod plan;
+mod raster;
+mod recording;
+mod resample;
 mod residency;
 pub mod scene;
-/// Every shader's SPIR-V builds, by shader (public for the stage table and tests).
-#[doc(hidden)]
-pub mod shaders;
-// The peers' scene is a built-in scene (`scene::peer`); its old path stays.
-pub use scene::peer;
-pub mod stages;
+mod shaders;
+mod stages;
 #[cfg(feature = "io")]
 pub mod terrain;
+#[cfg(feature = "lab")]
 pub mod truth;
 #[allow(unsafe_code)]
 pub mod vk;
@@ -115,6 +108,18 @@ pub enum Backend {
 }
 
 /// How to create a [`Renderer`].
+///
+/// ```no_run
+/// use voxsplat::{Renderer, RendererOptions};
+/// // Validation on (its messages are counted, never printed), a device by name, 4 GiB for frames.
+/// let mut options = RendererOptions::default();
+/// options.validation = true;
+/// options.device_name = Some("NVIDIA".into());
+/// options.gpu_budget_bytes = 4 << 30;
+/// let renderer = Renderer::new(&options)?;
+/// assert_eq!(renderer.validation_count(), 0);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 #[non_exhaustive]
 pub struct RendererOptions {
@@ -142,6 +147,24 @@ impl Default for RendererOptions {
 }
 
 /// A scene on a backend. `Send`: one renderer per thread.
+///
+/// ```
+/// use voxsplat::{Backend, Camera, Grid, RenderOptions, Renderer, RendererOptions, SplatSet};
+/// // A ball of orange voxels, drawn by the CPU mirrors (`Backend::Gpu`, the default, for Vulkan).
+/// let grid = Grid::centered([16; 3], [1.0; 3])?;
+/// let set = SplatSet::from_fn(grid, |i, j, k| {
+///     let d = voxsplat::glam::Vec3::new(i as f32, j as f32, k as f32) - 7.5;
+///     (d.length() < 6.0).then_some([1.0, 0.5, 0.1, 0.3])
+/// })?;
+/// let mut options = RendererOptions::default();
+/// options.backend = Backend::Cpu;
+/// let mut renderer = Renderer::new(&options)?;
+/// let camera = Camera::framing(set.grid(), 64, 64);
+/// renderer.set_scene(set)?;
+/// let frame = renderer.render(&camera, &RenderOptions::default())?;
+/// assert!(frame.image.pixels.iter().any(|p| p[3] > 0.0));
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 pub struct Renderer {
     gpu: Option<gpu::Gpu>,
     scene: Option<Prepared>,
@@ -535,7 +558,7 @@ impl Renderer {
             let one = RaycastOptions { supersample: 1, ..*options };
             let mut out = self.raycast(&fine, &one)?;
             let t = std::time::Instant::now();
-            out.image = truth::downsample(&out.image, k as usize, truth::Downsample::Box);
+            out.image = image::downsample(&out.image, k as usize, image::Downsample::Box);
             out.timings.push(StageTime { stage: "downsample", ms: t.elapsed().as_secs_f64() * 1e3 });
             return Ok(out);
         }

@@ -453,6 +453,17 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
 /// Only the bytes its header (or `hints`) says the data needs are read, slice by slice where the
 /// format allows (`SliceReader`), after the file is checked to hold them: a device or a file far
 /// larger than its header says is never read whole.
+///
+/// ```no_run
+/// use voxsplat::loaders::{load_volume, VolumeHints};
+/// let ct = load_volume("scan.nii.gz".as_ref(), &VolumeHints::default())?;
+/// // A raw file needs its grid size (and its sample type, unless u8).
+/// let mut hints = VolumeHints::default();
+/// hints.dims = Some([256, 256, 256]);
+/// let raw = load_volume("bonsai.raw".as_ref(), &hints)?;
+/// println!("{:?} and {:?}", ct.dims, raw.dims);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
     let what = path.display().to_string();
     let name = lower_name(path);

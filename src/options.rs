@@ -212,6 +212,18 @@ impl std::str::FromStr for BlurProfile {
 }
 
 /// Per-frame choices. `Default` gives PBTF, per-splat back-to-front compositing, the Gaussian.
+///
+/// ```
+/// use voxsplat::{Composite, Kernel, Lod, RenderOptions};
+/// // Westover's sheet buffer with the Gaussian kernel, over a dark background, no levels of detail.
+/// let mut options = RenderOptions::default();
+/// options.composite = Composite::Sheet;
+/// options.kernel = Kernel::Gaussian;
+/// options.background = Some([0.1, 0.1, 0.1, 1.0]);
+/// options.lod = Lod::Off;
+/// options.validate()?;
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RenderOptions {

@@ -51,6 +51,14 @@ fn write_file(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()
 }
 
 /// Write `img` as PNG or EXR, chosen by the extension.
+///
+/// ```no_run
+/// use voxsplat::{output::write_image, ImageF32};
+/// let frame = ImageF32::new(64, 64);
+/// write_image(&frame, "frame.png".as_ref())?; // 8-bit sRGB
+/// write_image(&frame, "frame.exr".as_ref())?; // linear float
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
     let format = ImageFormat::of(path)?;
     let encoding = |message: String| Error::Image { path: path.display().to_string(), message };

@@ -27,9 +27,13 @@ pub use pass::{sheet_layers, sheet_pass, SheetPass, TileRule};
 /// A scene ready to draw: the splat rows plus, per axis, the splats grouped by slice and each
 /// slice's rank among non-empty slices (what the sheet batches index).
 pub struct Prepared {
+    /// The splats.
     pub set: SplatSet,
+    /// Per axis, the splats grouped by slice and each slice's first entry.
     pub slices: [(Vec<u32>, Vec<u32>); 3],
+    /// Per axis in turn, each slice's rank among the non-empty slices.
     pub ranks: Vec<u32>,
+    /// Where each axis's ranks begin in `ranks`.
     pub rank_offsets: [u32; 3],
     /// A bricked volume (then `set` holds no splats, only the grid): its splats are made per frame.
     pub bricks: Option<crate::bricks::BrickScene>,
@@ -39,6 +43,7 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// A dense splat set's scene.
     pub fn new(set: SplatSet) -> Self {
         let slices = [0, 1, 2].map(|a| set.slices(a));
         let mut ranks = Vec::new();
@@ -132,9 +137,13 @@ pub fn order_frame(set: &SplatSet, camera: &Camera, direction: Direction) -> Fra
 /// One batch of sheets drawn into summation layers and composited together.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Batch {
+    /// The batch's first entry of the draw list.
     pub first_instance: u32,
+    /// Its entries.
     pub instances: u32,
+    /// Its sheets, one summation layer each.
     pub layers: u32,
+    /// Its footprint stages' push constants.
     pub push: FootprintPush,
 }
 

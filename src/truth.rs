@@ -7,7 +7,7 @@
 //! store the m×m×n buffer: each column is integrated as it is reconstructed.
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::image::ImageF32;
+use crate::image::{Downsample, ImageF32};
 use crate::kernel::Kernel;
 use crate::volume::SplatSet;
 pub use crate::volume::{DenseField, MAX_DENSE_BYTES};
@@ -50,19 +50,6 @@ impl Default for TruthOptions {
     }
 }
 
-/// How a supersampled reference is brought down to the camera's pixels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Downsample {
-    /// The mean of each pixel's samples: lets through much of what lies above the pixels' Nyquist
-    /// frequency.
-    #[default]
-    Box,
-    /// A Lanczos-3 low-pass at the pixels' Nyquist frequency (windowed sinc, three pixels each
-    /// side, weights normalised where the image ends): the reconstruction filter anti-aliasing is
-    /// measured against.
-    Lanczos3,
-}
-
 /// The truth rendered at `factor`× the camera's size and box-filtered down: a supersampled
 /// reference for anti-aliasing (chapter 3).
 pub fn supersampled(set: &SplatSet, camera: &Camera, factor: u32, opts: &TruthOptions) -> Result<ImageF32> {
@@ -82,66 +69,7 @@ pub fn supersampled_with(
     }
     let big = Camera { width: camera.width * factor, height: camera.height * factor, ..*camera };
     let img = volumetric_summation(set, &big, opts)?;
-    Ok(downsample(&img, factor as usize, filter))
-}
-
-/// `img` brought down `f`× along each axis by `filter`, separably (rows, then columns).
-pub fn downsample(img: &ImageF32, f: usize, filter: Downsample) -> ImageF32 {
-    let (w, h) = (img.width as usize / f, img.height as usize / f);
-    let big_w = img.width as usize;
-    // Per output index, its (sample index, weight) taps along one axis of n samples.
-    let taps = |n: usize, out: usize| -> Vec<Vec<(usize, f32)>> {
-        (0..out)
-            .map(|x| match filter {
-                Downsample::Box => (x * f..x * f + f).map(|i| (i, 1.0 / f as f32)).collect(),
-                Downsample::Lanczos3 => {
-                    let c = (x as f64 + 0.5) * f as f64;
-                    let lo = (c - 3.0 * f as f64).floor().max(0.0) as usize;
-                    let hi = ((c + 3.0 * f as f64).ceil() as usize).min(n);
-                    let t: Vec<(usize, f64)> =
-                        (lo..hi).map(|i| (i, lanczos3((i as f64 + 0.5 - c) / f as f64))).collect();
-                    let sum: f64 = t.iter().map(|p| p.1).sum();
-                    t.into_iter().map(|(i, wt)| (i, (wt / sum) as f32)).collect()
-                }
-            })
-            .collect()
-    };
-    let (tx, ty) = (taps(big_w, w), taps(img.height as usize, h));
-    let mut rows = vec![[0.0f32; 4]; w * img.height as usize];
-    for y in 0..img.height as usize {
-        for (x, t) in tx.iter().enumerate() {
-            let mut acc = [0.0f32; 4];
-            for &(i, wt) in t {
-                let p = img.pixels[y * big_w + i];
-                (0..4).for_each(|c| acc[c] += wt * p[c]);
-            }
-            rows[y * w + x] = acc;
-        }
-    }
-    let mut out = ImageF32::new(w as u32, h as u32);
-    for (y, t) in ty.iter().enumerate() {
-        for x in 0..w {
-            let mut acc = [0.0f32; 4];
-            for &(j, wt) in t {
-                let p = rows[j * w + x];
-                (0..4).for_each(|c| acc[c] += wt * p[c]);
-            }
-            out.pixels[y * w + x] = acc;
-        }
-    }
-    out
-}
-
-/// The Lanczos-3 kernel: sinc(x) sinc(x / 3) for |x| < 3.
-fn lanczos3(x: f64) -> f64 {
-    if x.abs() >= 3.0 {
-        return 0.0;
-    }
-    if x.abs() < 1e-9 {
-        return 1.0;
-    }
-    let px = std::f64::consts::PI * x;
-    3.0 * px.sin() * (px / 3.0).sin() / (px * px)
+    Ok(crate::image::downsample(&img, factor as usize, filter))
 }
 
 /// The ray through pixel (x, y)'s centre: origin on the near plane, unit direction, length to far.

@@ -15,6 +15,14 @@ pub const MAX_DIM: u32 = 1 << 16;
 /// the world position of voxel (0, 0, 0). Voxel (i, j, k) lies at `origin + U (i, j, k)` with
 /// U = [[sx, hxy, hxz], [0, sy, hyz], [0, 0, sz]]: upper triangular, so any index-to-world affine
 /// is a rotation of one (`Orientation::grid`), and an axis-aligned grid has a diagonal U.
+///
+/// ```
+/// use voxsplat::Grid;
+/// // 256 x 256 x 128 voxels, 0.5 mm apart in-plane and 1 mm between slices, centred on the origin.
+/// let grid = Grid::centered([256, 256, 128], [0.5, 0.5, 1.0])?;
+/// assert_eq!(grid.dims, [256, 256, 128]);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
     /// Voxels along x, y, z.
@@ -148,6 +156,14 @@ impl Grid {
 }
 
 /// The extracted voxels of a grid as rows along i: row (j, k) holds its voxels sorted by i.
+///
+/// ```
+/// use voxsplat::{Grid, SplatSet};
+/// // Keep every voxel of the lower half, translucent blue.
+/// let set = SplatSet::from_fn(Grid::centered([8; 3], [1.0; 3])?, |_, _, k| (k < 4).then_some([0.2, 0.4, 1.0, 0.5]))?;
+/// assert_eq!(set.len(), 8 * 8 * 4);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct SplatSet {
     grid: Grid,
@@ -505,6 +521,7 @@ impl DenseField {
 
     /// For each voxel, whether any non-empty voxel lies within `reach` cells (Chebyshev): lets the
     /// references skip empty space without changing the result.
+    #[cfg(feature = "lab")] // the truth's empty-space skipping reads it
     pub(crate) fn occupancy(&self, reach: i64) -> Vec<bool> {
         let [nx, ny, nz] = self.dims.map(|d| d as usize);
         let mut occ: Vec<bool> = self.values.iter().map(|v| v[3] > 0.0).collect();

@@ -1,7 +1,7 @@
 //! Chapter 3: Swan's anti-aliasing in the per-splat stage, and EWA beside it.
 mod common;
 use glam::Vec3;
-use voxsplat::plan::Prepared;
+use voxsplat::low_level::plan::Prepared;
 use voxsplat::truth::{supersampled, TruthOptions};
 use voxsplat::{scene, Antialias, Camera, Composite, Grid, Kernel, Projection, RenderOptions, SplatSet};
 
@@ -26,7 +26,7 @@ fn looking_at(p: Vec3, distance: f32, size: u32) -> Camera {
 #[test]
 fn a_splat_beyond_k_keeps_its_footprint_energy() {
     let set = one_voxel(0.01);
-    let tau = voxsplat::cpu::splat_params::optical_depth(0.01) as f64;
+    let tau = voxsplat::low_level::cpu::splat_params::optical_depth(0.01) as f64;
     let mut r = common::cpu();
     r.set_scene(set.clone()).unwrap();
     let probe = looking_at(set.grid().center(), 1.0, 64);
@@ -130,7 +130,7 @@ fn luma_image(w: u32, h: u32, f: impl Fn(f32, f32) -> f32) -> voxsplat::ImageF32
 
 #[test]
 fn lanczos_keeps_what_the_pixels_can_hold_and_drops_what_they_cannot() {
-    use voxsplat::truth::{downsample, Downsample};
+    use voxsplat::image::{downsample, Downsample};
     let f = 8usize;
     let sine = |period: f32| {
         luma_image(64 * f as u32, 8 * f as u32, move |x, _| 0.5 + 0.4 * (x * std::f32::consts::TAU / period).sin())

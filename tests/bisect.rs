@@ -4,8 +4,8 @@
 //! backend's frame bit for bit; elsewhere it lies within the mirror tolerance.
 mod common;
 use common::assert_clean;
+use voxsplat::low_level::stages::StageId;
 use voxsplat::output::diff_rgba8;
-use voxsplat::stages::StageId;
 use voxsplat::{scene, Bisect, Camera, Composite, Error, ImageF32, Lod, Raster, RenderOptions, Renderer};
 
 fn options(composite: Composite, raster: Raster) -> RenderOptions {

@@ -6,8 +6,8 @@ mod common;
 use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
 use voxsplat::classify::{classify, Shading, TransferFunction};
-use voxsplat::gpu_types::SplatParams;
-use voxsplat::stages::{Res, StageId};
+use voxsplat::low_level::gpu_types::SplatParams;
+use voxsplat::low_level::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
 use voxsplat::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
 
@@ -84,7 +84,7 @@ fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
     let set = store.classify(&tf(), None).unwrap();
     let grid = *set.grid();
     let nb = store.dims.map(|d| d.div_ceil(BRICK));
-    let tree = voxsplat::kdtree::build(nb, 1, |id| store.index[id] != u32::MAX);
+    let tree = voxsplat::low_level::kdtree::build(nb, 1, |id| store.index[id] != u32::MAX);
     assert!(tree.len() >= 3, "the tree cuts the bricks: {tree:?}");
     let (mut g, mut c) = (renderer(true, None), renderer(false, None));
     g.set_volume(&vol, &tf(), None).unwrap();
@@ -154,9 +154,9 @@ fn streaming_through_a_small_budget_draws_the_same_frame() {
         whole.set_volume(&vol, &tf(), None).unwrap();
         let scene = whole.volume().unwrap();
         // Room for about a fifth of the splats in each batch.
-        let least = voxsplat::plan::bricked_min_budget(scene, u64::MAX, 80, 80);
+        let least = voxsplat::low_level::plan::bricked_min_budget(scene, u64::MAX, 80, 80);
         let splats = scene.store.len() as u64;
-        let budget = least + splats / 5 * voxsplat::plan::BATCH_BYTES_PER_SPLAT;
+        let budget = least + splats / 5 * voxsplat::low_level::plan::BATCH_BYTES_PER_SPLAT;
         assert!(!scene.streams(budget), "the store stays resident");
         let mut streamed = renderer(gpu, Some(budget));
         streamed.set_volume(&vol, &tf(), None).unwrap();
@@ -355,7 +355,7 @@ fn waves_stop_where_nothing_is_hidden() {
 fn a_store_of_more_than_one_record_page_reads_every_page() {
     let dims = [340u32, 340, 300];
     let n = dims.iter().map(|&d| d as usize).product::<usize>();
-    assert!(n > voxsplat::constants::RECORD_PAGE as usize);
+    assert!(n > voxsplat::low_level::constants::RECORD_PAGE as usize);
     let mut values = vec![200.0f32; n];
     values[0] = 0.0;
     for (i, v) in values.iter_mut().enumerate() {
@@ -385,10 +385,10 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
     let count = a[0].iter().zip(&b[0]).filter(|(x, y)| x != y).count();
     assert_eq!(count, 0, "brick_cull's counts differ at {count} slots, first {differ:?}");
     // The first batch's splats: the bricks in slot order up to the batch capacity.
-    let budget = voxsplat::constants::DEFAULT_GPU_BUDGET;
-    let resident = voxsplat::plan::bricked_resident_bytes(g.volume().unwrap(), budget, 48, 48);
-    let capacity = ((budget - resident) / voxsplat::plan::BATCH_BYTES_PER_SPLAT)
-        .min(voxsplat::constants::MAX_GPU_SPLATS as u64) as u32;
+    let budget = voxsplat::low_level::constants::DEFAULT_GPU_BUDGET;
+    let resident = voxsplat::low_level::plan::bricked_resident_bytes(g.volume().unwrap(), budget, 48, 48);
+    let capacity = ((budget - resident) / voxsplat::low_level::plan::BATCH_BYTES_PER_SPLAT)
+        .min(voxsplat::low_level::constants::MAX_GPU_SPLATS as u64) as u32;
     let mut first = 0;
     for w in a[0].iter().filter(|&&w| w != 0) {
         if first + (w & 1023) > capacity {
@@ -424,7 +424,7 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
         // Under twice the records, the store streams; above the streamed minimum, it draws.
         let budget = 2 * records - 1;
         assert!(scene.streams(budget));
-        let least = voxsplat::plan::bricked_min_budget(scene, budget, 64, 64);
+        let least = voxsplat::low_level::plan::bricked_min_budget(scene, budget, 64, 64);
         assert!(least < budget, "{least} < {budget}");
         let mut streamed = renderer(gpu, Some(budget));
         streamed.set_volume(&vol, &tf(), None).unwrap();
@@ -512,9 +512,9 @@ fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classificat
     for gpu in [true, false] {
         let mut whole = renderer(gpu, None);
         whole.set_volume(&vol, &tf(), None).unwrap();
-        let least = voxsplat::plan::bricked_min_budget(whole.volume().unwrap(), u64::MAX, 96, 80);
+        let least = voxsplat::low_level::plan::bricked_min_budget(whole.volume().unwrap(), u64::MAX, 96, 80);
         let splats = whole.volume().unwrap().store.len() as u64;
-        let budget = least + 2 * sheet_budget + splats / 6 * voxsplat::plan::BATCH_BYTES_PER_SPLAT;
+        let budget = least + 2 * sheet_budget + splats / 6 * voxsplat::low_level::plan::BATCH_BYTES_PER_SPLAT;
         let mut small = renderer(gpu, Some(budget));
         small.set_volume(&vol, &tf(), None).unwrap();
         for composite in [Composite::Sheet, Composite::Slab] {
@@ -619,8 +619,8 @@ fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
 /// that leave partial tiles at the edges, boxes small and large, inside and across the border.
 #[test]
 fn the_occlusion_map_answers_a_box_as_its_pixels_do() {
-    use voxsplat::cpu::tile_occlusion::{box_hidden, tile_occlusion};
-    use voxsplat::plan::occlusion_len;
+    use voxsplat::low_level::cpu::tile_occlusion::{box_hidden, tile_occlusion};
+    use voxsplat::low_level::plan::occlusion_len;
     let threshold = 1.0 / 1024.0;
     let mut rng = Rng(0x6f63_636c);
     let (mut hidden, mut open) = (0, 0);
@@ -632,7 +632,7 @@ fn the_occlusion_map_answers_a_box_as_its_pixels_do() {
         }
         let mut map = vec![0u32; occlusion_len(w, h) as usize];
         tile_occlusion(&accum, threshold, &mut map);
-        let mut frame: voxsplat::gpu_types::Frame = bytemuck::Zeroable::zeroed();
+        let mut frame: voxsplat::low_level::gpu_types::Frame = bytemuck::Zeroable::zeroed();
         (frame.blur[2], frame.blur[3]) = (w as f32, h as f32);
         for _ in 0..4000 {
             let x0 = (rng.f32() * (w + 8) as f32) as i32 - 4;
@@ -699,7 +699,7 @@ fn uniform_bricks_draw_as_their_voxels_do() {
     whole.set_volume(&vol, &tf, None).unwrap();
     let scene = whole.volume().unwrap();
     assert!(scene.store.headers.iter().filter(|h| h.is_uniform()).count() >= 12);
-    let least = voxsplat::plan::bricked_min_budget(scene, u64::MAX, 72, 64);
+    let least = voxsplat::low_level::plan::bricked_min_budget(scene, u64::MAX, 72, 64);
     let most = scene.store.records.len() as u64 * 8; // streams below twice the records
     assert!(least < most, "{least} {most}");
     let budget = (least + most) / 2;
@@ -752,8 +752,11 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
             // Just under four times one buffer's bytes left by the store (and the pyramid, with
             // levels of detail): they do not fit.
             let bytes = scene.store.gradient_len() * 4;
-            let pyramid = voxsplat::plan::pyramid_bytes(voxsplat::plan::LOD_BUFFERS, scene.store.headers.len());
-            let resident = voxsplat::plan::bricked_resident_bytes(scene, u64::MAX, 80, 80);
+            let pyramid = voxsplat::low_level::plan::pyramid_bytes(
+                voxsplat::low_level::plan::LOD_BUFFERS,
+                scene.store.headers.len(),
+            );
+            let resident = voxsplat::low_level::plan::bricked_resident_bytes(scene, u64::MAX, 80, 80);
             assert!(!scene.streams(resident + 4 * bytes), "the store stays resident");
             for (o, which, held) in [(&fine, "full detail", 0), (&coarse, "coarse cells", pyramid)] {
                 let budget = resident + held + 4 * bytes - 4;

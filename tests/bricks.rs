@@ -107,7 +107,7 @@ fn real_volumes_take_under_8_bytes_a_voxel_and_classify_alike_through_the_store(
         let dense = classify(&vol, &tf, shading).unwrap();
         let bricked = store.classify(&tf, shading).unwrap();
         // Quantisation may move a voxel across a transfer-function edge: count those, compare the rest.
-        let key = |s: &voxsplat::gpu_types::Splat| (s.ijk[2], s.ijk[1], s.ijk[0]);
+        let key = |s: &voxsplat::low_level::gpu_types::Splat| (s.ijk[2], s.ijk[1], s.ijk[0]);
         let (a, b) = (dense.splats(), bricked.splats());
         let (mut ia, mut ib, mut common, mut worst) = (0, 0, 0usize, 0f32);
         while ia < a.len() && ib < b.len() {

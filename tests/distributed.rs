@@ -20,7 +20,7 @@ fn parts(
     ranks: u32,
     cam: &Camera,
     o: &RenderOptions,
-) -> (ImageF32, Vec<voxsplat::kdtree::Node>) {
+) -> (ImageF32, Vec<voxsplat::low_level::kdtree::Node>) {
     let hints = Default::default();
     let mut reader = distributed::open(path.as_ref(), &hints).unwrap();
     let nb = reader.dims.map(|d| d.div_ceil(voxsplat::bricks::BRICK));
@@ -115,7 +115,7 @@ fn the_partition_is_the_top_of_the_brick_tree_balanced_by_non_empty_bricks() {
         assert!(counts.iter().all(|&c| (c as f64 - share).abs() <= 16.0), "{ranks}: balanced {counts:?}");
         if ranks.is_power_of_two() {
             assert!(counts.iter().all(|&c| c == 128 / ranks), "{ranks}: balanced {counts:?}");
-            let one = voxsplat::kdtree::build(grid, 1, |id| occupied[id]);
+            let one = voxsplat::low_level::kdtree::build(grid, 1, |id| occupied[id]);
             assert_eq!(p.tree, one, "{ranks}: the one-process tree");
         }
         // Every eye: a back-to-front order of all ranks.

@@ -450,7 +450,7 @@ fn a_blur_takes_one_path_and_one_profile() {
 #[test]
 fn a_set_past_the_splat_cap_is_still_ray_cast() {
     let n = 150; // 3,375,000 voxels, past MAX_GPU_SPLATS
-    assert!(n * n * n > voxsplat::constants::MAX_GPU_SPLATS);
+    assert!(n * n * n > voxsplat::low_level::constants::MAX_GPU_SPLATS);
     let grid = Grid::centered([n; 3], [1.0; 3]).unwrap();
     let set = voxsplat::SplatSet::from_fn(grid, |_, _, _| Some([0.8, 0.6, 0.4, 0.02])).unwrap();
     let cam = Camera::framing(&grid, 24, 24);

@@ -3,7 +3,7 @@
 //! splat frames of scenes past two pages get a typed error (a ray cast takes them).
 mod common;
 use common::{assert_clean, cpu, gpu};
-use voxsplat::constants::{MAX_GPU_SPLATS, SPLAT_PAGE};
+use voxsplat::low_level::constants::{MAX_GPU_SPLATS, SPLAT_PAGE};
 use voxsplat::{Antialias, Camera, Composite, Error, Grid, Kernel, Raster, RenderOptions, SplatSet};
 
 /// `nx` x 100 x 100 translucent splats with a colour ramp, so neighbouring records differ.
@@ -79,7 +79,7 @@ fn scenes_past_two_pages_are_refused_with_a_typed_error() {
 /// in shorter chunks. Both match the mirror, which has no such budget.
 #[test]
 fn work_past_llvmpipes_loop_budget_is_split_not_cut_short() {
-    use voxsplat::constants::TILE_SEGMENT;
+    use voxsplat::low_level::constants::TILE_SEGMENT;
     use voxsplat::Direction;
     let (mut g, mut c) = (gpu(), cpu());
     let set = voxsplat::scene::build("stripes128").unwrap();
@@ -140,7 +140,7 @@ fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
 /// `max_steps`, on both engines (issue 25: the mirror stopped there silently); under both it draws.
 #[test]
 fn gpu_rays_past_the_loop_budget_are_refused() {
-    use voxsplat::constants::MAX_GPU_RAY_STEPS;
+    use voxsplat::low_level::constants::MAX_GPU_RAY_STEPS;
     let set = voxsplat::scene::build("cube40").unwrap();
     let cam = Camera::framing(set.grid(), 24, 24);
     let mut g = gpu();

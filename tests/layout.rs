@@ -342,8 +342,8 @@ fn the_maths_imports_no_gpu_layout() {
 fn every_stage_has_its_shader_and_a_mirror_file_of_its_name() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let table = std::fs::read_to_string(root.join("src/stages.rs")).unwrap();
-    assert!(voxsplat::stages::STAGES.len() >= 26);
-    for desc in voxsplat::stages::STAGES {
+    assert!(voxsplat::low_level::stages::STAGES.len() >= 26);
+    for desc in voxsplat::low_level::stages::STAGES {
         let name = desc.name;
         let comp = root.join(format!("glsl/{name}.comp")).exists();
         let draw = root.join(format!("glsl/{name}.vert")).exists() && root.join(format!("glsl/{name}.frag")).exists();
@@ -376,4 +376,55 @@ fn the_recording_reads_the_plan_not_the_options() {
         }
     }
     assert!(functions > 20, "functions read: {functions}");
+}
+
+/// A small public face: the top level holds what an embedder calls; the engine's parts are
+/// private modules reached through `low_level`; the research modules need the `lab` feature.
+#[test]
+fn the_top_level_holds_the_embedders_modules() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let lib = std::fs::read_to_string(root.join("lib.rs")).unwrap();
+    let embedder = [
+        "animate",
+        "bricks",
+        "camera",
+        "classify",
+        "distributed",
+        "embedding",
+        "image",
+        "kernel",
+        "loaders",
+        "low_level",
+        "options",
+        "order",
+        "orient",
+        "output",
+        "scene",
+        "terrain",
+        "vk",
+        "volume",
+    ];
+    let lab = ["aa", "metrics", "truth"];
+    let lines: Vec<&str> = lib.lines().collect();
+    let mut public = Vec::new();
+    for (i, l) in lines.iter().enumerate() {
+        let Some(rest) = l.strip_prefix("pub mod ") else { continue };
+        let name = rest.split(|c: char| !c.is_alphanumeric() && c != '_').next().unwrap();
+        if lab.contains(&name) {
+            assert_eq!(lines[i - 1].trim(), "#[cfg(feature = \"lab\")]", "{name} needs the lab feature");
+        } else {
+            assert!(embedder.contains(&name), "`pub mod {name}` at the top level: an engine part goes in low_level");
+        }
+        public.push(name);
+    }
+    assert!(public.len() >= 15 && public.len() <= embedder.len() + lab.len(), "{public:?}");
+    // What low_level re-exports is private at the top, so it has one path.
+    let low = std::fs::read_to_string(root.join("low_level.rs")).unwrap();
+    let mut reexported = 0;
+    for l in low.lines() {
+        let Some(m) = l.trim().strip_prefix("pub use crate::").and_then(|r| r.strip_suffix("::*;")) else { continue };
+        assert!(lines.contains(&format!("mod {m};").as_str()), "{m}: low_level's module is private at the top");
+        reexported += 1;
+    }
+    assert!(reexported >= 12, "{reexported} modules under low_level");
 }

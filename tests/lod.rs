@@ -5,8 +5,8 @@
 mod common;
 use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 use voxsplat::classify::{Shading, TransferFunction};
-use voxsplat::plan::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
-use voxsplat::stages::{Res, StageId};
+use voxsplat::low_level::plan::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
+use voxsplat::low_level::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
 use voxsplat::{Camera, Direction, Lod, Raster, RenderOptions, Renderer};
 
@@ -24,8 +24,8 @@ fn drawn_cells(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 4
         .chunks_exact(2)
         .take(total as usize)
         .map(|v| {
-            let [i, j, k] = voxsplat::cpu::brick::voxel_ijk([v[0], v[1]]);
-            [i, j, k, 1 << voxsplat::cpu::brick::voxel_level([v[0], v[1]])]
+            let [i, j, k] = voxsplat::low_level::cpu::brick::voxel_ijk([v[0], v[1]]);
+            [i, j, k, 1 << voxsplat::low_level::cpu::brick::voxel_level([v[0], v[1]])]
         })
         .collect()
 }
@@ -363,17 +363,18 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
         // summaries, each batch building its coarse bricks' pyramids.
         let scene = resident.volume().unwrap();
         let headers = scene.store.headers.len();
-        let per_batch = voxsplat::plan::bricked_min_budget(scene, records, SIDE, SIDE)
+        let per_batch = voxsplat::low_level::plan::bricked_min_budget(scene, records, SIDE, SIDE)
             + pyramid_bytes(STREAMED_LOD_BUFFERS, headers)
             + 64 * PYRAMID_BYTES;
         // The resident pyramid built in one batch, and in several (room for it and under all
         // the records).
         let slotted = pyramid_bytes(SLOTTED_LOD_BUFFERS, headers);
-        let several = voxsplat::plan::bricked_resident_bytes(scene, 2 * records - 1, SIDE, SIDE) + 2 * slotted;
+        let several =
+            voxsplat::low_level::plan::bricked_resident_bytes(scene, 2 * records - 1, SIDE, SIDE) + 2 * slotted;
         assert!(slotted < records, "the pyramid and a batch leave less room than the records take");
         let budgets = [2 * records - 1, several, per_batch];
         for (k, &budget) in budgets.iter().enumerate() {
-            let room = budget - voxsplat::plan::bricked_resident_bytes(scene, budget, SIDE, SIDE);
+            let room = budget - voxsplat::low_level::plan::bricked_resident_bytes(scene, budget, SIDE, SIDE);
             assert!(scene.streams(budget));
             assert_eq!(slotted <= room / 2, k < 2, "{budget}");
         }
@@ -494,9 +495,9 @@ fn coarse_cells_cover_what_their_voxels_cover_along_each_axis() {
         cells.push(r.probe(&cam, &o, StageId::BrickPyramid, &[Res::Pyramid]).unwrap().remove(0));
     }
     // 64 bricks, all holding rods.
-    let words = 64 * voxsplat::plan::SLOT_CELLS * voxsplat::plan::CELL_WORDS;
+    let words = 64 * voxsplat::low_level::plan::SLOT_CELLS * voxsplat::low_level::plan::CELL_WORDS;
     assert!(cells[0][..words] == cells[1][..words], "GPU vs mirror pyramid");
-    let alpha = |code: u32| 1.0 - (-voxsplat::cpu::lod::tau_decode(code)).exp();
+    let alpha = |code: u32| 1.0 - (-voxsplat::low_level::cpu::lod::tau_decode(code)).exp();
     let pyramid = &cells[0];
     let a0 = 1.0 - (1.0f32 - 0.999).powi(2);
     // Level 1 of brick 0: cell (0, 0, z) holds voxel column (1, 1) of its 2x2 (i, j).
@@ -590,8 +591,8 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
             .into();
         // The nodes, after the bricks' summaries (whose float sums differ from the mirror's in the
         // last bits: exp and log): packed fields within a step, sums within 1e-4, the brick exact.
-        let at = 512 * voxsplat::plan::SUMMARY_WORDS;
-        let words = voxsplat::plan::NODE_WORDS;
+        let at = 512 * voxsplat::low_level::plan::SUMMARY_WORDS;
+        let words = voxsplat::low_level::plan::NODE_WORDS;
         let fields = |w: u32, i: usize| match i {
             0 | 1 => vec![w & 0xffff, w >> 16],
             2 => vec![w & 1023, w >> 10 & 1023, w >> 20 & 1023],
@@ -603,7 +604,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
             _ => fields(a, i).iter().zip(fields(b, i)).all(|(x, y)| x.abs_diff(y) <= 1),
         };
         // 4³ + 2³ + 1 nodes over the 8³ bricks.
-        let n = voxsplat::plan::node_words([8; 3], 3) as usize;
+        let n = voxsplat::low_level::plan::node_words([8; 3], 3) as usize;
         assert_eq!(n, 73 * words);
         for (i, (x, y)) in nodes[0][at..at + n].iter().zip(&nodes[1][at..at + n]).enumerate() {
             assert!(

@@ -404,7 +404,7 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
 /// side first, or the low-side one first where the split runs between them.
 #[test]
 fn octree_order_in_a_leaf_is_a_visibility_order_with_consecutive_blocks() {
-    use voxsplat::cpu::brick::octree_pbtf;
+    use voxsplat::low_level::cpu::brick::octree_pbtf;
     let mut rng = Rng(777);
     let mut below = |n: u32| (rng.next_u64() % n as u64) as u32;
     for _ in 0..200 {

@@ -509,7 +509,7 @@ fn the_validator_runs_on_sheared_grids() {
 /// largest component.
 #[test]
 fn sheets_on_a_sheared_grid_face_the_view() {
-    use voxsplat::plan::sheet_axis;
+    use voxsplat::low_level::plan::sheet_axis;
     let tilt = 60f64.to_radians().tan() as f32;
     let sheared = Grid::centered_sheared(DIMS, [1.0; 3], [0.0, 0.0, tilt]).unwrap();
     let aligned = Grid::centered(DIMS, [1.0; 3]).unwrap();

@@ -1,14 +1,14 @@
 //! The frame's plan and the stages' named builds, checked without a device: what `plan::frame`
 //! decides for each mode, and what `Dispatch::new` refuses.
 mod common;
-use voxsplat::builds::{
+use voxsplat::low_level::builds::{
     Build, CompositeLayers, Footprint, Only, Pages, Records, SheetMode, SheetTiles, TileComposite, TileOrder, TABLES,
 };
-use voxsplat::dispatch::{Blend, Limits, List};
-use voxsplat::gpu_types::BrickPush;
+use voxsplat::low_level::dispatch::{Blend, Limits, List};
+use voxsplat::low_level::gpu_types::BrickPush;
+use voxsplat::low_level::plan::{Draw, OrderSource, Prepared, SplatRaster};
+use voxsplat::low_level::stages::{Dispatch, Kind, StageId};
 use voxsplat::options::{BlurProfile, Composite, Motion};
-use voxsplat::plan::{Draw, OrderSource, Prepared, SplatRaster};
-use voxsplat::stages::{Dispatch, Kind, StageId};
 use voxsplat::{scene, Camera, Direction, Error, OrderKind, Raster, RenderOptions};
 
 const LIMITS: Limits = Limits { max_layers: 2048, max_storage_range: 1 << 31, budget_bytes: 1 << 30 };
@@ -96,7 +96,7 @@ fn a_dense_frame_plans_its_order_and_raster() {
     let cam = Camera::framing(set.grid(), 96, 80);
     let prep = Prepared::new(set);
     let splats = prep.set.len() as u32;
-    let plan_of = |o: &RenderOptions| voxsplat::plan::frame(&prep, &cam, o, &LIMITS).unwrap();
+    let plan_of = |o: &RenderOptions| voxsplat::low_level::plan::frame(&prep, &cam, o, &LIMITS).unwrap();
 
     let p = plan_of(&options(Raster::Compute, Direction::FrontToBack));
     let Draw::Splats { splats: n, order, raster: SplatRaster::Tiles(rule), .. } = p.draw else { panic!("{p}") };
@@ -154,7 +154,7 @@ fn sheet_batches_stay_within_the_layer_limit_and_cover_the_list() {
         let limits = Limits { max_layers, ..LIMITS };
         let mut o = options(raster, direction);
         o.composite = Composite::Sheet;
-        let p = voxsplat::plan::frame(&prep, &cam, &o, &limits).unwrap();
+        let p = voxsplat::low_level::plan::frame(&prep, &cam, &o, &limits).unwrap();
         let Draw::Sheets { pass, axis, .. } = &p.draw else { panic!("{p}") };
         assert_eq!(pass.list, List::Slices(*axis as u8));
         assert!(pass.layers <= max_layers, "{} layers", pass.layers);
@@ -170,7 +170,7 @@ fn sheet_batches_stay_within_the_layer_limit_and_cover_the_list() {
     // Slabs: the geometry now, the batches once the binning's counts are back.
     let mut o = options(Raster::Graphics, Direction::FrontToBack);
     o.composite = Composite::Slab;
-    let p = voxsplat::plan::frame(&prep, &cam, &o, &LIMITS).unwrap();
+    let p = voxsplat::low_level::plan::frame(&prep, &cam, &o, &LIMITS).unwrap();
     let Draw::Slabs { geometry, pass, .. } = &p.draw else { panic!("{p}") };
     assert!(geometry.slabs > 1 && pass.batches.is_empty() && pass.list == List::SlabPairs);
     assert!(p.to_string().contains("cut after the binning"));
@@ -183,7 +183,7 @@ fn a_bricked_plan_streams_only_under_a_short_budget() {
     let mut r = common::cpu();
     r.set_volume(&vol, &common::blob_tf(), None).unwrap();
     let scene = r.volume().unwrap().clone();
-    let least = voxsplat::plan::bricked_min_budget(&scene, u64::MAX, 80, 80);
+    let least = voxsplat::low_level::plan::bricked_min_budget(&scene, u64::MAX, 80, 80);
     let records = scene.store.records.len() as u64 * 4;
     let o = options(Raster::Compute, Direction::FrontToBack);
     for lod in [voxsplat::Lod::Auto, voxsplat::Lod::Off] {
@@ -203,7 +203,7 @@ fn a_bricked_plan_streams_only_under_a_short_budget() {
     }
     // A budget under twice the records streams them (levels of detail off: no pyramid to hold).
     let budget = 2 * records - 1;
-    let streamed_least = voxsplat::plan::bricked_min_budget(&scene, budget, 80, 80);
+    let streamed_least = voxsplat::low_level::plan::bricked_min_budget(&scene, budget, 80, 80);
     assert!(scene.streams(budget) && budget >= streamed_least, "{budget} {streamed_least}");
     r.set_gpu_budget(budget).unwrap();
     let mut o = o.clone();

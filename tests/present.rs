@@ -4,8 +4,8 @@
 //! semaphores order frames; bad targets are refused.
 mod common;
 use common::assert_clean;
-use voxsplat::cpu::present::{decode, encode, present_pixel};
-use voxsplat::plan::present_push;
+use voxsplat::low_level::cpu::present::{decode, encode, present_pixel};
+use voxsplat::low_level::plan::present_push;
 use voxsplat::vk::ImageLayout as IL;
 use voxsplat::{scene, Camera, Composite, Motion, Raster, RenderOptions, TargetFormat};
 
@@ -22,7 +22,11 @@ fn most(format: TargetFormat, a: &[u8], b: &[u8]) -> f32 {
     // Compare in the stored encoding: an sRGB byte step is not a fixed linear step.
     let stored = |p: [f32; 4]| {
         if matches!(format, TargetFormat::Bgra8Srgb | TargetFormat::Rgba8Srgb) {
-            [0, 1, 2].map(|c| voxsplat::cpu::present::to_srgb(p[c])).into_iter().chain([p[3]]).collect::<Vec<_>>()
+            [0, 1, 2]
+                .map(|c| voxsplat::low_level::cpu::present::to_srgb(p[c]))
+                .into_iter()
+                .chain([p[3]])
+                .collect::<Vec<_>>()
         } else {
             p.to_vec()
         }

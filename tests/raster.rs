@@ -77,7 +77,8 @@ fn raster_variants_agree_with_the_graphics_path() {
 /// The validator: every tile's list is the subsequence of the draw order made of exactly the splats
 /// whose footprint box overlaps the tile.
 fn check_tile_lists(order: &[u32], boxes: &[Option<[i32; 4]>], tiles_x: u32, start: &[u32], entries: &[u32]) {
-    let (tw, th) = (voxsplat::constants::RASTER_TILE_W as i32, voxsplat::constants::RASTER_TILE_H as i32);
+    let (tw, th) =
+        (voxsplat::low_level::constants::RASTER_TILE_W as i32, voxsplat::low_level::constants::RASTER_TILE_H as i32);
     let mut pos = vec![u32::MAX; boxes.len()];
     for (i, &s) in order.iter().enumerate() {
         pos[s as usize] = i as u32;
@@ -118,14 +119,14 @@ fn tile_lists_keep_the_pbtf_order_and_hold_exactly_the_overlapping_splats() {
                 let (start, entries) = gpu.tile_lists(&cam, &o).unwrap();
                 assert_eq!((start.clone(), entries.clone()), cpu.tile_lists(&cam, &o).unwrap(), "GPU = mirror");
                 let order = gpu.pbtf_order(&cam, direction).unwrap();
-                let frame = voxsplat::plan::frame_for(&set, &cam, &o);
+                let frame = voxsplat::low_level::plan::frame_for(&set, &cam, &o);
                 let mut params = vec![Default::default(); set.len()];
-                voxsplat::cpu::splat_params(&frame, set.splats(), &[], &mut params);
+                voxsplat::low_level::cpu::splat_params(&frame, set.splats(), &[], &mut params);
                 let boxes: Vec<_> = params
                     .iter()
-                    .map(|p| voxsplat::cpu::footprint::screen_quad(&frame, p).map(|(_, b)| b.to_array()))
+                    .map(|p| voxsplat::low_level::cpu::footprint::screen_quad(&frame, p).map(|(_, b)| b.to_array()))
                     .collect();
-                let tiles_x = voxsplat::plan::tile_grid(&frame).0;
+                let tiles_x = voxsplat::low_level::plan::tile_grid(&frame).0;
                 check_tile_lists(&order, &boxes, tiles_x, &start, &entries);
                 assert!(!entries.is_empty() || boxes.iter().all(Option::is_none), "{kind:?}: something binned");
             }
@@ -300,7 +301,7 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
 
 #[test]
 fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphics_and_says_so() {
-    use voxsplat::raster::{choose, Device};
+    use voxsplat::low_level::raster::{choose, Device};
     let set = scene::build("cube40").unwrap();
     let small = Camera::framing(set.grid(), 96, 80);
     let cpu = Device { cpu: true, point_size_max: 64.0 };
@@ -355,18 +356,24 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
 /// sheet (so the composite, which reads only those layers, misses nothing), for quads and points:
 /// all entries drawn at once into one layer per global sheet by the footprint mirror.
 fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tiles: &[u32]) -> usize {
-    use voxsplat::cpu::footprint::{footprint, Blend, FootprintInputs};
-    use voxsplat::plan::{frame_for, sheet_plan, sheet_tiles_push, Prepared};
+    use voxsplat::low_level::cpu::footprint::{footprint, Blend, FootprintInputs};
+    use voxsplat::low_level::plan::{frame_for, sheet_plan, sheet_tiles_push, Prepared};
     let prep = Prepared::new(set.clone());
     let frame = frame_for(set, cam, o);
     let mut params = vec![Default::default(); set.len()];
-    voxsplat::cpu::splat_params(&frame, set.splats(), &[], &mut params);
+    voxsplat::low_level::cpu::splat_params(&frame, set.splats(), &[], &mut params);
     let (draw, batches) = if o.composite == Composite::Sheet {
         let (axis, batches) = sheet_plan(&prep, cam, o.direction(), 1 << 16);
         (prep.slices[axis].1.clone(), batches)
     } else {
-        let pc = voxsplat::plan::slab::slab_geometry(&frame, set.grid(), set.len(), o.slab_thickness, o.direction())
-            .unwrap();
+        let pc = voxsplat::low_level::plan::slab::slab_geometry(
+            &frame,
+            set.grid(),
+            set.len(),
+            o.slab_thickness,
+            o.direction(),
+        )
+        .unwrap();
         slab_bins(&pc, &params)
     };
     let push = sheet_tiles_push(&batches, &batches[0]);
@@ -385,7 +392,7 @@ fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tile
     let mut layers = vec![ImageF32::new(cam.width, cam.height); sheets];
     let points = o.raster == Raster::Points;
     footprint(&inputs, &push, Blend::Add, points, false, 0, push.count, &mut layers);
-    let tile = voxsplat::constants::COMPOSITE_TILE;
+    let tile = voxsplat::low_level::constants::COMPOSITE_TILE;
     let (tiles_x, n) = (cam.width.div_ceil(tile), tiles.len() / 2);
     let mut written = 0;
     for (s, layer) in layers.iter().enumerate() {
@@ -446,7 +453,7 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
     gpu.set_scene(sheet).unwrap();
     let tiles = gpu.sheet_tiles(&cam, &opts(Composite::Sheet, Raster::Compute)).unwrap();
     let n = tiles.len() / 2;
-    let [lo, hi] = voxsplat::plan::ALL_SHEETS;
+    let [lo, hi] = voxsplat::low_level::plan::ALL_SHEETS;
     assert!(tiles[..n].iter().all(|&t| t == lo) && tiles[n..].iter().all(|&t| t == hi), "single sheet: all layers");
     // Not a bound on speed: that the ranges skip anything at all on these sparse scenes.
     let mean = skipped_share.iter().sum::<f64>() / skipped_share.len() as f64;
@@ -457,15 +464,15 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
 /// The slab binning on the CPU mirrors, straight (the oracle beside the recording's): the pairs
 /// and the batches.
 fn slab_bins(
-    pc: &voxsplat::gpu_types::SlabPush,
-    params: &[voxsplat::gpu_types::SplatParams],
-) -> (Vec<u32>, Vec<voxsplat::plan::Batch>) {
+    pc: &voxsplat::low_level::gpu_types::SlabPush,
+    params: &[voxsplat::low_level::gpu_types::SplatParams],
+) -> (Vec<u32>, Vec<voxsplat::low_level::plan::Batch>) {
     let mut counts = vec![0u32; (pc.slabs * pc.chunks) as usize];
     let mut start = vec![0u32; pc.slabs as usize + 1];
-    voxsplat::cpu::slab_count(pc, params, None, &mut counts);
-    voxsplat::cpu::slab_scan(pc, &mut counts, &mut start);
-    let batches = voxsplat::plan::slab::slab_batches(pc, &start, 1 << 16).unwrap();
+    voxsplat::low_level::cpu::slab_count(pc, params, None, &mut counts);
+    voxsplat::low_level::cpu::slab_scan(pc, &mut counts, &mut start);
+    let batches = voxsplat::low_level::plan::slab::slab_batches(pc, &start, 1 << 16).unwrap();
     let mut pairs = vec![0u32; 2 * start[pc.slabs as usize] as usize];
-    voxsplat::cpu::slab_scatter(pc, params, None, &mut counts, &mut pairs);
+    voxsplat::low_level::cpu::slab_scatter(pc, params, None, &mut counts, &mut pairs);
     (pairs, batches)
 }

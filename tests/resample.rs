@@ -2,10 +2,11 @@
 //! is the backend's own frame of `scaled_camera`, resampled; close to the full-size frame where
 //! voxels cover several pixels; bad scales are typed errors.
 mod common;
-use voxsplat::resample::{scaled_camera, upsample};
+use voxsplat::low_level::resample::{scaled_camera, upsample};
+use voxsplat::scene::peer;
 use voxsplat::ImageF32;
 use voxsplat::RaycastOptions;
-use voxsplat::{classify, peer, scene, Camera, Error, Kernel, Raster, RenderOptions, Renderer};
+use voxsplat::{classify, scene, Camera, Error, Kernel, Raster, RenderOptions, Renderer};
 
 fn opts(raster: Raster, kernel: Kernel, scale: f32) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -124,6 +125,8 @@ fn bad_render_scales_are_typed_errors() {
     }
     // The smallest scale still draws at least one row and column.
     let tiny = Camera { width: 3, height: 2, ..cam };
-    let img = c.render(&tiny, &opts(Raster::Graphics, Kernel::Gaussian, voxsplat::resample::MIN_RENDER_SCALE)).unwrap();
+    let img = c
+        .render(&tiny, &opts(Raster::Graphics, Kernel::Gaussian, voxsplat::low_level::resample::MIN_RENDER_SCALE))
+        .unwrap();
     assert_eq!((img.image.width, img.image.height), (3, 2));
 }

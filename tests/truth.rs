@@ -3,9 +3,9 @@
 mod common;
 use common::assert_clean;
 use glam::Vec3;
-use voxsplat::cpu::raycast::raycast;
+use voxsplat::low_level::cpu::raycast::raycast;
+use voxsplat::low_level::plan::raycast_params;
 use voxsplat::metrics::{compare, temporal};
-use voxsplat::plan::raycast_params;
 use voxsplat::truth::{volumetric_summation, DenseField, Reconstruction, TruthOptions};
 use voxsplat::ImageF32;
 use voxsplat::RaycastOptions;
@@ -39,7 +39,7 @@ fn single_cubic_voxel_matches_its_analytic_line_integral() {
     };
     let img = volumetric_summation(&set, &cam, &opts).unwrap();
     let r = Kernel::Cubic.radius() as f64;
-    let tau = voxsplat::cpu::splat_params::optical_depth(opacity) as f64;
+    let tau = voxsplat::low_level::cpu::splat_params::optical_depth(opacity) as f64;
     let alpha = 1.0 - (-tau * 15.0 / (4.0 * std::f64::consts::PI * r * r)).exp();
     let got = img.pixels[0];
     assert!((got[3] as f64 - alpha).abs() < 1e-6, "alpha {} vs {alpha}", got[3]);
@@ -58,7 +58,7 @@ fn homogeneous_slab_transmittance_is_exp_minus_tau_m() {
     let cam = ortho_down_z(grid.center(), 1);
     let opts = TruthOptions { reconstruction: Reconstruction::Trilinear, oversampling: 4, min_transmittance: 0.0 };
     let img = volumetric_summation(&set, &cam, &opts).unwrap();
-    let tau = voxsplat::cpu::splat_params::optical_depth(opacity) as f64;
+    let tau = voxsplat::low_level::cpu::splat_params::optical_depth(opacity) as f64;
     // Trilinear: full density over m - 1 voxels plus two half-voxel ramps = tau * m.
     let alpha = 1.0 - (-tau * m as f64).exp();
     let got = img.pixels[0];

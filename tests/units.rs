@@ -1,9 +1,9 @@
 //! Kernels, cameras, scenes and the sheet plan.
 mod common;
 use glam::Vec3;
-use voxsplat::constants::{FOOTPRINT_TABLE_SIZE, MAX_GROUPS_X, WORKGROUP_SIZE};
+use voxsplat::low_level::constants::{FOOTPRINT_TABLE_SIZE, MAX_GROUPS_X, WORKGROUP_SIZE};
+use voxsplat::low_level::plan::{groups_1d, sheet_plan, Prepared};
 use voxsplat::order::Direction;
-use voxsplat::plan::{groups_1d, sheet_plan, Prepared};
 use voxsplat::{scene, Camera, Error, Grid, Kernel, Projection, SplatSet, Volume};
 
 #[test]
@@ -27,7 +27,7 @@ fn footprint_tables_integrate_to_one_and_vanish_at_the_radius() {
             for dy in -3..=3 {
                 let (u, v) = ((0.3 + dx as f64) / r, (0.2 + dy as f64) / r);
                 if u.abs() <= 1.0 && v.abs() <= 1.0 {
-                    sum += voxsplat::cpu::sample_table(&t, u as f32, v as f32) as f64;
+                    sum += voxsplat::low_level::cpu::sample_table(&t, u as f32, v as f32) as f64;
                 }
             }
         }

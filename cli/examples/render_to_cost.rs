@@ -23,7 +23,7 @@ fn main() -> voxsplat::Result<()> {
             Camera::framing(&grid, 512, 512)
         } else {
             let set = scene::build(name)?;
-            let cam = voxsplat::peer::camera(set.grid().dims[0], 512);
+            let cam = voxsplat::scene::peer::camera(set.grid().dims[0], 512);
             r.set_scene(set)?;
             cam
         };

@@ -5,7 +5,8 @@
 //! low-pass, aliasing energy, shimmer along a slow camera move, and time, for none, Swan and EWA.
 use crate::bricked::frame_ms;
 use std::fmt::Write as _;
-use voxsplat::truth::{supersampled_with, Downsample, TruthOptions};
+use voxsplat::image::Downsample;
+use voxsplat::truth::{supersampled_with, TruthOptions};
 use voxsplat::{Antialias, Camera, ImageF32, Projection, RenderOptions, Renderer, RendererOptions, Result};
 
 /// One mode on one figure's view.

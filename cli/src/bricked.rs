@@ -363,9 +363,9 @@ const LOD_CURVE_ERRORS: [f32; 5] = [0.003, 0.01, 0.02, 0.05, 0.25];
 /// voxel), alternated frame by frame over `frames` rounds; the dense classified splats beside them.
 /// The levels-of-detail curve (pixel test off, error swept) goes on a chart at `chart`.
 pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Result<String> {
-    let vol = voxsplat::peer::volume(n)?;
-    let tf = voxsplat::peer::transfer_function();
-    let camera = voxsplat::peer::camera(n, size);
+    let vol = voxsplat::scene::peer::volume(n)?;
+    let tf = voxsplat::scene::peer::transfer_function();
+    let camera = voxsplat::scene::peer::camera(n, size);
     let truth = voxsplat::truth::ray_integrate_scalars(&vol, &tf, &camera, 0.25)?;
     let mut dense = renderer()?;
     dense.set_scene(classify(&vol, &tf, None)?)?;

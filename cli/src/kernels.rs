@@ -21,9 +21,9 @@ pub struct KernelRow {
 /// The peers' `n`³ scene at `size`², the tile compositor, every kernel alternating frame by frame
 /// for `rounds` rounds after a warm-up.
 pub fn study(n: u32, size: u32, rounds: usize) -> Result<Vec<KernelRow>> {
-    let vol = voxsplat::peer::volume(n)?;
-    let tf = voxsplat::peer::transfer_function();
-    let camera = voxsplat::peer::camera(n, size);
+    let vol = voxsplat::scene::peer::volume(n)?;
+    let tf = voxsplat::scene::peer::transfer_function();
+    let camera = voxsplat::scene::peer::camera(n, size);
     let truth = voxsplat::truth::ray_integrate_scalars(&vol, &tf, &camera, 0.25)?;
     let mut r = Renderer::new(&RendererOptions::default())?;
     r.set_scene(voxsplat::classify::classify(&vol, &tf, None)?)?;

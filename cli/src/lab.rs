@@ -183,18 +183,18 @@ pub(crate) fn run(study: Study) -> Result<()> {
             }
             std::fs::create_dir_all(&out_dir)
                 .map_err(|e| Error::Io { path: out_dir.display().to_string(), source: e })?;
-            let cam = voxsplat::peer::camera(n, size);
+            let cam = voxsplat::scene::peer::camera(n, size);
             if let Some(step) = truth_step {
                 let t = std::time::Instant::now();
-                let vol = voxsplat::peer::volume(n)?;
+                let vol = voxsplat::scene::peer::volume(n)?;
                 let img = voxsplat::truth::ray_integrate_scalars(
                     &vol,
-                    &voxsplat::peer::transfer_function(),
+                    &voxsplat::scene::peer::transfer_function(),
                     &cam,
                     step as f64,
                 )?;
                 voxsplat::output::write_image(&img, &out_dir.join(format!("truth-scalar-{n}.png")))?;
-                let set = voxsplat::classify::classify(&vol, &voxsplat::peer::transfer_function(), None)?;
+                let set = voxsplat::classify::classify(&vol, &voxsplat::scene::peer::transfer_function(), None)?;
                 let opts = voxsplat::truth::TruthOptions {
                     reconstruction: voxsplat::truth::Reconstruction::Trilinear,
                     ..Default::default()

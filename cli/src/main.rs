@@ -170,7 +170,7 @@ struct OrderArgs {
 /// `info`'s line about the bricked store.
 fn print_store(store: &voxsplat::bricks::BrickStore) {
     let per_voxel = |bytes: u64| bytes as f64 / store.len().max(1) as f64;
-    let pyramid = voxsplat::plan::pyramid_bytes(voxsplat::plan::LOD_BUFFERS, store.headers.len());
+    let pyramid = voxsplat::low_level::plan::pyramid_bytes(voxsplat::low_level::plan::LOD_BUFFERS, store.headers.len());
     println!(
         "bricked store: {} stored voxels in {} bricks of {}^3, {} bytes on the GPU, {:.2} bytes per stored voxel \
          ({:.2} with the levels-of-detail pyramid of --lod auto; shaded or gradient-weighted frames add {:.2} for \
@@ -311,7 +311,7 @@ fn run(cli: Cli) -> Result<()> {
             };
             println!("splats: {}", set.len());
             println!("bytes per splat (--dense): {:.0}", voxsplat::gpu_bytes_per_splat(&set));
-            let most = voxsplat::constants::MAX_GPU_SPLATS as usize;
+            let most = voxsplat::low_level::constants::MAX_GPU_SPLATS as usize;
             if set.len() > most {
                 println!("over the dense GPU path's {most} splats: render it bricked (the default for volumes)");
             }

@@ -225,7 +225,7 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
     let o = content.orientation;
     let view = match a.view.as_str() {
         "auto" if a.terrain.is_some() || a.scene == "rmnp" => "flyover",
-        "auto" if voxsplat::peer::side_of(&a.scene).is_some() && a.volume.is_none() => "peer",
+        "auto" if voxsplat::scene::peer::side_of(&a.scene).is_some() && a.volume.is_none() => "peer",
         "auto" if o.is_some() => "oblique",
         "auto" => "framing",
         v => v,
@@ -249,7 +249,7 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
             if w != h {
                 return Err(Error::InvalidArgument("the peer view is square: use --size NxN".into()));
             }
-            voxsplat::peer::camera(grid.dims[0], w)
+            voxsplat::scene::peer::camera(grid.dims[0], w)
         }
         (v, Some(o)) if anatomical => {
             let (dir, up) = v.parse::<voxsplat::orient::View>()?.directions();
@@ -496,7 +496,7 @@ pub fn open(
     a: &SceneArgs,
     host_splats: bool,
 ) -> Result<(Option<voxsplat::bricks::BrickScene>, voxsplat::SplatSet, Content)> {
-    let peer = voxsplat::peer::side_of(&a.scene).filter(|_| a.volume.is_none() && a.terrain.is_none());
+    let peer = voxsplat::scene::peer::side_of(&a.scene).filter(|_| a.volume.is_none() && a.terrain.is_none());
     if a.dense && a.volume.is_none() && peer.is_none() {
         return Err(Error::InvalidArgument(
             "--dense classifies a --volume or the peers' scene (--scene peer128, peer256) on the host; this scene is \
@@ -511,9 +511,9 @@ pub fn open(
         }
         (None, Some(n)) if !host_splats && !a.dense => {
             refuse_volume_flags(a)?;
-            let store = voxsplat::bricks::BrickStore::build(&voxsplat::peer::volume(n)?)?;
+            let store = voxsplat::bricks::BrickStore::build(&voxsplat::scene::peer::volume(n)?)?;
             eprintln!("{} stored voxels in {} bricks", store.len(), store.headers.len());
-            (voxsplat::bricks::BrickScene::new(store, voxsplat::peer::transfer_function(), None)?, None)
+            (voxsplat::bricks::BrickScene::new(store, voxsplat::scene::peer::transfer_function(), None)?, None)
         }
         _ => return load_scene(a).map(|(set, content)| (None, set, content)),
     };

@@ -1,6 +1,6 @@
 //! The peers' comparison: every voxsplat mode timed on the shared scene of
-//! `voxsplat::peer`.
-use voxsplat::peer::{camera, transfer_function, volume};
+//! `voxsplat::scene::peer`.
+use voxsplat::scene::peer::{camera, transfer_function, volume};
 use voxsplat::Result;
 
 /// One voxsplat configuration in the peer comparison.

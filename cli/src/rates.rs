@@ -11,9 +11,9 @@ use std::path::Path;
 use voxsplat::image::ImageF32;
 use voxsplat::metrics::compare;
 use voxsplat::options::Composite;
-use voxsplat::raster::Raster;
 use voxsplat::scene::{rate_camera, rate_scene};
 use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
+use voxsplat::Raster;
 use voxsplat::{Error, Result};
 use voxsplat::{Kernel, Renderer};
 

@@ -1,5 +1,6 @@
 //! Issue 9: the peers' scene reproduced; voxsplat's reference integration agrees with VTK.
-use voxsplat::{classify, peer, truth};
+use voxsplat::scene::peer;
+use voxsplat::{classify, truth};
 
 /// The generated volume and transfer function give exactly the peers' 208,483 visible voxels
 /// (../shared/peers/README.md).

@@ -10,7 +10,7 @@ use voxsplat_cli::stability::{self, Variant};
 
 #[test]
 fn slice_table_starts_at_zero_rises_and_ends_at_the_footprint() {
-    let n = voxsplat::constants::FOOTPRINT_TABLE_SIZE as usize;
+    let n = voxsplat::low_level::constants::FOOTPRINT_TABLE_SIZE as usize;
     for kernel in [Kernel::Gaussian, Kernel::Cubic] {
         let t = kernel.slice_table();
         let rr = kernel.radius() as f64;
@@ -33,7 +33,7 @@ fn slice_table_starts_at_zero_rises_and_ends_at_the_footprint() {
 
 /// The footprint table's normaliser: its texel value over the unnormalised line integral there.
 fn norm(kernel: Kernel) -> f64 {
-    let n = voxsplat::constants::FOOTPRINT_TABLE_SIZE as usize;
+    let n = voxsplat::low_level::constants::FOOTPRINT_TABLE_SIZE as usize;
     let rr = kernel.radius() as f64;
     let c = n / 2;
     let u = ((c as f64 + 0.5) / n as f64 * 2.0 - 1.0) * rr;

@@ -8,16 +8,23 @@ use std::collections::HashMap;
 /// What a mirror reads and writes: the scene, the frame's uniforms and tables, and the frame's
 /// resources by name (buffers as 32-bit words, images as `ImageF32`).
 pub struct Bindings<'a> {
+    /// The scene.
     pub prep: &'a Prepared,
+    /// The frame's uniforms.
     pub frame: Frame,
     /// The radial footprint table and the kernel-slice table (`Kernel::radial_table`,
     /// `Kernel::slice_table`).
     pub table: Vec<f32>,
+    /// See `table`.
     pub slice_table: Vec<f32>,
+    /// The image's size.
     pub width: u32,
+    /// See `width`.
     pub height: u32,
     pub(crate) bufs: HashMap<Res, Vec<u32>>,
+    /// The raster target (`Res::Color`).
     pub color: ImageF32,
+    /// The accumulation image (`Res::Accum`).
     pub accum: ImageF32,
     /// The summation layers.
     pub sums: Vec<ImageF32>,
@@ -56,6 +63,7 @@ impl<'a> Bindings<'a> {
         self.bufs.remove(&res).unwrap_or_default()
     }
 
+    /// `res` now holds `words`.
     pub fn put(&mut self, res: Res, words: Vec<u32>) {
         self.bufs.insert(res, words);
     }
@@ -105,10 +113,15 @@ impl<'a> Bindings<'a> {
 /// The footprint stages' inputs, as bound on the GPU (the draw call's and the tile stages').
 #[derive(Clone, Copy)]
 pub struct FootprintInputs<'a> {
+    /// The frame's uniforms.
     pub frame: &'a Frame,
+    /// Per splat its parameters.
     pub params: &'a [SplatParams],
+    /// The dispatch's draw list.
     pub draw_list: &'a [u32],
+    /// The scene's splats.
     pub splats: &'a [Splat],
+    /// Each slice's rank among the non-empty slices.
     pub sheet_rank: &'a [u32],
     /// The radial footprint table (`Kernel::radial_table`).
     pub table: &'a [f32],

@@ -79,13 +79,17 @@ pub fn octree_pbtf(b: [u32; 3], lo: [u32; 3], hi: [u32; 3], s: [u32; 3]) -> u32 
 
 /// What the brick stages read: the frame, its brick uniforms, the TF table and the store.
 pub struct BrickInputs<'a> {
+    /// The frame's uniforms.
     pub frame: &'a Frame,
+    /// The brick stages' uniforms.
     pub bf: BrickFrame,
     /// `BrickScene::tf_words`.
     pub tf: &'a [u32],
+    /// The bricked store.
     pub store: &'a BrickStore,
     /// Levels of detail: the pyramid cells and per-brick summaries (empty when off).
     pub pyramid: &'a [u32],
+    /// See `pyramid`.
     pub summary: &'a [u32],
     /// Per brick its splats' morph this frame (`brick_cull`).
     pub morphs: &'a [f32],

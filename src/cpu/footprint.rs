@@ -221,7 +221,9 @@ pub(crate) const MAX_SWEEP_SAMPLES: i32 = 64;
 /// (-stretch, 0) to t_i at (stretch, 0) through (0, bend), radius units about the quad's centre.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sweep {
+    /// Half the path's length along x.
     pub stretch: f32,
+    /// The arc's height at its middle.
     pub bend: f32,
     /// `BlurProfile::code`.
     pub profile: f32,

@@ -212,7 +212,10 @@ pub(crate) fn child_error(a: f32, straight: Vec3, tk: f32, ck: Vec3, ek: f32, vo
 /// not 0: each brick into its own header's slot, a resident pyramid), and per header its slot
 /// (written).
 pub struct PyramidBatch<'a> {
+    /// The batch's brick list.
     pub list: &'a [[u32; 4]],
+    /// The range of it built.
     pub push: BrickPush,
+    /// Per header its slot (written).
     pub slots: &'a mut [u32],
 }

@@ -5,6 +5,7 @@ use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{SlabPush, SplatParams};
 
+/// Each (slab, chunk) cell's count of pairs (the stage's loops, whole).
 pub fn slab_count(pc: &SlabPush, params: &[SplatParams], voxels: Option<&[[u32; 2]]>, counts: &mut [u32]) {
     for chunk in 0..pc.chunks {
         for pos in 0..pc.slabs {

@@ -4,6 +4,7 @@ use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::SlabPush;
 
+/// Each slab's first pair, then the total (the stage's scan, whole).
 pub fn slab_scan(pc: &SlabPush, counts: &mut [u32], slab_start: &mut [u32]) {
     let mut carry = 0u32;
     for c in counts.iter_mut().take((pc.slabs * pc.chunks) as usize) {

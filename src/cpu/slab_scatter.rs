@@ -5,6 +5,7 @@ use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{SlabPush, SplatParams};
 
+/// The (splat, slab) pairs written in visiting order (the stage's loops, whole).
 pub fn slab_scatter(
     pc: &SlabPush,
     params: &[SplatParams],

@@ -6,6 +6,7 @@ use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{FootprintPush, ScreenQuad};
 
+/// Each tile's entries written in draw order (the stage's loops, whole).
 pub fn tile_scatter(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,

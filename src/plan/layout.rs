@@ -20,7 +20,9 @@ pub fn present_push(background: Option<[f32; 4]>, sources: u32, linear: bool, wi
 
 /// `Frame::aa[0]`: no anti-aliasing, Swan's, or the EWA low-pass (`params.glsl`).
 pub const AA_NONE: f32 = 0.0;
+/// See `AA_NONE`.
 pub const AA_SWAN: f32 = 1.0;
+/// See `AA_NONE`.
 pub const AA_EWA: f32 = 2.0;
 
 /// The anti-aliasing radius scale at eye-space `depth` (1 before k; Eq. 3.9 or the EWA low-pass).

@@ -38,7 +38,7 @@ pub fn antialias_study(
     let set = scene::build("plane")?;
     let camera = Camera::grazing(set.grid(), size, size);
     progress("anti-aliasing: supersampled truth");
-    let lanczos = voxsplat::truth::Downsample::Lanczos3;
+    let lanczos = voxsplat::image::Downsample::Lanczos3;
     let truth = voxsplat::truth::supersampled_with(&set, &camera, factor, lanczos, &TruthOptions::default())?;
     let regions = voxsplat::aa::k_regions(&set, &camera);
     r.set_scene(set.clone())?;
