@@ -72,6 +72,10 @@ fn every_readme_command_runs_as_written() {
                 if a[0] == "compare" {
                     assert!(String::from_utf8_lossy(&out.stdout).contains("psnr:"), "{c} printed no PSNR");
                 }
+                if a.iter().any(|f| f == "--plan") {
+                    let plan = String::from_utf8_lossy(&out.stdout);
+                    assert!(plan.contains("draw ") && plan.contains("budget "), "{c} printed no plan: {plan}");
+                }
                 if a[0] == "info" {
                     assert!(String::from_utf8_lossy(&out.stdout).contains("volume:"), "{c} printed no volume line");
                 }
