@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Regenerates docs/RESULTS.md and the charts in docs/bench/ from one full benchmark run on this
-# machine (the matrix, the roofline and the scaling series; several minutes on lavapipe).
-# Hand-written commentary lives in docs/results-notes.md and is appended verbatim.
+# Regenerates docs/RESULTS.md (one page: frames beside VTK, speed against accuracy, the targets, a
+# table of the detail pages) and docs/bench/ (the detail pages and charts) from one full run on this
+# machine: the bricked-volume study and VTK on the same files, the kernels, anti-aliasing and
+# motion-order studies, then the matrix, the roofline and the scaling series (about an hour on
+# lavapipe). Hand-written commentary lives in docs/results-notes.md and is appended verbatim.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh

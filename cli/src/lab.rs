@@ -156,7 +156,8 @@ pub(crate) struct MatrixArgs {
     /// Where the CSV files and SVG charts go.
     #[arg(long, default_value = "bench-out")]
     out_dir: PathBuf,
-    /// Also write the results page (e.g. docs/RESULTS.md), linking the charts in --out-dir.
+    /// Also write the results page (e.g. docs/RESULTS.md): one page linking the charts and the
+    /// detail pages it writes beside them in --out-dir.
     #[arg(long)]
     results: Option<PathBuf>,
     /// Skip the scaling series.
@@ -385,32 +386,8 @@ fn matrix(a: MatrixArgs) -> Result<()> {
         let notes_path = base.join("results-notes.md");
         let notes = std::fs::read_to_string(&notes_path).ok();
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
-        // The peer comparison is its own run (scripts/peers.sh); its section is kept when present.
-        let peers_md = std::fs::read_to_string(a.out_dir.join("peers.md")).unwrap_or_default();
-        // So are the bricked-volume study (`voxsplat lab bricks`) and the kernels' (`voxsplat lab kernels`),
-        // run by scripts/results.sh.
-        let bricks_md = std::fs::read_to_string(a.out_dir.join("bricks.md")).unwrap_or_default();
-        let kernels_md = std::fs::read_to_string(a.out_dir.join("kernels.md")).unwrap_or_default();
-        let aa_scenes_md = std::fs::read_to_string(a.out_dir.join("antialias.md")).unwrap_or_default();
-        let motion_orders_md = std::fs::read_to_string(a.out_dir.join("motion-orders.md")).unwrap_or_default();
         let roof_rates: Vec<(u32, f64)> = roof.0.iter().map(|p| (p.size_px, p.quads_per_s)).collect();
-        let motion_md = format!(
-            "{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}\n{}",
-            voxsplat_cli::rates::rates_markdown(
-                &rates,
-                &roof_rates,
-                &voxsplat_cli::bench::link(&chart_dir, "rates.svg")
-            ),
-            antialias_markdown(&aa, aa_size, aa_factor, aa_dolly),
-            aa_scenes_md,
-            motion_markdown(&mb, mb_size, mb_frame, &mb_images, &chart_dir),
-            motion_orders_md,
-            voxsplat_cli::stability::markdown(&stab, &chart_dir),
-            peers_md,
-            bricks_md,
-            kernels_md
-        );
-        let md = results_markdown(&Report {
+        let report = Report {
             device,
             commit,
             command: format!("voxsplat {cmd}"),
@@ -419,8 +396,55 @@ fn matrix(a: MatrixArgs) -> Result<()> {
             scaling: &scale,
             chart_dir,
             notes,
-            antialias: Some(motion_md),
-        })?;
+        };
+        // The detail pages, beside the charts they link. The studies that scripts/results.sh runs
+        // first (and scripts/peers.sh) wrote theirs; this run writes the rest.
+        let written = [
+            ("matrix.md", matrix_markdown(&report)?),
+            (
+                "raster.md",
+                voxsplat_cli::rates::rates_markdown(&rates, &roof_rates, &voxsplat_cli::bench::link("", "rates.svg")),
+            ),
+            ("antialias-plane.md", antialias_markdown(&aa, aa_size, aa_factor, aa_dolly)),
+            ("motion.md", motion_markdown(&mb, mb_size, mb_frame, &mb_images, "")),
+            ("stability.md", voxsplat_cli::stability::markdown(&stab, "")),
+        ];
+        for (file, md) in &written {
+            let p = a.out_dir.join(file);
+            std::fs::write(&p, md).map_err(io(&p))?;
+        }
+        let mut details = vec![
+            Detail {
+                file: "matrix.md",
+                what: "every method on every scene: stage times, error, the roofline, scaling",
+            },
+            Detail { file: "raster.md", what: "how footprints become pixels: splat rates by size" },
+            Detail { file: "antialias-plane.md", what: "anti-aliasing on the checkerboard plane (chapter 3)" },
+            Detail { file: "motion.md", what: "motion blur on the rotating box (chapter 4)" },
+            Detail { file: "stability.md", what: "stability where methods fail: popping, brightening" },
+        ];
+        let studies = [
+            ("bricks.md", "bricked volumes: levels of detail, streaming, beside VTK"),
+            ("kernels.md", "reconstruction kernels: ripple, error, time"),
+            ("antialias.md", "anti-aliasing on the terrain and the stripes"),
+            ("motion-orders.md", "visibility orders of motion-blurred frames"),
+            ("peers.md", "side by side with VTK and taichi on one scene"),
+        ];
+        let mut vtk = None;
+        for (file, what) in studies {
+            let p = a.out_dir.join(file);
+            let Ok(md) = std::fs::read_to_string(&p) else { continue };
+            // Written to be read from the results page: their charts' links become the page's own.
+            let beside = md.replace("](bench/", "](");
+            if beside != md {
+                std::fs::write(&p, &beside).map_err(io(&p))?;
+            }
+            if file == "bricks.md" {
+                vtk = section(&beside, "### Beside VTK on the same files").map(|v| relink(&v, &report.chart_dir));
+            }
+            details.push(Detail { file, what });
+        }
+        let md = results_markdown(&report, vtk.as_deref(), &details)?;
         std::fs::write(path, md).map_err(io(path))?;
         eprintln!("wrote {}", path.display());
     }
@@ -433,4 +457,42 @@ fn pathdiff(target: &std::path::Path, base: &std::path::Path) -> String {
     let t = std::fs::canonicalize(target).unwrap_or_else(|_| target.to_path_buf());
     let b = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
     t.strip_prefix(&b).map(|p| p.display().to_string()).unwrap_or_else(|_| target.display().to_string())
+}
+
+/// The section of `md` under `heading` (without it), up to the next heading of its level or above.
+fn section(md: &str, heading: &str) -> Option<String> {
+    let start = md.find(heading)? + heading.len();
+    let level = heading.chars().take_while(|&c| c == '#').count();
+    let rest = &md[start..];
+    let end = rest
+        .lines()
+        .scan(0, |at, l| {
+            let here = *at;
+            *at += l.len() + 1;
+            Some((here, l))
+        })
+        .find(|(_, l)| {
+            let hashes = l.chars().take_while(|&c| c == '#').count();
+            hashes > 0 && hashes <= level && l[hashes..].starts_with(' ')
+        })
+        .map_or(rest.len(), |(at, _)| at);
+    Some(rest[..end].trim().to_string())
+}
+
+/// A detail page's text moved to the results page: its links to files beside it (charts) go
+/// through `dir`, the charts' folder as the page sees it.
+fn relink(md: &str, dir: &str) -> String {
+    let mut out = String::with_capacity(md.len());
+    let mut rest = md;
+    while let Some(i) = rest.find("](") {
+        out.push_str(&rest[..i + 2]);
+        rest = &rest[i + 2..];
+        let local = !(rest.starts_with("http") || rest.starts_with('#') || rest.starts_with("../"));
+        if local && !dir.is_empty() {
+            out.push_str(dir);
+            out.push('/');
+        }
+    }
+    out.push_str(rest);
+    out
 }

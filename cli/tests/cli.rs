@@ -243,11 +243,23 @@ fn quick_bench_writes_valid_csv_and_svg() {
         assert!(rmse < 0.02, "every variant close to the truth: {r:?}");
     }
     let md = std::fs::read_to_string(&results).unwrap();
-    assert!(md.contains("## Targets") && md.contains("chart-cube40.svg"));
-    assert!(md.contains("## Raster variants") && md.contains("rates.svg"));
-    assert!(md.contains("## Anti-aliasing") && md.contains("Swan vs none beyond k"));
-    assert!(md.contains("## Motion blur") && md.contains("accumulation"));
-    assert!(md.contains("## Stability where methods fail") && md.contains("popping at the switch"));
+    // One page: the charts, the targets and a table of the detail pages, each written beside the
+    // charts it links.
+    assert!(md.contains("## Targets") && md.contains("chart-cube40.svg") && md.contains("## Details"));
+    assert!(md.lines().count() < 150, "the results page is one page: {} lines", md.lines().count());
+    let page = |file: &str| {
+        assert!(md.contains(&format!("]({file})")), "the results page links {file}");
+        std::fs::read_to_string(dir.join(file)).unwrap()
+    };
+    let m = page("matrix.md");
+    assert!(m.contains("| cube40 | pbtf splat gaussian |") && m.contains("## Roofline"));
+    let r = page("raster.md");
+    assert!(r.contains("## Raster variants") && r.contains("](rates.svg)"));
+    assert!(page("antialias-plane.md").contains("Swan vs none beyond k"));
+    let mb = page("motion.md");
+    assert!(mb.contains("## Motion blur") && mb.contains("accumulation"));
+    let st = page("stability.md");
+    assert!(st.contains("## Stability where methods fail") && st.contains("popping at the switch"));
     let stab = std::fs::read_to_string(dir.join("stability.csv")).unwrap();
     assert_eq!(stab.lines().count(), 1 + 5, "five variants through the axis switch");
     assert!(stab.contains("image-aligned slab 1,") && stab.contains("axis-aligned sheet,"));
