@@ -200,6 +200,25 @@ impl BrickStore {
 
 /// A bricked volume as a scene: the store, resident on the device, and the transfer function and
 /// shading its voxels are classified with on every frame (a TF change is a small buffer write).
+///
+/// ```
+/// use voxsplat::bricks::{BrickScene, BrickStore};
+/// use voxsplat::classify::TransferFunction;
+/// use voxsplat::volume::ScalarVolume;
+/// use voxsplat::{Backend, Camera, Grid, RenderOptions, Renderer, RendererOptions};
+/// // A 24³ ramp, its store classified by the `ramp` preset on every frame (here by the CPU mirrors).
+/// let values = (0..24 * 24 * 24).map(|i| (i % 24) as f32 / 23.0).collect();
+/// let volume = ScalarVolume { dims: [24; 3], spacing: [1.0; 3], values };
+/// let scene = BrickScene::new(BrickStore::build(&volume)?, TransferFunction::preset("ramp")?, None)?;
+/// let mut options = RendererOptions::default();
+/// options.backend = Backend::Cpu;
+/// let mut renderer = Renderer::new(&options)?;
+/// renderer.set_bricks(scene)?;
+/// let camera = Camera::framing(&Grid::centered(volume.dims, volume.spacing)?, 48, 48);
+/// let frame = renderer.render(&camera, &RenderOptions::default())?;
+/// assert!(frame.image.pixels.iter().any(|p| p[3] > 0.0));
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct BrickScene {
     /// The store.

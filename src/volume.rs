@@ -430,6 +430,13 @@ impl Volume {
 }
 
 /// A dense scalar volume as loaded: x fastest, then y, then z.
+///
+/// ```
+/// use voxsplat::volume::ScalarVolume;
+/// // 2 x 2 x 2 samples, 0.5 apart along z: sample (i, j, k) is values[i + 2 * (j + 2 * k)].
+/// let v = ScalarVolume { dims: [2, 2, 2], spacing: [1.0, 1.0, 0.5], values: (0..8).map(|i| i as f32).collect() };
+/// assert_eq!(v.values[1 + 2 * (0 + 2 * 1)], 5.0);
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScalarVolume {
     /// Voxels along x, y, z.
