@@ -135,8 +135,8 @@ pub fn results_markdown(rep: &Report<'_>, vtk: Option<&str>, details: &[Detail])
     let _ = writeln!(s, "## Speed against accuracy\n");
     let _ = writeln!(
         s,
-        "Each method's frame time against its error, per scene; every figure is in [{}]({}).\n",
-        "every method on every scene",
+        "Each method's frame time against its error, per scene; every figure is in [every method on every \
+         scene]({}).\n",
         link(&rep.chart_dir, "matrix.md")
     );
     for sc in &scenes {
