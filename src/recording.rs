@@ -77,8 +77,7 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
             bricked::record_bricks(e, prep, scene, plan, b)
         }
         Draw::Splats { rows, order, raster, .. } => {
-            e.begin(frame, plan.kernel, w, h)?;
-            e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+            begin_dense(e, plan, n)?;
             e.layers(1)?;
             e.ensure(Res::Order, n as u64 * 4)?;
             match order {
@@ -123,24 +122,28 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
             }
         }
         Draw::Sheets { pass, .. } => {
-            e.begin(frame, plan.kernel, w, h)?;
-            e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+            begin_dense(e, plan, n)?;
             if n > 0 {
                 record_params(e, n)?;
             }
-            record_sheets(e, pass, pass.batches.clone(), plan.background, w, h)
+            record_sheets(e, pass, &pass.batches, plan.background, w, h)
         }
         Draw::Slabs { geometry, pass, .. } => {
-            e.begin(frame, plan.kernel, w, h)?;
-            e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+            begin_dense(e, plan, n)?;
             if n > 0 {
                 record_params(e, n)?;
             }
             let starts = record_slab_bins(e, geometry, SlabBins::Slabs)?;
             let batches = pass.terminated(crate::plan::slab::slab_batches(geometry, &starts, pass.layers)?);
-            record_sheets(e, pass, batches, plan.background, w, h)
+            record_sheets(e, pass, &batches, plan.background, w, h)
         }
     }
+}
+
+/// A dense set's frame begins: its uniforms and kernel tables, room for its `n` splats' parameters.
+fn begin_dense(e: &mut dyn Engine, plan: &FramePlan, n: u32) -> Result<()> {
+    e.begin(&plan.frame, plan.kernel, plan.width, plan.height)?;
+    e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)
 }
 
 /// `splat_params` over a dense set's `n` splats.
@@ -173,14 +176,14 @@ fn record_slab_bins(e: &mut dyn Engine, pc: &SlabPush, bins: SlabBins) -> Result
 fn record_sheets(
     e: &mut dyn Engine,
     pass: &SheetPass,
-    batches: Vec<plan::Batch>,
+    batches: &[plan::Batch],
     background: Option<[f32; 4]>,
     w: u32,
     h: u32,
 ) -> Result<Recorded> {
-    let tiles_pass = plan::sheet_tiles_pay(&batches, w, h);
-    begin_sheets(e, pass, &batches, w, h, tiles_pass)?;
-    for b in &batches {
+    let tiles_pass = plan::sheet_tiles_pay(batches, w, h);
+    begin_sheets(e, pass, batches, w, h, tiles_pass)?;
+    for b in batches {
         sum_sheets(e, pass, b, b.first_instance, b.instances, false)?;
         composite_sheets(e, pass, b, w, h)?;
     }

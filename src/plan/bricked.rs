@@ -87,10 +87,6 @@ pub struct BrickedPlan {
     pub gradient_build: Records,
     /// The brick stages' uniforms.
     pub brick_frame: BrickFrame,
-    /// The brick grid's PBTF split.
-    pub split: [u32; 3],
-    /// Bricks across the grid.
-    pub grid: [u32; 3],
     /// The compute tile compositor (else the footprint draw).
     pub compute: bool,
     /// The per-splat footprint draw's build.
@@ -108,6 +104,18 @@ pub struct BrickedPlan {
 }
 
 impl BrickedPlan {
+    /// Bricks across the grid (the brick uniforms' `grid`).
+    pub fn grid(&self) -> [u32; 3] {
+        let g = self.brick_frame.grid;
+        [g[0], g[1], g[2]]
+    }
+
+    /// The brick grid's PBTF split (the brick uniforms' `split`).
+    pub fn split(&self) -> [u32; 3] {
+        let s = self.brick_frame.split;
+        [s[0], s[1], s[2]]
+    }
+
     /// The tile compositor's rule for a batch of `n` splats.
     pub fn tile_rule(&self, n: u32, width: u32, height: u32, direction: Direction) -> TileRule {
         TileRule::plan(n, width, height, direction, self.early_termination, self.blur)
@@ -300,8 +308,6 @@ pub fn plan(
         gradients,
         gradient_build: if gradients.is_some() { Records::Gradients } else { build },
         brick_frame: bf,
-        split,
-        grid,
         compute,
         footprint: Footprint::Ordered { blend, points: opts.raster == Raster::Points },
         terminating,
@@ -315,7 +321,7 @@ pub fn plan(
 
 impl fmt::Display for BrickedPlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let [x, y, z] = self.grid;
+        let [x, y, z] = self.grid();
         let mode = match &self.sheets {
             None => "composited per splat".to_string(),
             Some(s) if s.axis_sheets => format!("in axis-aligned sheets along axis {}", s.axis),

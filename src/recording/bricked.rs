@@ -33,7 +33,7 @@ pub(super) fn record_bricks(
 ) -> Result<Recorded> {
     let (w, h) = (plan.width, plan.height);
     let (streamed, lod, per_batch, available) = (b.streamed, b.lod, b.per_batch, b.available);
-    let (grid, node_levels, split, bf) = (b.grid, b.node_levels, b.split, &b.brick_frame);
+    let (grid, node_levels, split, bf) = (b.grid(), b.node_levels, b.split(), &b.brick_frame);
     let headers = scene.store.headers.len().max(1);
     let frame = &plan.frame;
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
@@ -43,15 +43,7 @@ pub(super) fn record_bricks(
     if let Some(bytes) = b.gradients {
         super::gradients::upload(e, scene, bytes)?;
     }
-    let cut = Cut {
-        streamed,
-        build: b.build,
-        gradient_build: b.gradient_build,
-        pyramid: b.batch_pyramid,
-        range: b.range,
-        cache: &scene.records_cache.0,
-        uploaded: Cell::new(0),
-    };
+    let cut = Cut { plan: b, cache: &scene.records_cache.0, uploaded: Cell::new(0) };
     if streamed {
         e.ensure(Res::BatchRecords, b.cache_slots as u64 * SLOT_WORDS * 4)?;
         let tag = cut.lock_cache().open(e.tag(Res::BatchRecords), b.cache_slots);
@@ -83,7 +75,7 @@ pub(super) fn record_bricks(
             // Per batch it holds batches' pyramids, not the store's.
             e.set_tag(Res::Pyramid, if per_batch { 0 } else { id });
         } else if !built && bf.grid[3] > 0 {
-            build_pyramids(e, cut.gradient_build, &all)?;
+            build_pyramids(e, cut.plan.gradient_build, &all)?;
             build_nodes(e, grid, node_levels)?;
             e.set_tag(Res::Pyramid, id);
             e.set_tag(Res::LodSummary, id);
@@ -213,17 +205,12 @@ pub(super) fn record_bricks(
     Ok(recorded)
 }
 
-/// How a bricked frame's visible bricks are cut into batches: records streamed or resident, the
-/// brick stages' build, the budget's bytes for batches, and each entry's pyramid bytes (a streamed
-/// store's levels of detail with pyramids built per batch, whose coarse entries need their records).
+/// How a bricked frame's visible bricks are cut into batches, by its plan: records streamed or
+/// resident, the brick stages' builds, each entry's pyramid bytes (a streamed store's levels of
+/// detail with pyramids built per batch, whose coarse entries need their records) and the device's
+/// largest storage binding (a batch's records, list and pyramids each fit one).
 struct Cut<'a> {
-    streamed: bool,
-    build: Records,
-    /// `brick_params`' and a resident pyramid's build: `build`, or `Records::Gradients`.
-    gradient_build: Records,
-    pyramid: u64,
-    /// The device's largest storage binding: a batch's records, list and pyramids each fit one.
-    range: u64,
+    plan: &'a BrickedPlan,
     /// A streamed store's record cache (`RecordCache`; opened with its slots this frame), and the
     /// record bytes uploaded so far this frame.
     cache: &'a Mutex<RecordCache>,
@@ -233,7 +220,7 @@ struct Cut<'a> {
 impl Cut<'_> {
     /// Bytes of the record cache's slots that hold a brick (0 when the store is resident).
     fn held_bytes(&self) -> u64 {
-        if self.streamed {
+        if self.plan.streamed {
             self.lock_cache().held() as u64 * SLOT_WORDS * 4
         } else {
             0
@@ -256,7 +243,7 @@ impl Cut<'_> {
         available: u64,
     ) -> Vec<Vec<[u32; 4]>> {
         let mut batches: Vec<Vec<[u32; 4]>> = vec![Vec::new()];
-        let cache_slots = if self.streamed { self.lock_cache().slots() } else { 0 };
+        let cache_slots = if self.plan.streamed { self.lock_cache().slots() } else { 0 };
         let (mut filled, mut slots, mut bytes) = (0u32, 0u32, 0u64);
         for [header, _, _, w] in entries {
             let n = w & 0xffff;
@@ -264,19 +251,19 @@ impl Cut<'_> {
             // A streamed brick's records take a slot of the cache, which holds the batch's.
             let slot = u32::from(self.uploads(w));
             let per_splat = BATCH_BYTES_PER_SPLAT + if w >> 16 != 0 { LOD_SPLAT_BYTES } else { 0 };
-            let cost = n as u64 * per_splat + self.pyramid;
+            let cost = n as u64 * per_splat + self.plan.batch_pyramid;
             let entries = batches.last().map_or(0, |b| b.len()) as u64 + 1;
-            let binding = (entries * 16).max(entries * self.pyramid);
+            let binding = (entries * 16).max(entries * self.plan.batch_pyramid);
             let open = batches.last().is_some_and(|b| !b.is_empty());
             let full = slots + slot > cache_slots;
-            if open && (filled + n > capacity || bytes + cost > available || binding > self.range || full) {
+            if open && (filled + n > capacity || bytes + cost > available || binding > self.plan.range || full) {
                 batches.push(Vec::new());
                 (filled, slots, bytes) = (0, 0, 0);
             }
             // A streamed brick's first record is its slot's, known when the batch is placed
             // (`upload_batch`).
             // A uniform brick has no records to stream: its first says its value (`record_at`).
-            let first = if self.streamed && !hd.is_uniform() { 0 } else { hd.first };
+            let first = if self.plan.streamed && !hd.is_uniform() { 0 } else { hd.first };
             batches.last_mut().expect("one batch at least").push([header, filled, first, w]);
             (filled, slots, bytes) = (filled + n, slots + slot, bytes + cost);
         }
@@ -286,7 +273,7 @@ impl Cut<'_> {
     /// Whether an entry (splats | level << 16) uploads its brick's records: its voxels, or with
     /// per-batch pyramids its level-1 cells (levels 2 and 3 stay resident in the summaries).
     fn uploads(&self, w: u32) -> bool {
-        self.streamed && (w >> 16 == 0 || (self.pyramid > 0 && w >> 16 == 1))
+        self.plan.streamed && (w >> 16 == 0 || (self.plan.batch_pyramid > 0 && w >> 16 == 1))
     }
 }
 
@@ -333,7 +320,7 @@ fn record_bricked_sheets(
         }
         let pc = geometry(n)?;
         let starts = record_slab_bins(e, &pc, binning)?;
-        return record_sheets(e, pass, plan_of(&pc, &starts)?, plan.background, w, h);
+        return record_sheets(e, pass, &plan_of(&pc, &starts)?, plan.background, w, h);
     }
     // Each brick's bins (sheets or slabs, in index order) and each bin's reach (bricks), in
     // visiting position order for the slabs, index order for the sheets, as the binning writes.
@@ -396,7 +383,7 @@ fn batch_splats(batch: &[[u32; 4]]) -> u32 {
 /// `brick_params` (voxels) and `brick_lod_params` (coarse cells) make their parameters (in buffers
 /// sized for the batch: the sheet modes cut their own).
 fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]], cut: &Cut) -> Result<()> {
-    let (streamed, build) = (cut.streamed, cut.build);
+    let (streamed, build) = (cut.plan.streamed, cut.plan.build);
     let n = batch_splats(batch);
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, n as u64 * 4)?;
@@ -420,7 +407,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     if !coarse.is_empty() {
         let cells = BrickPush { first: fine.len() as u32, count: coarse.len() as u32, ..push };
         let level_1 = coarse.iter().filter(|l| l[3] >> 16 == 1).count() as u32;
-        if cut.pyramid > 0 && level_1 > 0 {
+        if cut.plan.batch_pyramid > 0 && level_1 > 0 {
             // The level-1 bricks' pyramids, into their entries' slots.
             build_pyramids(e, build, &BrickPush { count: level_1, splats: 0, ..cells })?;
         }
@@ -430,7 +417,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
     }
     e.run(&Dispatch::new(
         StageId::BrickParams,
-        cut.gradient_build,
+        cut.plan.gradient_build,
         groups_1d(n),
         List::Order,
         bytemuck::bytes_of(&push),
@@ -493,8 +480,8 @@ fn upload_batch(
         list.iter().map(|&[h, pos, f, w]| [h, pos, first.get(&h).copied().unwrap_or(f), w]).collect();
     e.ensure(Res::BrickList, list.len().max(1) as u64 * 16)?;
     e.upload(Res::BrickList, bytemuck::cast_slice(&list))?;
-    if cut.pyramid > 0 {
-        e.ensure(Res::Pyramid, list.len().max(1) as u64 * cut.pyramid)?;
+    if cut.plan.batch_pyramid > 0 {
+        e.ensure(Res::Pyramid, list.len().max(1) as u64 * cut.plan.batch_pyramid)?;
     }
     Ok(())
 }
