@@ -14,6 +14,8 @@ layout(binding = 6) uniform sampler2D slices;
 // sides); the push constant's sheet_mode carries the same value for the CPU mirror.
 layout(constant_id = 0) const uint SHEET_MODE = SHEET_MODE_SPLAT;
 layout(constant_id = 1) const uint POINTS = 0u;
+// A projection mode's blend (BLEND_*, types.glsl): the pipeline blends by maximum or sum.
+layout(constant_id = 2) const uint PROJECT = BLEND_COMPOSITE;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) flat in vec4 in_emit;
@@ -36,6 +38,21 @@ void main() {
     out_color = vec4(in_emit.rgb * a.x, a.x);
     out_slot = vec4(in_emit.rgb * a.y, a.y);
 #else
+    if (PROJECT == BLEND_MAX) {
+        // As tile_composite: the key weighed by the footprint over its centre's, and the coverage.
+        float s = footprint_r2(uv, 0.0, 0.0);
+        if (s >= 1.0) discard;
+        float w = sample_radial(s) / radial[0].x;
+        out_color = vec4(in_emit.r * w, w, 0.0, 0.0);
+        return;
+    }
+    if (PROJECT == BLEND_SUM) {
+        float s = footprint_r2(uv, 0.0, 0.0);
+        if (s >= 1.0) discard;
+        float d = in_emit.a * sample_radial(s);
+        out_color = vec4(in_emit.r * d, d, 0.0, 0.0);
+        return;
+    }
     // Optical depth (sheets) or alpha (per splat).
     float v = footprint_value(slices, SHEET_MODE == SHEET_MODE_SLAB, uv, in_sweep, in_slab, in_emit.a,
                               SHEET_MODE == SHEET_MODE_SPLAT);

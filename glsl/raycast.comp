@@ -74,6 +74,10 @@ void main() {
     }
     vec3 col = vec3(0.0);
     float trans = 1.0;
+    // A projection mode (rc.inv_spacing.w): the largest or summed (key, weight) of the samples,
+    // which project.comp then maps; no early ray termination.
+    uint mode = uint(rc.inv_spacing.w);
+    vec2 acc = vec2(0.0);
     if (t1 > t0) {
         float step = rc.box_min.w;
         uint n = min(uint(ceil((t1 - t0) / step)), rc.dims.w);
@@ -92,11 +96,22 @@ void main() {
             }
             vec4 v = trilinear(field, u, dims);
             if (v.a <= 0.0) continue;
+            float seg = rc.origin.w * step;  // the step in voxel lengths
+            if (mode == PROJECT_MIP) {
+                acc = max(acc, v.rg);
+            } else if (mode == PROJECT_MINIP) {
+                acc = max(acc, vec2(v.g - v.r, v.g));
+            } else if (mode == PROJECT_AVERAGE) {
+                acc += v.rg * seg;
+            } else if (mode == PROJECT_XRAY) {
+                acc.x += v.a * seg;
+            }
+            if (mode != PROJECT_NONE) continue;
             float alpha = 1.0 - exp(-v.a * rc.origin.w * step);
             col += trans * alpha * (v.rgb / v.a);
             trans *= 1.0 - alpha;
             if (trans < rc.box_max.w) break;
         }
     }
-    imageStore(out_image, ivec2(px), vec4(col, 1.0 - trans));
+    imageStore(out_image, ivec2(px), mode != PROJECT_NONE ? vec4(acc, 0.0, 0.0) : vec4(col, 1.0 - trans));
 }

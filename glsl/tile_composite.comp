@@ -32,6 +32,8 @@ layout(constant_id = 2) const bool TERMINATE = false;  // front to back, pc.occl
 // Whether the frame is motion-blurred (else every splat's stretch is 0: one shuffle and the
 // stretch's arithmetic per pixel less).
 layout(constant_id = 3) const bool MOTION_BLUR = true;
+// A projection mode's blend (BLEND_*, types.glsl): order-independent, by maximum or sum.
+layout(constant_id = 4) const uint PROJECT = BLEND_COMPOSITE;
 layout(std430, binding = 10) readonly buffer TileStart { uint tile_start[]; };
 layout(std430, binding = 11) readonly buffer TileEntries { uint tile_entries[]; };
 layout(binding = 12, rgba32f) uniform image2D accum;
@@ -179,7 +181,14 @@ void main() {
                 // outside the quad has s > 1 (behind the quad plane's horizon too); `s < 1` also
                 // rejects a NaN there.
                 bool live = t < count && s < 1.0 && (!terminate || 1.0 - a.a > pc.occluded);
-                if (live) {
+                if (live && PROJECT == BLEND_MAX) {
+                    // A footprint weighs 1 at its centre: the key of the splat there, its coverage 1.
+                    float w = sample_radial(s) / radial[0].x;
+                    tile_acc[at] = max(a, vec4(q.emit.r * w, w, 0.0, 0.0));
+                } else if (live && PROJECT == BLEND_SUM) {
+                    float d = q.emit.a * sample_radial(s);
+                    tile_acc[at] = a + vec4(q.emit.r * d, d, 0.0, 0.0);
+                } else if (live) {
                     // A tapered or teardrop blur averages the moving footprint's alpha over time.
                     float alpha = swept ? footprint_value(slices, false, uv, vec3(q.inv0.w, q.inv1.w, frame.sweep.y),
                                                           vec2(0.0), q.emit.a, true)

@@ -141,9 +141,9 @@ impl Engine for Split<'_> {
             budget_bytes: a.budget_bytes.min(b.budget_bytes),
         }
     }
-    fn prepare_field(&mut self, brick: u32) -> Result<()> {
-        self.first.prepare_field(brick)?;
-        self.second.prepare_field(brick)
+    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
+        self.first.prepare_field(brick, projection)?;
+        self.second.prepare_field(brick, projection)
     }
     fn is_device(&self) -> bool {
         if self.switched {
@@ -244,8 +244,8 @@ impl Engine for Stop<'_> {
     fn limits(&self) -> Limits {
         self.inner.limits()
     }
-    fn prepare_field(&mut self, brick: u32) -> Result<()> {
-        self.inner.prepare_field(brick)
+    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
+        self.inner.prepare_field(brick, projection)
     }
     fn is_device(&self) -> bool {
         self.inner.is_device()

@@ -3,7 +3,7 @@
 //! CPU engine the mirror's [`Variant`]). A dispatch names a [`Build`] value, never an index:
 //! `Dispatch::new` finds the value in the stage's table and refuses one the stage lacks.
 use crate::dispatch::{Blend, DrawState, Pass, Variant};
-use crate::gpu_types::{SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{BLEND_MAX, BLEND_SUM, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
 
 /// A stage's builds: the values a dispatch may name and, in the same order, what each is made of.
 #[derive(Debug)]
@@ -124,6 +124,21 @@ pub enum TileOrder {
     FrontToBack,
     /// Front to back, ending a tile's walk once it is opaque.
     Terminating,
+    /// A projection: in any order, keeping the maximum (MIP, MinIP).
+    Maximum,
+    /// A projection: in any order, summing (average, X-ray).
+    Sum,
+}
+
+impl TileOrder {
+    /// A projection's blend: by maximum or by sum.
+    pub fn projection(max: bool) -> TileOrder {
+        if max {
+            TileOrder::Maximum
+        } else {
+            TileOrder::Sum
+        }
+    }
 }
 
 /// A build of the compute tile compositor.
@@ -188,6 +203,14 @@ pub enum Footprint {
     },
     /// A motion-blurred frame's two time slots (`SLOTS`), `Over` or `Under`.
     Slots(Blend),
+    /// A projection mode's footprints into the raster target, blended by maximum (`Max`) or
+    /// sum (`Add`) in any order.
+    Project {
+        /// `Max` or `Add`.
+        blend: Blend,
+        /// Point sprites rather than quads.
+        points: bool,
+    },
 }
 
 /// The layers `composite` reads.
@@ -282,6 +305,9 @@ const fn tc_variant(pages: Pages, order: TileOrder, blur: bool) -> Variant {
         (TileOrder::FrontToBack, true) => &[SHEET_MODE_SPLAT, 0, 0, 1],
         (TileOrder::Terminating, false) => &[SHEET_MODE_SPLAT, 0, 1, 0],
         (TileOrder::Terminating, true) => &[SHEET_MODE_SPLAT, 0, 1, 1],
+        // Spec 4: the projection's blend (motion blur is refused there).
+        (TileOrder::Maximum, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_MAX],
+        (TileOrder::Sum, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SUM],
     };
     v(defines, spec)
 }
@@ -306,6 +332,10 @@ pub const TILE_COMPOSITE: Table = tile_composite![
     (One, FrontToBack, true),
     (One, Terminating, false),
     (One, Terminating, true),
+    (Two, Maximum, false),
+    (Two, Sum, false),
+    (One, Maximum, false),
+    (One, Sum, false),
 ];
 
 const fn st(mode: SheetMode, points: bool) -> Build {
@@ -330,6 +360,10 @@ const fn sheet(mode: SheetMode, points: bool) -> Build {
     Build::Footprint(Footprint::Sheet { mode, points })
 }
 
+const fn project(blend: Blend, points: bool) -> Build {
+    Build::Footprint(Footprint::Project { blend, points })
+}
+
 /// The footprint draw: ordered into the target, summed into sheets, or two time slots.
 pub const FOOTPRINT: Table = table! {
     ordered(Blend::Over, false) => d(Blend::Over, false, Pass::Target, &[SHEET_MODE_SPLAT, 0]),
@@ -344,6 +378,10 @@ pub const FOOTPRINT: Table = table! {
     sheet(SheetMode::Binned, true) => d(Blend::Add, true, Pass::Sheet, &[SHEET_MODE_BINNED, 1]),
     Build::Footprint(Footprint::Slots(Blend::Over)) => d(Blend::Over, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
     Build::Footprint(Footprint::Slots(Blend::Under)) => d(Blend::Under, false, Pass::Slots, &[SHEET_MODE_SPLAT, 0]),
+    project(Blend::Max, false) => d(Blend::Max, false, Pass::Target, &[SHEET_MODE_SPLAT, 0, BLEND_MAX]),
+    project(Blend::Max, true) => d(Blend::Max, true, Pass::Target, &[SHEET_MODE_SPLAT, 1, BLEND_MAX]),
+    project(Blend::Add, false) => d(Blend::Add, false, Pass::Target, &[SHEET_MODE_SPLAT, 0, BLEND_SUM]),
+    project(Blend::Add, true) => d(Blend::Add, true, Pass::Target, &[SHEET_MODE_SPLAT, 1, BLEND_SUM]),
 };
 
 /// `footprint_sum`: the sheets it sums.

@@ -295,7 +295,7 @@ pub fn classify_field(
     } else {
         1.0
     };
-    SplatSet::from_fn(grid, |i, j, k| {
+    SplatSet::from_fn_valued(grid, |i, j, k| {
         let d = at(i as i64, j as i64, k as i64);
         if d < tf.threshold {
             return None;
@@ -319,7 +319,7 @@ pub fn classify_field(
                 }
             }
         }
-        (c[3] > 0.0).then_some(c)
+        (c[3] > 0.0).then_some((c, d.clamp(0.0, 1.0)))
     })
 }
 

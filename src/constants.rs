@@ -80,6 +80,9 @@ pub const MAX_CLIP_PLANES: usize = 6;
 /// Planes a frame holds: the clipping planes and the crop box's six faces.
 pub const CLIP_SLOTS: usize = MAX_CLIP_PLANES + 6;
 
+/// Entries of a projection mode's colour map (`Res::ColorMap`, glsl/project.comp).
+pub const COLOR_MAP_SIZE: u32 = 256;
+
 /// Macros injected into GLSL (name, value).
 pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
@@ -103,6 +106,7 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("RECORD_PAGE", RECORD_PAGE),
     ("PYRAMID_PAGE", PYRAMID_PAGE),
     ("CLIP_SLOTS", CLIP_SLOTS as u32),
+    ("COLOR_MAP_SIZE", COLOR_MAP_SIZE),
 ];
 
 /// Splats closer than this many radii to the near or far plane are culled (the quad's corners

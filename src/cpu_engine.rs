@@ -180,8 +180,8 @@ impl Engine for CpuEngine<'_> {
         false
     }
 
-    fn prepare_field(&mut self, brick: u32) -> Result<()> {
-        let field = self.b.prep.dense_field()?;
+    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
+        let field = self.b.prep.field_for(projection)?;
         self.b.bricks = field.brick_occupancy(brick.max(1)).1;
         Ok(())
     }

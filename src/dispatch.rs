@@ -9,8 +9,10 @@ pub enum Blend {
     Over,
     /// Front to back: (1 - dst.a) src + dst.
     Under,
-    /// Sheet summation: src + dst.
+    /// Sheet summation and the summing projections: src + dst.
     Add,
+    /// The maximum projections: max(src, dst) per channel.
+    Max,
 }
 
 /// A resource of a frame, named alike on both engines: stage bindings, probes and the bisect
@@ -69,6 +71,8 @@ pub enum Res {
     SlabPairs,
     /// The ray caster's uniforms (`RaycastParams`).
     RaycastParams,
+    /// A projection mode's colour map (`COLOR_MAP_SIZE` straight RGBA entries).
+    ColorMap,
     /// The ray caster's dense (colour * tau, tau) field, a 3D texture: a per-scene cache built on
     /// first use (`Engine::prepare_field`).
     Field,

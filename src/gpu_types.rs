@@ -8,7 +8,8 @@ use bytemuck::{Pod, Zeroable};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Splat {
-    /// Grid index i, j, k; the fourth lane is unused.
+    /// Grid index i, j, k; the fourth lane: the voxel's value in [0, 1], as `f32` bits (what the
+    /// projection modes take: a classified volume's normalised density, else the opacity).
     pub ijk: [u32; 4],
     /// Straight RGB and the opacity of one voxel-length of material.
     pub color: [f32; 4],
@@ -79,7 +80,7 @@ pub struct Frame {
     /// Motion blur: 1 = arc path (0 = straight), the profile's code (`BlurProfile::code`), unused, unused.
     pub sweep: [f32; 4],
     /// x: 1 = a rectilinear grid (voxel positions from the `Coords` buffer); y: clipping planes
-    /// in use (`clip`); z, w: unused.
+    /// in use (`clip`); z: the projection mode (`Mode::code`, 0: compositing); w: unused.
     pub rect: [u32; 4],
     /// Clipping planes (n, d): a splat is drawn where n · centre + d >= 0 for every one in use.
     pub clip: [[f32; 4]; crate::constants::CLIP_SLOTS],
@@ -97,7 +98,7 @@ pub struct RaycastParams {
     pub box_max: [f32; 4],
     /// The grid's origin; w: 1 / the kernel spacing.
     pub origin: [f32; 4],
-    /// 1 / the grid's spacing.
+    /// 1 / the grid's spacing; w: the projection mode (`Mode::code`, 0: compositing).
     pub inv_spacing: [f32; 4],
     /// The inverse cell matrix above its diagonal (a sheared grid's; zero when axis-aligned).
     pub inv_shear: [f32; 4],
@@ -177,6 +178,26 @@ pub struct PresentPush {
     pub linear: u32,
 }
 
+/// Push constants of `project.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ProjectPush {
+    /// `Mode::code` (`PROJECT_*`).
+    pub mode: u32,
+    pub width: u32,
+    pub height: u32,
+    /// 1: the accumulation image (the tile compositor), 2: the raster target (the footprint draw).
+    pub source: u32,
+    /// The radial table's value at a footprint's centre.
+    pub centre: f32,
+    pub pad: [u32; 3],
+}
+
+/// `project.comp`'s blend codes (glsl/shared/types.glsl `BLEND_*`): compositing, maximum, sum.
+pub const BLEND_COMPOSITE: u32 = 0;
+pub const BLEND_MAX: u32 = 1;
+pub const BLEND_SUM: u32 = 2;
+
 /// Push constants of `composite.comp`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -242,6 +263,7 @@ const _: () = assert!(std::mem::size_of::<ScreenQuad>() == 80);
 const _: () = assert!(std::mem::size_of::<Frame>() == 592);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<PresentPush>() == 32);
+const _: () = assert!(std::mem::size_of::<ProjectPush>() == 32);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 368);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -75,7 +75,7 @@ pub use image::ImageF32;
 pub use image::TargetFormat;
 pub use kernel::Kernel;
 pub use options::{
-    Antialias, BlurProfile, Clip, Composite, FrameStats, Lod, Motion, RaycastOptions, RenderOptions, Rendered,
+    Antialias, BlurProfile, Clip, Composite, FrameStats, Lod, Mode, Motion, RaycastOptions, RenderOptions, Rendered,
     StageTime,
 };
 pub use order::{Direction, OrderKind};
@@ -535,6 +535,9 @@ impl Renderer {
         if !(options.step.is_finite() && options.step > 0.0) {
             return Err(Error::InvalidArgument("ray caster step must be positive".into()));
         }
+        if let Some(tf) = &options.colormap {
+            tf.validate()?;
+        }
         if !(0.0..1.0).contains(&options.min_transmittance) {
             return Err(Error::InvalidArgument("the ray caster's stopping transmittance must be in [0, 1)".into()));
         }
@@ -555,7 +558,7 @@ impl Renderer {
             // its k x k rays (the finer grid's pixel centres sit on a regular grid inside it).
             let fine = Camera { width: camera.width * k, height: camera.height * k, ..*camera };
             fine.validate()?;
-            let one = RaycastOptions { supersample: 1, ..*options };
+            let one = RaycastOptions { supersample: 1, ..options.clone() };
             let mut out = self.raycast(&fine, &one)?;
             let t = std::time::Instant::now();
             out.image = image::downsample(&out.image, k as usize, image::Downsample::Box);
@@ -563,7 +566,7 @@ impl Renderer {
             return Ok(out);
         }
         if options.render_scale != 1.0 {
-            let full = RaycastOptions { render_scale: 1.0, ..*options };
+            let full = RaycastOptions { render_scale: 1.0, ..options.clone() };
             return resample::render_scaled(camera, options.render_scale, |low| self.raycast(low, &full));
         }
         let prep = Self::prepared_in(&self.scene)?;

@@ -4,6 +4,9 @@ use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::order::{Direction, OrderKind};
 
+mod mode;
+pub use mode::Mode;
+
 /// How splats become pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Composite {
@@ -227,6 +230,12 @@ impl std::str::FromStr for BlurProfile {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RenderOptions {
+    /// What the frame shows: compositing (the default) or an order-independent projection.
+    pub mode: Mode,
+    /// The projection modes' colour map: the values 0 to 1 mapped to this transfer function's
+    /// colours (its opacities are not used); `None`: a grey ramp. Compositing ignores it (its
+    /// colours come from the classification).
+    pub colormap: Option<crate::classify::TransferFunction>,
     /// The visibility order.
     pub order: OrderKind,
     /// Per-splat compositing or sheet buffers.
@@ -307,6 +316,8 @@ pub enum Lod {
 impl Default for RenderOptions {
     fn default() -> Self {
         Self {
+            mode: Mode::Composite,
+            colormap: None,
             order: OrderKind::Pbtf,
             composite: Composite::Splat,
             kernel: Kernel::Gaussian,
@@ -371,6 +382,27 @@ impl RenderOptions {
 
     /// Reject values no frame can use.
     pub fn validate(&self) -> Result<()> {
+        if self.mode.is_projection() {
+            let refuse = |what: &str| {
+                Err(Error::InvalidArgument(format!(
+                    "--mode {}: {what}; the projection modes are order-independent splats (--composite splat, \
+                     no order, direction or motion blur)",
+                    self.mode
+                )))
+            };
+            if self.composite != Composite::Splat {
+                return refuse("sheets and slabs composite in visibility order");
+            }
+            if self.order != OrderKind::Pbtf || self.direction.is_some() {
+                return refuse("a projection draws no visibility order");
+            }
+            if self.motion.is_some() {
+                return refuse("motion-blurred splats are composited in order");
+            }
+        }
+        if let Some(tf) = &self.colormap {
+            tf.validate()?;
+        }
         if self.slotted() && self.composite != Composite::Splat {
             return Err(Error::InvalidArgument(
                 "the slotted blur composites each half of the shutter per splat: use --composite splat".into(),
@@ -448,8 +480,13 @@ pub fn add_time(timings: &mut Vec<StageTime>, stage: &'static str, ms: f64) {
 }
 
 /// Ray caster settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RaycastOptions {
+    /// What the rays gather: compositing (the default) or a projection mode, over the trilinear
+    /// reconstruction of the classified voxels' values (`Mode`): the splats' reference.
+    pub mode: Mode,
+    /// A projection's colour map, as `RenderOptions::colormap`.
+    pub colormap: Option<crate::classify::TransferFunction>,
     /// Step length in voxel spacings.
     pub step: f32,
     /// Transmittance below which a ray stops.
@@ -479,6 +516,8 @@ pub const DEFAULT_BRICK: u32 = 8;
 impl Default for RaycastOptions {
     fn default() -> Self {
         Self {
+            mode: Mode::Composite,
+            colormap: None,
             step: 0.5,
             min_transmittance: 1e-3,
             max_steps: 1 << 16,

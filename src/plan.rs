@@ -20,7 +20,7 @@ mod layout;
 mod pass;
 pub mod slab;
 pub use bricked::{bricked_min_budget, bricked_resident_bytes, BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT};
-pub use frame::{frame, Draw, FramePlan, OrderSource, SplatRaster};
+pub use frame::{color_map, frame, Draw, FramePlan, OrderSource, SplatRaster};
 pub use layout::*;
 pub use pass::{sheet_layers, sheet_pass, SheetPass, TileRule};
 
@@ -40,6 +40,8 @@ pub struct Prepared {
     /// The CPU ray caster's dense (colour * tau, tau) field, built on first use and kept with the
     /// scene (the GPU path uploads it to a 3D texture and drops the host copy).
     field: std::sync::OnceLock<crate::volume::DenseField>,
+    /// The projection modes' field (`DenseField::projection`), likewise.
+    projection_field: std::sync::OnceLock<crate::volume::DenseField>,
 }
 
 impl Prepared {
@@ -52,7 +54,15 @@ impl Prepared {
             rank_offsets[a] = ranks.len() as u32;
             ranks.extend(SplatSet::sheet_ranks(&slices[a].0));
         }
-        Self { set, slices, ranks, rank_offsets, bricks: None, field: std::sync::OnceLock::new() }
+        Self {
+            set,
+            slices,
+            ranks,
+            rank_offsets,
+            bricks: None,
+            field: std::sync::OnceLock::new(),
+            projection_field: std::sync::OnceLock::new(),
+        }
     }
 
     /// A bricked volume's scene.
@@ -69,6 +79,18 @@ impl Prepared {
         }
         let f = crate::volume::DenseField::new(&self.set)?;
         Ok(self.field.get_or_init(|| f))
+    }
+
+    /// The ray caster's field for `projection` (a projection mode) or compositing, built once.
+    pub fn field_for(&self, projection: bool) -> Result<&crate::volume::DenseField> {
+        if !projection {
+            return self.dense_field();
+        }
+        if let Some(f) = self.projection_field.get() {
+            return Ok(f);
+        }
+        let f = crate::volume::DenseField::projection(&self.set)?;
+        Ok(self.projection_field.get_or_init(|| f))
     }
 }
 
@@ -318,7 +340,7 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
         box_min: [-1.0, -1.0, -1.0, step],
         box_max: [hi.x, hi.y, hi.z, opts.min_transmittance],
         origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
-        inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, 0.0],
+        inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, opts.mode.code() as f32],
         inv_shear: [inv_shear[0], inv_shear[1], inv_shear[2], 0.0],
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
         image: [camera.width, camera.height, opts.brick, clip_count],

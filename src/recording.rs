@@ -11,7 +11,7 @@ use crate::constants::{
     COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, TILE_SEGMENT,
 };
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickPush, FootprintPush, Frame, ScreenQuad, SlabPush, SplatParams};
+use crate::gpu_types::{BrickPush, FootprintPush, Frame, ProjectPush, ScreenQuad, SlabPush, SplatParams};
 use crate::image::ImageF32;
 use crate::options::RaycastOptions;
 use crate::options::{RenderOptions, StageTime};
@@ -120,6 +120,34 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
                     finish(e, plan.background, images, w, h, false)
                 }
             }
+        }
+        Draw::Projection { mode, raster, color_map, centre, .. } => {
+            begin_dense(e, plan, n)?;
+            e.layers(1)?;
+            // No order: the splats in storage order are the draw list.
+            e.ensure(Res::Order, n as u64 * 4)?;
+            e.upload(Res::Order, &(0..n).collect::<Vec<u32>>())?;
+            e.ensure(Res::ColorMap, color_map.len() as u64 * 16)?;
+            e.upload(Res::ColorMap, bytemuck::cast_slice(color_map))?;
+            if n > 0 {
+                record_params(e, n)?;
+            }
+            let source = match raster {
+                SplatRaster::Tiles(rule) => {
+                    record_tiles(e, frame, rule, w, h, false)?;
+                    1
+                }
+                &SplatRaster::Draw(build) => {
+                    let push = FootprintPush::default();
+                    let bytes = bytemuck::bytes_of(&push);
+                    e.run(&Dispatch::new(StageId::Footprint, build, [0, n, 0], List::Order, bytes)?)?;
+                    2
+                }
+            };
+            let push = ProjectPush { mode: mode.code(), width: w, height: h, source, centre: *centre, pad: [0; 3] };
+            let groups = tile_groups(StageId::Project, w, h);
+            e.run(&Dispatch::new(StageId::Project, Only, groups, List::Order, bytemuck::bytes_of(&push))?)?;
+            finish(e, plan.background, &[Res::Accum], w, h, false)
         }
         Draw::Sheets { pass, .. } => {
             begin_dense(e, plan, n)?;
@@ -412,11 +440,21 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
     let (w, h) = (camera.width, camera.height);
     let frame = plan::frame_for(&prep.set, camera, &RenderOptions::default());
     e.begin(&frame, crate::kernel::Kernel::Gaussian, w, h)?;
-    e.prepare_field(opts.brick)?;
+    let projection = opts.mode.is_projection();
+    e.prepare_field(opts.brick, projection)?;
     let words: &[u32] = bytemuck::cast_slice(bytemuck::bytes_of(&params));
     e.ensure(Res::RaycastParams, words.len() as u64 * 4)?;
     e.upload(Res::RaycastParams, words)?;
     let groups = tile_groups(StageId::Raycast, w, h);
     e.run(&Dispatch::new(StageId::Raycast, Only, groups, List::Order, &[])?)?;
+    if projection {
+        // The rays' (key, weight) mapped as the splats' are; one voxel length of coverage is opaque.
+        let map = crate::plan::color_map(opts.colormap.as_ref());
+        e.ensure(Res::ColorMap, map.len() as u64 * 16)?;
+        e.upload(Res::ColorMap, bytemuck::cast_slice(&map))?;
+        let push = ProjectPush { mode: opts.mode.code(), width: w, height: h, source: 1, centre: 1.0, pad: [0; 3] };
+        let groups = tile_groups(StageId::Project, w, h);
+        e.run(&Dispatch::new(StageId::Project, Only, groups, List::Order, bytemuck::bytes_of(&push))?)?;
+    }
     finish(e, None, &[Res::Accum], w, h, false)
 }

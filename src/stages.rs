@@ -12,7 +12,7 @@ use crate::builds::{self, Build, Table};
 use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, WORKGROUP_SIZE};
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickPush, CompositePush, FootprintPush, PresentPush, SlabPush};
+use crate::gpu_types::{BrickPush, CompositePush, FootprintPush, PresentPush, ProjectPush, SlabPush};
 
 pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, Limits, List, Pass, Res, Variant, Workgroup};
 use crate::gpu_types::Frame;
@@ -427,6 +427,16 @@ stages! {
         device_build: None,
         builds: &builds::ONLY,
     },
+    project => Project {
+        kind: Kind::Compute,
+        bindings: &[Res::Accum, Res::Color, Res::ColorMap],
+        writes: &[Res::Accum],
+        push: std::mem::size_of::<ProjectPush>() as u32,
+        workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
+        timing: "project",
+        device_build: None,
+        builds: &builds::ONLY,
+    },
 }
 
 const _: () = assert!(StageId::ALL.len() == STAGES.len());
@@ -562,7 +572,7 @@ pub trait Engine {
     fn limits(&self) -> Limits;
     /// Make the scene's dense field and its occupancy of `brick`-voxel bricks resident (the ray
     /// caster's `Res::Field`, `Res::Bricks`; brick 0: no skipping).
-    fn prepare_field(&mut self, brick: u32) -> Result<()>;
+    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()>;
     /// Whether this is a device (host orders are then reported as `order_cpu`).
     fn is_device(&self) -> bool;
 }

@@ -176,7 +176,18 @@ pub struct SplatSet {
 impl SplatSet {
     /// Visit every cell in (k, j, i) order and keep those for which `voxel` returns a colour
     /// (straight RGB, opacity). Memory is proportional to the kept voxels plus one entry per row.
+    /// Each splat's value (what the projection modes take, `Mode`) is its opacity.
     pub fn from_fn(grid: Grid, mut voxel: impl FnMut(u32, u32, u32) -> Option<[f32; 4]>) -> Result<Self> {
+        Self::from_fn_valued(grid, |i, j, k| voxel(i, j, k).map(|c| (c, c[3].clamp(0.0, 1.0))))
+    }
+
+    /// As `from_fn`, `voxel` giving each kept voxel's colour and its value in [0, 1] (a classified
+    /// volume's normalised density; what the projection modes take). A value outside [0, 1] or
+    /// not finite is refused.
+    pub fn from_fn_valued(
+        grid: Grid,
+        mut voxel: impl FnMut(u32, u32, u32) -> Option<([f32; 4], f32)>,
+    ) -> Result<Self> {
         grid.validate()?;
         let [nx, ny, nz] = grid.dims;
         let mut row_start = Vec::with_capacity((ny as usize) * (nz as usize) + 1);
@@ -185,9 +196,14 @@ impl SplatSet {
             for j in 0..ny {
                 row_start.push(splats.len() as u32);
                 for i in 0..nx {
-                    if let Some(c) = voxel(i, j, k) {
+                    if let Some((c, value)) = voxel(i, j, k) {
                         if c.iter().any(|v| !v.is_finite()) {
                             return Err(Error::InvalidArgument(format!("voxel ({i},{j},{k}) has a non-finite colour")));
+                        }
+                        if !(0.0..=1.0).contains(&value) {
+                            return Err(Error::InvalidArgument(format!(
+                                "voxel ({i},{j},{k}) has the value {value}: values lie in [0, 1]"
+                            )));
                         }
                         if c[3] <= 0.0 {
                             continue;
@@ -195,7 +211,7 @@ impl SplatSet {
                         if splats.len() >= MAX_SPLATS {
                             return Err(Error::TooLarge(format!("more than {MAX_SPLATS} non-empty voxels")));
                         }
-                        splats.push(Splat { ijk: [i, j, k, 0], color: c });
+                        splats.push(Splat { ijk: [i, j, k, value.to_bits()], color: c });
                     }
                 }
             }
@@ -515,6 +531,21 @@ impl DenseField {
             values[idx] = [sp.color[0] * tau, sp.color[1] * tau, sp.color[2] * tau, tau];
         }
         Ok(Self { dims: [nx, ny, nz], values })
+    }
+
+    /// The projection modes' field of `set`: (value, 1, 0, tau) at each non-empty voxel, zero
+    /// elsewhere, so a trilinear sample holds the reconstructed value, the voxels' coverage and
+    /// the optical depth (refused past `MAX_DENSE_BYTES`).
+    pub fn projection(set: &SplatSet) -> Result<Self> {
+        let mut field = Self::new(set)?;
+        let nx = field.dims[0] as usize;
+        let ny = field.dims[1] as usize;
+        for sp in set.splats() {
+            let idx = sp.ijk[0] as usize + nx * (sp.ijk[1] as usize + ny * sp.ijk[2] as usize);
+            let tau = field.values[idx][3];
+            field.values[idx] = [f32::from_bits(sp.ijk[3]), 1.0, 0.0, tau];
+        }
+        Ok(field)
     }
 
     /// The voxel at (i, j, k); empty outside the grid.

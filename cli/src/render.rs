@@ -17,6 +17,17 @@ pub(crate) struct RenderArgs {
     /// a window shows it; without it the PNG is transparent where nothing was drawn.
     #[arg(long, value_parser = parse_background)]
     background: Option<[f32; 4]>,
+    /// What each pixel shows of its ray: emission and absorption composited in order (the default);
+    /// the largest value (mip) or the smallest (minip), each mapped through --colormap; the mean
+    /// value (average); or an X-ray (the extinction summed along the ray, a radiograph). The
+    /// projections need no visibility order; they draw the volume as splats on the host, with
+    /// --raycast too.
+    #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray"])]
+    mode: String,
+    /// The colours of --mode mip, minip, average and xray: a transfer function preset or TOML file
+    /// (its colours over the values 0 to 1; --tf still picks the voxels drawn) [default: grey].
+    #[arg(long)]
+    colormap: Option<String>,
     /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
     /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
@@ -125,9 +136,33 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     }
     let order = a.scene.order.parse::<OrderKind>()?;
     let composite = a.composite.parse::<Composite>()?;
+    let mode = a.mode.parse::<voxsplat::Mode>()?;
+    if mode.is_projection() {
+        let refuse = |flag: &str, why: &str| Err(Error::InvalidArgument(format!("--mode {mode} {flag}: {why}")));
+        if a.truth {
+            return refuse("--truth", "the truth composites; the projections' reference is --raycast");
+        }
+        if a.k_line {
+            return refuse("--k-line", "the k line marks where composited splats grow; use --mode composite");
+        }
+        if a.scene.order != "pbtf" {
+            return refuse("--order", "a projection draws in no order");
+        }
+        if a.early_termination != voxsplat::options::DEFAULT_EARLY_TERMINATION || a.keep_hidden_bricks {
+            return refuse("early termination", "a projection reads every splat along the ray");
+        }
+    } else if a.colormap.is_some() {
+        return Err(Error::InvalidArgument(
+            "--colormap colours --mode mip, minip, average or xray; a composited frame takes its colours from --tf"
+                .into(),
+        ));
+    }
     // A volume is a bricked store classified on the device unless a mode needs host splats.
-    let host_splats = order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line;
+    let host_splats =
+        order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line || mode.is_projection();
     let mut opts = RenderOptions::default();
+    opts.mode = mode;
+    opts.colormap = a.colormap.as_deref().map(load_tf).transpose()?;
     opts.order = order;
     opts.composite = composite;
     opts.kernel = a.kernel.parse::<Kernel>()?;
@@ -223,6 +258,8 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         let f = match a.raycast {
             Some(step) => {
                 let mut o = voxsplat::RaycastOptions {
+                    mode,
+                    colormap: opts.colormap.clone(),
                     step,
                     render_scale: a.render_scale,
                     clip: opts.clip,

@@ -5,7 +5,7 @@
 
 // One extracted (non-empty) voxel; camera independent. 32 bytes.
 struct Splat {
-    uvec4 ijk;    // grid index i, j, k; w: unused
+    uvec4 ijk;    // grid index i, j, k; w: the voxel's value in [0, 1] as float bits (projections)
     vec4 color;   // straight rgb; a: opacity of one voxel-length of material, in [0, 1)
 };
 
@@ -90,7 +90,8 @@ struct Frame {
     vec4 sweep;       // x: 1 = arc path through motion_mid, 0 = straight; y: profile along the
                       // path (SWEEP_*); z, w: unused
     uvec4 rect;       // x: 1 = a rectilinear grid (voxel positions from splat_params' Coords
-                      // buffer); y: clipping planes in use; z, w: unused
+                      // buffer); y: clipping planes in use; z: the projection mode (PROJECT_*,
+                      // 0: compositing); w: unused
     vec4 clip[CLIP_SLOTS];  // clipping planes (n, d): drawn where n . centre + d >= 0 for all
 };
 
@@ -99,6 +100,21 @@ const uint SWEEP_UNIFORM = 0u;   // the seed's: uniform weight over the swept ca
 const uint SWEEP_TAPERED = 1u;   // the time average of the moving footprint (brightest mid-path)
 const uint SWEEP_TEARDROP = 2u;  // weighted towards t_i, fading towards t_{i-1}
 const uint SWEEP_SLOTTED = 3u;   // tapered, each half of the shutter composited apart (Pass::Slots)
+
+// Projection modes (Frame::rect.z; options::Mode::code). A projection's splat_params writes emit =
+// (key, 0, 0, tau): the key a maximum takes (MIP: the value, MinIP: 1 - the value) or a sum weighs
+// (average: the value, its tau 1 so the sum weighs the footprint alone; X-ray: 1).
+#define PROJECT_NONE 0u
+#define PROJECT_MIP 1u
+#define PROJECT_MINIP 2u
+#define PROJECT_AVERAGE 3u
+#define PROJECT_XRAY 4u
+// How a projection's footprints blend (the PROJECT specialization constant of tile_composite and
+// footprint.frag): 0 composite, 1 the maximum of (key, 1) x the footprint over its centre's, 2 the
+// sum of (key, 1) x tau x the footprint.
+#define BLEND_COMPOSITE 0u
+#define BLEND_MAX 1u
+#define BLEND_SUM 2u
 
 #define AA_NONE 0.0
 #define AA_SWAN 1.0
@@ -110,7 +126,8 @@ struct RaycastParams {
     vec4 box_min;        // index box sampled (voxel centres widened by one voxel); w: step length
     vec4 box_max;        // w: transmittance below which a ray stops (early ray termination)
     vec4 origin;         // world position of voxel (0,0,0); w: 1 / kernel spacing (sigma = tau * w)
-    vec4 inv_spacing;    // the inverse cell matrix's diagonal (1 / voxel spacing); w: unused
+    vec4 inv_spacing;    // the inverse cell matrix's diagonal (1 / voxel spacing); w: the projection
+                         // mode (PROJECT_*; its field holds (value, 1, 0, tau) per voxel)
     vec4 inv_shear;      // the inverse cell matrix above its diagonal (a sheared grid's); w: unused
     uvec4 dims;          // nx, ny, nz; w: most steps per ray
     uvec4 image;         // width, height, empty-space brick side, clipping planes in use

@@ -386,6 +386,19 @@ pub(crate) struct Shading<'a> {
 /// `targets` (one, or the two slots).
 pub(crate) fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF32], at: usize) {
     let tau = p.emit[3] * p.axis_u[3];
+    // A projection (footprint.frag's PROJECT): by maximum, the key weighed by the footprint over
+    // its centre's and the coverage; summed, the key and 1 weighed by the optical depth.
+    let project = match (s.blend, s.sheet, s.weight) {
+        (Blend::Max, _, Weight::Footprint(table)) => Some(s.weight.value(Vec2::new(u, v), s.sweep, 1.0, false) / table[0]),
+        (Blend::Add, false, _) => Some(s.weight.value(Vec2::new(u, v), s.sweep, tau, false)),
+        _ => None,
+    };
+    if let Some(w) = project {
+        if w > 0.0 {
+            blend(s.blend, [p.emit[0] * w, w, 0.0, 0.0], &mut targets[0].pixels[at]);
+        }
+        return;
+    }
     // Optical depth (sheets) or alpha (per splat), per target.
     let values = if s.slots {
         footprint_slots(s.weight, Vec2::new(u, v), s.sweep, tau)
@@ -412,6 +425,7 @@ pub(crate) fn blend(mode: Blend, src: [f32; 4], dst: &mut [f32; 4]) {
             *dst = [0, 1, 2, 3].map(|i| k * src[i] + dst[i]);
         }
         Blend::Add => *dst = [0, 1, 2, 3].map(|i| src[i] + dst[i]),
+        Blend::Max => *dst = [0, 1, 2, 3].map(|i| src[i].max(dst[i])),
     }
 }
 

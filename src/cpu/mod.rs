@@ -21,6 +21,7 @@ pub mod order_count;
 pub mod order_scan;
 pub mod order_scatter;
 pub mod present;
+pub mod project;
 pub mod raycast;
 pub mod sheet_tiles;
 pub mod slab;

@@ -103,6 +103,9 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                 }
             }
             let (mut col, mut trans) = ([0.0f32; 3], 1.0f32);
+            // A projection mode's (key, weight) (raycast.comp).
+            let mode = rc.inv_spacing[3] as u32;
+            let mut acc = [0.0f32; 2];
             if t1 > t0 {
                 let step = rc.box_min[3];
                 let n = (((t1 - t0) / step).ceil() as u32).min(rc.dims[3]);
@@ -128,6 +131,17 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                     if v[3] <= 0.0 {
                         continue;
                     }
+                    let length = rc.origin[3] * step;
+                    match mode {
+                        1 => acc = [acc[0].max(v[0]), acc[1].max(v[1])],
+                        2 => acc = [acc[0].max(v[1] - v[0]), acc[1].max(v[1])],
+                        3 => acc = [acc[0] + v[0] * length, acc[1] + v[1] * length],
+                        4 => acc[0] += v[3] * length,
+                        _ => {}
+                    }
+                    if mode != 0 {
+                        continue;
+                    }
                     let alpha = 1.0 - (-v[3] * rc.origin[3] * step).exp();
                     for c in 0..3 {
                         col[c] += trans * alpha * (v[c] / v[3]);
@@ -138,7 +152,7 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                     }
                 }
             }
-            *px = [col[0], col[1], col[2], 1.0 - trans];
+            *px = if mode != 0 { [acc[0], acc[1], 0.0, 0.0] } else { [col[0], col[1], col[2], 1.0 - trans] };
         }
     });
     ImageF32 { width: w, height: h, pixels }
@@ -153,7 +167,7 @@ fn hash01(seed: u64, x: u64, y: u64) -> f32 {
 
 pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let rc: RaycastParams = bytemuck::pod_read_unaligned(bytemuck::cast_slice(b.get::<u32>(Res::RaycastParams)));
-    let field = b.prep.dense_field()?;
+    let field = b.prep.field_for(rc.inv_spacing[3] != 0.0)?;
     b.accum = raycast(&rc, field, &b.bricks, None);
     Ok(())
 }

@@ -149,15 +149,30 @@ pub fn params_rect(frame: &Frame, coords: &[f32], ijk: [u32; 3], color: [f32; 4]
     params_world(frame, center, 1.0, 1.0, [color[0], color[1], color[2]], optical_depth(color[3]) * weight)
 }
 
+/// Mirror of `project_emit` in `glsl/splat_params.comp`: a projection's emit, the key its blend
+/// takes (MIP: the value, MinIP: one minus it, average: the value with tau 1, X-ray: 1).
+pub fn project_emit(mode: u32, value: f32, tau: f32) -> [f32; 4] {
+    let key = match mode {
+        2 => 1.0 - value,
+        4 => 1.0,
+        _ => value,
+    };
+    [key, 0.0, 0.0, if mode == 3 { 1.0 } else { tau }]
+}
+
 /// `coords`: a rectilinear grid's x, y, z coordinates, read when `frame.rect[0]` is 1.
 pub fn splat_params(frame: &Frame, splats: &[Splat], coords: &[f32], params: &mut [SplatParams]) {
     for (s, sp) in splats.iter().enumerate().take(frame.dims[3] as usize) {
         let ijk = [sp.ijk[0], sp.ijk[1], sp.ijk[2]];
-        params[s] = if frame.rect[0] != 0 {
+        let mut p = if frame.rect[0] != 0 {
             params_rect(frame, coords, ijk, sp.color)
         } else {
             params_of(frame, ijk, sp.color)
         };
+        if frame.rect[2] != 0 {
+            p.emit = project_emit(frame.rect[2], f32::from_bits(sp.ijk[3]), p.emit[3]);
+        }
+        params[s] = p;
     }
 }
 

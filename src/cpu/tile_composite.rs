@@ -5,17 +5,19 @@ use super::ImageF32;
 use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
-use crate::gpu_types::{FootprintPush, ScreenQuad};
+use crate::gpu_types::{FootprintPush, ScreenQuad, BLEND_COMPOSITE, BLEND_MAX, BLEND_SUM};
 use crate::plan::tile_grid;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 /// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it
 /// unless `push.carry` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
-/// order, whichever GPU lane composites it.
+/// order, whichever GPU lane composites it. `project`: a projection's blend (`BLEND_*`, the
+/// shader's PROJECT), by maximum or sum in place of compositing.
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
+    project: u32,
     quads: &[ScreenQuad],
     tile_start: &[u32],
     entries: &[u32],
@@ -52,6 +54,18 @@ pub fn tile_composite(
                 continue;
             }
             let sweep = Sweep { stretch: q.inv[0][3], bend: q.inv[1][3], profile: inputs.frame.sweep[1] };
+            if project == BLEND_MAX {
+                let w = footprint_value(inputs.table, uv, sweep, 1.0, false) / inputs.table[0];
+                if w > 0.0 {
+                    acc = [acc[0].max(q.emit[0] * w), acc[1].max(w), acc[2], acc[3]];
+                }
+                continue;
+            }
+            if project == BLEND_SUM {
+                let d = footprint_value(inputs.table, uv, sweep, q.emit[3], false);
+                acc = [acc[0] + q.emit[0] * d, acc[1] + d, acc[2], acc[3]];
+                continue;
+            }
             let a = footprint_value(inputs.table, uv, sweep, q.emit[3], true);
             if a <= 0.0 {
                 continue;
@@ -68,10 +82,11 @@ pub fn tile_composite(
     });
 }
 
-pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
+pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let mut image = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
     let (inputs, push) = (b.inputs(d.list), d.push_as());
-    tile_composite(&inputs, &push, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);
+    let project = v.spec.get(4).copied().unwrap_or(BLEND_COMPOSITE);
+    tile_composite(&inputs, &push, project, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);
     b.accum = image;
     Ok(())
 }

@@ -427,8 +427,8 @@ impl Engine for GpuEngine<'_> {
         true
     }
 
-    fn prepare_field(&mut self, brick: u32) -> Result<()> {
+    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
         self.flush()?;
-        self.gpu.upload_field(self.prep, brick)
+        self.gpu.upload_field(self.prep, brick, projection)
     }
 }

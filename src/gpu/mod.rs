@@ -86,15 +86,20 @@ impl Gpu {
 
     /// The dense field as a 3D texture and its brick occupancy for `brick`, built once per scene
     /// (the host copy is dropped after the upload).
-    pub(crate) fn upload_field(&mut self, prep: &Prepared, brick: u32) -> Result<()> {
+    pub(crate) fn upload_field(&mut self, prep: &Prepared, brick: u32, projection: bool) -> Result<()> {
         let scene = self.res.scene_mut()?;
         let need_bricks = scene.bricks.as_ref().is_none_or(|(b, _)| *b != brick);
+        // One field at a time: a frame of the other kind replaces it.
+        if scene.field_projection != projection {
+            scene.field = None;
+        }
         if scene.field.is_some() && !need_bricks {
             return Ok(());
         }
         self.res.clear_sets();
         let scene = self.res.scene_mut()?;
-        let dense = DenseField::new(&prep.set)?;
+        scene.field_projection = projection;
+        let dense = if projection { DenseField::projection(&prep.set)? } else { DenseField::new(&prep.set)? };
         if need_bricks {
             let (_, occ) = dense.brick_occupancy(brick.max(1));
             scene.bricks = None;

@@ -86,6 +86,7 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Resu
                     crate::dispatch::Blend::Over => Blend::Over,
                     crate::dispatch::Blend::Under => Blend::Under,
                     crate::dispatch::Blend::Add => Blend::Add,
+                    crate::dispatch::Blend::Max => Blend::Max,
                 };
                 let primitive = if state.points { Primitive::Points } else { Primitive::Quads };
                 let pass = match state.pass {

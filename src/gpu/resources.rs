@@ -30,6 +30,8 @@ pub struct SceneBuffers {
     /// The ray caster's 3D texture of (colour * tau, tau), and its brick occupancy (brick side,
     /// flags): built on first use.
     pub field: Option<Image>,
+    /// Whether `field` is the projection modes' (`DenseField::projection`).
+    pub field_projection: bool,
     pub bricks: Option<(u32, Buffer)>,
     /// A bricked volume's store: headers, masks, records, brick index (`Res::BrickHeaders`..).
     pub store: Option<[Buffer; 4]>,
@@ -161,6 +163,7 @@ impl Resources {
             ],
             ranks: storage(ctx, "sheet ranks", bytemuck::cast_slice(or_one(splats, &prep.ranks)))?,
             field: None,
+            field_projection: false,
             bricks: None,
             store: match &prep.bricks {
                 // At least one word each: a TF that leaves nothing must not make a zero-sized buffer.

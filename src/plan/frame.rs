@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::gpu_types::{Frame, SlabPush};
 use crate::kernel::Kernel;
 use crate::options::Raster;
-use crate::options::{Composite, RenderOptions};
+use crate::options::{Composite, Mode, RenderOptions};
 use crate::order::{Direction, OrderKind};
 use std::fmt;
 
@@ -71,6 +71,21 @@ pub enum Draw {
     },
     /// A bricked volume: its splats made per frame, batch by batch through the budget.
     Bricked(Box<BrickedPlan>),
+    /// An order-independent projection (`Mode`) of a dense splat set: no order stages, the
+    /// footprints blended by maximum or sum in storage order, then mapped through the colour map.
+    Projection {
+        /// Splats in the scene.
+        splats: u32,
+        /// The mode.
+        mode: Mode,
+        /// How the footprints reach the image (a tile rule whose walk is `Maximum` or `Sum`, or
+        /// a `Footprint::Project` draw).
+        raster: SplatRaster,
+        /// The colour map, `COLOR_MAP_SIZE` straight RGBA entries.
+        color_map: Vec<[f32; 4]>,
+        /// The radial table's value at a footprint's centre (the average's unit weight).
+        centre: f32,
+    },
 }
 
 /// Where the per-splat draw order comes from.
@@ -114,12 +129,34 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
                 "the slotted blur draws dense splat sets; a bricked volume takes splat:tapered".into(),
             ));
         }
+        if opts.mode.is_projection() {
+            return Err(Error::Unsupported(format!(
+                "--mode {} draws a dense splat set; this volume is a bricked store (render it as host splats: \
+                 Renderer::set_scene, or the CLI's projection modes, which load it so)",
+                opts.mode
+            )));
+        }
         let (frame, bricked) = super::bricked::plan(prep, scene, camera, opts, limits)?;
         return Ok(plan(frame, Draw::Bricked(Box::new(bricked))));
     }
     let set = &prep.set;
-    let frame = super::frame_for(set, camera, opts);
+    let mut frame = super::frame_for(set, camera, opts);
     let splats = set.len() as u32;
+    if opts.mode.is_projection() {
+        frame.rect[2] = opts.mode.code();
+        let max = opts.mode.takes_max();
+        let raster = if opts.raster == Raster::Compute {
+            let mut rule = TileRule::plan(splats, width, height, Direction::FrontToBack, 0.0, false);
+            rule.composite.order = TileOrder::projection(max);
+            SplatRaster::Tiles(rule)
+        } else {
+            let blend = if max { Blend::Max } else { Blend::Add };
+            SplatRaster::Draw(Footprint::Project { blend, points: opts.raster == Raster::Points })
+        };
+        let color_map = color_map(opts.colormap.as_ref());
+        let centre = opts.kernel.radial_table()[0];
+        return Ok(plan(frame, Draw::Projection { splats, mode: opts.mode, raster, color_map, centre }));
+    }
     let draw = match opts.composite {
         Composite::Splat => {
             let order = if opts.order == OrderKind::Pbtf { OrderSource::Pbtf } else { OrderSource::Host(opts.order) };
@@ -148,34 +185,43 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
     Ok(plan(frame, draw))
 }
 
+/// A projection's colour map: `tf`'s colours at `COLOR_MAP_SIZE` values from 0 to 1 (opacity
+/// unused), or a grey ramp.
+pub fn color_map(tf: Option<&crate::classify::TransferFunction>) -> Vec<[f32; 4]> {
+    let n = crate::constants::COLOR_MAP_SIZE;
+    (0..n)
+        .map(|i| {
+            let v = i as f32 / (n - 1) as f32;
+            match tf {
+                Some(tf) => {
+                    let c = tf.eval(v);
+                    [c[0], c[1], c[2], 1.0]
+                }
+                None => [v, v, v, 1.0],
+            }
+        })
+        .collect()
+}
+
 impl fmt::Display for FramePlan {
     /// A few lines: the draw, the order, the raster or sums, batches and layers; for a bricked
     /// volume its records, levels of detail and budget split.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "image      {}x{}, kernel {:?}, {:?}", self.width, self.height, self.kernel, self.direction)?;
         match &self.draw {
+            Draw::Projection { splats, mode, raster, .. } => {
+                let blend = if mode.takes_max() { "the largest" } else { "summed" };
+                writeln!(f, "draw       {splats} splats, {mode} projection: footprints {blend}, in any order")?;
+                writeln!(f, "order      none (order-independent)")?;
+                write_raster(f, raster)?;
+            }
             Draw::Splats { splats, order, raster, .. } => {
                 writeln!(f, "draw       {splats} splats, composited per splat")?;
                 match order {
                     OrderSource::Pbtf => writeln!(f, "order      PBTF on the engine")?,
                     OrderSource::Host(k) => writeln!(f, "order      {k:?}, on the host")?,
                 }
-                match raster {
-                    SplatRaster::Tiles(t) => {
-                        let walk = match t.composite.order {
-                            TileOrder::BackToFront => "back to front",
-                            TileOrder::FrontToBack => "front to back",
-                            TileOrder::Terminating => "front to back, ending opaque tiles",
-                        };
-                        let pages = if t.pages == Pages::One { "one page" } else { "two pages" };
-                        writeln!(
-                            f,
-                            "raster     compute tiles, {walk}; binned in {} chunks (at most {}); {pages} of splat records",
-                            t.push.chunks, t.most_chunks
-                        )?
-                    }
-                    SplatRaster::Draw(b) => writeln!(f, "raster     footprint draw {b:?}")?,
-                }
+                write_raster(f, raster)?;
             }
             Draw::Sheets { splats, axis, pass } => {
                 writeln!(f, "draw       {splats} splats in axis-aligned sheets along axis {axis}")?;
@@ -188,6 +234,27 @@ impl fmt::Display for FramePlan {
             Draw::Bricked(b) => write!(f, "{b}")?,
         }
         Ok(())
+    }
+}
+
+fn write_raster(f: &mut fmt::Formatter<'_>, raster: &SplatRaster) -> fmt::Result {
+    match raster {
+        SplatRaster::Tiles(t) => {
+            let walk = match t.composite.order {
+                TileOrder::BackToFront => "back to front",
+                TileOrder::FrontToBack => "front to back",
+                TileOrder::Terminating => "front to back, ending opaque tiles",
+                TileOrder::Maximum => "keeping the maximum",
+                TileOrder::Sum => "summing",
+            };
+            let pages = if t.pages == Pages::One { "one page" } else { "two pages" };
+            writeln!(
+                f,
+                "raster     compute tiles, {walk}; binned in {} chunks (at most {}); {pages} of splat records",
+                t.push.chunks, t.most_chunks
+            )
+        }
+        SplatRaster::Draw(b) => writeln!(f, "raster     footprint draw {b:?}"),
     }
 }
 

@@ -332,16 +332,20 @@ impl Pipeline {
                 vk::BlendFactor::ONE_MINUS_DST_ALPHA,
                 vk::BlendFactor::ONE,
             ),
-            Blend::Add => (vk::BlendFactor::ONE, vk::BlendFactor::ONE, vk::BlendFactor::ONE, vk::BlendFactor::ONE),
+            // MAX ignores the factors.
+            Blend::Add | Blend::Max => {
+                (vk::BlendFactor::ONE, vk::BlendFactor::ONE, vk::BlendFactor::ONE, vk::BlendFactor::ONE)
+            }
         };
+        let op = if blend == Blend::Max { vk::BlendOp::MAX } else { vk::BlendOp::ADD };
         let attachment = vk::PipelineColorBlendAttachmentState::default()
             .blend_enable(true)
             .src_color_blend_factor(src_c)
             .dst_color_blend_factor(dst_c)
-            .color_blend_op(vk::BlendOp::ADD)
+            .color_blend_op(op)
             .src_alpha_blend_factor(src_a)
             .dst_alpha_blend_factor(dst_a)
-            .alpha_blend_op(vk::BlendOp::ADD)
+            .alpha_blend_op(op)
             .color_write_mask(vk::ColorComponentFlags::RGBA);
         let attachments = vec![attachment; pass.attachments as usize];
         let color_blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
@@ -387,6 +391,8 @@ pub enum Blend {
     Under,
     /// Sheet summation: src + dst.
     Add,
+    /// Maximum projections: max(src, dst).
+    Max,
 }
 
 /// A single-subpass render pass over RGBA32F colour attachments (one, or several written by one
