@@ -2,8 +2,8 @@
 // A projection mode's colours (options::Mode): the blended (key, weight) of each pixel, read from
 // the tile compositor's image or the footprint draw's target, mapped through the colour map (the
 // values 0 to 1 in COLOR_MAP_SIZE entries, linear between them) into the premultiplied frame.
-// MIP: the largest key at the coverage (the largest weight over a footprint's centre's); MinIP: one
-// minus the largest key; average: the weighed mean, at opacity the summed weight over one centre's
+// MIP: the largest weighed key over the coverage (the largest weight over a footprint's centre's),
+// at that coverage; MinIP: one minus it; average: the weighed mean, at opacity the summed weight over one centre's
 // (clamped to 1); X-ray: the map's top colour at opacity 1 - exp(-the summed optical depth).
 // Mirror: cpu::project.
 #include "types.glsl"
@@ -34,11 +34,13 @@ void main() {
     if (p.x >= int(pc.width) || p.y >= int(pc.height)) return;
     vec4 acc = pc.source == 1u ? imageLoad(accum, p) : imageLoad(color, p);
     float v, a;
+    // MIP and MinIP: the largest weighed key over the coverage, so a region of one value keeps
+    // it between the voxels' centres (the weighed key alone ripples at the grid's pitch).
     if (pc.mode == PROJECT_MIP) {
-        v = acc.x;
+        v = acc.y > 0.0 ? acc.x / acc.y : 0.0;
         a = acc.y;
     } else if (pc.mode == PROJECT_MINIP) {
-        v = 1.0 - acc.x;
+        v = 1.0 - (acc.y > 0.0 ? acc.x / acc.y : 0.0);
         a = acc.y;
     } else if (pc.mode == PROJECT_AVERAGE) {
         v = acc.y > 0.0 ? acc.x / acc.y : 0.0;

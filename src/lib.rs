@@ -57,6 +57,7 @@ mod recording;
 mod resample;
 mod residency;
 pub mod scene;
+mod pick;
 mod shaders;
 mod stages;
 #[cfg(feature = "io")]
@@ -79,6 +80,7 @@ pub use options::{
     StageTime,
 };
 pub use order::{Direction, OrderKind};
+pub use pick::{Pick, PICK_OPACITY};
 pub use raster::{Raster, RasterChoice};
 pub use volume::{Grid, SplatSet, Volume};
 
@@ -526,6 +528,30 @@ impl Renderer {
         let n = self.prepared()?.set.len();
         let got = self.probe(camera, &opts, StageId::SplatParams, &[Res::Params])?;
         Ok(bytemuck::cast_slice(&got[0][..n * std::mem::size_of::<gpu_types::SplatParams>() / 4]).to_vec())
+    }
+
+    /// What pixel position (`x`, `y`) of `camera` shows (pixels from the top left corner; a
+    /// pixel's centre at + 0.5): the first point along its ray where the accumulated opacity
+    /// passes [`PICK_OPACITY`], or in MIP and MinIP the point of the extreme value, with the voxel
+    /// nearest it, its value and depth; `None` where the ray meets nothing. Computed on the host
+    /// over the ray caster's trilinear field with `options`' mode and clipping, so it needs no
+    /// frame. A bricked store is refused (`Error::Unsupported`).
+    ///
+    /// ```
+    /// use voxsplat::{scene, Backend, Camera, RenderOptions, Renderer, RendererOptions};
+    /// let mut o = RendererOptions::default();
+    /// o.backend = Backend::Cpu;
+    /// let mut r = Renderer::new(&o)?;
+    /// let set = scene::build("cube40")?;
+    /// let camera = Camera::framing(set.grid(), 64, 64);
+    /// r.set_scene(set)?;
+    /// let hit = r.pick(&camera, &RenderOptions::default(), 32.0, 32.0)?.expect("the cube fills the centre");
+    /// assert!(hit.depth > 0.0);
+    /// # Ok::<(), voxsplat::Error>(())
+    /// ```
+    pub fn pick(&mut self, camera: &Camera, options: &RenderOptions, x: f32, y: f32) -> Result<Option<Pick>> {
+        options.validate()?;
+        pick::pick(self.prepared()?, camera, options, x, y)
     }
 
     /// The ray caster: `raycast.comp` on the GPU, or its CPU mirror.

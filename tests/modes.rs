@@ -125,10 +125,11 @@ fn host_projection(vol: &ScalarVolume, tf: &TransferFunction, mode: Mode, cam: &
 
 /// The host's (key, weight) mapped as `project.comp` maps them through the grey ramp.
 fn host_pixel(mode: Mode, acc: [f32; 2], centre: f32) -> [f32; 2] {
+    let ratio = if acc[1] > 0.0 { acc[0] / acc[1] } else { 0.0 };
     let (v, a) = match mode {
-        Mode::Mip => (acc[0], acc[1]),
-        Mode::Minip => (1.0 - acc[0], acc[1]),
-        Mode::Average => (if acc[1] > 0.0 { acc[0] / acc[1] } else { 0.0 }, acc[1] / centre),
+        Mode::Mip => (ratio, acc[1]),
+        Mode::Minip => (1.0 - ratio, acc[1]),
+        Mode::Average => (ratio, acc[1] / centre),
         _ => (1.0, 1.0 - (-acc[0]).exp()),
     };
     let a = a.clamp(0.0, 1.0);

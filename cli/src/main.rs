@@ -38,6 +38,7 @@ fn stdout_or_exit(written: std::io::Result<()>) {
 
 // After the macros above, which the studies' printing uses too.
 mod lab;
+mod pick;
 mod render;
 use render::RenderArgs;
 
@@ -63,6 +64,9 @@ enum Command {
     Scenes,
     /// Render a scene to a PNG (straight alpha) or EXR (premultiplied alpha).
     Render(Box<RenderArgs>),
+    /// Print what one pixel of a view shows: the point along its ray where the volume turns
+    /// opaque (or, with --mode mip, the point of the largest value), its voxel, value and depth.
+    Pick(Box<pick::PickArgs>),
     /// Write or check a visibility order (back to front).
     Order(Box<OrderArgs>),
     /// Describe a volume or height file: dims, spacing, value range, splats at the default
@@ -194,6 +198,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Render(a) => render::render(a),
+        Command::Pick(a) => pick::pick(*a),
         Command::Animate(a) => animate(a),
         Command::MakeVolume { from, factor, procedural, phantom, out } => {
             // It writes NRRD (raw data, attached): a name that says otherwise would mislead.

@@ -729,3 +729,54 @@ fn the_peer_scene_bricked_draws_the_dense_frame() {
         assert!(String::from_utf8_lossy(&o.stderr).contains(names), "{bad:?}: {}", String::from_utf8_lossy(&o.stderr));
     }
 }
+
+#[test]
+fn projection_modes_and_picking_from_the_command_line() {
+    let dir = tmp("modes");
+    std::fs::create_dir_all(&dir).unwrap();
+    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/stent/stent.nrrd");
+    for mode in ["mip", "minip", "average", "xray"] {
+        let out_png = dir.join(format!("{mode}.png"));
+        let args = ["render", "--volume", stent, "--tf", "ct", "--size", "96x96", "--validation", "--mode", mode];
+        let mut args = args.to_vec();
+        let p = out_png.to_str().unwrap();
+        args.extend(["--out", p]);
+        let out = voxsplat(&args);
+        assert!(out.status.success(), "{mode}: {}", String::from_utf8_lossy(&out.stderr));
+        let img = image::open(&out_png).unwrap().to_rgba8();
+        assert!(img.pixels().filter(|px| px[3] > 128).count() > 200, "{mode}: the stent is drawn");
+        // The ray caster in the same mode.
+        args.extend(["--raycast", "0.5"]);
+        let out = voxsplat(&args);
+        assert!(out.status.success(), "{mode} --raycast: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    // Flags that cannot apply are refused.
+    let p = dir.join("x.png");
+    let p = p.to_str().unwrap();
+    for (extra, says) in [
+        (vec!["--mode", "mip", "--composite", "sheet"], "visibility order"),
+        (vec!["--mode", "mip", "--truth"], "--truth"),
+        (vec!["--mode", "mip", "--order", "btf"], "--order"),
+        (vec!["--mode", "mip", "--direction", "ftb"], "no visibility order"),
+        (vec!["--colormap", "ct"], "--colormap colours"),
+    ] {
+        let mut args = vec!["render", "--volume", stent, "--size", "32x32", "--out", p];
+        args.extend(extra.iter().copied());
+        let out = voxsplat(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{extra:?}: {err}");
+    }
+    // The plan says what a projection draws.
+    let out = voxsplat(&["render", "--volume", stent, "--mode", "mip", "--size", "64x64", "--plan"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("mip projection"), "{text}");
+    // Picking: the centre of the default view shows the stent; a corner shows nothing.
+    let out = voxsplat(&["pick", "--volume", stent, "--tf", "ct", "--size", "64x64", "--at", "32,32"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("voxel ") && text.contains("depth"), "{text}");
+    let out = voxsplat(&["pick", "--volume", stent, "--tf", "ct", "--size", "64x64", "--at", "0,0"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("nothing"), "{text}");
+    let out = voxsplat(&["pick", "--scene", "cube40", "--size", "64x64", "--at", "64,3"]);
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("outside the 64 x 64 view"));
+}

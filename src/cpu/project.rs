@@ -17,10 +17,11 @@ pub fn mapped(map: &[[f32; 4]], v: f32) -> [f32; 3] {
 
 /// One pixel's colour from its blended (key, weight).
 pub fn project_pixel(push: &ProjectPush, map: &[[f32; 4]], acc: [f32; 4]) -> [f32; 4] {
+    let ratio = if acc[1] > 0.0 { acc[0] / acc[1] } else { 0.0 };
     let (v, a) = match push.mode {
-        1 => (acc[0], acc[1]),
-        2 => (1.0 - acc[0], acc[1]),
-        3 => (if acc[1] > 0.0 { acc[0] / acc[1] } else { 0.0 }, acc[1] / push.centre),
+        1 => (ratio, acc[1]),
+        2 => (1.0 - ratio, acc[1]),
+        3 => (ratio, acc[1] / push.centre),
         _ => (1.0, 1.0 - (-acc[0]).exp()),
     };
     let a = a.clamp(0.0, 1.0);

@@ -16,6 +16,72 @@ fn to_index(rc: &RaycastParams, d: Vec3) -> Vec3 {
     Vec3::new(d.x * s[0] + d.y * h[0] + d.z * h[1], d.y * s[1] + d.z * h[2], d.z * s[2])
 }
 
+/// A pixel's ray as `raycast.comp` casts it: from `a` (on the near plane) along unit `dir`, cut
+/// to [t0, t1] by the sampled box and the clipping planes.
+pub(crate) struct Ray {
+    pub a: Vec3,
+    pub dir: Vec3,
+    pub t0: f32,
+    pub t1: f32,
+    /// `a` and `dir` in index units.
+    pub ia: Vec3,
+    pub idir: Vec3,
+    origin: Vec3,
+    rc: RaycastParams,
+}
+
+impl Ray {
+    /// The index-space point at `t`.
+    pub fn index(&self, t: f32) -> Vec3 {
+        to_index(&self.rc, self.a + self.dir * t - self.origin)
+    }
+}
+
+/// The ray through pixel position (`x`, `y`) (pixels from the top left; a centre at + 0.5), or
+/// `None` where the box and the planes leave none of it.
+pub(crate) fn ray_index(rc: &RaycastParams, x: f32, y: f32) -> Option<Ray> {
+    let (w, h) = (rc.image[0], rc.image[1]);
+    let inv = Mat4::from_cols_array_2d(&rc.inv_view_proj);
+    let (lo, hi) = (Vec3::from_slice(&rc.box_min[..3]), Vec3::from_slice(&rc.box_max[..3]));
+    let origin = Vec3::from_slice(&rc.origin[..3]);
+    let ndc = Vec3::new(x / w as f32 * 2.0 - 1.0, y / h as f32 * 2.0 - 1.0, 0.0);
+    let a4 = inv * Vec4::new(ndc.x, ndc.y, 0.0, 1.0);
+    let b4 = inv * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
+    let a = a4.truncate() / a4.w;
+    let d = b4.truncate() / b4.w - a;
+    let len = d.length();
+    let dir = d / len;
+    let (ia, idir) = (to_index(rc, a - origin), to_index(rc, dir));
+    let (mut t0, mut t1) = (0.0f32, len);
+    for ax in 0..3 {
+        if idir[ax].abs() < 1e-30 {
+            if ia[ax] < lo[ax] || ia[ax] > hi[ax] {
+                t1 = -1.0;
+            }
+            continue;
+        }
+        let p = (lo[ax] - ia[ax]) / idir[ax];
+        let q = (hi[ax] - ia[ax]) / idir[ax];
+        t0 = t0.max(p.min(q));
+        t1 = t1.min(p.max(q));
+    }
+    // Mirror of the clipping in raycast.comp.
+    for c in &rc.clip[..rc.image[3] as usize] {
+        let n = Vec3::new(c[0], c[1], c[2]);
+        let (na, nd) = (n.dot(a) + c[3], n.dot(dir));
+        if nd.abs() < 1e-30 {
+            if na < 0.0 {
+                t1 = -1.0;
+            }
+        } else if nd > 0.0 {
+            t0 = t0.max(-na / nd);
+        } else {
+            t1 = t1.min(-na / nd);
+        }
+    }
+    (t1 > t0).then_some(Ray { a, dir, t0, t1, ia, idir, origin, rc: *rc })
+}
+
 /// Mirror of `skip_brick` in `raycast.comp`.
 #[allow(clippy::too_many_arguments)]
 fn skip_brick(rc: &RaycastParams, b: [i32; 3], nb: [i32; 3], a: Vec3, dir: Vec3, t0: f32, offset: f32, s: u32) -> u32 {
@@ -61,52 +127,14 @@ pub fn trilinear(field: &DenseField, u: Vec3) -> [f32; 4] {
 /// `bricks`: `field.brick_occupancy(rc.image[2])` when skipping is on.
 pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: Option<u64>) -> ImageF32 {
     let (w, h) = (rc.image[0], rc.image[1]);
-    let inv = Mat4::from_cols_array_2d(&rc.inv_view_proj);
-    let (lo, hi) = (Vec3::from_slice(&rc.box_min[..3]), Vec3::from_slice(&rc.box_max[..3]));
-    let origin = Vec3::from_slice(&rc.origin[..3]);
     let mut pixels = vec![[0.0f32; 4]; (w * h) as usize];
     pixels.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
-            let ndc = Vec3::new((x as f32 + 0.5) / w as f32 * 2.0 - 1.0, (y as f32 + 0.5) / h as f32 * 2.0 - 1.0, 0.0);
-            let a4 = inv * Vec4::new(ndc.x, ndc.y, 0.0, 1.0);
-            let b4 = inv * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
-            let a = a4.truncate() / a4.w;
-            let d = b4.truncate() / b4.w - a;
-            let len = d.length();
-            let dir = d / len;
-            let (ia, idir) = (to_index(rc, a - origin), to_index(rc, dir));
-            let (mut t0, mut t1) = (0.0f32, len);
-            for ax in 0..3 {
-                if idir[ax].abs() < 1e-30 {
-                    if ia[ax] < lo[ax] || ia[ax] > hi[ax] {
-                        t1 = -1.0;
-                    }
-                    continue;
-                }
-                let p = (lo[ax] - ia[ax]) / idir[ax];
-                let q = (hi[ax] - ia[ax]) / idir[ax];
-                t0 = t0.max(p.min(q));
-                t1 = t1.min(p.max(q));
-            }
-            // Mirror of the clipping in raycast.comp.
-            for c in &rc.clip[..rc.image[3] as usize] {
-                let n = Vec3::new(c[0], c[1], c[2]);
-                let (na, nd) = (n.dot(a) + c[3], n.dot(dir));
-                if nd.abs() < 1e-30 {
-                    if na < 0.0 {
-                        t1 = -1.0;
-                    }
-                } else if nd > 0.0 {
-                    t0 = t0.max(-na / nd);
-                } else {
-                    t1 = t1.min(-na / nd);
-                }
-            }
             let (mut col, mut trans) = ([0.0f32; 3], 1.0f32);
             // A projection mode's (key, weight) (raycast.comp).
             let mode = rc.inv_spacing[3] as u32;
             let mut acc = [0.0f32; 2];
-            if t1 > t0 {
+            if let Some(Ray { a, dir, t0, t1, ia, idir, origin, .. }) = ray_index(rc, x as f32 + 0.5, y as f32 + 0.5) {
                 let step = rc.box_min[3];
                 let n = (((t1 - t0) / step).ceil() as u32).min(rc.dims[3]);
                 let offset = match jitter {
@@ -117,8 +145,7 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                 let nb = [0, 1, 2].map(|ax| (rc.dims[ax] as i32 + bs as i32 - 1) / (bs as i32).max(1));
                 let mut s = 0u32;
                 while s < n {
-                    let p = a + dir * (t0 + (s as f32 + offset) * step);
-                    let u = to_index(rc, p - origin);
+                    let u = to_index(rc, a + dir * (t0 + (s as f32 + offset) * step) - origin);
                     if bs > 0 {
                         let b = [0, 1, 2].map(|ax| ((u[ax] / bs as f32).floor() as i32).clamp(0, nb[ax] - 1));
                         if bricks[((b[2] * nb[1] + b[1]) * nb[0] + b[0]) as usize] == 0 {

@@ -13,7 +13,8 @@ pub enum Mode {
     #[default]
     Composite,
     /// Maximum intensity projection: per pixel the largest footprint-weighted value (a footprint
-    /// weighs 1 at its centre), mapped through the colour map, at opacity the footprints' coverage.
+    /// weighs 1 at its centre) over the largest weight, mapped through the colour map, at
+    /// opacity that largest weight (the footprints' coverage).
     Mip,
     /// Minimum intensity projection over the extracted voxels: the smallest value, as `Mip` of
     /// one minus the value.

@@ -1,0 +1,46 @@
+//! `voxsplat pick`: what one pixel of a view shows (the point, its voxel, value and depth).
+use super::*;
+
+#[derive(Args)]
+pub(crate) struct PickArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// The pixel X,Y of the view (--size), from the top left corner.
+    #[arg(long, value_parser = parse_floats::<2>)]
+    at: [f32; 2],
+    /// As `render --mode`: composite (the first point where the opacity passes one half), mip or
+    /// minip (the point of the largest or smallest value), average or xray (as composite).
+    #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray"])]
+    mode: String,
+}
+
+/// Runs `voxsplat pick`.
+pub(crate) fn pick(a: PickArgs) -> Result<()> {
+    let mut opts = RenderOptions::default();
+    opts.mode = a.mode.parse()?;
+    // Picking reads the scene's field on the host: a volume loads as splats.
+    let (_, set, content) = open(&a.scene, true)?;
+    let cam = camera_of(&a.scene, set.grid(), &content)?;
+    let [x, y] = a.at;
+    if !(x >= 0.0 && y >= 0.0 && x < cam.width as f32 && y < cam.height as f32) {
+        return Err(Error::InvalidArgument(format!(
+            "--at {x},{y}: outside the {} x {} view (--size)",
+            cam.width, cam.height
+        )));
+    }
+    let mut ro = RendererOptions::default();
+    ro.backend = Backend::Cpu;
+    let mut r = Renderer::new(&ro)?;
+    r.set_scene(set)?;
+    match r.pick(&cam, &opts, x.floor() + 0.5, y.floor() + 0.5)? {
+        None => println!("pixel {x},{y}: nothing (its ray meets no drawn voxel)"),
+        Some(p) => {
+            println!("pixel      {x},{y}");
+            println!("point      {:.4} {:.4} {:.4} (the grid's world frame)", p.world.x, p.world.y, p.world.z);
+            println!("voxel      {} {} {}", p.voxel[0], p.voxel[1], p.voxel[2]);
+            println!("value      {:.6} (0 to 1 over the transfer function's range)", p.value);
+            println!("depth      {:.4} (along the view, from the eye)", p.depth);
+        }
+    }
+    Ok(())
+}
