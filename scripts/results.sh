@@ -15,4 +15,5 @@ cargo run --release --quiet -- lab bricks --large target/large/bonsai512.nrrd --
 cargo run --release --quiet -- lab kernels --chart docs/bench/kernels.svg > docs/bench/kernels.md
 cargo run --release --quiet -- lab antialias > docs/bench/antialias.md
 cargo run --release --quiet -- lab motion-orders > docs/bench/motion-orders.md
+./scripts/modes.sh > docs/bench/modes.md
 cargo run --release --quiet -- lab matrix --out-dir docs/bench --results docs/RESULTS.md "$@"
