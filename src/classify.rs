@@ -240,6 +240,71 @@ pub fn classify_on(
     tf: &TransferFunction,
     shading: Option<Shading>,
 ) -> Result<SplatSet> {
+    let voxel = voxel_classifier(grid, vol, tf, shading)?;
+    SplatSet::from_fn_valued(grid, voxel)
+}
+
+/// Several scalar volumes on one grid (the channels of a fluorescence image), each classified by
+/// its own transfer function, combined per voxel into one splat: emission and extinction added
+/// (optical depths summed, colours weighed by them), the value the largest of the channels'.
+/// Refused: no channel, more than `MAX_CHANNELS`, or channels whose dimensions differ.
+pub fn classify_channels(
+    grid: Grid,
+    channels: &[(&ScalarVolume, &TransferFunction)],
+    shading: Option<Shading>,
+) -> Result<SplatSet> {
+    if channels.is_empty() || channels.len() > MAX_CHANNELS {
+        return Err(Error::InvalidArgument(format!(
+            "{} channels: a frame combines 1 to {MAX_CHANNELS}",
+            channels.len()
+        )));
+    }
+    for (i, (v, _)) in channels.iter().enumerate() {
+        if v.dims != grid.dims {
+            return Err(Error::InvalidArgument(format!(
+                "channel {} is {:?} voxels, the grid {:?}: channels share one grid",
+                i + 1,
+                v.dims,
+                grid.dims
+            )));
+        }
+    }
+    let voxels: Vec<_> =
+        channels.iter().map(|(v, tf)| voxel_classifier(grid, v, tf, shading)).collect::<Result<_>>()?;
+    SplatSet::from_fn_valued(grid, |i, j, k| combine(voxels.iter().map(|f| f(i, j, k))))
+}
+
+/// Most channels `classify_channels` combines.
+pub const MAX_CHANNELS: usize = 4;
+
+/// Voxels that share a place, combined: emission and extinction added (optical depths summed,
+/// straight colours weighed by them), the value the largest; `None` where none is drawn.
+pub fn combine(voxels: impl Iterator<Item = Option<([f32; 4], f32)>>) -> Option<([f32; 4], f32)> {
+    let (mut rgb_tau, mut tau, mut value, mut any) = ([0.0f64; 3], 0.0f64, 0.0f32, false);
+    for (c, v) in voxels.flatten() {
+        let t = crate::volume::optical_depth(c[3]) as f64;
+        for ch in 0..3 {
+            rgb_tau[ch] += c[ch] as f64 * t;
+        }
+        tau += t;
+        value = value.max(v);
+        any = true;
+    }
+    if !any || tau <= 0.0 {
+        return None;
+    }
+    let rgb = rgb_tau.map(|c| (c / tau) as f32);
+    Some(([rgb[0], rgb[1], rgb[2], (1.0 - (-tau).exp()) as f32], value))
+}
+
+/// The classification of `vol` on `grid` as a function of the voxel: its colour and normalised
+/// value where the transfer function draws it.
+fn voxel_classifier<'a>(
+    grid: Grid,
+    vol: &'a ScalarVolume,
+    tf: &'a TransferFunction,
+    shading: Option<Shading>,
+) -> Result<impl Fn(u32, u32, u32) -> Option<([f32; 4], f32)> + 'a> {
     if grid.dims != vol.dims {
         return Err(Error::InvalidArgument(format!("a {:?} grid for a {:?} volume", grid.dims, vol.dims)));
     }
@@ -252,7 +317,7 @@ pub fn classify_on(
     });
     // In f64: the span of an f32 range may pass f32's largest value.
     let span = if hi > lo { hi as f64 - lo as f64 } else { 1.0 };
-    let at = |i: i64, j: i64, k: i64| -> f32 {
+    let at = move |i: i64, j: i64, k: i64| -> f32 {
         let (i, j, k) = (i.clamp(0, nx as i64 - 1), j.clamp(0, ny as i64 - 1), k.clamp(0, nz as i64 - 1));
         let v = vol.values[(i + nx as i64 * (j + ny as i64 * k)) as usize];
         if v.is_finite() {
@@ -261,7 +326,7 @@ pub fn classify_on(
             0.0
         }
     };
-    classify_field(grid, tf, shading, at)
+    field_classifier(grid, tf, shading, at)
 }
 
 /// Classify the normalised field `at` (indices clamped to the grid by `at` itself) on `grid`:
@@ -272,10 +337,23 @@ pub fn classify_field(
     shading: Option<Shading>,
     at: impl Fn(i64, i64, i64) -> f32,
 ) -> Result<SplatSet> {
+    SplatSet::from_fn_valued(grid, field_classifier(grid, tf, shading, at)?)
+}
+
+/// `classify_field`'s per-voxel function.
+fn field_classifier<'a>(
+    grid: Grid,
+    tf: &'a TransferFunction,
+    shading: Option<Shading>,
+    at: impl Fn(i64, i64, i64) -> f32 + 'a,
+) -> Result<impl Fn(u32, u32, u32) -> Option<([f32; 4], f32)> + 'a> {
     tf.validate()?;
     let [nx, ny, nz] = grid.dims;
-    let grad = |i: u32, j: u32, k: u32| -> Vec3 {
+    let at = std::rc::Rc::new(at);
+    let field = at.clone();
+    let grad = move |i: u32, j: u32, k: u32| -> Vec3 {
         let (i, j, k) = (i as i64, j as i64, k as i64);
+        let at = &field;
         Vec3::from(grid.gradient([
             at(i + 1, j, k) - at(i - 1, j, k),
             at(i, j + 1, k) - at(i, j - 1, k),
@@ -295,7 +373,7 @@ pub fn classify_field(
     } else {
         1.0
     };
-    SplatSet::from_fn_valued(grid, |i, j, k| {
+    Ok(move |i: u32, j: u32, k: u32| {
         let d = at(i as i64, j as i64, k as i64);
         if d < tf.threshold {
             return None;

@@ -41,6 +41,7 @@ pub mod image;
 struct ReadmeDoctests;
 mod kdtree;
 pub mod kernel;
+pub mod labels;
 #[cfg(feature = "io")]
 pub mod loaders;
 pub mod low_level;
@@ -336,7 +337,8 @@ impl Renderer {
             }
             (None, _) => record_frame(&mut cpu, prep, camera, &opts)?,
         };
-        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats: recorded.stats })
+        let stats = options::FrameStats { unlabelled: prep.set.unlabelled(), ..recorded.stats };
+        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats })
     }
 
     /// The frame's plan: every decision `render` would make for this frame before it touches the

@@ -36,6 +36,8 @@ pub enum DType {
     U16,
     /// Signed 16-bit samples.
     I16,
+    /// Unsigned 32-bit samples (label volumes; held as f32, exact up to 2^24).
+    U32,
     /// 32-bit float samples.
     F32,
 }
@@ -46,7 +48,7 @@ impl DType {
         match self {
             DType::U8 => 1,
             DType::U16 | DType::I16 => 2,
-            DType::F32 => 4,
+            DType::F32 | DType::U32 => 4,
         }
     }
 }
@@ -58,8 +60,11 @@ impl std::str::FromStr for DType {
             "u8" | "uint8" | "uchar" | "unsigned char" | "uint8_t" => Ok(DType::U8),
             "u16" | "uint16" | "ushort" | "unsigned short" | "uint16_t" => Ok(DType::U16),
             "i16" | "int16" | "short" | "signed short" | "int16_t" => Ok(DType::I16),
+            "u32" | "uint32" | "uint" | "unsigned int" | "uint32_t" => Ok(DType::U32),
             "f32" | "float" | "float32" => Ok(DType::F32),
-            other => Err(Error::InvalidArgument(format!("unsupported sample type '{other}' (u8, u16, i16, f32)"))),
+            other => {
+                Err(Error::InvalidArgument(format!("unsupported sample type '{other}' (u8, u16, i16, u32, f32)")))
+            }
         }
     }
 }
@@ -122,6 +127,13 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
             .map(
                 |c| if big_endian { i16::from_be_bytes([c[0], c[1]]) } else { i16::from_le_bytes([c[0], c[1]]) } as f32,
             )
+            .collect(),
+        DType::U32 => b
+            .chunks_exact(4)
+            .map(|c| {
+                let a = [c[0], c[1], c[2], c[3]];
+                (if big_endian { u32::from_be_bytes(a) } else { u32::from_le_bytes(a) }) as f32
+            })
             .collect(),
         DType::F32 => b
             .chunks_exact(4)
@@ -296,6 +308,7 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
         nifti::NiftiType::Uint8 => DType::U8,
         nifti::NiftiType::Uint16 => DType::U16,
         nifti::NiftiType::Int16 => DType::I16,
+        nifti::NiftiType::Uint32 => DType::U32,
         nifti::NiftiType::Float32 => DType::F32,
         other => return Err(bad(what, format!("unsupported NIfTI type {other:?}"))),
     };

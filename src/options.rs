@@ -564,6 +564,9 @@ pub struct FrameStats {
     pub bytes_uploaded: u64,
     /// Bytes of brick records its record cache holds after the frame (whole-brick slots).
     pub records_resident: u64,
+    /// A label volume's voxels drawn hidden because the label table lacks their label
+    /// (`labels::classify_labels`).
+    pub unlabelled: u64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

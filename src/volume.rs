@@ -171,6 +171,8 @@ pub struct SplatSet {
     splats: Vec<Splat>,
     /// Per-axis voxel positions of a rectilinear grid (`with_coordinates`).
     coords: Option<std::sync::Arc<[Vec<f32>; 3]>>,
+    /// A label volume's voxels whose label its table lacks (`labels::classify_labels`).
+    unlabelled: u64,
 }
 
 impl SplatSet {
@@ -217,14 +219,25 @@ impl SplatSet {
             }
         }
         row_start.push(splats.len() as u32);
-        Ok(Self { grid, row_start, splats, coords: None })
+        Ok(Self { grid, row_start, splats, coords: None, unlabelled: 0 })
     }
 
     /// No splats on `grid` (a bricked volume's stand-in: its splats are made per frame).
     pub fn empty(grid: Grid) -> Result<Self> {
         grid.validate()?;
         let rows = grid.dims[1] as usize * grid.dims[2] as usize + 1;
-        Ok(Self { grid, row_start: vec![0; rows], splats: Vec::new(), coords: None })
+        Ok(Self { grid, row_start: vec![0; rows], splats: Vec::new(), coords: None, unlabelled: 0 })
+    }
+
+    /// A label volume's voxels whose label the table lacks, hidden (`Rendered::stats` reports them).
+    pub fn unlabelled(&self) -> u64 {
+        self.unlabelled
+    }
+
+    /// The same splats, recording `n` voxels hidden for a label the table lacks.
+    pub fn with_unlabelled(mut self, n: u64) -> Self {
+        self.unlabelled = n;
+        self
     }
 
     /// The grid the splats sit on.

@@ -393,6 +393,7 @@ fn the_top_level_holds_the_embedders_modules() {
         "embedding",
         "image",
         "kernel",
+        "labels",
         "loaders",
         "low_level",
         "options",

@@ -79,7 +79,7 @@ pub fn parse_finite(s: &str) -> std::result::Result<f32, String> {
 #[derive(Args)]
 pub struct SceneArgs {
     /// Built-in scene name (see `voxsplat scenes`).
-    #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain"])]
+    #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain", "labels"])]
     pub scene: String,
     /// Eye position (default: the --view's; patient RAS coordinates for a file with an anatomical
     /// frame, the grid's centred frame otherwise).
@@ -123,7 +123,7 @@ pub struct SceneArgs {
     #[arg(long, value_parser = parse_dims, requires = "volume")]
     pub dims: Option<[u32; 3]>,
     /// Raw sample type.
-    #[arg(long, value_parser = ["u8", "u16", "i16", "f32"], requires = "volume")]
+    #[arg(long, value_parser = ["u8", "u16", "i16", "u32", "f32"], requires = "volume")]
     pub dtype: Option<String>,
     /// Raw data is big-endian.
     #[arg(long, requires = "volume")]
@@ -147,6 +147,22 @@ pub struct SceneArgs {
     /// No shading, even for a preset shaded by default.
     #[arg(long)]
     pub no_shade: bool,
+    /// A label volume (a segmentation: one whole number per voxel, u8, u16 or u32) coloured by
+    /// --label-table, drawn alone or over the --volume on the same grid (the two added per voxel).
+    /// Label 0 is the background; voxels whose label the table lacks are hidden and counted.
+    #[arg(long, requires = "label_table", conflicts_with_all = ["terrain", "channels", "positions"])]
+    pub labels: Option<PathBuf>,
+    /// The label table, TOML: one [[label]] per label with value, color = [r, g, b], opacity and
+    /// optionally visible = false (docs/guide/cli.md).
+    #[arg(long, requires = "labels")]
+    pub label_table: Option<PathBuf>,
+    /// Another channel of the --volume (a scalar volume on its grid; up to 3 more), classified by
+    /// its own --channel-tf and added per voxel: emission and extinction summed.
+    #[arg(long = "channel", requires = "volume", conflicts_with = "positions")]
+    pub channels: Vec<PathBuf>,
+    /// The transfer function of each --channel, in the same order (a preset or a TOML file).
+    #[arg(long = "channel-tf", requires = "channels")]
+    pub channel_tfs: Vec<String>,
     /// Render a height grid (16-bit PNG, GeoTIFF, or 2D .npy) as voxel columns.
     #[arg(long)]
     pub terrain: Option<PathBuf>,
@@ -387,15 +403,79 @@ pub fn load_bricked(
     voxsplat::bricks::BrickScene::new(store, tf, shading)
 }
 
+/// The --volume and its --channel files, each classified by its transfer function and added per
+/// voxel.
+fn load_channels(
+    a: &SceneArgs,
+    grid: voxsplat::Grid,
+    first: &voxsplat::volume::ScalarVolume,
+    tf: &voxsplat::classify::TransferFunction,
+    shading: Option<voxsplat::classify::Shading>,
+) -> Result<voxsplat::SplatSet> {
+    if a.channel_tfs.len() != a.channels.len() {
+        return Err(Error::InvalidArgument(format!(
+            "{} --channel files and {} --channel-tf: give each channel its transfer function",
+            a.channels.len(),
+            a.channel_tfs.len()
+        )));
+    }
+    let more: Vec<_> = a
+        .channels
+        .iter()
+        .zip(&a.channel_tfs)
+        .map(|(p, t)| Ok((voxsplat::loaders::load_volume(p, &Default::default())?, load_tf(t)?)))
+        .collect::<Result<_>>()?;
+    let mut all = vec![(first, tf)];
+    all.extend(more.iter().map(|(v, t)| (v, t)));
+    voxsplat::classify::classify_channels(grid, &all, shading)
+}
+
+/// The --labels file classified by --label-table, alone or over the --volume; voxels whose label
+/// the table lacks are reported.
+fn load_labelled(a: &SceneArgs, path: &std::path::Path, orientation: Option<Orientation>) -> Result<voxsplat::SplatSet> {
+    let table_path = a.label_table.as_ref().ok_or_else(|| Error::InvalidArgument("--labels needs --label-table".into()))?;
+    let text = std::fs::read_to_string(table_path)
+        .map_err(|e| Error::InvalidArgument(format!("{}: {e}", table_path.display())))?;
+    let table = voxsplat::labels::LabelTable::from_toml(&text)?;
+    let seg = voxsplat::loaders::load_volume(path, &Default::default())?;
+    let labelled = match &a.volume {
+        Some(v) => {
+            let (vol, tf, shading) = load_volume_parts(a, v, orientation)?;
+            let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
+            voxsplat::labels::classify_labels(grid, &seg, &table, Some((&vol, &tf, shading)))?
+        }
+        None => {
+            let grid = voxsplat::orient::placed_grid(seg.dims, seg.spacing, None)?;
+            voxsplat::labels::classify_labels(grid, &seg, &table, None)?
+        }
+    };
+    if labelled.unlabelled > 0 {
+        let list: Vec<String> = labelled.missing.iter().map(u32::to_string).collect();
+        eprintln!(
+            "{} voxels hidden: their labels ({}{}) are not in the label table",
+            labelled.unlabelled,
+            list.join(", "),
+            if labelled.missing.len() == 8 { ", ..." } else { "" }
+        );
+    }
+    Ok(labelled.set)
+}
+
 /// The splats named by --volume, --terrain or --scene, with a one-line report of what was loaded,
 /// and what a camera frames of them: a volume's placement and the voxels its transfer function
 /// shows (a rectilinear grid's voxels lie at its --positions: framed whole).
 pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
     let orientation = orientation_of(a)?;
-    let set = if let Some(path) = &a.volume {
+    let set = if let Some(path) = &a.labels {
+        load_labelled(a, path, orientation)?
+    } else if let Some(path) = &a.volume {
         let (vol, tf, shading) = load_volume_parts(a, path, orientation)?;
         let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
-        let set = voxsplat::classify::classify_on(grid, &vol, &tf, shading)?;
+        let set = if a.channels.is_empty() {
+            voxsplat::classify::classify_on(grid, &vol, &tf, shading)?
+        } else {
+            load_channels(a, grid, &vol, &tf, shading)?
+        };
         match &a.positions {
             Some(p) => {
                 let coords = voxsplat::loaders::load_positions(p, set.grid())?;
@@ -505,7 +585,9 @@ pub fn open(
         ));
     }
     let (bricked, orientation) = match (&a.volume, peer) {
-        (Some(path), _) if !host_splats && !a.dense && a.positions.is_none() => {
+        (Some(path), _)
+            if !host_splats && !a.dense && a.positions.is_none() && a.labels.is_none() && a.channels.is_empty() =>
+        {
             let orientation = orientation_of(a)?;
             (load_bricked(a, path, orientation)?, orientation)
         }

@@ -780,3 +780,70 @@ fn projection_modes_and_picking_from_the_command_line() {
     let out = voxsplat(&["pick", "--scene", "cube40", "--size", "64x64", "--at", "64,3"]);
     assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("outside the 64 x 64 view"));
 }
+
+#[test]
+fn labels_and_channels_from_the_command_line() {
+    let dir = tmp("labels");
+    std::fs::create_dir_all(&dir).unwrap();
+    let n = 16usize;
+    // Labels 1 and 2 in two halves of a block, 9 (not in the table) in a corner.
+    let seg: Vec<u8> = (0..n * n * n)
+        .map(|v| {
+            let (i, j, k) = (v % n, v / n % n, v / (n * n));
+            match (i, j, k) {
+                _ if i < 2 && j < 2 => 9,
+                _ if (3..13).contains(&j) && (3..13).contains(&k) && (3..8).contains(&i) => 1,
+                _ if (3..13).contains(&j) && (3..13).contains(&k) && (8..13).contains(&i) => 2,
+                _ => 0,
+            }
+        })
+        .collect();
+    let shape = [n as u64; 3];
+    let seg_path = dir.join("seg.npy");
+    std::fs::write(&seg_path, common::npy(&shape, "|u1", &seg)).unwrap();
+    let table = dir.join("labels.toml");
+    std::fs::write(
+        &table,
+        "[[label]]\nvalue = 1\ncolor = [1, 0, 0]\nopacity = 0.8\n\n[[label]]\nvalue = 2\ncolor = [0, 0, 1]\nopacity = 0.8\n",
+    )
+    .unwrap();
+    let (seg_s, table_s) = (seg_path.to_str().unwrap(), table.to_str().unwrap());
+    let out_png = dir.join("labels.png");
+    let args = ["render", "--labels", seg_s, "--label-table", table_s, "--size", "64x64", "--cpu"];
+    let mut args = args.to_vec();
+    args.extend(["--out", out_png.to_str().unwrap()]);
+    let out = voxsplat(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("64 voxels hidden: their labels (9)"), "{err}");
+    let img = image::open(&out_png).unwrap().to_rgba8();
+    assert!(img.pixels().any(|p| p[0] > 150 && p[2] == 0) && img.pixels().any(|p| p[2] > 150 && p[0] == 0));
+    assert!(img.pixels().all(|p| p[1] == 0), "no label is green");
+    // Over a scalar volume of another size: refused.
+    let small: Vec<u8> = vec![100; 8 * 8 * 8];
+    let small_path = dir.join("small.npy");
+    std::fs::write(&small_path, common::npy(&[8; 3], "|u1", &small)).unwrap();
+    let small_s = small_path.to_str().unwrap();
+    let p = dir.join("x.png");
+    let p = p.to_str().unwrap();
+    let out = voxsplat(&["render", "--volume", small_s, "--labels", seg_s, "--label-table", table_s, "--out", p]);
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("must match"));
+    // Channels: the label volume's values as a second channel of itself.
+    let ramp: Vec<u8> = (0..n * n * n).map(|v| (v % 251) as u8).collect();
+    let ramp_path = dir.join("ramp.npy");
+    std::fs::write(&ramp_path, common::npy(&shape, "|u1", &ramp)).unwrap();
+    let ramp_s = ramp_path.to_str().unwrap();
+    let out = voxsplat(&["render", "--volume", ramp_s, "--channel", seg_s, "--channel-tf", "ct", "--size", "48x48", "--out", p]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for (extra, says) in [
+        (vec!["--channel", seg_s], "give each channel its transfer function"),
+        (vec!["--channel", small_s, "--channel-tf", "ramp"], "share one grid"),
+        (vec!["--channel-tf", "ramp"], "--channel <CHANNELS>"),
+    ] {
+        let mut args = vec!["render", "--volume", ramp_s, "--size", "32x32", "--out", p];
+        args.extend(extra.iter().copied());
+        let out = voxsplat(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{extra:?}: {err}");
+    }
+}

@@ -34,6 +34,7 @@ pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> 
         (npyz::TypeChar::Uint, 1) => read_all::<u8>(npy, what)?.into_iter().map(f32::from).collect(),
         (npyz::TypeChar::Uint, 2) => read_all::<u16>(npy, what)?.into_iter().map(f32::from).collect(),
         (npyz::TypeChar::Int, 2) => read_all::<i16>(npy, what)?.into_iter().map(f32::from).collect(),
+        (npyz::TypeChar::Uint, 4) => read_all::<u32>(npy, what)?.into_iter().map(|v| v as f32).collect(),
         (npyz::TypeChar::Float, 4) => read_all::<f32>(npy, what)?,
         (npyz::TypeChar::Float, 8) => read_all::<f64>(npy, what)?.into_iter().map(|v| v as f32).collect(),
         (c, s) => {
@@ -46,7 +47,7 @@ pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> 
                 _ => "other",
             };
             return Err(Error::Unsupported(format!(
-                "{what}: npy type {kind}{} is not read (uint8, uint16, int16, float32 and float64 are)",
+                "{what}: npy type {kind}{} is not read (uint8, uint16, int16, uint32, float32 and float64 are)",
                 s * 8
             )));
         }
