@@ -3,7 +3,8 @@
 // Bricks, pass 3 (issue 23): per splat of a batch, in draw order, classify its voxel on the device
 // (TF table, gradient weighting, headlight shading; gradients read through the store, or in the
 // GRADIENTS build from each voxel's precomputed differences) and make its
-// splat parameters (params.glsl, as splat_params does for a dense set); a voxel of a morphing brick
+// splat parameters (params.glsl, as splat_params does for a dense set; a projection's key from its
+// density, project_emit); a voxel of a morphing brick
 // grows toward its next level (levels of detail). Coarse cells are brick_lod_params': a branch to
 // them here would cost every voxel, since llvmpipe runs a branch's code under a mask even where no
 // lane takes it. Mirror: cpu::brick::brick_params.
@@ -26,5 +27,11 @@ void main() {
     uvec3 ijk = voxel_ijk(v);
     vec4 c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);
     float grow = (v.y & VOXEL_MORPHS) != 0u ? splat_growth(vec3(ijk), 0u) : 1.0;
-    params_store(s, params_at(vec3(ijk), 1.0, grow, c.rgb, optical_depth(c.a)));
+    SplatParams p = params_at(vec3(ijk), 1.0, grow, c.rgb, optical_depth(c.a));
+    // A projection (no levels of detail there): the voxel's normalised density as its key.
+    if (frame.rect.z != PROJECT_NONE) {
+        float d = clamp(float(v.y >> 16u) / Q_MAX * bf.tf.x + bf.tf.y, 0.0, 1.0);
+        p.emit = project_emit(frame.rect.z, d, p.emit.a);
+    }
+    params_store(s, p);
 }

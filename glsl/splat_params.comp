@@ -35,13 +35,6 @@ SplatParams params_rect(uvec3 ijk, vec4 color) {
     return params_world(center, 1.0, 1.0, color.rgb, optical_depth(color.a) * weight);
 }
 
-// A projection's emit: the key its blend takes (types.glsl, PROJECT_*). Mirror:
-// cpu::splat_params::project_emit.
-vec4 project_emit(uint mode, float value, float tau) {
-    float key = mode == PROJECT_MINIP ? 1.0 - value : (mode == PROJECT_XRAY ? 1.0 : value);
-    return vec4(key, 0.0, 0.0, mode == PROJECT_AVERAGE ? 1.0 : tau);
-}
-
 void main() {
     uint s = linear_invocation();
     if (s >= frame.dims.w) return;

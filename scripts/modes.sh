@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The projection modes' page (docs/bench/modes.md): each mode's frame of two gallery volumes at
-# 512² from the default view on this machine (the median of 5, `render --timings --repeat 5`),
-# beside the composited frame of the same splats and the default (bricked) composited frame; the
+# The projection modes' page (docs/bench/modes.md): each mode's default frame of two gallery
+# volumes at 512² from the default view on this machine (the median of 5, `render --timings
+# --repeat 5`; a bricked store, every voxel drawn), beside the composited frame of every voxel
+# (host splats, `--dense`) and the default (bricked) composited frame; the
 # ray caster in the same mode (step 0.5); and the splats' PSNR against a fine ray cast (step 0.25)
 # in the same mode. One process per frame; absolute times are this machine's.
 set -euo pipefail
@@ -16,12 +17,13 @@ psnr() { "$B" compare "$1" "$2" | awk '/psnr/ {print $2}'; }
 echo "# Projection modes"
 echo
 echo "\`scripts/modes.sh\` on $(nproc) cores, lavapipe ($(date -u +%Y-%m-%d)): 512², the default view and kernel,"
-echo "\`--raster auto\` (the compute tile compositor here). *Composite, same splats* draws the same host"
-echo "splats composited front to back (\`--dense\`); *composite, default* is the default frame (a bricked"
+echo "\`--raster auto\` (the compute tile compositor here). A projection's frame is the default: the"
+echo "bricked store, every voxel drawn. *Composite, every voxel* draws the same voxels as host splats"
+echo "composited front to back (\`--dense\`); *composite, default* is the default frame (the bricked"
 echo "store with levels of detail and early termination). PSNR: the splat frame against a ray cast at"
 echo "step 0.25 in the same mode (premultiplied RGBA)."
 echo
-echo "| volume | mode | frame ms | ÷ composite, same splats | ÷ composite, default | ray caster ms (step 0.5) | PSNR dB |"
+echo "| volume | mode | frame ms | ÷ composite, every voxel | ÷ composite, default | ray caster ms (step 0.5) | PSNR dB |"
 echo "|---|---|---:|---:|---:|---:|---:|"
 for spec in "bonsai ../shared/data/bonsai/bonsai.nii.gz bonsai" "stent ../shared/data/stent/stent.nrrd ct"; do
   set -- $spec

@@ -121,14 +121,12 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
                 }
             }
         }
-        Draw::Projection { mode, raster, color_map, centre, .. } => {
+        Draw::Projection { raster, projection, .. } => {
             begin_dense(e, plan, n)?;
             e.layers(1)?;
             // No order: the splats in storage order are the draw list.
             e.ensure(Res::Order, n as u64 * 4)?;
             e.upload(Res::Order, &(0..n).collect::<Vec<u32>>())?;
-            e.ensure(Res::ColorMap, color_map.len() as u64 * 16)?;
-            e.upload(Res::ColorMap, bytemuck::cast_slice(color_map))?;
             if n > 0 {
                 record_params(e, n)?;
             }
@@ -144,9 +142,7 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
                     2
                 }
             };
-            let push = ProjectPush { mode: mode.code(), width: w, height: h, source, centre: *centre, pad: [0; 3] };
-            let groups = tile_groups(StageId::Project, w, h);
-            e.run(&Dispatch::new(StageId::Project, Only, groups, List::Order, bytemuck::bytes_of(&push))?)?;
+            record_project(e, projection, source, w, h)?;
             finish(e, plan.background, &[Res::Accum], w, h, false)
         }
         Draw::Sheets { pass, .. } => {
@@ -289,6 +285,16 @@ fn composite_sheets(e: &mut dyn Engine, pass: &SheetPass, b: &plan::Batch, w: u3
     let groups = tile_groups(StageId::Composite, w, h);
     let layers = if compute { CompositeLayers::Fixed } else { CompositeLayers::Float };
     e.run(&Dispatch::new(StageId::Composite, layers, groups, pass.list, bytemuck::bytes_of(&push))?)
+}
+
+/// A projection's colours (`project`) from its blended (key, weight): in the accumulation image
+/// (`source` 1) or the raster target (2), written into the accumulation image.
+fn record_project(e: &mut dyn Engine, p: &crate::plan::Projection, source: u32, w: u32, h: u32) -> Result<()> {
+    e.ensure(Res::ColorMap, p.color_map.len() as u64 * 16)?;
+    e.upload(Res::ColorMap, bytemuck::cast_slice(&p.color_map))?;
+    let push = ProjectPush { mode: p.mode.code(), width: w, height: h, source, centre: p.centre, pad: [0; 3] };
+    let groups = tile_groups(StageId::Project, w, h);
+    e.run(&Dispatch::new(StageId::Project, Only, groups, List::Order, bytemuck::bytes_of(&push))?)
 }
 
 /// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
@@ -449,12 +455,12 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
     e.run(&Dispatch::new(StageId::Raycast, Only, groups, List::Order, &[])?)?;
     if projection {
         // The rays' (key, weight) mapped as the splats' are; one voxel length of coverage is opaque.
-        let map = crate::plan::color_map(opts.colormap.as_ref());
-        e.ensure(Res::ColorMap, map.len() as u64 * 16)?;
-        e.upload(Res::ColorMap, bytemuck::cast_slice(&map))?;
-        let push = ProjectPush { mode: opts.mode.code(), width: w, height: h, source: 1, centre: 1.0, pad: [0; 3] };
-        let groups = tile_groups(StageId::Project, w, h);
-        e.run(&Dispatch::new(StageId::Project, Only, groups, List::Order, bytemuck::bytes_of(&push))?)?;
+        let p = crate::plan::Projection {
+            mode: opts.mode,
+            color_map: crate::plan::color_map(opts.colormap.as_ref()),
+            centre: 1.0,
+        };
+        record_project(e, &p, 1, w, h)?;
     }
     finish(e, None, &[Res::Accum], w, h, false)
 }

@@ -258,12 +258,12 @@ fn a_projection_refuses_what_cannot_apply() {
     let mut o = options(Mode::Mip, Raster::Auto);
     o.motion = Some(voxsplat::Motion::straight(glam::Mat4::IDENTITY, 1.0));
     refused(o, &mut r);
-    // A bricked volume: refused with a typed error, not drawn wrong.
+    // A bricked volume takes no levels-of-detail flag it cannot apply: the plan draws every voxel.
     let mut b = cpu();
     let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
     b.set_bricks(voxsplat::bricks::BrickScene::new(store, tf(), None).unwrap()).unwrap();
-    let e = b.render(&cam, &options(Mode::Mip, Raster::Auto)).unwrap_err();
-    assert!(matches!(e, voxsplat::Error::Unsupported(_)), "{e}");
+    let plan = b.plan(&cam, &options(Mode::Mip, Raster::Auto)).unwrap().to_string();
+    assert!(plan.contains("mip projection, every voxel") && plan.contains("lod        off"), "{plan}");
     // Values outside [0, 1] are refused where a set is made.
     let grid = voxsplat::Grid::centered([2, 2, 2], [1.0; 3]).unwrap();
     let e = SplatSet::from_fn_valued(grid, |_, _, _| Some(([1.0; 4], 1.5))).unwrap_err().to_string();
@@ -297,5 +297,34 @@ fn the_ray_caster_projects_in_every_mode_and_mirrors_on_the_cpu() {
     let o = voxsplat::RaycastOptions::default();
     let (gi, ci) = (g.raycast(&cam, &o).unwrap().image, c.raycast(&cam, &o).unwrap().image);
     assert_mirrors(&gi, &ci, "ray-cast composite after the projections");
+    assert_clean(&g);
+}
+
+#[test]
+fn a_bricked_volume_projects_as_its_dense_splats_do() {
+    let vol = ball([30, 26, 20]);
+    let set = classify(&vol, &tf(), None).unwrap();
+    let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
+    let scene = voxsplat::bricks::BrickScene::new(store, tf(), None).unwrap();
+    let mut g = gpu();
+    let mut c = cpu();
+    let mut rng = Rng(4601);
+    for mode in PROJECTIONS {
+        for raster in [Raster::Compute, Raster::Graphics] {
+            let cam = common::random_camera(&mut rng, set.grid(), common::ViewKind::Outside);
+            let o = options(mode, raster);
+            g.set_scene(set.clone()).unwrap();
+            let dense = g.render(&cam, &o).unwrap().image;
+            g.set_bricks(scene.clone()).unwrap();
+            let bricked = g.render(&cam, &o).unwrap();
+            c.set_bricks(scene.clone()).unwrap();
+            assert_mirrors(&bricked.image, &c.render(&cam, &o).unwrap().image, &format!("bricked {mode} {raster}"));
+            // The store holds values in 16 bits and draws its bricks in another order (sums
+            // round otherwise): the same frame to within that.
+            let (worst, _) = common::diff(&bricked.image, &dense);
+            assert!(worst < 2e-3, "{mode} {raster}: bricked against dense, largest difference {worst}");
+            assert_eq!(bricked.stats.bricks_coarse, 0, "no levels of detail in a projection");
+        }
+    }
     assert_clean(&g);
 }

@@ -20,8 +20,8 @@ pub(crate) struct RenderArgs {
     /// What each pixel shows of its ray: emission and absorption composited in order (the default);
     /// the largest value (mip) or the smallest (minip), each mapped through --colormap; the mean
     /// value (average); or an X-ray (the extinction summed along the ray, a radiograph). The
-    /// projections need no visibility order; they draw the volume as splats on the host, with
-    /// --raycast too.
+    /// projections need no visibility order and read every voxel (no levels of detail or early
+    /// termination); --raycast casts in the same mode.
     #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray"])]
     mode: String,
     /// The colours of --mode mip, minip, average and xray: a transfer function preset or TOML file
@@ -151,6 +151,9 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         if a.early_termination != voxsplat::options::DEFAULT_EARLY_TERMINATION || a.keep_hidden_bricks {
             return refuse("early termination", "a projection reads every splat along the ray");
         }
+        if a.lod.as_deref() == Some("auto") || a.lod_nodes {
+            return refuse("levels of detail", "a projection reads each voxel's value, which coarse cells do not keep");
+        }
     } else if a.colormap.is_some() {
         return Err(Error::InvalidArgument(
             "--colormap colours --mode mip, minip, average or xray; a composited frame takes its colours from --tf"
@@ -158,8 +161,7 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         ));
     }
     // A volume is a bricked store classified on the device unless a mode needs host splats.
-    let host_splats =
-        order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line || mode.is_projection();
+    let host_splats = order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line;
     let mut opts = RenderOptions::default();
     opts.mode = mode;
     opts.colormap = a.colormap.as_deref().map(load_tf).transpose()?;

@@ -758,6 +758,7 @@ fn projection_modes_and_picking_from_the_command_line() {
         (vec!["--mode", "mip", "--truth"], "--truth"),
         (vec!["--mode", "mip", "--order", "btf"], "--order"),
         (vec!["--mode", "mip", "--direction", "ftb"], "no visibility order"),
+        (vec!["--mode", "average", "--lod", "auto"], "levels of detail"),
         (vec!["--colormap", "ct"], "--colormap colours"),
     ] {
         let mut args = vec!["render", "--volume", stent, "--size", "32x32", "--out", p];

@@ -107,6 +107,13 @@ float optical_depth(float a) {
     return -log(1.0 - clamp(a, 0.0, MAX_OPACITY));
 }
 
+// A projection's emit: the key its blend takes (types.glsl, PROJECT_*). Mirror:
+// cpu::splat_params::project_emit.
+vec4 project_emit(uint mode, float value, float tau) {
+    float key = mode == PROJECT_MINIP ? 1.0 - value : (mode == PROJECT_XRAY ? 1.0 : value);
+    return vec4(key, 0.0, 0.0, mode == PROJECT_AVERAGE ? 1.0 : tau);
+}
+
 SplatParams params_of(uvec3 ijk, vec4 color) {
     return params_at(vec3(ijk), 1.0, 1.0, color.rgb, optical_depth(color.a));
 }

@@ -1,11 +1,14 @@
 //! Mirror of `glsl/brick_params.comp` (the `brick_params` stage); shared helpers in `brick.rs`.
 use super::bindings::Bindings;
 use super::brick::*;
-use super::splat_params::{optical_depth, params_at};
+use super::splat_params::{optical_depth, params_at, project_emit};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{BrickPush, SplatParams};
 use glam::Vec3;
+
+/// The largest stored value (16 bits), as `brick.glsl`'s Q_MAX.
+const Q_MAX: f32 = 65535.0;
 
 /// Pass 3: per splat of the batch, classify its voxel and make its parameters, grown when its
 /// brick morphs (coarse cells are `brick_lod_params`').
@@ -19,7 +22,12 @@ pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 
         let c = inputs.classify_voxel(ijk.map(|c| c as i64), v[1] >> 16, shaded);
         let at = Vec3::from_array(ijk.map(|c| c as f32));
         let grow = if v[1] & VOXEL_MORPHS != 0 { inputs.splat_growth(at, 0) } else { 1.0 };
-        params[s] = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
+        let mut p = params_at(inputs.frame, at, 1.0, grow, [c[0], c[1], c[2]], optical_depth(c[3]));
+        if inputs.frame.rect[2] != 0 {
+            let d = ((v[1] >> 16) as f32 / Q_MAX * inputs.bf.tf[0] + inputs.bf.tf[1]).clamp(0.0, 1.0);
+            p.emit = project_emit(inputs.frame.rect[2], d, p.emit[3]);
+        }
+        params[s] = p;
     }
 }
 

@@ -101,6 +101,8 @@ pub struct BrickedPlan {
     pub blur: bool,
     /// The sheet modes' decisions (`None`: per-splat compositing).
     pub sheets: Option<BrickedSheets>,
+    /// A projection mode (no levels of detail, no early termination: every voxel is read).
+    pub projection: Option<super::Projection>,
 }
 
 impl BrickedPlan {
@@ -118,7 +120,14 @@ impl BrickedPlan {
 
     /// The tile compositor's rule for a batch of `n` splats.
     pub fn tile_rule(&self, n: u32, width: u32, height: u32, direction: Direction) -> TileRule {
-        TileRule::plan(n, width, height, direction, self.early_termination, self.blur)
+        match &self.projection {
+            Some(p) => {
+                let mut rule = TileRule::plan(n, width, height, Direction::FrontToBack, 0.0, false);
+                rule.composite.order = p.builds(false).0;
+                rule
+            }
+            None => TileRule::plan(n, width, height, direction, self.early_termination, self.blur),
+        }
     }
 }
 
@@ -170,7 +179,9 @@ pub fn plan(
     // classification changes (a streamed store's batch by batch: its coarse bricks then need no
     // records). When a streamed store's pyramid would take more than half of what the budget
     // leaves, only the bricks' summaries stay, and each batch rebuilds its coarse bricks' pyramids.
-    let lod = opts.lod == Lod::Auto && !sheets;
+    // A projection reads each voxel's value: coarse cells hold none (their colours are prefiltered).
+    let projection = super::Projection::of(opts);
+    let lod = opts.lod == Lod::Auto && !sheets && projection.is_none();
     let headers = scene.store.headers.len().max(1);
     let room = budget.saturating_sub(bricked_resident_bytes(scene, budget, w, h));
     let slotted = pyramid_bytes(SLOTTED_LOD_BUFFERS, headers);
@@ -252,7 +263,8 @@ pub fn plan(
     let build = Records::of(streamed, scene.store.records.len());
     let gradients = gradients_fit(scene, build, range, available);
     let available = available - gradients.unwrap_or(0);
-    let frame = super::frame_for(&prep.set, camera, opts);
+    let mut frame = super::frame_for(&prep.set, camera, opts);
+    frame.rect[2] = opts.mode.code();
     let split = crate::order::brick_split(&prep.set, camera, BRICK);
     let mut bf = super::brick_frame(scene, split);
     if lod {
@@ -263,7 +275,11 @@ pub fn plan(
     let direction = opts.direction();
     // Front to back with early termination, later batches drop the bricks that what is drawn
     // already hides: cut the frame into a few batches even when it fits one.
-    let terminating = compute && !sheets && direction == Direction::FrontToBack && opts.early_termination > 0.0;
+    let terminating = compute
+        && !sheets
+        && direction == Direction::FrontToBack
+        && opts.early_termination > 0.0
+        && projection.is_none();
     let blend = if direction == Direction::BackToFront { Blend::Over } else { Blend::Under };
     let sheets = if sheets {
         let axis_sheets = opts.composite == Composite::Sheet;
@@ -309,12 +325,16 @@ pub fn plan(
         gradient_build: if gradients.is_some() { Records::Gradients } else { build },
         brick_frame: bf,
         compute,
-        footprint: Footprint::Ordered { blend, points: opts.raster == Raster::Points },
+        footprint: match &projection {
+            Some(p) => p.builds(opts.raster == Raster::Points).1,
+            None => Footprint::Ordered { blend, points: opts.raster == Raster::Points },
+        },
         terminating,
         cull_hidden: terminating && opts.cull_hidden_bricks,
         early_termination: opts.early_termination,
         blur: opts.motion.is_some(),
         sheets,
+        projection,
     };
     Ok((frame, plan))
 }
@@ -322,10 +342,11 @@ pub fn plan(
 impl fmt::Display for BrickedPlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let [x, y, z] = self.grid();
-        let mode = match &self.sheets {
-            None => "composited per splat".to_string(),
-            Some(s) if s.axis_sheets => format!("in axis-aligned sheets along axis {}", s.axis),
-            Some(_) => "in image-aligned slabs".to_string(),
+        let mode = match (&self.sheets, &self.projection) {
+            (None, Some(p)) => format!("{} projection, every voxel (no levels of detail or early termination)", p.mode),
+            (None, None) => "composited per splat".to_string(),
+            (Some(s), _) if s.axis_sheets => format!("in axis-aligned sheets along axis {}", s.axis),
+            (Some(_), _) => "in image-aligned slabs".to_string(),
         };
         writeln!(f, "draw       bricked volume, {x}x{y}x{z} bricks ({} stored), {mode}", self.brick_frame.grid[3])?;
         let records = match self.build {

@@ -76,16 +76,41 @@ pub enum Draw {
     Projection {
         /// Splats in the scene.
         splats: u32,
-        /// The mode.
-        mode: Mode,
         /// How the footprints reach the image (a tile rule whose walk is `Maximum` or `Sum`, or
         /// a `Footprint::Project` draw).
         raster: SplatRaster,
-        /// The colour map, `COLOR_MAP_SIZE` straight RGBA entries.
-        color_map: Vec<[f32; 4]>,
-        /// The radial table's value at a footprint's centre (the average's unit weight).
-        centre: f32,
+        /// The mode and its colours.
+        projection: Projection,
     },
+}
+
+/// A projection mode's last step (`project`): how the blended (key, weight) become colours.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Projection {
+    /// The mode.
+    pub mode: Mode,
+    /// The colour map, `COLOR_MAP_SIZE` straight RGBA entries.
+    pub color_map: Vec<[f32; 4]>,
+    /// The radial table's value at a footprint's centre (the average's unit weight).
+    pub centre: f32,
+}
+
+impl Projection {
+    /// The projection `opts` asks for (`None`: compositing).
+    pub fn of(opts: &RenderOptions) -> Option<Projection> {
+        opts.mode.is_projection().then(|| Projection {
+            mode: opts.mode,
+            color_map: color_map(opts.colormap.as_ref()),
+            centre: opts.kernel.radial_table()[0],
+        })
+    }
+
+    /// Its tile compositor walk and footprint draw build.
+    pub fn builds(&self, points: bool) -> (TileOrder, Footprint) {
+        let max = self.mode.takes_max();
+        let blend = if max { Blend::Max } else { Blend::Add };
+        (TileOrder::projection(max), Footprint::Project { blend, points })
+    }
 }
 
 /// Where the per-splat draw order comes from.
@@ -129,33 +154,23 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
                 "the slotted blur draws dense splat sets; a bricked volume takes splat:tapered".into(),
             ));
         }
-        if opts.mode.is_projection() {
-            return Err(Error::Unsupported(format!(
-                "--mode {} draws a dense splat set; this volume is a bricked store (render it as host splats: \
-                 Renderer::set_scene, or the CLI's projection modes, which load it so)",
-                opts.mode
-            )));
-        }
         let (frame, bricked) = super::bricked::plan(prep, scene, camera, opts, limits)?;
         return Ok(plan(frame, Draw::Bricked(Box::new(bricked))));
     }
     let set = &prep.set;
     let mut frame = super::frame_for(set, camera, opts);
     let splats = set.len() as u32;
-    if opts.mode.is_projection() {
+    if let Some(projection) = Projection::of(opts) {
         frame.rect[2] = opts.mode.code();
-        let max = opts.mode.takes_max();
+        let (walk, draw) = projection.builds(opts.raster == Raster::Points);
         let raster = if opts.raster == Raster::Compute {
             let mut rule = TileRule::plan(splats, width, height, Direction::FrontToBack, 0.0, false);
-            rule.composite.order = TileOrder::projection(max);
+            rule.composite.order = walk;
             SplatRaster::Tiles(rule)
         } else {
-            let blend = if max { Blend::Max } else { Blend::Add };
-            SplatRaster::Draw(Footprint::Project { blend, points: opts.raster == Raster::Points })
+            SplatRaster::Draw(draw)
         };
-        let color_map = color_map(opts.colormap.as_ref());
-        let centre = opts.kernel.radial_table()[0];
-        return Ok(plan(frame, Draw::Projection { splats, mode: opts.mode, raster, color_map, centre }));
+        return Ok(plan(frame, Draw::Projection { splats, raster, projection }));
     }
     let draw = match opts.composite {
         Composite::Splat => {
@@ -209,7 +224,8 @@ impl fmt::Display for FramePlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "image      {}x{}, kernel {:?}, {:?}", self.width, self.height, self.kernel, self.direction)?;
         match &self.draw {
-            Draw::Projection { splats, mode, raster, .. } => {
+            Draw::Projection { splats, raster, projection } => {
+                let mode = projection.mode;
                 let blend = if mode.takes_max() { "the largest" } else { "summed" };
                 writeln!(f, "draw       {splats} splats, {mode} projection: footprints {blend}, in any order")?;
                 writeln!(f, "order      none (order-independent)")?;

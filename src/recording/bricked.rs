@@ -200,7 +200,15 @@ pub(super) fn record_bricks(
     stats.waves = batches.len() as u32;
     stats.bytes_uploaded = cut.uploaded.get();
     stats.records_resident = cut.held_bytes();
-    let mut recorded = finish(e, plan.background, &[if compute { Res::Accum } else { Res::Color }], w, h, false)?;
+    let image = if let Some(p) = &b.projection {
+        super::record_project(e, p, if compute { 1 } else { 2 }, w, h)?;
+        Res::Accum
+    } else if compute {
+        Res::Accum
+    } else {
+        Res::Color
+    };
+    let mut recorded = finish(e, plan.background, &[image], w, h, false)?;
     recorded.stats = stats;
     Ok(recorded)
 }
