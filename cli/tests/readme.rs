@@ -102,8 +102,8 @@ fn the_readme_stays_short_and_names_no_issue_numbers() {
     }
 }
 
-/// The guide's TOML examples are what the readers read: a transfer function (the first block)
-/// and an animation (the one naming a scene).
+/// The guide's TOML examples are what the readers read: a transfer function (the first block), a
+/// label table and an animation.
 #[test]
 fn the_guides_toml_examples_parse() {
     let guide = include_str!("../../docs/guide/cli.md");
@@ -123,9 +123,12 @@ fn the_guides_toml_examples_parse() {
             _ => {}
         }
     }
-    assert_eq!(blocks.len(), 2, "the guide's TOML blocks: {blocks:?}");
+    assert_eq!(blocks.len(), 3, "the guide's TOML blocks: {blocks:?}");
     let tf = voxsplat::classify::TransferFunction::from_toml(&blocks[0]).unwrap();
     assert_eq!((tf.points.len(), tf.range), (3, Some((0.0, 4095.0))));
-    let anim = voxsplat::animate::Animation::from_toml(&blocks[1]).unwrap();
+    let labels = voxsplat::labels::LabelTable::from_toml(&blocks[1]).unwrap();
+    assert_eq!(labels.labels.len(), 2);
+    assert!(labels.get(1).unwrap().visible && !labels.get(2).unwrap().visible);
+    let anim = voxsplat::animate::Animation::from_toml(&blocks[2]).unwrap();
     assert_eq!(anim.frames, 24);
 }
