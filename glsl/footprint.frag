@@ -20,6 +20,10 @@ layout(constant_id = 2) const uint PROJECT = BLEND_COMPOSITE;
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) flat in vec4 in_emit;
 layout(location = 2) flat in vec3 in_sweep;  // motion stretch, bend, profile
+layout(location = 4) flat in vec2 in_depth;    // the splat's eye-space depth; y: 1 = tested
+layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
+// The host's eye-space depth per pixel: a fragment of a splat deeper than it is dropped.
+layout(std430, binding = 18) readonly buffer HostDepth { float host_depth[]; };
 #ifndef SLOTS
 layout(location = 3) flat in vec2 in_slab;
 #endif
@@ -31,6 +35,10 @@ layout(location = 1) out vec4 out_slot;
 #endif
 
 void main() {
+    if (in_depth.y != 0.0) {
+        uvec2 px = uvec2(gl_FragCoord.xy);
+        if (in_depth.x > host_depth[px.y * uint(frame.blur.z) + px.x]) discard;
+    }
     vec2 uv = POINTS != 0u ? gl_PointCoord * 2.0 - 1.0 : in_uv;
 #ifdef SLOTS
     vec2 a = footprint_slots(uv, in_sweep, in_emit.a);

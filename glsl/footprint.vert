@@ -14,6 +14,7 @@ layout(constant_id = 1) const uint POINTS = 0u;
 layout(location = 0) out vec2 out_uv;
 layout(location = 1) flat out vec4 out_emit;
 layout(location = 2) flat out vec3 out_sweep;  // motion stretch, bend, profile
+layout(location = 4) flat out vec2 out_depth;  // eye-space depth; y: 1 = the host's depth test on
 #ifndef SLOTS
 layout(location = 3) flat out vec2 out_slab;
 #endif
@@ -26,6 +27,7 @@ void main() {
     out_uv = c;
     out_emit = vec4(p.emit.rgb, p.emit.a * p.axis_u.w);
     out_sweep = vec3(p.axis_v.w, p.screen.y, frame.sweep.y);
+    out_depth = vec2(p.screen.x, float(frame.rect.w));
     if (p.center.w == 0.0 || (SHEET_MODE != SHEET_MODE_SPLAT && pc.occluded > 0.0 && occluded(p))) {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: culled
         gl_PointSize = 1.0;

@@ -39,6 +39,8 @@ layout(std430, binding = 11) readonly buffer TileEntries { uint tile_entries[]; 
 layout(binding = 12, rgba32f) uniform image2D accum;
 layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads_lo[]; };
 layout(std430, binding = 16) readonly buffer QuadsHi { ScreenQuad quads_hi[]; };
+// The host's eye-space depth per pixel (frame.rect.w = 1): a splat deeper than it adds nothing there.
+layout(std430, binding = 18) readonly buffer HostDepth { float host_depth[]; };
 PAGED_READER(ScreenQuad, quads_at, quads_lo, quads_hi)
 
 const uint TILE_PIXELS = RASTER_TILE_W * RASTER_TILE_H;
@@ -83,6 +85,7 @@ void main() {
     uint end = min(list_end, begin + TILE_SEGMENT);
     const bool btf = BACK_TO_FRONT;
     bool swept = MOTION_BLUR && frame.sweep.y != float(SWEEP_UNIFORM);
+    bool depth_test = frame.rect.w != 0u;
     const bool terminate = !btf && TERMINATE;
     // Pixels still open, counted by the lanes that opened or closed them (only their sum means
     // anything).
@@ -143,6 +146,7 @@ void main() {
             q.inv1.xyz = subgroupShuffle(mine.inv1.xyz, j);
             q.inv1.w = MOTION_BLUR ? subgroupShuffle(mine.inv1.w, j) : 0.0;
             q.inv2.xyz = subgroupShuffle(mine.inv2.xyz, j);
+            if (depth_test) q.inv2.w = subgroupShuffle(mine.inv2.w, j);
             uvec2 b = subgroupShuffle(box_packed, j);
             q.box = ivec4(b & 0xffffu, b >> 16);
             q.emit = subgroupShuffle(mine.emit, j);
@@ -181,6 +185,10 @@ void main() {
                 // outside the quad has s > 1 (behind the quad plane's horizon too); `s < 1` also
                 // rejects a NaN there.
                 bool live = t < count && s < 1.0 && (!terminate || 1.0 - a.a > pc.occluded);
+                if (depth_test && live) {
+                    ivec2 xy = b0 + ivec2(int(c), int(r));
+                    live = q.inv2.w <= host_depth[uint(xy.y) * size.x + uint(xy.x)];
+                }
                 if (live && PROJECT == BLEND_MAX) {
                     // A footprint weighs 1 at its centre: the key of the splat there, its coverage 1.
                     float w = sample_radial(s) / radial[0].x;

@@ -73,6 +73,10 @@ pub enum Res {
     RaycastParams,
     /// A projection mode's colour map (`COLOR_MAP_SIZE` straight RGBA entries).
     ColorMap,
+    /// The host's depth buffer as it stores it (`DepthBuffer::texels`, row 0 at the top).
+    HostDepthRaw,
+    /// The host's depth as eye-space depth per pixel (`host_depth`), which hides the splats behind it.
+    HostDepth,
     /// The ray caster's dense (colour * tau, tau) field, a 3D texture: a per-scene cache built on
     /// first use (`Engine::prepare_field`).
     Field,

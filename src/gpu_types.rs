@@ -37,7 +37,8 @@ pub struct SplatParams {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ScreenQuad {
     /// Rows of the inverse projective map, pixel centre -> homogeneous quad coordinates;
-    /// `inv[0][3]` is the motion stretch, `inv[1][3]` the motion bend.
+    /// `inv[0][3]` is the motion stretch, `inv[1][3]` the motion bend, `inv[2][3]` the splat's
+    /// eye-space depth.
     pub inv: [[f32; 4]; 3],
     /// Inclusive pixel box x0, y0, x1, y1 (empty when culled: x0 > x1).
     pub bx: [i32; 4],
@@ -80,7 +81,8 @@ pub struct Frame {
     /// Motion blur: 1 = arc path (0 = straight), the profile's code (`BlurProfile::code`), unused, unused.
     pub sweep: [f32; 4],
     /// x: 1 = a rectilinear grid (voxel positions from the `Coords` buffer); y: clipping planes
-    /// in use (`clip`); z: the projection mode (`Mode::code`, 0: compositing); w: unused.
+    /// in use (`clip`); z: the projection mode (`Mode::code`, 0: compositing); w: 1 = the host's
+    /// depth buffer hides what lies behind it (`Res::HostDepth`).
     pub rect: [u32; 4],
     /// Clipping planes (n, d): a splat is drawn where n · centre + d >= 0 for every one in use.
     pub clip: [[f32; 4]; crate::constants::CLIP_SLOTS],
@@ -178,6 +180,19 @@ pub struct PresentPush {
     pub linear: u32,
 }
 
+/// Push constants of `host_depth.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DepthPush {
+    /// The host's projection inverted: its clip space to its eye space.
+    pub inv_proj: [[f32; 4]; 4],
+    pub width: u32,
+    pub height: u32,
+    /// `DepthFormat::code`: 0 D32 float, 1 D24 unorm (the low 24 bits of each word).
+    pub format: u32,
+    pub pad: u32,
+}
+
 /// Push constants of `project.comp`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -264,6 +279,7 @@ const _: () = assert!(std::mem::size_of::<Frame>() == 592);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<PresentPush>() == 32);
 const _: () = assert!(std::mem::size_of::<ProjectPush>() == 32);
+const _: () = assert!(std::mem::size_of::<DepthPush>() == 80);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 368);
 const _: () = assert!(std::mem::size_of::<SlabPush>() == 32);

@@ -77,7 +77,8 @@ pub use image::ImageF32;
 pub use image::TargetFormat;
 pub use kernel::Kernel;
 pub use options::{
-    Antialias, BlurProfile, Clip, Composite, FrameStats, Lod, Mode, Motion, RaycastOptions, RenderOptions, Rendered,
+    Antialias, BlurProfile, Clip, Composite, DepthBuffer, DepthFormat, FrameStats, Lod, Mode, Motion, RaycastOptions,
+    RenderOptions, Rendered,
     StageTime,
 };
 pub use order::{Direction, OrderKind};

@@ -4,7 +4,9 @@ use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::order::{Direction, OrderKind};
 
+mod depth;
 mod mode;
+pub use depth::{DepthBuffer, DepthFormat};
 pub use mode::Mode;
 
 /// How splats become pixels.
@@ -236,6 +238,10 @@ pub struct RenderOptions {
     /// colours (its opacities are not used); `None`: a grey ramp. Compositing ignores it (its
     /// colours come from the classification).
     pub colormap: Option<crate::classify::TransferFunction>,
+    /// The host's depth buffer: splats behind its geometry add nothing to a pixel (`None`: no
+    /// depth). `Renderer::render_to` can read the host's depth image on the device instead
+    /// (`vk::HostTarget::with_depth`).
+    pub depth: Option<std::sync::Arc<DepthBuffer>>,
     /// The visibility order.
     pub order: OrderKind,
     /// Per-splat compositing or sheet buffers.
@@ -318,6 +324,7 @@ impl Default for RenderOptions {
         Self {
             mode: Mode::Composite,
             colormap: None,
+            depth: None,
             order: OrderKind::Pbtf,
             composite: Composite::Splat,
             kernel: Kernel::Gaussian,
@@ -402,6 +409,11 @@ impl RenderOptions {
         }
         if let Some(tf) = &self.colormap {
             tf.validate()?;
+        }
+        if self.depth.is_some() && self.composite != Composite::Splat {
+            return Err(Error::InvalidArgument(
+                "the host's depth buffer hides splats per pixel as they are composited: use --composite splat".into(),
+            ));
         }
         if self.slotted() && self.composite != Composite::Splat {
             return Err(Error::InvalidArgument(

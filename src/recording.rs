@@ -167,6 +167,7 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
 /// A dense set's frame begins: its uniforms and kernel tables, room for its `n` splats' parameters.
 fn begin_dense(e: &mut dyn Engine, plan: &FramePlan, n: u32) -> Result<()> {
     e.begin(&plan.frame, plan.kernel, plan.width, plan.height)?;
+    record_host_depth(e, plan)?;
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)
 }
 
@@ -285,6 +286,25 @@ fn composite_sheets(e: &mut dyn Engine, pass: &SheetPass, b: &plan::Batch, w: u3
     let groups = tile_groups(StageId::Composite, w, h);
     let layers = if compute { CompositeLayers::Fixed } else { CompositeLayers::Float };
     e.run(&Dispatch::new(StageId::Composite, layers, groups, pass.list, bytemuck::bytes_of(&push))?)
+}
+
+/// The host's depth buffer, when the plan has one: its texels uploaded and turned into eye-space
+/// depth per pixel (`host_depth`), which the footprint stages read.
+fn record_host_depth(e: &mut dyn Engine, plan: &FramePlan) -> Result<()> {
+    let Some(d) = &plan.depth else { return Ok(()) };
+    let pixels = plan.width as u64 * plan.height as u64;
+    e.ensure(Res::HostDepthRaw, pixels * 4)?;
+    e.upload(Res::HostDepthRaw, &d.texels)?;
+    e.ensure(Res::HostDepth, pixels * 4)?;
+    let push = crate::gpu_types::DepthPush {
+        inv_proj: d.projection.inverse().to_cols_array_2d(),
+        width: plan.width,
+        height: plan.height,
+        format: d.format.code(),
+        pad: 0,
+    };
+    let groups = tile_groups(StageId::HostDepth, plan.width, plan.height);
+    e.run(&Dispatch::new(StageId::HostDepth, Only, groups, List::Order, bytemuck::bytes_of(&push))?)
 }
 
 /// A projection's colours (`project`) from its blended (key, weight): in the accumulation image

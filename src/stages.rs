@@ -12,7 +12,7 @@ use crate::builds::{self, Build, Table};
 use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, WORKGROUP_SIZE};
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickPush, CompositePush, FootprintPush, PresentPush, ProjectPush, SlabPush};
+use crate::gpu_types::{BrickPush, CompositePush, DepthPush, FootprintPush, PresentPush, ProjectPush, SlabPush};
 
 pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, Limits, List, Pass, Res, Variant, Workgroup};
 use crate::gpu_types::Frame;
@@ -72,6 +72,7 @@ const FOOTPRINT: &[Res] = &[
     Res::ParamsHi,
     Res::QuadsHi,
     Res::Status,
+    Res::HostDepth,
 ];
 /// glsl/shared/brick.glsl's bindings, shared by the brick stages.
 const BRICK: &[Res; 32] = &[
@@ -424,6 +425,16 @@ stages! {
         push: std::mem::size_of::<PresentPush>() as u32,
         workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
         timing: "present",
+        device_build: None,
+        builds: &builds::ONLY,
+    },
+    host_depth => HostDepth {
+        kind: Kind::Compute,
+        bindings: &[Res::HostDepthRaw, Res::HostDepth],
+        writes: &[Res::HostDepth],
+        push: std::mem::size_of::<DepthPush>() as u32,
+        workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
+        timing: "host_depth",
         device_build: None,
         builds: &builds::ONLY,
     },

@@ -388,6 +388,7 @@ fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tile
         table: &table,
         slice_table: &slice_table,
         occlusion: &[],
+        host_depth: &[],
     };
     let mut layers = vec![ImageF32::new(cam.width, cam.height); sheets];
     let points = o.raster == Raster::Points;

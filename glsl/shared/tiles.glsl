@@ -13,7 +13,7 @@ ScreenQuad screen_record(SplatParams p) {
     bool on = screen_quad(p, inv, box);
     q.inv0 = vec4(inv[0][0], inv[1][0], inv[2][0], p.axis_v.w);
     q.inv1 = vec4(inv[0][1], inv[1][1], inv[2][1], p.screen.y);
-    q.inv2 = vec4(inv[0][2], inv[1][2], inv[2][2], 0.0);
+    q.inv2 = vec4(inv[0][2], inv[1][2], inv[2][2], p.screen.x);
     q.box = on ? box : ivec4(0, 0, -1, -1);
     q.emit = vec4(p.emit.rgb, p.emit.a * p.axis_u.w);
     return q;

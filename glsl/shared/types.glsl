@@ -61,7 +61,7 @@ struct SplatParams {
 struct ScreenQuad {
     vec4 inv0;    // rows of the inverse projective map, pixel centre (x, y, 1) -> homogeneous
     vec4 inv1;    // quad coordinates (u, v, 1); inv0.w: motion stretch; inv1.w: motion bend
-    vec4 inv2;
+    vec4 inv2;    // w: the splat's eye-space depth (the host's depth test)
     ivec4 box;    // inclusive pixel box x0, y0, x1, y1 (empty when culled: x0 > x1)
     vec4 emit;    // rgb; a: optical depth scale (tau x energy)
 };
@@ -91,7 +91,8 @@ struct Frame {
                       // path (SWEEP_*); z, w: unused
     uvec4 rect;       // x: 1 = a rectilinear grid (voxel positions from splat_params' Coords
                       // buffer); y: clipping planes in use; z: the projection mode (PROJECT_*,
-                      // 0: compositing); w: unused
+                      // 0: compositing); w: 1 = the host's depth (HostDepth, eye-space depth per
+                      // pixel) hides the splats behind it
     vec4 clip[CLIP_SLOTS];  // clipping planes (n, d): drawn where n . centre + d >= 0 for all
 };
 

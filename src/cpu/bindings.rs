@@ -88,6 +88,7 @@ impl<'a> Bindings<'a> {
             table: &self.table,
             slice_table: &self.slice_table,
             occlusion: self.get(Res::Occlusion),
+            host_depth: self.get(Res::HostDepth),
         }
     }
 
@@ -129,4 +130,6 @@ pub struct FootprintInputs<'a> {
     pub slice_table: &'a [f32],
     /// Largest transmittance left per composite tile (early termination; empty when off).
     pub occlusion: &'a [f32],
+    /// The host's eye-space depth per pixel (`Res::HostDepth`; read when `frame.rect[3]` is 1).
+    pub host_depth: &'a [f32],
 }

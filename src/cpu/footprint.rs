@@ -113,7 +113,8 @@ pub fn footprint(
         let Some(target) = target else { continue };
         let p = &inputs.params[splat];
         let sheet = push.sheet_mode != 0;
-        let shading = Shading { sheet, blend, weight, sweep: Sweep::of(inputs.frame, p), slots };
+        let depth = (inputs.frame.rect[3] != 0).then_some(inputs.host_depth);
+        let shading = Shading { sheet, blend, weight, sweep: Sweep::of(inputs.frame, p), slots, depth };
         if points {
             raster_point(p, shading, vp, target);
         } else {
@@ -380,11 +381,16 @@ pub(crate) struct Shading<'a> {
     sweep: Sweep,
     /// Two time slots (`Pass::Slots`): one value per target.
     slots: bool,
+    /// The host's eye-space depth per pixel, when it hides what lies behind it.
+    depth: Option<&'a [f32]>,
 }
 
 /// The fragment shader's output at quad coordinates (u, v), blended into the pixel at `at` of
 /// `targets` (one, or the two slots).
 pub(crate) fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF32], at: usize) {
+    if s.depth.is_some_and(|d| p.screen[0] > d[at]) {
+        return;
+    }
     let tau = p.emit[3] * p.axis_u[3];
     // A projection (footprint.frag's PROJECT): by maximum, the key weighed by the footprint over
     // its centre's and the coverage; summed, the key and 1 weighed by the optical depth.

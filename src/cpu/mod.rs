@@ -20,6 +20,7 @@ pub mod order;
 pub mod order_count;
 pub mod order_scan;
 pub mod order_scatter;
+pub mod host_depth;
 pub mod present;
 pub mod project;
 pub mod raycast;

@@ -11,7 +11,7 @@ pub fn screen_record(frame: &Frame, p: &SplatParams) -> ScreenQuad {
     let (inv, bx) = screen_quad(frame, p).unwrap_or((Mat3::IDENTITY, IVec4::new(0, 0, -1, -1)));
     let row = |r: usize, w: f32| [inv.x_axis[r], inv.y_axis[r], inv.z_axis[r], w];
     ScreenQuad {
-        inv: [row(0, p.axis_v[3]), row(1, p.screen[1]), row(2, 0.0)],
+        inv: [row(0, p.axis_v[3]), row(1, p.screen[1]), row(2, p.screen[0])],
         bx: bx.to_array(),
         emit: [p.emit[0], p.emit[1], p.emit[2], p.emit[3] * p.axis_u[3]],
     }

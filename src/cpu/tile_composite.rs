@@ -27,6 +27,7 @@ pub fn tile_composite(
     let btf = push.back_to_front != 0;
     let terminate = !btf && push.occluded > 0.0;
     let width = image.width;
+    let depth_test = inputs.frame.rect[3] != 0;
     image.pixels.par_iter_mut().enumerate().for_each(|(i, px)| {
         let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
         let tile = ((y as u32 / RASTER_TILE_H) * tiles_x + x as u32 / RASTER_TILE_W) as usize;
@@ -51,6 +52,9 @@ pub fn tile_composite(
             let row = |r: usize| Vec3::new(q.inv[r][0], q.inv[r][1], q.inv[r][2]).dot(p);
             let uv = Vec2::new(row(0), row(1)) / row(2);
             if uv.x.abs() > 1.0 || uv.y.abs() > 1.0 {
+                continue;
+            }
+            if depth_test && q.inv[2][3] > inputs.host_depth[i] {
                 continue;
             }
             let sweep = Sweep { stretch: q.inv[0][3], bend: q.inv[1][3], profile: inputs.frame.sweep[1] };

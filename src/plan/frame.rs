@@ -33,6 +33,9 @@ pub struct FramePlan {
     pub direction: Direction,
     /// The straight-alpha background the frame is presented over, if any.
     pub background: Option<[f32; 4]>,
+    /// The host's depth buffer, uploaded and turned into eye-space depth (`host_depth`) when the
+    /// frame begins (`frame.rect[3]` is then 1).
+    pub depth: Option<std::sync::Arc<crate::options::DepthBuffer>>,
     /// What the frame draws and how.
     pub draw: Draw,
 }
@@ -138,15 +141,22 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
     let (width, height) = (camera.width, camera.height);
     let direction = opts.direction();
     let slotted = opts.slotted();
-    let plan = |frame, draw| FramePlan {
-        frame,
-        camera: *camera,
-        kernel: opts.kernel,
-        width,
-        height,
-        direction,
-        background: opts.background,
-        draw,
+    if let Some(d) = &opts.depth {
+        d.check(width, height)?;
+    }
+    let plan = |mut frame: Frame, draw| {
+        frame.rect[3] = opts.depth.is_some() as u32;
+        FramePlan {
+            frame,
+            camera: *camera,
+            kernel: opts.kernel,
+            width,
+            height,
+            direction,
+            background: opts.background,
+            depth: opts.depth.clone(),
+            draw,
+        }
     };
     if let Some(scene) = &prep.bricks {
         if slotted {

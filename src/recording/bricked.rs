@@ -38,6 +38,7 @@ pub(super) fn record_bricks(
     let frame = &plan.frame;
     let slots = bf.grid[0] as usize * bf.grid[1] as usize * bf.grid[2] as usize;
     e.begin(frame, plan.kernel, w, h)?;
+    super::record_host_depth(e, plan)?;
     e.upload(Res::BrickFrame, bytemuck::cast_slice(bytemuck::bytes_of(bf)))?;
     e.upload(Res::Tf, scene.tf_words())?;
     if let Some(bytes) = b.gradients {
