@@ -388,6 +388,11 @@ impl Renderer {
         }
         // Below scale 1 the frame is drawn on the coarser grid and the blit stretches it.
         let scaled = options.render_scale != 1.0;
+        if scaled && target.depth().is_some() {
+            return Err(Error::InvalidArgument(
+                "the host's depth image is read pixel for pixel: draw at render scale 1".into(),
+            ));
+        }
         let low = resample::scaled_camera(camera, options.render_scale)?;
         let mut full = options.clone();
         full.render_scale = 1.0;
@@ -407,6 +412,12 @@ impl Renderer {
     /// An image on this renderer's device that `render_to` can draw into and `read_target` read.
     pub fn target_image(&self, format: TargetFormat, width: u32, height: u32) -> Result<vk::TargetImage> {
         vk::TargetImage::new(self.device_context("a target image")?, format, width, height)
+    }
+
+    /// A depth image on this renderer's device, cleared to `depth` (a plane facing the camera),
+    /// that a target can read as the host's (`vk::DepthImage::attach`).
+    pub fn depth_image(&self, format: DepthFormat, width: u32, height: u32, depth: f32) -> Result<vk::DepthImage> {
+        vk::DepthImage::new(self.device_context("a depth image")?, format, (width, height), depth)
     }
 
     fn device_context(&self, what: &str) -> Result<&Arc<vk::Context>> {

@@ -410,6 +410,11 @@ impl RenderOptions {
         if let Some(tf) = &self.colormap {
             tf.validate()?;
         }
+        if self.depth.is_some() && self.render_scale != 1.0 {
+            return Err(Error::InvalidArgument(
+                "the host's depth buffer is read pixel for pixel: draw at render scale 1".into(),
+            ));
+        }
         if self.depth.is_some() && self.composite != Composite::Splat {
             return Err(Error::InvalidArgument(
                 "the host's depth buffer hides splats per pixel as they are composited: use --composite splat".into(),

@@ -57,7 +57,21 @@ pub struct Recorded {
 /// THE recording of a frame: `prep` drawn from `camera` with `opts` (whose raster is already
 /// chosen), on `e`: its plan (`plan::frame`), then the plan recorded.
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
-    let plan = plan::frame(prep, camera, opts, &e.limits())?;
+    let mut plan = plan::frame(prep, camera, opts, &e.limits())?;
+    if let Some((format, projection)) = e.target_depth() {
+        if plan.depth.is_some() {
+            return Err(Error::InvalidArgument(
+                "a depth buffer in the options and a depth image on the target: give one".into(),
+            ));
+        }
+        if opts.composite != crate::options::Composite::Splat {
+            return Err(Error::InvalidArgument(
+                "the host's depth image hides splats per pixel as they are composited: use --composite splat".into(),
+            ));
+        }
+        plan.depth = Some(plan::DepthSource::Target(format, projection));
+        plan.frame.rect[3] = 1;
+    }
     record_plan(e, prep, &plan)
 }
 
@@ -294,13 +308,22 @@ fn record_host_depth(e: &mut dyn Engine, plan: &FramePlan) -> Result<()> {
     let Some(d) = &plan.depth else { return Ok(()) };
     let pixels = plan.width as u64 * plan.height as u64;
     e.ensure(Res::HostDepthRaw, pixels * 4)?;
-    e.upload(Res::HostDepthRaw, &d.texels)?;
+    let (format, projection) = match d {
+        plan::DepthSource::Buffer(b) => {
+            e.upload(Res::HostDepthRaw, &b.texels)?;
+            (b.format, b.projection)
+        }
+        &plan::DepthSource::Target(format, projection) => {
+            e.copy_target_depth(Res::HostDepthRaw)?;
+            (format, projection)
+        }
+    };
     e.ensure(Res::HostDepth, pixels * 4)?;
     let push = crate::gpu_types::DepthPush {
-        inv_proj: d.projection.inverse().to_cols_array_2d(),
+        inv_proj: projection.inverse().to_cols_array_2d(),
         width: plan.width,
         height: plan.height,
-        format: d.format.code(),
+        format: format.code(),
         pad: 0,
     };
     let groups = tile_groups(StageId::HostDepth, plan.width, plan.height);

@@ -137,3 +137,85 @@ fn a_depth_buffer_that_does_not_fit_is_refused() {
     o.composite = voxsplat::Composite::Sheet;
     assert!(r.render(&cam, &o).unwrap_err().to_string().contains("--composite splat"));
 }
+
+#[test]
+fn render_to_reads_the_hosts_depth_image_on_the_device() {
+    use voxsplat::low_level::cpu::present::{decode, present_pixel};
+    use voxsplat::vk::ImageLayout as IL;
+    use voxsplat::TargetFormat;
+    let set = classify(&common::blob([26, 22, 18]), &common::blob_tf(), None).unwrap();
+    let mut g = gpu();
+    g.set_scene(set.clone()).unwrap();
+    for cam in cameras(&set) {
+        let d = depth_of_centre(&cam, &set) + 0.137;
+        // The plane's depth as the host's depth image holds it (D32), and the clipped frame.
+        let proj = cam.proj();
+        let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
+        let depth = g.depth_image(DepthFormat::D32, cam.width, cam.height, c.z / c.w).unwrap();
+        let image = g.target_image(TargetFormat::Rgba16Float, cam.width, cam.height).unwrap();
+        let target = depth.attach(image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(), proj).unwrap();
+        for raster in [Raster::Compute, Raster::Graphics] {
+            let mut o = RenderOptions::default();
+            o.raster = raster;
+            g.render_to(&cam, &o, &target).unwrap();
+            let got = decode(TargetFormat::Rgba16Float, &g.read_target(&target).unwrap()).unwrap();
+            let mut clipped = o.clone();
+            clipped.clip = clip_at(&cam, d);
+            let want = g.render(&cam, &clipped).unwrap().image;
+            let push = voxsplat::low_level::plan::present_push(None, 1, true, cam.width, cam.height);
+            let worst = got
+                .iter()
+                .zip(&want.pixels)
+                .map(|(a, &b)| {
+                    let w = present_pixel(&push, b, [0.0; 4]);
+                    (0..4).map(|k| (a[k] - w[k]).abs()).fold(0.0f32, f32::max)
+                })
+                .fold(0.0f32, f32::max);
+            // Half floats: 2e-3 as tests/present.rs allows.
+            assert!(worst <= 2e-3, "{raster} {:?}: render_to with the depth image against the clipped frame: {worst}", cam.projection);
+            // Both a depth image and a depth buffer: refused.
+            let mut both = o.clone();
+            both.depth = Some(Arc::new(plane_depth(&cam, d, DepthFormat::D32)));
+            assert!(g.render_to(&cam, &both, &target).unwrap_err().to_string().contains("give one"));
+        }
+        let mut scaled = RenderOptions::default();
+        scaled.render_scale = 0.5;
+        assert!(g.render_to(&cam, &scaled, &target).unwrap_err().to_string().contains("render scale 1"));
+    }
+    assert_clean(&g);
+}
+
+#[test]
+fn a_d24s8_depth_image_is_read_on_the_device_as_the_mirror_reads_its_texels() {
+    use voxsplat::low_level::cpu::present::{decode, present_pixel};
+    use voxsplat::vk::ImageLayout as IL;
+    use voxsplat::TargetFormat;
+    let set = classify(&common::blob([26, 22, 18]), &common::blob_tf(), None).unwrap();
+    let mut g = gpu();
+    g.set_scene(set.clone()).unwrap();
+    let cam = cameras(&set)[0];
+    let d = depth_of_centre(&cam, &set) + 0.137;
+    let proj = cam.proj();
+    let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
+    let depth = g.depth_image(DepthFormat::D24S8, cam.width, cam.height, c.z / c.w).unwrap();
+    let image = g.target_image(TargetFormat::Rgba16Float, cam.width, cam.height).unwrap();
+    let target = depth.attach(image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(), proj).unwrap();
+    let o = RenderOptions::default();
+    g.render_to(&cam, &o, &target).unwrap();
+    let got = decode(TargetFormat::Rgba16Float, &g.read_target(&target).unwrap()).unwrap();
+    // The same depth as texels: the plane's depth rounded to 24 bits, as the device stores it.
+    let mut with = o.clone();
+    with.depth = Some(Arc::new(plane_depth(&cam, d, DepthFormat::D24S8)));
+    let want = g.render(&cam, &with).unwrap().image;
+    let push = voxsplat::low_level::plan::present_push(None, 1, true, cam.width, cam.height);
+    let worst = got
+        .iter()
+        .zip(&want.pixels)
+        .map(|(a, &b)| {
+            let w = present_pixel(&push, b, [0.0; 4]);
+            (0..4).map(|k| (a[k] - w[k]).abs()).fold(0.0f32, f32::max)
+        })
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 2e-3, "the D24S8 image against its texels: {worst}");
+    assert_clean(&g);
+}

@@ -24,6 +24,8 @@ enum Cmd {
     Copy(Res, u64),
     /// Blit the accumulation image into the host's image (`GpuEngine::target`).
     Blit,
+    /// Copy the host's depth image into a resource.
+    CopyDepth(Res),
 }
 
 /// The Vulkan engine of one frame.
@@ -259,6 +261,12 @@ fn record(
             }
             rec.barrier(Stage::Transfer, Stage::Host);
         }
+        Cmd::CopyDepth(r) => {
+            let host = host.ok_or_else(|| Error::InvalidArgument("a depth copy without a host target".into()))?;
+            rec.barrier(Stage::All, Stage::Transfer);
+            rec.copy_host_depth(host, res.buffer(*r)?);
+            rec.barrier(Stage::Transfer, Stage::All);
+        }
         Cmd::Blit => {
             let host = host.ok_or_else(|| Error::InvalidArgument("a blit without a host target".into()))?;
             rec.barrier(Stage::All, Stage::Transfer);
@@ -400,6 +408,19 @@ impl Engine for GpuEngine<'_> {
 
     fn target_linear(&self) -> Option<bool> {
         self.target.map(|t| t.format().linear())
+    }
+
+    fn target_depth(&self) -> Option<(crate::options::DepthFormat, glam::Mat4)> {
+        self.target.and_then(|t| t.depth())
+    }
+
+    fn copy_target_depth(&mut self, res: Res) -> Result<()> {
+        if self.target_depth().is_none() {
+            return Err(Error::InvalidArgument("this frame's target has no depth image".into()));
+        }
+        self.live.insert(res);
+        self.pending.push(("", Cmd::CopyDepth(res)));
+        Ok(())
     }
 
     fn deliver(&mut self) -> Result<()> {

@@ -33,9 +33,9 @@ pub struct FramePlan {
     pub direction: Direction,
     /// The straight-alpha background the frame is presented over, if any.
     pub background: Option<[f32; 4]>,
-    /// The host's depth buffer, uploaded and turned into eye-space depth (`host_depth`) when the
-    /// frame begins (`frame.rect[3]` is then 1).
-    pub depth: Option<std::sync::Arc<crate::options::DepthBuffer>>,
+    /// The host's depth, turned into eye-space depth (`host_depth`) when the frame begins
+    /// (`frame.rect[3]` is then 1).
+    pub depth: Option<DepthSource>,
     /// What the frame draws and how.
     pub draw: Draw,
 }
@@ -85,6 +85,15 @@ pub enum Draw {
         /// The mode and its colours.
         projection: Projection,
     },
+}
+
+/// Where a frame's host depth comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DepthSource {
+    /// `RenderOptions::depth`: texels uploaded with the frame.
+    Buffer(std::sync::Arc<crate::options::DepthBuffer>),
+    /// The render target's depth image (`vk::HostTarget::with_depth`), copied on the device.
+    Target(crate::options::DepthFormat, glam::Mat4),
 }
 
 /// A projection mode's last step (`project`): how the blended (key, weight) become colours.
@@ -154,7 +163,7 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
             height,
             direction,
             background: opts.background,
-            depth: opts.depth.clone(),
+            depth: opts.depth.clone().map(DepthSource::Buffer),
             draw,
         }
     };

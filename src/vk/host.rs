@@ -4,6 +4,7 @@
 use super::{Buffer, Context, Image, Memory, Recorder};
 use crate::error::{Error, Result};
 use crate::image::TargetFormat;
+use crate::options::DepthFormat;
 use ash::vk;
 use std::sync::Arc;
 
@@ -40,6 +41,44 @@ pub struct HostTarget {
     pub(crate) new_layout: vk::ImageLayout,
     pub(crate) wait: Vec<vk::Semaphore>,
     pub(crate) signal: Vec<vk::Semaphore>,
+    pub(crate) depth: Option<HostDepth>,
+}
+
+/// The host's depth image a frame reads (`HostTarget::with_depth`).
+#[derive(Clone, Debug)]
+pub(crate) struct HostDepth {
+    pub(crate) image: vk::Image,
+    pub(crate) format: DepthFormat,
+    pub(crate) layout: vk::ImageLayout,
+    pub(crate) projection: glam::Mat4,
+}
+
+/// The depth format of a Vulkan format, or a typed error naming the ones voxsplat reads.
+pub fn depth_format(format: vk::Format) -> Result<DepthFormat> {
+    match format {
+        vk::Format::D32_SFLOAT => Ok(DepthFormat::D32),
+        vk::Format::D24_UNORM_S8_UINT => Ok(DepthFormat::D24S8),
+        other => Err(Error::Unsupported(format!(
+            "render_to reads D32_SFLOAT or D24_UNORM_S8_UINT depth images, not {other:?}"
+        ))),
+    }
+}
+
+/// The Vulkan format of a depth format.
+pub fn vk_depth_format(format: DepthFormat) -> vk::Format {
+    match format {
+        DepthFormat::D32 => vk::Format::D32_SFLOAT,
+        DepthFormat::D24S8 => vk::Format::D24_UNORM_S8_UINT,
+    }
+}
+
+/// The aspects a barrier on a depth image of `format` names (a combined format: both).
+fn depth_range(format: DepthFormat) -> vk::ImageSubresourceRange {
+    let aspect_mask = match format {
+        DepthFormat::D32 => vk::ImageAspectFlags::DEPTH,
+        DepthFormat::D24S8 => vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+    };
+    vk::ImageSubresourceRange { aspect_mask, ..color_range() }
 }
 
 impl HostTarget {
@@ -70,7 +109,51 @@ impl HostTarget {
         if width == 0 || height == 0 {
             return Err(Error::InvalidArgument(format!("a target of {width} x {height} pixels")));
         }
-        Ok(Self { image, format, width, height, old_layout, new_layout, wait: wait.to_vec(), signal: signal.to_vec() })
+        Ok(Self {
+            image,
+            format,
+            width,
+            height,
+            old_layout,
+            new_layout,
+            wait: wait.to_vec(),
+            signal: signal.to_vec(),
+            depth: None,
+        })
+    }
+
+    /// The same target with the host's depth image: splats behind the host's geometry add nothing
+    /// to a pixel (as `RenderOptions::depth`, read on the device). `projection` is the host's
+    /// (its eye space the camera's view; near, far and reversed depth its own).
+    ///
+    /// # Safety
+    ///
+    /// `image` is a valid 2D image of `format` (D32_SFLOAT or D24_UNORM_S8_UINT) and the target's
+    /// size on voxsplat's device, created with `TRANSFER_SRC` usage, in `layout` when the frame
+    /// starts (the frame leaves it there) and holding the host's depth: written by work submitted
+    /// earlier to the renderer's queue, or complete. It stays alive until `render_to` returns.
+    pub unsafe fn with_depth(
+        mut self,
+        image: vk::Image,
+        format: vk::Format,
+        layout: vk::ImageLayout,
+        projection: glam::Mat4,
+    ) -> Result<Self> {
+        let format = depth_format(format)?;
+        if layout == vk::ImageLayout::UNDEFINED || layout == vk::ImageLayout::PREINITIALIZED {
+            return Err(Error::InvalidArgument(format!("a depth image in layout {layout:?} holds no depth")));
+        }
+        let det = projection.determinant();
+        if !(projection.is_finite() && det.is_finite() && det != 0.0) {
+            return Err(Error::InvalidArgument("the depth image's projection must be finite and invertible".into()));
+        }
+        self.depth = Some(HostDepth { image, format, layout, projection });
+        Ok(self)
+    }
+
+    /// The depth image's format and projection, if the target has one.
+    pub fn depth(&self) -> Option<(DepthFormat, glam::Mat4)> {
+        self.depth.as_ref().map(|d| (d.format, d.projection))
     }
 
     /// Its size in pixels.
@@ -117,6 +200,78 @@ impl TargetImage {
         let (w, h) = (self.image.width, self.image.height);
         // SAFETY: voxsplat made the image with the needed usage; no semaphores.
         unsafe { HostTarget::new(self.image.raw, vk_format(self.format), (w, h), (old_layout, new_layout), &[], &[]) }
+    }
+}
+
+/// A depth image voxsplat owns (`D32_SFLOAT` or `D24_UNORM_S8_UINT`), cleared to one depth: the
+/// depth of a plane facing the camera, for hosts without their own and for tests.
+pub struct DepthImage {
+    image: Image,
+    format: DepthFormat,
+}
+
+impl DepthImage {
+    /// A `width` x `height` depth image of `format`, usable as a depth attachment and a transfer
+    /// source and destination, cleared to `depth` and left in `TRANSFER_SRC_OPTIMAL`.
+    pub fn new(ctx: &Arc<Context>, format: DepthFormat, (width, height): (u32, u32), depth: f32) -> Result<Self> {
+        use vk::ImageUsageFlags as IU;
+        let usage = IU::TRANSFER_DST | IU::TRANSFER_SRC | IU::DEPTH_STENCIL_ATTACHMENT;
+        let image = Image::new_depth(ctx, "host depth", (width, height), vk_depth_format(format), usage)?;
+        let range = [depth_range(format)];
+        ctx.submit(|rec| {
+            let to = |from, to| {
+                let b = [vk::ImageMemoryBarrier::default()
+                    .old_layout(from)
+                    .new_layout(to)
+                    .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+                    .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .image(image.raw)
+                    .subresource_range(range[0])];
+                let all = vk::PipelineStageFlags::ALL_COMMANDS;
+                // SAFETY: recording state; the image is ours, in `from`.
+                unsafe { rec.ctx.device.cmd_pipeline_barrier(rec.cmd, all, all, vk::DependencyFlags::empty(), &[], &[], &b) };
+            };
+            to(vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+            let value = vk::ClearDepthStencilValue { depth, stencil: 0 };
+            // SAFETY: the image is in TRANSFER_DST_OPTIMAL, made with TRANSFER_DST usage.
+            unsafe {
+                rec.ctx.device.cmd_clear_depth_stencil_image(
+                    rec.cmd,
+                    image.raw,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &value,
+                    &range,
+                )
+            };
+            to(vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            Ok(())
+        })?;
+        Ok(Self { image, format })
+    }
+
+    /// The raw handle.
+    pub fn raw(&self) -> vk::Image {
+        self.image.raw
+    }
+
+    /// `target` reading this image (in `TRANSFER_SRC_OPTIMAL`) as the host's depth, drawn with
+    /// `projection`.
+    pub fn attach(&self, target: HostTarget, projection: glam::Mat4) -> Result<HostTarget> {
+        if (self.image.width, self.image.height) != target.size() {
+            return Err(Error::InvalidArgument(format!(
+                "a {} x {} depth image for a {} x {} target",
+                self.image.width,
+                self.image.height,
+                target.width,
+                target.height
+            )));
+        }
+        let layout = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        // SAFETY: voxsplat made the image with TRANSFER_SRC usage, of the target's size, and left
+        // it in `layout`, holding the depth it was cleared to (that submission is complete).
+        unsafe { target.with_depth(self.image.raw, vk_depth_format(self.format), layout, projection) }
     }
 }
 
@@ -177,6 +332,46 @@ fn host_barrier(rec: &Recorder<'_>, image: vk::Image, layouts: (vk::ImageLayout,
 }
 
 impl Recorder<'_> {
+    /// Copy the depth aspect of the host's depth image (`HostTarget::with_depth`) into `buffer`
+    /// (one 32-bit word per pixel: D32's float, or D24's depth in the low 24 bits), leaving the
+    /// image in its layout.
+    pub fn copy_host_depth(&self, to: &HostTarget, buffer: &Buffer) {
+        let Some(d) = &to.depth else { return };
+        let range = depth_range(d.format);
+        let barrier = |from: vk::ImageLayout, into: vk::ImageLayout| {
+            let b = [vk::ImageMemoryBarrier::default()
+                .old_layout(from)
+                .new_layout(into)
+                .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+                .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(d.image)
+                .subresource_range(range)];
+            let all = vk::PipelineStageFlags::ALL_COMMANDS;
+            // SAFETY: recording state; the host promised the image is valid and in `from`.
+            unsafe { self.ctx.device.cmd_pipeline_barrier(self.cmd, all, all, vk::DependencyFlags::empty(), &[], &[], &b) };
+        };
+        let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        if d.layout != src {
+            barrier(d.layout, src);
+        }
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::DEPTH,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D { width: to.width, height: to.height, depth: 1 })];
+        // SAFETY: the image is in TRANSFER_SRC_OPTIMAL with TRANSFER_SRC usage (the host's
+        // promise); the buffer holds a word per pixel (the recording ensured it).
+        unsafe { self.ctx.device.cmd_copy_image_to_buffer(self.cmd, d.image, src, buffer.raw, &region) };
+        if d.layout != src {
+            barrier(src, d.layout);
+        }
+    }
+
     /// Blit `src` (in TRANSFER_SRC_OPTIMAL) into the host's image, which the blit converts to its
     /// format (sRGB encoding included), leaving it in its new layout. A smaller `src` (a render
     /// scale: `resample::scaled_camera`'s grid, as tall as the view and centred) is stretched

@@ -28,7 +28,18 @@ impl Image {
         usage: vk::ImageUsageFlags,
         array: bool,
     ) -> Result<Self> {
-        Self::create(ctx, name, (width, height, 1), layers, format, usage, array, false)
+        Self::create(ctx, name, (width, height, 1), layers, format, usage, array, false, vk::ImageAspectFlags::COLOR)
+    }
+
+    /// A device-local 2D depth image (its view of the depth aspect).
+    pub fn new_depth(
+        ctx: &Arc<Context>,
+        name: &str,
+        (width, height): (u32, u32),
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self> {
+        Self::create(ctx, name, (width, height, 1), 1, format, usage, false, false, vk::ImageAspectFlags::DEPTH)
     }
 
     /// A device-local 3D image (one layer).
@@ -39,7 +50,7 @@ impl Image {
         format: vk::Format,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self> {
-        Self::create(ctx, name, extent, 1, format, usage, false, true)
+        Self::create(ctx, name, extent, 1, format, usage, false, true, vk::ImageAspectFlags::COLOR)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -52,6 +63,7 @@ impl Image {
         usage: vk::ImageUsageFlags,
         array: bool,
         three_d: bool,
+        aspect: vk::ImageAspectFlags,
     ) -> Result<Self> {
         let info = vk::ImageCreateInfo::default()
             .image_type(if three_d { vk::ImageType::TYPE_3D } else { vk::ImageType::TYPE_2D })
@@ -112,7 +124,7 @@ impl Image {
                 vk::ImageViewType::TYPE_2D
             })
             .format(format)
-            .subresource_range(Self::range_of(layers));
+            .subresource_range(vk::ImageSubresourceRange { aspect_mask: aspect, ..Self::range_of(layers) });
         // SAFETY: bound image, matching format.
         image.view =
             unsafe { ctx.device.create_image_view(&view_info, None) }.map_err(Error::vk("vkCreateImageView"))?;
