@@ -365,7 +365,9 @@ impl Renderer {
     /// format (over `options.background`, sRGB encoded where the format says so: the bytes a PNG
     /// of `render` holds), leaves it in the target's new layout and signals the target's signal
     /// semaphores. It returns when the frame is complete (docs/guide/embedding.md). A `render_scale`
-    /// below 1 draws the coarser grid and stretches it in the blit (linear filter).
+    /// below 1 draws the coarser grid and stretches it in the blit (linear filter). A target with
+    /// the host's depth image (`vk::HostTarget::with_depth`) hides the splats behind the host's
+    /// geometry, per pixel.
     pub fn render_to(
         &mut self,
         camera: &Camera,
