@@ -253,6 +253,9 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
     let need_total = nifti_size(&head, what)?;
     let data = if is_gzip(bytes) { gunzip(bytes, need_total, what)? } else { head };
     let l = nifti_layout(&data, MAX_VOXELS, what)?;
+    if l.channels > 1 {
+        return Err(several_channels(what, l.channels));
+    }
     if l.offset > data.len() as u64 {
         return Err(bad(what, format!("voxel offset {} outside the file", l.offset)));
     }
@@ -264,6 +267,14 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
         nrrd::flip_rows(&mut values, l.dims[0] as usize);
     }
     Ok(ScalarVolume { dims: l.dims, spacing: l.spacing, values })
+}
+
+/// The error for a file of several channels read as one volume.
+pub(crate) fn several_channels(what: &str, channels: u32) -> Error {
+    Error::InvalidArgument(format!(
+        "{what} holds {channels} channels: read them with loaders::load_channels (voxsplat render --channel-tf for \
+         each channel after the first)"
+    ))
 }
 
 /// Where a NIfTI-1 file's voxels are and how to read them, from its checked header.
@@ -278,6 +289,9 @@ pub(crate) struct NiftiLayout {
     pub orientation: Option<crate::orient::Orientation>,
     /// `scl_slope`, `scl_inter` when they change the values.
     scale: Option<(f32, f32)>,
+    /// Channels stored one after another (a 4-D file's fourth axis, or a 5-D file's fifth with
+    /// one frame): 1 for a 3-D volume.
+    pub channels: u32,
 }
 
 impl NiftiLayout {
@@ -296,14 +310,28 @@ impl NiftiLayout {
 pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiLayout> {
     let header = nifti1_header(head, what)?;
     let dim = nifti_dims(&header, what)?;
-    if dim.is_empty() || dim.len() > 4 || (dim.len() == 4 && dim[3] != 1) {
-        return Err(bad(what, "only 3D NIfTI volumes (or 4D with one frame) are supported"));
-    }
+    // 3-D; 4-D with one frame or 2 to 4 channels; 5-D with one frame and 2 to 4 channels (the
+    // vector axis).
+    let channels = match dim.len() {
+        1..=3 => 1,
+        4 if dim[3] <= MAX_FILE_CHANNELS => dim[3],
+        5 if dim[3] == 1 && dim[4] <= MAX_FILE_CHANNELS => dim[4],
+        _ => {
+            return Err(bad(
+                what,
+                format!(
+                    "NIfTI dims {dim:?}: a 3-D volume is read, or one of 2 to {MAX_FILE_CHANNELS} channels (4-D, or 5-D with \
+                     one frame)"
+                ),
+            ))
+        }
+    };
     let mut d3 = [1u64; 3];
     for (i, d) in dim.iter().take(3).enumerate() {
         d3[i] = *d;
     }
     voxel_count_within(&d3, what, limit)?;
+    voxel_count_within(&[d3[0], d3[1], d3[2], channels], what, limit.saturating_mul(MAX_FILE_CHANNELS))?;
     let dtype = match header.data_type().map_err(|e| bad(what, format!("NIfTI type: {e}")))? {
         nifti::NiftiType::Uint8 => DType::U8,
         nifti::NiftiType::Uint16 => DType::U16,
@@ -337,7 +365,36 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
         big_endian: header.endianness == nifti::Endianness::Big,
         spacing,
         scale,
+        channels: channels as u32,
     })
+}
+
+/// Most channels a file may hold (`load_channels`; `classify::MAX_CHANNELS`).
+pub const MAX_FILE_CHANNELS: u64 = 4;
+
+/// Every channel of a volume file: a 4-D NIfTI's 2 to 4 channels (its fourth axis, or a 5-D
+/// file's fifth), each as the volume `load_volume` reads; any other file is one channel.
+pub fn load_channels(path: &Path, hints: &VolumeHints) -> Result<Vec<ScalarVolume>> {
+    let name = lower_name(path);
+    if !(name.ends_with(".nii") || name.ends_with(".nii.gz")) {
+        return Ok(vec![load_volume(path, hints)?]);
+    }
+    let what = path.display().to_string();
+    let channels = SliceReader::nifti_channels(path)?;
+    (0..channels)
+        .map(|k| {
+            let mut reader = SliceReader::nifti_channel(path, k)?;
+            let mut values = Vec::new();
+            reader.read(0, reader.dims[2], &mut values)?;
+            check_finite(&values, &what)?;
+            let mut v = ScalarVolume { dims: reader.dims, spacing: reader.spacing, values };
+            if let Some(s) = hints.spacing {
+                check_spacing(s, &what)?;
+                v.spacing = s;
+            }
+            Ok(v)
+        })
+        .collect()
 }
 
 /// The first `n` inflated bytes of a gzip stream (fewer if it is shorter).
@@ -446,6 +503,12 @@ pub(crate) fn raw_layout(path: &Path, hints: &VolumeHints, what: &str) -> Result
 /// parallel is `Error::Unsupported`; a less sheared one is placed (`Orientation::grid`).
 pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate::orient::Orientation>> {
     let what = path.display().to_string();
+    let name = lower_name(path);
+    // A NIfTI of several channels places them all as its first.
+    if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+        check_raw_hints(path, hints)?;
+        return crate::orient::respaced(SliceReader::nifti_channel(path, 0)?.orientation, hints.spacing);
+    }
     let o = match SliceReader::open(path, hints)? {
         Some(reader) => reader.orientation,
         // Not streamed: an .npy (no frame), or an NRRD in another encoding (its header alone).

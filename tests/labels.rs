@@ -203,3 +203,50 @@ fn label_tables_and_volumes_refuse_what_they_cannot_mean() {
     let mut t = table(true);
     assert!(t.set_visible(9, false).is_err());
 }
+
+/// A NIfTI-1 file of `channels` u8 channels of `dims`, stored one after another: 4-D, or 5-D
+/// with one frame.
+fn nifti_channels(dims: [u32; 3], data: &[u8], channels: u16, five: bool) -> Vec<u8> {
+    let mut f = common::nifti(dims, data, None, None);
+    let rank: i16 = if five { 5 } else { 4 };
+    f[40..42].copy_from_slice(&rank.to_le_bytes());
+    let at = if five { 50 } else { 48 };
+    f[at..at + 2].copy_from_slice(&(channels as i16).to_le_bytes());
+    f
+}
+
+#[test]
+fn a_four_d_nifti_reads_as_its_channels() {
+    let dir = std::env::temp_dir().join(format!("voxsplat-channels-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dims = [6u32, 5, 4];
+    let n = 120usize;
+    let data: Vec<u8> = (0..3 * n).map(|i| (i % 251) as u8).collect();
+    for (five, name) in [(false, "c.nii"), (true, "c5.nii")] {
+        let path = dir.join(name);
+        std::fs::write(&path, nifti_channels(dims, &data, 3, five)).unwrap();
+        let vols = voxsplat::loaders::load_channels(&path, &Default::default()).unwrap();
+        assert_eq!(vols.len(), 3, "{name}");
+        for (k, v) in vols.iter().enumerate() {
+            assert_eq!(v.dims, dims);
+            let want: Vec<f32> = data[k * n..(k + 1) * n].iter().map(|&b| b as f32).collect();
+            assert_eq!(v.values, want, "{name}: channel {k}");
+        }
+        let e = voxsplat::loaders::load_volume(&path, &Default::default()).unwrap_err().to_string();
+        assert!(e.contains("holds 3 channels"), "{e}");
+    }
+    // Too many channels, and a file too short for its channels.
+    let many = dir.join("many.nii");
+    std::fs::write(&many, nifti_channels(dims, &vec![0; 7 * n], 7, false)).unwrap();
+    let e = voxsplat::loaders::load_channels(&many, &Default::default()).unwrap_err().to_string();
+    assert!(e.contains("2 to 4 channels"), "{e}");
+    let short = dir.join("short.nii");
+    std::fs::write(&short, nifti_channels(dims, &data[..2 * n], 3, false)).unwrap();
+    let e = voxsplat::loaders::load_channels(&short, &Default::default()).unwrap_err().to_string();
+    assert!(e.contains("truncated"), "{e}");
+    // A 3-D file is one channel.
+    let one = dir.join("one.nii");
+    std::fs::write(&one, common::nifti(dims, &data[..n], None, None)).unwrap();
+    assert_eq!(voxsplat::loaders::load_channels(&one, &Default::default()).unwrap().len(), 1);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -156,12 +156,14 @@ pub struct SceneArgs {
     /// optionally visible = false (docs/guide/cli.md).
     #[arg(long, requires = "labels")]
     pub label_table: Option<PathBuf>,
-    /// Another channel of the --volume (a scalar volume on its grid; up to 3 more), classified by
-    /// its own --channel-tf and added per voxel: emission and extinction summed.
+    /// Another channel of the --volume (a scalar volume on its grid; up to 4 channels in all, a
+    /// 4-D NIfTI --volume's own included), classified by its own --channel-tf and added per
+    /// voxel: emission and extinction summed.
     #[arg(long = "channel", requires = "volume", conflicts_with = "positions")]
     pub channels: Vec<PathBuf>,
-    /// The transfer function of each --channel, in the same order (a preset or a TOML file).
-    #[arg(long = "channel-tf", requires = "channels")]
+    /// The transfer function of each channel after the first (--tf's): a 4-D NIfTI --volume's
+    /// further channels, then each --channel, in order (a preset or a TOML file).
+    #[arg(long = "channel-tf", requires = "volume")]
     pub channel_tfs: Vec<String>,
     /// Render a height grid (16-bit PNG, GeoTIFF, or 2D .npy) as voxel columns.
     #[arg(long)]
@@ -403,30 +405,35 @@ pub fn load_bricked(
     voxsplat::bricks::BrickScene::new(store, tf, shading)
 }
 
-/// The --volume and its --channel files, each classified by its transfer function and added per
-/// voxel.
+/// The --volume's channels (a 4-D NIfTI's, or the file alone) and the --channel files, each
+/// classified by its transfer function (--tf, then each --channel-tf) and added per voxel.
 fn load_channels(
     a: &SceneArgs,
-    grid: voxsplat::Grid,
-    first: &voxsplat::volume::ScalarVolume,
-    tf: &voxsplat::classify::TransferFunction,
-    shading: Option<voxsplat::classify::Shading>,
+    path: &std::path::Path,
+    orientation: Option<Orientation>,
 ) -> Result<voxsplat::SplatSet> {
-    if a.channel_tfs.len() != a.channels.len() {
+    let mut volumes = voxsplat::loaders::load_channels(path, &volume_hints(a)?)?;
+    let in_file = volumes.len();
+    for p in &a.channels {
+        volumes.extend(voxsplat::loaders::load_channels(p, &Default::default())?);
+    }
+    if a.channel_tfs.len() + 1 != volumes.len() {
         return Err(Error::InvalidArgument(format!(
-            "{} --channel files and {} --channel-tf: give each channel its transfer function",
+            "{} channels ({in_file} in --volume, {} --channel files) and {} --channel-tf: give each channel after the \
+             first its transfer function",
+            volumes.len(),
             a.channels.len(),
             a.channel_tfs.len()
         )));
     }
-    let more: Vec<_> = a
-        .channels
-        .iter()
-        .zip(&a.channel_tfs)
-        .map(|(p, t)| Ok((voxsplat::loaders::load_volume(p, &Default::default())?, load_tf(t)?)))
-        .collect::<Result<_>>()?;
-    let mut all = vec![(first, tf)];
-    all.extend(more.iter().map(|(v, t)| (v, t)));
+    let mut tfs = vec![transfer_function(a)?];
+    for t in &a.channel_tfs {
+        tfs.push(load_tf(t)?);
+    }
+    let first = &volumes[0];
+    let grid = voxsplat::orient::placed_grid(first.dims, first.spacing, orientation.as_ref())?;
+    let shading = headlight(a, first.dims, first.spacing, orientation);
+    let all: Vec<_> = volumes.iter().zip(&tfs).collect();
     voxsplat::classify::classify_channels(grid, &all, shading)
 }
 
@@ -469,12 +476,12 @@ pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
     let set = if let Some(path) = &a.labels {
         load_labelled(a, path, orientation)?
     } else if let Some(path) = &a.volume {
-        let (vol, tf, shading) = load_volume_parts(a, path, orientation)?;
-        let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
-        let set = if a.channels.is_empty() {
+        let set = if a.channels.is_empty() && a.channel_tfs.is_empty() {
+            let (vol, tf, shading) = load_volume_parts(a, path, orientation)?;
+            let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
             voxsplat::classify::classify_on(grid, &vol, &tf, shading)?
         } else {
-            load_channels(a, grid, &vol, &tf, shading)?
+            load_channels(a, path, orientation)?
         };
         match &a.positions {
             Some(p) => {
@@ -586,7 +593,12 @@ pub fn open(
     }
     let (bricked, orientation) = match (&a.volume, peer) {
         (Some(path), _)
-            if !host_splats && !a.dense && a.positions.is_none() && a.labels.is_none() && a.channels.is_empty() =>
+            if !host_splats
+                && !a.dense
+                && a.positions.is_none()
+                && a.labels.is_none()
+                && a.channels.is_empty()
+                && a.channel_tfs.is_empty() =>
         {
             let orientation = orientation_of(a)?;
             (load_bricked(a, path, orientation)?, orientation)

@@ -836,10 +836,21 @@ fn labels_and_channels_from_the_command_line() {
     let ramp_s = ramp_path.to_str().unwrap();
     let out = voxsplat(&["render", "--volume", ramp_s, "--channel", seg_s, "--channel-tf", "ct", "--size", "48x48", "--out", p]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // A 4-D NIfTI of two channels (the ramp, then the labels), each with its transfer function.
+    let mut four = common::nifti([n as u32; 3], &[ramp.clone(), seg.clone()].concat(), None, None);
+    four[40..42].copy_from_slice(&4i16.to_le_bytes());
+    four[48..50].copy_from_slice(&2i16.to_le_bytes());
+    let four_path = dir.join("two.nii");
+    std::fs::write(&four_path, four).unwrap();
+    let four_s = four_path.to_str().unwrap();
+    let out = voxsplat(&["render", "--volume", four_s, "--channel-tf", "ct", "--size", "48x48", "--out", p]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = voxsplat(&["render", "--volume", four_s, "--size", "48x48", "--out", p]);
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("holds 2 channels"));
     for (extra, says) in [
-        (vec!["--channel", seg_s], "give each channel its transfer function"),
+        (vec!["--channel", seg_s], "give each channel after the first its transfer function"),
         (vec!["--channel", small_s, "--channel-tf", "ramp"], "share one grid"),
-        (vec!["--channel-tf", "ramp"], "--channel <CHANNELS>"),
+        (vec!["--channel-tf", "ramp"], "give each channel after the first"),
     ] {
         let mut args = vec!["render", "--volume", ramp_s, "--size", "32x32", "--out", p];
         args.extend(extra.iter().copied());

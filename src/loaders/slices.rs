@@ -146,9 +146,23 @@ impl SliceReader {
         Self::from_file(file, &data_path, layout, what).map(Some)
     }
 
-    /// A NIfTI-1 file, compressed or not.
+    /// A NIfTI-1 file, compressed or not (of one channel: `nifti_channel` reads one of several).
     pub fn nifti(path: &Path) -> Result<Self> {
+        let channels = Self::nifti_channels(path)?;
+        if channels > 1 {
+            return Err(super::several_channels(&path.display().to_string(), channels));
+        }
+        Self::nifti_channel(path, 0)
+    }
+
+    /// The channels a NIfTI-1 file holds (1 for a 3-D volume).
+    pub fn nifti_channels(path: &Path) -> Result<u32> {
         let what = path.display().to_string();
+        Ok(nifti_layout(&Self::nifti_head(path)?.0, MAX_STREAMED_VOXELS, &what)?.channels)
+    }
+
+    /// The first 348 bytes of a NIfTI-1 file, inflated if it is compressed, and whether it is.
+    fn nifti_head(path: &Path) -> Result<(Vec<u8>, bool)> {
         let mut file = std::fs::File::open(path).map_err(io_err(path))?;
         let mut magic = [0u8; 2];
         let gz = file.read_exact(&mut magic).is_ok() && is_gzip(&magic);
@@ -159,9 +173,21 @@ impl SliceReader {
             file.seek(SeekFrom::Start(0)).map_err(io_err(path))?;
             (&mut file).take(348).read_to_end(&mut head).map_err(io_err(path))?;
         }
+        Ok((head, gz))
+    }
+
+    /// Channel `channel` of a NIfTI-1 file (the channels stored one after another).
+    pub fn nifti_channel(path: &Path, channel: u32) -> Result<Self> {
+        let what = path.display().to_string();
+        let (head, gz) = Self::nifti_head(path)?;
+        let file = std::fs::File::open(path).map_err(io_err(path))?;
         let l = nifti_layout(&head, MAX_STREAMED_VOXELS, &what)?;
+        if channel >= l.channels {
+            return Err(bad(&what, format!("no channel {channel}: the file holds {}", l.channels)));
+        }
+        let block = l.dims.iter().map(|&d| d as u64).product::<u64>() * l.dtype.size() as u64;
         let layout = Layout {
-            offset: l.offset,
+            offset: l.offset + channel as u64 * block,
             dims: l.dims,
             spacing: l.spacing,
             dtype: l.dtype,
