@@ -274,12 +274,16 @@ pub fn classify_channels(
     SplatSet::from_fn_valued(grid, |i, j, k| combine(voxels.iter().map(|f| f(i, j, k))))
 }
 
+/// A voxel classified: its straight colour and opacity and its normalised value, or `None` where
+/// nothing is drawn.
+pub type Classified = Option<([f32; 4], f32)>;
+
 /// Most channels `classify_channels` combines.
 pub const MAX_CHANNELS: usize = 4;
 
 /// Voxels that share a place, combined: emission and extinction added (optical depths summed,
 /// straight colours weighed by them), the value the largest; `None` where none is drawn.
-pub fn combine(voxels: impl Iterator<Item = Option<([f32; 4], f32)>>) -> Option<([f32; 4], f32)> {
+pub fn combine(voxels: impl Iterator<Item = Classified>) -> Classified {
     let (mut rgb_tau, mut tau, mut value, mut any) = ([0.0f64; 3], 0.0f64, 0.0f32, false);
     for (c, v) in voxels.flatten() {
         let t = crate::volume::optical_depth(c[3]) as f64;
@@ -304,7 +308,7 @@ fn voxel_classifier<'a>(
     vol: &'a ScalarVolume,
     tf: &'a TransferFunction,
     shading: Option<Shading>,
-) -> Result<impl Fn(u32, u32, u32) -> Option<([f32; 4], f32)> + 'a> {
+) -> Result<impl Fn(u32, u32, u32) -> Classified + 'a> {
     if grid.dims != vol.dims {
         return Err(Error::InvalidArgument(format!("a {:?} grid for a {:?} volume", grid.dims, vol.dims)));
     }
@@ -346,7 +350,7 @@ fn field_classifier<'a>(
     tf: &'a TransferFunction,
     shading: Option<Shading>,
     at: impl Fn(i64, i64, i64) -> f32 + 'a,
-) -> Result<impl Fn(u32, u32, u32) -> Option<([f32; 4], f32)> + 'a> {
+) -> Result<impl Fn(u32, u32, u32) -> Classified + 'a> {
     tf.validate()?;
     let [nx, ny, nz] = grid.dims;
     let at = std::rc::Rc::new(at);
