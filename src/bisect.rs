@@ -139,6 +139,7 @@ impl Engine for Split<'_> {
             max_layers: a.max_layers.min(b.max_layers),
             max_storage_range: a.max_storage_range.min(b.max_storage_range),
             budget_bytes: a.budget_bytes.min(b.budget_bytes),
+            target_depth: a.target_depth.or(b.target_depth),
         }
     }
     fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {

@@ -150,6 +150,8 @@ pub struct TileComposite {
     pub order: TileOrder,
     /// Motion-blurred footprints.
     pub blur: bool,
+    /// The host's depth hides what lies behind it (`HOST_DEPTH`; not with motion blur).
+    pub depth: bool,
 }
 
 /// The sheets a sheet stage works on (`SHEET_MODE_*`).
@@ -291,12 +293,23 @@ pub const PAGES: Table = table! {
     Build::Pages(Pages::One) => v("ONE_PAGE", &[]),
 };
 
-const fn tc(pages: Pages, order: TileOrder, blur: bool) -> Build {
-    Build::TileComposite(TileComposite { pages, order, blur })
+const fn tc(pages: Pages, order: TileOrder, blur: bool, depth: bool) -> Build {
+    Build::TileComposite(TileComposite { pages, order, blur, depth })
 }
 
-const fn tc_variant(pages: Pages, order: TileOrder, blur: bool) -> Variant {
+const fn tc_variant(pages: Pages, order: TileOrder, blur: bool, depth: bool) -> Variant {
     let defines = if matches!(pages, Pages::One) { "ONE_PAGE" } else { "" };
+    if depth {
+        // Spec 5: the host's depth (still footprints only).
+        let spec: &'static [u32] = match order {
+            TileOrder::BackToFront => &[SHEET_MODE_SPLAT, 1, 0, 0, 0, 1],
+            TileOrder::FrontToBack => &[SHEET_MODE_SPLAT, 0, 0, 0, 0, 1],
+            TileOrder::Terminating => &[SHEET_MODE_SPLAT, 0, 1, 0, 0, 1],
+            TileOrder::Maximum => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_MAX, 1],
+            TileOrder::Sum => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SUM, 1],
+        };
+        return v(defines, spec);
+    }
     // Spec: sheet mode, back to front, terminating, blurred.
     let spec: &'static [u32] = match (order, blur) {
         (TileOrder::BackToFront, false) => &[SHEET_MODE_SPLAT, 1, 0, 0],
@@ -313,29 +326,39 @@ const fn tc_variant(pages: Pages, order: TileOrder, blur: bool) -> Variant {
 }
 
 macro_rules! tile_composite {
-    ($(($p:ident, $o:ident, $b:expr)),* $(,)?) => {
-        table! { $(tc(Pages::$p, TileOrder::$o, $b) => tc_variant(Pages::$p, TileOrder::$o, $b)),* }
+    ($(($p:ident, $o:ident, $b:expr, $d:expr)),* $(,)?) => {
+        table! { $(tc(Pages::$p, TileOrder::$o, $b, $d) => tc_variant(Pages::$p, TileOrder::$o, $b, $d)),* }
     };
 }
 
-/// The compute tile compositor: pages x walk x blur.
+/// The compute tile compositor: pages x walk x (blur, or the host's depth).
 pub const TILE_COMPOSITE: Table = tile_composite![
-    (Two, BackToFront, false),
-    (Two, BackToFront, true),
-    (Two, FrontToBack, false),
-    (Two, FrontToBack, true),
-    (Two, Terminating, false),
-    (Two, Terminating, true),
-    (One, BackToFront, false),
-    (One, BackToFront, true),
-    (One, FrontToBack, false),
-    (One, FrontToBack, true),
-    (One, Terminating, false),
-    (One, Terminating, true),
-    (Two, Maximum, false),
-    (Two, Sum, false),
-    (One, Maximum, false),
-    (One, Sum, false),
+    (Two, BackToFront, false, false),
+    (Two, BackToFront, true, false),
+    (Two, FrontToBack, false, false),
+    (Two, FrontToBack, true, false),
+    (Two, Terminating, false, false),
+    (Two, Terminating, true, false),
+    (One, BackToFront, false, false),
+    (One, BackToFront, true, false),
+    (One, FrontToBack, false, false),
+    (One, FrontToBack, true, false),
+    (One, Terminating, false, false),
+    (One, Terminating, true, false),
+    (Two, Maximum, false, false),
+    (Two, Sum, false, false),
+    (One, Maximum, false, false),
+    (One, Sum, false, false),
+    (Two, BackToFront, false, true),
+    (Two, FrontToBack, false, true),
+    (Two, Terminating, false, true),
+    (Two, Maximum, false, true),
+    (Two, Sum, false, true),
+    (One, BackToFront, false, true),
+    (One, FrontToBack, false, true),
+    (One, Terminating, false, true),
+    (One, Maximum, false, true),
+    (One, Sum, false, true),
 ];
 
 const fn st(mode: SheetMode, points: bool) -> Build {

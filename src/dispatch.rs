@@ -327,4 +327,7 @@ pub struct Limits {
     /// splats stream through it in batches. The CPU engine keeps the same budget, so it cuts the
     /// same batches.
     pub budget_bytes: u64,
+    /// The host's depth image of the frame's target (`vk::HostTarget::with_depth`): its format
+    /// and projection; `None` for a frame read back.
+    pub target_depth: Option<(crate::options::DepthFormat, glam::Mat4)>,
 }

@@ -122,6 +122,10 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
             raster: Raster::Graphics,
             reason: "auto: a bent or tapered motion blur (graphics quads only)".into(),
         }),
+        Raster::Auto if opts.motion.is_some() && opts.depth.is_some() => Ok(RasterChoice {
+            raster: Raster::Graphics,
+            reason: "auto: motion blur over the host's depth (graphics quads only)".into(),
+        }),
         Raster::Auto => {
             let limit = match opts.composite {
                 Composite::Splat => AUTO_COMPUTE_TILES_MAX_PX,

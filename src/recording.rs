@@ -57,21 +57,7 @@ pub struct Recorded {
 /// THE recording of a frame: `prep` drawn from `camera` with `opts` (whose raster is already
 /// chosen), on `e`: its plan (`plan::frame`), then the plan recorded.
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {
-    let mut plan = plan::frame(prep, camera, opts, &e.limits())?;
-    if let Some((format, projection)) = e.target_depth() {
-        if plan.depth.is_some() {
-            return Err(Error::InvalidArgument(
-                "a depth buffer in the options and a depth image on the target: give one".into(),
-            ));
-        }
-        if opts.composite != crate::options::Composite::Splat {
-            return Err(Error::InvalidArgument(
-                "the host's depth image hides splats per pixel as they are composited: use --composite splat".into(),
-            ));
-        }
-        plan.depth = Some(plan::DepthSource::Target(format, projection));
-        plan.frame.rect[3] = 1;
-    }
+    let plan = plan::frame(prep, camera, opts, &e.limits())?;
     record_plan(e, prep, &plan)
 }
 

@@ -577,10 +577,6 @@ pub trait Engine {
     fn deliver(&mut self) -> Result<()> {
         Err(Error::Unsupported("only the Vulkan engine writes into a host's image".into()))
     }
-    /// The host's depth image of the frame's target, if it has one: its format and projection.
-    fn target_depth(&self) -> Option<(crate::options::DepthFormat, glam::Mat4)> {
-        None
-    }
     /// Copy the target's depth image into `res` (a word per pixel): only an engine with a
     /// target can.
     fn copy_target_depth(&mut self, _res: Res) -> Result<()> {

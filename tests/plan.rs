@@ -11,7 +11,8 @@ use voxsplat::low_level::stages::{Dispatch, Kind, StageId};
 use voxsplat::options::{BlurProfile, Composite, Motion};
 use voxsplat::{scene, Camera, Direction, Error, OrderKind, Raster, RenderOptions};
 
-const LIMITS: Limits = Limits { max_layers: 2048, max_storage_range: 1 << 31, budget_bytes: 1 << 30 };
+const LIMITS: Limits =
+    Limits { max_layers: 2048, max_storage_range: 1 << 31, budget_bytes: 1 << 30, target_depth: None };
 
 fn options(raster: Raster, direction: Direction) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -47,8 +48,9 @@ fn product_builds_list_every_combination() {
     for pages in [Pages::One, Pages::Two] {
         for order in [TileOrder::BackToFront, TileOrder::FrontToBack, TileOrder::Terminating] {
             for blur in [false, true] {
-                assert!(has(StageId::TileComposite, TileComposite { pages, order, blur }.into()));
+                assert!(has(StageId::TileComposite, TileComposite { pages, order, blur, depth: false }.into()));
             }
+            assert!(has(StageId::TileComposite, TileComposite { pages, order, blur: false, depth: true }.into()));
         }
     }
     for mode in [SheetMode::Axis, SheetMode::Slab, SheetMode::Binned] {

@@ -13,11 +13,13 @@ use rayon::prelude::*;
 /// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it
 /// unless `push.carry` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
 /// order, whichever GPU lane composites it. `project`: a projection's blend (`BLEND_*`, the
-/// shader's PROJECT), by maximum or sum in place of compositing.
+/// shader's PROJECT), by maximum or sum in place of compositing; `depth_test`: the host's depth
+/// hides what lies behind it (HOST_DEPTH).
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
     project: u32,
+    depth_test: bool,
     quads: &[ScreenQuad],
     tile_start: &[u32],
     entries: &[u32],
@@ -27,7 +29,6 @@ pub fn tile_composite(
     let btf = push.back_to_front != 0;
     let terminate = !btf && push.occluded > 0.0;
     let width = image.width;
-    let depth_test = inputs.frame.rect[3] != 0;
     image.pixels.par_iter_mut().enumerate().for_each(|(i, px)| {
         let (x, y) = ((i as u32 % width) as i32, (i as u32 / width) as i32);
         let tile = ((y as u32 / RASTER_TILE_H) * tiles_x + x as u32 / RASTER_TILE_W) as usize;
@@ -90,7 +91,8 @@ pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let mut image = std::mem::replace(&mut b.accum, ImageF32::new(0, 0));
     let (inputs, push) = (b.inputs(d.list), d.push_as());
     let project = v.spec.get(4).copied().unwrap_or(BLEND_COMPOSITE);
-    tile_composite(&inputs, &push, project, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);
+    let depth_test = v.spec.get(5).is_some_and(|&d| d != 0);
+    tile_composite(&inputs, &push, project, depth_test, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);
     b.accum = image;
     Ok(())
 }

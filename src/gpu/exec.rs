@@ -410,12 +410,8 @@ impl Engine for GpuEngine<'_> {
         self.target.map(|t| t.format().linear())
     }
 
-    fn target_depth(&self) -> Option<(crate::options::DepthFormat, glam::Mat4)> {
-        self.target.and_then(|t| t.depth())
-    }
-
     fn copy_target_depth(&mut self, res: Res) -> Result<()> {
-        if self.target_depth().is_none() {
+        if self.target.and_then(|t| t.depth()).is_none() {
             return Err(Error::InvalidArgument("this frame's target has no depth image".into()));
         }
         self.live.insert(res);
@@ -441,6 +437,7 @@ impl Engine for GpuEngine<'_> {
             max_layers: ctx.image_limits().1,
             max_storage_range: ctx.max_storage_range(),
             budget_bytes: self.gpu.budget_bytes,
+            target_depth: self.target.and_then(|t| t.depth()),
         }
     }
 

@@ -103,6 +103,8 @@ pub struct BrickedPlan {
     pub sheets: Option<BrickedSheets>,
     /// A projection mode (no levels of detail, no early termination: every voxel is read).
     pub projection: Option<super::Projection>,
+    /// The host's depth hides what lies behind it (the tile compositor's `depth` build).
+    pub depth: bool,
 }
 
 impl BrickedPlan {
@@ -120,6 +122,12 @@ impl BrickedPlan {
 
     /// The tile compositor's rule for a batch of `n` splats.
     pub fn tile_rule(&self, n: u32, width: u32, height: u32, direction: Direction) -> TileRule {
+        let mut rule = self.tile_walk(n, width, height, direction);
+        rule.composite.depth = self.depth;
+        rule
+    }
+
+    fn tile_walk(&self, n: u32, width: u32, height: u32, direction: Direction) -> TileRule {
         match &self.projection {
             Some(p) => {
                 let mut rule = TileRule::plan(n, width, height, Direction::FrontToBack, 0.0, false);
@@ -335,6 +343,7 @@ pub fn plan(
         blur: opts.motion.is_some(),
         sheets,
         projection,
+        depth: false,
     };
     Ok((frame, plan))
 }

@@ -5,7 +5,7 @@
 use super::bricked::BrickedPlan;
 use super::pass::{sheet_pass, SheetPass, TileRule};
 use super::{slab, Prepared};
-use crate::builds::{Footprint, Pages, TileOrder};
+use crate::builds::{Footprint, Pages, TileComposite, TileOrder};
 use crate::camera::Camera;
 use crate::dispatch::{Blend, Limits, List};
 use crate::error::{Error, Result};
@@ -150,11 +150,39 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
     let (width, height) = (camera.width, camera.height);
     let direction = opts.direction();
     let slotted = opts.slotted();
-    if let Some(d) = &opts.depth {
-        d.check(width, height)?;
+    // The host's depth: from the options (texels) or the engine's target (its depth image).
+    let depth = match (&opts.depth, limits.target_depth) {
+        (Some(_), Some(_)) => {
+            return Err(Error::InvalidArgument(
+                "a depth buffer in the options and a depth image on the target: give one".into(),
+            ))
+        }
+        (Some(d), None) => {
+            d.check(width, height)?;
+            Some(DepthSource::Buffer(d.clone()))
+        }
+        (None, Some((format, projection))) => Some(DepthSource::Target(format, projection)),
+        (None, None) => None,
+    };
+    if depth.is_some() {
+        if opts.composite != Composite::Splat {
+            return Err(Error::InvalidArgument(
+                "the host's depth hides splats per pixel as they are composited: use --composite splat".into(),
+            ));
+        }
+        if opts.motion.is_some() && opts.raster == Raster::Compute {
+            return Err(Error::Unsupported(
+                "the tile compositor draws still frames over the host's depth: use --raster graphics for motion blur"
+                    .into(),
+            ));
+        }
     }
+    let with_depth = |rule: TileRule| TileRule {
+        composite: TileComposite { depth: depth.is_some(), ..rule.composite },
+        ..rule
+    };
     let plan = |mut frame: Frame, draw| {
-        frame.rect[3] = opts.depth.is_some() as u32;
+        frame.rect[3] = depth.is_some() as u32;
         FramePlan {
             frame,
             camera: *camera,
@@ -163,7 +191,7 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
             height,
             direction,
             background: opts.background,
-            depth: opts.depth.clone().map(DepthSource::Buffer),
+            depth: depth.clone(),
             draw,
         }
     };
@@ -173,7 +201,8 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
                 "the slotted blur draws dense splat sets; a bricked volume takes splat:tapered".into(),
             ));
         }
-        let (frame, bricked) = super::bricked::plan(prep, scene, camera, opts, limits)?;
+        let (frame, mut bricked) = super::bricked::plan(prep, scene, camera, opts, limits)?;
+        bricked.depth = depth.is_some();
         return Ok(plan(frame, Draw::Bricked(Box::new(bricked))));
     }
     let set = &prep.set;
@@ -185,7 +214,7 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
         let raster = if opts.raster == Raster::Compute {
             let mut rule = TileRule::plan(splats, width, height, Direction::FrontToBack, 0.0, false);
             rule.composite.order = walk;
-            SplatRaster::Tiles(rule)
+            SplatRaster::Tiles(with_depth(rule))
         } else {
             SplatRaster::Draw(draw)
         };
@@ -196,7 +225,8 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
             let order = if opts.order == OrderKind::Pbtf { OrderSource::Pbtf } else { OrderSource::Host(opts.order) };
             let raster = if opts.raster == Raster::Compute {
                 let blur = opts.motion.is_some();
-                SplatRaster::Tiles(TileRule::plan(splats, width, height, direction, opts.early_termination, blur))
+                let rule = TileRule::plan(splats, width, height, direction, opts.early_termination, blur);
+                SplatRaster::Tiles(with_depth(rule))
             } else {
                 let blend = if direction == Direction::BackToFront { Blend::Over } else { Blend::Under };
                 let points = opts.raster == Raster::Points;

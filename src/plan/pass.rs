@@ -26,6 +26,7 @@ pub struct TileRule {
 impl TileRule {
     /// The rule for a draw list of `n` entries on a `width` x `height` image, in `direction`,
     /// terminating at `early_termination` front to back; `blur`: motion-blurred footprints.
+    /// (`composite.depth` is the frame's: `plan::frame` sets it.)
     pub fn plan(n: u32, width: u32, height: u32, direction: Direction, early_termination: f32, blur: bool) -> Self {
         let btf = direction == Direction::BackToFront;
         let tiles = (width.div_ceil(RASTER_TILE_W) as u64 * height.div_ceil(RASTER_TILE_H) as u64).max(1);
@@ -47,7 +48,7 @@ impl TileRule {
         let pages = Pages::of(n);
         // The original bound, without `most`'s floor: a frame past the cell limit is refused.
         let most_chunks = (super::MAX_TILE_CELLS / tiles).min(push.count.max(1) as u64) as u32;
-        TileRule { push, most_chunks, pages, composite: TileComposite { pages, order, blur } }
+        TileRule { push, most_chunks, pages, composite: TileComposite { pages, order, blur, depth: false } }
     }
 }
 
