@@ -15,6 +15,7 @@ use rayon::prelude::*;
 /// order, whichever GPU lane composites it. `project`: a projection's blend (`BLEND_*`, the
 /// shader's PROJECT), by maximum or sum in place of compositing; `depth_test`: the host's depth
 /// hides what lies behind it (HOST_DEPTH).
+#[allow(clippy::too_many_arguments)]
 pub fn tile_composite(
     inputs: &FootprintInputs<'_>,
     push: &FootprintPush,
