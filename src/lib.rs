@@ -551,7 +551,7 @@ impl Renderer {
     /// passes [`PICK_OPACITY`], or in MIP and MinIP the point of the extreme value, with the voxel
     /// nearest it, its value and depth; `None` where the ray meets nothing. Computed on the host
     /// over the ray caster's trilinear field with `options`' mode and clipping, so it needs no
-    /// frame. A bricked store is refused (`Error::Unsupported`).
+    /// frame; a bricked store is read where the ray passes, without a dense copy.
     ///
     /// ```
     /// use voxsplat::{scene, Backend, Camera, RenderOptions, Renderer, RendererOptions};

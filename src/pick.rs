@@ -2,10 +2,11 @@
 //! host along the pixel's ray through the ray caster's trilinear field (the reference the splats are
 //! compared with), so a viewer can show the value under its cursor without a frame.
 use crate::camera::Camera;
-use crate::cpu::raycast::{ray_index, trilinear};
+use crate::cpu::raycast::ray_index;
 use crate::error::{Error, Result};
 use crate::options::{Mode, RaycastOptions, RenderOptions};
 use crate::plan::Prepared;
+use crate::bricks::BRICK;
 use glam::Vec3;
 
 /// Accumulated opacity at which a ray's first hit is taken (compositing, average and X-ray).
@@ -40,15 +41,88 @@ pub fn pick(prep: &Prepared, camera: &Camera, opts: &RenderOptions, x: f32, y: f
             camera.width, camera.height
         )));
     }
-    if prep.bricks.is_some() {
-        return Err(Error::Unsupported(
-            "picking reads a dense scene's field; this volume is a bricked store (load it as host splats)".into(),
-        ));
+    match &prep.bricks {
+        Some(scene) => {
+            let voxel = bricked_voxel(scene)?;
+            march(prep, camera, opts, x, y, voxel)
+        }
+        None => {
+            let field = prep.field_for(true)?;
+            march(prep, camera, opts, x, y, |i, j, k| field.at(i, j, k))
+        }
     }
+}
+
+/// A bricked store's voxel as the projection field holds it: (value, 1, 0, tau) where the
+/// transfer function draws it (its opacity gradient-weighted as the brick stages weigh it),
+/// zero elsewhere; read through the store, so no dense copy is made.
+fn bricked_voxel(scene: &crate::bricks::BrickScene) -> Result<impl Fn(i64, i64, i64) -> [f32; 4] + '_> {
+    let (a, b) = scene.remap();
+    let tf = scene.transfer_function();
+    let grid = scene.store.grid()?;
+    let weight = tf.gradient_weight;
+    let gmax = if weight > 0.0 { (a * scene.gmax_stored()).max(1e-12) } else { 1.0 };
+    let d = move |i: i64, j: i64, k: i64| a * scene.store.value_at(i, j, k) + b;
+    let stored = move |i: i64, j: i64, k: i64| {
+        let [nx, ny, nz] = scene.store.dims.map(|n| n as i64);
+        (0..nx).contains(&i) && (0..ny).contains(&j) && (0..nz).contains(&k) && {
+            let v = [i, j, k].map(|c| c as u32);
+            let h = scene.store.header_of(v);
+            h != u32::MAX && {
+                let l = (v[0] % BRICK + BRICK * (v[1] % BRICK) + BRICK * BRICK * (v[2] % BRICK)) as usize;
+                scene.store.masks[h as usize][l / 64] >> (l % 64) & 1 == 1
+            }
+        }
+    };
+    Ok(move |i: i64, j: i64, k: i64| {
+        if !stored(i, j, k) {
+            return [0.0; 4];
+        }
+        let value = d(i, j, k);
+        if value < tf.threshold {
+            return [0.0; 4];
+        }
+        let mut opacity = tf.eval(value)[3];
+        if weight > 0.0 && opacity > 0.0 {
+            let g = glam::Vec3::from(grid.gradient([
+                d(i + 1, j, k) - d(i - 1, j, k),
+                d(i, j + 1, k) - d(i, j - 1, k),
+                d(i, j, k + 1) - d(i, j, k - 1),
+            ]));
+            opacity *= (g.length() / gmax).powf(weight);
+        }
+        if opacity <= 0.0 {
+            return [0.0; 4];
+        }
+        [value.clamp(0.0, 1.0), 1.0, 0.0, crate::volume::optical_depth(opacity)]
+    })
+}
+
+/// Trilinear reconstruction of `voxel` at index-space point `u` (as `cpu::raycast::trilinear`).
+fn trilinear(voxel: &impl Fn(i64, i64, i64) -> [f32; 4], u: Vec3) -> [f32; 4] {
+    let b = u.floor();
+    let f = u - b;
+    let (i, j, k) = (b.x as i64, b.y as i64, b.z as i64);
+    let lerp = |p: [f32; 4], q: [f32; 4], t: f32| [0, 1, 2, 3].map(|c| p[c] + (q[c] - p[c]) * t);
+    let x00 = lerp(voxel(i, j, k), voxel(i + 1, j, k), f.x);
+    let x10 = lerp(voxel(i, j + 1, k), voxel(i + 1, j + 1, k), f.x);
+    let x01 = lerp(voxel(i, j, k + 1), voxel(i + 1, j, k + 1), f.x);
+    let x11 = lerp(voxel(i, j + 1, k + 1), voxel(i + 1, j + 1, k + 1), f.x);
+    lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
+}
+
+/// The pick along the pixel's ray through the field `voxel` gives.
+fn march(
+    prep: &Prepared,
+    camera: &Camera,
+    opts: &RenderOptions,
+    x: f32,
+    y: f32,
+    voxel: impl Fn(i64, i64, i64) -> [f32; 4],
+) -> Result<Option<Pick>> {
     let step_vox = 1.0 / PICK_STEPS_PER_VOXEL;
     let ro = RaycastOptions { step: step_vox, clip: opts.clip, mode: opts.mode, ..Default::default() };
     let rc = crate::plan::raycast_params(&prep.set, camera, &ro);
-    let field = prep.field_for(true)?;
     let Some(ray) = ray_index(&rc, x, y) else { return Ok(None) };
     let step = rc.box_min[3];
     let n = ((ray.t1 - ray.t0) / step).ceil() as u64;
@@ -59,7 +133,7 @@ pub fn pick(prep: &Prepared, camera: &Camera, opts: &RenderOptions, x: f32, y: f
     let mut hit = None;
     for s in 0..n {
         let t = ray.t0 + (s as f32 + 0.5) * step;
-        let v = trilinear(field, ray.index(t));
+        let v = trilinear(&voxel, ray.index(t));
         if v[3] <= 0.0 {
             continue;
         }
@@ -82,16 +156,17 @@ pub fn pick(prep: &Prepared, camera: &Camera, opts: &RenderOptions, x: f32, y: f
         trans = after;
     }
     let t = if extreme { best.map(|b| b.1) } else { hit };
+    let voxel_at = voxel;
     Ok(t.map(|t| {
         let world = at(t);
         let u = ray.index(t);
         let g = &prep.set.grid().dims;
         let voxel = [0, 1, 2].map(|a| (u[a].round().max(0.0) as u32).min(g[a] - 1));
-        let here = field.at(voxel[0] as i64, voxel[1] as i64, voxel[2] as i64);
+        let here = voxel_at(voxel[0] as i64, voxel[1] as i64, voxel[2] as i64);
         let value = if here[1] > 0.0 {
             here[0]
         } else {
-            let v = trilinear(field, u);
+            let v = trilinear(&voxel_at, u);
             if v[1] > 0.0 {
                 v[0] / v[1]
             } else {

@@ -128,9 +128,35 @@ fn picking_refuses_what_it_cannot_read() {
         let e = r.pick(&cam, &RenderOptions::default(), x, y).unwrap_err().to_string();
         assert!(e.contains("outside the 32 x 32 image"), "{e}");
     }
-    let mut b = cpu();
+}
+
+#[test]
+fn a_bricked_store_picks_what_its_dense_splats_pick() {
+    let vol = ball([20, 20, 20]);
+    let set = classify(&vol, &opaque(), None).unwrap();
+    let mut dense = cpu();
+    dense.set_scene(set.clone()).unwrap();
+    let mut bricked = cpu();
     let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
-    b.set_bricks(voxsplat::bricks::BrickScene::new(store, opaque(), None).unwrap()).unwrap();
-    let e = b.pick(&cam, &RenderOptions::default(), 4.0, 4.0).unwrap_err();
-    assert!(matches!(e, voxsplat::Error::Unsupported(_)), "{e}");
+    bricked.set_bricks(voxsplat::bricks::BrickScene::new(store, opaque(), None).unwrap()).unwrap();
+    let cam = Camera::framing(set.grid(), 64, 64);
+    let mut rng = Rng(4605);
+    let mut hits = 0;
+    for mode in [Mode::Composite, Mode::Mip] {
+        let mut o = RenderOptions::default();
+        o.mode = mode;
+        for _ in 0..200 {
+            // Around the centre, where the ball is (and some misses at its edge).
+            let (x, y) = (rng.range(22.0, 42.0), rng.range(22.0, 42.0));
+            let (a, b) = (dense.pick(&cam, &o, x, y).unwrap(), bricked.pick(&cam, &o, x, y).unwrap());
+            assert_eq!(a.is_some(), b.is_some(), "{mode} ({x}, {y})");
+            if let (Some(a), Some(b)) = (a, b) {
+                // The store keeps values in 16 bits: the same voxel and point to within that.
+                assert_eq!(a.voxel, b.voxel, "{mode} ({x}, {y})");
+                assert!(a.world.distance(b.world) < 1e-2 && (a.value - b.value).abs() < 1e-4, "{a:?} {b:?}");
+                hits += 1;
+            }
+        }
+    }
+    assert!(hits > 100, "{hits} pixels hit the ball");
 }

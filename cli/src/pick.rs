@@ -18,8 +18,8 @@ pub(crate) struct PickArgs {
 pub(crate) fn pick(a: PickArgs) -> Result<()> {
     let mut opts = RenderOptions::default();
     opts.mode = a.mode.parse()?;
-    // Picking reads the scene's field on the host: a volume loads as splats.
-    let (_, set, content) = open(&a.scene, true)?;
+    // As render opens it: a volume as a bricked store, read where the ray passes.
+    let (bricked, set, content) = open(&a.scene, false)?;
     let cam = camera_of(&a.scene, set.grid(), &content)?;
     let [x, y] = a.at;
     if !(x >= 0.0 && y >= 0.0 && x < cam.width as f32 && y < cam.height as f32) {
@@ -31,7 +31,10 @@ pub(crate) fn pick(a: PickArgs) -> Result<()> {
     let mut ro = RendererOptions::default();
     ro.backend = Backend::Cpu;
     let mut r = Renderer::new(&ro)?;
-    r.set_scene(set)?;
+    match bricked {
+        Some(b) => r.set_bricks(b)?,
+        None => r.set_scene(set)?,
+    }
     match r.pick(&cam, &opts, x.floor() + 0.5, y.floor() + 0.5)? {
         None => println!("pixel {x},{y}: nothing (its ray meets no drawn voxel)"),
         Some(p) => {
