@@ -743,6 +743,18 @@ impl Viewer {
                     (0.5 * (a + b) + dx / width * span, ((b - a) * (1.0 + dy / height)).max(span * 1e-3));
                 self.edit_tf(Some((level - 0.5 * window, level + 0.5 * window)), 1.0)?;
             }
+        } else {
+            // No button held: the value under the cursor (Renderer::pick), shown in the title.
+            if let (Some(cam), Some(r)) = (self.camera(), self.renderer.as_mut()) {
+                self.message = match r.pick(&cam, &self.options, x as f32, y as f32) {
+                    Ok(Some(p)) => format!(
+                        "| value {:.3} at voxel {} {} {}",
+                        p.value, p.voxel[0], p.voxel[1], p.voxel[2]
+                    ),
+                    Ok(None) | Err(_) => String::new(),
+                };
+                self.title(self.times.last().copied().unwrap_or(0.0));
+            }
         }
         Ok(())
     }
