@@ -43,6 +43,38 @@ fn cameras(set: &voxsplat::SplatSet) -> Vec<Camera> {
     vec![cam, ortho]
 }
 
+/// A half-float target reading a depth image of `format` cleared to the plane at eye depth `d`
+/// (the target image and the depth image live as long as the returned values).
+fn target_with_depth(
+    g: &Renderer,
+    cam: &Camera,
+    d: f32,
+    format: DepthFormat,
+) -> (voxsplat::vk::TargetImage, voxsplat::vk::DepthImage, voxsplat::vk::HostTarget) {
+    use voxsplat::vk::ImageLayout as IL;
+    let proj = cam.proj();
+    let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
+    let depth = g.depth_image(format, cam.width, cam.height, c.z / c.w).unwrap();
+    let image = g.target_image(voxsplat::TargetFormat::Rgba16Float, cam.width, cam.height).unwrap();
+    let target = depth.attach(image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(), proj).unwrap();
+    (image, depth, target)
+}
+
+/// The largest difference of a half-float target's texels from `frame` presented as the blit
+/// delivers it (linear values, no background).
+fn target_against(g: &Renderer, target: &voxsplat::vk::HostTarget, frame: &voxsplat::ImageF32) -> f32 {
+    use voxsplat::low_level::cpu::present::{decode, present_pixel};
+    let got = decode(voxsplat::TargetFormat::Rgba16Float, &g.read_target(target).unwrap()).unwrap();
+    let push = voxsplat::low_level::plan::present_push(None, 1, true, frame.width, frame.height);
+    got.iter()
+        .zip(&frame.pixels)
+        .map(|(a, &b)| {
+            let w = present_pixel(&push, b, [0.0; 4]);
+            (0..4).map(|k| (a[k] - w[k]).abs()).fold(0.0f32, f32::max)
+        })
+        .fold(0.0f32, f32::max)
+}
+
 fn depth_of_centre(cam: &Camera, set: &voxsplat::SplatSet) -> f32 {
     (set.grid().center() - cam.eye).dot(cam.forward())
 }
@@ -140,37 +172,21 @@ fn a_depth_buffer_that_does_not_fit_is_refused() {
 
 #[test]
 fn render_to_reads_the_hosts_depth_image_on_the_device() {
-    use voxsplat::low_level::cpu::present::{decode, present_pixel};
-    use voxsplat::vk::ImageLayout as IL;
-    use voxsplat::TargetFormat;
     let set = classify(&common::blob([26, 22, 18]), &common::blob_tf(), None).unwrap();
     let mut g = gpu();
     g.set_scene(set.clone()).unwrap();
     for cam in cameras(&set) {
         let d = depth_of_centre(&cam, &set) + 0.137;
-        // The plane's depth as the host's depth image holds it (D32), and the clipped frame.
-        let proj = cam.proj();
-        let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
-        let depth = g.depth_image(DepthFormat::D32, cam.width, cam.height, c.z / c.w).unwrap();
-        let image = g.target_image(TargetFormat::Rgba16Float, cam.width, cam.height).unwrap();
-        let target = depth.attach(image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(), proj).unwrap();
+        // The plane's depth as the host's depth image holds it (D32), against the clipped frame.
+        let (_image, _depth, target) = target_with_depth(&g, &cam, d, DepthFormat::D32);
         for raster in [Raster::Compute, Raster::Graphics] {
             let mut o = RenderOptions::default();
             o.raster = raster;
             g.render_to(&cam, &o, &target).unwrap();
-            let got = decode(TargetFormat::Rgba16Float, &g.read_target(&target).unwrap()).unwrap();
             let mut clipped = o.clone();
             clipped.clip = clip_at(&cam, d);
             let want = g.render(&cam, &clipped).unwrap().image;
-            let push = voxsplat::low_level::plan::present_push(None, 1, true, cam.width, cam.height);
-            let worst = got
-                .iter()
-                .zip(&want.pixels)
-                .map(|(a, &b)| {
-                    let w = present_pixel(&push, b, [0.0; 4]);
-                    (0..4).map(|k| (a[k] - w[k]).abs()).fold(0.0f32, f32::max)
-                })
-                .fold(0.0f32, f32::max);
+            let worst = target_against(&g, &target, &want);
             // Half floats: 2e-3 as tests/present.rs allows.
             assert!(worst <= 2e-3, "{raster} {:?}: render_to with the depth image against the clipped frame: {worst}", cam.projection);
             // Both a depth image and a depth buffer: refused.
@@ -187,35 +203,19 @@ fn render_to_reads_the_hosts_depth_image_on_the_device() {
 
 #[test]
 fn a_d24s8_depth_image_is_read_on_the_device_as_the_mirror_reads_its_texels() {
-    use voxsplat::low_level::cpu::present::{decode, present_pixel};
-    use voxsplat::vk::ImageLayout as IL;
-    use voxsplat::TargetFormat;
     let set = classify(&common::blob([26, 22, 18]), &common::blob_tf(), None).unwrap();
     let mut g = gpu();
     g.set_scene(set.clone()).unwrap();
     let cam = cameras(&set)[0];
     let d = depth_of_centre(&cam, &set) + 0.137;
-    let proj = cam.proj();
-    let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
-    let depth = g.depth_image(DepthFormat::D24S8, cam.width, cam.height, c.z / c.w).unwrap();
-    let image = g.target_image(TargetFormat::Rgba16Float, cam.width, cam.height).unwrap();
-    let target = depth.attach(image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(), proj).unwrap();
+    let (_image, _depth, target) = target_with_depth(&g, &cam, d, DepthFormat::D24S8);
     let o = RenderOptions::default();
     g.render_to(&cam, &o, &target).unwrap();
-    let got = decode(TargetFormat::Rgba16Float, &g.read_target(&target).unwrap()).unwrap();
     // The same depth as texels: the plane's depth rounded to 24 bits, as the device stores it.
     let mut with = o.clone();
     with.depth = Some(Arc::new(plane_depth(&cam, d, DepthFormat::D24S8)));
     let want = g.render(&cam, &with).unwrap().image;
-    let push = voxsplat::low_level::plan::present_push(None, 1, true, cam.width, cam.height);
-    let worst = got
-        .iter()
-        .zip(&want.pixels)
-        .map(|(a, &b)| {
-            let w = present_pixel(&push, b, [0.0; 4]);
-            (0..4).map(|k| (a[k] - w[k]).abs()).fold(0.0f32, f32::max)
-        })
-        .fold(0.0f32, f32::max);
+    let worst = target_against(&g, &target, &want);
     assert!(worst <= 2e-3, "the D24S8 image against its texels: {worst}");
     assert_clean(&g);
 }

@@ -219,20 +219,7 @@ impl DepthImage {
         let image = Image::new_depth(ctx, "host depth", (width, height), vk_depth_format(format), usage)?;
         let range = [depth_range(format)];
         ctx.submit(|rec| {
-            let to = |from, to| {
-                let b = [vk::ImageMemoryBarrier::default()
-                    .old_layout(from)
-                    .new_layout(to)
-                    .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
-                    .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
-                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                    .image(image.raw)
-                    .subresource_range(range[0])];
-                let all = vk::PipelineStageFlags::ALL_COMMANDS;
-                // SAFETY: recording state; the image is ours, in `from`.
-                unsafe { rec.ctx.device.cmd_pipeline_barrier(rec.cmd, all, all, vk::DependencyFlags::empty(), &[], &[], &b) };
-            };
+            let to = |from, to| barrier_on(rec, image.raw, (from, to), range[0]);
             to(vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
             let value = vk::ClearDepthStencilValue { depth, stencil: 0 };
             // SAFETY: the image is in TRANSFER_DST_OPTIMAL, made with TRANSFER_DST usage.
@@ -317,6 +304,16 @@ fn color_range() -> vk::ImageSubresourceRange {
 /// A layout change of a host's image; the semaphore waits and the submission's own barriers order
 /// everything else, so every stage on both sides.
 fn host_barrier(rec: &Recorder<'_>, image: vk::Image, layouts: (vk::ImageLayout, vk::ImageLayout)) {
+    barrier_on(rec, image, layouts, color_range());
+}
+
+/// `host_barrier` over `range` (a depth image's aspects).
+fn barrier_on(
+    rec: &Recorder<'_>,
+    image: vk::Image,
+    layouts: (vk::ImageLayout, vk::ImageLayout),
+    range: vk::ImageSubresourceRange,
+) {
     let all = vk::PipelineStageFlags::ALL_COMMANDS;
     let b = [vk::ImageMemoryBarrier::default()
         .old_layout(layouts.0)
@@ -326,8 +323,8 @@ fn host_barrier(rec: &Recorder<'_>, image: vk::Image, layouts: (vk::ImageLayout,
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)
-        .subresource_range(color_range())];
-    // SAFETY: recording state; the host promised the image is valid and in `layouts.0`.
+        .subresource_range(range)];
+    // SAFETY: recording state; the image (the host's: its promise) is valid and in `layouts.0`.
     unsafe { rec.ctx.device.cmd_pipeline_barrier(rec.cmd, all, all, vk::DependencyFlags::empty(), &[], &[], &b) };
 }
 
@@ -338,20 +335,7 @@ impl Recorder<'_> {
     pub fn copy_host_depth(&self, to: &HostTarget, buffer: &Buffer) {
         let Some(d) = &to.depth else { return };
         let range = depth_range(d.format);
-        let barrier = |from: vk::ImageLayout, into: vk::ImageLayout| {
-            let b = [vk::ImageMemoryBarrier::default()
-                .old_layout(from)
-                .new_layout(into)
-                .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
-                .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .image(d.image)
-                .subresource_range(range)];
-            let all = vk::PipelineStageFlags::ALL_COMMANDS;
-            // SAFETY: recording state; the host promised the image is valid and in `from`.
-            unsafe { self.ctx.device.cmd_pipeline_barrier(self.cmd, all, all, vk::DependencyFlags::empty(), &[], &[], &b) };
-        };
+        let barrier = |from, into| barrier_on(self, d.image, (from, into), range);
         let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
         if d.layout != src {
             barrier(d.layout, src);
