@@ -747,10 +747,9 @@ impl Viewer {
             // No button held: the value under the cursor (Renderer::pick), shown in the title.
             if let (Some(cam), Some(r)) = (self.camera(), self.renderer.as_mut()) {
                 self.message = match r.pick(&cam, &self.options, x as f32, y as f32) {
-                    Ok(Some(p)) => format!(
-                        "| value {:.3} at voxel {} {} {}",
-                        p.value, p.voxel[0], p.voxel[1], p.voxel[2]
-                    ),
+                    Ok(Some(p)) => {
+                        format!("| value {:.3} at voxel {} {} {}", p.value, p.voxel[0], p.voxel[1], p.voxel[2])
+                    }
                     Ok(None) | Err(_) => String::new(),
                 };
                 self.title(self.times.last().copied().unwrap_or(0.0));

@@ -173,7 +173,12 @@ impl Engine for CpuEngine<'_> {
     }
 
     fn limits(&self) -> Limits {
-        Limits { max_layers: u32::MAX, max_storage_range: u64::MAX, budget_bytes: self.budget_bytes, target_depth: None }
+        Limits {
+            max_layers: u32::MAX,
+            max_storage_range: u64::MAX,
+            budget_bytes: self.budget_bytes,
+            target_depth: None,
+        }
     }
 
     fn is_device(&self) -> bool {

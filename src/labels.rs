@@ -186,5 +186,9 @@ pub fn classify_labels(
         }
     };
     let unlabelled = missing.values().sum();
-    Ok(Labelled { set: set.with_unlabelled(unlabelled), unlabelled, missing: missing.keys().take(8).copied().collect() })
+    Ok(Labelled {
+        set: set.with_unlabelled(unlabelled),
+        unlabelled,
+        missing: missing.keys().take(8).copied().collect(),
+    })
 }

@@ -52,13 +52,13 @@ pub mod order;
 pub mod orient;
 #[cfg(feature = "io")]
 pub mod output;
+mod pick;
 mod plan;
 mod raster;
 mod recording;
 mod resample;
 mod residency;
 pub mod scene;
-mod pick;
 mod shaders;
 mod stages;
 #[cfg(feature = "io")]
@@ -78,8 +78,7 @@ pub use image::TargetFormat;
 pub use kernel::Kernel;
 pub use options::{
     Antialias, BlurProfile, Clip, Composite, DepthBuffer, DepthFormat, FrameStats, Lod, Mode, Motion, RaycastOptions,
-    RenderOptions, Rendered,
-    StageTime,
+    RenderOptions, Rendered, StageTime,
 };
 pub use order::{Direction, OrderKind};
 pub use pick::{Pick, PICK_OPACITY};

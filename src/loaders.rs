@@ -62,9 +62,7 @@ impl std::str::FromStr for DType {
             "i16" | "int16" | "short" | "signed short" | "int16_t" => Ok(DType::I16),
             "u32" | "uint32" | "uint" | "unsigned int" | "uint32_t" => Ok(DType::U32),
             "f32" | "float" | "float32" => Ok(DType::F32),
-            other => {
-                Err(Error::InvalidArgument(format!("unsupported sample type '{other}' (u8, u16, i16, u32, f32)")))
-            }
+            other => Err(Error::InvalidArgument(format!("unsupported sample type '{other}' (u8, u16, i16, u32, f32)"))),
         }
     }
 }

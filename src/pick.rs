@@ -1,12 +1,12 @@
 //! Picking (`Renderer::pick`, `voxsplat pick`): the point of the volume a pixel shows, found on the
 //! host along the pixel's ray through the ray caster's trilinear field (the reference the splats are
 //! compared with), so a viewer can show the value under its cursor without a frame.
+use crate::bricks::BRICK;
 use crate::camera::Camera;
 use crate::cpu::raycast::ray_index;
 use crate::error::{Error, Result};
 use crate::options::{Mode, RaycastOptions, RenderOptions};
 use crate::plan::Prepared;
-use crate::bricks::BRICK;
 use glam::Vec3;
 
 /// Accumulated opacity at which a ray's first hit is taken (compositing, average and X-ray).

@@ -186,10 +186,7 @@ impl SplatSet {
     /// As `from_fn`, `voxel` giving each kept voxel's colour and its value in [0, 1] (a classified
     /// volume's normalised density; what the projection modes take). A value outside [0, 1] or
     /// not finite is refused.
-    pub fn from_fn_valued(
-        grid: Grid,
-        mut voxel: impl FnMut(u32, u32, u32) -> Option<([f32; 4], f32)>,
-    ) -> Result<Self> {
+    pub fn from_fn_valued(grid: Grid, mut voxel: impl FnMut(u32, u32, u32) -> Option<([f32; 4], f32)>) -> Result<Self> {
         grid.validate()?;
         let [nx, ny, nz] = grid.dims;
         let mut row_start = Vec::with_capacity((ny as usize) * (nz as usize) + 1);

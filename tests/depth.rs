@@ -122,9 +122,11 @@ fn a_d24_depth_buffer_and_a_projection_mode_and_a_bricked_store_take_it_too() {
     let mut c = cpu();
     let mut o = RenderOptions::default();
     o.depth = depth;
-    for (what, mode, bricked) in
-        [("dense", voxsplat::Mode::Composite, false), ("mip", voxsplat::Mode::Mip, false), ("bricked", voxsplat::Mode::Composite, true)]
-    {
+    for (what, mode, bricked) in [
+        ("dense", voxsplat::Mode::Composite, false),
+        ("mip", voxsplat::Mode::Mip, false),
+        ("bricked", voxsplat::Mode::Composite, true),
+    ] {
         o.mode = mode;
         let set_up = |r: &mut Renderer| {
             if bricked {
@@ -188,7 +190,11 @@ fn render_to_reads_the_hosts_depth_image_on_the_device() {
             let want = g.render(&cam, &clipped).unwrap().image;
             let worst = target_against(&g, &target, &want);
             // Half floats: 2e-3 as tests/present.rs allows.
-            assert!(worst <= 2e-3, "{raster} {:?}: render_to with the depth image against the clipped frame: {worst}", cam.projection);
+            assert!(
+                worst <= 2e-3,
+                "{raster} {:?}: render_to with the depth image against the clipped frame: {worst}",
+                cam.projection
+            );
             // Both a depth image and a depth buffer: refused.
             let mut both = o.clone();
             both.depth = Some(Arc::new(plane_depth(&cam, d, DepthFormat::D32)));

@@ -120,7 +120,10 @@ fn a_label_volume_over_a_scalar_volume_adds_their_emission_and_extinction() {
                 assert!((sp.color[3] - want_a).abs() < 1e-5, "{sp:?}");
                 let want_r = (s[0] * ts + tl) / (ts + tl);
                 assert!((sp.color[0] - want_r).abs() < 1e-5, "{sp:?} against {s:?}");
-                assert_eq!(f32::from_bits(sp.ijk[3]), f32::from_bits(alone.splats()[alone.find(i, j, k).unwrap()].ijk[3]));
+                assert_eq!(
+                    f32::from_bits(sp.ijk[3]),
+                    f32::from_bits(alone.splats()[alone.find(i, j, k).unwrap()].ijk[3])
+                );
                 checked += 1;
             }
             (0.0, Some(s)) => assert!(sp.color.iter().zip(s).all(|(a, b)| (a - b).abs() < 1e-6)),

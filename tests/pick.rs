@@ -19,7 +19,13 @@ fn ball(peak: [u32; 3]) -> ScalarVolume {
         for j in 0..N {
             for i in 0..N {
                 let r = Vec3::new(i as f32 - c, j as f32 - c, k as f32 - c).length();
-                values.push(if [i, j, k] == peak { 2.0 } else if r < RADIUS { 1.0 } else { 0.0 });
+                values.push(if [i, j, k] == peak {
+                    2.0
+                } else if r < RADIUS {
+                    1.0
+                } else {
+                    0.0
+                });
             }
         }
     }

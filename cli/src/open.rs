@@ -439,8 +439,13 @@ fn load_channels(
 
 /// The --labels file classified by --label-table, alone or over the --volume; voxels whose label
 /// the table lacks are reported.
-fn load_labelled(a: &SceneArgs, path: &std::path::Path, orientation: Option<Orientation>) -> Result<voxsplat::SplatSet> {
-    let table_path = a.label_table.as_ref().ok_or_else(|| Error::InvalidArgument("--labels needs --label-table".into()))?;
+fn load_labelled(
+    a: &SceneArgs,
+    path: &std::path::Path,
+    orientation: Option<Orientation>,
+) -> Result<voxsplat::SplatSet> {
+    let table_path =
+        a.label_table.as_ref().ok_or_else(|| Error::InvalidArgument("--labels needs --label-table".into()))?;
     let text = std::fs::read_to_string(table_path)
         .map_err(|e| Error::InvalidArgument(format!("{}: {e}", table_path.display())))?;
     let table = voxsplat::labels::LabelTable::from_toml(&text)?;

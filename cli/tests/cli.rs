@@ -834,7 +834,19 @@ fn labels_and_channels_from_the_command_line() {
     let ramp_path = dir.join("ramp.npy");
     std::fs::write(&ramp_path, common::npy(&shape, "|u1", &ramp)).unwrap();
     let ramp_s = ramp_path.to_str().unwrap();
-    let out = voxsplat(&["render", "--volume", ramp_s, "--channel", seg_s, "--channel-tf", "ct", "--size", "48x48", "--out", p]);
+    let out = voxsplat(&[
+        "render",
+        "--volume",
+        ramp_s,
+        "--channel",
+        seg_s,
+        "--channel-tf",
+        "ct",
+        "--size",
+        "48x48",
+        "--out",
+        p,
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // A 4-D NIfTI of two channels (the ramp, then the labels), each with its transfer function.
     let mut four = common::nifti([n as u32; 3], &[ramp.clone(), seg.clone()].concat(), None, None);

@@ -395,7 +395,9 @@ pub(crate) fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &m
     // A projection (footprint.frag's PROJECT): by maximum, the key weighed by the footprint over
     // its centre's and the coverage; summed, the key and 1 weighed by the optical depth.
     let project = match (s.blend, s.sheet, s.weight) {
-        (Blend::Max, _, Weight::Footprint(table)) => Some(s.weight.value(Vec2::new(u, v), s.sweep, 1.0, false) / table[0]),
+        (Blend::Max, _, Weight::Footprint(table)) => {
+            Some(s.weight.value(Vec2::new(u, v), s.sweep, 1.0, false) / table[0])
+        }
         (Blend::Add, false, _) => Some(s.weight.value(Vec2::new(u, v), s.sweep, tau, false)),
         _ => None,
     };

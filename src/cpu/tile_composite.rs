@@ -93,7 +93,16 @@ pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, v: &Variant) -> Result<()> {
     let (inputs, push) = (b.inputs(d.list), d.push_as());
     let project = v.spec.get(4).copied().unwrap_or(BLEND_COMPOSITE);
     let depth_test = v.spec.get(5).is_some_and(|&d| d != 0);
-    tile_composite(&inputs, &push, project, depth_test, b.get(Res::Quads), b.get(Res::TileStart), b.get(Res::TileEntries), &mut image);
+    tile_composite(
+        &inputs,
+        &push,
+        project,
+        depth_test,
+        b.get(Res::Quads),
+        b.get(Res::TileStart),
+        b.get(Res::TileEntries),
+        &mut image,
+    );
     b.accum = image;
     Ok(())
 }

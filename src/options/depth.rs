@@ -60,9 +60,7 @@ impl DepthBuffer {
         }
         let det = self.projection.determinant();
         if !(self.projection.is_finite() && det.is_finite() && det != 0.0) {
-            return Err(Error::InvalidArgument(
-                "the depth buffer's projection must be finite and invertible".into(),
-            ));
+            return Err(Error::InvalidArgument("the depth buffer's projection must be finite and invertible".into()));
         }
         Ok(())
     }

@@ -177,10 +177,8 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
             ));
         }
     }
-    let with_depth = |rule: TileRule| TileRule {
-        composite: TileComposite { depth: depth.is_some(), ..rule.composite },
-        ..rule
-    };
+    let with_depth =
+        |rule: TileRule| TileRule { composite: TileComposite { depth: depth.is_some(), ..rule.composite }, ..rule };
     let plan = |mut frame: Frame, draw| {
         frame.rect[3] = depth.is_some() as u32;
         FramePlan {

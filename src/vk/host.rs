@@ -249,10 +249,7 @@ impl DepthImage {
         if (self.image.width, self.image.height) != target.size() {
             return Err(Error::InvalidArgument(format!(
                 "a {} x {} depth image for a {} x {} target",
-                self.image.width,
-                self.image.height,
-                target.width,
-                target.height
+                self.image.width, self.image.height, target.width, target.height
             )));
         }
         let layout = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;

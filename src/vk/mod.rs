@@ -12,7 +12,9 @@ pub use ash;
 pub use ash::vk::{BufferUsageFlags, Format, ImageLayout, ImageUsageFlags, ShaderStageFlags};
 pub use buffer::{Buffer, Memory};
 pub use context::{Context, ContextOptions, HostHandles};
-pub use host::{depth_format, target_format, vk_depth_format, vk_format, DepthImage, HostTarget, Semaphore, TargetImage};
+pub use host::{
+    depth_format, target_format, vk_depth_format, vk_format, DepthImage, HostTarget, Semaphore, TargetImage,
+};
 pub use image::{Image, Sampler};
 pub use pipeline::{Bind, Blend, DescriptorSet, Framebuffer, Layout, Pipeline, Primitive, RenderPass, Slot};
 pub use submit::{Recorder, Stage};
