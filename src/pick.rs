@@ -3,7 +3,7 @@
 //! compared with), so a viewer can show the value under its cursor without a frame.
 use crate::bricks::BRICK;
 use crate::camera::Camera;
-use crate::cpu::raycast::ray_index;
+use crate::cpu::raycast::{ray_index, trilinear_by as trilinear};
 use crate::error::{Error, Result};
 use crate::options::{Mode, RaycastOptions, RenderOptions};
 use crate::plan::Prepared;
@@ -96,19 +96,6 @@ fn bricked_voxel(scene: &crate::bricks::BrickScene) -> Result<impl Fn(i64, i64, 
         }
         [value.clamp(0.0, 1.0), 1.0, 0.0, crate::volume::optical_depth(opacity)]
     })
-}
-
-/// Trilinear reconstruction of `voxel` at index-space point `u` (as `cpu::raycast::trilinear`).
-fn trilinear(voxel: &impl Fn(i64, i64, i64) -> [f32; 4], u: Vec3) -> [f32; 4] {
-    let b = u.floor();
-    let f = u - b;
-    let (i, j, k) = (b.x as i64, b.y as i64, b.z as i64);
-    let lerp = |p: [f32; 4], q: [f32; 4], t: f32| [0, 1, 2, 3].map(|c| p[c] + (q[c] - p[c]) * t);
-    let x00 = lerp(voxel(i, j, k), voxel(i + 1, j, k), f.x);
-    let x10 = lerp(voxel(i, j + 1, k), voxel(i + 1, j + 1, k), f.x);
-    let x01 = lerp(voxel(i, j, k + 1), voxel(i + 1, j, k + 1), f.x);
-    let x11 = lerp(voxel(i, j + 1, k + 1), voxel(i + 1, j + 1, k + 1), f.x);
-    lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
 }
 
 /// The pick along the pixel's ray through the field `voxel` gives.

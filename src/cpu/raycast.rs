@@ -112,14 +112,19 @@ fn skip_brick(rc: &RaycastParams, b: [i32; 3], nb: [i32; 3], a: Vec3, dir: Vec3,
 
 /// Mirror of `trilinear` in `glsl/shared/trilinear.glsl`.
 pub fn trilinear(field: &DenseField, u: Vec3) -> [f32; 4] {
+    trilinear_by(&|i, j, k| field.at(i, j, k), u)
+}
+
+/// `trilinear` over any voxel lookup (picking reads a bricked store through one).
+pub(crate) fn trilinear_by(voxel: &impl Fn(i64, i64, i64) -> [f32; 4], u: Vec3) -> [f32; 4] {
     let b = u.floor();
     let f = u - b;
     let (i, j, k) = (b.x as i64, b.y as i64, b.z as i64);
     let lerp = |p: [f32; 4], q: [f32; 4], t: f32| [0, 1, 2, 3].map(|c| p[c] + (q[c] - p[c]) * t);
-    let x00 = lerp(field.at(i, j, k), field.at(i + 1, j, k), f.x);
-    let x10 = lerp(field.at(i, j + 1, k), field.at(i + 1, j + 1, k), f.x);
-    let x01 = lerp(field.at(i, j, k + 1), field.at(i + 1, j, k + 1), f.x);
-    let x11 = lerp(field.at(i, j + 1, k + 1), field.at(i + 1, j + 1, k + 1), f.x);
+    let x00 = lerp(voxel(i, j, k), voxel(i + 1, j, k), f.x);
+    let x10 = lerp(voxel(i, j + 1, k), voxel(i + 1, j + 1, k), f.x);
+    let x01 = lerp(voxel(i, j, k + 1), voxel(i + 1, j, k + 1), f.x);
+    let x11 = lerp(voxel(i, j + 1, k + 1), voxel(i + 1, j + 1, k + 1), f.x);
     lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
 }
 
