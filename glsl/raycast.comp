@@ -6,6 +6,7 @@
 // past the brick, which skips exactly the samples that would add nothing. Mirror: cpu::raycast.
 #include "types.glsl"
 #include "trilinear.glsl"
+#include "surface.glsl"
 
 layout(local_size_x = COMPOSITE_TILE, local_size_y = COMPOSITE_TILE) in;
 layout(std430, binding = 0) readonly buffer ParamsBlock { RaycastParams rc; };
@@ -78,6 +79,8 @@ void main() {
     // which project.comp then maps; no early ray termination.
     uint mode = uint(rc.inv_spacing.w);
     vec2 acc = vec2(0.0);
+    vec2 prev = vec2(0.0);  // the isosurface's last sample below it: (t, value)
+    float hit = 0.0;
     if (t1 > t0) {
         float step = rc.box_min.w;
         uint n = min(uint(ceil((t1 - t0) / step)), rc.dims.w);
@@ -95,6 +98,37 @@ void main() {
                 }
             }
             vec4 v = trilinear(field, u, dims);
+            // The isosurface (value rc.inv_shear.w): the first sample at or above it, the crossing
+            // refined linearly from the sample before, shaded by its cell's trilinear gradient.
+            if (mode == PROJECT_ISO) {
+                float t = t0 + (float(s) + 0.5) * step;
+                if (v.r < rc.inv_shear.w || hit < 0.0) {
+                    // A ray that starts inside (an iso value at or below the outside's 0) meets
+                    // no crossing.
+                    hit = v.r < rc.inv_shear.w ? 0.0 : -1.0;
+                    prev = vec2(t, v.r);
+                    continue;
+                }
+                if (s == 0u) {
+                    hit = -1.0;
+                    continue;
+                }
+                float th = prev.x + (rc.inv_shear.w - prev.y) / (v.r - prev.y) * (t - prev.x);
+                vec3 h = to_index(a + dir * th - rc.origin.xyz);
+                ivec3 cell = ivec3(floor(h));
+                float corner[8];
+                for (int c = 0; c < 8; ++c) {
+                    corner[c] = fetch_or_zero(field, cell + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1), dims).r;
+                }
+                vec3 g = cell_gradient(corner, h - vec3(cell));
+                // World gradient: the inverse cell matrix's transpose times g.
+                vec3 is = rc.inv_spacing.xyz, ih = rc.inv_shear.xyz;
+                vec3 gw = vec3(is.x * g.x, ih.x * g.x + is.y * g.y, ih.y * g.x + ih.z * g.y + is.z * g.z);
+                float gl = length(gw);
+                acc = surface_light(gl > 0.0 ? gw / gl : -dir, dir);
+                hit = 1.0;
+                break;
+            }
             if (v.a <= 0.0) continue;
             float seg = rc.origin.w * step;  // the step in voxel lengths
             if (mode == PROJECT_MIP) {
@@ -113,5 +147,5 @@ void main() {
             if (trans < rc.box_max.w) break;
         }
     }
-    imageStore(out_image, ivec2(px), mode != PROJECT_NONE ? vec4(acc, 0.0, 0.0) : vec4(col, 1.0 - trans));
+    imageStore(out_image, ivec2(px), mode != PROJECT_NONE ? vec4(acc, max(hit, 0.0), 0.0) : vec4(col, 1.0 - trans));
 }

@@ -32,7 +32,8 @@ layout(constant_id = 2) const bool TERMINATE = false;  // front to back, pc.occl
 // Whether the frame is motion-blurred (else every splat's stretch is 0: one shuffle and the
 // stretch's arithmetic per pixel less).
 layout(constant_id = 3) const bool MOTION_BLUR = true;
-// A projection mode's blend (BLEND_*, types.glsl): order-independent, by maximum or sum.
+// A projection mode's blend (BLEND_*, types.glsl): order-independent, by maximum or sum; or the
+// isosurface's nearest discs (BLEND_SURFACE).
 layout(constant_id = 4) const uint PROJECT = BLEND_COMPOSITE;
 // The host's depth hides the splats behind it (frame.rect.w is then 1; a build of its own, since
 // llvmpipe pays for a branch on a uniform even where it is never taken: 4.5 % here).
@@ -47,6 +48,9 @@ layout(std430, binding = 18) readonly buffer HostDepth { float host_depth[]; };
 PAGED_READER(ScreenQuad, quads_at, quads_lo, quads_hi)
 
 const uint TILE_PIXELS = RASTER_TILE_W * RASTER_TILE_H;
+// The least weight, over a footprint's centre's, of a surface disc that hides the discs summed
+// behind it (mirror: cpu::tile_composite::SURFACE_RESET).
+const float SURFACE_RESET = 0.5;
 // The tile's accumulators, pixel (x, y) of the tile at y * RASTER_TILE_W + x.
 shared vec4 tile_acc[TILE_PIXELS];
 
@@ -89,6 +93,7 @@ void main() {
     const bool btf = BACK_TO_FRONT;
     bool swept = MOTION_BLUR && frame.sweep.y != float(SWEEP_UNIFORM);
     const bool depth_test = HOST_DEPTH;
+    const bool surface = PROJECT == BLEND_SURFACE;
     const bool terminate = !btf && TERMINATE;
     // Pixels still open, counted by the lanes that opened or closed them (only their sum means
     // anything).
@@ -145,18 +150,18 @@ void main() {
 #ifdef SHUFFLE
             ScreenQuad q;
             q.inv0.xyz = subgroupShuffle(mine.inv0.xyz, j);
-            q.inv0.w = MOTION_BLUR ? subgroupShuffle(mine.inv0.w, j) : 0.0;
+            q.inv0.w = MOTION_BLUR || surface ? subgroupShuffle(mine.inv0.w, j) : 0.0;
             q.inv1.xyz = subgroupShuffle(mine.inv1.xyz, j);
-            q.inv1.w = MOTION_BLUR ? subgroupShuffle(mine.inv1.w, j) : 0.0;
+            q.inv1.w = MOTION_BLUR || surface ? subgroupShuffle(mine.inv1.w, j) : 0.0;
             q.inv2.xyz = subgroupShuffle(mine.inv2.xyz, j);
-            if (depth_test) q.inv2.w = subgroupShuffle(mine.inv2.w, j);
+            if (depth_test || surface) q.inv2.w = subgroupShuffle(mine.inv2.w, j);
             uvec2 b = subgroupShuffle(box_packed, j);
             q.box = ivec4(b & 0xffffu, b >> 16);
             q.emit = subgroupShuffle(mine.emit, j);
 #else
             uint e = tile_entries[k0];
             ScreenQuad q = quads_at(e);
-            if (!MOTION_BLUR) q.inv0.w = q.inv1.w = 0.0;
+            if (!MOTION_BLUR && !surface) q.inv0.w = q.inv1.w = 0.0;
 #endif
             // The box's pixels inside the tile, dealt to the lanes in turn: every lane works on
             // every step but the last (a lane per row or column would idle on rows or columns the
@@ -196,6 +201,20 @@ void main() {
                     // A footprint weighs 1 at its centre: the key of the splat there, its coverage 1.
                     float w = sample_radial(s) / radial[0].x;
                     tile_acc[at] = max(a, vec4(q.emit.r * w, w, 0.0, 0.0));
+                } else if (live && surface) {
+                    // Surface splats (iso_splats): a disc nearer than the band (emit.a) at this
+                    // pixel (its plane's depth, from the depth's steps along u and v in inv0.w,
+                    // inv1.w) starts the sum afresh where it weighs at least SURFACE_RESET of a
+                    // centre's (a disc's fringe past a crease or a silhouette does not hide what
+                    // lies behind); discs within the band of the sum's nearest depth add their
+                    // weighed shading.
+                    float w = sample_radial(s);
+                    float z = q.inv2.w + uv.x * q.inv0.w + uv.y * q.inv1.w;
+                    if (w > 0.0 && (a.z <= 0.0 || (z < a.w - q.emit.a && w >= SURFACE_RESET * radial[0].x))) {
+                        tile_acc[at] = vec4(q.emit.xy * w, w, z);
+                    } else if (w > 0.0 && z <= a.w + q.emit.a) {
+                        tile_acc[at] = vec4(a.xy + q.emit.xy * w, a.z + w, min(a.w, z));
+                    }
                 } else if (live && PROJECT == BLEND_SUM) {
                     float d = q.emit.a * sample_radial(s);
                     tile_acc[at] = a + vec4(q.emit.r * d, d, 0.0, 0.0);

@@ -3,7 +3,7 @@
 //! CPU engine the mirror's [`Variant`]). A dispatch names a [`Build`] value, never an index:
 //! `Dispatch::new` finds the value in the stage's table and refuses one the stage lacks.
 use crate::dispatch::{Blend, DrawState, Pass, Variant};
-use crate::gpu_types::{BLEND_MAX, BLEND_SUM, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{BLEND_MAX, BLEND_SUM, BLEND_SURFACE, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
 
 /// A stage's builds: the values a dispatch may name and, in the same order, what each is made of.
 #[derive(Debug)]
@@ -128,6 +128,8 @@ pub enum TileOrder {
     Maximum,
     /// A projection: in any order, summing (average, X-ray).
     Sum,
+    /// The isosurface's discs: per pixel the nearest's depth, those within a band of it summed.
+    Surface,
 }
 
 impl TileOrder {
@@ -307,6 +309,7 @@ const fn tc_variant(pages: Pages, order: TileOrder, blur: bool, depth: bool) -> 
             TileOrder::Terminating => &[SHEET_MODE_SPLAT, 0, 1, 0, 0, 1],
             TileOrder::Maximum => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_MAX, 1],
             TileOrder::Sum => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SUM, 1],
+            TileOrder::Surface => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SURFACE, 1],
         };
         return v(defines, spec);
     }
@@ -321,6 +324,7 @@ const fn tc_variant(pages: Pages, order: TileOrder, blur: bool, depth: bool) -> 
         // Spec 4: the projection's blend (motion blur is refused there).
         (TileOrder::Maximum, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_MAX],
         (TileOrder::Sum, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SUM],
+        (TileOrder::Surface, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SURFACE],
     };
     v(defines, spec)
 }
@@ -359,6 +363,10 @@ pub const TILE_COMPOSITE: Table = tile_composite![
     (One, Terminating, false, true),
     (One, Maximum, false, true),
     (One, Sum, false, true),
+    (Two, Surface, false, false),
+    (One, Surface, false, false),
+    (Two, Surface, false, true),
+    (One, Surface, false, true),
 ];
 
 const fn st(mode: SheetMode, points: bool) -> Build {

@@ -73,6 +73,13 @@ pub enum Res {
     RaycastParams,
     /// A projection mode's colour map (`COLOR_MAP_SIZE` straight RGBA entries).
     ColorMap,
+    /// The isosurface's field (`iso::IsoField::words`): the scene's values, 16 bits each, uploaded
+    /// once per scene (`Engine::tag`).
+    IsoField,
+    /// Its voxel rows' ranges (`iso::IsoField::rows`), with it.
+    IsoRows,
+    /// Per row of cells its surface splats, then (scanned) its first one, then the total.
+    IsoCounts,
     /// The host's depth buffer as it stores it (`DepthBuffer::texels`, row 0 at the top).
     HostDepthRaw,
     /// The host's depth as eye-space depth per pixel (`host_depth`), which hides the splats behind it.

@@ -205,13 +205,33 @@ pub struct ProjectPush {
     pub source: u32,
     /// The radial table's value at a footprint's centre.
     pub centre: f32,
-    pub pad: [u32; 3],
+    /// `Mode::Iso`: the iso value (its colour is the colour map's there).
+    pub iso: f32,
+    pub pad: [u32; 2],
+}
+
+/// Push constants of the isosurface stages (`iso_count`, `iso_scan`, `iso_splats`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct IsoPush {
+    /// The iso value, normalised to [0, 1].
+    pub iso: f32,
+    /// The least quantised value (`IsoField`, 16 bits) at or above it: a corner is inside the
+    /// surface when its value is at least this.
+    pub threshold: u32,
+    /// Rows of cells, (ny + 1)(nz + 1): a cell (i, j, k) spans voxels i..=i+1, j..=j+1, k..=k+1,
+    /// from -1 (voxels outside the grid hold 0).
+    pub rows: u32,
+    /// The depth band (world units) over which the nearest surface's discs blend.
+    pub band: f32,
 }
 
 /// `project.comp`'s blend codes (glsl/shared/types.glsl `BLEND_*`): compositing, maximum, sum.
 pub const BLEND_COMPOSITE: u32 = 0;
 pub const BLEND_MAX: u32 = 1;
 pub const BLEND_SUM: u32 = 2;
+/// The isosurface: per pixel the nearest disc's depth, the discs within a band of it summed.
+pub const BLEND_SURFACE: u32 = 3;
 
 /// Push constants of `composite.comp`.
 #[repr(C)]
@@ -279,6 +299,7 @@ const _: () = assert!(std::mem::size_of::<Frame>() == 592);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<PresentPush>() == 32);
 const _: () = assert!(std::mem::size_of::<ProjectPush>() == 32);
+const _: () = assert!(std::mem::size_of::<IsoPush>() == 16);
 const _: () = assert!(std::mem::size_of::<DepthPush>() == 80);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 368);

@@ -35,6 +35,7 @@ mod error;
 mod gpu;
 mod gpu_types;
 pub mod image;
+mod iso;
 // The README's Rust example compiles (a doc test; cli/tests/readme.rs runs its commands).
 #[cfg(all(doctest, feature = "io"))]
 #[doc = include_str!("../README.md")]

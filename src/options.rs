@@ -238,6 +238,10 @@ pub struct RenderOptions {
     /// colours (its opacities are not used); `None`: a grey ramp. Compositing ignores it (its
     /// colours come from the classification).
     pub colormap: Option<crate::classify::TransferFunction>,
+    /// `Mode::Iso`'s value, in the scene's normalised values [0, 1] (required there, refused
+    /// with the other modes). A value the volume never crosses draws nothing
+    /// (`Rendered::stats.splats` is 0).
+    pub iso: Option<f32>,
     /// The host's depth buffer: splats behind its geometry add nothing to a pixel (`None`: no
     /// depth). `Renderer::render_to` can read the host's depth image on the device instead
     /// (`vk::HostTarget::with_depth`).
@@ -324,6 +328,7 @@ impl Default for RenderOptions {
         Self {
             mode: Mode::Composite,
             colormap: None,
+            iso: None,
             depth: None,
             order: OrderKind::Pbtf,
             composite: Composite::Splat,
@@ -406,6 +411,14 @@ impl RenderOptions {
             if self.motion.is_some() {
                 return refuse("motion-blurred splats are composited in order");
             }
+        }
+        check_iso(self.mode, self.iso)?;
+        if self.mode == Mode::Iso && matches!(self.raster, Raster::Graphics | Raster::Points) {
+            return Err(Error::InvalidArgument(
+                "--mode iso: surface splats blend by depth in the compute tile compositor: use --raster compute or \
+                 auto"
+                    .into(),
+            ));
         }
         if let Some(tf) = &self.colormap {
             tf.validate()?;
@@ -504,6 +517,9 @@ pub struct RaycastOptions {
     pub mode: Mode,
     /// A projection's colour map, as `RenderOptions::colormap`.
     pub colormap: Option<crate::classify::TransferFunction>,
+    /// `Mode::Iso`'s value, as `RenderOptions::iso`: the first crossing along each ray, refined
+    /// between its two samples, shaded as the surface splats are.
+    pub iso: Option<f32>,
     /// Step length in voxel spacings.
     pub step: f32,
     /// Transmittance below which a ray stops.
@@ -524,6 +540,20 @@ pub struct RaycastOptions {
     pub supersample: u32,
 }
 
+/// `iso` is given exactly when `mode` is `Mode::Iso`, and is a finite value.
+pub(crate) fn check_iso(mode: Mode, iso: Option<f32>) -> Result<()> {
+    match (mode, iso) {
+        (Mode::Iso, None) => Err(Error::InvalidArgument("--mode iso needs an iso value (--iso VALUE)".into())),
+        (Mode::Iso, Some(v)) if !v.is_finite() => {
+            Err(Error::InvalidArgument(format!("iso value {v}: not a finite number")))
+        }
+        (m, Some(_)) if m != Mode::Iso => {
+            Err(Error::InvalidArgument(format!("an iso value applies to --mode iso only, not --mode {m}")))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Most rays per pixel along each axis of a supersampled cast.
 pub const MAX_SUPERSAMPLE: u32 = 16;
 
@@ -535,6 +565,7 @@ impl Default for RaycastOptions {
         Self {
             mode: Mode::Composite,
             colormap: None,
+            iso: None,
             step: 0.5,
             min_transmittance: 1e-3,
             max_steps: 1 << 16,

@@ -20,7 +20,10 @@ mod layout;
 mod pass;
 pub mod slab;
 pub use bricked::{bricked_min_budget, bricked_resident_bytes, BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT};
-pub use frame::{color_map, frame, DepthSource, Draw, FramePlan, OrderSource, Projection, SplatRaster};
+pub use frame::{
+    color_map, frame, mode_color_map, DepthSource, Draw, FramePlan, OrderSource, Projection, SplatRaster, ISO_BAND_VOXELS,
+    ISO_COLOR,
+};
 pub use layout::*;
 pub use pass::{sheet_layers, sheet_pass, SheetPass, TileRule};
 
@@ -42,6 +45,8 @@ pub struct Prepared {
     field: std::sync::OnceLock<crate::volume::DenseField>,
     /// The projection modes' field (`DenseField::projection`), likewise.
     projection_field: std::sync::OnceLock<crate::volume::DenseField>,
+    /// The isosurface's field (`iso::IsoField`), built on its first frame.
+    iso_field: std::sync::OnceLock<crate::iso::IsoField>,
 }
 
 impl Prepared {
@@ -62,6 +67,7 @@ impl Prepared {
             bricks: None,
             field: std::sync::OnceLock::new(),
             projection_field: std::sync::OnceLock::new(),
+            iso_field: std::sync::OnceLock::new(),
         }
     }
 
@@ -79,6 +85,15 @@ impl Prepared {
         }
         let f = crate::volume::DenseField::new(&self.set)?;
         Ok(self.field.get_or_init(|| f))
+    }
+
+    /// The isosurface's field, built once.
+    pub fn iso_field(&self) -> Result<&crate::iso::IsoField> {
+        if let Some(f) = self.iso_field.get() {
+            return Ok(f);
+        }
+        let f = crate::iso::IsoField::of(self)?;
+        Ok(self.iso_field.get_or_init(|| f))
     }
 
     /// The ray caster's field for `projection` (a projection mode) or compositing, built once.
@@ -341,9 +356,11 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
         box_max: [hi.x, hi.y, hi.z, opts.min_transmittance],
         origin: [o.x, o.y, o.z, 1.0 / g.kernel_spacing()],
         inv_spacing: [1.0 / s.x, 1.0 / s.y, 1.0 / s.z, opts.mode.code() as f32],
-        inv_shear: [inv_shear[0], inv_shear[1], inv_shear[2], 0.0],
+        // w: the isosurface's value.
+        inv_shear: [inv_shear[0], inv_shear[1], inv_shear[2], opts.iso.unwrap_or(0.0)],
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
-        image: [camera.width, camera.height, opts.brick, clip_count],
+        // The isosurface reads values where nothing is drawn: no empty-space skipping.
+        image: [camera.width, camera.height, if opts.mode == crate::options::Mode::Iso { 0 } else { opts.brick }, clip_count],
         clip,
     }
 }

@@ -11,7 +11,7 @@ use crate::constants::{
     COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, TILE_SEGMENT,
 };
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickPush, FootprintPush, Frame, ProjectPush, ScreenQuad, SlabPush, SplatParams};
+use crate::gpu_types::{BrickPush, FootprintPush, Frame, IsoPush, ProjectPush, ScreenQuad, SlabPush, SplatParams};
 use crate::image::ImageF32;
 use crate::options::RaycastOptions;
 use crate::options::{RenderOptions, StageTime};
@@ -121,6 +121,7 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
                 }
             }
         }
+        Draw::Surface { push, projection } => record_surface(e, prep, plan, push, projection),
         Draw::Projection { raster, projection, .. } => {
             begin_dense(e, plan, n)?;
             e.layers(1)?;
@@ -316,12 +317,86 @@ fn record_host_depth(e: &mut dyn Engine, plan: &FramePlan) -> Result<()> {
     e.run(&Dispatch::new(StageId::HostDepth, Only, groups, List::Order, bytemuck::bytes_of(&push))?)
 }
 
+/// Device bytes an isosurface frame holds per surface splat: its parameters (80), draw-list entry
+/// (4), screen quad (80) and about four tile entries.
+pub const SURFACE_BYTES_PER_SPLAT: u64 = 80 + 4 + 80 + 16;
+
+/// The isosurface: the scene's field uploaded on its first frame; the cells the value crosses
+/// counted per row (`iso_count`), their first positions scanned (`iso_scan`) and the total read
+/// back; a disc per cell (`iso_splats`); the discs blended by depth (`record_tiles`, the
+/// `Surface` walk) and lit (`project`).
+fn record_surface(
+    e: &mut dyn Engine,
+    prep: &Prepared,
+    plan: &FramePlan,
+    push: &IsoPush,
+    projection: &crate::plan::Projection,
+) -> Result<Recorded> {
+    let (w, h) = (plan.width, plan.height);
+    e.begin(&plan.frame, plan.kernel, w, h)?;
+    record_host_depth(e, plan)?;
+    e.layers(1)?;
+    let limits = e.limits();
+    let field = prep.iso_field()?;
+    let values = field.words.len() as u64 * 4;
+    if values > limits.max_storage_range || field.bytes() > limits.budget_bytes / 2 {
+        return Err(Error::TooLarge(format!(
+            "the isosurface's field of {} x {} x {} voxels takes {} MiB: more than half the {} MiB GPU budget or              the device's largest binding ({} MiB)",
+            field.dims[0],
+            field.dims[1],
+            field.dims[2],
+            field.bytes() >> 20,
+            limits.budget_bytes >> 20,
+            limits.max_storage_range >> 20
+        )));
+    }
+    e.ensure(Res::IsoField, values)?;
+    e.ensure(Res::IsoRows, field.rows.len() as u64 * 4)?;
+    if e.tag(Res::IsoField) != field.id || e.tag(Res::IsoRows) != field.id {
+        let t = Instant::now();
+        e.upload(Res::IsoField, &field.words)?;
+        e.upload(Res::IsoRows, &field.rows)?;
+        e.set_tag(Res::IsoField, field.id);
+        e.set_tag(Res::IsoRows, field.id);
+        e.host_time("iso_field", t.elapsed().as_secs_f64() * 1e3);
+    }
+    let rows = push.rows;
+    e.ensure(Res::IsoCounts, (rows as u64 + 1) * 4)?;
+    let bytes = bytemuck::bytes_of(push);
+    e.run(&Dispatch::new(StageId::IsoCount, Only, groups_1d(rows), List::Order, bytes)?)?;
+    e.run(&Dispatch::new(StageId::IsoScan, Only, [1, 1, 1], List::Order, bytes)?)?;
+    let n = e.read(&[(Res::IsoCounts, rows as usize + 1)])?[0][rows as usize];
+    let room = limits.budget_bytes.saturating_sub(field.bytes());
+    if n as u64 * SURFACE_BYTES_PER_SPLAT > room {
+        return Err(Error::TooLarge(format!(
+            "the isosurface at {} crosses {n} cells: its splats take {} MiB, more than the {} MiB the GPU budget              leaves beside the field; raise the budget or pick a value that crosses fewer cells",
+            push.iso,
+            (n as u64 * SURFACE_BYTES_PER_SPLAT) >> 20,
+            room >> 20
+        )));
+    }
+    e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+    e.ensure(Res::Order, n as u64 * 4)?;
+    if n > 0 {
+        e.run(&Dispatch::new(StageId::IsoSplats, Only, groups_1d(rows), List::Order, bytes)?)?;
+    }
+    let mut rule = TileRule::plan(n, w, h, crate::order::Direction::FrontToBack, 0.0, false);
+    rule.composite.order = crate::builds::TileOrder::Surface;
+    rule.composite.depth = plan.depth.is_some();
+    record_tiles(e, &plan.frame, &rule, w, h, false)?;
+    record_project(e, projection, 1, w, h)?;
+    let mut recorded = finish(e, plan.background, &[Res::Accum], w, h, false)?;
+    recorded.stats.splats = n as u64;
+    Ok(recorded)
+}
+
 /// A projection's colours (`project`) from its blended (key, weight): in the accumulation image
 /// (`source` 1) or the raster target (2), written into the accumulation image.
 fn record_project(e: &mut dyn Engine, p: &crate::plan::Projection, source: u32, w: u32, h: u32) -> Result<()> {
     e.ensure(Res::ColorMap, p.color_map.len() as u64 * 16)?;
     e.upload(Res::ColorMap, bytemuck::cast_slice(&p.color_map))?;
-    let push = ProjectPush { mode: p.mode.code(), width: w, height: h, source, centre: p.centre, pad: [0; 3] };
+    let push =
+        ProjectPush { mode: p.mode.code(), width: w, height: h, source, centre: p.centre, iso: p.iso, pad: [0; 2] };
     let groups = tile_groups(StageId::Project, w, h);
     e.run(&Dispatch::new(StageId::Project, Only, groups, List::Order, bytemuck::bytes_of(&push))?)
 }
@@ -486,8 +561,9 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
         // The rays' (key, weight) mapped as the splats' are; one voxel length of coverage is opaque.
         let p = crate::plan::Projection {
             mode: opts.mode,
-            color_map: crate::plan::color_map(opts.colormap.as_ref()),
+            color_map: crate::plan::mode_color_map(opts.colormap.as_ref(), opts.mode),
             centre: 1.0,
+            iso: opts.iso.unwrap_or(0.0),
         };
         record_project(e, &p, 1, w, h)?;
     }

@@ -12,7 +12,9 @@ use crate::builds::{self, Build, Table};
 use crate::constants::{BRICK_LANES, COMPOSITE_TILE, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, WORKGROUP_SIZE};
 use crate::cpu::bindings::Bindings;
 use crate::error::{Error, Result};
-use crate::gpu_types::{BrickPush, CompositePush, DepthPush, FootprintPush, PresentPush, ProjectPush, SlabPush};
+use crate::gpu_types::{
+    BrickPush, CompositePush, DepthPush, FootprintPush, IsoPush, PresentPush, ProjectPush, SlabPush,
+};
 
 pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, Limits, List, Pass, Res, Variant, Workgroup};
 use crate::gpu_types::Frame;
@@ -113,6 +115,10 @@ const BRICK: &[Res; 32] = &[
 /// `brick_hidden`'s places (the brick stages' list is at lavapipe's 32 storage buffers a stage).
 const BRICK_GRADIENTS: &[Res] =
     &Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi);
+/// glsl/shared/iso.glsl's bindings and `iso_splats`' outputs.
+const ISO: &[Res] =
+    &[Res::Frame, Res::IsoField, Res::IsoRows, Res::IsoCounts, Res::Params, Res::ParamsHi, Res::Order];
+const ISO_PUSH: u32 = std::mem::size_of::<IsoPush>() as u32;
 const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
 const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
 
@@ -435,6 +441,36 @@ stages! {
         push: std::mem::size_of::<DepthPush>() as u32,
         workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
         timing: "host_depth",
+        device_build: None,
+        builds: &builds::ONLY,
+    },
+    iso_count => IsoCount {
+        kind: Kind::Compute,
+        bindings: ISO,
+        writes: &[Res::IsoCounts],
+        push: ISO_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "iso",
+        device_build: None,
+        builds: &builds::ONLY,
+    },
+    iso_scan => IsoScan {
+        kind: Kind::Compute,
+        bindings: ISO,
+        writes: &[Res::IsoCounts],
+        push: ISO_PUSH,
+        workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
+        timing: "iso",
+        device_build: None,
+        builds: &builds::ONLY,
+    },
+    iso_splats => IsoSplats {
+        kind: Kind::Compute,
+        bindings: ISO,
+        writes: &[Res::Params, Res::Order],
+        push: ISO_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "splat_params",
         device_build: None,
         builds: &builds::ONLY,
     },

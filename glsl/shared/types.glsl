@@ -110,12 +110,17 @@ const uint SWEEP_SLOTTED = 3u;   // tapered, each half of the shutter composited
 #define PROJECT_MINIP 2u
 #define PROJECT_AVERAGE 3u
 #define PROJECT_XRAY 4u
+// The isosurface (not a projection: surface splats, iso_splats; the ray caster's first crossing).
+#define PROJECT_ISO 5u
 // How a projection's footprints blend (the PROJECT specialization constant of tile_composite and
 // footprint.frag): 0 composite, 1 the maximum of (key, 1) x the footprint over its centre's, 2 the
 // sum of (key, 1) x tau x the footprint.
 #define BLEND_COMPOSITE 0u
 #define BLEND_MAX 1u
 #define BLEND_SUM 2u
+// 3: the isosurface, per pixel (sum of w lambert, sum of w specular, sum of w, nearest depth) over
+// the discs within a depth band of the nearest (tile_composite).
+#define BLEND_SURFACE 3u
 
 #define AA_NONE 0.0
 #define AA_SWAN 1.0

@@ -15,8 +15,23 @@ pub fn mapped(map: &[[f32; 4]], v: f32) -> [f32; 3] {
     [0, 1, 2].map(|c| map[i][c] + (map[i + 1][c] - map[i][c]) * f)
 }
 
-/// One pixel's colour from its blended (key, weight).
+/// Mirror of project.comp's `SURFACE_AMBIENT`, `SURFACE_DIFFUSE`, `SURFACE_SPECULAR`.
+pub const SURFACE_LIGHT: [f32; 3] = [0.3, 0.7, 0.25];
+
+/// One pixel's colour from its blended (key, weight); the isosurface's from its (sum of w
+/// lambert, sum of w specular, sum of w, depth).
 pub fn project_pixel(push: &ProjectPush, map: &[[f32; 4]], acc: [f32; 4]) -> [f32; 4] {
+    if push.mode == crate::options::Mode::Iso.code() {
+        let [ambient, diffuse, specular] = SURFACE_LIGHT;
+        let c = mapped(map, push.iso);
+        let lit = if acc[2] > 0.0 {
+            c.map(|c| c * (ambient + diffuse * acc[0] / acc[2]) + specular * acc[1] / acc[2])
+        } else {
+            [0.0; 3]
+        };
+        let a = (acc[2] / push.centre).clamp(0.0, 1.0);
+        return [lit[0] * a, lit[1] * a, lit[2] * a, a];
+    }
     let ratio = if acc[1] > 0.0 { acc[0] / acc[1] } else { 0.0 };
     let (v, a) = match push.mode {
         1 => (ratio, acc[1]),

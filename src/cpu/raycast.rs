@@ -139,6 +139,9 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
             // A projection mode's (key, weight) (raycast.comp).
             let mode = rc.inv_spacing[3] as u32;
             let mut acc = [0.0f32; 2];
+            // The isosurface's last sample below it (t, value), and whether it crossed (1), is
+            // below (0) or started inside (-1).
+            let (mut prev, mut hit) = ((0.0f32, 0.0f32), 0.0f32);
             if let Some(Ray { a, dir, t0, t1, ia, idir, origin, .. }) = ray_index(rc, x as f32 + 0.5, y as f32 + 0.5) {
                 let step = rc.box_min[3];
                 let n = (((t1 - t0) / step).ceil() as u32).min(rc.dims[3]);
@@ -160,6 +163,36 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                     }
                     s += 1;
                     let v = trilinear(field, u);
+                    if mode == crate::options::Mode::Iso.code() {
+                        let iso = rc.inv_shear[3];
+                        let t = t0 + ((s - 1) as f32 + offset) * step;
+                        if v[0] < iso || hit < 0.0 {
+                            hit = if v[0] < iso { 0.0 } else { -1.0 };
+                            prev = (t, v[0]);
+                            continue;
+                        }
+                        if s == 1 {
+                            hit = -1.0;
+                            continue;
+                        }
+                        let th = prev.0 + (iso - prev.1) / (v[0] - prev.1) * (t - prev.0);
+                        let h = to_index(rc, a + dir * th - origin);
+                        let cell = h.floor();
+                        let (ci, cj, ck) = (cell.x as i64, cell.y as i64, cell.z as i64);
+                        let corner: [f32; 8] =
+                            std::array::from_fn(|c| field.at(ci + (c & 1) as i64, cj + (c >> 1 & 1) as i64, ck + (c >> 2 & 1) as i64)[0]);
+                        let g = super::iso_splats::cell_gradient(&corner, h - cell);
+                        let (is, ih) = (rc.inv_spacing, rc.inv_shear);
+                        let gw = Vec3::new(
+                            is[0] * g.x,
+                            ih[0] * g.x + is[1] * g.y,
+                            ih[1] * g.x + ih[2] * g.y + is[2] * g.z,
+                        );
+                        let gl = gw.length();
+                        acc = super::iso_splats::surface_light(if gl > 0.0 { gw / gl } else { -dir }, dir);
+                        hit = 1.0;
+                        break;
+                    }
                     if v[3] <= 0.0 {
                         continue;
                     }
@@ -184,7 +217,7 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                     }
                 }
             }
-            *px = if mode != 0 { [acc[0], acc[1], 0.0, 0.0] } else { [col[0], col[1], col[2], 1.0 - trans] };
+            *px = if mode != 0 { [acc[0], acc[1], hit.max(0.0), 0.0] } else { [col[0], col[1], col[2], 1.0 - trans] };
         }
     });
     ImageF32 { width: w, height: h, pixels }

@@ -5,10 +5,14 @@ use super::ImageF32;
 use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
-use crate::gpu_types::{FootprintPush, ScreenQuad, BLEND_COMPOSITE, BLEND_MAX, BLEND_SUM};
+use crate::gpu_types::{FootprintPush, ScreenQuad, BLEND_COMPOSITE, BLEND_MAX, BLEND_SUM, BLEND_SURFACE};
 use crate::plan::tile_grid;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
+
+/// Mirror of `SURFACE_RESET`: the least weight, over a footprint's centre's, of a surface disc
+/// that hides the discs summed behind it.
+pub const SURFACE_RESET: f32 = 0.5;
 
 /// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it
 /// unless `push.carry` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
@@ -57,6 +61,20 @@ pub fn tile_composite(
                 continue;
             }
             if depth_test && q.inv[2][3] > inputs.host_depth[i] {
+                continue;
+            }
+            if project == BLEND_SURFACE {
+                // The nearest disc's plane depth here starts the sum afresh; discs within the band
+                // of it add (inv[0][3], inv[1][3]: the depth's steps along u and v).
+                let still = Sweep { stretch: 0.0, bend: 0.0, profile: inputs.frame.sweep[1] };
+                let w = footprint_value(inputs.table, uv, still, 1.0, false);
+                let z = q.inv[2][3] + uv.x * q.inv[0][3] + uv.y * q.inv[1][3];
+                let band = q.emit[3];
+                if w > 0.0 && (acc[2] <= 0.0 || (z < acc[3] - band && w >= SURFACE_RESET * inputs.table[0])) {
+                    acc = [q.emit[0] * w, q.emit[1] * w, w, z];
+                } else if w > 0.0 && z <= acc[3] + band {
+                    acc = [acc[0] + q.emit[0] * w, acc[1] + q.emit[1] * w, acc[2] + w, acc[3].min(z)];
+                }
                 continue;
             }
             let sweep = Sweep { stretch: q.inv[0][3], bend: q.inv[1][3], profile: inputs.frame.sweep[1] };

@@ -25,11 +25,18 @@ pub enum Mode {
     /// A digitally reconstructed radiograph: opacity 1 − exp(−Σ τ), the extinction summed along
     /// the ray, in the colour map's top colour.
     Xray,
+    /// The isosurface where the trilinear reconstruction of the values crosses
+    /// `RenderOptions::iso`: one oriented disc per cell the value crosses (EWA surface splatting),
+    /// headlight-shaded, the nearest surface per pixel blended over a thin depth band. The values
+    /// are the volume's, normalised to [0, 1] (a bricked volume's whole range; a classified set's
+    /// splat values, `Splat::ijk[3]`); its colour is the colour map's at the iso value (default:
+    /// bone). Drawn by the compute tile compositor.
+    Iso,
 }
 
 impl Mode {
     /// Every mode, for help texts and tests.
-    pub const ALL: [Mode; 5] = [Mode::Composite, Mode::Mip, Mode::Minip, Mode::Average, Mode::Xray];
+    pub const ALL: [Mode; 6] = [Mode::Composite, Mode::Mip, Mode::Minip, Mode::Average, Mode::Xray, Mode::Iso];
 
     /// The name the CLI takes.
     pub fn name(self) -> &'static str {
@@ -39,10 +46,12 @@ impl Mode {
             Mode::Minip => "minip",
             Mode::Average => "average",
             Mode::Xray => "xray",
+            Mode::Iso => "iso",
         }
     }
 
-    /// Whether the mode is an order-independent projection (not `Composite`).
+    /// Whether the mode draws no visibility order (not `Composite`): the projections and the
+    /// isosurface.
     pub fn is_projection(self) -> bool {
         self != Mode::Composite
     }
@@ -55,6 +64,7 @@ impl Mode {
             Mode::Minip => 2,
             Mode::Average => 3,
             Mode::Xray => 4,
+            Mode::Iso => 5,
         }
     }
 
@@ -76,6 +86,6 @@ impl std::str::FromStr for Mode {
         Mode::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| Error::InvalidArgument(format!("unknown mode '{s}' (composite, mip, minip, average, xray)")))
+            .ok_or_else(|| Error::InvalidArgument(format!("unknown mode '{s}' (composite, mip, minip, average, xray, iso)")))
     }
 }

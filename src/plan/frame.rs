@@ -74,6 +74,16 @@ pub enum Draw {
     },
     /// A bricked volume: its splats made per frame, batch by batch through the budget.
     Bricked(Box<BrickedPlan>),
+    /// The isosurface (`Mode::Iso`) of the scene's values (a dense set's or a bricked volume's):
+    /// its surface splats made on the device each frame from the scene's field
+    /// (`iso::IsoField`, uploaded once), blended by depth in the tile compositor, then lit.
+    Surface {
+        /// The isosurface stages' push constants: the value, its threshold, the rows of cells
+        /// and the depth band.
+        push: crate::gpu_types::IsoPush,
+        /// The surface's colour (`Projection::mode` is `Mode::Iso`).
+        projection: Projection,
+    },
     /// An order-independent projection (`Mode`) of a dense splat set: no order stages, the
     /// footprints blended by maximum or sum in storage order, then mapped through the colour map.
     Projection {
@@ -105,15 +115,26 @@ pub struct Projection {
     pub color_map: Vec<[f32; 4]>,
     /// The radial table's value at a footprint's centre (the average's unit weight).
     pub centre: f32,
+    /// The isosurface's value (its colour's place in the map; 0 for the projections).
+    pub iso: f32,
 }
+
+/// The isosurface's depth band, in voxel lengths: the discs within it of a pixel's nearest blend
+/// (neighbouring discs of one surface agree to far less; a surface behind it lies a voxel or more
+/// further).
+pub const ISO_BAND_VOXELS: f32 = 1.0;
+
+/// The isosurface's colour where no colour map is given: bone.
+pub const ISO_COLOR: [f32; 4] = [0.93, 0.87, 0.78, 1.0];
 
 impl Projection {
     /// The projection `opts` asks for (`None`: compositing).
     pub fn of(opts: &RenderOptions) -> Option<Projection> {
         opts.mode.is_projection().then(|| Projection {
             mode: opts.mode,
-            color_map: color_map(opts.colormap.as_ref()),
+            color_map: mode_color_map(opts.colormap.as_ref(), opts.mode),
             centre: opts.kernel.radial_table()[0],
+            iso: opts.iso.unwrap_or(0.0),
         })
     }
 
@@ -193,6 +214,9 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
             draw,
         }
     };
+    if opts.mode == Mode::Iso {
+        return surface(prep, camera, opts).map(|(frame, draw)| plan(frame, draw));
+    }
     if let Some(scene) = &prep.bricks {
         if slotted {
             return Err(Error::Unsupported(
@@ -247,6 +271,35 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
     Ok(plan(frame, draw))
 }
 
+/// The isosurface's frame and draw: its push constants from the iso value and the grid.
+fn surface(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<(Frame, Draw)> {
+    let set = &prep.set;
+    if set.coordinates().is_some() {
+        return Err(Error::Unsupported("--mode iso: isosurfaces are extracted on a uniform grid, not a rectilinear one".into()));
+    }
+    let iso = opts.iso.ok_or_else(|| Error::InvalidArgument("--mode iso needs an iso value (--iso VALUE)".into()))?;
+    let mut frame = super::frame_for(set, camera, opts);
+    frame.rect[2] = Mode::Iso.code();
+    let dims = set.grid().dims;
+    let push = crate::gpu_types::IsoPush {
+        iso,
+        threshold: crate::iso::threshold(iso),
+        rows: (dims[1] + 1) * (dims[2] + 1),
+        // One voxel length: the footprint's world radius over its radius in voxels.
+        band: ISO_BAND_VOXELS * frame.spacing[3] / frame.origin[3],
+    };
+    let projection = Projection::of(opts).ok_or_else(|| Error::InvalidArgument("--mode iso: no surface".into()))?;
+    Ok((frame, Draw::Surface { push, projection }))
+}
+
+/// Mode `mode`'s colour map: `color_map`, or for the isosurface without one, bone.
+pub fn mode_color_map(tf: Option<&crate::classify::TransferFunction>, mode: Mode) -> Vec<[f32; 4]> {
+    match (tf, mode) {
+        (None, Mode::Iso) => vec![ISO_COLOR; crate::constants::COLOR_MAP_SIZE as usize],
+        (tf, _) => color_map(tf),
+    }
+}
+
 /// A projection's colour map: `tf`'s colours at `COLOR_MAP_SIZE` values from 0 to 1 (opacity
 /// unused), or a grey ramp.
 pub fn color_map(tf: Option<&crate::classify::TransferFunction>) -> Vec<[f32; 4]> {
@@ -271,6 +324,15 @@ impl fmt::Display for FramePlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "image      {}x{}, kernel {:?}, {:?}", self.width, self.height, self.kernel, self.direction)?;
         match &self.draw {
+            Draw::Surface { push, .. } => {
+                writeln!(
+                    f,
+                    "draw       the isosurface at {}: a disc per cell it crosses, made on the device each frame",
+                    push.iso
+                )?;
+                writeln!(f, "order      none (the nearest disc per pixel, and those within {} of it)", push.band)?;
+                writeln!(f, "raster     compute tiles, by depth")?;
+            }
             Draw::Projection { splats, raster, projection } => {
                 let mode = projection.mode;
                 let blend = if mode.takes_max() { "the largest" } else { "summed" };
@@ -309,6 +371,7 @@ fn write_raster(f: &mut fmt::Formatter<'_>, raster: &SplatRaster) -> fmt::Result
                 TileOrder::Terminating => "front to back, ending opaque tiles",
                 TileOrder::Maximum => "keeping the maximum",
                 TileOrder::Sum => "summing",
+                TileOrder::Surface => "the nearest surface's discs",
             };
             let pages = if t.pages == Pages::One { "one page" } else { "two pages" };
             writeln!(

@@ -1,0 +1,65 @@
+// The isosurface stages' bindings and cells (issue 46), shared by iso_count, iso_scan and
+// iso_splats: the scene's values as 16-bit pairs (iso::IsoField), each voxel row's range, and per
+// row of cells its surface splats (counted, then scanned in place into first positions). A cell
+// (i, j, k) spans voxels i..=i+1, j..=j+1, k..=k+1 from -1 (voxels outside the grid hold 0, as in
+// the ray caster's field); its corner c is (c & 1, c >> 1 & 1, c >> 2). Mirror: cpu::iso_count.
+#include "types.glsl"
+
+layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
+layout(std430, binding = 1) readonly buffer IsoField { uint field[]; };
+layout(std430, binding = 2) readonly buffer IsoRows { uint row_range[]; };
+layout(std430, binding = 3) buffer IsoCounts { uint counts[]; };
+layout(push_constant) uniform Push {
+    float iso;        // normalised
+    uint threshold;   // a corner is inside when its quantised value is at least this
+    uint rows;        // rows of cells, (ny + 1)(nz + 1)
+    float band;       // the depth band the nearest surface's discs blend over (world units)
+} pc;
+
+const float ISO_Q = 65535.0;
+
+// The quantised value at voxel v, 0 outside the grid.
+uint iso_value(ivec3 v) {
+    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(frame.dims.xyz)))) return 0u;
+    uint i = uint(v.x) + frame.dims.x * (uint(v.y) + frame.dims.y * uint(v.z));
+    return (field[i >> 1u] >> (16u * (i & 1u))) & 0xffffu;
+}
+
+// Row r of cells: its (j, k).
+ivec2 cell_row(uint r) {
+    return ivec2(int(r % (frame.dims.y + 1u)) - 1, int(r / (frame.dims.y + 1u)) - 1);
+}
+
+// Whether row jk's cells can hold the surface: its four voxel rows hold a value inside and one
+// outside (a row outside the grid holds 0).
+bool row_crosses(ivec2 jk) {
+    uint lo = 0xffffu, hi = 0u;
+    for (int c = 0; c < 4; ++c) {
+        ivec2 v = jk + ivec2(c & 1, c >> 1);
+        if (v.x < 0 || v.y < 0 || v.x >= int(frame.dims.y) || v.y >= int(frame.dims.z)) {
+            lo = 0u;
+            continue;
+        }
+        uint r = row_range[uint(v.x) + frame.dims.y * uint(v.y)];
+        lo = min(lo, r & 0xffffu);
+        hi = max(hi, r >> 16u);
+    }
+    return lo < pc.threshold && hi >= pc.threshold;
+}
+
+// The four values of the face x = i of row jk's cells (corner order: dy + 2 dz).
+uvec4 iso_face(int i, ivec2 jk) {
+    return uvec4(iso_value(ivec3(i, jk.x, jk.y)), iso_value(ivec3(i, jk.x + 1, jk.y)),
+                 iso_value(ivec3(i, jk.x, jk.y + 1)), iso_value(ivec3(i, jk.x + 1, jk.y + 1)));
+}
+
+// The inside bits of a cell's eight corners from its faces x = i (f0) and x = i + 1 (f1).
+uint inside_bits(uvec4 f0, uvec4 f1) {
+    uint m = 0u;
+    for (uint c = 0u; c < 4u; ++c) {
+        uint dy = c & 1u, dz = c >> 1u;
+        if (f0[c] >= pc.threshold) m |= 1u << (2u * dy + 4u * dz);
+        if (f1[c] >= pc.threshold) m |= 1u << (1u + 2u * dy + 4u * dz);
+    }
+    return m;
+}
