@@ -32,8 +32,8 @@ layout(constant_id = 2) const bool TERMINATE = false;  // front to back, pc.occl
 // Whether the frame is motion-blurred (else every splat's stretch is 0: one shuffle and the
 // stretch's arithmetic per pixel less).
 layout(constant_id = 3) const bool MOTION_BLUR = true;
-// A projection mode's blend (BLEND_*, types.glsl): order-independent, by maximum or sum; or the
-// isosurface's nearest discs (BLEND_SURFACE).
+// A projection mode's blend (BLEND_*, types.glsl): order-independent, by maximum or sum; or one of
+// the isosurface's two passes (BLEND_SURFACE_DEPTH, then BLEND_SURFACE over the same lists).
 layout(constant_id = 4) const uint PROJECT = BLEND_COMPOSITE;
 // The host's depth hides the splats behind it (frame.rect.w is then 1; a build of its own, since
 // llvmpipe pays for a branch on a uniform even where it is never taken: 4.5 % here).
@@ -48,9 +48,11 @@ layout(std430, binding = 18) readonly buffer HostDepth { float host_depth[]; };
 PAGED_READER(ScreenQuad, quads_at, quads_lo, quads_hi)
 
 const uint TILE_PIXELS = RASTER_TILE_W * RASTER_TILE_H;
-// The least weight, over a footprint's centre's, of a surface disc that hides the discs summed
-// behind it (mirror: cpu::tile_composite::SURFACE_RESET).
-const float SURFACE_RESET = 0.5;
+// The least weight, over a footprint's centre's, of a surface disc that makes a pixel's visible
+// depth (mirror: cpu::tile_composite::SURFACE_VISIBLE).
+const float SURFACE_VISIBLE = 0.1;
+// The first pass's depth where no disc is visible.
+const float NO_SURFACE = 3.0e38;
 // The tile's accumulators, pixel (x, y) of the tile at y * RASTER_TILE_W + x.
 shared vec4 tile_acc[TILE_PIXELS];
 
@@ -93,7 +95,7 @@ void main() {
     const bool btf = BACK_TO_FRONT;
     bool swept = MOTION_BLUR && frame.sweep.y != float(SWEEP_UNIFORM);
     const bool depth_test = HOST_DEPTH;
-    const bool surface = PROJECT == BLEND_SURFACE;
+    const bool surface = PROJECT == BLEND_SURFACE || PROJECT == BLEND_SURFACE_DEPTH;
     const bool terminate = !btf && TERMINATE;
     // Pixels still open, counted by the lanes that opened or closed them (only their sum means
     // anything).
@@ -101,7 +103,7 @@ void main() {
     for (uint t = lane; t < TILE_PIXELS; t += RASTER_LANES) {
         ivec2 xy = tile_pixel(t0, t);
         bool inside = all(lessThanEqual(xy, t1));
-        vec4 a = carry && inside ? imageLoad(accum, xy) : vec4(0.0);
+        vec4 a = carry && inside ? imageLoad(accum, xy) : vec4(0.0, 0.0, 0.0, PROJECT == BLEND_SURFACE_DEPTH ? NO_SURFACE : 0.0);
         tile_acc[t] = a;
         open += inside && (!terminate || 1.0 - a.a > pc.occluded) ? 1 : 0;
     }
@@ -202,18 +204,17 @@ void main() {
                     float w = sample_radial(s) / radial[0].x;
                     tile_acc[at] = max(a, vec4(q.emit.r * w, w, 0.0, 0.0));
                 } else if (live && surface) {
-                    // Surface splats (iso_splats): a disc nearer than the band (emit.a) at this
-                    // pixel (its plane's depth, from the depth's steps along u and v in inv0.w,
-                    // inv1.w) starts the sum afresh where it weighs at least SURFACE_RESET of a
-                    // centre's (a disc's fringe past a crease or a silhouette does not hide what
-                    // lies behind); discs within the band of the sum's nearest depth add their
-                    // weighed shading.
+                    // Surface splats (iso_splats), at their plane's depth here (the depth's steps
+                    // along u and v in inv0.w, inv1.w). First pass: the pixel's visible depth, the
+                    // nearest of the discs weighing at least SURFACE_VISIBLE of a centre's (a
+                    // disc's fringe past a crease or a silhouette hides nothing); second pass: the
+                    // discs within the band (emit.a) of it add their weighed shading.
                     float w = sample_radial(s);
                     float z = q.inv2.w + uv.x * q.inv0.w + uv.y * q.inv1.w;
-                    if (w > 0.0 && (a.z <= 0.0 || (z < a.w - q.emit.a && w >= SURFACE_RESET * radial[0].x))) {
-                        tile_acc[at] = vec4(q.emit.xy * w, w, z);
-                    } else if (w > 0.0 && z <= a.w + q.emit.a) {
-                        tile_acc[at] = vec4(a.xy + q.emit.xy * w, a.z + w, min(a.w, z));
+                    if (PROJECT == BLEND_SURFACE_DEPTH) {
+                        if (w >= SURFACE_VISIBLE * radial[0].x) tile_acc[at].w = min(a.w, z);
+                    } else if (w > 0.0 && abs(z - a.w) <= q.emit.a) {
+                        tile_acc[at] = vec4(a.xy + q.emit.xy * w, a.z + w, a.w);
                     }
                 } else if (live && PROJECT == BLEND_SUM) {
                     float d = q.emit.a * sample_radial(s);

@@ -142,9 +142,9 @@ impl Engine for Split<'_> {
             target_depth: a.target_depth.or(b.target_depth),
         }
     }
-    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
-        self.first.prepare_field(brick, projection)?;
-        self.second.prepare_field(brick, projection)
+    fn prepare_field(&mut self, brick: u32, mode: crate::options::Mode) -> Result<()> {
+        self.first.prepare_field(brick, mode)?;
+        self.second.prepare_field(brick, mode)
     }
     fn is_device(&self) -> bool {
         if self.switched {
@@ -245,8 +245,8 @@ impl Engine for Stop<'_> {
     fn limits(&self) -> Limits {
         self.inner.limits()
     }
-    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
-        self.inner.prepare_field(brick, projection)
+    fn prepare_field(&mut self, brick: u32, mode: crate::options::Mode) -> Result<()> {
+        self.inner.prepare_field(brick, mode)
     }
     fn is_device(&self) -> bool {
         self.inner.is_device()

@@ -3,7 +3,7 @@
 //! CPU engine the mirror's [`Variant`]). A dispatch names a [`Build`] value, never an index:
 //! `Dispatch::new` finds the value in the stage's table and refuses one the stage lacks.
 use crate::dispatch::{Blend, DrawState, Pass, Variant};
-use crate::gpu_types::{BLEND_MAX, BLEND_SUM, BLEND_SURFACE, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{BLEND_MAX, BLEND_SUM, BLEND_SURFACE, BLEND_SURFACE_DEPTH, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
 
 /// A stage's builds: the values a dispatch may name and, in the same order, what each is made of.
 #[derive(Debug)]
@@ -128,8 +128,11 @@ pub enum TileOrder {
     Maximum,
     /// A projection: in any order, summing (average, X-ray).
     Sum,
-    /// The isosurface's discs: per pixel the nearest's depth, those within a band of it summed.
+    /// The isosurface's discs, second pass: those within a band of each pixel's visible depth
+    /// summed.
     Surface,
+    /// The isosurface's discs, first pass: each pixel's visible depth.
+    SurfaceDepth,
 }
 
 impl TileOrder {
@@ -310,6 +313,7 @@ const fn tc_variant(pages: Pages, order: TileOrder, blur: bool, depth: bool) -> 
             TileOrder::Maximum => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_MAX, 1],
             TileOrder::Sum => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SUM, 1],
             TileOrder::Surface => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SURFACE, 1],
+            TileOrder::SurfaceDepth => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SURFACE_DEPTH, 1],
         };
         return v(defines, spec);
     }
@@ -325,6 +329,7 @@ const fn tc_variant(pages: Pages, order: TileOrder, blur: bool, depth: bool) -> 
         (TileOrder::Maximum, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_MAX],
         (TileOrder::Sum, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SUM],
         (TileOrder::Surface, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SURFACE],
+        (TileOrder::SurfaceDepth, _) => &[SHEET_MODE_SPLAT, 0, 0, 0, BLEND_SURFACE_DEPTH],
     };
     v(defines, spec)
 }
@@ -367,6 +372,10 @@ pub const TILE_COMPOSITE: Table = tile_composite![
     (One, Surface, false, false),
     (Two, Surface, false, true),
     (One, Surface, false, true),
+    (Two, SurfaceDepth, false, false),
+    (One, SurfaceDepth, false, false),
+    (Two, SurfaceDepth, false, true),
+    (One, SurfaceDepth, false, true),
 ];
 
 const fn st(mode: SheetMode, points: bool) -> Build {

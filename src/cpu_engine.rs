@@ -185,8 +185,8 @@ impl Engine for CpuEngine<'_> {
         false
     }
 
-    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
-        let field = self.b.prep.field_for(projection)?;
+    fn prepare_field(&mut self, brick: u32, mode: crate::options::Mode) -> Result<()> {
+        let field = self.b.prep.field_for(mode)?;
         self.b.bricks = field.brick_occupancy(brick.max(1)).1;
         Ok(())
     }

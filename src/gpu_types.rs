@@ -230,8 +230,11 @@ pub struct IsoPush {
 pub const BLEND_COMPOSITE: u32 = 0;
 pub const BLEND_MAX: u32 = 1;
 pub const BLEND_SUM: u32 = 2;
-/// The isosurface: per pixel the nearest disc's depth, the discs within a band of it summed.
+/// The isosurface's second pass: the discs within a band of each pixel's visible depth summed.
 pub const BLEND_SURFACE: u32 = 3;
+/// The isosurface's first pass: each pixel's visible depth, the nearest of the discs that weigh
+/// enough there.
+pub const BLEND_SURFACE_DEPTH: u32 = 4;
 
 /// Push constants of `composite.comp`.
 #[repr(C)]

@@ -84,6 +84,15 @@ impl IsoField {
         (self.words[v / 2] >> (16 * (v % 2))) & 0xffff
     }
 
+    /// The ray caster's field of it: (value, 1, 0, 0) per voxel (`plan::FieldKind::Iso`).
+    pub fn dense(&self) -> crate::volume::DenseField {
+        let n = self.dims.iter().map(|&d| d as usize).product::<usize>();
+        let values = (0..n)
+            .map(|v| [((self.words[v / 2] >> (16 * (v % 2))) & 0xffff) as f32 / ISO_Q, 1.0, 0.0, 0.0])
+            .collect();
+        crate::volume::DenseField { dims: self.dims, values }
+    }
+
     /// Device bytes: the values and the row ranges.
     pub fn bytes(&self) -> u64 {
         (self.words.len() + self.rows.len()) as u64 * 4

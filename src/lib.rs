@@ -548,7 +548,8 @@ impl Renderer {
 
     /// What pixel position (`x`, `y`) of `camera` shows (pixels from the top left corner; a
     /// pixel's centre at + 0.5): the first point along its ray where the accumulated opacity
-    /// passes [`PICK_OPACITY`], or in MIP and MinIP the point of the extreme value, with the voxel
+    /// passes [`PICK_OPACITY`], in MIP and MinIP the point of the extreme value, or in `Mode::Iso`
+    /// the ray's first crossing of the iso value (the ray caster's surface), with the voxel
     /// nearest it, its value and depth; `None` where the ray meets nothing. Computed on the host
     /// over the ray caster's trilinear field with `options`' mode and clipping, so it needs no
     /// frame; a bricked store is read where the ray passes, without a dense copy.
@@ -580,6 +581,7 @@ impl Renderer {
         if let Some(tf) = &options.colormap {
             tf.validate()?;
         }
+        options::check_iso(options.mode, options.iso)?;
         if !(0.0..1.0).contains(&options.min_transmittance) {
             return Err(Error::InvalidArgument("the ray caster's stopping transmittance must be in [0, 1)".into()));
         }
@@ -615,8 +617,10 @@ impl Renderer {
         if prep.set.coordinates().is_some() {
             return Err(Error::Unsupported("the ray caster samples a uniform grid, not a rectilinear one".into()));
         }
-        if prep.bricks.is_some() {
-            return Err(Error::Unsupported("the ray caster draws classified splat sets, not bricked volumes".into()));
+        if prep.bricks.is_some() && options.mode != Mode::Iso {
+            return Err(Error::Unsupported(
+                "the ray caster draws classified splat sets, not bricked volumes (but their isosurfaces)".into(),
+            ));
         }
         let recorded = match &mut self.gpu {
             Some(g) => recording::record_raycast(&mut g.engine(prep), prep, camera, options)?,

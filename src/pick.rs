@@ -41,13 +41,20 @@ pub fn pick(prep: &Prepared, camera: &Camera, opts: &RenderOptions, x: f32, y: f
             camera.width, camera.height
         )));
     }
+    if opts.mode == Mode::Iso {
+        // The isosurface's values: every voxel's, as the surface splats and the ray caster read them.
+        crate::options::check_iso(opts.mode, opts.iso)?;
+        let field = prep.iso_field()?;
+        let q = crate::iso::ISO_Q;
+        return march(prep, camera, opts, x, y, |i, j, k| [field.at(i, j, k) as f32 / q, 1.0, 0.0, 0.0]);
+    }
     match &prep.bricks {
         Some(scene) => {
             let voxel = bricked_voxel(scene)?;
             march(prep, camera, opts, x, y, voxel)
         }
         None => {
-            let field = prep.field_for(true)?;
+            let field = prep.field_for(Mode::Mip)?;
             march(prep, camera, opts, x, y, |i, j, k| field.at(i, j, k))
         }
     }
@@ -118,9 +125,21 @@ fn march(
     // Extreme modes: the best (key, t); else the transmittance so far.
     let (mut best, mut trans) = (None::<(f32, f32)>, 1.0f32);
     let mut hit = None;
+    // The isosurface: the first crossing from below (the ray caster's), refined between samples.
+    let iso = (opts.mode == Mode::Iso).then(|| opts.iso.unwrap_or(0.0));
+    let mut below = None::<(f32, f32)>;
     for s in 0..n {
         let t = ray.t0 + (s as f32 + 0.5) * step;
         let v = trilinear(&voxel, ray.index(t));
+        if let Some(iso) = iso {
+            if v[0] < iso {
+                below = Some((t, v[0]));
+            } else if let Some((tb, vb)) = below {
+                hit = Some(tb + (iso - vb) / (v[0] - vb) * (t - tb));
+                break;
+            }
+            continue;
+        }
         if v[3] <= 0.0 {
             continue;
         }

@@ -47,6 +47,30 @@ pub struct Prepared {
     projection_field: std::sync::OnceLock<crate::volume::DenseField>,
     /// The isosurface's field (`iso::IsoField`), built on its first frame.
     iso_field: std::sync::OnceLock<crate::iso::IsoField>,
+    /// The ray caster's isosurface field (`FieldKind::Iso`) on the CPU, likewise.
+    iso_dense: std::sync::OnceLock<crate::volume::DenseField>,
+}
+
+/// Which dense field the ray caster samples for a mode (`Prepared::field_for`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FieldKind {
+    /// (colour x tau, tau): compositing.
+    Composite,
+    /// (value, 1, 0, tau): the projections.
+    Projection,
+    /// (value, 1, 0, 0) from every voxel (`iso::IsoField`): the isosurface.
+    Iso,
+}
+
+impl FieldKind {
+    /// The field `mode` reads.
+    pub fn of(mode: crate::options::Mode) -> Self {
+        match mode {
+            crate::options::Mode::Composite => FieldKind::Composite,
+            crate::options::Mode::Iso => FieldKind::Iso,
+            _ => FieldKind::Projection,
+        }
+    }
 }
 
 impl Prepared {
@@ -68,6 +92,7 @@ impl Prepared {
             field: std::sync::OnceLock::new(),
             projection_field: std::sync::OnceLock::new(),
             iso_field: std::sync::OnceLock::new(),
+            iso_dense: std::sync::OnceLock::new(),
         }
     }
 
@@ -96,10 +121,19 @@ impl Prepared {
         Ok(self.iso_field.get_or_init(|| f))
     }
 
-    /// The ray caster's field for `projection` (a projection mode) or compositing, built once.
-    pub fn field_for(&self, projection: bool) -> Result<&crate::volume::DenseField> {
-        if !projection {
-            return self.dense_field();
+    /// The ray caster's field for `mode`, built once: compositing's (colour x tau, tau), the
+    /// projections' (value, 1, 0, tau) or the isosurface's (value, 1, 0, 0; `iso::IsoField`).
+    pub fn field_for(&self, mode: crate::options::Mode) -> Result<&crate::volume::DenseField> {
+        match FieldKind::of(mode) {
+            FieldKind::Composite => return self.dense_field(),
+            FieldKind::Iso => {
+                if let Some(f) = self.iso_dense.get() {
+                    return Ok(f);
+                }
+                let f = self.iso_field()?.dense();
+                return Ok(self.iso_dense.get_or_init(|| f));
+            }
+            FieldKind::Projection => {}
         }
         if let Some(f) = self.projection_field.get() {
             return Ok(f);

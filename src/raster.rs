@@ -95,6 +95,13 @@ fn swept(opts: &RenderOptions) -> bool {
 /// Resolve `opts.raster` for this frame; `Auto` becomes a concrete variant. Explicit choices are
 /// checked: points cannot stretch along a motion path nor exceed the device's point size.
 pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Device) -> Result<RasterChoice> {
+    if opts.mode == crate::options::Mode::Iso {
+        // RenderOptions::validate refuses the graphics rasters here.
+        return Ok(RasterChoice {
+            raster: Raster::Compute,
+            reason: "iso: surface splats blend by depth in the tile compositor".into(),
+        });
+    }
     let size = footprint_size(set, camera, opts);
     match opts.raster {
         Raster::Points => {

@@ -5,7 +5,7 @@
 //! written once, for every engine.
 mod bricked;
 mod gradients;
-use crate::builds::{CompositeLayers, Footprint, Only, SheetTiles, SlabBins};
+use crate::builds::{CompositeLayers, Footprint, Only, SheetTiles, SlabBins, TileOrder};
 use crate::camera::Camera;
 use crate::constants::{
     COMPOSITE_TILE, MAX_GPU_RAY_STEPS, RASTER_TILE_H, RASTER_TILE_W, TILE_BIN_WORKGROUP, TILE_SEGMENT,
@@ -381,7 +381,7 @@ fn record_surface(
         e.run(&Dispatch::new(StageId::IsoSplats, Only, groups_1d(rows), List::Order, bytes)?)?;
     }
     let mut rule = TileRule::plan(n, w, h, crate::order::Direction::FrontToBack, 0.0, false);
-    rule.composite.order = crate::builds::TileOrder::Surface;
+    rule.composite.order = TileOrder::Surface;
     rule.composite.depth = plan.depth.is_some();
     record_tiles(e, &plan.frame, &rule, w, h, false)?;
     record_project(e, projection, 1, w, h)?;
@@ -444,10 +444,19 @@ fn record_tiles(e: &mut dyn Engine, frame: &Frame, rule: &TileRule, w: u32, h: u
     let bytes = bytemuck::bytes_of(&push);
     e.run(&Dispatch::new(StageId::TileScatter, rule.pages, tile_chunk_groups(&push), List::Order, bytes)?)?;
     let build = rule.composite;
-    for segment in 0..longest.div_ceil(TILE_SEGMENT).max(1) {
-        let push = FootprintPush { first: segment, ..push };
-        let groups = tile_groups(StageId::TileComposite, w, h);
-        e.run(&Dispatch::new(StageId::TileComposite, build, groups, List::Order, bytemuck::bytes_of(&push))?)?;
+    // The isosurface walks the lists twice: each pixel's visible depth, then the discs at it.
+    let passes = if build.order == TileOrder::Surface {
+        let depth = crate::builds::TileComposite { order: TileOrder::SurfaceDepth, ..build };
+        vec![(depth, push), (build, FootprintPush { carry: 1, ..push })]
+    } else {
+        vec![(build, push)]
+    };
+    for (build, push) in passes {
+        for segment in 0..longest.div_ceil(TILE_SEGMENT).max(1) {
+            let push = FootprintPush { first: segment, ..push };
+            let groups = tile_groups(StageId::TileComposite, w, h);
+            e.run(&Dispatch::new(StageId::TileComposite, build, groups, List::Order, bytemuck::bytes_of(&push))?)?;
+        }
     }
     Ok(())
 }
@@ -551,7 +560,7 @@ pub fn record_raycast(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts
     let frame = plan::frame_for(&prep.set, camera, &RenderOptions::default());
     e.begin(&frame, crate::kernel::Kernel::Gaussian, w, h)?;
     let projection = opts.mode.is_projection();
-    e.prepare_field(opts.brick, projection)?;
+    e.prepare_field(opts.brick, opts.mode)?;
     let words: &[u32] = bytemuck::cast_slice(bytemuck::bytes_of(&params));
     e.ensure(Res::RaycastParams, words.len() as u64 * 4)?;
     e.upload(Res::RaycastParams, words)?;

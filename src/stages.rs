@@ -622,9 +622,10 @@ pub trait Engine {
     fn live(&self) -> Vec<Res>;
     /// What the frame's plan must respect on this engine.
     fn limits(&self) -> Limits;
-    /// Make the scene's dense field and its occupancy of `brick`-voxel bricks resident (the ray
-    /// caster's `Res::Field`, `Res::Bricks`; brick 0: no skipping).
-    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()>;
+    /// Make the scene's dense field for `mode` (`Prepared::field_for`) and its occupancy of
+    /// `brick`-voxel bricks resident (the ray caster's `Res::Field`, `Res::Bricks`; brick 0: no
+    /// skipping).
+    fn prepare_field(&mut self, brick: u32, mode: crate::options::Mode) -> Result<()>;
     /// Whether this is a device (host orders are then reported as `order_cpu`).
     fn is_device(&self) -> bool;
 }

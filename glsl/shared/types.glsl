@@ -118,9 +118,12 @@ const uint SWEEP_SLOTTED = 3u;   // tapered, each half of the shutter composited
 #define BLEND_COMPOSITE 0u
 #define BLEND_MAX 1u
 #define BLEND_SUM 2u
-// 3: the isosurface, per pixel (sum of w lambert, sum of w specular, sum of w, nearest depth) over
-// the discs within a depth band of the nearest (tile_composite).
+// 3 and 4: the isosurface's two passes over the same lists (tile_composite): 4 finds each pixel's
+// visible depth (w), the nearest plane depth of the discs that weigh at least SURFACE_VISIBLE of a
+// centre's there; 3 sums the discs within the depth band of it into (sum of w lambert, sum of w
+// specular, sum of w).
 #define BLEND_SURFACE 3u
+#define BLEND_SURFACE_DEPTH 4u
 
 #define AA_NONE 0.0
 #define AA_SWAN 1.0

@@ -232,7 +232,8 @@ fn hash01(seed: u64, x: u64, y: u64) -> f32 {
 
 pub(crate) fn stage(b: &mut Bindings<'_>, _: &Args, _: &Variant) -> Result<()> {
     let rc: RaycastParams = bytemuck::pod_read_unaligned(bytemuck::cast_slice(b.get::<u32>(Res::RaycastParams)));
-    let field = b.prep.field_for(rc.inv_spacing[3] != 0.0)?;
+    let mode = crate::options::Mode::ALL.into_iter().find(|m| m.code() == rc.inv_spacing[3] as u32).unwrap_or_default();
+    let field = b.prep.field_for(mode)?;
     b.accum = raycast(&rc, field, &b.bricks, None);
     Ok(())
 }

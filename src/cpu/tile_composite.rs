@@ -5,14 +5,19 @@ use super::ImageF32;
 use crate::constants::{RASTER_TILE_H, RASTER_TILE_W, TILE_SEGMENT};
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
-use crate::gpu_types::{FootprintPush, ScreenQuad, BLEND_COMPOSITE, BLEND_MAX, BLEND_SUM, BLEND_SURFACE};
+use crate::gpu_types::{
+    FootprintPush, ScreenQuad, BLEND_COMPOSITE, BLEND_MAX, BLEND_SUM, BLEND_SURFACE, BLEND_SURFACE_DEPTH,
+};
 use crate::plan::tile_grid;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-/// Mirror of `SURFACE_RESET`: the least weight, over a footprint's centre's, of a surface disc
-/// that hides the discs summed behind it.
-pub const SURFACE_RESET: f32 = 0.5;
+/// Mirror of `SURFACE_VISIBLE`: the least weight, over a footprint's centre's, of a surface disc
+/// that makes a pixel's visible depth.
+pub const SURFACE_VISIBLE: f32 = 0.1;
+
+/// Mirror of `NO_SURFACE`: the first pass's depth where no disc is visible.
+pub const NO_SURFACE: f32 = 3.0e38;
 
 /// Composite segment `push.first` of every tile's list into `image` (segment 0 overwrites it
 /// unless `push.carry` marks a later batch, later ones carry on from it), pixel by pixel: every pixel takes its tile's entries in list
@@ -45,7 +50,8 @@ pub fn tile_composite(
             return;
         }
         let end = list_end.min(begin + TILE_SEGMENT as usize);
-        let mut acc = if carry { *px } else { [0.0f32; 4] };
+        let empty = if project == BLEND_SURFACE_DEPTH { [0.0, 0.0, 0.0, NO_SURFACE] } else { [0.0f32; 4] };
+        let mut acc = if carry { *px } else { empty };
         for &splat in &entries[begin..end] {
             if terminate && 1.0 - acc[3] <= push.occluded {
                 break;
@@ -63,17 +69,19 @@ pub fn tile_composite(
             if depth_test && q.inv[2][3] > inputs.host_depth[i] {
                 continue;
             }
-            if project == BLEND_SURFACE {
-                // The nearest disc's plane depth here starts the sum afresh; discs within the band
-                // of it add (inv[0][3], inv[1][3]: the depth's steps along u and v).
+            if project == BLEND_SURFACE || project == BLEND_SURFACE_DEPTH {
+                // At the disc plane's depth here (inv[0][3], inv[1][3]: the depth's steps along u
+                // and v): the first pass keeps the nearest visible disc's, the second sums the
+                // discs within the band (emit[3]) of it.
                 let still = Sweep { stretch: 0.0, bend: 0.0, profile: inputs.frame.sweep[1] };
                 let w = footprint_value(inputs.table, uv, still, 1.0, false);
                 let z = q.inv[2][3] + uv.x * q.inv[0][3] + uv.y * q.inv[1][3];
-                let band = q.emit[3];
-                if w > 0.0 && (acc[2] <= 0.0 || (z < acc[3] - band && w >= SURFACE_RESET * inputs.table[0])) {
-                    acc = [q.emit[0] * w, q.emit[1] * w, w, z];
-                } else if w > 0.0 && z <= acc[3] + band {
-                    acc = [acc[0] + q.emit[0] * w, acc[1] + q.emit[1] * w, acc[2] + w, acc[3].min(z)];
+                if project == BLEND_SURFACE_DEPTH {
+                    if w >= SURFACE_VISIBLE * inputs.table[0] {
+                        acc[3] = acc[3].min(z);
+                    }
+                } else if w > 0.0 && (z - acc[3]).abs() <= q.emit[3] {
+                    acc = [acc[0] + q.emit[0] * w, acc[1] + q.emit[1] * w, acc[2] + w, acc[3]];
                 }
                 continue;
             }

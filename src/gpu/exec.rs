@@ -445,8 +445,8 @@ impl Engine for GpuEngine<'_> {
         true
     }
 
-    fn prepare_field(&mut self, brick: u32, projection: bool) -> Result<()> {
+    fn prepare_field(&mut self, brick: u32, mode: crate::options::Mode) -> Result<()> {
         self.flush()?;
-        self.gpu.upload_field(self.prep, brick, projection)
+        self.gpu.upload_field(self.prep, brick, mode)
     }
 }

@@ -86,11 +86,12 @@ impl Gpu {
 
     /// The dense field as a 3D texture and its brick occupancy for `brick`, built once per scene
     /// (the host copy is dropped after the upload).
-    pub(crate) fn upload_field(&mut self, prep: &Prepared, brick: u32, projection: bool) -> Result<()> {
+    pub(crate) fn upload_field(&mut self, prep: &Prepared, brick: u32, mode: crate::options::Mode) -> Result<()> {
+        let kind = crate::plan::FieldKind::of(mode);
         let scene = self.res.scene_mut()?;
-        let need_bricks = scene.bricks.as_ref().is_none_or(|(b, _)| *b != brick);
-        // One field at a time: a frame of the other kind replaces it.
-        if scene.field_projection != projection {
+        // One field at a time: a frame of another kind replaces it, with its bricks.
+        let need_bricks = scene.bricks.as_ref().is_none_or(|(b, _)| *b != brick) || scene.field_kind != kind;
+        if scene.field_kind != kind {
             scene.field = None;
         }
         if scene.field.is_some() && !need_bricks {
@@ -98,8 +99,12 @@ impl Gpu {
         }
         self.res.clear_sets();
         let scene = self.res.scene_mut()?;
-        scene.field_projection = projection;
-        let dense = if projection { DenseField::projection(&prep.set)? } else { DenseField::new(&prep.set)? };
+        scene.field_kind = kind;
+        let dense = match kind {
+            crate::plan::FieldKind::Composite => DenseField::new(&prep.set)?,
+            crate::plan::FieldKind::Projection => DenseField::projection(&prep.set)?,
+            crate::plan::FieldKind::Iso => prep.iso_field()?.dense(),
+        };
         if need_bricks {
             let (_, occ) = dense.brick_occupancy(brick.max(1));
             scene.bricks = None;

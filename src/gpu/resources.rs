@@ -31,7 +31,7 @@ pub struct SceneBuffers {
     /// flags): built on first use.
     pub field: Option<Image>,
     /// Whether `field` is the projection modes' (`DenseField::projection`).
-    pub field_projection: bool,
+    pub field_kind: crate::plan::FieldKind,
     pub bricks: Option<(u32, Buffer)>,
     /// A bricked volume's store: headers, masks, records, brick index (`Res::BrickHeaders`..).
     pub store: Option<[Buffer; 4]>,
@@ -163,7 +163,7 @@ impl Resources {
             ],
             ranks: storage(ctx, "sheet ranks", bytemuck::cast_slice(or_one(splats, &prep.ranks)))?,
             field: None,
-            field_projection: false,
+            field_kind: crate::plan::FieldKind::Composite,
             bricks: None,
             store: match &prep.bricks {
                 // At least one word each: a TF that leaves nothing must not make a zero-sized buffer.

@@ -371,7 +371,7 @@ fn write_raster(f: &mut fmt::Formatter<'_>, raster: &SplatRaster) -> fmt::Result
                 TileOrder::Terminating => "front to back, ending opaque tiles",
                 TileOrder::Maximum => "keeping the maximum",
                 TileOrder::Sum => "summing",
-                TileOrder::Surface => "the nearest surface's discs",
+                TileOrder::Surface | TileOrder::SurfaceDepth => "the visible surface's discs, in two passes",
             };
             let pages = if t.pages == Pages::One { "one page" } else { "two pages" };
             writeln!(
