@@ -1,5 +1,5 @@
 #version 450
-// Isosurface splats, pass 1 of 3 (Mode::Iso): one lane per row of cells counts the cells the iso
+// Isosurface splats, pass 1 of 4 (Mode::Iso): one lane per row of cells counts the cells the iso
 // value crosses (some corner inside, some outside), sliding a face of four values along x; rows
 // whose voxel rows' ranges cannot hold the value are skipped whole. Mirror: cpu::iso_count.
 layout(local_size_x = WORKGROUP_SIZE) in;

@@ -1,10 +1,10 @@
 #version 450
-// Isosurface splats, pass 3 of 3 (Mode::Iso): one lane per row of cells walks its cells again and
-// writes each crossed cell's surface splat at the row's first position + its rank: at the mean of
-// the cell's edge crossings moved onto the cell's trilinear surface (two Newton steps), a disc of
-// the footprint's radius in the tangent plane (axis_u, axis_v), its (Lambert, specular) shading in
-// emit.xy and the depth band in emit.a, its depth's steps along u and v in axis_v.w and screen.y
-// (the tile compositor's per-pixel depth). The draw list is the storage order.
+// Isosurface splats, pass 4 of 4 (Mode::Iso): one lane per surface splat (its cell from iso_cells)
+// makes the splat at the mean of the cell's edge crossings moved onto the cell's trilinear surface
+// (two Newton steps): a disc of ISO_DISC_VOXELS in the tangent plane (axis_u, axis_v), its
+// (Lambert, specular) shading in emit.xy and the depth band in emit.a, its depth's steps along u and
+// v in axis_v.w and screen.y (the tile compositor's per-pixel depth). The draw list is the storage
+// order.
 // Mirror: cpu::iso_splats.
 layout(local_size_x = WORKGROUP_SIZE) in;
 #include "iso.glsl"
@@ -54,46 +54,32 @@ SplatParams surface_params(vec3 c, vec3 g) {
 }
 
 void main() {
-    uint r = linear_invocation();
-    if (r >= pc.rows) return;
-    uint pos = counts[r];
-    if (counts[r + 1u] == pos) return;
-    ivec2 jk = cell_row(r);
-    uvec4 f0 = uvec4(0u);
-    for (int i = -1; i < int(frame.dims.x); ++i) {
-        uvec4 f1 = iso_face(i + 1, jk);
-        uint m = inside_bits(f0, f1);
-        if (m != 0u && m != 255u) {
-            float v[8];
-            for (uint c = 0u; c < 4u; ++c) {
-                uint dy = c & 1u, dz = c >> 1u;
-                v[2u * dy + 4u * dz] = float(f0[c]) / ISO_Q;
-                v[1u + 2u * dy + 4u * dz] = float(f1[c]) / ISO_Q;
-            }
-            // The mean of the edges' crossings, then onto the cell's surface.
-            vec3 sum = vec3(0.0);
-            float crossings = 0.0;
-            for (uint c = 0u; c < 8u; ++c) {
-                for (uint b = 1u; b < 8u; b <<= 1u) {
-                    if ((c & b) != 0u || ((m >> c) & 1u) == ((m >> (c | b)) & 1u)) continue;
-                    float t = clamp((pc.iso - v[c]) / (v[c | b] - v[c]), 0.0, 1.0);
-                    vec3 p0 = vec3(c & 1u, (c >> 1u) & 1u, (c >> 2u) & 1u);
-                    vec3 p1 = vec3((c | b) & 1u, ((c | b) >> 1u) & 1u, ((c | b) >> 2u) & 1u);
-                    sum += mix(p0, p1, t);
-                    crossings += 1.0;
-                }
-            }
-            vec3 p = sum / crossings;
-            for (int s = 0; s < 2; ++s) {
-                vec3 g = cell_gradient(v, p);
-                float gg = dot(g, g);
-                if (gg > 1e-12) p = clamp(p - (cell_value(v, p) - pc.iso) * g / gg, 0.0, 1.0);
-            }
-            vec3 at = vec3(i, jk.x, jk.y) + p;
-            params_store(pos, surface_params(grid_point(at), world_gradient(cell_gradient(v, p))));
-            order_out[pos] = pos;
-            pos++;
+    uint n = linear_invocation();
+    if (n >= pc.splats) return;
+    uvec2 cell = cells[n];
+    ivec3 c0 = ivec3(int(cell.x & 0xffffu), int(cell.x >> 16u), int(cell.y & 0xffffu)) - 1;
+    uint m = cell.y >> 16u;
+    float v[8];
+    for (int c = 0; c < 8; ++c) v[c] = float(iso_value(c0 + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1))) / ISO_Q;
+    // The mean of the edges' crossings, then onto the cell's surface.
+    vec3 sum = vec3(0.0);
+    float crossings = 0.0;
+    for (uint c = 0u; c < 8u; ++c) {
+        for (uint b = 1u; b < 8u; b <<= 1u) {
+            if ((c & b) != 0u || ((m >> c) & 1u) == ((m >> (c | b)) & 1u)) continue;
+            float t = clamp((pc.iso - v[c]) / (v[c | b] - v[c]), 0.0, 1.0);
+            vec3 p0 = vec3(c & 1u, (c >> 1u) & 1u, (c >> 2u) & 1u);
+            vec3 p1 = vec3((c | b) & 1u, ((c | b) >> 1u) & 1u, ((c | b) >> 2u) & 1u);
+            sum += mix(p0, p1, t);
+            crossings += 1.0;
         }
-        f0 = f1;
     }
+    vec3 p = sum / crossings;
+    for (int s = 0; s < 2; ++s) {
+        vec3 g = cell_gradient(v, p);
+        float gg = dot(g, g);
+        if (gg > 1e-12) p = clamp(p - (cell_value(v, p) - pc.iso) * g / gg, 0.0, 1.0);
+    }
+    params_store(n, surface_params(grid_point(vec3(c0) + p), world_gradient(cell_gradient(v, p))));
+    order_out[n] = n;
 }

@@ -80,6 +80,8 @@ pub enum Res {
     IsoRows,
     /// Per row of cells its surface splats, then (scanned) its first one, then the total.
     IsoCounts,
+    /// Per surface splat its cell and inside corners (`iso_cells`).
+    IsoCells,
     /// The host's depth buffer as it stores it (`DepthBuffer::texels`, row 0 at the top).
     HostDepthRaw,
     /// The host's depth as eye-space depth per pixel (`host_depth`), which hides the splats behind it.

@@ -224,6 +224,9 @@ pub struct IsoPush {
     pub rows: u32,
     /// The depth band (world units) over which the nearest surface's discs blend.
     pub band: f32,
+    /// The frame's surface splats (`iso_splats`' lanes; read back after `iso_scan`).
+    pub splats: u32,
+    pub pad: [u32; 3],
 }
 
 /// `project.comp`'s blend codes (glsl/shared/types.glsl `BLEND_*`): compositing, maximum, sum.
@@ -302,7 +305,7 @@ const _: () = assert!(std::mem::size_of::<Frame>() == 592);
 const _: () = assert!(std::mem::size_of::<CompositePush>() == 32);
 const _: () = assert!(std::mem::size_of::<PresentPush>() == 32);
 const _: () = assert!(std::mem::size_of::<ProjectPush>() == 32);
-const _: () = assert!(std::mem::size_of::<IsoPush>() == 16);
+const _: () = assert!(std::mem::size_of::<IsoPush>() == 32);
 const _: () = assert!(std::mem::size_of::<DepthPush>() == 80);
 const _: () = assert!(std::mem::size_of::<FootprintPush>() == 52);
 const _: () = assert!(std::mem::size_of::<RaycastParams>() == 368);

@@ -317,13 +317,13 @@ fn record_host_depth(e: &mut dyn Engine, plan: &FramePlan) -> Result<()> {
     e.run(&Dispatch::new(StageId::HostDepth, Only, groups, List::Order, bytemuck::bytes_of(&push))?)
 }
 
-/// Device bytes an isosurface frame holds per surface splat: its parameters (80), draw-list entry
-/// (4), screen quad (80) and about four tile entries.
-pub const SURFACE_BYTES_PER_SPLAT: u64 = 80 + 4 + 80 + 16;
+/// Device bytes an isosurface frame holds per surface splat: its cell (8), parameters (80),
+/// draw-list entry (4), screen quad (80) and about four tile entries.
+pub const SURFACE_BYTES_PER_SPLAT: u64 = 8 + 80 + 4 + 80 + 16;
 
 /// The isosurface: the scene's field uploaded on its first frame; the cells the value crosses
 /// counted per row (`iso_count`), their first positions scanned (`iso_scan`) and the total read
-/// back; a disc per cell (`iso_splats`); the discs blended by depth (`record_tiles`, the
+/// back; the cells listed (`iso_cells`); a disc per cell (`iso_splats`); the discs blended by depth (`record_tiles`, the
 /// `Surface` walk) and lit (`project`).
 fn record_surface(
     e: &mut dyn Engine,
@@ -377,8 +377,11 @@ fn record_surface(
     }
     e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
     e.ensure(Res::Order, n as u64 * 4)?;
+    e.ensure(Res::IsoCells, n as u64 * 8)?;
     if n > 0 {
-        e.run(&Dispatch::new(StageId::IsoSplats, Only, groups_1d(rows), List::Order, bytes)?)?;
+        e.run(&Dispatch::new(StageId::IsoCells, Only, groups_1d(rows), List::Order, bytes)?)?;
+        let push = IsoPush { splats: n, ..*push };
+        e.run(&Dispatch::new(StageId::IsoSplats, Only, groups_1d(n), List::Order, bytemuck::bytes_of(&push))?)?;
     }
     let mut rule = TileRule::plan(n, w, h, crate::order::Direction::FrontToBack, 0.0, false);
     rule.composite.order = TileOrder::Surface;

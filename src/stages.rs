@@ -117,7 +117,7 @@ const BRICK_GRADIENTS: &[Res] =
     &Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi);
 /// glsl/shared/iso.glsl's bindings and `iso_splats`' outputs.
 const ISO: &[Res] =
-    &[Res::Frame, Res::IsoField, Res::IsoRows, Res::IsoCounts, Res::Params, Res::ParamsHi, Res::Order];
+    &[Res::Frame, Res::IsoField, Res::IsoRows, Res::IsoCounts, Res::Params, Res::ParamsHi, Res::Order, Res::IsoCells];
 const ISO_PUSH: u32 = std::mem::size_of::<IsoPush>() as u32;
 const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
 const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
@@ -460,6 +460,16 @@ stages! {
         writes: &[Res::IsoCounts],
         push: ISO_PUSH,
         workgroup: Workgroup::Single(crate::constants::SCAN_WORKGROUP_SIZE),
+        timing: "iso",
+        device_build: None,
+        builds: &builds::ONLY,
+    },
+    iso_cells => IsoCells {
+        kind: Kind::Compute,
+        bindings: ISO,
+        writes: &[Res::IsoCells],
+        push: ISO_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "iso",
         device_build: None,
         builds: &builds::ONLY,

@@ -19,13 +19,19 @@ pub(crate) struct RenderArgs {
     background: Option<[f32; 4]>,
     /// What each pixel shows of its ray: emission and absorption composited in order (the default);
     /// the largest value (mip) or the smallest (minip), each mapped through --colormap; the mean
-    /// value (average); or an X-ray (the extinction summed along the ray, a radiograph). The
-    /// projections need no visibility order and read every voxel (no levels of detail or early
-    /// termination); --raycast casts in the same mode.
-    #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray"])]
+    /// value (average); an X-ray (the extinction summed along the ray, a radiograph); or the
+    /// surface where the values cross --iso (iso: shaded discs on the surface, whatever --tf
+    /// draws). The projections need no visibility order and read every voxel (no levels of detail
+    /// or early termination); --raycast casts in the same mode.
+    #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray", "iso"])]
     mode: String,
-    /// The colours of --mode mip, minip, average and xray: a transfer function preset or TOML file
-    /// (its colours over the values 0 to 1; --tf still picks the voxels drawn) [default: grey].
+    /// The value of --mode iso's surface, in the volume file's units (a built-in scene's values lie
+    /// in 0 to 1). A value the data never crosses draws nothing, and says so.
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    iso: Option<f32>,
+    /// The colours of --mode mip, minip, average and xray (a transfer function preset or TOML file:
+    /// its colours over the values 0 to 1; --tf still picks the voxels drawn) [default: grey]; with
+    /// --mode iso, the surface takes the colour at its value [default: bone].
     #[arg(long)]
     colormap: Option<String>,
     /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
@@ -156,14 +162,28 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         }
     } else if a.colormap.is_some() {
         return Err(Error::InvalidArgument(
-            "--colormap colours --mode mip, minip, average or xray; a composited frame takes its colours from --tf"
+            "--colormap colours --mode mip, minip, average, xray or iso; a composited frame takes its colours from \
+             --tf"
                 .into(),
         ));
     }
-    // A volume is a bricked store classified on the device unless a mode needs host splats.
-    let host_splats = order != OrderKind::Pbtf || a.truth || a.raycast.is_some() || a.k_line;
+    match (mode, a.iso) {
+        (voxsplat::Mode::Iso, None) => {
+            return Err(Error::InvalidArgument("--mode iso needs the surface's value: --iso VALUE".into()))
+        }
+        (m, Some(_)) if m != voxsplat::Mode::Iso => {
+            return Err(Error::InvalidArgument(format!("--iso sets --mode iso's surface, not --mode {m}'s")))
+        }
+        _ => {}
+    }
+    // A volume is a bricked store classified on the device unless a mode needs host splats (the
+    // ray caster reads a bricked store's isosurface).
+    let cast_splats = a.raycast.is_some() && mode != voxsplat::Mode::Iso;
+    let host_splats = order != OrderKind::Pbtf || a.truth || cast_splats || a.k_line;
     let mut opts = RenderOptions::default();
     opts.mode = mode;
+    // In the file's units until the scene is open (then its store's normalisation).
+    opts.iso = a.iso;
     opts.colormap = a.colormap.as_deref().map(load_tf).transpose()?;
     opts.order = order;
     opts.composite = composite;
@@ -204,9 +224,32 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         if a.plan {
             return Err(Error::InvalidArgument("--plan prints one renderer's plan: run it without mpirun".into()));
         }
+        if mode == voxsplat::Mode::Iso {
+            return Err(Error::Unsupported("--mode iso draws on one renderer: run it without mpirun".into()));
+        }
         return render_distributed(&a, &opts, host_splats);
     }
     let (bricked, set, content) = open(&a.scene, host_splats)?;
+    // --iso in the file's units: the bricked store's normalisation (its values' range).
+    let iso_range = match (&bricked, a.iso) {
+        (Some(b), Some(v)) => {
+            let (lo, hi) = b.store.range;
+            opts.iso = Some(if hi > lo { (v - lo) / (hi - lo) } else { v - lo });
+            Some((lo, hi))
+        }
+        (None, Some(_)) if a.scene.volume.is_some() => {
+            return Err(Error::InvalidArgument(
+                "--mode iso reads a volume file's values from its bricked store: drop --dense, --labels, --channel \
+                 and --positions"
+                    .into(),
+            ))
+        }
+        (None, Some(v)) => {
+            opts.iso = Some(v);
+            None
+        }
+        _ => None,
+    };
     let asked =
         if a.lod_nodes { Some("--lod-nodes") } else { a.lod.as_deref().filter(|l| *l == "auto").map(|_| "--lod auto") };
     if let Some(flag) = asked.filter(|_| bricked.is_none() || composite != Composite::Splat) {
@@ -262,6 +305,7 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
                 let mut o = voxsplat::RaycastOptions {
                     mode,
                     colormap: opts.colormap.clone(),
+                    iso: opts.iso,
                     step,
                     render_scale: a.render_scale,
                     clip: opts.clip,
@@ -283,6 +327,7 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         report_validation(&r)?;
         f
     };
+    let empty = frame.image.pixels.iter().all(|p| p[3] == 0.0);
     let mut image = frame.image;
     if let (Some(bg), true) = (a.background, a.truth || a.raycast.is_some()) {
         // The reference renderers have no present stage: its mirror, on the host.
@@ -299,6 +344,12 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     voxsplat::output::write_image(&image, &out)?;
     let what = if r_bricked { "stored voxels" } else { "splats" };
     eprintln!("{splats} {what} -> {}", out.display());
+    if let Some(v) = a.iso.filter(|_| empty) {
+        let range = iso_range.map(|(lo, hi)| format!(" (its values lie in {lo} .. {hi})")).unwrap_or_default();
+        eprintln!("--iso {v}: the surface is not in view, or the data never crosses it{range}: nothing drawn");
+    } else if mode == voxsplat::Mode::Iso && a.raycast.is_none() {
+        eprintln!("isosurface: {} surface splats", frame.stats.splats);
+    }
     if let Some(c) = &frame.raster {
         eprintln!("raster: {} ({})", c.raster, c.reason);
     }

@@ -9,11 +9,17 @@ layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 1) readonly buffer IsoField { uint field[]; };
 layout(std430, binding = 2) readonly buffer IsoRows { uint row_range[]; };
 layout(std430, binding = 3) buffer IsoCounts { uint counts[]; };
+// Per surface splat its cell: i + 1 | (j + 1) << 16, k + 1 | inside bits << 16 (iso_cells).
+layout(std430, binding = 7) buffer IsoCells { uvec2 cells[]; };
 layout(push_constant) uniform Push {
     float iso;        // normalised
     uint threshold;   // a corner is inside when its quantised value is at least this
     uint rows;        // rows of cells, (ny + 1)(nz + 1)
     float band;       // the depth band the nearest surface's discs blend over (world units)
+    uint splats;      // the frame's surface splats (iso_splats' lanes)
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } pc;
 
 const float ISO_Q = 65535.0;

@@ -89,16 +89,15 @@ pub fn surface_params(frame: &Frame, c: Vec3, g: Vec3, band: f32) -> SplatParams
     }
 }
 
-/// The surface splat of crossed cell (i, j, k) (`bits`: its inside corners) whose faces x = i and
-/// x = i + 1 hold `f0`, `f1`.
-pub fn cell_splat(inputs: &IsoInputs<'_>, (i, j, k): (i32, i32, i32), f0: [u32; 4], f1: [u32; 4], m: u32) -> SplatParams {
+/// The surface splat of crossed cell `cell` (as `iso_cells` lists it).
+pub fn cell_splat(inputs: &IsoInputs<'_>, cell: [u32; 2]) -> SplatParams {
     let iso = inputs.push.iso;
-    let mut v = [0.0f32; 8];
-    for c in 0..4 {
-        let (dy, dz) = (c & 1, c >> 1);
-        v[2 * dy + 4 * dz] = f0[c] as f32 / crate::iso::ISO_Q;
-        v[1 + 2 * dy + 4 * dz] = f1[c] as f32 / crate::iso::ISO_Q;
-    }
+    let c0 = [(cell[0] & 0xffff) as i32 - 1, (cell[0] >> 16) as i32 - 1, (cell[1] & 0xffff) as i32 - 1];
+    let m = cell[1] >> 16;
+    let v: [f32; 8] = std::array::from_fn(|c| {
+        inputs.value(c0[0] + (c & 1) as i32, c0[1] + (c >> 1 & 1) as i32, c0[2] + (c >> 2 & 1) as i32) as f32
+            / crate::iso::ISO_Q
+    });
     let (mut sum, mut crossings) = (Vec3::ZERO, 0.0f32);
     for c in 0..8 {
         for b in [1usize, 2, 4] {
@@ -118,51 +117,31 @@ pub fn cell_splat(inputs: &IsoInputs<'_>, (i, j, k): (i32, i32, i32), f0: [u32; 
             p = (p - (cell_value(&v, p) - iso) * g / gg).clamp(Vec3::ZERO, Vec3::ONE);
         }
     }
-    let at = Vec3::new(i as f32, j as f32, k as f32) + p;
+    let at = Vec3::new(c0[0] as f32, c0[1] as f32, c0[2] as f32) + p;
     let frame = inputs.frame;
     surface_params(frame, frame_grid(frame).point(at), world_gradient(frame, cell_gradient(&v, p)), inputs.push.band)
 }
 
-/// Every row's surface splats at its first position (`counts`, scanned), and the draw list.
-pub fn iso_splats(inputs: &IsoInputs<'_>, counts: &[u32], params: &mut [SplatParams], order: &mut [u32]) {
-    let rows = inputs.push.rows as usize;
-    // Rows own disjoint runs of the outputs: split them at the rows' first positions.
-    let mut runs = Vec::with_capacity(rows);
-    let (mut p_rest, mut o_rest) = (params, order);
-    for r in 0..rows {
-        let n = (counts[r + 1] - counts[r]) as usize;
-        let (p, pr) = p_rest.split_at_mut(n);
-        let (o, or) = o_rest.split_at_mut(n);
-        (p_rest, o_rest) = (pr, or);
-        if n > 0 {
-            runs.push((r as u32, p, o));
-        }
+/// Every surface splat from its cell, and the draw list (the storage order).
+pub fn iso_splats(inputs: &IsoInputs<'_>, cells: &[[u32; 2]], params: &mut [SplatParams], order: &mut [u32]) {
+    params.par_iter_mut().zip(cells).for_each(|(p, &cell)| *p = cell_splat(inputs, cell));
+    for (i, o) in order.iter_mut().enumerate() {
+        *o = i as u32;
     }
-    runs.into_par_iter().for_each(|(r, p, o)| {
-        let (j, k) = inputs.cell_row(r);
-        let first = counts[r as usize];
-        let mut at = 0;
-        inputs.crossed(r, |i, f0, f1, m| {
-            p[at] = cell_splat(inputs, (i, j, k), f0, f1, m);
-            o[at] = first + at as u32;
-            at += 1;
-        });
-    });
 }
 
 pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
-    let counts = b.take(Res::IsoCounts);
     let mut params_words = b.take(Res::Params);
     let mut order = b.take(Res::Order);
     {
         let inputs =
             IsoInputs { field: b.get(Res::IsoField), rows: b.get(Res::IsoRows), frame: &b.frame, push: d.push_as() };
-        let n = counts[inputs.push.rows as usize] as usize;
+        let n = inputs.push.splats as usize;
         let words = std::mem::size_of::<SplatParams>() / 4;
         let params: &mut [SplatParams] = bytemuck::cast_slice_mut(&mut params_words[..n * words]);
-        iso_splats(&inputs, &counts, params, &mut order[..n]);
+        let cells: &[[u32; 2]] = &b.get::<[u32; 2]>(Res::IsoCells)[..n];
+        iso_splats(&inputs, cells, params, &mut order[..n]);
     }
-    b.put(Res::IsoCounts, counts);
     b.put(Res::Params, params_words);
     b.put(Res::Order, order);
     Ok(())

@@ -16,6 +16,7 @@ pub mod composite;
 pub mod footprint;
 pub mod footprint_sum;
 pub mod host_depth;
+pub mod iso_cells;
 pub mod iso_count;
 pub mod iso_scan;
 pub mod iso_splats;

@@ -287,6 +287,7 @@ fn surface(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<(Fr
         rows: (dims[1] + 1) * (dims[2] + 1),
         // One voxel length: the footprint's world radius over its radius in voxels.
         band: ISO_BAND_VOXELS * frame.spacing[3] / frame.origin[3],
+        ..Default::default()
     };
     let projection = Projection::of(opts).ok_or_else(|| Error::InvalidArgument("--mode iso: no surface".into()))?;
     Ok((frame, Draw::Surface { push, projection }))
