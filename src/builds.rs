@@ -3,7 +3,10 @@
 //! CPU engine the mirror's [`Variant`]). A dispatch names a [`Build`] value, never an index:
 //! `Dispatch::new` finds the value in the stage's table and refuses one the stage lacks.
 use crate::dispatch::{Blend, DrawState, Pass, Variant};
-use crate::gpu_types::{BLEND_MAX, BLEND_SUM, BLEND_SURFACE, BLEND_SURFACE_DEPTH, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB, SHEET_MODE_SPLAT};
+use crate::gpu_types::{
+    BLEND_MAX, BLEND_SUM, BLEND_SURFACE, BLEND_SURFACE_DEPTH, SHEET_MODE_AXIS, SHEET_MODE_BINNED, SHEET_MODE_SLAB,
+    SHEET_MODE_SPLAT,
+};
 
 /// A stage's builds: the values a dispatch may name and, in the same order, what each is made of.
 #[derive(Debug)]

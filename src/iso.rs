@@ -87,9 +87,8 @@ impl IsoField {
     /// The ray caster's field of it: (value, 1, 0, 0) per voxel (`plan::FieldKind::Iso`).
     pub fn dense(&self) -> crate::volume::DenseField {
         let n = self.dims.iter().map(|&d| d as usize).product::<usize>();
-        let values = (0..n)
-            .map(|v| [((self.words[v / 2] >> (16 * (v % 2))) & 0xffff) as f32 / ISO_Q, 1.0, 0.0, 0.0])
-            .collect();
+        let values =
+            (0..n).map(|v| [((self.words[v / 2] >> (16 * (v % 2))) & 0xffff) as f32 / ISO_Q, 1.0, 0.0, 0.0]).collect();
         crate::volume::DenseField { dims: self.dims, values }
     }
 

@@ -21,8 +21,8 @@ mod pass;
 pub mod slab;
 pub use bricked::{bricked_min_budget, bricked_resident_bytes, BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT};
 pub use frame::{
-    color_map, frame, mode_color_map, DepthSource, Draw, FramePlan, OrderSource, Projection, SplatRaster, ISO_BAND_VOXELS,
-    ISO_COLOR,
+    color_map, frame, mode_color_map, DepthSource, Draw, FramePlan, OrderSource, Projection, SplatRaster,
+    ISO_BAND_VOXELS, ISO_COLOR,
 };
 pub use layout::*;
 pub use pass::{sheet_layers, sheet_pass, SheetPass, TileRule};
@@ -394,7 +394,12 @@ pub fn raycast_params(set: &SplatSet, camera: &Camera, opts: &RaycastOptions) ->
         inv_shear: [inv_shear[0], inv_shear[1], inv_shear[2], opts.iso.unwrap_or(0.0)],
         dims: [g.dims[0], g.dims[1], g.dims[2], opts.max_steps],
         // The isosurface reads values where nothing is drawn: no empty-space skipping.
-        image: [camera.width, camera.height, if opts.mode == crate::options::Mode::Iso { 0 } else { opts.brick }, clip_count],
+        image: [
+            camera.width,
+            camera.height,
+            if opts.mode == crate::options::Mode::Iso { 0 } else { opts.brick },
+            clip_count,
+        ],
         clip,
     }
 }

@@ -34,11 +34,7 @@ fn iso(v: f32) -> RenderOptions {
 }
 
 fn cast(v: f32) -> RaycastOptions {
-    let mut o = RaycastOptions::default();
-    o.mode = Mode::Iso;
-    o.iso = Some(v);
-    o.step = 0.25;
-    o
+    RaycastOptions { mode: Mode::Iso, iso: Some(v), step: 0.25, ..Default::default() }
 }
 
 fn opaque(img: &ImageF32) -> Vec<bool> {
@@ -170,7 +166,8 @@ fn a_bricked_volume_draws_the_surface_of_its_dense_set() {
     let (worst, mean) = common::diff(&ra.image, &rb.image);
     assert!(worst < 0.02 && mean < 1e-3, "ray-cast bricked against dense: {worst} {mean}");
     // Picking meets the same surface.
-    let (pa, pb) = (bricked.pick(&cam, &iso(0.5 / max), 36.0, 36.0).unwrap(), dense.pick(&cam, &iso(0.5), 36.0, 36.0).unwrap());
+    let (pa, pb) =
+        (bricked.pick(&cam, &iso(0.5 / max), 36.0, 36.0).unwrap(), dense.pick(&cam, &iso(0.5), 36.0, 36.0).unwrap());
     let (pa, pb) = (pa.expect("bricked pick"), pb.expect("dense pick"));
     assert!((pa.depth - pb.depth).abs() < 1e-2, "{} {}", pa.depth, pb.depth);
     assert_clean(&bricked);
@@ -224,4 +221,3 @@ fn refusals() {
     c.iso = None;
     assert!(r.raycast(&cam, &c).is_err());
 }
-

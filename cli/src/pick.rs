@@ -9,9 +9,13 @@ pub(crate) struct PickArgs {
     #[arg(long, value_parser = parse_floats::<2>)]
     at: [f32; 2],
     /// As `render --mode`: composite (the first point where the opacity passes one half), mip or
-    /// minip (the point of the largest or smallest value), average or xray (as composite).
-    #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray"])]
+    /// minip (the point of the largest or smallest value), average or xray (as composite), iso
+    /// (the first crossing of --iso).
+    #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray", "iso"])]
     mode: String,
+    /// As `render --iso`: --mode iso's value, in the volume file's units.
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    iso: Option<f32>,
 }
 
 /// Runs `voxsplat pick`.
@@ -20,6 +24,7 @@ pub(crate) fn pick(a: PickArgs) -> Result<()> {
     opts.mode = a.mode.parse()?;
     // As render opens it: a volume as a bricked store, read where the ray passes.
     let (bricked, set, content) = open(&a.scene, false)?;
+    opts.iso = super::render::normalised_iso(bricked.as_ref(), &a.scene, a.iso)?;
     let cam = camera_of(&a.scene, set.grid(), &content)?;
     let [x, y] = a.at;
     if !(x >= 0.0 && y >= 0.0 && x < cam.width as f32 && y < cam.height as f32) {
@@ -41,7 +46,9 @@ pub(crate) fn pick(a: PickArgs) -> Result<()> {
             println!("pixel      {x},{y}");
             println!("point      {:.4} {:.4} {:.4} (the grid's world frame)", p.world.x, p.world.y, p.world.z);
             println!("voxel      {} {} {}", p.voxel[0], p.voxel[1], p.voxel[2]);
-            println!("value      {:.6} (0 to 1 over the transfer function's range)", p.value);
+            let over =
+                if opts.mode == voxsplat::Mode::Iso { "the volume's values" } else { "the transfer function's range" };
+            println!("value      {:.6} (0 to 1 over {over})", p.value);
             println!("depth      {:.4} (along the view, from the eye)", p.depth);
         }
     }

@@ -231,25 +231,8 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     }
     let (bricked, set, content) = open(&a.scene, host_splats)?;
     // --iso in the file's units: the bricked store's normalisation (its values' range).
-    let iso_range = match (&bricked, a.iso) {
-        (Some(b), Some(v)) => {
-            let (lo, hi) = b.store.range;
-            opts.iso = Some(if hi > lo { (v - lo) / (hi - lo) } else { v - lo });
-            Some((lo, hi))
-        }
-        (None, Some(_)) if a.scene.volume.is_some() => {
-            return Err(Error::InvalidArgument(
-                "--mode iso reads a volume file's values from its bricked store: drop --dense, --labels, --channel \
-                 and --positions"
-                    .into(),
-            ))
-        }
-        (None, Some(v)) => {
-            opts.iso = Some(v);
-            None
-        }
-        _ => None,
-    };
+    let iso_range = bricked.as_ref().map(|b| b.store.range);
+    opts.iso = normalised_iso(bricked.as_ref(), &a.scene, a.iso)?;
     let asked =
         if a.lod_nodes { Some("--lod-nodes") } else { a.lod.as_deref().filter(|l| *l == "auto").map(|_| "--lod auto") };
     if let Some(flag) = asked.filter(|_| bricked.is_none() || composite != Composite::Splat) {
@@ -344,11 +327,14 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     voxsplat::output::write_image(&image, &out)?;
     let what = if r_bricked { "stored voxels" } else { "splats" };
     eprintln!("{splats} {what} -> {}", out.display());
-    if let Some(v) = a.iso.filter(|_| empty) {
+    if let Some(v) = a.iso {
         let range = iso_range.map(|(lo, hi)| format!(" (its values lie in {lo} .. {hi})")).unwrap_or_default();
-        eprintln!("--iso {v}: the surface is not in view, or the data never crosses it{range}: nothing drawn");
-    } else if mode == voxsplat::Mode::Iso && a.raycast.is_none() {
-        eprintln!("isosurface: {} surface splats", frame.stats.splats);
+        let none = if a.raycast.is_some() { empty } else { frame.stats.splats == 0 };
+        if none {
+            eprintln!("--iso {v}: no cell of the data crosses it{range}: nothing drawn");
+        } else if a.raycast.is_none() {
+            eprintln!("isosurface: {} surface splats", frame.stats.splats);
+        }
     }
     if let Some(c) = &frame.raster {
         eprintln!("raster: {} ({})", c.raster, c.reason);
@@ -382,6 +368,30 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `--iso` (in the file's units) in the scene's normalised values: a bricked store's by its
+/// values' range; a built-in scene's as given. A volume file on the host path is refused (its
+/// classification normalises by the transfer function).
+pub(crate) fn normalised_iso(
+    bricked: Option<&voxsplat::bricks::BrickScene>,
+    scene: &SceneArgs,
+    iso: Option<f32>,
+) -> Result<Option<f32>> {
+    Ok(match (bricked, iso) {
+        (Some(b), Some(v)) => {
+            let (lo, hi) = b.store.range;
+            Some(if hi > lo { (v - lo) / (hi - lo) } else { v - lo })
+        }
+        (None, Some(_)) if scene.volume.is_some() => {
+            return Err(Error::InvalidArgument(
+                "--mode iso reads a volume file's values from its bricked store: drop --dense, --labels, --channel \
+                 and --positions"
+                    .into(),
+            ))
+        }
+        (_, v) => v,
+    })
 }
 
 /// The last of `frames` with each stage's median time over all of them, keeping one image at a

@@ -783,6 +783,56 @@ fn projection_modes_and_picking_from_the_command_line() {
 }
 
 #[test]
+fn isosurfaces_from_the_command_line() {
+    let dir = tmp("iso");
+    std::fs::create_dir_all(&dir).unwrap();
+    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/stent/stent.nrrd");
+    let png = dir.join("iso.png");
+    let p = png.to_str().unwrap();
+    // The stent's values lie in 0 .. 2000: its surface at 1000, in the file's units.
+    let base = ["render", "--volume", stent, "--size", "96x96", "--validation", "--mode", "iso", "--iso", "1000"];
+    for extra in [&[][..], &["--raycast", "0.5"][..]] {
+        let mut args = base.to_vec();
+        args.extend(extra.iter().copied());
+        args.extend(["--out", p]);
+        let out = voxsplat(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{extra:?}: {err}");
+        let img = image::open(&png).unwrap().to_rgba8();
+        assert!(img.pixels().filter(|px| px[3] > 128).count() > 100, "{extra:?}: the stent's surface is drawn");
+        assert!(extra.is_empty() == err.contains("surface splats"), "{err}");
+    }
+    // A value the data never crosses draws nothing and says so.
+    let out = voxsplat(&["render", "--volume", stent, "--size", "48x48", "--mode", "iso", "--iso", "5000", "--out", p]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("nothing drawn") && err.contains("0 .. 2000"), "{err}");
+    let img = image::open(&png).unwrap().to_rgba8();
+    assert!(img.pixels().all(|px| px[3] == 0));
+    // The plan, and a pick on the surface.
+    let out = voxsplat(&["render", "--volume", stent, "--mode", "iso", "--iso", "1000", "--size", "64x64", "--plan"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("isosurface at 0.5"), "{text}");
+    let out =
+        voxsplat(&["pick", "--volume", stent, "--mode", "iso", "--iso", "1000", "--size", "96x96", "--at", "50,50"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("voxel ") && text.contains("the volume's values"), "{text}");
+    // Flags that cannot apply are refused.
+    for (extra, says) in [
+        (vec!["--mode", "iso"], "--iso VALUE"),
+        (vec!["--mode", "mip", "--iso", "3"], "not --mode mip"),
+        (vec!["--mode", "iso", "--iso", "3", "--raster", "graphics"], "compute tile compositor"),
+        (vec!["--mode", "iso", "--iso", "3", "--dense"], "bricked store"),
+        (vec!["--mode", "iso", "--iso", "3", "--truth"], "--truth"),
+    ] {
+        let mut args = vec!["render", "--volume", stent, "--size", "32x32", "--out", p];
+        args.extend(extra.iter().copied());
+        let out = voxsplat(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{extra:?}: {err}");
+    }
+}
+
+#[test]
 fn labels_and_channels_from_the_command_line() {
     let dir = tmp("labels");
     std::fs::create_dir_all(&dir).unwrap();

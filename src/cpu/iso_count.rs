@@ -102,7 +102,8 @@ pub fn iso_count(inputs: &IsoInputs<'_>, counts: &mut [u32]) {
 
 pub(crate) fn stage(b: &mut Bindings<'_>, d: &Args, _: &Variant) -> Result<()> {
     let mut counts = b.take(Res::IsoCounts);
-    let inputs = IsoInputs { field: b.get(Res::IsoField), rows: b.get(Res::IsoRows), frame: &b.frame, push: d.push_as() };
+    let inputs =
+        IsoInputs { field: b.get(Res::IsoField), rows: b.get(Res::IsoRows), frame: &b.frame, push: d.push_as() };
     iso_count(&inputs, &mut counts);
     b.put(Res::IsoCounts, counts);
     Ok(())

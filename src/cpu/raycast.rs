@@ -179,15 +179,13 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                         let h = to_index(rc, a + dir * th - origin);
                         let cell = h.floor();
                         let (ci, cj, ck) = (cell.x as i64, cell.y as i64, cell.z as i64);
-                        let corner: [f32; 8] =
-                            std::array::from_fn(|c| field.at(ci + (c & 1) as i64, cj + (c >> 1 & 1) as i64, ck + (c >> 2 & 1) as i64)[0]);
+                        let corner: [f32; 8] = std::array::from_fn(|c| {
+                            field.at(ci + (c & 1) as i64, cj + (c >> 1 & 1) as i64, ck + (c >> 2 & 1) as i64)[0]
+                        });
                         let g = super::iso_splats::cell_gradient(&corner, h - cell);
                         let (is, ih) = (rc.inv_spacing, rc.inv_shear);
-                        let gw = Vec3::new(
-                            is[0] * g.x,
-                            ih[0] * g.x + is[1] * g.y,
-                            ih[1] * g.x + ih[2] * g.y + is[2] * g.z,
-                        );
+                        let gw =
+                            Vec3::new(is[0] * g.x, ih[0] * g.x + is[1] * g.y, ih[1] * g.x + ih[2] * g.y + is[2] * g.z);
                         let gl = gw.length();
                         acc = super::iso_splats::surface_light(if gl > 0.0 { gw / gl } else { -dir }, dir);
                         hit = 1.0;

@@ -83,9 +83,8 @@ impl std::fmt::Display for Mode {
 impl std::str::FromStr for Mode {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        Mode::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| Error::InvalidArgument(format!("unknown mode '{s}' (composite, mip, minip, average, xray, iso)")))
+        Mode::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            Error::InvalidArgument(format!("unknown mode '{s}' (composite, mip, minip, average, xray, iso)"))
+        })
     }
 }

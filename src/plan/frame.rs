@@ -275,7 +275,9 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
 fn surface(prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<(Frame, Draw)> {
     let set = &prep.set;
     if set.coordinates().is_some() {
-        return Err(Error::Unsupported("--mode iso: isosurfaces are extracted on a uniform grid, not a rectilinear one".into()));
+        return Err(Error::Unsupported(
+            "--mode iso: isosurfaces are extracted on a uniform grid, not a rectilinear one".into(),
+        ));
     }
     let iso = opts.iso.ok_or_else(|| Error::InvalidArgument("--mode iso needs an iso value (--iso VALUE)".into()))?;
     let mut frame = super::frame_for(set, camera, opts);
