@@ -16,8 +16,8 @@ pub struct IsoField {
     pub dims: [u32; 3],
     /// Two values a word: voxel v (x fastest) in word v / 2, the low half when v is even.
     pub words: Vec<u32>,
-    /// Per voxel row (j + ny k): its least value | its largest << 16 (rows the value never
-    /// crosses are skipped whole).
+    /// Per voxel row (j + ny k): its least value | its largest << 16 (rows of cells whose voxel
+    /// rows hold no value at or above the iso value are skipped whole).
     pub rows: Vec<u32>,
     /// The least and largest normalised value.
     pub range: (f32, f32),

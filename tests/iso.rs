@@ -73,51 +73,66 @@ fn gpu_matches_its_mirrors_and_the_ray_casters() {
     assert_clean(&g);
 }
 
+/// Pixels the rays hit (and their eight neighbours too) that the splats leave open.
+fn holes(splats: &[bool], rays: &[bool], w: usize, h: usize) -> usize {
+    let interior = |i: usize| {
+        let (x, y) = (i % w, i / w);
+        x > 0 && y > 0 && x + 1 < w && y + 1 < h && (0..9).all(|d| rays[(y + d / 3 - 1) * w + x + d % 3 - 1])
+    };
+    (0..w * h).filter(|&i| interior(i) && !splats[i]).count()
+}
+
 #[test]
 fn surface_lies_on_the_ray_casters_first_crossing_without_holes() {
-    // A ball of radius 40 voxels at iso 0.5: the sphere of radius 20. The discs reach past the
-    // silhouette by about r² / 2R (r: their radius, 1.25 voxels), so the coverage grows by about
-    // r² / R²: 0.4 % here (0.7 % at R = 15, measured).
+    // A ball of radius 40 voxels: at iso 0.5 the sphere of radius 20; at iso 0.3 the sphere of
+    // radius 28 cut by the grid's faces (creases where they meet, each cell of the cut a crossing
+    // with the 0 outside the grid). The discs reach past a silhouette by about r² / 2R (r: their
+    // radius, 1.25 voxels), so the coverage grows by about r² / R²: 0.4 % at R = 20 (0.7 % at
+    // R = 15, measured); the creases add a little.
     let set = ball(48, 40.0);
     let mut r = cpu();
     r.set_scene(set.clone()).unwrap();
-    for (name, cam) in views(set.grid(), 256) {
-        let o = iso(0.5);
-        let splats = r.render(&cam, &o).unwrap();
-        let rays = r.raycast(&cam, &cast(0.5)).unwrap();
-        let (s, t) = (opaque(&splats.image), opaque(&rays.image));
-        let (covered, truth) = (s.iter().filter(|&&b| b).count(), t.iter().filter(|&&b| b).count());
-        // Holes: pixels inside the rays' picture (they and their eight neighbours hit) that the
-        // splats leave open (the silhouette's pixels count in the coverage).
-        let (w, h) = (cam.width as usize, cam.height as usize);
-        let interior = |i: usize| {
-            let (x, y) = (i % w, i / w);
-            x > 0 && y > 0 && x + 1 < w && y + 1 < h && (0..9).all(|d| t[(y + d / 3 - 1) * w + x + d % 3 - 1])
-        };
-        let holes = (0..w * h).filter(|&i| interior(i) && !s[i]).count();
-        let excess = (covered as f64 - truth as f64).abs() / truth as f64;
-        println!("{name}: splats cover {covered} px, rays {truth}, holes {holes}, |difference| {excess:.4}");
-        assert!(truth > 1000, "{name}: the ball covers {truth} px");
-        assert!(excess <= 0.005, "{name}: coverage {covered} against the ray caster's {truth}");
-        assert_eq!(holes, 0, "{name}: pixels the rays hit and the splats leave open");
-        // Depth: the nearest discs' depth per pixel (the compositor's fourth channel) against the
-        // first crossing along the pixel's ray, over every pixel both cover.
-        let acc = r.probe(&cam, &o, StageId::TileComposite, &[Res::Accum]).unwrap().remove(0);
-        let (mut worst, mut n) = (0.0f32, 0);
-        for y in 0..h {
-            for x in 0..w {
-                let i = y * w + x;
-                if !(s[i] && t[i]) {
-                    continue;
-                }
-                let z = f32::from_bits(acc[4 * i + 3]);
-                let hit = r.pick(&cam, &o, x as f32 + 0.5, y as f32 + 0.5).unwrap().expect("the ray crosses");
-                worst = worst.max((z - hit.depth).abs());
-                n += 1;
-            }
+    for (v, most) in [(0.5f32, 0.005), (0.3, 0.01)] {
+        for (name, cam) in views(set.grid(), 256) {
+            let o = iso(v);
+            let splats = r.render(&cam, &o).unwrap();
+            let rays = r.raycast(&cam, &cast(v)).unwrap();
+            let (s, t) = (opaque(&splats.image), opaque(&rays.image));
+            let (w, h) = (cam.width as usize, cam.height as usize);
+            let (covered, truth) = (s.iter().filter(|&&b| b).count(), t.iter().filter(|&&b| b).count());
+            let open = holes(&s, &t, w, h);
+            let excess = (covered as f64 - truth as f64).abs() / truth as f64;
+            println!(
+                "iso {v}, {name}: splats cover {covered} px, rays {truth}, holes {open}, |difference| {excess:.4}"
+            );
+            assert!(truth > 1000, "{name}: the ball covers {truth} px");
+            assert!(excess <= most, "iso {v}, {name}: coverage {covered} against the ray caster's {truth}");
+            assert_eq!(open, 0, "iso {v}, {name}: pixels inside the rays' picture that the splats leave open");
+            // Depth: each pixel's visible depth (the compositor's fourth channel) against the
+            // first crossing along its ray, over every pixel both cover.
+            let acc = r.probe(&cam, &o, StageId::TileComposite, &[Res::Accum]).unwrap().remove(0);
+            let mut off: Vec<f32> = (0..w * h)
+                .filter(|&i| s[i] && t[i])
+                // (A ray that grazes a corner may cross between two of the ray caster's samples
+                // and none of picking's, or the other way round.)
+                .filter_map(|i| {
+                    let hit = r.pick(&cam, &o, (i % w) as f32 + 0.5, (i / w) as f32 + 0.5).unwrap()?;
+                    Some((f32::from_bits(acc[4 * i + 3]) - hit.depth).abs())
+                })
+                .collect();
+            off.sort_by(f32::total_cmp);
+            let (n, worst, p99) = (off.len(), off[off.len() - 1], off[off.len() * 99 / 100]);
+            println!(
+                "iso {v}, {name}: depth within {worst:.3} voxel of the first crossing over {n} px (99 %: {p99:.3})"
+            );
+            // Along a crease a disc's plane parts from the surface it meets (up to 2.57 voxels
+            // measured, on a few pixels: the depth band is 2); elsewhere within a voxel.
+            let most = if v == 0.5 { 1.0 } else { 3.0 };
+            assert!(
+                n > 1000 && worst <= most && p99 <= 1.0,
+                "iso {v}, {name}: depth off by {worst} voxels (99 %: {p99})"
+            );
         }
-        println!("{name}: depth within {worst:.3} voxel of the first crossing over {n} px");
-        assert!(n > 1000 && worst <= 1.0, "{name}: depth off by {worst} voxels");
     }
 }
 

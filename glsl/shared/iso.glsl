@@ -36,21 +36,16 @@ ivec2 cell_row(uint r) {
     return ivec2(int(r % (frame.dims.y + 1u)) - 1, int(r / (frame.dims.y + 1u)) - 1);
 }
 
-// Whether row jk's cells can hold the surface: its four voxel rows hold a value inside and one
-// outside (a row outside the grid holds 0).
+// Whether row jk's cells can hold the surface: one of its four voxel rows holds a value inside
+// (every row's end cells reach past the grid, whose 0 is outside for any threshold above 0).
 bool row_crosses(ivec2 jk) {
-    uint lo = 0xffffu, hi = 0u;
+    uint hi = 0u;
     for (int c = 0; c < 4; ++c) {
         ivec2 v = jk + ivec2(c & 1, c >> 1);
-        if (v.x < 0 || v.y < 0 || v.x >= int(frame.dims.y) || v.y >= int(frame.dims.z)) {
-            lo = 0u;
-            continue;
-        }
-        uint r = row_range[uint(v.x) + frame.dims.y * uint(v.y)];
-        lo = min(lo, r & 0xffffu);
-        hi = max(hi, r >> 16u);
+        if (v.x < 0 || v.y < 0 || v.x >= int(frame.dims.y) || v.y >= int(frame.dims.z)) continue;
+        hi = max(hi, row_range[uint(v.x) + frame.dims.y * uint(v.y)] >> 16u);
     }
-    return lo < pc.threshold && hi >= pc.threshold;
+    return pc.threshold > 0u && hi >= pc.threshold;
 }
 
 // The four values of the face x = i of row jk's cells (corner order: dy + 2 dz).

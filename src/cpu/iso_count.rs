@@ -38,18 +38,15 @@ impl IsoInputs<'_> {
     /// Mirror of `row_crosses`.
     pub fn row_crosses(&self, (j, k): (i32, i32)) -> bool {
         let (ny, nz) = (self.frame.dims[1] as i32, self.frame.dims[2] as i32);
-        let (mut lo, mut hi) = (0xffffu32, 0u32);
+        let mut hi = 0u32;
         for c in 0..4 {
             let (y, z) = (j + (c & 1), k + (c >> 1));
             if y < 0 || z < 0 || y >= ny || z >= nz {
-                lo = 0;
                 continue;
             }
-            let r = self.rows[(y + ny * z) as usize];
-            lo = lo.min(r & 0xffff);
-            hi = hi.max(r >> 16);
+            hi = hi.max(self.rows[(y + ny * z) as usize] >> 16);
         }
-        lo < self.push.threshold && hi >= self.push.threshold
+        self.push.threshold > 0 && hi >= self.push.threshold
     }
 
     /// Mirror of `iso_face`.

@@ -119,10 +119,11 @@ pub struct Projection {
     pub iso: f32,
 }
 
-/// The isosurface's depth band, in voxel lengths: the discs within it of a pixel's nearest blend
-/// (neighbouring discs of one surface agree to far less; a surface behind it lies a voxel or more
-/// further).
-pub const ISO_BAND_VOXELS: f32 = 1.0;
+/// The isosurface's depth band, in voxel lengths: the discs within it of a pixel's visible depth
+/// blend. Where two surfaces meet at a crease their discs' planes part by more than a voxel near
+/// it (one voxel left holes along the creases of a cut ball; two close them, and cost the bonsai
+/// 0.06 dB against the ray caster: 28.27 against 28.33 dB at 512², iso 60).
+pub const ISO_BAND_VOXELS: f32 = 2.0;
 
 /// The isosurface's colour where no colour map is given: bone.
 pub const ISO_COLOR: [f32; 4] = [0.93, 0.87, 0.78, 1.0];
