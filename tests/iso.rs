@@ -41,15 +41,18 @@ fn opaque(img: &ImageF32) -> Vec<bool> {
     img.pixels.iter().map(|p| p[3] >= 0.5).collect()
 }
 
-/// The views the comparisons take: the framing perspective, a close perspective, an oblique
-/// orthographic one.
+/// The views the comparisons take: the framing perspective, a close perspective, two oblique
+/// orthographic ones from opposite octants.
 fn views(grid: &Grid, size: u32) -> Vec<(&'static str, Camera)> {
     let framing = Camera::framing(grid, size, size);
     let close = voxsplat::scene::close_view(grid, size);
     let mut ortho = Camera::framing(grid, size, size);
     ortho.eye = Vec3::new(70.0, 45.0, 90.0);
     ortho.projection = voxsplat::Projection::Orthographic { height: grid.dims[1] as f32 * 1.3 };
-    vec![("framing", framing), ("close", close), ("ortho", ortho)]
+    // From the opposite octant: the grid's low faces.
+    let mut back = ortho;
+    back.eye = Vec3::new(-80.0, -40.0, -70.0);
+    vec![("framing", framing), ("close", close), ("ortho", ortho), ("back", back)]
 }
 
 #[test]
