@@ -140,6 +140,50 @@ fn surface_lies_on_the_ray_casters_first_crossing_without_holes() {
 }
 
 #[test]
+fn the_hosts_depth_hides_the_surface_behind_it() {
+    let set = ball(32, 28.0);
+    let (mut g, mut c) = (gpu(), cpu());
+    g.set_scene(set.clone()).unwrap();
+    c.set_scene(set.clone()).unwrap();
+    let cam = Camera::framing(set.grid(), 64, 64);
+    let plain = c.render(&cam, &iso(0.5)).unwrap();
+    let z = c.probe(&cam, &iso(0.5), StageId::TileComposite, &[Res::Accum]).unwrap().remove(0);
+    // A plane facing the camera through the front of the sphere (radius 14), 11 voxels before its
+    // centre: it hides the rim and leaves the middle.
+    let d = (voxsplat::glam::Vec3::ZERO - cam.eye).dot(cam.forward()) - 11.0;
+    let proj = cam.proj();
+    let clip = proj * voxsplat::glam::Vec4::new(0.0, 0.0, -d, 1.0);
+    let depth = voxsplat::DepthBuffer {
+        width: cam.width,
+        height: cam.height,
+        format: voxsplat::DepthFormat::D32,
+        texels: vec![(clip.z / clip.w).to_bits(); (cam.width * cam.height) as usize],
+        projection: proj,
+    };
+    let mut o = iso(0.5);
+    o.depth = Some(std::sync::Arc::new(depth));
+    let (a, b) = (g.render(&cam, &o).unwrap(), c.render(&cam, &o).unwrap());
+    assert_mirrors(&a.image, &b.image, "iso over the host's depth");
+    let (mut kept, mut hidden) = (0, 0);
+    for (i, (p, q)) in b.image.pixels.iter().zip(&plain.image.pixels).enumerate() {
+        let surface = f32::from_bits(z[4 * i + 3]);
+        if q[3] < 0.5 {
+            continue;
+        }
+        // The discs reach about their radius (1.25 voxels) either side of their centres' depth.
+        if surface < d - 2.0 {
+            assert!((0..4).all(|k| (p[k] - q[k]).abs() < 1e-4), "pixel {i}: in front of the host's plane, {p:?} {q:?}");
+            kept += 1;
+        } else if surface > d + 2.0 {
+            assert_eq!(p[3], 0.0, "pixel {i}: behind the host's plane");
+            hidden += 1;
+        }
+    }
+    assert!(kept > 100 && hidden > 100, "kept {kept}, hidden {hidden}");
+    assert_clean(&g);
+}
+
+#[test]
 fn a_new_iso_value_needs_no_new_upload() {
     let set = ball(32, 14.0);
     let mut g = gpu();
