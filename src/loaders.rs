@@ -204,20 +204,37 @@ const MAX_SPACING: f32 = 1e10;
 
 /// NRRD (attached or detached data, raw or gzip) as a dense volume.
 pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<ScalarVolume> {
-    let NrrdHeader {
-        dtype,
-        dims: d3,
-        voxels: n,
-        encoding,
-        big_endian: endian_big,
-        spacing,
-        data_file,
-        data_start,
-        orientation,
-    } = nrrd_header(bytes, what, MAX_VOXELS)?;
-    let enc = Some(encoding);
+    let (h, values) = nrrd_samples(bytes, dir, what)?;
+    if h.channels > 1 {
+        return Err(several_channels(what, h.channels));
+    }
+    Ok(ScalarVolume { dims: h.dims.map(|d| d as u32), spacing: h.spacing, values })
+}
+
+/// A 4-D NRRD's channels (a 3-D file's one volume), each a dense volume.
+pub fn nrrd_channels_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<Vec<ScalarVolume>> {
+    let (h, values) = nrrd_samples(bytes, dir, what)?;
+    let (n, c) = (h.voxels as usize, h.channels as usize);
+    let dims = h.dims.map(|d| d as u32);
+    Ok((0..c)
+        .map(|k| {
+            let values = if h.channel_first {
+                values.iter().skip(k).step_by(c).copied().collect()
+            } else {
+                values[k * n..(k + 1) * n].to_vec()
+            };
+            ScalarVolume { dims, spacing: h.spacing, values }
+        })
+        .collect())
+}
+
+/// An NRRD's header and samples (every channel's, in the file's order), decoded and checked.
+fn nrrd_samples(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<(NrrdHeader, Vec<f32>)> {
+    let h = nrrd_header(bytes, what, MAX_VOXELS)?;
+    let (dtype, n, endian_big, data_start) = (h.dtype, h.voxels * h.channels as u64, h.big_endian, h.data_start);
+    let enc = Some(h.encoding.clone());
     let need = n * dtype.size() as u64;
-    let payload: Vec<u8> = match &data_file {
+    let payload: Vec<u8> = match &h.data_file {
         Some(f) => {
             let dir = dir.ok_or_else(|| bad(what, "detached data file without a directory"))?;
             let p = dir.join(f);
@@ -236,10 +253,19 @@ pub fn nrrd_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<S
     };
     let mut values = decode(&data, n, dtype, endian_big, what)?;
     check_finite(&values, what)?;
-    if orientation.is_some_and(|o| o.flip_x()) {
-        nrrd::flip_rows(&mut values, d3[0] as usize);
+    if h.orientation.is_some_and(|o| o.flip_x()) {
+        // Rows of x samples (of every channel, when they are the fastest axis).
+        let per = if h.channel_first { h.channels as usize } else { 1 };
+        if per == 1 {
+            nrrd::flip_rows(&mut values, h.dims[0] as usize);
+        } else {
+            for row in values.chunks_exact_mut(h.dims[0] as usize * per) {
+                let flipped: Vec<f32> = row.chunks_exact(per).rev().flatten().copied().collect();
+                row.copy_from_slice(&flipped);
+            }
+        }
     }
-    Ok(ScalarVolume { dims: d3.map(|d| d as u32), spacing, values })
+    Ok((h, values))
 }
 
 /// NIfTI-1 (`.nii` or `.nii.gz`), through the `nifti` crate's header parser; the data is read
@@ -371,13 +397,23 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
 pub const MAX_FILE_CHANNELS: u64 = 4;
 
 /// Every channel of a volume file: a 4-D NIfTI's 2 to 4 channels (its fourth axis, or a 5-D
-/// file's fifth), each as the volume `load_volume` reads; any other file is one channel.
+/// file's fifth), or a 4-D NRRD's (the axis its `kinds` marks as not spatial, else a first or last
+/// axis of at most 4 samples; interleaved per voxel or one volume after another), each as the
+/// volume `load_volume` reads; any other file is one channel.
 pub fn load_channels(path: &Path, hints: &VolumeHints) -> Result<Vec<ScalarVolume>> {
     let name = lower_name(path);
+    let what = path.display().to_string();
+    if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
+        let mut channels = nrrd_channels_from_bytes(&read_bounded(path, MAX_INFLATED, &what)?, path.parent(), &what)?;
+        if let Some(s) = hints.spacing {
+            check_spacing(s, &what)?;
+            channels.iter_mut().for_each(|v| v.spacing = s);
+        }
+        return Ok(channels);
+    }
     if !(name.ends_with(".nii") || name.ends_with(".nii.gz")) {
         return Ok(vec![load_volume(path, hints)?]);
     }
-    let what = path.display().to_string();
     let channels = SliceReader::nifti_channels(path)?;
     (0..channels)
         .map(|k| {

@@ -253,3 +253,55 @@ fn a_four_d_nifti_reads_as_its_channels() {
     assert_eq!(voxsplat::loaders::load_channels(&one, &Default::default()).unwrap().len(), 1);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A 4-D NRRD of u8 samples with `sizes` and extra header lines, raw data attached.
+fn nrrd4(sizes: [usize; 4], extra: &str, data: &[u8]) -> Vec<u8> {
+    let s = sizes.map(|d| d.to_string()).join(" ");
+    let mut f = format!("NRRD0004\ntype: uint8\ndimension: 4\nsizes: {s}\n{extra}encoding: raw\n\n").into_bytes();
+    f.extend_from_slice(data);
+    f
+}
+
+#[test]
+fn a_four_d_nrrd_reads_as_its_channels() {
+    let dir = std::env::temp_dir().join(format!("voxsplat-nrrd-channels-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (dims, n) = ([6usize, 5, 4], 120usize);
+    // Channel k of voxel v holds (v + 40 k) % 251.
+    let value = |v: usize, k: usize| ((v + 40 * k) % 251) as u8;
+    let interleaved: Vec<u8> = (0..n).flat_map(|v| (0..3).map(move |k| value(v, k))).collect();
+    let planar: Vec<u8> = (0..3).flat_map(|k| (0..n).map(move |v| value(v, k))).collect();
+    let cases = [
+        ("first.nrrd", nrrd4([3, 6, 5, 4], "kinds: vector domain domain domain\nspacings: nan 1 2 3\n", &interleaved)),
+        ("first-unmarked.nrrd", nrrd4([3, 6, 5, 4], "", &interleaved)),
+        ("last.nrrd", nrrd4([6, 5, 4, 3], "kinds: domain domain domain list\n", &planar)),
+    ];
+    for (name, bytes) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let vols = voxsplat::loaders::load_channels(&path, &Default::default()).unwrap();
+        assert_eq!(vols.len(), 3, "{name}");
+        for (k, v) in vols.iter().enumerate() {
+            assert_eq!(v.dims, dims.map(|d| d as u32), "{name}");
+            let want: Vec<f32> = (0..n).map(|i| value(i, k) as f32).collect();
+            assert_eq!(v.values, want, "{name}: channel {k}");
+        }
+        if name == "first.nrrd" {
+            assert_eq!(vols[0].spacing, [1.0, 2.0, 3.0], "the channel axis's spacing is dropped");
+        }
+        let e = voxsplat::loaders::load_volume(&path, &Default::default()).unwrap_err().to_string();
+        assert!(e.contains("holds 3 channels"), "{name}: {e}");
+    }
+    // Five channels; a channel axis in the middle; four spatial-looking axes of which none is marked.
+    for (name, bytes, says) in [
+        ("five.nrrd", nrrd4([5, 6, 5, 4], "kinds: vector domain domain domain\n", &[0; 600]), "5 channels"),
+        ("middle.nrrd", nrrd4([6, 3, 5, 4], "kinds: domain vector domain domain\n", &[0; 360]), "first or last"),
+        ("unmarked.nrrd", nrrd4([6, 5, 7, 8], "", &[0; 1680]), "not marked"),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let e = voxsplat::loaders::load_channels(&path, &Default::default()).unwrap_err().to_string();
+        assert!(e.contains(says), "{name}: {e}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -17,6 +17,54 @@ pub(super) struct NrrdHeader {
     pub data_start: usize,
     /// Placement from `space`, `space directions` and `space origin`, when the space is anatomical.
     pub orientation: Option<Orientation>,
+    /// Samples per voxel: a 4-D file's channels (1 for a scalar volume).
+    pub channels: u32,
+    /// The channels are the fastest axis (interleaved per voxel), else the slowest (one volume
+    /// after another).
+    pub channel_first: bool,
+}
+
+/// Which axis of a 4-D NRRD holds its channels: the one its `kinds` marks as not spatial (neither
+/// `domain`, `space` nor `time`), else the first axis if it has at most `MAX_CHANNELS` samples
+/// (NRRD puts non-spatial axes first), else the last. Only the first or last may be.
+fn channel_axis(sizes: &[u64], kinds: Option<&[String]>, what: &str) -> Result<usize> {
+    let most = crate::classify::MAX_CHANNELS as u64;
+    let axis = match kinds {
+        Some(k) if k.len() == sizes.len() => {
+            let spatial = |s: &str| matches!(s, "domain" | "space" | "time");
+            let others: Vec<usize> = (0..k.len()).filter(|&a| !spatial(&k[a])).collect();
+            match others.as_slice() {
+                &[a] => a,
+                _ => {
+                    return Err(bad(
+                        what,
+                        format!("kinds '{}': a 4-D volume needs three spatial axes and one of channels", k.join(" ")),
+                    ))
+                }
+            }
+        }
+        Some(k) => return Err(bad(what, format!("kinds has {} entries for {} axes", k.len(), sizes.len()))),
+        None if sizes[0] <= most => 0,
+        None if sizes[3] <= most => 3,
+        None => {
+            return Err(bad(
+                what,
+                format!("sizes {sizes:?}: a 4-D volume's channel axis (first or last, at most {most}) is not marked"),
+            ))
+        }
+    };
+    if axis != 0 && axis != 3 {
+        return Err(Error::Unsupported(format!(
+            "{what}: channels on axis {axis}; the first or last axis may hold them"
+        )));
+    }
+    if !(1..=most).contains(&sizes[axis]) {
+        return Err(Error::Unsupported(format!(
+            "{what}: {} channels; a frame combines 1 to {most} (voxsplat render --channel)",
+            sizes[axis]
+        )));
+    }
+    Ok(axis)
 }
 
 /// Parse the header at the start of `bytes`, allowing at most `limit` voxels.
@@ -44,6 +92,7 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
         (None, None, None, false, [1.0f32; 3], None::<String>);
     let mut dimension = None;
     let (mut space, mut directions, mut space_origin) = (None, None, None);
+    let (mut kinds, mut spacings) = (None::<Vec<String>>, None::<Vec<String>>);
     for line in header.lines().skip(1) {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -75,12 +124,8 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
                     key.trim()
                 )));
             }
-            "spacings" => {
-                let v: Vec<f32> = value.split_whitespace().filter_map(|t| t.parse().ok()).collect();
-                for (i, s) in v.iter().take(3).enumerate() {
-                    spacing[i] = *s;
-                }
-            }
+            "spacings" => spacings = Some(value.split_whitespace().map(str::to_string).collect()),
+            "kinds" => kinds = Some(value.split_whitespace().map(|k| k.to_ascii_lowercase()).collect()),
             "data file" | "datafile" => {
                 // One detached file; a LIST or a numbered format names several.
                 if value.starts_with("LIST") || value.split_whitespace().count() > 1 {
@@ -97,13 +142,29 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
         }
     }
     let dtype = dtype.ok_or_else(|| bad(what, "no type field"))?;
-    let sizes = dims.ok_or_else(|| bad(what, "no sizes field"))?;
-    if sizes.is_empty() || sizes.len() > 3 || dimension.map(|d| d as usize != sizes.len()).unwrap_or(false) {
-        return Err(bad(what, "only 1 to 3 dimensional NRRD scalar volumes are supported"));
+    let mut sizes = dims.ok_or_else(|| bad(what, "no sizes field"))?;
+    if sizes.is_empty() || sizes.len() > 4 || dimension.map(|d| d as usize != sizes.len()).unwrap_or(false) {
+        return Err(bad(what, "only 1 to 3 dimensional NRRD volumes, or 4 with a channel axis, are supported"));
+    }
+    // A 4-D file: its channel axis out of the sizes and the spacings.
+    let (mut channels, mut channel_first) = (1u64, false);
+    let mut spacings = spacings.unwrap_or_default();
+    if sizes.len() == 4 {
+        let axis = channel_axis(&sizes, kinds.as_deref(), what)?;
+        (channels, channel_first) = (sizes.remove(axis), axis == 0);
+        if spacings.len() == 4 {
+            spacings.remove(axis);
+        }
+    }
+    for (i, t) in spacings.iter().take(3).enumerate() {
+        if let Ok(s) = t.parse::<f32>() {
+            spacing[i] = s;
+        }
     }
     let mut d3 = [1u64; 3];
     d3[..sizes.len()].copy_from_slice(&sizes);
     let n = voxel_count_within(&d3, what, limit)?;
+    voxel_count_within(&[n, channels, 1], what, limit)?;
     if d3.iter().any(|&d| d > crate::volume::MAX_DIM as u64) {
         return Err(Error::TooLarge(format!("{what}: a dimension exceeds {}", crate::volume::MAX_DIM)));
     }
@@ -123,6 +184,8 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
         data_file,
         data_start,
         orientation,
+        channels: channels as u32,
+        channel_first,
     })
 }
 

@@ -123,6 +123,9 @@ impl SliceReader {
         let mut head = Vec::new();
         (&mut file).take(1 << 20).read_to_end(&mut head).map_err(io_err(path))?;
         let h = nrrd_header(&head, &what, MAX_STREAMED_VOXELS)?;
+        if h.channels > 1 {
+            return Err(super::several_channels(&what, h.channels));
+        }
         let gz = match h.encoding.as_str() {
             "raw" => false,
             "gzip" | "gz" => true,
