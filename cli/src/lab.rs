@@ -429,7 +429,7 @@ fn matrix(a: MatrixArgs) -> Result<()> {
             ("antialias.md", "anti-aliasing on the terrain and the stripes"),
             ("motion-orders.md", "visibility orders of motion-blurred frames"),
             ("peers.md", "side by side with VTK and taichi on one scene"),
-            ("modes.md", "projection modes (MIP, MinIP, average, X-ray): time against compositing, the ray caster"),
+            ("modes.md", "projection modes (MIP, MinIP, average, X-ray) and isosurfaces: time against compositing, the ray caster"),
         ];
         let mut vtk = None;
         for (file, what) in studies {
