@@ -14,13 +14,21 @@ void main() {
     if (counts[r + 1u] == pos) return;
     ivec2 jk = cell_row(r);
     uvec4 f0 = uvec4(0u);
-    for (int i = -1; i < int(frame.dims.x); ++i) {
-        uvec4 f1 = iso_face(i + 1, jk);
-        uint m = inside_bits(f0, f1);
-        if (m != 0u && m != 255u) {
-            cells[pos] = uvec2(uint(i + 1) | (uint(jk.x + 1) << 16u), uint(jk.y + 1) | (m << 16u));
-            pos++;
+    int cells_x = int(frame.dims.x) + 1;
+    for (int b = 0; b * int(ISO_SEGMENT) < cells_x; ++b) {
+        if (!block_crosses(jk, b)) {
+            f0 = uvec4(0u);
+            continue;
         }
-        f0 = f1;
+        // Cell c's voxels are c - 1 and c along x.
+        for (int c = b * int(ISO_SEGMENT); c < min(cells_x, (b + 1) * int(ISO_SEGMENT)); ++c) {
+            uvec4 f1 = iso_face(c, jk);
+            uint m = inside_bits(f0, f1);
+            if (m != 0u && m != 255u) {
+                cells[pos] = uvec2(uint(c) | (uint(jk.x + 1) << 16u), uint(jk.y + 1) | (m << 16u));
+                pos++;
+            }
+            f0 = f1;
+        }
     }
 }

@@ -80,6 +80,10 @@ pub const MAX_CLIP_PLANES: usize = 6;
 /// Planes a frame holds: the clipping planes and the crop box's six faces.
 pub const CLIP_SLOTS: usize = MAX_CLIP_PLANES + 6;
 
+/// Voxels along x of a segment of the isosurface's row maxima (`iso::IsoField::rows`), and cells
+/// of a block its walks skip whole (glsl/shared/iso.glsl).
+pub const ISO_SEGMENT: u32 = 32;
+
 /// Entries of a projection mode's colour map (`Res::ColorMap`, glsl/project.comp).
 pub const COLOR_MAP_SIZE: u32 = 256;
 
@@ -107,6 +111,7 @@ pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("PYRAMID_PAGE", PYRAMID_PAGE),
     ("CLIP_SLOTS", CLIP_SLOTS as u32),
     ("COLOR_MAP_SIZE", COLOR_MAP_SIZE),
+    ("ISO_SEGMENT", ISO_SEGMENT),
 ];
 
 /// Splats closer than this many radii to the near or far plane are culled (the quad's corners

@@ -2,6 +2,7 @@
 //! ([`IsoField`]), made once per scene and uploaded once, from which the device extracts each
 //! frame's surface splats (`iso_count`, `iso_scan`, `iso_splats`): so a new iso value costs a push
 //! constant, not an upload.
+pub use crate::constants::ISO_SEGMENT;
 use crate::error::{check_host_memory, Error, Result};
 use crate::plan::Prepared;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -16,8 +17,8 @@ pub struct IsoField {
     pub dims: [u32; 3],
     /// Two values a word: voxel v (x fastest) in word v / 2, the low half when v is even.
     pub words: Vec<u32>,
-    /// Per voxel row (j + ny k): its least value | its largest << 16 (rows of cells whose voxel
-    /// rows hold no value at or above the iso value are skipped whole).
+    /// Per voxel row (j + ny k), per segment of `ISO_SEGMENT` voxels along x, its largest value:
+    /// the cells of a block whose voxels all lie below the iso value are skipped whole.
     pub rows: Vec<u32>,
     /// The least and largest normalised value.
     pub range: (f32, f32),
@@ -62,11 +63,7 @@ impl IsoField {
         }
         let rows: Vec<u32> = q
             .chunks(nx.max(1))
-            .map(|row| {
-                let lo = row.iter().copied().min().unwrap_or(0) as u32;
-                let hi = row.iter().copied().max().unwrap_or(0) as u32;
-                lo | hi << 16
-            })
+            .flat_map(|row| row.chunks(ISO_SEGMENT as usize).map(|s| s.iter().copied().max().unwrap_or(0) as u32))
             .collect();
         let lo = q.iter().copied().min().unwrap_or(0) as f32 / ISO_Q;
         let hi = q.iter().copied().max().unwrap_or(0) as f32 / ISO_Q;

@@ -7,6 +7,7 @@
 
 layout(std430, binding = 0) readonly buffer FrameBlock { Frame frame; };
 layout(std430, binding = 1) readonly buffer IsoField { uint field[]; };
+// Per voxel row, per segment of ISO_SEGMENT voxels along x, its largest value.
 layout(std430, binding = 2) readonly buffer IsoRows { uint row_range[]; };
 layout(std430, binding = 3) buffer IsoCounts { uint counts[]; };
 // Per surface splat its cell: i + 1 | (j + 1) << 16, k + 1 | inside bits << 16 (iso_cells).
@@ -36,14 +37,28 @@ ivec2 cell_row(uint r) {
     return ivec2(int(r % (frame.dims.y + 1u)) - 1, int(r / (frame.dims.y + 1u)) - 1);
 }
 
-// Whether row jk's cells can hold the surface: one of its four voxel rows holds a value inside
-// (every row's end cells reach past the grid, whose 0 is outside for any threshold above 0).
-bool row_crosses(ivec2 jk) {
+// Segments of a voxel row (ISO_SEGMENT voxels each) and blocks of a row of cells (ISO_SEGMENT
+// cells each: block b holds the cells whose upper x voxel is b ISO_SEGMENT + 0 .. 31).
+uint iso_segments() {
+    return (frame.dims.x + ISO_SEGMENT - 1u) / ISO_SEGMENT;
+}
+
+// The largest value of segment s of voxel row (j, k); 0 outside the grid.
+uint segment_max(int j, int k, int s) {
+    if (j < 0 || k < 0 || s < 0 || j >= int(frame.dims.y) || k >= int(frame.dims.z) || s >= int(iso_segments())) {
+        return 0u;
+    }
+    return row_range[(uint(j) + frame.dims.y * uint(k)) * iso_segments() + uint(s)];
+}
+
+// Whether block b of row jk's cells can hold the surface: a voxel of it lies inside (its voxels
+// are those of segments b - 1, for its first cell's lower voxel, and b, of its four voxel rows);
+// at threshold 0 every voxel is inside (the 0 outside the grid too) and nothing is crossed.
+bool block_crosses(ivec2 jk, int b) {
     uint hi = 0u;
     for (int c = 0; c < 4; ++c) {
         ivec2 v = jk + ivec2(c & 1, c >> 1);
-        if (v.x < 0 || v.y < 0 || v.x >= int(frame.dims.y) || v.y >= int(frame.dims.z)) continue;
-        hi = max(hi, row_range[uint(v.x) + frame.dims.y * uint(v.y)] >> 16u);
+        hi = max(hi, max(segment_max(v.x, v.y, b - 1), segment_max(v.x, v.y, b)));
     }
     return pc.threshold > 0u && hi >= pc.threshold;
 }

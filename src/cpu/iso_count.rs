@@ -4,6 +4,7 @@ use super::bindings::Bindings;
 use crate::dispatch::{Args, Res, Variant};
 use crate::error::Result;
 use crate::gpu_types::{Frame, IsoPush};
+use crate::iso::ISO_SEGMENT;
 use rayon::prelude::*;
 
 /// What the isosurface stages read: the field's words and row ranges, the frame, the push.
@@ -35,17 +36,25 @@ impl IsoInputs<'_> {
         ((r % ny1) as i32 - 1, (r / ny1) as i32 - 1)
     }
 
-    /// Mirror of `row_crosses`.
-    pub fn row_crosses(&self, (j, k): (i32, i32)) -> bool {
-        let (ny, nz) = (self.frame.dims[1] as i32, self.frame.dims[2] as i32);
-        let mut hi = 0u32;
-        for c in 0..4 {
-            let (y, z) = (j + (c & 1), k + (c >> 1));
-            if y < 0 || z < 0 || y >= ny || z >= nz {
-                continue;
-            }
-            hi = hi.max(self.rows[(y + ny * z) as usize] >> 16);
+    /// Mirror of `segment_max`.
+    pub fn segment_max(&self, j: i32, k: i32, s: i32) -> u32 {
+        let [nx, ny, nz, _] = self.frame.dims;
+        let segments = nx.div_ceil(ISO_SEGMENT);
+        if j < 0 || k < 0 || s < 0 || j >= ny as i32 || k >= nz as i32 || s >= segments as i32 {
+            return 0;
         }
+        self.rows[((j as u32 + ny * k as u32) * segments + s as u32) as usize]
+    }
+
+    /// Mirror of `block_crosses`.
+    pub fn block_crosses(&self, (j, k): (i32, i32), b: i32) -> bool {
+        let hi = (0..4)
+            .map(|c| {
+                let (y, z) = (j + (c & 1), k + (c >> 1));
+                self.segment_max(y, z, b - 1).max(self.segment_max(y, z, b))
+            })
+            .max()
+            .unwrap_or(0);
         self.push.threshold > 0 && hi >= self.push.threshold
     }
 
@@ -69,20 +78,24 @@ impl IsoInputs<'_> {
         m
     }
 
-    /// Walk row `r`'s cells, calling `f(i, faces, bits)` for each crossed one.
+    /// Walk row `r`'s cells (mirror of the walks of `iso_count` and `iso_cells`), calling
+    /// `f(i, faces, bits)` for each crossed one.
     pub fn crossed(&self, r: u32, mut f: impl FnMut(i32, [u32; 4], [u32; 4], u32)) {
         let jk = self.cell_row(r);
-        if !self.row_crosses(jk) {
-            return;
-        }
-        let mut f0 = [0u32; 4];
-        for i in -1..self.frame.dims[0] as i32 {
-            let f1 = self.face(i + 1, jk);
-            let m = self.inside_bits(f0, f1);
-            if m != 0 && m != 255 {
-                f(i, f0, f1, m);
+        let (mut f0, cells, seg) = ([0u32; 4], self.frame.dims[0] as i32 + 1, ISO_SEGMENT as i32);
+        for b in 0..(cells + seg - 1) / seg {
+            if !self.block_crosses(jk, b) {
+                f0 = [0; 4];
+                continue;
             }
-            f0 = f1;
+            for c in b * seg..cells.min((b + 1) * seg) {
+                let f1 = self.face(c, jk);
+                let m = self.inside_bits(f0, f1);
+                if m != 0 && m != 255 {
+                    f(c - 1, f0, f1, m);
+                }
+                f0 = f1;
+            }
         }
     }
 }
