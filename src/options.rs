@@ -590,7 +590,8 @@ pub struct Rendered {
     pub stats: FrameStats,
 }
 
-/// What a bricked volume's frame drew and what it left out, and why (`Rendered::stats`).
+/// What a frame drew and what it left out, and why (`Rendered::stats`): a bricked volume's bricks and
+/// splats, an isosurface's discs, a label volume's unlabelled voxels.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameStats {
     /// Non-empty bricks in the store.
@@ -604,7 +605,8 @@ pub struct FrameStats {
     pub nodes: u32,
     /// Visible bricks dropped because what earlier waves drew already hides them.
     pub bricks_hidden: u32,
-    /// Splats drawn: voxels and coarse cells.
+    /// Splats drawn: voxels and coarse cells; in `Mode::Iso`, the surface's discs (0: the value
+    /// crosses no cell, and the frame is empty).
     pub splats: u64,
     /// Batches (waves) the visible bricks were drawn in, front to back.
     pub waves: u32,
