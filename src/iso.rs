@@ -4,7 +4,6 @@
 //! constant, not an upload.
 pub use crate::constants::ISO_SEGMENT;
 use crate::error::{check_host_memory, Error, Result};
-use crate::plan::Prepared;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The quantisation of the field's values (a bricked store's own).
@@ -29,10 +28,10 @@ pub struct IsoField {
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
 impl IsoField {
-    /// The field of `prep`'s scene: a bricked store's stored values (its quantisation, exactly),
-    /// or a splat set's values (`Splat::ijk[3]`, 0 where no splat lies).
-    pub fn of(prep: &Prepared) -> Result<Self> {
-        let dims = prep.set.grid().dims;
+    /// The field of a scene: a bricked store's stored values (its quantisation, exactly), or a
+    /// splat set's values (`Splat::ijk[3]`, 0 where no splat lies).
+    pub fn of(set: &crate::volume::SplatSet, bricks: Option<&crate::bricks::BrickScene>) -> Result<Self> {
+        let dims = set.grid().dims;
         let n = dims.iter().map(|&d| d as u64).product::<u64>();
         let bytes = n.div_ceil(2) * 4 + n * 2;
         check_host_memory(bytes, &format!("the isosurface's field of {} x {} x {} voxels", dims[0], dims[1], dims[2]))?;
@@ -41,7 +40,7 @@ impl IsoField {
         }
         let mut q = vec![0u16; n as usize];
         let (nx, ny) = (dims[0] as usize, dims[1] as usize);
-        match &prep.bricks {
+        match bricks {
             Some(scene) => {
                 let s = &scene.store;
                 for hd in &s.headers {
@@ -54,7 +53,7 @@ impl IsoField {
                 }
             }
             None => {
-                for sp in prep.set.splats() {
+                for sp in set.splats() {
                     let v = f32::from_bits(sp.ijk[3]);
                     let i = sp.ijk[0] as usize + nx * (sp.ijk[1] as usize + ny * sp.ijk[2] as usize);
                     q[i] = quantise(v);

@@ -117,7 +117,7 @@ impl Prepared {
         if let Some(f) = self.iso_field.get() {
             return Ok(f);
         }
-        let f = crate::iso::IsoField::of(self)?;
+        let f = crate::iso::IsoField::of(&self.set, self.bricks.as_ref())?;
         Ok(self.iso_field.get_or_init(|| f))
     }
 

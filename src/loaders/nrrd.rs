@@ -1,8 +1,12 @@
 //! NRRD headers, and the placement in patient space that NIfTI and NRRD headers give.
-use super::{bad, check_spacing, voxel_count_within, DType};
+use super::{
+    bad, check_finite, check_spacing, decode, gunzip, read_bounded, voxel_count_within, DType, ScalarVolume,
+    MAX_INFLATED, MAX_VOXELS,
+};
 use crate::error::{Error, Result};
 use crate::orient::Orientation;
 use glam::{DMat4, DVec3, DVec4};
+use std::path::Path;
 
 /// An NRRD header's fields.
 pub(super) struct NrrdHeader {
@@ -187,6 +191,63 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
         channels: channels as u32,
         channel_first,
     })
+}
+
+/// A 4-D NRRD's channels (a 3-D file's one volume), each a dense volume.
+pub fn nrrd_channels_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<Vec<ScalarVolume>> {
+    let (h, values) = nrrd_samples(bytes, dir, what)?;
+    let (n, c) = (h.voxels as usize, h.channels as usize);
+    let dims = h.dims.map(|d| d as u32);
+    Ok((0..c)
+        .map(|k| {
+            let values = if h.channel_first {
+                values.iter().skip(k).step_by(c).copied().collect()
+            } else {
+                values[k * n..(k + 1) * n].to_vec()
+            };
+            ScalarVolume { dims, spacing: h.spacing, values }
+        })
+        .collect())
+}
+
+/// An NRRD's header and samples (every channel's, in the file's order), decoded and checked.
+pub(super) fn nrrd_samples(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<(NrrdHeader, Vec<f32>)> {
+    let h = nrrd_header(bytes, what, MAX_VOXELS)?;
+    let (dtype, n, endian_big, data_start) = (h.dtype, h.voxels * h.channels as u64, h.big_endian, h.data_start);
+    let enc = Some(h.encoding.clone());
+    let need = n * dtype.size() as u64;
+    let payload: Vec<u8> = match &h.data_file {
+        Some(f) => {
+            let dir = dir.ok_or_else(|| bad(what, "detached data file without a directory"))?;
+            let p = dir.join(f);
+            let len = std::fs::metadata(&p).map_err(|e| Error::Io { path: p.display().to_string(), source: e })?.len();
+            if !enc.as_deref().unwrap_or("raw").starts_with("gz") && len < need {
+                return Err(bad(what, format!("data file {} has {len} bytes, needs {need}", p.display())));
+            }
+            read_bounded(&p, MAX_INFLATED, what)?
+        }
+        None => bytes[data_start.min(bytes.len())..].to_vec(),
+    };
+    let data = match enc.as_deref().unwrap_or("raw") {
+        "raw" => payload,
+        "gzip" | "gz" => gunzip(&payload, need, what)?,
+        other => return Err(bad(what, format!("unsupported encoding '{other}' (raw, gzip)"))),
+    };
+    let mut values = decode(&data, n, dtype, endian_big, what)?;
+    check_finite(&values, what)?;
+    if h.orientation.is_some_and(|o| o.flip_x()) {
+        // Rows of x samples (of every channel, when they are the fastest axis).
+        let per = if h.channel_first { h.channels as usize } else { 1 };
+        if per == 1 {
+            flip_rows(&mut values, h.dims[0] as usize);
+        } else {
+            for row in values.chunks_exact_mut(h.dims[0] as usize * per) {
+                let flipped: Vec<f32> = row.chunks_exact(per).rev().flatten().copied().collect();
+                row.copy_from_slice(&flipped);
+            }
+        }
+    }
+    Ok((h, values))
 }
 
 /// The RAS+ placement an NRRD `space` (RAS, LAS or LPS, short or long names) with its directions
