@@ -7,7 +7,8 @@
 //! Mouse: left drag orbits, wheel zooms, middle drag (or ctrl + left) pans, right drag edits the
 //! transfer function's window (x: level, y: width), shift + left drag moves the clip plane.
 //! Keys: o order, c compositing, r raster, l levels of detail, [ ] opacity, p clip plane through the
-//! centre facing the eye, s save `viewer-tf.toml` and print the matching `render` command, q or Esc
+//! centre facing the eye, m mode (composite, mip, minip, average, xray, iso), , . the isosurface's
+//! value down or up, s save `viewer-tf.toml` and print the matching `render` command, q or Esc
 //! quit. The title shows the frame time and the modes. While a button is held, frames are drawn at
 //! `--interactive-scale` (0.5 by default) and stretched on the device; full size when let go.
 //!
@@ -375,6 +376,9 @@ impl View {
 const ORDERS: [&str; 5] = ["pbtf", "wbtf", "btf", "pbtf-octant", "sorted"];
 const COMPOSITES: [&str; 3] = ["splat", "sheet", "slab"];
 const RASTERS: [&str; 4] = ["auto", "compute", "graphics", "points"];
+/// The isosurface's first value (normalised) and a key's step.
+const ISO_START: f32 = 0.3;
+const ISO_STEP: f32 = 0.02;
 
 struct Viewer {
     args: Args,
@@ -625,8 +629,13 @@ impl Viewer {
         let Some(window) = &self.window else { return };
         let o = &self.options;
         let clip = if self.clip_offset.is_some() { ", clipped" } else { "" };
+        let mode = match o.iso {
+            Some(v) => format!(", iso {v:.2}"),
+            None if o.mode != voxsplat::Mode::Composite => format!(", {}", o.mode),
+            None => String::new(),
+        };
         window.set_title(&format!(
-            "voxsplat: {ms:.1} ms ({:.1} fps), {}, {:?}, {}, lod {:?}{clip} {}",
+            "voxsplat: {ms:.1} ms ({:.1} fps){mode}, {}, {:?}, {}, lod {:?}{clip} {}",
             1e3 / ms.max(1e-3),
             ORDERS[self.indices[0]],
             o.composite,
@@ -663,6 +672,19 @@ impl Viewer {
                 self.options.raster = RASTERS[self.indices[2]].parse()?;
             }
             "l" => self.options.lod = if self.options.lod == Lod::Off { Lod::Auto } else { Lod::Off },
+            "m" => {
+                let modes = voxsplat::Mode::ALL;
+                let at = modes.iter().position(|&m| m == self.options.mode).unwrap_or(0);
+                self.options.mode = modes[(at + 1) % modes.len()];
+                self.options.iso = (self.options.mode == voxsplat::Mode::Iso).then_some(ISO_START);
+            }
+            "," | "." => match self.options.iso {
+                Some(v) => {
+                    let step = if key == "." { ISO_STEP } else { -ISO_STEP };
+                    self.options.iso = Some((v + step).clamp(0.0, 1.0));
+                }
+                None => self.message = "the isosurface's value: m to --mode iso first".into(),
+            },
             "[" => self.edit_tf(None, 0.8)?,
             "]" => self.edit_tf(None, 1.25)?,
             "p" => {

@@ -95,8 +95,9 @@ fn the_viewer_refuses_what_render_refuses() {
 fn every_key_draws_validation_clean() {
     let stent = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/stent/stent.nrrd");
     for (scene, keys) in [
-        (vec!["--scene", "cube40"], "ocrlp[]rrcoooo"),
-        (vec!["--volume", stent.to_str().unwrap(), "--tf", "ct"], "lpr[oc"),
+        // m cycles the modes (the fifth is iso, whose value , and . move), back to composite.
+        (vec!["--scene", "cube40"], "ocrlp[]rrcoooommmmm.,m"),
+        (vec!["--volume", stent.to_str().unwrap(), "--tf", "ct"], "lpr[ocmmmmm..m,"),
     ] {
         let frames = (keys.len() + 1).to_string();
         let out = Command::new("xvfb-run")
