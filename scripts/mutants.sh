@@ -35,7 +35,7 @@ MUTANTS=(
   "a hidden label drawn|src/labels.rs|Some(l) if l.visible && l.opacity > 0.0 =>|Some(l) if l.opacity > 0.0 =>|--test labels labels_are_never"
   "an isosurface row's first cell skipped (the grid's low faces open)|src/cpu/iso_count.rs|            for c in b * seg..cells.min((b + 1) * seg) {|            for c in (b * seg).max(1)..cells.min((b + 1) * seg) {|--test iso surface_lies"
   "an isosurface pixel's visible depth from any disc|src/cpu/tile_composite.rs|if w >= SURFACE_VISIBLE * inputs.table[0] {|if w > 0.0 {|--test iso surface_lies"
-  "an isosurface's cells listed with those wholly inside, on the device|glsl/iso_cells.comp|            if (m != 0u && m != 255u) {|            if (m != 0u) {|--test iso gpu_matches"
+  "an isosurface's cells counted and listed with those wholly inside, on the device|glsl/shared/iso.glsl|            if (m != 0u && m != 255u) {|            if (m != 0u) {|--test iso gpu_matches"
 )
 filter=${1:-}
 backup=$(mktemp -d)

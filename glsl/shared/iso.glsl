@@ -79,3 +79,32 @@ uint inside_bits(uvec4 f0, uvec4 f1) {
     }
     return m;
 }
+
+// Walk row r's cells, sliding a face of four values along x; blocks of ISO_SEGMENT cells whose
+// voxels all lie outside are skipped whole (they cross nothing and leave their last face
+// outside). Returns the crossed cells (some corner inside, some outside); with `list`, each is
+// written (c = i + 1 | (j + 1) << 16, k + 1 | inside bits << 16) from `first` on. iso_count and
+// iso_cells walk alike, so their counts and lists agree. Mirror: IsoInputs::crossed.
+uint walk_row(uint r, uint first, bool list) {
+    ivec2 jk = cell_row(r);
+    uint n = 0u;
+    uvec4 f0 = uvec4(0u);
+    int cells_x = int(frame.dims.x) + 1;
+    for (int b = 0; b * int(ISO_SEGMENT) < cells_x; ++b) {
+        if (!block_crosses(jk, b)) {
+            f0 = uvec4(0u);
+            continue;
+        }
+        // Cell c's voxels are c - 1 and c along x.
+        for (int c = b * int(ISO_SEGMENT); c < min(cells_x, (b + 1) * int(ISO_SEGMENT)); ++c) {
+            uvec4 f1 = iso_face(c, jk);
+            uint m = inside_bits(f0, f1);
+            if (m != 0u && m != 255u) {
+                if (list) cells[first + n] = uvec2(uint(c) | (uint(jk.x + 1) << 16u), uint(jk.y + 1) | (m << 16u));
+                n++;
+            }
+            f0 = f1;
+        }
+    }
+    return n;
+}
