@@ -1,7 +1,7 @@
 //! Isosurfaces' host side (`Mode::Iso`): the scene's values as a dense 16-bit field
 //! ([`IsoField`]), made once per scene and uploaded once, from which the device extracts each
-//! frame's surface splats (`iso_count`, `iso_scan`, `iso_splats`): so a new iso value costs a push
-//! constant, not an upload.
+//! frame's surface splats (`iso_count`, `iso_scan`, `iso_cells`, `iso_splats`): so a new iso value
+//! costs a push constant, not an upload.
 pub use crate::constants::ISO_SEGMENT;
 use crate::error::{check_host_memory, Error, Result};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -19,8 +19,6 @@ pub struct IsoField {
     /// Per voxel row (j + ny k), per segment of `ISO_SEGMENT` voxels along x, its largest value:
     /// the cells of a block whose voxels all lie below the iso value are skipped whole.
     pub rows: Vec<u32>,
-    /// The least and largest normalised value.
-    pub range: (f32, f32),
     /// Tells one field from another (`Engine::tag`: uploaded once).
     pub id: u64,
 }
@@ -64,10 +62,8 @@ impl IsoField {
             .chunks(nx.max(1))
             .flat_map(|row| row.chunks(ISO_SEGMENT as usize).map(|s| s.iter().copied().max().unwrap_or(0) as u32))
             .collect();
-        let lo = q.iter().copied().min().unwrap_or(0) as f32 / ISO_Q;
-        let hi = q.iter().copied().max().unwrap_or(0) as f32 / ISO_Q;
         let words = q.chunks(2).map(|p| p[0] as u32 | (*p.get(1).unwrap_or(&0) as u32) << 16).collect();
-        Ok(Self { dims, words, rows, range: (lo, hi), id: NEXT_ID.fetch_add(1, Ordering::Relaxed) })
+        Ok(Self { dims, words, rows, id: NEXT_ID.fetch_add(1, Ordering::Relaxed) })
     }
 
     /// The quantised value at voxel (i, j, k); 0 outside the grid (as the ray caster's field).
@@ -76,26 +72,24 @@ impl IsoField {
         if i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz {
             return 0;
         }
-        let v = (i + nx * (j + ny * k)) as usize;
+        self.value((i + nx * (j + ny * k)) as usize)
+    }
+
+    /// The quantised value of voxel `v` (x fastest).
+    fn value(&self, v: usize) -> u32 {
         (self.words[v / 2] >> (16 * (v % 2))) & 0xffff
     }
 
     /// The ray caster's field of it: (value, 1, 0, 0) per voxel (`plan::FieldKind::Iso`).
     pub fn dense(&self) -> crate::volume::DenseField {
         let n = self.dims.iter().map(|&d| d as usize).product::<usize>();
-        let values =
-            (0..n).map(|v| [((self.words[v / 2] >> (16 * (v % 2))) & 0xffff) as f32 / ISO_Q, 1.0, 0.0, 0.0]).collect();
+        let values = (0..n).map(|v| [self.value(v) as f32 / ISO_Q, 1.0, 0.0, 0.0]).collect();
         crate::volume::DenseField { dims: self.dims, values }
     }
 
     /// Device bytes: the values and the row ranges.
     pub fn bytes(&self) -> u64 {
         (self.words.len() + self.rows.len()) as u64 * 4
-    }
-
-    /// Rows of cells a frame walks: (ny + 1)(nz + 1) (`IsoPush::rows`).
-    pub fn cell_rows(&self) -> u32 {
-        (self.dims[1] + 1) * (self.dims[2] + 1)
     }
 }
 
