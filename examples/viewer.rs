@@ -8,8 +8,9 @@
 //! transfer function's window (x: level, y: width), shift + left drag moves the clip plane.
 //! Keys: o order, c compositing, r raster, l levels of detail, [ ] opacity, p clip plane through the
 //! centre facing the eye, m mode (composite, mip, minip, average, xray, iso), , . the isosurface's
-//! value down or up, s save `viewer-tf.toml` and print the matching `render` command, q or Esc
-//! quit. The title shows the frame time and the modes. While a button is held, frames are drawn at
+//! value down or up, b the bounding box and a slice plane drawn through the volume by depth (the
+//! host's own geometry: `viewer_mesh.rs`), 9 0 the slice plane down or up, s save
+//! `viewer-tf.toml` and print the matching `render` command, q or Esc quit. The title shows the frame time and the modes. While a button is held, frames are drawn at
 //! `--interactive-scale` (0.5 by default) and stretched on the device; full size when let go.
 //!
 //! Headless runs (CI, under Xvfb): `--frames N` draws N frames of a scripted orbit ending at the
@@ -33,6 +34,9 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
+
+#[path = "viewer_mesh.rs"]
+mod mesh;
 
 #[derive(Parser)]
 #[command(name = "viewer", about = "voxsplat in a window: orbit, zoom, pan, modes, transfer function, clip plane")]
@@ -86,6 +90,13 @@ struct Args {
     /// Prefer a UNORM swapchain format over an sRGB one.
     #[arg(long)]
     unorm: bool,
+    /// Start with the bounding box and slice plane drawn through the volume (`b` toggles them).
+    /// They are drawn at full size: the render scales do not apply while they show.
+    #[arg(long)]
+    mesh: bool,
+    /// Where the slice plane lies along the grid's k axis, 0 to 1.
+    #[arg(long, default_value = "0.5")]
+    slice: f32,
 }
 
 static MESSAGES: AtomicU64 = AtomicU64::new(0);
@@ -385,10 +396,14 @@ struct Viewer {
     window: Option<Arc<Window>>,
     // Dropped in this order: voxsplat's objects, then the swapchain, then the host's device.
     acquire: Option<Semaphore>,
+    mesh_pass: Option<mesh::MeshPass>,
     swapchain: Option<Swapchain>,
     renderer: Option<Renderer>,
     host: Option<Host>,
     base: Option<Camera>,
+    grid: Option<voxsplat::volume::Grid>,
+    mesh: bool,
+    slice: f32,
     radius: f32,
     view: View,
     options: RenderOptions,
@@ -423,14 +438,19 @@ impl Viewer {
             COMPOSITES.iter().position(|c| *c == args.composite).unwrap_or(0),
             RASTERS.iter().position(|r| *r == args.raster).unwrap_or(0),
         ];
+        let (mesh, slice) = (args.mesh, args.slice.clamp(0.0, 1.0));
         Ok(Self {
             args,
             window: None,
             acquire: None,
+            mesh_pass: None,
             swapchain: None,
             renderer: None,
             host: None,
             base: None,
+            grid: None,
+            mesh,
+            slice,
             radius: 1.0,
             view: View::HOME,
             options,
@@ -471,6 +491,7 @@ impl Viewer {
             None => renderer.set_scene(set)?,
         }
         self.base = Some(camera_of(&self.args.scene, &grid, &content)?);
+        self.grid = Some(grid);
         self.radius = 0.5 * grid.diagonal() + 4.0 * grid.kernel_spacing();
         let size = window.inner_size();
         self.swapchain =
@@ -569,22 +590,67 @@ impl Viewer {
             Err(e) => return Err(vk_err("vkAcquireNextImageKHR")(e)),
         };
         let done = sc.done[index].raw();
-        // SAFETY: a swapchain image of this device, with TRANSFER_DST and TRANSFER_SRC usage, undefined
-        // after the acquire; the semaphores are the example's, alive across the call.
-        let target = unsafe {
-            HostTarget::new(
-                sc.images[index],
-                sc.format,
-                (sc.extent.width, sc.extent.height),
-                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::PRESENT_SRC_KHR),
-                &[acquire.raw()],
-                &[done],
-            )
-        }?;
+        let size = (sc.extent.width, sc.extent.height);
+        let target = if self.mesh {
+            // The host's geometry first: its colour into the swapchain image and its depth, after the
+            // acquire; the frame waits on the pass's semaphore, reads both and goes over them.
+            if self.mesh_pass.as_ref().is_none_or(|p| p.size != size) {
+                self.mesh_pass = None;
+                let ctx = self.renderer.as_ref().and_then(|r| r.context()).expect("started").clone();
+                // SAFETY: the host's own instance, device and queue family, which voxsplat adopted.
+                self.mesh_pass = Some(unsafe {
+                    mesh::MeshPass::new(&host.instance, host.physical, &host.device, host.family, &ctx, size)
+                }?);
+            }
+            let pass = self.mesh_pass.as_ref().expect("made above");
+            let grid = self.grid.as_ref().expect("started");
+            let bgra = matches!(sc.format, vk::Format::B8G8R8A8_SRGB | vk::Format::B8G8R8A8_UNORM);
+            let (color, depth) = mesh::draw(&cam, grid, self.slice, self.args.background, bgra);
+            // SAFETY: the acquired image has TRANSFER_DST usage; the pass's last work completed with
+            // the last frame's render_to; this thread alone uses the queue.
+            unsafe { pass.submit(host.queue, sc.images[index], acquire.raw(), &color, &depth) }?;
+            // SAFETY: the image and the depth image now hold the host's frame in TRANSFER_SRC_OPTIMAL
+            // (ordered by the pass's semaphore, and submitted before voxsplat's work on this queue);
+            // both have TRANSFER_SRC usage; the semaphores are alive across the call.
+            unsafe {
+                HostTarget::new(
+                    sc.images[index],
+                    sc.format,
+                    size,
+                    (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR),
+                    &[pass.drawn.raw()],
+                    &[done],
+                )?
+                .with_depth(
+                    pass.depth_image(),
+                    vk::Format::D32_SFLOAT,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    cam.proj(),
+                )?
+                .over()
+            }?
+        } else {
+            // SAFETY: a swapchain image of this device, with TRANSFER_DST and TRANSFER_SRC usage,
+            // undefined after the acquire; the semaphores are the example's, alive across the call.
+            unsafe {
+                HostTarget::new(
+                    sc.images[index],
+                    sc.format,
+                    size,
+                    (vk::ImageLayout::UNDEFINED, vk::ImageLayout::PRESENT_SRC_KHR),
+                    &[acquire.raw()],
+                    &[done],
+                )
+            }?
+        };
         let renderer = self.renderer.as_mut().expect("started");
         let mut options = self.options.clone();
         if self.buttons.iter().any(|&b| b) {
             options.render_scale = options.render_scale.min(self.args.interactive_scale);
+        }
+        if self.mesh {
+            // The host's image is the background, read pixel for pixel.
+            (options.background, options.render_scale) = (None, 1.0);
         }
         let t = Instant::now();
         let mut result = renderer.render_to(&cam, &options, &target);
@@ -598,7 +664,9 @@ impl Viewer {
                 (self.options.background, self.options.clip, self.options.render_scale);
             self.options = fallback;
             self.indices = [0; 3];
-            result = renderer.render_to(&cam, &fallback_or(&self.options, options.render_scale), &target);
+            let mut again = fallback_or(&self.options, options.render_scale);
+            again.background = options.background;
+            result = renderer.render_to(&cam, &again, &target);
         }
         result?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
@@ -693,6 +761,14 @@ impl Viewer {
                     None => self.camera().map(|c| (c.forward(), 0.0)),
                 };
                 self.update_clip()?;
+            }
+            "b" => self.mesh = !self.mesh,
+            "9" | "0" => {
+                let step = if key == "0" { 1.0 / 32.0 } else { -1.0 / 32.0 };
+                self.slice = (self.slice + step).clamp(0.0, 1.0);
+                if !self.mesh {
+                    self.message = "the slice plane: b to show it first".into();
+                }
             }
             "s" => self.save()?,
             _ => {}
@@ -890,6 +966,7 @@ fn run(args: Args) -> Result<()> {
     }
     // voxsplat's objects go before the host's device.
     viewer.acquire = None;
+    viewer.mesh_pass = None;
     let host = viewer.host.take();
     if let (Some(sc), Some(h)) = (viewer.swapchain.take(), &host) {
         sc.destroy(h);

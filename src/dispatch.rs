@@ -86,6 +86,9 @@ pub enum Res {
     HostDepthRaw,
     /// The host's depth as eye-space depth per pixel (`host_depth`), which hides the splats behind it.
     HostDepth,
+    /// The host's image as the frame finds it, texels as stored (`vk::HostTarget::over`): what
+    /// `present` composites the frame over.
+    HostColor,
     /// The ray caster's dense (colour * tau, tau) field, a 3D texture: a per-scene cache built on
     /// first use (`Engine::prepare_field`).
     Field,

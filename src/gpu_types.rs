@@ -175,10 +175,18 @@ pub struct PresentPush {
     pub width: u32,
     pub height: u32,
     /// Bit 0: the accumulation image, bit 1: the raster target; both: their mean (slotted blur).
+    /// `PRESENT_OVER` and the host image's `PRESENT_HOST_*` bits: over the host's image.
     pub sources: u32,
     /// 1: write linear values, for a target that encodes them itself (sRGB, float).
     pub linear: u32,
 }
+
+/// `PresentPush::sources`: the frame goes over the host's image (`Res::HostColor`), whose texels
+/// are 8-bit RGBA unless `PRESENT_HOST_BGRA` (8-bit BGRA) or `PRESENT_HOST_HALF` (16-bit float)
+/// (glsl/shared/types.glsl).
+pub const PRESENT_OVER: u32 = 4;
+pub const PRESENT_HOST_BGRA: u32 = 8;
+pub const PRESENT_HOST_HALF: u32 = 16;
 
 /// Push constants of `host_depth.comp`.
 #[repr(C)]

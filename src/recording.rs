@@ -467,7 +467,8 @@ fn record_tiles(e: &mut dyn Engine, frame: &Frame, rule: &TileRule, w: u32, h: u
 /// Read the frame's image, the mean of `images` (one, or the two time slots of `Pass::Slots`), and,
 /// after compute sheet sums, the status word; then the timings. Over a background, or into a host's
 /// image (`Engine::target_linear`), `present` first makes the final image; a host's image then
-/// receives it on the device and nothing is read but the status word.
+/// receives it on the device and nothing is read but the status word; over a host's image
+/// (`Engine::target_over`) `present` composites the frame over a copy of what it held.
 fn finish(
     e: &mut dyn Engine,
     background: Option<[f32; 4]>,
@@ -478,7 +479,12 @@ fn finish(
 ) -> Result<Recorded> {
     let linear = e.target_linear();
     let images = if background.is_some() || linear.is_some() {
-        let sources = images.iter().fold(0, |m, &r| m | if r == Res::Accum { 1 } else { 2 });
+        let mut sources = images.iter().fold(0, |m, &r| m | if r == Res::Accum { 1 } else { 2 });
+        if let Some(format) = e.target_over() {
+            e.ensure(Res::HostColor, w as u64 * h as u64 * format.texel_bytes() as u64)?;
+            e.copy_target_color(Res::HostColor)?;
+            sources |= crate::cpu::present::over_bits(format);
+        }
         let push = crate::plan::present_push(background, sources, linear.unwrap_or(false), w, h);
         let groups = tile_groups(StageId::Present, w, h);
         e.run(&Dispatch::new(StageId::Present, Only, groups, List::Order, bytemuck::bytes_of(&push))?)?;

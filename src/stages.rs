@@ -426,7 +426,7 @@ stages! {
     },
     present => Present {
         kind: Kind::Compute,
-        bindings: &[Res::Accum, Res::Color],
+        bindings: &[Res::Accum, Res::Color, Res::HostColor],
         writes: &[Res::Accum],
         push: std::mem::size_of::<PresentPush>() as u32,
         workgroup: Workgroup::Tile(COMPOSITE_TILE, COMPOSITE_TILE),
@@ -622,6 +622,15 @@ pub trait Engine {
     /// host's semaphores: only an engine with a target can.
     fn deliver(&mut self) -> Result<()> {
         Err(Error::Unsupported("only the Vulkan engine writes into a host's image".into()))
+    }
+    /// When the frame is composited over the host's image (`vk::HostTarget::over`): its format.
+    fn target_over(&self) -> Option<crate::image::TargetFormat> {
+        None
+    }
+    /// Copy the host's image as the frame finds it into `res` (its texels as stored): only an
+    /// engine with a target drawn over can.
+    fn copy_target_color(&mut self, _res: Res) -> Result<()> {
+        Err(Error::Unsupported("only the Vulkan engine reads a host's image".into()))
     }
     /// Copy the target's depth image into `res` (a word per pixel): only an engine with a
     /// target can.

@@ -69,7 +69,7 @@ fn target_against(g: &Renderer, target: &voxsplat::vk::HostTarget, frame: &voxsp
     got.iter()
         .zip(&frame.pixels)
         .map(|(a, &b)| {
-            let w = present_pixel(&push, b, [0.0; 4]);
+            let w = present_pixel(&push, b, [0.0; 4], [0.0; 4]);
             (0..4).map(|k| (a[k] - w[k]).abs()).fold(0.0f32, f32::max)
         })
         .fold(0.0f32, f32::max)

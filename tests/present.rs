@@ -4,7 +4,7 @@
 //! semaphores order frames; bad targets are refused.
 mod common;
 use common::assert_clean;
-use voxsplat::low_level::cpu::present::{decode, encode, present_pixel};
+use voxsplat::low_level::cpu::present::{decode, encode, host_texel, over_bits, present_pixel};
 use voxsplat::low_level::plan::present_push;
 use voxsplat::vk::ImageLayout as IL;
 use voxsplat::{scene, Camera, Composite, Motion, Raster, RenderOptions, TargetFormat};
@@ -72,7 +72,8 @@ fn render_to_writes_what_the_mirror_says_in_every_format_and_mode() {
             plain.background = None;
             let frame = g.render(&cam, &plain).unwrap().image;
             let push = present_push(o.background, 1, format.linear(), cam.width, cam.height);
-            let presented: Vec<[f32; 4]> = frame.pixels.iter().map(|&p| present_pixel(&push, p, [0.0; 4])).collect();
+            let presented: Vec<[f32; 4]> =
+                frame.pixels.iter().map(|&p| present_pixel(&push, p, [0.0; 4], [0.0; 4])).collect();
             let want = encode(format, &presented);
             let step = if format == TargetFormat::Rgba16Float { 2e-3 } else { 1.0 / 255.0 + 1e-6 };
             let d = most(format, &got, &want);
@@ -115,6 +116,79 @@ fn a_background_goes_through_present_on_both_engines_and_keeps_the_png_bytes() {
         .max()
         .unwrap();
     assert!(worst <= 1, "the sRGB target differs from the PNG by {worst} steps");
+    assert_clean(&g);
+}
+
+#[test]
+fn render_to_over_the_hosts_image_composites_the_frame_over_what_it_held() {
+    // The host's drawing: a frame of the cube over an opaque background; then a frame from
+    // another eye, transparent where it misses the cube, drawn over it.
+    let set = scene::build("cube60").unwrap();
+    let cam = Camera::framing(set.grid(), 80, 64);
+    let moved = Camera { eye: cam.eye + glam::Vec3::new(25.0, 10.0, 0.0), ..cam };
+    let mut g = common::gpu();
+    g.set_scene(set).unwrap();
+    let host = options(Composite::Splat, Raster::Compute, Some([0.1, 0.3, 0.8, 1.0]));
+    let over = options(Composite::Splat, Raster::Compute, None);
+    let frame = g.render(&moved, &over).unwrap().image;
+    let layout = IL::TRANSFER_SRC_OPTIMAL;
+    for format in TargetFormat::ALL {
+        let image = g.target_image(format, cam.width, cam.height).unwrap();
+        g.render_to(&cam, &host, &image.target(IL::UNDEFINED, layout).unwrap()).unwrap();
+        let held = g.read_target(&image.target(layout, layout).unwrap()).unwrap();
+        // SAFETY: voxsplat's image, made with TRANSFER_SRC usage, holds the frame just drawn.
+        let target = unsafe { image.target(layout, layout).unwrap().over() }.unwrap();
+        g.render_to(&moved, &over, &target).unwrap();
+        let got = g.read_target(&target).unwrap();
+        // The mirror: the frame presented for this format over the held texels, as stored.
+        let mut push = present_push(None, 1, format.linear(), cam.width, cam.height);
+        push.sources |= over_bits(format);
+        let words: Vec<u32> = held.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+        let presented: Vec<[f32; 4]> = (0..frame.pixels.len())
+            .map(|i| present_pixel(&push, frame.pixels[i], [0.0; 4], host_texel(&push, &words, i)))
+            .collect();
+        let step = if format == TargetFormat::Rgba16Float { 2e-3 } else { 1.0 / 255.0 + 1e-6 };
+        let d = most(format, &got, &encode(format, &presented));
+        assert!(d <= step, "{format:?}: {d} from the mirror");
+        // Over a host image of one colour the frame is the frame over that background.
+        let flat = g.target_image(format, cam.width, cam.height).unwrap();
+        let bg = options(Composite::Splat, Raster::Compute, Some([0.1, 0.3, 0.8, 1.0]));
+        let empty_cam = Camera { eye: cam.eye * 40.0, target: cam.eye * 41.0, ..cam };
+        g.render_to(&empty_cam, &bg, &flat.target(IL::UNDEFINED, layout).unwrap()).unwrap();
+        // SAFETY: as above.
+        g.render_to(&moved, &over, &unsafe { flat.target(layout, layout).unwrap().over() }.unwrap()).unwrap();
+        let on_flat = g.read_target(&flat.target(layout, layout).unwrap()).unwrap();
+        let alone = g.target_image(format, cam.width, cam.height).unwrap();
+        g.render_to(&moved, &bg, &alone.target(IL::UNDEFINED, layout).unwrap()).unwrap();
+        let want = g.read_target(&alone.target(layout, layout).unwrap()).unwrap();
+        let d = most(format, &on_flat, &want);
+        assert!(d <= step, "{format:?}: over one colour differs from that background by {d}");
+        // Both show: the host's drawing where the frame is empty, the frame where it is opaque,
+        // and neither alone in between.
+        // (8-bit texels pass through exactly; halves through display values and back.)
+        let (got_v, held_v) = (decode(format, &got).unwrap(), decode(format, &held).unwrap());
+        let apart = |i: usize| (0..4).map(|c| (got_v[i][c] - held_v[i][c]).abs()).fold(0.0, f32::max);
+        let kept = if format == TargetFormat::Rgba16Float { 2e-3 } else { 0.0 };
+        let empty = (0..frame.pixels.len()).filter(|&i| frame.pixels[i][3] == 0.0).collect::<Vec<_>>();
+        assert!(empty.len() > 500 && empty.iter().all(|&i| apart(i) <= kept), "{format:?}: host kept");
+        let changed = (0..frame.pixels.len()).filter(|&i| apart(i) > 0.02).count();
+        assert!(changed > 1000, "{format:?}: the frame drew over {changed} pixels only");
+    }
+    // Refused: a background (the host's image is the frame's), a target with nothing to draw over,
+    // a render scale (the host's image is read pixel for pixel).
+    let image = g.target_image(TargetFormat::Rgba8Unorm, cam.width, cam.height).unwrap();
+    g.render_to(&cam, &host, &image.target(IL::UNDEFINED, layout).unwrap()).unwrap();
+    // SAFETY: as above.
+    let target = unsafe { image.target(layout, layout).unwrap().over() }.unwrap();
+    let e = g.render_to(&cam, &host, &target).unwrap_err();
+    assert!(e.to_string().contains("no background"), "{e}");
+    let mut scaled = over.clone();
+    scaled.render_scale = 0.5;
+    let e = g.render_to(&cam, &scaled, &target).unwrap_err();
+    assert!(e.to_string().contains("render scale 1"), "{e}");
+    // SAFETY: as above.
+    let e = unsafe { image.target(IL::UNDEFINED, layout).unwrap().over() }.unwrap_err();
+    assert!(e.to_string().contains("nothing to draw over"), "{e}");
     assert_clean(&g);
 }
 

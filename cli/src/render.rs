@@ -315,7 +315,7 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     if let (Some(bg), true) = (a.background, a.truth || a.raycast.is_some()) {
         // The reference renderers have no present stage: its mirror, on the host.
         let push = voxsplat::low_level::plan::present_push(Some(bg), 1, false, cam.width, cam.height);
-        voxsplat::low_level::cpu::present::present(&push, &mut image, &voxsplat::ImageF32::new(0, 0));
+        voxsplat::low_level::cpu::present::present(&push, &mut image, &voxsplat::ImageF32::new(0, 0), &[]);
     }
     if a.k_line {
         let regions = voxsplat::aa::k_regions(&set_for_k, &cam);

@@ -76,6 +76,47 @@ fn the_viewer_under_xvfb_shows_what_render_draws() {
     }
 }
 
+/// The host's geometry through the volume (issue 46 item 5): the viewer draws a bounding box and a
+/// slice plane with depth before each frame, and `render_to` reads both (`HostTarget::with_depth`
+/// and `over`). The plane hides the volume behind it and the volume in front of it shows over it;
+/// where the viewer drew only its background the frame is the frame without the mesh, exactly.
+#[test]
+fn the_viewers_mesh_and_the_volume_intermix_by_depth() {
+    let volume = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/bonsai/bonsai.nii.gz");
+    let shot = |tag: &str, extra: &[&str]| {
+        let path = tmp_in("viewer", &format!("mesh-{tag}.png"));
+        let mut run = Command::new("xvfb-run");
+        run.args(["-a", "-s", "-screen 0 640x480x24"]).arg(viewer()).arg("--volume").arg(&volume);
+        run.args(["--tf", "bonsai", "--size", "128x112", "--frames", "2", "--orbit", "0", "--validation"]);
+        run.arg("--screenshot").arg(&path).args(extra);
+        let out = run.output().expect("xvfb-run");
+        assert!(out.status.success(), "{tag}: {}", String::from_utf8_lossy(&out.stderr));
+        rgba(&path)
+    };
+    // Both, the mesh alone (the volume made transparent before the last frame), the volume alone.
+    let (both, mesh, volume) =
+        (shot("both", &["--mesh"]), shot("mesh", &["--mesh", "--opacity", "0"]), shot("volume", &[]));
+    let is = |p: &image::Rgba<u8>, c: [u8; 3]| p[0] == c[0] && p[1] == c[1] && p[2] == c[2];
+    let (plane, edge) = ([70, 80, 96], [255, 200, 40]);
+    let n = |f: &dyn Fn(usize) -> bool| (0..mesh.pixels().len()).filter(|&i| f(i)).count();
+    let px = |img: &image::RgbaImage, i: usize| *img.get_pixel(i as u32 % 128, i as u32 / 128);
+    let on_plane = |i: usize| is(&px(&mesh, i), plane);
+    let lit = |i: usize| px(&volume, i).0[..3].iter().map(|&v| v as u32).sum::<u32>() > 30;
+    assert!(n(&on_plane) > 1000 && n(&|i| is(&px(&mesh, i), edge)) > 300, "the mesh is drawn");
+    let hidden = n(&|i| on_plane(i) && lit(i) && is(&px(&both, i), plane));
+    let shown = n(&|i| on_plane(i) && lit(i) && !is(&px(&both, i), plane));
+    assert!(hidden > 100, "the plane hides the volume behind it ({hidden} pixels)");
+    assert!(shown > 100, "the volume in front of the plane shows over it ({shown} pixels)");
+    let background = |i: usize| is(&px(&mesh, i), [0, 0, 0]);
+    assert!(n(&background) > 5000);
+    let worst = (0..mesh.pixels().len())
+        .filter(|&i| background(i))
+        .map(|i| px(&both, i).0.iter().zip(px(&volume, i).0).map(|(a, b)| a.abs_diff(b)).max().unwrap())
+        .max()
+        .unwrap();
+    assert_eq!(worst, 0, "beside the mesh the frame is the frame without it");
+}
+
 #[test]
 fn the_viewer_refuses_what_render_refuses() {
     let out = Command::new("xvfb-run")
@@ -96,8 +137,9 @@ fn every_key_draws_validation_clean() {
     let stent = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/stent/stent.nrrd");
     for (scene, keys) in [
         // m cycles the modes (the fifth is iso, whose value , and . move), back to composite.
-        (vec!["--scene", "cube40"], "ocrlp[]rrcoooommmmm.,m"),
-        (vec!["--volume", stent.to_str().unwrap(), "--tf", "ct"], "lpr[ocmmmmm..m,"),
+        // b shows the box and slice plane, 9 and 0 move the plane (first said to need b).
+        (vec!["--scene", "cube40"], "ocrlp[]rrcoooommmmm.,m9b90cb"),
+        (vec!["--volume", stent.to_str().unwrap(), "--tf", "ct"], "lpr[ocmmmmm..m,b0mmb"),
     ] {
         let frames = (keys.len() + 1).to_string();
         let out = Command::new("xvfb-run")

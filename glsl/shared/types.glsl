@@ -125,6 +125,11 @@ const uint SWEEP_SLOTTED = 3u;   // tapered, each half of the shutter composited
 #define BLEND_SURFACE 3u
 #define BLEND_SURFACE_DEPTH 4u
 
+// present.comp's sources beyond its images: over the host's image, its texels' layout.
+#define PRESENT_OVER 4u
+#define PRESENT_HOST_BGRA 8u
+#define PRESENT_HOST_HALF 16u
+
 #define AA_NONE 0.0
 #define AA_SWAN 1.0
 #define AA_EWA 2.0

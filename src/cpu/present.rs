@@ -2,9 +2,10 @@
 //! host's image (`Renderer::render_to`): the bytes a target of each format receives.
 use super::bindings::Bindings;
 use super::ImageF32;
+use crate::dispatch::Res;
 use crate::dispatch::{Args, Variant};
 use crate::error::{Error, Result};
-use crate::gpu_types::PresentPush;
+use crate::gpu_types::{PresentPush, PRESENT_HOST_BGRA, PRESENT_HOST_HALF, PRESENT_OVER};
 pub use crate::image::TargetFormat;
 
 /// The sRGB curve's inverse (IEC 61966-2-1), as `present.comp` applies it.
@@ -25,9 +26,40 @@ pub fn to_srgb(c: f32) -> f32 {
     }
 }
 
-/// One pixel: the mean of its sources, over the background, clamped, linear if asked (the
-/// premultiplied colour un-premultiplied, decoded and premultiplied again).
-pub fn present_pixel(push: &PresentPush, accum: [f32; 4], color: [f32; 4]) -> [f32; 4] {
+/// The host's texel `i` of `words` (its image as stored, `Res::HostColor`) as premultiplied
+/// display values (`present.comp`'s host_texel): 8-bit texels as stored (an sRGB texel's bytes are
+/// its display value), half-float ones encoded from linear.
+pub fn host_texel(push: &PresentPush, words: &[u32], i: usize) -> [f32; 4] {
+    if push.sources & PRESENT_HOST_HALF != 0 {
+        let w = [words[2 * i], words[2 * i + 1]];
+        let t = [w[0] & 0xffff, w[0] >> 16, w[1] & 0xffff, w[1] >> 16].map(|h| f16_value(h as u16).clamp(0.0, 1.0));
+        if t[3] <= 0.0 {
+            return [0.0; 4];
+        }
+        return [0, 1, 2, 3].map(|c| if c < 3 { to_srgb((t[c] / t[3]).min(1.0)) * t[3] } else { t[3] });
+    }
+    let t = words[i].to_le_bytes().map(|b| b as f32 / 255.0);
+    if push.sources & PRESENT_HOST_BGRA != 0 {
+        [t[2], t[1], t[0], t[3]]
+    } else {
+        t
+    }
+}
+
+/// The `PresentPush::sources` bits for a frame over a host's image of `format`.
+pub fn over_bits(format: TargetFormat) -> u32 {
+    let layout = match format {
+        TargetFormat::Rgba16Float => PRESENT_HOST_HALF,
+        f if f.bgra() => PRESENT_HOST_BGRA,
+        _ => 0,
+    };
+    PRESENT_OVER | layout
+}
+
+/// One pixel: the mean of its sources, over the background (or, where the push says so, over the
+/// host's texel `host`, `host_texel`), clamped, linear if asked (the premultiplied colour
+/// un-premultiplied, decoded and premultiplied again).
+pub fn present_pixel(push: &PresentPush, accum: [f32; 4], color: [f32; 4], host: [f32; 4]) -> [f32; 4] {
     let (mut sum, mut n) = ([0.0f32; 4], 0.0f32);
     for (bit, v) in [(1, accum), (2, color)] {
         if push.sources & bit != 0 {
@@ -35,7 +67,7 @@ pub fn present_pixel(push: &PresentPush, accum: [f32; 4], color: [f32; 4]) -> [f
             n += 1.0;
         }
     }
-    let bg = push.background;
+    let bg = if push.sources & PRESENT_OVER != 0 { host } else { push.background };
     let c = [0, 1, 2, 3].map(|i| sum[i] / n.max(1.0));
     let mut c = [0, 1, 2, 3].map(|i| (c[i] + (1.0 - c[3]) * bg[i]).clamp(0.0, 1.0));
     if push.linear != 0 && c[3] > 0.0 {
@@ -47,11 +79,13 @@ pub fn present_pixel(push: &PresentPush, accum: [f32; 4], color: [f32; 4]) -> [f
     c
 }
 
-/// Mirror of `present.comp`: the presented frame, written into `accum`.
-pub fn present(push: &PresentPush, accum: &mut ImageF32, color: &ImageF32) {
+/// Mirror of `present.comp`: the presented frame, written into `accum` (over the host's image
+/// `host`, its texels as stored, where the push says so).
+pub fn present(push: &PresentPush, accum: &mut ImageF32, color: &ImageF32, host: &[u32]) {
     let blank = [0.0f32; 4];
     for (i, px) in accum.pixels.iter_mut().enumerate() {
-        *px = present_pixel(push, *px, color.pixels.get(i).copied().unwrap_or(blank));
+        let under = if push.sources & PRESENT_OVER != 0 { host_texel(push, host, i) } else { blank };
+        *px = present_pixel(push, *px, color.pixels.get(i).copied().unwrap_or(blank), under);
     }
 }
 
@@ -62,7 +96,21 @@ pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, _: &Variant) -> Result<()
         // The accumulation image is written whole: start it from nothing, as the device does.
         b.accum = ImageF32::new(b.width, b.height);
     }
-    present(&push, &mut b.accum, &b.color);
+    let pixels = b.width as usize * b.height as usize;
+    let host: Vec<u32> = if push.sources & PRESENT_OVER != 0 {
+        let host: &[u32] = b.get(Res::HostColor);
+        let needed = if push.sources & PRESENT_HOST_HALF != 0 { 2 * pixels } else { pixels };
+        if host.len() < needed {
+            return Err(Error::InvalidArgument(format!(
+                "present: the host's image holds {} of {needed} words",
+                host.len()
+            )));
+        }
+        host[..needed].to_vec()
+    } else {
+        Vec::new()
+    };
+    present(&push, &mut b.accum, &b.color, &host);
     Ok(())
 }
 
@@ -163,7 +211,7 @@ mod tests {
         }
         // Display value 0.5 over an opaque pixel: linear 0.214, encoded by an sRGB target to 128.
         let push = present_push(None, 1, true, 1, 1);
-        let p = present_pixel(&push, [0.5, 0.5, 0.5, 1.0], [0.0; 4]);
+        let p = present_pixel(&push, [0.5, 0.5, 0.5, 1.0], [0.0; 4], [0.0; 4]);
         assert!((p[0] - 0.21404).abs() < 1e-4);
         assert_eq!(encode(TargetFormat::Bgra8Srgb, &[p])[..3], [128, 128, 128]);
         assert_eq!(encode(TargetFormat::Rgba8Unorm, &[[0.5, 0.25, 1.0, 1.0]]), [128, 64, 255, 255]);
@@ -172,9 +220,37 @@ mod tests {
     #[test]
     fn background_goes_under_and_sources_average() {
         let push = present_push(Some([0.0, 0.0, 1.0, 1.0]), 3, false, 1, 1);
-        let p = present_pixel(&push, [0.5, 0.0, 0.0, 0.5], [0.3, 0.0, 0.0, 0.3]);
+        let p = present_pixel(&push, [0.5, 0.0, 0.0, 0.5], [0.3, 0.0, 0.0, 0.3], [0.0; 4]);
         // Mean (0.4, 0, 0, 0.4), then 0.6 of the blue background under it.
         let want = [0.4, 0.0, 0.6, 1.0];
         assert!(p.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6), "{p:?}");
+    }
+
+    #[test]
+    fn over_the_host_image_in_the_targets_values() {
+        // Half-covered grey over the host's red texel, in each layout the host's image may have.
+        for format in TargetFormat::ALL {
+            let red = encode(format, &[[1.0, 0.0, 0.0, 1.0]]);
+            let words: Vec<u32> = red.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            let mut push = present_push(None, 1, format.linear(), 1, 1);
+            push.sources |= over_bits(format);
+            let red = host_texel(&push, &words, 0);
+            assert!(red.iter().zip([1.0, 0.0, 0.0, 1.0]).all(|(a, b)| (a - b).abs() < 1e-6), "{format:?}: {red:?}");
+            let p = present_pixel(&push, [0.25, 0.25, 0.25, 0.5], [0.0; 4], red);
+            // The frame's 0.5 display grey at alpha 0.5 over the red, as over a red background;
+            // decoded for the targets that store linear values.
+            let want = [0.75, 0.25, 0.25, 1.0].map(|v: f32| if format.linear() && v < 1.0 { to_linear(v) } else { v });
+            let over_bg = present_pixel(
+                &present_push(Some([1.0, 0.0, 0.0, 1.0]), 1, format.linear(), 1, 1),
+                [0.25, 0.25, 0.25, 0.5],
+                [0.0; 4],
+                [0.0; 4],
+            );
+            assert_eq!(p, over_bg, "{format:?}: the host's image acts as a background");
+            assert!(p.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6), "{format:?}: {p:?}");
+        }
+        // Without the bit the host's image is not read.
+        let push = present_push(None, 1, false, 1, 1);
+        assert_eq!(present_pixel(&push, [0.0; 4], [0.0; 4], [1.0; 4]), [0.0; 4]);
     }
 }

@@ -204,7 +204,7 @@ impl<C: Communicator> Distributed<C> {
         let mut image = ImageF32 { width: camera.width, height: camera.height, pixels };
         if opts.background.is_some() {
             let push = crate::plan::present_push(opts.background, 1, false, camera.width, camera.height);
-            crate::cpu::present::present(&push, &mut image, &ImageF32::new(0, 0));
+            crate::cpu::present::present(&push, &mut image, &ImageF32::new(0, 0), &[]);
         }
         let mut timings =
             vec![StageTime { stage: "render", ms: slowest }, StageTime { stage: "composite", ms: composite_ms }];

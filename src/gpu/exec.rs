@@ -26,6 +26,8 @@ enum Cmd {
     Blit,
     /// Copy the host's depth image into a resource.
     CopyDepth(Res),
+    /// Copy the host's image, as the frame finds it, into a resource (`HostTarget::over`).
+    CopyColor(Res),
 }
 
 /// The Vulkan engine of one frame.
@@ -108,8 +110,10 @@ impl<'a> GpuEngine<'a> {
         let gpu = &*self.gpu;
         let target = gpu.res.current_target()?;
         let mut per_run = vec![0.0f64; runs.len()];
-        // The submission holding the blit into the host's image carries the host's semaphores.
-        let synced = |cmds: &[&Cmd]| self.target.filter(|_| cmds.iter().any(|c| matches!(c, Cmd::Blit)));
+        // The submission holding the blit into the host's image (and the copy of what it held,
+        // queued with the blit's run) carries the host's semaphores.
+        let synced =
+            |cmds: &[&Cmd]| self.target.filter(|_| cmds.iter().any(|c| matches!(c, Cmd::Blit | Cmd::CopyColor(_))));
         if host_timed {
             for (i, (_, cmds)) in runs.iter().enumerate() {
                 let t = Instant::now();
@@ -267,6 +271,12 @@ fn record(
             rec.copy_host_depth(host, res.buffer(*r)?);
             rec.barrier(Stage::Transfer, Stage::All);
         }
+        Cmd::CopyColor(r) => {
+            let host = host.ok_or_else(|| Error::InvalidArgument("a colour copy without a host target".into()))?;
+            rec.barrier(Stage::All, Stage::Transfer);
+            rec.copy_host_color(host, res.buffer(*r)?);
+            rec.barrier(Stage::Transfer, Stage::All);
+        }
         Cmd::Blit => {
             let host = host.ok_or_else(|| Error::InvalidArgument("a blit without a host target".into()))?;
             rec.barrier(Stage::All, Stage::Transfer);
@@ -416,6 +426,20 @@ impl Engine for GpuEngine<'_> {
         }
         self.live.insert(res);
         self.pending.push(("", Cmd::CopyDepth(res)));
+        Ok(())
+    }
+
+    fn target_over(&self) -> Option<crate::image::TargetFormat> {
+        self.target.filter(|t| t.is_over()).map(|t| t.format())
+    }
+
+    fn copy_target_color(&mut self, res: Res) -> Result<()> {
+        if self.target_over().is_none() {
+            return Err(Error::InvalidArgument("this frame's target is not drawn over".into()));
+        }
+        self.live.insert(res);
+        // Named as the present stage: the copy runs in the blit's submission, after its waits.
+        self.pending.push(("present", Cmd::CopyColor(res)));
         Ok(())
     }
 

@@ -42,6 +42,8 @@ pub struct HostTarget {
     pub(crate) wait: Vec<vk::Semaphore>,
     pub(crate) signal: Vec<vk::Semaphore>,
     pub(crate) depth: Option<HostDepth>,
+    /// Composite the frame over what the image holds when the frame starts (`HostTarget::over`).
+    pub(crate) over: bool,
 }
 
 /// The host's depth image a frame reads (`HostTarget::with_depth`).
@@ -119,6 +121,7 @@ impl HostTarget {
             wait: wait.to_vec(),
             signal: signal.to_vec(),
             depth: None,
+            over: false,
         })
     }
 
@@ -149,6 +152,34 @@ impl HostTarget {
         }
         self.depth = Some(HostDepth { image, format, layout, projection });
         Ok(self)
+    }
+
+    /// The same target, the frame composited over what the image holds when the frame starts (the
+    /// host's own drawing: a mesh, a background) instead of replacing it: premultiplied "over",
+    /// in the image's stored values (linear light for sRGB and float formats, as the device's
+    /// blending would be). The image's texels are read as premultiplied colour. With the host's
+    /// depth image (`with_depth`) meshes and the volume then intermix: the volume hides what lies
+    /// behind it by its opacity, and geometry in front of it hides the volume.
+    ///
+    /// # Safety
+    ///
+    /// As `new`, and the image was created with `TRANSFER_SRC` usage and holds the host's drawing
+    /// in `old_layout` (not `UNDEFINED`) when the frame starts: written by work submitted earlier
+    /// to the renderer's queue, or complete, or ordered by a `wait` semaphore.
+    pub unsafe fn over(mut self) -> Result<Self> {
+        if matches!(self.old_layout, vk::ImageLayout::UNDEFINED | vk::ImageLayout::PREINITIALIZED) {
+            return Err(Error::InvalidArgument(format!(
+                "a target in layout {:?} holds nothing to draw over: give the layout the host's drawing left",
+                self.old_layout
+            )));
+        }
+        self.over = true;
+        Ok(self)
+    }
+
+    /// Whether the frame is composited over the image's contents (`over`).
+    pub fn is_over(&self) -> bool {
+        self.over
     }
 
     /// The depth image's format and projection, if the target has one.
@@ -350,6 +381,19 @@ impl Recorder<'_> {
         unsafe { self.ctx.device.cmd_copy_image_to_buffer(self.cmd, d.image, src, buffer.raw, &region) };
         if d.layout != src {
             barrier(src, d.layout);
+        }
+    }
+
+    /// Copy the host's image as it is when the frame starts (`HostTarget::over`) into `buffer`, its
+    /// texels as stored (a word per pixel, two for a float format), leaving it in its old layout.
+    pub fn copy_host_color(&self, to: &HostTarget, buffer: &Buffer) {
+        let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        if to.old_layout != src {
+            host_barrier(self, to.image, (to.old_layout, src));
+        }
+        self.copy_raw_to_buffer(to.image, (to.width, to.height), src, buffer);
+        if to.old_layout != src {
+            host_barrier(self, to.image, (src, to.old_layout));
         }
     }
 
