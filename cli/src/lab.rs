@@ -64,6 +64,23 @@ pub(crate) enum Study {
         #[arg(long)]
         chart: Option<PathBuf>,
     },
+    /// The rendering modes (composite, MIP, MinIP, average, X-ray, isosurface) of the gallery's
+    /// volumes: each mode's default frame beside the ray caster in the same mode, speed against
+    /// accuracy (PSNR against a fine ray cast in that mode); the page on stdout, a chart per volume.
+    Modes {
+        /// Image side.
+        #[arg(long, default_value_t = 512)]
+        size: u32,
+        /// Timed frames per mode (after a warm-up).
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Where the charts go (modes-NAME.svg); the page links them by file name.
+        #[arg(long, default_value = "docs/bench")]
+        charts: PathBuf,
+        /// The shared data folder (bonsai, stent).
+        #[arg(long, default_value = "../shared/data")]
+        data: PathBuf,
+    },
     /// The bricked-volume study: store sizes, dense against bricked frames, a TF change,
     /// hidden-brick culling and the 512³ bonsai against the 256³, alternating variants in one
     /// process; a markdown section on stdout. With --volume: one volume's load, store, frame and
@@ -274,6 +291,25 @@ pub(crate) fn run(study: Study) -> Result<()> {
             print!("{}", voxsplat_cli::kernels::markdown(&rows, n, size, chart.as_deref()));
             Ok(())
         }
+        Study::Modes { size, frames, charts, data } => {
+            if !(16..=4096).contains(&size) || frames == 0 {
+                return Err(Error::InvalidArgument("--size in 16..=4096, --frames at least 1".into()));
+            }
+            let volume = |name: &str, file: &str, tf: &str, iso: f32| voxsplat_cli::modes::ModeVolume {
+                name: name.into(),
+                path: data.join(file),
+                tf: tf.into(),
+                iso,
+            };
+            let volumes = [
+                volume("bonsai", "bonsai/bonsai.nii.gz", "bonsai", 60.0),
+                volume("stent", "stent/stent.nrrd", "ct", 1000.0),
+            ];
+            let rows = voxsplat_cli::modes::study(&volumes, size, frames)?;
+            let written = voxsplat_cli::modes::charts(&rows, &charts)?;
+            print!("{}", voxsplat_cli::modes::markdown(&rows, size, frames, &written));
+            Ok(())
+        }
         Study::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => voxsplat_cli::bench::scaling_chart(&csv, &svg),
         Study::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, orbit, lod_chart, .. } => {
             if frames < 1 || size < 16 {
@@ -395,6 +431,12 @@ fn matrix(a: MatrixArgs) -> Result<()> {
             roofline: Some(&roof),
             scaling: &scale,
             chart_dir,
+            // The modes study's charts (`lab modes`, which scripts/results.sh runs first).
+            mode_charts: ["bonsai", "stent"]
+                .map(|v| format!("modes-{v}.svg"))
+                .into_iter()
+                .filter(|f| a.out_dir.join(f).exists())
+                .collect(),
             notes,
         };
         // The detail pages, beside the charts they link. The studies that scripts/results.sh runs

@@ -6,6 +6,7 @@ pub mod antialias;
 pub mod bench;
 pub mod bricked;
 pub mod kernels;
+pub mod modes;
 pub mod motion_orders;
 pub mod open;
 pub mod peer;

@@ -12,6 +12,8 @@ pub struct Report<'a> {
     pub scaling: &'a [ScalePoint],
     /// Relative path from the markdown file to the charts.
     pub chart_dir: String,
+    /// The rendering modes' charts in it (`modes-NAME.svg`), linked beside the scenes'.
+    pub mode_charts: Vec<String>,
     pub notes: Option<String>,
 }
 
@@ -141,6 +143,10 @@ pub fn results_markdown(rep: &Report<'_>, vtk: Option<&str>, details: &[Detail])
     );
     for sc in &scenes {
         let _ = writeln!(s, "![{sc}]({})\n", link(&rep.chart_dir, &format!("chart-{sc}.svg")));
+    }
+    // The rendering modes beside the ray caster in the same mode (`lab modes`), where measured.
+    for file in &rep.mode_charts {
+        let _ = writeln!(s, "![{file}]({})\n", link(&rep.chart_dir, file));
     }
     let _ = writeln!(s, "## Targets\n");
     // 1. Order stage share and linearity.
