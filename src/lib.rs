@@ -390,15 +390,12 @@ impl Renderer {
         }
         // Below scale 1 the frame is drawn on the coarser grid and the blit stretches it.
         let scaled = options.render_scale != 1.0;
+        let refuse = |m: &str| Err(Error::InvalidArgument(m.into()));
         if scaled && (target.depth().is_some() || target.is_over()) {
-            return Err(Error::InvalidArgument(
-                "the host's depth and colour images are read pixel for pixel: draw at render scale 1".into(),
-            ));
+            return refuse("the host's depth and colour images are read pixel for pixel: draw at render scale 1");
         }
         if target.is_over() && options.background.is_some() {
-            return Err(Error::InvalidArgument(
-                "a frame drawn over the host's image has that image for its background: give no background".into(),
-            ));
+            return refuse("a frame drawn over the host's image has that image for its background: give no background");
         }
         let low = resample::scaled_camera(camera, options.render_scale)?;
         let mut full = options.clone();

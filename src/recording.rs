@@ -483,7 +483,7 @@ fn finish(
         if let Some(format) = e.target_over() {
             e.ensure(Res::HostColor, w as u64 * h as u64 * format.texel_bytes() as u64)?;
             e.copy_target_color(Res::HostColor)?;
-            sources |= crate::cpu::present::over_bits(format);
+            sources |= crate::plan::over_bits(format);
         }
         let push = crate::plan::present_push(background, sources, linear.unwrap_or(false), w, h);
         let groups = tile_groups(StageId::Present, w, h);

@@ -4,8 +4,8 @@
 //! semaphores order frames; bad targets are refused.
 mod common;
 use common::assert_clean;
-use voxsplat::low_level::cpu::present::{decode, encode, host_texel, over_bits, present_pixel};
-use voxsplat::low_level::plan::present_push;
+use voxsplat::low_level::cpu::present::{decode, encode, host_texel, present_pixel};
+use voxsplat::low_level::plan::{over_bits, present_push};
 use voxsplat::vk::ImageLayout as IL;
 use voxsplat::{scene, Camera, Composite, Motion, Raster, RenderOptions, TargetFormat};
 

@@ -46,16 +46,6 @@ pub fn host_texel(push: &PresentPush, words: &[u32], i: usize) -> [f32; 4] {
     }
 }
 
-/// The `PresentPush::sources` bits for a frame over a host's image of `format`.
-pub fn over_bits(format: TargetFormat) -> u32 {
-    let layout = match format {
-        TargetFormat::Rgba16Float => PRESENT_HOST_HALF,
-        f if f.bgra() => PRESENT_HOST_BGRA,
-        _ => 0,
-    };
-    PRESENT_OVER | layout
-}
-
 /// One pixel: the mean of its sources, over the background (or, where the push says so, over the
 /// host's texel `host`, `host_texel`), clamped, linear if asked (the premultiplied colour
 /// un-premultiplied, decoded and premultiplied again).
@@ -190,7 +180,7 @@ pub fn decode(format: TargetFormat, bytes: &[u8]) -> Result<Vec<[f32; 4]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::present_push;
+    use crate::plan::{over_bits, present_push};
 
     #[test]
     fn halves_round_trip_and_round_to_nearest() {

@@ -18,6 +18,17 @@ pub fn present_push(background: Option<[f32; 4]>, sources: u32, linear: bool, wi
     PresentPush { background: bg, width, height, sources, linear: linear as u32 }
 }
 
+/// The `PresentPush::sources` bits for a frame over a host's image of `format`.
+pub fn over_bits(format: crate::image::TargetFormat) -> u32 {
+    use crate::gpu_types::{PRESENT_HOST_BGRA, PRESENT_HOST_HALF, PRESENT_OVER};
+    let layout = match format {
+        crate::image::TargetFormat::Rgba16Float => PRESENT_HOST_HALF,
+        f if f.bgra() => PRESENT_HOST_BGRA,
+        _ => 0,
+    };
+    PRESENT_OVER | layout
+}
+
 /// `Frame::aa[0]`: no anti-aliasing, Swan's, or the EWA low-pass (`params.glsl`).
 pub const AA_NONE: f32 = 0.0;
 /// See `AA_NONE`.
