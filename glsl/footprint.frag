@@ -50,7 +50,7 @@ void main() {
         // As tile_composite: the key weighed by the footprint over its centre's, and the coverage.
         float s = footprint_r2(uv, 0.0, 0.0);
         if (s >= 1.0) discard;
-        float w = sample_radial(s) / radial[0].x;
+        float w = min(sample_radial(s) / (PROJECT_FULL * radial[0].x), 1.0);
         out_color = vec4(in_emit.r * w, w, 0.0, 0.0);
         return;
     }

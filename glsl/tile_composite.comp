@@ -200,8 +200,9 @@ void main() {
                     live = q.inv2.w <= host_depth[uint(xy.y) * size.x + uint(xy.x)];
                 }
                 if (live && PROJECT == BLEND_MAX) {
-                    // A footprint weighs 1 at its centre: the key of the splat there, its coverage 1.
-                    float w = sample_radial(s) / radial[0].x;
+                    // A footprint covers fully from PROJECT_FULL of its centre's weight: the key of
+                    // the splat there, its coverage 1.
+                    float w = min(sample_radial(s) / (PROJECT_FULL * radial[0].x), 1.0);
                     tile_acc[at] = max(a, vec4(q.emit.r * w, w, 0.0, 0.0));
                 } else if (live && surface) {
                     // Surface splats (iso_splats), at their plane's depth here (the depth's steps

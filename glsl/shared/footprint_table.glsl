@@ -45,6 +45,10 @@ float sample_radial(float s) {
     return e.x + e.y * (t - float(i));
 }
 
+// MIP and MinIP: a footprint covers a pixel fully where it weighs this share of its centre's
+// (params.glsl's PROJECT_SHRINK; mirror: cpu::footprint::PROJECT_FULL).
+const float PROJECT_FULL = 0.7;
+
 #include "sweep.glsl"
 
 // Time samples of a tapered or teardrop footprint: a quarter radius apart along the path or

@@ -387,6 +387,10 @@ pub(crate) struct Shading<'a> {
 
 /// The fragment shader's output at quad coordinates (u, v), blended into the pixel at `at` of
 /// `targets` (one, or the two slots).
+/// Mirror of types.glsl's `PROJECT_FULL`: MIP and MinIP cover a pixel fully where a footprint
+/// weighs this share of its centre's.
+pub const PROJECT_FULL: f32 = 0.7;
+
 pub(crate) fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF32], at: usize) {
     if s.depth.is_some_and(|d| p.screen[0] > d[at]) {
         return;
@@ -396,7 +400,7 @@ pub(crate) fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &m
     // its centre's and the coverage; summed, the key and 1 weighed by the optical depth.
     let project = match (s.blend, s.sheet, s.weight) {
         (Blend::Max, _, Weight::Footprint(table)) => {
-            Some(s.weight.value(Vec2::new(u, v), s.sweep, 1.0, false) / table[0])
+            Some((s.weight.value(Vec2::new(u, v), s.sweep, 1.0, false) / (PROJECT_FULL * table[0])).min(1.0))
         }
         (Blend::Add, false, _) => Some(s.weight.value(Vec2::new(u, v), s.sweep, tau, false)),
         _ => None,

@@ -38,13 +38,20 @@ pub fn frame_grid(frame: &Frame) -> crate::volume::Grid {
     }
 }
 
+/// Mirror of params.glsl's `PROJECT_SHRINK`: MIP's and MinIP's footprints at this share of the
+/// kernel's radius.
+pub const PROJECT_SHRINK: f32 = 0.65;
+
 /// Mirror of `params_world`: `params_at` with the splat's world centre given.
 pub fn params_world(frame: &Frame, center: Vec3, cell: f32, grow: f32, rgb: [f32; 3], tau: f32) -> SplatParams {
     let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
     let (eye, forward, right) = (v3(frame.eye), v3(frame.forward), v3(frame.right));
     let depth = (center - eye).dot(forward);
     // The kernel clear of the near and far planes; the widening, in perspective, short of the eye.
-    let base = grow * cell * frame.spacing[3];
+    let mut base = grow * cell * frame.spacing[3];
+    if [crate::options::Mode::Mip, crate::options::Mode::Minip].iter().any(|m| m.code() == frame.rect[2]) {
+        base *= PROJECT_SHRINK;
+    }
     let clear = (depth - frame.forward[3]).min(frame.right[3] - depth);
     let mut visible = clear >= CULL_RADII * base;
     let eye_room = if frame.eye[3] > 0.5 { depth / (CULL_RADII * base) } else { 1e30 };

@@ -12,6 +12,8 @@ use crate::plan::tile_grid;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+pub use super::footprint::PROJECT_FULL;
+
 /// Mirror of `SURFACE_VISIBLE`: the least weight, over a footprint's centre's, of a surface disc
 /// that makes a pixel's visible depth.
 pub const SURFACE_VISIBLE: f32 = 0.1;
@@ -87,7 +89,8 @@ pub fn tile_composite(
             }
             let sweep = Sweep { stretch: q.inv[0][3], bend: q.inv[1][3], profile: inputs.frame.sweep[1] };
             if project == BLEND_MAX {
-                let w = footprint_value(inputs.table, uv, sweep, 1.0, false) / inputs.table[0];
+                let w =
+                    (footprint_value(inputs.table, uv, sweep, 1.0, false) / (PROJECT_FULL * inputs.table[0])).min(1.0);
                 if w > 0.0 {
                     acc = [acc[0].max(q.emit[0] * w), acc[1].max(w), acc[2], acc[3]];
                 }
