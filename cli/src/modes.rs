@@ -137,7 +137,7 @@ pub fn markdown(rows: &[ModeRow], size: u32, rounds: usize, charts: &[PathBuf]) 
          back (`--dense`); *composite, default* is the default frame (levels of detail, early termination, hidden \
          bricks). `iso V`: the isosurface at V (the file's units), its surface splats made on the device each frame; \
          its ray caster has no empty-space skipping. One run on this machine: read the ratios.\n",
-        voxsplat_cli_device()
+        device_name()
     );
     let _ = writeln!(
         s,
@@ -166,7 +166,7 @@ pub fn markdown(rows: &[ModeRow], size: u32, rounds: usize, charts: &[PathBuf]) 
 }
 
 /// The device the study ran on, named as the renderer reports it.
-fn voxsplat_cli_device() -> String {
+fn device_name() -> String {
     Renderer::new(&RendererOptions::default())
         .ok()
         .and_then(|r| r.context().map(|c| c.device_name().to_string()))
