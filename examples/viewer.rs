@@ -696,7 +696,12 @@ impl Viewer {
     fn title(&self, ms: f64) {
         let Some(window) = &self.window else { return };
         let o = &self.options;
-        let clip = if self.clip_offset.is_some() { ", clipped" } else { "" };
+        let clip = match (self.clip_offset.is_some(), self.mesh) {
+            (true, true) => ", clipped, box and slice",
+            (true, false) => ", clipped",
+            (false, true) => ", box and slice",
+            (false, false) => "",
+        };
         let mode = match o.iso {
             Some(v) => format!(", iso {v:.2}"),
             None if o.mode != voxsplat::Mode::Composite => format!(", {}", o.mode),
