@@ -591,9 +591,9 @@ impl Viewer {
         };
         let done = sc.done[index].raw();
         let size = (sc.extent.width, sc.extent.height);
-        let target = if self.mesh {
-            // The host's geometry first: its colour into the swapchain image and its depth, after the
-            // acquire; the frame waits on the pass's semaphore, reads both and goes over them.
+        // The image's layout and what the frame waits on: the acquire, or with the mesh the pass
+        // that drew it (its colour into the swapchain image and its depth, after the acquire).
+        let (first, wait) = if self.mesh {
             if self.mesh_pass.as_ref().is_none_or(|p| p.size != size) {
                 self.mesh_pass = None;
                 let ctx = self.renderer.as_ref().and_then(|r| r.context()).expect("started").clone();
@@ -609,40 +609,38 @@ impl Viewer {
             // SAFETY: the acquired image has TRANSFER_DST usage; the pass's last work completed with
             // the last frame's render_to; this thread alone uses the queue.
             unsafe { pass.submit(host.queue, sc.images[index], acquire.raw(), &color, &depth) }?;
-            // SAFETY: the image and the depth image now hold the host's frame in TRANSFER_SRC_OPTIMAL
-            // (ordered by the pass's semaphore, and submitted before voxsplat's work on this queue);
-            // both have TRANSFER_SRC usage; the semaphores are alive across the call.
-            unsafe {
-                HostTarget::new(
-                    sc.images[index],
-                    sc.format,
-                    size,
-                    (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR),
-                    &[pass.drawn.raw()],
-                    &[done],
-                )?
-                .with_depth(
-                    pass.depth_image(),
-                    vk::Format::D32_SFLOAT,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    cam.proj(),
-                )?
-                .over()
-            }?
+            (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, pass.drawn.raw())
         } else {
-            // SAFETY: a swapchain image of this device, with TRANSFER_DST and TRANSFER_SRC usage,
-            // undefined after the acquire; the semaphores are the example's, alive across the call.
-            unsafe {
-                HostTarget::new(
-                    sc.images[index],
-                    sc.format,
-                    size,
-                    (vk::ImageLayout::UNDEFINED, vk::ImageLayout::PRESENT_SRC_KHR),
-                    &[acquire.raw()],
-                    &[done],
-                )
-            }?
+            (vk::ImageLayout::UNDEFINED, acquire.raw())
         };
+        // SAFETY: a swapchain image of this device, with TRANSFER_DST and TRANSFER_SRC usage, in
+        // `first` (undefined after the acquire, or holding the mesh pass's drawing); the semaphores
+        // are the example's, alive across the call.
+        let mut target = unsafe {
+            HostTarget::new(
+                sc.images[index],
+                sc.format,
+                size,
+                (first, vk::ImageLayout::PRESENT_SRC_KHR),
+                &[wait],
+                &[done],
+            )
+        }?;
+        if let (true, Some(pass)) = (self.mesh, &self.mesh_pass) {
+            // SAFETY: the pass left its depth image (TRANSFER_SRC usage) and the swapchain image in
+            // TRANSFER_SRC_OPTIMAL, ordered by the semaphore the frame waits on and submitted
+            // before voxsplat's work on this queue.
+            target = unsafe {
+                target
+                    .with_depth(
+                        pass.depth_image(),
+                        vk::Format::D32_SFLOAT,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        cam.proj(),
+                    )?
+                    .over()
+            }?;
+        }
         let renderer = self.renderer.as_mut().expect("started");
         let mut options = self.options.clone();
         if self.buttons.iter().any(|&b| b) {
@@ -696,12 +694,11 @@ impl Viewer {
     fn title(&self, ms: f64) {
         let Some(window) = &self.window else { return };
         let o = &self.options;
-        let clip = match (self.clip_offset.is_some(), self.mesh) {
-            (true, true) => ", clipped, box and slice",
-            (true, false) => ", clipped",
-            (false, true) => ", box and slice",
-            (false, false) => "",
-        };
+        let clip = format!(
+            "{}{}",
+            if self.clip_offset.is_some() { ", clipped" } else { "" },
+            if self.mesh { ", box and slice" } else { "" }
+        );
         let mode = match o.iso {
             Some(v) => format!(", iso {v:.2}"),
             None if o.mode != voxsplat::Mode::Composite => format!(", {}", o.mode),

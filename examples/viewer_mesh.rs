@@ -72,8 +72,7 @@ pub fn draw(cam: &Camera, grid: &Grid, slice: f32, background: [f32; 4], bgra: b
             }
         }
     }
-    let texels = color;
-    (texels, depth)
+    (color, depth)
 }
 
 /// A clip-space point in pixels (x, y; pixel centres at .5) and its depth.

@@ -305,9 +305,9 @@ pub(crate) fn run(study: Study) -> Result<()> {
                 volume("bonsai", "bonsai/bonsai.nii.gz", "bonsai", 60.0),
                 volume("stent", "stent/stent.nrrd", "ct", 1000.0),
             ];
-            let rows = voxsplat_cli::modes::study(&volumes, size, frames)?;
+            let (rows, device) = voxsplat_cli::modes::study(&volumes, size, frames)?;
             let written = voxsplat_cli::modes::charts(&rows, &charts)?;
-            print!("{}", voxsplat_cli::modes::markdown(&rows, size, frames, &written));
+            print!("{}", voxsplat_cli::modes::markdown(&rows, &device, size, frames, &written));
             Ok(())
         }
         Study::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => voxsplat_cli::bench::scaling_chart(&csv, &svg),

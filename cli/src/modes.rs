@@ -2,10 +2,11 @@
 //! the ray caster in the same mode, speed against accuracy, both scored against a fine ray cast in
 //! that mode; charted per volume, with the composited frames the projections are measured against.
 use crate::bench::{alternating_medians, median, scatter_svg_higher};
-use crate::bricked::{frame_ms, load};
+use crate::bricked::frame_ms;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
 use voxsplat::{Camera, Mode, RaycastOptions, RenderOptions, Renderer, RendererOptions, Result};
 
@@ -41,21 +42,24 @@ pub const FINE_STEP: f32 = 0.25;
 /// Every mode of each volume at `size`², the framing camera, no shading (the ray caster's
 /// reference has none): splat frames alternating mode by mode for `rounds` rounds after a
 /// warm-up, ray casts `rounds` times per mode.
-pub fn study(volumes: &[ModeVolume], size: u32, rounds: usize) -> Result<Vec<ModeRow>> {
+/// Returns the rows and the device's name.
+pub fn study(volumes: &[ModeVolume], size: u32, rounds: usize) -> Result<(Vec<ModeRow>, String)> {
     let mut rows = Vec::new();
+    // One renderer each for the dense set and the bricked store, their scenes replaced per volume.
+    let mut dense = Renderer::new(&RendererOptions::default())?;
+    let mut bricked = Renderer::new(&RendererOptions::default())?;
+    let device = bricked.context().map(|c| c.device_name().to_string()).unwrap_or_else(|| "no device".into());
     for v in volumes {
         let tf = TransferFunction::preset(&v.tf)?;
-        let loaded = load(&v.path, &tf)?;
-        let (lo, hi) = loaded.scene.store.range;
-        let iso = ((v.iso - lo) / (hi - lo).max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
-        let grid = loaded.scene.store.grid()?;
-        let cam = Camera::framing(&grid, size, size);
+        // Read once: the dense classification and the bricked store both come from it.
         let vol = voxsplat::loaders::load_volume(&v.path, &Default::default())?;
-        let mut dense = Renderer::new(&RendererOptions::default())?;
+        let store = BrickStore::build(&vol)?;
+        let (lo, hi) = store.range;
+        let iso = ((v.iso - lo) / (hi - lo).max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+        let cam = Camera::framing(&store.grid()?, size, size);
         dense.set_scene(voxsplat::classify::classify(&vol, &tf, None)?)?;
         drop(vol);
-        let mut bricked = Renderer::new(&RendererOptions::default())?;
-        bricked.set_bricks(loaded.scene)?;
+        bricked.set_bricks(BrickScene::new(store, tf, None)?)?;
         let options = |mode: Mode| {
             let mut o = RenderOptions::default();
             o.mode = mode;
@@ -101,7 +105,7 @@ pub fn study(volumes: &[ModeVolume], size: u32, rounds: usize) -> Result<Vec<Mod
             });
         }
     }
-    Ok(rows)
+    Ok((rows, device))
 }
 
 /// One chart per volume in `dir` (`modes-NAME.svg`): each mode's splats and ray caster, frame
@@ -125,19 +129,18 @@ pub fn charts(rows: &[ModeRow], dir: &Path) -> Result<Vec<PathBuf>> {
 }
 
 /// The study's page (docs/bench/modes.md); `charts` are linked by file name.
-pub fn markdown(rows: &[ModeRow], size: u32, rounds: usize, charts: &[PathBuf]) -> String {
+pub fn markdown(rows: &[ModeRow], device: &str, size: u32, rounds: usize, charts: &[PathBuf]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# Rendering modes\n\n`voxsplat lab modes` ({}): each mode's default frame (the bricked store; a projection \
+        "# Rendering modes\n\n`voxsplat lab modes` ({device}): each mode's default frame (the bricked store; a projection \
          draws every voxel) at {size}², the framing camera, no shading, `--raster auto`, the median of {rounds} frames \
          alternating mode by mode after a warm-up; beside it the ray caster in the same mode at step {RAY_STEP} \
          (median of {rounds}). Both are scored by PSNR against a ray cast at step {FINE_STEP} in that mode \
          (premultiplied RGBA). *Composite, every voxel* draws the same voxels as host splats composited front to \
          back (`--dense`); *composite, default* is the default frame (levels of detail, early termination, hidden \
          bricks). `iso V`: the isosurface at V (the file's units), its surface splats made on the device each frame; \
-         its ray caster has no empty-space skipping. One run on this machine: read the ratios.\n",
-        device_name()
+         its ray caster has no empty-space skipping. One run on this machine: read the ratios.\n"
     );
     let _ = writeln!(
         s,
@@ -163,12 +166,4 @@ pub fn markdown(rows: &[ModeRow], size: u32, rounds: usize, charts: &[PathBuf]) 
         let _ = writeln!(s, "\n![{file}]({file})");
     }
     s
-}
-
-/// The device the study ran on, named as the renderer reports it.
-fn device_name() -> String {
-    Renderer::new(&RendererOptions::default())
-        .ok()
-        .and_then(|r| r.context().map(|c| c.device_name().to_string()))
-        .unwrap_or_else(|| "no device".into())
 }

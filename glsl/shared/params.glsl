@@ -26,17 +26,17 @@ float footprint_scale(float depth, float cell) {
     return scale;
 }
 
+// MIP and MinIP draw each voxel's footprint at this share of the kernel's radius, its coverage
+// full from PROJECT_FULL of its centre's weight (footprint_table.glsl): a covered pixel takes its
+// voxels' largest value, and a footprint of under half the area costs less to bin and blend. Swept
+// on the bonsai and the stent against the ray caster's MIP (docs/results-notes.md): 0.65 and 0.7
+// gained 0.9 to 3.6 dB over the kernel's own footprint. Mirror: cpu::splat_params::PROJECT_SHRINK.
+const float PROJECT_SHRINK = 0.65;
+
 // A splat of `cell` voxels a side (a voxel, or a coarse cell of levels of detail: its kernel
 // `cell` times wider) at grid position `at`, of straight colour rgb and optical depth tau per cell;
 // `grow` widens it further with its energy scaled by 1 / grow^2 (levels of detail's morphing).
 // (params_at, below, places it on the uniform grid; this takes its world centre.)
-// MIP and MinIP draw each voxel's footprint at this share of the kernel's radius, its coverage
-// full from PROJECT_FULL of its centre's weight (types.glsl): a covered pixel takes its voxels'
-// largest value, and a footprint a third of the area costs a third to bin and blend. Swept on the
-// bonsai and the stent against the ray caster's MIP (docs/results-notes.md): 0.65 and 0.7 gained
-// 0.9 to 3.6 dB over the kernel's own footprint. Mirror: cpu::splat_params::PROJECT_SHRINK.
-const float PROJECT_SHRINK = 0.65;
-
 SplatParams params_world(vec3 center, float cell, float grow, vec3 rgb, float tau) {
     vec3 forward = frame.forward.xyz;
     float depth = dot(center - frame.eye.xyz, forward);

@@ -385,12 +385,12 @@ pub(crate) struct Shading<'a> {
     depth: Option<&'a [f32]>,
 }
 
-/// The fragment shader's output at quad coordinates (u, v), blended into the pixel at `at` of
-/// `targets` (one, or the two slots).
-/// Mirror of types.glsl's `PROJECT_FULL`: MIP and MinIP cover a pixel fully where a footprint
-/// weighs this share of its centre's.
+/// Mirror of footprint_table.glsl's `PROJECT_FULL`: MIP and MinIP cover a pixel fully where a
+/// footprint weighs this share of its centre's.
 pub const PROJECT_FULL: f32 = 0.7;
 
+/// The fragment shader's output at quad coordinates (u, v), blended into the pixel at `at` of
+/// `targets` (one, or the two slots).
 pub(crate) fn shade(p: &SplatParams, s: Shading<'_>, u: f32, v: f32, targets: &mut [ImageF32], at: usize) {
     if s.depth.is_some_and(|d| p.screen[0] > d[at]) {
         return;

@@ -155,9 +155,9 @@ impl HostTarget {
     }
 
     /// The same target, the frame composited over what the image holds when the frame starts (the
-    /// host's own drawing: a mesh, a background) instead of replacing it: premultiplied "over",
-    /// in the image's stored values (linear light for sRGB and float formats, as the device's
-    /// blending would be). The image's texels are read as premultiplied colour. With the host's
+    /// host's own drawing: a mesh, a background) instead of replacing it: its texels, read as
+    /// premultiplied display values (8-bit texels as stored, half floats encoded from linear), take
+    /// the place of `RenderOptions::background` pixel by pixel. With the host's
     /// depth image (`with_depth`) meshes and the volume then intermix: the volume hides what lies
     /// behind it by its opacity, and geometry in front of it hides the volume.
     ///
