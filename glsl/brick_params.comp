@@ -1,5 +1,5 @@
 #version 450
-// variants: PAGED_RECORDS STREAMED_STORE GRADIENTS
+// variants: PAGED_RECORDS STREAMED_STORE GRADIENTS PROJECT_VOXELS
 // Bricks, pass 3 (issue 23): per splat of a batch, in draw order, classify its voxel on the device
 // (TF table, gradient weighting, headlight shading; gradients read through the store, or in the
 // GRADIENTS build from each voxel's precomputed differences) and make its
@@ -22,7 +22,12 @@ layout(push_constant) uniform Push {
 void main() {
     uint s = linear_invocation();
     if (s >= pc.splats) return;
+#ifdef PROJECT_VOXELS
+    // A projection with texels: the batch's voxels that draw (project_winners).
+    uvec2 v = project_voxels[s];
+#else
     uvec2 v = voxels[s];
+#endif
     if (voxel_level(v) != 0u) return;
     uvec3 ijk = voxel_ijk(v);
     vec4 c = classify_voxel(ivec3(ijk), v.y >> 16u, bf.light.w > 0.5);

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Mutation check (issues 25, 44): plants twenty-eight known bugs one at a time, runs the tests that should
+# Mutation check (issues 25, 44): plants thirty known bugs one at a time, runs the tests that should
 # catch each, and prints a markdown table; exits 1 when a bug survives (no test failed). Each
 # mutant costs a release rebuild of the library and its tests (about 1-3 minutes here); the last
 # result lives in docs/RELIABILITY.md. The tree is restored after every mutant, also on Ctrl-C.
-#   scripts/mutants.sh            all twenty-eight
+#   scripts/mutants.sh            all thirty
 #   scripts/mutants.sh octant     the ones whose name contains "octant"
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,6 +37,8 @@ MUTANTS=(
   "an isosurface pixel's visible depth from any disc|src/cpu/tile_composite.rs|if w >= SURFACE_VISIBLE * inputs.table[0] {|if w > 0.0 {|--test iso surface_lies"
   "an isosurface's cells counted and listed with those wholly inside, on the device|glsl/shared/iso.glsl|            if (m != 0u && m != 255u) {|            if (m != 0u) {|--test iso gpu_matches"
   "MIP's footprints at the kernel's full radius, on the device|glsl/shared/params.glsl|base *= PROJECT_SHRINK;|base *= 1.0;|--test modes an_axis_aligned"
+  "a voxel beyond a clipping plane claims a texel, on the device|glsl/shared/texels.glsl|            if (dot(frame.clip[i].xyz, p) + frame.clip[i].w < 0.0) return false;|            if (false) return false;|--test modes clipping_planes"
+  "a texel kept by its last claim, not its largest|src/cpu/project_texels.rs|out.texels[t] = out.texels[t].max(claim_of(inputs, ijk, rec >> 16));|out.texels[t] = claim_of(inputs, ijk, rec >> 16);|--test modes one_voxel_a_column"
 )
 filter=${1:-}
 backup=$(mktemp -d)

@@ -65,6 +65,9 @@ pub enum Records {
     /// One page, with the voxels' differences read from `Res::BrickGradients` (`GRADIENTS`):
     /// `brick_params` and `brick_pyramid` only.
     Gradients,
+    /// A projection's voxels that draw, packed by `project_winners` (`PROJECT_VOXELS`):
+    /// `brick_params` only.
+    Winners,
 }
 
 impl Records {
@@ -283,6 +286,15 @@ pub const RECORDS_OR_GRADIENTS: Table = table! {
     Build::Records(Records::Gradients) => v("GRADIENTS", &[]),
 };
 
+/// `brick_params`: `RECORDS_OR_GRADIENTS`, or a projection's packed voxels.
+pub const PARAMS: Table = table! {
+    Build::Records(Records::OnePage) => v("", &[]),
+    Build::Records(Records::Paged) => v("PAGED_RECORDS", &[]),
+    Build::Records(Records::Streamed) => v("STREAMED_STORE", &[]),
+    Build::Records(Records::Gradients) => v("GRADIENTS", &[]),
+    Build::Records(Records::Winners) => v("PROJECT_VOXELS", &[]),
+};
+
 /// `brick_cells`.
 pub const PYRAMIDS: Table = table! {
     Build::Pyramids(Pyramids::Resident) => v("", &[]),
@@ -445,6 +457,7 @@ pub const TABLES: &[&Table] = &[
     &ONLY,
     &RECORDS,
     &RECORDS_OR_GRADIENTS,
+    &PARAMS,
     &PYRAMIDS,
     &SLAB_BINS,
     &PAGES,

@@ -155,6 +155,15 @@ pub enum Res {
     Pyramid3,
     /// Levels of detail: a batch's coarse splats' positions (`brick_lod_params`' lanes).
     LodSplats,
+    /// A projection's texels (MIP, MinIP): a batch's drawn voxels (`project_winners`' count), then
+    /// per texel the claim of the brightest voxel whose centre falls in it (`project_texels`), the
+    /// only one of them that draws.
+    ProjectTexels,
+    /// A projection's voxels that draw, packed (`project_winners`): `brick_params`' input then.
+    ProjectVoxels,
+    /// A projection's texels: per voxel of a batch the word of the texel it claims
+    /// (`project_texels`, for `project_winners`).
+    VoxelTexels,
     /// Images: the compute passes' accumulation image, the summation layers, the raster target.
     Accum,
     /// The summation layers.

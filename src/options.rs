@@ -6,8 +6,10 @@ use crate::order::{Direction, OrderKind};
 
 mod depth;
 mod mode;
+mod stats;
 pub use depth::{DepthBuffer, DepthFormat};
 pub use mode::Mode;
+pub use stats::FrameStats;
 
 /// How splats become pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -277,6 +279,11 @@ pub struct RenderOptions {
     /// frame into several batches and drop, before each later batch, the bricks the image so far
     /// already hides (the same frame; on by default, off to measure what it saves).
     pub cull_hidden_bricks: bool,
+    /// MIP and MinIP of a bricked volume: draw every voxel, where by default each third of a
+    /// pixel draws only the brightest voxel whose centre falls in it (the rest, that close to a
+    /// brighter one, add next to nothing: `FrameStats::splats_outshone` counts them). Slower;
+    /// refused in the other modes.
+    pub every_voxel: bool,
     /// How the footprint stage rasterises (`crate::raster`); `Auto` picks per device and footprint
     /// size, and `Rendered::raster` says what it picked.
     pub raster: Raster,
@@ -341,6 +348,7 @@ impl Default for RenderOptions {
             slab_thickness: 1.0,
             early_termination: DEFAULT_EARLY_TERMINATION,
             cull_hidden_bricks: true,
+            every_voxel: false,
             raster: Raster::Auto,
             render_scale: 1.0,
             lod: Lod::Auto,
@@ -411,6 +419,12 @@ impl RenderOptions {
             if self.motion.is_some() {
                 return refuse("motion-blurred splats are composited in order");
             }
+        }
+        if self.every_voxel && !matches!(self.mode, Mode::Mip | Mode::Minip) {
+            return Err(Error::InvalidArgument(format!(
+                "--every-voxel: --mode {} draws every voxel already; only MIP and MinIP draw the brightest voxel of                  each texel",
+                self.mode
+            )));
         }
         check_iso(self.mode, self.iso)?;
         if self.mode == Mode::Iso && matches!(self.raster, Raster::Graphics | Raster::Points) {
@@ -588,35 +602,6 @@ pub struct Rendered {
     pub raster: Option<RasterChoice>,
     /// What the frame drew and culled (a bricked volume's; zero elsewhere).
     pub stats: FrameStats,
-}
-
-/// What a frame drew and what it left out, and why (`Rendered::stats`): a bricked volume's bricks and
-/// splats, an isosurface's discs, a label volume's unlabelled voxels.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct FrameStats {
-    /// Non-empty bricks in the store.
-    pub bricks: u32,
-    /// Bricks left after culling those outside the view or empty under the transfer function.
-    pub bricks_visible: u32,
-    /// Visible bricks the level-of-detail cut drew coarser than their voxels.
-    pub bricks_coarse: u32,
-    /// Of those, nodes above the brick: one cell drawn for 2^k bricks a side, listed at the first
-    /// of its bricks that draws (the others are not counted as visible).
-    pub nodes: u32,
-    /// Visible bricks dropped because what earlier waves drew already hides them.
-    pub bricks_hidden: u32,
-    /// Splats drawn: voxels and coarse cells; in `Mode::Iso`, the surface's discs (0: the value
-    /// crosses no cell, and the frame is empty).
-    pub splats: u64,
-    /// Batches (waves) the visible bricks were drawn in, front to back.
-    pub waves: u32,
-    /// Bytes of brick records uploaded: a streamed store's bricks its record cache lacked.
-    pub bytes_uploaded: u64,
-    /// Bytes of brick records its record cache holds after the frame (whole-brick slots).
-    pub records_resident: u64,
-    /// A label volume's voxels drawn hidden because the label table lacks their label
-    /// (`labels::classify_labels`).
-    pub unlabelled: u64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

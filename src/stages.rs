@@ -115,6 +115,21 @@ const BRICK: &[Res; 32] = &[
 /// `brick_hidden`'s places (the brick stages' list is at lavapipe's 32 storage buffers a stage).
 const BRICK_GRADIENTS: &[Res] =
     &Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi);
+/// `brick_params`' bindings: `BRICK_GRADIENTS` with a projection's packed voxels
+/// (`project_winners`) in the place of `LodSplats` (projections have no levels of detail).
+const BRICK_PARAMS: &[Res] = &Res::replaced(
+    Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi),
+    Res::LodSplats,
+    Res::ProjectVoxels,
+);
+/// `project_texels`' and `project_winners`' bindings: the brick stages' with the texels in the
+/// place of `LodSplats`, the packed voxels in `brick_hidden`'s and each voxel's texel in the
+/// occlusion map's.
+const BRICK_TEXELS: &[Res] = &Res::replaced(
+    Res::replaced(Res::replaced(*BRICK, Res::LodSplats, Res::ProjectTexels), Res::BrickHidden, Res::ProjectVoxels),
+    Res::Occlusion,
+    Res::VoxelTexels,
+);
 /// glsl/shared/iso.glsl's bindings and `iso_splats`' outputs.
 const ISO: &[Res] =
     &[Res::Frame, Res::IsoField, Res::IsoRows, Res::IsoCounts, Res::Params, Res::ParamsHi, Res::Order, Res::IsoCells];
@@ -254,15 +269,35 @@ stages! {
         device_build: None,
         builds: &builds::PYRAMIDS,
     },
+    project_texels => ProjectTexels {
+        kind: Kind::Compute,
+        bindings: BRICK_TEXELS,
+        writes: &[Res::BrickVoxels, Res::Order, Res::ProjectTexels, Res::VoxelTexels],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::PerItem(BRICK_LANES),
+        timing: "texels",
+        device_build: None,
+        builds: &builds::RECORDS,
+    },
+    project_winners => ProjectWinners {
+        kind: Kind::Compute,
+        bindings: BRICK_TEXELS,
+        writes: &[Res::ProjectTexels, Res::ProjectVoxels],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "winners",
+        device_build: None,
+        builds: &builds::ONLY,
+    },
     brick_params => BrickParams {
         kind: Kind::Compute,
-        bindings: BRICK_GRADIENTS,
+        bindings: BRICK_PARAMS,
         writes: &[Res::Params],
         push: std::mem::size_of::<BrickPush>() as u32,
         workgroup: Workgroup::Linear(WORKGROUP_SIZE),
         timing: "splat_params",
         device_build: None,
-        builds: &builds::RECORDS_OR_GRADIENTS,
+        builds: &builds::PARAMS,
     },
     brick_lod_params => BrickLodParams {
         kind: Kind::Compute,

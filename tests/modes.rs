@@ -280,7 +280,16 @@ fn a_projection_refuses_what_cannot_apply() {
     let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
     b.set_bricks(voxsplat::bricks::BrickScene::new(store, tf(), None).unwrap()).unwrap();
     let plan = b.plan(&cam, &options(Mode::Mip, Raster::Auto)).unwrap().to_string();
-    assert!(plan.contains("mip projection, every voxel") && plan.contains("lod        off"), "{plan}");
+    assert!(plan.contains("mip projection") && plan.contains("lod        off"), "{plan}");
+    assert!(plan.contains("texels     3x3 a pixel"), "{plan}");
+    let mut every = options(Mode::Mip, Raster::Auto);
+    every.every_voxel = true;
+    assert!(!b.plan(&cam, &every).unwrap().to_string().contains("texels"), "--every-voxel draws every voxel");
+    // --every-voxel only changes what MIP and MinIP draw.
+    let mut o = options(Mode::Average, Raster::Auto);
+    o.every_voxel = true;
+    let e = r.render(&cam, &o).unwrap_err().to_string();
+    assert!(e.contains("--every-voxel") && e.contains("--mode average"), "{e}");
     // Values outside [0, 1] are refused where a set is made.
     let grid = voxsplat::Grid::centered([2, 2, 2], [1.0; 3]).unwrap();
     let e = SplatSet::from_fn_valued(grid, |_, _, _| Some(([1.0; 4], 1.5))).unwrap_err().to_string();
@@ -330,18 +339,110 @@ fn a_bricked_volume_projects_as_its_dense_splats_do() {
         for raster in [Raster::Compute, Raster::Graphics] {
             let cam = common::random_camera(&mut rng, set.grid(), common::ViewKind::Outside);
             let o = options(mode, raster);
+            // A dense set draws every voxel; MIP and MinIP of a store by default the brightest of
+            // each texel (below).
+            let extreme = matches!(mode, Mode::Mip | Mode::Minip);
+            let mut every = o.clone();
+            every.every_voxel = extreme;
             g.set_scene(set.clone()).unwrap();
             let dense = g.render(&cam, &o).unwrap().image;
             g.set_bricks(scene.clone()).unwrap();
-            let bricked = g.render(&cam, &o).unwrap();
+            let bricked = g.render(&cam, &every).unwrap();
             c.set_bricks(scene.clone()).unwrap();
-            assert_mirrors(&bricked.image, &c.render(&cam, &o).unwrap().image, &format!("bricked {mode} {raster}"));
+            assert_mirrors(&bricked.image, &c.render(&cam, &every).unwrap().image, &format!("bricked {mode} {raster}"));
             // The store holds values in 16 bits and draws its bricks in another order (sums
             // round otherwise): the same frame to within that.
             let (worst, _) = common::diff(&bricked.image, &dense);
             assert!(worst < 2e-3, "{mode} {raster}: bricked against dense, largest difference {worst}");
             assert_eq!(bricked.stats.bricks_coarse, 0, "no levels of detail in a projection");
+            assert_eq!(bricked.stats.splats_outshone, 0, "{mode}: every voxel drawn");
+            if extreme {
+                // The brightest voxel of each texel: the mirror draws the same, and the frame
+                // stays close to every voxel's.
+                let texels = g.render(&cam, &o).unwrap();
+                assert_mirrors(&texels.image, &c.render(&cam, &o).unwrap().image, &format!("texels {mode} {raster}"));
+                let (worst, mean) = common::diff(&texels.image, &bricked.image);
+                let dropped = texels.stats.splats_outshone as f64 / bricked.stats.splats as f64;
+                eprintln!(
+                    "{mode} {raster}: texels drop {dropped:.3} of the voxels; largest {worst:.3}, mean {mean:.5}"
+                );
+                assert!(texels.stats.splats_outshone > 0, "{mode} {raster}: the texels drop voxels");
+                assert_eq!(texels.stats.splats + texels.stats.splats_outshone, bricked.stats.splats);
+                assert!(mean < 2e-3, "{mode} {raster}: texels against every voxel, mean difference {mean}");
+            }
         }
+    }
+    assert_clean(&g);
+}
+
+/// A bricked ball for the texel tests.
+fn bricked_ball(dims: [u32; 3]) -> voxsplat::bricks::BrickScene {
+    let store = voxsplat::bricks::BrickStore::build(&ball(dims)).unwrap();
+    voxsplat::bricks::BrickScene::new(store, tf(), None).unwrap()
+}
+
+#[test]
+fn an_axis_aligned_projection_of_a_store_draws_one_voxel_a_column_and_the_same_frame() {
+    // Down the columns every voxel of a column falls in one texel: MIP and MinIP draw its
+    // brightest (darkest) voxel alone, whose footprint is every other's, so the frame is every
+    // voxel's to the bit.
+    let dims = [20, 16, 12];
+    let scene = bricked_ball(dims);
+    let cam = column_camera(dims, 4);
+    let columns = {
+        let vol = ball(dims);
+        let (lo, hi) = vol.values.iter().fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+        let shows = |i: u32, j: u32| {
+            (0..dims[2])
+                .any(|k| tf().eval((vol.values[(i + dims[0] * (j + dims[1] * k)) as usize] - lo) / (hi - lo))[3] > 0.0)
+        };
+        (0..dims[1]).flat_map(|j| (0..dims[0]).map(move |i| (i, j))).filter(|&(i, j)| shows(i, j)).count() as u64
+    };
+    for (engine, mut r) in [("gpu", gpu()), ("cpu", cpu())] {
+        r.set_bricks(scene.clone()).unwrap();
+        for mode in [Mode::Mip, Mode::Minip] {
+            let o = options(mode, Raster::Compute);
+            let mut every = o.clone();
+            every.every_voxel = true;
+            let (texels, all) = (r.render(&cam, &o).unwrap(), r.render(&cam, &every).unwrap());
+            assert_eq!(texels.stats.splats, columns, "{mode} {engine}: one voxel a column");
+            assert_eq!(texels.stats.splats + texels.stats.splats_outshone, all.stats.splats, "{mode} {engine}");
+            assert_eq!(texels.image.pixels, all.image.pixels, "{mode} {engine}: the frame of every voxel");
+        }
+        assert_clean(&r);
+    }
+}
+
+#[test]
+fn a_projection_s_texels_keep_the_clipping_planes_and_the_image_s_edges() {
+    // A voxel beyond a clipping plane, or too near the near plane, draws nothing and so may hide
+    // nothing: bricks across a plane claim no texel. A view cut by the image's edges and by a plane
+    // through the ball, with the camera close enough that the near plane crosses it too.
+    let dims = [48, 40, 32];
+    let scene = bricked_ball(dims);
+    let mut g = gpu();
+    g.set_bricks(scene.clone()).unwrap();
+    let mut c = cpu();
+    c.set_bricks(scene).unwrap();
+    let mut cam = Camera::framing(&voxsplat::Grid::centered(dims, [1.0; 3]).unwrap(), 56, 48);
+    cam.eye = cam.target + (cam.eye - cam.target) * 0.8;
+    cam.near = (cam.eye - cam.target).length() - 14.0;
+    for mode in [Mode::Mip, Mode::Minip] {
+        let mut o = options(mode, Raster::Compute);
+        o.clip = voxsplat::Clip::new(&[glam::Vec4::new(0.6, -0.3, 0.74, 1.5)], None).unwrap();
+        let mut every = o.clone();
+        every.every_voxel = true;
+        let texels = g.render(&cam, &o).unwrap();
+        assert_mirrors(&texels.image, &c.render(&cam, &o).unwrap().image, &format!("clipped {mode}"));
+        let all = g.render(&cam, &every).unwrap();
+        let (worst, mean) = common::diff(&texels.image, &all.image);
+        eprintln!("clipped {mode}: {} outshone; largest {worst:.3}, mean {mean:.5}", texels.stats.splats_outshone);
+        assert!(texels.stats.splats_outshone > 0, "{mode}: the texels drop voxels");
+        // A voxel the plane or the near plane removes, left to claim, blanks what it outshines.
+        assert!(
+            worst < 0.35 && mean < 2e-3,
+            "clipped {mode}: texels against every voxel, largest {worst}, mean {mean}"
+        );
     }
     assert_clean(&g);
 }

@@ -66,13 +66,22 @@ pub fn study(volumes: &[ModeVolume], size: u32, rounds: usize) -> Result<(Vec<Mo
             o.iso = (mode == Mode::Iso).then_some(iso);
             o
         };
-        // Splat frames: every mode's default frame, then the composited frame of every voxel.
+        // MIP drawing every voxel, not each texel's brightest (`--every-voxel`).
+        let every_voxel = || {
+            let mut o = options(Mode::Mip);
+            o.every_voxel = true;
+            o
+        };
+        // Splat frames: every mode's default frame, the composited frame of every voxel, MIP of
+        // every voxel.
         let n = Mode::ALL.len();
-        let splat_ms = alternating_medians(n + 1, 1, rounds, |i| {
+        let splat_ms = alternating_medians(n + 2, 1, rounds, |i| {
             if i < n {
                 frame_ms(&mut bricked, &cam, &options(Mode::ALL[i]))
-            } else {
+            } else if i == n {
                 frame_ms(&mut dense, &cam, &options(Mode::Composite))
+            } else {
+                frame_ms(&mut bricked, &cam, &every_voxel())
             }
         })?;
         for (i, &mode) in Mode::ALL.iter().enumerate() {
@@ -93,16 +102,30 @@ pub fn study(volumes: &[ModeVolume], size: u32, rounds: usize) -> Result<(Vec<Mo
             let ray_ms = median(&mut times[1..]);
             let ray = image.expect("cast at least once");
             let splats = bricked.render(&cam, &options(mode))?.image;
+            let ray_psnr = voxsplat::metrics::compare(&ray, &fine)?.psnr;
             rows.push(ModeRow {
                 volume: v.name.clone(),
                 mode: if mode == Mode::Iso { format!("iso {}", v.iso) } else { mode.to_string() },
                 splat_ms: splat_ms[i],
                 splat_psnr: voxsplat::metrics::compare(&splats, &fine)?.psnr,
                 ray_ms,
-                ray_psnr: voxsplat::metrics::compare(&ray, &fine)?.psnr,
+                ray_psnr,
                 dense_ms: splat_ms[n],
                 default_ms: splat_ms[0],
             });
+            if mode == Mode::Mip {
+                let every = bricked.render(&cam, &every_voxel())?.image;
+                rows.push(ModeRow {
+                    volume: v.name.clone(),
+                    mode: "mip, every voxel".into(),
+                    splat_ms: splat_ms[n + 1],
+                    splat_psnr: voxsplat::metrics::compare(&every, &fine)?.psnr,
+                    ray_ms,
+                    ray_psnr,
+                    dense_ms: splat_ms[n],
+                    default_ms: splat_ms[0],
+                });
+            }
         }
     }
     Ok((rows, device))
@@ -118,7 +141,10 @@ pub fn charts(rows: &[ModeRow], dir: &Path) -> Result<Vec<PathBuf>> {
         let mut points = Vec::new();
         for r in rows.iter().filter(|r| r.volume == name) {
             points.push((format!("{} splats", r.mode), r.splat_ms, r.splat_psnr));
-            points.push((format!("{} ray {RAY_STEP}", r.mode), r.ray_ms, r.ray_psnr));
+            // MIP of every voxel shares MIP's ray caster.
+            if r.mode != "mip, every voxel" {
+                points.push((format!("{} ray {RAY_STEP}", r.mode), r.ray_ms, r.ray_psnr));
+            }
         }
         let path = dir.join(format!("modes-{name}.svg"));
         let title = format!("{name}: each mode, splats and the ray caster in the same mode");
@@ -133,8 +159,8 @@ pub fn markdown(rows: &[ModeRow], device: &str, size: u32, rounds: usize, charts
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# Rendering modes\n\n`voxsplat lab modes` ({device}): each mode's default frame (the bricked store; a projection \
-         draws every voxel) at {size}², the framing camera, no shading, `--raster auto`, the median of {rounds} frames \
+        "# Rendering modes\n\n`voxsplat lab modes` ({device}): each mode's default frame (the bricked store; MIP and \
+         MinIP draw each texel's brightest voxel, *mip, every voxel* all of them: `--every-voxel`) at {size}², the framing camera, no shading, `--raster auto`, the median of {rounds} frames \
          alternating mode by mode after a warm-up; beside it the ray caster in the same mode at step {RAY_STEP} \
          (median of {rounds}). Both are scored by PSNR against a ray cast at step {FINE_STEP} in that mode \
          (premultiplied RGBA). *Composite, every voxel* draws the same voxels as host splats composited front to \

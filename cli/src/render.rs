@@ -47,6 +47,10 @@ pub(crate) struct RenderArgs {
     /// at most --early-termination; for measuring what dropping them saves).
     #[arg(long)]
     keep_hidden_bricks: bool,
+    /// --mode mip or minip: draw every voxel, where by default each third of a pixel draws only
+    /// the brightest voxel there (slower; the others add next to nothing).
+    #[arg(long)]
+    every_voxel: bool,
     /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25) [default: 1].
     #[arg(long, value_parser = parse_finite)]
     slab_thickness: Option<f32>,
@@ -202,6 +206,7 @@ pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
     }
     opts.early_termination = a.early_termination;
     opts.cull_hidden_bricks = !a.keep_hidden_bricks;
+    opts.every_voxel = a.every_voxel;
     opts.raster = a.raster.parse::<voxsplat::Raster>()?;
     opts.render_scale = a.render_scale;
     opts.lod = a.lod.as_deref().unwrap_or("auto").parse()?;

@@ -93,7 +93,11 @@ layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]
 layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
 // The batch's voxels in draw order: i | j << 16, k | stored value << 16.
 layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
-#ifndef GRADIENTS
+#if defined(PROJECT_TEXELS)
+// A projection's texels: per voxel of the batch the texel it claims (project_texels, for
+// project_winners; texels.glsl), in the occlusion map's place.
+layout(std430, binding = 13) buffer VoxelTexels { uint voxel_texels[]; };
+#elif !defined(GRADIENTS)
 // The occlusion map after the waves drawn so far (tile_occlusion; occlusion.glsl).
 layout(std430, binding = 13) readonly buffer Occlusion { float occlusion[]; };
 #endif
@@ -103,6 +107,9 @@ layout(std430, binding = 13) readonly buffer Occlusion { float occlusion[]; };
 // of brick_hidden's output and input (two bindings: each within maxStorageBufferRange).
 layout(std430, binding = 21) readonly buffer Gradients { uint gradients[]; };
 layout(std430, binding = 13) readonly buffer GradientsHi { uint gradients_hi[]; };
+#elif defined(PROJECT_WINNERS)
+// project_winners' output: a batch's voxels that draw in a projection, packed (texels.glsl).
+layout(std430, binding = 21) writeonly buffer ProjectVoxels { uvec2 project_out[]; };
 #else
 // Per entry of the next wave, 1 when it is hidden (brick_hidden).
 layout(std430, binding = 21) writeonly buffer Hidden { uint hidden_out[]; };
@@ -308,7 +315,16 @@ void pyramid_put(uint i, uint v) {
     }
 }
 // A batch's coarse splats' positions (brick_lod_params).
+#if defined(PROJECT_TEXELS)
+// A projection's texels (texels.glsl), in the place of LodSplats (projections have no levels of
+// detail).
+layout(std430, binding = 31) buffer ProjectTexels { uint project_texels[]; };
+#elif defined(PROJECT_VOXELS)
+// brick_params' voxels in a projection with texels: project_winners' (texels.glsl).
+layout(std430, binding = 31) readonly buffer ProjectVoxels { uvec2 project_voxels[]; };
+#else
 layout(std430, binding = 31) readonly buffer LodSplats { uint lod_splats[]; };
+#endif
 layout(std430, binding = 25) buffer LodSummary { uint lod_words[]; };
 const uint LOD_CELLS = 73u;
 // Cells in a brick's pyramid slot (level 1), and words per brick of LodSummary.

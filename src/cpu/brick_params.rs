@@ -33,7 +33,9 @@ pub fn brick_params(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 
 
 pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()> {
     let mut params = b.take(Res::Params);
-    brick_params(&inputs_for(b, v)?, &args.push_as(), b.get(Res::BrickVoxels), bytemuck::cast_slice_mut(&mut params));
+    // A projection with texels draws project_winners' packed voxels.
+    let voxels = b.get(if v.defines.contains("PROJECT_VOXELS") { Res::ProjectVoxels } else { Res::BrickVoxels });
+    brick_params(&inputs_for(b, v)?, &args.push_as(), voxels, bytemuck::cast_slice_mut(&mut params));
     b.put(Res::Params, params);
     Ok(())
 }

@@ -27,6 +27,8 @@ pub mod order_scan;
 pub mod order_scatter;
 pub mod present;
 pub mod project;
+pub mod project_texels;
+pub mod project_winners;
 pub mod raycast;
 pub mod sheet_tiles;
 pub mod slab;

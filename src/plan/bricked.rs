@@ -15,7 +15,7 @@ use crate::dispatch::{Blend, Limits, List, Res};
 use crate::error::{Error, Result};
 use crate::gpu_types::{BrickFrame, Frame};
 use crate::options::Raster;
-use crate::options::{Composite, Lod, RenderOptions};
+use crate::options::{Composite, Lod, Mode, RenderOptions};
 use crate::order::{Direction, OrderKind};
 use crate::residency::SLOT_WORDS;
 use std::fmt;
@@ -156,6 +156,32 @@ pub struct BrickedSheets {
     pub pass: SheetPass,
 }
 
+/// A projection's texels a pixel side (`project_texels`): PROJECT_TEXEL_SIDE, fewer where the
+/// image is large (at most PROJECT_TEXELS_MAX of them), `None` past that.
+pub fn texel_side(w: u32, h: u32) -> Option<u32> {
+    let pixels = w as u64 * h as u64;
+    (1..=PROJECT_TEXEL_SIDE).rev().find(|&s| pixels * (s * s) as u64 <= PROJECT_TEXELS_MAX)
+}
+
+/// Whether every value the TF table extracts draws (an optical depth above 0 in f32: a tiny
+/// opacity rounds to none), so that no voxel that claims a texel is transparent (texels.glsl).
+fn extracted_draw(table: &[u32]) -> bool {
+    (0..crate::constants::TF_ENTRIES)
+        .filter(|&q| crate::bricks::emits(table, q))
+        .all(|q| crate::volume::optical_depth(f32::from_bits(table[4 * q as usize + 3])) > 0.0)
+}
+
+/// The texels' bytes at `side` texels a pixel side (0: none).
+pub fn texel_bytes(w: u32, h: u32, side: u32) -> u64 {
+    w as u64 * side as u64 * h as u64 * side as u64 * 4
+}
+
+/// MIP's and MinIP's texels a pixel side: a voxel within a third of a pixel of a brighter one adds
+/// next to nothing (docs/results-notes.md, "Projection modes").
+pub const PROJECT_TEXEL_SIDE: u32 = 3;
+/// The most texels a frame holds (64 MiB of claims).
+const PROJECT_TEXELS_MAX: u64 = 1 << 24;
+
 /// The plan of a bricked frame: its uniforms and decisions.
 pub fn plan(
     prep: &Prepared,
@@ -282,6 +308,26 @@ pub fn plan(
         // (its gradients were most of the classification's cost: 60 against 30 ms, bonsai MIP).
         bf.light[3] = 0.0;
     }
+    // MIP and MinIP draw each texel's brightest voxel only (project_texels).
+    let depth = opts.depth.is_some() || limits.target_depth.is_some();
+    let extreme = matches!(opts.mode, Mode::Mip | Mode::Minip);
+    let weighted = scene.transfer_function().gradient_weight > 0.0;
+    let drawn = extracted_draw(scene.tf_words());
+    let side = if extreme
+        && !opts.every_voxel
+        && drawn
+        && !streamed
+        && !depth
+        && !weighted
+        && opts.motion.is_none()
+        && !sheets
+    {
+        texel_side(w, h).filter(|&s| texel_bytes(w, h, s) * 2 <= available).unwrap_or(0)
+    } else {
+        0
+    };
+    bf.split[3] = side;
+    let available = available - texel_bytes(w, h, side);
     if lod {
         (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, opts.lod_error, opts.lod_band);
         bf.hi[3] = node_levels;
@@ -359,12 +405,16 @@ impl fmt::Display for BrickedPlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let [x, y, z] = self.grid();
         let mode = match (&self.sheets, &self.projection) {
-            (None, Some(p)) => format!("{} projection, every voxel (no levels of detail or early termination)", p.mode),
+            (None, Some(p)) => format!("{} projection (no levels of detail or early termination)", p.mode),
             (None, None) => "composited per splat".to_string(),
             (Some(s), _) if s.axis_sheets => format!("in axis-aligned sheets along axis {}", s.axis),
             (Some(_), _) => "in image-aligned slabs".to_string(),
         };
         writeln!(f, "draw       bricked volume, {x}x{y}x{z} bricks ({} stored), {mode}", self.brick_frame.grid[3])?;
+        if self.brick_frame.split[3] > 0 {
+            let side = self.brick_frame.split[3];
+            writeln!(f, "texels     {side}x{side} a pixel, each drawing its brightest voxel")?;
+        }
         let records = match self.build {
             Records::Streamed => "streamed from the host batch by batch",
             Records::Paged => "resident, in pages",

@@ -152,6 +152,17 @@ pub(super) fn record_bricks(
         e.layers(1)?;
     }
     let words = |b: &[[u32; 4]]| b.iter().flatten().copied().collect::<Vec<u32>>();
+    // A projection's texels: each keeps its brightest voxel's claim (project_texels), over every
+    // batch before any draws.
+    let texels = bf.split[3] > 0;
+    if texels {
+        let side = bf.split[3] as u64;
+        e.ensure(Res::ProjectTexels, w as u64 * side * h as u64 * side * 4)?;
+        e.fill(Res::ProjectTexels, None, 0)?;
+        for batch in batches.iter().filter(|b| !b.is_empty()) {
+            record_texels(e, batch, &cut)?;
+        }
+    }
     let mut batches = batches;
     let mut i = 0;
     while i < batches.len() {
@@ -184,8 +195,13 @@ pub(super) fn record_bricks(
                 batch = std::mem::take(&mut batches[i]);
             }
         }
-        let n = batch_splats(&batch);
-        if !batch.is_empty() {
+        let mut n = batch_splats(&batch);
+        if texels && !batch.is_empty() {
+            // One batch's voxels stay extracted from its texels' pass.
+            n = record_winners(e, &batch, &cut, batches.len() > 1)?;
+            stats.splats_outshone += (batch_splats(&batch) - n) as u64;
+            stats.splats -= (batch_splats(&batch) - n) as u64;
+        } else if !batch.is_empty() {
             record_brick_batch(e, scene, &batch, &cut)?;
         }
         if compute {
@@ -441,6 +457,41 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         e.run(&Dispatch::new(StageId::BrickLodParams, build, groups, List::Order, bytemuck::bytes_of(&cells))?)?;
     }
     Ok(())
+}
+
+/// A batch of a projection with texels (resident stores without levels of detail): its voxels
+/// extracted in any order, each claiming its texel (`project_texels`, in `brick_order`'s place).
+/// Every batch claims before any draws.
+fn record_texels(e: &mut dyn Engine, batch: &[[u32; 4]], cut: &Cut) -> Result<BrickPush> {
+    let n = batch_splats(batch);
+    e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+    e.ensure(Res::Order, n as u64 * 4)?;
+    e.ensure(Res::BrickVoxels, n as u64 * 8)?;
+    e.ensure(Res::VoxelTexels, n as u64 * 4)?;
+    e.upload(Res::BrickList, bytemuck::cast_slice(batch))?;
+    let push = BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 };
+    let groups = plan::groups_per_item(batch.len() as u32);
+    e.run(&Dispatch::new(StageId::ProjectTexels, cut.plan.build, groups, List::Order, bytemuck::bytes_of(&push))?)?;
+    Ok(push)
+}
+
+/// A batch's voxels that draw, packed (`project_winners`; extracted again when the frame has
+/// several batches: claiming again changes no texel), and their parameters: their count.
+fn record_winners(e: &mut dyn Engine, batch: &[[u32; 4]], cut: &Cut, extract: bool) -> Result<u32> {
+    let n = batch_splats(batch);
+    let push = if extract {
+        record_texels(e, batch, cut)?
+    } else {
+        BrickPush { first: 0, count: batch.len() as u32, splats: n, occluded: 0.0 }
+    };
+    e.ensure(Res::ProjectVoxels, n as u64 * 8)?;
+    e.fill(Res::ProjectTexels, Some((0, 4)), 0)?;
+    e.run(&Dispatch::new(StageId::ProjectWinners, Only, groups_1d(n), List::Order, bytemuck::bytes_of(&push))?)?;
+    let drawn = e.read(&[(Res::ProjectTexels, 1)])?[0][0].min(n);
+    let push = BrickPush { splats: drawn, ..push };
+    let bytes = bytemuck::bytes_of(&push);
+    e.run(&Dispatch::new(StageId::BrickParams, Records::Winners, groups_1d(drawn), List::Order, bytes)?)?;
+    Ok(drawn)
 }
 
 /// `brick_pyramid` over `push.count` bricks (a resident store's all; a streamed store's batch entries

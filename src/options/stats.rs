@@ -1,0 +1,33 @@
+//! What a frame drew (`Rendered::stats`).
+
+/// What a frame drew and what it left out, and why (`Rendered::stats`): a bricked volume's bricks and
+/// splats, an isosurface's discs, a label volume's unlabelled voxels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Non-empty bricks in the store.
+    pub bricks: u32,
+    /// Bricks left after culling those outside the view or empty under the transfer function.
+    pub bricks_visible: u32,
+    /// Visible bricks the level-of-detail cut drew coarser than their voxels.
+    pub bricks_coarse: u32,
+    /// Of those, nodes above the brick: one cell drawn for 2^k bricks a side, listed at the first
+    /// of its bricks that draws (the others are not counted as visible).
+    pub nodes: u32,
+    /// Visible bricks dropped because what earlier waves drew already hides them.
+    pub bricks_hidden: u32,
+    /// Splats drawn: voxels and coarse cells; in `Mode::Iso`, the surface's discs (0: the value
+    /// crosses no cell, and the frame is empty).
+    pub splats: u64,
+    /// MIP and MinIP: voxels not drawn because a brighter one's centre falls in the same texel (a
+    /// third of a pixel a side), so that it adds next to nothing.
+    pub splats_outshone: u64,
+    /// Batches (waves) the visible bricks were drawn in, front to back.
+    pub waves: u32,
+    /// Bytes of brick records uploaded: a streamed store's bricks its record cache lacked.
+    pub bytes_uploaded: u64,
+    /// Bytes of brick records its record cache holds after the frame (whole-brick slots).
+    pub records_resident: u64,
+    /// A label volume's voxels drawn hidden because the label table lacks their label
+    /// (`labels::classify_labels`).
+    pub unlabelled: u64,
+}
