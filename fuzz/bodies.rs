@@ -99,3 +99,27 @@ pub fn sidecar(data: &[u8]) {
         let _ = voxsplat::loaders::sidecar_hints(text, "fuzz");
     }
 }
+
+/// Image stacks read as volumes (a multipage TIFF through `load_volume` and the streamed store),
+/// through a file.
+pub fn stacks(data: &[u8]) {
+    voxsplat::set_host_budget(Some(256 << 20));
+    let path = std::env::temp_dir().join(format!("voxsplat-fuzz-stacks-{}.tif", std::process::id()));
+    if std::fs::write(&path, data).is_ok() {
+        let hints = voxsplat::loaders::VolumeHints::default();
+        let _ = voxsplat::bricks::BrickStore::load(&path, &hints);
+        let _ = voxsplat::loaders::load_volume(&path, &hints);
+    }
+}
+
+/// DICOM series: the bytes as the one file of a folder read as a series (`load_volume` and the
+/// streamed store).
+pub fn dicom(data: &[u8]) {
+    voxsplat::set_host_budget(Some(256 << 20));
+    let dir = std::env::temp_dir().join(format!("voxsplat-fuzz-dicom-{}", std::process::id()));
+    if std::fs::create_dir_all(&dir).is_ok() && std::fs::write(dir.join("image.dcm"), data).is_ok() {
+        let hints = voxsplat::loaders::VolumeHints::default();
+        let _ = voxsplat::bricks::BrickStore::load(&dir, &hints);
+        let _ = voxsplat::loaders::load_volume(&dir, &hints);
+    }
+}

@@ -2,14 +2,15 @@
 # Installs what voxsplat needs on Debian 12 beyond Rust: lavapipe (Mesa's CPU Vulkan driver), the
 # Vulkan loader, the Khronos validation layers, and the static shaderc/glslang/SPIRV-Tools libraries
 # that build.rs links through .cargo/config.toml; Xvfb and the X libraries winit opens, for the
-# windowed viewer's headless test (examples/viewer.rs). Idempotent: does nothing when all are present.
+# windowed viewer's headless test (examples/viewer.rs); dcm2niix and pydicom, for the DICOM tests.
+# Idempotent: does nothing when all are present.
 # With --mpi, also OpenMPI and libclang: what `--features mpi` (sort-last rendering, rsmpi) builds
 # and runs with (docs/SCALE.md).
 set -euo pipefail
 mpi=()
 [ "${1:-}" = "--mpi" ] && mpi=(openmpi-bin libopenmpi-dev libclang-dev)
 pkgs=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools
-  xvfb xauth libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 "${mpi[@]}")
+  xvfb xauth libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 dcm2niix "${mpi[@]}")
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -22,4 +23,6 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
+# The DICOM tests read pydicom's bundled test series (cli/tests/dicom.rs).
+python3 -c "import pydicom" 2>/dev/null || python3 -m pip install --quiet pydicom
 command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust first (https://rustup.rs)" >&2; exit 1; }

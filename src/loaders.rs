@@ -10,18 +10,22 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 mod bounded;
+mod dicom;
 mod npy;
 mod nrrd;
 mod positions;
 mod slices;
+mod stacks;
 use bounded::read_bounded;
 pub use bounded::{read_text, MAX_TEXT_BYTES};
+pub use dicom::{is_dicom, series_in as dicom_series, SeriesInfo};
 use npy::read_npy;
 pub use npy::{npy_from_bytes, npy_shape};
 pub use nrrd::nrrd_channels_from_bytes;
 use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
 pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
+pub use stacks::is_stack;
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
 pub const MAX_VOXELS: u64 = 1 << 28;
@@ -442,7 +446,7 @@ pub fn sidecar_hints(text: &str, what: &str) -> Result<VolumeHints> {
         Some("big") => true,
         Some(o) => return Err(bad(what, format!("endian '{o}' (little, big)"))),
     };
-    Ok(VolumeHints { dims: Some(s.dims), dtype: Some(s.dtype.parse()?), big_endian, spacing: s.spacing })
+    Ok(VolumeHints { dims: Some(s.dims), dtype: Some(s.dtype.parse()?), big_endian, spacing: s.spacing, series: None })
 }
 
 /// Options for volumes whose files do not say everything (raw data).
@@ -456,6 +460,9 @@ pub struct VolumeHints {
     pub big_endian: bool,
     /// Voxel spacing, overriding the file's.
     pub spacing: Option<[f32; 3]>,
+    /// A folder of several DICOM series: the one to read, by its index in `dicom_series`' list or
+    /// its Series Instance UID.
+    pub series: Option<String>,
 }
 
 /// A raw file's dims, sample type, byte order and spacing: `hints` first, then its `.toml`
@@ -501,7 +508,8 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
     crate::orient::respaced(o, hints.spacing)
 }
 
-/// Load a volume by its extension: `.nrrd`/`.nhdr`, `.nii`/`.nii.gz`, `.npy`, anything else raw.
+/// Load a volume by its extension: `.nrrd`/`.nhdr`, `.nii`/`.nii.gz`, `.npy`, a multipage `.tif`/`.tiff`
+/// or a folder of numbered PNG or TIFF slices (`SliceReader`'s stacks), anything else raw.
 /// A file whose affine is left-handed comes back with its x axis reversed, so that its placement
 /// is a rotation (`Orientation::flip_x`, `load_orientation`); the `*_from_bytes` readers do the same.
 /// Only the bytes its header (or `hints`) says the data needs are read, slice by slice where the
@@ -550,10 +558,13 @@ pub(crate) fn lower_name(path: &Path) -> String {
     path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default()
 }
 
-/// Whether `path` is raw data by its name (anything but NRRD, NIfTI and npy).
+/// Whether `path` is raw data by its name (anything but NRRD, NIfTI, npy, a TIFF, a folder of
+/// slices) and content (not a DICOM file).
 pub fn is_raw(path: &Path) -> bool {
     let name = lower_name(path);
-    ![".nrrd", ".nhdr", ".nii", ".nii.gz", ".npy"].iter().any(|e| name.ends_with(e))
+    !path.is_dir()
+        && ![".nrrd", ".nhdr", ".nii", ".nii.gz", ".npy", ".tif", ".tiff"].iter().any(|e| name.ends_with(e))
+        && !dicom::is_dicom(path)
 }
 
 /// Dims, sample type and byte order describe raw files only: given for a file whose header says

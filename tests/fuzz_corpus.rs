@@ -20,6 +20,8 @@ const TARGETS: &[(&str, Body)] = &[
     ("animation", animation),
     ("positions", positions),
     ("sidecar", sidecar),
+    ("stacks", stacks),
+    ("dicom", dicom),
 ];
 
 /// The seeds of `target` (which must exist), then its corpus.

@@ -72,7 +72,9 @@ enum Command {
     /// Describe a volume or height file: dims, spacing, value range, splats at the default
     /// classification and GPU bytes per splat.
     Info {
-        /// The file (.nrrd/.nhdr, .nii/.nii.gz, .npy, .tif, .png; raw with --dims and --dtype).
+        /// The file (.nrrd/.nhdr, .nii/.nii.gz, .npy, .tif, .png, a DICOM file or a folder of DICOM
+        /// series or of numbered slices; raw with --dims and --dtype). A one-page TIFF or a PNG is a
+        /// height grid, a TIFF of several pages a volume.
         file: PathBuf,
         #[arg(long, value_parser = parse_dims)]
         dims: Option<[u32; 3]>,
@@ -87,6 +89,10 @@ enum Command {
         /// Horizontal cell size of a height grid (as `render --cell`; 0: relief a sixth of the width).
         #[arg(long, value_parser = parse_finite, default_value = "0")]
         cell: f32,
+        /// A folder of several DICOM series: the one to describe (its number in the list, or its
+        /// UID); without it the series are listed.
+        #[arg(long)]
+        series: Option<String>,
     },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
     Animate(AnimateArgs),
@@ -240,11 +246,25 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
-        Command::Info { file, dims, dtype, tf, vscale, cell } => {
+        Command::Info { file, dims, dtype, tf, vscale, cell, series } => {
+            // A folder of DICOM series: each listed, and the one picked (or the only one) described.
+            if file.is_dir() {
+                let all = voxsplat::loaders::dicom_series(&file)?;
+                for (i, s) in all.iter().enumerate() {
+                    println!(
+                        "series {i}: {} {} '{}', {:?} (columns, rows, images)",
+                        s.uid, s.modality, s.description, s.dims
+                    );
+                }
+                if all.len() > 1 && series.is_none() {
+                    println!("{} series: describe one with --series N or UID", all.len());
+                    return Ok(());
+                }
+            }
             let name = file.display().to_string().to_ascii_lowercase();
-            let heights = name.ends_with(".tif")
-                || name.ends_with(".tiff")
-                || name.ends_with(".png")
+            // A TIFF of several pages, or a folder of slices, is a volume.
+            let heights = (name.ends_with(".tif") || name.ends_with(".tiff") || name.ends_with(".png"))
+                && !voxsplat::loaders::is_stack(&file)?
                 || (name.ends_with(".npy") && voxsplat::loaders::npy_shape(&file)?.len() == 2);
             if heights && (dims.is_some() || dtype.is_some() || tf != "ramp") {
                 return Err(Error::InvalidArgument(
@@ -267,6 +287,7 @@ fn run(cli: Cli) -> Result<()> {
                 let hints = voxsplat::loaders::VolumeHints {
                     dims,
                     dtype: dtype.as_deref().map(str::parse).transpose()?,
+                    series: series.clone(),
                     ..Default::default()
                 };
                 match voxsplat::loaders::load_orientation(&file, &hints)? {

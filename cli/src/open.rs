@@ -116,7 +116,9 @@ pub struct SceneArgs {
     #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover", "peer",
         "anterior", "posterior", "left", "right", "superior", "inferior", "oblique"])]
     pub view: String,
-    /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, or raw with --dims and --dtype).
+    /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, a multipage .tif, a DICOM series (its
+    /// folder or a file of it), a folder of numbered PNG or TIFF slices, or raw with --dims and
+    /// --dtype).
     #[arg(long, conflicts_with = "terrain")]
     pub volume: Option<PathBuf>,
     /// Raw volume dimensions.
@@ -131,6 +133,10 @@ pub struct SceneArgs {
     /// Voxel spacing (overrides the file's).
     #[arg(long, value_parser = parse_vec3, requires = "volume")]
     pub spacing: Option<Vec3>,
+    /// A folder of several DICOM series: the one to read (its number in `voxsplat info DIR`'s
+    /// list, or its Series Instance UID).
+    #[arg(long)]
+    pub series: Option<String>,
     /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's
     /// world coordinate along that axis (e.g. irregular CT slices; an axis left out keeps the even
     /// spacing). Draws the volume as host splats.
@@ -346,6 +352,7 @@ pub fn volume_hints(a: &SceneArgs) -> Result<voxsplat::loaders::VolumeHints> {
         dtype: a.dtype.as_deref().map(str::parse).transpose()?,
         big_endian: a.big_endian,
         spacing: a.spacing.map(|v| v.to_array()),
+        series: a.series.clone(),
     })
 }
 

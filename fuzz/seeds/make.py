@@ -85,3 +85,59 @@ put("animation", "keys.toml", b'scene = "cube60"\nframes = 24\nshutter = 1.0\nsi
     b'eye = [1.0, 40.0, 100.0]\ntarget = [0.0, 1.0, 0.0]\n')
 put("positions", "xz.toml", b"x = [0.0, 1.0, 2.5, 4.0]\nz = [0, 3]\n")
 put("sidecar", "raw.toml", b'dims = [4, 3, 2]\ndtype = "uint16"\nendian = "big"\nspacing = [1.0, 1.0, 2.0]\n')
+
+# Image stacks read as volumes (the stacks target): a value (z, y, x) -> ((z * 4 + y) * 5 + x) * 7 % 251
+# (tests/stacks.rs reads these seeds back).
+stack = (np.arange(3 * 4 * 5) * 7 % 251).astype(np.uint16).reshape(3, 4, 5)
+buf = io.BytesIO()
+tifffile.imwrite(buf, stack, imagej=True, resolution=(1 / 0.5, 1 / 0.25),
+                 metadata={"spacing": 2.0, "unit": "um", "axes": "ZYX"})
+put("stacks", "imagej.tif", buf.getvalue())
+buf = io.BytesIO()
+tifffile.imwrite(buf, stack.astype(np.float32) / 4, ome=True, photometric="minisblack",
+                 metadata={"axes": "ZYX", "PhysicalSizeX": 0.3, "PhysicalSizeY": 0.4, "PhysicalSizeZ": 1.5})
+put("stacks", "ome.tif", buf.getvalue())
+buf = io.BytesIO()
+tifffile.imwrite(buf, np.zeros((2, 4, 5, 3), np.uint8), photometric="rgb")
+put("stacks", "rgb.tif", buf.getvalue(), "refused-")
+buf = io.BytesIO()
+with tifffile.TiffWriter(buf) as t:
+    t.write(np.zeros((4, 5), np.uint8))
+    t.write(np.zeros((3, 5), np.uint8))
+put("stacks", "sizes.tif", buf.getvalue(), "refused-")
+buf = io.BytesIO()
+tifffile.imwrite(buf, np.zeros((2, 3, 4, 5), np.uint8), imagej=True, metadata={"axes": "ZCYX"})
+put("stacks", "channels.tif", buf.getvalue(), "refused-")
+
+# DICOM (the dicom target): one CT image written by pydicom, and one without its Pixel Spacing.
+try:
+    import pydicom
+    from pydicom.dataset import Dataset, FileMetaDataset
+    from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+
+    def ct(spacing=True):
+        meta = FileMetaDataset()
+        meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.2"
+        meta.MediaStorageSOPInstanceUID = "1.2.3.4.5.6.7"
+        meta.TransferSyntaxUID = ExplicitVRLittleEndian
+        ds = Dataset()
+        ds.file_meta = meta
+        ds.SOPClassUID, ds.SOPInstanceUID = meta.MediaStorageSOPClassUID, meta.MediaStorageSOPInstanceUID
+        ds.Modality, ds.SeriesInstanceUID = "CT", "1.2.3.4.5.6.8"
+        ds.Rows, ds.Columns = 3, 4
+        ds.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]
+        ds.ImagePositionPatient = [0, 0, 0]
+        if spacing:
+            ds.PixelSpacing = [0.5, 0.5]
+        ds.RescaleSlope, ds.RescaleIntercept = 1, -1024
+        ds.SamplesPerPixel, ds.PhotometricInterpretation = 1, "MONOCHROME2"
+        ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 1
+        ds.PixelData = (np.arange(12, dtype=np.int16) * 100).tobytes()
+        buf = io.BytesIO()
+        pydicom.dcmwrite(buf, ds, enforce_file_format=True)
+        return buf.getvalue()
+
+    put("dicom", "ct.dcm", ct())
+    put("dicom", "no-spacing.dcm", ct(False), "refused-")
+except ImportError:
+    print("pydicom missing: the dicom seeds are left as they are", file=sys.stderr)

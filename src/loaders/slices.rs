@@ -15,6 +15,8 @@ pub const MAX_STREAMED_VOXELS: u64 = 1 << 34;
 /// Where the samples come from.
 enum Source {
     File(std::fs::File),
+    /// A multipage TIFF or a folder of numbered images, decoded a slice at a time.
+    Stack(Box<super::stacks::Stack>),
     /// A gzip stream from byte `start` of `path`, inflated from its start again whenever a read
     /// goes back (a store's build reads the volume twice, front to back).
     Gzip {
@@ -46,6 +48,7 @@ impl Source {
                 f.seek(SeekFrom::Start(at))?;
                 f.read_exact(buf)
             }
+            Source::Stack(_) => Err(std::io::ErrorKind::Unsupported.into()),
             Source::Gzip { path, start, stream, at: pos } => {
                 if at < *pos {
                     (*stream, *pos) = (open_gzip(path, *start)?, 0);
@@ -104,7 +107,23 @@ impl SliceReader {
     pub fn open(path: &Path, hints: &VolumeHints) -> Result<Option<Self>> {
         let name = super::lower_name(path);
         super::check_raw_hints(path, hints)?;
-        if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
+        let series = hints.series.as_deref();
+        if hints.series.is_some() && !(path.is_dir() || super::dicom::is_dicom(path)) {
+            return Err(super::bad(&path.display().to_string(), "--series picks a DICOM series of a folder"));
+        }
+        if path.is_dir() && super::dicom::holds_dicom(path) || !path.is_dir() && super::dicom::is_dicom(path) {
+            Ok(Some(Self::stack(super::stacks::Stack::dicom(path, series)?)))
+        } else if path.is_dir() {
+            if series.is_some() {
+                return Err(super::bad(
+                    &path.display().to_string(),
+                    "--series picks a DICOM series; this folder holds none",
+                ));
+            }
+            Ok(Some(Self::stack(super::stacks::Stack::folder(path)?)))
+        } else if name.ends_with(".tif") || name.ends_with(".tiff") {
+            Ok(Some(Self::stack(super::stacks::Stack::tiff(path)?)))
+        } else if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
             Self::nrrd(path)
         } else if name.ends_with(".nii") || name.ends_with(".nii.gz") {
             Self::nifti(path).map(Some)
@@ -242,8 +261,31 @@ impl SliceReader {
         self.dims[0] as u64 * self.dims[1] as u64 * self.dtype.size() as u64
     }
 
+    /// An image stack's reader (a DICOM series placed in patient space).
+    fn stack(stack: super::stacks::Stack) -> Self {
+        SliceReader {
+            dims: stack.dims,
+            spacing: stack.spacing,
+            orientation: stack.orientation,
+            source: Source::Stack(Box::new(stack)),
+            offset: 0,
+            dtype: DType::F32,
+            big_endian: false,
+            rescale: None,
+            what: String::new(),
+            bytes: Vec::new(),
+        }
+    }
+
     /// Slices `z0..z0 + count` (x fastest) into `out`.
     pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
+        if let Source::Stack(stack) = &mut self.source {
+            stack.read(z0, count, out)?;
+            if self.flip_x() {
+                super::nrrd::flip_rows(out, self.dims[0] as usize);
+            }
+            return Ok(());
+        }
         let plane = self.dims[0] as u64 * self.dims[1] as u64;
         let n = plane * count as u64;
         self.bytes.resize((self.plane_bytes() * count as u64) as usize, 0);
@@ -272,7 +314,7 @@ impl SliceReader {
             )));
         }
         let (w, h) = ((hi[0] - lo[0]) as usize, (hi[1] - lo[1]) as usize);
-        if let Source::Gzip { .. } = self.source {
+        if let Source::Gzip { .. } | Source::Stack(_) = self.source {
             let mut whole = Vec::new();
             self.read(z0, count, &mut whole)?;
             out.clear();

@@ -1,0 +1,160 @@
+//! DICOM series (issue 47) with files no one here wrote: the real series in pydicom's test data
+//! (pip-installed by scripts/setup.sh), read as a folder, a file of it or one series of several,
+//! beside `dcm2niix`'s NIfTI conversion of the same series; and what a folder that is not one
+//! series is refused for.
+mod cmd;
+use cmd::voxsplat;
+use std::path::{Path, PathBuf};
+use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};
+
+/// pydicom's test files (`dicomdirtests`: small CT, MR and CR series).
+fn pydicom_tests() -> PathBuf {
+    let out = std::process::Command::new("python3")
+        .args(["-c", "import os, pydicom; print(os.path.dirname(pydicom.__file__))"])
+        .output()
+        .expect("python3 (scripts/setup.sh installs pydicom)");
+    assert!(out.status.success(), "pydicom is missing: scripts/setup.sh installs it");
+    Path::new(String::from_utf8(out.stdout).unwrap().trim()).join("data/test_files/dicomdirtests")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    cmd::tmp_in("dicom", name)
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = voxsplat(args);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "voxsplat {args:?}: {text}");
+    text
+}
+
+fn refused(args: &[&str]) -> String {
+    let out = voxsplat(args);
+    let text = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success() && text.starts_with("error:"), "voxsplat {args:?} should fail: {text}");
+    assert!(!text.contains("panicked"), "{text}");
+    text
+}
+
+#[test]
+fn a_ct_series_reads_in_slice_order_and_renders_as_dcm2niix_converts_it() {
+    let ct = pydicom_tests().join("98892001/CT5N");
+    // Its five images, named against their order along the normal (z falls as the names rise).
+    let hints = VolumeHints::default();
+    let v = load_volume(&ct, &hints).unwrap();
+    assert_eq!((v.dims, v.spacing), ([16, 16, 5], [0.488281, 0.488281, 2.5]));
+    let o = load_orientation(&ct, &hints).unwrap().expect("a series is placed in patient space");
+    assert_eq!(o.code(), "LPS");
+    // pydicom's pixel values with the rescale, slice by slice in position order.
+    let script = format!(
+        "import glob, pydicom\n\
+         ds = sorted((pydicom.dcmread(f) for f in glob.glob('{}/*')), key=lambda d: float(d.ImagePositionPatient[2]))\n\
+         print(' '.join(str(float(v) * float(d.get('RescaleSlope', 1)) + float(d.get('RescaleIntercept', 0))) for d in ds for v in d.pixel_array.ravel()))",
+        ct.display()
+    );
+    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let want: Vec<f32> =
+        String::from_utf8(out.stdout).unwrap().split_whitespace().map(|s| s.parse().unwrap()).collect();
+    // The slices run toward superior (z rises with k): pydicom's, sorted by z, in the same order.
+    assert_eq!(v.values, want);
+    // A file of the series names its series; the folder with another file beside it reads the same.
+    let file = std::fs::read_dir(&ct).unwrap().next().unwrap().unwrap().path();
+    assert_eq!(load_volume(&file, &hints).unwrap().values, v.values);
+    // dcm2niix's NIfTI of the same series: the same frame, placed and valued alike.
+    let out = tmp("d2n");
+    std::fs::create_dir_all(&out).unwrap();
+    let conv = std::process::Command::new("dcm2niix")
+        .args(["-o", out.to_str().unwrap(), "-f", "ct5n", "-z", "n"])
+        .arg(&ct)
+        .output()
+        .expect("dcm2niix (scripts/setup.sh installs it)");
+    assert!(conv.status.success(), "{}", String::from_utf8_lossy(&conv.stderr));
+    let nii = out.join("ct5n.nii");
+    let (a, b) = (tmp("series.png"), tmp("nifti.png"));
+    for (input, png) in [(&ct, &a), (&nii, &b)] {
+        ok(&[
+            "render",
+            "--volume",
+            input.to_str().unwrap(),
+            "--tf",
+            "ct",
+            "--size",
+            "96x96",
+            "--cpu",
+            "--out",
+            png.to_str().unwrap(),
+        ]);
+    }
+    let compared = ok(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    let psnr: f64 = compared
+        .lines()
+        .find_map(|l| l.strip_prefix("psnr:"))
+        .map(|s| s.trim().trim_end_matches(" dB").parse().unwrap_or(f64::INFINITY))
+        .unwrap();
+    assert!(psnr > 60.0, "the series against dcm2niix's NIfTI: {compared}");
+}
+
+#[test]
+fn a_folder_of_several_series_lists_them_and_reads_the_one_picked() {
+    let mr = pydicom_tests().join("98892003/MR2");
+    let listed = ok(&["info", mr.to_str().unwrap()]);
+    assert!(
+        listed.contains("series 2:") && listed.contains("FAST LOCALIZER") && listed.contains("3 series"),
+        "{listed}"
+    );
+    let e = refused(&["render", "--volume", mr.to_str().unwrap(), "--out", tmp("mr.png").to_str().unwrap()]);
+    assert!(e.contains("holds 3 series") && e.contains("--series"), "{e}");
+    // The localizer alone (one image), by its number and by its UID.
+    let one = ok(&["info", mr.to_str().unwrap(), "--series", "2"]);
+    assert!(one.contains("volume: [16, 16, 1]"), "{one}");
+    let uid = "1.3.6.1.4.1.5962.1.1.0.0.0.1196533885.18148.0.481";
+    let hints = VolumeHints { series: Some(uid.into()), ..Default::default() };
+    assert_eq!(load_volume(&mr, &hints).unwrap().dims, [16, 16, 1]);
+    let hints = VolumeHints { series: Some("7".into()), ..Default::default() };
+    let e = load_volume(&mr, &hints).unwrap_err().to_string();
+    assert!(e.contains("no series 7"), "{e}");
+}
+
+#[test]
+fn a_folder_that_is_not_one_even_series_is_refused_by_name() {
+    let tests = pydicom_tests();
+    let hints = VolumeHints::default();
+    for (dir, says) in [
+        ("98892003/MR700", "mixed orientations"),
+        ("98892001/CT2N", "mixed orientations"),
+        ("77654033/CT2", "uneven slice gaps"),
+    ] {
+        let e = load_volume(&tests.join(dir), &hints).unwrap_err().to_string();
+        assert!(e.contains(says), "{dir}: {e}");
+    }
+    // A copy of the CT series: another file beside it is left alone; a duplicate position and a
+    // truncated image are refused naming the files.
+    let ct = tests.join("98892001/CT5N");
+    let copy = tmp("ct-copy");
+    let _ = std::fs::remove_dir_all(&copy);
+    std::fs::create_dir_all(&copy).unwrap();
+    let files: Vec<PathBuf> = {
+        let mut f: Vec<PathBuf> = std::fs::read_dir(&ct).unwrap().map(|e| e.unwrap().path()).collect();
+        f.sort();
+        f
+    };
+    for f in &files {
+        std::fs::copy(f, copy.join(f.file_name().unwrap())).unwrap();
+    }
+    std::fs::write(copy.join("README.txt"), "not DICOM").unwrap();
+    assert_eq!(load_volume(&copy, &hints).unwrap().dims, [16, 16, 5]);
+    std::fs::copy(&files[0], copy.join("again")).unwrap();
+    let e = load_volume(&copy, &hints).unwrap_err().to_string();
+    assert!(e.contains("duplicate positions"), "{e}");
+    std::fs::remove_file(copy.join("again")).unwrap();
+    let bytes = std::fs::read(&files[1]).unwrap();
+    let cut = copy.join(files[1].file_name().unwrap());
+    std::fs::write(&cut, &bytes[..bytes.len() - 100]).unwrap();
+    let e = load_volume(&copy, &hints).unwrap_err().to_string();
+    assert!(e.contains(cut.to_str().unwrap()), "{e}");
+    // --series picks a DICOM series: refused elsewhere.
+    let e = refused(&["info", "--series", "0", copy.join("README.txt").to_str().unwrap()]);
+    assert!(e.contains("--series"), "{e}");
+    let _ = std::fs::remove_dir_all(&copy);
+}

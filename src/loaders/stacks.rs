@@ -1,0 +1,291 @@
+//! Image stacks read a slice at a time (`SliceReader`): a multipage TIFF, each page a z slice (its
+//! spacing from ImageJ's or OME-TIFF's metadata where present), and a folder of numbered 2-D images
+//! (PNG or TIFF), ordered by the number in each name. Every page or image must be one channel of
+//! one size; the stack's size is checked against `MAX_STREAMED_VOXELS` before any slice is decoded.
+use super::MAX_STREAMED_VOXELS;
+use super::{bad, MAX_VOXELS};
+use crate::error::{Error, Result};
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::tags::Tag;
+
+/// Most pages of a multipage TIFF (each read as a slice).
+const MAX_PAGES: u32 = 1 << 16;
+
+/// Where a stack's slices are.
+enum Slices {
+    /// A multipage TIFF and the decoder at its current page (opened again to go back).
+    Pages { path: PathBuf, at: Option<(Decoder<BufReader<std::fs::File>>, u32)> },
+    /// One image a slice, in order.
+    Files(Vec<PathBuf>),
+    /// A DICOM series, its images in order along their normal.
+    Dicom(super::dicom::Series),
+}
+
+/// A stack of 2-D images read as z slices.
+pub struct Stack {
+    slices: Slices,
+    /// Voxels along x, y, z.
+    pub dims: [u32; 3],
+    /// Voxel spacing (1 where the files give none).
+    pub spacing: [f32; 3],
+    /// A DICOM series' placement in patient space.
+    pub orientation: Option<crate::orient::Orientation>,
+    what: String,
+}
+
+fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
+    move |e| Error::Io { path: path.display().to_string(), source: e }
+}
+
+fn decoder(path: &Path, what: &str) -> Result<Decoder<BufReader<std::fs::File>>> {
+    let file = std::fs::File::open(path).map_err(io(path))?;
+    let mut limits = Limits::default();
+    limits.decoding_buffer_size = (MAX_VOXELS * 8) as usize;
+    limits.intermediate_buffer_size = (MAX_VOXELS * 8) as usize;
+    Ok(Decoder::new(BufReader::new(file)).map_err(|e| bad(what, format!("tiff: {e}")))?.with_limits(limits))
+}
+
+/// A page's size, refused unless it is one channel.
+fn page_size(dec: &mut Decoder<BufReader<std::fs::File>>, page: u32, what: &str) -> Result<(u32, u32)> {
+    let size = dec.dimensions().map_err(|e| bad(what, format!("tiff page {page}: {e}")))?;
+    match dec.colortype().map_err(|e| bad(what, format!("tiff page {page}: {e}")))? {
+        tiff::ColorType::Gray(_) => Ok(size),
+        other => Err(bad(what, format!("tiff page {page} is {other:?}: a volume's slices are single-channel images"))),
+    }
+}
+
+/// Refuses a TIFF whose pages interleave several channels or time points (ImageJ's `channels=` or
+/// `frames=`, OME-TIFF's `SizeC` or `SizeT` above 1): its pages are not one volume's slices.
+fn one_volume(dec: &mut Decoder<BufReader<std::fs::File>>, what: &str) -> Result<()> {
+    let description = dec.get_tag_ascii_string(Tag::ImageDescription).unwrap_or_default();
+    let count = |key: &str| -> u64 {
+        description.find(key).map_or(1, |at| {
+            let rest = description[at + key.len()..].trim_start_matches('"');
+            rest[..rest.find(|c: char| !c.is_ascii_digit()).unwrap_or(rest.len())].parse().unwrap_or(1)
+        })
+    };
+    let keys: &[(&str, &str)] = if description.starts_with("ImageJ=") {
+        &[("channels=", "channels"), ("frames=", "time points")]
+    } else if description.contains("<OME") {
+        &[("SizeC=", "channels"), ("SizeT=", "time points")]
+    } else {
+        &[]
+    };
+    for (key, name) in keys {
+        let n = count(key);
+        if n > 1 {
+            return Err(bad(what, format!("its pages interleave {n} {name}: a TIFF stack read as a volume holds one")));
+        }
+    }
+    Ok(())
+}
+
+/// Spacing from a TIFF's description: ImageJ's `spacing=` (z; x and y from the resolution tags,
+/// pixels per unit) or OME-TIFF's `PhysicalSizeX/Y/Z`.
+fn tiff_spacing(dec: &mut Decoder<BufReader<std::fs::File>>) -> [f32; 3] {
+    let mut s = [1.0f32; 3];
+    let description = dec.get_tag_ascii_string(Tag::ImageDescription).unwrap_or_default();
+    let number = |key: &str| -> Option<f32> {
+        let at = description.find(key)? + key.len();
+        let rest = description[at..].trim_start_matches('"');
+        let end = rest.find(|c: char| !(c.is_ascii_digit() || "+-.eE".contains(c))).unwrap_or(rest.len());
+        let v: f32 = rest[..end].parse().ok()?;
+        (v.is_finite() && v > 0.0).then_some(v)
+    };
+    if description.starts_with("ImageJ=") {
+        if let Some(z) = number("spacing=") {
+            s[2] = z;
+        }
+        for (axis, tag) in [(0, Tag::XResolution), (1, Tag::YResolution)] {
+            if let Ok(r) = dec.get_tag_u32_vec(tag) {
+                if r.len() == 2 && r[0] > 0 && r[1] > 0 {
+                    s[axis] = r[1] as f32 / r[0] as f32;
+                }
+            }
+        }
+    } else if description.contains("<OME") {
+        for (axis, key) in ["PhysicalSizeX=", "PhysicalSizeY=", "PhysicalSizeZ="].iter().enumerate() {
+            if let Some(v) = number(key) {
+                s[axis] = v;
+            }
+        }
+    }
+    s
+}
+
+/// A decoded image's samples as f32, refused unless it is one channel of `w` x `h`.
+fn samples(image: DecodingResult, w: u32, h: u32, what: &str) -> Result<Vec<f32>> {
+    use DecodingResult as D;
+    let v: Vec<f32> = match image {
+        D::U8(v) => v.into_iter().map(f32::from).collect(),
+        D::U16(v) => v.into_iter().map(f32::from).collect(),
+        D::I16(v) => v.into_iter().map(f32::from).collect(),
+        D::I8(v) => v.into_iter().map(f32::from).collect(),
+        D::U32(v) => v.into_iter().map(|x| x as f32).collect(),
+        D::I32(v) => v.into_iter().map(|x| x as f32).collect(),
+        D::F32(v) => v,
+        D::F64(v) => v.into_iter().map(|x| x as f32).collect(),
+        _ => {
+            return Err(bad(what, "64-bit integer samples are not read (8, 16 and 32-bit integers, float32, float64)"))
+        }
+    };
+    if v.len() as u64 != w as u64 * h as u64 {
+        return Err(bad(what, format!("{} samples, not one channel of {w} x {h}", v.len())));
+    }
+    Ok(v)
+}
+
+/// The number in a file name's stem (its last run of digits), which orders a folder's slices.
+fn slice_number(path: &Path) -> Option<u64> {
+    let stem = path.file_stem()?.to_string_lossy().into_owned();
+    let end = stem.rfind(|c: char| c.is_ascii_digit())? + 1;
+    let start = stem[..end].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
+    stem[start..end].parse().ok()
+}
+
+/// Whether `path` is an image stack that reads as a volume: a folder, or a TIFF of more than one
+/// page (a one-page TIFF is a height grid to `info`).
+pub fn is_stack(path: &Path) -> Result<bool> {
+    let name = super::lower_name(path);
+    if path.is_dir() {
+        return Ok(true);
+    }
+    if !(name.ends_with(".tif") || name.ends_with(".tiff")) {
+        return Ok(false);
+    }
+    Ok(decoder(path, &path.display().to_string())?.more_images())
+}
+
+impl Stack {
+    /// A multipage TIFF: every page a slice of the first page's size.
+    pub fn tiff(path: &Path) -> Result<Stack> {
+        let what = path.display().to_string();
+        let mut dec = decoder(path, &what)?;
+        let (w, h) = page_size(&mut dec, 0, &what)?;
+        one_volume(&mut dec, &what)?;
+        let spacing = tiff_spacing(&mut dec);
+        let mut pages = 1u32;
+        while dec.more_images() {
+            if pages == MAX_PAGES {
+                return Err(bad(&what, format!("more than {MAX_PAGES} pages")));
+            }
+            dec.next_image().map_err(|e| bad(&what, format!("tiff page {pages}: {e}")))?;
+            let size = page_size(&mut dec, pages, &what)?;
+            if size != (w, h) {
+                return Err(bad(&what, format!("tiff page {pages} is {} x {}, page 0 {w} x {h}", size.0, size.1)));
+            }
+            pages += 1;
+        }
+        Self::sized(Slices::Pages { path: path.to_path_buf(), at: None }, [w, h, pages], spacing, what)
+    }
+
+    /// A folder of numbered 2-D images (`.png`, `.tif`, `.tiff`), one slice each, ordered by the
+    /// number in each name; the other files are left alone.
+    pub fn folder(dir: &Path) -> Result<Stack> {
+        let what = dir.display().to_string();
+        let mut files = Vec::new();
+        for entry in std::fs::read_dir(dir).map_err(io(dir))? {
+            let path = entry.map_err(io(dir))?.path();
+            let name = super::lower_name(&path);
+            if [".png", ".tif", ".tiff"].iter().any(|e| name.ends_with(e)) {
+                let n = slice_number(&path).ok_or_else(|| {
+                    bad(&what, format!("{} has no number in its name to order the slices by", path.display()))
+                })?;
+                files.push((n, path));
+            }
+        }
+        if files.is_empty() {
+            return Err(bad(&what, "a folder read as a volume holds numbered PNG or TIFF slices; this one holds none"));
+        }
+        files.sort();
+        if let Some(w) = files.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(bad(
+                &what,
+                format!("{} and {} share slice number {}", w[0].1.display(), w[1].1.display(), w[0].0),
+            ));
+        }
+        let files: Vec<PathBuf> = files.into_iter().map(|(_, p)| p).collect();
+        let first = read_image(&files[0])?;
+        let (w, h) = (first.1, first.2);
+        let depth = u32::try_from(files.len()).map_err(|_| bad(&what, "too many slices"))?;
+        Self::sized(Slices::Files(files), [w, h, depth], [1.0; 3], what)
+    }
+
+    /// A DICOM series: a folder of one (or `pick`: its index or UID), or one file of its series.
+    pub fn dicom(path: &Path, pick: Option<&str>) -> Result<Stack> {
+        let series = super::dicom::open(path, pick)?;
+        let (dims, orientation) = (series.dims, series.orientation);
+        let mut stack = Self::sized(Slices::Dicom(series), dims, orientation.spacing(), path.display().to_string())?;
+        stack.orientation = Some(orientation);
+        Ok(stack)
+    }
+
+    fn sized(slices: Slices, dims: [u32; 3], spacing: [f32; 3], what: String) -> Result<Stack> {
+        super::voxel_count_within(&dims.map(u64::from), &what, MAX_STREAMED_VOXELS)?;
+        Ok(Stack { slices, dims, spacing, orientation: None, what })
+    }
+
+    /// Slices `z0..z0 + count` (x fastest) into `out`.
+    pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
+        out.clear();
+        let [w, h, _] = self.dims;
+        for z in z0..z0 + count {
+            let slice = match &mut self.slices {
+                Slices::Pages { path, at } => {
+                    if at.as_ref().is_none_or(|(_, page)| *page > z) {
+                        *at = Some((decoder(path, &self.what)?, 0));
+                    }
+                    let (dec, page) = at.as_mut().expect("opened above");
+                    while *page < z {
+                        dec.next_image().map_err(|e| bad(&self.what, format!("tiff page {}: {e}", *page + 1)))?;
+                        *page += 1;
+                    }
+                    let image = dec.read_image().map_err(|e| bad(&self.what, format!("tiff page {z}: {e}")))?;
+                    samples(image, w, h, &format!("{} page {z}", self.what))?
+                }
+                Slices::Dicom(series) => series.slice(z)?,
+                Slices::Files(files) => {
+                    let (values, fw, fh) = read_image(&files[z as usize])?;
+                    if (fw, fh) != (w, h) {
+                        let first = files[0].display();
+                        return Err(bad(
+                            &files[z as usize].display().to_string(),
+                            format!("{fw} x {fh}, {first} {w} x {h}"),
+                        ));
+                    }
+                    values
+                }
+            };
+            out.extend_from_slice(&slice);
+        }
+        super::check_finite(out, &self.what)
+    }
+}
+
+/// One single-channel 2-D image (PNG, or a TIFF's first page): its samples and size.
+fn read_image(path: &Path) -> Result<(Vec<f32>, u32, u32)> {
+    let what = path.display().to_string();
+    let name = super::lower_name(path);
+    if name.ends_with(".tif") || name.ends_with(".tiff") {
+        let mut dec = decoder(path, &what)?;
+        let (w, h) = page_size(&mut dec, 0, &what)?;
+        let image = dec.read_image().map_err(|e| bad(&what, format!("tiff: {e}")))?;
+        return Ok((samples(image, w, h, &what)?, w, h));
+    }
+    let mut reader = image::ImageReader::open(path).map_err(io(path))?.with_guessed_format().map_err(io(path))?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(MAX_VOXELS * 4);
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| bad(&what, e))?;
+    let (w, h) = (img.width(), img.height());
+    let values: Vec<f32> = match img {
+        image::DynamicImage::ImageLuma8(i) => i.pixels().map(|p| p[0] as f32).collect(),
+        image::DynamicImage::ImageLuma16(i) => i.pixels().map(|p| p[0] as f32).collect(),
+        other => {
+            return Err(bad(&what, format!("{:?}: a volume's slices are single-channel (grey) images", other.color())))
+        }
+    };
+    Ok((values, w, h))
+}
