@@ -58,6 +58,10 @@ fn a_ct_series_reads_in_slice_order_and_renders_as_dcm2niix_converts_it() {
         String::from_utf8(out.stdout).unwrap().split_whitespace().map(|s| s.parse().unwrap()).collect();
     // The slices run toward superior (z rises with k): pydicom's, sorted by z, in the same order.
     assert_eq!(v.values, want);
+    // Streamed a slice at a time into the bricked store, as the whole volume builds it.
+    let streamed = voxsplat::bricks::BrickStore::load(&ct, &hints).unwrap();
+    let whole = voxsplat::bricks::BrickStore::build(&v).unwrap();
+    assert_eq!((streamed.records, streamed.headers), (whole.records, whole.headers));
     // A file of the series names its series; the folder with another file beside it reads the same.
     let file = std::fs::read_dir(&ct).unwrap().next().unwrap().unwrap().path();
     assert_eq!(load_volume(&file, &hints).unwrap().values, v.values);
@@ -157,4 +161,46 @@ fn a_folder_that_is_not_one_even_series_is_refused_by_name() {
     let e = refused(&["info", "--series", "0", copy.join("README.txt").to_str().unwrap()]);
     assert!(e.contains("--series"), "{e}");
     let _ = std::fs::remove_dir_all(&copy);
+}
+
+#[test]
+fn a_tilted_gantry_s_series_is_placed_as_a_sheared_grid() {
+    // Written by pydicom: six slices whose positions step 2 mm along the normal and 0.5 mm along
+    // the columns (a gantry tilt), under names that do not follow their order.
+    let dir = tmp("tilted");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = format!(
+        "import numpy as np, pydicom\n\
+         from pydicom.dataset import Dataset, FileMetaDataset\n\
+         from pydicom.uid import ExplicitVRLittleEndian\n\
+         for k, name in enumerate(['f', 'c', 'a', 'e', 'b', 'd']):\n\
+         \x20   m = FileMetaDataset(); m.MediaStorageSOPClassUID = '1.2.840.10008.5.1.4.1.1.2'\n\
+         \x20   m.MediaStorageSOPInstanceUID = '1.2.3.%d' % (k + 10); m.TransferSyntaxUID = ExplicitVRLittleEndian\n\
+         \x20   d = Dataset(); d.file_meta = m; d.SOPClassUID = m.MediaStorageSOPClassUID\n\
+         \x20   d.SOPInstanceUID = m.MediaStorageSOPInstanceUID; d.Modality = 'CT'; d.SeriesInstanceUID = '1.2.3.1'\n\
+         \x20   d.InstanceNumber = 6 - k; d.Rows, d.Columns = 6, 8\n\
+         \x20   d.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]; d.ImagePositionPatient = [0, 0.5 * k, 2.0 * k]\n\
+         \x20   d.PixelSpacing = [1, 1]; d.SamplesPerPixel = 1; d.PhotometricInterpretation = 'MONOCHROME2'\n\
+         \x20   d.BitsAllocated, d.BitsStored, d.HighBit, d.PixelRepresentation = 16, 16, 15, 0\n\
+         \x20   d.PixelData = (np.full((6, 8), 100 * k, np.uint16)).tobytes()\n\
+         \x20   pydicom.dcmwrite('{}/' + name, d, enforce_file_format=True)\n",
+        dir.display()
+    );
+    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let hints = VolumeHints::default();
+    let v = load_volume(&dir, &hints).unwrap();
+    assert_eq!(v.dims, [8, 6, 6]);
+    // In position order, whatever the names and instance numbers.
+    let firsts: Vec<f32> = (0..6).map(|k| v.values[k * 48]).collect();
+    assert_eq!(firsts, [0.0, 100.0, 200.0, 300.0, 400.0, 500.0]);
+    let o = load_orientation(&dir, &hints).unwrap().unwrap();
+    assert!(o.is_sheared(), "a tilted series places a sheared grid");
+    // The slice step (0, 0.5, 2) against the columns' direction (0, 1, 0): 75.96 degrees.
+    let jk = o.angles()[2];
+    assert!((jk - 75.964).abs() < 0.01, "j-k at {jk} degrees");
+    let described = ok(&["info", dir.to_str().unwrap()]);
+    assert!(described.contains("sheared"), "{described}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
