@@ -24,6 +24,114 @@ pub fn is_dicom(path: &Path) -> bool {
     std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut head)).is_ok() && &head[128..] == b"DICM"
 }
 
+/// Most bytes of one DICOM file (an image of a series).
+const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// How a data set's elements are encoded.
+#[derive(Clone, Copy, PartialEq)]
+enum Encoding {
+    ImplicitLittle,
+    ExplicitLittle,
+    ExplicitBig,
+}
+
+/// Walks a DICOM file's elements (the file meta group, then the data set in its transfer syntax)
+/// before dicom-rs reads it, which sizes its buffers by each element's declared length: every
+/// defined length must lie within the file; sequences and items are walked into. A deflated data
+/// set is refused (its lengths cannot be checked before it is inflated).
+fn check_lengths(bytes: &[u8], what: &str) -> Result<()> {
+    if bytes.len() < 132 || &bytes[128..132] != b"DICM" {
+        return Err(bad(what, "not a DICOM file (no DICM after the preamble)"));
+    }
+    let (data, syntax) = walk(bytes, 132, Encoding::ExplicitLittle, true, what)?;
+    let encoding = match syntax.as_str() {
+        "1.2.840.10008.1.2" => Encoding::ImplicitLittle,
+        "1.2.840.10008.1.2.2" => Encoding::ExplicitBig,
+        "1.2.840.10008.1.2.1.99" => {
+            return Err(bad(what, "the deflated transfer syntax (1.2.840.10008.1.2.1.99) is not read"))
+        }
+        _ => Encoding::ExplicitLittle,
+    };
+    walk(bytes, data, encoding, false, what).map(|_| ())
+}
+
+/// The elements from `pos` (only the meta group's, group 2, with `meta`): where they end, and the
+/// Transfer Syntax UID when the meta group names one.
+fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> Result<(usize, String)> {
+    use dicom_core::dictionary::{DataDictionary, VirtualVr};
+    let big = enc == Encoding::ExplicitBig;
+    let u16_at = |p: usize| {
+        let b = [bytes[p], bytes[p + 1]];
+        if big {
+            u16::from_be_bytes(b)
+        } else {
+            u16::from_le_bytes(b)
+        }
+    };
+    let u32_at = |p: usize| {
+        let b = [bytes[p], bytes[p + 1], bytes[p + 2], bytes[p + 3]];
+        if big {
+            u32::from_be_bytes(b)
+        } else {
+            u32::from_le_bytes(b)
+        }
+    };
+    let mut syntax = String::new();
+    while pos < bytes.len() {
+        let short = || bad(what, format!("DICOM: an element header is cut off at byte {pos}"));
+        if pos + 8 > bytes.len() {
+            return Err(short());
+        }
+        let (group, element) = (u16_at(pos), u16_at(pos + 2));
+        if meta && group != 2 {
+            break;
+        }
+        let (header, len, container) = if group == 0xFFFE {
+            // An item (walked into) or a delimiter.
+            (8, u32_at(pos + 4), true)
+        } else if enc == Encoding::ImplicitLittle {
+            let tag = dicom_core::Tag(group, element);
+            let sq = dicom_dictionary_std::StandardDataDictionary
+                .by_tag(tag)
+                .is_some_and(|e| matches!(e.vr, VirtualVr::Exact(dicom_core::VR::SQ)));
+            (8, u32_at(pos + 4), sq)
+        } else {
+            let vr = &bytes[pos + 4..pos + 6];
+            let long = [b"OB", b"OD", b"OF", b"OL", b"OV", b"OW", b"SQ", b"SV", b"UC", b"UN", b"UR", b"UT", b"UV"]
+                .iter()
+                .any(|v| v.as_slice() == vr);
+            if long {
+                if pos + 12 > bytes.len() {
+                    return Err(short());
+                }
+                (12, u32_at(pos + 8), vr == b"SQ")
+            } else {
+                (8, u16_at(pos + 6) as u32, false)
+            }
+        };
+        pos += header;
+        // Undefined lengths (sequences, encapsulated pixel data) and sequences hold elements.
+        if len == u32::MAX || container {
+            continue;
+        }
+        let end = pos.checked_add(len as usize).filter(|&e| e <= bytes.len()).ok_or_else(|| {
+            bad(what, format!("DICOM: element ({group:04X},{element:04X}) declares {len} bytes past the file's end"))
+        })?;
+        if meta && (group, element) == (2, 0x10) {
+            syntax = String::from_utf8_lossy(&bytes[pos..end]).trim_end_matches(['\0', ' ']).to_string();
+        }
+        pos = end;
+    }
+    Ok((pos, syntax))
+}
+
+/// A DICOM file read whole (within `MAX_FILE_BYTES`) and its lengths checked (`check_lengths`).
+fn checked_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
+    let bytes = super::read_bounded(path, MAX_FILE_BYTES, what)?;
+    check_lengths(&bytes, what)?;
+    Ok(bytes)
+}
+
 /// One image of a series, from its header.
 #[derive(Clone, Debug)]
 struct Image {
@@ -76,10 +184,11 @@ fn numbers(
 /// Rows): a folder's other objects are left alone.
 fn header(path: &Path) -> Result<Option<(String, String, String, Image)>> {
     let what = path.display().to_string();
+    let bytes = checked_bytes(path, &what)?;
     let obj = OpenFileOptions::new()
         .read_preamble(ReadPreamble::Always)
         .read_until(tags::PIXEL_DATA)
-        .open_file(path)
+        .from_reader(bytes.as_slice())
         .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
     if obj.element_opt(tags::ROWS).ok().flatten().is_none() {
         return Ok(None);
@@ -288,9 +397,10 @@ impl Series {
     pub fn slice(&self, z: u32) -> Result<Vec<f32>> {
         let image = &self.images[z as usize];
         let what = image.path.display().to_string();
+        let bytes = checked_bytes(&image.path, &what)?;
         let obj = OpenFileOptions::new()
             .read_preamble(ReadPreamble::Always)
-            .open_file(&image.path)
+            .from_reader(bytes.as_slice())
             .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
         let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
         let pixels =

@@ -39,11 +39,102 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
     move |e| Error::Io { path: path.display().to_string(), source: e }
 }
 
+/// Bytes of one value of TIFF field type `t` (an unknown type: 1).
+fn type_size(t: u16) -> u64 {
+    match t {
+        3 | 8 => 2,
+        4 | 9 | 11 | 13 => 4,
+        5 | 10 | 12 | 16 | 17 | 18 => 8,
+        _ => 1,
+    }
+}
+
+/// Walks a TIFF's IFDs (classic or BigTIFF) before the tiff crate reads them, which sizes its
+/// buffers by each entry's count: every entry's values must lie within the file, at most
+/// `MAX_PAGES` IFDs, none visited twice.
+fn check_ifds(path: &Path, what: &str) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = std::fs::File::open(path).map_err(io(path))?;
+    let len = f.metadata().map_err(io(path))?.len();
+    let short = || bad(what, "tiff: truncated IFD");
+    let mut head = [0u8; 16];
+    let n = f.read(&mut head).map_err(io(path))?;
+    if n < 8 {
+        return Err(short());
+    }
+    let big_endian = match &head[..2] {
+        b"II" => false,
+        b"MM" => true,
+        _ => return Err(bad(what, "not a TIFF file (no II or MM byte order)")),
+    };
+    let u16_at =
+        |b: &[u8]| if big_endian { u16::from_be_bytes([b[0], b[1]]) } else { u16::from_le_bytes([b[0], b[1]]) };
+    let u32_at = |b: &[u8]| {
+        let a = [b[0], b[1], b[2], b[3]];
+        if big_endian {
+            u32::from_be_bytes(a)
+        } else {
+            u32::from_le_bytes(a)
+        }
+    };
+    let u64_at = |b: &[u8]| {
+        let a: [u8; 8] = b[..8].try_into().expect("8 bytes");
+        if big_endian {
+            u64::from_be_bytes(a)
+        } else {
+            u64::from_le_bytes(a)
+        }
+    };
+    let bigtiff = match u16_at(&head[2..]) {
+        42 => false,
+        43 if n >= 16 => true,
+        _ => return Err(bad(what, "not a TIFF file (no 42 or 43 after the byte order)")),
+    };
+    let (count_bytes, entry_bytes, field) = if bigtiff { (8u64, 20u64, 8u64) } else { (2, 12, 4) };
+    let mut at = if bigtiff { u64_at(&head[8..]) } else { u32_at(&head[4..]) as u64 };
+    let mut seen = std::collections::HashSet::new();
+    let mut buf = Vec::new();
+    while at != 0 {
+        if seen.len() as u32 > MAX_PAGES || !seen.insert(at) {
+            return Err(bad(what, "tiff: more IFDs than pages are read, or a loop of IFDs"));
+        }
+        if at.checked_add(count_bytes).is_none_or(|e| e > len) {
+            return Err(short());
+        }
+        f.seek(SeekFrom::Start(at)).map_err(io(path))?;
+        buf.resize(count_bytes as usize, 0);
+        f.read_exact(&mut buf).map_err(|_| short())?;
+        let entries = if bigtiff { u64_at(&buf) } else { u16_at(&buf) as u64 };
+        let size = entries.checked_mul(entry_bytes).and_then(|b| b.checked_add(field));
+        if size.and_then(|s| s.checked_add(at + count_bytes)).is_none_or(|e| e > len) {
+            return Err(short());
+        }
+        buf.resize(size.unwrap_or(0) as usize, 0);
+        f.read_exact(&mut buf).map_err(|_| short())?;
+        for e in buf[..(entries * entry_bytes) as usize].chunks(entry_bytes as usize) {
+            let count = if bigtiff { u64_at(&e[4..]) } else { u32_at(&e[4..]) as u64 };
+            let bytes = count.checked_mul(type_size(u16_at(&e[2..]))).ok_or_else(short)?;
+            if bytes > field {
+                let offset = if bigtiff { u64_at(&e[12..]) } else { u32_at(&e[8..]) as u64 };
+                if offset.checked_add(bytes).is_none_or(|end| end > len) {
+                    return Err(bad(what, format!("tiff: tag {} holds {count} values past the file's end", u16_at(e))));
+                }
+            }
+        }
+        let next = &buf[(entries * entry_bytes) as usize..];
+        at = if bigtiff { u64_at(next) } else { u32_at(next) as u64 };
+    }
+    Ok(())
+}
+
 fn decoder(path: &Path, what: &str) -> Result<Decoder<BufReader<std::fs::File>>> {
+    check_ifds(path, what)?;
     let file = std::fs::File::open(path).map_err(io(path))?;
     let mut limits = Limits::default();
-    limits.decoding_buffer_size = (MAX_VOXELS * 8) as usize;
-    limits.intermediate_buffer_size = (MAX_VOXELS * 8) as usize;
+    // A page's samples, within the host budget (the page's size is checked before it decodes).
+    let most = crate::error::host_budget().unwrap_or(u64::MAX).min(MAX_VOXELS * 8) as usize;
+    limits.decoding_buffer_size = most;
+    limits.intermediate_buffer_size = most;
     Ok(Decoder::new(BufReader::new(file)).map_err(|e| bad(what, format!("tiff: {e}")))?.with_limits(limits))
 }
 
