@@ -43,7 +43,21 @@ fn check_lengths(bytes: &[u8], what: &str) -> Result<()> {
     if bytes.len() < 132 || &bytes[128..132] != b"DICM" {
         return Err(bad(what, "not a DICOM file (no DICM after the preamble)"));
     }
-    let (data, syntax) = walk(bytes, 132, Encoding::ExplicitLittle, true, what)?;
+    // dicom-rs reads the meta group as far as its group length says, whatever groups it meets
+    // there: walked as far (the group length's own element first), else to the first other group.
+    let group_length = (bytes.len() >= 144 && bytes[132..136] == [2, 0, 0, 0] && &bytes[136..138] == b"UL")
+        .then(|| u32::from_le_bytes([bytes[140], bytes[141], bytes[142], bytes[143]]) as usize);
+    let (data, syntax) = match group_length {
+        Some(n) => {
+            let end = 144usize
+                .checked_add(n)
+                .filter(|&e| e <= bytes.len())
+                .ok_or_else(|| bad(what, format!("DICOM: the file meta group's length {n} passes the file's end")))?;
+            let (at, syntax) = walk(&bytes[..end], 144, Encoding::ExplicitLittle, false, what)?;
+            (at, syntax)
+        }
+        None => walk(bytes, 132, Encoding::ExplicitLittle, true, what)?,
+    };
     let encoding = match syntax.as_str() {
         "1.2.840.10008.1.2" => Encoding::ImplicitLittle,
         "1.2.840.10008.1.2.2" => Encoding::ExplicitBig,
@@ -97,9 +111,12 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
             (8, u32_at(pos + 4), sq)
         } else {
             let vr = &bytes[pos + 4..pos + 6];
-            let long = [b"OB", b"OD", b"OF", b"OL", b"OV", b"OW", b"SQ", b"SV", b"UC", b"UN", b"UR", b"UT", b"UV"]
-                .iter()
-                .any(|v| v.as_slice() == vr);
+            // dicom-rs reads a VR it does not know as UN: a long header.
+            let short_vrs = [
+                b"AE", b"AS", b"AT", b"CS", b"DA", b"DS", b"DT", b"FL", b"FD", b"IS", b"LO", b"LT", b"PN", b"SH",
+                b"SL", b"SS", b"ST", b"TM", b"UI", b"UL", b"US",
+            ];
+            let long = !short_vrs.iter().any(|v| v.as_slice() == vr);
             if long {
                 if pos + 12 > bytes.len() {
                     return Err(short());
@@ -117,7 +134,7 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
         let end = pos.checked_add(len as usize).filter(|&e| e <= bytes.len()).ok_or_else(|| {
             bad(what, format!("DICOM: element ({group:04X},{element:04X}) declares {len} bytes past the file's end"))
         })?;
-        if meta && (group, element) == (2, 0x10) {
+        if group == 2 && (group, element) == (2, 0x10) {
             syntax = String::from_utf8_lossy(&bytes[pos..end]).trim_end_matches(['\0', ' ']).to_string();
         }
         pos = end;
