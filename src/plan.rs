@@ -19,7 +19,9 @@ mod frame;
 mod layout;
 mod pass;
 pub mod slab;
-pub use bricked::{bricked_min_budget, bricked_resident_bytes, BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT};
+pub use bricked::{
+    bricked_min_budget, bricked_resident_bytes, texel_bytes, BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT,
+};
 pub use frame::{color_map, frame, mode_color_map, DepthSource, Draw, FramePlan, OrderSource, Projection, SplatRaster};
 pub use layout::*;
 pub use pass::{sheet_layers, sheet_pass, SheetPass, TileRule};

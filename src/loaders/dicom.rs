@@ -134,7 +134,7 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
         let end = pos.checked_add(len as usize).filter(|&e| e <= bytes.len()).ok_or_else(|| {
             bad(what, format!("DICOM: element ({group:04X},{element:04X}) declares {len} bytes past the file's end"))
         })?;
-        if group == 2 && (group, element) == (2, 0x10) {
+        if (group, element) == (2, 0x10) {
             syntax = String::from_utf8_lossy(&bytes[pos..end]).trim_end_matches(['\0', ' ']).to_string();
         }
         pos = end;

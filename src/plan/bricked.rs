@@ -171,9 +171,13 @@ fn extracted_draw(table: &[u32]) -> bool {
         .all(|q| crate::volume::optical_depth(f32::from_bits(table[4 * q as usize + 3])) > 0.0)
 }
 
-/// The texels' bytes at `side` texels a pixel side (0: none).
+/// The texels' bytes at `side` texels a pixel side (0: none), with the word before them that
+/// counts a batch's drawn voxels (texels.glsl's TEXELS_FIRST).
 pub fn texel_bytes(w: u32, h: u32, side: u32) -> u64 {
-    w as u64 * side as u64 * h as u64 * side as u64 * 4
+    if side == 0 {
+        return 0;
+    }
+    (1 + w as u64 * side as u64 * h as u64 * side as u64) * 4
 }
 
 /// MIP's and MinIP's texels a pixel side: a voxel within a third of a pixel of a brighter one adds

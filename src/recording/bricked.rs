@@ -156,8 +156,7 @@ pub(super) fn record_bricks(
     // batch before any draws.
     let texels = bf.split[3] > 0;
     if texels {
-        let side = bf.split[3] as u64;
-        e.ensure(Res::ProjectTexels, w as u64 * side * h as u64 * side * 4)?;
+        e.ensure(Res::ProjectTexels, crate::plan::texel_bytes(w, h, bf.split[3]))?;
         e.fill(Res::ProjectTexels, None, 0)?;
         for batch in batches.iter().filter(|b| !b.is_empty()) {
             record_texels(e, batch, &cut)?;
