@@ -17,8 +17,9 @@ fn affine(cols: [DVec3; 3], t: DVec3) -> DMat4 {
 
 /// A "T": a slab across the superior end (k 12..14) on a thin column. Stored with superior at high
 /// k (RAS), and stored upside down with the affine flipped along k (superior at low k: RAI, a
-/// left-handed file).
-fn files() -> [std::path::PathBuf; 2] {
+/// left-handed file). Each test passes its own `tag`: tests run in parallel, and one rewriting a
+/// file another is reading hands it a truncated volume.
+fn files(tag: &str) -> [std::path::PathBuf; 2] {
     let tee =
         |i: u32, j: u32, k: u32| ((12..=14).contains(&k) || (5..=6).contains(&i) && (4..=5).contains(&j)) as u8 * 200;
     let [nx, ny, nz] = DIMS;
@@ -36,7 +37,7 @@ fn files() -> [std::path::PathBuf; 2] {
     let up = nifti(DIMS, &stored(false), Some(affine([DVec3::X, DVec3::Y, DVec3::Z], DVec3::ZERO)), None);
     let t = DVec3::Z * (nz - 1) as f64;
     let down = nifti(DIMS, &stored(true), Some(affine([DVec3::X, DVec3::Y, -DVec3::Z], t)), None);
-    let (a, b) = (tmp("ras.nii"), tmp("rai.nii"));
+    let (a, b) = (tmp(&format!("{tag}-ras.nii")), tmp(&format!("{tag}-rai.nii")));
     std::fs::write(&a, up).unwrap();
     std::fs::write(&b, down).unwrap();
     [a, b]
@@ -81,7 +82,7 @@ fn mean_row(img: &image::RgbaImage) -> f64 {
 
 #[test]
 fn a_flipped_affine_renders_the_same_way_up() {
-    let [up, down] = files();
+    let [up, down] = files("views");
     for view in ["anterior", "oblique", "left", "superior"] {
         let (a, b) = (render(&up, view, &format!("up-{view}.png")), render(&down, view, &format!("down-{view}.png")));
         // The two grids are drawn in different (both valid) visibility orders: rounding apart.
@@ -102,7 +103,7 @@ fn a_flipped_affine_renders_the_same_way_up() {
 
 #[test]
 fn info_prints_the_orientation_code() {
-    let [up, down] = files();
+    let [up, down] = files("info");
     for (f, code) in [(&up, "RAS"), (&down, "RAI")] {
         let o = voxsplat(&["info", f.to_str().unwrap()]);
         let text = String::from_utf8_lossy(&o.stdout);
