@@ -123,3 +123,43 @@ pub fn dicom(data: &[u8]) {
         let _ = voxsplat::loaders::load_volume(&dir, &hints);
     }
 }
+
+/// Writes an OME-Zarr image packed as the `zarr` target takes it into a fresh folder, and returns
+/// the folder: the first byte picks Zarr v2 (OME-NGFF 0.4) or v3 (0.5), the rest is the image's
+/// files joined by "\n--\n": the root metadata, level 0's array metadata and its first chunk, then
+/// level 1's (the levels' paths are 0 and 1).
+pub fn zarr_image(data: &[u8]) -> Option<std::path::PathBuf> {
+    let (&kind, mut rest) = data.split_first()?;
+    let dir = std::env::temp_dir().join(format!("voxsplat-fuzz-zarr-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let names = if kind & 1 == 1 {
+        ["zarr.json", "0/zarr.json", "0/c/0/0/0", "1/zarr.json", "1/c/0/0/0"]
+    } else {
+        [".zattrs", "0/.zarray", "0/0/0/0", "1/.zarray", "1/0/0/0"]
+    };
+    for name in names {
+        let (part, next) = match rest.windows(4).position(|w| w == b"\n--\n") {
+            Some(i) => (&rest[..i], &rest[i + 4..]),
+            None => (rest, &[][..]),
+        };
+        let path = dir.join(name);
+        std::fs::create_dir_all(path.parent()?).ok()?;
+        std::fs::write(&path, part).ok()?;
+        rest = next;
+    }
+    Some(dir)
+}
+
+/// OME-Zarr images (`zarr_image` unpacks them) through the streamed and the dense loaders, each
+/// level and channel.
+pub fn zarr(data: &[u8]) {
+    voxsplat::set_host_budget(Some(256 << 20));
+    if let Some(dir) = zarr_image(data) {
+        for level in [None, Some(1)] {
+            let hints = voxsplat::loaders::VolumeHints { level, ..Default::default() };
+            let _ = voxsplat::bricks::BrickStore::load(&dir, &hints);
+            let _ = voxsplat::loaders::load_volume(&dir, &hints);
+            let _ = voxsplat::loaders::load_channels(&dir, &hints);
+        }
+    }
+}

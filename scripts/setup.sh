@@ -25,4 +25,7 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 # The DICOM tests read pydicom's bundled test series (cli/tests/dicom.rs).
 python3 -c "import pydicom" 2>/dev/null || python3 -m pip install --quiet pydicom
+# The OME-Zarr tests write their images with the ome-zarr package (cli/tests/zarr.rs); 0.18 writes
+# OME-NGFF 0.4 and 0.5 through zarr-python 3.
+python3 -c "import ome_zarr, zarr; assert zarr.__version__ >= '3'" 2>/dev/null || python3 -m pip install --quiet "ome-zarr==0.18.0"
 command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust first (https://rustup.rs)" >&2; exit 1; }

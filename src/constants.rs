@@ -21,7 +21,8 @@ pub const RASTER_TILE_W: u32 = 16;
 pub const RASTER_TILE_H: u32 = 16;
 /// Lanes of a compositor workgroup (llvmpipe's SIMD width on AVX2).
 pub const RASTER_LANES: u32 = 8;
-const _: () = assert!((RASTER_TILE_W * RASTER_TILE_H) % RASTER_LANES == 0 && RASTER_TILE_W * RASTER_TILE_H <= 256);
+const _: () =
+    assert!((RASTER_TILE_W * RASTER_TILE_H).is_multiple_of(RASTER_LANES) && RASTER_TILE_W * RASTER_TILE_H <= 256);
 const _: () = assert!((RASTER_TILE_W * RASTER_TILE_H).is_power_of_two());
 /// Draw-list entries per invocation of the tile binning stages.
 pub const TILE_CHUNK: u32 = 1024;

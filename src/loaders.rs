@@ -16,6 +16,7 @@ mod nrrd;
 mod positions;
 mod slices;
 mod stacks;
+mod zarr;
 use bounded::read_bounded;
 pub use bounded::{read_text, MAX_TEXT_BYTES};
 pub use dicom::{is_dicom, series_in as dicom_series, SeriesInfo};
@@ -26,6 +27,7 @@ use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
 pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
 pub use stacks::is_stack;
+pub use zarr::{is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, MAX_CHUNK_BYTES};
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
 pub const MAX_VOXELS: u64 = 1 << 28;
@@ -359,6 +361,9 @@ pub fn load_channels(path: &Path, hints: &VolumeHints) -> Result<Vec<ScalarVolum
         }
         return Ok(channels);
     }
+    if is_ome_zarr(path) {
+        return zarr::channels(path, hints);
+    }
     if !(name.ends_with(".nii") || name.ends_with(".nii.gz")) {
         return Ok(vec![load_volume(path, hints)?]);
     }
@@ -446,7 +451,13 @@ pub fn sidecar_hints(text: &str, what: &str) -> Result<VolumeHints> {
         Some("big") => true,
         Some(o) => return Err(bad(what, format!("endian '{o}' (little, big)"))),
     };
-    Ok(VolumeHints { dims: Some(s.dims), dtype: Some(s.dtype.parse()?), big_endian, spacing: s.spacing, series: None })
+    Ok(VolumeHints {
+        dims: Some(s.dims),
+        dtype: Some(s.dtype.parse()?),
+        big_endian,
+        spacing: s.spacing,
+        ..Default::default()
+    })
 }
 
 /// Options for volumes whose files do not say everything (raw data).
@@ -463,6 +474,10 @@ pub struct VolumeHints {
     /// A folder of several DICOM series: the one to read, by its index in `dicom_series`' list or
     /// its Series Instance UID.
     pub series: Option<String>,
+    /// An OME-Zarr image's pyramid level to read (0, the finest, by default).
+    pub level: Option<u32>,
+    /// An OME-Zarr image's time point to read (needed when it holds several).
+    pub time: Option<u32>,
 }
 
 /// A raw file's dims, sample type, byte order and spacing: `hints` first, then its `.toml`
@@ -493,6 +508,11 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
     if name.ends_with(".nii") || name.ends_with(".nii.gz") {
         check_raw_hints(path, hints)?;
         return crate::orient::respaced(SliceReader::nifti_channel(path, 0)?.orientation, hints.spacing);
+    }
+    // An OME-Zarr image has no anatomical frame (NGFF 0.4 and 0.5 give none).
+    if is_ome_zarr(path) {
+        OmeZarr::open(path)?;
+        return Ok(None);
     }
     let o = match SliceReader::open(path, hints)? {
         Some(reader) => reader.orientation,

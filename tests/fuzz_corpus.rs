@@ -22,6 +22,7 @@ const TARGETS: &[(&str, Body)] = &[
     ("sidecar", sidecar),
     ("stacks", stacks),
     ("dicom", dicom),
+    ("zarr", zarr),
 ];
 
 /// The seeds of `target` (which must exist), then its corpus.
@@ -93,6 +94,23 @@ fn the_streamed_seeds_load_as_stores() {
             (true, Err(e)) => panic!("{name}: {e}"),
             (false, Ok(_)) if name.starts_with("refused-") => panic!("{name} loaded"),
             _ => {}
+        }
+    }
+}
+
+/// The OME-Zarr seeds (written by the ome-zarr package: zstd and blosc on Zarr v2, zstd and
+/// sharding on v3) unpack into images whose two levels read.
+#[test]
+fn the_zarr_seeds_load() {
+    for f in inputs("zarr").iter().filter(|f| f.file_name().unwrap().to_string_lossy().starts_with("seed-")) {
+        let dir = zarr_image(&std::fs::read(f).unwrap()).unwrap();
+        for level in [0, 1] {
+            let hints = voxsplat::loaders::VolumeHints { level: Some(level), ..Default::default() };
+            let v = voxsplat::loaders::load_volume(&dir, &hints).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+            assert_eq!(v.dims, [[8, 6, 4], [4, 3, 2]][level as usize], "{}", f.display());
+            if level == 0 {
+                assert!(v.values.iter().enumerate().all(|(i, &x)| x == (i * 7) as f32), "{}", f.display());
+            }
         }
     }
 }

@@ -73,7 +73,7 @@ enum Command {
     /// classification and GPU bytes per splat.
     Info {
         /// The file (.nrrd/.nhdr, .nii/.nii.gz, .npy, .tif, .png, a DICOM file or a folder of DICOM
-        /// series or of numbered slices; raw with --dims and --dtype). A one-page TIFF or a PNG is a
+        /// series or of numbered slices, an OME-Zarr image's folder; raw with --dims and --dtype). A one-page TIFF or a PNG is a
         /// height grid, a TIFF of several pages a volume.
         file: PathBuf,
         #[arg(long, value_parser = parse_dims)]
@@ -93,6 +93,12 @@ enum Command {
         /// UID); without it the series are listed.
         #[arg(long)]
         series: Option<String>,
+        /// An OME-Zarr image's pyramid level to describe (its levels are listed; 0 by default).
+        #[arg(long)]
+        level: Option<u32>,
+        /// An OME-Zarr image's time point to describe (needed when it holds several).
+        #[arg(long)]
+        time: Option<u32>,
     },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
     Animate(AnimateArgs),
@@ -178,6 +184,38 @@ struct OrderArgs {
 }
 
 /// `info`'s line about the bricked store.
+/// An OME-Zarr image's axes and pyramid, one line per level.
+fn print_ome_zarr(image: &voxsplat::loaders::OmeZarr) {
+    let axes: Vec<String> = image
+        .axes
+        .iter()
+        .map(|a| match &a.unit {
+            Some(u) => format!("{} ({u})", a.name),
+            None => a.name.clone(),
+        })
+        .collect();
+    println!(
+        "OME-Zarr {} '{}': axes {}; {} time point(s), {} channel(s)",
+        image.version,
+        image.name.as_deref().unwrap_or(""),
+        axes.join(", "),
+        image.times,
+        image.channels
+    );
+    for (i, l) in image.levels.iter().enumerate() {
+        println!(
+            "level {i} '{}': {:?} voxels, spacing {:?}, origin {:?}, chunks {:?}, {} {}",
+            l.path,
+            l.dims,
+            l.spacing,
+            l.origin,
+            l.chunk,
+            l.dtype,
+            l.codecs.join("+")
+        );
+    }
+}
+
 fn print_store(store: &voxsplat::bricks::BrickStore) {
     let per_voxel = |bytes: u64| bytes as f64 / store.len().max(1) as f64;
     let pyramid = voxsplat::low_level::plan::pyramid_bytes(voxsplat::low_level::plan::LOD_BUFFERS, store.headers.len());
@@ -246,9 +284,17 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
-        Command::Info { file, dims, dtype, tf, vscale, cell, series } => {
+        Command::Info { file, dims, dtype, tf, vscale, cell, series, level, time } => {
+            if voxsplat::loaders::is_ome_zarr(&file) {
+                let image = voxsplat::loaders::OmeZarr::open(&file)?;
+                print_ome_zarr(&image);
+                if image.channels > 1 {
+                    println!("{} channels: render them with --channel-tf for each after the first", image.channels);
+                    return Ok(());
+                }
+            }
             // A folder of DICOM series: each listed, and the one picked (or the only one) described.
-            if file.is_dir() {
+            if file.is_dir() && !voxsplat::loaders::is_ome_zarr(&file) {
                 let all = voxsplat::loaders::dicom_series(&file)?;
                 for (i, s) in all.iter().enumerate() {
                     println!(
@@ -288,6 +334,8 @@ fn run(cli: Cli) -> Result<()> {
                     dims,
                     dtype: dtype.as_deref().map(str::parse).transpose()?,
                     series: series.clone(),
+                    level,
+                    time,
                     ..Default::default()
                 };
                 match voxsplat::loaders::load_orientation(&file, &hints)? {

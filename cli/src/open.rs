@@ -117,8 +117,8 @@ pub struct SceneArgs {
         "anterior", "posterior", "left", "right", "superior", "inferior", "oblique"])]
     pub view: String,
     /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, a multipage .tif, a DICOM series (its
-    /// folder or a file of it), a folder of numbered PNG or TIFF slices, or raw with --dims and
-    /// --dtype).
+    /// folder or a file of it), an OME-Zarr image's folder, a folder of numbered PNG or TIFF slices,
+    /// or raw with --dims and --dtype).
     #[arg(long, conflicts_with = "terrain")]
     pub volume: Option<PathBuf>,
     /// Raw volume dimensions.
@@ -137,6 +137,13 @@ pub struct SceneArgs {
     /// list, or its Series Instance UID).
     #[arg(long)]
     pub series: Option<String>,
+    /// An OME-Zarr image's pyramid level to draw (0, the finest, by default; `voxsplat info`
+    /// lists them).
+    #[arg(long, requires = "volume")]
+    pub level: Option<u32>,
+    /// An OME-Zarr image's time point to draw (needed when it holds several).
+    #[arg(long, requires = "volume")]
+    pub time: Option<u32>,
     /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's
     /// world coordinate along that axis (e.g. irregular CT slices; an axis left out keeps the even
     /// spacing). Draws the volume as host splats.
@@ -353,6 +360,8 @@ pub fn volume_hints(a: &SceneArgs) -> Result<voxsplat::loaders::VolumeHints> {
         big_endian: a.big_endian,
         spacing: a.spacing.map(|v| v.to_array()),
         series: a.series.clone(),
+        level: a.level,
+        time: a.time,
     })
 }
 

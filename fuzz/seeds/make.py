@@ -141,3 +141,41 @@ try:
     put("dicom", "no-spacing.dcm", ct(False), "refused-")
 except ImportError:
     print("pydicom missing: the dicom seeds are left as they are", file=sys.stderr)
+
+# OME-Zarr (the zarr target): small two-level images written by the ome-zarr package, each packed as
+# a first byte (0: Zarr v2 / NGFF 0.4, 1: Zarr v3 / 0.5) and its files joined by "\n--\n": the
+# root metadata, level 0's array metadata and only chunk, level 1's (see the target's source).
+try:
+    import json, tempfile
+    import zarr
+    from numcodecs import Blosc
+    from ome_zarr.format import FormatV04, FormatV05
+    from ome_zarr.io import parse_url
+    from ome_zarr.writer import write_image
+
+    def zarr_seed(fmt, **options):
+        v3 = fmt.version == "0.5"
+        data = (np.arange(4 * 6 * 8, dtype=np.uint16) * 7).reshape(4, 6, 8)
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "image.zarr")
+            root = zarr.group(store=parse_url(path, mode="w", fmt=fmt).store)
+            write_image(image=data, group=root, axes="zyx", fmt=fmt, scale_factors=[{"z": 2, "y": 2, "x": 2}],
+                        storage_options=dict(chunks=(4, 6, 8), **options))
+            meta, array, chunk = (("zarr.json", "zarr.json", "c/0/0/0") if v3 else (".zattrs", ".zarray", "0/0/0"))
+            read = lambda p: open(os.path.join(path, p), "rb").read()
+            # The target names the levels 0 and 1.
+            top = json.loads(read(meta))
+            ms = top["attributes"]["ome"]["multiscales"] if v3 else top["multiscales"]
+            for i, ds in enumerate(ms[0]["datasets"]):
+                ds["path"] = str(i)
+            parts = [json.dumps(top).encode()]
+            for level in ("s0", "s1"):
+                parts += [read(f"{level}/{array}"), read(f"{level}/{chunk}")]
+            return bytes([int(v3)]) + b"\n--\n".join(parts)
+
+    put("zarr", "v2-zstd", zarr_seed(FormatV04()))
+    put("zarr", "v2-blosc", zarr_seed(FormatV04(), compressor=Blosc(cname="lz4", shuffle=Blosc.SHUFFLE)))
+    put("zarr", "v3-zstd", zarr_seed(FormatV05()))
+    put("zarr", "v3-sharded", zarr_seed(FormatV05(), shards=(4, 6, 8)))
+except ImportError:
+    print("ome-zarr missing: the zarr seeds are left as they are", file=sys.stderr)

@@ -160,7 +160,7 @@ pub fn encode(format: TargetFormat, pixels: &[[f32; 4]]) -> Vec<u8> {
 /// Texels of `format` back to RGBA values (sRGB decoded to what `present` wrote), for comparisons.
 pub fn decode(format: TargetFormat, bytes: &[u8]) -> Result<Vec<[f32; 4]>> {
     let n = format.texel_bytes();
-    if bytes.len() % n != 0 {
+    if !bytes.len().is_multiple_of(n) {
         return Err(Error::InvalidArgument(format!("{} bytes are not whole {format:?} texels", bytes.len())));
     }
     Ok(bytes

@@ -17,6 +17,8 @@ enum Source {
     File(std::fs::File),
     /// A multipage TIFF or a folder of numbered images, decoded a slice at a time.
     Stack(Box<super::stacks::Stack>),
+    /// One level, time point and channel of an OME-Zarr image, decoded a row of chunks at a time.
+    Zarr(Box<super::zarr::ZarrReader>),
     /// A gzip stream from byte `start` of `path`, inflated from its start again whenever a read
     /// goes back (a store's build reads the volume twice, front to back).
     Gzip {
@@ -48,7 +50,7 @@ impl Source {
                 f.seek(SeekFrom::Start(at))?;
                 f.read_exact(buf)
             }
-            Source::Stack(_) => Err(std::io::ErrorKind::Unsupported.into()),
+            Source::Stack(_) | Source::Zarr(_) => Err(std::io::ErrorKind::Unsupported.into()),
             Source::Gzip { path, start, stream, at: pos } => {
                 if at < *pos {
                     (*stream, *pos) = (open_gzip(path, *start)?, 0);
@@ -108,6 +110,20 @@ impl SliceReader {
         let name = super::lower_name(path);
         super::check_raw_hints(path, hints)?;
         let series = hints.series.as_deref();
+        if path.is_dir() && super::zarr::is_ome_zarr(path) {
+            let image = super::zarr::OmeZarr::open(path)?;
+            zarr_time(path, &image, hints)?;
+            if image.channels > 1 {
+                return Err(super::several_channels(&path.display().to_string(), image.channels));
+            }
+            return Self::zarr(path, &image, hints, 0).map(Some);
+        }
+        if hints.level.is_some() || hints.time.is_some() {
+            return Err(super::bad(
+                &path.display().to_string(),
+                "--level and --time pick a level and a time point of an OME-Zarr image; this is none",
+            ));
+        }
         if hints.series.is_some() && !(path.is_dir() || super::dicom::is_dicom(path)) {
             return Err(super::bad(&path.display().to_string(), "--series picks a DICOM series of a folder"));
         }
@@ -261,6 +277,29 @@ impl SliceReader {
         self.dims[0] as u64 * self.dims[1] as u64 * self.dtype.size() as u64
     }
 
+    /// Channel `channel` of an OME-Zarr image, at `hints.level` (the finest by default) and
+    /// `hints.time` (needed when the image holds several time points).
+    pub fn zarr(path: &Path, image: &super::zarr::OmeZarr, hints: &VolumeHints, channel: u32) -> Result<Self> {
+        let what = path.display().to_string();
+        if hints.series.is_some() {
+            return Err(bad(&what, "--series picks a DICOM series; this is an OME-Zarr image"));
+        }
+        let time = zarr_time(path, image, hints)?;
+        let reader = super::zarr::ZarrReader::open(path, image, hints.level.unwrap_or(0), time, channel)?;
+        Ok(SliceReader {
+            dims: reader.dims,
+            spacing: reader.spacing,
+            orientation: None,
+            source: Source::Zarr(Box::new(reader)),
+            offset: 0,
+            dtype: DType::F32,
+            big_endian: false,
+            rescale: None,
+            what,
+            bytes: Vec::new(),
+        })
+    }
+
     /// An image stack's reader (a DICOM series placed in patient space).
     fn stack(stack: super::stacks::Stack) -> Self {
         SliceReader {
@@ -279,6 +318,9 @@ impl SliceReader {
 
     /// Slices `z0..z0 + count` (x fastest) into `out`.
     pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
+        if let Source::Zarr(zarr) = &mut self.source {
+            return zarr.read(z0, count, out);
+        }
         if let Source::Stack(stack) = &mut self.source {
             stack.read(z0, count, out)?;
             if self.flip_x() {
@@ -314,7 +356,7 @@ impl SliceReader {
             )));
         }
         let (w, h) = ((hi[0] - lo[0]) as usize, (hi[1] - lo[1]) as usize);
-        if let Source::Gzip { .. } | Source::Stack(_) = self.source {
+        if let Source::Gzip { .. } | Source::Stack(_) | Source::Zarr(_) = self.source {
             let mut whole = Vec::new();
             self.read(z0, count, &mut whole)?;
             out.clear();
@@ -355,6 +397,17 @@ impl SliceReader {
             super::nrrd::flip_rows(out, row);
         }
         Ok(())
+    }
+}
+
+/// The time point of `image` to read: `hints.time`, needed when it holds several.
+fn zarr_time(path: &Path, image: &super::zarr::OmeZarr, hints: &VolumeHints) -> Result<u32> {
+    match hints.time {
+        Some(t) => Ok(t),
+        None if image.times > 1 => {
+            Err(bad(&path.display().to_string(), format!("holds {} time points: pick one with --time N", image.times)))
+        }
+        None => Ok(0),
     }
 }
 

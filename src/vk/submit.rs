@@ -109,7 +109,7 @@ impl Recorder<'_> {
     /// Fill `bytes` from `offset` (both multiples of 4, clamped to the buffer) with `value`.
     pub fn fill_buffer_range(&self, buffer: &Buffer, offset: u64, bytes: u64, value: u32) {
         let size = bytes.min(buffer.size().saturating_sub(offset)) & !3;
-        if size == 0 || offset % 4 != 0 {
+        if size == 0 || !offset.is_multiple_of(4) {
             return;
         }
         // SAFETY: outside a render pass; TRANSFER_DST buffer; the range lies within it.

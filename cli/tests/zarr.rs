@@ -1,0 +1,250 @@
+//! OME-Zarr images (issue 47) with files no one here wrote: pyramids the `ome-zarr` package writes
+//! from the shared bonsai (0.4 on Zarr v2 with zstd, 0.5 on Zarr v3 sharded), and a series of time
+//! points and channels compressed with blosc, each level checked against what zarr-python reads
+//! back; then files broken one way each, refused by name.
+mod cmd;
+use cmd::voxsplat;
+use std::path::{Path, PathBuf};
+use voxsplat::loaders::{load_channels, load_volume, npy_from_bytes, OmeZarr, VolumeHints};
+
+fn tmp(name: &str) -> PathBuf {
+    cmd::tmp_in("zarr", name)
+}
+
+/// Runs tests/data/write_ome_zarr.py (the ome-zarr package, pip-installed by scripts/setup.sh).
+fn write_with_python(args: &[&str]) {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/write_ome_zarr.py");
+    let out = std::process::Command::new("python3").arg(script).args(args).output().expect("python3");
+    assert!(
+        out.status.success(),
+        "write_ome_zarr.py {args:?} (scripts/setup.sh installs ome-zarr): {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn level(l: u32) -> VolumeHints {
+    VolumeHints { level: Some(l), ..Default::default() }
+}
+
+fn npy(path: &Path) -> (Vec<u64>, Vec<f32>) {
+    npy_from_bytes(&std::fs::read(path).unwrap(), &path.display().to_string()).unwrap()
+}
+
+fn refused(args: &[&str]) -> String {
+    let out = voxsplat(args);
+    let text = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success() && text.starts_with("error:"), "voxsplat {args:?} should fail: {text}");
+    assert!(!text.contains("panicked"), "{text}");
+    text
+}
+
+fn render(args: &[&str], out: &Path) -> image::RgbaImage {
+    let mut all = vec!["render", "--size", "64x64", "--validation", "--out", out.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let o = voxsplat(&all);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    image::open(out).unwrap().to_rgba8()
+}
+
+#[test]
+fn the_ome_zarr_packages_pyramids_read_as_zarr_python_reads_them() {
+    let dir = tmp("bonsai");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bonsai = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/bonsai/bonsai.nii.gz");
+    write_with_python(&["bonsai", bonsai, dir.to_str().unwrap()]);
+    for (name, version) in [("v04.zarr", "0.4"), ("v05.zarr", "0.5")] {
+        let path = dir.join(name);
+        let image = OmeZarr::open(&path).unwrap();
+        assert_eq!((image.version.as_str(), image.levels.len(), image.times, image.channels), (version, 3, 1, 1));
+        for l in 0..3u32 {
+            let v = load_volume(&path, &level(l)).unwrap();
+            let (shape, want) = npy(&dir.join(format!("{name}.level{l}.npy")));
+            let side = 256 >> l;
+            assert_eq!((shape, v.dims), (vec![side as u64; 3], [side; 3]), "{name} level {l}");
+            assert!(v.values == want, "{name} level {l}: the values zarr-python reads");
+            // The file's scale: 1.5 along z at level 0, doubling with each level.
+            let s = (1 << l) as f32;
+            assert_eq!(v.spacing, [s, s, 1.5 * s], "{name} level {l}");
+        }
+        // Streamed a row of chunks at a time into the bricked store, as the whole volume builds it.
+        let streamed = voxsplat::bricks::BrickStore::load(&path, &level(0)).unwrap();
+        let whole = voxsplat::bricks::BrickStore::build(&load_volume(&path, &level(0)).unwrap()).unwrap();
+        assert!(streamed.records == whole.records && streamed.headers == whole.headers, "{name}");
+    }
+    // The CLI draws a level as it draws the same samples from zarr-python's .npy, spaced alike.
+    let (a, b) = (tmp("level1.png"), tmp("level1-npy.png"));
+    let zarr = dir.join("v05.zarr");
+    let level1 = dir.join("v05.zarr.level1.npy");
+    let from_zarr = render(&["--volume", zarr.to_str().unwrap(), "--tf", "bonsai", "--level", "1"], &a);
+    let from_npy = render(&["--volume", level1.to_str().unwrap(), "--tf", "bonsai", "--spacing", "2,2,3"], &b);
+    assert!(from_zarr == from_npy, "the level's frame");
+    assert!(from_zarr.pixels().any(|p| p[3] > 0), "something drawn");
+    // `info` lists the pyramid; a level past it and a level of a file without one are refused.
+    let out = voxsplat(&["info", zarr.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("OME-Zarr 0.5") && text.contains("level 2 's2': [64, 64, 64]"),
+        "{text}"
+    );
+    let err = refused(&["info", zarr.to_str().unwrap(), "--level", "3"]);
+    assert!(err.contains("no level 3: the pyramid has 3"), "{err}");
+    let err = refused(&["render", "--volume", level1.to_str().unwrap(), "--level", "1", "--out", a.to_str().unwrap()]);
+    assert!(err.contains("--level and --time pick"), "{err}");
+}
+
+#[test]
+fn time_points_and_channels_are_picked_and_blosc_decodes() {
+    let dir = tmp("series");
+    std::fs::create_dir_all(&dir).unwrap();
+    write_with_python(&["series", dir.to_str().unwrap()]);
+    let path = dir.join("tczyx.zarr");
+    let image = OmeZarr::open(&path).unwrap();
+    assert_eq!((image.times, image.channels, image.levels[0].dims), (3, 2, [28, 24, 20]));
+    // Several time points need one picked; several channels are read together.
+    let err = load_channels(&path, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(err.contains("holds 3 time points: pick one with --time N"), "{err}");
+    let err = load_volume(&path, &VolumeHints { time: Some(0), ..Default::default() }).unwrap_err().to_string();
+    assert!(err.contains("holds 2 channels"), "{err}");
+    for (l, file) in [(0u32, "tczyx.npy"), (1, "tczyx.zarr.level1.npy")] {
+        let (shape, all) = npy(&dir.join(file));
+        // Saved as 3-D: the six volumes of (time, channel) one after another along z.
+        let block = (shape[0] / 6 * shape[1] * shape[2]) as usize;
+        for t in 0..3u32 {
+            let hints = VolumeHints { time: Some(t), level: Some(l), ..Default::default() };
+            let channels = load_channels(&path, &hints).unwrap();
+            assert_eq!(channels.len(), 2);
+            for (c, v) in channels.iter().enumerate() {
+                let at = (t as usize * 2 + c) * block;
+                assert!(v.values == all[at..at + block], "level {l}, time {t}, channel {c}");
+            }
+        }
+    }
+    let err = load_channels(&path, &VolumeHints { time: Some(3), ..Default::default() }).unwrap_err().to_string();
+    assert!(err.contains("no time point 3: the image has 3"), "{err}");
+    // The CLI draws the two channels of a time point, each by its transfer function.
+    let png = tmp("channels.png");
+    let p = path.to_str().unwrap();
+    let img = render(&["--volume", p, "--time", "2", "--tf", "ramp", "--channel-tf", "ramp", "--mode", "mip"], &png);
+    assert!(img.pixels().any(|p| p[3] > 0));
+    let err = refused(&["render", "--volume", p, "--out", png.to_str().unwrap()]);
+    assert!(err.contains("time points"), "{err}");
+}
+
+/// A hand-written OME-NGFF 0.4 image of two levels (raw chunks, no compressor): 12 x 10 x 8
+/// voxels of u16 in chunks of 4 x 4 x 4, and its 6 x 5 x 4 half.
+fn small_image(dir: &Path) {
+    let _ = std::fs::remove_dir_all(dir);
+    let level = |path: &str, shape: [u64; 3], scale: f64| {
+        let d = dir.join(path);
+        std::fs::create_dir_all(&d).unwrap();
+        let zarray = format!(
+            r#"{{"zarr_format": 2, "shape": [{}, {}, {}], "chunks": [4, 4, 4], "dtype": "<u2", "compressor": null,
+               "fill_value": 0, "order": "C", "filters": null, "dimension_separator": "/"}}"#,
+            shape[0], shape[1], shape[2]
+        );
+        std::fs::write(d.join(".zarray"), zarray).unwrap();
+        let chunks = shape.map(|s| s.div_ceil(4));
+        for cz in 0..chunks[0] {
+            for cy in 0..chunks[1] {
+                for cx in 0..chunks[2] {
+                    let mut bytes = Vec::new();
+                    for z in 0..4 {
+                        for y in 0..4 {
+                            for x in 0..4 {
+                                let v = ((cz * 4 + z) * 100 + (cy * 4 + y) * 10 + cx * 4 + x) as u16 + scale as u16;
+                                bytes.extend_from_slice(&v.to_le_bytes());
+                            }
+                        }
+                    }
+                    let c = d.join(format!("{cz}/{cy}"));
+                    std::fs::create_dir_all(&c).unwrap();
+                    std::fs::write(c.join(cx.to_string()), bytes).unwrap();
+                }
+            }
+        }
+    };
+    level("0", [8, 10, 12], 1.0);
+    level("1", [4, 5, 6], 2.0);
+    let axes = r#"[{"name": "z", "type": "space"}, {"name": "y", "type": "space"}, {"name": "x", "type": "space"}]"#;
+    let zattrs = format!(
+        r#"{{"multiscales": [{{"version": "0.4", "axes": {axes}, "datasets": [
+            {{"path": "0", "coordinateTransformations": [{{"type": "scale", "scale": [1, 1, 1]}}]}},
+            {{"path": "1", "coordinateTransformations": [{{"type": "scale", "scale": [2, 2, 2]}}]}}]}}]}}"#
+    );
+    std::fs::write(dir.join(".zattrs"), zattrs).unwrap();
+    std::fs::write(dir.join(".zgroup"), r#"{"zarr_format": 2}"#).unwrap();
+}
+
+/// `path`'s text with `from` replaced by `to` (which must occur).
+fn edit(path: &Path, from: &str, to: &str) {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains(from), "{from} in {}", path.display());
+    std::fs::write(path, text.replacen(from, to, 1)).unwrap();
+}
+
+#[test]
+fn broken_images_are_refused_by_file_and_field() {
+    let dir = tmp("small.zarr");
+    small_image(&dir);
+    let v = load_volume(&dir, &VolumeHints::default()).unwrap();
+    assert_eq!((v.dims, v.values[0], v.values[12 * 10 * 8 - 1]), ([12, 10, 8], 1.0, 7.0 * 100.0 + 90.0 + 11.0 + 1.0));
+    let l1 = load_volume(&dir, &level(1)).unwrap();
+    assert_eq!((l1.dims, l1.spacing), ([6, 5, 4], [2.0; 3]));
+    type Break = fn(&Path);
+    let cases: [(&str, Break, &str); 11] = [
+        (
+            "truncated chunk",
+            |d| std::fs::write(d.join("0/1/1/2"), [0u8; 17]).unwrap(),
+            "chunk 0/1/1/2: the size of a decoded chunk is 17",
+        ),
+        (
+            "chunks that disagree with the data",
+            |d| edit(&d.join("0/.zarray"), r#""chunks": [4, 4, 4]"#, r#""chunks": [4, 4, 8]"#),
+            "level 0",
+        ),
+        (
+            "a level whose shape disagrees with its scale",
+            |d| edit(&d.join(".zattrs"), r#""scale": [2, 2, 2]"#, r#""scale": [2, 2, 3]"#),
+            "disagrees with its scale",
+        ),
+        (
+            "levels coarsest first",
+            |d| edit(&d.join(".zattrs"), r#""scale": [1, 1, 1]"#, r#""scale": [4, 4, 4]"#),
+            "finer than level 0",
+        ),
+        (
+            "a path out of the image",
+            |d| edit(&d.join(".zattrs"), r#""path": "1""#, r#""path": "../1""#),
+            "not a folder inside",
+        ),
+        ("a missing level", |d| std::fs::remove_file(d.join("1/.zarray")).unwrap(), "missing"),
+        (
+            "a chunk past the limit",
+            |d| edit(&d.join("0/.zarray"), r#""chunks": [4, 4, 4]"#, r#""chunks": [4096, 4096, 4096]"#),
+            "decodes to more than",
+        ),
+        (
+            "a shape past the limit",
+            |d| edit(&d.join("0/.zarray"), r#""shape": [8, 10, 12]"#, r#""shape": [8000000, 10000000, 12]"#),
+            "voxels",
+        ),
+        (
+            "another version",
+            |d| edit(&d.join(".zattrs"), r#""version": "0.4""#, r#""version": "0.3""#),
+            "0.3 is not read",
+        ),
+        ("a 2-D image", |d| edit(&d.join(".zattrs"), r#"{"name": "z", "type": "space"}, "#, ""), "three spatial axes"),
+        ("a sample type not read", |d| edit(&d.join("0/.zarray"), r#""<u2""#, r#""<c8""#), "sample type"),
+    ];
+    for (case, damage, expect) in cases {
+        small_image(&dir);
+        damage(&dir);
+        let err = match load_volume(&dir, &VolumeHints::default()) {
+            Ok(_) => panic!("{case}: read"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(expect) && err.contains("small.zarr"), "{case}: {err}");
+        let text = refused(&["info", dir.to_str().unwrap()]);
+        assert!(text.contains(expect), "{case}: {text}");
+    }
+}

@@ -1,0 +1,597 @@
+//! OME-Zarr multiscale images (OME-NGFF 0.4 on Zarr v2, 0.5 on Zarr v3) from a local folder, read a
+//! slab of z slices at a time (`SliceReader`) through zarrs: only the chunks a slab touches are read
+//! and decoded, and a row of chunks is decoded once for the slabs it holds. Every level's metadata is
+//! read and checked as JSON before zarrs opens it (shapes against `MAX_STREAMED_VOXELS`, a decoded
+//! chunk against `MAX_CHUNK_BYTES`, the pyramid's levels against each other), so nothing is sized by
+//! a header that has not been checked.
+use super::{bad, MAX_STREAMED_VOXELS};
+use crate::error::{Error, Result};
+use serde_json::Value;
+use std::path::Path;
+use std::sync::Arc;
+use zarrs::array::{data_type as dt, Array, ArraySubset};
+use zarrs::filesystem::FilesystemStore;
+
+/// Most bytes one decoded chunk (a shard's inner chunk) may take: zarrs decodes a chunk whole.
+pub const MAX_CHUNK_BYTES: u64 = 256 << 20;
+/// Most bytes of decoded chunks kept between slab reads (a row of chunks along z).
+const MAX_ROW_BYTES: u64 = 512 << 20;
+/// Most levels of a pyramid.
+const MAX_LEVELS: usize = 32;
+/// Most inner chunks in one shard (each costs 16 bytes of the shard's index).
+const MAX_SHARD_CHUNKS: u64 = 1 << 20;
+
+/// One axis of an image.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Axis {
+    /// Its name (`x`, `y`, `z`, `c`, `t` by convention).
+    pub name: String,
+    /// `space`, `time`, `channel`, or empty where the file gives none.
+    pub kind: String,
+    /// Its unit, where the file gives one (`micrometer`, `second`).
+    pub unit: Option<String>,
+}
+
+/// One level of a pyramid (level 0 the finest).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level {
+    /// Its array's path inside the image.
+    pub path: String,
+    /// Voxels along x, y, z.
+    pub dims: [u32; 3],
+    /// Voxel spacing along x, y, z: the level's scale (times the image's own, where it has one).
+    pub spacing: [f32; 3],
+    /// Where voxel 0 lies along x, y, z (the translations), in the spacing's units.
+    pub origin: [f64; 3],
+    /// The chunk (a shard's inner chunk, when sharded) in array order, as decoded.
+    pub chunk: Vec<u64>,
+    /// The sample type, as the file names it.
+    pub dtype: String,
+    /// The codecs (Zarr v2: the filters and compressor), as the file names them.
+    pub codecs: Vec<String>,
+}
+
+/// An OME-Zarr image's checked multiscale metadata.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OmeZarr {
+    /// The OME-NGFF version (`0.4` or `0.5`).
+    pub version: String,
+    /// The image's name, where it has one.
+    pub name: Option<String>,
+    /// Its axes, in array order (time and channel before the three spatial axes).
+    pub axes: Vec<Axis>,
+    /// Its levels, finest first.
+    pub levels: Vec<Level>,
+    /// Time points (1 without a time axis).
+    pub times: u32,
+    /// Channels (1 without a channel axis).
+    pub channels: u32,
+    /// Where the time and channel axes are, when present.
+    time_axis: Option<usize>,
+    channel_axis: Option<usize>,
+    zarr_v3: bool,
+}
+
+/// Whether `path` is a folder holding an OME-Zarr image (multiscales in its `.zattrs` or in its
+/// `zarr.json`'s `ome` attributes).
+pub fn is_ome_zarr(path: &Path) -> bool {
+    path.is_dir() && root_multiscales(path).is_ok_and(|m| m.is_some())
+}
+
+/// The group's metadata JSON, when the folder has one: `zarr.json` (v3) or `.zattrs` (v2).
+fn read_json(path: &Path, what: &str) -> Result<Option<Value>> {
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = super::read_text(path, what)?;
+    serde_json::from_str(&text).map(Some).map_err(|e| bad(what, format!("JSON: {e}")))
+}
+
+/// The image's first multiscales entry, its NGFF version and whether it is Zarr v3; `None` when
+/// the folder is no OME-Zarr image.
+fn root_multiscales(dir: &Path) -> Result<Option<(Value, String, bool)>> {
+    let v3 = dir.join("zarr.json");
+    if let Some(root) = read_json(&v3, &v3.display().to_string())? {
+        let ome = &root["attributes"]["ome"];
+        return Ok(ome["multiscales"].get(0).map(|m| (m.clone(), version_of(&ome["version"]), true)));
+    }
+    let v2 = dir.join(".zattrs");
+    let Some(root) = read_json(&v2, &v2.display().to_string())? else { return Ok(None) };
+    Ok(root["multiscales"].get(0).map(|m| (m.clone(), version_of(&m["version"]), false)))
+}
+
+fn version_of(v: &Value) -> String {
+    v.as_str().unwrap_or("").to_string()
+}
+
+/// An array of `n` numbers at `v` (a transformation's scale or translation).
+fn numbers(v: &Value, n: usize, what: &str, field: &str) -> Result<Vec<f64>> {
+    let a = v.as_array().ok_or_else(|| bad(what, format!("{field} is not a list of numbers")))?;
+    if a.len() != n {
+        return Err(bad(what, format!("{field} has {} values for {n} axes", a.len())));
+    }
+    a.iter()
+        .map(|x| x.as_f64().ok_or_else(|| bad(what, format!("{field} holds a value that is not a number"))))
+        .collect()
+}
+
+/// A list of coordinate transformations (a scale, then optionally a translation) as the scale
+/// and translation they make.
+fn transforms(v: &Value, n: usize, what: &str) -> Result<(Vec<f64>, Vec<f64>)> {
+    let (mut scale, mut shift) = (vec![1.0; n], vec![0.0; n]);
+    let Some(list) = v.as_array() else { return Ok((scale, shift)) };
+    for t in list {
+        match t["type"].as_str() {
+            Some("scale") if t.get("path").is_some() => {
+                return Err(bad(what, "a scale stored in a file (\"path\") is not read; give it inline"))
+            }
+            Some("scale") => {
+                let s = numbers(&t["scale"], n, what, "scale")?;
+                // A translation before the scale is scaled by it: the spec orders scale first.
+                scale.iter_mut().zip(&s).for_each(|(a, b)| *a *= b);
+                shift.iter_mut().zip(&s).for_each(|(a, b)| *a *= b);
+            }
+            Some("translation") if t.get("path").is_some() => {
+                return Err(bad(what, "a translation stored in a file (\"path\") is not read; give it inline"))
+            }
+            Some("translation") => {
+                let s = numbers(&t["translation"], n, what, "translation")?;
+                shift.iter_mut().zip(&s).for_each(|(a, b)| *a += b);
+            }
+            Some("identity") => {}
+            other => {
+                return Err(bad(what, format!("coordinate transformation {other:?} is not read (scale, translation)")))
+            }
+        }
+    }
+    Ok((scale, shift))
+}
+
+/// The sample types read, by their Zarr v3 and v2 names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    U8,
+    I8,
+    U16,
+    I16,
+    U32,
+    I32,
+    F32,
+    F64,
+}
+
+impl Kind {
+    fn parse(name: &str) -> Option<Kind> {
+        // Zarr v2 names carry a byte order first (`<u2`, `|u1`); zarrs reads either order.
+        let bare = name.trim_start_matches(['<', '>', '|', '=']);
+        Some(match bare {
+            "uint8" | "u1" => Kind::U8,
+            "int8" | "i1" => Kind::I8,
+            "uint16" | "u2" => Kind::U16,
+            "int16" | "i2" => Kind::I16,
+            "uint32" | "u4" => Kind::U32,
+            "int32" | "i4" => Kind::I32,
+            "float32" | "f4" => Kind::F32,
+            "float64" | "f8" => Kind::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> u64 {
+        match self {
+            Kind::U8 | Kind::I8 => 1,
+            Kind::U16 | Kind::I16 => 2,
+            Kind::U32 | Kind::I32 | Kind::F32 => 4,
+            Kind::F64 => 8,
+        }
+    }
+}
+
+/// A level's array metadata as the file states it, checked: shape, decoded chunk, sample type and
+/// codec names.
+struct ArrayMeta {
+    shape: Vec<u64>,
+    chunk: Vec<u64>,
+    dtype: String,
+    codecs: Vec<String>,
+}
+
+fn shape_of(v: &Value, what: &str, field: &str) -> Result<Vec<u64>> {
+    let a = v.as_array().ok_or_else(|| bad(what, format!("{field} is not a list of sizes")))?;
+    a.iter()
+        .map(|x| match x.as_u64() {
+            Some(n) if n > 0 => Ok(n),
+            _ => Err(bad(what, format!("{field} holds {x}: sizes must be positive integers"))),
+        })
+        .collect()
+}
+
+fn array_meta(dir: &Path, v3: bool, n: usize) -> Result<ArrayMeta> {
+    let file = dir.join(if v3 { "zarr.json" } else { ".zarray" });
+    let what = file.display().to_string();
+    let meta = read_json(&file, &what)?.ok_or_else(|| bad(&what, "missing: the level's array metadata"))?;
+    let shape = shape_of(&meta["shape"], &what, "shape")?;
+    let (mut chunk, dtype, codecs) = if v3 {
+        if meta["node_type"].as_str() != Some("array") {
+            return Err(bad(&what, "not an array (node_type)"));
+        }
+        if meta["chunk_grid"]["name"].as_str() != Some("regular") {
+            return Err(bad(&what, format!("chunk grid {} is not read (regular)", meta["chunk_grid"]["name"])));
+        }
+        let chunk = shape_of(&meta["chunk_grid"]["configuration"]["chunk_shape"], &what, "chunk_shape")?;
+        let dtype = meta["data_type"].as_str().unwrap_or_default().to_string();
+        let codecs = meta["codecs"].as_array().map(|c| c.iter().map(codec_name).collect()).unwrap_or_default();
+        (chunk, dtype, codecs)
+    } else {
+        let chunk = shape_of(&meta["chunks"], &what, "chunks")?;
+        let dtype = meta["dtype"].as_str().unwrap_or_default().to_string();
+        let mut codecs: Vec<String> =
+            meta["filters"].as_array().map(|f| f.iter().map(id_name).collect()).unwrap_or_default();
+        if !meta["compressor"].is_null() {
+            codecs.push(id_name(&meta["compressor"]));
+        }
+        (chunk, dtype, codecs)
+    };
+    let kind = Kind::parse(&dtype).ok_or_else(|| {
+        bad(
+            &what,
+            format!("sample type {dtype:?} is not read (uint8, int8, uint16, int16, uint32, int32, float32, float64)"),
+        )
+    })?;
+    if shape.len() != n || chunk.len() != n {
+        return Err(bad(&what, format!("shape and chunks must have {n} sizes, one per axis of the image")));
+    }
+    // A sharded array decodes inner chunks; the shard's index holds 16 bytes per inner chunk.
+    if v3 && meta["codecs"][0]["name"].as_str() == Some("sharding_indexed") {
+        let inner = shape_of(&meta["codecs"][0]["configuration"]["chunk_shape"], &what, "the shards' chunk_shape")?;
+        if inner.len() != n || inner.iter().zip(&chunk).any(|(i, s)| s % i != 0) {
+            return Err(bad(&what, "the shards' chunk_shape must divide the shard shape, axis by axis"));
+        }
+        let per_shard = chunk.iter().zip(&inner).try_fold(1u64, |a, (s, i)| a.checked_mul(s / i));
+        if per_shard.is_none_or(|c| c > MAX_SHARD_CHUNKS) {
+            return Err(Error::TooLarge(format!("{what}: more than {MAX_SHARD_CHUNKS} chunks in a shard")));
+        }
+        chunk = inner;
+    }
+    let bytes = chunk.iter().try_fold(kind.size(), |a, &c| a.checked_mul(c));
+    if bytes.is_none_or(|b| b > MAX_CHUNK_BYTES) {
+        return Err(Error::TooLarge(format!(
+            "{what}: a chunk of {chunk:?} decodes to more than {MAX_CHUNK_BYTES} bytes"
+        )));
+    }
+    Ok(ArrayMeta { shape, chunk, dtype, codecs })
+}
+
+/// A v3 codec's name; a sharded array's with its inner codecs.
+fn codec_name(c: &Value) -> String {
+    let name = c["name"].as_str().or(c.as_str()).unwrap_or("?");
+    match c["configuration"]["codecs"].as_array() {
+        Some(inner) if name == "sharding_indexed" => {
+            format!("{name}({})", inner.iter().map(codec_name).collect::<Vec<_>>().join("+"))
+        }
+        _ => name.to_string(),
+    }
+}
+
+fn id_name(c: &Value) -> String {
+    c["id"].as_str().unwrap_or("?").to_string()
+}
+
+impl OmeZarr {
+    /// The image at `dir`, its metadata and every level's array metadata read and checked: the
+    /// axes (time and channel, then three spatial ones), each level's shape within
+    /// `MAX_STREAMED_VOXELS` and its chunks within `MAX_CHUNK_BYTES`, and the pyramid consistent
+    /// (levels finest first, each no finer than the one before, covering the same extent to within
+    /// one of its voxels, with the same time points and channels).
+    pub fn open(dir: &Path) -> Result<Self> {
+        let what = dir.display().to_string();
+        let (ms, version, zarr_v3) =
+            root_multiscales(dir)?.ok_or_else(|| bad(&what, "not an OME-Zarr image: no multiscales metadata"))?;
+        match (version.as_str(), zarr_v3) {
+            ("0.4", false) | ("0.5", true) => {}
+            ("", _) => {
+                return Err(bad(&what, "the multiscales metadata gives no version (OME-NGFF 0.4 or 0.5 are read)"))
+            }
+            (v, _) => return Err(bad(&what, format!("OME-NGFF {v} is not read (0.4 on Zarr v2, 0.5 on Zarr v3)"))),
+        }
+        let axes: Vec<Axis> = ms["axes"]
+            .as_array()
+            .ok_or_else(|| bad(&what, "the multiscales metadata lists no axes"))?
+            .iter()
+            .map(|a| Axis {
+                name: a["name"].as_str().unwrap_or_default().to_string(),
+                kind: a["type"].as_str().unwrap_or_default().to_string(),
+                unit: a["unit"].as_str().map(str::to_string),
+            })
+            .collect();
+        let n = axes.len();
+        let space: Vec<usize> = (0..n).filter(|&i| axes[i].kind == "space").collect();
+        if space.len() != 3 || space != [n - 3, n - 2, n - 1] {
+            return Err(bad(
+                &what,
+                format!(
+                    "axes {:?}: a volume has three spatial axes, last (z, y, x)",
+                    axes.iter().map(|a| a.name.as_str()).collect::<Vec<_>>()
+                ),
+            ));
+        }
+        let find = |kind: &str| (0..n - 3).find(|&i| axes[i].kind == kind);
+        let (time_axis, channel_axis) = (find("time"), find("channel"));
+        if (0..n - 3).any(|i| Some(i) != time_axis && Some(i) != channel_axis) {
+            return Err(bad(&what, "an axis before the spatial ones is neither time nor channel"));
+        }
+        let (global_scale, global_shift) = transforms(&ms["coordinateTransformations"], n, &what)?;
+        let datasets =
+            ms["datasets"].as_array().ok_or_else(|| bad(&what, "the multiscales metadata lists no datasets"))?;
+        if datasets.is_empty() || datasets.len() > MAX_LEVELS {
+            return Err(bad(&what, format!("{} levels (1 to {MAX_LEVELS} are read)", datasets.len())));
+        }
+        let mut levels = Vec::new();
+        let mut lead: Option<Vec<u64>> = None;
+        for (l, d) in datasets.iter().enumerate() {
+            let path = d["path"].as_str().ok_or_else(|| bad(&what, format!("level {l} has no path")))?;
+            // The path names a folder inside the image: no way out of it.
+            if path.is_empty() || path.split('/').any(|p| p.is_empty() || p == "." || p == "..") {
+                return Err(bad(&what, format!("level {l}'s path {path:?} is not a folder inside the image")));
+            }
+            let meta = array_meta(&dir.join(path), zarr_v3, n)?;
+            let (s, t) = transforms(&d["coordinateTransformations"], n, &what)?;
+            let scale: Vec<f64> = (0..n).map(|a| s[a] * global_scale[a]).collect();
+            let shift: Vec<f64> = (0..n).map(|a| t[a] * global_scale[a] + global_shift[a]).collect();
+            // Array order (z, y, x) to the grid's (x, y, z).
+            let xyz = |a: usize| n - 1 - a;
+            super::voxel_count_within(&[0, 1, 2].map(|a| meta.shape[xyz(a)]), &what, MAX_STREAMED_VOXELS)?;
+            let spacing = [0, 1, 2].map(|a| scale[xyz(a)] as f32);
+            super::check_spacing(spacing, &format!("{what} level {l}"))?;
+            let origin = [0, 1, 2].map(|a| shift[xyz(a)]);
+            if !origin.iter().all(|o| o.is_finite()) {
+                return Err(bad(&what, format!("level {l}'s translation is not finite")));
+            }
+            let here = meta.shape[..n - 3].to_vec();
+            if lead.as_ref().is_some_and(|first| *first != here) {
+                return Err(bad(&what, format!("level {l} holds other time points or channels than level 0")));
+            }
+            lead.get_or_insert(here);
+            levels.push(Level {
+                path: path.to_string(),
+                dims: [0, 1, 2].map(|a| meta.shape[xyz(a)] as u32),
+                spacing,
+                origin,
+                chunk: meta.chunk,
+                dtype: meta.dtype,
+                codecs: meta.codecs,
+            });
+        }
+        check_pyramid(&levels, &what)?;
+        let lead = lead.unwrap_or_default();
+        let count = |axis: Option<usize>| axis.map_or(Ok(1), |i| u32::try_from(lead[i]));
+        let too_many = |_| bad(&what, "too many time points or channels");
+        Ok(OmeZarr {
+            version,
+            name: ms["name"].as_str().map(str::to_string),
+            axes,
+            levels,
+            times: count(time_axis).map_err(too_many)?,
+            channels: count(channel_axis).map_err(too_many)?,
+            time_axis,
+            channel_axis,
+            zarr_v3,
+        })
+    }
+}
+
+/// Levels finest first, each no finer than the one before along any axis, all over the same extent
+/// (to within one voxel of the coarser level: a halved odd size rounds).
+fn check_pyramid(levels: &[Level], what: &str) -> Result<()> {
+    let first = &levels[0];
+    for (l, pair) in levels.windows(2).enumerate() {
+        let (a, b) = (&pair[0], &pair[1]);
+        for k in 0..3 {
+            if b.spacing[k] < a.spacing[k] || b.dims[k] > a.dims[k] {
+                return Err(bad(
+                    what,
+                    format!("level {} is finer than level {l} along axis {k}: levels go finest first", l + 1),
+                ));
+            }
+            let extent = |v: &Level| v.dims[k] as f64 * v.spacing[k] as f64;
+            if (extent(b) - extent(first)).abs() > b.spacing[k] as f64 * 1.001 {
+                return Err(bad(
+                    what,
+                    format!(
+                        "level {}'s {} voxels of {} along axis {k} span {:.4}, level 0's {:.4}: its shape disagrees with its scale",
+                        l + 1,
+                        b.dims[k],
+                        b.spacing[k],
+                        extent(b),
+                        extent(first)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One level of an image read a slab at a time.
+pub struct ZarrReader {
+    array: Array<FilesystemStore>,
+    kind: Kind,
+    /// Voxels along x, y, z.
+    pub dims: [u32; 3],
+    /// Voxel spacing.
+    pub spacing: [f32; 3],
+    /// The fixed index of each axis before the spatial ones (the time point, the channel).
+    lead: Vec<u64>,
+    /// Slices of a chunk along z.
+    chunk_z: u32,
+    /// The row of chunks last decoded (its first slice) and its samples.
+    row: Option<(u32, Vec<f32>)>,
+    what: String,
+}
+
+impl ZarrReader {
+    /// Level `level` of `image` (at `dir`), at time point `time` and channel `channel`.
+    pub fn open(dir: &Path, image: &OmeZarr, level: u32, time: u32, channel: u32) -> Result<Self> {
+        let what = dir.display().to_string();
+        let l = image.levels.get(level as usize).ok_or_else(|| {
+            bad(
+                &what,
+                format!("no level {level}: the pyramid has {} (0 to {})", image.levels.len(), image.levels.len() - 1),
+            )
+        })?;
+        if time >= image.times {
+            return Err(bad(&what, format!("no time point {time}: the image has {}", image.times)));
+        }
+        if channel >= image.channels {
+            return Err(bad(&what, format!("no channel {channel}: the image has {}", image.channels)));
+        }
+        let store = FilesystemStore::new(dir).map_err(|e| bad(&what, e))?;
+        let array = Array::open(Arc::new(store), &format!("/{}", l.path))
+            .map_err(|e| bad(&what, format!("level {level} ({}): {e}", l.path)))?;
+        let n = image.axes.len();
+        // zarrs read the same metadata: it must agree with what was checked.
+        let shape: Vec<u64> = (0..3).rev().map(|a| l.dims[a] as u64).collect();
+        if array.shape()[n - 3..] != shape[..] {
+            return Err(bad(&what, format!("level {level}: zarrs reads shape {:?}", array.shape())));
+        }
+        let kind = Kind::parse(&l.dtype).expect("checked by OmeZarr::open");
+        let dtype = array.data_type();
+        let agrees = match kind {
+            Kind::U8 => dtype.is::<dt::UInt8DataType>(),
+            Kind::I8 => dtype.is::<dt::Int8DataType>(),
+            Kind::U16 => dtype.is::<dt::UInt16DataType>(),
+            Kind::I16 => dtype.is::<dt::Int16DataType>(),
+            Kind::U32 => dtype.is::<dt::UInt32DataType>(),
+            Kind::I32 => dtype.is::<dt::Int32DataType>(),
+            Kind::F32 => dtype.is::<dt::Float32DataType>(),
+            Kind::F64 => dtype.is::<dt::Float64DataType>(),
+        };
+        if !agrees {
+            return Err(bad(&what, format!("level {level}: zarrs reads another sample type than {}", l.dtype)));
+        }
+        let mut lead = vec![0u64; n - 3];
+        if let Some(i) = image.time_axis {
+            lead[i] = time as u64;
+        }
+        if let Some(i) = image.channel_axis {
+            lead[i] = channel as u64;
+        }
+        let chunk_z = l.chunk[n - 3].min(l.dims[2] as u64) as u32;
+        let what = format!("{what} level {level} ({})", l.path);
+        Ok(ZarrReader { array, kind, dims: l.dims, spacing: l.spacing, lead, chunk_z, row: None, what })
+    }
+
+    /// Slices `z0..z0 + count` (x fastest) into `out`.
+    pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
+        let plane = self.dims[0] as usize * self.dims[1] as usize;
+        let first = z0 / self.chunk_z * self.chunk_z;
+        let row_bytes = self.chunk_z as u64 * plane as u64 * 4;
+        // A slab inside one row of chunks: the row decoded once, its slabs copied from it.
+        if count > 0 && (z0 + count - 1) / self.chunk_z == z0 / self.chunk_z && row_bytes <= MAX_ROW_BYTES {
+            if self.row.as_ref().is_none_or(|(at, _)| *at != first) {
+                let n = self.chunk_z.min(self.dims[2] - first);
+                crate::error::check_host_memory(row_bytes, &format!("{}'s row of chunks", self.what))?;
+                self.row = None;
+                self.row = Some((first, self.samples(first, n)?));
+            }
+            let (_, row) = self.row.as_ref().expect("decoded above");
+            let at = (z0 - first) as usize * plane;
+            out.clear();
+            out.extend_from_slice(&row[at..at + count as usize * plane]);
+            return Ok(());
+        }
+        *out = self.samples(z0, count)?;
+        Ok(())
+    }
+
+    /// After a failed read of `subset`: the first of its chunks that fails alone, and why (not
+    /// searched when a whole chunk, a shard, would decode past `MAX_CHUNK_BYTES`).
+    fn failing_chunk(&self, subset: &ArraySubset) -> Option<(String, zarrs::array::ArrayError)> {
+        let chunks = self.array.chunks_in_array_subset(subset).ok()??;
+        for idx in &chunks.indices() {
+            let bytes = self.array.chunk_shape(&idx).ok()?.iter().map(|c| c.get()).product::<u64>() * self.kind.size();
+            if bytes > MAX_CHUNK_BYTES {
+                return None;
+            }
+            if let Err(e) = self.array.retrieve_chunk::<zarrs::array::ArrayBytes<'static>>(&idx) {
+                return Some((self.array.chunk_key(&idx).to_string(), e));
+            }
+        }
+        None
+    }
+
+    /// Slices `z0..z0 + count` decoded, as f32, checked finite.
+    fn samples(&self, z0: u32, count: u32) -> Result<Vec<f32>> {
+        let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
+        ranges.push(z0 as u64..(z0 + count) as u64);
+        ranges.push(0..self.dims[1] as u64);
+        ranges.push(0..self.dims[0] as u64);
+        let n = ranges.iter().map(|r| r.end - r.start).product::<u64>();
+        crate::error::check_host_memory(n * (4 + self.kind.size()), &format!("{}'s slices", self.what))?;
+        let subset = ArraySubset::new_with_ranges(&ranges);
+        let err = |e: zarrs::array::ArrayError| match self.failing_chunk(&subset) {
+            Some((key, e)) => bad(&self.what, format!("chunk {key}: {e}")),
+            None => bad(&self.what, format!("slices {z0}..{}: {e}", z0 + count)),
+        };
+        let a = &self.array;
+        let values: Vec<f32> = match self.kind {
+            Kind::U8 => a.retrieve_array_subset::<Vec<u8>>(&subset).map_err(err)?.into_iter().map(f32::from).collect(),
+            Kind::I8 => a.retrieve_array_subset::<Vec<i8>>(&subset).map_err(err)?.into_iter().map(f32::from).collect(),
+            Kind::U16 => {
+                a.retrieve_array_subset::<Vec<u16>>(&subset).map_err(err)?.into_iter().map(f32::from).collect()
+            }
+            Kind::I16 => {
+                a.retrieve_array_subset::<Vec<i16>>(&subset).map_err(err)?.into_iter().map(f32::from).collect()
+            }
+            Kind::U32 => {
+                a.retrieve_array_subset::<Vec<u32>>(&subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+            }
+            Kind::I32 => {
+                a.retrieve_array_subset::<Vec<i32>>(&subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+            }
+            Kind::F32 => a.retrieve_array_subset::<Vec<f32>>(&subset).map_err(err)?,
+            Kind::F64 => {
+                a.retrieve_array_subset::<Vec<f64>>(&subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+            }
+        };
+        if values.len() as u64 != n {
+            return Err(bad(&self.what, format!("slices {z0}..{}: {} samples for {n}", z0 + count, values.len())));
+        }
+        super::check_finite(&values, &self.what)?;
+        Ok(values)
+    }
+}
+
+impl OmeZarr {
+    /// Whether the image is stored as Zarr v3 (OME-NGFF 0.5).
+    pub fn is_zarr_v3(&self) -> bool {
+        self.zarr_v3
+    }
+}
+
+/// Every channel of the image at `dir` (`loaders::load_channels`), each read whole at
+/// `hints.level` and `hints.time`.
+pub(super) fn channels(dir: &Path, hints: &super::VolumeHints) -> Result<Vec<super::ScalarVolume>> {
+    let what = dir.display().to_string();
+    let image = OmeZarr::open(dir)?;
+    if image.channels as u64 > super::MAX_FILE_CHANNELS {
+        return Err(bad(
+            &what,
+            format!("{} channels: at most {} are drawn together", image.channels, super::MAX_FILE_CHANNELS),
+        ));
+    }
+    (0..image.channels)
+        .map(|c| {
+            let mut reader = super::SliceReader::zarr(dir, &image, hints, c)?;
+            super::voxel_count(&reader.dims.map(u64::from), &what)?;
+            let mut values = Vec::new();
+            reader.read(0, reader.dims[2], &mut values)?;
+            let mut spacing = reader.spacing;
+            if let Some(s) = hints.spacing {
+                super::check_spacing(s, &what)?;
+                spacing = s;
+            }
+            Ok(super::ScalarVolume { dims: reader.dims, spacing, values })
+        })
+        .collect()
+}
