@@ -27,7 +27,7 @@ use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
 pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
 pub use stacks::is_stack;
-pub use zarr::{is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, MAX_CHUNK_BYTES};
+pub use zarr::{is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, LEVEL_PIXELS, MAX_CHUNK_BYTES};
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
 pub const MAX_VOXELS: u64 = 1 << 28;
@@ -474,7 +474,8 @@ pub struct VolumeHints {
     /// A folder of several DICOM series: the one to read, by its index in `dicom_series`' list or
     /// its Series Instance UID.
     pub series: Option<String>,
-    /// An OME-Zarr image's pyramid level to read (0, the finest, by default).
+    /// An OME-Zarr image's pyramid level to read (by default the finest the host budget holds:
+    /// `OmeZarr::default_level`).
     pub level: Option<u32>,
     /// An OME-Zarr image's time point to read (needed when it holds several).
     pub time: Option<u32>,

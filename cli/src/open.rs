@@ -52,6 +52,14 @@ pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+/// `--level`: a pyramid level's number or `auto`.
+pub fn parse_level(s: &str) -> std::result::Result<String, String> {
+    match s {
+        "auto" => Ok(s.into()),
+        n => n.parse::<u32>().map(|_| s.into()).map_err(|_| format!("'{s}' is neither a level number nor auto")),
+    }
+}
+
 pub fn parse_dims(s: &str) -> std::result::Result<[u32; 3], String> {
     let v: Vec<&str> = s.split(',').collect();
     if v.len() != 3 {
@@ -137,10 +145,12 @@ pub struct SceneArgs {
     /// list, or its Series Instance UID).
     #[arg(long)]
     pub series: Option<String>,
-    /// An OME-Zarr image's pyramid level to draw (0, the finest, by default; `voxsplat info`
-    /// lists them).
-    #[arg(long, requires = "volume")]
-    pub level: Option<u32>,
+    /// An OME-Zarr image's pyramid level to draw (`voxsplat info` lists them), or `auto`: the
+    /// coarsest whose voxels span at most 0.75 px in this view, which reads only that level's
+    /// chunks but averages thin structures away (a preview). By default the finest the host's
+    /// memory holds.
+    #[arg(long, value_parser = parse_level, requires = "volume")]
+    pub level: Option<String>,
     /// An OME-Zarr image's time point to draw (needed when it holds several).
     #[arg(long, requires = "volume")]
     pub time: Option<u32>,
@@ -232,7 +242,8 @@ pub struct Content {
 pub fn orientation_of(a: &SceneArgs) -> Result<Option<Orientation>> {
     match &a.volume {
         Some(path) if a.terrain.is_none() => {
-            let o = voxsplat::loaders::load_orientation(path, &volume_hints(a)?)?;
+            // No level is read for it (a pyramid's levels share their placement).
+            let o = voxsplat::loaders::load_orientation(path, &volume_hints_at(a, None)?)?;
             if a.positions.is_some() {
                 if o.is_some_and(|o| o.flip_x()) {
                     return Err(Error::Unsupported(
@@ -354,13 +365,28 @@ pub fn load_tf(spec: &str) -> Result<voxsplat::classify::TransferFunction> {
 
 /// The --dims, --dtype, --big-endian and --spacing hints for the --volume file.
 pub fn volume_hints(a: &SceneArgs) -> Result<voxsplat::loaders::VolumeHints> {
+    let level =
+        match a.level.as_deref() {
+            None => None,
+            Some("auto") => return Err(Error::InvalidArgument(
+                "--level auto picks a level of an OME-Zarr --volume drawn from its bricked store (not with --dense, \
+                 --labels, --channel, --channel-tf or host splats); give --level N"
+                    .into(),
+            )),
+            Some(n) => Some(n.parse().expect("checked by parse_level")),
+        };
+    volume_hints_at(a, level)
+}
+
+/// `volume_hints` with the pyramid level `level`.
+fn volume_hints_at(a: &SceneArgs, level: Option<u32>) -> Result<voxsplat::loaders::VolumeHints> {
     Ok(voxsplat::loaders::VolumeHints {
         dims: a.dims,
         dtype: a.dtype.as_deref().map(str::parse).transpose()?,
         big_endian: a.big_endian,
         spacing: a.spacing.map(|v| v.to_array()),
         series: a.series.clone(),
-        level: a.level,
+        level,
         time: a.time,
     })
 }
@@ -402,7 +428,18 @@ pub fn load_bricked(
     path: &std::path::Path,
     orientation: Option<Orientation>,
 ) -> Result<voxsplat::bricks::BrickScene> {
-    let mut store = voxsplat::bricks::BrickStore::load(path, &volume_hints(a)?)?;
+    let auto = a.level.as_deref() == Some("auto");
+    let mut hints = volume_hints_at(a, None)?;
+    hints.level = if auto { None } else { volume_hints(a)?.level };
+    if voxsplat::loaders::is_ome_zarr(path) && hints.level.is_none() {
+        hints.level = Some(ome_zarr_level(a, path, &hints, auto)?);
+    } else if auto {
+        return Err(Error::InvalidArgument(format!(
+            "{}: --level auto picks a level of an OME-Zarr image",
+            path.display()
+        )));
+    }
+    let mut store = voxsplat::bricks::BrickStore::load(path, &hints)?;
     if let Some(o) = &orientation {
         store.place(o)?;
     }
@@ -419,6 +456,48 @@ pub fn load_bricked(
         store.dims[2]
     );
     voxsplat::bricks::BrickScene::new(store, tf, shading)
+}
+
+/// The level of an OME-Zarr --volume to draw, reported when it is not the finest: by default
+/// `OmeZarr::default_level`; with `auto` the one --view needs (`OmeZarr::level_for`): the view
+/// framed on what the coarsest level shows (the levels span one extent, and it reads fastest),
+/// then the coarsest level whose voxels project to at most `LEVEL_PIXELS` there.
+fn ome_zarr_level(
+    a: &SceneArgs,
+    path: &std::path::Path,
+    hints: &voxsplat::loaders::VolumeHints,
+    auto: bool,
+) -> Result<u32> {
+    let image = voxsplat::loaders::OmeZarr::open(path)?;
+    let last = image.levels.len() as u32 - 1;
+    if !auto || last == 0 {
+        let level = image.default_level();
+        if level > 0 {
+            let l = &image.levels[level as usize];
+            eprintln!(
+                "OME-Zarr level {level} of 0..{last} drawn ({:?} voxels): the finer ones may not fit the host's memory \
+                 (--host-budget-mib, --level N)",
+                l.dims
+            );
+        }
+        return Ok(level);
+    }
+    let coarse = voxsplat::loaders::VolumeHints { level: Some(last), ..hints.clone() };
+    let store = voxsplat::bricks::BrickStore::load(path, &coarse)?;
+    let grid = store.grid()?;
+    let scene = voxsplat::bricks::BrickScene::new(store, transfer_function(a)?, None)?;
+    let camera = camera_of(a, &grid, &Content { orientation: None, bounds: scene.visible_bounds() })?;
+    let level = image.level_for(&camera, voxsplat::loaders::LEVEL_PIXELS);
+    let l = &image.levels[level as usize];
+    eprintln!(
+        "OME-Zarr level {level} of 0..{last} drawn ({:?} voxels, spacing {:?}): its voxels span at most {:.2} px in this \
+         view (levels are picked at {} px; --level N draws another)",
+        l.dims,
+        l.spacing,
+        image.voxel_pixels(&camera, level),
+        voxsplat::loaders::LEVEL_PIXELS
+    );
+    Ok(level)
 }
 
 /// The --volume's channels (a 4-D NIfTI's, or the file alone) and the --channel files, each

@@ -39,7 +39,11 @@ fn refused(args: &[&str]) -> String {
 }
 
 fn render(args: &[&str], out: &Path) -> image::RgbaImage {
-    let mut all = vec!["render", "--size", "64x64", "--validation", "--out", out.to_str().unwrap()];
+    render_at("64x64", args, out)
+}
+
+fn render_at(size: &str, args: &[&str], out: &Path) -> image::RgbaImage {
+    let mut all = vec!["render", "--size", size, "--validation", "--out", out.to_str().unwrap()];
     all.extend_from_slice(args);
     let o = voxsplat(&all);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -79,6 +83,36 @@ fn the_ome_zarr_packages_pyramids_read_as_zarr_python_reads_them() {
     let from_npy = render(&["--volume", level1.to_str().unwrap(), "--tf", "bonsai", "--spacing", "2,2,3"], &b);
     assert!(from_zarr == from_npy, "the level's frame");
     assert!(from_zarr.pixels().any(|p| p[3] > 0), "something drawn");
+    // By default the finest level; the coarsest the host budget holds when it cannot hold that
+    // (level 0's store may take 67 MiB, level 1's 8.4), said on stderr.
+    let z = zarr.to_str().unwrap();
+    let finest = render(&["--volume", z, "--tf", "bonsai"], &tmp("default.png"));
+    assert!(finest == render(&["--volume", z, "--tf", "bonsai", "--level", "0"], &tmp("level0.png")));
+    let out = tmp("budget.png");
+    let o = voxsplat(&[
+        "--host-budget-mib",
+        "32",
+        "render",
+        "--volume",
+        z,
+        "--tf",
+        "bonsai",
+        "--size",
+        "64x64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && err.contains("OME-Zarr level 1 of 0..2 drawn"), "{err}");
+    assert!(image::open(&out).unwrap().to_rgba8() == from_zarr, "the budget's level is level 1");
+    // `auto` reads the coarsest level whose voxels span at most 0.75 px: level 1 at 64 x 64
+    // (0.65 px), level 0 at 256 x 256 (level 1's would span 1.3).
+    let auto = ["--volume", z, "--tf", "bonsai", "--level", "auto"];
+    assert!(render(&auto, &tmp("auto.png")) == from_zarr, "auto at 64 x 64");
+    let level0 = render_at("256x256", &["--volume", z, "--tf", "bonsai", "--level", "0"], &tmp("l0-256.png"));
+    assert!(render_at("256x256", &auto, &tmp("auto-256.png")) == level0, "auto at 256 x 256");
+    let err = refused(&["render", "--volume", z, "--level", "auto", "--dense", "--out", out.to_str().unwrap()]);
+    assert!(err.contains("--level auto picks a level of an OME-Zarr --volume drawn from its bricked store"), "{err}");
     // `info` lists the pyramid; a level past it and a level of a file without one are refused.
     let out = voxsplat(&["info", zarr.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -239,12 +273,12 @@ fn broken_images_are_refused_by_file_and_field() {
     for (case, damage, expect) in cases {
         small_image(&dir);
         damage(&dir);
-        let err = match load_volume(&dir, &VolumeHints::default()) {
+        let err = match load_volume(&dir, &level(0)) {
             Ok(_) => panic!("{case}: read"),
             Err(e) => e.to_string(),
         };
         assert!(err.contains(expect) && err.contains("small.zarr"), "{case}: {err}");
-        let text = refused(&["info", dir.to_str().unwrap()]);
+        let text = refused(&["info", dir.to_str().unwrap(), "--level", "0"]);
         assert!(text.contains(expect), "{case}: {text}");
     }
 }

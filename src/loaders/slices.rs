@@ -277,7 +277,8 @@ impl SliceReader {
         self.dims[0] as u64 * self.dims[1] as u64 * self.dtype.size() as u64
     }
 
-    /// Channel `channel` of an OME-Zarr image, at `hints.level` (the finest by default) and
+    /// Channel `channel` of an OME-Zarr image, at `hints.level` (by default the finest the host
+    /// budget holds: `OmeZarr::default_level`) and
     /// `hints.time` (needed when the image holds several time points).
     pub fn zarr(path: &Path, image: &super::zarr::OmeZarr, hints: &VolumeHints, channel: u32) -> Result<Self> {
         let what = path.display().to_string();
@@ -285,7 +286,13 @@ impl SliceReader {
             return Err(bad(&what, "--series picks a DICOM series; this is an OME-Zarr image"));
         }
         let time = zarr_time(path, image, hints)?;
-        let reader = super::zarr::ZarrReader::open(path, image, hints.level.unwrap_or(0), time, channel)?;
+        let reader = super::zarr::ZarrReader::open(
+            path,
+            image,
+            hints.level.unwrap_or_else(|| image.default_level()),
+            time,
+            channel,
+        )?;
         Ok(SliceReader {
             dims: reader.dims,
             spacing: reader.spacing,

@@ -1,8 +1,8 @@
 //! OME-Zarr multiscale images (OME-NGFF 0.4 on Zarr v2, 0.5 on Zarr v3) from a local folder, read a
 //! slab of z slices at a time (`SliceReader`) through zarrs: only the chunks a slab touches are read
 //! and decoded, and a row of chunks is decoded once for the slabs it holds. Every level's metadata is
-//! read and checked as JSON before zarrs opens it (shapes against `MAX_STREAMED_VOXELS`, a decoded
-//! chunk against `MAX_CHUNK_BYTES`, the pyramid's levels against each other), so nothing is sized by
+//! read and checked as JSON before zarrs opens it (a decoded chunk against `MAX_CHUNK_BYTES`, the
+//! level read against `MAX_STREAMED_VOXELS`, the pyramid's levels against each other), so nothing is sized by
 //! a header that has not been checked.
 use super::{bad, MAX_STREAMED_VOXELS};
 use crate::error::{Error, Result};
@@ -279,8 +279,8 @@ fn id_name(c: &Value) -> String {
 
 impl OmeZarr {
     /// The image at `dir`, its metadata and every level's array metadata read and checked: the
-    /// axes (time and channel, then three spatial ones), each level's shape within
-    /// `MAX_STREAMED_VOXELS` and its chunks within `MAX_CHUNK_BYTES`, and the pyramid consistent
+    /// axes (time and channel, then three spatial ones), each level's chunks within
+    /// `MAX_CHUNK_BYTES`, and the pyramid consistent
     /// (levels finest first, each no finer than the one before, covering the same extent to within
     /// one of its voxels, with the same time points and channels).
     pub fn open(dir: &Path) -> Result<Self> {
@@ -340,7 +340,12 @@ impl OmeZarr {
             let shift: Vec<f64> = (0..n).map(|a| t[a] * global_scale[a] + global_shift[a]).collect();
             // Array order (z, y, x) to the grid's (x, y, z).
             let xyz = |a: usize| n - 1 - a;
-            super::voxel_count_within(&[0, 1, 2].map(|a| meta.shape[xyz(a)]), &what, MAX_STREAMED_VOXELS)?;
+            if meta.shape.iter().any(|&d| d > u32::MAX as u64) {
+                return Err(Error::TooLarge(format!(
+                    "{what}: level {l}'s shape {:?} passes 2^32 voxels along an axis",
+                    meta.shape
+                )));
+            }
             let spacing = [0, 1, 2].map(|a| scale[xyz(a)] as f32);
             super::check_spacing(spacing, &format!("{what} level {l}"))?;
             let origin = [0, 1, 2].map(|a| shift[xyz(a)]);
@@ -439,6 +444,7 @@ impl ZarrReader {
                 format!("no level {level}: the pyramid has {} (0 to {})", image.levels.len(), image.levels.len() - 1),
             )
         })?;
+        super::voxel_count_within(&l.dims.map(u64::from), &format!("{what} level {level}"), MAX_STREAMED_VOXELS)?;
         if time >= image.times {
             return Err(bad(&what, format!("no time point {time}: the image has {}", image.times)));
         }
@@ -562,7 +568,61 @@ impl ZarrReader {
     }
 }
 
+/// The largest size, in pixels, at the nearest point of the view, of a voxel of the level
+/// `OmeZarr::level_for` picks: the levels-of-detail cut draws cells of `DEFAULT_LOD_PIXELS` (1.5 px),
+/// two voxels a side, from what it is given, so a level whose voxels project to at most half that
+/// holds every cell the cut would draw from the finest level's voxels.
+pub const LEVEL_PIXELS: f32 = crate::options::DEFAULT_LOD_PIXELS * 0.5;
+
 impl OmeZarr {
+    /// The level read when none is asked for: the finest whose bricked store fits the host budget
+    /// (`host_budget`) even with every voxel stored, else the coarsest. The file's levels average
+    /// the raw samples, and a transfer function that shows a narrow band of values loses thin
+    /// structures in them (on the bonsai, level 1 against level 0: 20-21 dB at 32² to 64²), so a
+    /// coarser level is read only when the finest cannot be held.
+    pub fn default_level(&self) -> u32 {
+        let fits = |l: &Level| {
+            let voxels = l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
+            let bricks = l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d.div_ceil(crate::bricks::BRICK) as u64));
+            // Records, headers and masks, the index (`BrickStore::from_region`'s worst case).
+            let worst = voxels.saturating_mul(4).saturating_add(bricks.saturating_mul(16 + 64 + 4));
+            crate::error::host_budget().is_none_or(|b| worst <= b)
+        };
+        self.levels.iter().position(fits).unwrap_or(self.levels.len() - 1) as u32
+    }
+
+    /// The coarsest level whose voxels project to at most `pixels` pixels in `camera`'s view
+    /// (`voxel_pixels`); level 0 when none is fine enough. A frame drawn from it reads the chunks
+    /// of that level only.
+    pub fn level_for(&self, camera: &crate::Camera, pixels: f32) -> u32 {
+        (0..self.levels.len() as u32).rev().find(|&l| self.voxel_pixels(camera, l) <= pixels).unwrap_or(0)
+    }
+
+    /// The pixels a voxel of `level` (its widest spacing) spans at the point of the image nearest
+    /// the eye of `camera` (the image centred on the origin, as its grids are; the near plane when
+    /// the eye is inside it).
+    pub fn voxel_pixels(&self, camera: &crate::Camera, level: u32) -> f32 {
+        let first = &self.levels[0];
+        let half = glam::Vec3::from(first.dims.map(|d| d as f32)) * glam::Vec3::from(first.spacing) * 0.5;
+        let forward = camera.forward();
+        // The box's nearest depth along the view: one of its corners.
+        let mut depth = f32::INFINITY;
+        for i in 0..8 {
+            let sign = |bit: i32| if i & bit == 0 { -1.0 } else { 1.0 };
+            let corner = half * glam::Vec3::new(sign(1), sign(2), sign(4));
+            depth = depth.min((corner - camera.eye).dot(forward));
+        }
+        let inside = (camera.eye.abs() - half).max_element() <= 0.0;
+        let per_unit = match camera.projection {
+            crate::Projection::Perspective { .. } if inside => camera.pixels_per_unit() / camera.near,
+            crate::Projection::Perspective { .. } => camera.pixels_per_unit() / depth.max(camera.near),
+            crate::Projection::Orthographic { .. } => camera.pixels_per_unit(),
+        };
+        let widest =
+            self.levels.get(level as usize).map_or(f32::INFINITY, |l| l.spacing.into_iter().fold(0f32, f32::max));
+        widest * per_unit
+    }
+
     /// Whether the image is stored as Zarr v3 (OME-NGFF 0.5).
     pub fn is_zarr_v3(&self) -> bool {
         self.zarr_v3
