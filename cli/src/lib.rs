@@ -9,6 +9,7 @@ pub mod kernels;
 pub mod modes;
 pub mod motion_orders;
 pub mod open;
+pub mod parse;
 pub mod peer;
 pub mod rates;
 pub mod soak;

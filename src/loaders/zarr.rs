@@ -583,7 +583,8 @@ impl OmeZarr {
     pub fn default_level(&self) -> u32 {
         let fits = |l: &Level| {
             let voxels = l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
-            let bricks = l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d.div_ceil(crate::bricks::BRICK) as u64));
+            let bricks =
+                l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d.div_ceil(crate::constants::BRICK_SIDE) as u64));
             // Records, headers and masks, the index (`BrickStore::from_region`'s worst case).
             let worst = voxels.saturating_mul(4).saturating_add(bricks.saturating_mul(16 + 64 + 4));
             crate::error::host_budget().is_none_or(|b| worst <= b)
