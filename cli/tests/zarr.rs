@@ -282,3 +282,27 @@ fn broken_images_are_refused_by_file_and_field() {
         assert!(text.contains(expect), "{case}: {text}");
     }
 }
+
+/// `level_for` takes the coarsest level whose voxels span at most the given pixels at the point
+/// nearest the eye: a far view takes level 1, a near one level 0, and an eye inside the image
+/// level 0 (measured at the near plane).
+#[test]
+fn the_level_for_a_view_follows_the_voxels_projected_size() {
+    let dir = tmp("levels.zarr");
+    small_image(&dir);
+    let image = OmeZarr::open(&dir).unwrap();
+    let grid = voxsplat::Grid::centered([12, 10, 8], [1.0; 3]).unwrap();
+    let mut cam = voxsplat::Camera::framing(&grid, 64, 64);
+    let (near, far) = (image.voxel_pixels(&cam, 0), image.voxel_pixels(&cam, 1));
+    assert!((far / near - 2.0).abs() < 1e-4, "level 1's voxels are twice level 0's: {near} {far}");
+    assert_eq!(image.level_for(&cam, far * 1.01), 1);
+    assert_eq!(image.level_for(&cam, far * 0.99), 0);
+    assert_eq!(image.level_for(&cam, near * 0.5), 0, "none fine enough: the finest");
+    // Twice as far from the target: the nearest corner more than twice as far.
+    let further = voxsplat::Camera { eye: cam.target + (cam.eye - cam.target) * 2.0, ..cam };
+    let ratio = image.voxel_pixels(&cam, 0) / image.voxel_pixels(&further, 0);
+    assert!(ratio > 2.0 && ratio < 4.0, "{ratio}");
+    let outside = far * 1.01;
+    cam.eye = glam::Vec3::new(0.1, 0.2, 0.3);
+    assert_eq!(image.level_for(&cam, outside), 0, "the eye inside the image: measured at the near plane");
+}
