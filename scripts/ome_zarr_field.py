@@ -16,24 +16,35 @@ import zarr
 
 
 def slab(n, z0, count):
-    """Slices z0..z0+count of the field, u8 (voxsplat's formula, in float32)."""
+    """Slices z0..z0+count of the field, u8 (voxsplat's formula, in float32), 8 slices at a time
+    (arrays that stay in cache)."""
     c = n * 0.5
     f = np.float32(6.0 * np.pi / n)
-    x = np.arange(n, dtype=np.float32) + 0.5 - c
-    z = np.arange(z0, z0 + count, dtype=np.float32) + 0.5 - c
-    px, py, pz = x[None, None, :], x[None, :, None], z[:, None, None]
-    r = np.sqrt(px * px + py * py + pz * pz) / c
-    g = np.sin(f * px) * np.cos(f * py) + np.sin(f * py) * np.cos(f * pz) + np.sin(f * pz) * np.cos(f * px)
-    shell = np.maximum(1.0 - np.abs(g) / 0.45, 0.0)
-    v = np.where(r < 0.95, shell * (1.0 - 0.5 * r), 0.0)
-    return np.round(v * 255.0).astype(np.uint8)
+    x = np.arange(n, dtype=np.float32) + np.float32(0.5 - c)
+    sx, cx = np.sin(f * x), np.cos(f * x)
+    # sin(f x) cos(f y) over the plane, and x² + y², computed once.
+    plane_g = sx[None, :] * cx[:, None]
+    plane_r = x[None, :] ** 2 + x[:, None] ** 2
+    out = np.empty((count, n, n), np.uint8)
+    for k in range(count):
+        z = np.float32(z0 + k + 0.5 - c)
+        sz, cz = np.sin(f * z), np.cos(f * z)
+        # sin(f y) cos(f z) + sin(f z) cos(f x), then the plane's term.
+        g = plane_g + (sx[:, None] * cz + sz * cx[None, :])
+        r = np.sqrt(plane_r + z * z) / np.float32(c)
+        shell = np.maximum(np.float32(1.0) - np.abs(g) / np.float32(0.45), np.float32(0.0))
+        v = np.where(r < 0.95, shell * (np.float32(1.0) - np.float32(0.5) * r), np.float32(0.0))
+        out[k] = np.round(v * np.float32(255.0))
+    return out
 
 
 def halve(a):
-    """The 2x2x2 mean (a's sides even), rounded."""
-    s = a.shape
-    m = a.reshape(s[0] // 2, 2, s[1] // 2, 2, s[2] // 2, 2).astype(np.float32).mean(axis=(1, 3, 5))
-    return np.round(m).astype(np.uint8)
+    """The 2x2x2 mean (a's sides even), rounded half up."""
+    s = a.astype(np.uint16)
+    s = s[0::2] + s[1::2]
+    s = s[:, 0::2] + s[:, 1::2]
+    s = s[:, :, 0::2] + s[:, :, 1::2]
+    return ((s + 4) // 8).astype(np.uint8)
 
 
 def main(n, out, levels=4):
