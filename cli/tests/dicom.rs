@@ -3,7 +3,7 @@
 //! beside `dcm2niix`'s NIfTI conversion of the same series; and what a folder that is not one
 //! series is refused for.
 mod cmd;
-use cmd::voxsplat;
+use cmd::{refused, voxsplat};
 use std::path::{Path, PathBuf};
 use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};
 
@@ -25,14 +25,6 @@ fn ok(args: &[&str]) -> String {
     let out = voxsplat(args);
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "voxsplat {args:?}: {text}");
-    text
-}
-
-fn refused(args: &[&str]) -> String {
-    let out = voxsplat(args);
-    let text = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success() && text.starts_with("error:"), "voxsplat {args:?} should fail: {text}");
-    assert!(!text.contains("panicked"), "{text}");
     text
 }
 

@@ -3,7 +3,7 @@
 //! points and channels compressed with blosc, each level checked against what zarr-python reads
 //! back; then files broken one way each, refused by name.
 mod cmd;
-use cmd::voxsplat;
+use cmd::{refused, voxsplat};
 use std::path::{Path, PathBuf};
 use voxsplat::loaders::{load_channels, load_volume, npy_from_bytes, OmeZarr, VolumeHints};
 
@@ -28,14 +28,6 @@ fn level(l: u32) -> VolumeHints {
 
 fn npy(path: &Path) -> (Vec<u64>, Vec<f32>) {
     npy_from_bytes(&std::fs::read(path).unwrap(), &path.display().to_string()).unwrap()
-}
-
-fn refused(args: &[&str]) -> String {
-    let out = voxsplat(args);
-    let text = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success() && text.starts_with("error:"), "voxsplat {args:?} should fail: {text}");
-    assert!(!text.contains("panicked"), "{text}");
-    text
 }
 
 fn render(args: &[&str], out: &Path) -> image::RgbaImage {

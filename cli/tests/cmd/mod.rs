@@ -13,3 +13,12 @@ pub fn tmp_in(tag: &str, name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }
+
+/// `voxsplat ARGS`, which must fail with a typed error (no panic); its stderr.
+pub fn refused(args: &[&str]) -> String {
+    let out = voxsplat(args);
+    let text = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success() && text.starts_with("error:"), "voxsplat {args:?} should fail: {text}");
+    assert!(!text.contains("panicked"), "{text}");
+    text
+}
