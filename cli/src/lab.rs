@@ -160,6 +160,22 @@ pub(crate) enum Study {
     /// roofline, raster rates and scaling: CSV files and SVG charts in --out-dir, and with
     /// --results the results page (scripts/results.sh runs it after the other studies).
     Matrix(MatrixArgs),
+    /// How fast a volume file loads: the dense volume (`load_volume`) and the bricked store
+    /// streamed from it (`BrickStore::load`), medians of --repeat reads, in MB/s of the samples as
+    /// the file stores them (scripts/dicom_bench.sh sets a DICOM series beside dcm2niix).
+    Load {
+        /// The file or folder (any `render --volume`).
+        file: PathBuf,
+        /// Reads of each kind.
+        #[arg(long, default_value_t = 3)]
+        repeat: usize,
+        /// Bytes per stored sample (2 for 16-bit DICOM), for the MB/s.
+        #[arg(long, default_value_t = 2)]
+        sample_bytes: u64,
+        /// A folder of several DICOM series: the one to read.
+        #[arg(long)]
+        series: Option<String>,
+    },
 }
 
 #[derive(Args)]
@@ -185,6 +201,35 @@ pub(crate) struct MatrixArgs {
 /// Runs one study.
 pub(crate) fn run(study: Study) -> Result<()> {
     match study {
+        Study::Load { file, repeat, sample_bytes, series } => {
+            if repeat < 1 {
+                return Err(Error::InvalidArgument("--repeat must be at least 1".into()));
+            }
+            let hints = voxsplat::loaders::VolumeHints { series, ..Default::default() };
+            let median = |mut t: Vec<f64>| {
+                t.sort_by(f64::total_cmp);
+                t[t.len() / 2]
+            };
+            let (mut dense, mut bricked, mut voxels) = (Vec::new(), Vec::new(), 0u64);
+            for _ in 0..repeat {
+                let t = std::time::Instant::now();
+                let v = voxsplat::loaders::load_volume(&file, &hints)?;
+                dense.push(t.elapsed().as_secs_f64());
+                voxels = v.values.len() as u64;
+                drop(v);
+                let t = std::time::Instant::now();
+                voxsplat::bricks::BrickStore::load(&file, &hints)?;
+                bricked.push(t.elapsed().as_secs_f64());
+            }
+            let mb = (voxels * sample_bytes) as f64 / 1e6;
+            println!("| read | median of {repeat} | MB/s ({mb:.1} MB of samples) |\n|---|---:|---:|");
+            for (what, t) in
+                [("dense volume (load_volume)", median(dense)), ("bricked store (BrickStore::load)", median(bricked))]
+            {
+                println!("| {what} | {:.3} s | {:.0} |", t, mb / t);
+            }
+            Ok(())
+        }
         Study::Rates { n, sizes, frames } => {
             if frames < 1 {
                 return Err(Error::InvalidArgument("--frames must be at least 1".into()));
