@@ -27,7 +27,10 @@ use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
 pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
 pub use stacks::is_stack;
-pub use zarr::{is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, LEVEL_PIXELS, MAX_CHUNK_BYTES};
+pub use zarr::{
+    chunks_read as zarr_chunks_read, is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, LEVEL_PIXELS,
+    MAX_CHUNK_BYTES,
+};
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
 pub const MAX_VOXELS: u64 = 1 << 28;

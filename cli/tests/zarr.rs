@@ -96,6 +96,9 @@ fn the_ome_zarr_packages_pyramids_read_as_zarr_python_reads_them() {
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && err.contains("OME-Zarr level 1 of 0..2 drawn"), "{err}");
+    // Level 1's 16 shards, 4 a row of 16 slices, read row by row in each of the store's two
+    // passes; no chunk of level 0.
+    assert!(err.contains("the store read 64 chunks (0 read before it"), "{err}");
     assert!(image::open(&out).unwrap().to_rgba8() == from_zarr, "the budget's level is level 1");
     // `auto` reads the coarsest level whose voxels span at most 0.75 px: level 1 at 64 x 64
     // (0.65 px), level 0 at 256 x 256 (level 1's would span 1.3).

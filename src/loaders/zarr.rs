@@ -21,6 +21,15 @@ const MAX_LEVELS: usize = 32;
 /// Most inner chunks in one shard (each costs 16 bytes of the shard's index).
 const MAX_SHARD_CHUNKS: u64 = 1 << 20;
 
+/// Chunks (shards, when sharded) this process has asked zarrs to read, every image and level.
+static CHUNKS_READ: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many chunks (shards, when sharded) of OME-Zarr images this process has read so far: the
+/// difference across a load or a frame is what it read (`voxsplat render` reports it).
+pub fn chunks_read() -> u64 {
+    CHUNKS_READ.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// One axis of an image.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Axis {
@@ -535,6 +544,9 @@ impl ZarrReader {
         let n = ranges.iter().map(|r| r.end - r.start).product::<u64>();
         crate::error::check_host_memory(n * (4 + self.kind.size()), &format!("{}'s slices", self.what))?;
         let subset = ArraySubset::new_with_ranges(&ranges);
+        if let Ok(Some(chunks)) = self.array.chunks_in_array_subset(&subset) {
+            CHUNKS_READ.fetch_add(chunks.num_elements(), std::sync::atomic::Ordering::Relaxed);
+        }
         let err = |e: zarrs::array::ArrayError| match self.failing_chunk(&subset) {
             Some((key, e)) => bad(&self.what, format!("chunk {key}: {e}")),
             None => bad(&self.what, format!("slices {z0}..{}: {e}", z0 + count)),
