@@ -371,20 +371,21 @@ pub fn load_channels(path: &Path, hints: &VolumeHints) -> Result<Vec<ScalarVolum
         return Ok(vec![load_volume(path, hints)?]);
     }
     let channels = SliceReader::nifti_channels(path)?;
-    (0..channels)
-        .map(|k| {
-            let mut reader = SliceReader::nifti_channel(path, k)?;
-            let mut values = Vec::new();
-            reader.read(0, reader.dims[2], &mut values)?;
-            check_finite(&values, &what)?;
-            let mut v = ScalarVolume { dims: reader.dims, spacing: reader.spacing, values };
-            if let Some(s) = hints.spacing {
-                check_spacing(s, &what)?;
-                v.spacing = s;
-            }
-            Ok(v)
-        })
-        .collect()
+    (0..channels).map(|k| read_whole(SliceReader::nifti_channel(path, k)?, hints, &what)).collect()
+}
+
+/// Every slice `reader` reads, as one volume (its samples finite), with `hints.spacing` over the
+/// file's: a channel of a file of several.
+fn read_whole(mut reader: SliceReader, hints: &VolumeHints, what: &str) -> Result<ScalarVolume> {
+    let mut values = Vec::new();
+    reader.read(0, reader.dims[2], &mut values)?;
+    check_finite(&values, what)?;
+    let mut v = ScalarVolume { dims: reader.dims, spacing: reader.spacing, values };
+    if let Some(s) = hints.spacing {
+        check_spacing(s, what)?;
+        v.spacing = s;
+    }
+    Ok(v)
 }
 
 /// The first `n` inflated bytes of a gzip stream (fewer if it is shorter).

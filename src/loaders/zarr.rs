@@ -78,7 +78,6 @@ pub struct OmeZarr {
     /// Where the time and channel axes are, when present.
     time_axis: Option<usize>,
     channel_axis: Option<usize>,
-    zarr_v3: bool,
 }
 
 /// Whether `path` is a folder holding an OME-Zarr image (multiscales in its `.zattrs` or in its
@@ -389,7 +388,6 @@ impl OmeZarr {
             channels: count(channel_axis).map_err(too_many)?,
             time_axis,
             channel_axis,
-            zarr_v3,
         })
     }
 }
@@ -635,11 +633,6 @@ impl OmeZarr {
             self.levels.get(level as usize).map_or(f32::INFINITY, |l| l.spacing.into_iter().fold(0f32, f32::max));
         widest * per_unit
     }
-
-    /// Whether the image is stored as Zarr v3 (OME-NGFF 0.5).
-    pub fn is_zarr_v3(&self) -> bool {
-        self.zarr_v3
-    }
 }
 
 /// Every channel of the image at `dir` (`loaders::load_channels`), each read whole at
@@ -655,16 +648,9 @@ pub(super) fn channels(dir: &Path, hints: &super::VolumeHints) -> Result<Vec<sup
     }
     (0..image.channels)
         .map(|c| {
-            let mut reader = super::SliceReader::zarr(dir, &image, hints, c)?;
+            let reader = super::SliceReader::zarr(dir, &image, hints, c)?;
             super::voxel_count(&reader.dims.map(u64::from), &what)?;
-            let mut values = Vec::new();
-            reader.read(0, reader.dims[2], &mut values)?;
-            let mut spacing = reader.spacing;
-            if let Some(s) = hints.spacing {
-                super::check_spacing(s, &what)?;
-                spacing = s;
-            }
-            Ok(super::ScalarVolume { dims: reader.dims, spacing, values })
+            super::read_whole(reader, hints, &what)
         })
         .collect()
 }
