@@ -117,7 +117,7 @@ pub fn study(
     // A TF change, then the frame it gives (alternating two transfer functions), then back.
     let tf_change = |r: &mut Renderer, o: &RenderOptions, i: usize| -> Result<f64> {
         let t = Instant::now();
-        r.set_transfer_function(if i % 2 == 0 { &other } else { &tf }, None)?;
+        r.set_transfer_function(if i.is_multiple_of(2) { &other } else { &tf }, None)?;
         r.render(&cam, o)?;
         let spent = ms(t);
         r.set_transfer_function(&tf, None)?;
