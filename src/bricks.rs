@@ -19,7 +19,9 @@ use bytemuck::{Pod, Zeroable};
 
 mod build;
 mod gradients;
+mod series;
 pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
+pub use series::Patch;
 pub use gradients::{pack_differences, unpack_differences};
 
 /// Voxels along each side of a brick.
@@ -106,6 +108,47 @@ impl BrickStore {
             store.spacing = s;
         }
         Ok(store)
+    }
+
+    /// Load one time point of a series (`hints.time`) as a store normalised by `range` (the
+    /// series' first time point's, so that `Renderer::update_volume` takes it): one pass over
+    /// the file, slice by slice where the format streams. Values below the range read as empty
+    /// and values above it as its top; the second value returned counts those voxels.
+    #[cfg(feature = "io")]
+    pub fn load_in_range(
+        path: &std::path::Path,
+        hints: &crate::loaders::VolumeHints,
+        range: (f32, f32),
+    ) -> Result<(Self, u64)> {
+        let mut outside = 0u64;
+        let mut count = |values: &[f32]| {
+            outside += values.iter().filter(|&&v| v.is_finite() && (v < range.0 || v > range.1)).count() as u64
+        };
+        let mut store = match crate::loaders::SliceReader::open(path, hints)? {
+            Some(mut reader) => {
+                let (dims, spacing) = (reader.dims, reader.spacing);
+                Self::from_region(dims, spacing, range, [[0; 3], dims], |z0, n, out| {
+                    reader.read(z0, n, out)?;
+                    count(out);
+                    Ok(())
+                })?
+            }
+            None => {
+                let v = crate::loaders::load_volume(path, hints)?;
+                count(&v.values);
+                let plane = v.dims[0] as usize * v.dims[1] as usize;
+                Self::from_region(v.dims, v.spacing, range, [[0; 3], v.dims], |z0, n, out| {
+                    out.clear();
+                    out.extend_from_slice(&v.values[z0 as usize * plane..(z0 + n) as usize * plane]);
+                    Ok(())
+                })?
+            }
+        };
+        if let Some(s) = hints.spacing {
+            crate::loaders::check_spacing(s, &path.display().to_string())?;
+            store.spacing = s;
+        }
+        Ok((store, outside))
     }
 
     /// The grid the store's voxels lie on, centred on the origin.
@@ -469,6 +512,29 @@ impl BrickScene {
         let vol = ScalarVolume { dims: g.dims, spacing: g.spacing, values };
         let store = BrickStore { shear: g.shear, ..BrickStore::build_over(&vol, 0.0)? };
         Self::new(store, tf, None)
+    }
+
+    /// Make the store `next`, the scene's next time point (`BrickStore::patch`: the same grid and
+    /// range), keeping its classification, part and what a device holds of the bricks that did
+    /// not change. A scene drawing one rank's part is refused (its tree cuts the whole volume).
+    pub fn update(&mut self, next: BrickStore) -> Result<Patch> {
+        if self.part != [[0; 3], store_bricks(&self.store)] {
+            return Err(Error::InvalidArgument("a time point replaces a scene that draws one rank's part".into()));
+        }
+        let patch = self.store.patch(next)?;
+        if patch.layout {
+            let s = &self.store;
+            self.tree = crate::kdtree::build(store_bricks(s), 1, |id| s.index[id] != u32::MAX);
+        }
+        (self.drawn, self.gmax) = (std::sync::OnceLock::new(), std::sync::OnceLock::new());
+        self.classification = next_classification();
+        let mut cache = self.records_cache.0.lock().map_err(|_| Error::Unsupported("record cache poisoned".into()))?;
+        if patch.layout || patch.compacted {
+            cache.forget();
+        } else {
+            cache.evict(&patch.headers);
+        }
+        Ok(patch)
     }
 
     /// Classify with another transfer function and shading from the next frame on.

@@ -60,6 +60,7 @@ mod recording;
 mod resample;
 mod residency;
 pub mod scene;
+mod series;
 mod shaders;
 mod stages;
 #[cfg(feature = "io")]
@@ -78,22 +79,14 @@ pub use image::ImageF32;
 pub use image::TargetFormat;
 pub use kernel::Kernel;
 pub use options::{
-    Antialias, BlurProfile, Clip, Composite, DepthBuffer, DepthFormat, FrameStats, Lod, Mode, Motion, RaycastOptions,
-    RenderOptions, Rendered, StageTime,
+    Antialias, BlurProfile, Clip, Composite, Delivered, DepthBuffer, DepthFormat, FrameStats, Lod, Mode, Motion,
+    RaycastOptions, RenderOptions, Rendered, StageTime,
 };
 pub use order::{Direction, OrderKind};
 pub use pick::{Pick, PICK_OPACITY};
 pub use raster::{Raster, RasterChoice};
+pub use series::VolumeUpdate;
 pub use volume::{Grid, SplatSet, Volume};
-
-/// What a frame drawn into a host's image (`Renderer::render_to`) reports.
-#[derive(Clone, Debug)]
-pub struct Delivered {
-    /// Per-stage times, as `Rendered::timings`.
-    pub timings: Vec<StageTime>,
-    /// What `Raster::Auto` picked.
-    pub raster: RasterChoice,
-}
 
 use cpu_engine::CpuEngine;
 use plan::Prepared;

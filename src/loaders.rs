@@ -233,6 +233,9 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
     if l.channels > 1 {
         return Err(several_channels(what, l.channels));
     }
+    if l.times > 1 {
+        return Err(several_times(what, l.times));
+    }
     if l.offset > data.len() as u64 {
         return Err(bad(what, format!("voxel offset {} outside the file", l.offset)));
     }
@@ -244,6 +247,14 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
         nrrd::flip_rows(&mut values, l.dims[0] as usize);
     }
     Ok(ScalarVolume { dims: l.dims, spacing: l.spacing, values })
+}
+
+/// The error for a series of several time points read as one volume.
+pub(crate) fn several_times(what: &str, times: u32) -> Error {
+    Error::InvalidArgument(format!(
+        "{what} holds {times} time points: pick one with --time N (VolumeHints::time), or play them all with \
+         voxsplat animate"
+    ))
 }
 
 /// The error for a file of several channels read as one volume.
@@ -269,6 +280,9 @@ pub(crate) struct NiftiLayout {
     /// Channels stored one after another (a 4-D file's fourth axis, or a 5-D file's fifth with
     /// one frame): 1 for a 3-D volume.
     pub channels: u32,
+    /// Time points stored one after another (a 4-D file's fourth axis when its units say time or
+    /// it holds more than `MAX_FILE_CHANNELS`): 1 otherwise.
+    pub times: u32,
 }
 
 impl NiftiLayout {
@@ -287,18 +301,21 @@ impl NiftiLayout {
 pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiLayout> {
     let header = nifti1_header(head, what)?;
     let dim = nifti_dims(&header, what)?;
-    // 3-D; 4-D with one frame or 2 to 4 channels; 5-D with one frame and 2 to 4 channels (the
-    // vector axis).
-    let channels = match dim.len() {
-        1..=3 => 1,
-        4 if dim[3] <= MAX_FILE_CHANNELS => dim[3],
-        5 if dim[3] == 1 && dim[4] <= MAX_FILE_CHANNELS => dim[4],
+    // 3-D; 4-D over time (its units say so, or it holds more frames than a file holds
+    // channels: the standard's fourth axis is time); 4-D of 2 to 4 channels; 5-D with one frame
+    // and 2 to 4 channels (the vector axis).
+    let time_units = header.xyzt_units & 0o70 != 0;
+    let (channels, times) = match dim.len() {
+        1..=3 => (1, 1),
+        4 if dim[3] > 1 && (time_units || dim[3] > MAX_FILE_CHANNELS) && dim[3] <= MAX_TIME_POINTS => (1, dim[3]),
+        4 if dim[3] <= MAX_FILE_CHANNELS => (dim[3], 1),
+        5 if dim[3] == 1 && dim[4] <= MAX_FILE_CHANNELS => (dim[4], 1),
         _ => {
             return Err(bad(
                 what,
                 format!(
-                    "NIfTI dims {dim:?}: a 3-D volume is read, or one of 2 to {MAX_FILE_CHANNELS} channels (4-D, or 5-D with \
-                     one frame)"
+                    "NIfTI dims {dim:?}: a 3-D volume is read, a 4-D series of at most {MAX_TIME_POINTS} time points, or \
+                     a volume of 2 to {MAX_FILE_CHANNELS} channels (4-D, or 5-D with one frame)"
                 ),
             ))
         }
@@ -343,11 +360,15 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
         spacing,
         scale,
         channels: channels as u32,
+        times: times as u32,
     })
 }
 
 /// Most channels a file may hold (`load_channels`; `classify::MAX_CHANNELS`).
 pub const MAX_FILE_CHANNELS: u64 = 4;
+
+/// Most time points a 4-D file may hold (one is read at a time: `VolumeHints::time`).
+pub const MAX_TIME_POINTS: u64 = 1 << 16;
 
 /// Every channel of a volume file: a 4-D NIfTI's 2 to 4 channels (its fourth axis, or a 5-D
 /// file's fifth), or a 4-D NRRD's (the axis its `kinds` marks as not spatial, else a first or last
@@ -371,6 +392,9 @@ pub fn load_channels(path: &Path, hints: &VolumeHints) -> Result<Vec<ScalarVolum
         return Ok(vec![load_volume(path, hints)?]);
     }
     let channels = SliceReader::nifti_channels(path)?;
+    if channels == 1 {
+        return Ok(vec![read_whole(SliceReader::nifti_at(path, hints.time)?, hints, &what)?]);
+    }
     (0..channels).map(|k| read_whole(SliceReader::nifti_channel(path, k)?, hints, &what)).collect()
 }
 
@@ -481,8 +505,23 @@ pub struct VolumeHints {
     /// An OME-Zarr image's pyramid level to read (by default the finest the host budget holds:
     /// `OmeZarr::default_level`).
     pub level: Option<u32>,
-    /// An OME-Zarr image's time point to read (needed when it holds several).
+    /// The time point of a 4-D NIfTI or an OME-Zarr image to read (needed when it holds several:
+    /// `time_points`).
     pub time: Option<u32>,
+}
+
+/// The time points `path` holds: a 4-D NIfTI's fourth axis when it is time (`NiftiLayout`), an
+/// OME-Zarr image's time axis; 1 for any other file. Each is read as a volume with
+/// `VolumeHints::time` (`animate` plays them; `Renderer::update_volume` swaps them in).
+pub fn time_points(path: &Path) -> Result<u32> {
+    let name = lower_name(path);
+    if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+        return SliceReader::nifti_times(path);
+    }
+    if is_ome_zarr(path) {
+        return Ok(OmeZarr::open(path)?.times);
+    }
+    Ok(1)
 }
 
 /// A raw file's dims, sample type, byte order and spacing: `hints` first, then its `.toml`

@@ -680,3 +680,12 @@ pub fn check_scale(scale: f32) -> Result<()> {
         Err(Error::InvalidArgument(format!("render scale {scale} must be in [{MIN_RENDER_SCALE}, 1]")))
     }
 }
+
+/// What a frame drawn into a host's image (`Renderer::render_to`) reports.
+#[derive(Clone, Debug)]
+pub struct Delivered {
+    /// Per-stage times, as `Rendered::timings`.
+    pub timings: Vec<StageTime>,
+    /// What `Raster::Auto` picked.
+    pub raster: crate::RasterChoice,
+}

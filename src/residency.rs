@@ -87,6 +87,17 @@ impl RecordCache {
         (self.last_start, self.frame_start) = (self.batch + 1, self.batch + 1);
     }
 
+    /// Drop the bricks of these headers (their records changed), keeping the rest.
+    pub fn evict(&mut self, headers: &[u32]) {
+        for h in headers {
+            if let Some(s) = self.slot_of.remove(h) {
+                self.by_use.remove(&(self.used[s as usize], s));
+                self.holder[s as usize] = u32::MAX;
+                self.free.push(s);
+            }
+        }
+    }
+
     /// Slots of the cache.
     pub fn slots(&self) -> u32 {
         self.holder.len() as u32

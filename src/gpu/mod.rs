@@ -74,6 +74,11 @@ impl Gpu {
         self.res.set_scene(prep, self.budget_bytes)
     }
 
+    /// Follow `patch` of the scene's store (`Resources::patch_store`); the bytes written.
+    pub fn patch_store(&mut self, prep: &Prepared, patch: &crate::bricks::Patch) -> Result<u64> {
+        self.res.patch_store(prep, patch, self.budget_bytes)
+    }
+
     /// An engine for one frame of `prep` (the scene `set_scene` uploaded).
     pub fn engine<'a>(&'a mut self, prep: &'a Prepared) -> exec::GpuEngine<'a> {
         exec::GpuEngine::new(self, prep)

@@ -173,10 +173,12 @@ impl Resources {
                     Some([
                         storage(ctx, "brick headers", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.headers))))?,
                         storage(ctx, "brick masks", bytemuck::cast_slice(&words(&s.mask_words())))?,
-                        storage(
+                        // Copied from when a time point's records outgrow it (`patch_store`).
+                        Buffer::with_data(
                             ctx,
                             "brick records",
                             bytemuck::cast_slice(&words(if b.streams(budget) { &[] } else { &s.records })),
+                            USAGE,
                         )?,
                         storage(ctx, "brick index", bytemuck::cast_slice(&words(&b.index_words())))?,
                     ])
@@ -185,6 +187,78 @@ impl Resources {
             },
         });
         Ok(())
+    }
+
+    /// Follow a bricked store's `patch` (`BrickScene::update`): the changed headers, masks and
+    /// records rewritten in place, a buffer replaced only when the brick set changed or the records
+    /// outgrew theirs (then with a quarter to spare, for the next time points' moved bricks).
+    /// Returns the bytes written.
+    pub fn patch_store(&mut self, prep: &Prepared, patch: &crate::bricks::Patch, budget: u64) -> Result<u64> {
+        let b = prep.bricks.as_ref().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
+        let (s, streams) = (&b.store, b.streams(budget));
+        let most = RECORD_PAGE as u64 * RECORD_PAGES as u64;
+        if !streams && s.records.len() as u64 > most {
+            return Err(Error::TooLarge(format!(
+                "a bricked store of {} records: the GPU path binds at most {most}",
+                s.records.len()
+            )));
+        }
+        self.ctx.wait_idle();
+        let ctx = self.ctx.clone();
+        let scene = self.scene.as_mut().ok_or_else(|| Error::InvalidArgument("no scene on the device".into()))?;
+        // The ray caster's field and its occupancy hold the old values.
+        (scene.field, scene.bricks) = (None, None);
+        let store = scene.store.as_mut().ok_or_else(|| Error::InvalidArgument("the scene is not bricked".into()))?;
+        let words = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
+        let masks = s.mask_words();
+        let (mut written, mut replaced) = (0u64, false);
+        if patch.layout {
+            let index = b.index_words();
+            store[0] = storage(&ctx, "brick headers", bytemuck::cast_slice(&words(bytemuck::cast_slice(&s.headers))))?;
+            store[1] = storage(&ctx, "brick masks", bytemuck::cast_slice(&words(&masks)))?;
+            store[3] = storage(&ctx, "brick index", bytemuck::cast_slice(&words(&index)))?;
+            written += (s.headers.len() * 16 + masks.len() * 4 + index.len() * 4) as u64;
+            replaced = true;
+        } else {
+            let per = masks.len() / s.headers.len().max(1);
+            for &h in &patch.headers {
+                let h = h as usize;
+                store[0].write_at(h as u64 * 16, bytemuck::bytes_of(&s.headers[h]))?;
+                store[1].write_at((h * per * 4) as u64, bytemuck::cast_slice(&masks[h * per..(h + 1) * per]))?;
+                written += 16 + per as u64 * 4;
+            }
+        }
+        let need = s.records.len() as u64 * 4;
+        if streams {
+            // Records travel batch by batch (the record cache dropped the changed bricks).
+            if store[2].size() > 16 {
+                store[2] = storage(&ctx, "brick records", bytemuck::cast_slice(&[0u32]))?;
+                replaced = true;
+            }
+        } else {
+            let stand_in = store[2].size() == 16 && need > 16;
+            if patch.compacted || stand_in || store[2].size() < need {
+                let size = (need + need / 4).clamp(need.max(4), most * 4);
+                let buf = Buffer::new(&ctx, "brick records", size, USAGE, Memory::Upload)?;
+                if !(patch.compacted || stand_in) {
+                    // The records that stay keep their places: copied on the device, not sent again.
+                    ctx.submit(|rec| {
+                        rec.copy_buffer(&store[2], &buf, store[2].size());
+                        Ok(())
+                    })?;
+                }
+                (store[2], replaced) = (buf, true);
+            }
+            for &[first, n] in &patch.records {
+                let r = &s.records[first as usize..(first + n) as usize];
+                store[2].write_at(first as u64 * 4, bytemuck::cast_slice(r))?;
+                written += n as u64 * 4;
+            }
+        }
+        if replaced {
+            self.sets.clear();
+        }
+        Ok(written)
     }
 
     /// Refuse a splat frame of a set past the GPU path's splat cap (it may still be ray cast).

@@ -118,10 +118,15 @@ impl SliceReader {
             }
             return Self::zarr(path, &image, hints, 0).map(Some);
         }
-        if hints.level.is_some() || hints.time.is_some() {
+        let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
+        if hints.level.is_some() || hints.time.is_some() && !nifti {
             return Err(super::bad(
                 &path.display().to_string(),
-                "--level and --time pick a level and a time point of an OME-Zarr image; this is none",
+                if hints.level.is_some() {
+                    "--level picks a level of an OME-Zarr image; this is none"
+                } else {
+                    "--time picks a time point of a 4-D NIfTI or an OME-Zarr image; this is neither"
+                },
             ));
         }
         if hints.series.is_some() && !(path.is_dir() || super::dicom::is_dicom(path)) {
@@ -141,8 +146,8 @@ impl SliceReader {
             Ok(Some(Self::stack(super::stacks::Stack::tiff(path)?)))
         } else if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
             Self::nrrd(path)
-        } else if name.ends_with(".nii") || name.ends_with(".nii.gz") {
-            Self::nifti(path).map(Some)
+        } else if nifti {
+            Self::nifti_at(path, hints.time).map(Some)
         } else if name.ends_with(".npy") {
             Ok(None)
         } else {
@@ -184,19 +189,38 @@ impl SliceReader {
         Self::from_file(file, &data_path, layout, what).map(Some)
     }
 
-    /// A NIfTI-1 file, compressed or not (of one channel: `nifti_channel` reads one of several).
+    /// A NIfTI-1 file, compressed or not (of one channel: `nifti_channel` reads one of several;
+    /// of one time point: `nifti_at` reads one of several).
     pub fn nifti(path: &Path) -> Result<Self> {
-        let channels = Self::nifti_channels(path)?;
-        if channels > 1 {
-            return Err(super::several_channels(&path.display().to_string(), channels));
+        Self::nifti_at(path, None)
+    }
+
+    /// Time point `time` of a 4-D NIfTI-1 file of one channel (`None`: a file of one time point).
+    pub fn nifti_at(path: &Path, time: Option<u32>) -> Result<Self> {
+        let what = path.display().to_string();
+        let l = nifti_layout(&Self::nifti_head(path)?.0, MAX_STREAMED_VOXELS, &what)?;
+        if l.channels > 1 {
+            return Err(super::several_channels(&what, l.channels));
         }
-        Self::nifti_channel(path, 0)
+        match time {
+            None if l.times > 1 => Err(super::several_times(&what, l.times)),
+            Some(t) if t >= l.times => {
+                Err(bad(&what, format!("--time {t}: the file holds time points 0 to {}", l.times - 1)))
+            }
+            t => Self::nifti_block(path, t.unwrap_or(0)),
+        }
     }
 
     /// The channels a NIfTI-1 file holds (1 for a 3-D volume).
     pub fn nifti_channels(path: &Path) -> Result<u32> {
         let what = path.display().to_string();
         Ok(nifti_layout(&Self::nifti_head(path)?.0, MAX_STREAMED_VOXELS, &what)?.channels)
+    }
+
+    /// The time points a NIfTI-1 file holds (1 unless it is a 4-D series).
+    pub fn nifti_times(path: &Path) -> Result<u32> {
+        let what = path.display().to_string();
+        Ok(nifti_layout(&Self::nifti_head(path)?.0, MAX_STREAMED_VOXELS, &what)?.times)
     }
 
     /// The first 348 bytes of a NIfTI-1 file, inflated if it is compressed, and whether it is.
@@ -217,15 +241,22 @@ impl SliceReader {
     /// Channel `channel` of a NIfTI-1 file (the channels stored one after another).
     pub fn nifti_channel(path: &Path, channel: u32) -> Result<Self> {
         let what = path.display().to_string();
-        let (head, gz) = Self::nifti_head(path)?;
-        let file = std::fs::File::open(path).map_err(io_err(path))?;
-        let l = nifti_layout(&head, MAX_STREAMED_VOXELS, &what)?;
+        let l = nifti_layout(&Self::nifti_head(path)?.0, MAX_STREAMED_VOXELS, &what)?;
         if channel >= l.channels {
             return Err(bad(&what, format!("no channel {channel}: the file holds {}", l.channels)));
         }
-        let block = l.dims.iter().map(|&d| d as u64).product::<u64>() * l.dtype.size() as u64;
+        Self::nifti_block(path, channel)
+    }
+
+    /// The `block`th volume of a NIfTI-1 file whose channels or time points lie one after another.
+    fn nifti_block(path: &Path, block: u32) -> Result<Self> {
+        let what = path.display().to_string();
+        let (head, gz) = Self::nifti_head(path)?;
+        let file = std::fs::File::open(path).map_err(io_err(path))?;
+        let l = nifti_layout(&head, MAX_STREAMED_VOXELS, &what)?;
+        let size = l.dims.iter().map(|&d| d as u64).product::<u64>() * l.dtype.size() as u64;
         let layout = Layout {
-            offset: l.offset + channel as u64 * block,
+            offset: l.offset + block as u64 * size,
             dims: l.dims,
             spacing: l.spacing,
             dtype: l.dtype,

@@ -87,15 +87,21 @@ impl Buffer {
 
     /// Copy `data` to the start of a host-visible buffer.
     pub fn write(&mut self, data: &[u8]) -> Result<()> {
+        self.write_at(0, data)
+    }
+
+    /// Copy `data` into a host-visible buffer from byte `offset` on (the device must not be using
+    /// the bytes: the caller waits for it).
+    pub fn write_at(&mut self, offset: u64, data: &[u8]) -> Result<()> {
         let slice = self
             .allocation
             .as_mut()
             .and_then(|a| a.mapped_slice_mut())
             .ok_or_else(|| Error::Unsupported("buffer is not host visible".into()))?;
-        if data.len() > slice.len() {
-            return Err(Error::InvalidArgument(format!("{} bytes into a {}-byte buffer", data.len(), slice.len())));
-        }
-        slice[..data.len()].copy_from_slice(data);
+        let end = offset.checked_add(data.len() as u64).filter(|&e| e <= slice.len() as u64).ok_or_else(|| {
+            Error::InvalidArgument(format!("{} bytes at {offset} into a {}-byte buffer", data.len(), slice.len()))
+        })?;
+        slice[offset as usize..end as usize].copy_from_slice(data);
         Ok(())
     }
 

@@ -1,0 +1,80 @@
+//! A volume over time: each time point swapped into the renderer's bricked scene
+//! (`Renderer::update_volume`), the device rewriting only the bricks that changed.
+use crate::bricks::BrickStore;
+use crate::error::{Error, Result};
+use crate::plan::Prepared;
+use crate::Renderer;
+
+/// What `Renderer::update_volume` changed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct VolumeUpdate {
+    /// Bricks whose voxels changed, appeared or went empty.
+    pub changed: usize,
+    /// Non-empty bricks of the new time point.
+    pub bricks: usize,
+    /// Bytes written to the device's store (0 on the CPU backend).
+    pub uploaded: u64,
+    /// Bytes the store takes on a device (`BrickStore::bytes`): what `set_volume` uploads.
+    pub store_bytes: u64,
+    /// Whether the set of non-empty bricks changed (the headers, masks and index were rewritten
+    /// whole).
+    pub layout: bool,
+}
+
+impl Renderer {
+    /// Make `store` the bricked scene's next time point, classified as the scene is: the same
+    /// grid, normalised by the same range (build it with `BrickStore::from_region(.., range, ..)`
+    /// or `BrickStore::load_in_range`). The device keeps its pipelines, frame buffers and the
+    /// records of every brick that did not change; the changed bricks are written in place
+    /// (`BrickStore::patch`). What the frame derives from the values (the level-of-detail
+    /// pyramid, a shaded frame's gradients, the ray caster's field) is derived again on the next
+    /// frame. Refused, with the scene kept, when the grid or the range differ.
+    ///
+    /// ```
+    /// use voxsplat::bricks::BrickStore;
+    /// use voxsplat::classify::TransferFunction;
+    /// use voxsplat::volume::ScalarVolume;
+    /// use voxsplat::{Backend, Renderer, RendererOptions};
+    /// // Two time points of a 32³ volume: a block that moves by one voxel along x.
+    /// let at = |t: u32| {
+    ///     let values = (0..32 * 32 * 32u32)
+    ///         .map(|i| if (10 + t..20 + t).contains(&(i % 32)) && (10..20).contains(&(i / 32 % 32)) { 1.0 } else { 0.0 })
+    ///         .collect();
+    ///     ScalarVolume { dims: [32; 3], spacing: [1.0; 3], values }
+    /// };
+    /// let mut renderer = Renderer::new(&RendererOptions { backend: Backend::Cpu, ..Default::default() })?;
+    /// renderer.set_volume(&at(0), &TransferFunction::default(), None)?;
+    /// let range = renderer.volume().unwrap().store.range;
+    /// let next = at(1);
+    /// let plane = 32 * 32;
+    /// let store = BrickStore::from_region(next.dims, next.spacing, range, [[0; 3], next.dims], |z0, n, out| {
+    ///     out.clear();
+    ///     out.extend_from_slice(&next.values[z0 as usize * plane..(z0 + n) as usize * plane]);
+    ///     Ok(())
+    /// })?;
+    /// let update = renderer.update_volume(store)?;
+    /// assert!(update.changed > 0 && update.changed < update.bricks);
+    /// # Ok::<(), voxsplat::Error>(())
+    /// ```
+    pub fn update_volume(&mut self, store: BrickStore) -> Result<VolumeUpdate> {
+        let needs = || Error::InvalidArgument("update_volume needs a bricked volume (Renderer::set_volume)".into());
+        let prep = self.scene.as_mut().ok_or_else(needs)?;
+        let mut scene = prep.bricks.take().ok_or_else(needs)?;
+        let patch = match scene.update(store) {
+            Ok(p) => p,
+            Err(e) => {
+                prep.bricks = Some(scene);
+                return Err(e);
+            }
+        };
+        let (bricks, store_bytes) = (scene.store.headers.len(), scene.store.bytes());
+        // The scene's fields (the ray caster's, the isosurface's) were made from the old values.
+        let next = Prepared::bricked(scene)?;
+        let uploaded = match &mut self.gpu {
+            Some(g) => g.patch_store(&next, &patch)?,
+            None => 0,
+        };
+        *prep = next;
+        Ok(VolumeUpdate { changed: patch.changed, bricks, uploaded, store_bytes, layout: patch.layout })
+    }
+}

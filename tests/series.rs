@@ -1,0 +1,256 @@
+//! Volumes over time (issue 47, item 4): a time point swapped into a bricked scene in place
+//! (`BrickStore::patch`, `Renderer::update_volume`) draws what the same store set afresh draws,
+//! on the device and on the CPU mirrors, while the device rewrites only the bricks that changed;
+//! 4-D NIfTI files read one time point at a time. Validation on: any message fails.
+mod common;
+use common::{assert_clean, assert_mirrors, blob, blob_tf as tf};
+use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
+use voxsplat::classify::Shading;
+use voxsplat::volume::ScalarVolume;
+use voxsplat::{Camera, Error, Mode, RenderOptions};
+
+const DIMS: [u32; 3] = [61, 53, 47];
+
+/// Time point `t` of a series: the blob, and a bright ball that moves 3 voxels along x per time
+/// point (from t = 4 on it also loses its middle, so some bricks lose records or go empty).
+fn at(t: u32) -> ScalarVolume {
+    ball(t, blob(DIMS))
+}
+
+/// `at` on a larger grid (the ball as large), for a store that streams through a budget that
+/// holds a frame.
+fn large_at(t: u32) -> ScalarVolume {
+    ball(t, blob(LARGE))
+}
+
+const LARGE: [u32; 3] = [120, 110, 100];
+
+/// The ball of time point `t` over `v`.
+fn ball(t: u32, mut v: ScalarVolume) -> ScalarVolume {
+    let c = [12.0 + 3.0 * t as f32, 40.0, 30.0];
+    let dims = v.dims;
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let d = [i as f32 - c[0], j as f32 - c[1], k as f32 - c[2]];
+                let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                if r < 7.0 && !(t >= 4 && r < 3.0) {
+                    v.values[(i + dims[0] * (j + dims[1] * k)) as usize] = 60.0 + 30.0 * (r / 7.0);
+                }
+            }
+        }
+    }
+    v
+}
+
+/// `vol` as a store normalised by `range`.
+fn store_in(vol: &ScalarVolume, range: (f32, f32)) -> BrickStore {
+    let plane = (vol.dims[0] * vol.dims[1]) as usize;
+    BrickStore::from_region(vol.dims, vol.spacing, range, [[0; 3], vol.dims], |z0, n, out| {
+        out.clear();
+        out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + n) as usize * plane]);
+        Ok(())
+    })
+    .unwrap()
+}
+
+/// The series' range: every time point's values.
+fn range(times: &[ScalarVolume]) -> (f32, f32) {
+    let all = times.iter().flat_map(|v| v.values.iter().copied());
+    all.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
+}
+
+/// Bricks where `a` and `b` differ in some voxel (counted from the dense volumes).
+fn bricks_that_differ(a: &ScalarVolume, b: &ScalarVolume) -> usize {
+    let nb = a.dims.map(|d| d.div_ceil(BRICK));
+    let mut differ = vec![false; (nb[0] * nb[1] * nb[2]) as usize];
+    for (n, (x, y)) in a.values.iter().zip(&b.values).enumerate() {
+        if x != y {
+            let n = n as u32;
+            let (i, j, k) = (n % a.dims[0], n / a.dims[0] % a.dims[1], n / (a.dims[0] * a.dims[1]));
+            differ[(i / BRICK + nb[0] * (j / BRICK + nb[1] * (k / BRICK))) as usize] = true;
+        }
+    }
+    differ.iter().filter(|&&d| d).count()
+}
+
+#[test]
+fn a_patched_store_reads_back_every_value_and_keeps_what_did_not_change() {
+    let times: Vec<ScalarVolume> = (0..12).map(at).collect();
+    let range = range(&times);
+    let mut store = store_in(&times[0], range);
+    let mut compacted = false;
+    for t in 1..times.len() {
+        let next = store_in(&times[t], range);
+        let before = store.clone();
+        let patch = store.patch(next.clone()).unwrap();
+        assert_eq!(patch.changed, bricks_that_differ(&times[t - 1], &times[t]), "t {t}: bricks changed");
+        assert!(patch.changed > 0 && patch.changed < store.headers.len() / 2, "t {t}: {} changed", patch.changed);
+        for k in 0..DIMS[2] as i64 {
+            for j in 0..DIMS[1] as i64 {
+                for i in 0..DIMS[0] as i64 {
+                    assert_eq!(store.value_at(i, j, k), next.value_at(i, j, k), "t {t}: voxel {i},{j},{k}");
+                }
+            }
+        }
+        assert_eq!(store.masks, next.masks);
+        assert_eq!(store.index, next.index);
+        for (h, n) in store.headers.iter().zip(&next.headers) {
+            assert_eq!((h.brick, h.count, h.range), (n.brick, n.count, n.range), "t {t}: headers");
+        }
+        // A brick that did not change keeps its records where they were.
+        let written: Vec<u32> = patch.records.iter().map(|r| r[0]).collect();
+        if !patch.compacted {
+            for h in &store.headers {
+                let old = before.header_of(h.coords().map(|c| c * BRICK));
+                if !h.is_uniform() && !written.contains(&h.first) {
+                    assert_eq!(before.headers[old as usize].first, h.first, "t {t}: an unchanged brick moved");
+                }
+            }
+        }
+        compacted |= patch.compacted;
+        let live: usize = store.headers.iter().filter(|h| !h.is_uniform()).map(|h| h.count as usize).sum();
+        assert!(store.records.len() <= 2 * live + 512, "t {t}: holes are bounded");
+    }
+    assert!(!compacted, "the ball's holes stay below the blob's records");
+    // The same store again changes nothing.
+    let again = store_in(&times[11], range);
+    assert_eq!(store.patch(again).unwrap(), voxsplat::bricks::Patch::default());
+    // The ball alone: its moves leave holes that pass its records, which are then laid out afresh.
+    let empty = ScalarVolume { values: vec![0.0; times[0].values.len()], ..times[0].clone() };
+    let mut store = store_in(&ball(0, empty.clone()), range);
+    let mut compacted = 0;
+    for t in 1..12 {
+        let next = store_in(&ball(t, empty.clone()), range);
+        let patch = store.patch(next.clone()).unwrap();
+        if patch.compacted {
+            compacted += 1;
+            assert_eq!(patch.records, vec![[0, store.records.len() as u32]]);
+            assert_eq!(store.records, next.records, "t {t}: laid out as a fresh store");
+        }
+        let live: usize = store.headers.iter().filter(|h| !h.is_uniform()).map(|h| h.count as usize).sum();
+        assert!(store.records.len() <= 2 * live + 512, "t {t}: holes are bounded");
+        assert_eq!(store.masks, next.masks);
+    }
+    assert!(compacted > 0, "the ball's moves lay its records out afresh");
+}
+
+#[test]
+fn a_time_point_of_another_grid_or_range_is_refused_and_the_scene_kept() {
+    let (a, b) = (at(0), at(1));
+    let range = range(&[a.clone(), b.clone()]);
+    let mut r = common::cpu();
+    let err = r.update_volume(store_in(&a, range)).unwrap_err();
+    assert!(matches!(err, Error::InvalidArgument(ref m) if m.contains("bricked volume")), "{err}");
+    r.set_bricks(BrickScene::new(store_in(&a, range), tf(), None).unwrap()).unwrap();
+    let err = r.update_volume(store_in(&b, (range.0, range.1 + 1.0))).unwrap_err();
+    assert!(matches!(err, Error::InvalidArgument(ref m) if m.contains("from_region")), "{err}");
+    let small = ScalarVolume { dims: [8, 8, 8], spacing: [1.0; 3], values: vec![1.0; 512] };
+    let err = r.update_volume(store_in(&small, range)).unwrap_err();
+    assert!(matches!(err, Error::InvalidArgument(ref m) if m.contains("keeps its grid")), "{err}");
+    // Still the first time point.
+    let cam = Camera::framing(&voxsplat::Grid::centered(DIMS, a.spacing).unwrap(), 48, 48);
+    let mut fresh = common::cpu();
+    fresh.set_bricks(BrickScene::new(store_in(&a, range), tf(), None).unwrap()).unwrap();
+    let o = RenderOptions::default();
+    assert!(r.render(&cam, &o).unwrap().image.pixels == fresh.render(&cam, &o).unwrap().image.pixels);
+}
+
+/// Plays the series through `update_volume` on `played` and sets each time point afresh on
+/// another renderer: the frames agree bit for bit; returns the frames and the updates.
+fn play(
+    gpu: bool,
+    budget: Option<u64>,
+    shading: Option<Shading>,
+    o: &RenderOptions,
+    series: fn(u32) -> ScalarVolume,
+) -> (Vec<voxsplat::ImageF32>, Vec<(voxsplat::VolumeUpdate, u64)>) {
+    let times: Vec<ScalarVolume> = (0..6).map(series).collect();
+    let range = range(&times);
+    let cam = Camera::framing(&voxsplat::Grid::centered(times[0].dims, times[0].spacing).unwrap(), 80, 72);
+    let renderer = || {
+        let mut r = if gpu { common::gpu() } else { common::cpu() };
+        if let Some(b) = budget {
+            r.set_gpu_budget(b).unwrap();
+        }
+        r
+    };
+    let mut played = renderer();
+    played.set_bricks(BrickScene::new(store_in(&times[0], range), tf(), shading).unwrap()).unwrap();
+    let (mut frames, mut updates) = (Vec::new(), Vec::new());
+    for (t, vol) in times.iter().enumerate() {
+        if t > 0 {
+            let u = played.update_volume(store_in(vol, range)).unwrap();
+            // What the device's headers, masks and index take of the bytes written.
+            let scene = played.volume().unwrap();
+            let tables = if u.layout {
+                scene.store.headers.len() * 16 + (scene.store.mask_words().len() + scene.index_words().len()) * 4
+            } else {
+                u.changed * (16 + scene.store.mask_words().len() * 4 / u.bricks)
+            };
+            updates.push((u, tables as u64));
+        }
+        let a = played.render(&cam, o).unwrap().image;
+        let mut fresh = renderer();
+        fresh.set_bricks(BrickScene::new(store_in(vol, range), tf(), shading).unwrap()).unwrap();
+        let b = fresh.render(&cam, o).unwrap().image;
+        assert!(common::covered(&a) > 100, "t {t}: something drawn");
+        let differ = a.pixels.iter().zip(&b.pixels).filter(|(p, q)| p != q).count();
+        assert_eq!(differ, 0, "gpu {gpu} budget {budget:?} t {t}: pixels where the played frame differs");
+        if gpu {
+            assert_clean(&fresh);
+        }
+        frames.push(a);
+    }
+    if gpu {
+        assert_clean(&played);
+    }
+    (frames, updates)
+}
+
+#[test]
+fn a_played_series_draws_what_each_time_point_draws_set_afresh() {
+    let cam = Camera::framing(&voxsplat::Grid::centered(DIMS, [1.0, 1.2, 0.9]).unwrap(), 80, 72);
+    let shading = Some(Shading::headlight(cam.forward()));
+    let mut mip = RenderOptions::default();
+    mip.mode = Mode::Mip;
+    for (shading, o, what) in
+        [(None, RenderOptions::default(), "plain"), (shading, RenderOptions::default(), "shaded"), (None, mip, "mip")]
+    {
+        let (g, updates) = play(true, None, shading, &o, at);
+        let (c, _) = play(false, None, shading, &o, at);
+        for (t, (a, b)) in g.iter().zip(&c).enumerate() {
+            assert_mirrors(a, b, &format!("{what} t {t}"));
+        }
+        // The ball's bricks are written, not the store: their records (at most a brick's each),
+        // and their headers and masks, or all headers, masks and the index when bricks appeared
+        // or went (`VolumeUpdate::layout`).
+        // Bricks appear (the tables rewritten whole) and change in place (theirs alone).
+        assert!(updates.iter().any(|u| u.0.layout) && updates.iter().any(|u| !u.0.layout), "{what}: {updates:?}");
+        for (t, (u, tables)) in updates.iter().enumerate() {
+            assert!(u.changed > 0 && u.uploaded > *tables, "{what} t {}: {u:?}", t + 1);
+            assert!(u.uploaded <= tables + u.changed as u64 * 2048, "{what} t {}: {u:?}", t + 1);
+            assert!(u.uploaded * 3 < u.store_bytes, "{what} t {}: {u:?}", t + 1);
+        }
+    }
+}
+
+#[test]
+fn a_series_streamed_through_a_small_budget_plays_the_same_frames() {
+    let vol = large_at(0);
+    let store = store_in(&vol, range(&[vol.clone()]));
+    // Below twice the records: they stream, batch by batch.
+    let budget = store.records.len() as u64 * 8 - 1;
+    let scene = BrickScene::new(store, tf(), None).unwrap();
+    assert!(scene.streams(budget));
+    assert!(voxsplat::low_level::plan::bricked_min_budget(&scene, budget, 80, 72) < budget);
+    let o = RenderOptions::default();
+    let (resident, _) = play(true, None, None, &o, large_at);
+    let (streamed, updates) = play(true, Some(budget), None, &o, large_at);
+    assert!(resident.iter().zip(&streamed).all(|(a, b)| a.pixels == b.pixels), "streaming changes a frame");
+    // A streamed store's records stay on the host (they travel batch by batch): only headers,
+    // masks and the index are written.
+    for (u, tables) in &updates {
+        assert!(u.changed > 0 && u.uploaded == *tables, "{u:?}: {tables} bytes of tables");
+    }
+}
