@@ -25,7 +25,7 @@ pub use npy::{npy_from_bytes, npy_shape};
 pub use nrrd::nrrd_channels_from_bytes;
 use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
-pub use slices::{SliceReader, MAX_STREAMED_VOXELS};
+pub use slices::{value_range, SliceReader, MAX_STREAMED_VOXELS};
 pub use stacks::is_stack;
 pub use zarr::{
     chunks_read as zarr_chunks_read, is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, LEVEL_PIXELS,

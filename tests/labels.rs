@@ -238,11 +238,16 @@ fn a_four_d_nifti_reads_as_its_channels() {
         let e = voxsplat::loaders::load_volume(&path, &Default::default()).unwrap_err().to_string();
         assert!(e.contains("holds 3 channels"), "{e}");
     }
-    // Too many channels, and a file too short for its channels.
+    // Too many channels (a 5-D file's vector axis), and a file too short for its channels. A 4-D
+    // file of 7 is a series of 7 time points (the standard's fourth axis is time;
+    // tests/series.rs reads them).
     let many = dir.join("many.nii");
-    std::fs::write(&many, nifti_channels(dims, &vec![0; 7 * n], 7, false)).unwrap();
+    std::fs::write(&many, nifti_channels(dims, &vec![0; 7 * n], 7, true)).unwrap();
     let e = voxsplat::loaders::load_channels(&many, &Default::default()).unwrap_err().to_string();
     assert!(e.contains("2 to 4 channels"), "{e}");
+    std::fs::write(&many, nifti_channels(dims, &vec![0; 7 * n], 7, false)).unwrap();
+    let e = voxsplat::loaders::load_channels(&many, &Default::default()).unwrap_err().to_string();
+    assert!(e.contains("holds 7 time points"), "{e}");
     let short = dir.join("short.nii");
     std::fs::write(&short, nifti_channels(dims, &data[..2 * n], 3, false)).unwrap();
     let e = voxsplat::loaders::load_channels(&short, &Default::default()).unwrap_err().to_string();

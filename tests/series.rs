@@ -254,3 +254,68 @@ fn a_series_streamed_through_a_small_budget_plays_the_same_frames() {
         assert!(u.changed > 0 && u.uploaded == *tables, "{u:?}: {tables} bytes of tables");
     }
 }
+
+/// A 4-D NIfTI-1 file of u8 samples: `frames` volumes of `dims`, `units` its xyzt_units.
+fn nifti4(dims: [u32; 3], frames: u32, units: u8, v: &[u8]) -> Vec<u8> {
+    let mut h = common::nifti(dims, &[], None, None);
+    let dim: [i16; 5] = [4, dims[0] as i16, dims[1] as i16, dims[2] as i16, frames as i16];
+    for (i, d) in dim.iter().enumerate() {
+        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    h[123] = units;
+    h.extend_from_slice(v);
+    h
+}
+
+#[test]
+fn a_4d_nifti_is_read_one_time_point_at_a_time() {
+    use voxsplat::loaders::{load_channels, load_volume, time_points, VolumeHints};
+    let dims = [9, 8, 7];
+    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let dir = std::env::temp_dir().join(format!("voxsplat-series-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let frames = |t: u32| (0..n).map(|i| ((i as u32 * 7 + t * 31) % 251) as u8).collect::<Vec<u8>>();
+    let all = |count: u32| (0..count).flat_map(frames).collect::<Vec<u8>>();
+    let at = |t| VolumeHints { time: Some(t), ..Default::default() };
+    // Seconds as its units: a series of three time points, not three channels.
+    let timed = dir.join("timed.nii");
+    std::fs::write(&timed, nifti4(dims, 3, 8, &all(3))).unwrap();
+    assert_eq!(time_points(&timed).unwrap(), 3);
+    for t in 0..3 {
+        let v = load_volume(&timed, &at(t)).unwrap();
+        assert_eq!(v.values, frames(t).iter().map(|&b| b as f32).collect::<Vec<_>>(), "time point {t}");
+        assert_eq!(load_channels(&timed, &at(t)).unwrap()[0].values, v.values);
+        let store = BrickStore::load(&timed, &at(t)).unwrap();
+        let (banded, outside) = BrickStore::load_in_range(&timed, &at(t), (0.0, 100.0)).unwrap();
+        let beyond = v.values.iter().filter(|&&x| x > 100.0).count() as u64;
+        assert_eq!((banded.range, outside), ((0.0, 100.0), beyond));
+        assert_eq!(store.len(), v.values.iter().filter(|&&x| x > store.range.0).count());
+    }
+    let err = load_volume(&timed, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(err.contains("holds 3 time points") && err.contains("--time"), "{err}");
+    let err = load_volume(&timed, &at(3)).unwrap_err().to_string();
+    assert!(err.contains("--time 3") && err.contains("0 to 2"), "{err}");
+    // No time units and at most 4 frames: channels, as before; more frames: time points.
+    let channels = dir.join("channels.nii");
+    std::fs::write(&channels, nifti4(dims, 3, 0, &all(3))).unwrap();
+    assert_eq!(time_points(&channels).unwrap(), 1);
+    assert_eq!(load_channels(&channels, &VolumeHints::default()).unwrap().len(), 3);
+    let long = dir.join("long.nii");
+    std::fs::write(&long, nifti4(dims, 6, 0, &all(6))).unwrap();
+    assert_eq!(time_points(&long).unwrap(), 6);
+    assert_eq!(load_volume(&long, &at(5)).unwrap().values, frames(5).iter().map(|&b| b as f32).collect::<Vec<_>>());
+    // Truncated before the last time point: that one is refused, naming the file.
+    let cut = dir.join("cut.nii");
+    let mut bytes = nifti4(dims, 6, 8, &all(6));
+    bytes.truncate(bytes.len() - 10);
+    std::fs::write(&cut, bytes).unwrap();
+    load_volume(&cut, &at(4)).unwrap();
+    let err = load_volume(&cut, &at(5)).unwrap_err().to_string();
+    assert!(err.contains("cut.nii") && err.contains("truncated"), "{err}");
+    // --time on a file without a time axis.
+    let plain = dir.join("plain.nii");
+    std::fs::write(&plain, common::nifti(dims, &frames(0), None, None)).unwrap();
+    let err = load_volume(&plain, &at(1)).unwrap_err().to_string();
+    assert!(err.contains("--time 1") && err.contains("no time axis"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -12,6 +12,7 @@ pub mod open;
 pub mod parse;
 pub mod peer;
 pub mod rates;
+pub mod series;
 pub mod soak;
 pub mod stability;
 pub mod volumes;

@@ -96,7 +96,8 @@ enum Command {
         /// An OME-Zarr image's pyramid level to describe (its levels are listed; 0 by default).
         #[arg(long)]
         level: Option<u32>,
-        /// An OME-Zarr image's time point to describe (needed when it holds several).
+        /// The time point of a 4-D NIfTI or an OME-Zarr image to describe (needed when it holds
+        /// several).
         #[arg(long)]
         time: Option<u32>,
     },
@@ -142,31 +143,32 @@ enum Command {
 #[derive(Args)]
 struct AnimateArgs {
     /// A built-in animation (rotating-box, spinning-box, rotating-terrain, rotating-terrain-ortho)
-    /// or a TOML file.
-    #[arg(long, default_value = "rotating-box")]
-    anim: String,
+    /// or a TOML file [default: rotating-box]. Not with --volume, whose time points are the frames.
+    #[arg(long)]
+    anim: Option<String>,
     /// none, splat (motion-blurred splats) or accum:N (N sub-frames averaged). Blurred splats
     /// take a path and a profile: splat:arc bends each path through its halfway point,
     /// splat:tapered averages the footprint over the shutter, splat:teardrop weights it towards
     /// the frame's time, splat:slotted composites the two halves of the shutter apart (the
-    /// closest to accum:N); joined with '+', e.g. splat:arc+slotted.
-    #[arg(long, default_value = "splat")]
-    blur: String,
+    /// closest to accum:N); joined with '+', e.g. splat:arc+slotted [default: splat]. Not with
+    /// --volume.
+    #[arg(long)]
+    blur: Option<String>,
     /// Per-splat compositing or sheet summation.
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet"])]
     composite: String,
-    /// Visibility order.
-    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
-    order: String,
     /// Frame files: png or exr.
     #[arg(long, default_value = "png", value_parser = ["png", "exr"])]
     format: String,
     /// Where the frames and anim.gif go.
     #[arg(long, default_value = "anim-out")]
     out_dir: PathBuf,
-    /// Render on the CPU instead of the Vulkan device (slower; the same frames to within rounding).
-    #[arg(long)]
-    cpu: bool,
+    /// With --volume (a 4-D NIfTI, or an OME-Zarr image with a time axis): one frame per time
+    /// point, from the view the scene flags describe, the whole series classified by one
+    /// transfer function over its value range. Without it, the animation's own scene and camera
+    /// (only --order, --cpu and --validation apply).
+    #[command(flatten)]
+    scene: SceneArgs,
 }
 
 #[derive(Args)]
@@ -330,12 +332,21 @@ fn run(cli: Cli) -> Result<()> {
                 let opts = voxsplat::terrain::TerrainOptions { cell, vscale, ..Default::default() };
                 voxsplat::terrain::terrain_splats(&h, &opts)?
             } else {
+                // A series: the time point asked for, else the first.
+                let times = voxsplat::loaders::time_points(&file)?;
+                if times > 1 {
+                    println!(
+                        "{times} time points (a series: --time N describes one, time point {} below; animate --volume \
+                         plays them all)",
+                        time.unwrap_or(0)
+                    );
+                }
                 let hints = voxsplat::loaders::VolumeHints {
                     dims,
                     dtype: dtype.as_deref().map(str::parse).transpose()?,
                     series: series.clone(),
                     level,
-                    time,
+                    time: time.or((times > 1).then_some(0)),
                     ..Default::default()
                 };
                 match voxsplat::loaders::load_orientation(&file, &hints)? {
@@ -443,38 +454,85 @@ fn run(cli: Cli) -> Result<()> {
 
 fn animate(a: AnimateArgs) -> Result<()> {
     use voxsplat::animate::{render_frame, Animation, Blur};
-    let anim = if a.anim.ends_with(".toml") {
-        let text = voxsplat::loaders::read_text(std::path::Path::new(&a.anim), &a.anim)?;
+    voxsplat::output::ImageFormat::of(std::path::Path::new(&format!("frame.{}", a.format)))?;
+    let composite = a.composite.parse::<Composite>()?;
+    let out = |dir: &std::path::Path| {
+        std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.display().to_string(), source: e })?;
+        // Frames go to the GIF as they are drawn: one frame held at a time.
+        voxsplat::output::GifWriter::create(&dir.join("anim.gif"), 1000 / 12)
+    };
+    let write = |i: u32, img: &voxsplat::ImageF32, gif: &mut voxsplat::output::GifWriter| {
+        voxsplat::output::write_image(img, &a.out_dir.join(format!("frame{i:04}.{}", a.format)))?;
+        gif.push(img)
+    };
+    if a.scene.volume.is_some() {
+        if let Some(flag) = [(a.anim.is_some(), "--anim"), (a.blur.is_some(), "--blur")].iter().find(|f| f.0) {
+            return Err(Error::InvalidArgument(format!(
+                "{} with --volume: its time points are the frames, drawn from one view (the scene flags)",
+                flag.1
+            )));
+        }
+        // As `render` draws a volume (its --kernel default), so that frame t is `render --time t`'s.
+        let mut opts = RenderOptions::default();
+        (opts.composite, opts.kernel) = (composite, Kernel::CrawfisMax);
+        let mut gif = out(&a.out_dir)?;
+        let report = voxsplat_cli::series::play(&a.scene, &opts, |t, img| write(t, img, &mut gif))?;
+        gif.finish()?;
+        eprintln!("{report}\nframes -> {}", a.out_dir.display());
+        return Ok(());
+    }
+    refuse_scene_flags(&a.scene)?;
+    let anim = a.anim.as_deref().unwrap_or("rotating-box");
+    let anim = if anim.ends_with(".toml") {
+        let text = voxsplat::loaders::read_text(std::path::Path::new(anim), anim)?;
         Animation::from_toml(&text)?
     } else {
-        Animation::builtin(&a.anim)?
+        Animation::builtin(anim)?
     };
-    let blur: Blur = a.blur.parse()?;
-    voxsplat::output::ImageFormat::of(std::path::Path::new(&format!("frame.{}", a.format)))?;
+    let blur: Blur = a.blur.as_deref().unwrap_or("splat").parse()?;
     let set = scene::build(&anim.scene)?;
     let grid = *set.grid();
     anim.check_path(&grid, blur)?;
     let mut opts = RenderOptions::default();
-    opts.composite = a.composite.parse::<Composite>()?;
-    opts.order = a.order.parse::<OrderKind>()?;
-    let mut ropts = RendererOptions::default();
-    ropts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
-    let mut r = Renderer::new(&ropts)?;
+    opts.composite = composite;
+    opts.order = a.scene.order.parse::<OrderKind>()?;
+    let mut r = renderer_of(&a.scene)?;
     r.set_scene(set)?;
-    std::fs::create_dir_all(&a.out_dir).map_err(|e| Error::Io { path: a.out_dir.display().to_string(), source: e })?;
+    let mut gif = out(&a.out_dir)?;
     let bar = indicatif::ProgressBar::new(anim.frames as u64);
-    // Frames go to the GIF as they are drawn: one frame held at a time.
-    let mut gif = voxsplat::output::GifWriter::create(&a.out_dir.join("anim.gif"), 1000 / 12)?;
     for i in 0..anim.frames {
         let img = render_frame(&mut r, &anim, &grid, i, blur, &opts)?;
-        voxsplat::output::write_image(&img, &a.out_dir.join(format!("frame{i:04}.{}", a.format)))?;
-        gif.push(&img)?;
+        write(i, &img, &mut gif)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
     gif.finish()?;
+    report_validation(&r)?;
     eprintln!("{} frames -> {}", anim.frames, a.out_dir.display());
     Ok(())
+}
+
+/// An animation sets its own scene and camera: the scene flags (other than --order, --cpu and
+/// --validation) would be ignored.
+fn refuse_scene_flags(s: &SceneArgs) -> Result<()> {
+    let given = [
+        (s.scene != "cube60", "--scene"),
+        (s.eye.is_some() || s.target.is_some() || s.up.is_some(), "--eye, --target and --up"),
+        (s.fov.is_some() || s.ortho.is_some() || s.near.is_some() || s.far.is_some(), "the projection flags"),
+        (s.size != (512, 512), "--size"),
+        (s.view != "auto", "--view"),
+        (s.tf.is_some() || s.shade || s.no_shade, "--tf and shading"),
+        (s.labels.is_some() || !s.channels.is_empty() || !s.channel_tfs.is_empty(), "--labels and --channel"),
+        (s.terrain.is_some() || s.color.is_some() || s.vscale != 1.0 || s.cell != 0.0, "the terrain flags"),
+        (s.series.is_some() || s.level.is_some() || s.time.is_some(), "--series, --level and --time"),
+        (s.dense || s.bisect.is_some() || s.gpu_budget_mib != 1024, "--dense, --bisect and --gpu-budget-mib"),
+    ];
+    match given.iter().find(|g| g.0) {
+        Some((_, flags)) => Err(Error::InvalidArgument(format!(
+            "{flags}: an animation (--anim) sets its own scene and camera; --volume plays a volume's time points"
+        ))),
+        None => Ok(()),
+    }
 }
 
 fn main() -> ExitCode {

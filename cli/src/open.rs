@@ -76,7 +76,8 @@ pub struct SceneArgs {
     /// memory holds.
     #[arg(long, value_parser = parse_level, requires = "volume")]
     pub level: Option<String>,
-    /// An OME-Zarr image's time point to draw (needed when it holds several).
+    /// The time point of a 4-D NIfTI or an OME-Zarr image to draw (needed when it holds several;
+    /// `voxsplat animate --volume` plays them all).
     #[arg(long, requires = "volume")]
     pub time: Option<u32>,
     /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's

@@ -204,6 +204,7 @@ impl SliceReader {
         }
         match time {
             None if l.times > 1 => Err(super::several_times(&what, l.times)),
+            Some(t) if l.times == 1 => Err(bad(&what, format!("--time {t}: the file holds one volume, no time axis"))),
             Some(t) if t >= l.times => {
                 Err(bad(&what, format!("--time {t}: the file holds time points 0 to {}", l.times - 1)))
             }
@@ -436,6 +437,30 @@ impl SliceReader {
         }
         Ok(())
     }
+}
+
+/// The smallest and largest finite values of `path` (of the time point `hints.time` picks), read
+/// a few slices at a time where the format streams; (inf, -inf) when it holds none. A series'
+/// range is the union of its time points' (`bricks::store_range` of it normalises every store
+/// alike: `BrickStore::load_in_range`).
+pub fn value_range(path: &Path, hints: &VolumeHints) -> Result<(f32, f32)> {
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    let mut take = |values: &[f32]| {
+        for &v in values.iter().filter(|v| v.is_finite()) {
+            (lo, hi) = (lo.min(v), hi.max(v));
+        }
+    };
+    match SliceReader::open(path, hints)? {
+        Some(mut reader) => {
+            let (mut slab, step) = (Vec::new(), crate::constants::BRICK_SIDE);
+            for z0 in (0..reader.dims[2]).step_by(step as usize) {
+                reader.read(z0, step.min(reader.dims[2] - z0), &mut slab)?;
+                take(&slab);
+            }
+        }
+        None => take(&super::load_volume(path, hints)?.values),
+    }
+    Ok((lo, hi))
 }
 
 /// The time point of `image` to read: `hints.time`, needed when it holds several.

@@ -1,0 +1,160 @@
+//! A volume's time points played as frames (`voxsplat animate --volume`, `voxsplat lab series`):
+//! the series' value range read once, then each time point built as a store normalised by it and
+//! swapped into the renderer (`Renderer::update_volume`), which rewrites only the bricks that
+//! changed on the device.
+use crate::open::*;
+use std::path::PathBuf;
+use std::time::Instant;
+use voxsplat::bricks::{BrickScene, BrickStore};
+use voxsplat::loaders::VolumeHints;
+use voxsplat::orient::Orientation;
+use voxsplat::{Camera, Error, RenderOptions, Renderer, Result};
+
+/// A volume file's time points, each read as a store normalised by the whole series' range (so
+/// that one transfer function classifies every time point alike and nothing flickers).
+pub struct Series {
+    /// The file.
+    pub path: PathBuf,
+    /// Its time points.
+    pub times: u32,
+    /// The smallest and largest value over every time point.
+    pub range: (f32, f32),
+    hints: VolumeHints,
+    orientation: Option<Orientation>,
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// The median of `v` (0 when empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
+impl Series {
+    /// The --volume of `a` as a series (its value range read first, with a progress bar). Flags
+    /// that describe something other than a scalar volume's bricked store are refused.
+    pub fn open(a: &SceneArgs) -> Result<Self> {
+        let path = a.volume.clone().ok_or_else(|| Error::InvalidArgument("a series needs --volume FILE".into()))?;
+        let refused = [
+            (a.time.is_some(), "--time", "it draws one time point (voxsplat render --time N); animate plays them all"),
+            (a.level.as_deref() == Some("auto"), "--level auto", "it picks a level for one view: give --level N"),
+            (a.dense, "--dense", "a series plays from its bricked store"),
+            (a.positions.is_some(), "--positions", "a series plays from its bricked store, on a uniform grid"),
+            (a.labels.is_some(), "--labels", "a series plays one scalar volume"),
+            (!a.channels.is_empty() || !a.channel_tfs.is_empty(), "--channel", "a series plays one scalar volume"),
+            (a.order != "pbtf", "--order", "a series plays from its bricked store, in PBTF order"),
+        ];
+        if let Some((_, flag, why)) = refused.iter().find(|r| r.0) {
+            return Err(Error::InvalidArgument(format!("{flag} with a series: {why}")));
+        }
+        let times = voxsplat::loaders::time_points(&path)?;
+        if times < 2 {
+            return Err(Error::InvalidArgument(format!(
+                "{}: one volume, no time axis: a series is a 4-D NIfTI or an OME-Zarr image with a time axis \
+                 (voxsplat render draws one volume)",
+                path.display()
+            )));
+        }
+        let mut hints = volume_hints(a)?;
+        if voxsplat::loaders::is_ome_zarr(&path) && hints.level.is_none() {
+            let image = voxsplat::loaders::OmeZarr::open(&path)?;
+            let level = image.default_level();
+            if level > 0 {
+                eprintln!("OME-Zarr level {level} drawn: the finer ones may not fit the host's memory (--level N)");
+            }
+            hints.level = Some(level);
+        }
+        let bar = indicatif::ProgressBar::new(times as u64).with_message("the series' value range");
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for t in 0..times {
+            let (l, h) = voxsplat::loaders::value_range(&path, &VolumeHints { time: Some(t), ..hints.clone() })?;
+            (lo, hi) = (lo.min(l), hi.max(h));
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
+        let range = voxsplat::bricks::store_range(lo, hi);
+        Ok(Self { path, times, range, hints, orientation: orientation_of(a)? })
+    }
+
+    /// Time point `t` as a store normalised by the series' range, placed as the file places it.
+    pub fn store(&self, t: u32) -> Result<BrickStore> {
+        let hints = VolumeHints { time: Some(t), ..self.hints.clone() };
+        let (mut store, _) = BrickStore::load_in_range(&self.path, &hints, self.range)?;
+        if let Some(o) = &self.orientation {
+            store.place(o)?;
+        }
+        Ok(store)
+    }
+
+    /// Time point `t` as a scene classified by --tf, shaded as `render` shades the file.
+    pub fn scene(&self, a: &SceneArgs, t: u32) -> Result<BrickScene> {
+        let store = self.store(t)?;
+        let shading = headlight(a, store.dims, store.spacing, self.orientation);
+        BrickScene::new(store, transfer_function(a)?, shading)
+    }
+
+    /// A renderer (`a`'s backend and budget) holding time point 0, and the camera of --view
+    /// framed on what time point 0 shows.
+    pub fn first(&self, a: &SceneArgs) -> Result<(Renderer, Camera)> {
+        let scene = self.scene(a, 0)?;
+        let content = Content { orientation: self.orientation, bounds: scene.visible_bounds() };
+        let camera = camera_of(a, &scene.store.grid()?, &content)?;
+        let mut r = renderer_of(a)?;
+        r.set_bricks(scene)?;
+        Ok((r, camera))
+    }
+}
+
+/// `voxsplat animate --volume`: every time point drawn with `opts` from one view, each frame
+/// handed to `frame(t, image)`; the timings and what the device was sent, as a report.
+pub fn play(
+    a: &SceneArgs,
+    opts: &RenderOptions,
+    mut frame: impl FnMut(u32, &voxsplat::ImageF32) -> Result<()>,
+) -> Result<String> {
+    let series = Series::open(a)?;
+    let (mut r, cam) = series.first(a)?;
+    let bar = indicatif::ProgressBar::new(series.times as u64);
+    let (mut frames, mut reads, mut swaps) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut changed, mut written, mut whole, mut bricks) = (0usize, 0u64, 0u64, 0usize);
+    for t in 0..series.times {
+        if t > 0 {
+            let t0 = Instant::now();
+            let store = series.store(t)?;
+            reads.push(ms(t0));
+            let t0 = Instant::now();
+            let u = r.update_volume(store)?;
+            swaps.push(ms(t0));
+            (changed, written, whole, bricks) = (changed + u.changed, written + u.uploaded, whole + u.store_bytes, bricks + u.bricks);
+        }
+        let t0 = Instant::now();
+        let img = r.render(&cam, opts)?.image;
+        frames.push(ms(t0));
+        frame(t, &img)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    report_validation(&r)?;
+    let mib = |b: u64| b as f64 / (1 << 20) as f64;
+    let sent = if a.cpu {
+        String::new()
+    } else {
+        format!(
+            "; {:.2} MiB written to the device, where setting each time point afresh would send {:.2} MiB",
+            mib(written),
+            mib(whole)
+        )
+    };
+    Ok(format!(
+        "{} time points (values {:?} over the series): a frame {:.1} ms, reading a time point {:.1} ms, swapping it in \
+         {:.2} ms (medians); {changed} of {bricks} bricks changed{sent}",
+        series.times,
+        series.range,
+        median(frames),
+        median(reads),
+        median(swaps),
+    ))
+}
