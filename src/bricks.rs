@@ -21,8 +21,8 @@ mod build;
 mod gradients;
 mod series;
 pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
-pub use series::Patch;
 pub use gradients::{pack_differences, unpack_differences};
+pub use series::Patch;
 
 /// Voxels along each side of a brick.
 pub const BRICK: u32 = crate::constants::BRICK_SIDE;

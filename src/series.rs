@@ -35,15 +35,19 @@ impl Renderer {
     /// use voxsplat::classify::TransferFunction;
     /// use voxsplat::volume::ScalarVolume;
     /// use voxsplat::{Backend, Renderer, RendererOptions};
-    /// // Two time points of a 32³ volume: a block that moves by one voxel along x.
+    /// // Two time points of a 32³ volume: a block that moves by one voxel along x, beside one
+    /// // that stays.
     /// let at = |t: u32| {
-    ///     let values = (0..32 * 32 * 32u32)
-    ///         .map(|i| if (10 + t..20 + t).contains(&(i % 32)) && (10..20).contains(&(i / 32 % 32)) { 1.0 } else { 0.0 })
-    ///         .collect();
+    ///     let (x, y) = (|i: u32| i % 32, |i: u32| i / 32 % 32);
+    ///     let moving = |i| (10 + t..20 + t).contains(&x(i)) && (10..20).contains(&y(i));
+    ///     let still = |i| x(i) >= 24 && y(i) >= 24;
+    ///     let values = (0..32 * 32 * 32u32).map(|i| if moving(i) || still(i) { 1.0 } else { 0.0 }).collect();
     ///     ScalarVolume { dims: [32; 3], spacing: [1.0; 3], values }
     /// };
-    /// let mut renderer = Renderer::new(&RendererOptions { backend: Backend::Cpu, ..Default::default() })?;
-    /// renderer.set_volume(&at(0), &TransferFunction::default(), None)?;
+    /// let mut options = RendererOptions::default();
+    /// options.backend = Backend::Cpu;
+    /// let mut renderer = Renderer::new(&options)?;
+    /// renderer.set_volume(&at(0), &TransferFunction::preset("ramp")?, None)?;
     /// let range = renderer.volume().unwrap().store.range;
     /// let next = at(1);
     /// let plane = 32 * 32;

@@ -238,7 +238,7 @@ fn a_played_series_draws_what_each_time_point_draws_set_afresh() {
 #[test]
 fn a_series_streamed_through_a_small_budget_plays_the_same_frames() {
     let vol = large_at(0);
-    let store = store_in(&vol, range(&[vol.clone()]));
+    let store = store_in(&vol, range(std::slice::from_ref(&vol)));
     // Below twice the records: they stream, batch by batch.
     let budget = store.records.len() as u64 * 8 - 1;
     let scene = BrickScene::new(store, tf(), None).unwrap();

@@ -160,6 +160,11 @@ pub(crate) enum Study {
     /// roofline, raster rates and scaling: CSV files and SVG charts in --out-dir, and with
     /// --results the results page (scripts/results.sh runs it after the other studies).
     Matrix(MatrixArgs),
+    /// A series (a 4-D NIfTI, or an OME-Zarr image with a time axis) played: each time point
+    /// swapped into the renderer (`update_volume`) against set afresh (`set_bricks`), with the
+    /// frames after each; the scene flags as `render` takes them (scripts/make_series.py writes
+    /// series from the shared bonsai).
+    Series(Box<SceneArgs>),
     /// How fast a volume file loads: the dense volume (`load_volume`) and the bricked store
     /// streamed from it (`BrickStore::load`), medians of --repeat reads, in MB/s of the samples as
     /// the file stores them (scripts/dicom_bench.sh sets a DICOM series beside dcm2niix).
@@ -201,6 +206,10 @@ pub(crate) struct MatrixArgs {
 /// Runs one study.
 pub(crate) fn run(study: Study) -> Result<()> {
     match study {
+        Study::Series(a) => {
+            print!("{}", voxsplat_cli::series::study(&a)?);
+            Ok(())
+        }
         Study::Load { file, repeat, sample_bytes, series } => {
             if repeat < 1 {
                 return Err(Error::InvalidArgument("--repeat must be at least 1".into()));

@@ -102,7 +102,7 @@ enum Command {
         time: Option<u32>,
     },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
-    Animate(AnimateArgs),
+    Animate(Box<AnimateArgs>),
     /// Make a test volume: a file upsampled by an integer factor (e.g. a 512³ bonsai from the 256³
     /// one), a procedural field of side N (e.g. 1024³), or a T1 MRI head phantom of side N (placed
     /// in RAS); written as 8-bit NRRD slice by slice, so it may be larger than memory.
@@ -452,7 +452,7 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
-fn animate(a: AnimateArgs) -> Result<()> {
+fn animate(a: Box<AnimateArgs>) -> Result<()> {
     use voxsplat::animate::{render_frame, Animation, Blur};
     voxsplat::output::ImageFormat::of(std::path::Path::new(&format!("frame.{}", a.format)))?;
     let composite = a.composite.parse::<Composite>()?;

@@ -128,7 +128,8 @@ pub fn play(
             let t0 = Instant::now();
             let u = r.update_volume(store)?;
             swaps.push(ms(t0));
-            (changed, written, whole, bricks) = (changed + u.changed, written + u.uploaded, whole + u.store_bytes, bricks + u.bricks);
+            (changed, written, whole, bricks) =
+                (changed + u.changed, written + u.uploaded, whole + u.store_bytes, bricks + u.bricks);
         }
         let t0 = Instant::now();
         let img = r.render(&cam, opts)?.image;
@@ -150,11 +151,89 @@ pub fn play(
     };
     Ok(format!(
         "{} time points (values {:?} over the series): a frame {:.1} ms, reading a time point {:.1} ms, swapping it in \
-         {:.2} ms (medians); {changed} of {bricks} bricks changed{sent}",
+         {:.2} ms (medians); per time point {:.0} of {:.0} bricks changed (means){sent}",
         series.times,
         series.range,
         median(frames),
         median(reads),
         median(swaps),
+        changed as f64 / (series.times - 1) as f64,
+        bricks as f64 / (series.times - 1) as f64,
+    ))
+}
+
+/// `voxsplat lab series`: per time point after the first, swapping it into a renderer that holds
+/// the last (`update_volume`) against setting it afresh on another (`set_bricks`, as a program
+/// without `update_volume` would), each followed by two frames (the first derives what the new
+/// values need: levels of detail, gradients); alternated time point by time point so drift falls
+/// on both. Reading the time point is left out of both; making the scene (its k-d tree) is in
+/// both. A markdown table of medians.
+pub fn study(a: &SceneArgs) -> Result<String> {
+    let series = Series::open(a)?;
+    let (mut played, cam) = series.first(a)?;
+    let mut fresh = renderer_of(a)?;
+    let mut opts = RenderOptions::default();
+    opts.kernel = voxsplat::Kernel::CrawfisMax;
+    fresh.set_bricks(series.scene(a, 0)?)?;
+    played.render(&cam, &opts)?;
+    fresh.render(&cam, &opts)?;
+    let mut rows = [[(); 3].map(|_| Vec::new()), [(); 3].map(|_| Vec::new())];
+    let (mut written, mut whole, mut changed, mut bricks) = (0u64, 0u64, 0usize, 0usize);
+    let bar = indicatif::ProgressBar::new(series.times as u64 - 1);
+    for t in 1..series.times {
+        let store = series.store(t)?;
+        let t0 = Instant::now();
+        let u = played.update_volume(store)?;
+        rows[0][0].push(ms(t0));
+        (written, whole, changed, bricks) =
+            (written + u.uploaded, whole + u.store_bytes, changed + u.changed, bricks + u.bricks);
+        let store = series.store(t)?;
+        let t0 = Instant::now();
+        let shading = headlight(a, store.dims, store.spacing, series.orientation);
+        fresh.set_bricks(BrickScene::new(store, transfer_function(a)?, shading)?)?;
+        rows[1][0].push(ms(t0));
+        for (r, row) in [&mut played, &mut fresh].into_iter().zip(rows.iter_mut()) {
+            for times in &mut row[1..] {
+                let t0 = Instant::now();
+                r.render(&cam, &opts)?;
+                times.push(ms(t0));
+            }
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    report_validation(&played)?;
+    report_validation(&fresh)?;
+    let [p, f] = rows.map(|r| r.map(median));
+    let mib = |b: u64| b as f64 / (1 << 20) as f64;
+    let n = series.times - 1;
+    Ok(format!(
+        "{} time points of {}, {}x{}, {}: medians over the {n} after the first\n\n\
+         | | swap in (ms) | first frame (ms) | next frame (ms) | swap + first frame (ms) | MiB sent per time point |\n\
+         |---|---:|---:|---:|---:|---:|\n\
+         | update_volume | {:.2} | {:.1} | {:.1} | {:.1} | {:.3} |\n\
+         | set_bricks afresh | {:.2} | {:.1} | {:.1} | {:.1} | {:.3} |\n\n\
+         played / afresh: first frame {:.2}x, next frame {:.2}x, swap + first frame {:.2}x; per time point {:.0} of \
+         {:.0} bricks changed (means)\n",
+        series.times,
+        series.path.display(),
+        a.size.0,
+        a.size.1,
+        played.device_name(),
+        p[0],
+        p[1],
+        p[2],
+        p[0] + p[1],
+        mib(written) / n as f64,
+        f[0],
+        f[1],
+        f[2],
+        f[0] + f[1],
+        mib(whole) / n as f64,
+        p[1] / f[1],
+        p[2] / f[2],
+        (p[0] + p[1]) / (f[0] + f[1]),
+        changed as f64 / n as f64,
+        bricks as f64 / n as f64,
     ))
 }
