@@ -9,7 +9,9 @@
 //! Keys: o order, c compositing, r raster, l levels of detail, [ ] opacity, p clip plane through the
 //! centre facing the eye, m mode (composite, mip, minip, average, xray, iso), , . the isosurface's
 //! value down or up, b the bounding box and a slice plane drawn through the volume by depth (the
-//! host's own geometry: `viewer_mesh.rs`), 9 0 the slice plane down or up, s save
+//! host's own geometry: `viewer_mesh.rs`), 9 0 the slice plane down or up, t T the next or the
+//! previous time point of a series (a 4-D NIfTI or an OME-Zarr image with a time axis, opened
+//! without --time: `Renderer::update_volume` swaps each in), s save
 //! `viewer-tf.toml` and print the matching `render` command, q or Esc quit. The title shows the frame time and the modes. While a button is held, frames are drawn at
 //! `--interactive-scale` (0.5 by default) and stretched on the device; full size when let go.
 //!
@@ -410,6 +412,8 @@ struct Viewer {
     indices: [usize; 3],
     tf: Option<voxsplat::classify::TransferFunction>,
     raw_range: (f32, f32),
+    /// A series' time points, and the one shown.
+    series: Option<(voxsplat_cli::series::Series, u32)>,
     clip_offset: Option<(Vec3, f32)>,
     frame: u32,
     times: Vec<f64>,
@@ -457,6 +461,7 @@ impl Viewer {
             indices,
             tf: None,
             raw_range: (0.0, 1.0),
+            series: None,
             clip_offset: None,
             frame: 0,
             times: Vec::new(),
@@ -480,7 +485,19 @@ impl Viewer {
         // first); the queue is used from this thread only, never while voxsplat submits.
         let ctx = unsafe { Context::from_host(host.handles()) }?;
         let mut renderer = Renderer::with_context(ctx.clone())?;
-        let (bricked, set, content) = open(&self.args.scene, self.options.order != OrderKind::Pbtf)?;
+        let a = &self.args.scene;
+        let series = a.volume.as_ref().filter(|_| a.time.is_none()).map(|p| voxsplat::loaders::time_points(p));
+        let (bricked, set, content) = if series.transpose()?.is_some_and(|t| t > 1) {
+            // A series: its first time point, normalised by the whole series' range.
+            let s = voxsplat_cli::series::Series::open(a)?;
+            let scene = s.scene(a, 0)?;
+            let content = voxsplat_cli::open::Content { orientation: s.orientation(), bounds: scene.visible_bounds() };
+            let set = voxsplat::SplatSet::empty(scene.store.grid()?)?;
+            self.series = Some((s, 0));
+            (Some(scene), set, content)
+        } else {
+            open(a, self.options.order != OrderKind::Pbtf)?
+        };
         let grid = *set.grid();
         match bricked {
             Some(b) => {
@@ -704,8 +721,12 @@ impl Viewer {
             None if o.mode != voxsplat::Mode::Composite => format!(", {}", o.mode),
             None => String::new(),
         };
+        let time = match &self.series {
+            Some((s, at)) => format!(", t {at}/{}", s.times - 1),
+            None => String::new(),
+        };
         window.set_title(&format!(
-            "voxsplat: {ms:.1} ms ({:.1} fps){mode}, {}, {:?}, {}, lod {:?}{clip} {}",
+            "voxsplat: {ms:.1} ms ({:.1} fps){time}{mode}, {}, {:?}, {}, lod {:?}{clip} {}",
             1e3 / ms.max(1e-3),
             ORDERS[self.indices[0]],
             o.composite,
@@ -772,6 +793,15 @@ impl Viewer {
                     self.message = "the slice plane: b to show it first".into();
                 }
             }
+            "t" | "T" => match (&mut self.series, &mut self.renderer) {
+                (Some((series, at)), Some(renderer)) => {
+                    let n = series.times;
+                    *at = if key == "t" { (*at + 1) % n } else { (*at + n - 1) % n };
+                    let u = renderer.update_volume(series.store(*at)?)?;
+                    self.message = format!("time point {} of 0..{}, {} bricks changed", *at, n - 1, u.changed);
+                }
+                _ => self.message = "time points: open a 4-D NIfTI or an OME-Zarr image with a time axis".into(),
+            },
             "s" => self.save()?,
             _ => {}
         }

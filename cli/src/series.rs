@@ -79,6 +79,11 @@ impl Series {
         Ok(Self { path, times, range, hints, orientation: orientation_of(a)? })
     }
 
+    /// The file's placement in patient space (`None`: no anatomical frame).
+    pub fn orientation(&self) -> Option<Orientation> {
+        self.orientation
+    }
+
     /// Time point `t` as a store normalised by the series' range, placed as the file places it.
     pub fn store(&self, t: u32) -> Result<BrickStore> {
         let hints = VolumeHints { time: Some(t), ..self.hints.clone() };

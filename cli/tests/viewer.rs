@@ -157,3 +157,33 @@ fn every_key_draws_validation_clean() {
         }
     }
 }
+
+/// A series in the viewer (issue 47 item 4): `t` swaps in the next time point
+/// (`Renderer::update_volume`), and the frame after three presses is `render --time 3`'s.
+#[test]
+fn the_viewer_steps_through_a_series() {
+    let dir = tmp_in("viewer", "series");
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/write_series.py");
+    let out = Command::new("python3").arg(script).arg(&dir).output().expect("python3");
+    assert!(out.status.success(), "write_series.py: {}", String::from_utf8_lossy(&out.stderr));
+    let volume = dir.join("series.nii.gz");
+    let (shot, reference) = (dir.join("shot.png"), dir.join("ref.png"));
+    let view = ["--size", "96x80", "--eye", "60,50,80", "--target", "0,0,0"];
+    let mut run = Command::new("xvfb-run");
+    run.args(["-a", "-s", "-screen 0 640x480x24"]).arg(viewer()).arg("--volume").arg(&volume).args(view);
+    run.args(["--frames", "4", "--orbit", "0", "--keys", "ttt", "--validation"]).arg("--screenshot").arg(&shot);
+    let out = run.output().expect("xvfb-run");
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "the viewer failed:\n{log}");
+    assert!(log.contains("frame 2: key t time point 3 of 0..5"), "{log}");
+    let mut args = vec!["render", "--volume", volume.to_str().unwrap(), "--time", "3", "--background", "0,0,0"];
+    args.extend_from_slice(&view);
+    args.extend_from_slice(&["--validation", "--out", reference.to_str().unwrap()]);
+    let out = voxsplat(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (a, b) = (rgba(&shot), rgba(&reference));
+    assert!(b.pixels().filter(|p| p[0] as u32 + p[1] as u32 + p[2] as u32 > 30).count() > 300, "something drawn");
+    let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    assert!(worst <= 1, "the screenshot differs from render --time 3 by {worst}/255");
+}
