@@ -268,6 +268,10 @@ pub const MAX_TIME_POINTS: u64 = 1 << 16;
 pub fn load_channels(path: &Path, hints: &VolumeHints) -> Result<Vec<ScalarVolume>> {
     let name = lower_name(path);
     let what = path.display().to_string();
+    if (name.ends_with(".nrrd") || name.ends_with(".nhdr")) && SliceReader::nrrd_times(path)? > 1 {
+        // One time point of a series.
+        return Ok(vec![load_volume(path, hints)?]);
+    }
     if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
         let mut channels = nrrd_channels_from_bytes(&read_bounded(path, MAX_INFLATED, &what)?, path.parent(), &what)?;
         if let Some(s) = hints.spacing {
@@ -372,13 +376,17 @@ pub struct VolumeHints {
     pub time: Option<u32>,
 }
 
-/// The time points `path` holds: a 4-D NIfTI's fourth axis when it is time (`NiftiLayout`), an
-/// OME-Zarr image's time axis; 1 for any other file. Each is read as a volume with
+/// The time points `path` holds: a 4-D NIfTI's fourth axis when it is time (`NiftiLayout`), a 4-D
+/// NRRD's last axis when its `kinds` says `time`, an OME-Zarr image's time axis; 1 for any other
+/// file. Each is read as a volume with
 /// `VolumeHints::time` (`animate` plays them; `Renderer::update_volume` swaps them in).
 pub fn time_points(path: &Path) -> Result<u32> {
     let name = lower_name(path);
     if name.ends_with(".nii") || name.ends_with(".nii.gz") {
         return SliceReader::nifti_times(path);
+    }
+    if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
+        return SliceReader::nrrd_times(path);
     }
     if is_ome_zarr(path) {
         return Ok(OmeZarr::open(path)?.times);
@@ -420,6 +428,9 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
         OmeZarr::open(path)?;
         return Ok(None);
     }
+    // A series' time points share the header's placement.
+    let first = VolumeHints { time: Some(0), ..hints.clone() };
+    let hints = if hints.time.is_none() && time_points(path)? > 1 { &first } else { hints };
     let o = match SliceReader::open(path, hints)? {
         Some(reader) => reader.orientation,
         // Not streamed: an .npy (no frame), or an NRRD in another encoding (its header alone).

@@ -319,3 +319,43 @@ fn a_4d_nifti_is_read_one_time_point_at_a_time() {
     assert!(err.contains("--time 1") && err.contains("no time axis"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_4d_nrrd_with_a_time_axis_is_read_one_time_point_at_a_time() {
+    use voxsplat::loaders::{load_channels, load_volume, time_points, VolumeHints};
+    let dir = std::env::temp_dir().join(format!("voxsplat-series-nrrd-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let n = 5 * 4 * 3;
+    let data: Vec<u8> = (0..4 * n).map(|i| (i * 3 % 256) as u8).collect();
+    let file = |kinds: &str, sizes: &str, bytes: &[u8]| {
+        let kinds = if kinds.is_empty() { String::new() } else { format!("kinds: {kinds}\n") };
+        let mut f =
+            format!("NRRD0004\ntype: uint8\ndimension: 4\nsizes: {sizes}\n{kinds}encoding: raw\n\n").into_bytes();
+        f.extend_from_slice(bytes);
+        f
+    };
+    let at = |t| VolumeHints { time: Some(t), ..Default::default() };
+    let path = dir.join("t.nrrd");
+    std::fs::write(&path, file("space space space time", "5 4 3 4", &data)).unwrap();
+    assert_eq!(time_points(&path).unwrap(), 4);
+    for t in 0..4u32 {
+        let want: Vec<f32> = data[t as usize * n..(t as usize + 1) * n].iter().map(|&b| b as f32).collect();
+        assert_eq!(load_volume(&path, &at(t)).unwrap().values, want, "time point {t}");
+        assert_eq!(load_channels(&path, &at(t)).unwrap()[0].values, want);
+    }
+    let err = load_volume(&path, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(err.contains("holds 4 time points"), "{err}");
+    // Truncated inside the last time point: the earlier ones read, the last is refused.
+    std::fs::write(&path, file("space space space time", "5 4 3 4", &data[..4 * n - 1])).unwrap();
+    load_volume(&path, &at(2)).unwrap();
+    let err = load_volume(&path, &at(3)).unwrap_err().to_string();
+    assert!(err.contains("truncated"), "{err}");
+    // Time on the fastest axis interleaves the time points: refused by name.
+    std::fs::write(&path, file("time space space space", "4 5 4 3", &data)).unwrap();
+    let err = load_volume(&path, &at(0)).unwrap_err().to_string();
+    assert!(err.contains("time on axis 0") && err.contains("last"), "{err}");
+    // Without kinds a 4-D file keeps the channel reading: four on the first axis are channels.
+    std::fs::write(&path, file("", "4 5 4 3", &data)).unwrap();
+    assert_eq!((time_points(&path).unwrap(), load_channels(&path, &Default::default()).unwrap().len()), (1, 4));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

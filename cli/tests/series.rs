@@ -1,12 +1,13 @@
-//! Time series (issue 47, item 4) written by others: a 4-D NIfTI from nibabel and an OME-Zarr
-//! image with a time axis from the ome-zarr package (tests/data/write_series.py). `animate
+//! Time series (issue 47, item 4) written by others: a 4-D NIfTI from nibabel, a 4-D NRRD from
+//! pynrrd and an OME-Zarr image with a time axis from the ome-zarr package
+//! (tests/data/write_series.py). `animate
 //! --volume` plays every time point, each frame the one `render --time T` draws from the same
 //! view, while the device is sent only what changed; flags that cannot apply are refused.
 mod cmd;
 use cmd::{refused, voxsplat};
 use std::path::{Path, PathBuf};
 
-/// The two series files, written once per test process (its tests share them).
+/// The series files, written once per test process (its tests share them).
 fn series() -> PathBuf {
     static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
     DIR.get_or_init(|| {
@@ -39,7 +40,7 @@ fn png(p: &Path) -> image::RgbaImage {
 fn animate_plays_each_time_point_as_render_draws_it() {
     let dir = series();
     let view = ["--size", "72x64", "--eye", "60,50,80", "--target", "0,0,0", "--validation"];
-    for (name, tag) in [("series.nii.gz", "nii"), ("series.zarr", "zarr")] {
+    for (name, tag) in [("series.nii.gz", "nii"), ("series.nrrd", "nrrd"), ("series.zarr", "zarr")] {
         let file = dir.join(name);
         let file = file.to_str().unwrap();
         assert!(ok(&["info", file]).contains("6 time points"), "{name}");

@@ -1,7 +1,7 @@
 //! NRRD headers, and the placement in patient space that NIfTI and NRRD headers give.
 use super::{
     bad, check_finite, check_spacing, decode, gunzip, read_bounded, voxel_count_within, DType, ScalarVolume,
-    MAX_INFLATED, MAX_VOXELS,
+    MAX_INFLATED, MAX_TIME_POINTS, MAX_VOXELS,
 };
 use crate::error::{Error, Result};
 use crate::orient::Orientation;
@@ -26,6 +26,27 @@ pub(super) struct NrrdHeader {
     /// The channels are the fastest axis (interleaved per voxel), else the slowest (one volume
     /// after another).
     pub channel_first: bool,
+    /// Time points, one volume after another (a 4-D file whose last axis `kinds` marks `time`): 1
+    /// otherwise.
+    pub times: u32,
+}
+
+/// The time axis of a 4-D NRRD: the one `kinds` marks `time` when the other three are spatial.
+/// Only the last (slowest) may be: each time point is then one block of the data.
+fn time_axis(kinds: Option<&[String]>, what: &str) -> Result<Option<usize>> {
+    let Some(k) = kinds.filter(|k| k.len() == 4) else { return Ok(None) };
+    let time: Vec<usize> = (0..4).filter(|&a| k[a] == "time").collect();
+    if time.len() != 1 || k.iter().any(|s| !matches!(s.as_str(), "domain" | "space" | "time")) {
+        return Ok(None);
+    }
+    if time[0] != 3 {
+        return Err(Error::Unsupported(format!(
+            "{what}: kinds '{}': time on axis {}; a series is read with time as its last (slowest) axis",
+            k.join(" "),
+            time[0]
+        )));
+    }
+    Ok(Some(3))
 }
 
 /// Which axis of a 4-D NRRD holds its channels: the one its `kinds` marks as not spatial (neither
@@ -150,14 +171,24 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
     if sizes.is_empty() || sizes.len() > 4 || dimension.map(|d| d as usize != sizes.len()).unwrap_or(false) {
         return Err(bad(what, "only 1 to 3 dimensional NRRD volumes, or 4 with a channel axis, are supported"));
     }
-    // A 4-D file: its channel axis out of the sizes and the spacings.
-    let (mut channels, mut channel_first) = (1u64, false);
+    // A 4-D file: its time or channel axis out of the sizes and the spacings.
+    let (mut channels, mut channel_first, mut times) = (1u64, false, 1u64);
     let mut spacings = spacings.unwrap_or_default();
     if sizes.len() == 4 {
-        let axis = channel_axis(&sizes, kinds.as_deref(), what)?;
-        (channels, channel_first) = (sizes.remove(axis), axis == 0);
-        if spacings.len() == 4 {
-            spacings.remove(axis);
+        if let Some(axis) = time_axis(kinds.as_deref(), what)? {
+            times = sizes.remove(axis);
+            if !(1..=MAX_TIME_POINTS).contains(&times) {
+                return Err(bad(what, format!("{times} time points: a series holds 1 to {MAX_TIME_POINTS}")));
+            }
+            if spacings.len() == 4 {
+                spacings.remove(axis);
+            }
+        } else {
+            let axis = channel_axis(&sizes, kinds.as_deref(), what)?;
+            (channels, channel_first) = (sizes.remove(axis), axis == 0);
+            if spacings.len() == 4 {
+                spacings.remove(axis);
+            }
         }
     }
     for (i, t) in spacings.iter().take(3).enumerate() {
@@ -190,6 +221,7 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
         orientation,
         channels: channels as u32,
         channel_first,
+        times: times as u32,
     })
 }
 
@@ -213,6 +245,10 @@ pub fn nrrd_channels_from_bytes(bytes: &[u8], dir: Option<&Path>, what: &str) ->
 /// An NRRD's header and samples (every channel's, in the file's order), decoded and checked.
 pub(super) fn nrrd_samples(bytes: &[u8], dir: Option<&Path>, what: &str) -> Result<(NrrdHeader, Vec<f32>)> {
     let h = nrrd_header(bytes, what, MAX_VOXELS)?;
+    if h.times > 1 {
+        // A series is read a time point at a time (`SliceReader::nrrd_at`).
+        return Err(super::several_times(what, h.times));
+    }
     let (dtype, n, endian_big, data_start) = (h.dtype, h.voxels * h.channels as u64, h.big_endian, h.data_start);
     let enc = Some(h.encoding.clone());
     let need = n * dtype.size() as u64;

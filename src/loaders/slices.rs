@@ -119,13 +119,14 @@ impl SliceReader {
             return Self::zarr(path, &image, hints, 0).map(Some);
         }
         let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
-        if hints.level.is_some() || hints.time.is_some() && !nifti {
+        let nrrd = name.ends_with(".nrrd") || name.ends_with(".nhdr");
+        if hints.level.is_some() || hints.time.is_some() && !(nifti || nrrd) {
             return Err(super::bad(
                 &path.display().to_string(),
                 if hints.level.is_some() {
                     "--level picks a level of an OME-Zarr image; this is none"
                 } else {
-                    "--time picks a time point of a 4-D NIfTI or an OME-Zarr image; this is neither"
+                    "--time picks a time point of a 4-D NIfTI or NRRD or an OME-Zarr image; this is none"
                 },
             ));
         }
@@ -144,8 +145,8 @@ impl SliceReader {
             Ok(Some(Self::stack(super::stacks::Stack::folder(path)?)))
         } else if name.ends_with(".tif") || name.ends_with(".tiff") {
             Ok(Some(Self::stack(super::stacks::Stack::tiff(path)?)))
-        } else if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
-            Self::nrrd(path)
+        } else if nrrd {
+            Self::nrrd_at(path, hints.time)
         } else if nifti {
             Self::nifti_at(path, hints.time).map(Some)
         } else if name.ends_with(".npy") {
@@ -158,14 +159,41 @@ impl SliceReader {
     /// `path` when it is an NRRD with raw or gzip data, attached or detached; `None` for any other
     /// encoding.
     pub fn nrrd(path: &Path) -> Result<Option<Self>> {
-        let what = path.display().to_string();
+        Self::nrrd_at(path, None)
+    }
+
+    /// An NRRD's header (its first MiB read) and the open file.
+    fn nrrd_head(path: &Path) -> Result<(super::nrrd::NrrdHeader, std::fs::File)> {
         let mut file = std::fs::File::open(path).map_err(io_err(path))?;
         let mut head = Vec::new();
         (&mut file).take(1 << 20).read_to_end(&mut head).map_err(io_err(path))?;
-        let h = nrrd_header(&head, &what, MAX_STREAMED_VOXELS)?;
+        Ok((nrrd_header(&head, &path.display().to_string(), MAX_STREAMED_VOXELS)?, file))
+    }
+
+    /// The time points an NRRD holds (1 unless it is a 4-D series).
+    pub fn nrrd_times(path: &Path) -> Result<u32> {
+        Ok(Self::nrrd_head(path)?.0.times)
+    }
+
+    /// `nrrd`, of time point `time` of a 4-D series (`None`: a file of one time point).
+    pub fn nrrd_at(path: &Path, time: Option<u32>) -> Result<Option<Self>> {
+        let what = path.display().to_string();
+        let (h, file) = Self::nrrd_head(path)?;
         if h.channels > 1 {
             return Err(super::several_channels(&what, h.channels));
         }
+        let t = match time {
+            None if h.times > 1 => return Err(super::several_times(&what, h.times)),
+            Some(t) if h.times == 1 => {
+                return Err(bad(&what, format!("--time {t}: the file holds one volume, no time axis")))
+            }
+            Some(t) if t >= h.times => {
+                return Err(bad(&what, format!("--time {t}: the file holds time points 0 to {}", h.times - 1)))
+            }
+            t => t.unwrap_or(0) as u64,
+        };
+        // Time point t starts t volumes into the data.
+        let skip = t * h.voxels * h.dtype.size() as u64;
         let gz = match h.encoding.as_str() {
             "raw" => false,
             "gzip" | "gz" => true,
@@ -182,10 +210,10 @@ impl SliceReader {
         let orientation = h.orientation;
         if gz {
             // The inflated data starts at its first byte.
-            let layout = Layout { offset: 0, dims, spacing, dtype, big_endian, orientation };
+            let layout = Layout { offset: skip, dims, spacing, dtype, big_endian, orientation };
             return Ok(Some(Self::new(Source::gzip(&data_path, offset)?, layout, what)));
         }
-        let layout = Layout { offset, dims, spacing, dtype, big_endian, orientation };
+        let layout = Layout { offset: offset + skip, dims, spacing, dtype, big_endian, orientation };
         Self::from_file(file, &data_path, layout, what).map(Some)
     }
 

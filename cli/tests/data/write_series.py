@@ -1,6 +1,6 @@
 """Writes a time series the way others write one (cli/tests/series.rs): a 4-D NIfTI with nibabel
-(its fourth axis in seconds) and an OME-Zarr image with a t, z, y, x axis with the ome-zarr package,
-of the same voxels: a still blob and a bright ball moving along x, every time point spanning the
+(its fourth axis in seconds), a 4-D NRRD with pynrrd (kinds space space space time, gzip) and an
+OME-Zarr image with a t, z, y, x axis with the ome-zarr package, of the same voxels: a still blob and a bright ball moving along x, every time point spanning the
 same values (0 to 250).
 
     python3 write_series.py OUT
@@ -8,6 +8,7 @@ same values (0 to 250).
 import sys
 
 import nibabel
+import nrrd
 import numpy as np
 import zarr
 from ome_zarr.format import FormatV05
@@ -31,6 +32,7 @@ def main(out):
     img = nibabel.Nifti1Image(xyzt, np.eye(4))
     img.header.set_xyzt_units("mm", "sec")
     nibabel.save(img, f"{out}/series.nii.gz")
+    nrrd.write(f"{out}/series.nrrd", xyzt, {"kinds": ["space", "space", "space", "time"], "encoding": "gzip"})
     tzyx = np.ascontiguousarray(xyzt.transpose(3, 2, 1, 0))
     root = zarr.group(store=parse_url(f"{out}/series.zarr", mode="w", fmt=FormatV05()).store)
     write_image(image=tzyx, group=root, axes="tzyx", fmt=FormatV05(), scale_factors=[],
