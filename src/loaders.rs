@@ -15,6 +15,7 @@ mod nifti1;
 mod npy;
 mod nrrd;
 mod positions;
+mod sequence;
 mod slices;
 mod stacks;
 mod zarr;
@@ -28,6 +29,7 @@ pub use npy::{npy_from_bytes, npy_shape};
 pub use nrrd::nrrd_channels_from_bytes;
 use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
+pub use sequence::{files as series_files, is_pattern};
 pub use slices::{value_range, SliceReader, MAX_STREAMED_VOXELS};
 pub use stacks::is_stack;
 pub use zarr::{
@@ -266,6 +268,9 @@ pub const MAX_TIME_POINTS: u64 = 1 << 16;
 /// axis of at most 4 samples; interleaved per voxel or one volume after another), each as the
 /// volume `load_volume` reads; any other file is one channel.
 pub fn load_channels(path: &Path, hints: &VolumeHints) -> Result<Vec<ScalarVolume>> {
+    if let Some((file, hints)) = sequence::member(path, hints)? {
+        return load_channels(&file, &hints);
+    }
     let name = lower_name(path);
     let what = path.display().to_string();
     if (name.ends_with(".nrrd") || name.ends_with(".nhdr")) && SliceReader::nrrd_times(path)? > 1 {
@@ -377,10 +382,13 @@ pub struct VolumeHints {
 }
 
 /// The time points `path` holds: a 4-D NIfTI's fourth axis when it is time (`NiftiLayout`), a 4-D
-/// NRRD's last axis when its `kinds` says `time`, an OME-Zarr image's time axis; 1 for any other
-/// file. Each is read as a volume with
+/// NRRD's last axis when its `kinds` says `time`, an OME-Zarr image's time axis, the files a
+/// pattern matches (`is_pattern`: `scan_*.nii.gz`, one time point each); 1 for any other file. Each is read as a volume with
 /// `VolumeHints::time` (`animate` plays them; `Renderer::update_volume` swaps them in).
 pub fn time_points(path: &Path) -> Result<u32> {
+    if is_pattern(path) {
+        return Ok(sequence::files(path)?.len() as u32);
+    }
     let name = lower_name(path);
     if name.ends_with(".nii") || name.ends_with(".nii.gz") {
         return SliceReader::nifti_times(path);
@@ -416,6 +424,12 @@ pub(crate) fn raw_layout(path: &Path, hints: &VolumeHints, what: &str) -> Result
 /// space, NIfTI with both codes 0). An affine whose axes meet within `orient::MAX_SHEAR` of
 /// parallel is `Error::Unsupported`; a less sheared one is placed (`Orientation::grid`).
 pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate::orient::Orientation>> {
+    // A series' time points share the header's placement.
+    let first = VolumeHints { time: Some(0), ..hints.clone() };
+    let hints = if hints.time.is_none() && time_points(path)? > 1 { &first } else { hints };
+    if let Some((file, hints)) = sequence::member(path, hints)? {
+        return load_orientation(&file, &hints);
+    }
     let what = path.display().to_string();
     let name = lower_name(path);
     // A NIfTI of several channels places them all as its first.
@@ -428,9 +442,6 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
         OmeZarr::open(path)?;
         return Ok(None);
     }
-    // A series' time points share the header's placement.
-    let first = VolumeHints { time: Some(0), ..hints.clone() };
-    let hints = if hints.time.is_none() && time_points(path)? > 1 { &first } else { hints };
     let o = match SliceReader::open(path, hints)? {
         Some(reader) => reader.orientation,
         // Not streamed: an .npy (no frame), or an NRRD in another encoding (its header alone).
@@ -464,6 +475,9 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
 /// # Ok::<(), voxsplat::Error>(())
 /// ```
 pub fn load_volume(path: &Path, hints: &VolumeHints) -> Result<ScalarVolume> {
+    if let Some((file, hints)) = sequence::member(path, hints)? {
+        return load_volume(&file, &hints);
+    }
     let what = path.display().to_string();
     let name = lower_name(path);
     let mut v = if let Some(mut reader) = SliceReader::open(path, hints)? {

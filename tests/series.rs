@@ -359,3 +359,38 @@ fn a_4d_nrrd_with_a_time_axis_is_read_one_time_point_at_a_time() {
     assert_eq!((time_points(&path).unwrap(), load_channels(&path, &Default::default()).unwrap().len()), (1, 4));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_pattern_names_a_series_of_files_ordered_by_number() {
+    use voxsplat::loaders::{is_pattern, load_volume, series_files, time_points, VolumeHints};
+    let dir = std::env::temp_dir().join(format!("voxsplat-series-files-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dims = [6, 5, 4];
+    let frame = |t: u32| (0..120u32).map(|i| ((i + 17 * t) % 200) as u8).collect::<Vec<u8>>();
+    for (name, t) in [("scan_2.nii", 0), ("scan_10.nii", 1), ("scan_11.nii", 2), ("notes_1.txt", 9)] {
+        std::fs::write(dir.join(name), common::nifti(dims, &frame(t), None, None)).unwrap();
+    }
+    let pattern = dir.join("scan_*.nii");
+    assert!(is_pattern(&pattern) && !is_pattern(&dir.join("scan_2.nii")));
+    let names: Vec<String> =
+        series_files(&pattern).unwrap().iter().map(|p| p.file_name().unwrap().to_string_lossy().into()).collect();
+    assert_eq!(names, ["scan_2.nii", "scan_10.nii", "scan_11.nii"], "by number, not by name");
+    assert_eq!(time_points(&pattern).unwrap(), 3);
+    for t in 0..3 {
+        let v = load_volume(&pattern, &VolumeHints { time: Some(t), ..Default::default() }).unwrap();
+        assert_eq!(v.values, frame(t).iter().map(|&b| b as f32).collect::<Vec<_>>(), "time point {t}");
+    }
+    assert_eq!(time_points(&dir.join("scan_1?.nii")).unwrap(), 2);
+    let err = load_volume(&pattern, &Default::default()).unwrap_err().to_string();
+    assert!(err.contains("holds 3 time points"), "{err}");
+    let err = load_volume(&pattern, &VolumeHints { time: Some(3), ..Default::default() }).unwrap_err().to_string();
+    assert!(err.contains("0 to 2"), "{err}");
+    let err = time_points(&dir.join("none_*.nii")).unwrap_err().to_string();
+    assert!(err.contains("matches no file"), "{err}");
+    let err = time_points(&dir.join("*").join("scan_*.nii")).unwrap_err().to_string();
+    assert!(err.contains("not folders"), "{err}");
+    std::fs::write(dir.join("scan_010.nii"), common::nifti(dims, &frame(3), None, None)).unwrap();
+    let err = time_points(&pattern).unwrap_err().to_string();
+    assert!(err.contains("share number 10"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

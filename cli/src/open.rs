@@ -51,7 +51,8 @@ pub struct SceneArgs {
     pub view: String,
     /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, a multipage .tif, a DICOM series (its
     /// folder or a file of it), an OME-Zarr image's folder, a folder of numbered PNG or TIFF slices,
-    /// or raw with --dims and --dtype).
+    /// or raw with --dims and --dtype); a series of numbered files as a quoted pattern
+    /// ('scan_*.nii.gz', one time point each).
     #[arg(long, conflicts_with = "terrain")]
     pub volume: Option<PathBuf>,
     /// Raw volume dimensions.
@@ -76,8 +77,8 @@ pub struct SceneArgs {
     /// memory holds.
     #[arg(long, value_parser = parse_level, requires = "volume")]
     pub level: Option<String>,
-    /// The time point of a 4-D NIfTI or an OME-Zarr image to draw (needed when it holds several;
-    /// `voxsplat animate --volume` plays them all).
+    /// The time point of a series to draw: a 4-D NIfTI or NRRD, an OME-Zarr image, a pattern of
+    /// numbered files (needed when it holds several; `voxsplat animate --volume` plays them all).
     #[arg(long, requires = "volume")]
     pub time: Option<u32>,
     /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's

@@ -66,6 +66,19 @@ fn animate_plays_each_time_point_as_render_draws_it() {
     // Time points differ: the ball moved.
     let (a, b) = (png(&dir.join("anim-nii/frame0000.png")), png(&dir.join("anim-nii/frame0005.png")));
     assert!(a != b);
+    // The same series as numbered files (vol_t0, vol_t4, .. vol_t20: by number, not by name) plays
+    // the same frames.
+    let pattern = dir.join("vol_t*.nii.gz");
+    let out = dir.join("anim-files");
+    let mut args = vec!["animate", "--volume", pattern.to_str().unwrap(), "--out-dir", out.to_str().unwrap()];
+    args.extend_from_slice(&view);
+    assert!(ok(&args).contains("6 time points"));
+    for t in 0..6 {
+        let frame = format!("frame{t:04}.png");
+        assert!(png(&out.join(&frame)) == png(&dir.join("anim-nii").join(&frame)), "time point {t} of the files");
+    }
+    let e = refused(&["render", "--volume", pattern.to_str().unwrap(), "--out", out.join("x.png").to_str().unwrap()]);
+    assert!(e.contains("holds 6 time points"), "{e}");
 }
 
 #[test]

@@ -107,6 +107,9 @@ impl SliceReader {
     /// (a raw file's dims and type); sizes are checked against `MAX_STREAMED_VOXELS` and the
     /// data's length before anything is read.
     pub fn open(path: &Path, hints: &VolumeHints) -> Result<Option<Self>> {
+        if let Some((file, hints)) = super::sequence::member(path, hints)? {
+            return Self::open(&file, &hints);
+        }
         let name = super::lower_name(path);
         super::check_raw_hints(path, hints)?;
         let series = hints.series.as_deref();

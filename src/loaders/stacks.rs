@@ -229,7 +229,7 @@ fn samples(image: DecodingResult, w: u32, h: u32, what: &str) -> Result<Vec<f32>
 }
 
 /// The number in a file name's stem (its last run of digits), which orders a folder's slices.
-fn slice_number(path: &Path) -> Option<u64> {
+pub(super) fn slice_number(path: &Path) -> Option<u64> {
     let stem = path.file_stem()?.to_string_lossy().into_owned();
     let end = stem.rfind(|c: char| c.is_ascii_digit())? + 1;
     let start = stem[..end].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);

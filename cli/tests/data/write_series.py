@@ -1,5 +1,5 @@
 """Writes a time series the way others write one (cli/tests/series.rs): a 4-D NIfTI with nibabel
-(its fourth axis in seconds), a 4-D NRRD with pynrrd (kinds space space space time, gzip) and an
+(its fourth axis in seconds) and as numbered 3-D files, a 4-D NRRD with pynrrd (kinds space space space time, gzip) and an
 OME-Zarr image with a t, z, y, x axis with the ome-zarr package, of the same voxels: a still blob and a bright ball moving along x, every time point spanning the
 same values (0 to 250).
 
@@ -32,6 +32,9 @@ def main(out):
     img = nibabel.Nifti1Image(xyzt, np.eye(4))
     img.header.set_xyzt_units("mm", "sec")
     nibabel.save(img, f"{out}/series.nii.gz")
+    # The same time points as numbered files (t2 before t10: ordered by number, not by name).
+    for t in range(T):
+        nibabel.save(nibabel.Nifti1Image(xyzt[..., t], np.eye(4)), f"{out}/vol_t{t * 4}.nii.gz")
     nrrd.write(f"{out}/series.nrrd", xyzt, {"kinds": ["space", "space", "space", "time"], "encoding": "gzip"})
     tzyx = np.ascontiguousarray(xyzt.transpose(3, 2, 1, 0))
     root = zarr.group(store=parse_url(f"{out}/series.zarr", mode="w", fmt=FormatV05()).store)
