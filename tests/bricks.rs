@@ -370,3 +370,24 @@ fn every_stored_voxel_keeps_the_stores_central_differences() {
     assert!(n > 0 && words[at..at + n].iter().chain(&hi[at..at + n]).all(|&w| w == 0));
     assert_ne!(store.gradient_words(|_| true)[0][at..at + n], words[at..at + n]);
 }
+
+/// A stream that fits the slab cache is read once: the brick pass takes what the range pass kept
+/// (a DICOM decoder or compressed chunks are the slow part of a load), and the store is the one
+/// the volume in memory gives.
+#[test]
+fn a_stream_that_fits_is_read_once() {
+    let vol = common::blob([37, 29, 23]);
+    let plane = (vol.dims[0] * vol.dims[1]) as usize;
+    let mut slices = 0;
+    let streamed = BrickStore::from_slices(vol.dims, vol.spacing, |z0, count, out| {
+        slices += count;
+        out.clear();
+        out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + count) as usize * plane]);
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(slices, vol.dims[2], "each slice read once");
+    let whole = BrickStore::build(&vol).unwrap();
+    assert_eq!((streamed.range, &streamed.headers, &streamed.records), (whole.range, &whole.headers, &whole.records));
+    assert_eq!(streamed.masks, whole.masks);
+}

@@ -60,7 +60,8 @@ impl BrickStore {
     /// `build`, with the empty value at most `background` (`from_slices_over`).
     pub(super) fn build_over(vol: &ScalarVolume, background: f32) -> Result<Self> {
         let plane = vol.dims[0] as usize * vol.dims[1] as usize;
-        Self::from_slices_over(vol.dims, vol.spacing, background, |z0, count, out| {
+        // The volume is in memory: nothing to keep between the passes.
+        Self::from_slices_over(vol.dims, vol.spacing, background, false, |z0, count, out| {
             out.clear();
             out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + count) as usize * plane]);
             Ok(())
@@ -69,34 +70,58 @@ impl BrickStore {
 
     /// Build the store from z-slices without holding the volume: `read(z0, count, out)` puts
     /// slices `z0..z0 + count` (x fastest) in `out`. Two passes: the value range, then the bricks,
-    /// `BRICK` slices at a time. Refused before any large allocation when the store could exceed
-    /// the host's available memory.
+    /// `BRICK` slices at a time; the second reads what the first kept when the samples fit
+    /// `SLAB_CACHE_BYTES` (and a quarter of the host budget), else it reads them again. Refused
+    /// before any large allocation when the store could exceed the host's available memory.
     pub fn from_slices(
         dims: [u32; 3],
         spacing: [f32; 3],
         read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
-        Self::from_slices_over(dims, spacing, f32::INFINITY, read)
+        Self::from_slices_over(dims, spacing, f32::INFINITY, true, read)
     }
 
     /// `from_slices`, with the empty value at most `background` (a volume with no empty voxel
-    /// keeps its minimum).
+    /// keeps its minimum); `may_keep`: whether the samples may be kept between the passes.
     fn from_slices_over(
         dims: [u32; 3],
         spacing: [f32; 3],
         background: f32,
+        may_keep: bool,
         mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
         check_dims(dims)?;
         let mut slab = Vec::new();
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        // The samples, kept for the brick pass when they fit, so that a slow reader (a DICOM
+        // decoder, compressed chunks) reads each once.
+        let bytes = dims.iter().map(|&d| d as u64).product::<u64>() * 4;
+        let keep = may_keep
+            && bytes <= SLAB_CACHE_BYTES
+            && crate::error::host_budget().is_none_or(|b| bytes <= b / 4)
+            && crate::error::check_host_memory(2 * bytes, "").is_ok();
+        let mut kept = Vec::new();
         for z0 in (0..dims[2]).step_by(BRICK as usize) {
             read(z0, BRICK.min(dims[2] - z0), &mut slab)?;
             for &v in slab.iter().filter(|v| v.is_finite()) {
                 (lo, hi) = (lo.min(v), hi.max(v));
             }
+            if keep {
+                kept.extend_from_slice(&slab);
+            }
         }
-        Self::from_region(dims, spacing, store_range(lo.min(background), hi), [[0; 3], dims], read)
+        let range = store_range(lo.min(background), hi);
+        if !keep {
+            return Self::from_region(dims, spacing, range, [[0; 3], dims], read);
+        }
+        let plane = dims[0] as usize * dims[1] as usize;
+        Self::from_region(dims, spacing, range, [[0; 3], dims], |z0, count, out| {
+            let at = z0 as usize * plane..(z0 + count) as usize * plane;
+            let part = kept.get(at).ok_or_else(|| Error::InvalidArgument("a slab read past the volume".into()))?;
+            out.clear();
+            out.extend_from_slice(part);
+            Ok(())
+        })
     }
 
     /// The store of the voxels in `region` (`lo..hi`, voxel coordinates) of a `dims` grid whose
@@ -207,6 +232,9 @@ impl BrickStore {
         Ok(store)
     }
 }
+
+/// Most bytes of samples `from_slices` keeps from its range pass for its brick pass.
+pub const SLAB_CACHE_BYTES: u64 = 1 << 30;
 
 /// The range a store normalises by, from the smallest and largest finite values read (none read:
 /// (0, 0)).
