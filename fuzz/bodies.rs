@@ -32,7 +32,7 @@ pub fn raw(data: &[u8]) {
 }
 
 /// The streamed loader a volume file renders from (`BrickStore::load`: NRRD, NIfTI, gzip inflated
-/// as it is read) and the dense loader, through a file: the first byte picks the file's kind, the
+/// as it is read; a series' last time point) and the dense loader, through a file: the first byte picks the file's kind, the
 /// rest is the file. The host budget bounds what a header may make them allocate.
 pub fn slices(data: &[u8]) {
     let Some((&kind, rest)) = data.split_first() else { return };
@@ -43,6 +43,13 @@ pub fn slices(data: &[u8]) {
         let hints = voxsplat::loaders::VolumeHints::default();
         let _ = voxsplat::bricks::BrickStore::load(&path, &hints);
         let _ = voxsplat::loaders::load_volume(&path, &hints);
+        // A series (a 4-D NIfTI or NRRD): its last time point, the one furthest into the file,
+        // as a series plays it (one range for every time point) and as `render --time` reads it.
+        if let Ok(times) = voxsplat::loaders::time_points(&path) {
+            let last = voxsplat::loaders::VolumeHints { time: Some(times.max(1) - 1), ..hints };
+            let _ = voxsplat::bricks::BrickStore::load_in_range(&path, &last, (0.0, 1.0));
+            let _ = voxsplat::loaders::load_volume(&path, &last);
+        }
     }
 }
 
@@ -109,6 +116,13 @@ pub fn stacks(data: &[u8]) {
         let hints = voxsplat::loaders::VolumeHints::default();
         let _ = voxsplat::bricks::BrickStore::load(&path, &hints);
         let _ = voxsplat::loaders::load_volume(&path, &hints);
+        // A series (a 4-D NIfTI or NRRD): its last time point, the one furthest into the file,
+        // as a series plays it (one range for every time point) and as `render --time` reads it.
+        if let Ok(times) = voxsplat::loaders::time_points(&path) {
+            let last = voxsplat::loaders::VolumeHints { time: Some(times.max(1) - 1), ..hints };
+            let _ = voxsplat::bricks::BrickStore::load_in_range(&path, &last, (0.0, 1.0));
+            let _ = voxsplat::loaders::load_volume(&path, &last);
+        }
     }
 }
 

@@ -86,9 +86,16 @@ fn the_streamed_seeds_load_as_stores() {
         let ext = ["nrrd", "nii", "nii.gz"][data[0] as usize % 3];
         let path = std::env::temp_dir().join(format!("voxsplat-corpus-{}.{ext}", std::process::id()));
         std::fs::write(&path, &data[1..]).unwrap();
-        let store = voxsplat::bricks::BrickStore::load(&path, &Default::default());
-        std::fs::remove_file(&path).unwrap();
         let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        // A series' seed: its last time point (of 3).
+        let time = name.contains("series").then_some(2);
+        let hints = voxsplat::loaders::VolumeHints { time, ..Default::default() };
+        let store = voxsplat::bricks::BrickStore::load(&path, &hints);
+        if let (Some(_), Ok(s)) = (time, &store) {
+            assert_eq!(voxsplat::loaders::time_points(&path).unwrap(), 3, "{name}");
+            assert_eq!(s.range, (2.0, 209.0), "{name}: the last time point's values");
+        }
+        std::fs::remove_file(&path).unwrap();
         match (name.starts_with("seed-"), store) {
             (true, Ok(s)) => assert_eq!(s.dims, [4, 3, 2], "{name}"),
             (true, Err(e)) => panic!("{name}: {e}"),

@@ -63,6 +63,13 @@ put("slices", "gzip.nrrd", b"\0" + nrrd_gz)
 put("slices", "skip.nrrd", b"\0" + nrrd_skip, "refused-")
 put("slices", "plain.nii", b"\1" + nii)
 put("slices", "plain.nii.gz", b"\2" + gzip.compress(nii))
+# Series: a 4-D NIfTI over time (nibabel, seconds) and a 4-D NRRD whose last axis is time.
+series = np.stack([vol.transpose(2, 1, 0) + t for t in range(3)], axis=-1)
+img4 = nib.Nifti1Image(series.astype(np.uint8), np.eye(4))
+img4.header.set_xyzt_units("mm", "sec")
+put("slices", "series.nii", b"\1" + img4.to_bytes())
+put("slices", "series.nrrd", b"\0" + b"NRRD0004\ntype: uchar\ndimension: 4\nsizes: 4 3 2 3\n"
+    b"kinds: space space space time\nencoding: raw\n\n" + series.transpose(3, 2, 1, 0).astype(np.uint8).tobytes())
 
 # heights: the first byte picks png, tif, npy (see fuzz_targets/heights.rs).
 from PIL import Image
