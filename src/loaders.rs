@@ -379,6 +379,34 @@ pub struct VolumeHints {
     /// The time point of a 4-D NIfTI or an OME-Zarr image to read (needed when it holds several:
     /// `time_points`).
     pub time: Option<u32>,
+    /// The caller places the voxels at `file_positions`: a DICOM series with uneven slice gaps is
+    /// read (its grid spaced by the mean gap) instead of refused.
+    pub rectilinear: bool,
+}
+
+/// The positions of an unevenly spaced DICOM series' slices along their normal, from the first
+/// (mm); `None` for evenly spaced slices and any other file.
+pub fn slice_offsets(path: &Path, hints: &VolumeHints) -> Result<Option<Vec<f64>>> {
+    let dir = path.is_dir() && !is_ome_zarr(path);
+    if !(dir && dicom::holds_dicom(path) || !path.is_dir() && is_dicom(path)) {
+        return Ok(None);
+    }
+    Ok(dicom::open(path, hints.series.as_deref(), true)?.offsets)
+}
+
+/// The voxel positions of a file whose slices are not evenly spaced (a DICOM series with uneven
+/// gaps), per axis for `SplatSet::with_coordinates` on `grid` (its grid, placed: x and y its own,
+/// z from the slices' positions along their normal, centred as the grid is); `None` for any
+/// other file.
+pub fn file_positions(path: &Path, hints: &VolumeHints, grid: &crate::volume::Grid) -> Result<Option<[Vec<f32>; 3]>> {
+    let Some(offsets) = slice_offsets(path, hints)? else { return Ok(None) };
+    if offsets.len() != grid.dims[2] as usize {
+        return Err(bad(&path.display().to_string(), "its slices do not match the grid given"));
+    }
+    let own = |a: usize| (0..grid.dims[a]).map(|i| grid.origin[a] + i as f32 * grid.spacing[a]).collect::<Vec<_>>();
+    let last = offsets.last().copied().unwrap_or(0.0);
+    let z = offsets.iter().map(|o| (o - last / 2.0) as f32).collect();
+    Ok(Some([own(0), own(1), z]))
 }
 
 /// The time points `path` holds: a 4-D NIfTI's fourth axis when it is time (`NiftiLayout`), a 4-D

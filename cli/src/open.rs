@@ -169,8 +169,10 @@ pub struct Content {
 pub fn orientation_of(a: &SceneArgs) -> Result<Option<Orientation>> {
     match &a.volume {
         Some(path) if a.terrain.is_none() => {
-            // No level is read for it (a pyramid's levels share their placement).
-            let o = voxsplat::loaders::load_orientation(path, &volume_hints_at(a, None)?)?;
+            // No level is read for it (a pyramid's levels share their placement); an unevenly
+            // spaced DICOM series is placed by its first slice and mean gap.
+            let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints_at(a, None)? };
+            let o = voxsplat::loaders::load_orientation(path, &hints)?;
             if a.positions.is_some() {
                 if o.is_some_and(|o| o.flip_x()) {
                     return Err(Error::Unsupported(
@@ -315,6 +317,7 @@ fn volume_hints_at(a: &SceneArgs, level: Option<u32>) -> Result<voxsplat::loader
         series: a.series.clone(),
         level,
         time: a.time,
+        rectilinear: false,
     })
 }
 
@@ -342,7 +345,9 @@ pub fn load_volume_parts(
     path: &std::path::Path,
     orientation: Option<Orientation>,
 ) -> Result<VolumeParts> {
-    let vol = voxsplat::loaders::load_volume(path, &volume_hints(a)?)?;
+    // An unevenly spaced DICOM series reads at its mean gap; `load_scene` places its slices.
+    let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints(a)? };
+    let vol = voxsplat::loaders::load_volume(path, &hints)?;
     let tf = transfer_function(a)?;
     let shading = headlight(a, vol.dims, vol.spacing, orientation);
     Ok((vol, tf, shading))
@@ -521,7 +526,10 @@ pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
                 let coords = voxsplat::loaders::load_positions(p, set.grid())?;
                 set.with_coordinates(coords)?
             }
-            None => set,
+            None => match uneven_positions(a, path, set.grid())? {
+                Some(coords) => set.with_coordinates(coords)?,
+                None => set,
+            },
         }
     } else if let Some(path) = &a.terrain {
         // (clap drops `requires = "volume"` when --terrain, which conflicts with it, is given.)
@@ -609,6 +617,17 @@ fn refuse_volume_flags(a: &SceneArgs) -> Result<()> {
     }
 }
 
+/// The slice positions of an unevenly spaced DICOM --volume (`loaders::file_positions`) on
+/// `grid`, said on stderr: such a series is drawn as a rectilinear grid of host splats.
+fn uneven_positions(a: &SceneArgs, path: &std::path::Path, grid: &voxsplat::Grid) -> Result<Option<[Vec<f32>; 3]>> {
+    let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints(a)? };
+    let coords = voxsplat::loaders::file_positions(path, &hints, grid)?;
+    if coords.is_some() {
+        eprintln!("uneven slice gaps: drawn as a rectilinear grid at the slices' positions (host splats)");
+    }
+    Ok(coords)
+}
+
 /// The scene `a` names: a --volume as a bricked store classified on the device unless
 /// `host_splats` (a mode that needs host splats), else host splats; with the grid's splat set
 /// (empty for a bricked store) for cameras and orders, and what a camera frames (`Content`).
@@ -624,10 +643,19 @@ pub fn open(
                 .into(),
         ));
     }
+    // An unevenly spaced DICOM series draws as a rectilinear grid: host splats.
+    let uneven = match &a.volume {
+        Some(path) if a.positions.is_none() && a.labels.is_none() => {
+            let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints_at(a, None)? };
+            voxsplat::loaders::slice_offsets(path, &hints)?.is_some()
+        }
+        _ => false,
+    };
     let (bricked, orientation) = match (&a.volume, peer) {
         (Some(path), _)
             if !host_splats
                 && !a.dense
+                && !uneven
                 && a.positions.is_none()
                 && a.labels.is_none()
                 && a.channels.is_empty()

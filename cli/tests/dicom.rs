@@ -196,3 +196,91 @@ fn a_tilted_gantry_s_series_is_placed_as_a_sheared_grid() {
     assert!(described.contains("sheared"), "{described}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Uneven slice gaps (issue 47 item 1): refused by the loaders unless the caller places the slices
+/// (`VolumeHints::rectilinear`), and drawn by `render` as a rectilinear grid at the slices'
+/// positions: pydicom's own CT2 (a slice 202.5 mm before three 1.25 mm apart), and a series written
+/// here whose gaps are 2, 2, 4, 2, 3, 2, 1, 2 and 4 mm.
+#[test]
+fn an_uneven_series_is_drawn_at_its_slices_positions() {
+    use voxsplat::loaders::{file_positions, slice_offsets};
+    let rect = VolumeHints { rectilinear: true, ..Default::default() };
+    // CT2's positions along its normal, as pydicom reads them.
+    let ct2 = pydicom_tests().join("77654033/CT2");
+    let script = format!(
+        "import glob, pydicom\nz = sorted(float(pydicom.dcmread(f).ImagePositionPatient[2]) for f in glob.glob('{}/*'))\n\
+         print(' '.join(str(v - z[0]) for v in z))",
+        ct2.display()
+    );
+    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
+    let want: Vec<f64> = String::from_utf8_lossy(&out.stdout).split_whitespace().map(|v| v.parse().unwrap()).collect();
+    assert_eq!(want.len(), 4);
+    let got = slice_offsets(&ct2, &rect).unwrap().expect("CT2's gaps are uneven");
+    assert!(got.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-3), "{got:?} against pydicom's {want:?}");
+    assert_eq!(load_volume(&ct2, &rect).unwrap().dims, [16, 16, 4]);
+    let e = load_volume(&ct2, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("uneven slice gaps") && e.contains("rectilinear"), "{e}");
+    let shot = tmp("ct2.png");
+    let said = ok(&[
+        "render",
+        "--volume",
+        ct2.to_str().unwrap(),
+        "--size",
+        "64x64",
+        "--validation",
+        "--out",
+        shot.to_str().unwrap(),
+    ]);
+    assert!(said.contains("drawn as a rectilinear grid"), "{said}");
+    // A ball written at uneven slice positions.
+    let zs = [0, 2, 4, 8, 10, 13, 15, 16, 18, 22];
+    let write = |dir: &Path, zs: &[i32]| {
+        let _ = std::fs::remove_dir_all(dir);
+        std::fs::create_dir_all(dir).unwrap();
+        let script = format!(
+            "import numpy as np, pydicom\n\
+             from pydicom.dataset import Dataset, FileMetaDataset\n\
+             from pydicom.uid import ExplicitVRLittleEndian\n\
+             x, y = np.meshgrid(np.arange(24), np.arange(20))\n\
+             for k, z in enumerate({zs:?}):\n\
+             \x20   m = FileMetaDataset(); m.MediaStorageSOPClassUID = '1.2.840.10008.5.1.4.1.1.2'\n\
+             \x20   m.MediaStorageSOPInstanceUID = '1.2.3.%d' % (k + 10); m.TransferSyntaxUID = ExplicitVRLittleEndian\n\
+             \x20   d = Dataset(); d.file_meta = m; d.SOPClassUID = m.MediaStorageSOPClassUID\n\
+             \x20   d.SOPInstanceUID = m.MediaStorageSOPInstanceUID; d.Modality = 'CT'; d.SeriesInstanceUID = '1.2.3.1'\n\
+             \x20   d.InstanceNumber = k + 1; d.Rows, d.Columns = 20, 24\n\
+             \x20   d.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]; d.ImagePositionPatient = [0, 0, z]\n\
+             \x20   d.PixelSpacing = [1, 1]; d.SamplesPerPixel = 1; d.PhotometricInterpretation = 'MONOCHROME2'\n\
+             \x20   d.BitsAllocated, d.BitsStored, d.HighBit, d.PixelRepresentation = 16, 16, 15, 0\n\
+             \x20   r = np.sqrt((x - 12) ** 2 + (y - 10) ** 2 + (z - 11) ** 2)\n\
+             \x20   d.PixelData = np.where(r < 9, 1000 - 80 * r, 0).astype(np.uint16).tobytes()\n\
+             \x20   pydicom.dcmwrite('{}/s%d' % k, d, enforce_file_format=True)\n",
+            dir.display()
+        );
+        let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    let (uneven, even) = (tmp("uneven"), tmp("even"));
+    write(&uneven, &zs);
+    write(&even, &[0, 2, 4, 6, 8, 10, 12, 14, 16, 18]);
+    let grid = voxsplat::Grid::centered([24, 20, 10], [1.0, 1.0, 22.0 / 9.0]).unwrap();
+    let [x, y, z] = file_positions(&uneven, &rect, &grid).unwrap().expect("uneven");
+    // x and y the grid's own; z the slices' positions, centred as the grid is (22 mm long).
+    assert_eq!((x[0], x[23], y[0], y[19]), (-11.5, 11.5, -9.5, 9.5));
+    let centred: Vec<f32> = zs.iter().map(|&z| z as f32 - 11.0).collect();
+    assert!(z.iter().zip(&centred).all(|(a, b)| (a - b).abs() < 1e-4), "{z:?}");
+    assert!(file_positions(&even, &rect, &grid).unwrap().is_none(), "even gaps need no positions");
+    // The ball drawn at its slices' positions, not at their mean gap: another picture than the
+    // same images evenly spaced, and one that the store's even grid refuses to draw unplaced.
+    let (a, b) = (tmp("uneven.png"), tmp("even.png"));
+    let view = ["--size", "64x64", "--view", "anterior", "--validation", "--out"];
+    let said = ok(&[&["render", "--volume", uneven.to_str().unwrap()][..], &view, &[a.to_str().unwrap()]].concat());
+    assert!(said.contains("drawn as a rectilinear grid"), "{said}");
+    ok(&[&["render", "--volume", even.to_str().unwrap()][..], &view, &[b.to_str().unwrap()]].concat());
+    let (a, b) = (image::open(&a).unwrap().to_rgba8(), image::open(&b).unwrap().to_rgba8());
+    assert!(a.pixels().filter(|p| p[3] > 0).count() > 200, "the ball is drawn");
+    assert!(a != b);
+    let e = voxsplat::bricks::BrickStore::load(&uneven, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("uneven slice gaps"), "{e}");
+    let _ = std::fs::remove_dir_all(&uneven);
+    let _ = std::fs::remove_dir_all(&even);
+}

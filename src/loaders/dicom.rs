@@ -302,11 +302,15 @@ pub struct Series {
     /// Placement in patient space (RAS).
     pub orientation: crate::orient::Orientation,
     rescale: [f64; 2],
+    /// Unevenly spaced slices' positions along the normal, from the first (mm); `None` when the
+    /// gaps are even (the orientation's step places them).
+    pub offsets: Option<Vec<f64>>,
 }
 
 /// The series `path` names: a folder holding one series (or `pick`, its index in `voxsplat info`'s
-/// list or its UID), or one DICOM file of its series.
-pub fn open(path: &Path, pick: Option<&str>) -> Result<Series> {
+/// list or its UID), or one DICOM file of its series. Uneven slice gaps are refused unless
+/// `rectilinear` (the caller places the slices at `Series::offsets`).
+pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool) -> Result<Series> {
     let what = path.display().to_string();
     let (dir, own) = if path.is_dir() {
         (path.to_path_buf(), None)
@@ -338,11 +342,11 @@ pub fn open(path: &Path, pick: Option<&str>) -> Result<Series> {
             n => return Err(bad(&what, format!("holds {n} series: pick one with --series N or UID ({})", list()))),
         },
     };
-    build(chosen, &what)
+    build(chosen, &what, rectilinear)
 }
 
 /// Checks a series' images agree and orders them along their normal.
-fn build(s: &SeriesInfo, what: &str) -> Result<Series> {
+fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let first = &s.images[0];
     let name = |i: &Image| i.path.display().to_string();
     for i in &s.images {
@@ -380,18 +384,31 @@ fn build(s: &SeriesInfo, what: &str) -> Result<Series> {
         return Err(bad(what, format!("duplicate positions: {} and {}", name(&images[k]), name(&images[k + 1]))));
     }
     let mean = steps.iter().sum::<f64>() / steps.len().max(1) as f64;
-    if let Some(k) = steps.iter().position(|d| (d - mean).abs() > 0.01 * mean) {
-        return Err(bad(
-            what,
-            format!(
-                "uneven slice gaps ({:.4} between {} and {}, {mean:.4} on average): a rectilinear series is not read yet",
-                steps[k],
-                name(&images[k]),
-                name(&images[k + 1])
-            ),
-        ));
-    }
     let n = images.len();
+    let mut offsets = None;
+    if let Some(k) = steps.iter().position(|d| (d - mean).abs() > 0.01 * mean) {
+        let gap = format!(
+            "uneven slice gaps ({:.4} between {} and {}, {mean:.4} on average)",
+            steps[k],
+            name(&images[k]),
+            name(&images[k + 1])
+        );
+        if !rectilinear {
+            return Err(bad(
+                what,
+                format!(
+                    "{gap}: read it as a rectilinear grid (VolumeHints::rectilinear and loaders::file_positions; \
+                     voxsplat render does)"
+                ),
+            ));
+        }
+        // A tilted series' positions leave the normal: its grid would be sheared and uneven.
+        let along = (images[n - 1].position - images[0].position).normalize_or_zero();
+        if along.dot(normal).abs() < 1.0 - 1e-6 {
+            return Err(Error::Unsupported(format!("{what}: {gap} with a gantry tilt: not read")));
+        }
+        offsets = Some(images.iter().map(|i| (i.position - images[0].position).dot(normal)).collect());
+    }
     // The slice step: the first to the last position, over the gaps (a gantry tilt leans it off the
     // normal, which places the grid sheared); one image steps one pixel spacing along the normal.
     let step =
@@ -406,7 +423,7 @@ fn build(s: &SeriesInfo, what: &str) -> Result<Series> {
     let affine = DMat4::from_diagonal(DVec4::new(-1.0, -1.0, 1.0, 1.0)) * lps;
     let dims = [first.size[0], first.size[1], n as u32];
     let orientation = crate::orient::Orientation::from_affine(affine, dims).map_err(|e| bad(what, e))?;
-    Ok(Series { images, dims, orientation, rescale: first.rescale })
+    Ok(Series { images, dims, orientation, rescale: first.rescale, offsets })
 }
 
 impl Series {

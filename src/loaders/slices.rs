@@ -137,7 +137,7 @@ impl SliceReader {
             return Err(super::bad(&path.display().to_string(), "--series picks a DICOM series of a folder"));
         }
         if path.is_dir() && super::dicom::holds_dicom(path) || !path.is_dir() && super::dicom::is_dicom(path) {
-            Ok(Some(Self::stack(super::stacks::Stack::dicom(path, series)?)))
+            Ok(Some(Self::stack(super::stacks::Stack::dicom(path, series, hints.rectilinear)?)))
         } else if path.is_dir() {
             if series.is_some() {
                 return Err(super::bad(

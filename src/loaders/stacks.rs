@@ -305,8 +305,8 @@ impl Stack {
     }
 
     /// A DICOM series: a folder of one (or `pick`: its index or UID), or one file of its series.
-    pub fn dicom(path: &Path, pick: Option<&str>) -> Result<Stack> {
-        let series = super::dicom::open(path, pick)?;
+    pub fn dicom(path: &Path, pick: Option<&str>, rectilinear: bool) -> Result<Stack> {
+        let series = super::dicom::open(path, pick, rectilinear)?;
         let (dims, orientation) = (series.dims, series.orientation);
         let mut stack = Self::sized(Slices::Dicom(series), dims, orientation.spacing(), path.display().to_string())?;
         stack.orientation = Some(orientation);
