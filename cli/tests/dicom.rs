@@ -284,3 +284,47 @@ fn an_uneven_series_is_drawn_at_its_slices_positions() {
     let _ = std::fs::remove_dir_all(&uneven);
     let _ = std::fs::remove_dir_all(&even);
 }
+
+/// Multi-frame images (issue 47 item 1): pydicom's RT Dose grids, 15 frames of 32-bit samples
+/// placed by their Grid Frame Offset Vector and scaled by Dose Grid Scaling, little- and
+/// big-endian, read voxel for voxel as pydicom reads them; a multi-frame file that dicom-rs
+/// cannot decode (JPEG-LS) is refused naming its transfer syntax.
+#[test]
+fn rt_dose_grids_read_frame_by_frame_as_pydicom_reads_them() {
+    for name in ["rtdose", "rtdose_expb"] {
+        let dir = tmp(name);
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join(format!("{name}.dcm"));
+        std::fs::copy(pydicom_tests().join(format!("../{name}.dcm")), &file).unwrap();
+        let npy = dir.join("want.npy");
+        let script = format!(
+            "import numpy as np, pydicom\nd = pydicom.dcmread('{}')\n\
+             np.save('{}', (d.pixel_array * float(d.DoseGridScaling)).astype(np.float32))",
+            file.display(),
+            npy.display()
+        );
+        let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let (shape, want) =
+            voxsplat::loaders::npy_from_bytes(&std::fs::read(&npy).unwrap(), &npy.display().to_string()).unwrap();
+        assert_eq!(shape, [15, 10, 10], "{name}: frames, rows, columns");
+        let v = load_volume(&dir, &VolumeHints::default()).unwrap();
+        assert_eq!((v.dims, v.spacing), ([10, 10, 15], [10.0, 10.0, 5.0]), "{name}");
+        let worst = v.values.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(worst < 1e-6, "{name}: {worst} from pydicom's values");
+        // The grid starts at Image Position (Patient), its frames 5 mm apart along +z (RAS x, y
+        // are LPS's negated).
+        let o = load_orientation(&dir, &VolumeHints::default()).unwrap().unwrap();
+        let first = o.to_world(voxsplat::glam::Vec3::new(-45.0, -45.0, -35.0));
+        assert!((first - voxsplat::glam::Vec3::new(-189.43125, -199.43125, -761.87)).length() < 1e-2, "{first}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    let dir = tmp("jpegls");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(pydicom_tests().join("../MR_small_jpeg_ls_lossless.dcm"), dir.join("a.dcm")).unwrap();
+    let e = load_volume(&dir, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("1.2.840.10008.1.2.4.80"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,4 +1,5 @@
-//! DICOM series (issue 47): the single-frame images of one series in a folder, read with dicom-rs.
+//! DICOM series (issue 47): the images of one series in a folder (single-frame, or multi-frame
+//! with a Grid Frame Offset Vector such as RT Dose), read with dicom-rs.
 //! Slices are ordered by their position along the slice normal (DICOM C.7.6.2: Image Position and
 //! Orientation (Patient), Pixel Spacing), not by file name or instance number; the grid is placed
 //! in patient space (LPS turned RAS), a gantry tilt as a sheared grid; values are rescaled by the
@@ -91,6 +92,9 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
         }
     };
     let mut syntax = String::new();
+    // Inside encapsulated pixel data (undefined length): its items hold compressed fragments,
+    // skipped by their lengths, not walked into, until the sequence delimiter.
+    let mut encapsulated = false;
     while pos < bytes.len() {
         let short = || bad(what, format!("DICOM: an element header is cut off at byte {pos}"));
         if pos + 8 > bytes.len() {
@@ -127,8 +131,14 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
             }
         };
         pos += header;
-        // Undefined lengths (sequences, encapsulated pixel data) and sequences hold elements.
-        if len == u32::MAX || container {
+        if (group, element) == (0x7FE0, 0x10) && len == u32::MAX {
+            encapsulated = true;
+            continue;
+        }
+        if encapsulated && group == 0xFFFE {
+            encapsulated = element != 0xE0DD;
+        } else if len == u32::MAX || container {
+            // Undefined lengths (sequences) and sequences hold elements.
             continue;
         }
         let end = pos.checked_add(len as usize).filter(|&e| e <= bytes.len()).ok_or_else(|| {
@@ -160,7 +170,8 @@ struct Image {
     spacing: [f64; 2],
     rescale: [f64; 2],
     size: [u32; 2],
-    frames: u32,
+    /// The file's frame this slice is (0 for a single-frame image).
+    frame: u32,
 }
 
 /// A series in a folder: what `voxsplat info DIR` lists.
@@ -197,9 +208,15 @@ fn numbers(
     Ok(v)
 }
 
+/// A file's series UID, description, modality and slices.
+type Header = (String, String, String, Vec<Image>);
+
 /// An image's header (up to its pixel data), or `None` for an object that is not an image (no
-/// Rows): a folder's other objects are left alone.
-fn header(path: &Path) -> Result<Option<(String, String, String, Image)>> {
+/// Rows): a folder's other objects are left alone. A multi-frame image is one slice per frame,
+/// placed by its Grid Frame Offset Vector (RT Dose: offsets along the normal from Image Position
+/// (Patient) when the first is 0, else the frames' z coordinates on an axial grid) and scaled by
+/// its Dose Grid Scaling; other multi-frame images (per-frame functional groups) are refused.
+fn header(path: &Path) -> Result<Option<Header>> {
     let what = path.display().to_string();
     let bytes = checked_bytes(path, &what)?;
     let obj = OpenFileOptions::new()
@@ -245,22 +262,49 @@ fn header(path: &Path) -> Result<Option<(String, String, String, Image)>> {
             None => Ok(default),
         }
     };
-    let rescale = [
-        scalar(tags::RESCALE_SLOPE, 1.0, "Rescale Slope")?,
-        scalar(tags::RESCALE_INTERCEPT, 0.0, "Rescale Intercept")?,
-    ];
-    let image = Image {
-        path: path.to_path_buf(),
-        position: DVec3::new(p[0], p[1], p[2]),
-        row: row.normalize(),
-        column: column.normalize(),
-        spacing: [s[0], s[1]],
-        rescale,
-        size,
-        frames,
+    // RT Dose stores its values scaled: Dose Grid Scaling, where no Rescale Slope is given.
+    let slope = match obj.element_opt(tags::RESCALE_SLOPE).ok().flatten() {
+        Some(_) => scalar(tags::RESCALE_SLOPE, 1.0, "Rescale Slope")?,
+        None => scalar(tags::DOSE_GRID_SCALING, 1.0, "Dose Grid Scaling")?,
     };
+    let rescale = [slope, scalar(tags::RESCALE_INTERCEPT, 0.0, "Rescale Intercept")?];
+    let (row, column) = (row.normalize(), column.normalize());
+    let position = DVec3::new(p[0], p[1], p[2]);
+    let offsets = if frames > 1 {
+        if obj.element_opt(tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE).ok().flatten().is_some() {
+            return Err(Error::Unsupported(format!(
+                "{what}: a multi-frame image placed by per-frame functional groups (an enhanced image) is not read yet"
+            )));
+        }
+        if frames as u64 > MAX_FILES as u64 {
+            return Err(bad(&what, format!("{frames} frames: at most {MAX_FILES} slices")));
+        }
+        numbers(&obj, tags::GRID_FRAME_OFFSET_VECTOR, "Grid Frame Offset Vector", frames as usize, &what)?
+    } else {
+        vec![0.0]
+    };
+    let normal = row.cross(column);
+    // Offsets from the first frame, or (a first offset other than 0) the frames' z on an axial grid.
+    let relative = offsets[0] == 0.0;
+    if !relative && (normal.z.abs() - 1.0).abs() > 1e-6 {
+        return Err(bad(&what, "Grid Frame Offset Vector of z coordinates on a grid that is not axial"));
+    }
+    let images = offsets
+        .iter()
+        .enumerate()
+        .map(|(k, &o)| Image {
+            path: path.to_path_buf(),
+            position: if relative { position + normal * o } else { DVec3::new(position.x, position.y, o) },
+            row,
+            column,
+            spacing: [s[0], s[1]],
+            rescale,
+            size,
+            frame: k as u32,
+        })
+        .collect();
     let uid = text(&obj, tags::SERIES_INSTANCE_UID);
-    Ok(Some((uid, text(&obj, tags::SERIES_DESCRIPTION), text(&obj, tags::MODALITY), image)))
+    Ok(Some((uid, text(&obj, tags::SERIES_DESCRIPTION), text(&obj, tags::MODALITY), images)))
 }
 
 /// The series of the DICOM images in folder `dir` (its files, not its subfolders), in order of
@@ -276,10 +320,10 @@ pub fn series_in(dir: &Path) -> Result<Vec<SeriesInfo>> {
     files.sort();
     let mut series: Vec<SeriesInfo> = Vec::new();
     for path in files.into_iter().filter(|p| is_dicom(p)) {
-        let Some((uid, description, modality, image)) = header(&path)? else { continue };
+        let Some((uid, description, modality, images)) = header(&path)? else { continue };
         match series.iter_mut().find(|s| s.uid == uid) {
-            Some(s) => s.images.push(image),
-            None => series.push(SeriesInfo { uid, description, modality, dims: [0; 3], images: vec![image] }),
+            Some(s) => s.images.extend(images),
+            None => series.push(SeriesInfo { uid, description, modality, dims: [0; 3], images }),
         }
     }
     series.sort_by(|a, b| a.uid.cmp(&b.uid));
@@ -297,6 +341,9 @@ pub fn holds_dicom(dir: &Path) -> bool {
 /// A series read a slice at a time.
 pub struct Series {
     images: Vec<Image>,
+    /// The last multi-frame file decoded: its path and every frame's raw samples (its slices are
+    /// read in turn, and dicom-pixeldata decodes a file whole).
+    frames: Option<(PathBuf, Vec<Vec<f64>>)>,
     /// Columns, rows, slices.
     pub dims: [u32; 3],
     /// Placement in patient space (RAS).
@@ -349,10 +396,10 @@ pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool) -> Result<Series
 fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let first = &s.images[0];
     let name = |i: &Image| i.path.display().to_string();
+    if s.images.len() > MAX_FILES {
+        return Err(bad(what, format!("{} slices: a series holds at most {MAX_FILES}", s.images.len())));
+    }
     for i in &s.images {
-        if i.frames != 1 {
-            return Err(bad(&name(i), format!("{} frames: multi-frame images are not read yet", i.frames)));
-        }
         if i.size != first.size {
             return Err(bad(
                 what,
@@ -423,27 +470,68 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let affine = DMat4::from_diagonal(DVec4::new(-1.0, -1.0, 1.0, 1.0)) * lps;
     let dims = [first.size[0], first.size[1], n as u32];
     let orientation = crate::orient::Orientation::from_affine(affine, dims).map_err(|e| bad(what, e))?;
-    Ok(Series { images, dims, orientation, rescale: first.rescale, offsets })
+    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, offsets })
 }
 
 impl Series {
     /// Slice `z`'s rescaled values, x fastest.
-    pub fn slice(&self, z: u32) -> Result<Vec<f32>> {
-        let image = &self.images[z as usize];
+    pub fn slice(&mut self, z: u32) -> Result<Vec<f32>> {
+        let image = self.images[z as usize].clone();
         let what = image.path.display().to_string();
-        let bytes = checked_bytes(&image.path, &what)?;
-        let obj = OpenFileOptions::new()
-            .read_preamble(ReadPreamble::Always)
-            .from_reader(bytes.as_slice())
-            .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
-        let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
-        let pixels =
-            obj.decode_pixel_data().map_err(|e| bad(&what, format!("pixel data (transfer syntax {syntax}): {e}")))?;
-        let options =
-            ConvertOptions::new().with_modality_lut(ModalityLutOption::None).with_voi_lut(VoiLutOption::Identity);
-        let raw: Vec<f64> = pixels
-            .to_vec_frame_with_options(0, &options)
-            .map_err(|e| bad(&what, format!("pixel data (transfer syntax {syntax}): {e}")))?;
+        let frames = self.images.iter().filter(|i| i.path == image.path).count() as u32;
+        let raw = match &self.frames {
+            Some((path, all)) if *path == image.path => all[image.frame as usize].clone(),
+            _ => {
+                let [w, h] = image.size.map(u64::from);
+                crate::error::check_host_memory(frames as u64 * w * h * 8, &format!("{what}'s frames"))?;
+                let bytes = checked_bytes(&image.path, &what)?;
+                let obj = OpenFileOptions::new()
+                    .read_preamble(ReadPreamble::Always)
+                    .from_reader(bytes.as_slice())
+                    .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
+                let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
+                let failed =
+                    |e: &dyn std::fmt::Display| bad(&what, format!("pixel data (transfer syntax {syntax}): {e}"));
+                let pixels = obj.decode_pixel_data().map_err(|e| failed(&e))?;
+                let options = ConvertOptions::new()
+                    .with_modality_lut(ModalityLutOption::None)
+                    .with_voi_lut(VoiLutOption::Identity);
+                let frame = |f: u32| -> Result<Vec<f64>> {
+                    if pixels.bits_allocated() != 32 || pixels.samples_per_pixel() != 1 {
+                        return pixels.to_vec_frame_with_options(f, &options).map_err(|e| failed(&e));
+                    }
+                    // 32-bit samples (RT Dose), which dicom-pixeldata's conversion does not take: the
+                    // decoded frame's words. dicom-rs reads big-endian pixel data (OW) as 16-bit
+                    // little-endian words, so a big-endian file's sample is its high word first.
+                    let signed = pixels.pixel_representation() == dicom_pixeldata::PixelRepresentation::Signed;
+                    let big = syntax == "1.2.840.10008.1.2.2";
+                    let words = pixels.frame_data(f).map_err(|e| failed(&e))?.chunks_exact(4);
+                    Ok(words
+                        .map(|b| {
+                            let u = if big {
+                                (u16::from_le_bytes([b[0], b[1]]) as u32) << 16
+                                    | u16::from_le_bytes([b[2], b[3]]) as u32
+                            } else {
+                                u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+                            };
+                            if signed {
+                                u as i32 as f64
+                            } else {
+                                u as f64
+                            }
+                        })
+                        .collect())
+                };
+                if frames == 1 {
+                    frame(image.frame)?
+                } else {
+                    let all = (0..frames).map(frame).collect::<Result<Vec<Vec<f64>>>>()?;
+                    let raw = all[image.frame as usize].clone();
+                    self.frames = Some((image.path.clone(), all));
+                    raw
+                }
+            }
+        };
         let [w, h, _] = self.dims;
         if raw.len() as u64 != w as u64 * h as u64 {
             return Err(bad(&what, format!("pixel data holds {} samples, not Rows x Columns = {h} x {w}", raw.len())));
