@@ -28,7 +28,8 @@ impl Renderer {
     /// records of every brick that did not change; the changed bricks are written in place
     /// (`BrickStore::patch`). What the frame derives from the values (the level-of-detail
     /// pyramid, a shaded frame's gradients, the ray caster's field) is derived again on the next
-    /// frame. Refused, with the scene kept, when the grid or the range differ.
+    /// frame. Refused, with the scene kept, when the grid or the range differ; when the device
+    /// fails while it is written (out of memory), the renderer is left without a scene.
     ///
     /// ```
     /// use voxsplat::bricks::BrickStore;
@@ -73,12 +74,20 @@ impl Renderer {
         };
         let (bricks, store_bytes) = (scene.store.headers.len(), scene.store.bytes());
         // The scene's fields (the ray caster's, the isosurface's) were made from the old values.
-        let next = Prepared::bricked(scene)?;
-        let uploaded = match &mut self.gpu {
-            Some(g) => g.patch_store(&next, &patch)?,
-            None => 0,
-        };
-        *prep = next;
-        Ok(VolumeUpdate { changed: patch.changed, bricks, uploaded, store_bytes, layout: patch.layout })
+        let next = Prepared::bricked(scene).and_then(|next| match &mut self.gpu {
+            Some(g) => g.patch_store(&next, &patch).map(|sent| (next, sent)),
+            None => Ok((next, 0)),
+        });
+        match next {
+            Ok((next, uploaded)) => {
+                *prep = next;
+                Ok(VolumeUpdate { changed: patch.changed, bricks, uploaded, store_bytes, layout: patch.layout })
+            }
+            Err(e) => {
+                // The device holds part of the new time point: no scene rather than a wrong frame.
+                self.scene = None;
+                Err(e)
+            }
+        }
     }
 }
