@@ -121,3 +121,30 @@ fn the_zarr_seeds_load() {
         }
     }
 }
+
+/// The DICOM seeds (pydicom): a CT image and a multi-frame RT Dose grid read as series of one
+/// file; the `refused-` one is refused.
+#[test]
+fn the_dicom_seeds_load() {
+    for f in inputs("dicom") {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        if !(name.starts_with("seed-") || name.starts_with("refused-")) {
+            continue;
+        }
+        let dir = std::env::temp_dir().join(format!("voxsplat-corpus-dicom-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::copy(&f, dir.join("image.dcm")).unwrap();
+        let v = voxsplat::loaders::load_volume(&dir, &Default::default());
+        std::fs::remove_dir_all(&dir).unwrap();
+        match name.as_str() {
+            "seed-ct.dcm" => assert_eq!(v.unwrap().dims, [4, 3, 1]),
+            "seed-dose.dcm" => {
+                let v = v.unwrap();
+                assert_eq!(v.dims, [4, 3, 3]);
+                // 1000 k scaled by 1e-4, frame by frame.
+                assert!(v.values.iter().enumerate().all(|(k, &x)| (x - k as f32 * 0.1).abs() < 1e-5), "{:?}", v.values);
+            }
+            _ => assert!(v.is_err() || !name.starts_with("refused-"), "{name} loaded"),
+        }
+    }
+}

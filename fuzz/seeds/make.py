@@ -116,7 +116,8 @@ buf = io.BytesIO()
 tifffile.imwrite(buf, np.zeros((2, 3, 4, 5), np.uint8), imagej=True, metadata={"axes": "ZCYX"})
 put("stacks", "channels.tif", buf.getvalue(), "refused-")
 
-# DICOM (the dicom target): one CT image written by pydicom, and one without its Pixel Spacing.
+# DICOM (the dicom target): one CT image written by pydicom, one without its Pixel Spacing, and a
+# multi-frame RT Dose grid.
 try:
     import pydicom
     from pydicom.dataset import Dataset, FileMetaDataset
@@ -144,8 +145,21 @@ try:
         pydicom.dcmwrite(buf, ds, enforce_file_format=True)
         return buf.getvalue()
 
+    def dose():
+        # A multi-frame RT Dose grid: 3 frames of 32-bit samples placed by a Grid Frame Offset Vector.
+        ds = pydicom.dcmread(io.BytesIO(ct()))
+        ds.Modality = "RTDOSE"
+        del ds.RescaleSlope, ds.RescaleIntercept
+        ds.NumberOfFrames, ds.GridFrameOffsetVector, ds.DoseGridScaling = 3, [0, 2.5, 5], 1e-4
+        ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 32, 32, 31, 0
+        ds.PixelData = (np.arange(36, dtype=np.uint32) * 1000).tobytes()
+        buf = io.BytesIO()
+        pydicom.dcmwrite(buf, ds, enforce_file_format=True)
+        return buf.getvalue()
+
     put("dicom", "ct.dcm", ct())
     put("dicom", "no-spacing.dcm", ct(False), "refused-")
+    put("dicom", "dose.dcm", dose())
 except ImportError:
     print("pydicom missing: the dicom seeds are left as they are", file=sys.stderr)
 
