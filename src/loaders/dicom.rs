@@ -115,12 +115,13 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
             (8, u32_at(pos + 4), sq)
         } else {
             let vr = &bytes[pos + 4..pos + 6];
-            // dicom-rs reads a VR it does not know as UN: a long header.
-            let short_vrs = [
-                b"AE", b"AS", b"AT", b"CS", b"DA", b"DS", b"DT", b"FL", b"FD", b"IS", b"LO", b"LT", b"PN", b"SH",
-                b"SL", b"SS", b"ST", b"TM", b"UI", b"UL", b"US",
-            ];
-            let long = !short_vrs.iter().any(|v| v.as_slice() == vr);
+            // As dicom-rs reads the header (dicom-encoding's explicit decoders): these VRs, and a VR
+            // it does not know (read as UN), have a long one; every other VR it knows a short one,
+            // OV, SV and UV included (a fuzzed file with an OV pixel data element made it read a
+            // 4 GB length where this walk read the standard's 144 bytes).
+            let long_vrs = [b"OB", b"OD", b"OF", b"OL", b"OW", b"SQ", b"UC", b"UR", b"UT", b"UN"];
+            let known = dicom_core::VR::from_binary([vr[0], vr[1]]).is_some();
+            let long = !known || long_vrs.iter().any(|v| v.as_slice() == vr);
             if long {
                 if pos + 12 > bytes.len() {
                     return Err(short());
