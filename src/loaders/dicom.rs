@@ -104,15 +104,16 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
         if meta && group != 2 {
             break;
         }
-        let (header, len, container) = if group == 0xFFFE {
+        let (header, len, container, vr) = if group == 0xFFFE {
             // An item (walked into) or a delimiter.
-            (8, u32_at(pos + 4), true)
+            (8, u32_at(pos + 4), true, None)
         } else if enc == Encoding::ImplicitLittle {
             let tag = dicom_core::Tag(group, element);
-            let sq = dicom_dictionary_std::StandardDataDictionary
-                .by_tag(tag)
-                .is_some_and(|e| matches!(e.vr, VirtualVr::Exact(dicom_core::VR::SQ)));
-            (8, u32_at(pos + 4), sq)
+            let vr = dicom_dictionary_std::StandardDataDictionary.by_tag(tag).and_then(|e| match e.vr {
+                VirtualVr::Exact(vr) => Some(vr),
+                _ => None,
+            });
+            (8, u32_at(pos + 4), vr == Some(dicom_core::VR::SQ), vr)
         } else {
             let vr = &bytes[pos + 4..pos + 6];
             // As dicom-rs reads the header (dicom-encoding's explicit decoders): these VRs, and a VR
@@ -120,17 +121,35 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
             // OV, SV and UV included (a fuzzed file with an OV pixel data element made it read a
             // 4 GB length where this walk read the standard's 144 bytes).
             let long_vrs = [b"OB", b"OD", b"OF", b"OL", b"OW", b"SQ", b"UC", b"UR", b"UT", b"UN"];
-            let known = dicom_core::VR::from_binary([vr[0], vr[1]]).is_some();
-            let long = !known || long_vrs.iter().any(|v| v.as_slice() == vr);
+            let known = dicom_core::VR::from_binary([vr[0], vr[1]]);
+            let long = known.is_none() || long_vrs.iter().any(|v| v.as_slice() == vr);
             if long {
                 if pos + 12 > bytes.len() {
                     return Err(short());
                 }
-                (12, u32_at(pos + 8), vr == b"SQ")
+                (12, u32_at(pos + 8), vr == b"SQ", known)
             } else {
-                (8, u16_at(pos + 6) as u32, false)
+                (8, u16_at(pos + 6) as u32, false, known)
             }
         };
+        // dicom-rs reads a binary element's whole values only, so a length that is not a multiple
+        // of its value's size leaves it reading the next header from inside this value (a fuzzed
+        // FL of 2 bytes made it read a length of 4 GB).
+        use dicom_core::VR;
+        let size = match vr {
+            Some(VR::SS | VR::US | VR::OW) => 2,
+            Some(VR::FL | VR::SL | VR::UL | VR::AT | VR::OF | VR::OL) => 4,
+            Some(VR::FD | VR::SV | VR::UV | VR::OD | VR::OV) => 8,
+            _ => 1,
+        };
+        if len != u32::MAX && len % size != 0 {
+            return Err(bad(
+                what,
+                format!(
+                    "DICOM: element ({group:04X},{element:04X}) holds {len} bytes: not whole values of {size} bytes"
+                ),
+            ));
+        }
         pos += header;
         if (group, element) == (0x7FE0, 0x10) && len == u32::MAX {
             encapsulated = true;
