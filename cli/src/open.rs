@@ -374,7 +374,8 @@ pub fn load_bricked(
     let chunks = voxsplat::loaders::zarr_chunks_read();
     let mut store = voxsplat::bricks::BrickStore::load(path, &hints)?;
     if voxsplat::loaders::is_ome_zarr(path) {
-        // A pass for the value range, one for the bricks; before them, what choosing the level read.
+        // The value range's pass (the bricks' takes what it kept, when that fits); before it, what
+        // choosing the level read.
         let read = voxsplat::loaders::zarr_chunks_read() - chunks;
         eprintln!("OME-Zarr: the store read {read} chunks ({chunks} read before it to choose the level)");
     }
