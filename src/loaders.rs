@@ -249,6 +249,17 @@ pub(crate) fn several_times(what: &str, times: u32) -> Error {
     ))
 }
 
+/// The time point `time` asks for of a file of `times` (0 when it holds one and none is asked
+/// for): a series needs one, and one past it, or one of a file without a time axis, is refused.
+pub(crate) fn time_point(what: &str, times: u32, time: Option<u32>) -> Result<u32> {
+    match time {
+        None if times > 1 => Err(several_times(what, times)),
+        Some(t) if times == 1 => Err(bad(what, format!("--time {t}: it holds one volume, no time axis"))),
+        Some(t) if t >= times => Err(bad(what, format!("--time {t}: it holds time points 0 to {}", times - 1))),
+        t => Ok(t.unwrap_or(0)),
+    }
+}
+
 /// The error for a file of several channels read as one volume.
 pub(crate) fn several_channels(what: &str, channels: u32) -> Error {
     Error::InvalidArgument(format!(

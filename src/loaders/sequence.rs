@@ -61,13 +61,8 @@ pub(super) fn member(path: &Path, hints: &VolumeHints) -> Result<Option<(PathBuf
         return Ok(None);
     }
     let files = files(path)?;
-    let what = path.display().to_string();
-    let t = match hints.time {
-        None if files.len() > 1 => return Err(super::several_times(&what, files.len() as u32)),
-        Some(t) if t as usize >= files.len() => {
-            return Err(bad(&what, format!("--time {t}: the pattern matches time points 0 to {}", files.len() - 1)))
-        }
-        t => t.unwrap_or(0) as usize,
-    };
+    // A pattern of one file is a series of one time point: --time 0 picks it.
+    let time = hints.time.filter(|&t| !(files.len() == 1 && t == 0));
+    let t = super::time_point(&path.display().to_string(), files.len() as u32, time)? as usize;
     Ok(Some((files[t].clone(), VolumeHints { time: None, ..hints.clone() })))
 }

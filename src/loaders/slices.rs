@@ -185,16 +185,7 @@ impl SliceReader {
         if h.channels > 1 {
             return Err(super::several_channels(&what, h.channels));
         }
-        let t = match time {
-            None if h.times > 1 => return Err(super::several_times(&what, h.times)),
-            Some(t) if h.times == 1 => {
-                return Err(bad(&what, format!("--time {t}: the file holds one volume, no time axis")))
-            }
-            Some(t) if t >= h.times => {
-                return Err(bad(&what, format!("--time {t}: the file holds time points 0 to {}", h.times - 1)))
-            }
-            t => t.unwrap_or(0) as u64,
-        };
+        let t = super::time_point(&what, h.times, time)? as u64;
         // Time point t starts t volumes into the data.
         let skip = t * h.voxels * h.dtype.size() as u64;
         let gz = match h.encoding.as_str() {
@@ -233,14 +224,7 @@ impl SliceReader {
         if l.channels > 1 {
             return Err(super::several_channels(&what, l.channels));
         }
-        match time {
-            None if l.times > 1 => Err(super::several_times(&what, l.times)),
-            Some(t) if l.times == 1 => Err(bad(&what, format!("--time {t}: the file holds one volume, no time axis"))),
-            Some(t) if t >= l.times => {
-                Err(bad(&what, format!("--time {t}: the file holds time points 0 to {}", l.times - 1)))
-            }
-            t => Self::nifti_block(path, t.unwrap_or(0)),
-        }
+        Self::nifti_block(path, super::time_point(&what, l.times, time)?)
     }
 
     /// The channels a NIfTI-1 file holds (1 for a 3-D volume).
