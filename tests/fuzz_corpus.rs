@@ -122,8 +122,8 @@ fn the_zarr_seeds_load() {
     }
 }
 
-/// The DICOM seeds (pydicom): a CT image and a multi-frame RT Dose grid read as series of one
-/// file; the `refused-` one, and the files the fuzzer found (`found-`: each made dicom-rs size a
+/// The DICOM seeds (pydicom): a CT image, a multi-frame RT Dose grid, an enhanced image and a
+/// JPEG 2000 image read as series of one file; the `refused-` one, and the files the fuzzer found (`found-`: each made dicom-rs size a
 /// buffer of gigabytes by a length the walk before it now checks), are refused.
 #[test]
 fn the_dicom_seeds_load() {
@@ -144,6 +144,17 @@ fn the_dicom_seeds_load() {
                 assert_eq!(v.dims, [4, 3, 3]);
                 // 1000 k scaled by 1e-4, frame by frame.
                 assert!(v.values.iter().enumerate().all(|(k, &x)| (x - k as f32 * 0.1).abs() < 1e-5), "{:?}", v.values);
+            }
+            "seed-enhanced.dcm" => {
+                // Its frames are stored top first: frame 2 (z = 0) is the grid's first slice.
+                let v = v.unwrap();
+                assert_eq!(v.dims, [4, 3, 2]);
+                let want: Vec<f32> = (12..24).chain(0..12).map(|k| (k * 50 - 1024) as f32).collect();
+                assert_eq!(v.values, want);
+            }
+            "seed-j2k.dcm" => {
+                let v = v.unwrap();
+                assert_eq!(v.values, (0..12).map(|k| (k * 100 - 1024) as f32).collect::<Vec<_>>());
             }
             _ => assert!(v.is_err(), "{name} loaded"),
         }

@@ -328,3 +328,117 @@ fn rt_dose_grids_read_frame_by_frame_as_pydicom_reads_them() {
     assert!(e.contains("1.2.840.10008.1.2.4.80"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Voxel `(i, j, k)` of a grid loaded with orientation `o` in world (RAS) coordinates.
+fn world(o: &voxsplat::orient::Orientation, dims: [u32; 3], [i, j, k]: [u32; 3]) -> voxsplat::glam::DVec3 {
+    let i = if o.flip_x() { dims[0] - 1 - i } else { i };
+    o.affine().transform_point3(voxsplat::glam::DVec3::new(i as f64, j as f64, k as f64))
+}
+
+/// Enhanced multi-frame images (issue 47 item 1): an enhanced MR whose 12 frames are stored out of
+/// order on an oblique plane, placed by per-frame Plane Position and shared Plane Orientation,
+/// Pixel Measures and Pixel Value Transformation (cli/tests/data/write_enhanced.py), reads voxel
+/// for voxel where dcm2niix's NIfTI of it puts each value; frames of several temporal positions and
+/// a Per-frame Functional Groups Sequence of the wrong length are refused.
+#[test]
+fn an_enhanced_image_is_placed_by_its_functional_groups_as_dcm2niix_places_it() {
+    let dir = tmp("enhanced");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("in")).unwrap();
+    let write = |file: &Path, extra: &[&str]| {
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/write_enhanced.py");
+        let out = std::process::Command::new("python3").arg(script).arg(file).args(extra).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    let series = dir.join("in");
+    write(&series.join("e.dcm"), &[]);
+    let hints = VolumeHints::default();
+    let v = load_volume(&series, &hints).unwrap();
+    assert_eq!((v.dims, v.spacing), ([24, 20, 12], [0.9, 0.8, 2.5]));
+    let o = load_orientation(&series, &hints).unwrap().unwrap();
+    let conv = std::process::Command::new("dcm2niix")
+        .args(["-o", dir.to_str().unwrap(), "-f", "e", "-z", "n"])
+        .arg(&series)
+        .output()
+        .expect("dcm2niix (scripts/setup.sh installs it)");
+    assert!(conv.status.success(), "{}", String::from_utf8_lossy(&conv.stderr));
+    let nii = dir.join("e.nii");
+    let n = load_volume(&nii, &hints).unwrap();
+    let no = load_orientation(&nii, &hints).unwrap().unwrap();
+    assert_ne!(o.code(), no.code(), "dcm2niix stores the rows the other way up");
+    let back = no.affine().inverse();
+    let [w, h, d] = v.dims;
+    for k in 0..d {
+        for j in 0..h {
+            for i in 0..w {
+                let p = back.transform_point3(world(&o, v.dims, [i, j, k]));
+                let q = p.round();
+                assert!((p - q).length() < 1e-3, "voxel {i} {j} {k} lands between dcm2niix's voxels: {p}");
+                let [a, b, c] = [q.x as u32, q.y as u32, q.z as u32];
+                let a = if no.flip_x() { n.dims[0] - 1 - a } else { a };
+                let at = |dims: [u32; 3], [i, j, k]: [u32; 3]| (i + dims[0] * (j + dims[1] * k)) as usize;
+                assert_eq!(v.values[at(v.dims, [i, j, k])], n.values[at(n.dims, [a, b, c])], "voxel {i} {j} {k}");
+            }
+        }
+    }
+    // Streamed frame by frame into the bricked store as the whole volume builds it.
+    let streamed = voxsplat::bricks::BrickStore::load(&series, &hints).unwrap();
+    let whole = voxsplat::bricks::BrickStore::build(&v).unwrap();
+    assert_eq!((streamed.records, streamed.headers), (whole.records, whole.headers));
+    // The same frame as the NIfTI's under validation. Sheet compositing: per-splat compositing
+    // blends overlapping splats in storage order, and dcm2niix stores the rows the other way up.
+    let (a, b) = (dir.join("dicom.png"), dir.join("nifti.png"));
+    for (input, png) in [(&series, &a), (&nii, &b)] {
+        let s = input.to_str().unwrap();
+        ok(&[
+            "render",
+            "--volume",
+            s,
+            "--composite",
+            "sheet",
+            "--size",
+            "64x64",
+            "--validation",
+            "--out",
+            png.to_str().unwrap(),
+        ]);
+    }
+    let compared = ok(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    assert!(compared.contains("psnr:       inf dB"), "{compared}");
+    // Refused: frames of two temporal positions, and per-frame items that are not one per frame.
+    for (name, extra, says) in [
+        ("times", ["--times", "2"], "2 temporal positions"),
+        ("items", ["--items", "5"], "holds 5 items for 12 frames"),
+    ] {
+        let bad = dir.join(name);
+        std::fs::create_dir_all(&bad).unwrap();
+        write(&bad.join("e.dcm"), &extra);
+        let e = load_volume(&bad, &hints).unwrap_err().to_string();
+        assert!(e.contains(says) && e.contains("e.dcm"), "{e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// JPEG 2000 (issue 47 item 1) through dicom-pixeldata's pure-Rust OpenJPEG port: pydicom's
+/// lossless JPEG 2000 copy of its MR image reads value for value as the uncompressed one (and as
+/// the RLE copy); JPEG-LS, which dicom-rs decodes only through the C++ CharLS, is refused by name.
+#[test]
+fn jpeg_2000_images_read_as_their_uncompressed_originals() {
+    let files = pydicom_tests().join("..");
+    let read = |name: &str| {
+        let dir = tmp(name);
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::copy(files.join(format!("{name}.dcm")), dir.join("a.dcm")).unwrap();
+        let v = load_volume(&dir, &VolumeHints::default());
+        let _ = std::fs::remove_dir_all(&dir);
+        v
+    };
+    let plain = read("MR_small").unwrap();
+    assert_eq!(plain.dims, [64, 64, 1]);
+    for name in ["MR_small_jp2klossless", "MR_small_RLE"] {
+        assert_eq!(read(name).unwrap().values, plain.values, "{name}");
+    }
+    let e = read("MR_small_jpeg_ls_lossless").unwrap_err().to_string();
+    assert!(e.contains("JPEG-LS Lossless") && e.contains("1.2.840.10008.1.2.4.80"), "{e}");
+}

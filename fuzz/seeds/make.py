@@ -116,8 +116,8 @@ buf = io.BytesIO()
 tifffile.imwrite(buf, np.zeros((2, 3, 4, 5), np.uint8), imagej=True, metadata={"axes": "ZCYX"})
 put("stacks", "channels.tif", buf.getvalue(), "refused-")
 
-# DICOM (the dicom target): one CT image written by pydicom, one without its Pixel Spacing, and a
-# multi-frame RT Dose grid.
+# DICOM (the dicom target): one CT image written by pydicom, one without its Pixel Spacing, a
+# multi-frame RT Dose grid, an enhanced image of two frames, and a JPEG 2000 image.
 try:
     import pydicom
     from pydicom.dataset import Dataset, FileMetaDataset
@@ -157,9 +157,51 @@ try:
         pydicom.dcmwrite(buf, ds, enforce_file_format=True)
         return buf.getvalue()
 
+    def enhanced():
+        # An enhanced image: 2 frames placed by per-frame Plane Position, the rest shared.
+        from pydicom.sequence import Sequence
+        ds = pydicom.dcmread(io.BytesIO(ct()))
+        shared = Dataset()
+        shared.PlaneOrientationSequence = Sequence([Dataset()])
+        shared.PlaneOrientationSequence[0].ImageOrientationPatient = ds.ImageOrientationPatient
+        shared.PixelMeasuresSequence = Sequence([Dataset()])
+        shared.PixelMeasuresSequence[0].PixelSpacing = ds.PixelSpacing
+        del ds.ImageOrientationPatient, ds.ImagePositionPatient, ds.PixelSpacing
+        ds.SharedFunctionalGroupsSequence = Sequence([shared])
+        frames = []
+        for z in (2.0, 0.0):
+            item = Dataset()
+            item.PlanePositionSequence = Sequence([Dataset()])
+            item.PlanePositionSequence[0].ImagePositionPatient = [0, 0, z]
+            frames.append(item)
+        ds.PerFrameFunctionalGroupsSequence = Sequence(frames)
+        ds.NumberOfFrames = 2
+        ds.PixelData = (np.arange(24, dtype=np.int16) * 50).tobytes()
+        buf = io.BytesIO()
+        pydicom.dcmwrite(buf, ds, enforce_file_format=True)
+        return buf.getvalue()
+
+    def j2k():
+        # A JPEG 2000 image (lossless, encoded by Pillow's OpenJPEG), encapsulated.
+        from PIL import Image
+        from pydicom.encaps import encapsulate
+        ds = pydicom.dcmread(io.BytesIO(ct()))
+        ds.PixelRepresentation = 0
+        j = io.BytesIO()
+        Image.fromarray((np.arange(12, dtype=np.uint16) * 100).reshape(3, 4)).save(j, "JPEG2000", irreversible=False)
+        ds.file_meta.TransferSyntaxUID = "1.2.840.10008.1.2.4.90"
+        ds.PixelData = encapsulate([j.getvalue()])
+        ds["PixelData"].VR = "OB"
+        ds["PixelData"].is_undefined_length = True
+        buf = io.BytesIO()
+        pydicom.dcmwrite(buf, ds, enforce_file_format=True)
+        return buf.getvalue()
+
     put("dicom", "ct.dcm", ct())
     put("dicom", "no-spacing.dcm", ct(False), "refused-")
     put("dicom", "dose.dcm", dose())
+    put("dicom", "enhanced.dcm", enhanced())
+    put("dicom", "j2k.dcm", j2k())
 except ImportError:
     print("pydicom missing: the dicom seeds are left as they are", file=sys.stderr)
 

@@ -1,11 +1,13 @@
-//! DICOM series (issue 47): the images of one series in a folder (single-frame, or multi-frame
-//! with a Grid Frame Offset Vector such as RT Dose), read with dicom-rs.
+//! DICOM series (issue 47): the images of one series in a folder (single-frame, enhanced
+//! multi-frame placed by per-frame functional groups, or multi-frame with a Grid Frame Offset
+//! Vector such as RT Dose), read with dicom-rs.
 //! Slices are ordered by their position along the slice normal (DICOM C.7.6.2: Image Position and
 //! Orientation (Patient), Pixel Spacing), not by file name or instance number; the grid is placed
 //! in patient space (LPS turned RAS), a gantry tilt as a sheared grid; values are rescaled by the
-//! series' Rescale Slope and Intercept. Pixel data is decoded by dicom-pixeldata (native, JPEG
-//! baseline/extended/lossless and RLE; other transfer syntaxes are refused by name), a slice at a
-//! time, so a series streams into the bricked store as NIfTI does.
+//! series' Rescale Slope and Intercept. Pixel data is decoded by dicom-pixeldata (JPEG
+//! baseline/extended/lossless, JPEG 2000 through OpenJPEG's pure-Rust port, and RLE; other
+//! transfer syntaxes, JPEG-LS among them, are refused by name), a slice at a time, so a series
+//! streams into the bricked store as NIfTI does.
 use super::bad;
 use crate::error::{Error, Result};
 use dicom_dictionary_std::tags;
@@ -228,14 +230,82 @@ fn numbers(
     Ok(v)
 }
 
+/// The data set that holds an enhanced image's attribute `tag` for a frame: the frame's item of
+/// functional group `seq` (C.7.6.16), else the shared one, else the data set itself (a classic
+/// image, or a group the file left out).
+fn group<'a>(
+    frame: Option<&'a dicom_object::InMemDicomObject>,
+    shared: Option<&'a dicom_object::InMemDicomObject>,
+    top: &'a dicom_object::InMemDicomObject,
+    seq: dicom_core::Tag,
+    tag: dicom_core::Tag,
+) -> &'a dicom_object::InMemDicomObject {
+    [frame, shared]
+        .into_iter()
+        .flatten()
+        .filter_map(|g| g.element_opt(seq).ok().flatten()?.items()?.first())
+        .find(|item| item.element_opt(tag).ok().flatten().is_some())
+        .unwrap_or(top)
+}
+
+/// An image's plane and rescale, read from the data sets that hold Image Orientation (Patient),
+/// Pixel Spacing, Rescale Slope (or RT Dose's Dose Grid Scaling) and Rescale Intercept; its
+/// position, size and frame are left for the caller.
+fn plane(
+    orientation: &dicom_object::InMemDicomObject,
+    measures: &dicom_object::InMemDicomObject,
+    slope: &dicom_object::InMemDicomObject,
+    intercept: &dicom_object::InMemDicomObject,
+    what: &str,
+) -> Result<Image> {
+    let o = numbers(orientation, tags::IMAGE_ORIENTATION_PATIENT, "Image Orientation (Patient)", 6, what)?;
+    let s = numbers(measures, tags::PIXEL_SPACING, "Pixel Spacing", 2, what)?;
+    if !(s[0] > 0.0 && s[1] > 0.0) {
+        return Err(bad(what, format!("Pixel Spacing {s:?}: spacings must be positive")));
+    }
+    let (row, column) = (DVec3::new(o[0], o[1], o[2]), DVec3::new(o[3], o[4], o[5]));
+    if (row.length() - 1.0).abs() > 1e-3 || (column.length() - 1.0).abs() > 1e-3 || row.dot(column).abs() > 1e-3 {
+        return Err(bad(what, format!("Image Orientation (Patient) {o:?} is not two unit, perpendicular directions")));
+    }
+    let scalar = |obj: &dicom_object::InMemDicomObject, tag, default: f64, name: &str| -> Result<f64> {
+        match obj.element_opt(tag).ok().flatten() {
+            Some(e) => e.to_float64().map_err(|e| bad(what, format!("{name}: {e}"))).and_then(|v| {
+                if v.is_finite() {
+                    Ok(v)
+                } else {
+                    Err(bad(what, format!("{name} is {v}")))
+                }
+            }),
+            None => Ok(default),
+        }
+    };
+    // RT Dose stores its values scaled: Dose Grid Scaling, where no Rescale Slope is given.
+    let slope = match slope.element_opt(tags::RESCALE_SLOPE).ok().flatten() {
+        Some(_) => scalar(slope, tags::RESCALE_SLOPE, 1.0, "Rescale Slope")?,
+        None => scalar(slope, tags::DOSE_GRID_SCALING, 1.0, "Dose Grid Scaling")?,
+    };
+    Ok(Image {
+        path: PathBuf::new(),
+        position: DVec3::ZERO,
+        row: row.normalize(),
+        column: column.normalize(),
+        spacing: [s[0], s[1]],
+        rescale: [slope, scalar(intercept, tags::RESCALE_INTERCEPT, 0.0, "Rescale Intercept")?],
+        size: [0; 2],
+        frame: 0,
+    })
+}
+
 /// A file's series UID, description, modality and slices.
 type Header = (String, String, String, Vec<Image>);
 
 /// An image's header (up to its pixel data), or `None` for an object that is not an image (no
 /// Rows): a folder's other objects are left alone. A multi-frame image is one slice per frame,
-/// placed by its Grid Frame Offset Vector (RT Dose: offsets along the normal from Image Position
-/// (Patient) when the first is 0, else the frames' z coordinates on an axial grid) and scaled by
-/// its Dose Grid Scaling; other multi-frame images (per-frame functional groups) are refused.
+/// placed by its own functional groups (an enhanced CT or MR image: Plane Position, Plane
+/// Orientation, Pixel Measures and Pixel Value Transformation, per frame or shared; frames of
+/// several temporal positions are refused), or by its Grid Frame Offset Vector (RT Dose: offsets
+/// along the normal from Image Position (Patient) when the first is 0, else the frames' z
+/// coordinates on an axial grid) and scaled by its Dose Grid Scaling.
 fn header(path: &Path) -> Result<Option<Header>> {
     let what = path.display().to_string();
     let bytes = checked_bytes(path, &what)?;
@@ -260,69 +330,96 @@ fn header(path: &Path) -> Result<Option<Header>> {
         Some(e) => e.to_int::<u32>().map_err(|e| bad(&what, format!("Number of Frames: {e}")))?,
         None => 1,
     };
-    let o = numbers(&obj, tags::IMAGE_ORIENTATION_PATIENT, "Image Orientation (Patient)", 6, &what)?;
-    let p = numbers(&obj, tags::IMAGE_POSITION_PATIENT, "Image Position (Patient)", 3, &what)?;
-    let s = numbers(&obj, tags::PIXEL_SPACING, "Pixel Spacing", 2, &what)?;
-    if !(s[0] > 0.0 && s[1] > 0.0) {
-        return Err(bad(&what, format!("Pixel Spacing {s:?}: spacings must be positive")));
+    if frames == 0 || frames as u64 > MAX_FILES as u64 {
+        return Err(bad(&what, format!("Number of Frames {frames}: 1 to {MAX_FILES}")));
     }
-    let (row, column) = (DVec3::new(o[0], o[1], o[2]), DVec3::new(o[3], o[4], o[5]));
-    if (row.length() - 1.0).abs() > 1e-3 || (column.length() - 1.0).abs() > 1e-3 || row.dot(column).abs() > 1e-3 {
-        return Err(bad(&what, format!("Image Orientation (Patient) {o:?} is not two unit, perpendicular directions")));
-    }
-    let scalar = |tag, default: f64, name: &str| -> Result<f64> {
-        match obj.element_opt(tag).ok().flatten() {
-            Some(e) => e.to_float64().map_err(|e| bad(&what, format!("{name}: {e}"))).and_then(|v| {
-                if v.is_finite() {
-                    Ok(v)
-                } else {
-                    Err(bad(&what, format!("{name} is {v}")))
+    let per_frame = obj.element_opt(tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE).ok().flatten();
+    let images = match per_frame {
+        // An enhanced image: each frame placed by its own functional groups.
+        Some(e) => {
+            let items =
+                e.items().ok_or_else(|| bad(&what, "Per-frame Functional Groups Sequence is not a sequence"))?;
+            if items.len() != frames as usize {
+                return Err(bad(
+                    &what,
+                    format!("Per-frame Functional Groups Sequence holds {} items for {frames} frames", items.len()),
+                ));
+            }
+            let shared = obj
+                .element_opt(tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE)
+                .ok()
+                .flatten()
+                .and_then(|e| e.items())
+                .and_then(|i| i.first());
+            let mut temporal = std::collections::BTreeSet::new();
+            let mut images = Vec::with_capacity(items.len());
+            for (k, item) in items.iter().enumerate() {
+                let at = |seq, tag| group(Some(item), shared, &obj, seq, tag);
+                let frame = format!("{what} frame {}", k + 1);
+                let p = numbers(
+                    at(tags::PLANE_POSITION_SEQUENCE, tags::IMAGE_POSITION_PATIENT),
+                    tags::IMAGE_POSITION_PATIENT,
+                    "Image Position (Patient)",
+                    3,
+                    &frame,
+                )?;
+                let plane = plane(
+                    at(tags::PLANE_ORIENTATION_SEQUENCE, tags::IMAGE_ORIENTATION_PATIENT),
+                    at(tags::PIXEL_MEASURES_SEQUENCE, tags::PIXEL_SPACING),
+                    at(tags::PIXEL_VALUE_TRANSFORMATION_SEQUENCE, tags::RESCALE_SLOPE),
+                    at(tags::PIXEL_VALUE_TRANSFORMATION_SEQUENCE, tags::RESCALE_INTERCEPT),
+                    &frame,
+                )?;
+                let content = at(tags::FRAME_CONTENT_SEQUENCE, tags::TEMPORAL_POSITION_INDEX);
+                if let Some(t) = content.element_opt(tags::TEMPORAL_POSITION_INDEX).ok().flatten() {
+                    temporal
+                        .insert(t.to_int::<i64>().map_err(|e| bad(&frame, format!("Temporal Position Index: {e}")))?);
                 }
-            }),
-            None => Ok(default),
+                images.push(Image {
+                    path: path.to_path_buf(),
+                    position: DVec3::new(p[0], p[1], p[2]),
+                    size,
+                    frame: k as u32,
+                    ..plane
+                });
+            }
+            if temporal.len() > 1 {
+                return Err(Error::Unsupported(format!(
+                    "{what}: an enhanced image of {} temporal positions (Temporal Position Index) is not read as a \
+                     time series yet",
+                    temporal.len()
+                )));
+            }
+            images
+        }
+        None => {
+            let p = numbers(&obj, tags::IMAGE_POSITION_PATIENT, "Image Position (Patient)", 3, &what)?;
+            let plane = plane(&obj, &obj, &obj, &obj, &what)?;
+            let position = DVec3::new(p[0], p[1], p[2]);
+            let offsets = if frames > 1 {
+                numbers(&obj, tags::GRID_FRAME_OFFSET_VECTOR, "Grid Frame Offset Vector", frames as usize, &what)?
+            } else {
+                vec![0.0]
+            };
+            let normal = plane.row.cross(plane.column);
+            // Offsets from the first frame, or (a first offset other than 0) the frames' z on an axial grid.
+            let relative = offsets[0] == 0.0;
+            if !relative && (normal.z.abs() - 1.0).abs() > 1e-6 {
+                return Err(bad(&what, "Grid Frame Offset Vector of z coordinates on a grid that is not axial"));
+            }
+            offsets
+                .iter()
+                .enumerate()
+                .map(|(k, &o)| Image {
+                    path: path.to_path_buf(),
+                    position: if relative { position + normal * o } else { DVec3::new(position.x, position.y, o) },
+                    size,
+                    frame: k as u32,
+                    ..plane.clone()
+                })
+                .collect()
         }
     };
-    // RT Dose stores its values scaled: Dose Grid Scaling, where no Rescale Slope is given.
-    let slope = match obj.element_opt(tags::RESCALE_SLOPE).ok().flatten() {
-        Some(_) => scalar(tags::RESCALE_SLOPE, 1.0, "Rescale Slope")?,
-        None => scalar(tags::DOSE_GRID_SCALING, 1.0, "Dose Grid Scaling")?,
-    };
-    let rescale = [slope, scalar(tags::RESCALE_INTERCEPT, 0.0, "Rescale Intercept")?];
-    let (row, column) = (row.normalize(), column.normalize());
-    let position = DVec3::new(p[0], p[1], p[2]);
-    let offsets = if frames > 1 {
-        if obj.element_opt(tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE).ok().flatten().is_some() {
-            return Err(Error::Unsupported(format!(
-                "{what}: a multi-frame image placed by per-frame functional groups (an enhanced image) is not read yet"
-            )));
-        }
-        if frames as u64 > MAX_FILES as u64 {
-            return Err(bad(&what, format!("{frames} frames: at most {MAX_FILES} slices")));
-        }
-        numbers(&obj, tags::GRID_FRAME_OFFSET_VECTOR, "Grid Frame Offset Vector", frames as usize, &what)?
-    } else {
-        vec![0.0]
-    };
-    let normal = row.cross(column);
-    // Offsets from the first frame, or (a first offset other than 0) the frames' z on an axial grid.
-    let relative = offsets[0] == 0.0;
-    if !relative && (normal.z.abs() - 1.0).abs() > 1e-6 {
-        return Err(bad(&what, "Grid Frame Offset Vector of z coordinates on a grid that is not axial"));
-    }
-    let images = offsets
-        .iter()
-        .enumerate()
-        .map(|(k, &o)| Image {
-            path: path.to_path_buf(),
-            position: if relative { position + normal * o } else { DVec3::new(position.x, position.y, o) },
-            row,
-            column,
-            spacing: [s[0], s[1]],
-            rescale,
-            size,
-            frame: k as u32,
-        })
-        .collect();
     let uid = text(&obj, tags::SERIES_INSTANCE_UID);
     Ok(Some((uid, text(&obj, tags::SERIES_DESCRIPTION), text(&obj, tags::MODALITY), images)))
 }
@@ -356,6 +453,21 @@ pub fn series_in(dir: &Path) -> Result<Vec<SeriesInfo>> {
 /// Whether folder `dir` holds a DICOM file (read as a series rather than a stack of images).
 pub fn holds_dicom(dir: &Path) -> bool {
     std::fs::read_dir(dir).is_ok_and(|d| d.filter_map(|e| e.ok()).take(MAX_FILES).any(|e| is_dicom(&e.path())))
+}
+
+/// Why pixel data in transfer syntax `uid` is not decoded, naming it, or `None` when it is (or is
+/// unknown, and the decoder's own error says more).
+fn undecoded(uid: &str) -> Option<String> {
+    use dicom_encoding::TransferSyntaxIndex;
+    let ts = dicom_transfer_syntax_registry::TransferSyntaxRegistry.get(uid)?;
+    let why = if ts.name().starts_with("JPEG-LS") {
+        "dicom-rs decodes it only through the C++ library CharLS, which voxsplat does not build"
+    } else {
+        "dicom-rs has no decoder for it"
+    };
+    (!ts.can_decode_all()).then(|| {
+        format!("pixel data in {} ({uid}) is not decoded: {why} (uncompressed, RLE, JPEG and JPEG 2000 are)", ts.name())
+    })
 }
 
 /// A series read a slice at a time.
@@ -415,7 +527,11 @@ pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool) -> Result<Series
 /// Checks a series' images agree and orders them along their normal.
 fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let first = &s.images[0];
-    let name = |i: &Image| i.path.display().to_string();
+    // A file, or a frame of a multi-frame file.
+    let name = |i: &Image| match s.images.iter().filter(|j| j.path == i.path).count() {
+        1 => i.path.display().to_string(),
+        _ => format!("{} frame {}", i.path.display(), i.frame + 1),
+    };
     if s.images.len() > MAX_FILES {
         return Err(bad(what, format!("{} slices: a series holds at most {MAX_FILES}", s.images.len())));
     }
@@ -512,7 +628,10 @@ impl Series {
                 let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
                 let failed =
                     |e: &dyn std::fmt::Display| bad(&what, format!("pixel data (transfer syntax {syntax}): {e}"));
-                let pixels = obj.decode_pixel_data().map_err(|e| failed(&e))?;
+                let pixels = obj.decode_pixel_data().map_err(|e| match undecoded(&syntax) {
+                    Some(refusal) => Error::Unsupported(format!("{what}: {refusal}")),
+                    None => failed(&e),
+                })?;
                 let options = ConvertOptions::new()
                     .with_modality_lut(ModalityLutOption::None)
                     .with_voi_lut(VoiLutOption::Identity);
