@@ -47,23 +47,31 @@ pub const MAX_INFLATED: u64 = MAX_VOXELS * 8 + (1 << 20);
 pub enum DType {
     /// Unsigned 8-bit samples.
     U8,
+    /// Signed 8-bit samples.
+    I8,
     /// Unsigned 16-bit samples.
     U16,
     /// Signed 16-bit samples.
     I16,
     /// Unsigned 32-bit samples (label volumes; held as f32, exact up to 2^24).
     U32,
+    /// Signed 32-bit samples (label volumes; held as f32, exact within ±2^24).
+    I32,
     /// 32-bit float samples.
     F32,
+    /// 64-bit float samples (held as f32: rounded, and those past f32's range non-finite, which
+    /// the loaders treat as they treat NaN).
+    F64,
 }
 
 impl DType {
     /// Bytes per sample.
     pub fn size(self) -> usize {
         match self {
-            DType::U8 => 1,
+            DType::U8 | DType::I8 => 1,
             DType::U16 | DType::I16 => 2,
-            DType::F32 | DType::U32 => 4,
+            DType::F32 | DType::U32 | DType::I32 => 4,
+            DType::F64 => 8,
         }
     }
 }
@@ -73,11 +81,16 @@ impl std::str::FromStr for DType {
     fn from_str(s: &str) -> Result<Self> {
         match s {
             "u8" | "uint8" | "uchar" | "unsigned char" | "uint8_t" => Ok(DType::U8),
+            "i8" | "int8" | "signed char" | "int8_t" => Ok(DType::I8),
             "u16" | "uint16" | "ushort" | "unsigned short" | "uint16_t" => Ok(DType::U16),
             "i16" | "int16" | "short" | "signed short" | "int16_t" => Ok(DType::I16),
             "u32" | "uint32" | "uint" | "unsigned int" | "uint32_t" => Ok(DType::U32),
+            "i32" | "int32" | "int" | "signed int" | "int32_t" => Ok(DType::I32),
             "f32" | "float" | "float32" => Ok(DType::F32),
-            other => Err(Error::InvalidArgument(format!("unsupported sample type '{other}' (u8, u16, i16, u32, f32)"))),
+            "f64" | "double" | "float64" => Ok(DType::F64),
+            other => Err(Error::InvalidArgument(format!(
+                "unsupported sample type '{other}' (u8, i8, u16, i16, u32, i32, f32, f64)"
+            ))),
         }
     }
 }
@@ -116,6 +129,7 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
     let b = &bytes[..need as usize];
     let v = match dtype {
         DType::U8 => b.iter().map(|&x| x as f32).collect(),
+        DType::I8 => b.iter().map(|&x| x as i8 as f32).collect(),
         DType::U16 => b
             .chunks_exact(2)
             .map(
@@ -133,6 +147,20 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
             .map(|c| {
                 let a = [c[0], c[1], c[2], c[3]];
                 (if big_endian { u32::from_be_bytes(a) } else { u32::from_le_bytes(a) }) as f32
+            })
+            .collect(),
+        DType::I32 => b
+            .chunks_exact(4)
+            .map(|c| {
+                let a = [c[0], c[1], c[2], c[3]];
+                (if big_endian { i32::from_be_bytes(a) } else { i32::from_le_bytes(a) }) as f32
+            })
+            .collect(),
+        DType::F64 => b
+            .chunks_exact(8)
+            .map(|c| {
+                let a = [c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]];
+                (if big_endian { f64::from_be_bytes(a) } else { f64::from_le_bytes(a) }) as f32
             })
             .collect(),
         DType::F32 => b

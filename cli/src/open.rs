@@ -59,7 +59,7 @@ pub struct SceneArgs {
     #[arg(long, value_parser = parse_dims, requires = "volume")]
     pub dims: Option<[u32; 3]>,
     /// Raw sample type.
-    #[arg(long, value_parser = ["u8", "u16", "i16", "u32", "f32"], requires = "volume")]
+    #[arg(long, value_parser = ["u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"], requires = "volume")]
     pub dtype: Option<String>,
     /// Raw data is big-endian.
     #[arg(long, requires = "volume")]

@@ -79,6 +79,9 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
     voxel_count_within(&[d3[0], d3[1], d3[2], channels], what, limit.saturating_mul(MAX_FILE_CHANNELS))?;
     let dtype = match header.data_type().map_err(|e| bad(what, format!("NIfTI type: {e}")))? {
         nifti::NiftiType::Uint8 => DType::U8,
+        nifti::NiftiType::Int8 => DType::I8,
+        nifti::NiftiType::Int32 => DType::I32,
+        nifti::NiftiType::Float64 => DType::F64,
         nifti::NiftiType::Uint16 => DType::U16,
         nifti::NiftiType::Int16 => DType::I16,
         nifti::NiftiType::Uint32 => DType::U32,
