@@ -156,6 +156,11 @@ fn the_dicom_seeds_load() {
                 let v = v.unwrap();
                 assert_eq!(v.values, (0..12).map(|k| (k * 100 - 1024) as f32).collect::<Vec<_>>());
             }
+            // Samples per Pixel 9217 on a JPEG 2000 image: the decoder sized 4.7 GB by it.
+            "found-j2k-samples-per-pixel.dcm" => {
+                let e = v.unwrap_err().to_string();
+                assert!(e.contains("Samples per Pixel 9217"), "{e}");
+            }
             _ => assert!(v.is_err(), "{name} loaded"),
         }
     }

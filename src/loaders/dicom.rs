@@ -326,6 +326,16 @@ fn header(path: &Path) -> Result<Option<Header>> {
     if size.contains(&0) {
         return Err(bad(&what, format!("an image of {} x {} pixels", size[0], size[1])));
     }
+    // A decoder sizes its frame by Rows x Columns x Samples per Pixel before it reads a byte.
+    let samples = match obj.element_opt(tags::SAMPLES_PER_PIXEL).ok().flatten() {
+        Some(e) => e.to_int::<u32>().map_err(|e| bad(&what, format!("Samples per Pixel: {e}")))?,
+        None => 1,
+    };
+    if samples != 1 {
+        return Err(Error::Unsupported(format!(
+            "{what}: Samples per Pixel {samples}: only one sample per pixel (a grey-scale image) is read"
+        )));
+    }
     let frames = match obj.element_opt(tags::NUMBER_OF_FRAMES).ok().flatten() {
         Some(e) => e.to_int::<u32>().map_err(|e| bad(&what, format!("Number of Frames: {e}")))?,
         None => 1,
