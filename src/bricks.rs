@@ -93,9 +93,13 @@ impl BrickStore {
     /// Load a volume file as a store (`hints` as `loaders::load_volume` takes them): NRRD (raw
     /// or gzip), NIfTI and raw files stream slice by slice (gzip inflated as it is read), never
     /// held whole (volumes past the dense loader's `MAX_VOXELS` too); an `.npy` is loaded, cut
-    /// and dropped.
+    /// and dropped. With `hints.crop`, an OME-Zarr image reads only the region it needs
+    /// (`VolumeHints::crop`).
     #[cfg(feature = "io")]
     pub fn load(path: &std::path::Path, hints: &crate::loaders::VolumeHints) -> Result<Self> {
+        if let Some(crop) = hints.crop.filter(|_| crate::loaders::is_ome_zarr(path)) {
+            return Self::load_cropped(path, hints, crop);
+        }
         let mut store = match crate::loaders::SliceReader::open(path, hints)? {
             Some(mut reader) => {
                 let (dims, spacing) = (reader.dims, reader.spacing);

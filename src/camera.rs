@@ -312,4 +312,70 @@ impl Camera {
             }
         }
     }
+
+    /// The bounds of the part of box `lo..hi` this view can see, `margin` pixels past the image's
+    /// edges (its side planes only: near and far aside), or `None` when it sees none of it. A
+    /// reader that needs only what the frame shows reads these bounds.
+    pub fn box_in_view(&self, lo: Vec3, hi: Vec3, margin: f32) -> Option<[Vec3; 2]> {
+        let (f, r, u) = (self.forward(), self.right(), self.true_up());
+        let (half_w, half_h) = (0.5 * self.width as f32 + margin, 0.5 * self.height as f32 + margin);
+        let per = self.pixels_per_unit();
+        let (sx, sy) = (half_w / per, half_h / per);
+        // Side planes (inward normal n: n . p >= d) and edges (a point, a direction, a ray or not).
+        type Sides = (Vec<(Vec3, f32)>, Vec<(Vec3, Vec3, bool)>);
+        let (planes, edges): Sides = match self.projection {
+            Projection::Perspective { .. } => {
+                let normals = [f * sx + r, f * sx - r, f * sy + u, f * sy - u];
+                let planes = normals.iter().map(|&n| (n, n.dot(self.eye))).collect();
+                let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
+                (planes, corners.iter().map(|&(a, b)| (self.eye, f + r * (a * sx) + u * (b * sy), true)).collect())
+            }
+            Projection::Orthographic { .. } => {
+                let e = self.eye;
+                let planes = vec![(r, r.dot(e) - sx), (-r, -r.dot(e) - sx), (u, u.dot(e) - sy), (-u, -u.dot(e) - sy)];
+                let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
+                (planes, corners.iter().map(|&(a, b)| (e + r * (a * sx) + u * (b * sy), f, false)).collect())
+            }
+        };
+        let slack = 1e-4 * (hi - lo).max_element().max(1.0);
+        let in_view = |p: Vec3| planes.iter().all(|&(n, d)| n.dot(p) >= d - slack * n.length());
+        let in_box = |p: Vec3| (p - lo).min_element() >= -slack && (hi - p).min_element() >= -slack;
+        let mut points = Vec::new();
+        // The box's corners in view, and where its edges cross the side planes.
+        let corner = |i: usize| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2]);
+        for i in 0..8 {
+            points.push(corner(i));
+            for bit in [1, 2, 4] {
+                if i & bit == 0 {
+                    let (a, b) = (corner(i), corner(i | bit));
+                    for &(n, d) in &planes {
+                        let (da, db) = (n.dot(a) - d, n.dot(b) - d);
+                        if (da < 0.0) != (db < 0.0) {
+                            points.push(a + (b - a) * (da / (da - db)));
+                        }
+                    }
+                }
+            }
+        }
+        // The view's apex and edges where they cross the box's faces.
+        if self.is_perspective() {
+            points.push(self.eye);
+        }
+        for &(p, dir, ray) in &edges {
+            for a in 0..3 {
+                if dir[a].abs() > 1e-12 {
+                    for face in [lo[a], hi[a]] {
+                        let t = (face - p[a]) / dir[a];
+                        if t >= 0.0 || !ray {
+                            points.push(p + dir * t);
+                        }
+                    }
+                }
+            }
+        }
+        let inside: Vec<Vec3> = points.into_iter().filter(|&p| in_view(p) && in_box(p)).collect();
+        let first = *inside.first()?;
+        let bounds = inside.iter().fold([first, first], |[a, b], &p| [a.min(p), b.max(p)]);
+        Some([bounds[0].max(lo), bounds[1].min(hi)])
+    }
 }

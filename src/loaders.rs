@@ -15,6 +15,7 @@ mod nifti1;
 mod npy;
 mod nrrd;
 mod positions;
+mod pyramid;
 mod sequence;
 mod slices;
 mod stacks;
@@ -29,12 +30,12 @@ pub use npy::{npy_from_bytes, npy_shape};
 pub use nrrd::nrrd_channels_from_bytes;
 use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
+pub use pyramid::LEVEL_PIXELS;
 pub use sequence::{files as series_files, is_pattern};
 pub use slices::{value_range, SliceReader, MAX_STREAMED_VOXELS};
 pub use stacks::is_stack;
 pub use zarr::{
-    chunks_read as zarr_chunks_read, is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, LEVEL_PIXELS,
-    MAX_CHUNK_BYTES,
+    chunks_read as zarr_chunks_read, is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, MAX_CHUNK_BYTES,
 };
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
@@ -421,6 +422,11 @@ pub struct VolumeHints {
     /// The caller places the voxels at `file_positions`: a DICOM series with uneven slice gaps is
     /// read (its grid spaced by the mean gap) instead of refused.
     pub rectilinear: bool,
+    /// Only what lies in this box (lo, hi; in the grid's frame, centred on the origin) will be
+    /// drawn: a bricked store of an OME-Zarr image reads only the chunks of the voxels it needs
+    /// there (`OmeZarr::region`), normalised by their own range, and its default level is the
+    /// finest whose region fits the host budget. Other files are read whole.
+    pub crop: Option<[[f32; 3]; 2]>,
 }
 
 /// The positions of an unevenly spaced DICOM series' slices along their normal, from the first

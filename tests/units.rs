@@ -221,3 +221,63 @@ fn the_crawfis_max_kernel_is_the_least_variance_cubic() {
     assert_eq!(Kernel::CrawfisMax.radius(), 1.6);
     assert_eq!("crawfis-max".parse::<Kernel>().unwrap(), Kernel::CrawfisMax);
 }
+
+/// `Camera::box_in_view` (the part of an OME-Zarr image a view reads): over random views outside,
+/// inside and orthographic, every sampled point of the box that projects into the image (with the
+/// margin) lies inside the bounds it returns, which lie inside the box; a view that frames the
+/// box sees all of it, one turned away none, and a narrow view into a corner a small part.
+#[test]
+fn the_box_in_view_holds_every_point_the_view_sees() {
+    let grid = Grid::centered([90, 70, 50], [1.0, 1.0, 1.5]).unwrap();
+    let (lo, hi) = (Vec3::new(-45.0, -35.0, -37.5), Vec3::new(45.0, 35.0, 37.5));
+    let mut rng = common::Rng(11);
+    let margin = 4.0;
+    let mut total = 0;
+    for v in 0..60 {
+        let kind = [common::ViewKind::Outside, common::ViewKind::Inside, common::ViewKind::Orthographic][v % 3];
+        let mut cam = common::random_camera(&mut rng, &grid, kind);
+        (cam.width, cam.height) = (120, 80);
+        // Narrow some views so that they see part of the box.
+        if let Projection::Perspective { fov_y_deg } = &mut cam.projection {
+            *fov_y_deg = rng.range(5.0, 60.0);
+        }
+        let seen = cam.box_in_view(lo, hi, margin);
+        let per = cam.pixels_per_unit();
+        let mut hits = 0;
+        for _ in 0..4000 {
+            let p = lo + (hi - lo) * Vec3::new(rng.f32(), rng.f32(), rng.f32());
+            let e = cam.world_to_eye(p);
+            let (x, y) = match cam.projection {
+                Projection::Perspective { .. } if e.z <= 0.0 => continue,
+                Projection::Perspective { .. } => (e.x / e.z * per, e.y / e.z * per),
+                Projection::Orthographic { .. } => (e.x * per, e.y * per),
+            };
+            if x.abs() > 60.0 + margin || y.abs() > 40.0 + margin {
+                continue;
+            }
+            hits += 1;
+            let [a, b] = seen.unwrap_or_else(|| panic!("view {v} sees {p} but box_in_view says nothing"));
+            let slack = Vec3::splat(1e-3);
+            assert!(p.cmpge(a - slack).all() && p.cmple(b + slack).all(), "view {v}: {p} outside {a}..{b}");
+        }
+        if let Some([a, b]) = seen {
+            assert!(a.cmpge(lo).all() && b.cmple(hi).all() && a.cmple(b).all(), "view {v}: {a}..{b}");
+        }
+        total += hits;
+    }
+    assert!(total > 20_000, "{total} sampled points in view");
+    let framing = Camera::framing(&grid, 120, 80);
+    assert_eq!(framing.box_in_view(lo, hi, margin), Some([lo, hi]));
+    let away = Camera { target: framing.eye * 2.0, ..framing };
+    assert_eq!(away.box_in_view(lo, hi, margin), None);
+    // A narrow view along x at a corner of the y-z face: its bounds span x, little of y and z.
+    let corner = Camera {
+        eye: Vec3::new(120.0, 30.0, 30.0),
+        target: Vec3::new(40.0, 30.0, 30.0),
+        projection: Projection::Perspective { fov_y_deg: 8.0 },
+        ..framing
+    };
+    let [a, b] = corner.box_in_view(lo, hi, margin).unwrap();
+    let part = (b - a).x * (b - a).y * (b - a).z / ((hi - lo).x * (hi - lo).y * (hi - lo).z);
+    assert!(part < 0.1 && b.x == hi.x, "a narrow view at a corner sees {part} of the box: {a}..{b}");
+}

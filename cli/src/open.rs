@@ -11,6 +11,10 @@ pub use crate::parse::*;
 
 #[derive(Args)]
 pub struct SceneArgs {
+    /// What `render` draws of the volume (lo, hi): --crop's box, or the part of an OME-Zarr image
+    /// its one view sees; an OME-Zarr image reads only what it needs there.
+    #[arg(skip)]
+    pub crop: Option<[[f32; 3]; 2]>,
     /// Built-in scene name (see `voxsplat scenes`).
     #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain", "labels"])]
     pub scene: String,
@@ -318,6 +322,7 @@ fn volume_hints_at(a: &SceneArgs, level: Option<u32>) -> Result<voxsplat::loader
         level,
         time: a.time,
         rectilinear: false,
+        crop: a.crop,
     })
 }
 
@@ -410,11 +415,14 @@ fn ome_zarr_level(
     let image = voxsplat::loaders::OmeZarr::open(path)?;
     let last = image.levels.len() as u32 - 1;
     if !auto || last == 0 {
-        let level = image.default_level();
+        let level = image
+            .default_level_within(hints.crop)
+            .ok_or_else(|| Error::InvalidArgument(format!("{}: --crop holds no voxel of the image", path.display())))?;
+        let within = if hints.crop.is_some() { " for the part read" } else { "" };
         if level > 0 {
             let l = &image.levels[level as usize];
             eprintln!(
-                "OME-Zarr level {level} of 0..{last} drawn ({:?} voxels): the finer ones may not fit the host's memory \
+                "OME-Zarr level {level} of 0..{last} drawn ({:?} voxels): the finer ones may not fit the host's memory{within} \
                  (--host-budget-mib, --level N)",
                 l.dims
             );

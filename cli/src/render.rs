@@ -10,7 +10,9 @@ pub(crate) struct RenderArgs {
     /// not drawn (splat centres; the ray caster cuts its rays). Up to 6.
     #[arg(long = "clip", value_parser = parse_floats::<4>, allow_hyphen_values = true)]
     clip: Vec<[f32; 4]>,
-    /// A crop box X0,Y0,Z0,X1,Y1,Z1 in world space: only what lies inside is drawn.
+    /// A crop box X0,Y0,Z0,X1,Y1,Z1 in world space: only what lies inside is drawn. An OME-Zarr
+    /// image reads only the chunks the box needs, from the finest level whose part fits the host's
+    /// memory, its values normalised by their own range.
     #[arg(long, value_parser = parse_floats::<6>, allow_hyphen_values = true)]
     crop: Option<[f32; 6]>,
     /// Composite the frame over this colour R,G,B[,A] (each in [0, 1]; A defaults to 1, opaque), as
@@ -139,7 +141,13 @@ pub(crate) struct RenderArgs {
 }
 
 /// Runs `voxsplat render`.
-pub(crate) fn render(a: Box<RenderArgs>) -> Result<()> {
+pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
+    a.scene.crop = match (a.crop, &a.scene.volume) {
+        (Some(c), _) => Some([[c[0], c[1], c[2]], [c[3], c[4], c[5]]]),
+        // One frame: an OME-Zarr image need be read only where it is seen.
+        (None, Some(path)) if voxsplat::loaders::is_ome_zarr(path) => voxsplat_cli::pyramid::seen_box(&a.scene, path)?,
+        _ => None,
+    };
     let out = a.out.clone().unwrap_or_default();
     if !a.plan {
         voxsplat::output::ImageFormat::of(&out)?;

@@ -301,3 +301,164 @@ fn the_level_for_a_view_follows_the_voxels_projected_size() {
     cam.eye = glam::Vec3::new(0.1, 0.2, 0.3);
     assert_eq!(image.level_for(&cam, outside), 0, "the eye inside the image: measured at the near plane");
 }
+
+/// `render --crop` on an OME-Zarr image (issue 47 item 2): the bricked store reads only the chunks
+/// of the voxels its box needs (the bricks the box touches and one brick around them): every chunk
+/// of level 0 farther out is corrupted and never read, while the image read whole is refused
+/// naming one. It holds zarr-python's values in the box, nothing outside its region, and the
+/// default level within the box is the finest whose region fits the host budget.
+#[test]
+fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
+    let dir = tmp("crop");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bonsai = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/bonsai/bonsai.nii.gz");
+    write_with_python(&["bonsai", bonsai, dir.to_str().unwrap()]);
+    let path = dir.join("v04.zarr");
+    let (_, want) = npy(&dir.join("v04.zarr.level0.npy"));
+    // Voxels 100..140 along x, 90..150 along y, 60..100 along z of the 256³ level 0 (spacing 1, 1,
+    // 1.5, in chunks of 64, 64, 32), as a box in the grid's centred frame around their centres.
+    let (lo, hi, spacing) = ([100u32, 90, 60], [140u32, 150, 100], [1.0f32, 1.0, 1.5]);
+    let at = |v: u32, a: usize, off: f32| (v as f32 - 127.5 + off) * spacing[a];
+    let crop = [[0, 1, 2].map(|a| at(lo[a], a, -0.25)), [0, 1, 2].map(|a| at(hi[a] - 1, a, 0.25))];
+    // A narrow view along x reads only what it sees: the same frame as the whole image read, up to
+    // the quantisation of values normalised by the part's range instead of the whole level's (a
+    // transfer function over the file's values, 0 to 255; sheets: per-splat compositing blends in
+    // the order of the bricks stored).
+    let tf = dir.join("tf.toml");
+    std::fs::write(
+        &tf,
+        "points = [[0.0, [0, 0, 0, 0]], [0.4, [0.9, 0.5, 0.3, 0.05]], [1.0, [1, 1, 1, 0.9]]]\nrange = [0.0, 255.0]\n",
+    )
+    .unwrap();
+    let view =
+        ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--composite", "sheet", "--tf", tf.to_str().unwrap()];
+    let seen = voxsplat(
+        &[
+            &["render", "--volume", path.to_str().unwrap(), "--size", "48x48"][..],
+            &view,
+            &["--validation", "--out", dir.join("seen.png").to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    let said = String::from_utf8_lossy(&seen.stderr);
+    assert!(seen.status.success() && said.contains("the view sees"), "{said}");
+    let read: u32 = said.split("the store read ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+    // It sees |y|, |z| < 44 at the far face (5° either side at 428 units, and the margin): along
+    // y 2 of the 4 chunks of 64, along z 4 of the 8 chunks of 32 (z spacing 1.5), every x.
+    assert!(read <= 32, "{read} of level 0's 128 chunks read for a view along x: {said}");
+    let all = "-128,-128,-192,128,128,192";
+    let whole = voxsplat(
+        &[
+            &["render", "--volume", path.to_str().unwrap(), "--size", "48x48"][..],
+            &view,
+            &["--crop", all, "--out", dir.join("all.png").to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    let said = String::from_utf8_lossy(&whole.stderr);
+    assert!(whole.status.success() && said.contains("the store read 128 chunks"), "{said}");
+    let compared =
+        voxsplat(&["compare", dir.join("seen.png").to_str().unwrap(), dir.join("all.png").to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&compared.stdout);
+    let psnr: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("psnr:"))
+        .unwrap()
+        .trim()
+        .trim_end_matches(" dB")
+        .parse()
+        .unwrap_or(f64::INFINITY);
+    assert!(psnr > 70.0, "the part the view sees against the whole image: {text}");
+    // Corrupt every chunk wholly farther than 16 voxels (two bricks) from the box.
+    let chunk = [64u32, 64, 32];
+    let mut kept = 0;
+    for entry in walk(&path.join("s0")) {
+        let rel = entry.strip_prefix(path.join("s0")).unwrap().to_string_lossy().into_owned();
+        if rel.starts_with('.') {
+            continue;
+        }
+        let zyx: Vec<u32> = rel.split(['/', '.']).map(|s| s.parse().unwrap()).collect();
+        let c = [zyx[2], zyx[1], zyx[0]];
+        let near = (0..3).all(|a| c[a] * chunk[a] < hi[a] + 16 && (c[a] + 1) * chunk[a] + 16 > lo[a]);
+        if near {
+            kept += 1;
+        } else {
+            std::fs::write(&entry, b"not a zstd frame").unwrap();
+        }
+    }
+    assert!(kept > 0 && kept < 24, "{kept} of level 0's 128 chunks kept");
+    let hints = VolumeHints { crop: Some(crop), ..Default::default() };
+    let store = voxsplat::bricks::BrickStore::load(&path, &hints).unwrap();
+    assert_eq!(store.dims, [256; 3]);
+    let (rlo, rhi) = store.range;
+    let step = (rhi - rlo) / 65535.0;
+    for z in lo[2]..hi[2] {
+        for y in lo[1]..hi[1] {
+            for x in lo[0]..hi[0] {
+                let got = rlo + store.value_at(x as i64, y as i64, z as i64) * (rhi - rlo);
+                let w = want[(x + 256 * (y + 256 * z)) as usize];
+                assert!((got - w).abs() <= step, "voxel {x} {y} {z}: {got} against zarr-python's {w}");
+            }
+        }
+    }
+    // Nothing of the pot's rim far below the box is stored.
+    let far = (0..256u32 * 256 * 40).filter(|&i| want[i as usize] > rlo).count();
+    assert!(far > 0 && (0..256 * 256 * 40).all(|i: i64| store.value_at(i % 256, i / 256 % 256, i / 65536) == 0.0));
+    let e = voxsplat::bricks::BrickStore::load(&path, &level(0)).unwrap_err().to_string();
+    assert!(e.contains("chunk"), "{e}");
+    // Through the CLI, under a host budget that holds level 1 whole but not level 0: the box's
+    // region is read from level 0; without the box, level 1 is drawn.
+    let c = format!("{},{},{},{},{},{}", crop[0][0], crop[0][1], crop[0][2], crop[1][0], crop[1][1], crop[1][2]);
+    let cropped = voxsplat(&[
+        "--host-budget-mib",
+        "48",
+        "render",
+        "--volume",
+        path.to_str().unwrap(),
+        "--crop",
+        &c,
+        "--size",
+        "48x48",
+        "--validation",
+        "--out",
+        dir.join("crop.png").to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&cropped.stderr);
+    assert!(cropped.status.success() && !said.contains("OME-Zarr level"), "{said}");
+    let read: u32 = said.split("the store read ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+    assert!(read > 0 && read <= kept, "{said}");
+    assert!(image::open(dir.join("crop.png")).unwrap().to_rgba8().pixels().any(|p| p[3] > 0), "the box is drawn");
+    let whole = voxsplat(&[
+        "--host-budget-mib",
+        "48",
+        "render",
+        "--volume",
+        path.to_str().unwrap(),
+        "--size",
+        "48x48",
+        "--out",
+        dir.join("whole.png").to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&whole.stderr);
+    assert!(whole.status.success() && said.contains("OME-Zarr level 1 of 0..2 drawn"), "{said}");
+    // A box that holds no voxel of the image is refused.
+    let out = dir.join("none.png");
+    let far_box = ["--crop", "500,500,500,600,600,600", "--out", out.to_str().unwrap()];
+    let e = refused(&[&["render", "--volume", path.to_str().unwrap()][..], &far_box].concat());
+    assert!(e.contains("holds no voxel"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every file under `dir`.
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}

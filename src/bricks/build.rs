@@ -61,7 +61,7 @@ impl BrickStore {
     pub(super) fn build_over(vol: &ScalarVolume, background: f32) -> Result<Self> {
         let plane = vol.dims[0] as usize * vol.dims[1] as usize;
         // The volume is in memory: nothing to keep between the passes.
-        Self::from_slices_over(vol.dims, vol.spacing, background, false, |z0, count, out| {
+        Self::from_slices_over(vol.dims, vol.spacing, [[0; 3], vol.dims], background, false, |z0, count, out| {
             out.clear();
             out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + count) as usize * plane]);
             Ok(())
@@ -78,49 +78,97 @@ impl BrickStore {
         spacing: [f32; 3],
         read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
-        Self::from_slices_over(dims, spacing, f32::INFINITY, true, read)
+        Self::from_slices_over(dims, spacing, [[0; 3], dims], f32::INFINITY, true, read)
     }
 
-    /// `from_slices`, with the empty value at most `background` (a volume with no empty voxel
-    /// keeps its minimum); `may_keep`: whether the samples may be kept between the passes.
+    /// `from_slices` over the voxels in `region` only (`lo..hi`): `read` puts the region's part
+    /// of slices `z0..z0 + count` (x fastest over the region's width) in `out`, as `from_region`
+    /// takes it, and the values are normalised by the region's own range. Every other voxel is
+    /// empty. A cropped OME-Zarr image is read this way, its chunks outside the region untouched.
+    pub fn from_region_slices(
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        region: [[u32; 3]; 2],
+        read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
+    ) -> Result<Self> {
+        Self::from_slices_over(dims, spacing, region, f32::INFINITY, true, read)
+    }
+
+    /// `from_region_slices`, with the empty value at most `background` (a volume with no empty
+    /// voxel keeps its minimum); `may_keep`: whether the samples may be kept between the passes.
     fn from_slices_over(
         dims: [u32; 3],
         spacing: [f32; 3],
+        region: [[u32; 3]; 2],
         background: f32,
         may_keep: bool,
         mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
         check_dims(dims)?;
+        let [r0, r1] = region;
+        if (0..3).any(|a| r0[a] >= r1[a] || r1[a] > dims[a]) {
+            return Err(Error::InvalidArgument(format!(
+                "the region {r0:?}..{r1:?} is empty or leaves the {dims:?} grid"
+            )));
+        }
         let mut slab = Vec::new();
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         // The samples, kept for the brick pass when they fit, so that a slow reader (a DICOM
         // decoder, compressed chunks) reads each once.
-        let bytes = dims.iter().map(|&d| d as u64).product::<u64>() * 4;
+        let plane = (r1[0] - r0[0]) as usize * (r1[1] - r0[1]) as usize;
+        let bytes = plane as u64 * (r1[2] - r0[2]) as u64 * 4;
         let keep = may_keep
             && bytes <= SLAB_CACHE_BYTES
             && crate::error::host_budget().is_none_or(|b| bytes <= b / 4)
             && crate::error::check_host_memory(2 * bytes, "").is_ok();
         let mut kept = Vec::new();
-        for z0 in (0..dims[2]).step_by(BRICK as usize) {
-            read(z0, BRICK.min(dims[2] - z0), &mut slab)?;
+        // The slabs `from_region` reads: a brick's slices within the region.
+        let mut z0 = r0[2];
+        while z0 < r1[2] {
+            let z1 = ((z0 / BRICK + 1) * BRICK).min(r1[2]);
+            read(z0, z1 - z0, &mut slab)?;
             for &v in slab.iter().filter(|v| v.is_finite()) {
                 (lo, hi) = (lo.min(v), hi.max(v));
             }
             if keep {
                 kept.extend_from_slice(&slab);
             }
+            z0 = z1;
         }
         let range = store_range(lo.min(background), hi);
         if !keep {
-            return Self::from_region(dims, spacing, range, [[0; 3], dims], read);
+            return Self::from_region(dims, spacing, range, region, read);
         }
-        let plane = dims[0] as usize * dims[1] as usize;
-        Self::from_region(dims, spacing, range, [[0; 3], dims], |z0, count, out| {
-            let at = z0 as usize * plane..(z0 + count) as usize * plane;
+        Self::from_region(dims, spacing, range, region, |z0, count, out| {
+            let at = (z0 - r0[2]) as usize * plane..(z0 - r0[2] + count) as usize * plane;
             let part = kept.get(at).ok_or_else(|| Error::InvalidArgument("a slab read past the volume".into()))?;
             out.clear();
             out.extend_from_slice(part);
             Ok(())
+        })
+    }
+
+    /// An OME-Zarr image's store of what `crop` needs (`VolumeHints::crop`): at `hints.level`,
+    /// else the finest level whose region fits the host budget, only that region's chunks read.
+    #[cfg(feature = "io")]
+    pub(super) fn load_cropped(
+        path: &std::path::Path,
+        hints: &crate::loaders::VolumeHints,
+        crop: [[f32; 3]; 2],
+    ) -> Result<Self> {
+        let image = crate::loaders::OmeZarr::open(path)?;
+        let misses =
+            || Error::InvalidArgument(format!("{}: the crop box {crop:?} holds no voxel of the image", path.display()));
+        let level = match hints.level {
+            Some(l) => l,
+            None => image.default_level_within(Some(crop)).ok_or_else(misses)?,
+        };
+        let whole = crate::loaders::VolumeHints { level: Some(level), crop: None, ..hints.clone() };
+        let not_read = || Error::InvalidArgument(format!("{}: not read as an OME-Zarr image", path.display()));
+        let mut reader = crate::loaders::SliceReader::open(path, &whole)?.ok_or_else(not_read)?;
+        let region @ [lo, hi] = image.region(level, crop).ok_or_else(misses)?;
+        Self::from_region_slices(reader.dims, reader.spacing, region, |z0, count, out| {
+            reader.read_part(z0, count, [lo[0], lo[1]], [hi[0], hi[1]], out)
         })
     }
 

@@ -396,9 +396,9 @@ impl SliceReader {
     }
 
     /// The part `lo..hi` (x and y) of slices `z0..z0 + count` into `out`, x fastest over the
-    /// part: a file is read row by row at its offsets, only the part's bytes; a gzip stream is
-    /// inflated through (the slices whole, the part kept). Sort-last rendering reads a rank's box
-    /// this way.
+    /// part: a file is read row by row at its offsets, only the part's bytes; an OME-Zarr level
+    /// reads only the chunks the part touches; a gzip stream is inflated through (the slices
+    /// whole, the part kept). Sort-last rendering and a cropped OME-Zarr store read boxes this way.
     pub fn read_part(&mut self, z0: u32, count: u32, lo: [u32; 2], hi: [u32; 2], out: &mut Vec<f32>) -> Result<()> {
         let [nx, ny, _] = self.dims;
         if lo[0] > hi[0] || lo[1] > hi[1] || hi[0] > nx || hi[1] > ny || z0 + count > self.dims[2] {
@@ -410,7 +410,10 @@ impl SliceReader {
             )));
         }
         let (w, h) = ((hi[0] - lo[0]) as usize, (hi[1] - lo[1]) as usize);
-        if let Source::Gzip { .. } | Source::Stack(_) | Source::Zarr(_) = self.source {
+        if let Source::Zarr(zarr) = &mut self.source {
+            return zarr.read_part(z0, count, lo, hi, out);
+        }
+        if let Source::Gzip { .. } | Source::Stack(_) = self.source {
             let mut whole = Vec::new();
             self.read(z0, count, &mut whole)?;
             out.clear();

@@ -436,8 +436,9 @@ pub struct ZarrReader {
     lead: Vec<u64>,
     /// Slices of a chunk along z.
     chunk_z: u32,
-    /// The row of chunks last decoded (its first slice) and its samples.
-    row: Option<(u32, Vec<f32>)>,
+    /// The row of chunks last decoded: its first slice, the part of the plane (x and y from, to)
+    /// and its samples.
+    row: Option<(u32, [u32; 4], Vec<f32>)>,
     what: String,
 }
 
@@ -496,24 +497,31 @@ impl ZarrReader {
 
     /// Slices `z0..z0 + count` (x fastest) into `out`.
     pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
-        let plane = self.dims[0] as usize * self.dims[1] as usize;
+        self.read_part(z0, count, [0, 0], [self.dims[0], self.dims[1]], out)
+    }
+
+    /// The part `lo..hi` (x and y) of slices `z0..z0 + count` into `out`, x fastest over the
+    /// part: only the chunks the part touches are read.
+    pub fn read_part(&mut self, z0: u32, count: u32, lo: [u32; 2], hi: [u32; 2], out: &mut Vec<f32>) -> Result<()> {
+        let part = [lo[0], lo[1], hi[0], hi[1]];
+        let plane = (hi[0] - lo[0]) as usize * (hi[1] - lo[1]) as usize;
         let first = z0 / self.chunk_z * self.chunk_z;
         let row_bytes = self.chunk_z as u64 * plane as u64 * 4;
         // A slab inside one row of chunks: the row decoded once, its slabs copied from it.
         if count > 0 && (z0 + count - 1) / self.chunk_z == z0 / self.chunk_z && row_bytes <= MAX_ROW_BYTES {
-            if self.row.as_ref().is_none_or(|(at, _)| *at != first) {
+            if self.row.as_ref().is_none_or(|(at, p, _)| *at != first || *p != part) {
                 let n = self.chunk_z.min(self.dims[2] - first);
                 crate::error::check_host_memory(row_bytes, &format!("{}'s row of chunks", self.what))?;
                 self.row = None;
-                self.row = Some((first, self.samples(first, n)?));
+                self.row = Some((first, part, self.samples(first, n, part)?));
             }
-            let (_, row) = self.row.as_ref().expect("decoded above");
+            let (_, _, row) = self.row.as_ref().expect("decoded above");
             let at = (z0 - first) as usize * plane;
             out.clear();
             out.extend_from_slice(&row[at..at + count as usize * plane]);
             return Ok(());
         }
-        *out = self.samples(z0, count)?;
+        *out = self.samples(z0, count, part)?;
         Ok(())
     }
 
@@ -533,12 +541,12 @@ impl ZarrReader {
         None
     }
 
-    /// Slices `z0..z0 + count` decoded, as f32, checked finite.
-    fn samples(&self, z0: u32, count: u32) -> Result<Vec<f32>> {
+    /// The part (x0, y0, x1, y1) of slices `z0..z0 + count` decoded, as f32, checked finite.
+    fn samples(&self, z0: u32, count: u32, [x0, y0, x1, y1]: [u32; 4]) -> Result<Vec<f32>> {
         let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
         ranges.push(z0 as u64..(z0 + count) as u64);
-        ranges.push(0..self.dims[1] as u64);
-        ranges.push(0..self.dims[0] as u64);
+        ranges.push(y0 as u64..y1 as u64);
+        ranges.push(x0 as u64..x1 as u64);
         let n = ranges.iter().map(|r| r.end - r.start).product::<u64>();
         crate::error::check_host_memory(n * (4 + self.kind.size()), &format!("{}'s slices", self.what))?;
         let subset = ArraySubset::new_with_ranges(&ranges);
@@ -575,63 +583,6 @@ impl ZarrReader {
         }
         super::check_finite(&values, &self.what)?;
         Ok(values)
-    }
-}
-
-/// The largest size, in pixels, at the nearest point of the view, of a voxel of the level
-/// `OmeZarr::level_for` picks: the levels-of-detail cut draws cells of `DEFAULT_LOD_PIXELS` (1.5 px),
-/// two voxels a side, from what it is given, so a level whose voxels project to at most half that
-/// holds every cell the cut would draw from the finest level's voxels.
-pub const LEVEL_PIXELS: f32 = crate::options::DEFAULT_LOD_PIXELS * 0.5;
-
-impl OmeZarr {
-    /// The level read when none is asked for: the finest whose bricked store fits the host budget
-    /// (`host_budget`) even with every voxel stored, else the coarsest. The file's levels average
-    /// the raw samples, and a transfer function that shows a narrow band of values loses thin
-    /// structures in them (on the bonsai, level 1 against level 0: 20-21 dB at 32² to 64²), so a
-    /// coarser level is read only when the finest cannot be held.
-    pub fn default_level(&self) -> u32 {
-        let fits = |l: &Level| {
-            let voxels = l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
-            let bricks =
-                l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d.div_ceil(crate::constants::BRICK_SIDE) as u64));
-            // Records, headers and masks, the index (`BrickStore::from_region`'s worst case).
-            let worst = voxels.saturating_mul(4).saturating_add(bricks.saturating_mul(16 + 64 + 4));
-            crate::error::host_budget().is_none_or(|b| worst <= b)
-        };
-        self.levels.iter().position(fits).unwrap_or(self.levels.len() - 1) as u32
-    }
-
-    /// The coarsest level whose voxels project to at most `pixels` pixels in `camera`'s view
-    /// (`voxel_pixels`); level 0 when none is fine enough. A frame drawn from it reads the chunks
-    /// of that level only.
-    pub fn level_for(&self, camera: &crate::Camera, pixels: f32) -> u32 {
-        (0..self.levels.len() as u32).rev().find(|&l| self.voxel_pixels(camera, l) <= pixels).unwrap_or(0)
-    }
-
-    /// The pixels a voxel of `level` (its widest spacing) spans at the point of the image nearest
-    /// the eye of `camera` (the image centred on the origin, as its grids are; the near plane when
-    /// the eye is inside it).
-    pub fn voxel_pixels(&self, camera: &crate::Camera, level: u32) -> f32 {
-        let first = &self.levels[0];
-        let half = glam::Vec3::from(first.dims.map(|d| d as f32)) * glam::Vec3::from(first.spacing) * 0.5;
-        let forward = camera.forward();
-        // The box's nearest depth along the view: one of its corners.
-        let mut depth = f32::INFINITY;
-        for i in 0..8 {
-            let sign = |bit: i32| if i & bit == 0 { -1.0 } else { 1.0 };
-            let corner = half * glam::Vec3::new(sign(1), sign(2), sign(4));
-            depth = depth.min((corner - camera.eye).dot(forward));
-        }
-        let inside = (camera.eye.abs() - half).max_element() <= 0.0;
-        let per_unit = match camera.projection {
-            crate::Projection::Perspective { .. } if inside => camera.pixels_per_unit() / camera.near,
-            crate::Projection::Perspective { .. } => camera.pixels_per_unit() / depth.max(camera.near),
-            crate::Projection::Orthographic { .. } => camera.pixels_per_unit(),
-        };
-        let widest =
-            self.levels.get(level as usize).map_or(f32::INFINITY, |l| l.spacing.into_iter().fold(0f32, f32::max));
-        widest * per_unit
     }
 }
 
