@@ -152,8 +152,25 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
                 ),
             ));
         }
+        // Delimiters hold nothing, and an item lies within the file: dicom-rs reads a delimiter's
+        // length as a value's (a fuzzed one of 4 GB after a stray item).
+        if group == 0xFFFE && element != 0xE000 && len != 0 {
+            return Err(bad(what, format!("DICOM: delimiter (FFFE,{element:04X}) declares {len} bytes, not 0")));
+        }
+        if group == 0xFFFE
+            && len != u32::MAX
+            && (pos + header).checked_add(len as usize).is_none_or(|e| e > bytes.len())
+        {
+            return Err(bad(
+                what,
+                format!("DICOM: item (FFFE,{element:04X}) declares {len} bytes past the file's end"),
+            ));
+        }
         pos += header;
-        if (group, element) == (0x7FE0, 0x10) && len == u32::MAX {
+        // Encapsulated pixel data, or any OB or OW of undefined length, which dicom-rs reads as
+        // fragments too (a fuzzed OB so read made it size a delimiter's 4 GB length).
+        let fragments = (group, element) == (0x7FE0, 0x10) || matches!(vr, Some(VR::OB | VR::OW));
+        if fragments && len == u32::MAX {
             encapsulated = true;
             continue;
         }
