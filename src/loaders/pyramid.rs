@@ -27,11 +27,14 @@ impl OmeZarr {
                 Some(c) => self.region(level as u32, c)?,
                 None => [[0; 3], l.dims],
             };
+            let b = crate::constants::BRICK_SIDE;
             let voxels = (0..3).fold(1u64, |a, i| a.saturating_mul((hi[i] - lo[i]) as u64));
-            let bricks =
-                l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d.div_ceil(crate::constants::BRICK_SIDE) as u64));
-            // Records, headers and masks, the index (`BrickStore::from_region`'s worst case).
-            let worst = voxels.saturating_mul(4).saturating_add(bricks.saturating_mul(16 + 64 + 4));
+            let bricks = l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d.div_ceil(b) as u64));
+            let part = (0..3).fold(1u64, |a, i| a.saturating_mul((hi[i].div_ceil(b) - lo[i] / b) as u64));
+            // Records, the part's headers and masks, the whole grid's index (`BrickStore::from_region`'s
+            // worst case).
+            let worst =
+                voxels.saturating_mul(4).saturating_add(part.saturating_mul(16 + 64)).saturating_add(bricks * 4);
             Some(crate::error::host_budget().is_none_or(|b| worst <= b))
         };
         let mut last = None;
