@@ -313,28 +313,44 @@ impl Camera {
         }
     }
 
+    /// The view's side planes, `margin` pixels past the image's edges, as (inward normal n, d):
+    /// a point p is in view when n . p >= d for each (near and far aside).
+    pub fn side_planes(&self, margin: f32) -> [(Vec3, f32); 4] {
+        let (f, r, u) = (self.forward(), self.right(), self.true_up());
+        let per = self.pixels_per_unit();
+        let (sx, sy) = ((0.5 * self.width as f32 + margin) / per, (0.5 * self.height as f32 + margin) / per);
+        let e = self.eye;
+        match self.projection {
+            Projection::Perspective { .. } => [f * sx + r, f * sx - r, f * sy + u, f * sy - u].map(|n| (n, n.dot(e))),
+            Projection::Orthographic { .. } => {
+                [(r, r.dot(e) - sx), (-r, -r.dot(e) - sx), (u, u.dot(e) - sy), (-u, -u.dot(e) - sy)]
+            }
+        }
+    }
+
+    /// Whether box `lo..hi` may hold something in view (`side_planes(margin)`): false only when
+    /// all its corners lie outside one side plane.
+    pub fn may_see_box(&self, lo: Vec3, hi: Vec3, margin: f32) -> bool {
+        let corner = |i: usize| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2]);
+        self.side_planes(margin).iter().all(|&(n, d)| (0..8).any(|i| n.dot(corner(i)) >= d))
+    }
+
     /// The bounds of the part of box `lo..hi` this view can see, `margin` pixels past the image's
     /// edges (its side planes only: near and far aside), or `None` when it sees none of it. A
     /// reader that needs only what the frame shows reads these bounds.
     pub fn box_in_view(&self, lo: Vec3, hi: Vec3, margin: f32) -> Option<[Vec3; 2]> {
         let (f, r, u) = (self.forward(), self.right(), self.true_up());
-        let (half_w, half_h) = (0.5 * self.width as f32 + margin, 0.5 * self.height as f32 + margin);
         let per = self.pixels_per_unit();
-        let (sx, sy) = (half_w / per, half_h / per);
-        // Side planes (inward normal n: n . p >= d) and edges (a point, a direction, a ray or not).
-        type Sides = (Vec<(Vec3, f32)>, Vec<(Vec3, Vec3, bool)>);
-        let (planes, edges): Sides = match self.projection {
+        let (sx, sy) = ((0.5 * self.width as f32 + margin) / per, (0.5 * self.height as f32 + margin) / per);
+        let planes = self.side_planes(margin);
+        // The view's edges: a point, a direction, and whether it is a ray from the eye.
+        let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
+        let edges: Vec<(Vec3, Vec3, bool)> = match self.projection {
             Projection::Perspective { .. } => {
-                let normals = [f * sx + r, f * sx - r, f * sy + u, f * sy - u];
-                let planes = normals.iter().map(|&n| (n, n.dot(self.eye))).collect();
-                let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
-                (planes, corners.iter().map(|&(a, b)| (self.eye, f + r * (a * sx) + u * (b * sy), true)).collect())
+                corners.iter().map(|&(a, b)| (self.eye, f + r * (a * sx) + u * (b * sy), true)).collect()
             }
             Projection::Orthographic { .. } => {
-                let e = self.eye;
-                let planes = vec![(r, r.dot(e) - sx), (-r, -r.dot(e) - sx), (u, u.dot(e) - sy), (-u, -u.dot(e) - sy)];
-                let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
-                (planes, corners.iter().map(|&(a, b)| (e + r * (a * sx) + u * (b * sy), f, false)).collect())
+                corners.iter().map(|&(a, b)| (self.eye + r * (a * sx) + u * (b * sy), f, false)).collect()
             }
         };
         let slack = 1e-4 * (hi - lo).max_element().max(1.0);

@@ -30,7 +30,7 @@ pub use npy::{npy_from_bytes, npy_shape};
 pub use nrrd::nrrd_channels_from_bytes;
 use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
-pub use pyramid::LEVEL_PIXELS;
+pub use pyramid::{LEVEL_PIXELS, VIEW_MARGIN_PX};
 pub use sequence::{files as series_files, is_pattern};
 pub use slices::{value_range, SliceReader, MAX_STREAMED_VOXELS};
 pub use stacks::is_stack;
@@ -427,6 +427,11 @@ pub struct VolumeHints {
     /// there (`OmeZarr::region`), normalised by their own range, and its default level is the
     /// finest whose region fits the host budget. Other files are read whole.
     pub crop: Option<[[f32; 3]; 2]>,
+    /// With `crop`: the one view (in the grid's centred frame) a store will be drawn from. An
+    /// OME-Zarr image then reads only the chunks it may see (within `VIEW_MARGIN_PX` of the
+    /// image's edges and one brick around), the others' voxels empty, and its default level
+    /// counts only those. A view that moves must read again.
+    pub view: Option<crate::Camera>,
 }
 
 /// The positions of an unevenly spaced DICOM series' slices along their normal, from the first

@@ -15,6 +15,10 @@ pub struct SceneArgs {
     /// its one view sees; an OME-Zarr image reads only what it needs there.
     #[arg(skip)]
     pub crop: Option<[[f32; 3]; 2]>,
+    /// `render`'s one view, when it sees only part of an OME-Zarr image: only the chunks it may
+    /// see are read.
+    #[arg(skip)]
+    pub view_read: Option<voxsplat::Camera>,
     /// Built-in scene name (see `voxsplat scenes`).
     #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain", "labels"])]
     pub scene: String,
@@ -323,6 +327,7 @@ fn volume_hints_at(a: &SceneArgs, level: Option<u32>) -> Result<voxsplat::loader
         time: a.time,
         rectilinear: false,
         crop: a.crop,
+        view: a.view_read,
     })
 }
 
@@ -416,7 +421,7 @@ fn ome_zarr_level(
     let last = image.levels.len() as u32 - 1;
     if !auto || last == 0 {
         let level = image
-            .default_level_within(hints.crop)
+            .default_level_within(hints.crop, hints.view.as_ref())
             .ok_or_else(|| Error::InvalidArgument(format!("{}: --crop holds no voxel of the image", path.display())))?;
         let within = if hints.crop.is_some() { " for the part read" } else { "" };
         if level > 0 {

@@ -142,12 +142,13 @@ pub(crate) struct RenderArgs {
 
 /// Runs `voxsplat render`.
 pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
-    a.scene.crop = match (a.crop, &a.scene.volume) {
-        (Some(c), _) => Some([[c[0], c[1], c[2]], [c[3], c[4], c[5]]]),
-        // One frame: an OME-Zarr image need be read only where it is seen.
-        (None, Some(path)) if voxsplat::loaders::is_ome_zarr(path) => voxsplat_cli::pyramid::seen_box(&a.scene, path)?,
-        _ => None,
-    };
+    a.scene.crop = a.crop.map(|c| [[c[0], c[1], c[2]], [c[3], c[4], c[5]]]);
+    // One frame: an OME-Zarr image need be read only where it is seen.
+    if let Some(path) = a.scene.volume.clone().filter(|p| a.crop.is_none() && voxsplat::loaders::is_ome_zarr(p)) {
+        if let Some((seen, camera)) = voxsplat_cli::pyramid::seen_box(&a.scene, &path)? {
+            (a.scene.crop, a.scene.view_read) = (Some(seen), Some(camera));
+        }
+    }
     let out = a.out.clone().unwrap_or_default();
     if !a.plan {
         voxsplat::output::ImageFormat::of(&out)?;

@@ -369,6 +369,40 @@ fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
         .parse()
         .unwrap_or(f64::INFINITY);
     assert!(psnr > 70.0, "the part the view sees against the whole image: {text}");
+    // A narrow view along a diagonal: its bounds hold nearly the whole image, and only the
+    // chunks it may see are read, drawing the same frame.
+    let diagonal = ["--eye", "300,250,350", "--target", "0,0,0", "--fov", "8"];
+    let mut frames = Vec::new();
+    for (name, extra) in [("diagonal.png", &[][..]), ("diagonal-all.png", &["--crop", all][..])] {
+        let out = dir.join(name);
+        let o = voxsplat(
+            &[
+                &["render", "--volume", path.to_str().unwrap(), "--size", "48x48"][..],
+                &view[6..],
+                &diagonal,
+                extra,
+                &["--out", out.to_str().unwrap()],
+            ]
+            .concat(),
+        );
+        let said = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "{said}");
+        let read: u32 =
+            said.split("the store read ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+        frames.push((out, read, said));
+    }
+    assert!(frames[0].1 < 80 && frames[1].1 == 128, "{} and {} chunks read: {}", frames[0].1, frames[1].1, frames[0].2);
+    let compared = voxsplat(&["compare", frames[0].0.to_str().unwrap(), frames[1].0.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&compared.stdout);
+    let psnr: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("psnr:"))
+        .unwrap()
+        .trim()
+        .trim_end_matches(" dB")
+        .parse()
+        .unwrap_or(f64::INFINITY);
+    assert!(psnr > 70.0, "the chunks a diagonal view sees against the whole image: {text}");
     // Corrupt every chunk wholly farther than 16 voxels (two bricks) from the box.
     let chunk = [64u32, 64, 32];
     let mut kept = 0;

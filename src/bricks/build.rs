@@ -161,11 +161,14 @@ impl BrickStore {
             || Error::InvalidArgument(format!("{}: the crop box {crop:?} holds no voxel of the image", path.display()));
         let level = match hints.level {
             Some(l) => l,
-            None => image.default_level_within(Some(crop)).ok_or_else(misses)?,
+            None => image.default_level_within(Some(crop), hints.view.as_ref()).ok_or_else(misses)?,
         };
         let whole = crate::loaders::VolumeHints { level: Some(level), crop: None, ..hints.clone() };
         let not_read = || Error::InvalidArgument(format!("{}: not read as an OME-Zarr image", path.display()));
         let mut reader = crate::loaders::SliceReader::open(path, &whole)?.ok_or_else(not_read)?;
+        if let Some(camera) = hints.view {
+            reader.only_in_view(camera, crate::loaders::VIEW_MARGIN_PX);
+        }
         let region @ [lo, hi] = image.region(level, crop).ok_or_else(misses)?;
         Self::from_region_slices(reader.dims, reader.spacing, region, |z0, count, out| {
             reader.read_part(z0, count, [lo[0], lo[1]], [hi[0], hi[1]], out)

@@ -8,6 +8,11 @@ use super::zarr::OmeZarr;
 /// holds every cell the cut would draw from the finest level's voxels.
 pub const LEVEL_PIXELS: f32 = crate::options::DEFAULT_LOD_PIXELS * 0.5;
 
+/// Pixels past the image's edges a view's read reaches (`VolumeHints::view`): a coarse
+/// level-of-detail splat centred outside the image spills about 2.4 px into it (a brick's one
+/// cell, radius 1.6 cells).
+pub const VIEW_MARGIN_PX: f32 = 4.0;
+
 impl OmeZarr {
     /// The level read when none is asked for: the finest whose bricked store fits the host budget
     /// (`host_budget`) even with every voxel stored, else the coarsest. The file's levels average
@@ -15,12 +20,13 @@ impl OmeZarr {
     /// structures in them (on the bonsai, level 1 against level 0: 20-21 dB at 32² to 64²), so a
     /// coarser level is read only when the finest cannot be held.
     pub fn default_level(&self) -> u32 {
-        self.default_level_within(None).unwrap_or(0)
+        self.default_level_within(None, None).unwrap_or(0)
     }
 
-    /// `default_level` for the part of the image inside `crop` (`region`): the finest level
-    /// whose region's store fits. `None` when the box misses the image.
-    pub fn default_level_within(&self, crop: Option<[[f32; 3]; 2]>) -> Option<u32> {
+    /// `default_level` for the part of the image inside `crop` (`region`), and of it what `view`
+    /// may see (`VolumeHints::view`): the finest level whose part's store fits. `None` when the
+    /// box misses the image.
+    pub fn default_level_within(&self, crop: Option<[[f32; 3]; 2]>, view: Option<&crate::Camera>) -> Option<u32> {
         let fits = |level: usize| {
             let l = &self.levels[level];
             let [lo, hi] = match crop {
@@ -28,7 +34,10 @@ impl OmeZarr {
                 None => [[0; 3], l.dims],
             };
             let b = crate::constants::BRICK_SIDE;
-            let voxels = (0..3).fold(1u64, |a, i| a.saturating_mul((hi[i] - lo[i]) as u64));
+            let voxels = match view {
+                Some(camera) => self.seen_voxels(level, [lo, hi], camera),
+                None => (0..3).fold(1u64, |a, i| a.saturating_mul((hi[i] - lo[i]) as u64)),
+            };
             let bricks = l.dims.iter().fold(1u64, |a, &d| a.saturating_mul(d.div_ceil(b) as u64));
             let part = (0..3).fold(1u64, |a, i| a.saturating_mul((hi[i].div_ceil(b) - lo[i] / b) as u64));
             // Records, the part's headers and masks, the whole grid's index (`BrickStore::from_region`'s
@@ -45,6 +54,37 @@ impl OmeZarr {
             }
         }
         last
+    }
+
+    /// The voxels of `region` of level `level` in the chunks `camera` may see (as
+    /// `ZarrReader::only_in_view` reads them).
+    fn seen_voxels(&self, level: usize, [lo, hi]: [[u32; 3]; 2], camera: &crate::Camera) -> u64 {
+        let l = &self.levels[level];
+        let n = l.chunk.len();
+        // The chunk along x, y, z (array order is z, y, x last).
+        let chunk = [0, 1, 2].map(|a| l.chunk[n - 1 - a].max(1));
+        let cell = |a: usize, i: u64| (i as f32 - (l.dims[a] as f32 - 1.0) * 0.5) * l.spacing[a];
+        let pad = |a: usize| crate::constants::BRICK_SIDE as f32 * l.spacing[a];
+        let first = [0, 1, 2].map(|a| lo[a] as u64 / chunk[a]);
+        let last = [0, 1, 2].map(|a| (hi[a] as u64 - 1) / chunk[a]);
+        let mut voxels = 0u64;
+        for cz in first[2]..=last[2] {
+            for cy in first[1]..=last[1] {
+                for cx in first[0]..=last[0] {
+                    let c = [cx, cy, cz];
+                    let s = [0, 1, 2].map(|a| (c[a] * chunk[a]).max(lo[a] as u64));
+                    let e = [0, 1, 2].map(|a| ((c[a] + 1) * chunk[a]).min(hi[a] as u64));
+                    let a = glam::Vec3::from([0, 1, 2].map(|a| cell(a, c[a] * chunk[a]) - pad(a)));
+                    let b = glam::Vec3::from(
+                        [0, 1, 2].map(|a| cell(a, ((c[a] + 1) * chunk[a]).min(l.dims[a] as u64) - 1) + pad(a)),
+                    );
+                    if camera.may_see_box(a, b, VIEW_MARGIN_PX) {
+                        voxels = voxels.saturating_add((0..3).map(|a| e[a] - s[a]).product());
+                    }
+                }
+            }
+        }
+        voxels
     }
 
     /// The voxels of level `level` a store needs to draw what lies inside `crop` (a box in the

@@ -395,6 +395,14 @@ impl SliceReader {
         self.orientation.is_some_and(|o| o.flip_x())
     }
 
+    /// An OME-Zarr level reads only the chunks `camera` may see (`ZarrReader::only_in_view`);
+    /// other files are read whole.
+    pub fn only_in_view(&mut self, camera: crate::Camera, margin_px: f32) {
+        if let Source::Zarr(zarr) = &mut self.source {
+            zarr.only_in_view(camera, margin_px);
+        }
+    }
+
     /// The part `lo..hi` (x and y) of slices `z0..z0 + count` into `out`, x fastest over the
     /// part: a file is read row by row at its offsets, only the part's bytes; an OME-Zarr level
     /// reads only the chunks the part touches; a gzip stream is inflated through (the slices

@@ -439,6 +439,8 @@ pub struct ZarrReader {
     /// The row of chunks last decoded: its first slice, the part of the plane (x and y from, to)
     /// and its samples.
     row: Option<(u32, [u32; 4], Vec<f32>)>,
+    /// Only the chunks this view (and margin in pixels) may see are read (`only_in_view`).
+    seen: Option<(crate::Camera, f32)>,
     what: String,
 }
 
@@ -492,7 +494,7 @@ impl ZarrReader {
         }
         let chunk_z = l.chunk[n - 3].min(l.dims[2] as u64) as u32;
         let what = format!("{what} level {level} ({})", l.path);
-        Ok(ZarrReader { array, kind, dims: l.dims, spacing: l.spacing, lead, chunk_z, row: None, what })
+        Ok(ZarrReader { array, kind, dims: l.dims, spacing: l.spacing, lead, chunk_z, row: None, seen: None, what })
     }
 
     /// Slices `z0..z0 + count` (x fastest) into `out`.
@@ -550,32 +552,69 @@ impl ZarrReader {
         let n = ranges.iter().map(|r| r.end - r.start).product::<u64>();
         crate::error::check_host_memory(n * (4 + self.kind.size()), &format!("{}'s slices", self.what))?;
         let subset = ArraySubset::new_with_ranges(&ranges);
-        if let Ok(Some(chunks)) = self.array.chunks_in_array_subset(&subset) {
-            CHUNKS_READ.fetch_add(chunks.num_elements(), std::sync::atomic::Ordering::Relaxed);
+        let Some(seen) = &self.seen else {
+            if let Ok(Some(chunks)) = self.array.chunks_in_array_subset(&subset) {
+                CHUNKS_READ.fetch_add(chunks.num_elements(), std::sync::atomic::Ordering::Relaxed);
+            }
+            return self.decoded(&subset, n, z0, count);
+        };
+        // Chunk by chunk: those the view cannot see read as NaN (empty to the store's passes).
+        let mut out = vec![f32::NAN; n as usize];
+        let (w, h) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let chunks = self.array.chunks_in_array_subset(&subset).map_err(|e| bad(&self.what, e))?;
+        let lead = self.lead.len();
+        for idx in chunks.iter().flat_map(|c| c.indices().into_iter()) {
+            let part =
+                self.array.chunk_subset(&idx).and_then(|c| Ok(c.overlap(&subset)?)).map_err(|e| bad(&self.what, e))?;
+            let (start, shape) = (part.start()[lead..].to_vec(), part.shape()[lead..].to_vec());
+            // The chunk's part in the grid's centred frame, one brick wider each way.
+            let cell = |a: usize, i: u64| (i as f32 - (self.dims[a] as f32 - 1.0) * 0.5) * self.spacing[a];
+            let pad = |a: usize| crate::constants::BRICK_SIDE as f32 * self.spacing[a];
+            let (lo, hi) = (
+                glam::Vec3::from([0, 1, 2].map(|a| cell(a, start[2 - a]) - pad(a))),
+                glam::Vec3::from([0, 1, 2].map(|a| cell(a, start[2 - a] + shape[2 - a] - 1) + pad(a))),
+            );
+            if !seen.0.may_see_box(lo, hi, seen.1) {
+                continue;
+            }
+            CHUNKS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let values = self.decoded(&part, part.num_elements(), z0, count)?;
+            let (pw, ph) = (shape[2] as usize, shape[1] as usize);
+            for (k, z) in (start[0]..start[0] + shape[0]).enumerate() {
+                for (j, y) in (start[1]..start[1] + shape[1]).enumerate() {
+                    let to = (z - z0 as u64) as usize * w * h
+                        + (y - y0 as u64) as usize * w
+                        + (start[2] - x0 as u64) as usize;
+                    let from = (k * ph + j) * pw;
+                    out[to..to + pw].copy_from_slice(&values[from..from + pw]);
+                }
+            }
         }
-        let err = |e: zarrs::array::ArrayError| match self.failing_chunk(&subset) {
+        Ok(out)
+    }
+
+    /// `subset` (`n` samples, of slices `z0..z0 + count` for messages) decoded, as f32, checked
+    /// finite.
+    fn decoded(&self, subset: &ArraySubset, n: u64, z0: u32, count: u32) -> Result<Vec<f32>> {
+        let err = |e: zarrs::array::ArrayError| match self.failing_chunk(subset) {
             Some((key, e)) => bad(&self.what, format!("chunk {key}: {e}")),
             None => bad(&self.what, format!("slices {z0}..{}: {e}", z0 + count)),
         };
         let a = &self.array;
         let values: Vec<f32> = match self.kind {
-            Kind::U8 => a.retrieve_array_subset::<Vec<u8>>(&subset).map_err(err)?.into_iter().map(f32::from).collect(),
-            Kind::I8 => a.retrieve_array_subset::<Vec<i8>>(&subset).map_err(err)?.into_iter().map(f32::from).collect(),
-            Kind::U16 => {
-                a.retrieve_array_subset::<Vec<u16>>(&subset).map_err(err)?.into_iter().map(f32::from).collect()
-            }
-            Kind::I16 => {
-                a.retrieve_array_subset::<Vec<i16>>(&subset).map_err(err)?.into_iter().map(f32::from).collect()
-            }
+            Kind::U8 => a.retrieve_array_subset::<Vec<u8>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
+            Kind::I8 => a.retrieve_array_subset::<Vec<i8>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
+            Kind::U16 => a.retrieve_array_subset::<Vec<u16>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
+            Kind::I16 => a.retrieve_array_subset::<Vec<i16>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
             Kind::U32 => {
-                a.retrieve_array_subset::<Vec<u32>>(&subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+                a.retrieve_array_subset::<Vec<u32>>(subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
             }
             Kind::I32 => {
-                a.retrieve_array_subset::<Vec<i32>>(&subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+                a.retrieve_array_subset::<Vec<i32>>(subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
             }
-            Kind::F32 => a.retrieve_array_subset::<Vec<f32>>(&subset).map_err(err)?,
+            Kind::F32 => a.retrieve_array_subset::<Vec<f32>>(subset).map_err(err)?,
             Kind::F64 => {
-                a.retrieve_array_subset::<Vec<f64>>(&subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+                a.retrieve_array_subset::<Vec<f64>>(subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
             }
         };
         if values.len() as u64 != n {
@@ -583,6 +622,14 @@ impl ZarrReader {
         }
         super::check_finite(&values, &self.what)?;
         Ok(values)
+    }
+
+    /// Read only the chunks `camera` (in the grid's centred frame) may see, within `margin_px`
+    /// of the image's edges and one brick around: the others' samples read as NaN, which a
+    /// store's passes leave empty (`BrickStore::load` with `VolumeHints::view`).
+    pub fn only_in_view(&mut self, camera: crate::Camera, margin_px: f32) {
+        self.seen = Some((camera, margin_px));
+        self.row = None;
     }
 }
 

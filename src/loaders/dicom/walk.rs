@@ -1,0 +1,177 @@
+//! The length walk a DICOM file passes before dicom-rs reads it: dicom-rs sizes its buffers by
+//! each element's declared length, so every length is checked against the file first, headers
+//! read as dicom-rs's decoders read them (fuzzing found each rule here).
+use super::super::bad;
+use crate::error::Result;
+use std::path::Path;
+
+/// Most bytes of one DICOM file (an image of a series).
+const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// How a data set's elements are encoded.
+#[derive(Clone, Copy, PartialEq)]
+enum Encoding {
+    ImplicitLittle,
+    ExplicitLittle,
+    ExplicitBig,
+}
+
+/// Walks a DICOM file's elements (the file meta group, then the data set in its transfer syntax)
+/// before dicom-rs reads it, which sizes its buffers by each element's declared length: every
+/// defined length must lie within the file; sequences and items are walked into. A deflated data
+/// set is refused (its lengths cannot be checked before it is inflated).
+fn check_lengths(bytes: &[u8], what: &str) -> Result<()> {
+    if bytes.len() < 132 || &bytes[128..132] != b"DICM" {
+        return Err(bad(what, "not a DICOM file (no DICM after the preamble)"));
+    }
+    // dicom-rs reads the meta group as far as its group length says, whatever groups it meets
+    // there: walked as far (the group length's own element first), else to the first other group.
+    let group_length = (bytes.len() >= 144 && bytes[132..136] == [2, 0, 0, 0] && &bytes[136..138] == b"UL")
+        .then(|| u32::from_le_bytes([bytes[140], bytes[141], bytes[142], bytes[143]]) as usize);
+    let (data, syntax) = match group_length {
+        Some(n) => {
+            let end = 144usize
+                .checked_add(n)
+                .filter(|&e| e <= bytes.len())
+                .ok_or_else(|| bad(what, format!("DICOM: the file meta group's length {n} passes the file's end")))?;
+            let (at, syntax) = walk(&bytes[..end], 144, Encoding::ExplicitLittle, false, what)?;
+            (at, syntax)
+        }
+        None => walk(bytes, 132, Encoding::ExplicitLittle, true, what)?,
+    };
+    let encoding = match syntax.as_str() {
+        "1.2.840.10008.1.2" => Encoding::ImplicitLittle,
+        "1.2.840.10008.1.2.2" => Encoding::ExplicitBig,
+        "1.2.840.10008.1.2.1.99" => {
+            return Err(bad(what, "the deflated transfer syntax (1.2.840.10008.1.2.1.99) is not read"))
+        }
+        _ => Encoding::ExplicitLittle,
+    };
+    walk(bytes, data, encoding, false, what).map(|_| ())
+}
+
+/// The elements from `pos` (only the meta group's, group 2, with `meta`): where they end, and the
+/// Transfer Syntax UID when the meta group names one.
+fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> Result<(usize, String)> {
+    use dicom_core::dictionary::{DataDictionary, VirtualVr};
+    let big = enc == Encoding::ExplicitBig;
+    let u16_at = |p: usize| {
+        let b = [bytes[p], bytes[p + 1]];
+        if big {
+            u16::from_be_bytes(b)
+        } else {
+            u16::from_le_bytes(b)
+        }
+    };
+    let u32_at = |p: usize| {
+        let b = [bytes[p], bytes[p + 1], bytes[p + 2], bytes[p + 3]];
+        if big {
+            u32::from_be_bytes(b)
+        } else {
+            u32::from_le_bytes(b)
+        }
+    };
+    let mut syntax = String::new();
+    // Inside encapsulated pixel data (undefined length): its items hold compressed fragments,
+    // skipped by their lengths, not walked into, until the sequence delimiter.
+    let mut encapsulated = false;
+    while pos < bytes.len() {
+        let short = || bad(what, format!("DICOM: an element header is cut off at byte {pos}"));
+        if pos + 8 > bytes.len() {
+            return Err(short());
+        }
+        let (group, element) = (u16_at(pos), u16_at(pos + 2));
+        if meta && group != 2 {
+            break;
+        }
+        let (header, len, container, vr) = if group == 0xFFFE {
+            // An item (walked into) or a delimiter.
+            (8, u32_at(pos + 4), true, None)
+        } else if enc == Encoding::ImplicitLittle {
+            let tag = dicom_core::Tag(group, element);
+            let vr = dicom_dictionary_std::StandardDataDictionary.by_tag(tag).and_then(|e| match e.vr {
+                VirtualVr::Exact(vr) => Some(vr),
+                _ => None,
+            });
+            (8, u32_at(pos + 4), vr == Some(dicom_core::VR::SQ), vr)
+        } else {
+            let vr = &bytes[pos + 4..pos + 6];
+            // As dicom-rs reads the header (dicom-encoding's explicit decoders): these VRs, and a VR
+            // it does not know (read as UN), have a long one; every other VR it knows a short one,
+            // OV, SV and UV included (a fuzzed file with an OV pixel data element made it read a
+            // 4 GB length where this walk read the standard's 144 bytes).
+            let long_vrs = [b"OB", b"OD", b"OF", b"OL", b"OW", b"SQ", b"UC", b"UR", b"UT", b"UN"];
+            let known = dicom_core::VR::from_binary([vr[0], vr[1]]);
+            let long = known.is_none() || long_vrs.iter().any(|v| v.as_slice() == vr);
+            if long {
+                if pos + 12 > bytes.len() {
+                    return Err(short());
+                }
+                (12, u32_at(pos + 8), vr == b"SQ", known)
+            } else {
+                (8, u16_at(pos + 6) as u32, false, known)
+            }
+        };
+        // dicom-rs reads a binary element's whole values only, so a length that is not a multiple
+        // of its value's size leaves it reading the next header from inside this value (a fuzzed
+        // FL of 2 bytes made it read a length of 4 GB).
+        use dicom_core::VR;
+        let size = match vr {
+            Some(VR::SS | VR::US | VR::OW) => 2,
+            Some(VR::FL | VR::SL | VR::UL | VR::AT | VR::OF | VR::OL) => 4,
+            Some(VR::FD | VR::SV | VR::UV | VR::OD | VR::OV) => 8,
+            _ => 1,
+        };
+        if len != u32::MAX && len % size != 0 {
+            return Err(bad(
+                what,
+                format!(
+                    "DICOM: element ({group:04X},{element:04X}) holds {len} bytes: not whole values of {size} bytes"
+                ),
+            ));
+        }
+        // Delimiters hold nothing, and an item lies within the file: dicom-rs reads a delimiter's
+        // length as a value's (a fuzzed one of 4 GB after a stray item).
+        if group == 0xFFFE && element != 0xE000 && len != 0 {
+            return Err(bad(what, format!("DICOM: delimiter (FFFE,{element:04X}) declares {len} bytes, not 0")));
+        }
+        if group == 0xFFFE
+            && len != u32::MAX
+            && (pos + header).checked_add(len as usize).is_none_or(|e| e > bytes.len())
+        {
+            return Err(bad(
+                what,
+                format!("DICOM: item (FFFE,{element:04X}) declares {len} bytes past the file's end"),
+            ));
+        }
+        pos += header;
+        // Encapsulated pixel data, or any OB or OW of undefined length, which dicom-rs reads as
+        // fragments too (a fuzzed OB so read made it size a delimiter's 4 GB length).
+        let fragments = (group, element) == (0x7FE0, 0x10) || matches!(vr, Some(VR::OB | VR::OW));
+        if fragments && len == u32::MAX {
+            encapsulated = true;
+            continue;
+        }
+        if encapsulated && group == 0xFFFE {
+            encapsulated = element != 0xE0DD;
+        } else if len == u32::MAX || container {
+            // Undefined lengths (sequences) and sequences hold elements.
+            continue;
+        }
+        let end = pos.checked_add(len as usize).filter(|&e| e <= bytes.len()).ok_or_else(|| {
+            bad(what, format!("DICOM: element ({group:04X},{element:04X}) declares {len} bytes past the file's end"))
+        })?;
+        if (group, element) == (2, 0x10) {
+            syntax = String::from_utf8_lossy(&bytes[pos..end]).trim_end_matches(['\0', ' ']).to_string();
+        }
+        pos = end;
+    }
+    Ok((pos, syntax))
+}
+
+/// A DICOM file read whole (within `MAX_FILE_BYTES`) and its lengths checked (`check_lengths`).
+pub(super) fn checked_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
+    let bytes = super::super::read_bounded(path, MAX_FILE_BYTES, what)?;
+    check_lengths(&bytes, what)?;
+    Ok(bytes)
+}
