@@ -166,6 +166,12 @@ fn the_dicom_seeds_load() {
                 let e = v.unwrap_err().to_string();
                 assert!(e.contains("delimiter (FFFE,E0DD) declares"), "{e}");
             }
+            // A JPEG 2000 codestream of 4 x 3 pixels in an image of 4 x 2: dicom-rs's adapter
+            // wrote past the frame and panicked.
+            "found-j2k-larger-than-rows.dcm" => {
+                let e = v.unwrap_err().to_string();
+                assert!(e.contains("4 x 3 pixels, not Columns x Rows = 4 x 2"), "{e}");
+            }
             _ => assert!(v.is_err(), "{name} loaded"),
         }
     }

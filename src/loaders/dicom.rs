@@ -487,6 +487,11 @@ impl Series {
                 let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
                 let failed =
                     |e: &dyn std::fmt::Display| bad(&what, format!("pixel data (transfer syntax {syntax}): {e}"));
+                if syntax.starts_with("1.2.840.10008.1.2.4.9") || syntax.starts_with("1.2.840.10008.1.2.4.20") {
+                    let pixel_data = obj.element(tags::PIXEL_DATA).map_err(|e| failed(&e))?;
+                    let fragments = pixel_data.value().fragments().unwrap_or_default();
+                    walk::check_j2k(fragments, image.size, frames, &what)?;
+                }
                 let pixels = obj.decode_pixel_data().map_err(|e| match undecoded(&syntax) {
                     Some(refusal) => Error::Unsupported(format!("{what}: {refusal}")),
                     None => failed(&e),

@@ -175,3 +175,51 @@ pub(super) fn checked_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
     check_lengths(&bytes, what)?;
     Ok(bytes)
 }
+
+/// Most tiles of a JPEG 2000 codestream (OpenJPEG sizes its tile table by their count).
+const MAX_J2K_TILES: u64 = 1 << 16;
+
+/// JPEG 2000 pixel data (its fragments) checked before it is decoded: each codestream's SIZ
+/// must describe one component of `size` (Columns, Rows) in at most `MAX_J2K_TILES` tiles, and
+/// there must be one per frame. dicom-rs's adapter writes the decoded samples into a frame sized
+/// by Rows and Columns, past its end when the codestream is larger (a fuzzed file panicked it),
+/// and OpenJPEG sizes its buffers by the SIZ.
+pub(super) fn check_j2k(fragments: &[Vec<u8>], size: [u32; 2], frames: u32, what: &str) -> Result<()> {
+    let be16 = |b: &[u8], i: usize| u16::from_be_bytes([b[i], b[i + 1]]) as u64;
+    let be32 = |b: &[u8], i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]) as u64;
+    let mut found = 0u32;
+    for f in fragments {
+        for i in (0..f.len().saturating_sub(3)).filter(|&i| f[i..i + 4] == [0xFF, 0x4F, 0xFF, 0x51]) {
+            let siz = |why: String| bad(what, format!("JPEG 2000 codestream {}: {why}", found + 1));
+            if i + 45 > f.len() {
+                return Err(siz("its SIZ is cut off".into()));
+            }
+            let [x, y, x0, y0] = [8, 12, 16, 20].map(|o| be32(f, i + o));
+            let [tw, th, tx0, ty0] = [24, 28, 32, 36].map(|o| be32(f, i + o));
+            let (components, dx, dy) = (be16(f, i + 40), f[i + 43] as u64, f[i + 44] as u64);
+            if components != 1 || dx == 0 || dy == 0 {
+                return Err(siz(format!(
+                    "{components} components sampled {dx} x {dy}: one component, every pixel, is read"
+                )));
+            }
+            let (w, h) =
+                (x.div_ceil(dx).saturating_sub(x0.div_ceil(dx)), y.div_ceil(dy).saturating_sub(y0.div_ceil(dy)));
+            if [w, h] != [size[0] as u64, size[1] as u64] {
+                return Err(siz(format!("{w} x {h} pixels, not Columns x Rows = {} x {}", size[0], size[1])));
+            }
+            let tiles = if tw == 0 || th == 0 || tx0 > x0 || ty0 > y0 {
+                u64::MAX
+            } else {
+                x.saturating_sub(tx0).div_ceil(tw).saturating_mul(y.saturating_sub(ty0).div_ceil(th))
+            };
+            if tiles > MAX_J2K_TILES {
+                return Err(siz(format!("tiles of {tw} x {th}: at most {MAX_J2K_TILES} tiles are read")));
+            }
+            found += 1;
+        }
+    }
+    if found < frames {
+        return Err(bad(what, format!("{found} JPEG 2000 codestreams for {frames} frames")));
+    }
+    Ok(())
+}
