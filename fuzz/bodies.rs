@@ -165,7 +165,7 @@ pub fn zarr_image(data: &[u8]) -> Option<std::path::PathBuf> {
 }
 
 /// OME-Zarr images (`zarr_image` unpacks them) through the streamed and the dense loaders, each
-/// level and channel.
+/// level and channel, and a part of one read as `render --crop` and a narrow view read it.
 pub fn zarr(data: &[u8]) {
     voxsplat::set_host_budget(Some(256 << 20));
     if let Some(dir) = zarr_image(data) {
@@ -174,6 +174,18 @@ pub fn zarr(data: &[u8]) {
             let _ = voxsplat::bricks::BrickStore::load(&dir, &hints);
             let _ = voxsplat::loaders::load_volume(&dir, &hints);
             let _ = voxsplat::loaders::load_channels(&dir, &hints);
+        }
+        // A part of it (`VolumeHints::crop`), and of that only the chunks a narrow view may see.
+        if let Ok(grid) = voxsplat::Grid::centered([8; 3], [1.0; 3]) {
+            let camera = voxsplat::Camera {
+                projection: voxsplat::Projection::Perspective { fov_y_deg: 10.0 },
+                ..voxsplat::Camera::framing(&grid, 16, 16)
+            };
+            for view in [None, Some(camera)] {
+                let crop = Some([[-2.0, -1.0, -3.0], [3.0, 2.0, 1.0]]);
+                let hints = voxsplat::loaders::VolumeHints { crop, view, ..Default::default() };
+                let _ = voxsplat::bricks::BrickStore::load(&dir, &hints);
+            }
         }
     }
 }
