@@ -332,77 +332,36 @@ fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
     .unwrap();
     let view =
         ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--composite", "sheet", "--tf", tf.to_str().unwrap()];
-    let seen = voxsplat(
-        &[
-            &["render", "--volume", path.to_str().unwrap(), "--size", "48x48"][..],
-            &view,
-            &["--validation", "--out", dir.join("seen.png").to_str().unwrap()],
-        ]
-        .concat(),
-    );
-    let said = String::from_utf8_lossy(&seen.stderr);
-    assert!(seen.status.success() && said.contains("the view sees"), "{said}");
-    let read: u32 = said.split("the store read ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+    let draw = |args: &[&str], out: &str| -> (u32, String) {
+        let base = ["render", "--volume", path.to_str().unwrap(), "--size", "48x48", "--validation", "--out"];
+        let o = voxsplat(&[&base[..], &[dir.join(out).to_str().unwrap()], args].concat());
+        let said = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "{said}");
+        (said.split("the store read ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap(), said)
+    };
+    let psnr = |a: &str, b: &str| -> (f64, String) {
+        let o = voxsplat(&["compare", dir.join(a).to_str().unwrap(), dir.join(b).to_str().unwrap()]);
+        let text = String::from_utf8_lossy(&o.stdout).into_owned();
+        let db = text.lines().find_map(|l| l.strip_prefix("psnr:")).unwrap().trim().trim_end_matches(" dB");
+        (db.parse().unwrap_or(f64::INFINITY), text)
+    };
+    let (read, said) = draw(&view, "seen.png");
+    assert!(said.contains("the view sees"), "{said}");
     // It sees |y|, |z| < 44 at the far face (5° either side at 428 units, and the margin): along
     // y 2 of the 4 chunks of 64, along z 4 of the 8 chunks of 32 (z spacing 1.5), every x.
     assert!(read <= 32, "{read} of level 0's 128 chunks read for a view along x: {said}");
-    let all = "-128,-128,-192,128,128,192";
-    let whole = voxsplat(
-        &[
-            &["render", "--volume", path.to_str().unwrap(), "--size", "48x48"][..],
-            &view,
-            &["--crop", all, "--out", dir.join("all.png").to_str().unwrap()],
-        ]
-        .concat(),
-    );
-    let said = String::from_utf8_lossy(&whole.stderr);
-    assert!(whole.status.success() && said.contains("the store read 128 chunks"), "{said}");
-    let compared =
-        voxsplat(&["compare", dir.join("seen.png").to_str().unwrap(), dir.join("all.png").to_str().unwrap()]);
-    let text = String::from_utf8_lossy(&compared.stdout);
-    let psnr: f64 = text
-        .lines()
-        .find_map(|l| l.strip_prefix("psnr:"))
-        .unwrap()
-        .trim()
-        .trim_end_matches(" dB")
-        .parse()
-        .unwrap_or(f64::INFINITY);
-    assert!(psnr > 70.0, "the part the view sees against the whole image: {text}");
+    let all = ["--crop", "-128,-128,-192,128,128,192"];
+    assert_eq!(draw(&[&view[..], &all].concat(), "all.png").0, 128);
+    let (db, text) = psnr("seen.png", "all.png");
+    assert!(db > 70.0, "the part the view sees against the whole image: {text}");
     // A narrow view along a diagonal: its bounds hold nearly the whole image, and only the
     // chunks it may see are read, drawing the same frame.
-    let diagonal = ["--eye", "300,250,350", "--target", "0,0,0", "--fov", "8"];
-    let mut frames = Vec::new();
-    for (name, extra) in [("diagonal.png", &[][..]), ("diagonal-all.png", &["--crop", all][..])] {
-        let out = dir.join(name);
-        let o = voxsplat(
-            &[
-                &["render", "--volume", path.to_str().unwrap(), "--size", "48x48"][..],
-                &view[6..],
-                &diagonal,
-                extra,
-                &["--out", out.to_str().unwrap()],
-            ]
-            .concat(),
-        );
-        let said = String::from_utf8_lossy(&o.stderr).into_owned();
-        assert!(o.status.success(), "{said}");
-        let read: u32 =
-            said.split("the store read ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
-        frames.push((out, read, said));
-    }
-    assert!(frames[0].1 < 80 && frames[1].1 == 128, "{} and {} chunks read: {}", frames[0].1, frames[1].1, frames[0].2);
-    let compared = voxsplat(&["compare", frames[0].0.to_str().unwrap(), frames[1].0.to_str().unwrap()]);
-    let text = String::from_utf8_lossy(&compared.stdout);
-    let psnr: f64 = text
-        .lines()
-        .find_map(|l| l.strip_prefix("psnr:"))
-        .unwrap()
-        .trim()
-        .trim_end_matches(" dB")
-        .parse()
-        .unwrap_or(f64::INFINITY);
-    assert!(psnr > 70.0, "the chunks a diagonal view sees against the whole image: {text}");
+    let diagonal = [&view[6..], &["--eye", "300,250,350", "--target", "0,0,0", "--fov", "8"]].concat();
+    let (read, said) = draw(&diagonal, "diagonal.png");
+    assert!(read < 80, "{read} chunks read: {said}");
+    assert_eq!(draw(&[&diagonal[..], &all].concat(), "diagonal-all.png").0, 128);
+    let (db, text) = psnr("diagonal.png", "diagonal-all.png");
+    assert!(db > 70.0, "the chunks a diagonal view sees against the whole image: {text}");
     // Corrupt every chunk wholly farther than 16 voxels (two bricks) from the box.
     let chunk = [64u32, 64, 32];
     let mut kept = 0;
