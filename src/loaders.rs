@@ -441,7 +441,7 @@ pub fn slice_offsets(path: &Path, hints: &VolumeHints) -> Result<Option<Vec<f64>
     if !(dir && dicom::holds_dicom(path) || !path.is_dir() && is_dicom(path)) {
         return Ok(None);
     }
-    Ok(dicom::open(path, hints.series.as_deref(), true)?.offsets)
+    Ok(dicom::open(path, hints.series.as_deref(), true, hints.time)?.offsets)
 }
 
 /// The voxel positions of a file whose slices are not evenly spaced (a DICOM series with uneven
@@ -460,8 +460,8 @@ pub fn file_positions(path: &Path, hints: &VolumeHints, grid: &crate::volume::Gr
 }
 
 /// The time points `path` holds: a 4-D NIfTI's fourth axis when it is time (`NiftiLayout`), a 4-D
-/// NRRD's last axis when its `kinds` says `time`, an OME-Zarr image's time axis, the files a
-/// pattern matches (`is_pattern`: `scan_*.nii.gz`, one time point each); 1 for any other file. Each is read as a volume with
+/// NRRD's last axis when its `kinds` says `time`, an OME-Zarr image's time axis, a DICOM series'
+/// temporal positions (of the folder's one series), the files a pattern matches (`is_pattern`: `scan_*.nii.gz`, one time point each); 1 for any other file. Each is read as a volume with
 /// `VolumeHints::time` (`animate` plays them; `Renderer::update_volume` swaps them in).
 pub fn time_points(path: &Path) -> Result<u32> {
     if is_pattern(path) {
@@ -476,6 +476,9 @@ pub fn time_points(path: &Path) -> Result<u32> {
     }
     if is_ome_zarr(path) {
         return Ok(OmeZarr::open(path)?.times);
+    }
+    if path.is_dir() && dicom::holds_dicom(path) || !path.is_dir() && is_dicom(path) {
+        return dicom::time_points(path, None);
     }
     Ok(1)
 }

@@ -299,8 +299,10 @@ fn run(cli: Cli) -> Result<()> {
             if file.is_dir() && !voxsplat::loaders::is_ome_zarr(&file) {
                 let all = voxsplat::loaders::dicom_series(&file)?;
                 for (i, s) in all.iter().enumerate() {
+                    let times =
+                        if s.times > 1 { format!(", {} time points (--time N)", s.times) } else { String::new() };
                     println!(
-                        "series {i}: {} {} '{}', {:?} (columns, rows, images)",
+                        "series {i}: {} {} '{}', {:?} (columns, rows, images){times}",
                         s.uid, s.modality, s.description, s.dims
                     );
                 }

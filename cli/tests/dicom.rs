@@ -338,8 +338,9 @@ fn world(o: &voxsplat::orient::Orientation, dims: [u32; 3], [i, j, k]: [u32; 3])
 /// Enhanced multi-frame images (issue 47 item 1): an enhanced MR whose 12 frames are stored out of
 /// order on an oblique plane, placed by per-frame Plane Position and shared Plane Orientation,
 /// Pixel Measures and Pixel Value Transformation (cli/tests/data/write_enhanced.py), reads voxel
-/// for voxel where dcm2niix's NIfTI of it puts each value; frames of several temporal positions and
-/// a Per-frame Functional Groups Sequence of the wrong length are refused.
+/// for voxel where dcm2niix's NIfTI of it puts each value; frames of several temporal positions are
+/// its time points (`--time`), and a Per-frame Functional Groups Sequence of the wrong length is
+/// refused.
 #[test]
 fn an_enhanced_image_is_placed_by_its_functional_groups_as_dcm2niix_places_it() {
     let dir = tmp("enhanced");
@@ -405,17 +406,33 @@ fn an_enhanced_image_is_placed_by_its_functional_groups_as_dcm2niix_places_it() 
     }
     let compared = ok(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
     assert!(compared.contains("psnr:       inf dB"), "{compared}");
-    // Refused: frames of two temporal positions, and per-frame items that are not one per frame.
-    for (name, extra, says) in [
-        ("times", ["--times", "2"], "2 temporal positions"),
-        ("items", ["--items", "5"], "holds 5 items for 12 frames"),
-    ] {
-        let bad = dir.join(name);
-        std::fs::create_dir_all(&bad).unwrap();
-        write(&bad.join("e.dcm"), &extra);
-        let e = load_volume(&bad, &hints).unwrap_err().to_string();
-        assert!(e.contains(says) && e.contains("e.dcm"), "{e}");
+    // Frames of three temporal positions, interleaved in the file: three time points, each the
+    // volume above plus 100 t stored (200 t rescaled).
+    let times = dir.join("times");
+    std::fs::create_dir_all(&times).unwrap();
+    write(&times.join("e.dcm"), &["--times", "3"]);
+    assert_eq!(voxsplat::loaders::time_points(&times).unwrap(), 3);
+    for t in 0..3u32 {
+        let at = VolumeHints { time: Some(t), ..Default::default() };
+        let vt = load_volume(&times, &at).unwrap();
+        assert_eq!(vt.dims, v.dims);
+        assert!(vt.values.iter().zip(&v.values).all(|(a, b)| *a == b + 200.0 * t as f32), "time point {t}");
+        assert_eq!(load_orientation(&times, &at).unwrap().unwrap().affine(), o.affine(), "time point {t}");
     }
+    let e = load_volume(&times, &hints).unwrap_err().to_string();
+    assert!(e.contains("3 time points"), "{e}");
+    let e = load_volume(&times, &VolumeHints { time: Some(3), ..Default::default() }).unwrap_err().to_string();
+    assert!(e.contains("time points 0 to 2"), "{e}");
+    let e = load_volume(&series, &VolumeHints { time: Some(1), ..Default::default() }).unwrap_err().to_string();
+    assert!(e.contains("one volume"), "{e}");
+    let listed = ok(&["info", times.to_str().unwrap()]);
+    assert!(listed.contains("[24, 20, 12] (columns, rows, images), 3 time points"), "{listed}");
+    // Refused: per-frame items that are not one per frame.
+    let bad = dir.join("items");
+    std::fs::create_dir_all(&bad).unwrap();
+    write(&bad.join("e.dcm"), &["--items", "5"]);
+    let e = load_volume(&bad, &hints).unwrap_err().to_string();
+    assert!(e.contains("holds 5 items for 12 frames") && e.contains("e.dcm"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

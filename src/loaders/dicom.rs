@@ -41,8 +41,12 @@ struct Image {
     spacing: [f64; 2],
     rescale: [f64; 2],
     size: [u32; 2],
-    /// The file's frame this slice is (0 for a single-frame image).
+    /// The file's frame this slice is (0 for a single-frame image), of its `frames`.
     frame: u32,
+    frames: u32,
+    /// Its temporal position (an enhanced image's Temporal Position Index, else a classic
+    /// image's Temporal Position Identifier; 0 without one).
+    time: i64,
 }
 
 /// A series in a folder: what `voxsplat info DIR` lists.
@@ -54,8 +58,10 @@ pub struct SeriesInfo {
     pub description: String,
     /// Modality (CT, MR, ...).
     pub modality: String,
-    /// Columns, rows, images.
+    /// Columns, rows, images (of one time point).
     pub dims: [u32; 3],
+    /// Its temporal positions, in order (one for a series without time).
+    pub times: u32,
     images: Vec<Image>,
 }
 
@@ -142,6 +148,8 @@ fn plane(
         rescale: [slope, scalar(intercept, tags::RESCALE_INTERCEPT, 0.0, "Rescale Intercept")?],
         size: [0; 2],
         frame: 0,
+        frames: 1,
+        time: 0,
     })
 }
 
@@ -152,7 +160,7 @@ type Header = (String, String, String, Vec<Image>);
 /// Rows): a folder's other objects are left alone. A multi-frame image is one slice per frame,
 /// placed by its own functional groups (an enhanced CT or MR image: Plane Position, Plane
 /// Orientation, Pixel Measures and Pixel Value Transformation, per frame or shared; frames of
-/// several temporal positions are refused), or by its Grid Frame Offset Vector (RT Dose: offsets
+/// several temporal positions are time points), or by its Grid Frame Offset Vector (RT Dose: offsets
 /// along the normal from Image Position (Patient) when the first is 0, else the frames' z
 /// coordinates on an axial grid) and scaled by its Dose Grid Scaling.
 fn header(path: &Path) -> Result<Option<Header>> {
@@ -210,7 +218,6 @@ fn header(path: &Path) -> Result<Option<Header>> {
                 .flatten()
                 .and_then(|e| e.items())
                 .and_then(|i| i.first());
-            let mut temporal = std::collections::BTreeSet::new();
             let mut images = Vec::with_capacity(items.len());
             for (k, item) in items.iter().enumerate() {
                 let at = |seq, tag| group(Some(item), shared, &obj, seq, tag);
@@ -230,30 +237,29 @@ fn header(path: &Path) -> Result<Option<Header>> {
                     &frame,
                 )?;
                 let content = at(tags::FRAME_CONTENT_SEQUENCE, tags::TEMPORAL_POSITION_INDEX);
-                if let Some(t) = content.element_opt(tags::TEMPORAL_POSITION_INDEX).ok().flatten() {
-                    temporal
-                        .insert(t.to_int::<i64>().map_err(|e| bad(&frame, format!("Temporal Position Index: {e}")))?);
-                }
+                let time = match content.element_opt(tags::TEMPORAL_POSITION_INDEX).ok().flatten() {
+                    Some(t) => t.to_int::<i64>().map_err(|e| bad(&frame, format!("Temporal Position Index: {e}")))?,
+                    None => 0,
+                };
                 images.push(Image {
                     path: path.to_path_buf(),
                     position: DVec3::new(p[0], p[1], p[2]),
                     size,
                     frame: k as u32,
+                    frames,
+                    time,
                     ..plane
                 });
-            }
-            if temporal.len() > 1 {
-                return Err(Error::Unsupported(format!(
-                    "{what}: an enhanced image of {} temporal positions (Temporal Position Index) is not read as a \
-                     time series yet",
-                    temporal.len()
-                )));
             }
             images
         }
         None => {
             let p = numbers(&obj, tags::IMAGE_POSITION_PATIENT, "Image Position (Patient)", 3, &what)?;
-            let plane = plane(&obj, &obj, &obj, &obj, &what)?;
+            let time = match obj.element_opt(tags::TEMPORAL_POSITION_IDENTIFIER).ok().flatten() {
+                Some(t) => t.to_int::<i64>().map_err(|e| bad(&what, format!("Temporal Position Identifier: {e}")))?,
+                None => 0,
+            };
+            let plane = Image { frames, time, ..plane(&obj, &obj, &obj, &obj, &what)? };
             let position = DVec3::new(p[0], p[1], p[2]);
             let offsets = if frames > 1 {
                 numbers(&obj, tags::GRID_FRAME_OFFSET_VECTOR, "Grid Frame Offset Vector", frames as usize, &what)?
@@ -299,12 +305,14 @@ pub fn series_in(dir: &Path) -> Result<Vec<SeriesInfo>> {
         let Some((uid, description, modality, images)) = header(&path)? else { continue };
         match series.iter_mut().find(|s| s.uid == uid) {
             Some(s) => s.images.extend(images),
-            None => series.push(SeriesInfo { uid, description, modality, dims: [0; 3], images }),
+            None => series.push(SeriesInfo { uid, description, modality, dims: [0; 3], times: 1, images }),
         }
     }
     series.sort_by(|a, b| a.uid.cmp(&b.uid));
     for s in &mut series {
-        s.dims = [s.images[0].size[0], s.images[0].size[1], s.images.len() as u32];
+        let times = s.images.iter().map(|i| i.time).collect::<std::collections::BTreeSet<_>>().len();
+        s.times = times as u32;
+        s.dims = [s.images[0].size[0], s.images[0].size[1], (s.images.len() / times) as u32];
     }
     Ok(series)
 }
@@ -346,9 +354,33 @@ pub struct Series {
 }
 
 /// The series `path` names: a folder holding one series (or `pick`, its index in `voxsplat info`'s
-/// list or its UID), or one DICOM file of its series. Uneven slice gaps are refused unless
+/// list or its UID), or one DICOM file of its series, at time point `time` (its images of one
+/// temporal position, needed when it has several). Uneven slice gaps are refused unless
 /// `rectilinear` (the caller places the slices at `Series::offsets`).
-pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool) -> Result<Series> {
+pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool, time: Option<u32>) -> Result<Series> {
+    let what = path.display().to_string();
+    let chosen = chosen(path, pick)?;
+    let t = super::time_point(&what, chosen.times, time)?;
+    let at = *chosen
+        .images
+        .iter()
+        .map(|i| i.time)
+        .collect::<std::collections::BTreeSet<_>>()
+        .iter()
+        .nth(t as usize)
+        .expect("checked by time_point");
+    let images = chosen.images.iter().filter(|i| i.time == at).cloned().collect();
+    build(&SeriesInfo { images, ..chosen }, &what, rectilinear)
+}
+
+/// The temporal positions of the series `path` names (`open`'s), 1 when it names none alone (a
+/// folder of several series without `pick`).
+pub fn time_points(path: &Path, pick: Option<&str>) -> Result<u32> {
+    Ok(chosen(path, pick).map_or(1, |s| s.times))
+}
+
+/// The series `path` and `pick` name (`open`).
+fn chosen(path: &Path, pick: Option<&str>) -> Result<SeriesInfo> {
     let what = path.display().to_string();
     let (dir, own) = if path.is_dir() {
         (path.to_path_buf(), None)
@@ -380,7 +412,7 @@ pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool) -> Result<Series
             n => return Err(bad(&what, format!("holds {n} series: pick one with --series N or UID ({})", list()))),
         },
     };
-    build(chosen, &what, rectilinear)
+    Ok(chosen.clone())
 }
 
 /// Checks a series' images agree and orders them along their normal.
@@ -473,7 +505,7 @@ impl Series {
     pub fn slice(&mut self, z: u32) -> Result<Vec<f32>> {
         let image = self.images[z as usize].clone();
         let what = image.path.display().to_string();
-        let frames = self.images.iter().filter(|i| i.path == image.path).count() as u32;
+        let frames = image.frames;
         let raw = match &self.frames {
             Some((path, all)) if *path == image.path => all[image.frame as usize].clone(),
             _ => {

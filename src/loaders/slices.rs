@@ -123,21 +123,22 @@ impl SliceReader {
         }
         let nifti = name.ends_with(".nii") || name.ends_with(".nii.gz");
         let nrrd = name.ends_with(".nrrd") || name.ends_with(".nhdr");
-        if hints.level.is_some() || hints.time.is_some() && !(nifti || nrrd) {
+        let dicom = path.is_dir() && super::dicom::holds_dicom(path) || !path.is_dir() && super::dicom::is_dicom(path);
+        if hints.level.is_some() || hints.time.is_some() && !(nifti || nrrd || dicom) {
             return Err(super::bad(
                 &path.display().to_string(),
                 if hints.level.is_some() {
                     "--level picks a level of an OME-Zarr image; this is none"
                 } else {
-                    "--time picks a time point of a 4-D NIfTI or NRRD or an OME-Zarr image; this is none"
+                    "--time picks a time point of a 4-D NIfTI or NRRD, a DICOM series or an OME-Zarr image; this is none"
                 },
             ));
         }
         if hints.series.is_some() && !(path.is_dir() || super::dicom::is_dicom(path)) {
             return Err(super::bad(&path.display().to_string(), "--series picks a DICOM series of a folder"));
         }
-        if path.is_dir() && super::dicom::holds_dicom(path) || !path.is_dir() && super::dicom::is_dicom(path) {
-            Ok(Some(Self::stack(super::stacks::Stack::dicom(path, series, hints.rectilinear)?)))
+        if dicom {
+            Ok(Some(Self::stack(super::stacks::Stack::dicom(path, series, hints.rectilinear, hints.time)?)))
         } else if path.is_dir() {
             if series.is_some() {
                 return Err(super::bad(

@@ -304,9 +304,10 @@ impl Stack {
         Self::sized(Slices::Files(files), [w, h, depth], [1.0; 3], what)
     }
 
-    /// A DICOM series: a folder of one (or `pick`: its index or UID), or one file of its series.
-    pub fn dicom(path: &Path, pick: Option<&str>, rectilinear: bool) -> Result<Stack> {
-        let series = super::dicom::open(path, pick, rectilinear)?;
+    /// A DICOM series: a folder of one (or `pick`: its index or UID), or one file of its series,
+    /// at time point `time` (`dicom::open`).
+    pub fn dicom(path: &Path, pick: Option<&str>, rectilinear: bool, time: Option<u32>) -> Result<Stack> {
+        let series = super::dicom::open(path, pick, rectilinear, time)?;
         let (dims, orientation) = (series.dims, series.orientation);
         let mut stack = Self::sized(Slices::Dicom(series), dims, orientation.spacing(), path.display().to_string())?;
         stack.orientation = Some(orientation);

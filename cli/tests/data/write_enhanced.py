@@ -11,7 +11,7 @@ from pydicom.uid import ExplicitVRLittleEndian, generate_uid
 
 ap = argparse.ArgumentParser()
 ap.add_argument("out")
-ap.add_argument("--times", type=int, default=1, help="temporal positions (each a copy of the frames)")
+ap.add_argument("--times", type=int, default=1, help="temporal positions (time point t: the frames plus 100 t)")
 ap.add_argument("--items", type=int, default=None, help="per-frame items to write (default: one per frame)")
 a = ap.parse_args()
 
@@ -47,7 +47,7 @@ ds.ImageType = ["ORIGINAL", "PRIMARY", "M", "NONE"]
 ds.Rows, ds.Columns = rows, cols
 ds.SamplesPerPixel, ds.PhotometricInterpretation = 1, "MONOCHROME2"
 ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 0
-frames = [(t, k) for t in range(a.times) for k in order]
+frames = [(t, k) for k in order for t in range(a.times)]  # time points interleaved
 ds.NumberOfFrames = len(frames)
 ds.ContentDate, ds.ContentTime, ds.AcquisitionDateTime = "20260101", "120000", "20260101120000"
 
@@ -78,5 +78,5 @@ for t, k in frames:
     item.FrameContentSequence = Sequence([content])
     items.append(item)
 ds.PerFrameFunctionalGroupsSequence = Sequence(items[: a.items] if a.items is not None else items)
-ds.PixelData = np.stack([vol[k] for _, k in frames]).tobytes()
+ds.PixelData = np.stack([vol[k] + 100 * t for t, k in frames]).astype(np.uint16).tobytes()
 ds.save_as(a.out, enforce_file_format=True)
