@@ -147,12 +147,20 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
         pos += header;
         // Encapsulated pixel data, or any OB or OW of undefined length, which dicom-rs reads as
         // fragments too (a fuzzed OB so read made it size a delimiter's 4 GB length).
-        let fragments = (group, element) == (0x7FE0, 0x10) || matches!(vr, Some(VR::OB | VR::OW));
+        let fragments = (group & 0xFF00, element) == (0x7F00, 0x10) || matches!(vr, Some(VR::OB | VR::OW));
         if fragments && len == u32::MAX {
             encapsulated = true;
             continue;
         }
-        if encapsulated && group == 0xFFFE {
+        if encapsulated && !(group == 0xFFFE && matches!(element, 0xE000 | 0xE0DD)) {
+            // dicom-rs reads whatever stands there as an item's header and its length (a fuzzed
+            // one read a tag as a length of 3.7 GB).
+            return Err(bad(
+                what,
+                format!("DICOM: encapsulated pixel data holds ({group:04X},{element:04X}) where an item belongs"),
+            ));
+        }
+        if encapsulated {
             encapsulated = element != 0xE0DD;
         } else if len == u32::MAX || container {
             // Undefined lengths (sequences) and sequences hold elements.
