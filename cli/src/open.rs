@@ -85,8 +85,9 @@ pub struct SceneArgs {
     /// memory holds.
     #[arg(long, value_parser = parse_level, requires = "volume")]
     pub level: Option<String>,
-    /// The time point of a series to draw: a 4-D NIfTI or NRRD, an OME-Zarr image, a pattern of
-    /// numbered files (needed when it holds several; `voxsplat animate --volume` plays them all).
+    /// The time point of a series to draw: a 4-D NIfTI or NRRD, an OME-Zarr image, a DICOM series
+    /// of several temporal positions, a pattern of numbered files (needed when it holds several;
+    /// `voxsplat animate --volume` plays them all).
     #[arg(long, requires = "volume")]
     pub time: Option<u32>,
     /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's
