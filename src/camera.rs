@@ -317,8 +317,7 @@ impl Camera {
     /// a point p is in view when n . p >= d for each (near and far aside).
     pub fn side_planes(&self, margin: f32) -> [(Vec3, f32); 4] {
         let (f, r, u) = (self.forward(), self.right(), self.true_up());
-        let per = self.pixels_per_unit();
-        let (sx, sy) = ((0.5 * self.width as f32 + margin) / per, (0.5 * self.height as f32 + margin) / per);
+        let (sx, sy) = self.half_view(margin);
         let e = self.eye;
         match self.projection {
             Projection::Perspective { .. } => [f * sx + r, f * sx - r, f * sy + u, f * sy - u].map(|n| (n, n.dot(e))),
@@ -331,8 +330,14 @@ impl Camera {
     /// Whether box `lo..hi` may hold something in view (`side_planes(margin)`): false only when
     /// all its corners lie outside one side plane.
     pub fn may_see_box(&self, lo: Vec3, hi: Vec3, margin: f32) -> bool {
-        let corner = |i: usize| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2]);
-        self.side_planes(margin).iter().all(|&(n, d)| (0..8).any(|i| n.dot(corner(i)) >= d))
+        self.side_planes(margin).iter().all(|&(n, d)| (0..8).any(|i| n.dot(box_corner(lo, hi, i)) >= d))
+    }
+
+    /// Half the view's width and height, `margin` pixels past the image's edges: at unit depth
+    /// (perspective) or in world units (orthographic).
+    fn half_view(&self, margin: f32) -> (f32, f32) {
+        let per = self.pixels_per_unit();
+        ((0.5 * self.width as f32 + margin) / per, (0.5 * self.height as f32 + margin) / per)
     }
 
     /// The bounds of the part of box `lo..hi` this view can see, `margin` pixels past the image's
@@ -340,8 +345,7 @@ impl Camera {
     /// reader that needs only what the frame shows reads these bounds.
     pub fn box_in_view(&self, lo: Vec3, hi: Vec3, margin: f32) -> Option<[Vec3; 2]> {
         let (f, r, u) = (self.forward(), self.right(), self.true_up());
-        let per = self.pixels_per_unit();
-        let (sx, sy) = ((0.5 * self.width as f32 + margin) / per, (0.5 * self.height as f32 + margin) / per);
+        let (sx, sy) = self.half_view(margin);
         let planes = self.side_planes(margin);
         // The view's edges: a point, a direction, and whether it is a ray from the eye.
         let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
@@ -358,7 +362,7 @@ impl Camera {
         let in_box = |p: Vec3| (p - lo).min_element() >= -slack && (hi - p).min_element() >= -slack;
         let mut points = Vec::new();
         // The box's corners in view, and where its edges cross the side planes.
-        let corner = |i: usize| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2]);
+        let corner = |i: usize| box_corner(lo, hi, i);
         for i in 0..8 {
             points.push(corner(i));
             for bit in [1, 2, 4] {
@@ -394,4 +398,9 @@ impl Camera {
         let bounds = inside.iter().fold([first, first], |[a, b], &p| [a.min(p), b.max(p)]);
         Some([bounds[0].max(lo), bounds[1].min(hi)])
     }
+}
+
+/// Corner `i` (0 to 7: bit 0 high x, bit 1 high y, bit 2 high z) of box `lo..hi`.
+fn box_corner(lo: Vec3, hi: Vec3, i: usize) -> Vec3 {
+    Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2])
 }

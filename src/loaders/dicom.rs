@@ -310,11 +310,18 @@ pub fn series_in(dir: &Path) -> Result<Vec<SeriesInfo>> {
     }
     series.sort_by(|a, b| a.uid.cmp(&b.uid));
     for s in &mut series {
-        let times = s.images.iter().map(|i| i.time).collect::<std::collections::BTreeSet<_>>().len();
+        let times = s.temporal_positions().len();
         s.times = times as u32;
         s.dims = [s.images[0].size[0], s.images[0].size[1], (s.images.len() / times) as u32];
     }
     Ok(series)
+}
+
+impl SeriesInfo {
+    /// Its images' temporal positions, each once, in order.
+    fn temporal_positions(&self) -> Vec<i64> {
+        self.images.iter().map(|i| i.time).collect::<std::collections::BTreeSet<_>>().into_iter().collect()
+    }
 }
 
 /// Whether folder `dir` holds a DICOM file (read as a series rather than a stack of images).
@@ -361,14 +368,7 @@ pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool, time: Option<u32
     let what = path.display().to_string();
     let chosen = chosen(path, pick)?;
     let t = super::time_point(&what, chosen.times, time)?;
-    let at = *chosen
-        .images
-        .iter()
-        .map(|i| i.time)
-        .collect::<std::collections::BTreeSet<_>>()
-        .iter()
-        .nth(t as usize)
-        .expect("checked by time_point");
+    let at = chosen.temporal_positions()[t as usize];
     let images = chosen.images.iter().filter(|i| i.time == at).cloned().collect();
     build(&SeriesInfo { images, ..chosen }, &what, rectilinear)
 }

@@ -1,6 +1,6 @@
 //! Which level of an OME-Zarr pyramid to read, and which part of it: the finest the host budget
 //! holds (whole, or the part a crop box needs), or the one a view needs (`--level auto`).
-use super::zarr::OmeZarr;
+use super::zarr::{may_see_voxels, OmeZarr};
 
 /// The largest size, in pixels, at the nearest point of the view, of a voxel of the level
 /// `OmeZarr::level_for` picks: the levels-of-detail cut draws cells of `DEFAULT_LOD_PIXELS` (1.5 px),
@@ -60,11 +60,10 @@ impl OmeZarr {
     /// `ZarrReader::only_in_view` reads them).
     fn seen_voxels(&self, level: usize, [lo, hi]: [[u32; 3]; 2], camera: &crate::Camera) -> u64 {
         let l = &self.levels[level];
+        let Ok(grid) = crate::Grid::centered(l.dims, l.spacing) else { return u64::MAX };
         let n = l.chunk.len();
         // The chunk along x, y, z (array order is z, y, x last).
         let chunk = [0, 1, 2].map(|a| l.chunk[n - 1 - a].max(1));
-        let cell = |a: usize, i: u64| (i as f32 - (l.dims[a] as f32 - 1.0) * 0.5) * l.spacing[a];
-        let pad = |a: usize| crate::constants::BRICK_SIDE as f32 * l.spacing[a];
         let first = [0, 1, 2].map(|a| lo[a] as u64 / chunk[a]);
         let last = [0, 1, 2].map(|a| (hi[a] as u64 - 1) / chunk[a]);
         let mut voxels = 0u64;
@@ -72,13 +71,11 @@ impl OmeZarr {
             for cy in first[1]..=last[1] {
                 for cx in first[0]..=last[0] {
                     let c = [cx, cy, cz];
-                    let s = [0, 1, 2].map(|a| (c[a] * chunk[a]).max(lo[a] as u64));
-                    let e = [0, 1, 2].map(|a| ((c[a] + 1) * chunk[a]).min(hi[a] as u64));
-                    let a = glam::Vec3::from([0, 1, 2].map(|a| cell(a, c[a] * chunk[a]) - pad(a)));
-                    let b = glam::Vec3::from(
-                        [0, 1, 2].map(|a| cell(a, ((c[a] + 1) * chunk[a]).min(l.dims[a] as u64) - 1) + pad(a)),
-                    );
-                    if camera.may_see_box(a, b, VIEW_MARGIN_PX) {
+                    let start = [0, 1, 2].map(|a| c[a] * chunk[a]);
+                    let end = [0, 1, 2].map(|a| ((c[a] + 1) * chunk[a]).min(l.dims[a] as u64));
+                    if may_see_voxels(camera, VIEW_MARGIN_PX, &grid, start, end) {
+                        let s = [0, 1, 2].map(|a| start[a].max(lo[a] as u64));
+                        let e = [0, 1, 2].map(|a| end[a].min(hi[a] as u64));
                         voxels = voxels.saturating_add((0..3).map(|a| e[a] - s[a]).product());
                     }
                 }

@@ -563,18 +563,15 @@ impl ZarrReader {
         let (w, h) = ((x1 - x0) as usize, (y1 - y0) as usize);
         let chunks = self.array.chunks_in_array_subset(&subset).map_err(|e| bad(&self.what, e))?;
         let lead = self.lead.len();
+        let grid = crate::Grid::centered(self.dims, self.spacing)?;
         for idx in chunks.iter().flat_map(|c| c.indices().into_iter()) {
             let part =
                 self.array.chunk_subset(&idx).and_then(|c| Ok(c.overlap(&subset)?)).map_err(|e| bad(&self.what, e))?;
             let (start, shape) = (part.start()[lead..].to_vec(), part.shape()[lead..].to_vec());
-            // The chunk's part in the grid's centred frame, one brick wider each way.
-            let cell = |a: usize, i: u64| (i as f32 - (self.dims[a] as f32 - 1.0) * 0.5) * self.spacing[a];
-            let pad = |a: usize| crate::constants::BRICK_SIDE as f32 * self.spacing[a];
-            let (lo, hi) = (
-                glam::Vec3::from([0, 1, 2].map(|a| cell(a, start[2 - a]) - pad(a))),
-                glam::Vec3::from([0, 1, 2].map(|a| cell(a, start[2 - a] + shape[2 - a] - 1) + pad(a))),
-            );
-            if !seen.0.may_see_box(lo, hi, seen.1) {
+            // Array order is z, y, x.
+            let xyz = [2, 1, 0].map(|a| start[a]);
+            let end = [2, 1, 0].map(|a| start[a] + shape[a]);
+            if !may_see_voxels(&seen.0, seen.1, &grid, xyz, end) {
                 continue;
             }
             CHUNKS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -631,6 +628,22 @@ impl ZarrReader {
         self.seen = Some((camera, margin_px));
         self.row = None;
     }
+}
+
+/// Whether `camera` may see voxels `start..end` (x, y, z) of `grid` (a level's, centred) or the
+/// brick around them, whose gradients and levels of detail read them (`Camera::may_see_box`,
+/// `margin` pixels past the image's edges).
+pub(super) fn may_see_voxels(
+    camera: &crate::Camera,
+    margin: f32,
+    grid: &crate::Grid,
+    start: [u64; 3],
+    end: [u64; 3],
+) -> bool {
+    let pad = glam::Vec3::splat(crate::constants::BRICK_SIDE as f32);
+    let [lo, hi] = [start, end.map(|e| e - 1)].map(|c| glam::Vec3::from(c.map(|v| v as f32)));
+    let [lo, hi] = grid.world_box(lo - pad, hi + pad);
+    camera.may_see_box(lo, hi, margin)
 }
 
 /// Every channel of the image at `dir` (`loaders::load_channels`), each read whole at
