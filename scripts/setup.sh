@@ -25,6 +25,8 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 # The DICOM tests read pydicom's bundled test series (cli/tests/dicom.rs).
 python3 -c "import pydicom" 2>/dev/null || python3 -m pip install --quiet pydicom
+# pyjpegls (CharLS) writes and decodes the JPEG-LS images the DICOM tests read against.
+python3 -c "import jpeg_ls" 2>/dev/null || python3 -m pip install --quiet "pyjpegls==1.5.1"
 # pynrrd writes the 4-D NRRD series cli/tests/series.rs reads.
 python3 -c "import nrrd" 2>/dev/null || python3 -m pip install --quiet "pynrrd==1.1.3"
 # The OME-Zarr tests write their images with the ome-zarr package (cli/tests/zarr.rs); 0.18 writes

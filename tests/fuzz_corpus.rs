@@ -170,6 +170,13 @@ fn the_dicom_seeds_load() {
                 let v = v.unwrap();
                 assert_eq!(v.values, (0..12).map(|k| (k * 100 - 1024) as f32).collect::<Vec<_>>());
             }
+            "seed-jpegls.dcm" => {
+                // The enhanced image's layout, 16 x 16 frames of k * 7, each frame in two fragments.
+                let v = v.unwrap();
+                assert_eq!(v.dims, [16, 16, 2]);
+                let want: Vec<f32> = (256..512).chain(0..256).map(|k| (k * 7 - 1024) as f32).collect();
+                assert_eq!(v.values, want);
+            }
             // The later finds, each refused by the check that now stops it.
             _ if found.is_some() => {
                 let e = v.unwrap_err().to_string();

@@ -287,8 +287,7 @@ fn an_uneven_series_is_drawn_at_its_slices_positions() {
 
 /// Multi-frame images (issue 47 item 1): pydicom's RT Dose grids, 15 frames of 32-bit samples
 /// placed by their Grid Frame Offset Vector and scaled by Dose Grid Scaling, little- and
-/// big-endian, read voxel for voxel as pydicom reads them; a multi-frame file that dicom-rs
-/// cannot decode (JPEG-LS) is refused naming its transfer syntax.
+/// big-endian, read voxel for voxel as pydicom reads them.
 #[test]
 fn rt_dose_grids_read_frame_by_frame_as_pydicom_reads_them() {
     for name in ["rtdose", "rtdose_expb"] {
@@ -320,13 +319,6 @@ fn rt_dose_grids_read_frame_by_frame_as_pydicom_reads_them() {
         assert!((first - voxsplat::glam::Vec3::new(-189.43125, -199.43125, -761.87)).length() < 1e-2, "{first}");
         let _ = std::fs::remove_dir_all(&dir);
     }
-    let dir = tmp("jpegls");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::copy(pydicom_tests().join("../MR_small_jpeg_ls_lossless.dcm"), dir.join("a.dcm")).unwrap();
-    let e = load_volume(&dir, &VolumeHints::default()).unwrap_err().to_string();
-    assert!(e.contains("1.2.840.10008.1.2.4.80"), "{e}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Voxel `(i, j, k)` of a grid loaded with orientation `o` in world (RAS) coordinates.
@@ -438,7 +430,7 @@ fn an_enhanced_image_is_placed_by_its_functional_groups_as_dcm2niix_places_it() 
 
 /// JPEG 2000 (issue 47 item 1) through dicom-pixeldata's pure-Rust OpenJPEG port: pydicom's
 /// lossless JPEG 2000 copy of its MR image reads value for value as the uncompressed one (and as
-/// the RLE copy); JPEG-LS, which dicom-rs decodes only through the C++ CharLS, is refused by name.
+/// the RLE copy).
 #[test]
 fn jpeg_2000_images_read_as_their_uncompressed_originals() {
     let files = pydicom_tests().join("..");
@@ -456,6 +448,108 @@ fn jpeg_2000_images_read_as_their_uncompressed_originals() {
     for name in ["MR_small_jp2klossless", "MR_small_RLE"] {
         assert_eq!(read(name).unwrap().values, plain.values, "{name}");
     }
-    let e = read("MR_small_jpeg_ls_lossless").unwrap_err().to_string();
-    assert!(e.contains("JPEG-LS Lossless") && e.contains("1.2.840.10008.1.2.4.80"), "{e}");
+}
+
+/// Runs `script` with python3 (pydicom, numpy, pyjpegls), its `{}` replaced by `args` in turn.
+fn python(script: &str, args: &[&Path]) {
+    let script = args.iter().fold(script.to_string(), |s, a| s.replacen("{}", &a.display().to_string(), 1));
+    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// JPEG-LS (issue 47 item 1), which dicom-rs decodes only through the C++ CharLS, decoded by the
+/// pure-Rust `pure_jpegls`:
+/// - pydicom's lossless JPEG-LS copy of its signed MR image reads value for value as the
+///   uncompressed one;
+/// - an enhanced MR compressed by CharLS (through pydicom and pyjpegls), unsigned 16-bit and signed
+///   12-bit, each frame in one or in three fragments, reads as its uncompressed original;
+/// - pydicom's near-lossless images (8 and 16 bits) read value for value as CharLS decodes them;
+/// - a codestream cut short, one whose size is not Rows x Columns, and a transfer syntax no
+///   decoder takes are refused naming the file.
+#[test]
+fn jpeg_ls_images_read_as_charls_reads_them() {
+    let files = pydicom_tests().join("..");
+    let dir = tmp("jpegls");
+    let _ = std::fs::remove_dir_all(&dir);
+    let hints = VolumeHints::default();
+    let one = |name: &str, file: &Path| {
+        let d = dir.join(name);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::copy(file, d.join("a.dcm")).unwrap();
+        d
+    };
+    let plain = load_volume(&one("plain", &files.join("MR_small.dcm")), &hints).unwrap();
+    let jls = load_volume(&one("mr", &files.join("MR_small_jpeg_ls_lossless.dcm")), &hints).unwrap();
+    assert!(plain.values.iter().any(|v| *v < 0.0) || plain.values.iter().any(|v| *v > 0.0));
+    assert_eq!(jls.values, plain.values, "MR_small_jpeg_ls_lossless");
+
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/write_enhanced.py");
+    let write = |name: &str, extra: &[&str]| {
+        let d = dir.join(name);
+        std::fs::create_dir_all(&d).unwrap();
+        let out = std::process::Command::new("python3").arg(&script).arg(d.join("e.dcm")).args(extra).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        d
+    };
+    let original = load_volume(&write("enhanced", &[]), &hints).unwrap();
+    for (name, extra) in [
+        ("u16-1", &["--jpegls", "1"][..]),
+        ("u16-3", &["--jpegls", "3"]),
+        ("s12", &["--signed"]),
+        ("s12-1", &["--signed", "--jpegls", "1"]),
+        ("s12-3", &["--signed", "--jpegls", "3"]),
+    ] {
+        let v = load_volume(&write(name, extra), &hints).unwrap();
+        assert_eq!((v.dims, &v.values), (original.dims, &original.values), "{name}");
+    }
+    // Streamed into the bricked store as the whole volume builds it.
+    let streamed = voxsplat::bricks::BrickStore::load(&dir.join("s12-3"), &hints).unwrap();
+    let whole = voxsplat::bricks::BrickStore::build(&original).unwrap();
+    assert_eq!((streamed.records, streamed.headers), (whole.records, whole.headers));
+
+    // Near-lossless: placed (pydicom's files carry no plane), then CharLS's values as the truth.
+    for bits in ["08", "16"] {
+        let d = dir.join(format!("near{bits}"));
+        std::fs::create_dir_all(&d).unwrap();
+        let (file, npy) = (d.join("a.dcm"), dir.join(format!("near{bits}.npy")));
+        python(
+            "import numpy as np, pydicom\n\
+             d = pydicom.dcmread('{}')\n\
+             d.ImagePositionPatient, d.ImageOrientationPatient = [0, 0, 0], [1, 0, 0, 0, 1, 0]\n\
+             d.PixelSpacing, d.SliceThickness = [1, 1], 1\n\
+             d.save_as('{}')\n\
+             np.save('{}', pydicom.dcmread('{}').pixel_array.astype(np.float32))",
+            &[&files.join(format!("JPEGLSNearLossless_{bits}.dcm")), &file, &npy, &file],
+        );
+        let (shape, want) =
+            voxsplat::loaders::npy_from_bytes(&std::fs::read(&npy).unwrap(), &npy.display().to_string()).unwrap();
+        let v = load_volume(&d, &hints).unwrap();
+        assert_eq!(v.dims, [shape[1] as u32, shape[0] as u32, 1], "near-lossless {bits}");
+        assert_eq!(v.values, want, "near-lossless {bits}");
+    }
+
+    // Refused, naming the file: a codestream cut short, a size that is not Rows x Columns, and a
+    // transfer syntax no decoder takes.
+    let u16 = dir.join("u16-1/e.dcm");
+    let broken = |name: &str, edit: &str| {
+        let d = dir.join(name);
+        std::fs::create_dir_all(&d).unwrap();
+        python(
+            &format!(
+                "import pydicom\nfrom pydicom.encaps import encapsulate, generate_frames\n\
+                 d = pydicom.dcmread('{{}}')\n\
+                 f = list(generate_frames(d.PixelData, number_of_frames=int(d.NumberOfFrames)))\n{edit}\n\
+                 d.save_as('{{}}')"
+            ),
+            &[&u16, &d.join("e.dcm")],
+        );
+        load_volume(&d, &hints).unwrap_err().to_string()
+    };
+    let e = broken("cut", "f[4] = f[4][: len(f[4]) // 2]\nd.PixelData = encapsulate(f, has_bot=True)");
+    assert!(e.contains("e.dcm") && e.contains("JPEG-LS codestream 5"), "{e}");
+    let e = broken("wide", "d.Columns = 25");
+    assert!(e.contains("e.dcm") && e.contains("JPEG-LS codestream 1") && e.contains("Columns x Rows = 25 x 20"), "{e}");
+    let e = broken("mpeg", "d.file_meta.TransferSyntaxUID = '1.2.840.10008.1.2.4.100'");
+    assert!(e.contains("e.dcm") && e.contains("1.2.840.10008.1.2.4.100") && e.contains("not decoded"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

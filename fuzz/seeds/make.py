@@ -117,7 +117,7 @@ tifffile.imwrite(buf, np.zeros((2, 3, 4, 5), np.uint8), imagej=True, metadata={"
 put("stacks", "channels.tif", buf.getvalue(), "refused-")
 
 # DICOM (the dicom target): one CT image written by pydicom, one without its Pixel Spacing, a
-# multi-frame RT Dose grid, an enhanced image of two frames, and a JPEG 2000 image.
+# multi-frame RT Dose grid, an enhanced image of two frames, a JPEG 2000 image, and a JPEG-LS one.
 try:
     import pydicom
     from pydicom.dataset import Dataset, FileMetaDataset
@@ -197,11 +197,28 @@ try:
         pydicom.dcmwrite(buf, ds, enforce_file_format=True)
         return buf.getvalue()
 
+    def jpegls():
+        # The enhanced image compressed as JPEG-LS (lossless, by CharLS through pyjpegls), each
+        # frame's codestream in two fragments.
+        from pydicom.encaps import encapsulate, generate_frames
+        from pydicom.uid import JPEGLSLossless
+        ds = pydicom.dcmread(io.BytesIO(enhanced()))
+        # 16 x 16 frames: CharLS refuses frames so small that their codestream outgrows them.
+        ds.Rows = ds.Columns = 16
+        ds.PixelData = (np.arange(512, dtype=np.int16) * 7).tobytes()
+        ds.compress(JPEGLSLossless, encoding_plugin="pyjpegls")
+        streams = list(generate_frames(ds.PixelData, number_of_frames=2))
+        ds.PixelData = encapsulate(streams, fragments_per_frame=2, has_bot=True)
+        buf = io.BytesIO()
+        pydicom.dcmwrite(buf, ds, enforce_file_format=True)
+        return buf.getvalue()
+
     put("dicom", "ct.dcm", ct())
     put("dicom", "no-spacing.dcm", ct(False), "refused-")
     put("dicom", "dose.dcm", dose())
     put("dicom", "enhanced.dcm", enhanced())
     put("dicom", "j2k.dcm", j2k())
+    put("dicom", "jpegls.dcm", jpegls())
 except ImportError:
     print("pydicom missing: the dicom seeds are left as they are", file=sys.stderr)
 

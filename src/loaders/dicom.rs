@@ -5,9 +5,10 @@
 //! Orientation (Patient), Pixel Spacing), not by file name or instance number; the grid is placed
 //! in patient space (LPS turned RAS), a gantry tilt as a sheared grid; values are rescaled by the
 //! series' Rescale Slope and Intercept. Pixel data is decoded by dicom-pixeldata (JPEG
-//! baseline/extended/lossless, JPEG 2000 through OpenJPEG's pure-Rust port, and RLE; other
-//! transfer syntaxes, JPEG-LS among them, are refused by name), a slice at a time, so a series
-//! streams into the bricked store as NIfTI does.
+//! baseline/extended/lossless, JPEG 2000 through OpenJPEG's pure-Rust port, and RLE) or by
+//! `pure_jpegls` (JPEG-LS; dicom-rs has only the C++ CharLS for it); other transfer syntaxes are
+//! refused by name. A series is read a slice at a time, so it streams into the bricked store as
+//! NIfTI does.
 use super::bad;
 use crate::error::{Error, Result};
 use dicom_dictionary_std::tags;
@@ -27,6 +28,7 @@ pub fn is_dicom(path: &Path) -> bool {
     std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut head)).is_ok() && &head[128..] == b"DICM"
 }
 
+mod jpegls;
 mod walk;
 use walk::checked_bytes;
 
@@ -334,13 +336,12 @@ pub fn holds_dicom(dir: &Path) -> bool {
 fn undecoded(uid: &str) -> Option<String> {
     use dicom_encoding::TransferSyntaxIndex;
     let ts = dicom_transfer_syntax_registry::TransferSyntaxRegistry.get(uid)?;
-    let why = if ts.name().starts_with("JPEG-LS") {
-        "dicom-rs decodes it only through the C++ library CharLS, which voxsplat does not build"
-    } else {
-        "dicom-rs has no decoder for it"
-    };
     (!ts.can_decode_all()).then(|| {
-        format!("pixel data in {} ({uid}) is not decoded: {why} (uncompressed, RLE, JPEG and JPEG 2000 are)", ts.name())
+        format!(
+            "pixel data in {} ({uid}) is not decoded: dicom-rs has no decoder for it \
+             (uncompressed, RLE, JPEG, JPEG-LS and JPEG 2000 are)",
+            ts.name()
+        )
     })
 }
 
@@ -517,50 +518,10 @@ impl Series {
                     .from_reader(bytes.as_slice())
                     .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
                 let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
-                let failed =
-                    |e: &dyn std::fmt::Display| bad(&what, format!("pixel data (transfer syntax {syntax}): {e}"));
-                if syntax.starts_with("1.2.840.10008.1.2.4.9") || syntax.starts_with("1.2.840.10008.1.2.4.20") {
-                    let pixel_data = obj.element(tags::PIXEL_DATA).map_err(|e| failed(&e))?;
-                    let fragments = pixel_data.value().fragments().unwrap_or_default();
-                    walk::check_j2k(fragments, image.size, frames, &what)?;
-                }
-                let pixels = obj.decode_pixel_data().map_err(|e| match undecoded(&syntax) {
-                    Some(refusal) => Error::Unsupported(format!("{what}: {refusal}")),
-                    None => failed(&e),
-                })?;
-                let options = ConvertOptions::new()
-                    .with_modality_lut(ModalityLutOption::None)
-                    .with_voi_lut(VoiLutOption::Identity);
-                let frame = |f: u32| -> Result<Vec<f64>> {
-                    if pixels.bits_allocated() != 32 || pixels.samples_per_pixel() != 1 {
-                        return pixels.to_vec_frame_with_options(f, &options).map_err(|e| failed(&e));
-                    }
-                    // 32-bit samples (RT Dose), which dicom-pixeldata's conversion does not take: the
-                    // decoded frame's words. dicom-rs reads big-endian pixel data (OW) as 16-bit
-                    // little-endian words, so a big-endian file's sample is its high word first.
-                    let signed = pixels.pixel_representation() == dicom_pixeldata::PixelRepresentation::Signed;
-                    let big = syntax == "1.2.840.10008.1.2.2";
-                    let words = pixels.frame_data(f).map_err(|e| failed(&e))?.chunks_exact(4);
-                    Ok(words
-                        .map(|b| {
-                            let u = if big {
-                                (u16::from_le_bytes([b[0], b[1]]) as u32) << 16
-                                    | u16::from_le_bytes([b[2], b[3]]) as u32
-                            } else {
-                                u32::from_le_bytes([b[0], b[1], b[2], b[3]])
-                            };
-                            if signed {
-                                u as i32 as f64
-                            } else {
-                                u as f64
-                            }
-                        })
-                        .collect())
-                };
+                let mut all = decode(&obj, &syntax, image.size, frames, &what)?;
                 if frames == 1 {
-                    frame(image.frame)?
+                    all.swap_remove(0)
                 } else {
-                    let all = (0..frames).map(frame).collect::<Result<Vec<Vec<f64>>>>()?;
                     let raw = all[image.frame as usize].clone();
                     self.frames = Some((image.path.clone(), all));
                     raw
@@ -574,4 +535,55 @@ impl Series {
         let [slope, intercept] = self.rescale;
         Ok(raw.into_iter().map(|v| (v * slope + intercept) as f32).collect())
     }
+}
+
+/// Every frame's raw samples of `obj`, a file of `frames` frames of `size` (Columns, Rows) in
+/// transfer syntax `syntax`.
+fn decode(
+    obj: &dicom_object::FileDicomObject<dicom_object::InMemDicomObject>,
+    syntax: &str,
+    size: [u32; 2],
+    frames: u32,
+    what: &str,
+) -> Result<Vec<Vec<f64>>> {
+    if jpegls::is_jpegls(syntax) {
+        return jpegls::frames(obj, size, frames, what);
+    }
+    let failed = |e: &dyn std::fmt::Display| bad(what, format!("pixel data (transfer syntax {syntax}): {e}"));
+    if syntax.starts_with("1.2.840.10008.1.2.4.9") || syntax.starts_with("1.2.840.10008.1.2.4.20") {
+        let pixel_data = obj.element(tags::PIXEL_DATA).map_err(|e| failed(&e))?;
+        let fragments = pixel_data.value().fragments().unwrap_or_default();
+        walk::check_j2k(fragments, size, frames, what)?;
+    }
+    let pixels = obj.decode_pixel_data().map_err(|e| match undecoded(syntax) {
+        Some(refusal) => Error::Unsupported(format!("{what}: {refusal}")),
+        None => failed(&e),
+    })?;
+    let options = ConvertOptions::new().with_modality_lut(ModalityLutOption::None).with_voi_lut(VoiLutOption::Identity);
+    let frame = |f: u32| -> Result<Vec<f64>> {
+        if pixels.bits_allocated() != 32 || pixels.samples_per_pixel() != 1 {
+            return pixels.to_vec_frame_with_options(f, &options).map_err(|e| failed(&e));
+        }
+        // 32-bit samples (RT Dose), which dicom-pixeldata's conversion does not take: the
+        // decoded frame's words. dicom-rs reads big-endian pixel data (OW) as 16-bit
+        // little-endian words, so a big-endian file's sample is its high word first.
+        let signed = pixels.pixel_representation() == dicom_pixeldata::PixelRepresentation::Signed;
+        let big = syntax == "1.2.840.10008.1.2.2";
+        let words = pixels.frame_data(f).map_err(|e| failed(&e))?.chunks_exact(4);
+        Ok(words
+            .map(|b| {
+                let u = if big {
+                    (u16::from_le_bytes([b[0], b[1]]) as u32) << 16 | u16::from_le_bytes([b[2], b[3]]) as u32
+                } else {
+                    u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+                };
+                if signed {
+                    u as i32 as f64
+                } else {
+                    u as f64
+                }
+            })
+            .collect())
+    };
+    (0..frames).map(frame).collect()
 }
