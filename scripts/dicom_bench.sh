@@ -2,21 +2,25 @@
 # DICOM loading throughput (issue 47's target): a CT series of SLICES 512 x 512 16-bit images
 # (default 256, 128 MiB of pixel data) written by pydicom from the procedural field, read by
 # `voxsplat lab load` (the dense volume and the bricked store) beside dcm2niix converting it to an
-# uncompressed NIfTI; medians of 5 alternating rounds, in MB/s of pixel data. Never committed (target/).
-#   scripts/dicom_bench.sh [SLICES]
+# uncompressed NIfTI; medians of 5 alternating rounds, in MB/s of pixel data. With `jpegls` each
+# image is compressed as JPEG-LS lossless (CharLS, through pydicom and pyjpegls) and dcm2niix decodes
+# it with CharLS. Never committed (target/).
+#   scripts/dicom_bench.sh [SLICES] [jpegls]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 slices=${1:-256}
+syntax=${2:-plain}
+case "$syntax" in plain|jpegls) ;; *) echo "dicom_bench.sh: the second argument is plain or jpegls, not $syntax" >&2; exit 2;; esac
 dir=target/dicom-bench
 rm -rf "$dir" && mkdir -p "$dir/series" "$dir/out"
 cargo build --release --quiet
-python3 - "$dir/series" "$slices" <<'PY'
+python3 - "$dir/series" "$slices" "$syntax" <<'PY'
 import sys
 import numpy as np
 import pydicom
 from pydicom.dataset import Dataset, FileMetaDataset
 from pydicom.uid import CTImageStorage, ExplicitVRLittleEndian, generate_uid
-out, n = sys.argv[1], int(sys.argv[2])
+out, n, syntax = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 series, study, frame = generate_uid(), generate_uid(), generate_uid()
 x = np.arange(512, dtype=np.float32) - 256
 for k in range(n):
@@ -36,6 +40,9 @@ for k in range(n):
     ds.SamplesPerPixel, ds.PhotometricInterpretation = 1, "MONOCHROME2"
     ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 1
     ds.PixelData = img.tobytes()
+    if syntax == "jpegls":
+        from pydicom.uid import JPEGLSLossless
+        ds.compress(JPEGLSLossless, img, encoding_plugin="pyjpegls")
     pydicom.dcmwrite(f"{out}/im{k:04d}.dcm", ds, enforce_file_format=True)
 PY
 mb=$(python3 -c "print(512 * 512 * 2 * $slices / 1e6)")
@@ -53,6 +60,7 @@ for _ in 1 2 3 4 5; do
   t1=$(date +%s.%N)
   rows+=("$dense $bricked $(python3 -c "print($t1 - $t0)")")
 done
+echo "pixel data: $syntax, $(du -sm "$dir/series" | cut -f1) MiB on disk"
 python3 - "$mb" "${rows[@]}" <<'PY'
 import statistics, sys
 mb = float(sys.argv[1])

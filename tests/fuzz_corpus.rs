@@ -153,6 +153,10 @@ fn the_dicom_seeds_load() {
         let found = FOUND_REFUSALS.iter().find(|(f, _)| *f == name);
         match name.as_str() {
             "seed-ct.dcm" => assert_eq!(v.unwrap().dims, [4, 3, 1]),
+            "seed-deflated.dcm" => {
+                let v = v.unwrap();
+                assert_eq!(v.values, (0..12).map(|k| (k * 100 - 1024) as f32).collect::<Vec<_>>());
+            }
             "seed-dose.dcm" => {
                 let v = v.unwrap();
                 assert_eq!(v.dims, [4, 3, 3]);

@@ -553,3 +553,42 @@ fn jpeg_ls_images_read_as_charls_reads_them() {
     assert!(e.contains("e.dcm") && e.contains("1.2.840.10008.1.2.4.100") && e.contains("not decoded"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Deflated data sets (issue 47 item 1, Deflated Explicit VR Little Endian), which dicom-rs 0.8
+/// does not inflate: pydicom's deflated image (placed, as it carries no plane, and written deflated
+/// again by pydicom) reads value for value as pydicom reads it; a deflated stream cut short is
+/// refused naming the file.
+#[test]
+fn a_deflated_data_set_reads_as_pydicom_reads_it() {
+    let dir = tmp("deflated");
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.join("in");
+    std::fs::create_dir_all(&d).unwrap();
+    let (file, npy) = (d.join("a.dcm"), dir.join("want.npy"));
+    python(
+        "import numpy as np, pydicom\n\
+         d = pydicom.dcmread('{}')\n\
+         assert d.file_meta.TransferSyntaxUID == '1.2.840.10008.1.2.1.99'\n\
+         d.ImagePositionPatient, d.ImageOrientationPatient = [0, 0, 0], [1, 0, 0, 0, 1, 0]\n\
+         d.PixelSpacing, d.SliceThickness = [0.5, 0.5], 1\n\
+         d.save_as('{}')\n\
+         e = pydicom.dcmread('{}')\n\
+         assert e.file_meta.TransferSyntaxUID == '1.2.840.10008.1.2.1.99'\n\
+         np.save('{}', e.pixel_array.astype(np.float32))",
+        &[&pydicom_tests().join("../image_dfl.dcm"), &file, &file, &npy],
+    );
+    let (shape, want) =
+        voxsplat::loaders::npy_from_bytes(&std::fs::read(&npy).unwrap(), &npy.display().to_string()).unwrap();
+    let v = load_volume(&d, &VolumeHints::default()).unwrap();
+    assert_eq!(v.dims, [shape[1] as u32, shape[0] as u32, 1]);
+    assert_eq!(v.values, want);
+    assert!(want.iter().any(|&x| x != want[0]), "the image is not flat");
+    // Its deflated stream cut short.
+    let bytes = std::fs::read(&file).unwrap();
+    let cut = dir.join("cut");
+    std::fs::create_dir_all(&cut).unwrap();
+    std::fs::write(cut.join("a.dcm"), &bytes[..bytes.len() * 2 / 3]).unwrap();
+    let e = load_volume(&cut, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("a.dcm") && e.contains("deflated data set"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

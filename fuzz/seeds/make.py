@@ -117,7 +117,8 @@ tifffile.imwrite(buf, np.zeros((2, 3, 4, 5), np.uint8), imagej=True, metadata={"
 put("stacks", "channels.tif", buf.getvalue(), "refused-")
 
 # DICOM (the dicom target): one CT image written by pydicom, one without its Pixel Spacing, a
-# multi-frame RT Dose grid, an enhanced image of two frames, a JPEG 2000 image, and a JPEG-LS one.
+# multi-frame RT Dose grid, an enhanced image of two frames, a JPEG 2000 image, a JPEG-LS
+# one, and a deflated data set.
 try:
     import pydicom
     from pydicom.dataset import Dataset, FileMetaDataset
@@ -213,7 +214,16 @@ try:
         pydicom.dcmwrite(buf, ds, enforce_file_format=True)
         return buf.getvalue()
 
+    def deflated():
+        # The CT image with its data set deflated (Deflated Explicit VR Little Endian).
+        ds = pydicom.dcmread(io.BytesIO(ct()))
+        ds.file_meta.TransferSyntaxUID = "1.2.840.10008.1.2.1.99"
+        buf = io.BytesIO()
+        pydicom.dcmwrite(buf, ds, enforce_file_format=True)
+        return buf.getvalue()
+
     put("dicom", "ct.dcm", ct())
+    put("dicom", "deflated.dcm", deflated())
     put("dicom", "no-spacing.dcm", ct(False), "refused-")
     put("dicom", "dose.dcm", dose())
     put("dicom", "enhanced.dcm", enhanced())

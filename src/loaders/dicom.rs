@@ -7,7 +7,8 @@
 //! series' Rescale Slope and Intercept. Pixel data is decoded by dicom-pixeldata (JPEG
 //! baseline/extended/lossless, JPEG 2000 through OpenJPEG's pure-Rust port, and RLE) or by
 //! `pure_jpegls` (JPEG-LS; dicom-rs has only the C++ CharLS for it); other transfer syntaxes are
-//! refused by name. A series is read a slice at a time, so it streams into the bricked store as
+//! refused by name; a deflated data set is inflated (`walk::checked_bytes`). A series is read a
+//! slice at a time, so it streams into the bricked store as
 //! NIfTI does.
 use super::bad;
 use crate::error::{Error, Result};

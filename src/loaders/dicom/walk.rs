@@ -16,11 +16,14 @@ enum Encoding {
     ExplicitBig,
 }
 
+/// The VRs dicom-rs reads with a long (4-byte) length in explicit VR, besides those it does not know.
+const LONG_VRS: [&[u8; 2]; 10] = [b"OB", b"OD", b"OF", b"OL", b"OW", b"SQ", b"UC", b"UR", b"UT", b"UN"];
+
 /// Walks a DICOM file's elements (the file meta group, then the data set in its transfer syntax)
 /// before dicom-rs reads it, which sizes its buffers by each element's declared length: every
 /// defined length must lie within the file; sequences and items are walked into. A deflated data
-/// set is refused (its lengths cannot be checked before it is inflated).
-fn check_lengths(bytes: &[u8], what: &str) -> Result<()> {
+/// set is not walked: where it starts is returned, to be inflated (`inflated`) and walked then.
+fn check_lengths(bytes: &[u8], what: &str) -> Result<Option<usize>> {
     if bytes.len() < 132 || &bytes[128..132] != b"DICM" {
         return Err(bad(what, "not a DICOM file (no DICM after the preamble)"));
     }
@@ -42,12 +45,10 @@ fn check_lengths(bytes: &[u8], what: &str) -> Result<()> {
     let encoding = match syntax.as_str() {
         "1.2.840.10008.1.2" => Encoding::ImplicitLittle,
         "1.2.840.10008.1.2.2" => Encoding::ExplicitBig,
-        "1.2.840.10008.1.2.1.99" => {
-            return Err(bad(what, "the deflated transfer syntax (1.2.840.10008.1.2.1.99) is not read"))
-        }
+        "1.2.840.10008.1.2.1.99" => return Ok(Some(data)),
         _ => Encoding::ExplicitLittle,
     };
-    walk(bytes, data, encoding, false, what).map(|_| ())
+    walk(bytes, data, encoding, false, what).map(|_| None)
 }
 
 /// The elements from `pos` (only the meta group's, group 2, with `meta`): where they end, and the
@@ -100,9 +101,8 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
             // it does not know (read as UN), have a long one; every other VR it knows a short one,
             // OV, SV and UV included (a fuzzed file with an OV pixel data element made it read a
             // 4 GB length where this walk read the standard's 144 bytes).
-            let long_vrs = [b"OB", b"OD", b"OF", b"OL", b"OW", b"SQ", b"UC", b"UR", b"UT", b"UN"];
             let known = dicom_core::VR::from_binary([vr[0], vr[1]]);
-            let long = known.is_none() || long_vrs.iter().any(|v| v.as_slice() == vr);
+            let long = known.is_none() || LONG_VRS.iter().any(|v| v.as_slice() == vr);
             if long {
                 if pos + 12 > bytes.len() {
                     return Err(short());
@@ -177,11 +177,65 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
     Ok((pos, syntax))
 }
 
-/// A DICOM file read whole (within `MAX_FILE_BYTES`) and its lengths checked (`check_lengths`).
+/// A DICOM file read whole (within `MAX_FILE_BYTES`) and its lengths checked (`check_lengths`); a
+/// deflated data set inflated first (`inflated`).
 pub(super) fn checked_bytes(path: &Path, what: &str) -> Result<Vec<u8>> {
     let bytes = super::super::read_bounded(path, MAX_FILE_BYTES, what)?;
-    check_lengths(&bytes, what)?;
-    Ok(bytes)
+    let Some(data) = check_lengths(&bytes, what)? else {
+        return Ok(bytes);
+    };
+    let bytes = inflated(&bytes, data, what)?;
+    match check_lengths(&bytes, what)? {
+        None => Ok(bytes),
+        Some(_) => Err(bad(what, "DICOM: a deflated data set inflates to another deflated one")),
+    }
+}
+
+/// A file whose data set (from byte `data`) is deflated (Deflated Explicit VR Little Endian, PS3.5
+/// A.5: raw deflate, no zlib header) rewritten with it inflated, within `MAX_FILE_BYTES`, behind a
+/// meta group that names Explicit VR Little Endian: dicom-rs 0.8 does not inflate, and the walk
+/// checks the inflated data set's lengths as any other's. The meta group was walked already.
+fn inflated(bytes: &[u8], data: usize, what: &str) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let cut = || bad(what, "DICOM: the file meta group is cut off");
+    let mut meta = Vec::new();
+    let mut pos = 132;
+    while pos < data {
+        let head = bytes.get(pos..pos + 8).ok_or_else(cut)?;
+        let vr = [head[4], head[5]];
+        let long = dicom_core::VR::from_binary(vr).is_none() || LONG_VRS.contains(&&vr);
+        let (header, len) = if long {
+            let b = bytes.get(pos + 8..pos + 12).ok_or_else(cut)?;
+            (12, u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+        } else {
+            (8, u16::from_le_bytes([head[6], head[7]]) as usize)
+        };
+        let end = (pos + header).checked_add(len).filter(|&e| e <= data).ok_or_else(cut)?;
+        match [u16::from_le_bytes([head[0], head[1]]), u16::from_le_bytes([head[2], head[3]])] {
+            // The group's length, written anew below.
+            [2, 0] => {}
+            [2, 0x10] => {
+                meta.extend_from_slice(&head[..4]);
+                meta.extend_from_slice(b"UI\x14\x00");
+                meta.extend_from_slice(b"1.2.840.10008.1.2.1\0");
+            }
+            _ => meta.extend_from_slice(&bytes[pos..end]),
+        }
+        pos = end;
+    }
+    let mut out = bytes[..132].to_vec();
+    out.extend_from_slice(b"\x02\x00\x00\x00UL\x04\x00");
+    out.extend_from_slice(&(meta.len() as u32).to_le_bytes());
+    out.extend_from_slice(&meta);
+    let room = MAX_FILE_BYTES.saturating_sub(out.len() as u64);
+    flate2::read::DeflateDecoder::new(&bytes[data..])
+        .take(room + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| bad(what, format!("DICOM: the deflated data set does not inflate: {e}")))?;
+    if out.len() as u64 > MAX_FILE_BYTES {
+        return Err(bad(what, format!("DICOM: the deflated data set inflates past {} MiB", MAX_FILE_BYTES >> 20)));
+    }
+    Ok(out)
 }
 
 /// Most tiles of a JPEG 2000 codestream (OpenJPEG sizes its tile table by their count).
