@@ -97,8 +97,8 @@ impl BrickStore {
     /// (`VolumeHints::crop`).
     #[cfg(feature = "io")]
     pub fn load(path: &std::path::Path, hints: &crate::loaders::VolumeHints) -> Result<Self> {
-        if let Some(crop) = hints.crop.filter(|_| crate::loaders::is_ome_zarr(path)) {
-            return Self::load_cropped(path, hints, crop);
+        if let Some((reader, region)) = crate::loaders::SliceReader::part(path, hints)? {
+            return Self::load_cropped(reader, region);
         }
         let mut store = match crate::loaders::SliceReader::open(path, hints)? {
             Some(mut reader) => {
@@ -128,6 +128,15 @@ impl BrickStore {
         let mut count = |values: &[f32]| {
             outside += values.iter().filter(|&&v| v.is_finite() && (v < range.0 || v > range.1)).count() as u64
         };
+        if let Some((mut reader, region)) = crate::loaders::SliceReader::part(path, hints)? {
+            let (dims, spacing) = (reader.dims, reader.spacing);
+            let store = Self::from_region(dims, spacing, range, region, |z0, n, out| {
+                reader.read_region(z0, n, region, out)?;
+                count(out);
+                Ok(())
+            })?;
+            return Ok((store, outside));
+        }
         let mut store = match crate::loaders::SliceReader::open(path, hints)? {
             Some(mut reader) => {
                 let (dims, spacing) = (reader.dims, reader.spacing);

@@ -165,8 +165,9 @@ struct AnimateArgs {
     out_dir: PathBuf,
     /// With --volume (a 4-D NIfTI, or an OME-Zarr image with a time axis): one frame per time
     /// point, from the view the scene flags describe, the whole series classified by one
-    /// transfer function over its value range. Without it, the animation's own scene and camera
-    /// (only --order, --cpu and --validation apply).
+    /// transfer function over its value range; an OME-Zarr image that --eye and --target see in
+    /// part is read only there. Without it, the animation's own scene and camera (only --order,
+    /// --cpu and --validation apply).
     #[command(flatten)]
     scene: SceneArgs,
 }

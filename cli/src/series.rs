@@ -59,14 +59,27 @@ impl Series {
             )));
         }
         let mut hints = volume_hints(a)?;
-        if voxsplat::loaders::is_ome_zarr(&path) && hints.level.is_none() {
-            let image = voxsplat::loaders::OmeZarr::open(&path)?;
-            let level = image.default_level();
-            if level > 0 {
-                eprintln!("OME-Zarr level {level} drawn: the finer ones may not fit the host's memory (--level N)");
+        if voxsplat::loaders::is_ome_zarr(&path) {
+            // One view: where it sees part of the image, each time point reads only that part, as
+            // `render` reads one.
+            if let Some((seen, camera)) = crate::pyramid::seen_box(a, &path)? {
+                (hints.crop, hints.view) = (Some(seen), Some(camera));
             }
-            hints.level = Some(level);
+            if hints.level.is_none() {
+                let image = voxsplat::loaders::OmeZarr::open(&path)?;
+                let level = match hints.crop {
+                    None => image.default_level(),
+                    Some(crop) => image.default_level_within(Some(crop), hints.view.as_ref()).ok_or_else(|| {
+                        Error::InvalidArgument(format!("{}: the view sees none of the image", path.display()))
+                    })?,
+                };
+                if level > 0 {
+                    eprintln!("OME-Zarr level {level} drawn: the finer ones may not fit the host's memory (--level N)");
+                }
+                hints.level = Some(level);
+            }
         }
+        let chunks = voxsplat::loaders::zarr_chunks_read();
         let bar = indicatif::ProgressBar::new(times as u64).with_message("the series' value range");
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         for t in 0..times {
@@ -75,6 +88,10 @@ impl Series {
             bar.inc(1);
         }
         bar.finish_and_clear();
+        if hints.crop.is_some() {
+            let read = voxsplat::loaders::zarr_chunks_read() - chunks;
+            eprintln!("OME-Zarr: the value range read {read} chunks over {times} time points");
+        }
         let range = voxsplat::bricks::store_range(lo, hi);
         Ok(Self { path, times, range, hints, orientation: orientation_of(a)? })
     }
@@ -121,6 +138,7 @@ pub fn play(
     mut frame: impl FnMut(u32, &voxsplat::ImageF32) -> Result<()>,
 ) -> Result<String> {
     let series = Series::open(a)?;
+    let chunks = voxsplat::loaders::zarr_chunks_read();
     let (mut r, cam) = series.first(a)?;
     let bar = indicatif::ProgressBar::new(series.times as u64);
     let (mut frames, mut reads, mut swaps) = (Vec::new(), Vec::new(), Vec::new());
@@ -145,6 +163,12 @@ pub fn play(
     bar.finish_and_clear();
     report_validation(&r)?;
     let mib = |b: u64| b as f64 / (1 << 20) as f64;
+    let read = voxsplat::loaders::zarr_chunks_read() - chunks;
+    let chunks = if voxsplat::loaders::is_ome_zarr(&series.path) {
+        format!("; {:.0} OME-Zarr chunks read per time point", read as f64 / series.times as f64)
+    } else {
+        String::new()
+    };
     let sent = if a.cpu {
         String::new()
     } else {
@@ -156,7 +180,7 @@ pub fn play(
     };
     Ok(format!(
         "{} time points (values {:?} over the series): a frame {:.1} ms, reading a time point {:.1} ms, swapping it in \
-         {:.2} ms (medians); per time point {:.0} of {:.0} bricks changed (means){sent}",
+         {:.2} ms (medians); per time point {:.0} of {:.0} bricks changed (means){chunks}{sent}",
         series.times,
         series.range,
         median(frames),

@@ -455,3 +455,54 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
     }
     out
 }
+
+/// A series played from one view that sees part of the image (`animate --volume` with --eye and
+/// --target) reads each time point's part only, as `render` reads one: the bonsai moved along x
+/// over 3 time points, seen along x at 10°, reads 24 of level 0's 128 chunks per time point, and
+/// each frame is the frame `render` draws of that time point read whole (sheets: per-splat
+/// compositing blends in the order the bricks are stored).
+#[test]
+fn a_series_seen_in_part_reads_only_that_part_at_each_time_point() {
+    let dir = tmp("series-part");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let bonsai = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/bonsai/bonsai.nii.gz");
+    write_with_python(&["bonsai-t", bonsai, dir.to_str().unwrap()]);
+    let path = dir.join("t.zarr");
+    let tf = dir.join("tf.toml");
+    std::fs::write(
+        &tf,
+        "points = [[0.0, [0, 0, 0, 0]], [0.4, [0.9, 0.5, 0.3, 0.05]], [1.0, [1, 1, 1, 0.9]]]\nrange = [0.0, 255.0]\n",
+    )
+    .unwrap();
+    let (p, t) = (path.to_str().unwrap(), tf.to_str().unwrap());
+    let view =
+        ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--tf", t, "--size", "48x48", "--composite", "sheet"];
+    let frames = dir.join("frames");
+    let o = voxsplat(
+        &[&["animate", "--volume", p, "--validation", "--out-dir", frames.to_str().unwrap()], &view[..]].concat(),
+    );
+    let said = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(o.status.success(), "{said}");
+    assert!(said.contains("the view sees"), "{said}");
+    let per_time: f64 = said
+        .split("; ")
+        .find_map(|s| s.strip_suffix(" OME-Zarr chunks read per time point"))
+        .unwrap_or_else(|| panic!("{said}"))
+        .parse()
+        .unwrap();
+    assert!(per_time <= 32.0, "{per_time} of level 0's 128 chunks read per time point: {said}");
+    for k in 0..3 {
+        let whole = dir.join(format!("whole{k}.png"));
+        let crop = ["--time", &k.to_string(), "--crop", "-128,-128,-192,128,128,192", "--out", whole.to_str().unwrap()];
+        let o = voxsplat(&[&["render", "--volume", p], &view[..], &crop].concat());
+        let text = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success() && text.contains("the store read 128 chunks"), "{text}");
+        let frame = frames.join(format!("frame{k:04}.png"));
+        let o = voxsplat(&["compare", frame.to_str().unwrap(), whole.to_str().unwrap()]);
+        let text = String::from_utf8_lossy(&o.stdout).into_owned();
+        let db = text.lines().find_map(|l| l.strip_prefix("psnr:")).unwrap().trim().trim_end_matches(" dB");
+        assert!(db.parse().unwrap_or(f64::INFINITY) > 70.0, "time point {k} seen in part against whole: {text}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -148,30 +148,12 @@ impl BrickStore {
         })
     }
 
-    /// An OME-Zarr image's store of what `crop` needs (`VolumeHints::crop`): at `hints.level`,
-    /// else the finest level whose region fits the host budget, only that region's chunks read.
+    /// An OME-Zarr image's store of what `hints.crop` needs (`SliceReader::part`), normalised by
+    /// the part's own range.
     #[cfg(feature = "io")]
-    pub(super) fn load_cropped(
-        path: &std::path::Path,
-        hints: &crate::loaders::VolumeHints,
-        crop: [[f32; 3]; 2],
-    ) -> Result<Self> {
-        let image = crate::loaders::OmeZarr::open(path)?;
-        let misses =
-            || Error::InvalidArgument(format!("{}: the crop box {crop:?} holds no voxel of the image", path.display()));
-        let level = match hints.level {
-            Some(l) => l,
-            None => image.default_level_within(Some(crop), hints.view.as_ref()).ok_or_else(misses)?,
-        };
-        let whole = crate::loaders::VolumeHints { level: Some(level), crop: None, ..hints.clone() };
-        let not_read = || Error::InvalidArgument(format!("{}: not read as an OME-Zarr image", path.display()));
-        let mut reader = crate::loaders::SliceReader::open(path, &whole)?.ok_or_else(not_read)?;
-        if let Some(camera) = hints.view {
-            reader.only_in_view(camera, crate::loaders::VIEW_MARGIN_PX);
-        }
-        let region @ [lo, hi] = image.region(level, crop).ok_or_else(misses)?;
+    pub(super) fn load_cropped(mut reader: crate::loaders::SliceReader, region: [[u32; 3]; 2]) -> Result<Self> {
         Self::from_region_slices(reader.dims, reader.spacing, region, |z0, count, out| {
-            reader.read_part(z0, count, [lo[0], lo[1]], [hi[0], hi[1]], out)
+            reader.read_region(z0, count, region, out)
         })
     }
 

@@ -451,6 +451,37 @@ impl SliceReader {
         self.decode((count as usize * h * w) as u64, w, out)
     }
 
+    /// With `hints.crop` on an OME-Zarr image, a reader of the part it needs and that part's
+    /// voxels (`lo..hi`): at `hints.level`, else the finest level whose part fits the host budget,
+    /// and with `hints.view` only the chunks the view may see (the others read as NaN, empty).
+    /// `None` for other files, or with no crop.
+    pub fn part(path: &Path, hints: &VolumeHints) -> Result<Option<(Self, [[u32; 3]; 2])>> {
+        let Some(crop) = hints.crop.filter(|_| super::is_ome_zarr(path)) else {
+            return Ok(None);
+        };
+        let image = super::OmeZarr::open(path)?;
+        let misses =
+            || Error::InvalidArgument(format!("{}: the crop box {crop:?} holds no voxel of the image", path.display()));
+        let level = match hints.level {
+            Some(l) => l,
+            None => image.default_level_within(Some(crop), hints.view.as_ref()).ok_or_else(misses)?,
+        };
+        let whole = VolumeHints { level: Some(level), crop: None, ..hints.clone() };
+        let not_read = || Error::InvalidArgument(format!("{}: not read as an OME-Zarr image", path.display()));
+        let mut reader = Self::open(path, &whole)?.ok_or_else(not_read)?;
+        if let Some(camera) = hints.view {
+            reader.only_in_view(camera, super::VIEW_MARGIN_PX);
+        }
+        let region = image.region(level, crop).ok_or_else(misses)?;
+        Ok(Some((reader, region)))
+    }
+
+    /// `read_part` of slices `z0..z0 + count` over `region`'s x and y.
+    pub fn read_region(&mut self, z0: u32, count: u32, region: [[u32; 3]; 2], out: &mut Vec<f32>) -> Result<()> {
+        let [lo, hi] = region;
+        self.read_part(z0, count, [lo[0], lo[1]], [hi[0], hi[1]], out)
+    }
+
     /// `n` samples from the bytes read, in rows of `row` samples: rescaled, checked finite, and
     /// each row reversed for a left-handed file (`Orientation::flip_x`).
     fn decode(&self, n: u64, row: usize, out: &mut Vec<f32>) -> Result<()> {
@@ -477,15 +508,23 @@ pub fn value_range(path: &Path, hints: &VolumeHints) -> Result<(f32, f32)> {
             (lo, hi) = (lo.min(v), hi.max(v));
         }
     };
-    match SliceReader::open(path, hints)? {
-        Some(mut reader) => {
-            let (mut slab, step) = (Vec::new(), crate::constants::BRICK_SIDE);
-            for z0 in (0..reader.dims[2]).step_by(step as usize) {
-                reader.read(z0, step.min(reader.dims[2] - z0), &mut slab)?;
-                take(&slab);
-            }
+    let (mut slab, step) = (Vec::new(), crate::constants::BRICK_SIDE);
+    // An OME-Zarr image's part (`VolumeHints::crop`), or the whole.
+    if let Some((mut reader, region @ [r0, r1])) = SliceReader::part(path, hints)? {
+        for z0 in (r0[2]..r1[2]).step_by(step as usize) {
+            reader.read_region(z0, step.min(r1[2] - z0), region, &mut slab)?;
+            take(&slab);
         }
-        None => take(&super::load_volume(path, hints)?.values),
+    } else {
+        match SliceReader::open(path, hints)? {
+            Some(mut reader) => {
+                for z0 in (0..reader.dims[2]).step_by(step as usize) {
+                    reader.read(z0, step.min(reader.dims[2] - z0), &mut slab)?;
+                    take(&slab);
+                }
+            }
+            None => take(&super::load_volume(path, hints)?.values),
+        }
     }
     Ok((lo, hi))
 }

@@ -3,6 +3,7 @@
 
     python3 write_ome_zarr.py bonsai NIFTI OUT   # 0.4 (Zarr v2, zstd) and 0.5 (Zarr v3, sharded) pyramids
     python3 write_ome_zarr.py series OUT         # t, c, z, y, x: 3 time points of 2 channels, blosc
+    python3 write_ome_zarr.py bonsai-t NIFTI OUT # t, z, y, x: 3 time points of the bonsai, moved along x
 """
 import sys
 
@@ -48,5 +49,12 @@ def series(out):
     save(f"{out}/tczyx.npy", data)
 
 
+def bonsai_t(nifti, out):
+    data = np.ascontiguousarray(np.asarray(nibabel.load(nifti).dataobj).astype(np.uint8).T)
+    data = np.stack([np.roll(data, 8 * t, axis=2) for t in range(3)])
+    write(f"{out}/t.zarr", data, FormatV04(), "tzyx", scale_factors=[{"z": 2, "y": 2, "x": 2}],
+          scale={"t": 1.0, "z": 1.5, "y": 1.0, "x": 1.0}, storage_options={"chunks": (1, 32, 64, 64)})
+
+
 if __name__ == "__main__":
-    {"bonsai": bonsai, "series": series}[sys.argv[1]](*sys.argv[2:])
+    {"bonsai": bonsai, "series": series, "bonsai-t": bonsai_t}[sys.argv[1]](*sys.argv[2:])
