@@ -3,8 +3,9 @@
 # (default 256, 128 MiB of pixel data) written by pydicom from the procedural field, read by
 # `voxsplat lab load` (the dense volume and the bricked store) beside dcm2niix converting it to an
 # uncompressed NIfTI; medians of 5 alternating rounds, in MB/s of pixel data. With `jpegls` each
-# image is compressed as JPEG-LS lossless (CharLS, through pydicom and pyjpegls) and dcm2niix decodes
-# it with CharLS. Never committed (target/).
+# image is compressed as JPEG-LS lossless (CharLS, through pydicom and pyjpegls), and the peer is
+# pydicom decoding the series into one array with CharLS (pyjpegls): Debian's dcm2niix is built
+# without JPEG-LS. Never committed (target/).
 #   scripts/dicom_bench.sh [SLICES] [jpegls]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -56,19 +57,23 @@ for _ in 1 2 3 4 5; do
   bricked=$(echo "$out" | grep "bricked store" | awk -F'|' '{print $3}' | tr -d ' s')
   rm -f "$dir"/out/*
   t0=$(date +%s.%N)
-  dcm2niix -o "$dir/out" -f bench -z n "$dir/series" > /dev/null
+  if [ "$syntax" = jpegls ]; then
+    python3 -c "import glob, sys, numpy, pydicom; numpy.stack([pydicom.dcmread(f).pixel_array for f in sorted(glob.glob(sys.argv[1] + '/*.dcm'))])" "$dir/series"
+  else
+    dcm2niix -o "$dir/out" -f bench -z n "$dir/series" > /dev/null
+  fi
   t1=$(date +%s.%N)
   rows+=("$dense $bricked $(python3 -c "print($t1 - $t0)")")
 done
 echo "pixel data: $syntax, $(du -sm "$dir/series" | cut -f1) MiB on disk"
-python3 - "$mb" "${rows[@]}" <<'PY'
+python3 - "$mb" "$syntax" "${rows[@]}" <<'PY'
 import statistics, sys
 mb = float(sys.argv[1])
-runs = [list(map(float, r.split())) for r in sys.argv[2:]]
+runs = [list(map(float, r.split())) for r in sys.argv[3:]]
 med = [statistics.median(r[i] for r in runs) for i in range(3)]
-print(f"| read ({mb:.1f} MB of pixel data, median of {len(runs)} alternating rounds) | time | MB/s | against dcm2niix |")
+peer = "pydicom + pyjpegls (CharLS) into one array" if sys.argv[2] == "jpegls" else "dcm2niix to an uncompressed NIfTI"
+print(f"| read ({mb:.1f} MB of pixel data, median of {len(runs)} alternating rounds) | time | MB/s | against the peer |")
 print("|---|---:|---:|---:|")
-for name, t in zip(["voxsplat, dense volume (load_volume)", "voxsplat, bricked store (BrickStore::load)",
-                    "dcm2niix to an uncompressed NIfTI"], med):
+for name, t in zip(["voxsplat, dense volume (load_volume)", "voxsplat, bricked store (BrickStore::load)", peer], med):
     print(f"| {name} | {t:.3f} s | {mb / t:.0f} | {t / med[2]:.2f}x its time |")
 PY

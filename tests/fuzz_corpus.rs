@@ -128,11 +128,14 @@ fn the_zarr_seeds_load() {
 /// - a JPEG 2000 codestream of 4 x 3 pixels in an image of 4 x 2: dicom-rs's adapter wrote past
 ///   the frame and panicked;
 /// - a header other than an item's inside encapsulated data: dicom-rs read a tag as a 3.7 GB length.
-const FOUND_REFUSALS: [(&str, &str); 4] = [
+const FOUND_REFUSALS: [(&str, &str); 5] = [
     ("found-j2k-samples-per-pixel.dcm", "Samples per Pixel 9217"),
     ("found-delimiter-length.dcm", "delimiter (FFFE,E0DD) declares"),
     ("found-j2k-larger-than-rows.dcm", "4 x 3 pixels, not Columns x Rows = 4 x 2"),
-    ("found-encapsulated-stray-header.dcm", "(FFB0,FFFF) where an item belongs"),
+    // A retired (7FA5,0010) of undefined length: dicom-rs reads it as a sequence, not as
+    // fragments, and its item's element declares 3.7 GB.
+    ("found-encapsulated-stray-header.dcm", "(0000,0000) declares 3758161918 bytes past the file's end"),
+    ("found-ob-undefined-length-item.dcm", "(0000,0000) declares 3758161918 bytes past the file's end"),
 ];
 
 /// The DICOM seeds (pydicom): a CT image, a multi-frame RT Dose grid, an enhanced image and a

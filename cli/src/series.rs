@@ -180,7 +180,8 @@ pub fn play(
     };
     Ok(format!(
         "{} time points (values {:?} over the series): a frame {:.1} ms, reading a time point {:.1} ms, swapping it in \
-         {:.2} ms (medians); per time point {:.0} of {:.0} bricks changed (means){chunks}{sent}",
+         {:.2} ms (medians); per time point {:.0} bricks changed (their voxels, or appeared or went empty), {:.0} non-empty \
+         (means){chunks}{sent}",
         series.times,
         series.range,
         median(frames),
@@ -242,8 +243,8 @@ pub fn study(a: &SceneArgs) -> Result<String> {
          |---|---:|---:|---:|---:|---:|\n\
          | update_volume | {:.2} | {:.1} | {:.1} | {:.1} | {:.3} |\n\
          | set_bricks afresh | {:.2} | {:.1} | {:.1} | {:.1} | {:.3} |\n\n\
-         played / afresh: first frame {:.2}x, next frame {:.2}x, swap + first frame {:.2}x; per time point {:.0} of \
-         {:.0} bricks changed (means)\n",
+         played / afresh: first frame {:.2}x, next frame {:.2}x, swap + first frame {:.2}x; per time point {:.0} \
+         bricks changed (their voxels, or appeared or went empty), {:.0} non-empty (means)\n",
         series.times,
         series.path.display(),
         a.size.0,

@@ -505,37 +505,68 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
 impl Series {
     /// Slice `z`'s rescaled values, x fastest.
     pub fn slice(&mut self, z: u32) -> Result<Vec<f32>> {
-        let image = self.images[z as usize].clone();
-        let what = image.path.display().to_string();
-        let frames = image.frames;
+        let image = &self.images[z as usize];
         let raw = match &self.frames {
             Some((path, all)) if *path == image.path => all[image.frame as usize].clone(),
+            _ if image.frames == 1 => frames_of(image)?.swap_remove(0),
             _ => {
-                let [w, h] = image.size.map(u64::from);
-                crate::error::check_host_memory(frames as u64 * w * h * 8, &format!("{what}'s frames"))?;
-                let bytes = checked_bytes(&image.path, &what)?;
-                let obj = OpenFileOptions::new()
-                    .read_preamble(ReadPreamble::Always)
-                    .from_reader(bytes.as_slice())
-                    .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
-                let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
-                let mut all = decode(&obj, &syntax, image.size, frames, &what)?;
-                if frames == 1 {
-                    all.swap_remove(0)
-                } else {
-                    let raw = all[image.frame as usize].clone();
-                    self.frames = Some((image.path.clone(), all));
-                    raw
-                }
+                let all = frames_of(image)?;
+                let raw = all[image.frame as usize].clone();
+                self.frames = Some((image.path.clone(), all));
+                raw
             }
         };
+        self.rescaled(z, raw)
+    }
+
+    /// Slices `z0..z0 + count`, as `slice` reads them: single-frame images decoded in parallel,
+    /// a few per thread at a time (a compressed series' decoding is most of its reading).
+    pub fn slices(&mut self, z0: u32, count: u32) -> Result<Vec<Vec<f32>>> {
+        use rayon::prelude::*;
+        let zs: Vec<u32> = (z0..z0 + count).collect();
+        let mut out = Vec::with_capacity(zs.len());
+        for group in zs.chunks(2 * rayon::current_num_threads()) {
+            if group.iter().all(|&z| self.images[z as usize].frames == 1) {
+                let raws: Vec<Result<Vec<f64>>> = group
+                    .par_iter()
+                    .map(|&z| frames_of(&self.images[z as usize]).map(|mut f| f.swap_remove(0)))
+                    .collect();
+                for (&z, raw) in group.iter().zip(raws) {
+                    out.push(self.rescaled(z, raw?)?);
+                }
+            } else {
+                for &z in group {
+                    out.push(self.slice(z)?);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Slice `z`'s raw samples checked against Rows x Columns and rescaled.
+    fn rescaled(&self, z: u32, raw: Vec<f64>) -> Result<Vec<f32>> {
         let [w, h, _] = self.dims;
         if raw.len() as u64 != w as u64 * h as u64 {
+            let what = self.images[z as usize].path.display().to_string();
             return Err(bad(&what, format!("pixel data holds {} samples, not Rows x Columns = {h} x {w}", raw.len())));
         }
         let [slope, intercept] = self.rescale;
         Ok(raw.into_iter().map(|v| (v * slope + intercept) as f32).collect())
     }
+}
+
+/// Every frame's raw samples of `image`'s file, read and decoded.
+fn frames_of(image: &Image) -> Result<Vec<Vec<f64>>> {
+    let what = image.path.display().to_string();
+    let [w, h] = image.size.map(u64::from);
+    crate::error::check_host_memory(image.frames as u64 * w * h * 8, &format!("{what}'s frames"))?;
+    let bytes = checked_bytes(&image.path, &what)?;
+    let obj = OpenFileOptions::new()
+        .read_preamble(ReadPreamble::Always)
+        .from_reader(bytes.as_slice())
+        .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
+    let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
+    decode(&obj, &syntax, image.size, image.frames, &what)
 }
 
 /// Every frame's raw samples of `obj`, a file of `frames` frames of `size` (Columns, Rows) in

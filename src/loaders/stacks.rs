@@ -322,6 +322,12 @@ impl Stack {
     /// Slices `z0..z0 + count` (x fastest) into `out`.
     pub fn read(&mut self, z0: u32, count: u32, out: &mut Vec<f32>) -> Result<()> {
         out.clear();
+        if let Slices::Dicom(series) = &mut self.slices {
+            for slice in series.slices(z0, count)? {
+                out.extend_from_slice(&slice);
+            }
+            return super::check_finite(out, &self.what);
+        }
         let [w, h, _] = self.dims;
         for z in z0..z0 + count {
             let slice = match &mut self.slices {

@@ -145,10 +145,11 @@ fn walk(bytes: &[u8], mut pos: usize, enc: Encoding, meta: bool, what: &str) -> 
             ));
         }
         pos += header;
-        // Encapsulated pixel data, or any OB or OW of undefined length, which dicom-rs reads as
-        // fragments too (a fuzzed OB so read made it size a delimiter's 4 GB length).
-        let fragments = (group & 0xFF00, element) == (0x7F00, 0x10) || matches!(vr, Some(VR::OB | VR::OW));
-        if fragments && len == u32::MAX {
+        // Encapsulated pixel data: dicom-rs reads only (7FE0,0010) of undefined length as
+        // fragments, and every other element of undefined length as a sequence, its items'
+        // elements walked here too (a fuzzed OB of undefined length, walked as fragments, hid an
+        // element of 3.7 GB in its item).
+        if (group, element) == (0x7FE0, 0x10) && len == u32::MAX {
             encapsulated = true;
             continue;
         }
