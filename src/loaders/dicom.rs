@@ -8,8 +8,7 @@
 //! baseline/extended/lossless, JPEG 2000 through OpenJPEG's pure-Rust port, and RLE) or by
 //! `pure_jpegls` (JPEG-LS; dicom-rs has only the C++ CharLS for it); other transfer syntaxes are
 //! refused by name; a deflated data set is inflated (`walk::checked_bytes`). A series is read a
-//! slice at a time, so it streams into the bricked store as
-//! NIfTI does.
+//! few slices at a time, so it streams into the bricked store as NIfTI does.
 use super::bad;
 use crate::error::{Error, Result};
 use dicom_dictionary_std::tags;
@@ -18,6 +17,9 @@ use dicom_object::OpenFileOptions;
 use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder, VoiLutOption};
 use glam::{DMat4, DVec3, DVec4};
 use std::path::{Path, PathBuf};
+
+/// Most bytes the images decoded in parallel hold together (`Series::slices`).
+const PARALLEL_BYTES: u64 = 256 << 20;
 
 /// Most files a folder may hold to be scanned for series.
 const MAX_FILES: usize = 1 << 16;
@@ -520,12 +522,16 @@ impl Series {
     }
 
     /// Slices `z0..z0 + count`, as `slice` reads them: single-frame images decoded in parallel,
-    /// a few per thread at a time (a compressed series' decoding is most of its reading).
+    /// two per thread at a time within `PARALLEL_BYTES` (a compressed series' decoding is most of
+    /// its reading).
     pub fn slices(&mut self, z0: u32, count: u32) -> Result<Vec<Vec<f32>>> {
         use rayon::prelude::*;
+        // An image's file and its samples as f64 and f32, about.
+        let per_image = self.dims[0] as u64 * self.dims[1] as u64 * 16;
+        let at_once = (PARALLEL_BYTES / per_image.max(1)).clamp(1, 2 * rayon::current_num_threads() as u64);
         let zs: Vec<u32> = (z0..z0 + count).collect();
         let mut out = Vec::with_capacity(zs.len());
-        for group in zs.chunks(2 * rayon::current_num_threads()) {
+        for group in zs.chunks(at_once as usize) {
             if group.iter().all(|&z| self.images[z as usize].frames == 1) {
                 let raws: Vec<Result<Vec<f64>>> = group
                     .par_iter()
