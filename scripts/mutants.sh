@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
 # Mutation check (issues 25, 44): plants thirty known bugs one at a time, runs the tests that should
 # catch each, and prints a markdown table; exits 1 when a bug survives (no test failed). Each
-# mutant costs a release rebuild of the library and its tests (about 1-3 minutes here); the last
-# result lives in docs/RELIABILITY.md. The tree is restored after every mutant, also on Ctrl-C.
+# mutant costs a release rebuild of the library and one test binary: incremental (below), about
+# 15-30 s each here after the first; the last result lives in docs/RELIABILITY.md. The tree is
+# restored after every mutant, also on Ctrl-C.
 #   scripts/mutants.sh            all thirty
 #   scripts/mutants.sh octant     the ones whose name contains "octant"
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each mutant changes a line or two of the library: rustc's incremental cache rebuilds only the
+# code units that changed (measured here: 65 s a mutant without it, 16-24 s with it after the
+# first). Dependencies are never built incrementally, so this rebuilds none of them.
+export CARGO_INCREMENTAL=1
 # name | file | exact text (must occur once) | replacement | cargo test arguments
 MUTANTS=(
   "swap the octant order|src/order.rs|for octant in 0..8u32 {|for octant in (0..8u32).rev() {|--test order"
