@@ -22,7 +22,7 @@ mod stacks;
 mod zarr;
 use bounded::read_bounded;
 pub use bounded::{read_text, MAX_TEXT_BYTES};
-pub use dicom::{is_dicom, series_in as dicom_series, SeriesInfo};
+pub use dicom::{even_slices, is_dicom, series_in as dicom_series, SeriesInfo};
 use nifti1::nifti_size;
 pub(crate) use nifti1::{nifti_layout, NiftiLayout};
 use npy::read_npy;
@@ -420,7 +420,8 @@ pub struct VolumeHints {
     /// `time_points`).
     pub time: Option<u32>,
     /// The caller places the voxels at `file_positions`: a DICOM series with uneven slice gaps is
-    /// read (its grid spaced by the mean gap) instead of refused.
+    /// read as its images lie (its grid spaced by the mean gap) instead of resampled onto even
+    /// slices (`even_slices`) or, when that would take too many, refused.
     pub rectilinear: bool,
     /// Only what lies in this box (lo, hi; in the grid's frame, centred on the origin) will be
     /// drawn: a bricked store of an OME-Zarr image reads only the chunks of the voxels it needs

@@ -16,4 +16,5 @@ pub mod rates;
 pub mod series;
 pub mod soak;
 pub mod stability;
+pub mod uneven;
 pub mod volumes;

@@ -178,9 +178,10 @@ pub struct Content {
 pub fn orientation_of(a: &SceneArgs) -> Result<Option<Orientation>> {
     match &a.volume {
         Some(path) if a.terrain.is_none() => {
-            // No level is read for it (a pyramid's levels share their placement); an unevenly
-            // spaced DICOM series is placed by its first slice and mean gap.
-            let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints_at(a, None)? };
+            // No level is read for it (a pyramid's levels share their placement); a DICOM series
+            // drawn at its slices' positions is placed by its first slice and mean gap.
+            let hints =
+                voxsplat::loaders::VolumeHints { rectilinear: at_positions(a, path)?, ..volume_hints_at(a, None)? };
             let o = voxsplat::loaders::load_orientation(path, &hints)?;
             if a.positions.is_some() {
                 if o.is_some_and(|o| o.flip_x()) {
@@ -356,8 +357,8 @@ pub fn load_volume_parts(
     path: &std::path::Path,
     orientation: Option<Orientation>,
 ) -> Result<VolumeParts> {
-    // An unevenly spaced DICOM series reads at its mean gap; `load_scene` places its slices.
-    let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints(a)? };
+    // A DICOM series drawn at its slices' positions reads at its mean gap; `load_scene` places them.
+    let hints = voxsplat::loaders::VolumeHints { rectilinear: at_positions(a, path)?, ..volume_hints(a)? };
     let vol = voxsplat::loaders::load_volume(path, &hints)?;
     let tf = transfer_function(a)?;
     let shading = headlight(a, vol.dims, vol.spacing, orientation);
@@ -541,10 +542,11 @@ pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
                 let coords = voxsplat::loaders::load_positions(p, set.grid())?;
                 set.with_coordinates(coords)?
             }
-            None => match uneven_positions(a, path, set.grid())? {
+            None if at_positions(a, path)? => match crate::uneven::positions(path, &volume_hints(a)?, set.grid())? {
                 Some(coords) => set.with_coordinates(coords)?,
                 None => set,
             },
+            None => set,
         }
     } else if let Some(path) = &a.terrain {
         // (clap drops `requires = "volume"` when --terrain, which conflicts with it, is given.)
@@ -632,15 +634,9 @@ fn refuse_volume_flags(a: &SceneArgs) -> Result<()> {
     }
 }
 
-/// The slice positions of an unevenly spaced DICOM --volume (`loaders::file_positions`) on
-/// `grid`, said on stderr: such a series is drawn as a rectilinear grid of host splats.
-fn uneven_positions(a: &SceneArgs, path: &std::path::Path, grid: &voxsplat::Grid) -> Result<Option<[Vec<f32>; 3]>> {
-    let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints(a)? };
-    let coords = voxsplat::loaders::file_positions(path, &hints, grid)?;
-    if coords.is_some() {
-        eprintln!("uneven slice gaps: drawn as a rectilinear grid at the slices' positions (host splats)");
-    }
-    Ok(coords)
+/// Whether --volume is a DICOM series drawn at its slices' own positions (`uneven::at_positions`).
+fn at_positions(a: &SceneArgs, path: &std::path::Path) -> Result<bool> {
+    Ok(a.positions.is_none() && a.labels.is_none() && crate::uneven::at_positions(path, &volume_hints_at(a, None)?)?)
 }
 
 /// The scene `a` names: a --volume as a bricked store classified on the device unless
@@ -658,11 +654,11 @@ pub fn open(
                 .into(),
         ));
     }
-    // An unevenly spaced DICOM series draws as a rectilinear grid: host splats.
+    // An unevenly spaced DICOM series is resampled evenly (said here), or when its gaps are too far
+    // apart, drawn as a rectilinear grid: host splats.
     let uneven = match &a.volume {
         Some(path) if a.positions.is_none() && a.labels.is_none() => {
-            let hints = voxsplat::loaders::VolumeHints { rectilinear: true, ..volume_hints_at(a, None)? };
-            voxsplat::loaders::slice_offsets(path, &hints)?.is_some()
+            crate::uneven::report(path, &volume_hints_at(a, None)?)?
         }
         _ => false,
     };

@@ -32,7 +32,9 @@ pub fn is_dicom(path: &Path) -> bool {
 }
 
 mod jpegls;
+mod resample;
 mod walk;
+pub use resample::even_slices;
 use walk::checked_bytes;
 
 /// One image of a series, from its header.
@@ -360,14 +362,19 @@ pub struct Series {
     pub orientation: crate::orient::Orientation,
     rescale: [f64; 2],
     /// Unevenly spaced slices' positions along the normal, from the first (mm); `None` when the
-    /// gaps are even (the orientation's step places them).
+    /// gaps are even (the orientation's step places them) or the series is resampled.
     pub offsets: Option<Vec<f64>>,
+    /// An unevenly spaced series resampled evenly: per slice, the image below it and the weight
+    /// of the one above (`resample::weights`).
+    resampled: Option<Vec<(u32, f32)>>,
 }
 
 /// The series `path` names: a folder holding one series (or `pick`, its index in `voxsplat info`'s
 /// list or its UID), or one DICOM file of its series, at time point `time` (its images of one
-/// temporal position, needed when it has several). Uneven slice gaps are refused unless
-/// `rectilinear` (the caller places the slices at `Series::offsets`).
+/// temporal position, needed when it has several). Uneven slice gaps are resampled onto even
+/// slices at the smallest gap (each linear between its two images; refused when that would take
+/// more than `resample::MAX_GROWTH` slices per image), or with `rectilinear` read as they lie (the
+/// caller places the slices at `Series::offsets`).
 pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool, time: Option<u32>) -> Result<Series> {
     let what = path.display().to_string();
     let chosen = chosen(path, pick)?;
@@ -464,6 +471,8 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let mean = steps.iter().sum::<f64>() / steps.len().max(1) as f64;
     let n = images.len();
     let mut offsets = None;
+    let mut resampled = None;
+    let mut slices = n;
     if let Some(k) = steps.iter().position(|d| (d - mean).abs() > 0.01 * mean) {
         let gap = format!(
             "uneven slice gaps ({:.4} between {} and {}, {mean:.4} on average)",
@@ -471,26 +480,36 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
             name(&images[k]),
             name(&images[k + 1])
         );
-        if !rectilinear {
-            return Err(bad(
-                what,
-                format!(
-                    "{gap}: read it as a rectilinear grid (VolumeHints::rectilinear and loaders::file_positions; \
-                     voxsplat render does)"
-                ),
-            ));
-        }
         // A tilted series' positions leave the normal: its grid would be sheared and uneven.
         let along = (images[n - 1].position - images[0].position).normalize_or_zero();
         if along.dot(normal).abs() < 1.0 - 1e-6 {
             return Err(Error::Unsupported(format!("{what}: {gap} with a gantry tilt: not read")));
         }
-        offsets = Some(images.iter().map(|i| (i.position - images[0].position).dot(normal)).collect());
+        let at: Vec<f64> = images.iter().map(|i| (i.position - images[0].position).dot(normal)).collect();
+        if rectilinear {
+            offsets = Some(at);
+        } else {
+            let m = resample::even_slices(&at).ok_or_else(|| {
+                bad(
+                    what,
+                    format!(
+                        "{gap}: resampled at its smallest gap it would take over {} slices per image; read it as \
+                         a rectilinear grid (VolumeHints::rectilinear and loaders::file_positions; voxsplat render does)",
+                        resample::MAX_GROWTH
+                    ),
+                )
+            })?;
+            resampled = Some(resample::weights(&at, m));
+            slices = m as usize;
+        }
     }
     // The slice step: the first to the last position, over the gaps (a gantry tilt leans it off the
     // normal, which places the grid sheared); one image steps one pixel spacing along the normal.
-    let step =
-        if n > 1 { (images[n - 1].position - images[0].position) / (n - 1) as f64 } else { normal * first.spacing[0] };
+    let step = if n > 1 {
+        (images[n - 1].position - images[0].position) / (slices - 1) as f64
+    } else {
+        normal * first.spacing[0]
+    };
     let lps = DMat4::from_cols(
         (first.row * first.spacing[1]).extend(0.0),
         (first.column * first.spacing[0]).extend(0.0),
@@ -499,14 +518,22 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     );
     // LPS to RAS: x and y negated.
     let affine = DMat4::from_diagonal(DVec4::new(-1.0, -1.0, 1.0, 1.0)) * lps;
-    let dims = [first.size[0], first.size[1], n as u32];
+    let dims = [first.size[0], first.size[1], slices as u32];
     let orientation = crate::orient::Orientation::from_affine(affine, dims).map_err(|e| bad(what, e))?;
-    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, offsets })
+    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, offsets, resampled })
 }
 
 impl Series {
     /// Slice `z`'s rescaled values, x fastest.
     pub fn slice(&mut self, z: u32) -> Result<Vec<f32>> {
+        if self.resampled.is_some() {
+            return Ok(self.slices(z, 1)?.swap_remove(0));
+        }
+        self.image(z)
+    }
+
+    /// Image `z`'s rescaled values (in order along the normal).
+    fn image(&mut self, z: u32) -> Result<Vec<f32>> {
         let image = &self.images[z as usize];
         let raw = match &self.frames {
             Some((path, all)) if *path == image.path => all[image.frame as usize].clone(),
@@ -525,6 +552,24 @@ impl Series {
     /// two per thread at a time within `PARALLEL_BYTES` (a compressed series' decoding is most of
     /// its reading).
     pub fn slices(&mut self, z0: u32, count: u32) -> Result<Vec<Vec<f32>>> {
+        let Some(weights) = self.resampled.clone() else { return self.images_at(z0, count) };
+        let picked = &weights[z0 as usize..(z0 + count) as usize];
+        let (Some(first), Some(last)) = (picked.first(), picked.last()) else { return Ok(Vec::new()) };
+        let below = first.0;
+        let above = (last.0 + 1).min(self.images.len() as u32 - 1);
+        let images = self.images_at(below, above - below + 1)?;
+        let blend = |&(k, t): &(u32, f32)| {
+            let a = &images[(k - below) as usize];
+            match images.get((k + 1 - below) as usize) {
+                Some(b) if t > 0.0 => a.iter().zip(b).map(|(a, b)| a + t * (b - a)).collect(),
+                _ => a.clone(),
+            }
+        };
+        Ok(picked.iter().map(blend).collect())
+    }
+
+    /// Images `z0..z0 + count` (in order along the normal), as `image` reads them.
+    fn images_at(&mut self, z0: u32, count: u32) -> Result<Vec<Vec<f32>>> {
         use rayon::prelude::*;
         // An image's file and its samples as f64 and f32, about.
         let per_image = self.dims[0] as u64 * self.dims[1] as u64 * 16;
@@ -542,7 +587,7 @@ impl Series {
                 }
             } else {
                 for &z in group {
-                    out.push(self.slice(z)?);
+                    out.push(self.image(z)?);
                 }
             }
         }

@@ -22,3 +22,22 @@ pub fn refused(args: &[&str]) -> String {
     assert!(!text.contains("panicked"), "{text}");
     text
 }
+
+/// `voxsplat compare A B`'s PSNR in dB (infinite for equal images).
+pub fn psnr(a: &std::path::Path, b: &std::path::Path) -> f64 {
+    let out = voxsplat(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "compare: {}", String::from_utf8_lossy(&out.stderr));
+    text.lines()
+        .find_map(|l| l.strip_prefix("psnr:"))
+        .map(|s| s.trim().trim_end_matches(" dB").parse().unwrap_or(f64::INFINITY))
+        .unwrap_or_else(|| panic!("no psnr in {text}"))
+}
+
+/// A transfer function file at `path` over the file values `lo..hi` (a fixed range: frames of
+/// different parts or time points classify alike).
+pub fn tf_file(path: &std::path::Path, lo: f32, hi: f32) -> &std::path::Path {
+    let points = "points = [[0.0, [0, 0, 0, 0]], [0.4, [0.9, 0.5, 0.3, 0.05]], [1.0, [1, 1, 1, 0.9]]]";
+    std::fs::write(path, format!("{points}\nrange = [{lo:?}, {hi:?}]\n")).unwrap();
+    path
+}
