@@ -325,11 +325,7 @@ fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
     // transfer function over the file's values, 0 to 255; sheets: per-splat compositing blends in
     // the order of the bricks stored).
     let tf = dir.join("tf.toml");
-    std::fs::write(
-        &tf,
-        "points = [[0.0, [0, 0, 0, 0]], [0.4, [0.9, 0.5, 0.3, 0.05]], [1.0, [1, 1, 1, 0.9]]]\nrange = [0.0, 255.0]\n",
-    )
-    .unwrap();
+    cmd::tf_file(&tf, 0.0, 255.0);
     let view =
         ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--composite", "sheet", "--tf", tf.to_str().unwrap()];
     let draw = |args: &[&str], out: &str| -> (u32, String) {
@@ -340,10 +336,8 @@ fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
         (said.split("the store read ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap(), said)
     };
     let psnr = |a: &str, b: &str| -> (f64, String) {
-        let o = voxsplat(&["compare", dir.join(a).to_str().unwrap(), dir.join(b).to_str().unwrap()]);
-        let text = String::from_utf8_lossy(&o.stdout).into_owned();
-        let db = text.lines().find_map(|l| l.strip_prefix("psnr:")).unwrap().trim().trim_end_matches(" dB");
-        (db.parse().unwrap_or(f64::INFINITY), text)
+        let db = cmd::psnr(&dir.join(a), &dir.join(b));
+        (db, format!("{a} against {b}: {db} dB"))
     };
     let (read, said) = draw(&view, "seen.png");
     assert!(said.contains("the view sees"), "{said}");
@@ -470,11 +464,7 @@ fn a_series_seen_in_part_reads_only_that_part_at_each_time_point() {
     write_with_python(&["bonsai-t", bonsai, dir.to_str().unwrap()]);
     let path = dir.join("t.zarr");
     let tf = dir.join("tf.toml");
-    std::fs::write(
-        &tf,
-        "points = [[0.0, [0, 0, 0, 0]], [0.4, [0.9, 0.5, 0.3, 0.05]], [1.0, [1, 1, 1, 0.9]]]\nrange = [0.0, 255.0]\n",
-    )
-    .unwrap();
+    cmd::tf_file(&tf, 0.0, 255.0);
     let (p, t) = (path.to_str().unwrap(), tf.to_str().unwrap());
     let view =
         ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--tf", t, "--size", "48x48", "--composite", "sheet"];
@@ -499,10 +489,8 @@ fn a_series_seen_in_part_reads_only_that_part_at_each_time_point() {
         let text = String::from_utf8_lossy(&o.stderr).into_owned();
         assert!(o.status.success() && text.contains("the store read 128 chunks"), "{text}");
         let frame = frames.join(format!("frame{k:04}.png"));
-        let o = voxsplat(&["compare", frame.to_str().unwrap(), whole.to_str().unwrap()]);
-        let text = String::from_utf8_lossy(&o.stdout).into_owned();
-        let db = text.lines().find_map(|l| l.strip_prefix("psnr:")).unwrap().trim().trim_end_matches(" dB");
-        assert!(db.parse().unwrap_or(f64::INFINITY) > 70.0, "time point {k} seen in part against whole: {text}");
+        let db = cmd::psnr(&frame, &whole);
+        assert!(db > 70.0, "time point {k} seen in part against whole: {db} dB");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
