@@ -138,7 +138,8 @@ const FOUND_REFUSALS: [(&str, &str); 5] = [
     ("found-ob-undefined-length-item.dcm", "(0000,0000) declares 3758161918 bytes past the file's end"),
 ];
 
-/// The DICOM seeds (pydicom): a CT image, a multi-frame RT Dose grid, an enhanced image and a
+/// The DICOM seeds (pydicom): a CT image, a multi-frame RT Dose grid (and one whose frames are
+/// unevenly spaced, resampled evenly), an enhanced image and a
 /// JPEG 2000 image read as series of one file; the `refused-` one, and the files the fuzzer found (`found-`: each made dicom-rs size a
 /// buffer of gigabytes by a length the walk before it now checks), are refused.
 #[test]
@@ -165,6 +166,16 @@ fn the_dicom_seeds_load() {
                 assert_eq!(v.dims, [4, 3, 3]);
                 // 1000 k scaled by 1e-4, frame by frame.
                 assert!(v.values.iter().enumerate().all(|(k, &x)| (x - k as f32 * 0.1).abs() < 1e-5), "{:?}", v.values);
+            }
+            "seed-dose-uneven.dcm" => {
+                // Frames at 0, 1 and 3.5 mm: five even slices 0.875 mm apart, each linear between
+                // the frames around it (frame f holds (12 f + i) / 10).
+                let v = v.unwrap();
+                assert_eq!(v.dims, [4, 3, 5]);
+                assert!((v.spacing[2] - 0.875).abs() < 1e-5, "{:?}", v.spacing);
+                let at = [0.0, 0.875, 1.3, 1.65, 2.0];
+                let want = (0..60).map(|k| (at[k / 12] * 12.0 + (k % 12) as f32) * 0.1);
+                assert!(v.values.iter().zip(want).all(|(x, w)| (x - w).abs() < 1e-4), "{:?}", v.values);
             }
             "seed-enhanced.dcm" => {
                 // Its frames are stored top first: frame 2 (z = 0) is the grid's first slice.

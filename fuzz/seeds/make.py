@@ -146,12 +146,13 @@ try:
         pydicom.dcmwrite(buf, ds, enforce_file_format=True)
         return buf.getvalue()
 
-    def dose():
-        # A multi-frame RT Dose grid: 3 frames of 32-bit samples placed by a Grid Frame Offset Vector.
+    def dose(offsets=(0, 2.5, 5)):
+        # A multi-frame RT Dose grid: 3 frames of 32-bit samples placed by a Grid Frame Offset Vector
+        # (uneven offsets: resampled onto even slices).
         ds = pydicom.dcmread(io.BytesIO(ct()))
         ds.Modality = "RTDOSE"
         del ds.RescaleSlope, ds.RescaleIntercept
-        ds.NumberOfFrames, ds.GridFrameOffsetVector, ds.DoseGridScaling = 3, [0, 2.5, 5], 1e-4
+        ds.NumberOfFrames, ds.GridFrameOffsetVector, ds.DoseGridScaling = 3, list(offsets), 1e-4
         ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 32, 32, 31, 0
         ds.PixelData = (np.arange(36, dtype=np.uint32) * 1000).tobytes()
         buf = io.BytesIO()
@@ -226,6 +227,7 @@ try:
     put("dicom", "deflated.dcm", deflated())
     put("dicom", "no-spacing.dcm", ct(False), "refused-")
     put("dicom", "dose.dcm", dose())
+    put("dicom", "dose-uneven.dcm", dose((0, 1, 3.5)))
     put("dicom", "enhanced.dcm", enhanced())
     put("dicom", "j2k.dcm", j2k())
     put("dicom", "jpegls.dcm", jpegls())
