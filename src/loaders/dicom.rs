@@ -552,8 +552,10 @@ impl Series {
     /// two per thread at a time within `PARALLEL_BYTES` (a compressed series' decoding is most of
     /// its reading).
     pub fn slices(&mut self, z0: u32, count: u32) -> Result<Vec<Vec<f32>>> {
-        let Some(weights) = self.resampled.clone() else { return self.images_at(z0, count) };
-        let picked = &weights[z0 as usize..(z0 + count) as usize];
+        let Some(weights) = &self.resampled else { return self.images_at(z0, count) };
+        let Some(picked) = weights.get(z0 as usize..z0 as usize + count as usize).map(<[_]>::to_vec) else {
+            return Err(bad(&self.images[0].path.display().to_string(), format!("no slices {z0}..{z0}+{count}")));
+        };
         let (Some(first), Some(last)) = (picked.first(), picked.last()) else { return Ok(Vec::new()) };
         let below = first.0;
         let above = (last.0 + 1).min(self.images.len() as u32 - 1);
