@@ -367,6 +367,9 @@ pub struct Series {
     /// An unevenly spaced series resampled evenly: per slice, the image below it and the weight
     /// of the one above (`resample::weights`).
     resampled: Option<Vec<(u32, f32)>>,
+    /// The last image a resampled read decoded, and its index: the next read of the slices
+    /// after it starts from it.
+    kept: Option<(u32, Vec<f32>)>,
 }
 
 /// The series `path` names: a folder holding one series (or `pick`, its index in `voxsplat info`'s
@@ -520,7 +523,7 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let affine = DMat4::from_diagonal(DVec4::new(-1.0, -1.0, 1.0, 1.0)) * lps;
     let dims = [first.size[0], first.size[1], slices as u32];
     let orientation = crate::orient::Orientation::from_affine(affine, dims).map_err(|e| bad(what, e))?;
-    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, offsets, resampled })
+    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, offsets, resampled, kept: None })
 }
 
 impl Series {
@@ -559,7 +562,16 @@ impl Series {
         let (Some(first), Some(last)) = (picked.first(), picked.last()) else { return Ok(Vec::new()) };
         let below = first.0;
         let above = (last.0 + 1).min(self.images.len() as u32 - 1);
-        let images = self.images_at(below, above - below + 1)?;
+        // The image below the first slice is often the one above the last read's last slice.
+        let mut images = match self.kept.take() {
+            Some((k, image)) if k == below => vec![image],
+            _ => Vec::new(),
+        };
+        let next = below + images.len() as u32;
+        if next <= above {
+            images.extend(self.images_at(next, above - next + 1)?);
+        }
+        self.kept = images.last().map(|image| (above, image.clone()));
         let blend = |&(k, t): &(u32, f32)| {
             let a = &images[(k - below) as usize];
             match images.get((k + 1 - below) as usize) {
