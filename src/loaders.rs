@@ -20,6 +20,7 @@ mod sequence;
 mod slices;
 mod stacks;
 mod zarr;
+mod zarr_chunks;
 use bounded::read_bounded;
 pub use bounded::{read_text, MAX_TEXT_BYTES};
 pub use dicom::{even_slices, is_dicom, series_in as dicom_series, SeriesInfo};
@@ -33,10 +34,11 @@ pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
 pub use pyramid::{LEVEL_PIXELS, VIEW_MARGIN_PX};
 pub use sequence::{files as series_files, is_pattern};
 pub use slices::{value_range, SliceReader, MAX_STREAMED_VOXELS};
-pub use stacks::is_stack;
+pub use stacks::{is_stack, tiff_heights};
 pub use zarr::{
     chunks_read as zarr_chunks_read, is_ome_zarr, Axis as ZarrAxis, Level as ZarrLevel, OmeZarr, MAX_CHUNK_BYTES,
 };
+pub use zarr_chunks::{ChunkCache, ChunkCacheStats};
 
 /// Most voxels (or height cells) a loader accepts: 2^28 (1 GiB as f32).
 pub const MAX_VOXELS: u64 = 1 << 28;
@@ -431,8 +433,12 @@ pub struct VolumeHints {
     /// With `crop`: the one view (in the grid's centred frame) a store will be drawn from. An
     /// OME-Zarr image then reads only the chunks it may see (within `VIEW_MARGIN_PX` of the
     /// image's edges and one brick around), the others' voxels empty, and its default level
-    /// counts only those. A view that moves must read again.
+    /// counts only those. A view that moves must read again: through `chunk_cache`, only the
+    /// chunks it did not read before.
     pub view: Option<crate::Camera>,
+    /// OME-Zarr chunks are read through this cache: those it holds are not read from the file
+    /// again, and those read are held for later loads given the same cache.
+    pub chunk_cache: Option<ChunkCache>,
 }
 
 /// The positions of an unevenly spaced DICOM series' slices along their normal, from the first
@@ -652,42 +658,6 @@ fn load_height_file(path: &Path) -> Result<HeightGrid> {
     let img = reader.decode().map_err(|e| bad(&what, e))?.to_luma16();
     let (w, h) = img.dimensions();
     Ok(HeightGrid { width: w, rows: h, heights: img.pixels().map(|p| p[0] as f32).collect() })
-}
-
-/// The first image of a TIFF as heights (u8, u16, i16, u32, f32), within `MAX_VOXELS`.
-pub fn tiff_heights(bytes: &[u8], what: &str) -> Result<HeightGrid> {
-    let mut limits = tiff::decoder::Limits::default();
-    limits.decoding_buffer_size = (MAX_VOXELS * 4) as usize;
-    limits.intermediate_buffer_size = (MAX_VOXELS * 4) as usize;
-    let mut dec = tiff::decoder::Decoder::new(std::io::Cursor::new(bytes))
-        .map_err(|e| bad(what, format!("tiff: {e}")))?
-        .with_limits(limits);
-    let (w, h) = dec.dimensions().map_err(|e| bad(what, format!("tiff: {e}")))?;
-    voxel_count(&[w as u64, h as u64], what)?;
-    use tiff::decoder::DecodingResult as D;
-    const READ: &str = "uint8, uint16, int16, uint32, float32 and float64 single-channel heights are read";
-    let heights: Vec<f32> = match dec.read_image().map_err(|e| bad(what, format!("tiff: {e} ({READ})")))? {
-        D::U8(v) => v.into_iter().map(f32::from).collect(),
-        D::U16(v) => v.into_iter().map(f32::from).collect(),
-        D::I16(v) => v.into_iter().map(f32::from).collect(),
-        D::U32(v) => v.into_iter().map(|x| x as f32).collect(),
-        D::F32(v) => v,
-        D::F64(v) => v.into_iter().map(|x| x as f32).collect(),
-        other => {
-            let kind = match other {
-                D::I8(_) => "int8",
-                D::I32(_) => "int32",
-                D::U64(_) => "uint64",
-                D::I64(_) => "int64",
-                _ => "this sample type",
-            };
-            return Err(bad(what, format!("TIFF samples of {kind} are not read ({READ})")));
-        }
-    };
-    if heights.len() as u64 != w as u64 * h as u64 {
-        return Err(bad(what, "TIFF is not a single-channel height grid"));
-    }
-    Ok(HeightGrid { width: w, rows: h, heights })
 }
 
 /// Where the shared real datasets live: `$VOXSPLAT_DATA`, else `../shared/data` beside the crate.

@@ -425,3 +425,90 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     }
     Ok(s)
 }
+
+/// Orbit the OME-Zarr image `path` in `steps` steps about its framing camera's up axis, the view
+/// narrowed to `fov` degrees so each sees part of the image: every frame's store is read for that
+/// view alone (`VolumeHints::crop` and `view`: the chunks it may see, at the finest level whose
+/// part fits the host budget), through one chunk cache of `cache_bytes` (0: none), then drawn at
+/// the default settings within `budget_bytes`. Per frame the level, the chunks read from the file
+/// and those the cache held, the load and frame times; a markdown table on stdout.
+pub fn zarr_orbit(
+    path: &Path,
+    size: u32,
+    budget_bytes: u64,
+    tf: &str,
+    steps: u32,
+    fov: f32,
+    cache_bytes: u64,
+) -> Result<String> {
+    use voxsplat::loaders::{ChunkCache, OmeZarr, VolumeHints, VIEW_MARGIN_PX};
+    if !(1..=3600).contains(&steps) {
+        return Err(Error::InvalidArgument(format!("--orbit {steps}: between 1 and 3600 steps")));
+    }
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(Error::InvalidArgument(format!("--fov {fov}: between 0 and 180 degrees")));
+    }
+    let tf = TransferFunction::preset(tf)?;
+    let image = OmeZarr::open(path)?;
+    let l = &image.levels[0];
+    let grid = voxsplat::Grid::centered(l.dims, l.spacing)?;
+    let half = voxsplat::glam::Vec3::from(l.dims.map(|d| d as f32)) * voxsplat::glam::Vec3::from(l.spacing) * 0.5;
+    let mut cam = Camera::framing(&grid, size, size);
+    cam.projection = voxsplat::Projection::Perspective { fov_y_deg: fov };
+    let cache = (cache_bytes > 0).then(|| ChunkCache::new(cache_bytes)).transpose()?;
+    let mut o = RendererOptions::default();
+    o.gpu_budget_bytes = budget_bytes;
+    let mut r = Renderer::new(&o)?;
+    let mut out = String::from(
+        "| frame | degrees | level | chunks read | chunks held, reused | load ms | frame ms | splats |\n\
+         |---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let (mut read_total, mut loads, mut frames) = (0u64, Vec::new(), Vec::new());
+    for i in 0..steps {
+        let angle = i as f32 * std::f32::consts::TAU / steps as f32;
+        let mut c = cam;
+        c.eye = cam.target + voxsplat::glam::Quat::from_axis_angle(cam.up.normalize(), angle) * (cam.eye - cam.target);
+        let Some([lo, hi]) = c.box_in_view(-half, half, VIEW_MARGIN_PX) else {
+            return Err(Error::InvalidArgument(format!("{}: the view at step {i} sees none of it", path.display())));
+        };
+        let crop = [lo.to_array(), hi.to_array()];
+        let level = image.default_level_within(Some(crop), Some(&c)).ok_or_else(|| {
+            Error::InvalidArgument(format!("{}: the view at step {i} sees none of it", path.display()))
+        })?;
+        let hints = VolumeHints {
+            level: Some(level),
+            crop: Some(crop),
+            view: Some(c),
+            chunk_cache: cache.clone(),
+            ..Default::default()
+        };
+        let (before, chunks) =
+            (cache.as_ref().map(|c| c.stats()).unwrap_or_default(), voxsplat::loaders::zarr_chunks_read());
+        let t = Instant::now();
+        let store = BrickStore::load(path, &hints)?;
+        r.set_bricks(BrickScene::new(store, tf.clone(), None)?)?;
+        loads.push(ms(t));
+        let read = voxsplat::loaders::zarr_chunks_read() - chunks;
+        let hits = cache.as_ref().map_or(0, |c| c.stats().hits - before.hits);
+        read_total += read;
+        let t = Instant::now();
+        let st = r.render(&c, &RenderOptions::default())?.stats;
+        frames.push(ms(t));
+        let (load_ms, frame_ms) = (loads[i as usize], frames[i as usize]);
+        out += &format!(
+            "| {i} | {:.0} | {level} | {read} | {hits} | {load_ms:.0} | {frame_ms:.0} | {} |\n",
+            angle.to_degrees(),
+            st.splats
+        );
+    }
+    let held = cache.as_ref().map_or(0, |c| c.stats().held_bytes);
+    out += &format!(
+        "\n{read_total} chunks read in {steps} frames; median load {:.0} ms, median frame {:.0} ms; the chunk cache \
+         ({} MiB) holds {:.0} MiB\n",
+        median(&mut loads),
+        median(&mut frames),
+        cache_bytes >> 20,
+        held as f64 / 1048576.0
+    );
+    Ok(out)
+}

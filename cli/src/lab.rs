@@ -112,6 +112,14 @@ pub(crate) enum Study {
         /// budget keeps the records it used in a cache on the device).
         #[arg(long, requires = "volume")]
         orbit: Option<u32>,
+        /// With --orbit of an OME-Zarr image: the view's field of view in degrees. Each frame then
+        /// reads its own part of the image (the chunks it may see, at the finest level that part
+        /// fits the host budget at) through one chunk cache, and the table says what each read.
+        #[arg(long, requires = "orbit")]
+        fov: Option<f32>,
+        /// With --fov: the chunk cache's size in MiB (0: none, every frame reads its chunks anew).
+        #[arg(long, default_value_t = 1024, requires = "fov")]
+        chunk_cache_mib: u64,
         /// Chart of the levels-of-detail study on peer256 (its markdown links it as bench/FILE).
         #[arg(long)]
         lod_chart: Option<PathBuf>,
@@ -365,12 +373,39 @@ pub(crate) fn run(study: Study) -> Result<()> {
             Ok(())
         }
         Study::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => voxsplat_cli::bench::scaling_chart(&csv, &svg),
-        Study::Bricks { bonsai, large, size, frames, volume, gpu_budget_mib, tf, orbit, lod_chart, .. } => {
+        Study::Bricks {
+            bonsai,
+            large,
+            size,
+            frames,
+            volume,
+            gpu_budget_mib,
+            tf,
+            orbit,
+            fov,
+            chunk_cache_mib,
+            lod_chart,
+            ..
+        } => {
             if frames < 1 || size < 16 {
                 return Err(Error::InvalidArgument("--frames must be at least 1 and --size at least 16".into()));
             }
             if let (Some(v), Some(steps)) = (&volume, orbit) {
                 let budget = mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?;
+                if let Some(fov) = fov {
+                    if !voxsplat::loaders::is_ome_zarr(v) {
+                        return Err(Error::InvalidArgument(format!(
+                            "--fov orbits an OME-Zarr image a part at a time; {} is read whole (drop --fov)",
+                            v.display()
+                        )));
+                    }
+                    let cache = match chunk_cache_mib {
+                        0 => 0,
+                        m => mib_bytes(m, "--chunk-cache-mib")?,
+                    };
+                    print!("{}", voxsplat_cli::bricked::zarr_orbit(v, size, budget, &tf, steps, fov, cache)?);
+                    return Ok(());
+                }
                 print!("{}", voxsplat_cli::bricked::orbit(v, size, budget, &tf, steps)?);
                 return Ok(());
             }

@@ -330,6 +330,7 @@ fn volume_hints_at(a: &SceneArgs, level: Option<u32>) -> Result<voxsplat::loader
         rectilinear: false,
         crop: a.crop,
         view: a.view_read,
+        chunk_cache: None,
     })
 }
 

@@ -356,6 +356,8 @@ fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
     assert_eq!(draw(&[&diagonal[..], &all].concat(), "diagonal-all.png").0, 128);
     let (db, text) = psnr("diagonal.png", "diagonal-all.png");
     assert!(db > 70.0, "the chunks a diagonal view sees against the whole image: {text}");
+    a_moving_view_reads_through_a_chunk_cache(&path);
+    an_orbit_reads_each_chunk_once_through_the_cache(&path);
     // Corrupt every chunk wholly farther than 16 voxels (two bricks) from the box.
     let chunk = [64u32, 64, 32];
     let mut kept = 0;
@@ -434,6 +436,100 @@ fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
     let e = refused(&[&["render", "--volume", path.to_str().unwrap()][..], &far_box].concat());
     assert!(e.contains("holds no voxel"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Views that turn about the bonsai's z axis (narrow, along x at first), each store read through
+/// one `ChunkCache`: each equals the store read without it, and each view reads from the file
+/// only the chunks the views before it did not, while the cache holds them.
+fn a_moving_view_reads_through_a_chunk_cache(path: &Path) {
+    use voxsplat::glam::Vec3;
+    use voxsplat::loaders::{ChunkCache, VIEW_MARGIN_PX};
+    let view = |deg: f32| {
+        let a = deg.to_radians();
+        voxsplat::Camera {
+            eye: Vec3::new(a.cos(), a.sin(), 0.0) * 300.0,
+            target: Vec3::ZERO,
+            up: Vec3::Z,
+            projection: voxsplat::Projection::Perspective { fov_y_deg: 10.0 },
+            near: 1.0,
+            far: 1000.0,
+            width: 48,
+            height: 48,
+        }
+    };
+    let half = Vec3::new(128.0, 128.0, 192.0);
+    let load = |camera: voxsplat::Camera, cache: Option<&ChunkCache>| {
+        let [lo, hi] = camera.box_in_view(-half, half, VIEW_MARGIN_PX).unwrap();
+        let hints = VolumeHints {
+            level: Some(0),
+            crop: Some([lo.to_array(), hi.to_array()]),
+            view: Some(camera),
+            chunk_cache: cache.cloned(),
+            ..Default::default()
+        };
+        voxsplat::bricks::BrickStore::load(path, &hints).unwrap()
+    };
+    let same = |a: &voxsplat::bricks::BrickStore, b: &voxsplat::bricks::BrickStore| {
+        a.records == b.records && a.headers == b.headers && a.range == b.range
+    };
+    // Level 0's chunks are 64 x 64 x 32 samples, 512 KiB as f32: 64 MiB holds all 128.
+    let cache = ChunkCache::new(64 << 20).unwrap();
+    let mut reads = Vec::new();
+    for deg in [0.0, 10.0, 20.0] {
+        let before = cache.stats();
+        assert!(same(&load(view(deg), Some(&cache)), &load(view(deg), None)), "the view at {deg} degrees");
+        let alone = ChunkCache::new(64 << 20).unwrap();
+        load(view(deg), Some(&alone));
+        let (s, seen) = (cache.stats(), alone.stats().reads);
+        reads.push((s.reads - before.reads, seen));
+        assert!(s.reads - before.reads <= seen && s.evicted == 0, "{deg} degrees: {s:?}, {seen} chunks seen");
+    }
+    // The first view reads what it sees; each turn reads some chunks new to it, and not the rest.
+    assert!(reads[0].0 == reads[0].1 && reads[0].1 > 0, "{reads:?}");
+    assert!(reads[1..].iter().all(|&(new, seen)| new > 0 && new < seen), "{reads:?}");
+    // Looking back reads nothing from the file.
+    let before = cache.stats();
+    load(view(0.0), Some(&cache));
+    assert_eq!(cache.stats().reads, before.reads);
+    // A cache of four chunks lets go of the oldest and still reads the same store.
+    let small = ChunkCache::new(2 << 20).unwrap();
+    for deg in [0.0, 10.0] {
+        assert!(same(&load(view(deg), Some(&small)), &load(view(deg), None)), "{deg} degrees, a small cache");
+    }
+    let s = small.stats();
+    assert!(s.evicted > 0 && s.held_bytes <= 2 << 20, "{s:?}");
+}
+
+/// `voxsplat lab bricks --orbit N --fov DEG` of an OME-Zarr image: each frame reads its own part;
+/// through the chunk cache no chunk is read twice, and without it each frame reads every chunk it
+/// uses (those the cache held for it).
+fn an_orbit_reads_each_chunk_once_through_the_cache(path: &Path) {
+    let orbit = |cache: &str| -> Vec<(u64, u64)> {
+        let args = ["lab", "bricks", "--volume", path.to_str().unwrap(), "--orbit", "4", "--fov", "10", "--size", "48"];
+        let o = voxsplat(&[&args[..], &["--tf", "bonsai", "--chunk-cache-mib", cache]].concat());
+        let said = String::from_utf8_lossy(&o.stdout).into_owned();
+        assert!(o.status.success(), "{said}{}", String::from_utf8_lossy(&o.stderr));
+        let rows: Vec<(u64, u64)> = said
+            .lines()
+            .filter(|l| l.starts_with("| ") && l.as_bytes()[2].is_ascii_digit())
+            .map(|l| {
+                let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+                (cells[4].parse().unwrap(), cells[5].parse().unwrap())
+            })
+            .collect();
+        assert_eq!(rows.len(), 4, "{said}");
+        rows
+    };
+    let (cached, anew) = (orbit("64"), orbit("0"));
+    let read: u64 = cached.iter().map(|r| r.0).sum();
+    assert!(read > 0 && read <= 128, "{cached:?}: level 0 has 128 chunks");
+    assert!(cached.iter().skip(1).any(|r| r.1 > 0), "{cached:?}");
+    for (c, a) in cached.iter().zip(&anew) {
+        assert_eq!((c.0 + c.1, 0), *a, "each frame's chunks, read or held: {cached:?} against {anew:?}");
+    }
+    let bonsai = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/bonsai/bonsai.nii.gz");
+    let e = refused(&["lab", "bricks", "--volume", bonsai, "--orbit", "2", "--fov", "10"]);
+    assert!(e.contains("--fov orbits an OME-Zarr image"), "{e}");
 }
 
 /// Every file under `dir`.

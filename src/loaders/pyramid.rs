@@ -1,6 +1,7 @@
 //! Which level of an OME-Zarr pyramid to read, and which part of it: the finest the host budget
 //! holds (whole, or the part a crop box needs), or the one a view needs (`--level auto`).
-use super::zarr::{may_see_voxels, OmeZarr};
+use super::zarr::OmeZarr;
+use super::zarr_chunks::may_see_voxels;
 
 /// The largest size, in pixels, at the nearest point of the view, of a voxel of the level
 /// `OmeZarr::level_for` picks: the levels-of-detail cut draws cells of `DEFAULT_LOD_PIXELS` (1.5 px),

@@ -334,13 +334,16 @@ impl SliceReader {
             return Err(bad(&what, "--series picks a DICOM series; this is an OME-Zarr image"));
         }
         let time = zarr_time(path, image, hints)?;
-        let reader = super::zarr::ZarrReader::open(
+        let mut reader = super::zarr::ZarrReader::open(
             path,
             image,
             hints.level.unwrap_or_else(|| image.default_level()),
             time,
             channel,
         )?;
+        if let Some(cache) = &hints.chunk_cache {
+            reader.use_cache(cache.clone());
+        }
         Ok(SliceReader {
             dims: reader.dims,
             spacing: reader.spacing,

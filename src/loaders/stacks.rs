@@ -387,3 +387,39 @@ fn read_image(path: &Path) -> Result<(Vec<f32>, u32, u32)> {
     };
     Ok((values, w, h))
 }
+
+/// The first image of a TIFF as heights (u8, u16, i16, u32, f32), within `MAX_VOXELS`.
+pub fn tiff_heights(bytes: &[u8], what: &str) -> Result<super::HeightGrid> {
+    let mut limits = tiff::decoder::Limits::default();
+    limits.decoding_buffer_size = (MAX_VOXELS * 4) as usize;
+    limits.intermediate_buffer_size = (MAX_VOXELS * 4) as usize;
+    let mut dec = tiff::decoder::Decoder::new(std::io::Cursor::new(bytes))
+        .map_err(|e| bad(what, format!("tiff: {e}")))?
+        .with_limits(limits);
+    let (w, h) = dec.dimensions().map_err(|e| bad(what, format!("tiff: {e}")))?;
+    super::voxel_count(&[w as u64, h as u64], what)?;
+    use tiff::decoder::DecodingResult as D;
+    const READ: &str = "uint8, uint16, int16, uint32, float32 and float64 single-channel heights are read";
+    let heights: Vec<f32> = match dec.read_image().map_err(|e| bad(what, format!("tiff: {e} ({READ})")))? {
+        D::U8(v) => v.into_iter().map(f32::from).collect(),
+        D::U16(v) => v.into_iter().map(f32::from).collect(),
+        D::I16(v) => v.into_iter().map(f32::from).collect(),
+        D::U32(v) => v.into_iter().map(|x| x as f32).collect(),
+        D::F32(v) => v,
+        D::F64(v) => v.into_iter().map(|x| x as f32).collect(),
+        other => {
+            let kind = match other {
+                D::I8(_) => "int8",
+                D::I32(_) => "int32",
+                D::U64(_) => "uint64",
+                D::I64(_) => "int64",
+                _ => "this sample type",
+            };
+            return Err(bad(what, format!("TIFF samples of {kind} are not read ({READ})")));
+        }
+    };
+    if heights.len() as u64 != w as u64 * h as u64 {
+        return Err(bad(what, "TIFF is not a single-channel height grid"));
+    }
+    Ok(super::HeightGrid { width: w, rows: h, heights })
+}

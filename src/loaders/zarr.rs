@@ -4,6 +4,7 @@
 //! read and checked as JSON before zarrs opens it (a decoded chunk against `MAX_CHUNK_BYTES`, the
 //! level read against `MAX_STREAMED_VOXELS`, the pyramid's levels against each other), so nothing is sized by
 //! a header that has not been checked.
+use super::zarr_chunks::{copy_part, may_see_voxels};
 use super::{bad, MAX_STREAMED_VOXELS};
 use crate::error::{Error, Result};
 use serde_json::Value;
@@ -441,6 +442,11 @@ pub struct ZarrReader {
     row: Option<(u32, [u32; 4], Vec<f32>)>,
     /// Only the chunks this view (and margin in pixels) may see are read (`only_in_view`).
     seen: Option<(crate::Camera, f32)>,
+    /// Decoded chunks kept between reads (`use_cache`).
+    cache: Option<super::ChunkCache>,
+    /// The level's array path and the image's folder: the chunks' keys in the cache.
+    level_path: String,
+    dir: std::path::PathBuf,
     what: String,
 }
 
@@ -494,7 +500,22 @@ impl ZarrReader {
         }
         let chunk_z = l.chunk[n - 3].min(l.dims[2] as u64) as u32;
         let what = format!("{what} level {level} ({})", l.path);
-        Ok(ZarrReader { array, kind, dims: l.dims, spacing: l.spacing, lead, chunk_z, row: None, seen: None, what })
+        let level_path = l.path.clone();
+        let (dims, spacing, row, seen, cache) = (l.dims, l.spacing, None, None, None);
+        Ok(ZarrReader {
+            array,
+            kind,
+            dims,
+            spacing,
+            lead,
+            chunk_z,
+            row,
+            seen,
+            cache,
+            level_path,
+            dir: dir.into(),
+            what,
+        })
     }
 
     /// Slices `z0..z0 + count` (x fastest) into `out`.
@@ -552,38 +573,60 @@ impl ZarrReader {
         let n = ranges.iter().map(|r| r.end - r.start).product::<u64>();
         crate::error::check_host_memory(n * (4 + self.kind.size()), &format!("{}'s slices", self.what))?;
         let subset = ArraySubset::new_with_ranges(&ranges);
-        let Some(seen) = &self.seen else {
+        if self.seen.is_none() && self.cache.is_none() {
             if let Ok(Some(chunks)) = self.array.chunks_in_array_subset(&subset) {
                 CHUNKS_READ.fetch_add(chunks.num_elements(), std::sync::atomic::Ordering::Relaxed);
             }
             return self.decoded(&subset, n, z0, count);
-        };
+        }
         // Chunk by chunk: those the view cannot see read as NaN (empty to the store's passes).
         let mut out = vec![f32::NAN; n as usize];
-        let (w, h) = ((x1 - x0) as usize, (y1 - y0) as usize);
         let chunks = self.array.chunks_in_array_subset(&subset).map_err(|e| bad(&self.what, e))?;
         let lead = self.lead.len();
         let grid = crate::Grid::centered(self.dims, self.spacing)?;
+        let to = ([z0, y0, x0].map(u64::from), [count, y1 - y0, x1 - x0].map(u64::from));
+        let spatial = |s: &ArraySubset| -> ([u64; 3], [u64; 3]) {
+            let (start, shape) = (s.start(), s.shape());
+            ([0, 1, 2].map(|a| start[lead + a]), [0, 1, 2].map(|a| shape[lead + a]))
+        };
         for idx in chunks.iter().flat_map(|c| c.indices().into_iter()) {
             let part =
                 self.array.chunk_subset(&idx).and_then(|c| Ok(c.overlap(&subset)?)).map_err(|e| bad(&self.what, e))?;
-            let (start, shape) = (part.start()[lead..].to_vec(), part.shape()[lead..].to_vec());
+            let (start, shape) = spatial(&part);
             // Array order is z, y, x.
             let xyz = [2, 1, 0].map(|a| start[a]);
             let end = [2, 1, 0].map(|a| start[a] + shape[a]);
-            if !may_see_voxels(&seen.0, seen.1, &grid, xyz, end) {
-                continue;
+            if let Some(seen) = &self.seen {
+                if !may_see_voxels(&seen.0, seen.1, &grid, xyz, end) {
+                    continue;
+                }
             }
-            CHUNKS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let values = self.decoded(&part, part.num_elements(), z0, count)?;
-            let (pw, ph) = (shape[2] as usize, shape[1] as usize);
-            for (k, z) in (start[0]..start[0] + shape[0]).enumerate() {
-                for (j, y) in (start[1]..start[1] + shape[1]).enumerate() {
-                    let to = (z - z0 as u64) as usize * w * h
-                        + (y - y0 as u64) as usize * w
-                        + (start[2] - x0 as u64) as usize;
-                    let from = (k * ph + j) * pw;
-                    out[to..to + pw].copy_from_slice(&values[from..from + pw]);
+            // The chunk's samples at this time point and channel, within the array.
+            let whole = self.array.chunk_subset_bounded(&idx).map_err(|e| bad(&self.what, e))?;
+            let block = spatial(&whole);
+            let bytes = block.1.iter().product::<u64>() * 4;
+            match &self.cache {
+                Some(cache) if bytes <= MAX_CHUNK_BYTES => {
+                    let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
+                    ranges.extend((0..3).map(|a| block.0[a]..block.0[a] + block.1[a]));
+                    let key = super::zarr_chunks::ChunkKey {
+                        image: self.dir.clone(),
+                        level: self.level_path.clone(),
+                        lead: self.lead.clone(),
+                        chunk: idx.to_vec(),
+                    };
+                    let values = cache.get_or_read(key, || {
+                        crate::error::check_host_memory(bytes, &format!("{}'s chunk", self.what))?;
+                        CHUNKS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let whole = ArraySubset::new_with_ranges(&ranges);
+                        self.decoded(&whole, whole.num_elements(), z0, count)
+                    })?;
+                    copy_part(&mut out, to, block, &values, (start, shape));
+                }
+                _ => {
+                    CHUNKS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let values = self.decoded(&part, part.num_elements(), z0, count)?;
+                    copy_part(&mut out, to, (start, shape), &values, (start, shape));
                 }
             }
         }
@@ -628,22 +671,12 @@ impl ZarrReader {
         self.seen = Some((camera, margin_px));
         self.row = None;
     }
-}
 
-/// Whether `camera` may see voxels `start..end` (x, y, z) of `grid` (a level's, centred) or the
-/// brick around them, whose gradients and levels of detail read them (`Camera::may_see_box`,
-/// `margin` pixels past the image's edges).
-pub(super) fn may_see_voxels(
-    camera: &crate::Camera,
-    margin: f32,
-    grid: &crate::Grid,
-    start: [u64; 3],
-    end: [u64; 3],
-) -> bool {
-    let pad = glam::Vec3::splat(crate::constants::BRICK_SIDE as f32);
-    let [lo, hi] = [start, end.map(|e| e - 1)].map(|c| glam::Vec3::from(c.map(|v| v as f32)));
-    let [lo, hi] = grid.world_box(lo - pad, hi + pad);
-    camera.may_see_box(lo, hi, margin)
+    /// Read chunks through `cache`: those it holds are not read again, and those read are held
+    /// there for later reads (of any level, view or reader).
+    pub fn use_cache(&mut self, cache: super::ChunkCache) {
+        self.cache = Some(cache);
+    }
 }
 
 /// Every channel of the image at `dir` (`loaders::load_channels`), each read whole at

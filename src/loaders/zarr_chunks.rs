@@ -1,0 +1,189 @@
+//! Which OME-Zarr chunks a read takes from the file: only those a view may see
+//! (`may_see_voxels`), and none that a `ChunkCache` holds. A view that moves, and so reads a new
+//! part of the image (`VolumeHints::crop` and `view`), reads from the file only the chunks it did
+//! not read before, while the cache holds them. Chunks are let go least recently used first.
+use crate::error::Result;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+/// One chunk of one image: the image's folder, the level's array path, the fixed indices before
+/// the spatial axes (time point, channel) and the chunk's index in the array's chunk grid.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub(super) struct ChunkKey {
+    pub image: PathBuf,
+    pub level: String,
+    pub lead: Vec<u64>,
+    pub chunk: Vec<u64>,
+}
+
+/// What a `ChunkCache` has done since it was made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ChunkCacheStats {
+    /// Chunks read from the file and decoded (not held when asked for).
+    pub reads: u64,
+    /// Chunks found held.
+    pub hits: u64,
+    /// Chunks let go to stay within the budget.
+    pub evicted: u64,
+    /// Bytes of decoded samples held now.
+    pub held_bytes: u64,
+}
+
+struct Inner {
+    budget: u64,
+    /// Uses so far: each held chunk keeps the count at its last use.
+    clock: u64,
+    chunks: HashMap<ChunkKey, (Arc<[f32]>, u64)>,
+    stats: ChunkCacheStats,
+}
+
+/// Decoded chunks of OME-Zarr images (as f32, the spatial part of one chunk at one time point and
+/// channel) held within a byte budget and shared by the reads given it
+/// (`VolumeHints::chunk_cache`). Clones share one cache. A chunk larger than the budget is read
+/// and not held.
+#[derive(Clone)]
+pub struct ChunkCache(Arc<Mutex<Inner>>);
+
+impl std::fmt::Debug for ChunkCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = self.stats();
+        write!(f, "ChunkCache {{ budget: {}, {s:?} }}", self.budget())
+    }
+}
+
+impl ChunkCache {
+    /// A cache holding at most `budget_bytes` of decoded samples, checked against the host budget
+    /// (`set_host_budget`) and the memory available.
+    pub fn new(budget_bytes: u64) -> Result<Self> {
+        crate::error::check_host_memory(budget_bytes, "the OME-Zarr chunk cache")?;
+        Ok(ChunkCache(Arc::new(Mutex::new(Inner {
+            budget: budget_bytes,
+            clock: 0,
+            chunks: HashMap::new(),
+            stats: ChunkCacheStats::default(),
+        }))))
+    }
+
+    fn inner(&self) -> std::sync::MutexGuard<'_, Inner> {
+        // A read that failed while another held the lock left the map whole: take it.
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Its budget in bytes.
+    pub fn budget(&self) -> u64 {
+        self.inner().budget
+    }
+
+    /// What it has done so far.
+    pub fn stats(&self) -> ChunkCacheStats {
+        self.inner().stats
+    }
+
+    /// The chunk at `key`: held, or `read` and then held when it fits the budget (the least
+    /// recently used let go to make room).
+    pub(super) fn get_or_read(&self, key: ChunkKey, read: impl FnOnce() -> Result<Vec<f32>>) -> Result<Arc<[f32]>> {
+        {
+            let mut c = self.inner();
+            c.clock += 1;
+            let now = c.clock;
+            if let Some((values, used)) = c.chunks.get_mut(&key) {
+                *used = now;
+                let values = values.clone();
+                c.stats.hits += 1;
+                return Ok(values);
+            }
+        }
+        // Read with the lock let go: a read takes milliseconds, and fails without touching the map.
+        let values: Arc<[f32]> = read()?.into();
+        let bytes = values.len() as u64 * 4;
+        let mut c = self.inner();
+        c.stats.reads += 1;
+        if bytes > c.budget {
+            return Ok(values);
+        }
+        while c.stats.held_bytes + bytes > c.budget {
+            let Some(oldest) = c.chunks.iter().min_by_key(|(_, (_, used))| *used).map(|(k, _)| k.clone()) else {
+                break;
+            };
+            let (gone, _) = c.chunks.remove(&oldest).expect("found above");
+            c.stats.held_bytes -= gone.len() as u64 * 4;
+            c.stats.evicted += 1;
+        }
+        let now = c.clock;
+        if let Some((old, _)) = c.chunks.insert(key, (values.clone(), now)) {
+            // Another clone read the same chunk meanwhile: count it once.
+            c.stats.held_bytes -= old.len() as u64 * 4;
+        }
+        c.stats.held_bytes += bytes;
+        Ok(values)
+    }
+}
+
+/// Whether `camera` may see voxels `start..end` (x, y, z) of `grid` (a level's, centred) or the
+/// brick around them, whose gradients and levels of detail read them (`Camera::may_see_box`,
+/// `margin` pixels past the image's edges).
+pub(super) fn may_see_voxels(
+    camera: &crate::Camera,
+    margin: f32,
+    grid: &crate::Grid,
+    start: [u64; 3],
+    end: [u64; 3],
+) -> bool {
+    let pad = glam::Vec3::splat(crate::constants::BRICK_SIDE as f32);
+    let [lo, hi] = [start, end.map(|e| e - 1)].map(|c| glam::Vec3::from(c.map(|v| v as f32)));
+    let [lo, hi] = grid.world_box(lo - pad, hi + pad);
+    camera.may_see_box(lo, hi, margin)
+}
+
+/// A box of samples in array order (z, y, x): its first voxel and its shape.
+pub(super) type Block = ([u64; 3], [u64; 3]);
+
+/// The part `part` of `block` (its samples `values`, x fastest) copied into `out`, the samples of
+/// the box `to` (x fastest).
+pub(super) fn copy_part(out: &mut [f32], to: Block, block: Block, values: &[f32], part: Block) {
+    let ((os, on), (bs, bn), (ps, pn)) = (to, block, part);
+    let row = pn[2] as usize;
+    for z in ps[0]..ps[0] + pn[0] {
+        for y in ps[1]..ps[1] + pn[1] {
+            let at = (((z - os[0]) * on[1] + y - os[1]) * on[2] + ps[2] - os[2]) as usize;
+            let from = (((z - bs[0]) * bn[1] + y - bs[1]) * bn[2] + ps[2] - bs[2]) as usize;
+            out[at..at + row].copy_from_slice(&values[from..from + row]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(i: u64) -> ChunkKey {
+        ChunkKey { image: "a.zarr".into(), level: "0".into(), lead: vec![], chunk: vec![i, 0, 0] }
+    }
+
+    #[test]
+    fn the_least_recently_used_chunk_goes_first_and_a_chunk_past_the_budget_is_not_held() {
+        // Room for two chunks of 4 samples.
+        let cache = ChunkCache::new(32).unwrap();
+        let read = |v: f32| move || Ok(vec![v; 4]);
+        assert_eq!(cache.get_or_read(key(0), read(0.0)).unwrap()[0], 0.0);
+        assert_eq!(cache.get_or_read(key(1), read(1.0)).unwrap()[0], 1.0);
+        // Chunk 0 used again: chunk 1 is the older when chunk 2 comes.
+        let held = cache.get_or_read(key(0), || panic!("held")).unwrap();
+        assert_eq!(held[0], 0.0);
+        cache.get_or_read(key(2), read(2.0)).unwrap();
+        let s = cache.stats();
+        assert_eq!((s.reads, s.hits, s.evicted, s.held_bytes), (3, 1, 1, 32));
+        cache.get_or_read(key(0), || panic!("still held")).unwrap();
+        assert_eq!(cache.get_or_read(key(1), read(1.5)).unwrap()[0], 1.5, "chunk 1 was let go and read again");
+        // Nine samples are 36 bytes: read, handed back, not held.
+        let big = cache.get_or_read(key(3), || Ok(vec![3.0; 9])).unwrap();
+        assert_eq!(big.len(), 9);
+        let s = cache.stats();
+        assert_eq!((s.reads, s.hits, s.evicted, s.held_bytes), (5, 2, 2, 32));
+        // A failed read holds nothing.
+        let e = cache.get_or_read(key(4), || Err(crate::Error::InvalidArgument("broken".into())));
+        assert!(e.is_err());
+        assert_eq!(cache.stats().reads, 5);
+    }
+}
