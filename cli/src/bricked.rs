@@ -314,14 +314,39 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     ))
 }
 
-/// Orbit `path` (preset `tf`) in `steps` equal steps about its framing camera's up axis at the
+/// An orbit's path: `steps` equal steps over `degrees` about the framing camera's up axis.
+#[derive(Clone, Copy, Debug)]
+pub struct Arc {
+    /// Frames drawn, the first from the framing camera.
+    pub steps: u32,
+    /// Degrees turned over all of them (360: each step turns 360 / steps).
+    pub degrees: f32,
+}
+
+impl Arc {
+    /// The steps, when they and the degrees are in range.
+    fn check(&self) -> Result<u32> {
+        if !(1..=3600).contains(&self.steps) {
+            return Err(Error::InvalidArgument(format!("--orbit {}: between 1 and 3600 steps", self.steps)));
+        }
+        if !(self.degrees > 0.0 && self.degrees <= 360.0) {
+            return Err(Error::InvalidArgument(format!("--arc {}: above 0 and at most 360 degrees", self.degrees)));
+        }
+        Ok(self.steps)
+    }
+
+    /// The angle of step `i`, radians.
+    fn angle(&self, i: u32) -> f32 {
+        i as f32 * self.degrees.to_radians() / self.steps as f32
+    }
+}
+
+/// Orbit `path` (preset `tf`) along `arc` about its framing camera's up axis at the
 /// default settings within `budget_bytes`: per frame its time, splats, and the bytes of brick
 /// records it uploaded against those the record cache holds after it (a streamed store); then the
 /// largest fraction after the first frame. A markdown table on stdout.
-pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, steps: u32) -> Result<String> {
-    if !(1..=3600).contains(&steps) {
-        return Err(Error::InvalidArgument(format!("--orbit {steps}: between 1 and 3600 steps")));
-    }
+pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, arc: Arc) -> Result<String> {
+    let steps = arc.check()?;
     let tf = TransferFunction::preset(tf)?;
     let (mut r, cam) = framed(load(path, &tf)?.scene, size, budget_bytes)?;
     let opts = RenderOptions::default();
@@ -330,7 +355,7 @@ pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, steps: u32) ->
     );
     let mut worst = 0.0f64;
     for i in 0..steps {
-        let angle = i as f32 * std::f32::consts::TAU / steps as f32;
+        let angle = arc.angle(i);
         let mut c = cam;
         c.eye = cam.target + glam::Quat::from_axis_angle(cam.up.normalize(), angle) * (cam.eye - cam.target);
         let t = Instant::now();
@@ -426,7 +451,7 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     Ok(s)
 }
 
-/// Orbit the OME-Zarr image `path` in `steps` steps about its framing camera's up axis, the view
+/// Orbit the OME-Zarr image `path` along `arc` about its framing camera's up axis, the view
 /// narrowed to `fov` degrees so each sees part of the image: every frame's store is read for that
 /// view alone (`VolumeHints::crop` and `view`: the chunks it may see, at the finest level whose
 /// part fits the host budget), through one chunk cache of `cache_bytes` (0: none), then drawn at
@@ -437,14 +462,12 @@ pub fn zarr_orbit(
     size: u32,
     budget_bytes: u64,
     tf: &str,
-    steps: u32,
+    arc: Arc,
     fov: f32,
     cache_bytes: u64,
 ) -> Result<String> {
     use voxsplat::loaders::{ChunkCache, OmeZarr, VolumeHints, VIEW_MARGIN_PX};
-    if !(1..=3600).contains(&steps) {
-        return Err(Error::InvalidArgument(format!("--orbit {steps}: between 1 and 3600 steps")));
-    }
+    let steps = arc.check()?;
     if !(fov > 0.0 && fov < 180.0) {
         return Err(Error::InvalidArgument(format!("--fov {fov}: between 0 and 180 degrees")));
     }
@@ -464,8 +487,9 @@ pub fn zarr_orbit(
          |---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     let (mut read_total, mut loads, mut frames) = (0u64, Vec::new(), Vec::new());
+    let bar = indicatif::ProgressBar::new(steps as u64);
     for i in 0..steps {
-        let angle = i as f32 * std::f32::consts::TAU / steps as f32;
+        let angle = arc.angle(i);
         let mut c = cam;
         c.eye = cam.target + voxsplat::glam::Quat::from_axis_angle(cam.up.normalize(), angle) * (cam.eye - cam.target);
         let Some([lo, hi]) = c.box_in_view(-half, half, VIEW_MARGIN_PX) else {
@@ -500,7 +524,9 @@ pub fn zarr_orbit(
             angle.to_degrees(),
             st.splats
         );
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let held = cache.as_ref().map_or(0, |c| c.stats().held_bytes);
     out += &format!(
         "\n{read_total} chunks read in {steps} frames; median load {:.0} ms, median frame {:.0} ms; the chunk cache \

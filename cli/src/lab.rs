@@ -112,6 +112,9 @@ pub(crate) enum Study {
         /// budget keeps the records it used in a cache on the device).
         #[arg(long, requires = "volume")]
         orbit: Option<u32>,
+        /// With --orbit: the degrees the whole orbit turns (a viewer's drag turns a few).
+        #[arg(long, default_value_t = 360.0, requires = "orbit")]
+        arc: f32,
         /// With --orbit of an OME-Zarr image: the view's field of view in degrees. Each frame then
         /// reads its own part of the image (the chunks it may see, at the finest level that part
         /// fits the host budget at) through one chunk cache, and the table says what each read.
@@ -382,6 +385,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
             gpu_budget_mib,
             tf,
             orbit,
+            arc,
             fov,
             chunk_cache_mib,
             lod_chart,
@@ -392,6 +396,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
             }
             if let (Some(v), Some(steps)) = (&volume, orbit) {
                 let budget = mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?;
+                let arc = voxsplat_cli::bricked::Arc { steps, degrees: arc };
                 if let Some(fov) = fov {
                     if !voxsplat::loaders::is_ome_zarr(v) {
                         return Err(Error::InvalidArgument(format!(
@@ -403,10 +408,10 @@ pub(crate) fn run(study: Study) -> Result<()> {
                         0 => 0,
                         m => mib_bytes(m, "--chunk-cache-mib")?,
                     };
-                    print!("{}", voxsplat_cli::bricked::zarr_orbit(v, size, budget, &tf, steps, fov, cache)?);
+                    print!("{}", voxsplat_cli::bricked::zarr_orbit(v, size, budget, &tf, arc, fov, cache)?);
                     return Ok(());
                 }
-                print!("{}", voxsplat_cli::bricked::orbit(v, size, budget, &tf, steps)?);
+                print!("{}", voxsplat_cli::bricked::orbit(v, size, budget, &tf, arc)?);
                 return Ok(());
             }
             match volume {

@@ -4,7 +4,7 @@
 //! read and checked as JSON before zarrs opens it (a decoded chunk against `MAX_CHUNK_BYTES`, the
 //! level read against `MAX_STREAMED_VOXELS`, the pyramid's levels against each other), so nothing is sized by
 //! a header that has not been checked.
-use super::zarr_chunks::{copy_part, may_see_voxels};
+use super::zarr_chunks::{copy_part, may_see_voxels, ChunkKey, Samples};
 use super::{bad, MAX_STREAMED_VOXELS};
 use crate::error::{Error, Result};
 use serde_json::Value;
@@ -444,9 +444,8 @@ pub struct ZarrReader {
     seen: Option<(crate::Camera, f32)>,
     /// Decoded chunks kept between reads (`use_cache`).
     cache: Option<super::ChunkCache>,
-    /// The level's array path and the image's folder: the chunks' keys in the cache.
-    level_path: String,
-    dir: std::path::PathBuf,
+    /// Where this level's chunks are in the cache (`chunk` set per chunk).
+    key: ChunkKey,
     what: String,
 }
 
@@ -500,22 +499,9 @@ impl ZarrReader {
         }
         let chunk_z = l.chunk[n - 3].min(l.dims[2] as u64) as u32;
         let what = format!("{what} level {level} ({})", l.path);
-        let level_path = l.path.clone();
+        let key = ChunkKey { image: dir.into(), level: l.path.clone(), lead: lead.clone(), chunk: Vec::new() };
         let (dims, spacing, row, seen, cache) = (l.dims, l.spacing, None, None, None);
-        Ok(ZarrReader {
-            array,
-            kind,
-            dims,
-            spacing,
-            lead,
-            chunk_z,
-            row,
-            seen,
-            cache,
-            level_path,
-            dir: dir.into(),
-            what,
-        })
+        Ok(ZarrReader { array, kind, dims, spacing, lead, chunk_z, row, seen, cache, key, what })
     }
 
     /// Slices `z0..z0 + count` (x fastest) into `out`.
@@ -577,7 +563,7 @@ impl ZarrReader {
             if let Ok(Some(chunks)) = self.array.chunks_in_array_subset(&subset) {
                 CHUNKS_READ.fetch_add(chunks.num_elements(), std::sync::atomic::Ordering::Relaxed);
             }
-            return self.decoded(&subset, n, z0, count);
+            return Ok(self.decoded(&subset, n, z0, count)?.into_f32());
         }
         // Chunk by chunk: those the view cannot see read as NaN (empty to the store's passes).
         let mut out = vec![f32::NAN; n as usize];
@@ -609,12 +595,7 @@ impl ZarrReader {
                 Some(cache) if bytes <= MAX_CHUNK_BYTES => {
                     let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
                     ranges.extend((0..3).map(|a| block.0[a]..block.0[a] + block.1[a]));
-                    let key = super::zarr_chunks::ChunkKey {
-                        image: self.dir.clone(),
-                        level: self.level_path.clone(),
-                        lead: self.lead.clone(),
-                        chunk: idx.to_vec(),
-                    };
+                    let key = ChunkKey { chunk: idx.to_vec(), ..self.key.clone() };
                     let values = cache.get_or_read(key, || {
                         crate::error::check_host_memory(bytes, &format!("{}'s chunk", self.what))?;
                         CHUNKS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -633,34 +614,37 @@ impl ZarrReader {
         Ok(out)
     }
 
-    /// `subset` (`n` samples, of slices `z0..z0 + count` for messages) decoded, as f32, checked
-    /// finite.
-    fn decoded(&self, subset: &ArraySubset, n: u64, z0: u32, count: u32) -> Result<Vec<f32>> {
+    /// `subset` (`n` samples, of slices `z0..z0 + count` for messages) decoded: 8- and 16-bit
+    /// integers as stored, the others as f32, checked finite.
+    fn decoded(&self, subset: &ArraySubset, n: u64, z0: u32, count: u32) -> Result<Samples> {
         let err = |e: zarrs::array::ArrayError| match self.failing_chunk(subset) {
             Some((key, e)) => bad(&self.what, format!("chunk {key}: {e}")),
             None => bad(&self.what, format!("slices {z0}..{}: {e}", z0 + count)),
         };
         let a = &self.array;
-        let values: Vec<f32> = match self.kind {
-            Kind::U8 => a.retrieve_array_subset::<Vec<u8>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
-            Kind::I8 => a.retrieve_array_subset::<Vec<i8>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
-            Kind::U16 => a.retrieve_array_subset::<Vec<u16>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
-            Kind::I16 => a.retrieve_array_subset::<Vec<i16>>(subset).map_err(err)?.into_iter().map(f32::from).collect(),
+        let f32s = |v: Vec<f32>| -> Result<Samples> {
+            super::check_finite(&v, &self.what)?;
+            Ok(Samples::F32(v))
+        };
+        let values = match self.kind {
+            Kind::U8 => Samples::U8(a.retrieve_array_subset(subset).map_err(err)?),
+            Kind::I8 => Samples::I8(a.retrieve_array_subset(subset).map_err(err)?),
+            Kind::U16 => Samples::U16(a.retrieve_array_subset(subset).map_err(err)?),
+            Kind::I16 => Samples::I16(a.retrieve_array_subset(subset).map_err(err)?),
             Kind::U32 => {
-                a.retrieve_array_subset::<Vec<u32>>(subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+                f32s(a.retrieve_array_subset::<Vec<u32>>(subset).map_err(err)?.iter().map(|&v| v as f32).collect())?
             }
             Kind::I32 => {
-                a.retrieve_array_subset::<Vec<i32>>(subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+                f32s(a.retrieve_array_subset::<Vec<i32>>(subset).map_err(err)?.iter().map(|&v| v as f32).collect())?
             }
-            Kind::F32 => a.retrieve_array_subset::<Vec<f32>>(subset).map_err(err)?,
+            Kind::F32 => f32s(a.retrieve_array_subset(subset).map_err(err)?)?,
             Kind::F64 => {
-                a.retrieve_array_subset::<Vec<f64>>(subset).map_err(err)?.into_iter().map(|v| v as f32).collect()
+                f32s(a.retrieve_array_subset::<Vec<f64>>(subset).map_err(err)?.iter().map(|&v| v as f32).collect())?
             }
         };
         if values.len() as u64 != n {
             return Err(bad(&self.what, format!("slices {z0}..{}: {} samples for {n}", z0 + count, values.len())));
         }
-        super::check_finite(&values, &self.what)?;
         Ok(values)
     }
 

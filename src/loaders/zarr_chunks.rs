@@ -34,12 +34,12 @@ struct Inner {
     budget: u64,
     /// Uses so far: each held chunk keeps the count at its last use.
     clock: u64,
-    chunks: HashMap<ChunkKey, (Arc<[f32]>, u64)>,
+    chunks: HashMap<ChunkKey, (Arc<Samples>, u64)>,
     stats: ChunkCacheStats,
 }
 
-/// Decoded chunks of OME-Zarr images (as f32, the spatial part of one chunk at one time point and
-/// channel) held within a byte budget and shared by the reads given it
+/// Decoded chunks of OME-Zarr images (the spatial part of one chunk at one time point and channel;
+/// 8- and 16-bit integers held as stored, other samples as f32) held within a byte budget and shared by the reads given it
 /// (`VolumeHints::chunk_cache`). Clones share one cache. A chunk larger than the budget is read
 /// and not held.
 #[derive(Clone)]
@@ -82,7 +82,7 @@ impl ChunkCache {
 
     /// The chunk at `key`: held, or `read` and then held when it fits the budget (the least
     /// recently used let go to make room).
-    pub(super) fn get_or_read(&self, key: ChunkKey, read: impl FnOnce() -> Result<Vec<f32>>) -> Result<Arc<[f32]>> {
+    pub(super) fn get_or_read(&self, key: ChunkKey, read: impl FnOnce() -> Result<Samples>) -> Result<Arc<Samples>> {
         {
             let mut c = self.inner();
             c.clock += 1;
@@ -95,8 +95,8 @@ impl ChunkCache {
             }
         }
         // Read with the lock let go: a read takes milliseconds, and fails without touching the map.
-        let values: Arc<[f32]> = read()?.into();
-        let bytes = values.len() as u64 * 4;
+        let values = Arc::new(read()?);
+        let bytes = values.bytes();
         let mut c = self.inner();
         c.stats.reads += 1;
         if bytes > c.budget {
@@ -107,13 +107,13 @@ impl ChunkCache {
                 break;
             };
             let (gone, _) = c.chunks.remove(&oldest).expect("found above");
-            c.stats.held_bytes -= gone.len() as u64 * 4;
+            c.stats.held_bytes -= gone.bytes();
             c.stats.evicted += 1;
         }
         let now = c.clock;
         if let Some((old, _)) = c.chunks.insert(key, (values.clone(), now)) {
             // Another clone read the same chunk meanwhile: count it once.
-            c.stats.held_bytes -= old.len() as u64 * 4;
+            c.stats.held_bytes -= old.bytes();
         }
         c.stats.held_bytes += bytes;
         Ok(values)
@@ -136,19 +136,76 @@ pub(super) fn may_see_voxels(
     camera.may_see_box(lo, hi, margin)
 }
 
+/// A chunk's samples, decoded: 8- and 16-bit integers as the file stores them (a cache holds four
+/// or two times the chunks it would as f32), the others as f32.
+#[derive(Debug)]
+pub(super) enum Samples {
+    U8(Vec<u8>),
+    I8(Vec<i8>),
+    U16(Vec<u16>),
+    I16(Vec<i16>),
+    F32(Vec<f32>),
+}
+
+impl Samples {
+    pub fn len(&self) -> usize {
+        match self {
+            Samples::U8(v) => v.len(),
+            Samples::I8(v) => v.len(),
+            Samples::U16(v) => v.len(),
+            Samples::I16(v) => v.len(),
+            Samples::F32(v) => v.len(),
+        }
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> u64 {
+        let size = match self {
+            Samples::U8(_) | Samples::I8(_) => 1,
+            Samples::U16(_) | Samples::I16(_) => 2,
+            Samples::F32(_) => 4,
+        };
+        self.len() as u64 * size
+    }
+
+    /// Samples `from..from + out.len()` as f32 into `out`.
+    fn row_into(&self, from: usize, out: &mut [f32]) {
+        let n = out.len();
+        match self {
+            Samples::U8(v) => out.iter_mut().zip(&v[from..from + n]).for_each(|(o, &s)| *o = s.into()),
+            Samples::I8(v) => out.iter_mut().zip(&v[from..from + n]).for_each(|(o, &s)| *o = s.into()),
+            Samples::U16(v) => out.iter_mut().zip(&v[from..from + n]).for_each(|(o, &s)| *o = s.into()),
+            Samples::I16(v) => out.iter_mut().zip(&v[from..from + n]).for_each(|(o, &s)| *o = s.into()),
+            Samples::F32(v) => out.copy_from_slice(&v[from..from + n]),
+        }
+    }
+
+    /// All of them as f32.
+    pub fn into_f32(self) -> Vec<f32> {
+        match self {
+            Samples::F32(v) => v,
+            other => {
+                let mut out = vec![0.0; other.len()];
+                other.row_into(0, &mut out);
+                out
+            }
+        }
+    }
+}
+
 /// A box of samples in array order (z, y, x): its first voxel and its shape.
 pub(super) type Block = ([u64; 3], [u64; 3]);
 
 /// The part `part` of `block` (its samples `values`, x fastest) copied into `out`, the samples of
 /// the box `to` (x fastest).
-pub(super) fn copy_part(out: &mut [f32], to: Block, block: Block, values: &[f32], part: Block) {
+pub(super) fn copy_part(out: &mut [f32], to: Block, block: Block, values: &Samples, part: Block) {
     let ((os, on), (bs, bn), (ps, pn)) = (to, block, part);
     let row = pn[2] as usize;
     for z in ps[0]..ps[0] + pn[0] {
         for y in ps[1]..ps[1] + pn[1] {
             let at = (((z - os[0]) * on[1] + y - os[1]) * on[2] + ps[2] - os[2]) as usize;
             let from = (((z - bs[0]) * bn[1] + y - bs[1]) * bn[2] + ps[2] - bs[2]) as usize;
-            out[at..at + row].copy_from_slice(&values[from..from + row]);
+            values.row_into(from, &mut out[at..at + row]);
         }
     }
 }
@@ -165,19 +222,24 @@ mod tests {
     fn the_least_recently_used_chunk_goes_first_and_a_chunk_past_the_budget_is_not_held() {
         // Room for two chunks of 4 samples.
         let cache = ChunkCache::new(32).unwrap();
-        let read = |v: f32| move || Ok(vec![v; 4]);
-        assert_eq!(cache.get_or_read(key(0), read(0.0)).unwrap()[0], 0.0);
-        assert_eq!(cache.get_or_read(key(1), read(1.0)).unwrap()[0], 1.0);
+        let read = |v: f32| move || Ok(Samples::F32(vec![v; 4]));
+        let first = |s: Arc<Samples>| {
+            let mut v = [0.0];
+            s.row_into(0, &mut v);
+            v[0]
+        };
+        assert_eq!(first(cache.get_or_read(key(0), read(0.0)).unwrap()), 0.0);
+        assert_eq!(first(cache.get_or_read(key(1), read(1.0)).unwrap()), 1.0);
         // Chunk 0 used again: chunk 1 is the older when chunk 2 comes.
         let held = cache.get_or_read(key(0), || panic!("held")).unwrap();
-        assert_eq!(held[0], 0.0);
+        assert_eq!(first(held), 0.0);
         cache.get_or_read(key(2), read(2.0)).unwrap();
         let s = cache.stats();
         assert_eq!((s.reads, s.hits, s.evicted, s.held_bytes), (3, 1, 1, 32));
         cache.get_or_read(key(0), || panic!("still held")).unwrap();
-        assert_eq!(cache.get_or_read(key(1), read(1.5)).unwrap()[0], 1.5, "chunk 1 was let go and read again");
+        assert_eq!(first(cache.get_or_read(key(1), read(1.5)).unwrap()), 1.5, "chunk 1 was let go and read again");
         // Nine samples are 36 bytes: read, handed back, not held.
-        let big = cache.get_or_read(key(3), || Ok(vec![3.0; 9])).unwrap();
+        let big = cache.get_or_read(key(3), || Ok(Samples::F32(vec![3.0; 9]))).unwrap();
         assert_eq!(big.len(), 9);
         let s = cache.stats();
         assert_eq!((s.reads, s.hits, s.evicted, s.held_bytes), (5, 2, 2, 32));
@@ -185,5 +247,14 @@ mod tests {
         let e = cache.get_or_read(key(4), || Err(crate::Error::InvalidArgument("broken".into())));
         assert!(e.is_err());
         assert_eq!(cache.stats().reads, 5);
+        // 8-bit samples are held as stored: 32 of them fit where 8 f32 do, and read back as f32.
+        let cache = ChunkCache::new(32).unwrap();
+        let bytes = (0..32u8).collect::<Vec<_>>();
+        let held = cache.get_or_read(key(0), || Ok(Samples::U8(bytes))).unwrap();
+        assert_eq!(cache.stats().held_bytes, 32);
+        let mut row = [0.0; 3];
+        held.row_into(29, &mut row);
+        assert_eq!(row, [29.0, 30.0, 31.0]);
+        assert_eq!(Samples::I16(vec![-3, 7]).into_f32(), vec![-3.0, 7.0]);
     }
 }
