@@ -165,7 +165,8 @@ pub fn zarr_image(data: &[u8]) -> Option<std::path::PathBuf> {
 }
 
 /// OME-Zarr images (`zarr_image` unpacks them) through the streamed and the dense loaders, each
-/// level and channel, and a part of one read as `render --crop` and a narrow view read it.
+/// level and channel, and a part of one read as `render --crop` and a narrow view read it, with
+/// and without a chunk cache.
 pub fn zarr(data: &[u8]) {
     voxsplat::set_host_budget(Some(256 << 20));
     if let Some(dir) = zarr_image(data) {
@@ -181,10 +182,19 @@ pub fn zarr(data: &[u8]) {
                 projection: voxsplat::Projection::Perspective { fov_y_deg: 10.0 },
                 ..voxsplat::Camera::framing(&grid, 16, 16)
             };
-            for view in [None, Some(camera)] {
-                let crop = Some([[-2.0, -1.0, -3.0], [3.0, 2.0, 1.0]]);
-                let hints = voxsplat::loaders::VolumeHints { crop, view, ..Default::default() };
-                let _ = voxsplat::bricks::BrickStore::load(&dir, &hints);
+            // Without a chunk cache, then twice through one (the second finds the chunks held).
+            let cache = voxsplat::loaders::ChunkCache::new(1 << 20).ok();
+            for chunk_cache in [None, cache.clone(), cache] {
+                for view in [None, Some(camera)] {
+                    let crop = Some([[-2.0, -1.0, -3.0], [3.0, 2.0, 1.0]]);
+                    let hints = voxsplat::loaders::VolumeHints {
+                        crop,
+                        view,
+                        chunk_cache: chunk_cache.clone(),
+                        ..Default::default()
+                    };
+                    let _ = voxsplat::bricks::BrickStore::load(&dir, &hints);
+                }
             }
         }
     }
