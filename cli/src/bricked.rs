@@ -456,7 +456,8 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
 /// view alone (`VolumeHints::crop` and `view`: the chunks it may see, at the finest level whose
 /// part fits the host budget), through one chunk cache of `cache_bytes` (0: none), then drawn at
 /// the default settings within `budget_bytes`. Per frame the level, the chunks read from the file
-/// and those the cache held, the load and frame times; a markdown table on stdout.
+/// and those the cache held, the load time (the store read and handed to the renderer) and the
+/// frame time; a markdown table on stdout.
 pub fn zarr_orbit(
     path: &Path,
     size: u32,

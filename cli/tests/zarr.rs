@@ -491,7 +491,9 @@ fn a_moving_view_reads_through_a_chunk_cache(path: &Path) {
     let before = cache.stats();
     load(view(0.0), Some(&cache));
     assert_eq!(cache.stats().reads, before.reads);
-    // A cache of four chunks lets go of the oldest and still reads the same store.
+    // A cache smaller than a view's chunks (16 of level 0's 8-bit ones) still reads the same
+    // stores. (The next view, reading in the same order, lets go of the chunks it needs before
+    // it reaches them: a cache must hold a view's chunks to help it.)
     let small = ChunkCache::new(2 << 20).unwrap();
     for deg in [0.0, 10.0] {
         assert!(same(&load(view(deg), Some(&small)), &load(view(deg), None)), "{deg} degrees, a small cache");

@@ -659,6 +659,7 @@ impl ZarrReader {
     /// Read chunks through `cache`: those it holds are not read again, and those read are held
     /// there for later reads (of any level, view or reader).
     pub fn use_cache(&mut self, cache: super::ChunkCache) {
+        cache.begin_read();
         self.cache = Some(cache);
     }
 }

@@ -34,14 +34,21 @@ struct Inner {
     budget: u64,
     /// Uses so far: each held chunk keeps the count at its last use.
     clock: u64,
+    /// The clock when the latest read began (`begin_read`): chunks used since serve that read.
+    read_began: u64,
     chunks: HashMap<ChunkKey, (Arc<Samples>, u64)>,
     stats: ChunkCacheStats,
 }
 
 /// Decoded chunks of OME-Zarr images (the spatial part of one chunk at one time point and channel;
-/// 8- and 16-bit integers held as stored, other samples as f32) held within a byte budget and shared by the reads given it
-/// (`VolumeHints::chunk_cache`). Clones share one cache. A chunk larger than the budget is read
-/// and not held.
+/// 8- and 16-bit integers held as stored, other samples as f32) held within a byte budget and
+/// shared by the reads given it (`VolumeHints::chunk_cache`). Clones share one cache. A chunk
+/// larger than the budget is read and not held. Room is made by letting go of the least recently
+/// used chunk, but never of one the current read has used: a read of more than the budget keeps
+/// its first chunks, so that reading the same part again finds them (least recently used alone
+/// would let each go before the next read reached it). A read of another part, in the same
+/// order, still lets go of the chunks it needs before it reaches them: give the cache room for a
+/// view's chunks.
 #[derive(Clone)]
 pub struct ChunkCache(Arc<Mutex<Inner>>);
 
@@ -60,6 +67,8 @@ impl ChunkCache {
         Ok(ChunkCache(Arc::new(Mutex::new(Inner {
             budget: budget_bytes,
             clock: 0,
+            // No read begun: none kept from being let go.
+            read_began: u64::MAX,
             chunks: HashMap::new(),
             stats: ChunkCacheStats::default(),
         }))))
@@ -80,8 +89,15 @@ impl ChunkCache {
         self.inner().stats
     }
 
+    /// A new read begins (a reader of one level and part): the chunks it uses from now on are
+    /// not let go while it lasts.
+    pub(super) fn begin_read(&self) {
+        let mut c = self.inner();
+        c.read_began = c.clock + 1;
+    }
+
     /// The chunk at `key`: held, or `read` and then held when it fits the budget (the least
-    /// recently used let go to make room).
+    /// recently used let go to make room, unless the current read used it).
     pub(super) fn get_or_read(&self, key: ChunkKey, read: impl FnOnce() -> Result<Samples>) -> Result<Arc<Samples>> {
         {
             let mut c = self.inner();
@@ -103,9 +119,15 @@ impl ChunkCache {
             return Ok(values);
         }
         while c.stats.held_bytes + bytes > c.budget {
-            let Some(oldest) = c.chunks.iter().min_by_key(|(_, (_, used))| *used).map(|(k, _)| k.clone()) else {
+            let Some((oldest, used)) =
+                c.chunks.iter().min_by_key(|(_, (_, used))| *used).map(|(k, v)| (k.clone(), v.1))
+            else {
                 break;
             };
+            if used >= c.read_began {
+                // Every chunk held serves this read: the new one is not held.
+                return Ok(values);
+            }
             let (gone, _) = c.chunks.remove(&oldest).expect("found above");
             c.stats.held_bytes -= gone.bytes();
             c.stats.evicted += 1;
@@ -256,5 +278,26 @@ mod tests {
         held.row_into(29, &mut row);
         assert_eq!(row, [29.0, 30.0, 31.0]);
         assert_eq!(Samples::I16(vec![-3, 7]).into_f32(), vec![-3.0, 7.0]);
+    }
+
+    #[test]
+    fn a_read_larger_than_the_budget_keeps_its_first_chunks_for_the_next() {
+        // Room for two of the three chunks each read uses, in the same order each time.
+        let cache = ChunkCache::new(32).unwrap();
+        for _ in 0..3 {
+            cache.begin_read();
+            for i in 0..3 {
+                cache.get_or_read(key(i), || Ok(Samples::F32(vec![i as f32; 4]))).unwrap();
+            }
+        }
+        // Least recently used alone would let chunk 0 go for chunk 2, then 1 for 0, and so on:
+        // no read would find any held.
+        let s = cache.stats();
+        assert_eq!((s.reads, s.hits, s.evicted, s.held_bytes), (5, 4, 0, 32));
+        // A read of other chunks lets the earlier read's go.
+        cache.begin_read();
+        cache.get_or_read(key(7), || Ok(Samples::F32(vec![7.0; 4]))).unwrap();
+        assert_eq!(cache.stats().evicted, 1);
+        cache.get_or_read(key(7), || panic!("held")).unwrap();
     }
 }
