@@ -476,6 +476,9 @@ impl SliceReader {
             reader.only_in_view(camera, super::VIEW_MARGIN_PX);
         }
         let region = image.region(level, crop).ok_or_else(misses)?;
+        if let Source::Zarr(zarr) = &reader.source {
+            zarr.pin(region)?;
+        }
         Ok(Some((reader, region)))
     }
 

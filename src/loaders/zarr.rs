@@ -4,7 +4,7 @@
 //! read and checked as JSON before zarrs opens it (a decoded chunk against `MAX_CHUNK_BYTES`, the
 //! level read against `MAX_STREAMED_VOXELS`, the pyramid's levels against each other), so nothing is sized by
 //! a header that has not been checked.
-use super::zarr_chunks::{copy_part, may_see_voxels, ChunkKey, Samples};
+use super::zarr_chunks::{copy_part, may_see_block, spatial, ChunkKey, Samples};
 use super::{bad, MAX_STREAMED_VOXELS};
 use crate::error::{Error, Result};
 use serde_json::Value;
@@ -571,21 +571,13 @@ impl ZarrReader {
         let lead = self.lead.len();
         let grid = crate::Grid::centered(self.dims, self.spacing)?;
         let to = ([z0, y0, x0].map(u64::from), [count, y1 - y0, x1 - x0].map(u64::from));
-        let spatial = |s: &ArraySubset| -> ([u64; 3], [u64; 3]) {
-            let (start, shape) = (s.start(), s.shape());
-            ([0, 1, 2].map(|a| start[lead + a]), [0, 1, 2].map(|a| shape[lead + a]))
-        };
+        let spatial = |s: &ArraySubset| spatial(s, lead);
         for idx in chunks.iter().flat_map(|c| c.indices().into_iter()) {
             let part =
                 self.array.chunk_subset(&idx).and_then(|c| Ok(c.overlap(&subset)?)).map_err(|e| bad(&self.what, e))?;
             let (start, shape) = spatial(&part);
-            // Array order is z, y, x.
-            let xyz = [2, 1, 0].map(|a| start[a]);
-            let end = [2, 1, 0].map(|a| start[a] + shape[a]);
-            if let Some(seen) = &self.seen {
-                if !may_see_voxels(&seen.0, seen.1, &grid, xyz, end) {
-                    continue;
-                }
+            if !may_see_block(self.seen.as_ref(), &grid, (start, shape)) {
+                continue;
             }
             // The chunk's samples at this time point and channel, within the array.
             let whole = self.array.chunk_subset_bounded(&idx).map_err(|e| bad(&self.what, e))?;
@@ -659,8 +651,29 @@ impl ZarrReader {
     /// Read chunks through `cache`: those it holds are not read again, and those read are held
     /// there for later reads (of any level, view or reader).
     pub fn use_cache(&mut self, cache: super::ChunkCache) {
-        cache.begin_read();
+        cache.begin_read(Default::default());
         self.cache = Some(cache);
+    }
+
+    /// With a cache, a read of `region` (lo, hi; x, y, z) begins: the chunks it will use (those
+    /// the view may see) are not let go while it lasts, so that what it finds held stays held.
+    pub fn pin(&self, [lo, hi]: [[u32; 3]; 2]) -> Result<()> {
+        let Some(cache) = &self.cache else { return Ok(()) };
+        let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
+        ranges.extend([2, 1, 0].map(|a| lo[a] as u64..hi[a] as u64));
+        let region = ArraySubset::new_with_ranges(&ranges);
+        let chunks = self.array.chunks_in_array_subset(&region).map_err(|e| bad(&self.what, e))?;
+        let grid = crate::Grid::centered(self.dims, self.spacing)?;
+        let mut pinned = std::collections::HashSet::new();
+        for idx in chunks.iter().flat_map(|c| c.indices().into_iter()) {
+            let part =
+                self.array.chunk_subset(&idx).and_then(|c| Ok(c.overlap(&region)?)).map_err(|e| bad(&self.what, e))?;
+            if may_see_block(self.seen.as_ref(), &grid, spatial(&part, self.lead.len())) {
+                pinned.insert(ChunkKey { chunk: idx.to_vec(), ..self.key.clone() });
+            }
+        }
+        cache.begin_read(pinned);
+        Ok(())
     }
 }
 

@@ -3,7 +3,7 @@
 //! part of the image (`VolumeHints::crop` and `view`), reads from the file only the chunks it did
 //! not read before, while the cache holds them. Chunks are let go least recently used first.
 use crate::error::Result;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
@@ -36,6 +36,8 @@ struct Inner {
     clock: u64,
     /// The clock when the latest read began (`begin_read`): chunks used since serve that read.
     read_began: u64,
+    /// The chunks the latest read will use, when it said (`ZarrReader::pin`).
+    pinned: HashSet<ChunkKey>,
     chunks: HashMap<ChunkKey, (Arc<Samples>, u64)>,
     stats: ChunkCacheStats,
 }
@@ -44,11 +46,10 @@ struct Inner {
 /// 8- and 16-bit integers held as stored, other samples as f32) held within a byte budget and
 /// shared by the reads given it (`VolumeHints::chunk_cache`). Clones share one cache. A chunk
 /// larger than the budget is read and not held. Room is made by letting go of the least recently
-/// used chunk, but never of one the current read has used: a read of more than the budget keeps
-/// its first chunks, so that reading the same part again finds them (least recently used alone
-/// would let each go before the next read reached it). A read of another part, in the same
-/// order, still lets go of the chunks it needs before it reaches them: give the cache room for a
-/// view's chunks.
+/// used chunk, but never of one the current read has used or will use (`ZarrReader::pin`): a read
+/// of more than the budget keeps its first chunks, and a read of another part keeps those of its
+/// chunks that are held until it reaches them (least recently used alone would let each go
+/// before the next read, in the same order, reached it).
 #[derive(Clone)]
 pub struct ChunkCache(Arc<Mutex<Inner>>);
 
@@ -69,6 +70,7 @@ impl ChunkCache {
             clock: 0,
             // No read begun: none kept from being let go.
             read_began: u64::MAX,
+            pinned: HashSet::new(),
             chunks: HashMap::new(),
             stats: ChunkCacheStats::default(),
         }))))
@@ -89,15 +91,16 @@ impl ChunkCache {
         self.inner().stats
     }
 
-    /// A new read begins (a reader of one level and part): the chunks it uses from now on are
-    /// not let go while it lasts.
-    pub(super) fn begin_read(&self) {
+    /// A new read begins (a reader of one level and part): neither the chunks it uses from now
+    /// on nor those `pinned` (the chunks it will use, where known) are let go while it lasts.
+    pub(super) fn begin_read(&self, pinned: HashSet<ChunkKey>) {
         let mut c = self.inner();
         c.read_began = c.clock + 1;
+        c.pinned = pinned;
     }
 
     /// The chunk at `key`: held, or `read` and then held when it fits the budget (the least
-    /// recently used let go to make room, unless the current read used it).
+    /// recently used let go to make room, unless the current read used it or will).
     pub(super) fn get_or_read(&self, key: ChunkKey, read: impl FnOnce() -> Result<Samples>) -> Result<Arc<Samples>> {
         {
             let mut c = self.inner();
@@ -119,15 +122,12 @@ impl ChunkCache {
             return Ok(values);
         }
         while c.stats.held_bytes + bytes > c.budget {
-            let Some((oldest, used)) =
-                c.chunks.iter().min_by_key(|(_, (_, used))| *used).map(|(k, v)| (k.clone(), v.1))
-            else {
-                break;
-            };
-            if used >= c.read_began {
+            let began = c.read_began;
+            let free = c.chunks.iter().filter(|(k, (_, used))| *used < began && !c.pinned.contains(*k));
+            let Some(oldest) = free.min_by_key(|(_, (_, used))| *used).map(|(k, _)| k.clone()) else {
                 // Every chunk held serves this read: the new one is not held.
                 return Ok(values);
-            }
+            };
             let (gone, _) = c.chunks.remove(&oldest).expect("found above");
             c.stats.held_bytes -= gone.bytes();
             c.stats.evicted += 1;
@@ -156,6 +156,20 @@ pub(super) fn may_see_voxels(
     let [lo, hi] = [start, end.map(|e| e - 1)].map(|c| glam::Vec3::from(c.map(|v| v as f32)));
     let [lo, hi] = grid.world_box(lo - pad, hi + pad);
     camera.may_see_box(lo, hi, margin)
+}
+
+/// Where a subset of an array with `lead` axes before the spatial ones lies: its first voxel and
+/// shape along z, y, x.
+pub(super) fn spatial(s: &zarrs::array::ArraySubset, lead: usize) -> Block {
+    let (start, shape) = (s.start(), s.shape());
+    ([0, 1, 2].map(|a| start[lead + a]), [0, 1, 2].map(|a| shape[lead + a]))
+}
+
+/// Whether the view `seen` (camera and margin; `None`: every voxel) may see `block` of `grid`.
+pub(super) fn may_see_block(seen: Option<&(crate::Camera, f32)>, grid: &crate::Grid, (start, shape): Block) -> bool {
+    // Array order is z, y, x.
+    let (xyz, end) = ([2, 1, 0].map(|a| start[a]), [2, 1, 0].map(|a| start[a] + shape[a]));
+    seen.is_none_or(|(camera, margin)| may_see_voxels(camera, *margin, grid, xyz, end))
 }
 
 /// A chunk's samples, decoded: 8- and 16-bit integers as the file stores them (a cache holds four
@@ -285,7 +299,7 @@ mod tests {
         // Room for two of the three chunks each read uses, in the same order each time.
         let cache = ChunkCache::new(32).unwrap();
         for _ in 0..3 {
-            cache.begin_read();
+            cache.begin_read(HashSet::new());
             for i in 0..3 {
                 cache.get_or_read(key(i), || Ok(Samples::F32(vec![i as f32; 4]))).unwrap();
             }
@@ -294,10 +308,15 @@ mod tests {
         // no read would find any held.
         let s = cache.stats();
         assert_eq!((s.reads, s.hits, s.evicted, s.held_bytes), (5, 4, 0, 32));
-        // A read of other chunks lets the earlier read's go.
-        cache.begin_read();
-        cache.get_or_read(key(7), || Ok(Samples::F32(vec![7.0; 4]))).unwrap();
+        // A read that will use chunks 1 and 2 keeps them when chunk 5 comes: chunk 0 goes.
+        cache.begin_read([key(1), key(2)].into_iter().collect());
+        cache.get_or_read(key(5), || Ok(Samples::F32(vec![5.0; 4]))).unwrap();
+        cache.get_or_read(key(1), || panic!("kept")).unwrap();
         assert_eq!(cache.stats().evicted, 1);
+        // A read of other chunks lets the earlier read's go.
+        cache.begin_read(HashSet::new());
+        cache.get_or_read(key(7), || Ok(Samples::F32(vec![7.0; 4]))).unwrap();
+        assert_eq!(cache.stats().evicted, 2);
         cache.get_or_read(key(7), || panic!("held")).unwrap();
     }
 }
