@@ -339,6 +339,12 @@ impl Arc {
     fn angle(&self, i: u32) -> f32 {
         i as f32 * self.degrees.to_radians() / self.steps as f32
     }
+
+    /// `cam` turned to step `i` about its up axis through its target.
+    fn camera(&self, cam: &Camera, i: u32) -> Camera {
+        let turn = glam::Quat::from_axis_angle(cam.up.normalize(), self.angle(i));
+        Camera { eye: cam.target + turn * (cam.eye - cam.target), ..*cam }
+    }
 }
 
 /// Orbit `path` (preset `tf`) along `arc` about its framing camera's up axis at the
@@ -355,9 +361,7 @@ pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, arc: Arc) -> R
     );
     let mut worst = 0.0f64;
     for i in 0..steps {
-        let angle = arc.angle(i);
-        let mut c = cam;
-        c.eye = cam.target + glam::Quat::from_axis_angle(cam.up.normalize(), angle) * (cam.eye - cam.target);
+        let (angle, c) = (arc.angle(i), arc.camera(&cam, i));
         let t = Instant::now();
         let st = r.render(&c, &opts)?.stats;
         let (up, held) = (st.bytes_uploaded as f64, st.records_resident as f64);
@@ -490,9 +494,7 @@ pub fn zarr_orbit(
     let (mut read_total, mut loads, mut frames) = (0u64, Vec::new(), Vec::new());
     let bar = indicatif::ProgressBar::new(steps as u64);
     for i in 0..steps {
-        let angle = arc.angle(i);
-        let mut c = cam;
-        c.eye = cam.target + voxsplat::glam::Quat::from_axis_angle(cam.up.normalize(), angle) * (cam.eye - cam.target);
+        let (angle, c) = (arc.angle(i), arc.camera(&cam, i));
         let Some([lo, hi]) = c.box_in_view(-half, half, VIEW_MARGIN_PX) else {
             return Err(Error::InvalidArgument(format!("{}: the view at step {i} sees none of it", path.display())));
         };

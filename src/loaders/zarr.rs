@@ -550,15 +550,17 @@ impl ZarrReader {
         None
     }
 
+    /// The array's samples at this time point and channel over `zyx` (along z, y, x).
+    fn at_lead(&self, zyx: [std::ops::Range<u64>; 3]) -> ArraySubset {
+        let ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).chain(zyx).collect();
+        ArraySubset::new_with_ranges(&ranges)
+    }
+
     /// The part (x0, y0, x1, y1) of slices `z0..z0 + count` decoded, as f32, checked finite.
     fn samples(&self, z0: u32, count: u32, [x0, y0, x1, y1]: [u32; 4]) -> Result<Vec<f32>> {
-        let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
-        ranges.push(z0 as u64..(z0 + count) as u64);
-        ranges.push(y0 as u64..y1 as u64);
-        ranges.push(x0 as u64..x1 as u64);
-        let n = ranges.iter().map(|r| r.end - r.start).product::<u64>();
+        let subset = self.at_lead([z0..z0 + count, y0..y1, x0..x1].map(|r| r.start as u64..r.end as u64));
+        let n = subset.num_elements();
         crate::error::check_host_memory(n * (4 + self.kind.size()), &format!("{}'s slices", self.what))?;
-        let subset = ArraySubset::new_with_ranges(&ranges);
         if self.seen.is_none() && self.cache.is_none() {
             if let Ok(Some(chunks)) = self.array.chunks_in_array_subset(&subset) {
                 CHUNKS_READ.fetch_add(chunks.num_elements(), std::sync::atomic::Ordering::Relaxed);
@@ -585,13 +587,11 @@ impl ZarrReader {
             let bytes = block.1.iter().product::<u64>() * 4;
             match &self.cache {
                 Some(cache) if bytes <= MAX_CHUNK_BYTES => {
-                    let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
-                    ranges.extend((0..3).map(|a| block.0[a]..block.0[a] + block.1[a]));
+                    let whole = self.at_lead([0, 1, 2].map(|a| block.0[a]..block.0[a] + block.1[a]));
                     let key = ChunkKey { chunk: idx.to_vec(), ..self.key.clone() };
                     let values = cache.get_or_read(key, || {
                         crate::error::check_host_memory(bytes, &format!("{}'s chunk", self.what))?;
                         CHUNKS_READ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let whole = ArraySubset::new_with_ranges(&ranges);
                         self.decoded(&whole, whole.num_elements(), z0, count)
                     })?;
                     copy_part(&mut out, to, block, &values, (start, shape));
@@ -659,9 +659,7 @@ impl ZarrReader {
     /// the view may see) are not let go while it lasts, so that what it finds held stays held.
     pub fn pin(&self, [lo, hi]: [[u32; 3]; 2]) -> Result<()> {
         let Some(cache) = &self.cache else { return Ok(()) };
-        let mut ranges: Vec<std::ops::Range<u64>> = self.lead.iter().map(|&i| i..i + 1).collect();
-        ranges.extend([2, 1, 0].map(|a| lo[a] as u64..hi[a] as u64));
-        let region = ArraySubset::new_with_ranges(&ranges);
+        let region = self.at_lead([2, 1, 0].map(|a| lo[a] as u64..hi[a] as u64));
         let chunks = self.array.chunks_in_array_subset(&region).map_err(|e| bad(&self.what, e))?;
         let grid = crate::Grid::centered(self.dims, self.spacing)?;
         let mut pinned = std::collections::HashSet::new();
