@@ -448,7 +448,7 @@ pub fn slice_offsets(path: &Path, hints: &VolumeHints) -> Result<Option<Vec<f64>
     if !(dir && dicom::holds_dicom(path) || !path.is_dir() && is_dicom(path)) {
         return Ok(None);
     }
-    Ok(dicom::open(path, hints.series.as_deref(), true, hints.time)?.offsets)
+    Ok(dicom::open(path, hints.series.as_deref(), true, hints.time)?.offsets().map(<[f64]>::to_vec))
 }
 
 /// The voxel positions of a file whose slices are not evenly spaced (a DICOM series with uneven

@@ -635,9 +635,15 @@ fn refuse_volume_flags(a: &SceneArgs) -> Result<()> {
     }
 }
 
+/// Whether --volume's file places its voxels and classifies them itself: no --positions file
+/// places them, no --labels classify them.
+fn file_places(a: &SceneArgs) -> bool {
+    a.positions.is_none() && a.labels.is_none()
+}
+
 /// Whether --volume is a DICOM series drawn at its slices' own positions (`uneven::at_positions`).
 fn at_positions(a: &SceneArgs, path: &std::path::Path) -> Result<bool> {
-    Ok(a.positions.is_none() && a.labels.is_none() && crate::uneven::at_positions(path, &volume_hints_at(a, None)?)?)
+    Ok(file_places(a) && crate::uneven::at_positions(path, &volume_hints_at(a, None)?)?)
 }
 
 /// The scene `a` names: a --volume as a bricked store classified on the device unless
@@ -658,9 +664,7 @@ pub fn open(
     // An unevenly spaced DICOM series is resampled evenly (said here), or when its gaps are too far
     // apart, drawn as a rectilinear grid: host splats.
     let uneven = match &a.volume {
-        Some(path) if a.positions.is_none() && a.labels.is_none() => {
-            crate::uneven::report(path, &volume_hints_at(a, None)?)?
-        }
+        Some(path) if file_places(a) => crate::uneven::report(path, &volume_hints_at(a, None)?)?,
         _ => false,
     };
     let (bricked, orientation) = match (&a.volume, peer) {
@@ -668,8 +672,7 @@ pub fn open(
             if !host_splats
                 && !a.dense
                 && !uneven
-                && a.positions.is_none()
-                && a.labels.is_none()
+                && file_places(a)
                 && a.channels.is_empty()
                 && a.channel_tfs.is_empty() =>
         {

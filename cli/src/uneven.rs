@@ -4,21 +4,23 @@
 use voxsplat::loaders::{even_slices, file_positions, slice_offsets, VolumeHints};
 use voxsplat::Result;
 
-/// The series whose offsets were found last (path, --series, --time) and its offsets: a scene
-/// asks up to four times while it opens, and each scan reads every file of the folder.
-type Scanned = (std::path::PathBuf, Option<String>, Option<u32>, Option<Vec<f64>>);
-static LAST: std::sync::Mutex<Option<Scanned>> = std::sync::Mutex::new(None);
+/// The series whose offsets were found last (path, its modification time, --series, --time) and
+/// its offsets: a scene asks up to four times while it opens, and each scan reads every file of the
+/// folder. The time keeps a viewer that reopens a folder whose files changed from stale offsets.
+type Key = (std::path::PathBuf, Option<std::time::SystemTime>, Option<String>, Option<u32>);
+static LAST: std::sync::Mutex<Option<(Key, Option<Vec<f64>>)>> = std::sync::Mutex::new(None);
 
 /// The slices' positions of `path` when it is an unevenly spaced DICOM series (`hints` as the
 /// scene reads it), scanned once for the same series.
 fn offsets(path: &std::path::Path, hints: &VolumeHints) -> Result<Option<Vec<f64>>> {
-    let same = |s: &Scanned| s.0 == path && s.1 == hints.series && s.2 == hints.time;
+    let modified = std::fs::metadata(path).and_then(|m| m.modified()).ok();
+    let key = (path.to_path_buf(), modified, hints.series.clone(), hints.time);
     let mut last = LAST.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(s) = last.as_ref().filter(|s| same(s)) {
-        return Ok(s.3.clone());
+    if let Some((_, found)) = last.as_ref().filter(|(k, _)| *k == key) {
+        return Ok(found.clone());
     }
     let found = slice_offsets(path, &VolumeHints { rectilinear: true, ..hints.clone() })?;
-    *last = Some((path.to_path_buf(), hints.series.clone(), hints.time, found.clone()));
+    *last = Some((key, found.clone()));
     Ok(found)
 }
 

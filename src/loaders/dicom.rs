@@ -33,6 +33,7 @@ pub fn is_dicom(path: &Path) -> bool {
 
 mod jpegls;
 mod resample;
+use resample::Gaps;
 mod walk;
 pub use resample::even_slices;
 use walk::checked_bytes;
@@ -361,12 +362,8 @@ pub struct Series {
     /// Placement in patient space (RAS).
     pub orientation: crate::orient::Orientation,
     rescale: [f64; 2],
-    /// Unevenly spaced slices' positions along the normal, from the first (mm); `None` when the
-    /// gaps are even (the orientation's step places them) or the series is resampled.
-    pub offsets: Option<Vec<f64>>,
-    /// An unevenly spaced series resampled evenly: per slice, the image below it and the weight
-    /// of the one above (`resample::weights`).
-    resampled: Option<Vec<(u32, f32)>>,
+    /// How its slices are spaced.
+    gaps: Gaps,
     /// The last image a resampled read decoded, and its index: the next read of the slices
     /// after it starts from it.
     kept: Option<(u32, Vec<f32>)>,
@@ -473,8 +470,7 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     }
     let mean = steps.iter().sum::<f64>() / steps.len().max(1) as f64;
     let n = images.len();
-    let mut offsets = None;
-    let mut resampled = None;
+    let mut gaps = Gaps::Even;
     let mut slices = n;
     if let Some(k) = steps.iter().position(|d| (d - mean).abs() > 0.01 * mean) {
         let gap = format!(
@@ -490,7 +486,7 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
         }
         let at: Vec<f64> = images.iter().map(|i| (i.position - images[0].position).dot(normal)).collect();
         if rectilinear {
-            offsets = Some(at);
+            gaps = Gaps::At(at);
         } else {
             let m = resample::even_slices(&at).ok_or_else(|| {
                 bad(
@@ -502,7 +498,7 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
                     ),
                 )
             })?;
-            resampled = Some(resample::weights(&at, m));
+            gaps = Gaps::Resampled(resample::weights(&at, m));
             slices = m as usize;
         }
     }
@@ -523,13 +519,22 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let affine = DMat4::from_diagonal(DVec4::new(-1.0, -1.0, 1.0, 1.0)) * lps;
     let dims = [first.size[0], first.size[1], slices as u32];
     let orientation = crate::orient::Orientation::from_affine(affine, dims).map_err(|e| bad(what, e))?;
-    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, offsets, resampled, kept: None })
+    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, gaps, kept: None })
 }
 
 impl Series {
+    /// Unevenly spaced slices' positions along the normal, from the first (mm), when they are
+    /// read as they lie; `None` when the gaps are even or the series is resampled.
+    pub fn offsets(&self) -> Option<&[f64]> {
+        match &self.gaps {
+            Gaps::At(at) => Some(at),
+            _ => None,
+        }
+    }
+
     /// Slice `z`'s rescaled values, x fastest.
     pub fn slice(&mut self, z: u32) -> Result<Vec<f32>> {
-        if self.resampled.is_some() {
+        if matches!(self.gaps, Gaps::Resampled(_)) {
             return Ok(self.slices(z, 1)?.swap_remove(0));
         }
         self.image(z)
@@ -555,7 +560,7 @@ impl Series {
     /// two per thread at a time within `PARALLEL_BYTES` (a compressed series' decoding is most of
     /// its reading).
     pub fn slices(&mut self, z0: u32, count: u32) -> Result<Vec<Vec<f32>>> {
-        let Some(weights) = &self.resampled else { return self.images_at(z0, count) };
+        let Gaps::Resampled(weights) = &self.gaps else { return self.images_at(z0, count) };
         let Some(picked) = weights.get(z0 as usize..z0 as usize + count as usize).map(<[_]>::to_vec) else {
             return Err(bad(&self.images[0].path.display().to_string(), format!("no slices {z0}..{z0}+{count}")));
         };

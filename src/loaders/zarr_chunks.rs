@@ -49,7 +49,9 @@ struct Inner {
 /// used chunk, but never of one the current read has used or will use (`ZarrReader::pin`): a read
 /// of more than the budget keeps its first chunks, and a read of another part keeps those of its
 /// chunks that are held until it reaches them (least recently used alone would let each go
-/// before the next read, in the same order, reached it).
+/// before the next read, in the same order, reached it). Reads on several threads may share one
+/// cache and each gets the right samples, but the pins are those of the read that began last: a
+/// concurrent read's chunks may be let go and read again.
 #[derive(Clone)]
 pub struct ChunkCache(Arc<Mutex<Inner>>);
 

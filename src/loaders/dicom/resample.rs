@@ -37,6 +37,17 @@ pub fn weights(offsets: &[f64], m: u32) -> Vec<(u32, f32)> {
         .collect()
 }
 
+/// How a series' slices are spaced.
+pub(super) enum Gaps {
+    /// Evenly: the orientation's step places them.
+    Even,
+    /// Unevenly, read as the images lie: their positions along the normal, from the first (mm).
+    At(Vec<f64>),
+    /// Unevenly, resampled evenly: per slice, the image below it and the weight of the one above
+    /// (`weights`).
+    Resampled(Vec<(u32, f32)>),
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
