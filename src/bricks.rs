@@ -19,9 +19,11 @@ use bytemuck::{Pod, Zeroable};
 
 mod build;
 mod gradients;
+mod histogram;
 mod series;
 pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
 pub use gradients::{pack_differences, unpack_differences};
+pub use histogram::{Histogram, MAX_BINS};
 pub use series::Patch;
 
 /// Voxels along each side of a brick.

@@ -391,3 +391,66 @@ fn a_stream_that_fits_is_read_once() {
     assert_eq!((streamed.range, &streamed.headers, &streamed.records), (whole.range, &whole.headers, &whole.records));
     assert_eq!(streamed.masks, whole.masks);
 }
+
+/// The histogram a transfer-function editor draws over (issue 48 item 2): on the bonsai, a uint8
+/// volume, each bin holds exactly the voxels whose file value lies in it, counted from the volume
+/// itself; uniform bricks count every voxel; the empty voxels are counted apart; the log heights
+/// run from 0 to 1; a bin count outside 1 to `MAX_BINS` is refused.
+#[test]
+fn the_histogram_counts_each_stored_voxel_in_the_bin_of_its_file_value() {
+    let data = voxsplat::loaders::data_dir();
+    let vol = voxsplat::loaders::load_volume(&data.join("bonsai/bonsai.nii.gz"), &Default::default()).unwrap();
+    let store = BrickStore::build(&vol).unwrap();
+    let (lo, hi) = store.range;
+    assert!(vol.values.iter().all(|v| v.fract() == 0.0) && hi > lo, "integer samples");
+    let span = (hi - lo) as u64;
+    for bins in [1, 7, 16, 64, span as u32] {
+        let h = store.histogram(bins).unwrap();
+        let mut want = vec![0u64; bins as usize];
+        let mut empty = 0;
+        for &v in &vol.values {
+            if v <= lo {
+                empty += 1;
+                continue;
+            }
+            // ⌊(v − lo) / (hi − lo) × bins⌋ in integers, the last bin closed.
+            let at = (((v - lo) as u64 * bins as u64) / span).min(bins as u64 - 1);
+            want[at as usize] += 1;
+        }
+        assert_eq!(h.counts, want, "{bins} bins");
+        assert_eq!(h.empty, empty, "{bins} bins: the empty voxels");
+        assert_eq!(h.counts.iter().sum::<u64>(), store.len() as u64);
+        assert_eq!((h.edge(0), h.edge(bins as usize)), (lo, hi));
+        let heights = h.log_heights();
+        let top = h.counts.iter().position(|&c| c == *h.counts.iter().max().unwrap()).unwrap();
+        assert_eq!(heights[top], 1.0);
+        for (c, y) in h.counts.iter().zip(&heights) {
+            assert!((*c == 0) == (*y == 0.0) && (0.0..=1.0).contains(y), "{bins} bins: {c} voxels drawn {y} high");
+        }
+    }
+
+    // A span that does not divide the 65,535 quanta: 125 of 0..200 is stored just under its edge
+    // (40,959 of 40,959.375), and still binned as its value.
+    let values: Vec<f32> = (0..24 * 24 * 24).map(|i| (i % 201) as f32).collect();
+    let vol = ScalarVolume { dims: [24, 24, 24], spacing: [1.0; 3], values };
+    let h = BrickStore::build(&vol).unwrap().histogram(8).unwrap();
+    let mut want = vec![0u64; 8];
+    for &v in vol.values.iter().filter(|&&v| v > 0.0) {
+        want[((v as usize * 8) / 200).min(7)] += 1;
+    }
+    assert_eq!(h.counts, want, "values 0 to 200 in 8 bins");
+
+    let vol = common::flat_blocks([37, 29, 40]);
+    let store = BrickStore::build(&vol).unwrap();
+    assert!(store.headers.iter().any(|h| h.is_uniform()));
+    let h = store.histogram(8).unwrap();
+    // The flat block (50 of 0..~90) is the fullest bin, uniform bricks and all.
+    let block = vol.values.iter().filter(|&&v| v == 50.0).count() as u64;
+    let at = ((50.0 - store.range.0) / (store.range.1 - store.range.0) * 8.0) as usize;
+    assert!(h.counts[at] >= block, "{} in the block's bin, {block} in the block", h.counts[at]);
+    assert_eq!(h.counts.iter().sum::<u64>() + h.empty, vol.values.len() as u64);
+    for bins in [0, voxsplat::bricks::MAX_BINS + 1] {
+        let e = store.histogram(bins).unwrap_err().to_string();
+        assert!(e.contains("1 to 65536 bins"), "{e}");
+    }
+}

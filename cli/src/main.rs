@@ -100,6 +100,11 @@ enum Command {
         /// several).
         #[arg(long)]
         time: Option<u32>,
+        /// Also print how the volume's values are spread, in this many equal bins over its value
+        /// range (bars on a log scale; its empty voxels counted apart): where to put a transfer
+        /// function's ramps.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=voxsplat::bricks::MAX_BINS as i64))]
+        histogram: Option<u32>,
     },
     /// Render an animation (built-in name or TOML file) to numbered frames and an animated GIF.
     Animate(Box<AnimateArgs>),
@@ -219,6 +224,21 @@ fn print_ome_zarr(image: &voxsplat::loaders::OmeZarr) {
     }
 }
 
+/// `store`'s histogram in `bins` bins (`info --histogram`), one line a bin: its values, its voxels and
+/// a bar as long as its log height.
+fn print_histogram(store: &voxsplat::bricks::BrickStore, bins: u32) -> Result<()> {
+    let h = store.histogram(bins)?;
+    println!(
+        "histogram: {bins} bins of the stored values {} .. {}, bars on a log scale ({} voxels empty, not counted)",
+        h.range.0, h.range.1, h.empty
+    );
+    for (i, (count, height)) in h.counts.iter().zip(h.log_heights()).enumerate() {
+        let bar = "#".repeat((height * 40.0).round() as usize);
+        println!("{:>12} .. {:<12} {count:>12} {bar}", h.edge(i), h.edge(i + 1));
+    }
+    Ok(())
+}
+
 fn print_store(store: &voxsplat::bricks::BrickStore) {
     let per_voxel = |bytes: u64| bytes as f64 / store.len().max(1) as f64;
     let pyramid = voxsplat::low_level::plan::pyramid_bytes(voxsplat::low_level::plan::LOD_BUFFERS, store.headers.len());
@@ -287,7 +307,7 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
-        Command::Info { file, dims, dtype, tf, vscale, cell, series, level, time } => {
+        Command::Info { file, dims, dtype, tf, vscale, cell, series, level, time, histogram } => {
             if voxsplat::loaders::is_ome_zarr(&file) {
                 let image = voxsplat::loaders::OmeZarr::open(&file)?;
                 print_ome_zarr(&image);
@@ -317,9 +337,9 @@ fn run(cli: Cli) -> Result<()> {
             let heights = (name.ends_with(".tif") || name.ends_with(".tiff") || name.ends_with(".png"))
                 && !voxsplat::loaders::is_stack(&file)?
                 || (name.ends_with(".npy") && voxsplat::loaders::npy_shape(&file)?.len() == 2);
-            if heights && (dims.is_some() || dtype.is_some() || tf != "ramp") {
+            if heights && (dims.is_some() || dtype.is_some() || tf != "ramp" || histogram.is_some()) {
                 return Err(Error::InvalidArgument(
-                    "--dims, --dtype and --tf describe volumes, not height grids".into(),
+                    "--dims, --dtype, --tf and --histogram describe volumes, not height grids".into(),
                 ));
             }
             if !heights && (vscale != 1.0 || cell != 0.0) {
@@ -383,6 +403,7 @@ fn run(cli: Cli) -> Result<()> {
                             store.dims, store.spacing, store.range.0, store.range.1
                         );
                         print_store(&store);
+                        histogram.map(|bins| print_histogram(&store, bins)).transpose()?;
                         println!(
                             "splats: not counted (more than the dense loader's {} voxels): rendered bricked",
                             voxsplat::loaders::MAX_VOXELS
@@ -394,7 +415,9 @@ fn run(cli: Cli) -> Result<()> {
                 let (lo, hi) =
                     v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
                 println!("volume: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
-                print_store(&voxsplat::bricks::BrickStore::build(&v)?);
+                let store = voxsplat::bricks::BrickStore::build(&v)?;
+                print_store(&store);
+                histogram.map(|bins| print_histogram(&store, bins)).transpose()?;
                 voxsplat::classify::classify(&v, &tf, None)?
             };
             println!("splats: {}", set.len());

@@ -350,6 +350,24 @@ fn info_counts_splats_and_names_the_gpu_limit() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("splats: 184675") && !text.contains("over the GPU path"), "{text}");
+    // --histogram: its bins hold every stored voxel, the empty ones counted apart, over the range.
+    let out = voxsplat(&["info", stent, "--histogram", "5"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let number = |line: &str, after: &str| -> u64 {
+        line.split(after).nth(1).and_then(|t| t.split_whitespace().next()).and_then(|n| n.parse().ok()).unwrap()
+    };
+    let stored = text.lines().find(|l| l.starts_with("bricked store: ")).map(|l| number(l, "store: ")).unwrap();
+    let head = text.lines().position(|l| l.starts_with("histogram: 5 bins")).expect(&text);
+    let bins: Vec<u64> =
+        text.lines().skip(head + 1).take(5).map(|l| l.split_whitespace().nth(3).unwrap().parse().unwrap()).collect();
+    assert_eq!(bins.iter().sum::<u64>(), stored, "{text}");
+    let empty = number(text.lines().nth(head).unwrap(), "(");
+    assert_eq!(stored + empty, 128 * 128 * 256, "the stent's voxels: {text}");
+    for bad in ["0", "65537"] {
+        let out = voxsplat(&["info", stent, "--histogram", bad]);
+        assert_eq!(out.status.code(), Some(2), "--histogram {bad}");
+    }
     // A 150^3 block of full-scale voxels but one at zero, so the ramp spans 0..255 (an .npy written
     // here): 3 374 999 splats.
     let n = 150u64;

@@ -56,6 +56,7 @@ fn flags_that_would_be_ignored_are_refused() {
     fails_with(&["render", "--terrain", &dem, "--spacing", "1,1,2", "--out", out], "--volume");
     fails_with(&["render", "--raycast", "0.5", "--repeat", "3", "--out", out], "cannot be used with");
     fails_with(&["info", &stent, "--vscale", "2"], "describe height grids");
+    fails_with(&["info", &data("rmnp/rmnp-dem.tif"), "--histogram", "8"], "describe volumes");
 }
 
 #[test]
