@@ -96,16 +96,20 @@ impl BrickStore {
     /// or gzip), NIfTI and raw files stream slice by slice (gzip inflated as it is read), never
     /// held whole (volumes past the dense loader's `MAX_VOXELS` too); an `.npy` is loaded, cut
     /// and dropped. With `hints.crop`, an OME-Zarr image reads only the region it needs
-    /// (`VolumeHints::crop`).
+    /// (`VolumeHints::crop`). A streamed file reports its slices read to `hints.progress`.
     #[cfg(feature = "io")]
     pub fn load(path: &std::path::Path, hints: &crate::loaders::VolumeHints) -> Result<Self> {
+        let progress = hints.progress.as_ref().map(|p| p.as_fn());
         if let Some((reader, region)) = crate::loaders::SliceReader::part(path, hints)? {
-            return Self::load_cropped(reader, region);
+            return Self::load_cropped(reader, region, progress);
         }
         let mut store = match crate::loaders::SliceReader::open(path, hints)? {
             Some(mut reader) => {
                 let (dims, spacing) = (reader.dims, reader.spacing);
-                Self::from_slices(dims, spacing, |z0, count, out| reader.read(z0, count, out))?
+                let all = [[0; 3], dims];
+                Self::from_slices_over(dims, spacing, all, f32::INFINITY, true, progress, |z0, count, out| {
+                    reader.read(z0, count, out)
+                })?
             }
             None => Self::build(&crate::loaders::load_volume(path, hints)?)?,
         };

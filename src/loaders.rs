@@ -15,6 +15,7 @@ mod nifti1;
 mod npy;
 mod nrrd;
 mod positions;
+mod progress;
 mod pyramid;
 mod sequence;
 mod slices;
@@ -31,6 +32,7 @@ pub use npy::{npy_from_bytes, npy_shape};
 pub use nrrd::nrrd_channels_from_bytes;
 use nrrd::{nrrd_header, nrrd_samples};
 pub use positions::{load_positions, positions_from_text, MAX_POSITIONS_BYTES};
+pub use progress::Progress;
 pub use pyramid::{LEVEL_PIXELS, VIEW_MARGIN_PX};
 pub use sequence::{files as series_files, is_pattern};
 pub use slices::{value_range, SliceReader, MAX_STREAMED_VOXELS};
@@ -439,6 +441,8 @@ pub struct VolumeHints {
     /// OME-Zarr chunks are read through this cache: those it holds are not read from the file
     /// again, and those read are held for later loads given the same cache.
     pub chunk_cache: Option<ChunkCache>,
+    /// Told how far `BrickStore::load` has read a file it streams, for a progress bar.
+    pub progress: Option<Progress>,
 }
 
 /// The positions of an unevenly spaced DICOM series' slices along their normal, from the first

@@ -454,3 +454,23 @@ fn the_histogram_counts_each_stored_voxel_in_the_bin_of_its_file_value() {
         assert!(e.contains("1 to 65536 bins"), "{e}");
     }
 }
+
+/// `VolumeHints::progress` follows a streamed load (issue 48 item 5's progress bar): after each
+/// slab, the slices read of all it reads, rising to all of them, and the store is the one loaded
+/// without it.
+#[test]
+fn a_streamed_load_tells_its_progress() {
+    let path = voxsplat::loaders::data_dir().join("bonsai/bonsai.nii.gz");
+    let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let log = seen.clone();
+    let progress = voxsplat::loaders::Progress::new(move |read, of| log.lock().unwrap().push((read, of)));
+    let hints = voxsplat::loaders::VolumeHints { progress: Some(progress), ..Default::default() };
+    let store = BrickStore::load(&path, &hints).unwrap();
+    let seen = seen.lock().unwrap().clone();
+    // The bonsai's 256 slices fit the kept samples: one pass over the file, 32 slabs.
+    assert_eq!(seen.len(), 32, "{seen:?}");
+    assert!(seen.windows(2).all(|w| w[0].0 < w[1].0 && w[0].1 == w[1].1), "{seen:?}");
+    assert_eq!(seen.last(), Some(&(256, 256)));
+    let plain = BrickStore::load(&path, &Default::default()).unwrap();
+    assert_eq!((store.records, store.headers), (plain.records, plain.headers));
+}

@@ -11,6 +11,7 @@ pub mod motion_orders;
 pub mod open;
 pub mod parse;
 pub mod peer;
+pub mod progress;
 pub mod pyramid;
 pub mod rates;
 pub mod series;

@@ -330,7 +330,7 @@ fn volume_hints_at(a: &SceneArgs, level: Option<u32>) -> Result<voxsplat::loader
         rectilinear: false,
         crop: a.crop,
         view: a.view_read,
-        chunk_cache: None,
+        ..Default::default()
     })
 }
 
@@ -385,7 +385,12 @@ pub fn load_bricked(
         )));
     }
     let chunks = voxsplat::loaders::zarr_chunks_read();
-    let mut store = voxsplat::bricks::BrickStore::load(path, &hints)?;
+    let (bar, progress) = crate::progress::load_bar(path);
+    let mut store = voxsplat::bricks::BrickStore::load(
+        path,
+        &voxsplat::loaders::VolumeHints { progress: Some(progress), ..hints },
+    )?;
+    bar.finish_and_clear();
     if voxsplat::loaders::is_ome_zarr(path) {
         // The value range's pass (the bricks' takes what it kept, when that fits); before it, what
         // choosing the level read.

@@ -61,7 +61,7 @@ impl BrickStore {
     pub(super) fn build_over(vol: &ScalarVolume, background: f32) -> Result<Self> {
         let plane = vol.dims[0] as usize * vol.dims[1] as usize;
         // The volume is in memory: nothing to keep between the passes.
-        Self::from_slices_over(vol.dims, vol.spacing, [[0; 3], vol.dims], background, false, |z0, count, out| {
+        Self::from_slices_over(vol.dims, vol.spacing, [[0; 3], vol.dims], background, false, None, |z0, count, out| {
             out.clear();
             out.extend_from_slice(&vol.values[z0 as usize * plane..(z0 + count) as usize * plane]);
             Ok(())
@@ -78,7 +78,7 @@ impl BrickStore {
         spacing: [f32; 3],
         read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
-        Self::from_slices_over(dims, spacing, [[0; 3], dims], f32::INFINITY, true, read)
+        Self::from_slices_over(dims, spacing, [[0; 3], dims], f32::INFINITY, true, None, read)
     }
 
     /// `from_slices` over the voxels in `region` only (`lo..hi`): `read` puts the region's part
@@ -91,17 +91,20 @@ impl BrickStore {
         region: [[u32; 3]; 2],
         read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
-        Self::from_slices_over(dims, spacing, region, f32::INFINITY, true, read)
+        Self::from_slices_over(dims, spacing, region, f32::INFINITY, true, None, read)
     }
 
     /// `from_region_slices`, with the empty value at most `background` (a volume with no empty
-    /// voxel keeps its minimum); `may_keep`: whether the samples may be kept between the passes.
-    fn from_slices_over(
+    /// voxel keeps its minimum); `may_keep`: whether the samples may be kept between the passes;
+    /// `progress(read, of)` after each read: slices read so far and slices it reads in all (the
+    /// region's twice when the second pass reads them again).
+    pub(super) fn from_slices_over(
         dims: [u32; 3],
         spacing: [f32; 3],
         region: [[u32; 3]; 2],
         background: f32,
         may_keep: bool,
+        progress: Option<&dyn Fn(u64, u64)>,
         mut read: impl FnMut(u32, u32, &mut Vec<f32>) -> Result<()>,
     ) -> Result<Self> {
         check_dims(dims)?;
@@ -122,11 +125,19 @@ impl BrickStore {
             && crate::error::host_budget().is_none_or(|b| bytes <= b / 4)
             && crate::error::check_host_memory(2 * bytes, "").is_ok();
         let mut kept = Vec::new();
+        let slices = (r1[2] - r0[2]) as u64;
+        let of = if keep { slices } else { 2 * slices };
+        let report = |read: u64| {
+            if let Some(p) = progress {
+                p(read, of)
+            }
+        };
         // The slabs `from_region` reads: a brick's slices within the region.
         let mut z0 = r0[2];
         while z0 < r1[2] {
             let z1 = ((z0 / BRICK + 1) * BRICK).min(r1[2]);
             read(z0, z1 - z0, &mut slab)?;
+            report((z1 - r0[2]) as u64);
             for &v in slab.iter().filter(|v| v.is_finite()) {
                 (lo, hi) = (lo.min(v), hi.max(v));
             }
@@ -137,7 +148,11 @@ impl BrickStore {
         }
         let range = store_range(lo.min(background), hi);
         if !keep {
-            return Self::from_region(dims, spacing, range, region, read);
+            return Self::from_region(dims, spacing, range, region, |z0, count, out| {
+                read(z0, count, out)?;
+                report(slices + (z0 + count - r0[2]) as u64);
+                Ok(())
+            });
         }
         Self::from_region(dims, spacing, range, region, |z0, count, out| {
             let at = (z0 - r0[2]) as usize * plane..(z0 - r0[2] + count) as usize * plane;
@@ -151,8 +166,13 @@ impl BrickStore {
     /// An OME-Zarr image's store of what `hints.crop` needs (`SliceReader::part`), normalised by
     /// the part's own range.
     #[cfg(feature = "io")]
-    pub(super) fn load_cropped(mut reader: crate::loaders::SliceReader, region: [[u32; 3]; 2]) -> Result<Self> {
-        Self::from_region_slices(reader.dims, reader.spacing, region, |z0, count, out| {
+    pub(super) fn load_cropped(
+        mut reader: crate::loaders::SliceReader,
+        region: [[u32; 3]; 2],
+        progress: Option<&dyn Fn(u64, u64)>,
+    ) -> Result<Self> {
+        let (dims, spacing) = (reader.dims, reader.spacing);
+        Self::from_slices_over(dims, spacing, region, f32::INFINITY, true, progress, |z0, count, out| {
             reader.read_region(z0, count, region, out)
         })
     }
@@ -294,4 +314,46 @@ fn check_dims(dims: [u32; 3]) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A load tells its progress after each slab: rising to all of it, the file counted twice when
+    /// the second pass reads it again, and the same store either way.
+    #[test]
+    fn progress_rises_to_the_slices_read_in_all() {
+        let dims = [9, 7, 21];
+        let value = |i: usize| ((i * 37) % 11) as f32;
+        let plane = (dims[0] * dims[1]) as usize;
+        let mut stores = Vec::new();
+        for keep in [true, false] {
+            let seen = std::cell::RefCell::new(Vec::new());
+            let report = |read: u64, of: u64| seen.borrow_mut().push((read, of));
+            let store = BrickStore::from_slices_over(
+                dims,
+                [1.0; 3],
+                [[0; 3], dims],
+                f32::INFINITY,
+                keep,
+                Some(&report),
+                |z0, n, out| {
+                    *out = (z0 as usize * plane..(z0 + n) as usize * plane).map(value).collect();
+                    Ok(())
+                },
+            )
+            .unwrap();
+            let seen = seen.into_inner();
+            let of = if keep { 21 } else { 42 };
+            assert!(seen.iter().all(|&(_, o)| o == of), "keep {keep}: {seen:?}");
+            assert!(seen.windows(2).all(|w| w[0].0 < w[1].0), "keep {keep}: rising {seen:?}");
+            assert_eq!(seen.last(), Some(&(of, of)), "keep {keep}");
+            // Slabs of a brick's slices: 8, 16, 21 for each pass.
+            assert_eq!(seen.len(), if keep { 3 } else { 6 }, "keep {keep}: {seen:?}");
+            stores.push(store);
+        }
+        assert_eq!(stores[0].records, stores[1].records);
+        assert_eq!(stores[0].headers, stores[1].headers);
+    }
 }
