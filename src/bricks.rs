@@ -20,10 +20,12 @@ use bytemuck::{Pod, Zeroable};
 mod build;
 mod gradients;
 mod histogram;
+mod planes;
 mod series;
 pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
 pub use gradients::{pack_differences, unpack_differences};
 pub use histogram::{Histogram, MAX_BINS};
+pub use planes::Plane;
 pub use series::Patch;
 
 /// Voxels along each side of a brick.

@@ -474,3 +474,35 @@ fn a_streamed_load_tells_its_progress() {
     let plain = BrickStore::load(&path, &Default::default()).unwrap();
     assert_eq!((store.records, store.headers), (plain.records, plain.headers));
 }
+
+/// A plane through the store (issue 48 item 4's slice panes) reads the file's values back, to
+/// half a quantum, along each axis; empty voxels read as the range's start, the value they had;
+/// planes outside the grid are refused.
+#[test]
+fn a_plane_through_the_store_reads_the_files_values() {
+    let path = voxsplat::loaders::data_dir().join("stent/stent.nrrd");
+    let vol = voxsplat::loaders::load_volume(&path, &Default::default()).unwrap();
+    let store = BrickStore::build(&vol).unwrap();
+    let [nx, ny, nz] = vol.dims;
+    let at = |i: u32, j: u32, k: u32| vol.values[(i + nx * (j + ny * k)) as usize];
+    let tolerance = (store.range.1 - store.range.0) / 65535.0 * 0.5 + 1e-3;
+    for (axis, index) in [(0, 40), (1, 77), (2, 130), (2, 0), (0, nx - 1)] {
+        let p = store.plane(axis, index).unwrap();
+        let (w, h) = [(ny, nz), (nx, nz), (nx, ny)][axis];
+        assert_eq!((p.width, p.height, p.values.len()), (w, h, (w * h) as usize), "axis {axis}");
+        for row in 0..h {
+            for col in 0..w {
+                let want = match axis {
+                    0 => at(index, col, row),
+                    1 => at(col, index, row),
+                    _ => at(col, row, index),
+                };
+                let got = p.values[(row * w + col) as usize];
+                assert!((got - want).abs() <= tolerance, "axis {axis} plane {index} ({col}, {row}): {got} for {want}");
+            }
+        }
+    }
+    for (axis, index) in [(0, nx), (2, nz), (3, 0)] {
+        assert!(store.plane(axis, index).unwrap_err().to_string().contains("no plane"), "axis {axis}, {index}");
+    }
+}

@@ -40,6 +40,7 @@ fn stdout_or_exit(written: std::io::Result<()>) {
 mod lab;
 mod pick;
 mod render;
+mod slice;
 use render::RenderArgs;
 
 #[derive(Parser)]
@@ -67,6 +68,9 @@ enum Command {
     /// Print what one pixel of a view shows: the point along its ray where the volume turns
     /// opaque (or, with --mode mip, the point of the largest value), its voxel, value and depth.
     Pick(Box<pick::PickArgs>),
+    /// Write one plane of a volume's voxels as a grey PNG (an axial, coronal or sagittal view of
+    /// the data), windowed.
+    Slice(Box<slice::SliceArgs>),
     /// Write or check a visibility order (back to front).
     Order(Box<OrderArgs>),
     /// Describe a volume or height file: dims, spacing, value range, splats at the default
@@ -266,6 +270,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Render(a) => render::render(a),
         Command::Pick(a) => pick::pick(*a),
+        Command::Slice(a) => slice::slice(*a),
         Command::Animate(a) => animate(a),
         Command::MakeVolume { from, factor, procedural, phantom, out } => {
             // It writes NRRD (raw data, attached): a name that says otherwise would mislead.

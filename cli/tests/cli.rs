@@ -342,6 +342,53 @@ fn peer_subcommand_times_every_mode() {
     }
 }
 
+/// `voxsplat slice` writes a plane of the file's voxels, windowed, as grey: each pixel is the
+/// file's value there (to a quantum of the store, at most one grey step), row 0 at the top; a
+/// plane or window that cannot apply and an output that is not PNG are refused.
+#[test]
+fn slice_writes_a_plane_of_the_files_values() {
+    let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/stent/stent.nrrd");
+    let vol = voxsplat::loaders::load_volume(std::path::Path::new(stent), &Default::default()).unwrap();
+    let [nx, ny, _] = vol.dims;
+    let png = tmp("slice-x.png");
+    let out = voxsplat(&[
+        "slice",
+        stent,
+        "--axis",
+        "x",
+        "--index",
+        "50",
+        "--window",
+        "100,900",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&png).unwrap().to_luma8();
+    assert_eq!(img.dimensions(), (ny, vol.dims[2]));
+    let mut lit = 0;
+    for (col, row, p) in img.enumerate_pixels() {
+        let v = vol.values[(50 + nx * (col + ny * row)) as usize];
+        let want = ((v - 100.0) / 800.0 * 255.0).round().clamp(0.0, 255.0);
+        assert!((p[0] as f32 - want).abs() <= 1.0, "({col}, {row}): {} for {want}", p[0]);
+        lit += usize::from(p[0] > 0);
+    }
+    assert!(lit > 100, "the plane cuts the stent ({lit} pixels lit)");
+    // The middle z plane by default, over the value range.
+    let out = voxsplat(&["slice", stent, "--out", png.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("plane z = 128 of the [128, 128, 256] grid"));
+    for (args, says) in [
+        (&["--index", "256"][..], "the z axis has 256 voxels (0 to 255)"),
+        (&["--window", "5,5"][..], "HI must exceed LO"),
+    ] {
+        let out = voxsplat(&[&["slice", stent, "--out", png.to_str().unwrap()][..], args].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
+    }
+    let out = voxsplat(&["slice", stent, "--out", tmp("slice.jpg").to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("slice writes PNG"));
+}
+
 /// `voxsplat info` counts a file's splats and says when they pass the GPU path's limit.
 #[test]
 fn info_counts_splats_and_names_the_gpu_limit() {
