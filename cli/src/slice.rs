@@ -12,7 +12,8 @@ pub(crate) struct SliceArgs {
     /// The plane's voxel index along --axis, from 0 [default: the middle].
     #[arg(long)]
     index: Option<u32>,
-    /// The values drawn black and white, LO,HI in the file's units [default: its value range].
+    /// The values drawn black and white, LO,HI in the file's units [default: the plane's own
+    /// smallest and largest].
     #[arg(long, value_parser = parse_floats::<2>, allow_hyphen_values = true)]
     window: Option<[f32; 2]>,
     /// A folder of several DICOM series: the one to cut (its number or UID in `info`'s list).
@@ -42,27 +43,13 @@ pub(crate) fn slice(a: SliceArgs) -> Result<()> {
         "y" => 1,
         _ => 2,
     };
-    let (bar, progress) = voxsplat_cli::progress::load_bar(&a.file);
-    let hints = voxsplat::loaders::VolumeHints {
-        series: a.series,
-        time: a.time,
-        level: a.level,
-        progress: Some(progress),
-        ..Default::default()
-    };
-    let store = voxsplat::bricks::BrickStore::load(&a.file, &hints)?;
-    bar.finish_and_clear();
-    let index = a.index.unwrap_or(store.dims[axis] / 2);
-    if index >= store.dims[axis] {
-        return Err(Error::InvalidArgument(format!(
-            "--index {index}: the {} axis has {} voxels (0 to {})",
-            a.axis,
-            store.dims[axis],
-            store.dims[axis] - 1
-        )));
-    }
-    let plane = store.plane(axis, index)?;
-    let [lo, hi] = a.window.unwrap_or([store.range.0, store.range.1]);
+    let hints = voxsplat::loaders::VolumeHints { series: a.series, time: a.time, level: a.level, ..Default::default() };
+    let (dims, plane) = read_plane(&a.file, &hints, axis, a.index, &a.axis)?;
+    let index = a.index.unwrap_or(dims[axis] / 2);
+    let [lo, hi] = a.window.unwrap_or_else(|| {
+        let finite = plane.values.iter().filter(|v| v.is_finite());
+        finite.fold([f32::INFINITY, f32::NEG_INFINITY], |[l, h], &v| [l.min(v), h.max(v)])
+    });
     let span = if hi > lo { hi - lo } else { 1.0 };
     let grey: Vec<u8> =
         plane.values.iter().map(|&v| ((v - lo) / span * 255.0).round().clamp(0.0, 255.0) as u8).collect();
@@ -71,10 +58,71 @@ pub(crate) fn slice(a: SliceArgs) -> Result<()> {
     println!(
         "plane {} = {index} of the {:?} grid, {} x {} voxels, values {lo} .. {hi} drawn black to white -> {}",
         a.axis,
-        store.dims,
+        dims,
         plane.width,
         plane.height,
         a.out.display()
     );
     Ok(())
+}
+
+/// The grid's dims and the plane `index` (the middle by default) across `axis` (`name`) of the
+/// file's values as stored: a z plane reads its one slice, an x or y plane a row of each slice,
+/// slab by slab with a progress bar; a file that does not stream (`.npy`) is loaded whole.
+fn read_plane(
+    path: &std::path::Path,
+    hints: &voxsplat::loaders::VolumeHints,
+    axis: usize,
+    index: Option<u32>,
+    name: &str,
+) -> Result<([u32; 3], voxsplat::bricks::Plane)> {
+    let whole = match voxsplat::loaders::SliceReader::open(path, hints)? {
+        Some(reader) => Err(reader),
+        None => Ok(voxsplat::loaders::load_volume(path, hints)?),
+    };
+    let dims = match &whole {
+        Ok(v) => v.dims,
+        Err(r) => r.dims,
+    };
+    let index = index.unwrap_or(dims[axis] / 2);
+    if index >= dims[axis] {
+        return Err(Error::InvalidArgument(format!(
+            "--index {index}: the {name} axis has {} voxels (0 to {})",
+            dims[axis],
+            dims[axis] - 1
+        )));
+    }
+    let [nx, ny, nz] = dims;
+    let plane = (nx * ny) as usize;
+    // Slice z's part of the plane: all of it across z, row y = index across y, column x = index across x.
+    let take = |slice: &[f32], out: &mut Vec<f32>| match axis {
+        2 => out.extend_from_slice(slice),
+        1 => out.extend_from_slice(&slice[(index * nx) as usize..((index + 1) * nx) as usize]),
+        _ => out.extend((0..ny).map(|y| slice[(index + y * nx) as usize])),
+    };
+    let mut values = Vec::new();
+    match whole {
+        Ok(v) if axis == 2 => take(&v.values[index as usize * plane..(index as usize + 1) * plane], &mut values),
+        Ok(v) => v.values.chunks(plane).for_each(|s| take(s, &mut values)),
+        Err(mut reader) if axis == 2 => {
+            let mut slab = Vec::new();
+            reader.read(index, 1, &mut slab)?;
+            take(&slab, &mut values);
+        }
+        Err(mut reader) => {
+            let (bar, _) = voxsplat_cli::progress::load_bar(path);
+            bar.set_length(u64::from(nz));
+            let mut slab = Vec::new();
+            let step = voxsplat::bricks::BRICK;
+            for z0 in (0..nz).step_by(step as usize) {
+                let count = step.min(nz - z0);
+                reader.read(z0, count, &mut slab)?;
+                slab.chunks(plane).for_each(|s| take(s, &mut values));
+                bar.set_position(u64::from(z0 + count));
+            }
+            bar.finish_and_clear();
+        }
+    }
+    let (width, height) = [(ny, nz), (nx, nz), (nx, ny)][axis];
+    Ok((dims, voxsplat::bricks::Plane { width, height, values }))
 }
