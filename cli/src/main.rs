@@ -396,13 +396,14 @@ fn run(cli: Cli) -> Result<()> {
                     None => println!("orientation: none (no anatomical frame: --view framing)"),
                 }
                 // Past the dense loader (a file read slice by slice, of more than MAX_VOXELS): the store only.
-                if let Some(mut reader) = voxsplat::loaders::SliceReader::open(&file, &hints)? {
+                if let Some(reader) = voxsplat::loaders::SliceReader::open(&file, &hints)? {
                     let voxels: u64 = reader.dims.iter().map(|&d| d as u64).product();
                     if voxels > voxsplat::loaders::MAX_VOXELS {
-                        let (dims, spacing) = (reader.dims, reader.spacing);
-                        let store = voxsplat::bricks::BrickStore::from_slices(dims, spacing, |z0, count, out| {
-                            reader.read(z0, count, out)
-                        })?;
+                        drop(reader);
+                        let (bar, progress) = voxsplat_cli::progress::load_bar(&file);
+                        let hints = voxsplat::loaders::VolumeHints { progress: Some(progress), ..hints };
+                        let store = voxsplat::bricks::BrickStore::load(&file, &hints)?;
+                        bar.finish_and_clear();
                         println!(
                             "volume: {:?} voxels, spacing {:?}, values {} .. {}",
                             store.dims, store.spacing, store.range.0, store.range.1

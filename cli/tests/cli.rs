@@ -386,6 +386,37 @@ fn slice_writes_a_plane_of_the_files_values() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("slice writes PNG"));
 }
 
+/// `voxsplat info` on a file past the dense loader (272 M voxels, streamed into the store, with
+/// the progress bar's hook): the store, the histogram and no splat count.
+#[test]
+fn info_streams_a_file_past_the_dense_loader() {
+    let (nx, ny, nz) = (1024usize, 512usize, 520usize);
+    let mut bytes =
+        format!("NRRD0004\ntype: uint8\ndimension: 3\nsizes: {nx} {ny} {nz}\nencoding: raw\n\n").into_bytes();
+    let head = bytes.len();
+    bytes.resize(head + nx * ny * nz, 0);
+    // One 16³ block at 9, one voxel at 200.
+    for z in 100..116 {
+        for y in 40..56 {
+            let at = head + (z * ny + y) * nx + 300;
+            bytes[at..at + 16].fill(9);
+        }
+    }
+    bytes[head + (7 * ny + 3) * nx + 5] = 200;
+    let path = tmp("big.nrrd");
+    std::fs::write(&path, &bytes).unwrap();
+    drop(bytes);
+    let out = voxsplat(&["info", path.to_str().unwrap(), "--histogram", "2"]);
+    let _ = std::fs::remove_file(&path);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("volume: [1024, 512, 520] voxels, spacing [1.0, 1.0, 1.0], values 0 .. 200"), "{text}");
+    assert!(text.contains("bricked store: 4097 stored voxels"), "{text}");
+    let bins: Vec<&str> = text.lines().skip_while(|l| !l.starts_with("histogram: 2 bins")).skip(1).take(2).collect();
+    assert!(bins[0].contains(" 4096 ") && bins[1].contains(" 1 "), "{text}");
+    assert!(text.contains("splats: not counted"), "{text}");
+}
+
 /// `voxsplat info` counts a file's splats and says when they pass the GPU path's limit.
 #[test]
 fn info_counts_splats_and_names_the_gpu_limit() {
