@@ -68,8 +68,8 @@ enum Command {
     /// Print what one pixel of a view shows: the point along its ray where the volume turns
     /// opaque (or, with --mode mip, the point of the largest value), its voxel, value and depth.
     Pick(Box<pick::PickArgs>),
-    /// Write one plane of a volume's voxels as a grey PNG (an axial, coronal or sagittal view of
-    /// the data), windowed.
+    /// Write one plane of a volume's voxels, across x, y or z of its grid as the file stores it,
+    /// as a grey PNG, windowed.
     Slice(Box<slice::SliceArgs>),
     /// Write or check a visibility order (back to front).
     Order(Box<OrderArgs>),

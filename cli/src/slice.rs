@@ -1,12 +1,13 @@
-//! `voxsplat slice`: one plane of a volume's voxels as a grey PNG, windowed (the axial, coronal
-//! and sagittal views of the data that a viewer shows beside the frame).
+//! `voxsplat slice`: one plane of a volume's voxels as a grey PNG, windowed (the views of the data
+//! that a viewer shows beside the frame).
 use super::*;
 
 #[derive(Args)]
 pub(crate) struct SliceArgs {
     /// The volume file (any that `render --volume` reads).
     file: PathBuf,
-    /// The axis the plane cuts across: z (rows along y), y (rows along z) or x (rows along z).
+    /// The grid axis the plane cuts across, as the file stores it: z (the image's x across, y
+    /// down), y (x across, z down) or x (y across, z down).
     #[arg(long, default_value = "z", value_parser = ["x", "y", "z"])]
     axis: String,
     /// The plane's voxel index along --axis, from 0 [default: the middle].
