@@ -11,8 +11,9 @@
 //! value down or up, b the bounding box and a slice plane drawn through the volume by depth (the
 //! host's own geometry: `viewer_mesh.rs`), 9 0 the slice plane down or up, t T the next or the
 //! previous time point of a series (a 4-D NIfTI or an OME-Zarr image with a time axis, opened
-//! without --time: `Renderer::update_volume` swaps each in), s save
-//! `viewer-tf.toml` and print the matching `render` command, q or Esc quit. The title shows the frame time and the modes. While a button is held, frames are drawn at
+//! without --time: `Renderer::update_volume` swaps each in), s save `viewer-tf.toml` and, for a
+//! volume, `viewer-session.toml` (the camera, transfer function, shading, mode and options) and
+//! print the `render` command that draws the frame again, q or Esc quit. The title shows the frame time and the modes. While a button is held, frames are drawn at
 //! `--interactive-scale` (0.5 by default) and stretched on the device; full size when let go.
 //!
 //! Headless runs (CI, under Xvfb): `--frames N` draws N frames of a scripted orbit ending at the
@@ -66,6 +67,10 @@ struct Args {
     /// Save the transfer function in use at exit (TOML, for `voxsplat render --tf`).
     #[arg(long)]
     save_tf: Option<PathBuf>,
+    /// Save the session at exit: the last frame's camera, the transfer function, shading, mode
+    /// and options, which `voxsplat render --volume FILE --session S --size WxH` draws again.
+    #[arg(long)]
+    save_session: Option<PathBuf>,
     /// The window's background, R,G,B[,A].
     #[arg(long, value_parser = parse_background, default_value = "0,0,0")]
     background: [f32; 4],
@@ -574,7 +579,40 @@ impl Viewer {
             p.1[3] = (p.1[3] * opacity).clamp(0.0, 1.0);
         }
         tf.validate()?;
-        renderer.set_transfer_function(tf, None)
+        // The volume keeps the shading it was opened with.
+        let shading = renderer.volume().and_then(|v| v.shading());
+        renderer.set_transfer_function(tf, shading)
+    }
+
+    /// The session of the last frame drawn (`--save-session`): what `render --session` needs to
+    /// draw it again. A clip plane and the host's mesh are not part of a session: refused.
+    fn session(&self) -> Result<voxsplat_cli::session::Session> {
+        if self.clip_offset.is_some() || self.mesh {
+            return Err(Error::InvalidArgument(
+                "--save-session: a session holds no clip plane or host mesh; turn them off (p, b) first".into(),
+            ));
+        }
+        let (Some(cam), Some(volume)) = (self.camera(), self.renderer.as_ref().and_then(|r| r.volume())) else {
+            return Err(Error::InvalidArgument("--save-session needs a bricked --volume, drawn".into()));
+        };
+        let o = &self.options;
+        let lod = match o.lod {
+            Lod::Off => "off",
+            _ => "auto",
+        };
+        Ok(voxsplat_cli::session::Session {
+            mode: o.mode.to_string(),
+            iso: o.iso,
+            order: ORDERS[self.indices[0]].into(),
+            composite: COMPOSITES[self.indices[1]].into(),
+            raster: RASTERS[self.indices[2]].into(),
+            lod: lod.into(),
+            kernel: self.args.kernel.clone(),
+            background: o.background.unwrap_or([0.0; 4]),
+            camera: voxsplat_cli::session::Session::view_of(&cam),
+            light: voxsplat_cli::session::Session::light_of(volume.shading()),
+            tf: volume.transfer_function().clone(),
+        })
     }
 
     fn camera(&self) -> Option<Camera> {
@@ -825,6 +863,18 @@ impl Viewer {
             std::fs::write("viewer-tf.toml", tf.to_toml()?)
                 .map_err(|e| Error::Io { path: "viewer-tf.toml".into(), source: e })?;
         }
+        // A bricked volume: the session, which draws this frame again.
+        if let (Ok(session), Some(volume), Some(cam)) = (self.session(), &self.args.scene.volume, self.camera()) {
+            session.save(std::path::Path::new("viewer-session.toml"))?;
+            println!(
+                "voxsplat render --volume {} --session viewer-session.toml --size {}x{}",
+                volume.display(),
+                cam.width,
+                cam.height
+            );
+            self.message = "saved viewer-session.toml and viewer-tf.toml".into();
+            return Ok(());
+        }
         if let Some(cam) = self.camera() {
             let v = |p: Vec3| format!("{},{},{}", p.x, p.y, p.z);
             println!(
@@ -989,6 +1039,9 @@ fn run(args: Args) -> Result<()> {
     }
     if let (Some(path), Some(tf)) = (save_tf, &viewer.tf) {
         std::fs::write(&path, tf.to_toml()?).map_err(|e| Error::Io { path: path.display().to_string(), source: e })?;
+    }
+    if let Some(path) = &viewer.args.save_session {
+        viewer.session()?.save(path)?;
     }
     let mut times = viewer.times.clone();
     if !times.is_empty() {

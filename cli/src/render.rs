@@ -135,6 +135,12 @@ pub(crate) struct RenderArgs {
     /// volume's memory split and levels of detail) instead of rendering it.
     #[arg(long, conflicts_with_all = ["raycast", "truth", "out", "k_line", "repeat", "timings"])]
     plan: bool,
+    /// Draw a session the viewer saved (its camera, transfer function, shading, mode and the
+    /// options its keys change) of the same --volume, at --size.
+    #[arg(long, requires = "volume", conflicts_with_all = ["eye", "target", "up", "fov", "ortho", "near", "far",
+        "view", "tf", "shade", "no_shade", "mode", "iso", "order", "composite", "raster", "lod", "kernel",
+        "background"])]
+    session: Option<PathBuf>,
     /// Output file, .png or .exr.
     #[arg(long, required_unless_present = "plan")]
     out: Option<PathBuf>,
@@ -142,6 +148,17 @@ pub(crate) struct RenderArgs {
 
 /// Runs `voxsplat render`.
 pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
+    if let Some(path) = &a.session {
+        let s = voxsplat_cli::session::Session::load(path)?;
+        (a.mode, a.composite, a.raster, a.kernel) =
+            (s.mode.clone(), s.composite.clone(), s.raster.clone(), s.kernel.clone());
+        a.background = Some(s.background);
+        // A projection draws in no order and without levels of detail, whatever the viewer had set.
+        if s.mode == "composite" {
+            (a.scene.order, a.lod) = (s.order.clone(), Some(s.lod.clone()));
+        }
+        a.scene.session = Some(s);
+    }
     a.scene.crop = a.crop.map(|c| [[c[0], c[1], c[2]], [c[3], c[4], c[5]]]);
     // One frame: an OME-Zarr image need be read only where it is seen.
     if let Some(path) = a.scene.volume.clone().filter(|p| a.crop.is_none() && voxsplat::loaders::is_ome_zarr(p)) {
@@ -180,7 +197,8 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
                 .into(),
         ));
     }
-    match (mode, a.iso) {
+    let session_iso = a.scene.session.as_ref().and_then(|s| s.iso);
+    match (mode, a.iso.or(session_iso)) {
         (voxsplat::Mode::Iso, None) => {
             return Err(Error::InvalidArgument("--mode iso needs the surface's value: --iso VALUE".into()))
         }
@@ -246,7 +264,10 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     let (bricked, set, content) = open(&a.scene, host_splats)?;
     // --iso in the file's units: the bricked store's normalisation (its values' range).
     let iso_range = bricked.as_ref().map(|b| b.store.range);
-    opts.iso = normalised_iso(bricked.as_ref(), &a.scene, a.iso)?;
+    opts.iso = match session_iso {
+        Some(v) => Some(v),
+        None => normalised_iso(bricked.as_ref(), &a.scene, a.iso)?,
+    };
     let asked =
         if a.lod_nodes { Some("--lod-nodes") } else { a.lod.as_deref().filter(|l| *l == "auto").map(|_| "--lod auto") };
     if let Some(flag) = asked.filter(|_| bricked.is_none() || composite != Composite::Splat) {

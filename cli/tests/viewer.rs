@@ -117,6 +117,52 @@ fn the_viewers_mesh_and_the_volume_intermix_by_depth() {
     assert_eq!(worst, 0, "beside the mesh the frame is the frame without it");
 }
 
+/// A session the viewer saves (issue 48 item 6) draws the same frame with `render --session`: the
+/// shaded bonsai seen from another eye, its transfer function edited (which keeps the shading) and
+/// its mode switched to MIP by key; within one 8-bit step. `--session` takes the place of the flags
+/// it holds (given with them, refused), needs the --volume, and a file that is not one is refused.
+#[test]
+fn a_saved_session_draws_again_with_render() {
+    let bonsai = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/bonsai/bonsai.nii.gz");
+    let bonsai = bonsai.to_str().unwrap();
+    for (tag, keys) in [("composite", ""), ("mip", "m")] {
+        let (shot, session, reference) = (
+            tmp_in("viewer", &format!("session-{tag}.png")),
+            tmp_in("viewer", &format!("session-{tag}.toml")),
+            tmp_in("viewer", &format!("session-{tag}-ref.png")),
+        );
+        let mut run = Command::new("xvfb-run");
+        run.args(["-a", "-s", "-screen 0 640x480x24"]).arg(viewer());
+        run.args(["--volume", bonsai, "--tf", "bonsai", "--size", "160x128", "--frames", "4", "--eye", "-300,120,260"]);
+        run.args(["--tf-range", "20,200", "--keys", keys, "--validation"]);
+        run.arg("--screenshot").arg(&shot).arg("--save-session").arg(&session);
+        let out = run.output().expect("xvfb-run (scripts/setup.sh installs xvfb)");
+        assert!(out.status.success(), "{tag}: the viewer failed:\n{}", String::from_utf8_lossy(&out.stderr));
+        let text = std::fs::read_to_string(&session).unwrap();
+        assert!(text.contains(&format!("mode = \"{tag}\"")) && text.contains("range = [20.0, 200.0]"), "{text}");
+        assert!(text.contains("[light]"), "{tag}: the edit kept the preset's shading:\n{text}");
+        let args = ["render", "--volume", bonsai, "--session", session.to_str().unwrap(), "--size", "160x128"];
+        let out = voxsplat(&[&args[..], &["--validation", "--out", reference.to_str().unwrap()]].concat());
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let (a, b) = (rgba(&shot), rgba(&reference));
+        let worst = a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+        let lit = b.pixels().filter(|p| p[0] as u32 + p[1] as u32 + p[2] as u32 > 30).count();
+        assert!(lit > 500, "{tag}: the reference shows the bonsai ({lit} pixels lit)");
+        assert!(worst <= 1, "{tag}: the screenshot differs from render --session by {worst}/255");
+        if tag == "mip" {
+            let refused =
+                voxsplat(&[&args[..], &["--mode", "composite", "--out", reference.to_str().unwrap()]].concat());
+            assert!(String::from_utf8_lossy(&refused.stderr).contains("cannot be used with"));
+            let out =
+                voxsplat(&["render", "--session", session.to_str().unwrap(), "--out", reference.to_str().unwrap()]);
+            assert!(String::from_utf8_lossy(&out.stderr).contains("--volume"));
+            std::fs::write(&session, "mode = 3\n").unwrap();
+            let out = voxsplat(&[&args[..], &["--out", reference.to_str().unwrap()]].concat());
+            assert!(String::from_utf8_lossy(&out.stderr).contains("not a session"));
+        }
+    }
+}
+
 #[test]
 fn the_viewer_refuses_what_render_refuses() {
     let out = Command::new("xvfb-run")

@@ -1,0 +1,121 @@
+//! A session: what the viewer shows (its camera, transfer function, shading and the options its
+//! keys change), saved as TOML so that `voxsplat render --session FILE` draws the same frame of
+//! the same file.
+use serde::{Deserialize, Serialize};
+use voxsplat::classify::{Shading, TransferFunction};
+use voxsplat::glam::Vec3;
+use voxsplat::{Camera, Error, Projection, Result};
+
+/// The view, in the grid's frame (the one `render` prints as "camera (grid frame)").
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct View {
+    pub eye: [f32; 3],
+    pub target: [f32; 3],
+    pub up: [f32; 3],
+    /// Perspective: the vertical field of view in degrees.
+    pub fov: Option<f32>,
+    /// Orthographic: the view's height in world units.
+    pub height: Option<f32>,
+    pub near: f32,
+    pub far: f32,
+}
+
+/// The headlight the volume was classified with (`classify::Shading`).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Light {
+    pub direction: [f32; 3],
+    pub ambient: f32,
+    pub diffuse: f32,
+    pub specular: f32,
+    pub shininess: f32,
+}
+
+/// A saved session.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Session {
+    /// As `render --mode`.
+    pub mode: String,
+    /// --mode iso's value, normalised to 0..1 over the store's range (`RenderOptions::iso`).
+    pub iso: Option<f32>,
+    /// As `render --order`, `--composite`, `--raster`, `--lod` and `--kernel`.
+    pub order: String,
+    pub composite: String,
+    pub raster: String,
+    pub lod: String,
+    pub kernel: String,
+    /// The background the frame is composited over, R, G, B, A.
+    pub background: [f32; 4],
+    pub camera: View,
+    /// None: unshaded.
+    pub light: Option<Light>,
+    pub tf: TransferFunction,
+}
+
+impl Session {
+    /// The session in `path`, checked.
+    pub fn load(path: &std::path::Path) -> Result<Self> {
+        let text = voxsplat::loaders::read_text(path, &path.display().to_string())?;
+        let s: Session = toml::from_str(&text)
+            .map_err(|e| Error::InvalidArgument(format!("{}: not a session: {e}", path.display())))?;
+        s.tf.validate()?;
+        s.camera(1, 1)?;
+        Ok(s)
+    }
+
+    /// Written to `path` as TOML.
+    pub fn save(&self, path: &std::path::Path) -> Result<()> {
+        let text = toml::to_string(self).map_err(|e| Error::InvalidArgument(format!("session: {e}")))?;
+        let head = "# A voxsplat session: `voxsplat render --volume FILE --session THIS --size WxH` draws it again.\n";
+        std::fs::write(path, format!("{head}{text}"))
+            .map_err(|e| Error::Io { path: path.display().to_string(), source: e })
+    }
+
+    /// The camera, at `width` x `height` pixels.
+    pub fn camera(&self, width: u32, height: u32) -> Result<Camera> {
+        let c = &self.camera;
+        let projection = match (c.fov, c.height) {
+            (Some(fov_y_deg), None) => Projection::Perspective { fov_y_deg },
+            (None, Some(height)) => Projection::Orthographic { height },
+            _ => return Err(Error::InvalidArgument("a session's camera has a fov or a height, one of them".into())),
+        };
+        let (eye, target, up) = (Vec3::from(c.eye), Vec3::from(c.target), Vec3::from(c.up));
+        let cam = Camera { eye, target, up, projection, near: c.near, far: c.far, width, height };
+        cam.validate()?;
+        Ok(cam)
+    }
+
+    /// The view of `cam`.
+    pub fn view_of(cam: &Camera) -> View {
+        let (fov, height) = match cam.projection {
+            Projection::Perspective { fov_y_deg } => (Some(fov_y_deg), None),
+            Projection::Orthographic { height } => (None, Some(height)),
+        };
+        let (eye, target, up) = (cam.eye.to_array(), cam.target.to_array(), cam.up.to_array());
+        View { eye, target, up, fov, height, near: cam.near, far: cam.far }
+    }
+
+    /// The shading, if any.
+    pub fn shading(&self) -> Option<Shading> {
+        self.light.map(|l| Shading {
+            light: Vec3::from(l.direction),
+            ambient: l.ambient,
+            diffuse: l.diffuse,
+            specular: l.specular,
+            shininess: l.shininess,
+        })
+    }
+
+    /// The light of `shading`.
+    pub fn light_of(shading: Option<Shading>) -> Option<Light> {
+        shading.map(|s| Light {
+            direction: s.light.to_array(),
+            ambient: s.ambient,
+            diffuse: s.diffuse,
+            specular: s.specular,
+            shininess: s.shininess,
+        })
+    }
+}
