@@ -60,9 +60,31 @@ impl Session {
         let text = voxsplat::loaders::read_text(path, &path.display().to_string())?;
         let s: Session = toml::from_str(&text)
             .map_err(|e| Error::InvalidArgument(format!("{}: not a session: {e}", path.display())))?;
-        s.tf.validate()?;
-        s.camera(1, 1)?;
+        s.check().map_err(|e| Error::InvalidArgument(format!("{}: {e}", path.display())))?;
         Ok(s)
+    }
+
+    /// Refuse what would draw a wrong frame rather than fail: a value that is not finite, a
+    /// background or iso value outside 0 to 1, a light with no direction.
+    fn check(&self) -> Result<()> {
+        self.tf.validate()?;
+        self.camera(1, 1)?;
+        let bad = |m: &str| Err(Error::InvalidArgument(format!("a session's {m}")));
+        if !self.background.iter().all(|c| (0.0..=1.0).contains(c)) {
+            return bad("background is R, G, B, A in 0 to 1");
+        }
+        if self.iso.is_some_and(|v| !(0.0..=1.0).contains(&v)) {
+            return bad("iso value is normalised: 0 to 1");
+        }
+        if let Some(l) = &self.light {
+            let terms = [l.ambient, l.diffuse, l.specular, l.shininess];
+            let direction = Vec3::from(l.direction);
+            if !(direction.is_finite() && direction.length() > 0.0 && terms.iter().all(|t| t.is_finite() && *t >= 0.0))
+            {
+                return bad("light needs a direction and finite, non-negative terms");
+            }
+        }
+        Ok(())
     }
 
     /// Written to `path` as TOML.
@@ -117,5 +139,54 @@ impl Session {
             specular: s.specular,
             shininess: s.shininess,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn session() -> Session {
+        let cam = Camera::framing(&voxsplat::Grid::centered([8; 3], [1.0; 3]).unwrap(), 4, 4);
+        Session {
+            mode: "composite".into(),
+            iso: None,
+            order: "pbtf".into(),
+            composite: "splat".into(),
+            raster: "auto".into(),
+            lod: "auto".into(),
+            kernel: "crawfis-max".into(),
+            background: [0.0, 0.0, 0.0, 1.0],
+            camera: Session::view_of(&cam),
+            light: Session::light_of(Some(Shading::headlight(Vec3::NEG_Z))),
+            tf: TransferFunction::preset("ct").unwrap(),
+        }
+    }
+
+    /// A saved session reads back as it was; one that would draw a wrong frame is refused.
+    #[test]
+    fn a_session_reads_back_and_a_wrong_one_is_refused() {
+        let dir = std::env::temp_dir().join(format!("voxsplat-session-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("s.toml");
+        session().save(&path).unwrap();
+        assert_eq!(Session::load(&path).unwrap(), session());
+        type Spoil = fn(&mut Session);
+        let broken: [(&str, Spoil); 6] = [
+            ("background", |s| s.background[3] = 2.0),
+            ("iso", |s| s.iso = Some(f32::NAN)),
+            ("light", |s| s.light.as_mut().unwrap().direction = [0.0; 3]),
+            ("light", |s| s.light.as_mut().unwrap().ambient = f32::INFINITY),
+            ("fov", |s| s.camera.height = Some(3.0)),
+            ("transfer function", |s| s.tf.points.clear()),
+        ];
+        for (what, spoil) in broken {
+            let mut s = session();
+            spoil(&mut s);
+            s.save(&path).unwrap();
+            let e = Session::load(&path).unwrap_err().to_string();
+            assert!(e.contains(what), "{what}: {e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
