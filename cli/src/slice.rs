@@ -45,8 +45,7 @@ pub(crate) fn slice(a: SliceArgs) -> Result<()> {
         _ => 2,
     };
     let hints = voxsplat::loaders::VolumeHints { series: a.series, time: a.time, level: a.level, ..Default::default() };
-    let (dims, plane) = read_plane(&a.file, &hints, axis, a.index, &a.axis)?;
-    let index = a.index.unwrap_or(dims[axis] / 2);
+    let (dims, index, plane) = read_plane(&a.file, &hints, axis, a.index, &a.axis)?;
     let [lo, hi] = a.window.unwrap_or_else(|| {
         let finite = plane.values.iter().filter(|v| v.is_finite());
         finite.fold([f32::INFINITY, f32::NEG_INFINITY], |[l, h], &v| [l.min(v), h.max(v)])
@@ -67,7 +66,7 @@ pub(crate) fn slice(a: SliceArgs) -> Result<()> {
     Ok(())
 }
 
-/// The grid's dims and the plane `index` (the middle by default) across `axis` (`name`) of the
+/// The grid's dims, the index and the plane `index` (the middle by default) across `axis` (`name`) of the
 /// file's values as stored: a z plane reads its one slice, an x or y plane a row of each slice,
 /// slab by slab with a progress bar; a file that does not stream (`.npy`) is loaded whole.
 fn read_plane(
@@ -76,7 +75,7 @@ fn read_plane(
     axis: usize,
     index: Option<u32>,
     name: &str,
-) -> Result<([u32; 3], voxsplat::bricks::Plane)> {
+) -> Result<([u32; 3], u32, voxsplat::bricks::Plane)> {
     let whole = match voxsplat::loaders::SliceReader::open(path, hints)? {
         Some(reader) => Err(reader),
         None => Ok(voxsplat::loaders::load_volume(path, hints)?),
@@ -94,7 +93,8 @@ fn read_plane(
         )));
     }
     let [nx, ny, nz] = dims;
-    let plane = (nx * ny) as usize;
+    // In usize: a plane of two large sides passes u32.
+    let plane = nx as usize * ny as usize;
     // Slice z's part of the plane: all of it across z, row y = index across y, column x = index across x.
     let take = |slice: &[f32], out: &mut Vec<f32>| match axis {
         2 => out.extend_from_slice(slice),
@@ -125,5 +125,5 @@ fn read_plane(
         }
     }
     let (width, height) = [(ny, nz), (nx, nz), (nx, ny)][axis];
-    Ok((dims, voxsplat::bricks::Plane { width, height, values }))
+    Ok((dims, index, voxsplat::bricks::Plane { width, height, values }))
 }
