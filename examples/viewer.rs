@@ -27,11 +27,12 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
-use voxsplat::glam::{Quat, Vec3, Vec4};
+use voxsplat::glam::{Vec3, Vec4};
 use voxsplat::vk::ash::{self, vk};
 use voxsplat::vk::{Context, HostHandles, HostTarget, Semaphore};
 use voxsplat::{Camera, Clip, Composite, Error, Lod, OrderKind, Raster, RenderOptions, Renderer, Result};
 use voxsplat_cli::open::{camera_of, open, parse_background, SceneArgs};
+use voxsplat_cli::view::{Orbit, COMPOSITES, ORDERS, RASTERS};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -361,39 +362,6 @@ impl Swapchain {
     }
 }
 
-/// The view the mouse edits, around the command line's camera.
-#[derive(Clone, Copy)]
-struct View {
-    yaw: f32,
-    pitch: f32,
-    zoom: f32,
-    pan: Vec3,
-}
-
-impl View {
-    const HOME: View = View { yaw: 0.0, pitch: 0.0, zoom: 1.0, pan: Vec3::ZERO };
-
-    fn camera(&self, base: &Camera, radius: f32, size: (u32, u32)) -> Camera {
-        let mut cam = *base;
-        (cam.width, cam.height) = size;
-        if self.yaw == 0.0 && self.pitch == 0.0 && self.zoom == 1.0 && self.pan == Vec3::ZERO {
-            return cam; // the command line's camera, bit for bit
-        }
-        let right = base.right();
-        let turn = Quat::from_axis_angle(Vec3::Y, self.yaw) * Quat::from_axis_angle(right, self.pitch);
-        let offset = turn * (base.eye - base.target) * self.zoom;
-        cam.target = base.target + self.pan;
-        cam.eye = cam.target + offset;
-        let d = offset.length();
-        cam.near = if cam.is_perspective() { (d - radius).max(1e-3 * d.max(1.0)) } else { d - radius - 1.0 };
-        cam.far = d + radius + 1.0;
-        cam
-    }
-}
-
-const ORDERS: [&str; 5] = ["pbtf", "wbtf", "btf", "pbtf-octant", "sorted"];
-const COMPOSITES: [&str; 3] = ["splat", "sheet", "slab"];
-const RASTERS: [&str; 4] = ["auto", "compute", "graphics", "points"];
 /// The isosurface's first value (normalised) and a key's step.
 const ISO_START: f32 = 0.3;
 const ISO_STEP: f32 = 0.02;
@@ -412,7 +380,7 @@ struct Viewer {
     mesh: bool,
     slice: f32,
     radius: f32,
-    view: View,
+    view: Orbit,
     options: RenderOptions,
     indices: [usize; 3],
     tf: Option<voxsplat::classify::TransferFunction>,
@@ -461,7 +429,7 @@ impl Viewer {
             mesh,
             slice,
             radius: 1.0,
-            view: View::HOME,
+            view: Orbit::HOME,
             options,
             indices,
             tf: None,
@@ -908,12 +876,10 @@ impl Viewer {
             }
         } else if middle || (left && ctrl) {
             if let Some(base) = &self.base {
-                let scale = 2.0 * self.radius * self.view.zoom / height;
-                self.view.pan += (-base.right() * dx + base.up.normalize() * dy) * scale;
+                self.view.slide(base, self.radius, dx, dy, height);
             }
         } else if left {
-            self.view.yaw -= dx / width * std::f32::consts::PI;
-            self.view.pitch = (self.view.pitch - dy / height * std::f32::consts::PI).clamp(-1.5, 1.5);
+            self.view.turn(dx, dy, width, height);
         } else if right {
             let (lo, hi) = self.raw_range;
             let span = hi - lo;
@@ -1004,7 +970,7 @@ impl ApplicationHandler for Viewer {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
-                self.view.zoom = (self.view.zoom * 0.9f32.powf(lines)).clamp(0.05, 20.0);
+                self.view.wheel(lines);
                 Ok(())
             }
             WindowEvent::RedrawRequested => {

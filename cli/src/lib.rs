@@ -20,4 +20,5 @@ pub mod session;
 pub mod soak;
 pub mod stability;
 pub mod uneven;
+pub mod view;
 pub mod volumes;

@@ -71,6 +71,9 @@ enum Command {
     /// Write one plane of a volume's voxels, across x, y or z of its grid as the file stores it,
     /// as a grey PNG, windowed.
     Slice(Box<slice::SliceArgs>),
+    /// Open a window with the volume and a panel: modes, shading, the transfer function over the
+    /// data's histogram, the value under the pointer, sessions and screenshots.
+    View(Box<voxsplat_cli::view::ViewArgs>),
     /// Write or check a visibility order (back to front).
     Order(Box<OrderArgs>),
     /// Describe a volume or height file: dims, spacing, value range, splats at the default
@@ -271,6 +274,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(a) => render::render(a),
         Command::Pick(a) => pick::pick(*a),
         Command::Slice(a) => slice::slice(*a),
+        Command::View(a) => voxsplat_cli::view::view(*a),
         Command::Animate(a) => animate(a),
         Command::MakeVolume { from, factor, procedural, phantom, out } => {
             // It writes NRRD (raw data, attached): a name that says otherwise would mislead.

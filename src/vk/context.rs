@@ -88,6 +88,12 @@ fn device_rank(t: vk::PhysicalDeviceType) -> u32 {
 impl Context {
     /// A headless context on the best device: discrete > integrated > virtual > CPU.
     pub fn new(options: &ContextOptions) -> Result<Arc<Self>> {
+        Self::create(options, &[])
+    }
+
+    /// `new`, with a window system's surface extensions on the instance and `VK_KHR_swapchain` on
+    /// the device when `surface` is not empty (the `Presenter`'s context).
+    pub(crate) fn create(options: &ContextOptions, surface: &[*const std::ffi::c_char]) -> Result<Arc<Self>> {
         // SAFETY: loading the system Vulkan loader; it stays alive as long as `_entry`.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
         let debug_state = Box::<DebugState>::default();
@@ -110,6 +116,7 @@ impl Context {
             layers.push(VALIDATION_LAYER.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
+        extensions.extend_from_slice(surface);
         let app = vk::ApplicationInfo::default()
             .application_name(c"voxsplat")
             .engine_name(c"voxsplat")
@@ -192,8 +199,13 @@ impl Context {
         let core = vk::PhysicalDeviceFeatures::default()
             .large_points(supported.large_points == vk::TRUE)
             .shader_int64(int64_atomics);
-        let device_info =
-            vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&core).push_next(&mut f12);
+        let swapchain = [ash::khr::swapchain::NAME.as_ptr()];
+        let device_extensions: &[_] = if surface.is_empty() { &[] } else { &swapchain };
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queues)
+            .enabled_features(&core)
+            .enabled_extension_names(device_extensions)
+            .push_next(&mut f12);
         // SAFETY: `physical` came from this instance; features were checked in pick_device.
         let device = match unsafe { instance.create_device(physical, &device_info, None) } {
             Ok(d) => d,

@@ -319,7 +319,7 @@ impl Drop for Semaphore {
     }
 }
 
-fn color_range() -> vk::ImageSubresourceRange {
+pub(super) fn color_range() -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange {
         aspect_mask: vk::ImageAspectFlags::COLOR,
         base_mip_level: 0,

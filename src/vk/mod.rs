@@ -5,6 +5,8 @@ mod debug;
 mod host;
 mod image;
 mod pipeline;
+#[cfg(feature = "window")]
+mod present;
 mod submit;
 mod timer;
 
@@ -17,5 +19,7 @@ pub use host::{
 };
 pub use image::{Image, Sampler};
 pub use pipeline::{Bind, Blend, DescriptorSet, Framebuffer, Layout, Pipeline, Primitive, RenderPass, Slot};
+#[cfg(feature = "window")]
+pub use present::{DrawView, OverlayFrame, PresentOptions, PresentWindow, Presented, Presenter, Viewport};
 pub use submit::{Recorder, Stage};
 pub use timer::Timer;

@@ -1,0 +1,225 @@
+//! The side panel and the view's own input: what the user sees and edits each frame. It reads and
+//! writes `State`; the window loop applies what changed to the renderer.
+use super::{State, COMPOSITES, KERNELS, ORDERS, RASTERS};
+use egui::{Key, PointerButton, Rect, Sense};
+use voxsplat::{Lod, Mode};
+
+/// The key help the panel shows (and `?` opens).
+pub const KEYS: &[(&str, &str)] = &[
+    ("left drag", "orbit"),
+    ("middle drag, ctrl + left drag", "pan"),
+    ("wheel", "zoom"),
+    ("pointer over the volume", "the value, voxel and position under it"),
+    ("m", "next mode (composite, MIP, MinIP, average, X-ray, iso)"),
+    (", .", "iso value down, up"),
+    ("l", "levels of detail on or off"),
+    ("t T", "next, previous time point of a series"),
+    ("h", "home: the start camera"),
+    ("s", "save the session (view-session.toml) and the transfer function (view-tf.toml)"),
+    ("p", "save a screenshot of the window (view.png)"),
+    ("tf editor", "drag a point; double-click adds one; right-click deletes one"),
+    ("q, Esc", "quit"),
+];
+
+/// Draw the panel and the central view; record what changed in `state`.
+pub fn ui(ui: &mut egui::Ui, s: &mut State) {
+    egui::Panel::left("controls").exact_size(s.panel_width).resizable(false).show(ui, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| controls(ui, s));
+    });
+    egui::CentralPanel::no_frame().show(ui, |ui| {
+        let rect = ui.available_rect_before_wrap();
+        let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        s.view_rect = Some(rect);
+        view_input(ui, s, rect, &response);
+    });
+    keys(ui, s);
+}
+
+fn controls(ui: &mut egui::Ui, s: &mut State) {
+    ui.heading("voxsplat");
+    ui.label(&s.title);
+    ui.label(format!(
+        "{:.1} ms a frame ({:.1} fps){}",
+        s.last_ms,
+        1e3 / s.last_ms.max(1e-3),
+        if s.scale < 1.0 { format!(", drawn at {:.2} scale", s.scale) } else { String::new() }
+    ));
+    if !s.stats.is_empty() {
+        ui.label(&s.stats);
+    }
+    match &s.hover {
+        Some(text) => ui.label(text),
+        None => ui.label("(point at the volume for its value)"),
+    };
+    if !s.message.is_empty() {
+        ui.colored_label(egui::Color32::LIGHT_YELLOW, &s.message);
+    }
+    ui.separator();
+    let mut mode = s.options.mode;
+    egui::ComboBox::from_label("mode").selected_text(mode.name()).show_ui(ui, |ui| {
+        for m in Mode::ALL {
+            ui.selectable_value(&mut mode, m, m.name());
+        }
+    });
+    if mode != s.options.mode {
+        s.set_mode(mode);
+    }
+    if let Some(mut iso) = s.options.iso {
+        if ui.add(egui::Slider::new(&mut iso, 0.0..=1.0).text("iso value")).changed() {
+            s.options.iso = Some(iso);
+            s.dirty = true;
+        }
+    }
+    ui.separator();
+    match (&mut s.tf, &s.histogram) {
+        (Some(tf), Some(h)) => {
+            ui.label("transfer function (opacity over the histogram, log)");
+            if s.tf_editor.ui(ui, tf, h) {
+                s.tf_changed = true;
+            }
+        }
+        _ => {
+            ui.label("transfer-function editing needs a --volume file");
+        }
+    }
+    ui.separator();
+    if s.tf.is_some() {
+        let mut shaded = s.shading_on;
+        if ui.checkbox(&mut shaded, "shading (headlight)").changed() {
+            s.shading_on = shaded;
+            s.tf_changed = true;
+        }
+    }
+    choice(ui, "order", ORDERS, &mut s.order, &mut s.dirty);
+    choice(ui, "compositing", COMPOSITES, &mut s.composite, &mut s.dirty);
+    choice(ui, "raster", RASTERS, &mut s.raster, &mut s.dirty);
+    choice(ui, "kernel", KERNELS, &mut s.kernel, &mut s.dirty);
+    ui.horizontal(|ui| {
+        let mut lod = s.options.lod != Lod::Off;
+        if ui.checkbox(&mut lod, "levels of detail").changed() {
+            s.options.lod = if lod { Lod::Auto } else { Lod::Off };
+            s.dirty = true;
+        }
+        if lod && ui.add(egui::Slider::new(&mut s.options.lod_pixels, 0.25..=8.0).text("px")).changed() {
+            s.dirty = true;
+        }
+    });
+    if let Some((series, at)) = &s.series {
+        let mut t = *at;
+        let last = series.times - 1;
+        if ui.add(egui::Slider::new(&mut t, 0..=last).text("time point")).changed() {
+            s.time_to = Some(t);
+        }
+    }
+    ui.separator();
+    ui.horizontal(|ui| {
+        if ui.button("save session").clicked() {
+            s.save_now = true;
+        }
+        if ui.button("screenshot").clicked() {
+            s.shot_now = Some("view.png".into());
+        }
+        if ui.button("home").clicked() {
+            s.home();
+        }
+    });
+    egui::CollapsingHeader::new("keys and mouse").default_open(s.help).show(ui, |ui| {
+        egui::Grid::new("keys").striped(true).show(ui, |ui| {
+            for (key, what) in KEYS {
+                ui.label(*key);
+                ui.label(*what);
+                ui.end_row();
+            }
+        });
+    });
+}
+
+fn choice(ui: &mut egui::Ui, label: &str, names: &[&str], value: &mut String, dirty: &mut bool) {
+    egui::ComboBox::from_label(label).selected_text(value.as_str()).show_ui(ui, |ui| {
+        for name in names {
+            if ui.selectable_label(value == name, *name).clicked() && value != name {
+                *value = name.to_string();
+                *dirty = true;
+            }
+        }
+    });
+}
+
+/// Orbit, pan and zoom on the view; the pointer's position for the pick.
+fn view_input(ui: &egui::Ui, s: &mut State, rect: Rect, r: &egui::Response) {
+    let ctrl = ui.input(|i| i.modifiers.ctrl);
+    let delta = r.drag_delta();
+    s.dragging = r.dragged();
+    if delta != egui::Vec2::ZERO {
+        let ppp = ui.ctx().pixels_per_point();
+        let (w, h) = (rect.width() * ppp, rect.height() * ppp);
+        let (dx, dy) = (delta.x * ppp, delta.y * ppp);
+        if r.dragged_by(PointerButton::Middle) || (r.dragged_by(PointerButton::Primary) && ctrl) {
+            if let Some(base) = &s.base {
+                s.orbit.slide(base, s.radius, dx, dy, h);
+            }
+        } else if r.dragged_by(PointerButton::Primary) {
+            s.orbit.turn(dx, dy, w, h);
+        }
+        s.dirty = true;
+    }
+    if r.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            s.orbit.wheel(scroll / 40.0);
+            s.dirty = true;
+        }
+    }
+    s.pointer = r.hover_pos().filter(|_| !r.dragged()).map(|p| p - rect.min);
+}
+
+/// The keyboard, when no text field holds it.
+fn keys(ui: &egui::Ui, s: &mut State) {
+    if ui.ctx().egui_wants_keyboard_input() {
+        return;
+    }
+    let pressed = |k: Key| ui.input(|i| i.key_pressed(k));
+    if pressed(Key::M) {
+        let at = Mode::ALL.iter().position(|&m| m == s.options.mode).unwrap_or(0);
+        s.set_mode(Mode::ALL[(at + 1) % Mode::ALL.len()]);
+    }
+    for (key, step) in [(Key::Comma, -0.02), (Key::Period, 0.02)] {
+        if pressed(key) {
+            match s.options.iso {
+                Some(v) => {
+                    s.options.iso = Some((v + step).clamp(0.0, 1.0));
+                    s.dirty = true;
+                }
+                None => s.message = "the iso value: m to the iso mode first".into(),
+            }
+        }
+    }
+    if pressed(Key::L) {
+        s.options.lod = if s.options.lod == Lod::Off { Lod::Auto } else { Lod::Off };
+        s.dirty = true;
+    }
+    if pressed(Key::T) {
+        let back = ui.input(|i| i.modifiers.shift);
+        if let Some((series, at)) = &s.series {
+            let n = series.times;
+            s.time_to = Some(if back { (*at + n - 1) % n } else { (*at + 1) % n });
+        } else {
+            s.message = "time points: open a 4-D NIfTI or an OME-Zarr image with a time axis".into();
+        }
+    }
+    if pressed(Key::H) {
+        s.home();
+    }
+    if pressed(Key::S) {
+        s.save_now = true;
+    }
+    if pressed(Key::P) {
+        s.shot_now = Some("view.png".into());
+    }
+    if pressed(Key::Questionmark) {
+        s.help = !s.help;
+    }
+    if pressed(Key::Q) || pressed(Key::Escape) {
+        s.quit = true;
+    }
+}

@@ -1,0 +1,234 @@
+//! `view --script FILE`: synthetic pointer and key events, one line a frame, fed to the panel as
+//! the window's own events would be. Positions are resolved when a line runs, against the last
+//! frame's layout (the editor's points move as they are dragged).
+//!
+//! ```text
+//! move X Y            pointer to (X, Y) points from the window's top left
+//! drag X0 Y0 X1 Y1    left-drag over a few frames (the view orbits)
+//! drag-tf I X Y       drag the editor's point I to (X, Y): fractions of its width and height
+//! add-tf X Y          double-click the editor there: a new point
+//! delete-tf I         right-click the editor's point I
+//! key K               press and release key K (a letter, comma, period)
+//! pick X Y            pointer to (X, Y), fractions of the view; print the value under it
+//! wait N              N frames
+//! shot PATH           the window's pixels as a PNG
+//! view PATH           the volume's image alone as a PNG
+//! session PATH        save the session (render --session draws it again)
+//! tf PATH             save the transfer function (render --tf reads it)
+//! ```
+use super::State;
+use egui::{Event, Key, Modifiers, PointerButton, Pos2, RawInput};
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use voxsplat::{Camera, Error, Result};
+
+#[derive(Clone, Debug)]
+enum Line {
+    Move(Pos2),
+    Drag(Pos2, Pos2),
+    DragTf(usize, Pos2),
+    AddTf(Pos2),
+    DeleteTf(usize),
+    Key(Key),
+    Pick(Pos2),
+    Wait(u32),
+    Shot(PathBuf),
+    View(PathBuf),
+    Session(PathBuf),
+    Tf(PathBuf),
+}
+
+/// One frame's events and what to do once it is drawn.
+#[derive(Default)]
+pub struct Step {
+    events: Vec<Event>,
+    after: Option<Line>,
+}
+
+/// A loaded script and where it is.
+pub struct Script {
+    lines: VecDeque<(usize, Line)>,
+    /// Frames expanded from the running line.
+    pending: VecDeque<Step>,
+    /// The first frame lays out the panel; the script starts after it.
+    started: bool,
+}
+
+fn parse_line(n: usize, text: &str) -> Result<Option<Line>> {
+    let words: Vec<&str> = text.split_whitespace().collect();
+    let Some((&cmd, rest)) = words.split_first() else { return Ok(None) };
+    if cmd.starts_with('#') {
+        return Ok(None);
+    }
+    let bad = |why: &str| Error::InvalidArgument(format!("script line {n}: {why}: {text}"));
+    let num = |i: usize| -> Result<f32> {
+        rest.get(i)
+            .and_then(|w| w.parse::<f32>().ok())
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad("expected a number"))
+    };
+    let index = |i: usize| -> Result<usize> {
+        rest.get(i).and_then(|w| w.parse().ok()).ok_or_else(|| bad("expected an index"))
+    };
+    let path = || -> Result<PathBuf> { rest.first().map(PathBuf::from).ok_or_else(|| bad("expected a path")) };
+    let pos = |i: usize| -> Result<Pos2> { Ok(Pos2::new(num(i)?, num(i + 1)?)) };
+    let line = match cmd {
+        "move" => Line::Move(pos(0)?),
+        "drag" => Line::Drag(pos(0)?, pos(2)?),
+        "drag-tf" => Line::DragTf(index(0)?, pos(1)?),
+        "add-tf" => Line::AddTf(pos(0)?),
+        "delete-tf" => Line::DeleteTf(index(0)?),
+        "key" => {
+            let name = rest.first().ok_or_else(|| bad("expected a key"))?;
+            let key = match *name {
+                "," | "comma" => Some(Key::Comma),
+                "." | "period" => Some(Key::Period),
+                k => Key::from_name(&k.to_uppercase()),
+            };
+            Line::Key(key.ok_or_else(|| bad("unknown key"))?)
+        }
+        "pick" => Line::Pick(pos(0)?),
+        "wait" => Line::Wait(index(0)?.min(10_000) as u32),
+        "shot" => Line::Shot(path()?),
+        "view" => Line::View(path()?),
+        "session" => Line::Session(path()?),
+        "tf" => Line::Tf(path()?),
+        _ => return Err(bad("unknown command")),
+    };
+    Ok(Some(line))
+}
+
+fn button(pos: Pos2, button: PointerButton, pressed: bool) -> Event {
+    Event::PointerButton { pos, button, pressed, modifiers: Modifiers::NONE }
+}
+
+/// A left drag from `a` to `b`: press, four moves, release, one frame each.
+fn drag(a: Pos2, b: Pos2) -> Vec<Step> {
+    let mut steps =
+        vec![Step { events: vec![Event::PointerMoved(a), button(a, PointerButton::Primary, true)], after: None }];
+    for i in 1..=4 {
+        let p = a + (b - a) * (i as f32 / 4.0);
+        steps.push(Step { events: vec![Event::PointerMoved(p)], after: None });
+    }
+    steps.push(Step { events: vec![button(b, PointerButton::Primary, false)], after: None });
+    steps
+}
+
+impl Script {
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = voxsplat::loaders::read_text(path, &path.display().to_string())?;
+        let mut lines = VecDeque::new();
+        for (i, l) in text.lines().enumerate() {
+            if let Some(line) = parse_line(i + 1, l)? {
+                lines.push_back((i + 1, line));
+            }
+        }
+        Ok(Self { lines, pending: VecDeque::new(), started: false })
+    }
+
+    pub fn done(&self) -> bool {
+        self.started && self.lines.is_empty() && self.pending.is_empty()
+    }
+
+    /// This frame's events, added to `raw`; the step to finish once the frame is drawn.
+    pub fn step(&mut self, s: &State, raw: &mut RawInput) -> Result<Step> {
+        if !self.started {
+            self.started = true;
+            return Ok(Step::default());
+        }
+        if self.pending.is_empty() {
+            if let Some((n, line)) = self.lines.pop_front() {
+                self.pending = expand(n, line, s)?.into();
+            }
+        }
+        let step = self.pending.pop_front().unwrap_or_default();
+        raw.events.extend(step.events.iter().cloned());
+        Ok(Step { events: Vec::new(), after: step.after })
+    }
+}
+
+/// A line as frames, its positions resolved against the last frame's layout.
+fn expand(n: usize, line: Line, s: &State) -> Result<Vec<Step>> {
+    let missing = |what: &str| Error::InvalidArgument(format!("script line {n}: {what}"));
+    let editor = || -> Result<(egui::Rect, &voxsplat::classify::TransferFunction, &voxsplat::bricks::Histogram)> {
+        match (s.tf_editor.rect, &s.tf, &s.histogram) {
+            (Some(r), Some(tf), Some(h)) => Ok((r, tf, h)),
+            _ => Err(missing("no transfer-function editor (a --volume file opens one)")),
+        }
+    };
+    let in_rect = |r: egui::Rect, f: Pos2| Pos2::new(r.left() + f.x * r.width(), r.top() + f.y * r.height());
+    let point = |i: usize| -> Result<Pos2> {
+        let (_, tf, h) = editor()?;
+        s.tf_editor.point_pos(tf, h, i).ok_or_else(|| missing(&format!("the editor has no point {i}")))
+    };
+    Ok(match line {
+        Line::Move(p) => vec![Step { events: vec![Event::PointerMoved(p)], after: None }],
+        Line::Drag(a, b) => drag(a, b),
+        Line::DragTf(i, to) => {
+            let (rect, ..) = editor()?;
+            // y: opacity, up the editor.
+            drag(point(i)?, in_rect(rect, Pos2::new(to.x, 1.0 - to.y)))
+        }
+        Line::AddTf(at) => {
+            let (rect, ..) = editor()?;
+            let p = in_rect(rect, Pos2::new(at.x, 1.0 - at.y));
+            let click = |pressed| button(p, PointerButton::Primary, pressed);
+            vec![
+                Step { events: vec![Event::PointerMoved(p)], after: None },
+                Step { events: vec![click(true), click(false), click(true), click(false)], after: None },
+            ]
+        }
+        Line::DeleteTf(i) => {
+            let p = point(i)?;
+            vec![
+                Step { events: vec![Event::PointerMoved(p)], after: None },
+                Step {
+                    events: vec![button(p, PointerButton::Secondary, true), button(p, PointerButton::Secondary, false)],
+                    after: None,
+                },
+            ]
+        }
+        Line::Key(key) => {
+            let k =
+                |pressed| Event::Key { key, physical_key: None, pressed, repeat: false, modifiers: Modifiers::NONE };
+            vec![Step { events: vec![k(true)], after: None }, Step { events: vec![k(false)], after: None }]
+        }
+        Line::Pick(f) => {
+            let rect = s.view_rect.ok_or_else(|| missing("no view laid out"))?;
+            let p = in_rect(rect, f);
+            // One frame to move and pick, one to report it.
+            vec![
+                Step { events: vec![Event::PointerMoved(p)], after: None },
+                Step { events: vec![], after: Some(Line::Pick(f)) },
+            ]
+        }
+        Line::Wait(frames) => (0..frames).map(|_| Step::default()).collect(),
+        // The next frame reads the window back.
+        Line::Shot(path) => vec![Step { events: vec![], after: Some(Line::Shot(path)) }, Step::default()],
+        other => vec![Step { events: vec![], after: Some(other) }],
+    })
+}
+
+impl Step {
+    /// After the frame: report a pick, save what was asked.
+    pub fn after(self, s: &mut State, cam: &Camera, view: Result<Vec<u8>>, size: (u32, u32)) -> Result<()> {
+        match self.after {
+            Some(Line::Pick(_)) => println!("pick: {}", s.hover.clone().unwrap_or_default().replace('\n', "; ")),
+            Some(Line::Shot(path)) => s.shot_now = Some(path),
+            Some(Line::View(path)) => {
+                let img = image::RgbaImage::from_raw(size.0, size.1, view?)
+                    .ok_or_else(|| Error::InvalidArgument("the view's image is short".into()))?;
+                img.save(&path)
+                    .map_err(|e| Error::Image { path: path.display().to_string(), message: e.to_string() })?;
+            }
+            Some(Line::Session(path)) => s.session(cam)?.save(&path)?,
+            Some(Line::Tf(path)) => {
+                let tf = s.tf.as_ref().ok_or_else(|| Error::InvalidArgument("no transfer function to save".into()))?;
+                std::fs::write(&path, tf.to_toml()?)
+                    .map_err(|e| Error::Io { path: path.display().to_string(), source: e })?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
