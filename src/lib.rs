@@ -398,7 +398,7 @@ impl Renderer {
         let gpu = self.gpu.as_mut().ok_or_else(|| Error::Unsupported("render_to needs the GPU backend".into()))?;
         gpu.context().check_target(target.format(), scaled)?;
         let recorded = record_frame(&mut gpu.engine_to(prep, target), prep, &low, &opts)?;
-        Ok(Delivered { timings: recorded.timings, raster: choice })
+        Ok(Delivered { timings: recorded.timings, raster: choice, stats: recorded.stats })
     }
 
     /// The texels of a target after `render_to`, in its format (it needs `TRANSFER_SRC` usage).

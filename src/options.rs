@@ -688,4 +688,6 @@ pub struct Delivered {
     pub timings: Vec<StageTime>,
     /// What `Raster::Auto` picked.
     pub raster: crate::RasterChoice,
+    /// What a bricked volume's frame drew and culled, as `Rendered::stats`.
+    pub stats: FrameStats,
 }

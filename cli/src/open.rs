@@ -239,7 +239,14 @@ pub fn load_bricked(
         )));
     }
     let chunks = voxsplat::loaders::zarr_chunks_read();
-    let (bar, progress) = crate::progress::load_bar(path);
+    let (bar, terminal) = crate::progress::load_bar(path);
+    let progress = match a.progress.clone() {
+        Some(window) => voxsplat::loaders::Progress::new(move |read, of| {
+            terminal.report(read, of);
+            window.report(read, of);
+        }),
+        None => terminal,
+    };
     let mut store = voxsplat::bricks::BrickStore::load(
         path,
         &voxsplat::loaders::VolumeHints { progress: Some(progress), ..hints },

@@ -149,6 +149,10 @@ pub(crate) struct RenderArgs {
 /// Runs `voxsplat render`.
 pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     if let Some(path) = &a.session {
+        // (clap's `requires` does not reach the flattened --volume.)
+        if a.scene.volume.is_none() {
+            return Err(Error::InvalidArgument("--session draws the --volume it was saved from: give it".into()));
+        }
         let s = voxsplat_cli::session::Session::load(path)?;
         (a.mode, a.composite, a.raster, a.kernel) =
             (s.mode.clone(), s.composite.clone(), s.raster.clone(), s.kernel.clone());

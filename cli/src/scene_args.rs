@@ -19,6 +19,9 @@ pub struct SceneArgs {
     /// see are read.
     #[arg(skip)]
     pub view_read: Option<voxsplat::Camera>,
+    /// Told how far a volume file's read has got (the viewer's bar), besides the terminal's.
+    #[arg(skip)]
+    pub progress: Option<voxsplat::loaders::Progress>,
     /// Built-in scene name (see `voxsplat scenes`).
     #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain", "labels"])]
     pub scene: String,

@@ -11,6 +11,7 @@ use std::sync::Arc;
 use std::time::Instant;
 use voxsplat::bricks::Histogram;
 use voxsplat::classify::{Shading, TransferFunction};
+use voxsplat::glam::{Vec3, Vec4};
 use voxsplat::vk::{OverlayFrame, PresentOptions, Presenter, Viewport};
 use voxsplat::{Camera, Error, Mode, RenderOptions, Renderer, Result};
 use winit::application::ApplicationHandler;
@@ -18,9 +19,11 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
+mod load;
 mod orbit;
 mod panel;
 mod script;
+mod slices;
 mod tf_editor;
 
 pub use orbit::Orbit;
@@ -30,6 +33,11 @@ pub const ORDERS: &[&str] = &["pbtf", "wbtf", "btf", "pbtf-octant", "sorted"];
 pub const COMPOSITES: &[&str] = &["splat", "sheet", "slab"];
 pub const RASTERS: &[&str] = &["auto", "compute", "graphics", "points"];
 pub const KERNELS: &[&str] = &["crawfis-max", "gaussian", "cubic", "narrow"];
+/// A drag frame's coarseness at the first drag, and at most (`State::coarse`).
+const DRAG_COARSE_START: f32 = 2.0;
+const DRAG_COARSE_MAX: f32 = 8.0;
+/// A drag frame's bound on a coarse level's error (`RenderOptions::lod_error`): none that matters.
+const DRAG_LOD_ERROR: f32 = 1e6;
 /// The isosurface's first value (normalised).
 const ISO_START: f32 = 0.3;
 /// The window's least height in pixels: the panel's controls and editor fit.
@@ -44,13 +52,19 @@ pub struct ViewArgs {
     /// The side panel's width in points.
     #[arg(long, default_value = "340")]
     pub panel: f32,
-    /// While the pointer drags the view, draw at the render scale that keeps a frame within this
-    /// many milliseconds (down to a quarter of the size); the full frame follows when it stops.
+    /// While the pointer drags the view, draw coarser frames (a lower render scale, coarser levels
+    /// of detail) that keep the window's frame within this many milliseconds; the full frame
+    /// follows when the drag stops.
     #[arg(long, default_value = "100")]
     pub drag_ms: f32,
     /// Present without waiting for the display's refresh.
     #[arg(long)]
     pub no_vsync: bool,
+    /// Open a saved session (`s`, or a script's `session`) of the same --volume: its camera,
+    /// transfer function, shading, mode and options.
+    #[arg(long, requires = "volume", conflicts_with_all = ["eye", "target", "up", "fov", "ortho", "near", "far",
+        "view", "tf", "shade", "no_shade", "order"])]
+    pub session: Option<PathBuf>,
     /// Run a script of synthetic pointer and key events, one line a frame, then exit (tests;
     /// docs/guide/cli.md lists its commands).
     #[arg(long)]
@@ -79,12 +93,27 @@ pub struct State {
     /// The pointer over the view, in points from its top left corner.
     pub pointer: Option<egui::Vec2>,
     pub hover: Option<String>,
+    /// The voxel under the pointer, and where the pointer and camera were when it was picked.
+    pub hover_voxel: Option<[u32; 3]>,
+    picked_at: Option<(egui::Vec2, Camera)>,
+    /// A click on the volume: the crosshair goes to the voxel under it.
+    pub clicked: bool,
+    pub slices: Option<slices::Slices>,
+    pub grid: Option<voxsplat::Grid>,
+    /// A clip plane through the grid's centre (its normal, the offset along it) keeping what lies
+    /// beyond it, and a crop box as fractions of the grid along each axis.
+    pub clip_plane: Option<(Vec3, f32)>,
+    pub crop: Option<[[f32; 3]; 2]>,
     pub view_rect: Option<egui::Rect>,
     pub last_ms: f64,
     pub stats: String,
     pub message: String,
-    /// The render scale a drag draws at (adapted to `drag_ms`).
-    pub scale: f32,
+    /// How much coarser a drag frame is than the still one (adapted to `drag_ms`): it draws at
+    /// 1 / coarse of the render scale (a quarter at least) with levels of detail `coarse` times
+    /// the pixel bound, the error bound set aside.
+    pub coarse: f32,
+    /// The last window frame's time beyond drawing the volume.
+    pub overhead_ms: f64,
     pub dragging: bool,
     pub help: bool,
     // What the window loop does after the panel ran.
@@ -104,6 +133,13 @@ impl State {
         self.dirty = true;
     }
 
+    /// The direction the current view looks along.
+    pub fn view_direction(&self) -> Option<Vec3> {
+        let base = self.base.as_ref()?;
+        let cam = self.orbit.camera(base, self.radius, (base.width, base.height));
+        Some(cam.forward())
+    }
+
     pub fn home(&mut self) {
         self.orbit = Orbit::HOME;
         self.dirty = true;
@@ -116,6 +152,16 @@ impl State {
         o.composite = self.composite.parse()?;
         o.raster = self.raster.parse()?;
         o.kernel = self.kernel.parse()?;
+        if let Some(g) = &self.grid {
+            let planes: Vec<Vec4> = self
+                .clip_plane
+                .map(|(n, offset)| Vec4::new(n.x, n.y, n.z, -n.dot(g.center()) - offset))
+                .into_iter()
+                .collect();
+            let last = Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32));
+            let crop = self.crop.map(|[lo, hi]| g.world_box(Vec3::from(lo) * last, Vec3::from(hi) * last));
+            o.clip = voxsplat::Clip::new(&planes, crop)?;
+        }
         if o.mode != Mode::Composite {
             // As `render`: a projection draws in no visibility order and at full detail.
             (o.order, o.lod) = (voxsplat::OrderKind::Pbtf, voxsplat::Lod::Off);
@@ -127,6 +173,9 @@ impl State {
     /// The session of the frame drawn through `cam`: what `render --session` draws again.
     pub fn session(&self, cam: &Camera) -> Result<Session> {
         let tf = self.tf.clone().ok_or_else(|| Error::InvalidArgument("a session needs a --volume file".into()))?;
+        if self.clip_plane.is_some() || self.crop.is_some() {
+            return Err(Error::InvalidArgument("a session holds no clipping: turn the plane and box off first".into()));
+        }
         let o = &self.options;
         let projection = o.mode != Mode::Composite;
         Ok(Session {
@@ -153,8 +202,18 @@ impl State {
     }
 }
 
+/// The flags the window loop reads.
+struct Settings {
+    panel: f32,
+    drag_ms: f32,
+    no_vsync: bool,
+}
+
 struct App {
-    args: ViewArgs,
+    args: Settings,
+    /// The scene flags: lent to the loading thread, then back.
+    scene: Option<SceneArgs>,
+    loading: Option<load::Loading>,
     window: Option<Arc<Window>>,
     egui: egui::Context,
     input: Option<egui_winit::State>,
@@ -165,13 +224,20 @@ struct App {
     script: Option<script::Script>,
     /// The viewport of the last frame drawn, in pixels.
     drawn: Option<(Viewport, Camera, RenderOptions)>,
-    times: Vec<f64>,
+    /// Each frame drawn: milliseconds drawing the volume, whether a drag drew it (at what
+    /// scale), and milliseconds for the whole window frame.
+    times: Vec<(f64, Option<f32>, f64)>,
+    /// From the command's start to the first frame presented.
+    started: Instant,
+    first_frame: Option<f64>,
     failure: Option<Error>,
 }
 
 impl App {
     fn new(args: ViewArgs) -> Result<Self> {
-        let script = args.script.as_deref().map(script::Script::load).transpose()?;
+        let ViewArgs { mut scene, panel, drag_ms, no_vsync, session, script } = args;
+        let args = Settings { panel, drag_ms, no_vsync };
+        let script = script.as_deref().map(script::Script::load).transpose()?;
         if !(args.panel.is_finite() && (120.0..=2000.0).contains(&args.panel)) {
             return Err(Error::InvalidArgument(format!("--panel {}: 120 to 2000 points", args.panel)));
         }
@@ -179,9 +245,22 @@ impl App {
             return Err(Error::InvalidArgument(format!("--drag-ms {}: a positive time", args.drag_ms)));
         }
         let mut options = RenderOptions::default();
-        options.order = args.scene.order.parse()?;
         // Opaque black behind the volume: the window shows no transparency.
         options.background = Some([0.0, 0.0, 0.0, 1.0]);
+        let mut names = (scene.order.clone(), "splat".to_string(), "auto".to_string(), "crawfis-max".to_string());
+        if let Some(path) = &session {
+            if scene.volume.is_none() {
+                return Err(Error::InvalidArgument("--session draws the --volume it was saved from: give it".into()));
+            }
+            let saved = Session::load(path)?;
+            (options.mode, options.iso, options.lod) = (saved.mode.parse()?, saved.iso, saved.lod.parse()?);
+            if saved.background[3] == 1.0 {
+                options.background = Some(saved.background);
+            }
+            names = (saved.order.clone(), saved.composite.clone(), saved.raster.clone(), saved.kernel.clone());
+            scene.session = Some(saved);
+        }
+        options.order = names.0.parse()?;
         let state = State {
             title: String::new(),
             panel_width: args.panel,
@@ -189,10 +268,10 @@ impl App {
             radius: 1.0,
             orbit: Orbit::HOME,
             options,
-            order: args.scene.order.clone(),
-            composite: "splat".into(),
-            raster: "auto".into(),
-            kernel: "crawfis-max".into(),
+            order: names.0,
+            composite: names.1,
+            raster: names.2,
+            kernel: names.3,
             tf: None,
             histogram: None,
             tf_editor: Default::default(),
@@ -201,11 +280,19 @@ impl App {
             series: None,
             pointer: None,
             hover: None,
+            hover_voxel: None,
+            picked_at: None,
+            clicked: false,
+            slices: None,
+            grid: None,
+            clip_plane: None,
+            crop: None,
             view_rect: None,
             last_ms: 0.0,
             stats: String::new(),
             message: String::new(),
-            scale: 1.0,
+            coarse: DRAG_COARSE_START,
+            overhead_ms: 0.0,
             dragging: false,
             help: false,
             dirty: true,
@@ -217,6 +304,8 @@ impl App {
         };
         Ok(Self {
             args,
+            scene: Some(scene),
+            loading: None,
             window: None,
             egui: egui::Context::default(),
             input: None,
@@ -226,14 +315,18 @@ impl App {
             script,
             drawn: None,
             times: Vec::new(),
+            started: Instant::now(),
+            first_frame: None,
             failure: None,
         })
     }
 
-    /// The window (the view at --size, the panel beside it), the device, the scene.
+    /// The window (the view at --size, the panel beside it) and the device; the scene opens on a
+    /// thread.
     fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let a = self.scene.take().expect("the scene flags until the start");
         // --size is the view's; the window is as tall as the panel needs at least.
-        let (w, h) = self.args.scene.size;
+        let (w, h) = a.size;
         let (width, h) = (w + self.args.panel.ceil() as u32, h.max(MIN_HEIGHT));
         let attributes = Window::default_attributes()
             .with_title("voxsplat")
@@ -241,62 +334,69 @@ impl App {
         let window = Arc::new(event_loop.create_window(attributes).map_err(|e| Error::Unsupported(e.to_string()))?);
         let size = window.inner_size();
         let options = PresentOptions {
-            context: voxsplat::vk::ContextOptions { validation: self.args.scene.validation, device_name: None },
+            context: voxsplat::vk::ContextOptions { validation: a.validation, device_name: None },
             no_vsync: self.args.no_vsync,
         };
         let presenter = Presenter::new(window.clone(), (size.width, size.height), &options)?;
-        let mut renderer = Renderer::with_context(presenter.context().clone())?;
-        let a = &self.args.scene;
-        let s = &mut self.state;
-        let series = a.volume.as_ref().filter(|_| a.time.is_none()).map(|p| voxsplat::loaders::time_points(p));
-        let (bricked, set, content) = if series.transpose()?.is_some_and(|t| t > 1) {
-            let series = crate::series::Series::open(a)?;
-            let scene = series.scene(a, 0)?;
-            let content = crate::open::Content { orientation: series.orientation(), bounds: scene.visible_bounds() };
-            let set = voxsplat::SplatSet::empty(scene.store.grid()?)?;
-            s.series = Some((series, 0));
-            (Some(scene), set, content)
-        } else {
-            crate::open::open(a, s.options.order != voxsplat::OrderKind::Pbtf)?
-        };
-        let grid = *set.grid();
-        match bricked {
-            Some(b) => {
-                s.histogram = Some(b.store.histogram(HISTOGRAM_BINS)?);
-                s.tf = Some(b.transfer_function().clone());
-                s.light = b.shading();
-                s.shading_on = s.light.is_some();
-                let d = b.store.dims;
-                s.title = format!("{} x {} x {} voxels on {}", d[0], d[1], d[2], renderer.device_name());
-                renderer.set_bricks(b)?;
-            }
-            None => {
-                s.title = format!("{} splats on {}", set.len(), renderer.device_name());
-                renderer.set_scene(set)?;
-            }
-        }
-        s.base = Some(crate::open::camera_of(a, &grid, &content)?);
-        s.radius = 0.5 * grid.diagonal() + 4.0 * grid.kernel_spacing();
-        let viewport_id = egui::ViewportId::ROOT;
+        self.renderer = Some(Renderer::with_context(presenter.context().clone())?);
+        self.loading = Some(load::Loading::start(a, self.state.options.order != voxsplat::OrderKind::Pbtf));
         let input = egui_winit::State::new(
             self.egui.clone(),
-            viewport_id,
+            egui::ViewportId::ROOT,
             &window,
             Some(window.scale_factor() as f32),
             None,
             None,
         );
         self.input = Some(input);
-        self.renderer = Some(renderer);
         self.presenter = Some(presenter);
         self.window = Some(window);
         Ok(())
+    }
+
+    /// While the file opens: its progress, until the thread hands the scene over.
+    fn wait_for_load(&mut self, window: &Window) -> Result<bool> {
+        let Some(loading) = &self.loading else { return Ok(true) };
+        let renderer = self.renderer.as_mut().expect("made with the window");
+        if let Some(a) = loading.poll(&mut self.state, renderer)? {
+            self.scene = Some(a);
+            self.loading = None;
+            return Ok(true);
+        }
+        let input = self.input.as_mut().expect("made with the window");
+        let raw = input.take_egui_input(window);
+        let (what, fraction) = (loading.what.clone(), loading.fraction());
+        let full = self.egui.run_ui(raw, |ui| {
+            egui::CentralPanel::default().show(ui, |ui| {
+                ui.heading(format!("opening {what}"));
+                match fraction {
+                    Some(f) => ui.add(egui::ProgressBar::new(f).show_percentage()),
+                    None => ui.spinner(),
+                };
+            });
+        });
+        input.handle_platform_output(window, full.platform_output);
+        let primitives = self.egui.tessellate(full.shapes, full.pixels_per_point);
+        let overlay = OverlayFrame {
+            primitives: &primitives,
+            textures: &full.textures_delta,
+            pixels_per_point: full.pixels_per_point,
+        };
+        let presenter = self.presenter.as_mut().expect("made with the window");
+        presenter.frame(None, [0.0, 0.0, 0.0, 1.0], None, &overlay, false)?;
+        std::thread::sleep(std::time::Duration::from_millis(30));
+        window.request_redraw();
+        Ok(false)
     }
 
     /// One frame: the panel, what it changed, the volume when something it shows changed, the
     /// overlay, the scripted steps.
     fn redraw(&mut self) -> Result<()> {
         let Some(window) = self.window.clone() else { return Ok(()) };
+        if !self.wait_for_load(&window)? {
+            return Ok(());
+        }
+        let frame_start = Instant::now();
         let input = self.input.as_mut().expect("made with the window");
         let mut raw = input.take_egui_input(&window);
         let step = match &mut self.script {
@@ -304,7 +404,8 @@ impl App {
             None => None,
         };
         let state = &mut self.state;
-        let full = self.egui.run_ui(raw, |ui| panel::ui(ui, state));
+        let store = self.renderer.as_ref().and_then(|r| r.volume()).map(|v| &v.store);
+        let full = self.egui.run_ui(raw, |ui| panel::ui(ui, state, store));
         input.handle_platform_output(&window, full.platform_output);
         self.apply()?;
         let ppp = full.pixels_per_point;
@@ -328,24 +429,27 @@ impl App {
         let cam = s.orbit.camera(&base, s.radius, (viewport.width, viewport.height));
         let mut options = s.render_options()?;
         if s.dragging {
-            options.render_scale = options.render_scale.min(s.scale);
+            // A drag frame: fewer pixels and fewer splats. The splats set the cost, and they come
+            // in levels (each a quarter of the last), so the pixel bound moves with the scale.
+            options.render_scale = (options.render_scale / s.coarse).max(0.25);
+            options.lod_pixels *= s.coarse;
+            options.lod_error = options.lod_error.max(DRAG_LOD_ERROR);
         }
         let changed = s.dirty || self.drawn.as_ref().is_none_or(|d| d.0 != viewport || d.1 != cam || d.2 != options);
         let renderer = self.renderer.as_mut().expect("started");
         let mut ms = None;
-        let mut timings = Vec::new();
+        let mut delivered = None;
         let mut draw = |t: &voxsplat::vk::HostTarget| {
             let start = Instant::now();
-            let delivered = renderer.render_to(&cam, &options, t)?;
+            delivered = Some(renderer.render_to(&cam, &options, t)?);
             ms = Some(start.elapsed().as_secs_f64() * 1e3);
-            timings = delivered.timings;
             Ok(())
         };
         let overlay = OverlayFrame { primitives: &primitives, textures: &full.textures_delta, pixels_per_point: ppp };
         let read_back = s.shot_now.is_some();
         let clear = [0.0, 0.0, 0.0, 1.0];
         let draw: Option<voxsplat::vk::DrawView<'_>> = if changed { Some(&mut draw) } else { None };
-        let presented = presenter.frame(viewport, clear, draw, &overlay, read_back)?;
+        let presented = presenter.frame(Some(viewport), clear, draw, &overlay, read_back)?;
         if !presented.shown {
             presenter.resize((window.inner_size().width, window.inner_size().height))?;
             self.drawn = None;
@@ -353,13 +457,19 @@ impl App {
         }
         if let Some(ms) = ms {
             s.last_ms = ms;
-            self.times.push(ms);
-            s.stats = stage_summary(&timings);
+            self.times.push((ms, s.dragging.then_some(options.render_scale), ms));
+            if self.first_frame.is_none() {
+                self.first_frame = Some(self.started.elapsed().as_secs_f64());
+            }
+            s.stats = delivered.as_ref().map(frame_summary).unwrap_or_default();
             s.dirty = false;
             if s.dragging {
-                // Hold the target: the cost goes roughly with the pixels drawn.
-                let ratio = (self.args.drag_ms as f64 / ms).sqrt() as f32;
-                s.scale = (options.render_scale * ratio).clamp(0.25, 1.0);
+                // Hold the target: coarser when over it, finer when well under.
+                // The window's own share (the panel, the overlay, the present) counts too.
+                let ratio = ((ms + s.overhead_ms) / self.args.drag_ms as f64).sqrt() as f32;
+                if !(0.7..=1.0).contains(&ratio) {
+                    s.coarse = (s.coarse * ratio).clamp(1.0, DRAG_COARSE_MAX);
+                }
             }
             self.drawn = Some((viewport, cam, options.clone()));
         }
@@ -367,21 +477,34 @@ impl App {
             save_png(&path, presenter.size(), rgba)?;
             s.message = format!("saved {}", path.display());
         }
-        // The value under the pointer, for the next frame's panel.
-        let hover = match s.pointer {
-            Some(p) if !s.dragging => {
+        // The value under the pointer, for the next frame's panel (picked again only when the
+        // pointer or the camera moved).
+        let at = s.pointer.filter(|_| !s.dragging).map(|p| (p, cam));
+        if at != s.picked_at {
+            s.picked_at = at;
+            let pick = at.map(|(p, _)| {
                 let (px, py) = (p.x * ppp, p.y * ppp);
-                match renderer.pick(&cam, &options, px.min(cam.width as f32), py.min(cam.height as f32)) {
-                    Ok(Some(pick)) => Some(pick_text(&pick, s.histogram.as_ref(), s.tf.as_ref())),
-                    Ok(None) => Some("(nothing under the pointer)".into()),
-                    Err(e) => Some(e.to_string()),
-                }
+                renderer.pick(&cam, &options, px.min(cam.width as f32), py.min(cam.height as f32))
+            });
+            s.hover_voxel = match &pick {
+                Some(Ok(Some(p))) => Some(p.voxel),
+                _ => None,
+            };
+            let hover = pick.map(|p| match p {
+                Ok(Some(pick)) => pick_text(&pick, s.histogram.as_ref()),
+                Ok(None) => "(nothing under the pointer)".into(),
+                Err(e) => e.to_string(),
+            });
+            if hover != s.hover {
+                s.hover = hover;
+                window.request_redraw();
             }
-            _ => None,
-        };
-        if hover != s.hover {
-            s.hover = hover;
-            window.request_redraw();
+        }
+        if std::mem::take(&mut s.clicked) {
+            if let (Some(v), Some(slices)) = (s.hover_voxel, &mut s.slices) {
+                slices.voxel = v;
+                window.request_redraw();
+            }
         }
         if let Some(step) = step {
             let view = presenter.read_view();
@@ -393,6 +516,13 @@ impl App {
         }
         if self.script.as_ref().is_some_and(|s| s.done()) {
             self.state.quit = true;
+        }
+        if ms.is_some() {
+            // The whole window frame: the panel, the volume, the overlay, the present.
+            if let Some(last) = self.times.last_mut() {
+                last.2 = frame_start.elapsed().as_secs_f64() * 1e3;
+                self.state.overhead_ms = (last.2 - last.0).max(0.0);
+            }
         }
         Ok(())
     }
@@ -435,15 +565,23 @@ impl App {
     }
 }
 
-/// The stages that took the most of the frame.
-fn stage_summary(timings: &[voxsplat::StageTime]) -> String {
-    let mut t: Vec<_> = timings.iter().filter(|s| s.ms > 0.0).collect();
+/// The stages that took the most of the frame (ms), and what a bricked volume's frame drew.
+fn frame_summary(d: &voxsplat::Delivered) -> String {
+    let mut t: Vec<_> = d.timings.iter().filter(|s| s.ms > 0.0).collect();
     t.sort_by(|a, b| b.ms.total_cmp(&a.ms));
-    t.iter().take(4).map(|s| format!("{} {:.1}", s.stage, s.ms)).collect::<Vec<_>>().join(", ")
+    let stages = t.iter().take(4).map(|s| format!("{} {:.1}", s.stage, s.ms)).collect::<Vec<_>>().join(", ");
+    let st = &d.stats;
+    if st.bricks == 0 {
+        return stages;
+    }
+    format!(
+        "{stages}\n{} splats from {} of {} bricks ({} coarser, {} hidden by nearer ones)",
+        st.splats, st.bricks_visible, st.bricks, st.bricks_coarse, st.bricks_hidden
+    )
 }
 
 /// The pick as the panel shows it: the raw value where the store's range is known.
-fn pick_text(p: &voxsplat::Pick, h: Option<&Histogram>, _tf: Option<&TransferFunction>) -> String {
+fn pick_text(p: &voxsplat::Pick, h: Option<&Histogram>) -> String {
     let raw = h.map(|h| h.range.0 + p.value * (h.range.1 - h.range.0));
     let value = match raw {
         Some(r) => format!("value {r:.4} ({:.3} of the range)", p.value),
@@ -516,10 +654,24 @@ pub fn view(args: ViewArgs) -> Result<()> {
     if let Some(e) = app.failure.take() {
         return Err(e);
     }
-    let mut times = app.times.clone();
-    if !times.is_empty() {
-        times.sort_by(f64::total_cmp);
-        println!("{} frames drawn, median {:.1} ms", times.len(), times[times.len() / 2]);
+    if let Some(first) = app.first_frame {
+        println!("first frame {first:.2} s after the start (the file read, the device made, the frame drawn)");
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    for (what, dragged) in [("still", false), ("while dragging", true)] {
+        let t: Vec<_> = app.times.iter().filter(|t| t.1.is_some() == dragged).collect();
+        if !t.is_empty() {
+            let volume = median(t.iter().map(|t| t.0).collect());
+            let window = median(t.iter().map(|t| t.2).collect());
+            let scale = median(t.iter().map(|t| t.1.unwrap_or(1.0) as f64).collect());
+            println!(
+                "{} frames drawn {what}: median {volume:.1} ms the volume, {window:.1} ms the window frame, scale {scale:.2}",
+                t.len()
+            );
+        }
     }
     if let Some((n, messages)) = validation.filter(|v| v.0 > 0) {
         for m in messages {

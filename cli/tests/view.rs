@@ -1,8 +1,10 @@
 //! `voxsplat view` end to end (issue 48 item 7): under Xvfb on lavapipe with the validation layer,
 //! a scripted session opens the bonsai, edits the transfer function with synthetic pointer events
-//! (a point dragged, one added), switches to MIP by key and picks a voxel. The window's screenshot
+//! (a point dragged, one added), switches to MIP by key and clicks a voxel (the slices' crosshair
+//! follows). The window's screenshot
 //! shows the panel and the image; the image equals `render --session` of the saved session within
-//! one 8-bit step; the picked value is the file's value at the picked voxel (nibabel reads it).
+//! one 8-bit step, as does `view --session` of it; the picked value is the file's value at the
+//! picked voxel (nibabel reads it).
 mod cmd;
 use cmd::{tmp_in, voxsplat};
 use std::path::Path;
@@ -75,6 +77,18 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     assert!(lit > 3000, "the reference shows the bonsai ({lit} pixels lit)");
     assert!(worst <= 1, "the view differs from render --session by {worst}/255");
 
+    // The window opens the saved session again: the same image.
+    let (again, script2) = (tmp_in("view", "again.png"), tmp_in("view", "again.txt"));
+    std::fs::write(&script2, format!("wait 1\nview {}\n", again.display())).unwrap();
+    let mut run = Command::new("xvfb-run");
+    run.args(["-a", "-s", "-screen 0 800x600x24", env!("CARGO_BIN_EXE_voxsplat"), "view", "--volume", volume]);
+    run.args(["--session", session, "--size", "160x480", "--validation", "--script"]).arg(&script2);
+    let out = run.output().expect("xvfb-run");
+    assert!(out.status.success(), "view --session failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    let again = rgba(&again);
+    let worst = image.pixels().zip(again.pixels()).map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap());
+    assert!(worst.max().unwrap() <= 1, "view --session draws the session's frame again");
+
     // The pick: the file's value at the voxel, read by nibabel.
     let line = stdout.lines().find(|l| l.starts_with("pick: value")).unwrap_or_else(|| panic!("no pick:\n{stdout}"));
     let words: Vec<&str> = line.split_whitespace().collect();
@@ -88,6 +102,8 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     let out = Command::new("python3").args(["-c", &script]).output().expect("python3 with nibabel");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let file: f64 = String::from_utf8_lossy(&out.stdout).trim().parse().unwrap();
+    let crosshair = format!("crosshair [{}, {}, {}]", voxel[0], voxel[1], voxel[2]);
+    assert!(line.contains(&crosshair), "the click moved the slices' crosshair to the picked voxel: {line}");
     assert!((value - file).abs() < 1e-3, "picked {value} at {voxel:?}, the file holds {file}");
 }
 
@@ -97,6 +113,7 @@ fn view_refuses_what_cannot_apply_before_opening_a_window() {
     std::fs::write(&script, "wait 1\nwiggle 3 4\n").unwrap();
     for (args, says) in [
         (vec!["view", "--scene", "cube40", "--cpu"], "--cpu does not apply"),
+        (vec!["view", "--scene", "cube40", "--session", "s.toml"], "--volume"),
         (vec!["view", "--scene", "cube40", "--panel", "50"], "--panel 50"),
         (vec!["view", "--scene", "cube40", "--drag-ms", "0"], "--drag-ms 0"),
         (vec!["view", "--scene", "cube40", "--script", script.to_str().unwrap()], "script line 2: unknown command"),

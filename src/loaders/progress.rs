@@ -14,6 +14,11 @@ impl Progress {
         Progress(Arc::new(report))
     }
 
+    /// Report `read` of `of` (as the loader does after each slab).
+    pub fn report(&self, read: u64, of: u64) {
+        (self.0)(read, of)
+    }
+
     pub(crate) fn as_fn(&self) -> &dyn Fn(u64, u64) {
         &*self.0
     }

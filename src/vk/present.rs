@@ -376,10 +376,11 @@ impl Presenter {
     /// image is `viewport`'s size and the swapchain's format) and returns; without it the last
     /// frame's image is shown again (the overlay alone changed). The image is copied into
     /// `viewport`, the rest of the window cleared to `clear` (linear RGBA), the overlay drawn over
-    /// both, and the window presented. `read_back` also returns the window's pixels.
+    /// both, and the window presented. With no viewport (nothing loaded yet) the window is the
+    /// clear colour and the overlay. `read_back` also returns the window's pixels.
     pub fn frame(
         &mut self,
-        viewport: Viewport,
+        viewport: Option<Viewport>,
         clear: [f32; 4],
         draw: Option<DrawView<'_>>,
         overlay: &OverlayFrame<'_>,
@@ -387,11 +388,13 @@ impl Presenter {
     ) -> Result<Presented> {
         let Some(chain) = &self.chain else { return Ok(Presented { shown: false, window_rgba: None }) };
         let extent = chain.extent;
-        let fits = viewport.width > 0
-            && viewport.height > 0
-            && viewport.x.checked_add(viewport.width).is_some_and(|r| r <= extent.width)
-            && viewport.y.checked_add(viewport.height).is_some_and(|b| b <= extent.height);
-        if !fits {
+        let fits = |v: &Viewport| {
+            v.width > 0
+                && v.height > 0
+                && v.x.checked_add(v.width).is_some_and(|r| r <= extent.width)
+                && v.y.checked_add(v.height).is_some_and(|b| b <= extent.height)
+        };
+        if let Some(viewport) = viewport.filter(|v| !fits(v)) {
             return Err(Error::InvalidArgument(format!(
                 "viewport {viewport:?} is not inside the {} x {} window",
                 extent.width, extent.height
@@ -406,16 +409,8 @@ impl Presenter {
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => return Ok(Presented { shown: false, window_rgba: None }),
             Err(e) => return Err(Error::vk("vkAcquireNextImageKHR")(e)),
         };
-        let size = (viewport.width, viewport.height);
-        let fresh = self.view.is_none() || self.view_size != size;
-        if fresh {
-            self.view = Some(TargetImage::new(&self.ctx, target_format(self.format)?, size.0, size.1)?);
-            self.view_size = size;
-        }
-        let view = self.view.as_ref().expect("made above");
-        let drawn = match draw {
-            Some(draw) => draw(&view.target(vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)?),
-            None if fresh => Err(Error::InvalidArgument("a viewport of a new size needs a frame drawn".into())),
+        let drawn = match viewport {
+            Some(v) => self.draw_view((v.width, v.height), draw),
             None => Ok(()),
         };
         let chain = self.chain.as_ref().expect("checked above");
@@ -461,32 +456,35 @@ impl Presenter {
             None
         };
         let framebuffer = chain.framebuffers[index];
-        let view_image = view.raw();
+        let copy_view = viewport.zip(self.view.as_ref().map(|v| v.raw()));
         let render_pass = self.render_pass;
         let overlay_renderer = &mut self.overlay;
         self.ctx.submit_synced(Some(&target), |rec| {
             let (d, cmd) = (&rec.ctx.device, rec.cmd);
             layout(rec.ctx, cmd, image, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
             let range = [color_range()];
-            let copy = [vk::ImageCopy::default()
-                .src_subresource(color_layers())
-                .dst_subresource(color_layers())
-                .dst_offset(vk::Offset3D { x: viewport.x as i32, y: viewport.y as i32, z: 0 })
-                .extent(vk::Extent3D { width: viewport.width, height: viewport.height, depth: 1 })];
-            // SAFETY: recording on this frame's command buffer; the images are in the named
-            // layouts (the view as render_to left it, ordered by the submission's first barrier).
-            unsafe {
-                let color = vk::ClearColorValue { float32: clear };
-                d.cmd_clear_color_image(cmd, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &color, &range);
-                transfer_barrier(d, cmd, image);
-                d.cmd_copy_image(
-                    cmd,
-                    view_image,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    image,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &copy,
-                );
+            let color = vk::ClearColorValue { float32: clear };
+            // SAFETY: recording on this frame's command buffer; the image is in TRANSFER_DST.
+            unsafe { d.cmd_clear_color_image(cmd, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &color, &range) };
+            if let Some((viewport, view_image)) = copy_view {
+                let copy = [vk::ImageCopy::default()
+                    .src_subresource(color_layers())
+                    .dst_subresource(color_layers())
+                    .dst_offset(vk::Offset3D { x: viewport.x as i32, y: viewport.y as i32, z: 0 })
+                    .extent(vk::Extent3D { width: viewport.width, height: viewport.height, depth: 1 })];
+                // SAFETY: as above; the view is as render_to left it, ordered by the submission's
+                // first barrier.
+                unsafe {
+                    transfer_barrier(d, cmd, image);
+                    d.cmd_copy_image(
+                        cmd,
+                        view_image,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        image,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        &copy,
+                    );
+                }
             }
             layout(
                 rec.ctx,
@@ -535,6 +533,21 @@ impl Presenter {
         };
         let shown = self.present(index, done)?;
         Ok(Presented { shown, window_rgba })
+    }
+
+    /// The volume's image at `size`, drawn by `draw` (or the last one, when the size is the same).
+    fn draw_view(&mut self, size: (u32, u32), draw: Option<DrawView<'_>>) -> Result<()> {
+        let fresh = self.view.is_none() || self.view_size != size;
+        if fresh {
+            self.view = Some(TargetImage::new(&self.ctx, target_format(self.format)?, size.0, size.1)?);
+            self.view_size = size;
+        }
+        let view = self.view.as_ref().expect("made above");
+        match draw {
+            Some(draw) => draw(&view.target(vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)?),
+            None if fresh => Err(Error::InvalidArgument("a viewport of a new size needs a frame drawn".into())),
+            None => Ok(()),
+        }
     }
 
     /// The volume's image of the last frame as the display shows it: RGBA8, `viewport`'s size.

@@ -2,6 +2,7 @@
 //! writes `State`; the window loop applies what changed to the renderer.
 use super::{State, COMPOSITES, KERNELS, ORDERS, RASTERS};
 use egui::{Key, PointerButton, Rect, Sense};
+use voxsplat::bricks::BrickStore;
 use voxsplat::{Lod, Mode};
 
 /// The key help the panel shows (and `?` opens).
@@ -10,6 +11,8 @@ pub const KEYS: &[(&str, &str)] = &[
     ("middle drag, ctrl + left drag", "pan"),
     ("wheel", "zoom"),
     ("pointer over the volume", "the value, voxel and position under it"),
+    ("click on the volume", "the slices' crosshair to the voxel under the pointer"),
+    ("click in a slice", "the crosshair within that plane"),
     ("m", "next mode (composite, MIP, MinIP, average, X-ray, iso)"),
     (", .", "iso value down, up"),
     ("l", "levels of detail on or off"),
@@ -22,9 +25,9 @@ pub const KEYS: &[(&str, &str)] = &[
 ];
 
 /// Draw the panel and the central view; record what changed in `state`.
-pub fn ui(ui: &mut egui::Ui, s: &mut State) {
+pub fn ui(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
     egui::Panel::left("controls").exact_size(s.panel_width).resizable(false).show(ui, |ui| {
-        egui::ScrollArea::vertical().show(ui, |ui| controls(ui, s));
+        egui::ScrollArea::vertical().show(ui, |ui| controls(ui, s, store));
     });
     egui::CentralPanel::no_frame().show(ui, |ui| {
         let rect = ui.available_rect_before_wrap();
@@ -35,14 +38,14 @@ pub fn ui(ui: &mut egui::Ui, s: &mut State) {
     keys(ui, s);
 }
 
-fn controls(ui: &mut egui::Ui, s: &mut State) {
+fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
     ui.heading("voxsplat");
     ui.label(&s.title);
     ui.label(format!(
         "{:.1} ms a frame ({:.1} fps){}",
         s.last_ms,
         1e3 / s.last_ms.max(1e-3),
-        if s.scale < 1.0 { format!(", drawn at {:.2} scale", s.scale) } else { String::new() }
+        if s.dragging { format!(", a drag frame {:.1}x coarser", s.coarse) } else { String::new() }
     ));
     if !s.stats.is_empty() {
         ui.label(&s.stats);
@@ -82,6 +85,12 @@ fn controls(ui: &mut egui::Ui, s: &mut State) {
             ui.label("transfer-function editing needs a --volume file");
         }
     }
+    if let (Some(slices), Some(store), Some(h)) = (&mut s.slices, store, &s.histogram) {
+        let window = s.tf.as_ref().and_then(|t| t.range).unwrap_or(h.range);
+        egui::CollapsingHeader::new("slices").default_open(true).show(ui, |ui| {
+            slices.ui(ui, store, window);
+        });
+    }
     ui.separator();
     if s.tf.is_some() {
         let mut shaded = s.shading_on;
@@ -111,6 +120,7 @@ fn controls(ui: &mut egui::Ui, s: &mut State) {
             s.time_to = Some(t);
         }
     }
+    egui::CollapsingHeader::new("clipping").show(ui, |ui| clipping(ui, s));
     ui.separator();
     ui.horizontal(|ui| {
         if ui.button("save session").clicked() {
@@ -132,6 +142,43 @@ fn controls(ui: &mut egui::Ui, s: &mut State) {
             }
         });
     });
+}
+
+/// A clip plane facing the view and a crop box.
+fn clipping(ui: &mut egui::Ui, s: &mut State) {
+    let mut plane = s.clip_plane.is_some();
+    if ui.checkbox(&mut plane, "plane through the centre, facing the view").changed() {
+        s.clip_plane = if plane { s.view_direction().map(|n| (n, 0.0)) } else { None };
+        s.dirty = true;
+    }
+    let radius = s.radius;
+    if let Some((_, offset)) = &mut s.clip_plane {
+        if ui.add(egui::Slider::new(offset, -radius..=radius).text("offset")).changed() {
+            s.dirty = true;
+        }
+    }
+    let mut crop = s.crop.is_some();
+    if ui.checkbox(&mut crop, "crop box (fractions of the grid)").changed() {
+        s.crop = crop.then_some([[0.0; 3], [1.0; 3]]);
+        s.dirty = true;
+    }
+    if let Some([lo, hi]) = &mut s.crop {
+        for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
+            ui.horizontal(|ui| {
+                let a = ui.add(egui::Slider::new(&mut lo[axis], 0.0..=1.0).text(name));
+                let b = ui.add(egui::Slider::new(&mut hi[axis], 0.0..=1.0));
+                if a.changed() || b.changed() {
+                    // Never empty: the box keeps a hundredth of the grid at least.
+                    if a.changed() {
+                        lo[axis] = lo[axis].min(hi[axis] - 0.01).max(0.0);
+                    } else {
+                        hi[axis] = hi[axis].max(lo[axis] + 0.01).min(1.0);
+                    }
+                    s.dirty = true;
+                }
+            });
+        }
+    }
 }
 
 fn choice(ui: &mut egui::Ui, label: &str, names: &[&str], value: &mut String, dirty: &mut bool) {
@@ -171,6 +218,9 @@ fn view_input(ui: &egui::Ui, s: &mut State, rect: Rect, r: &egui::Response) {
         }
     }
     s.pointer = r.hover_pos().filter(|_| !r.dragged()).map(|p| p - rect.min);
+    if r.clicked() {
+        s.clicked = true;
+    }
 }
 
 /// The keyboard, when no text field holds it.

@@ -9,7 +9,8 @@
 //! add-tf X Y          double-click the editor there: a new point
 //! delete-tf I         right-click the editor's point I
 //! key K               press and release key K (a letter, comma, period)
-//! pick X Y            pointer to (X, Y), fractions of the view; print the value under it
+//! pick X Y            click at (X, Y), fractions of the view; print the value under it and
+//!                     the slices' crosshair
 //! wait N              N frames
 //! shot PATH           the window's pixels as a PNG
 //! view PATH           the volume's image alone as a PNG
@@ -196,10 +197,11 @@ fn expand(n: usize, line: Line, s: &State) -> Result<Vec<Step>> {
         Line::Pick(f) => {
             let rect = s.view_rect.ok_or_else(|| missing("no view laid out"))?;
             let p = in_rect(rect, f);
-            // One frame to move and pick, one to report it.
+            // One frame to move and pick, one to click (the crosshair follows) and report it.
+            let click = |pressed| button(p, PointerButton::Primary, pressed);
             vec![
                 Step { events: vec![Event::PointerMoved(p)], after: None },
-                Step { events: vec![], after: Some(Line::Pick(f)) },
+                Step { events: vec![click(true), click(false)], after: Some(Line::Pick(f)) },
             ]
         }
         Line::Wait(frames) => (0..frames).map(|_| Step::default()).collect(),
@@ -213,7 +215,10 @@ impl Step {
     /// After the frame: report a pick, save what was asked.
     pub fn after(self, s: &mut State, cam: &Camera, view: Result<Vec<u8>>, size: (u32, u32)) -> Result<()> {
         match self.after {
-            Some(Line::Pick(_)) => println!("pick: {}", s.hover.clone().unwrap_or_default().replace('\n', "; ")),
+            Some(Line::Pick(_)) => {
+                let crosshair = s.slices.as_ref().map(|c| format!("; crosshair {:?}", c.voxel)).unwrap_or_default();
+                println!("pick: {}{crosshair}", s.hover.clone().unwrap_or_default().replace('\n', "; "));
+            }
             Some(Line::Shot(path)) => s.shot_now = Some(path),
             Some(Line::View(path)) => {
                 let img = image::RgbaImage::from_raw(size.0, size.1, view?)
