@@ -507,8 +507,7 @@ impl App {
             }
         }
         if let Some(step) = step {
-            let view = presenter.read_view();
-            step.after(s, &cam, view, (viewport.width, viewport.height))?;
+            step.after(s, &cam, || presenter.read_view(), (viewport.width, viewport.height))?;
         }
         let repaint = full.viewport_output.get(&egui::ViewportId::ROOT).is_some_and(|v| v.repaint_delay.is_zero());
         if s.dirty || repaint || self.script.as_ref().is_some_and(|s| !s.done()) {
@@ -593,7 +592,7 @@ fn pick_text(p: &voxsplat::Pick, h: Option<&Histogram>) -> String {
     )
 }
 
-fn save_png(path: &std::path::Path, size: (u32, u32), rgba: Vec<u8>) -> Result<()> {
+pub(super) fn save_png(path: &std::path::Path, size: (u32, u32), rgba: Vec<u8>) -> Result<()> {
     let img = image::RgbaImage::from_raw(size.0, size.1, rgba)
         .ok_or_else(|| Error::InvalidArgument("a screenshot of the wrong size".into()))?;
     img.save(path).map_err(|e| Error::Image { path: path.display().to_string(), message: e.to_string() })

@@ -519,16 +519,8 @@ impl Presenter {
             self.overlay.free_texture(*id).map_err(overlay_err)?;
         }
         let window_rgba = match &back {
-            Some(b) => {
-                let bgra = matches!(self.format, vk::Format::B8G8R8A8_SRGB | vk::Format::B8G8R8A8_UNORM);
-                let texels = b.read()?;
-                Some(
-                    texels
-                        .chunks_exact(4)
-                        .flat_map(|t| if bgra { [t[2], t[1], t[0], 255] } else { [t[0], t[1], t[2], 255] })
-                        .collect(),
-                )
-            }
+            // The window is opaque: its alpha says nothing.
+            Some(b) => Some(rgba8(self.format, b.read()?, Some(255))),
             None => None,
         };
         let shown = self.present(index, done)?;
@@ -554,12 +546,7 @@ impl Presenter {
     pub fn read_view(&self) -> Result<Vec<u8>> {
         let view = self.view.as_ref().ok_or_else(|| Error::InvalidArgument("no frame drawn yet".into()))?;
         let target = view.target(vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)?;
-        let texels = self.ctx.read_target(&target)?;
-        let bgra = matches!(self.format, vk::Format::B8G8R8A8_SRGB | vk::Format::B8G8R8A8_UNORM);
-        Ok(texels
-            .chunks_exact(4)
-            .flat_map(|t| if bgra { [t[2], t[1], t[0], t[3]] } else { [t[0], t[1], t[2], t[3]] })
-            .collect())
+        Ok(rgba8(self.format, &self.ctx.read_target(&target)?, None))
     }
 
     /// Present image `index` once `done` signals; false when the swapchain is out of date.
@@ -595,6 +582,22 @@ impl Drop for Presenter {
             self.surface_fn.destroy_surface(self.surface, None);
         }
     }
+}
+
+/// 8-bit texels of `format` as RGBA, with `alpha` in place of theirs when given.
+fn rgba8(format: vk::Format, texels: &[u8], alpha: Option<u8>) -> Vec<u8> {
+    let bgra = matches!(format, vk::Format::B8G8R8A8_SRGB | vk::Format::B8G8R8A8_UNORM);
+    texels
+        .chunks_exact(4)
+        .flat_map(|t| {
+            let a = alpha.unwrap_or(t[3]);
+            if bgra {
+                [t[2], t[1], t[0], a]
+            } else {
+                [t[0], t[1], t[2], a]
+            }
+        })
+        .collect()
 }
 
 fn color_layers() -> vk::ImageSubresourceLayers {

@@ -213,19 +213,21 @@ fn expand(n: usize, line: Line, s: &State) -> Result<Vec<Step>> {
 
 impl Step {
     /// After the frame: report a pick, save what was asked.
-    pub fn after(self, s: &mut State, cam: &Camera, view: Result<Vec<u8>>, size: (u32, u32)) -> Result<()> {
+    /// `view` reads the volume's image back, when a line saves it.
+    pub fn after(
+        self,
+        s: &mut State,
+        cam: &Camera,
+        view: impl FnOnce() -> Result<Vec<u8>>,
+        size: (u32, u32),
+    ) -> Result<()> {
         match self.after {
             Some(Line::Pick(_)) => {
                 let crosshair = s.slices.as_ref().map(|c| format!("; crosshair {:?}", c.voxel)).unwrap_or_default();
                 println!("pick: {}{crosshair}", s.hover.clone().unwrap_or_default().replace('\n', "; "));
             }
             Some(Line::Shot(path)) => s.shot_now = Some(path),
-            Some(Line::View(path)) => {
-                let img = image::RgbaImage::from_raw(size.0, size.1, view?)
-                    .ok_or_else(|| Error::InvalidArgument("the view's image is short".into()))?;
-                img.save(&path)
-                    .map_err(|e| Error::Image { path: path.display().to_string(), message: e.to_string() })?;
-            }
+            Some(Line::View(path)) => super::save_png(&path, size, view()?)?,
             Some(Line::Session(path)) => s.session(cam)?.save(&path)?,
             Some(Line::Tf(path)) => {
                 let tf = s.tf.as_ref().ok_or_else(|| Error::InvalidArgument("no transfer function to save".into()))?;
