@@ -140,6 +140,10 @@ fn render_to_over_the_hosts_image_composites_the_frame_over_what_it_held() {
         let target = unsafe { image.target(layout, layout).unwrap().over() }.unwrap();
         g.render_to(&moved, &over, &target).unwrap();
         let got = g.read_target(&target).unwrap();
+        // The same drawing written by the host (`TargetImage::over`) gets the same frame.
+        let written = g.target_image(format, cam.width, cam.height).unwrap();
+        g.render_to(&moved, &over, &written.over(&held, layout).unwrap()).unwrap();
+        assert!(g.read_target(&written.target(layout, layout).unwrap()).unwrap() == got, "{format:?}: written");
         // The mirror: the frame presented for this format over the held texels, as stored.
         let mut push = present_push(None, 1, format.linear(), cam.width, cam.height);
         push.sources |= over_bits(format);
@@ -189,6 +193,8 @@ fn render_to_over_the_hosts_image_composites_the_frame_over_what_it_held() {
     // SAFETY: as above.
     let e = unsafe { image.target(IL::UNDEFINED, layout).unwrap().over() }.unwrap_err();
     assert!(e.to_string().contains("nothing to draw over"), "{e}");
+    let e = image.over(&[0; 12], layout).unwrap_err();
+    assert!(e.to_string().contains("12 bytes of drawing for a 80 x 64 image"), "{e}");
     assert_clean(&g);
 }
 

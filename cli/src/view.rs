@@ -10,8 +10,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 use voxsplat::bricks::Histogram;
-use voxsplat::classify::{Shading, TransferFunction};
-use voxsplat::glam::{Vec3, Vec4};
+use voxsplat::classify::Shading;
 use voxsplat::vk::{OverlayFrame, PresentOptions, Presenter, Viewport};
 use voxsplat::{Camera, Error, Mode, RenderOptions, Renderer, Result};
 use winit::application::ApplicationHandler;
@@ -19,14 +18,17 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
+mod handles;
 mod load;
 mod orbit;
 mod panel;
 mod script;
 mod slices;
+mod state;
 mod tf_editor;
 
 pub use orbit::Orbit;
+pub use state::State;
 
 /// The names the panel offers, as `render` takes them.
 pub const ORDERS: &[&str] = &["pbtf", "wbtf", "btf", "pbtf-octant", "sorted"];
@@ -71,137 +73,6 @@ pub struct ViewArgs {
     pub script: Option<PathBuf>,
 }
 
-/// What the panel shows and edits; the window loop applies it.
-pub struct State {
-    pub title: String,
-    pub panel_width: f32,
-    pub base: Option<Camera>,
-    pub radius: f32,
-    pub orbit: Orbit,
-    pub options: RenderOptions,
-    pub order: String,
-    pub composite: String,
-    pub raster: String,
-    pub kernel: String,
-    pub tf: Option<TransferFunction>,
-    pub histogram: Option<Histogram>,
-    pub tf_editor: tf_editor::TfEditor,
-    /// The light the volume opened with (or a headlight made when shading is first turned on).
-    pub light: Option<Shading>,
-    pub shading_on: bool,
-    pub series: Option<(crate::series::Series, u32)>,
-    /// The pointer over the view, in points from its top left corner.
-    pub pointer: Option<egui::Vec2>,
-    pub hover: Option<String>,
-    /// The voxel under the pointer, and where the pointer and camera were when it was picked.
-    pub hover_voxel: Option<[u32; 3]>,
-    picked_at: Option<(egui::Vec2, Camera)>,
-    /// A click on the volume: the crosshair goes to the voxel under it.
-    pub clicked: bool,
-    pub slices: Option<slices::Slices>,
-    pub grid: Option<voxsplat::Grid>,
-    /// A clip plane through the grid's centre (its normal, the offset along it) keeping what lies
-    /// beyond it, and a crop box as fractions of the grid along each axis.
-    pub clip_plane: Option<(Vec3, f32)>,
-    pub crop: Option<[[f32; 3]; 2]>,
-    pub view_rect: Option<egui::Rect>,
-    pub last_ms: f64,
-    pub stats: String,
-    pub message: String,
-    /// How much coarser a drag frame is than the still one (adapted to `drag_ms`): it draws at
-    /// 1 / coarse of the render scale (a quarter at least) with levels of detail `coarse` times
-    /// the pixel bound, the error bound set aside.
-    pub coarse: f32,
-    /// The last window frame's time beyond drawing the volume.
-    pub overhead_ms: f64,
-    pub dragging: bool,
-    pub help: bool,
-    // What the window loop does after the panel ran.
-    pub dirty: bool,
-    pub tf_changed: bool,
-    pub time_to: Option<u32>,
-    pub save_now: bool,
-    pub shot_now: Option<PathBuf>,
-    pub quit: bool,
-}
-
-impl State {
-    /// A mode, with the iso value it needs.
-    pub fn set_mode(&mut self, mode: Mode) {
-        self.options.mode = mode;
-        self.options.iso = (mode == Mode::Iso).then_some(self.options.iso.unwrap_or(ISO_START));
-        self.dirty = true;
-    }
-
-    /// The direction the current view looks along.
-    pub fn view_direction(&self) -> Option<Vec3> {
-        let base = self.base.as_ref()?;
-        let cam = self.orbit.camera(base, self.radius, (base.width, base.height));
-        Some(cam.forward())
-    }
-
-    pub fn home(&mut self) {
-        self.orbit = Orbit::HOME;
-        self.dirty = true;
-    }
-
-    /// The options the panel's names stand for.
-    fn render_options(&self) -> Result<RenderOptions> {
-        let mut o = self.options.clone();
-        o.order = self.order.parse()?;
-        o.composite = self.composite.parse()?;
-        o.raster = self.raster.parse()?;
-        o.kernel = self.kernel.parse()?;
-        if let Some(g) = &self.grid {
-            let planes: Vec<Vec4> = self
-                .clip_plane
-                .map(|(n, offset)| Vec4::new(n.x, n.y, n.z, -n.dot(g.center()) - offset))
-                .into_iter()
-                .collect();
-            let last = Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32));
-            let crop = self.crop.map(|[lo, hi]| g.world_box(Vec3::from(lo) * last, Vec3::from(hi) * last));
-            o.clip = voxsplat::Clip::new(&planes, crop)?;
-        }
-        if o.mode != Mode::Composite {
-            // As `render`: a projection draws in no visibility order and at full detail.
-            (o.order, o.lod) = (voxsplat::OrderKind::Pbtf, voxsplat::Lod::Off);
-        }
-        o.validate()?;
-        Ok(o)
-    }
-
-    /// The session of the frame drawn through `cam`: what `render --session` draws again.
-    pub fn session(&self, cam: &Camera) -> Result<Session> {
-        let tf = self.tf.clone().ok_or_else(|| Error::InvalidArgument("a session needs a --volume file".into()))?;
-        if self.clip_plane.is_some() || self.crop.is_some() {
-            return Err(Error::InvalidArgument("a session holds no clipping: turn the plane and box off first".into()));
-        }
-        let o = &self.options;
-        let projection = o.mode != Mode::Composite;
-        Ok(Session {
-            mode: o.mode.to_string(),
-            iso: o.iso,
-            order: if projection { "pbtf".into() } else { self.order.clone() },
-            composite: self.composite.clone(),
-            raster: self.raster.clone(),
-            lod: if projection || o.lod == voxsplat::Lod::Off { "off".into() } else { "auto".into() },
-            kernel: self.kernel.clone(),
-            background: o.background.unwrap_or([0.0; 4]),
-            camera: Session::view_of(cam),
-            light: Session::light_of(self.shading()),
-            tf,
-        })
-    }
-
-    fn shading(&self) -> Option<Shading> {
-        if self.shading_on {
-            self.light
-        } else {
-            None
-        }
-    }
-}
-
 /// The flags the window loop reads.
 struct Settings {
     panel: f32,
@@ -224,6 +95,8 @@ struct App {
     script: Option<script::Script>,
     /// The viewport of the last frame drawn, in pixels.
     drawn: Option<(Viewport, Camera, RenderOptions)>,
+    /// Whether the view's image holds the clipping's handles (drawn under a still frame).
+    view_has_handles: bool,
     /// Each frame drawn: milliseconds drawing the volume, whether a drag drew it (at what
     /// scale), and milliseconds for the whole window frame.
     times: Vec<(f64, Option<f32>, f64)>,
@@ -287,7 +160,10 @@ impl App {
             grid: None,
             clip_plane: None,
             crop: None,
+            grip: None,
+            handle_pixels: 0,
             view_rect: None,
+            pixels_per_point: 1.0,
             last_ms: 0.0,
             stats: String::new(),
             message: String::new(),
@@ -295,6 +171,7 @@ impl App {
             overhead_ms: 0.0,
             dragging: false,
             help: false,
+            help_pressed: false,
             dirty: true,
             tf_changed: false,
             time_to: None,
@@ -314,6 +191,7 @@ impl App {
             state,
             script,
             drawn: None,
+            view_has_handles: false,
             times: Vec::new(),
             started: Instant::now(),
             first_frame: None,
@@ -409,7 +287,7 @@ impl App {
         input.handle_platform_output(&window, full.platform_output);
         self.apply()?;
         let ppp = full.pixels_per_point;
-        let primitives = self.egui.tessellate(full.shapes, ppp);
+        let mut painted = full.shapes;
         let presenter = self.presenter.as_mut().expect("started");
         let (ww, wh) = presenter.size();
         let Some(rect) = self.state.view_rect else { return Ok(()) };
@@ -436,12 +314,43 @@ impl App {
             options.lod_error = options.lod_error.max(DRAG_LOD_ERROR);
         }
         let changed = s.dirty || self.drawn.as_ref().is_none_or(|d| d.0 != viewport || d.1 != cam || d.2 != options);
+        let handles = s.handle_shapes();
+        // The handles go under a still frame with their depth; the host's depth takes no lower
+        // render scale (a drag frame's) and no sheets or slabs, which get them over the volume.
+        let depth_path = handles.is_some()
+            && options.render_scale == 1.0
+            && options.composite == voxsplat::Composite::Splat
+            && matches!(options.mode, Mode::Composite | Mode::Iso);
+        let mut frame_options = options.clone();
+        if let (true, true, Some(shapes)) = (changed, depth_path, &handles) {
+            let layer = handles::Layer::draw(&cam, shapes, display_bytes(options.background.unwrap_or([0.0; 4])));
+            frame_options.depth = Some(Arc::new(layer.depth_buffer(cam.proj())));
+            frame_options.background = None;
+            s.handle_pixels = layer.drawn;
+            presenter.underlay((viewport.width, viewport.height), layer.rgba)?;
+        }
+        if changed {
+            self.view_has_handles = depth_path;
+        }
+        if let (false, Some(h)) = (self.view_has_handles, &handles) {
+            // Over the volume: in points, from the view's corner.
+            let at = |p: voxsplat::glam::Vec2| rect.min + egui::vec2(p.x, p.y) / ppp;
+            for ([a, b], c) in h.screen_lines(&cam) {
+                let stroke =
+                    egui::Stroke::new(2.0 / ppp, egui::Color32::from_rgba_premultiplied(c[0], c[1], c[2], c[3]));
+                painted.push(egui::epaint::ClippedShape {
+                    clip_rect: rect,
+                    shape: egui::Shape::line_segment([at(a), at(b)], stroke),
+                });
+            }
+        }
+        let primitives = self.egui.tessellate(painted, ppp);
         let renderer = self.renderer.as_mut().expect("started");
         let mut ms = None;
         let mut delivered = None;
         let mut draw = |t: &voxsplat::vk::HostTarget| {
             let start = Instant::now();
-            delivered = Some(renderer.render_to(&cam, &options, t)?);
+            delivered = Some(renderer.render_to(&cam, &frame_options, t)?);
             ms = Some(start.elapsed().as_secs_f64() * 1e3);
             Ok(())
         };
@@ -590,6 +499,17 @@ fn pick_text(p: &voxsplat::Pick, h: Option<&Histogram>) -> String {
         "{value}\nvoxel {} {} {}, at {:.2} {:.2} {:.2}",
         p.voxel[0], p.voxel[1], p.voxel[2], p.world.x, p.world.y, p.world.z
     )
+}
+
+/// A premultiplied linear colour as the display's bytes (sRGB-encoded, premultiplied).
+fn display_bytes(c: [f32; 4]) -> [u8; 4] {
+    let a = c[3].clamp(0.0, 1.0);
+    let encode = |v: f32| {
+        let l = if a > 0.0 { (v / a).clamp(0.0, 1.0) } else { 0.0 };
+        let s = if l <= 0.0031308 { 12.92 * l } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 };
+        (s * a * 255.0).round() as u8
+    };
+    [encode(c[0]), encode(c[1]), encode(c[2]), (a * 255.0).round() as u8]
 }
 
 pub(super) fn save_png(path: &std::path::Path, size: (u32, u32), rgba: Vec<u8>) -> Result<()> {

@@ -4,7 +4,8 @@
 //! follows). The window's screenshot
 //! shows the panel and the image; the image equals `render --session` of the saved session within
 //! one 8-bit step, as does `view --session` of it; the picked value is the file's value at the
-//! picked voxel (nibabel reads it).
+//! picked voxel (nibabel reads it). The crop box's handles draw under the volume with their depth,
+//! a grip dragged moves its face, and a click in a slice pane moves the crosshair.
 mod cmd;
 use cmd::{tmp_in, voxsplat};
 use std::path::Path;
@@ -19,10 +20,16 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     let volume = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/bonsai/bonsai.nii.gz");
     assert!(volume.exists(), "{} (../shared/data beside the clone)", volume.display());
     let volume = volume.to_str().unwrap();
-    let [script, shot, view, session, reference] =
-        ["script.txt", "window.png", "view.png", "session.toml", "reference.png"].map(|f| tmp_in("view", f));
+    let [script, shot, view, session, reference, plain, handles] =
+        ["script.txt", "window.png", "view.png", "session.toml", "reference.png", "plain.png", "handles.png"]
+            .map(|f| tmp_in("view", f));
+    // The crop box's handles (key b) on the composite frame, its z+ grip dragged down, a click in the
+    // z slice; then MIP, a pick, the saved frame.
     let text = format!(
-        "wait 1\ndrag-tf 1 0.23 0.6\nadd-tf 0.9 0.5\nkey m\npick 0.5 0.45\nshot {}\nview {}\nsession {}\n",
+        "wait 1\ndrag-tf 1 0.23 0.6\nadd-tf 0.9 0.5\nview {}\nkey b\nstate\nview {}\ngrip z+ 0 20\nwait 1\nstate\n\
+         key b\nslice z 0.25 0.25\nkey m\npick 0.5 0.45\nshot {}\nview {}\nsession {}\n",
+        plain.display(),
+        handles.display(),
         shot.display(),
         view.display(),
         session.display()
@@ -88,6 +95,28 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     let again = rgba(&again);
     let worst = image.pixels().zip(again.pixels()).map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap());
     assert!(worst.max().unwrap() <= 1, "view --session draws the session's frame again");
+
+    // The handles go under the volume with their depth: they show, the volume hides some of
+    // them, and no pixel they do not cover changes (the box holds the whole grid: it cuts nothing).
+    let states: Vec<&str> = stdout.lines().filter(|l| l.starts_with("state: ")).collect();
+    assert_eq!(states.len(), 2, "{stdout}");
+    let covered: usize = states[0].rsplit(' ').next().unwrap().parse().unwrap();
+    assert!(states[0].contains("crop Some([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])"), "{}", states[0]);
+    let (plain, handles) = (rgba(&plain), rgba(&handles));
+    let near = |p: &image::Rgba<u8>, c: [u8; 3]| (0..3).all(|k| p[k].abs_diff(c[k]) <= 2);
+    let shown = handles.pixels().filter(|p| near(p, [255, 170, 0]) || near(p, [255, 255, 255])).count();
+    let changed = plain.pixels().zip(handles.pixels()).filter(|(a, b)| (0..3).any(|k| a[k].abs_diff(b[k]) > 1)).count();
+    assert!(shown > 200, "the box's edges and grips show ({shown} pixels)");
+    assert!(shown < covered, "the volume hides the handles behind it ({shown} of {covered} pixels shown)");
+    assert!(changed <= covered, "{changed} pixels changed, the handles cover {covered}");
+    // The z+ grip (the top face's, the one in this narrow view) dragged down: that face moved in,
+    // nothing else.
+    let moved = states[1].strip_prefix("state: crop Some([[0.0, 0.0, 0.0], [1.0, 1.0, ").expect(states[1]);
+    let hi_z: f32 = moved.split(']').next().unwrap().parse().unwrap();
+    assert!((0.5..0.99).contains(&hi_z), "{}", states[1]);
+    // The click in the z slice, a quarter across and down it: x a quarter of 256, y three.
+    let slice = stdout.lines().find(|l| l.starts_with("slice: ")).unwrap_or_else(|| panic!("{stdout}"));
+    assert_eq!(slice, "slice: crosshair Some([64, 192, 128])");
 
     // The pick: the file's value at the voxel, read by nibabel.
     let line = stdout.lines().find(|l| l.starts_with("pick: value")).unwrap_or_else(|| panic!("no pick:\n{stdout}"));

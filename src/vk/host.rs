@@ -206,6 +206,7 @@ impl HostTarget {
 /// An image voxsplat owns that frames can be rendered into (`Renderer::render_to`) and read back:
 /// for hosts that sample a texture rather than present a swapchain, and for tests.
 pub struct TargetImage {
+    ctx: Arc<Context>,
     image: Image,
     format: TargetFormat,
 }
@@ -217,7 +218,35 @@ impl TargetImage {
         use vk::ImageUsageFlags as IU;
         let usage = IU::TRANSFER_DST | IU::TRANSFER_SRC | IU::SAMPLED | IU::COLOR_ATTACHMENT;
         let image = Image::new(ctx, "render_to target", (width, height, 1), vk_format(format), usage, false)?;
-        Ok(Self { image, format })
+        Ok(Self { ctx: ctx.clone(), image, format })
+    }
+
+    /// Fill the image with `texels` (the host's drawing: row by row from the top, in the image's
+    /// format's bytes, as `Context::read_target` gives them back) and return it as a frame's
+    /// destination composited over them (`HostTarget::over`), left in `new_layout`. The copy is
+    /// complete when this returns.
+    pub fn over(&self, texels: &[u8], new_layout: vk::ImageLayout) -> Result<HostTarget> {
+        let (w, h) = (self.image.width, self.image.height);
+        let want = w as usize * h as usize * self.format.texel_bytes();
+        if texels.len() != want {
+            return Err(Error::InvalidArgument(format!(
+                "{} bytes of drawing for a {w} x {h} image of {want} bytes ({:?})",
+                texels.len(),
+                self.format
+            )));
+        }
+        let staging = Buffer::with_data(&self.ctx, "target texels", texels, vk::BufferUsageFlags::TRANSFER_SRC)?;
+        let (dst, src) = (vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        self.ctx.submit(|rec| {
+            host_barrier(rec, self.image.raw, (vk::ImageLayout::UNDEFINED, dst));
+            rec.copy_buffer_to_image(&staging, &self.image);
+            host_barrier(rec, self.image.raw, (dst, src));
+            Ok(())
+        })?;
+        let target = self.target(src, new_layout)?;
+        // SAFETY: voxsplat made the image with TRANSFER_SRC usage; the submission above left the
+        // drawing in TRANSFER_SRC_OPTIMAL, the target's old layout, and is complete.
+        unsafe { target.over() }
     }
 
     /// The raw handle, for a host that samples it.

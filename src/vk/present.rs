@@ -87,6 +87,8 @@ pub struct Presenter {
     acquire: Option<Semaphore>,
     view: Option<TargetImage>,
     view_size: (u32, u32),
+    /// The host's drawing under the next view drawn (`underlay`): RGBA8, its size.
+    under: Option<(Vec<u8>, (u32, u32))>,
     _window: Arc<dyn PresentWindow>,
 }
 
@@ -166,6 +168,7 @@ impl Presenter {
             chain: None,
             view: None,
             view_size: (0, 0),
+            under: None,
             _window: window,
         };
         presenter.resize(size)?;
@@ -527,6 +530,24 @@ impl Presenter {
         Ok(Presented { shown, window_rgba })
     }
 
+    /// The host's drawing under the volume of the next frame that draws the view: `rgba` (RGBA8,
+    /// premultiplied, as the display shows it; opaque where nothing is drawn, as it stands in for
+    /// the background) at `size`, the viewport's. That frame's draw gets a target composited over
+    /// it (`HostTarget::over`): render with no background, and with the drawing's depth
+    /// (`RenderOptions::depth`) so that the volume and the drawing hide what lies behind them.
+    pub fn underlay(&mut self, size: (u32, u32), rgba: Vec<u8>) -> Result<()> {
+        if rgba.len() as u64 != size.0 as u64 * size.1 as u64 * 4 {
+            return Err(Error::InvalidArgument(format!(
+                "an underlay of {} bytes for {} x {} pixels",
+                rgba.len(),
+                size.0,
+                size.1
+            )));
+        }
+        self.under = Some((rgba, size));
+        Ok(())
+    }
+
     /// The volume's image at `size`, drawn by `draw` (or the last one, when the size is the same).
     fn draw_view(&mut self, size: (u32, u32), draw: Option<DrawView<'_>>) -> Result<()> {
         let fresh = self.view.is_none() || self.view_size != size;
@@ -535,10 +556,18 @@ impl Presenter {
             self.view_size = size;
         }
         let view = self.view.as_ref().expect("made above");
-        match draw {
-            Some(draw) => draw(&view.target(vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)?),
-            None if fresh => Err(Error::InvalidArgument("a viewport of a new size needs a frame drawn".into())),
-            None => Ok(()),
+        let under = self.under.take();
+        let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        match (draw, under) {
+            (Some(_), Some((_, at))) if at != size => Err(Error::InvalidArgument(format!(
+                "an underlay of {} x {} for a {} x {} view",
+                at.0, at.1, size.0, size.1
+            ))),
+            (Some(draw), Some((rgba, _))) => draw(&view.over(&rgba8(self.format, &rgba, None), src)?),
+            (Some(draw), None) => draw(&view.target(vk::ImageLayout::UNDEFINED, src)?),
+            (None, Some(_)) => Err(Error::InvalidArgument("an underlay needs a frame drawn over it".into())),
+            (None, None) if fresh => Err(Error::InvalidArgument("a viewport of a new size needs a frame drawn".into())),
+            (None, None) => Ok(()),
         }
     }
 
@@ -584,7 +613,8 @@ impl Drop for Presenter {
     }
 }
 
-/// 8-bit texels of `format` as RGBA, with `alpha` in place of theirs when given.
+/// 8-bit texels of `format` as RGBA, with `alpha` in place of theirs when given (and RGBA as
+/// texels of `format`: the swizzle is its own inverse).
 fn rgba8(format: vk::Format, texels: &[u8], alpha: Option<u8>) -> Vec<u8> {
     let bgra = matches!(format, vk::Format::B8G8R8A8_SRGB | vk::Format::B8G8R8A8_UNORM);
     texels

@@ -13,6 +13,8 @@ pub const KEYS: &[(&str, &str)] = &[
     ("pointer over the volume", "the value, voxel and position under it"),
     ("click on the volume", "the slices' crosshair to the voxel under the pointer"),
     ("click in a slice", "the crosshair within that plane"),
+    ("c, b", "a clip plane facing the view, a crop box: on or off"),
+    ("drag a grip", "move the crop box's face or the clip plane (white and cyan squares)"),
     ("m", "next mode (composite, MIP, MinIP, average, X-ray, iso)"),
     (", .", "iso value down, up"),
     ("l", "levels of detail on or off"),
@@ -33,6 +35,7 @@ pub fn ui(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         s.view_rect = Some(rect);
+        s.pixels_per_point = ui.ctx().pixels_per_point();
         view_input(ui, s, rect, &response);
     });
     keys(ui, s);
@@ -133,7 +136,10 @@ fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
             s.home();
         }
     });
-    egui::CollapsingHeader::new("keys and mouse").default_open(s.help).show(ui, |ui| {
+    // `?` opens or closes it (`open` forces the state for that frame only); a click on the
+    // header does too, and `help` follows it.
+    let forced = std::mem::take(&mut s.help_pressed).then_some(s.help);
+    let header = egui::CollapsingHeader::new("keys and mouse").open(forced).show(ui, |ui| {
         egui::Grid::new("keys").striped(true).show(ui, |ui| {
             for (key, what) in KEYS {
                 ui.label(*key);
@@ -142,14 +148,16 @@ fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
             }
         });
     });
+    if header.header_response.clicked() {
+        s.help = !s.help;
+    }
 }
 
 /// A clip plane facing the view and a crop box.
 fn clipping(ui: &mut egui::Ui, s: &mut State) {
     let mut plane = s.clip_plane.is_some();
     if ui.checkbox(&mut plane, "plane through the centre, facing the view").changed() {
-        s.clip_plane = if plane { s.view_direction().map(|n| (n, 0.0)) } else { None };
-        s.dirty = true;
+        s.toggle_plane();
     }
     let radius = s.radius;
     if let Some((_, offset)) = &mut s.clip_plane {
@@ -159,8 +167,7 @@ fn clipping(ui: &mut egui::Ui, s: &mut State) {
     }
     let mut crop = s.crop.is_some();
     if ui.checkbox(&mut crop, "crop box (fractions of the grid)").changed() {
-        s.crop = crop.then_some([[0.0; 3], [1.0; 3]]);
-        s.dirty = true;
+        s.toggle_crop();
     }
     if let Some([lo, hi]) = &mut s.crop {
         for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
@@ -197,9 +204,29 @@ fn view_input(ui: &egui::Ui, s: &mut State, rect: Rect, r: &egui::Response) {
     let ctrl = ui.input(|i| i.modifiers.ctrl);
     let delta = r.drag_delta();
     s.dragging = r.dragged();
-    if delta != egui::Vec2::ZERO {
-        let ppp = ui.ctx().pixels_per_point();
-        let (w, h) = (rect.width() * ppp, rect.height() * ppp);
+    let ppp = ui.ctx().pixels_per_point();
+    let (w, h) = (rect.width() * ppp, rect.height() * ppp);
+    let cam = s.base.as_ref().map(|b| s.orbit.camera(b, s.radius, (w.round() as u32, h.round() as u32)));
+    // A press on a clipping handle's grip drags the grip, not the view.
+    if r.drag_started_by(PointerButton::Primary) && !ctrl {
+        let origin = ui.input(|i| i.pointer.press_origin());
+        s.grip = match (&cam, s.handle_shapes(), origin) {
+            (Some(cam), Some(shapes), Some(p)) => {
+                let p = (p - rect.min) * ppp;
+                shapes.grip_at(cam, voxsplat::glam::Vec2::new(p.x, p.y))
+            }
+            _ => None,
+        };
+    }
+    if !r.dragged() {
+        s.grip = None;
+    }
+    if let (Some(grip), Some(cam), Some(shapes)) = (s.grip, &cam, s.handle_shapes()) {
+        if delta != egui::Vec2::ZERO {
+            let amount = shapes.drag(cam, grip, voxsplat::glam::Vec2::new(delta.x * ppp, delta.y * ppp));
+            s.move_grip(grip, amount);
+        }
+    } else if delta != egui::Vec2::ZERO {
         let (dx, dy) = (delta.x * ppp, delta.y * ppp);
         if r.dragged_by(PointerButton::Middle) || (r.dragged_by(PointerButton::Primary) && ctrl) {
             if let Some(base) = &s.base {
@@ -257,6 +284,12 @@ fn keys(ui: &egui::Ui, s: &mut State) {
             s.message = "time points: open a 4-D NIfTI or an OME-Zarr image with a time axis".into();
         }
     }
+    if pressed(Key::C) {
+        s.toggle_plane();
+    }
+    if pressed(Key::B) {
+        s.toggle_crop();
+    }
     if pressed(Key::H) {
         s.home();
     }
@@ -268,6 +301,7 @@ fn keys(ui: &egui::Ui, s: &mut State) {
     }
     if pressed(Key::Questionmark) {
         s.help = !s.help;
+        s.help_pressed = true;
     }
     if pressed(Key::Q) || pressed(Key::Escape) {
         s.quit = true;

@@ -11,6 +11,11 @@
 //! key K               press and release key K (a letter, comma, period)
 //! pick X Y            click at (X, Y), fractions of the view; print the value under it and
 //!                     the slices' crosshair
+//! slice A X Y         click the slice pane across axis A (x, y or z) at (X, Y), fractions of
+//!                     it from its top left; print the crosshair
+//! grip G DX DY        drag the clipping's grip G (x+, x-, y+, y-, z+, z-: the crop box's
+//!                     faces; plane) by (DX, DY) points
+//! state               print the clipping (crop box, plane offset) and the handles' pixels
 //! wait N              N frames
 //! shot PATH           the window's pixels as a PNG
 //! view PATH           the volume's image alone as a PNG
@@ -32,6 +37,9 @@ enum Line {
     DeleteTf(usize),
     Key(Key),
     Pick(Pos2),
+    Slice(usize, Pos2),
+    Grip(super::handles::Grip, egui::Vec2),
+    State,
     Wait(u32),
     Shot(PathBuf),
     View(PathBuf),
@@ -89,6 +97,18 @@ fn parse_line(n: usize, text: &str) -> Result<Option<Line>> {
             Line::Key(key.ok_or_else(|| bad("unknown key"))?)
         }
         "pick" => Line::Pick(pos(0)?),
+        "slice" => {
+            let axis = rest.first().and_then(|a| "xyz".find(*a).filter(|_| a.len() == 1));
+            Line::Slice(axis.ok_or_else(|| bad("expected an axis: x, y or z"))?, pos(1)?)
+        }
+        "grip" => {
+            let grip = rest.first().and_then(|g| super::handles::Grip::parse(g));
+            Line::Grip(
+                grip.ok_or_else(|| bad("expected a grip: x+, x-, y+, y-, z+, z- or plane"))?,
+                pos(1)? - Pos2::ZERO,
+            )
+        }
+        "state" => Line::State,
         "wait" => Line::Wait(index(0)?.min(10_000) as u32),
         "shot" => Line::Shot(path()?),
         "view" => Line::View(path()?),
@@ -204,6 +224,27 @@ fn expand(n: usize, line: Line, s: &State) -> Result<Vec<Step>> {
                 Step { events: vec![click(true), click(false)], after: Some(Line::Pick(f)) },
             ]
         }
+        Line::Slice(axis, f) => {
+            let rect =
+                s.slices.as_ref().and_then(|c| c.rects[axis]).ok_or_else(|| missing("no slice pane laid out"))?;
+            let p = in_rect(rect, f);
+            let click = |pressed| button(p, PointerButton::Primary, pressed);
+            vec![
+                Step { events: vec![Event::PointerMoved(p)], after: None },
+                Step { events: vec![click(true), click(false)], after: Some(Line::Slice(axis, f)) },
+            ]
+        }
+        Line::Grip(grip, by) => {
+            let (cam, rect) = (s.view_camera(), s.view_rect);
+            let at = match (cam, rect, s.handle_shapes()) {
+                (Some(cam), Some(rect), Some(h)) => {
+                    h.grip_screen(&cam, grip).map(|p| rect.min + egui::vec2(p.x, p.y) / s.pixels_per_point)
+                }
+                _ => None,
+            };
+            let a = at.ok_or_else(|| missing(&format!("no grip {grip:?} in view (c: the plane, b: the crop box)")))?;
+            drag(a, a + by)
+        }
         Line::Wait(frames) => (0..frames).map(|_| Step::default()).collect(),
         // The next frame reads the window back.
         Line::Shot(path) => vec![Step { events: vec![], after: Some(Line::Shot(path)) }, Step::default()],
@@ -225,6 +266,13 @@ impl Step {
             Some(Line::Pick(_)) => {
                 let crosshair = s.slices.as_ref().map(|c| format!("; crosshair {:?}", c.voxel)).unwrap_or_default();
                 println!("pick: {}{crosshair}", s.hover.clone().unwrap_or_default().replace('\n', "; "));
+            }
+            Some(Line::Slice(..)) => {
+                println!("slice: crosshair {:?}", s.slices.as_ref().map(|c| c.voxel));
+            }
+            Some(Line::State) => {
+                let plane = s.clip_plane.map(|p| p.1);
+                println!("state: crop {:?}; plane offset {plane:?}; handle pixels {}", s.crop, s.handle_pixels);
             }
             Some(Line::Shot(path)) => s.shot_now = Some(path),
             Some(Line::View(path)) => super::save_png(&path, size, view()?)?,

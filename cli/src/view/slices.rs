@@ -16,6 +16,8 @@ pub struct Slices {
     /// The voxel the three planes pass through.
     pub voxel: [u32; 3],
     panes: [Option<Pane>; 3],
+    /// Where each pane was laid out last (points), for a script's clicks.
+    pub rects: [Option<Rect>; 3],
 }
 
 /// The axes across and down a pane of the plane along `axis`, as `BrickStore::plane` lays it out.
@@ -29,7 +31,7 @@ fn axes(axis: usize) -> [usize; 2] {
 
 impl Slices {
     pub fn new(dims: [u32; 3]) -> Self {
-        Self { voxel: dims.map(|d| d / 2), panes: [None, None, None] }
+        Self { voxel: dims.map(|d| d / 2), panes: [None, None, None], rects: [None; 3] }
     }
 
     /// The panes side by side; true when a click moved the crosshair.
@@ -75,6 +77,7 @@ impl Slices {
         let (nu, nv) = (store.dims[u] as f32, store.dims[v] as f32);
         let size = if nu >= nv { Vec2::new(side, side * nv / nu) } else { Vec2::new(side * nu / nv, side) };
         let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
+        self.rects[axis] = Some(rect);
         let pane = self.panes[axis].as_ref().expect("made above");
         let painter = ui.painter_at(rect);
         let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
