@@ -1,7 +1,9 @@
 //! What `voxsplat render` opens and how: the scene flags shared by the commands and the viewer
 //! example (`SceneArgs`, in `scene_args`), their parsers (`parse`), the camera they describe, and
 //! loading the scene as host splats or a bricked store classified on the device.
+mod parts;
 use glam::Vec3;
+pub use parts::Parts;
 use voxsplat::orient::Orientation;
 use voxsplat::{scene, Backend, Camera, Error, Projection, Renderer, RendererOptions, Result};
 
@@ -321,88 +323,28 @@ fn ome_zarr_level(
     Ok(level)
 }
 
-/// The --volume's channels (a 4-D NIfTI's, or the file alone) and the --channel files, each
-/// classified by its transfer function (--tf, then each --channel-tf) and added per voxel.
-fn load_channels(
-    a: &SceneArgs,
-    path: &std::path::Path,
-    orientation: Option<Orientation>,
-) -> Result<voxsplat::SplatSet> {
-    let mut volumes = voxsplat::loaders::load_channels(path, &volume_hints(a)?)?;
-    let in_file = volumes.len();
-    for p in &a.channels {
-        volumes.extend(voxsplat::loaders::load_channels(p, &Default::default())?);
-    }
-    if a.channel_tfs.len() + 1 != volumes.len() {
-        return Err(Error::InvalidArgument(format!(
-            "{} channels ({in_file} in --volume, {} --channel files) and {} --channel-tf: give each channel after the \
-             first its transfer function",
-            volumes.len(),
-            a.channels.len(),
-            a.channel_tfs.len()
-        )));
-    }
-    let mut tfs = vec![transfer_function(a)?];
-    for t in &a.channel_tfs {
-        tfs.push(load_tf(t)?);
-    }
-    let first = &volumes[0];
-    let grid = voxsplat::orient::placed_grid(first.dims, first.spacing, orientation.as_ref())?;
-    let shading = headlight(a, first.dims, first.spacing, orientation);
-    let all: Vec<_> = volumes.iter().zip(&tfs).collect();
-    voxsplat::classify::classify_channels(grid, &all, shading)
-}
-
-/// The --labels file classified by --label-table, alone or over the --volume; voxels whose label
-/// the table lacks are reported.
-fn load_labelled(
-    a: &SceneArgs,
-    path: &std::path::Path,
-    orientation: Option<Orientation>,
-) -> Result<voxsplat::SplatSet> {
-    let table_path =
-        a.label_table.as_ref().ok_or_else(|| Error::InvalidArgument("--labels needs --label-table".into()))?;
-    let text = std::fs::read_to_string(table_path)
-        .map_err(|e| Error::InvalidArgument(format!("{}: {e}", table_path.display())))?;
-    let table = voxsplat::labels::LabelTable::from_toml(&text)?;
-    let seg = voxsplat::loaders::load_volume(path, &Default::default())?;
-    let labelled = match &a.volume {
-        Some(v) => {
-            let (vol, tf, shading) = load_volume_parts(a, v, orientation)?;
-            let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
-            voxsplat::labels::classify_labels(grid, &seg, &table, Some((&vol, &tf, shading)))?
-        }
-        None => {
-            let grid = voxsplat::orient::placed_grid(seg.dims, seg.spacing, None)?;
-            voxsplat::labels::classify_labels(grid, &seg, &table, None)?
-        }
-    };
-    if labelled.unlabelled > 0 {
-        let list: Vec<String> = labelled.missing.iter().map(u32::to_string).collect();
-        eprintln!(
-            "{} voxels hidden: their labels ({}{}) are not in the label table",
-            labelled.unlabelled,
-            list.join(", "),
-            if labelled.missing.len() == 8 { ", ..." } else { "" }
-        );
-    }
-    Ok(labelled.set)
-}
-
 /// The splats named by --volume, --terrain or --scene, with a one-line report of what was loaded,
 /// and what a camera frames of them: a volume's placement and the voxels its transfer function
 /// shows (a rectilinear grid's voxels lie at its --positions: framed whole).
 pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
+    load_scene_parts(a).map(|(set, content, _)| (set, content))
+}
+
+/// `load_scene`, and for labels or channels what they were classified from (the viewer
+/// classifies them again as its panel shows or hides one).
+pub fn load_scene_parts(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content, Option<Parts>)> {
     let orientation = orientation_of(a)?;
-    let set = if let Some(path) = &a.labels {
-        load_labelled(a, path, orientation)?
+    let parts = Parts::load(a, orientation)?;
+    let set = if let (Some(parts), true) = (&parts, a.labels.is_some()) {
+        parts.classify(true)?
     } else if let Some(path) = &a.volume {
-        let set = if a.channels.is_empty() && a.channel_tfs.is_empty() {
-            let (vol, tf, shading) = load_volume_parts(a, path, orientation)?;
-            let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
-            voxsplat::classify::classify_on(grid, &vol, &tf, shading)?
-        } else {
-            load_channels(a, path, orientation)?
+        let set = match &parts {
+            Some(channels) => channels.classify(true)?,
+            None => {
+                let (vol, tf, shading) = load_volume_parts(a, path, orientation)?;
+                let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, orientation.as_ref())?;
+                voxsplat::classify::classify_on(grid, &vol, &tf, shading)?
+            }
         };
         match &a.positions {
             Some(p) => {
@@ -447,7 +389,7 @@ pub fn load_scene(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content)> {
         set.grid().dims[2]
     );
     let bounds = if a.volume.is_some() && a.positions.is_none() { set.bounds() } else { None };
-    Ok((set, Content { orientation, bounds }))
+    Ok((set, Content { orientation, bounds }, parts))
 }
 
 /// `mib` MiB in bytes: positive, and without wrapping past u64.

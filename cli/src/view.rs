@@ -151,6 +151,8 @@ impl App {
             light: None,
             shading_on: false,
             series: None,
+            parts: None,
+            reclassify: false,
             pointer: None,
             hover: None,
             hover_voxel: None,
@@ -278,7 +280,7 @@ impl App {
         let input = self.input.as_mut().expect("made with the window");
         let mut raw = input.take_egui_input(&window);
         let step = match &mut self.script {
-            Some(script) => Some(script.step(&self.state, &mut raw)?),
+            Some(script) => Some(script.step(&mut self.state, &mut raw)?),
             None => None,
         };
         let state = &mut self.state;
@@ -452,6 +454,14 @@ impl App {
                 renderer.set_transfer_function(tf, s.shading())?;
             }
             s.dirty = true;
+        }
+        if std::mem::take(&mut s.reclassify) {
+            if let Some(parts) = &s.parts {
+                let set = parts.classify(false)?;
+                s.message = format!("classified again: {} splats", set.len());
+                renderer.set_scene(set)?;
+                s.dirty = true;
+            }
         }
         if let (Some(t), Some((series, at))) = (s.time_to.take(), &mut s.series) {
             let u = renderer.update_volume(series.store(t)?)?;

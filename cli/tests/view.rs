@@ -152,3 +152,117 @@ fn view_refuses_what_cannot_apply_before_opening_a_window() {
         assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
     }
 }
+
+/// A `n`^3 uint8 NRRD of `values` (x fastest).
+fn nrrd(path: &Path, n: usize, values: impl Fn(usize, usize, usize) -> u8) {
+    let mut bytes = format!("NRRD0004\ntype: uint8\ndimension: 3\nsizes: {n} {n} {n}\nencoding: raw\n\n").into_bytes();
+    bytes.extend((0..n * n * n).map(|v| values(v % n, v / n % n, v / (n * n))));
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// `voxsplat view ARGS --script` of `lines` under Xvfb, with validation; its stdout.
+fn view_script(args: &[&str], lines: &str, tag: &str) -> String {
+    let script = tmp_in("view", &format!("{tag}.txt"));
+    std::fs::write(&script, lines).unwrap();
+    let mut run = Command::new("xvfb-run");
+    run.args(["-a", "-s", "-screen 0 800x600x24", env!("CARGO_BIN_EXE_voxsplat"), "view"]).args(args);
+    run.args(["--validation", "--script"]).arg(&script);
+    let out = run.output().expect("xvfb-run");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "view {args:?} failed:\n{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    stdout
+}
+
+/// The largest difference of two images' colour channels, in 8-bit steps.
+fn worst(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap()).max().unwrap()
+}
+
+#[test]
+fn the_panel_hides_a_label_and_a_channel_as_render_leaves_them_out() {
+    // Labels 1 and 2 in two halves of a block; the second channel is the label volume.
+    let n = 24;
+    let (seg, ramp, table, hidden, green) = (
+        tmp_in("view", "seg.nrrd"),
+        tmp_in("view", "ramp.nrrd"),
+        tmp_in("view", "labels.toml"),
+        tmp_in("view", "labels-hidden.toml"),
+        tmp_in("view", "green.toml"),
+    );
+    // The first channel faint, the second (the labels) green.
+    let faint = tmp_in("view", "faint.toml");
+    std::fs::write(&faint, "points = [[0.0, [0, 0, 0, 0]], [1.0, [1, 0.5, 0.5, 0.02]]]\nrange = [0.0, 255.0]\n")
+        .unwrap();
+    std::fs::write(
+        &green,
+        "points = [[0.0, [0, 0, 0, 0]], [0.4, [0, 1, 0, 0.8]], [1.0, [0, 1, 0, 0.8]]]\nrange = [0.0, 2.0]\n",
+    )
+    .unwrap();
+    nrrd(&seg, n, |i, j, k| match (i, j, k) {
+        _ if !((4..20).contains(&j) && (4..20).contains(&k)) => 0,
+        _ if (4..12).contains(&i) => 1,
+        _ if (12..20).contains(&i) => 2,
+        _ => 0,
+    });
+    nrrd(&ramp, n, |i, j, k| ((i + 2 * j + 3 * k) * 255 / (6 * n)) as u8);
+    let label = |v: u32, rgb: &str, shown: bool| {
+        format!("[[label]]\nvalue = {v}\ncolor = [{rgb}]\nopacity = 0.8\nvisible = {shown}\n\n")
+    };
+    std::fs::write(&table, label(1, "1, 0, 0", true) + &label(2, "0, 0, 1", true)).unwrap();
+    std::fs::write(&hidden, label(1, "1, 0, 0", true) + &label(2, "0, 0, 1", false)).unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let size = ["--size", "120x480"];
+    let shots =
+        ["labels-both.png", "labels-one.png", "channels-both.png", "channels-one.png"].map(|f| tmp_in("view", f));
+    let labels = [vec!["--labels".to_string(), s(&seg), "--label-table".into(), s(&table)]];
+    let args: Vec<&str> = labels[0].iter().map(String::as_str).chain(size).collect();
+    view_script(
+        &args,
+        &format!("wait 1\nview {}\nlabel 2 off\nview {}\n", shots[0].display(), shots[1].display()),
+        "labels",
+    );
+    let channels = [vec![
+        "--volume".to_string(),
+        s(&ramp),
+        "--tf".into(),
+        s(&faint),
+        "--channel".into(),
+        s(&seg),
+        "--channel-tf".into(),
+        s(&green),
+    ]];
+    let args: Vec<&str> = channels[0].iter().map(String::as_str).chain(size).collect();
+    view_script(
+        &args,
+        &format!("wait 1\nview {}\nchannel 1 off\nview {}\n", shots[2].display(), shots[3].display()),
+        "channels",
+    );
+
+    // What render draws: the table with label 2 hidden; the first channel alone.
+    let render = |args: &[&str], out: &Path| {
+        let mut all = vec!["render"];
+        all.extend(args);
+        all.extend(["--size", "120x480", "--background", "0,0,0,1", "--validation", "--out", out.to_str().unwrap()]);
+        let out = voxsplat(&all);
+        assert!(out.status.success(), "{all:?}: {}", String::from_utf8_lossy(&out.stderr));
+    };
+    let refs = ["ref-labels.png", "ref-channel.png"].map(|f| tmp_in("view", f));
+    render(&["--labels", &s(&seg), "--label-table", &s(&hidden)], &refs[0]);
+    render(&["--volume", &s(&ramp), "--tf", &s(&faint)], &refs[1]);
+    let [both, one, ch_both, ch_one] = shots.map(|p| rgba(&p));
+    let (ref_labels, ref_channel) = (rgba(&refs[0]), rgba(&refs[1]));
+    let blue = |img: &image::RgbaImage| img.pixels().filter(|p| p[2] > 60 && p[0] < 30).count();
+    assert!(blue(&both) > 300, "label 2 (blue) is drawn at first ({} pixels)", blue(&both));
+    assert_eq!(blue(&one), 0, "hidden, label 2 draws nothing");
+    assert!(
+        worst(&one, &ref_labels) <= 1,
+        "the view without label 2 differs from render by {}",
+        worst(&one, &ref_labels)
+    );
+    let greener = |img: &image::RgbaImage| img.pixels().filter(|p| p[1] as i32 > p[0] as i32 + 40).count();
+    assert!(greener(&ch_both) > 300, "the second channel draws green ({} pixels)", greener(&ch_both));
+    assert_eq!(greener(&ch_one), 0, "without it, no green");
+    let w = worst(&ch_one, &ref_channel);
+    assert!(w <= 1, "the view without channel 1 differs from render of the first channel alone by {w}/255");
+}

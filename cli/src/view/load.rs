@@ -15,6 +15,7 @@ struct Opened {
     set: SplatSet,
     content: Content,
     series: Option<crate::series::Series>,
+    parts: Option<crate::open::Parts>,
 }
 
 /// A file being opened: the bytes read so far, of how many, and the thread's answer (with the
@@ -33,11 +34,16 @@ fn open(a: &SceneArgs, host_splats: bool) -> Result<Opened> {
         let content = Content { orientation: series.orientation(), bounds: scene.visible_bounds() };
         let set = SplatSet::empty(scene.store.grid()?)?;
         let histogram = scene.store.histogram(HISTOGRAM_BINS)?;
-        return Ok(Opened { bricked: Some((scene, histogram)), set, content, series: Some(series) });
+        return Ok(Opened { bricked: Some((scene, histogram)), set, content, series: Some(series), parts: None });
+    }
+    if a.labels.is_some() || !a.channels.is_empty() || !a.channel_tfs.is_empty() {
+        // Kept whole, for the panel to show or hide a label or a channel.
+        let (set, content, parts) = crate::open::load_scene_parts(a)?;
+        return Ok(Opened { bricked: None, set, content, series: None, parts });
     }
     let (bricked, set, content) = crate::open::open(a, host_splats)?;
     let bricked = bricked.map(|b| b.store.histogram(HISTOGRAM_BINS).map(|h| (b, h))).transpose()?;
-    Ok(Opened { bricked, set, content, series: None })
+    Ok(Opened { bricked, set, content, series: None, parts: None })
 }
 
 impl Loading {
@@ -79,7 +85,8 @@ impl Loading {
             }
         };
         a.progress = None;
-        let Opened { bricked, set, content, series } = opened?;
+        let Opened { bricked, set, content, series, parts } = opened?;
+        s.parts = parts;
         let grid = *set.grid();
         match bricked {
             Some((b, histogram)) => {

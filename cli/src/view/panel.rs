@@ -1,8 +1,12 @@
 //! The side panel and the view's own input: what the user sees and edits each frame. It reads and
 //! writes `State`; the window loop applies what changed to the renderer.
 use super::{State, COMPOSITES, KERNELS, ORDERS, RASTERS};
+use crate::open::Parts;
 use egui::{Key, PointerButton, Rect, Sense};
 use voxsplat::bricks::BrickStore;
+
+/// Labels listed in the panel, at most.
+const LABELS_SHOWN: usize = 64;
 use voxsplat::{Lod, Mode};
 
 /// The key help the panel shows (and `?` opens).
@@ -88,6 +92,10 @@ fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
             ui.label("transfer-function editing needs a --volume file");
         }
     }
+    if let Some(parts) = &s.parts {
+        let title = if matches!(parts, Parts::Labels { .. }) { "labels" } else { "channels" };
+        egui::CollapsingHeader::new(title).default_open(true).show(ui, |ui| parts_ui(ui, s));
+    }
     if let (Some(slices), Some(store), Some(h)) = (&mut s.slices, store, &s.histogram) {
         let window = s.tf.as_ref().and_then(|t| t.range).unwrap_or(h.range);
         egui::CollapsingHeader::new("slices").default_open(true).show(ui, |ui| {
@@ -151,6 +159,35 @@ fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
     if header.header_response.clicked() {
         s.help = !s.help;
     }
+}
+
+/// Labels shown or hidden, with their colours and opacities; channels drawn or not. A change
+/// classifies the scene again (once a slider is let go).
+fn parts_ui(ui: &mut egui::Ui, s: &mut State) {
+    let mut changed = false;
+    match &mut s.parts {
+        Some(Parts::Labels { table, .. }) => {
+            let n = table.labels.len();
+            for l in table.labels.iter_mut().take(LABELS_SHOWN) {
+                ui.horizontal(|ui| {
+                    changed |= ui.checkbox(&mut l.visible, format!("label {}", l.value)).changed();
+                    changed |= ui.color_edit_button_rgb(&mut l.color).changed();
+                    let r = ui.add(egui::Slider::new(&mut l.opacity, 0.0..=1.0).text("opacity"));
+                    changed |= r.drag_stopped() || (r.changed() && !r.dragged());
+                });
+            }
+            if n > LABELS_SHOWN {
+                ui.label(format!("(the first {LABELS_SHOWN} of {n} labels; the table sets the others)"));
+            }
+        }
+        Some(Parts::Channels { channels, .. }) => {
+            for (i, c) in channels.iter_mut().enumerate() {
+                changed |= ui.checkbox(&mut c.2, format!("channel {i} (its --tf or --channel-tf)")).changed();
+            }
+        }
+        None => {}
+    }
+    s.reclassify |= changed;
 }
 
 /// A clip plane facing the view and a crop box.

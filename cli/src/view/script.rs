@@ -16,6 +16,8 @@
 //! grip G DX DY        drag the clipping's grip G (x+, x-, y+, y-, z+, z-: the crop box's
 //!                     faces; plane) by (DX, DY) points
 //! state               print the clipping (crop box, plane offset) and the handles' pixels
+//! label V on|off      show or hide label V, as its checkbox in the panel does
+//! channel I on|off    draw channel I (0 the first) or not, as its checkbox does
 //! wait N              N frames
 //! shot PATH           the window's pixels as a PNG
 //! view PATH           the volume's image alone as a PNG
@@ -23,6 +25,7 @@
 //! tf PATH             save the transfer function (render --tf reads it)
 //! ```
 use super::State;
+use crate::open::Parts;
 use egui::{Event, Key, Modifiers, PointerButton, Pos2, RawInput};
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -40,6 +43,8 @@ enum Line {
     Slice(usize, Pos2),
     Grip(super::handles::Grip, egui::Vec2),
     State,
+    Label(u32, bool),
+    Channel(usize, bool),
     Wait(u32),
     Shot(PathBuf),
     View(PathBuf),
@@ -109,6 +114,19 @@ fn parse_line(n: usize, text: &str) -> Result<Option<Line>> {
             )
         }
         "state" => Line::State,
+        "label" | "channel" => {
+            let on = match rest.get(1) {
+                Some(&"on") => true,
+                Some(&"off") => false,
+                _ => return Err(bad("expected on or off")),
+            };
+            let i = index(0)?;
+            if cmd == "label" {
+                Line::Label(u32::try_from(i).map_err(|_| bad("a label past u32"))?, on)
+            } else {
+                Line::Channel(i, on)
+            }
+        }
         "wait" => Line::Wait(index(0)?.min(10_000) as u32),
         "shot" => Line::Shot(path()?),
         "view" => Line::View(path()?),
@@ -152,7 +170,7 @@ impl Script {
     }
 
     /// This frame's events, added to `raw`; the step to finish once the frame is drawn.
-    pub fn step(&mut self, s: &State, raw: &mut RawInput) -> Result<Step> {
+    pub fn step(&mut self, s: &mut State, raw: &mut RawInput) -> Result<Step> {
         if !self.started {
             self.started = true;
             return Ok(Step::default());
@@ -169,7 +187,7 @@ impl Script {
 }
 
 /// A line as frames, its positions resolved against the last frame's layout.
-fn expand(n: usize, line: Line, s: &State) -> Result<Vec<Step>> {
+fn expand(n: usize, line: Line, s: &mut State) -> Result<Vec<Step>> {
     let missing = |what: &str| Error::InvalidArgument(format!("script line {n}: {what}"));
     let editor = || -> Result<(egui::Rect, &voxsplat::classify::TransferFunction, &voxsplat::bricks::Histogram)> {
         match (s.tf_editor.rect, &s.tf, &s.histogram) {
@@ -244,6 +262,22 @@ fn expand(n: usize, line: Line, s: &State) -> Result<Vec<Step>> {
             };
             let a = at.ok_or_else(|| missing(&format!("no grip {grip:?} in view (c: the plane, b: the crop box)")))?;
             drag(a, a + by)
+        }
+        Line::Label(value, on) => {
+            match &mut s.parts {
+                Some(Parts::Labels { table, .. }) => table.set_visible(value, on)?,
+                _ => return Err(missing("no labels (--labels with --label-table)")),
+            }
+            s.reclassify = true;
+            vec![Step::default()]
+        }
+        Line::Channel(i, on) => {
+            match &mut s.parts {
+                Some(Parts::Channels { channels, .. }) if i < channels.len() => channels[i].2 = on,
+                _ => return Err(missing(&format!("no channel {i} (--channel files, a 4-D --volume)"))),
+            }
+            s.reclassify = true;
+            vec![Step::default()]
         }
         Line::Wait(frames) => (0..frames).map(|_| Step::default()).collect(),
         // The next frame reads the window back.

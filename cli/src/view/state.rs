@@ -27,6 +27,9 @@ pub struct State {
     pub light: Option<Shading>,
     pub shading_on: bool,
     pub series: Option<(crate::series::Series, u32)>,
+    /// Labels or channels, kept to classify them again (`reclassify`) when the panel changes one.
+    pub parts: Option<crate::open::Parts>,
+    pub reclassify: bool,
     /// The pointer over the view, in points from its top left corner.
     pub pointer: Option<egui::Vec2>,
     pub hover: Option<String>,
