@@ -18,7 +18,7 @@ layout(local_size_x = BRICK_LANES) in;
 #include "brick.glsl"
 
 layout(push_constant) uniform Push {
-    uint first;      // STREAMED_STORE: the batch's first entry of brick_list to build
+    uint first;      // the first brick to build (STREAMED_STORE: the batch's first entry of brick_list)
     uint count;      // and how many
     uint splats;     // not 0: into each brick's own slot (a resident pyramid), else the entry's
     float occluded;
@@ -80,7 +80,10 @@ void main() {
     uint first = brick_list[e].z;
     uint slot = pc.splats != 0u ? h : e;
 #else
-    uint h = workgroup_item();
+    // A resident store's bricks pc.first .. pc.first + pc.count (the build goes in parts, each
+    // its own dispatch, so a host can show how far it has got).
+    if (workgroup_item() >= pc.count) return;
+    uint h = pc.first + workgroup_item();
     if (h >= bf.grid.w) return;
     uint slot = h;
     uint first = headers[h].y;

@@ -367,29 +367,38 @@ impl Renderer {
         options: &RenderOptions,
         target: &vk::HostTarget,
     ) -> Result<Delivered> {
+        self.render_to_with(camera, options, target, None)
+    }
+
+    /// `render_to`, telling `progress` how far a long one-off build has got: a bricked volume's
+    /// levels of detail, built on the first frame and after each change of its transfer function
+    /// (`progress(done, of)` in bricks, each time after that much has run on the device; seconds
+    /// on a CPU device for a large volume). A host with a window can present a frame with a
+    /// progress bar from it; an error it returns stops the frame.
+    pub fn render_to_with_progress(
+        &mut self,
+        camera: &Camera,
+        options: &RenderOptions,
+        target: &vk::HostTarget,
+        progress: &mut dyn FnMut(u64, u64) -> Result<()>,
+    ) -> Result<Delivered> {
+        self.render_to_with(camera, options, target, Some(progress))
+    }
+
+    fn render_to_with(
+        &mut self,
+        camera: &Camera,
+        options: &RenderOptions,
+        target: &vk::HostTarget,
+        progress: Option<&mut dyn FnMut(u64, u64) -> Result<()>>,
+    ) -> Result<Delivered> {
         options.validate()?;
         camera.validate()?;
-        if (camera.width, camera.height) != target.size() {
-            return Err(Error::InvalidArgument(format!(
-                "the camera's {} x {} frame does not fit the {} x {} target",
-                camera.width,
-                camera.height,
-                target.size().0,
-                target.size().1
-            )));
-        }
+        target.check_frame(camera, options)?;
         if self.bisect.is_some() {
             return Err(Error::Unsupported("render_to with a bisect split: use render()".into()));
         }
-        // Below scale 1 the frame is drawn on the coarser grid and the blit stretches it.
         let scaled = options.render_scale != 1.0;
-        let refuse = |m: &str| Err(Error::InvalidArgument(m.into()));
-        if scaled && (target.depth().is_some() || target.is_over()) {
-            return refuse("the host's depth and colour images are read pixel for pixel: draw at render scale 1");
-        }
-        if target.is_over() && options.background.is_some() {
-            return refuse("a frame drawn over the host's image has that image for its background: give no background");
-        }
         let low = resample::scaled_camera(camera, options.render_scale)?;
         let mut full = options.clone();
         full.render_scale = 1.0;
@@ -397,7 +406,11 @@ impl Renderer {
         let prep = Self::prepared_in(&self.scene)?;
         let gpu = self.gpu.as_mut().ok_or_else(|| Error::Unsupported("render_to needs the GPU backend".into()))?;
         gpu.context().check_target(target.format(), scaled)?;
-        let recorded = record_frame(&mut gpu.engine_to(prep, target), prep, &low, &opts)?;
+        let mut engine = gpu.engine_to(prep, target);
+        if let Some(p) = progress {
+            engine = engine.with_progress(p);
+        }
+        let recorded = record_frame(&mut engine, prep, &low, &opts)?;
         Ok(Delivered { timings: recorded.timings, raster: choice, stats: recorded.stats })
     }
 
@@ -506,39 +519,6 @@ impl Renderer {
         let n = self.prepared()?.set.len();
         let got = self.probe(camera, &opts, StageId::OrderScatter, &[Res::Order])?;
         Ok(got[0][..n].to_vec())
-    }
-
-    /// The image-aligned sheets' binning for this camera: the (splat, slab) pairs, interleaved, in
-    /// visiting order (stages `splat_params`, `slab_count`, `slab_scan`, `slab_scatter`).
-    #[doc(hidden)]
-    pub fn slab_pairs(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
-        let opts = RenderOptions { composite: Composite::Slab, render_scale: 1.0, ..options.clone() };
-        let set = &self.prepared()?.set;
-        let frame = plan::frame_for(set, camera, &opts);
-        let pc = plan::slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, opts.direction())?;
-        let got = self.probe(camera, &opts, StageId::SlabScatter, &[Res::SlabStart, Res::SlabPairs])?;
-        let pairs = got[0][pc.slabs as usize] as usize * 2;
-        Ok(got[1][..pairs].to_vec())
-    }
-
-    /// The splat_params stage's output for this camera (GPU stage, or its CPU mirror).
-    #[doc(hidden)]
-    pub fn splat_params(
-        &mut self,
-        camera: &Camera,
-        kernel: Kernel,
-        antialias: Antialias,
-    ) -> Result<Vec<gpu_types::SplatParams>> {
-        let opts = RenderOptions {
-            raster: Raster::Graphics,
-            direction: Some(Direction::BackToFront),
-            kernel,
-            antialias,
-            ..Default::default()
-        };
-        let n = self.prepared()?.set.len();
-        let got = self.probe(camera, &opts, StageId::SplatParams, &[Res::Params])?;
-        Ok(bytemuck::cast_slice(&got[0][..n * std::mem::size_of::<gpu_types::SplatParams>() / 4]).to_vec())
     }
 
     /// What pixel position (`x`, `y`) of `camera` shows (pixels from the top left corner; a

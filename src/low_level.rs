@@ -62,3 +62,46 @@ pub mod kdtree {
 pub mod bisect {
     pub use crate::bisect::*;
 }
+
+/// Stage outputs the tests read, each a frame probed after its stage (here, so that lib.rs keeps
+/// to the embedder's face).
+impl crate::Renderer {
+    /// The image-aligned sheets' binning for this camera: the (splat, slab) pairs, interleaved, in
+    /// visiting order (stages `splat_params`, `slab_count`, `slab_scan`, `slab_scatter`).
+    #[doc(hidden)]
+    pub fn slab_pairs(&mut self, camera: &crate::Camera, options: &crate::RenderOptions) -> crate::Result<Vec<u32>> {
+        let opts = crate::RenderOptions { composite: crate::Composite::Slab, render_scale: 1.0, ..options.clone() };
+        let set = &self.prepared()?.set;
+        let frame = crate::plan::frame_for(set, camera, &opts);
+        let pc =
+            crate::plan::slab::slab_geometry(&frame, set.grid(), set.len(), opts.slab_thickness, opts.direction())?;
+        let got = self.probe(
+            camera,
+            &opts,
+            crate::stages::StageId::SlabScatter,
+            &[crate::dispatch::Res::SlabStart, crate::dispatch::Res::SlabPairs],
+        )?;
+        let pairs = got[0][pc.slabs as usize] as usize * 2;
+        Ok(got[1][..pairs].to_vec())
+    }
+
+    /// The splat_params stage's output for this camera (GPU stage, or its CPU mirror).
+    #[doc(hidden)]
+    pub fn splat_params(
+        &mut self,
+        camera: &crate::Camera,
+        kernel: crate::Kernel,
+        antialias: crate::Antialias,
+    ) -> crate::Result<Vec<crate::gpu_types::SplatParams>> {
+        let opts = crate::RenderOptions {
+            raster: crate::Raster::Graphics,
+            direction: Some(crate::Direction::BackToFront),
+            kernel,
+            antialias,
+            ..Default::default()
+        };
+        let n = self.prepared()?.set.len();
+        let got = self.probe(camera, &opts, crate::stages::StageId::SplatParams, &[crate::dispatch::Res::Params])?;
+        Ok(bytemuck::cast_slice(&got[0][..n * std::mem::size_of::<crate::gpu_types::SplatParams>() / 4]).to_vec())
+    }
+}

@@ -635,6 +635,11 @@ pub trait Engine {
     fn upload_regions(&mut self, res: Res, data: &[u32], regions: &[[u64; 3]]) -> Result<()>;
     /// Run (or queue) one stage dispatch.
     fn run(&mut self, dispatch: &Dispatch) -> Result<()>;
+    /// How far a long one-off build (the levels of detail) has got: `done` of `of` bricks, once
+    /// the work so far has run. Only an engine given the host's hook does anything.
+    fn progress(&mut self, _done: u64, _of: u64) -> Result<()> {
+        Ok(())
+    }
     /// Finish the work so far and read the first `words` 32-bit words of each resource.
     fn read(&mut self, what: &[(Res, usize)]) -> Result<Vec<Vec<u32>>>;
     /// Words `res` holds now (0 when it does not exist).

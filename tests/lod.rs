@@ -677,3 +677,73 @@ fn nodes_above_the_brick_keep_a_visibility_order() {
     assert!(views >= 16 && with_nodes >= 6, "{views} views, {with_nodes} with nodes");
     assert_clean(&g);
 }
+
+/// A resident pyramid builds in parts, each its own dispatch: `render_to_with_progress` hears of
+/// each once it has run, rising to every brick; a frame with the pyramid built hears nothing; an
+/// error from the hook stops the frame (the next builds it all); the frame is `render_to`'s.
+#[test]
+fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
+    use voxsplat::vk::ImageLayout as IL;
+    let gz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bonsai/bonsai.nii.gz");
+    let store = voxsplat::bricks::BrickStore::load(&gz, &Default::default()).unwrap();
+    let tf = TransferFunction::preset("bonsai").unwrap();
+    let (mut a, mut b) = (common::gpu(), common::gpu());
+    a.set_bricks(voxsplat::bricks::BrickScene::new(store.clone(), tf.clone(), None).unwrap()).unwrap();
+    b.set_bricks(voxsplat::bricks::BrickScene::new(store, tf, None).unwrap()).unwrap();
+    let bricks = a.volume().unwrap().store.headers.len() as u64;
+    assert!(bricks > 2 * 4096, "several parts: {bricks} bricks");
+    let cam = Camera::framing(&a.volume().unwrap().store.grid().unwrap(), 40, 40);
+    let o = RenderOptions::default();
+    assert_eq!(o.lod, Lod::Auto);
+    let format = voxsplat::TargetFormat::Rgba16Float;
+    let (ia, ib) = (a.target_image(format, 40, 40).unwrap(), b.target_image(format, 40, 40).unwrap());
+    let (ta, tb) = (
+        ia.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(),
+        ib.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(),
+    );
+    let mut heard = Vec::new();
+    for _ in 0..2 {
+        a.render_to_with_progress(&cam, &o, &ta, &mut |done, of| {
+            heard.push((done, of));
+            Ok(())
+        })
+        .unwrap();
+    }
+    // All from the first frame: the second found the pyramid built.
+    assert!(heard.len() >= 3, "{heard:?}");
+    assert!(heard.windows(2).all(|w| w[0].0 < w[1].0) && heard.iter().all(|h| h.1 == bricks), "{heard:?}");
+    assert_eq!(heard.last(), Some(&(bricks, bricks)));
+    let mut parts = 0;
+    let stop = b.render_to_with_progress(&cam, &o, &tb, &mut |_, _| {
+        parts += 1;
+        Err(voxsplat::Error::InvalidArgument("stop".into()))
+    });
+    assert!(parts == 1 && stop.is_err_and(|e| e.to_string().contains("stop")));
+    b.render_to(&cam, &o, &tb).unwrap();
+    assert!(a.read_target(&ta).unwrap() == b.read_target(&tb).unwrap(), "the same frame");
+    // Every part built its own bricks: the summaries are the CPU mirror's, brick for brick
+    // (one word each of what levels it draws, then its levels' errors).
+    let mut c = common::cpu();
+    c.set_bricks(
+        voxsplat::bricks::BrickScene::new(
+            b.volume().unwrap().store.clone(),
+            TransferFunction::preset("bonsai").unwrap(),
+            None,
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let what = [Res::LodSummary];
+    let (gpu, cpu) = (
+        b.probe(&cam, &o, StageId::BrickPyramid, &what).unwrap(),
+        c.probe(&cam, &o, StageId::BrickPyramid, &what).unwrap(),
+    );
+    let words = voxsplat::low_level::plan::SUMMARY_WORDS;
+    let differ = (0..bricks as usize).filter(|&h| gpu[0][h * words] != cpu[0][h * words]).count();
+    let built = (0..bricks as usize).filter(|&h| cpu[0][h * words] != 0).count();
+    let later = (2 * 4096..bricks as usize).filter(|&h| cpu[0][h * words] != 0).count();
+    assert!(later > 500, "the third part builds {later} bricks that draw");
+    assert!(differ * 1000 <= built, "{differ} of {built} bricks' levels differ");
+    assert_clean(&a);
+    assert_clean(&b);
+}

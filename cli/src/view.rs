@@ -44,6 +44,9 @@ const DRAG_LOD_ERROR: f32 = 1e6;
 const ISO_START: f32 = 0.3;
 /// The window's least height in pixels: the panel's controls and editor fit.
 const MIN_HEIGHT: u32 = 480;
+/// A frame's long build (the levels of detail) shows its progress in the window once it has
+/// taken this long (a short one would only flash past the panel).
+const BUSY_AFTER_S: f64 = 1.0;
 /// Bins of the editor's histogram.
 const HISTOGRAM_BINS: u32 = 256;
 
@@ -244,26 +247,8 @@ impl App {
             return Ok(true);
         }
         let input = self.input.as_mut().expect("made with the window");
-        let raw = input.take_egui_input(window);
-        let (what, fraction) = (loading.what.clone(), loading.fraction());
-        let full = self.egui.run_ui(raw, |ui| {
-            egui::CentralPanel::default().show(ui, |ui| {
-                ui.heading(format!("opening {what}"));
-                match fraction {
-                    Some(f) => ui.add(egui::ProgressBar::new(f).show_percentage()),
-                    None => ui.spinner(),
-                };
-            });
-        });
-        input.handle_platform_output(window, full.platform_output);
-        let primitives = self.egui.tessellate(full.shapes, full.pixels_per_point);
-        let overlay = OverlayFrame {
-            primitives: &primitives,
-            textures: &full.textures_delta,
-            pixels_per_point: full.pixels_per_point,
-        };
         let presenter = self.presenter.as_mut().expect("made with the window");
-        presenter.frame(None, [0.0, 0.0, 0.0, 1.0], None, &overlay, false)?;
+        busy_frame(window, input, &self.egui, presenter, &format!("opening {}", loading.what), loading.fraction())?;
         std::thread::sleep(std::time::Duration::from_millis(30));
         window.request_redraw();
         Ok(false)
@@ -348,19 +333,32 @@ impl App {
         }
         let primitives = self.egui.tessellate(painted, ppp);
         let renderer = self.renderer.as_mut().expect("started");
+        let input = self.input.as_mut().expect("made with the window");
         let mut ms = None;
         let mut delivered = None;
-        let mut draw = |t: &voxsplat::vk::HostTarget| {
+        if changed {
+            // Drawn outside the window's frame: a long build of the levels of detail presents
+            // frames of its own, with its progress.
+            let target = presenter.view_target((viewport.width, viewport.height))?;
             let start = Instant::now();
-            delivered = Some(renderer.render_to(&cam, &frame_options, t)?);
-            ms = Some(start.elapsed().as_secs_f64() * 1e3);
-            Ok(())
-        };
+            let mut busy = 0.0;
+            let mut progress = |done: u64, of: u64| -> Result<()> {
+                if start.elapsed().as_secs_f64() < BUSY_AFTER_S || done >= of {
+                    return Ok(());
+                }
+                let t = Instant::now();
+                let what = format!("building the levels of detail: {done} of {of} bricks");
+                busy_frame(&window, input, &self.egui, presenter, &what, Some(done as f32 / of as f32))?;
+                busy += t.elapsed().as_secs_f64() * 1e3;
+                Ok(())
+            };
+            delivered = Some(renderer.render_to_with_progress(&cam, &frame_options, &target, &mut progress)?);
+            ms = Some(start.elapsed().as_secs_f64() * 1e3 - busy);
+        }
         let overlay = OverlayFrame { primitives: &primitives, textures: &full.textures_delta, pixels_per_point: ppp };
         let read_back = s.shot_now.is_some();
         let clear = [0.0, 0.0, 0.0, 1.0];
-        let draw: Option<voxsplat::vk::DrawView<'_>> = if changed { Some(&mut draw) } else { None };
-        let presented = presenter.frame(Some(viewport), clear, draw, &overlay, read_back)?;
+        let presented = presenter.frame(Some(viewport), clear, None, &overlay, read_back)?;
         if !presented.shown {
             presenter.resize((window.inner_size().width, window.inner_size().height))?;
             self.drawn = None;
@@ -481,6 +479,36 @@ impl App {
         }
         Ok(())
     }
+}
+
+/// A window frame while the window waits: what for and how far it has got, nothing else.
+fn busy_frame(
+    window: &Window,
+    input: &mut egui_winit::State,
+    egui: &egui::Context,
+    presenter: &mut Presenter,
+    what: &str,
+    fraction: Option<f32>,
+) -> Result<()> {
+    let raw = input.take_egui_input(window);
+    let full = egui.run_ui(raw, |ui| {
+        egui::CentralPanel::default().show(ui, |ui| {
+            ui.heading(what);
+            match fraction {
+                Some(f) => ui.add(egui::ProgressBar::new(f).show_percentage()),
+                None => ui.spinner(),
+            };
+        });
+    });
+    input.handle_platform_output(window, full.platform_output);
+    let primitives = egui.tessellate(full.shapes, full.pixels_per_point);
+    let overlay = OverlayFrame {
+        primitives: &primitives,
+        textures: &full.textures_delta,
+        pixels_per_point: full.pixels_per_point,
+    };
+    presenter.frame(None, [0.0, 0.0, 0.0, 1.0], None, &overlay, false)?;
+    Ok(())
 }
 
 /// The stages that took the most of the frame (ms), and what a bricked volume's frame drew.

@@ -21,10 +21,12 @@ struct Sums {
     axes: [f32; 3],
 }
 
-/// Mirror of `brick_pyramid.comp`: every non-empty brick's pyramid cells and summary, or with
-/// `batch` (a streamed store) the batch range's bricks' into their entries' slots.
+/// Mirror of `brick_pyramid.comp`: the non-empty bricks' pyramid cells and summaries of the
+/// push's range of bricks, or with `batch` (a streamed store) the batch range's bricks' into
+/// their entries' slots.
 pub fn brick_pyramid(
     inputs: &BrickInputs<'_>,
+    push: &crate::gpu_types::BrickPush,
     batch: Option<PyramidBatch<'_>>,
     pyramid: &mut [u32],
     summary: &mut [u32],
@@ -42,7 +44,10 @@ pub fn brick_pyramid(
                 Some(slots),
             )
         }
-        None => ((0..store.headers.len()).map(|h| (h, h)).collect(), None),
+        None => {
+            let end = (push.first as usize + push.count as usize).min(store.headers.len());
+            ((push.first as usize..end).map(|h| (h, h)).collect(), None)
+        }
     };
     for (h, slot) in bricks {
         let hd = &store.headers[h];
@@ -133,10 +138,10 @@ pub(crate) fn stage(b: &mut Bindings<'_>, args: &Args, v: &Variant) -> Result<()
     if streamed(v) {
         let mut slots = b.take(Res::PyramidSlot);
         let batch = Some(PyramidBatch { list: b.get(Res::BrickList), push: args.push_as(), slots: &mut slots });
-        brick_pyramid(&inputs(b)?, batch, &mut pyramid, &mut summary);
+        brick_pyramid(&inputs(b)?, &args.push_as(), batch, &mut pyramid, &mut summary);
         b.put(Res::PyramidSlot, slots);
     } else {
-        brick_pyramid(&super::brick::inputs_for(b, v)?, None, &mut pyramid, &mut summary);
+        brick_pyramid(&super::brick::inputs_for(b, v)?, &args.push_as(), None, &mut pyramid, &mut summary);
     }
     b.put(Res::Pyramid, pyramid);
     b.put(Res::LodSummary, summary);

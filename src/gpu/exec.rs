@@ -45,6 +45,8 @@ pub struct GpuEngine<'a> {
     layouts: [IL; 3],
     /// The host's image the frame goes to (`Renderer::render_to`), if any.
     target: Option<&'a HostTarget>,
+    /// The host's hook told how far a long build has got (`Engine::progress`).
+    progress: Option<&'a mut dyn FnMut(u64, u64) -> Result<()>>,
 }
 
 impl<'a> GpuEngine<'a> {
@@ -61,12 +63,18 @@ impl<'a> GpuEngine<'a> {
             layers: 1,
             layouts: [IL::UNDEFINED; 3],
             target: None,
+            progress: None,
         }
     }
 
     /// An engine whose frame goes into the host's image `target` instead of being read back.
     pub fn to_target(gpu: &'a mut Gpu, prep: &'a Prepared, target: &'a HostTarget) -> Self {
         Self { target: Some(target), ..Self::new(gpu, prep) }
+    }
+
+    /// The same engine, telling `progress` how far a long build has got.
+    pub fn with_progress(self, progress: &'a mut dyn FnMut(u64, u64) -> Result<()>) -> Self {
+        Self { progress: Some(progress), ..self }
     }
 
     /// Submit the queued commands. On a GPU: one submission with a timestamp after each run of
@@ -363,6 +371,18 @@ impl Engine for GpuEngine<'_> {
             Buffer::with_data(&self.gpu.ctx, &format!("{res:?} upload"), bytemuck::cast_slice(data), BU::TRANSFER_SRC)?;
         self.pending.push(("", Cmd::UploadRegions(res, staging, bytes)));
         Ok(())
+    }
+
+    fn progress(&mut self, done: u64, of: u64) -> Result<()> {
+        if self.progress.is_none() {
+            return Ok(());
+        }
+        // What was queued runs first: the host hears of work done, not recorded.
+        self.flush()?;
+        match &mut self.progress {
+            Some(p) => p(done, of),
+            None => Ok(()),
+        }
     }
 
     fn run(&mut self, d: &Dispatch) -> Result<()> {

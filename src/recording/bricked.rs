@@ -64,10 +64,13 @@ pub(super) fn record_bricks(
                 // slot), batch by batch through the budget, in batches of at most
                 // SUMMARY_BATCH_BYTES: larger ones gain nothing and the host copies each to upload.
                 let every = (0..bf.grid[3]).map(|h| [h, 0, 0, 0]);
+                let mut done = 0;
                 for batch in cut.batches(scene, every, u32::MAX, available.min(SUMMARY_BATCH_BYTES)) {
                     upload_batch(e, scene, &batch, &batch, &cut)?;
                     let push = BrickPush { count: batch.len() as u32, splats: u32::from(!per_batch), ..all };
                     build_pyramids(e, b.build, &push)?;
+                    done += batch.len() as u64;
+                    e.progress(done, bf.grid[3] as u64)?;
                 }
                 cut.lock_cache().forget();
                 build_nodes(e, grid, node_levels)?;
@@ -76,7 +79,12 @@ pub(super) fn record_bricks(
             // Per batch it holds batches' pyramids, not the store's.
             e.set_tag(Res::Pyramid, if per_batch { 0 } else { id });
         } else if !built && bf.grid[3] > 0 {
-            build_pyramids(e, cut.plan.gradient_build, &all)?;
+            // In parts, each its own dispatch, so a host can show how far the build has got.
+            for first in (0..bf.grid[3]).step_by(PYRAMID_PART as usize) {
+                let count = PYRAMID_PART.min(bf.grid[3] - first);
+                build_pyramids(e, cut.plan.gradient_build, &BrickPush { first, count, ..all })?;
+                e.progress((first + count) as u64, bf.grid[3] as u64)?;
+            }
             build_nodes(e, grid, node_levels)?;
             e.set_tag(Res::Pyramid, id);
             e.set_tag(Res::LodSummary, id);
@@ -557,5 +565,8 @@ pub const HIDDEN_BATCH_MIN: u32 = 1 << 16;
 /// (at 512² heptane, the stent and the procedural field hide nothing there, the bonsai 43 %, the
 /// head phantom 27 %, the 1024³ field 13 %).
 const HIDDEN_SHARE: u32 = 16;
+/// A resident store's pyramids are built this many bricks at a time (about a twentieth of the
+/// 512³ bonsai's; a dispatch each).
+const PYRAMID_PART: u32 = 4096;
 /// Most splats of one brick.
 const BRICK_SPLATS: u32 = BRICK * BRICK * BRICK;

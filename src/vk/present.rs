@@ -550,24 +550,35 @@ impl Presenter {
 
     /// The volume's image at `size`, drawn by `draw` (or the last one, when the size is the same).
     fn draw_view(&mut self, size: (u32, u32), draw: Option<DrawView<'_>>) -> Result<()> {
-        let fresh = self.view.is_none() || self.view_size != size;
-        if fresh {
+        match draw {
+            Some(draw) => draw(&self.view_target(size)?),
+            None if self.under.is_some() => {
+                Err(Error::InvalidArgument("an underlay needs a frame drawn over it".into()))
+            }
+            None if self.view.is_none() || self.view_size != size => {
+                Err(Error::InvalidArgument("a viewport of a new size needs a frame drawn".into()))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// The volume's image at `size` as a frame's destination, over the `underlay` given before
+    /// if any, for a host that renders into it outside `frame` (as `render_to_with_progress`
+    /// does, presenting frames of its own meanwhile); the next `frame` without a draw shows it.
+    pub fn view_target(&mut self, size: (u32, u32)) -> Result<HostTarget> {
+        if self.view.is_none() || self.view_size != size {
             self.view = Some(TargetImage::new(&self.ctx, target_format(self.format)?, size.0, size.1)?);
             self.view_size = size;
         }
         let view = self.view.as_ref().expect("made above");
-        let under = self.under.take();
         let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
-        match (draw, under) {
-            (Some(_), Some((_, at))) if at != size => Err(Error::InvalidArgument(format!(
+        match self.under.take() {
+            Some((_, at)) if at != size => Err(Error::InvalidArgument(format!(
                 "an underlay of {} x {} for a {} x {} view",
                 at.0, at.1, size.0, size.1
             ))),
-            (Some(draw), Some((rgba, _))) => draw(&view.over(&rgba8(self.format, &rgba, None), src)?),
-            (Some(draw), None) => draw(&view.target(vk::ImageLayout::UNDEFINED, src)?),
-            (None, Some(_)) => Err(Error::InvalidArgument("an underlay needs a frame drawn over it".into())),
-            (None, None) if fresh => Err(Error::InvalidArgument("a viewport of a new size needs a frame drawn".into())),
-            (None, None) => Ok(()),
+            Some((rgba, _)) => view.over(&rgba8(self.format, &rgba, None), src),
+            None => view.target(vk::ImageLayout::UNDEFINED, src),
         }
     }
 
