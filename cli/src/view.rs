@@ -151,6 +151,8 @@ impl App {
             tf: None,
             histogram: None,
             tf_editor: Default::default(),
+            tf_file: "view-tf.toml".into(),
+            tf_io: None,
             light: None,
             shading_on: false,
             series: None,
@@ -440,6 +442,22 @@ impl App {
     fn apply(&mut self) -> Result<()> {
         let s = &mut self.state;
         let renderer = self.renderer.as_mut().expect("started");
+        match s.tf_io.take() {
+            Some(state::TfIo::Load) => match crate::open::load_tf(s.tf_file.trim()) {
+                Ok(tf) => {
+                    s.message = format!("loaded {}", s.tf_file.trim());
+                    s.tf = Some(tf);
+                    s.tf_editor.selected = None;
+                    s.tf_changed = true;
+                }
+                Err(e) => s.message = e.to_string(),
+            },
+            Some(state::TfIo::Save) => {
+                let file = s.tf_file.trim().to_string();
+                s.message = save_tf(s, &file).unwrap_or_else(|e| e.to_string());
+            }
+            None => {}
+        }
         if std::mem::take(&mut s.tf_changed) {
             if s.shading_on && s.light.is_none() {
                 // A headlight along the current view.
@@ -471,7 +489,8 @@ impl App {
             s.message = match self.drawn.as_ref().map(|d| s.session(&d.1)) {
                 Some(Ok(session)) => {
                     session.save(std::path::Path::new("view-session.toml"))?;
-                    "saved view-session.toml".into()
+                    save_tf(s, "view-tf.toml")
+                        .map_or_else(|e| e.to_string(), |m| format!("saved view-session.toml, {m}"))
                 }
                 Some(Err(e)) => e.to_string(),
                 None => "nothing drawn yet".into(),
@@ -479,6 +498,13 @@ impl App {
         }
         Ok(())
     }
+}
+
+/// Save the transfer function as the TOML `render --tf` reads; what the panel says of it.
+fn save_tf(s: &State, file: &str) -> Result<String> {
+    let tf = s.tf.as_ref().ok_or_else(|| Error::InvalidArgument("no transfer function to save".into()))?;
+    std::fs::write(file, tf.to_toml()?).map_err(|e| Error::Io { path: file.to_string(), source: e })?;
+    Ok(format!("saved {file}"))
 }
 
 /// A window frame while the window waits: what for and how far it has got, nothing else.

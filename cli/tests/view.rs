@@ -23,17 +23,23 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     let [script, shot, view, session, reference, plain, handles] =
         ["script.txt", "window.png", "view.png", "session.toml", "reference.png", "plain.png", "handles.png"]
             .map(|f| tmp_in("view", f));
+    let (loaded_tf, saved_tf) = (tmp_in("view", "loaded-tf.toml"), tmp_in("view", "saved-tf.toml"));
     // The crop box's handles (key b) on the composite frame, its z+ grip dragged down, a click in the
     // z slice; then MIP, a pick, the saved frame.
     let text = format!(
         "wait 1\ndrag-tf 1 0.23 0.6\nadd-tf 0.9 0.5\nview {}\nkey b\nstate\nview {}\ngrip z+ 0 20\nwait 1\nstate\n\
-         key b\nslice z 0.25 0.25\nkey m\npick 0.5 0.45\nshot {}\nview {}\nsession {}\n",
+         key b\nslice z 0.25 0.25\nkey m\npick 0.5 0.45\nshot {}\nview {}\nsession {}\nload-tf {}\ntf {}\n",
         plain.display(),
         handles.display(),
         shot.display(),
         view.display(),
-        session.display()
+        session.display(),
+        loaded_tf.display(),
+        saved_tf.display()
     );
+    // A transfer function loaded from a file (as the panel's load), saved again (its save).
+    let three = "points = [[0.0, [0, 0, 0, 0]], [0.5, [1, 0.5, 0.25, 0.25]], [1.0, [1, 1, 1, 0.75]]]\n";
+    std::fs::write(&loaded_tf, three).unwrap();
     std::fs::write(&script, text).unwrap();
     let mut run = Command::new("xvfb-run");
     run.args(["-a", "-s", "-screen 0 800x600x24", env!("CARGO_BIN_EXE_voxsplat"), "view", "--volume", volume]);
@@ -61,6 +67,11 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     assert!((x - 0.23).abs() < 0.01 && (c[3] - 0.6).abs() < 0.01, "point 1 at {x}, opacity {}", c[3]);
     let (x, c) = saved.tf.points[5];
     assert!((x - 0.9).abs() < 0.01 && (c[3] - 0.5).abs() < 0.01, "the added point at {x}, opacity {}", c[3]);
+
+    let read_tf =
+        |p: &Path| voxsplat::classify::TransferFunction::from_toml(&std::fs::read_to_string(p).unwrap()).unwrap();
+    assert_eq!(read_tf(&saved_tf).points, read_tf(&loaded_tf).points, "the loaded transfer function saved again");
+    assert_eq!(read_tf(&saved_tf).points.len(), 3);
 
     // The image is what render draws from the session.
     let (session, reference_path) = (session.to_str().unwrap(), reference.to_str().unwrap());

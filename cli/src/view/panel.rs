@@ -1,5 +1,6 @@
 //! The side panel and the view's own input: what the user sees and edits each frame. It reads and
 //! writes `State`; the window loop applies what changed to the renderer.
+use super::state::TfIo;
 use super::{State, COMPOSITES, KERNELS, ORDERS, RASTERS};
 use crate::open::Parts;
 use egui::{Key, PointerButton, Rect, Sense};
@@ -133,6 +134,19 @@ fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
     }
     egui::CollapsingHeader::new("clipping").show(ui, |ui| clipping(ui, s));
     ui.separator();
+    if s.tf.is_some() {
+        // Below the slices: it moves none of the controls above.
+        ui.horizontal(|ui| {
+            ui.label("transfer function");
+            ui.add(egui::TextEdit::singleline(&mut s.tf_file).desired_width(110.0));
+            if ui.button("load").on_hover_text("a TOML file render --tf reads, or a preset's name").clicked() {
+                s.tf_io = Some(TfIo::Load);
+            }
+            if ui.button("save").clicked() {
+                s.tf_io = Some(TfIo::Save);
+            }
+        });
+    }
     ui.horizontal(|ui| {
         if ui.button("save session").clicked() {
             s.save_now = true;

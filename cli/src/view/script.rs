@@ -23,6 +23,7 @@
 //! view PATH           the volume's image alone as a PNG
 //! session PATH        save the session (render --session draws it again)
 //! tf PATH             save the transfer function (render --tf reads it)
+//! load-tf SPEC        load a transfer function (a TOML file or a preset), as the panel's load
 //! ```
 use super::State;
 use crate::open::Parts;
@@ -50,6 +51,7 @@ enum Line {
     View(PathBuf),
     Session(PathBuf),
     Tf(PathBuf),
+    LoadTf(String),
 }
 
 /// One frame's events and what to do once it is drawn.
@@ -132,6 +134,8 @@ fn parse_line(n: usize, text: &str) -> Result<Option<Line>> {
         "view" => Line::View(path()?),
         "session" => Line::Session(path()?),
         "tf" => Line::Tf(path()?),
+        "load-tf" if !rest.is_empty() => Line::LoadTf(rest.join(" ")),
+        "load-tf" => return Err(bad("expected a TOML file or a preset's name")),
         _ => return Err(bad("unknown command")),
     };
     Ok(Some(line))
@@ -277,6 +281,11 @@ fn expand(n: usize, line: Line, s: &mut State) -> Result<Vec<Step>> {
                 _ => return Err(missing(&format!("no channel {i} (--channel files, a 4-D --volume)"))),
             }
             s.reclassify = true;
+            vec![Step::default()]
+        }
+        Line::LoadTf(spec) => {
+            s.tf_file = spec;
+            s.tf_io = Some(super::state::TfIo::Load);
             vec![Step::default()]
         }
         Line::Wait(frames) => (0..frames).map(|_| Step::default()).collect(),

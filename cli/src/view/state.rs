@@ -23,6 +23,9 @@ pub struct State {
     pub tf: Option<TransferFunction>,
     pub histogram: Option<Histogram>,
     pub tf_editor: tf_editor::TfEditor,
+    /// The transfer function's file (or a preset's name) to load or save, and which, this frame.
+    pub tf_file: String,
+    pub tf_io: Option<TfIo>,
     /// The light the volume opened with (or a headlight made when shading is first turned on).
     pub light: Option<Shading>,
     pub shading_on: bool,
@@ -69,6 +72,13 @@ pub struct State {
     pub save_now: bool,
     pub shot_now: Option<PathBuf>,
     pub quit: bool,
+}
+
+/// Loading or saving the transfer function (`State::tf_file`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TfIo {
+    Load,
+    Save,
 }
 
 impl State {
