@@ -453,7 +453,7 @@ impl App {
                 Err(e) => s.message = e.to_string(),
             },
             Some(state::TfIo::Save) => {
-                let file = s.tf_file.trim().to_string();
+                let file = PathBuf::from(s.tf_file.trim());
                 s.message = save_tf(s, &file).unwrap_or_else(|e| e.to_string());
             }
             None => {}
@@ -489,7 +489,7 @@ impl App {
             s.message = match self.drawn.as_ref().map(|d| s.session(&d.1)) {
                 Some(Ok(session)) => {
                     session.save(std::path::Path::new("view-session.toml"))?;
-                    save_tf(s, "view-tf.toml")
+                    save_tf(s, std::path::Path::new("view-tf.toml"))
                         .map_or_else(|e| e.to_string(), |m| format!("saved view-session.toml, {m}"))
                 }
                 Some(Err(e)) => e.to_string(),
@@ -501,10 +501,10 @@ impl App {
 }
 
 /// Save the transfer function as the TOML `render --tf` reads; what the panel says of it.
-fn save_tf(s: &State, file: &str) -> Result<String> {
+pub(super) fn save_tf(s: &State, file: &std::path::Path) -> Result<String> {
     let tf = s.tf.as_ref().ok_or_else(|| Error::InvalidArgument("no transfer function to save".into()))?;
-    std::fs::write(file, tf.to_toml()?).map_err(|e| Error::Io { path: file.to_string(), source: e })?;
-    Ok(format!("saved {file}"))
+    std::fs::write(file, tf.to_toml()?).map_err(|e| Error::Io { path: file.display().to_string(), source: e })?;
+    Ok(format!("saved {}", file.display()))
 }
 
 /// A window frame while the window waits: what for and how far it has got, nothing else.
@@ -570,8 +570,7 @@ fn display_bytes(c: [f32; 4]) -> [u8; 4] {
     let a = c[3].clamp(0.0, 1.0);
     let encode = |v: f32| {
         let l = if a > 0.0 { (v / a).clamp(0.0, 1.0) } else { 0.0 };
-        let s = if l <= 0.0031308 { 12.92 * l } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 };
-        (s * a * 255.0).round() as u8
+        (voxsplat::low_level::cpu::present::to_srgb(l) * a * 255.0).round() as u8
     };
     [encode(c[0]), encode(c[1]), encode(c[2]), (a * 255.0).round() as u8]
 }

@@ -257,11 +257,11 @@ fn view_input(ui: &egui::Ui, s: &mut State, rect: Rect, r: &egui::Response) {
     s.dragging = r.dragged();
     let ppp = ui.ctx().pixels_per_point();
     let (w, h) = (rect.width() * ppp, rect.height() * ppp);
-    let cam = s.base.as_ref().map(|b| s.orbit.camera(b, s.radius, (w.round() as u32, h.round() as u32)));
+    let (cam, shapes) = (s.view_camera(), s.handle_shapes());
     // A press on a clipping handle's grip drags the grip, not the view.
     if r.drag_started_by(PointerButton::Primary) && !ctrl {
         let origin = ui.input(|i| i.pointer.press_origin());
-        s.grip = match (&cam, s.handle_shapes(), origin) {
+        s.grip = match (&cam, &shapes, origin) {
             (Some(cam), Some(shapes), Some(p)) => {
                 let p = (p - rect.min) * ppp;
                 shapes.grip_at(cam, voxsplat::glam::Vec2::new(p.x, p.y))
@@ -272,7 +272,7 @@ fn view_input(ui: &egui::Ui, s: &mut State, rect: Rect, r: &egui::Response) {
     if !r.dragged() {
         s.grip = None;
     }
-    if let (Some(grip), Some(cam), Some(shapes)) = (s.grip, &cam, s.handle_shapes()) {
+    if let (Some(grip), Some(cam), Some(shapes)) = (s.grip, &cam, &shapes) {
         if delta != egui::Vec2::ZERO {
             let amount = shapes.drag(cam, grip, voxsplat::glam::Vec2::new(delta.x * ppp, delta.y * ppp));
             s.move_grip(grip, amount);

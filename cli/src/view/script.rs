@@ -321,9 +321,7 @@ impl Step {
             Some(Line::View(path)) => super::save_png(&path, size, view()?)?,
             Some(Line::Session(path)) => s.session(cam)?.save(&path)?,
             Some(Line::Tf(path)) => {
-                let tf = s.tf.as_ref().ok_or_else(|| Error::InvalidArgument("no transfer function to save".into()))?;
-                std::fs::write(&path, tf.to_toml()?)
-                    .map_err(|e| Error::Io { path: path.display().to_string(), source: e })?;
+                super::save_tf(s, &path)?;
             }
             _ => {}
         }
