@@ -577,6 +577,8 @@ impl Viewer {
             lod: lod.into(),
             kernel: self.args.kernel.clone(),
             background: o.background.unwrap_or([0.0; 4]),
+            clip: Vec::new(),
+            crop: None,
             camera: voxsplat_cli::session::Session::view_of(&cam),
             light: voxsplat_cli::session::Session::light_of(volume.shading()),
             tf: volume.transfer_function().clone(),

@@ -1,8 +1,8 @@
 #version 450
-// Compute per-splat compositing, binning pass 1 of 4 (the count matrix is zeroed before): each invocation owns a chunk of the
-// draw-list entries, records each one's footprint in screen space for the later stages and counts,
-// serially and without atomics, how many of them each screen tile receives (its column of the
-// tile x chunk count matrix). Mirror: cpu::tile::tile_count.
+// Compute per-splat compositing, binning pass 1 of 4 (the count matrix is zeroed before, and
+// screen_quads has made each entry's footprint in screen space): each invocation owns a chunk of
+// the draw-list entries and counts, serially and without atomics, how many of them each screen
+// tile receives (its column of the tile x chunk count matrix). Mirror: cpu::tile_count.
 // ONE_PAGE: scenes within one page of splat records (types.glsl).
 // variants: ONE_PAGE
 #define FOOTPRINT_COMPUTE
@@ -11,9 +11,9 @@
 
 layout(local_size_x = TILE_BIN_WORKGROUP) in;
 layout(std430, binding = 9) buffer Counts { uint counts[]; };
-layout(std430, binding = 13) writeonly buffer Quads { ScreenQuad quads_lo[]; };
-layout(std430, binding = 16) writeonly buffer QuadsHi { ScreenQuad quads_hi[]; };
-PAGED_WRITER(ScreenQuad, quads_store, quads_lo, quads_hi)
+layout(std430, binding = 13) readonly buffer Quads { ScreenQuad quads_lo[]; };
+layout(std430, binding = 16) readonly buffer QuadsHi { ScreenQuad quads_hi[]; };
+PAGED_FIELD_READER(ivec4, box_at, quads_lo, quads_hi, box)
 // llvmpipe ends every loop of an invocation once it has made 65535 iterations in all: a chunk whose
 // loops would pass LOOP_BUDGET says so here (bit 1) and the host bins again in shorter chunks
 // (recording.rs, record_tiles). tile_scatter's loops are the same, so a chunk that fits here fits there.
@@ -27,11 +27,8 @@ void main() {
     uint planned = 0u;  // loop iterations so far: one per entry, per tile row and per tile
     for (uint e = range.x; e < range.y; ++e) {
         planned += 1u;
-        uint splat = draw_list[e];
-        ScreenQuad q = screen_record(params_at(splat));
-        quads_store(splat, q);
         uvec4 r;
-        if (!tile_range(q.box, r)) continue;
+        if (!tile_range(box_at(draw_list[e]), r)) continue;
         planned += (r.w - r.y + 1u) * (r.z - r.x + 2u);
         if (planned > LOOP_BUDGET) {
             atomicOr(loop_budget_spent, 1u);

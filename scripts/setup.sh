@@ -27,6 +27,9 @@ fi
 python3 -c "import pydicom" 2>/dev/null || python3 -m pip install --quiet pydicom
 # pyjpegls (CharLS) writes and decodes the JPEG-LS images the DICOM tests read against.
 python3 -c "import jpeg_ls" 2>/dev/null || python3 -m pip install --quiet "pyjpegls==1.5.1"
+# nibabel writes the NIfTI files cli/tests/series.rs and sample_types.rs read (not every Python
+# image has it).
+python3 -c "import nibabel" 2>/dev/null || python3 -m pip install --quiet "nibabel==5.3.2"
 # pynrrd writes the 4-D NRRD series cli/tests/series.rs reads.
 python3 -c "import nrrd" 2>/dev/null || python3 -m pip install --quiet "pynrrd==1.1.3"
 # The OME-Zarr tests write their images with the ome-zarr package (cli/tests/zarr.rs); 0.18 writes

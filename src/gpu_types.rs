@@ -32,7 +32,7 @@ pub struct SplatParams {
     pub screen: [f32; 4],
 }
 
-/// A footprint in screen space (`tile_count` writes one per splat for the later tile stages).
+/// A footprint in screen space (`screen_quads` writes one per splat for the tile stages).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ScreenQuad {

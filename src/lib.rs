@@ -27,6 +27,7 @@ pub mod classify;
 mod constants;
 mod cpu;
 mod cpu_engine;
+pub mod device;
 mod dispatch;
 pub mod distributed;
 #[doc = include_str!("../docs/guide/embedding.md")]
@@ -112,7 +113,7 @@ pub enum Backend {
 /// let mut options = RendererOptions::default();
 /// options.validation = true;
 /// options.device_name = Some("NVIDIA".into());
-/// options.gpu_budget_bytes = 4 << 30;
+/// options.gpu_budget_bytes = Some(4 << 30);
 /// let renderer = Renderer::new(&options)?;
 /// assert_eq!(renderer.validation_count(), 0);
 /// # Ok::<(), voxsplat::Error>(())
@@ -127,19 +128,16 @@ pub struct RendererOptions {
     pub validation: bool,
     /// Pick the Vulkan device whose name contains this text.
     pub device_name: Option<String>,
-    /// Device memory a frame may hold, in bytes (default 1 GiB, as on a mid-range GPU): a bricked
-    /// volume's splats stream through it in batches ([`Renderer::set_volume`]).
-    pub gpu_budget_bytes: u64,
+    /// Device memory a frame may hold, in bytes: a bricked volume's splats stream through it in
+    /// batches ([`Renderer::set_volume`]). `None`: the device's default
+    /// ([`device::DeviceChoices::default_budget`]: 1 GiB on a CPU device, half the largest
+    /// device-local heap on a GPU).
+    pub gpu_budget_bytes: Option<u64>,
 }
 
 impl Default for RendererOptions {
     fn default() -> Self {
-        Self {
-            backend: Backend::Gpu,
-            validation: false,
-            device_name: None,
-            gpu_budget_bytes: constants::DEFAULT_GPU_BUDGET,
-        }
+        Self { backend: Backend::Gpu, validation: false, device_name: None, gpu_budget_bytes: None }
     }
 }
 
@@ -183,7 +181,9 @@ impl Renderer {
             Backend::Cpu => None,
         };
         let mut renderer = Self { gpu, scene: None, bisect: None, budget_bytes: 0 };
-        renderer.set_gpu_budget(options.gpu_budget_bytes)?;
+        let device_default =
+            renderer.gpu.as_ref().map_or(constants::DEFAULT_GPU_BUDGET, |g| g.context().choices().default_budget);
+        renderer.set_gpu_budget(options.gpu_budget_bytes.unwrap_or(device_default))?;
         Ok(renderer)
     }
 
@@ -192,6 +192,16 @@ impl Renderer {
     pub fn set_gpu_budget(&mut self, bytes: u64) -> Result<()> {
         if bytes == 0 {
             return Err(Error::InvalidArgument("a GPU budget of 0 bytes".into()));
+        }
+        if let Some(g) = &self.gpu {
+            let most = g.context().choices().max_budget;
+            if bytes > most {
+                return Err(Error::InvalidArgument(format!(
+                    "a GPU budget of {} MiB exceeds the device's {} MiB of device-local memory",
+                    bytes >> 20,
+                    most >> 20
+                )));
+            }
         }
         self.budget_bytes = bytes;
         if let Some(g) = &mut self.gpu {
@@ -206,7 +216,7 @@ impl Renderer {
 
     /// A renderer on a host program's Vulkan device (see [`vk::Context::from_host`]).
     pub fn with_context(ctx: Arc<vk::Context>) -> Result<Self> {
-        let budget_bytes = constants::DEFAULT_GPU_BUDGET;
+        let budget_bytes = ctx.choices().default_budget;
         Ok(Self { gpu: Some(gpu::Gpu::new(ctx)?), scene: None, bisect: None, budget_bytes })
     }
 
@@ -440,9 +450,9 @@ impl Renderer {
         let device = match &self.gpu {
             Some(g) => {
                 gpu::resources::Resources::check_splat_cap(prep)?;
-                raster::Device { cpu: g.context().is_cpu_device(), point_size_max: g.context().point_size_max() }
+                g.context().choices().raster()
             }
-            None => raster::Device { cpu: true, point_size_max: f32::INFINITY },
+            None => raster::Device { cpu: true, point_size_max: f32::INFINITY, graphics: true },
         };
         let choice = raster::choose(&prep.set, camera, options, device)?;
         let mut opts = options.clone();

@@ -29,6 +29,8 @@ pub struct Device {
     pub cpu: bool,
     /// Widest point sprite in pixels.
     pub point_size_max: f32,
+    /// The graphics pipeline can draw footprints (RGBA32F targets blend): else compute only.
+    pub graphics: bool,
 }
 
 /// Footprint diameters in pixels, estimated from the grid's bounds (O(1), no pass over splats).
@@ -103,6 +105,31 @@ pub fn choose(set: &SplatSet, camera: &Camera, opts: &RenderOptions, device: Dev
         });
     }
     let size = footprint_size(set, camera, opts);
+    if !device.graphics {
+        let needs_quads = swept(opts) || (opts.motion.is_some() && opts.depth.is_some());
+        match opts.raster {
+            Raster::Graphics | Raster::Points => {
+                return Err(Error::Unsupported(format!(
+                    "--raster {} needs RGBA32F targets that blend, which this device lacks: use --raster compute",
+                    opts.raster.name()
+                )))
+            }
+            Raster::Auto if needs_quads => {
+                return Err(Error::Unsupported(
+                    "a bent or tapered motion blur, or one over the host's depth, needs the graphics pipeline, \
+                     whose RGBA32F targets this device cannot blend"
+                        .into(),
+                ))
+            }
+            Raster::Auto => {
+                return Ok(RasterChoice {
+                    raster: Raster::Compute,
+                    reason: "auto: the device's RGBA32F targets do not blend".into(),
+                })
+            }
+            Raster::Compute => {}
+        }
+    }
     match opts.raster {
         Raster::Points => {
             if opts.motion.is_some() {

@@ -103,7 +103,7 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
             }
             match raster {
                 SplatRaster::Tiles(rule) => {
-                    record_tiles(e, frame, rule, w, h, false)?;
+                    record_tiles(e, frame, rule, w, h, false, false)?;
                     finish(e, plan.background, &[Res::Accum], w, h, false)
                 }
                 &SplatRaster::Draw(build) => {
@@ -133,7 +133,7 @@ pub fn record_plan(e: &mut dyn Engine, prep: &Prepared, plan: &FramePlan) -> Res
             }
             let source = match raster {
                 SplatRaster::Tiles(rule) => {
-                    record_tiles(e, frame, rule, w, h, false)?;
+                    record_tiles(e, frame, rule, w, h, false, false)?;
                     1
                 }
                 &SplatRaster::Draw(build) => {
@@ -386,7 +386,7 @@ fn record_surface(
     let mut rule = TileRule::plan(n, w, h, crate::order::Direction::FrontToBack, 0.0, false);
     rule.composite.order = TileOrder::Surface;
     rule.composite.depth = plan.depth.is_some();
-    record_tiles(e, &plan.frame, &rule, w, h, false)?;
+    record_tiles(e, &plan.frame, &rule, w, h, false, false)?;
     record_project(e, projection, 1, w, h)?;
     let mut recorded = finish(e, plan.background, &[Res::Accum], w, h, false)?;
     recorded.stats.splats = n as u64;
@@ -404,10 +404,19 @@ fn record_project(e: &mut dyn Engine, p: &crate::plan::Projection, source: u32, 
     e.run(&Dispatch::new(StageId::Project, Only, groups, List::Order, bytemuck::bytes_of(&push))?)
 }
 
-/// The compute tile compositor: bin the draw list into screen tiles (redoing the counts with
-/// shorter chunks when an invocation ran out of llvmpipe's loop budget), then composite each
-/// tile's list `TILE_SEGMENT` entries per dispatch.
-fn record_tiles(e: &mut dyn Engine, frame: &Frame, rule: &TileRule, w: u32, h: u32, carry: bool) -> Result<()> {
+/// The compute tile compositor: the footprints in screen space (unless `made`: a bricked batch's
+/// `brick_quads` made them), binned into screen tiles (the counts redone with shorter chunks when
+/// an invocation ran out of llvmpipe's loop budget), then each tile's list composited
+/// `TILE_SEGMENT` entries per dispatch.
+fn record_tiles(
+    e: &mut dyn Engine,
+    frame: &Frame,
+    rule: &TileRule,
+    w: u32,
+    h: u32,
+    carry: bool,
+    made: bool,
+) -> Result<()> {
     let (tx, ty) = crate::plan::tile_grid(frame);
     let tiles = tx as u64 * ty as u64;
     let n = rule.push.count;
@@ -416,6 +425,10 @@ fn record_tiles(e: &mut dyn Engine, frame: &Frame, rule: &TileRule, w: u32, h: u
     e.ensure(Res::Quads, n as u64 * std::mem::size_of::<ScreenQuad>() as u64)?;
     e.ensure(Res::TileStart, (tiles + 1) * 4)?;
     e.ensure(Res::Status, 4)?;
+    if !made {
+        let bytes = bytemuck::bytes_of(&push);
+        e.run(&Dispatch::new(StageId::ScreenQuads, rule.pages, groups_1d(n), List::Order, bytes)?)?;
+    }
     let starts = loop {
         let cells = crate::raster::check_tile_cells(tiles, push.chunks)?;
         e.ensure(Res::TileCounts, cells * 4)?;

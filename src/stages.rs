@@ -50,89 +50,9 @@ pub struct StageDesc {
     pub shaders: crate::shaders::Shaders,
 }
 
-const ORDER: &[Res] = &[Res::Frame, Res::Splats, Res::RowStart, Res::RowSplit, Res::Segments, Res::Order];
-const PARAMS: &[Res] = &[Res::Frame, Res::Splats, Res::Params, Res::ParamsHi, Res::Coords];
-const SLAB: &[Res] = &[Res::Params, Res::SlabCounts, Res::SlabPairs, Res::SlabStart, Res::ParamsHi, Res::BrickVoxels];
-const COMPOSITE: &[Res] = &[Res::Sums, Res::Accum, Res::Occlusion, Res::Fixed, Res::SheetTiles];
-/// glsl/shared/footprint.glsl's bindings, shared by every footprint-reading stage.
-const FOOTPRINT: &[Res] = &[
-    Res::Frame,
-    Res::Params,
-    Res::DrawList,
-    Res::Splats,
-    Res::Ranks,
-    Res::Radial,
-    Res::SliceTable,
-    Res::Occlusion,
-    Res::Fixed,
-    Res::TileCounts,
-    Res::TileStart,
-    Res::TileEntries,
-    Res::Accum,
-    Res::Quads,
-    Res::SheetTiles,
-    Res::ParamsHi,
-    Res::QuadsHi,
-    Res::Status,
-    Res::HostDepth,
-];
-/// glsl/shared/brick.glsl's bindings, shared by the brick stages.
-const BRICK: &[Res; 32] = &[
-    Res::Frame,
-    Res::BrickFrame,
-    Res::Tf,
-    Res::BrickHeaders,
-    Res::BrickMasks,
-    Res::BrickRecords,
-    Res::BrickIndex,
-    Res::BrickSlots,
-    Res::BrickList,
-    Res::Params,
-    Res::ParamsHi,
-    Res::Order,
-    Res::BrickVoxels,
-    Res::Occlusion,
-    Res::BrickRecords1,
-    Res::BrickRecords2,
-    Res::BrickRecords3,
-    Res::BrickRecords4,
-    Res::BrickRecords5,
-    Res::BrickRecords6,
-    Res::BrickRecords7,
-    Res::BrickHidden,
-    Res::BatchRecords,
-    Res::BrickCounts,
-    Res::Pyramid,
-    Res::LodSummary,
-    Res::BrickMorph,
-    Res::PyramidSlot,
-    Res::Pyramid1,
-    Res::Pyramid2,
-    Res::Pyramid3,
-    Res::LodSplats,
-];
-/// `brick_params`' and `brick_pyramid`'s bindings: their `GRADIENTS` builds' inputs in
-/// `brick_hidden`'s places (the brick stages' list is at lavapipe's 32 storage buffers a stage).
-const BRICK_GRADIENTS: &[Res] =
-    &Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi);
-/// `brick_params`' bindings: `BRICK_GRADIENTS` with a projection's packed voxels
-/// (`project_winners`) in the place of `LodSplats` (projections have no levels of detail).
-const BRICK_PARAMS: &[Res] = &Res::replaced(
-    Res::replaced(Res::replaced(*BRICK, Res::BrickHidden, Res::BrickGradients), Res::Occlusion, Res::BrickGradientsHi),
-    Res::LodSplats,
-    Res::ProjectVoxels,
-);
-/// `project_texels`' and `project_winners`' bindings: the brick stages' with the texels in the
-/// place of `LodSplats`, the packed voxels in `brick_hidden`'s and each voxel's texel in the
-/// occlusion map's.
-const BRICK_TEXELS: &[Res] = &Res::replaced(
-    Res::replaced(Res::replaced(*BRICK, Res::LodSplats, Res::ProjectTexels), Res::BrickHidden, Res::ProjectVoxels),
-    Res::Occlusion,
-    Res::VoxelTexels,
-);
-/// glsl/shared/iso.glsl's bindings and `iso_splats`' outputs.
-const ISO: &[Res] =
-    &[Res::Frame, Res::IsoField, Res::IsoRows, Res::IsoCounts, Res::Params, Res::ParamsHi, Res::Order, Res::IsoCells];
+mod bindings;
+use bindings::*;
+
 const ISO_PUSH: u32 = std::mem::size_of::<IsoPush>() as u32;
 const FOOTPRINT_PUSH: u32 = std::mem::size_of::<FootprintPush>() as u32;
 const SLAB_PUSH: u32 = std::mem::size_of::<SlabPush>() as u32;
@@ -299,6 +219,26 @@ stages! {
         device_build: None,
         builds: &builds::PARAMS,
     },
+    brick_quads => BrickQuads {
+        kind: Kind::Compute,
+        bindings: BRICK_QUADS,
+        writes: &[Res::Quads],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "splat_params",
+        device_build: None,
+        builds: &builds::RECORDS_OR_GRADIENTS,
+    },
+    brick_lod_quads => BrickLodQuads {
+        kind: Kind::Compute,
+        bindings: BRICK_LOD_QUADS,
+        writes: &[Res::Quads],
+        push: std::mem::size_of::<BrickPush>() as u32,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "splat_params",
+        device_build: None,
+        builds: &builds::RECORDS,
+    },
     brick_lod_params => BrickLodParams {
         kind: Kind::Compute,
         bindings: BRICK,
@@ -359,10 +299,20 @@ stages! {
         device_build: None,
         builds: &builds::SLAB_BINS,
     },
+    screen_quads => ScreenQuads {
+        kind: Kind::Compute,
+        bindings: FOOTPRINT,
+        writes: &[Res::Quads],
+        push: FOOTPRINT_PUSH,
+        workgroup: Workgroup::Linear(WORKGROUP_SIZE),
+        timing: "tile_bins",
+        device_build: None,
+        builds: &builds::PAGES,
+    },
     tile_count => TileCount {
         kind: Kind::Compute,
         bindings: FOOTPRINT,
-        writes: &[Res::TileCounts, Res::Quads, Res::Status],
+        writes: &[Res::TileCounts, Res::Status],
         push: FOOTPRINT_PUSH,
         workgroup: Workgroup::Linear(TILE_BIN_WORKGROUP),
         timing: "tile_bins",

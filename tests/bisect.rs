@@ -120,7 +120,7 @@ fn bricked_volumes_split_at_the_brick_stages() {
     // Full detail, then levels of detail (the default: the pyramid, built in floating point by
     // the engine that runs first, makes the later stages' inputs differ in the last bits).
     for (lod, stage) in [Lod::Off, Lod::Auto].into_iter().flat_map(|l| {
-        [StageId::BrickCull, StageId::BrickOrder, StageId::BrickParams, StageId::TileCount].map(|s| (l, s))
+        [StageId::BrickCull, StageId::BrickOrder, StageId::BrickQuads, StageId::TileCount].map(|s| (l, s))
     }) {
         let mut o = RenderOptions::default();
         (o.raster, o.lod) = (Raster::Compute, lod);
@@ -139,7 +139,7 @@ fn bricked_volumes_split_at_the_brick_stages() {
                     .fold(0.0, f32::max)
             };
             assert!(most(&s, &g) <= 2e-3 && most(&s, &c) <= 2e-3, "{split:?}: {} / {}", most(&s, &g), most(&s, &c));
-            // The stages before brick_params compute integers alike: the rest is one backend's.
+            // The stages before brick_quads compute integers alike: the rest is one backend's.
             if lod == Lod::Off && matches!(stage, StageId::BrickCull | StageId::BrickOrder) {
                 let rest = if matches!(split, Bisect::GpuUntil(_)) { &c } else { &g };
                 assert!(identical(&s, rest), "{split:?}: the other backend's frame bit for bit");

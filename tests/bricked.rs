@@ -3,10 +3,9 @@
 //! over a random view battery, streaming through a small budget, transfer-function changes, and
 //! bad budgets. Validation on: any message fails.
 mod common;
-use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
+use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, splat_stage, Rng, ViewKind};
 use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
 use voxsplat::classify::{classify, Shading, TransferFunction};
-use voxsplat::low_level::gpu_types::SplatParams;
 use voxsplat::low_level::stages::{Res, StageId};
 use voxsplat::volume::ScalarVolume;
 use voxsplat::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
@@ -64,16 +63,14 @@ fn gpu_frames_match_the_cpu_mirrors_and_the_dense_classification() {
     }
 }
 
-/// The voxels of the frame's splats in draw order (read back after `brick_params`), and whether
-/// every non-empty brick was kept.
+/// The voxels of the frame's splats in draw order (read back once the splats are made).
 fn drawn_sequence(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 3]> {
-    let got = r.probe(cam, o, StageId::BrickParams, &[Res::BrickSlots, Res::Params]).unwrap();
+    let got = r.probe(cam, o, splat_stage(o), &[Res::BrickSlots, Res::BrickVoxels]).unwrap();
     let total: u32 = got[0].iter().map(|w| w & 1023).sum();
-    let params: &[SplatParams] = bytemuck::cast_slice(&got[1]);
-    let grid = *r.scene().unwrap().grid();
-    params[..total as usize]
-        .iter()
-        .map(|p| [0, 1, 2].map(|a| ((p.center[a] - grid.origin[a]) / grid.spacing[a]).round() as u32))
+    got[1]
+        .chunks_exact(2)
+        .take(total as usize)
+        .map(|v| voxsplat::low_level::cpu::brick::voxel_ijk([v[0], v[1]]))
         .collect()
 }
 

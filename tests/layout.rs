@@ -389,6 +389,8 @@ fn the_top_level_holds_the_embedders_modules() {
         "bricks",
         "camera",
         "classify",
+        // What the device reports and what voxsplat chooses from it (`vk::Context::choices`).
+        "device",
         "distributed",
         "embedding",
         "image",

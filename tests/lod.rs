@@ -3,7 +3,7 @@
 //! validator over a random view battery, and the pyramid rebuilt when the classification
 //! changes. Validation on: any message fails.
 mod common;
-use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
+use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, splat_stage, Rng, ViewKind};
 use voxsplat::classify::{Shading, TransferFunction};
 use voxsplat::low_level::plan::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
 use voxsplat::low_level::stages::{Res, StageId};
@@ -16,9 +16,9 @@ fn lod(raster: Raster, direction: Direction, pixels: f32) -> RenderOptions {
     o
 }
 
-/// The frame's cells in draw order, (i, j, k, side), read back after `brick_params`.
+/// The frame's cells in draw order, (i, j, k, side), read back once the splats are made.
 fn drawn_cells(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 4]> {
-    let got = r.probe(cam, o, StageId::BrickParams, &[Res::BrickSlots, Res::BrickVoxels]).unwrap();
+    let got = r.probe(cam, o, splat_stage(o), &[Res::BrickSlots, Res::BrickVoxels]).unwrap();
     let total: u32 = got[0].iter().filter(|&&w| w != 0).map(|&w| voxsplat::bricks::slot_entry(w).2).sum();
     got[1]
         .chunks_exact(2)

@@ -304,8 +304,8 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
     use voxsplat::low_level::raster::{choose, Device};
     let set = scene::build("cube40").unwrap();
     let small = Camera::framing(set.grid(), 96, 80);
-    let cpu = Device { cpu: true, point_size_max: 64.0 };
-    let wide_points = Device { cpu: true, point_size_max: 256.0 };
+    let cpu = Device { cpu: true, point_size_max: 64.0, graphics: true };
+    let wide_points = Device { cpu: true, point_size_max: 256.0, graphics: true };
     let pick = |set: &SplatSet, cam: &Camera, o: &RenderOptions, d: Device| choose(set, cam, o, d).unwrap();
     let mut blurred = opts(Composite::Splat, Raster::Auto);
     blurred.motion = Some(voxsplat::Motion::straight(glam::Mat4::IDENTITY, 1.0));
@@ -331,7 +331,7 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
     assert_eq!(c.raster, Raster::Compute, "small sheet footprints: fixed-point sums: {}", c.reason);
     let c = pick(&set, &small, &blurred, cpu);
     assert_eq!(c.raster, Raster::Compute, "motion blur, small footprints: the tile compositor: {}", c.reason);
-    let hw = Device { cpu: false, point_size_max: 64.0 };
+    let hw = Device { cpu: false, point_size_max: 64.0, graphics: true };
     assert_eq!(pick(&set, &small, &opts(Composite::Splat, Raster::Auto), hw).raster, Raster::Graphics);
 
     // Footprints 40-110 px: past a 64-px point size the quads; within a 256-px one point sprites,

@@ -273,7 +273,7 @@ pub fn study(
 fn framed(scene: voxsplat::bricks::BrickScene, size: u32, budget_bytes: u64) -> Result<(Renderer, Camera)> {
     let cam = Camera::framing(&scene.store.grid()?, size, size);
     let mut o = RendererOptions::default();
-    o.gpu_budget_bytes = budget_bytes;
+    o.gpu_budget_bytes = Some(budget_bytes);
     let mut r = Renderer::new(&o)?;
     r.set_bricks(scene)?;
     Ok((r, cam))
@@ -485,7 +485,7 @@ pub fn zarr_orbit(
     cam.projection = voxsplat::Projection::Perspective { fov_y_deg: fov };
     let cache = (cache_bytes > 0).then(|| ChunkCache::new(cache_bytes)).transpose()?;
     let mut o = RendererOptions::default();
-    o.gpu_budget_bytes = budget_bytes;
+    o.gpu_budget_bytes = Some(budget_bytes);
     let mut r = Renderer::new(&o)?;
     let mut out = String::from(
         "| frame | degrees | level | chunks read | chunks held, reused | load ms | frame ms | splats |\n\

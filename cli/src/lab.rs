@@ -495,7 +495,7 @@ fn matrix(a: MatrixArgs) -> Result<()> {
     } else {
         let (cubes, images): (&[u32], &[u32]) =
             if a.quick { (&[22, 46], &[128, 256]) } else { (&[22, 46, 100, 146], &[128, 256, 512, 1024, 2048]) };
-        let s = scaling(&mut r, cubes, images, 5, |msg| eprintln!("{msg}"))?;
+        let s = scaling(&mut r, cubes, images, if a.quick { m.frames } else { 5 }, |msg| eprintln!("{msg}"))?;
         write_scaling_csv(&s, &a.out_dir.join("scaling.csv"))?;
         // The bricked volumes' series (scripts/bricks-vtk.sh, run first by scripts/results.sh).
         let bricks = a.out_dir.join("bricks-scaling.csv");

@@ -5,6 +5,8 @@
 pub mod antialias;
 pub mod bench;
 pub mod bricked;
+pub mod devices;
+pub use devices::{describe_device, device_toml};
 pub mod kernels;
 pub mod modes;
 pub mod motion_orders;
@@ -19,6 +21,7 @@ pub mod series;
 pub mod session;
 pub mod soak;
 pub mod stability;
+pub mod suite;
 pub mod uneven;
 pub mod view;
 pub mod volumes;

@@ -37,6 +37,7 @@ fn stdout_or_exit(written: std::io::Result<()>) {
 }
 
 // After the macros above, which the studies' printing uses too.
+mod benchmark;
 mod lab;
 mod pick;
 mod render;
@@ -142,6 +143,20 @@ enum Command {
         a: PathBuf,
         /// The reference.
         b: PathBuf,
+    },
+    /// Measure this machine's GPU: a fixed suite of named cases (scenes, the gallery files, the 512³
+    /// bonsai and the 1024³ field, terrain, motion blur, MIP and iso), each drawn with the defaults;
+    /// frame times, frames per second, splats a second, memory, PSNR against a truth, and a score.
+    Bench(Box<benchmark::BenchArgs>),
+    /// Describe the Vulkan device voxsplat would use: what it reports, and every choice voxsplat
+    /// makes from it (raster path, subgroup build, timing, limits, memory budget, fallbacks).
+    Device {
+        /// Pick the device whose name contains this text.
+        #[arg(long)]
+        name: Option<String>,
+        /// Print the profile as TOML (what tests/data/devices records), nothing else.
+        #[arg(long)]
+        toml: bool,
     },
     /// Studies that measure the renderer (for its developers): the timing matrix and the results
     /// page, anti-aliasing, orders under motion, kernels, bricked volumes, the peers' scene,
@@ -449,6 +464,17 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Lab { study } => lab::run(study),
+        Command::Bench(a) => benchmark::bench(*a),
+        Command::Device { name, toml } => {
+            let ctx =
+                voxsplat::vk::Context::new(&voxsplat::vk::ContextOptions { validation: false, device_name: name })?;
+            if toml {
+                print!("{}", voxsplat_cli::device_toml(ctx.profile())?);
+            } else {
+                print!("{}", voxsplat_cli::describe_device(ctx.profile()));
+            }
+            Ok(())
+        }
         Command::Order(a) => {
             let (set, content) = load_scene(&a.scene)?;
             let cam = camera_of(&a.scene, set.grid(), &content)?;
@@ -561,7 +587,7 @@ fn refuse_scene_flags(s: &SceneArgs) -> Result<()> {
         (s.labels.is_some() || !s.channels.is_empty() || !s.channel_tfs.is_empty(), "--labels and --channel"),
         (s.terrain.is_some() || s.color.is_some() || s.vscale != 1.0 || s.cell != 0.0, "the terrain flags"),
         (s.series.is_some() || s.level.is_some() || s.time.is_some(), "--series, --level and --time"),
-        (s.dense || s.bisect.is_some() || s.gpu_budget_mib != 1024, "--dense, --bisect and --gpu-budget-mib"),
+        (s.dense || s.bisect.is_some() || s.gpu_budget_mib.is_some(), "--dense, --bisect and --gpu-budget-mib"),
     ];
     match given.iter().find(|g| g.0) {
         Some((_, flags)) => Err(Error::InvalidArgument(format!(

@@ -407,7 +407,7 @@ pub fn renderer_of(a: &SceneArgs) -> Result<Renderer> {
     let mut opts = RendererOptions::default();
     opts.backend = if a.cpu { Backend::Cpu } else { Backend::Gpu };
     opts.validation = a.validation;
-    opts.gpu_budget_bytes = mib_bytes(a.gpu_budget_mib, "--gpu-budget-mib")?;
+    opts.gpu_budget_bytes = a.gpu_budget_mib.map(|m| mib_bytes(m, "--gpu-budget-mib")).transpose()?;
     let mut r = Renderer::new(&opts)?;
     r.set_bisect(a.bisect)?;
     Ok(r)
@@ -498,4 +498,28 @@ pub fn open(
     let set = voxsplat::SplatSet::empty(bricked.store.grid()?)?;
     let content = Content { orientation, bounds: bricked.visible_bounds() };
     Ok((Some(bricked), set, content))
+}
+
+/// `--iso` (in the file's units) in the scene's normalised values: a bricked store's by its
+/// values' range; a built-in scene's as given. A volume file on the host path is refused (its
+/// classification normalises by the transfer function).
+pub fn normalised_iso(
+    bricked: Option<&voxsplat::bricks::BrickScene>,
+    scene: &SceneArgs,
+    iso: Option<f32>,
+) -> Result<Option<f32>> {
+    Ok(match (bricked, iso) {
+        (Some(b), Some(v)) => {
+            let (lo, hi) = b.store.range;
+            Some(if hi > lo { (v - lo) / (hi - lo) } else { v - lo })
+        }
+        (None, Some(_)) if scene.volume.is_some() => {
+            return Err(Error::InvalidArgument(
+                "--mode iso reads a volume file's values from its bricked store: drop --dense, --labels, --channel \
+                 and --positions"
+                    .into(),
+            ))
+        }
+        (_, v) => v,
+    })
 }

@@ -24,7 +24,7 @@ pub(crate) fn pick(a: PickArgs) -> Result<()> {
     opts.mode = a.mode.parse()?;
     // As render opens it: a volume as a bricked store, read where the ray passes.
     let (bricked, set, content) = open(&a.scene, false)?;
-    opts.iso = super::render::normalised_iso(bricked.as_ref(), &a.scene, a.iso)?;
+    opts.iso = normalised_iso(bricked.as_ref(), &a.scene, a.iso)?;
     let cam = camera_of(&a.scene, set.grid(), &content)?;
     let [x, y] = a.at;
     if !(x >= 0.0 && y >= 0.0 && x < cam.width as f32 && y < cam.height as f32) {

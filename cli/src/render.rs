@@ -135,11 +135,11 @@ pub(crate) struct RenderArgs {
     /// volume's memory split and levels of detail) instead of rendering it.
     #[arg(long, conflicts_with_all = ["raycast", "truth", "out", "k_line", "repeat", "timings"])]
     plan: bool,
-    /// Draw a session the viewer saved (its camera, transfer function, shading, mode and the
-    /// options its keys change) of the same --volume, at --size.
+    /// Draw a session the viewer saved (its camera, transfer function, shading, mode, clipping and
+    /// the options its keys change) of the same --volume, at --size.
     #[arg(long, requires = "volume", conflicts_with_all = ["eye", "target", "up", "fov", "ortho", "near", "far",
         "view", "tf", "shade", "no_shade", "mode", "iso", "order", "composite", "raster", "lod", "kernel",
-        "background"])]
+        "background", "clip", "crop"])]
     session: Option<PathBuf>,
     /// Output file, .png or .exr.
     #[arg(long, required_unless_present = "plan")]
@@ -244,6 +244,10 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     let planes: Vec<voxsplat::glam::Vec4> = a.clip.iter().map(|p| voxsplat::glam::Vec4::from(*p)).collect();
     let crop = a.crop.map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])]);
     opts.clip = voxsplat::Clip::new(&planes, crop)?;
+    // A session's clipping cuts the whole volume, as the viewer did (--crop would read a part).
+    if let Some(s) = &a.scene.session {
+        opts.clip = s.clip()?;
+    }
     opts.background = a.background;
     (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
     if a.lod_nodes && opts.lod == voxsplat::Lod::Off {
@@ -407,30 +411,6 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// `--iso` (in the file's units) in the scene's normalised values: a bricked store's by its
-/// values' range; a built-in scene's as given. A volume file on the host path is refused (its
-/// classification normalises by the transfer function).
-pub(crate) fn normalised_iso(
-    bricked: Option<&voxsplat::bricks::BrickScene>,
-    scene: &SceneArgs,
-    iso: Option<f32>,
-) -> Result<Option<f32>> {
-    Ok(match (bricked, iso) {
-        (Some(b), Some(v)) => {
-            let (lo, hi) = b.store.range;
-            Some(if hi > lo { (v - lo) / (hi - lo) } else { v - lo })
-        }
-        (None, Some(_)) if scene.volume.is_some() => {
-            return Err(Error::InvalidArgument(
-                "--mode iso reads a volume file's values from its bricked store: drop --dense, --labels, --channel \
-                 and --positions"
-                    .into(),
-            ))
-        }
-        (_, v) => v,
-    })
 }
 
 /// The last of `frames` with each stage's median time over all of them, keeping one image at a

@@ -161,7 +161,7 @@ pub struct SceneArgs {
     #[arg(long)]
     pub dense: bool,
     /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
-    /// batches.
-    #[arg(long, default_value = "1024")]
-    pub gpu_budget_mib: u64,
+    /// batches [default: 1024 on a CPU device such as lavapipe, half the GPU's memory on a GPU].
+    #[arg(long)]
+    pub gpu_budget_mib: Option<u64>,
 }

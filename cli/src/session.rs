@@ -3,7 +3,7 @@
 //! the same file.
 use serde::{Deserialize, Serialize};
 use voxsplat::classify::{Shading, TransferFunction};
-use voxsplat::glam::Vec3;
+use voxsplat::glam::{Vec3, Vec4};
 use voxsplat::{Camera, Error, Projection, Result};
 
 /// The view, in the grid's frame (the one `render` prints as "camera (grid frame)").
@@ -48,6 +48,13 @@ pub struct Session {
     pub kernel: String,
     /// The background the frame is composited over, R, G, B, A.
     pub background: [f32; 4],
+    /// Clip planes NX, NY, NZ, D in world space, as `render --clip` (a unit normal: what lies
+    /// where NX x + NY y + NZ z + D < 0 is cut).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clip: Vec<[f32; 4]>,
+    /// A crop box's world corners (low, high), as `render --crop`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crop: Option<[[f32; 3]; 2]>,
     pub camera: View,
     /// None: unshaded.
     pub light: Option<Light>,
@@ -65,9 +72,10 @@ impl Session {
     }
 
     /// Refuse what would draw a wrong frame rather than fail: a value that is not finite, a
-    /// background or iso value outside 0 to 1, a light with no direction.
+    /// background or iso value outside 0 to 1, a light with no direction, clipping `Clip` refuses.
     fn check(&self) -> Result<()> {
         self.tf.validate()?;
+        self.clip()?;
         self.camera(1, 1)?;
         let bad = |m: &str| Err(Error::InvalidArgument(format!("a session's {m}")));
         if !self.background.iter().all(|c| (0.0..=1.0).contains(c)) {
@@ -119,6 +127,17 @@ impl Session {
         View { eye, target, up, fov, height, near: cam.near, far: cam.far }
     }
 
+    /// The clip planes and the crop box, as the viewer keeps them.
+    pub fn clipping(&self) -> (Vec<Vec4>, Option<[Vec3; 2]>) {
+        (self.clip.iter().map(|&p| Vec4::from(p)).collect(), self.crop.map(|[lo, hi]| [Vec3::from(lo), Vec3::from(hi)]))
+    }
+
+    /// The clipping as the renderer takes it.
+    pub fn clip(&self) -> Result<voxsplat::Clip> {
+        let (planes, crop) = self.clipping();
+        voxsplat::Clip::new(&planes, crop).map_err(|e| Error::InvalidArgument(format!("a session's clipping: {e}")))
+    }
+
     /// The shading, if any.
     pub fn shading(&self) -> Option<Shading> {
         self.light.map(|l| Shading {
@@ -157,6 +176,8 @@ mod tests {
             lod: "auto".into(),
             kernel: "crawfis-max".into(),
             background: [0.0, 0.0, 0.0, 1.0],
+            clip: vec![[0.0, 0.6, 0.8, -1.0]],
+            crop: Some([[-2.0, -2.0, -2.0], [2.0, 2.5, 3.0]]),
             camera: Session::view_of(&cam),
             light: Session::light_of(Some(Shading::headlight(Vec3::NEG_Z))),
             tf: TransferFunction::preset("ct").unwrap(),
@@ -172,13 +193,15 @@ mod tests {
         session().save(&path).unwrap();
         assert_eq!(Session::load(&path).unwrap(), session());
         type Spoil = fn(&mut Session);
-        let broken: [(&str, Spoil); 6] = [
+        let broken: [(&str, Spoil); 8] = [
             ("background", |s| s.background[3] = 2.0),
             ("iso", |s| s.iso = Some(f32::NAN)),
             ("light", |s| s.light.as_mut().unwrap().direction = [0.0; 3]),
             ("light", |s| s.light.as_mut().unwrap().ambient = f32::INFINITY),
             ("fov", |s| s.camera.height = Some(3.0)),
             ("transfer function", |s| s.tf.points.clear()),
+            ("clipping", |s| s.clip[0] = [0.0; 4]),
+            ("clipping", |s| s.crop.as_mut().unwrap()[1][2] = -3.0),
         ];
         for (what, spoil) in broken {
             let mut s = session();

@@ -124,6 +124,7 @@ impl App {
         // Opaque black behind the volume: the window shows no transparency.
         options.background = Some([0.0, 0.0, 0.0, 1.0]);
         let mut names = (scene.order.clone(), "splat".to_string(), "auto".to_string(), "crawfis-max".to_string());
+        let (mut clip_planes, mut crop) = (Vec::new(), None);
         if let Some(path) = &session {
             if scene.volume.is_none() {
                 return Err(Error::InvalidArgument("--session draws the --volume it was saved from: give it".into()));
@@ -134,58 +135,11 @@ impl App {
                 options.background = Some(saved.background);
             }
             names = (saved.order.clone(), saved.composite.clone(), saved.raster.clone(), saved.kernel.clone());
+            (clip_planes, crop) = saved.clipping();
             scene.session = Some(saved);
         }
         options.order = names.0.parse()?;
-        let state = State {
-            title: String::new(),
-            panel_width: args.panel,
-            base: None,
-            radius: 1.0,
-            orbit: Orbit::HOME,
-            options,
-            order: names.0,
-            composite: names.1,
-            raster: names.2,
-            kernel: names.3,
-            tf: None,
-            histogram: None,
-            tf_editor: Default::default(),
-            tf_file: "view-tf.toml".into(),
-            tf_io: None,
-            light: None,
-            shading_on: false,
-            series: None,
-            parts: None,
-            reclassify: false,
-            pointer: None,
-            hover: None,
-            hover_voxel: None,
-            picked_at: None,
-            clicked: false,
-            slices: None,
-            grid: None,
-            clip_plane: None,
-            crop: None,
-            grip: None,
-            handle_pixels: 0,
-            view_rect: None,
-            pixels_per_point: 1.0,
-            last_ms: 0.0,
-            stats: String::new(),
-            message: String::new(),
-            coarse: DRAG_COARSE_START,
-            overhead_ms: 0.0,
-            dragging: false,
-            help: false,
-            help_pressed: false,
-            dirty: true,
-            tf_changed: false,
-            time_to: None,
-            save_now: false,
-            shot_now: None,
-            quit: false,
-        };
+        let state = State::new(args.panel, options, names, (clip_planes, crop));
         Ok(Self {
             args,
             scene: Some(scene),

@@ -1014,3 +1014,50 @@ fn labels_and_channels_from_the_command_line() {
         assert!(!out.status.success() && err.contains(says), "{extra:?}: {err}");
     }
 }
+
+/// `voxsplat bench`: two cases with validation on, the report as a table and as JSON (the score
+/// the geometric mean of the frame rates, a PSNR against the cached truth, the device named), the
+/// comparison of a report with itself, and the refusals.
+#[test]
+fn bench_runs_named_cases_and_compares_reports() {
+    let (cache, json) = (tmp("bench-cache"), tmp("bench.json"));
+    let args = ["bench", "--case", "cube60", "--case", "motion", "--frames", "2", "--warmup", "0", "--validation"];
+    let mut all: Vec<&str> = args.to_vec();
+    all.extend(["--cache", cache.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    let out = voxsplat(&all);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("suite 1") && text.contains("score:") && text.contains("validation was on"), "{text}");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let cases = r["cases"].as_array().unwrap();
+    assert_eq!(cases.iter().map(|c| c["name"].as_str().unwrap()).collect::<Vec<_>>(), ["cube60", "motion"]);
+    let fps: Vec<f64> = cases.iter().map(|c| c["fps"].as_f64().unwrap()).collect();
+    let geo = (fps[0] * fps[1]).sqrt();
+    assert!((r["score"].as_f64().unwrap() - geo).abs() < 1e-9 * geo, "{r}");
+    // cube60 against its volumetric-summation truth (35.1 dB measured); the animation has none.
+    let psnr = cases[0]["psnr_db"].as_f64().unwrap();
+    assert!(psnr > 30.0, "{psnr}");
+    assert!(cases[1]["psnr_db"].is_null());
+    assert_eq!(cases[0]["splats"].as_u64(), Some(20888));
+    assert!(
+        !r["platform"]["device"].as_str().unwrap().is_empty() && !r["platform"]["commit"].as_str().unwrap().is_empty()
+    );
+    assert!(cache.join("truth-v1-cube60-512x512.exr").exists(), "the truth is cached");
+    // A report against itself: every case level, the scores' ratio 1.
+    let j = json.to_str().unwrap();
+    let out = voxsplat(&["bench", "--compare", j, j]);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success() && text.contains("B/A 1.000x") && text.matches("within the noise").count() == 2,
+        "{text}"
+    );
+    // Refusals: an unknown case, a report of another suite version, a case without its data.
+    assert!(cmd::refused(&["bench", "--case", "teapot"]).contains("no case 'teapot'"));
+    let other = tmp("bench-v99.json");
+    std::fs::write(&other, std::fs::read_to_string(&json).unwrap().replacen("\"suite\": 1", "\"suite\": 99", 1))
+        .unwrap();
+    assert!(cmd::refused(&["bench", "--compare", j, other.to_str().unwrap()]).contains("suite 1 against suite 99"));
+    let text =
+        cmd::refused(&["bench", "--case", "bonsai", "--data", "/nonexistent", "--cache", cache.to_str().unwrap()]);
+    assert!(text.contains("no case ran"), "{text}");
+}

@@ -5,7 +5,8 @@
 //! shows the panel and the image; the image equals `render --session` of the saved session within
 //! one 8-bit step, as does `view --session` of it; the picked value is the file's value at the
 //! picked voxel (nibabel reads it). The crop box's handles draw under the volume with their depth,
-//! a grip dragged moves its face, and a click in a slice pane moves the crosshair.
+//! a grip dragged moves its face or plane, the session keeps two clip planes and the crop box (so
+//! `render --session` cuts the same), and a click in a slice pane moves the crosshair.
 mod cmd;
 use cmd::{tmp_in, voxsplat};
 use std::path::Path;
@@ -24,11 +25,14 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
         ["script.txt", "window.png", "view.png", "session.toml", "reference.png", "plain.png", "handles.png"]
             .map(|f| tmp_in("view", f));
     let (loaded_tf, saved_tf) = (tmp_in("view", "loaded-tf.toml"), tmp_in("view", "saved-tf.toml"));
-    // The crop box's handles (key b) on the composite frame, its z+ grip dragged down, a click in the
-    // z slice; then MIP, a pick, the saved frame.
+    // The crop box's handles (key b) on the composite frame, its z+ grip dragged down; two clip
+    // planes (key c), the first pushed away by its grip, the second added after an orbit, a third
+    // added and removed (shift+c); a click in the z slice; then MIP, a pick, the handles hidden
+    // (key g) and the saved frame.
     let text = format!(
         "wait 1\ndrag-tf 1 0.23 0.6\nadd-tf 0.9 0.5\nview {}\nkey b\nstate\nview {}\ngrip z+ 0 20\nwait 1\nstate\n\
-         key b\nslice z 0.25 0.25\nkey m\npick 0.5 0.45\nshot {}\nview {}\nsession {}\nload-tf {}\ntf {}\n",
+         key c\ngrip plane 0 -15\ndrag 345 470 375 470\nkey c\nkey c\nkey shift+c\nwait 1\nstate\n\
+         slice z 0.25 0.25\nkey m\npick 0.5 0.45\nkey g\nshot {}\nview {}\nsession {}\nload-tf {}\ntf {}\n",
         plain.display(),
         handles.display(),
         shot.display(),
@@ -67,6 +71,12 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     assert!((x - 0.23).abs() < 0.01 && (c[3] - 0.6).abs() < 0.01, "point 1 at {x}, opacity {}", c[3]);
     let (x, c) = saved.tf.points[5];
     assert!((x - 0.9).abs() < 0.01 && (c[3] - 0.5).abs() < 0.01, "the added point at {x}, opacity {}", c[3]);
+    // The clipping too: two planes facing two views, and the crop box with its top face moved in.
+    assert_eq!(saved.clip.len(), 2, "{:?}", saved.clip);
+    let [a, b] = [saved.clip[0], saved.clip[1]].map(|p| voxsplat::glam::Vec4::from(p).truncate());
+    assert!(a.dot(b) < 0.9999 && (a.length() - 1.0).abs() < 1e-5, "two planes facing two views: {a} {b}");
+    let crop = saved.crop.expect("the crop box");
+    assert!(crop[0][2] < crop[1][2] && crop[1][2] < crop[1][0], "the crop box's top face moved in: {crop:?}");
 
     let read_tf =
         |p: &Path| voxsplat::classify::TransferFunction::from_toml(&std::fs::read_to_string(p).unwrap()).unwrap();
@@ -110,7 +120,7 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     // The handles go under the volume with their depth: they show, the volume hides some of
     // them, and no pixel they do not cover changes (the box holds the whole grid: it cuts nothing).
     let states: Vec<&str> = stdout.lines().filter(|l| l.starts_with("state: ")).collect();
-    assert_eq!(states.len(), 2, "{stdout}");
+    assert_eq!(states.len(), 3, "{stdout}");
     let covered: usize = states[0].rsplit(' ').next().unwrap().parse().unwrap();
     assert!(states[0].contains("crop Some([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])"), "{}", states[0]);
     let (plain, handles) = (rgba(&plain), rgba(&handles));
@@ -125,6 +135,10 @@ fn a_scripted_session_edits_picks_and_draws_what_render_draws() {
     let moved = states[1].strip_prefix("state: crop Some([[0.0, 0.0, 0.0], [1.0, 1.0, ").expect(states[1]);
     let hi_z: f32 = moved.split(']').next().unwrap().parse().unwrap();
     assert!((0.5..0.99).contains(&hi_z), "{}", states[1]);
+    // The first plane pushed away from the eye (beyond the centre), the second through the centre.
+    let offsets = states[2].split("plane offsets [").nth(1).and_then(|r| r.split(']').next()).expect(states[2]);
+    let offsets: Vec<f32> = offsets.split(", ").map(|o| o.parse().unwrap()).collect();
+    assert!(offsets.len() == 2 && offsets[0] > 1.0 && offsets[1].abs() < 1e-3, "{}", states[2]);
     // The click in the z slice, a quarter across and down it: x a quarter of 256, y three.
     let slice = stdout.lines().find(|l| l.starts_with("slice: ")).unwrap_or_else(|| panic!("{stdout}"));
     assert_eq!(slice, "slice: crosshair Some([64, 192, 128])");

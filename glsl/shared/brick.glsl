@@ -88,8 +88,15 @@ layout(std430, binding = 7) buffer BrickSlots { uint slots[]; };
 // record (in the resident store, or in the batch's records when the store streams), its splats |
 // its level of detail << 16.
 layout(std430, binding = 8) readonly buffer BrickList { uvec4 brick_list[]; };
+#ifdef SCREEN_QUADS
+// brick_quads and brick_lod_quads: each splat's footprint in screen space (screen.glsl) in its
+// parameters' place, for the compute tile compositor.
+layout(std430, binding = 9) writeonly buffer Quads { ScreenQuad quads_lo[]; };
+layout(std430, binding = 10) writeonly buffer QuadsHi { ScreenQuad quads_hi[]; };
+#else
 layout(std430, binding = 9) writeonly buffer Params { SplatParams params_lo[]; };
 layout(std430, binding = 10) writeonly buffer ParamsHi { SplatParams params_hi[]; };
+#endif
 layout(std430, binding = 11) writeonly buffer Order { uint order_out[]; };
 // The batch's voxels in draw order: i | j << 16, k | stored value << 16.
 layout(std430, binding = 12) buffer Voxels { uvec2 voxels[]; };
@@ -564,8 +571,20 @@ vec4 node_color(uint k, uvec3 n, vec3 view, out vec3 normal) {
     return cell_seen(lod_words[w], lod_words[w + 1u], lod_words[w + 2u], view, normal);
 }
 
-PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
 #include "params.glsl"
+#ifdef SCREEN_QUADS
+#include "screen.glsl"
+PAGED_WRITER(ScreenQuad, quads_store, quads_lo, quads_hi)
+// The splat's screen quad where brick_params would write its parameters.
+void splat_store(uint s, SplatParams p) {
+    quads_store(s, screen_record(p));
+}
+#else
+PAGED_WRITER(SplatParams, params_store, params_lo, params_hi)
+void splat_store(uint s, SplatParams p) {
+    params_store(s, p);
+}
+#endif
 
 // The depths along the view of the box lo..hi's nearest and farthest corners.
 vec2 box_depths(vec3 lo, vec3 hi) {

@@ -57,7 +57,7 @@ struct SplatParams {
                   // footprint radius in pixels; anti-aliasing radius scale
 };
 
-// A footprint in screen space, written by tile_count for the later tile stages. 80 bytes.
+// A footprint in screen space, written by screen_quads for the tile stages. 80 bytes.
 struct ScreenQuad {
     vec4 inv0;    // rows of the inverse projective map, pixel centre (x, y, 1) -> homogeneous
     vec4 inv1;    // quad coordinates (u, v, 1); inv0.w: motion stretch; inv1.w: motion bend

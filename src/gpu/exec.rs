@@ -109,7 +109,7 @@ impl<'a> GpuEngine<'a> {
             runs.push(("", waiting));
         }
         let ctx = gpu.ctx.clone();
-        let host_timed = ctx.is_cpu_device() || ctx.timestamp_period.is_none();
+        let host_timed = ctx.choices().timing == crate::device::Timing::Host;
         let needed = runs.len() as u32 + 1;
         if !host_timed && gpu.timer.capacity < needed {
             gpu.timer = Timer::new(&ctx, needed.next_power_of_two())?;

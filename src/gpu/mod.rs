@@ -62,7 +62,7 @@ impl Gpu {
             )?,
             roofline_layout,
         };
-        let budget_bytes = crate::constants::DEFAULT_GPU_BUDGET;
+        let budget_bytes = ctx.choices().default_budget;
         Ok(Self { res: Resources::new(&ctx)?, timer: Timer::new(&ctx, 16)?, pipes, extra, ctx, budget_bytes })
     }
 

@@ -209,10 +209,12 @@ pub(super) fn record_bricks(
             stats.splats_outshone += (batch_splats(&batch) - n) as u64;
             stats.splats -= (batch_splats(&batch) - n) as u64;
         } else if !batch.is_empty() {
-            record_brick_batch(e, scene, &batch, &cut)?;
+            // The compute tiles take the splats as screen quads, made with them.
+            record_brick_batch(e, scene, &batch, &cut, compute)?;
         }
         if compute {
-            record_tiles(e, frame, &b.tile_rule(n, w, h, plan.direction), w, h, i > 0)?;
+            let made = !texels && !batch.is_empty();
+            record_tiles(e, frame, &b.tile_rule(n, w, h, plan.direction), w, h, i > 0, made)?;
         } else {
             let build = b.footprint;
             // A later batch draws on the target (the LOAD pass).
@@ -348,7 +350,7 @@ fn record_bricked_sheets(
         let part = &parts[0];
         let n = batch_splats(part);
         if n > 0 {
-            record_brick_batch(e, scene, part, cut)?;
+            record_brick_batch(e, scene, part, cut, false)?;
         }
         let pc = geometry(n)?;
         let starts = record_slab_bins(e, &pc, binning)?;
@@ -394,7 +396,7 @@ fn record_bricked_sheets(
         for (k, part) in cut.batches(scene, near, MAX_GPU_SPLATS, available).iter().enumerate() {
             let n = batch_splats(part);
             if n > 0 {
-                record_brick_batch(e, scene, part, cut)?;
+                record_brick_batch(e, scene, part, cut, false)?;
             }
             let starts = record_slab_bins(e, &geometry(n)?, binning)?;
             let (first, end) = (starts[p0 as usize], starts[p1 as usize + 1]);
@@ -413,11 +415,23 @@ fn batch_splats(batch: &[[u32; 4]]) -> u32 {
 /// One batch of visible bricks (entries: header, first position, first record, voxels): its
 /// records when they stream, then `brick_order` and `brick_cells` list its splats and
 /// `brick_params` (voxels) and `brick_lod_params` (coarse cells) make their parameters (in buffers
-/// sized for the batch: the sheet modes cut their own).
-fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]], cut: &Cut) -> Result<()> {
+/// sized for the batch: the sheet modes cut their own); with `quads`, `brick_quads` and
+/// `brick_lod_quads` make them as footprints in screen space for the compute tile compositor.
+fn record_brick_batch(
+    e: &mut dyn Engine,
+    scene: &BrickScene,
+    batch: &[[u32; 4]],
+    cut: &Cut,
+    quads: bool,
+) -> Result<()> {
     let (streamed, build) = (cut.plan.streamed, cut.plan.build);
     let n = batch_splats(batch);
-    e.ensure(Res::Params, n as u64 * std::mem::size_of::<SplatParams>() as u64)?;
+    let (out, size, voxel_stage, cell_stage) = if quads {
+        (Res::Quads, std::mem::size_of::<ScreenQuad>(), StageId::BrickQuads, StageId::BrickLodQuads)
+    } else {
+        (Res::Params, std::mem::size_of::<SplatParams>(), StageId::BrickParams, StageId::BrickLodParams)
+    };
+    e.ensure(out, n as u64 * size as u64)?;
     e.ensure(Res::Order, n as u64 * 4)?;
     e.ensure(Res::BrickVoxels, n as u64 * 8)?;
     // Voxel bricks first (brick_order's workgroups), then coarse ones (brick_cells' lanes), level 1
@@ -447,13 +461,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         let pyramids = if streamed { Pyramids::Streamed } else { Pyramids::Resident };
         e.run(&Dispatch::new(StageId::BrickCells, pyramids, groups, List::Order, bytemuck::bytes_of(&cells))?)?;
     }
-    e.run(&Dispatch::new(
-        StageId::BrickParams,
-        cut.plan.gradient_build,
-        groups_1d(n),
-        List::Order,
-        bytemuck::bytes_of(&push),
-    )?)?;
+    e.run(&Dispatch::new(voxel_stage, cut.plan.gradient_build, groups_1d(n), List::Order, bytemuck::bytes_of(&push))?)?;
     // The coarse splats' positions, for brick_lod_params' lanes.
     let lod_splats: Vec<u32> = coarse.iter().flat_map(|l| l[1]..l[1] + (l[3] & 0xffff)).collect();
     if !lod_splats.is_empty() {
@@ -461,7 +469,7 @@ fn record_brick_batch(e: &mut dyn Engine, scene: &BrickScene, batch: &[[u32; 4]]
         e.upload(Res::LodSplats, &lod_splats)?;
         let cells = BrickPush { splats: lod_splats.len() as u32, ..push };
         let groups = groups_1d(cells.splats);
-        e.run(&Dispatch::new(StageId::BrickLodParams, build, groups, List::Order, bytemuck::bytes_of(&cells))?)?;
+        e.run(&Dispatch::new(cell_stage, build, groups, List::Order, bytemuck::bytes_of(&cells))?)?;
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! Instance, device, queue and allocator: created headless, or adopted from a host program.
 use super::debug::{callback, DebugState};
+use crate::device::{DeviceChoices, DeviceProfile};
 use crate::error::{Error, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -59,30 +60,16 @@ pub struct Context {
     debug: Option<Debug>,
     debug_state: Box<DebugState>,
     owned: bool,
-    /// Nanoseconds per timestamp tick; `None` when the queue has no timestamps.
-    pub(crate) timestamp_period: Option<f64>,
-    /// The device was created with `largePoints` (by us, or as its host says).
-    large_points: bool,
-    int64_atomics: bool,
-    /// Compute shaders have subgroup shuffles and arithmetic in subgroups of at least RASTER_LANES
-    /// (a property, so adopted devices have it too).
+    /// What the device reports (the optional features as it was created with them).
+    profile: DeviceProfile,
+    /// Every choice made from `profile`.
+    choices: DeviceChoices,
+    /// `choices.subgroup_shuffle`, which a test may turn off.
     subgroup_shuffle: AtomicBool,
-    device_name: String,
-    device_type: vk::PhysicalDeviceType,
     /// Set once a call reports VK_ERROR_DEVICE_LOST: later submissions fail fast.
     pub(crate) lost: AtomicBool,
     /// Test-only fault for the next submission (a raw `vk::Result`, 0 = none).
     pub(crate) injected: AtomicI32,
-}
-
-fn device_rank(t: vk::PhysicalDeviceType) -> u32 {
-    match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => 4,
-        vk::PhysicalDeviceType::INTEGRATED_GPU => 3,
-        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-        vk::PhysicalDeviceType::CPU => 1,
-        _ => 0,
-    }
 }
 
 impl Context {
@@ -257,8 +244,8 @@ impl Context {
             device: self.device.clone(),
             queue: self.queue.lock().map(|q| *q).unwrap_or_default(),
             queue_family: self.queue_family,
-            large_points: self.large_points,
-            int64_atomics: self.int64_atomics,
+            large_points: self.profile.large_points,
+            int64_atomics: self.profile.int64_atomics,
         }
     }
 
@@ -270,27 +257,9 @@ impl Context {
     ) -> Result<Arc<Self>> {
         let HostHandles { entry, instance, physical, device, queue, queue_family, large_points, int64_atomics } =
             handles;
-        // SAFETY: plain queries on a valid physical device.
-        let (props, families) = unsafe {
-            (
-                instance.get_physical_device_properties(physical),
-                instance.get_physical_device_queue_family_properties(physical),
-            )
-        };
-        let ts_bits = families.get(queue_family as usize).map(|f| f.timestamp_valid_bits).unwrap_or(0);
-        let timestamp_period =
-            (ts_bits > 0 && props.limits.timestamp_period > 0.0).then_some(props.limits.timestamp_period as f64);
-        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
-        // SAFETY: plain query on a valid physical device; the chain lives on the stack.
-        unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
-        let ops = vk::SubgroupFeatureFlags::SHUFFLE | vk::SubgroupFeatureFlags::ARITHMETIC;
-        // The compositor's lanes share their tile's pixels with subgroup barriers only, so its
-        // workgroup must fit one subgroup.
-        let subgroup_shuffle = subgroup.supported_stages.contains(vk::ShaderStageFlags::COMPUTE)
-            && subgroup.supported_operations.contains(ops)
-            && subgroup.subgroup_size >= crate::constants::RASTER_LANES;
-        let device_name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let profile =
+            super::profile::read(&instance, physical, Some(queue_family), Some((large_points, int64_atomics)));
+        let choices = profile.choices();
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -326,12 +295,9 @@ impl Context {
             debug,
             debug_state,
             owned,
-            timestamp_period,
-            large_points,
-            int64_atomics,
-            subgroup_shuffle: AtomicBool::new(subgroup_shuffle),
-            device_name,
-            device_type: props.device_type,
+            subgroup_shuffle: AtomicBool::new(choices.subgroup_shuffle),
+            profile,
+            choices,
             lost: AtomicBool::new(false),
             injected: AtomicI32::new(0),
         }))
@@ -344,36 +310,20 @@ impl Context {
         let mut best: Option<(u32, vk::PhysicalDevice, u32)> = None;
         let mut rejected = Vec::new();
         for pd in devices {
-            // SAFETY: `pd` is a valid handle from this instance.
-            let props = unsafe { instance.get_physical_device_properties(pd) };
-            let name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            let family = super::profile::queue_family(instance, pd);
+            let profile = super::profile::read(instance, pd, family, None);
             if let Some(want) = &options.device_name {
-                if !name.to_lowercase().contains(&want.to_lowercase()) {
+                if !profile.name.to_lowercase().contains(&want.to_lowercase()) {
                     continue;
                 }
             }
-            if vk::api_version_major(props.api_version) == 1 && vk::api_version_minor(props.api_version) < 2 {
-                rejected.push(format!("{name}: Vulkan 1.2 required"));
-                continue;
-            }
-            let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
-            let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12);
-            // SAFETY: valid handle; the chain lives on the stack for the call.
-            unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-            if f12.shader_output_layer == vk::FALSE {
-                rejected.push(format!("{name}: shaderOutputLayer missing"));
-                continue;
-            }
-            // SAFETY: valid handle.
-            let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-            let want = vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE;
-            let Some(family) = families.iter().position(|f| f.queue_flags.contains(want)) else {
-                rejected.push(format!("{name}: no graphics+compute queue"));
+            let choices = profile.choices();
+            let (Some(family), None) = (family, &choices.unusable) else {
+                rejected.push(format!("{}: {}", profile.name, choices.unusable.unwrap_or_default()));
                 continue;
             };
-            let rank = device_rank(props.device_type);
-            if best.map(|b| rank > b.0).unwrap_or(true) {
-                best = Some((rank, pd, family as u32));
+            if best.map(|b| choices.rank > b.0).unwrap_or(true) {
+                best = Some((choices.rank, pd, family));
             }
         }
         best.map(|(_, pd, f)| (pd, f)).ok_or_else(|| {
@@ -387,40 +337,38 @@ impl Context {
 
     /// The device's name as the driver reports it.
     pub fn device_name(&self) -> &str {
-        &self.device_name
+        &self.profile.name
+    }
+
+    /// What the device reports that voxsplat's choices depend on.
+    pub fn profile(&self) -> &DeviceProfile {
+        &self.profile
+    }
+
+    /// Every choice voxsplat makes from the device (`DeviceProfile::choices`).
+    pub fn choices(&self) -> &DeviceChoices {
+        &self.choices
     }
 
     /// Largest 2D image / framebuffer side and array layer count the device accepts.
     pub fn image_limits(&self) -> (u32, u32) {
-        // SAFETY: plain query on a valid physical device.
-        let l = unsafe { self.instance.get_physical_device_properties(self.physical) }.limits;
-        (
-            l.max_image_dimension2_d.min(l.max_framebuffer_width).min(l.max_framebuffer_height),
-            l.max_image_array_layers.min(l.max_framebuffer_layers),
-        )
+        (self.choices.max_image_side, self.choices.max_layers)
     }
 
     /// Largest range of one storage-buffer binding (`maxStorageBufferRange`; 2^27 bytes on lavapipe).
     pub fn max_storage_range(&self) -> u64 {
-        // SAFETY: plain query on a valid physical device.
-        let l = unsafe { self.instance.get_physical_device_properties(self.physical) }.limits;
-        l.max_storage_buffer_range as u64
+        self.choices.max_storage_range
     }
 
     /// Widest point sprite the device draws, in pixels (1 without the `largePoints` feature, which
     /// a host says in `HostHandles::large_points`: then points wider than one pixel are refused).
     pub fn point_size_max(&self) -> f32 {
-        if !self.large_points {
-            return 1.0;
-        }
-        // SAFETY: plain query on a valid physical device.
-        let props = unsafe { self.instance.get_physical_device_properties(self.physical) };
-        props.limits.point_size_range[1]
+        self.choices.point_size_max
     }
 
     /// Whether 64-bit buffer atomics are enabled (`HostHandles::int64_atomics`).
     pub fn int64_atomics(&self) -> bool {
-        self.int64_atomics
+        self.choices.int64_atomics
     }
 
     /// Whether compute shaders have subgroup shuffles and arithmetic in subgroups that hold the tile
@@ -439,7 +387,7 @@ impl Context {
 
     /// True for a CPU implementation such as lavapipe.
     pub fn is_cpu_device(&self) -> bool {
-        self.device_type == vk::PhysicalDeviceType::CPU
+        self.choices.cpu
     }
 
     /// Validation messages seen so far (0 when validation is off).

@@ -7,6 +7,7 @@ mod image;
 mod pipeline;
 #[cfg(feature = "window")]
 mod present;
+mod profile;
 mod submit;
 mod timer;
 

@@ -1,5 +1,6 @@
 //! GPU timestamp queries: one pool, read back after the frame's fence.
 use super::Context;
+use crate::device::Timing;
 use crate::error::{Error, Result};
 use ash::vk;
 use std::sync::Arc;
@@ -14,7 +15,7 @@ pub struct Timer {
 impl Timer {
     /// A pool of `capacity` timestamps; inert when the device has no timestamps.
     pub fn new(ctx: &Arc<Context>, capacity: u32) -> Result<Self> {
-        let pool = if ctx.timestamp_period.is_some() {
+        let pool = if matches!(ctx.choices().timing, Timing::Timestamps { .. }) {
             let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(capacity);
             // SAFETY: valid create info.
             Some(unsafe { ctx.device.create_query_pool(&info, None) }.map_err(Error::vk("vkCreateQueryPool"))?)
@@ -26,7 +27,9 @@ impl Timer {
 
     /// Milliseconds between consecutive written timestamps `0..count`; `None` without timestamps.
     pub fn read_ms(&self, count: u32) -> Result<Option<Vec<f64>>> {
-        let (Some(pool), Some(period)) = (self.pool, self.ctx.timestamp_period) else { return Ok(None) };
+        let (Some(pool), Timing::Timestamps { period_ns, mask }) = (self.pool, self.ctx.choices().timing) else {
+            return Ok(None);
+        };
         let count = count.min(self.capacity);
         if count < 2 {
             return Ok(Some(Vec::new()));
@@ -42,7 +45,8 @@ impl Timer {
             )
         }
         .map_err(Error::vk("vkGetQueryPoolResults"))?;
-        Ok(Some(ticks.windows(2).map(|w| w[1].saturating_sub(w[0]) as f64 * period * 1e-6).collect()))
+        // Counts hold `timestampValidBits` bits and wrap past them.
+        Ok(Some(ticks.windows(2).map(|w| (w[1].wrapping_sub(w[0]) & mask) as f64 * period_ns * 1e-6).collect()))
     }
 }
 

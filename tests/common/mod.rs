@@ -308,3 +308,14 @@ pub fn nifti(
     h.extend_from_slice(v);
     h
 }
+
+/// The stage that makes a bricked batch's splats under `o` (a probe reads its outputs): the compute
+/// tiles take them as screen quads (`brick_quads`), the other rasters as parameters.
+pub fn splat_stage(o: &RenderOptions) -> voxsplat::low_level::stages::StageId {
+    use voxsplat::low_level::stages::StageId;
+    if o.raster == voxsplat::Raster::Compute {
+        StageId::BrickQuads
+    } else {
+        StageId::BrickParams
+    }
+}

@@ -1,5 +1,5 @@
-//! The clip plane's and crop box's handles in the view: the box's edges, the plane's outline where
-//! it cuts the grid's box, and a grip on each face of the box and on the plane. On a still frame
+//! The clip planes' and crop box's handles in the view: the box's edges, each plane's outline where
+//! it cuts the grid's box, and a grip on each face of the box and on each plane. On a still frame
 //! they are drawn under the volume with their depth (the host-depth path: `Presenter::underlay`
 //! and `RenderOptions::depth`), so the volume hides the handles behind it and the handles hide
 //! the volume behind them. A drag frame (a lower render scale, which the host's depth does not
@@ -13,15 +13,18 @@ use voxsplat::{Camera, DepthBuffer, DepthFormat};
 pub enum Grip {
     /// The crop box's face across `axis`, its high or low one.
     Face { axis: usize, high: bool },
-    /// The clip plane, along its normal.
-    Plane,
+    /// Clip plane `i` (0 the first), along its normal.
+    Plane(usize),
 }
 
 impl Grip {
-    /// The name a script gives it: `x+`, `z-`, `plane`.
+    /// The name a script gives it: `x+`, `z-`, `plane` (the first plane), `plane2`.
     pub fn parse(name: &str) -> Option<Self> {
-        if name == "plane" {
-            return Some(Grip::Plane);
+        if let Some(n) = name.strip_prefix("plane") {
+            return match n {
+                "" => Some(Grip::Plane(0)),
+                n => n.parse::<usize>().ok().filter(|&i| i >= 1).map(|i| Grip::Plane(i - 1)),
+            };
         }
         let mut c = name.chars();
         let axis = "xyz".find(c.next()?)?;
@@ -51,9 +54,9 @@ pub struct Shapes {
 }
 
 impl Shapes {
-    /// The crop box `crop` (world corners) and the plane through `point` with normal `n`, cut by
-    /// the grid's world box `bounds`.
-    pub fn of(bounds: [Vec3; 2], crop: Option<[Vec3; 2]>, plane: Option<(Vec3, Vec3)>) -> Self {
+    /// The crop box `crop` (world corners) and each plane, (its normal, a point on it), cut by the
+    /// grid's world box `bounds`.
+    pub fn of(bounds: [Vec3; 2], crop: Option<[Vec3; 2]>, planes: &[(Vec3, Vec3)]) -> Self {
         let mut s = Shapes::default();
         if let Some([lo, hi]) = crop {
             for (a, b) in box_edges(lo, hi) {
@@ -68,14 +71,14 @@ impl Shapes {
                 }
             }
         }
-        if let Some((n, point)) = plane {
+        for (i, &(n, point)) in planes.iter().enumerate() {
             let outline = plane_outline(bounds, n, point);
             for i in 0..outline.len() {
                 s.lines.push((outline[i], outline[(i + 1) % outline.len()], PLANE_COLOR));
             }
             if !outline.is_empty() {
                 let centre = outline.iter().copied().sum::<Vec3>() / outline.len() as f32;
-                s.grips.push((Grip::Plane, centre, n));
+                s.grips.push((Grip::Plane(i), centre, n));
             }
         }
         s
@@ -139,7 +142,7 @@ impl Shapes {
 
 fn grip_color(g: Grip) -> [u8; 4] {
     match g {
-        Grip::Plane => PLANE_COLOR,
+        Grip::Plane(_) => PLANE_COLOR,
         Grip::Face { .. } => [255, 255, 255, 255],
     }
 }
@@ -294,7 +297,10 @@ mod tests {
     fn grips_parse_and_outlines_close() {
         assert_eq!(Grip::parse("x+"), Some(Grip::Face { axis: 0, high: true }));
         assert_eq!(Grip::parse("z-"), Some(Grip::Face { axis: 2, high: false }));
-        assert_eq!(Grip::parse("plane"), Some(Grip::Plane));
+        assert_eq!(Grip::parse("plane"), Some(Grip::Plane(0)));
+        assert_eq!(Grip::parse("plane3"), Some(Grip::Plane(2)));
+        assert_eq!(Grip::parse("plane0"), None);
+        assert_eq!(Grip::parse("planes"), None);
         assert_eq!(Grip::parse("w+"), None);
         assert_eq!(Grip::parse("x+-"), None);
         assert_eq!(box_edges(Vec3::ZERO, Vec3::ONE).len(), 12);
@@ -313,7 +319,7 @@ mod tests {
         let grid = voxsplat::Grid::centered([32, 32, 32], [1.0; 3]).unwrap();
         let cam = Camera::framing(&grid, 96, 96);
         let bounds = grid.world_box(Vec3::ZERO, Vec3::splat(31.0));
-        let shapes = Shapes::of(bounds, Some(bounds), None);
+        let shapes = Shapes::of(bounds, Some(bounds), &[]);
         let layer = Layer::draw(&cam, &shapes, [0, 0, 0, 255]);
         assert!(layer.drawn > 0);
         // Every covered pixel holds a handle's colour and a depth in front of the far plane.
@@ -334,8 +340,12 @@ mod tests {
         assert!((d - 2.0).abs() < 0.1, "{d}");
         assert_eq!(shapes.grip_at(&cam, at + Vec2::new(1.0, 1.0)), Some(g));
         // A plane facing the view: the pointer up pushes it away from the eye.
-        let plane = Shapes::of(bounds, None, Some((cam.forward(), grid.center())));
-        assert!(plane.drag(&cam, Grip::Plane, Vec2::new(0.0, -10.0)) > 0.0);
-        assert!(plane.drag(&cam, Grip::Plane, Vec2::new(0.0, 10.0)) < 0.0);
+        let plane = Shapes::of(bounds, None, &[(cam.forward(), grid.center())]);
+        assert!(plane.drag(&cam, Grip::Plane(0), Vec2::new(0.0, -10.0)) > 0.0);
+        assert!(plane.drag(&cam, Grip::Plane(0), Vec2::new(0.0, 10.0)) < 0.0);
+        // Two planes: a grip each, the second's named by its index.
+        let two = Shapes::of(bounds, None, &[(cam.forward(), grid.center()), (Vec3::X, grid.center())]);
+        let named: Vec<Grip> = two.grips.iter().map(|g| g.0).collect();
+        assert_eq!(named, [Grip::Plane(0), Grip::Plane(1)]);
     }
 }

@@ -18,8 +18,10 @@ pub const KEYS: &[(&str, &str)] = &[
     ("pointer over the volume", "the value, voxel and position under it"),
     ("click on the volume", "the slices' crosshair to the voxel under the pointer"),
     ("click in a slice", "the crosshair within that plane"),
-    ("c, b", "a clip plane facing the view, a crop box: on or off"),
-    ("drag a grip", "move the crop box's face or the clip plane (white and cyan squares)"),
+    ("c C", "add a clip plane facing the view (up to 6), remove the last"),
+    ("b", "a crop box: on or off"),
+    ("g", "the clipping's handles: shown or hidden"),
+    ("drag a grip", "move the crop box's face or a clip plane (white and cyan squares)"),
     ("m", "next mode (composite, MIP, MinIP, average, X-ray, iso)"),
     (", .", "iso value down, up"),
     ("l", "levels of detail on or off"),
@@ -204,35 +206,49 @@ fn parts_ui(ui: &mut egui::Ui, s: &mut State) {
     s.reclassify |= changed;
 }
 
-/// A clip plane facing the view and a crop box.
+/// Clip planes (each added facing the view) and a crop box.
 fn clipping(ui: &mut egui::Ui, s: &mut State) {
-    let mut plane = s.clip_plane.is_some();
-    if ui.checkbox(&mut plane, "plane through the centre, facing the view").changed() {
-        s.toggle_plane();
-    }
-    let radius = s.radius;
-    if let Some((_, offset)) = &mut s.clip_plane {
-        if ui.add(egui::Slider::new(offset, -radius..=radius).text("offset")).changed() {
-            s.dirty = true;
+    let mut remove = None;
+    for i in 0..s.clip_planes.len() {
+        let (n, Some(mut offset)) = (s.clip_planes[i].truncate(), s.plane_offset(i)) else { continue };
+        ui.horizontal(|ui| {
+            ui.label(format!("plane {}: normal {:.2}, {:.2}, {:.2}", i + 1, n.x, n.y, n.z));
+            if ui.small_button("flip").on_hover_text("keep the other side").clicked() {
+                s.clip_planes[i] = -s.clip_planes[i];
+                s.dirty = true;
+            }
+            if ui.small_button("remove").clicked() {
+                remove = Some(i);
+            }
+        });
+        let radius = s.radius;
+        let slider = egui::Slider::new(&mut offset, -radius..=radius).text("beyond the centre");
+        if ui.add(slider).changed() {
+            s.set_plane_offset(i, offset);
         }
+    }
+    if let Some(i) = remove {
+        s.remove_plane(i);
+    }
+    let room = s.clip_planes.len() < voxsplat::options::MAX_CLIP_PLANES;
+    if ui.add_enabled(room, egui::Button::new("add a plane facing the view")).clicked() {
+        s.add_plane();
+    }
+    if ui.checkbox(&mut s.handles_shown, "handles (g)").changed() {
+        s.dirty = true;
     }
     let mut crop = s.crop.is_some();
     if ui.checkbox(&mut crop, "crop box (fractions of the grid)").changed() {
         s.toggle_crop();
     }
-    if let Some([lo, hi]) = &mut s.crop {
+    if let Some([mut lo, mut hi]) = s.crop_fractions() {
         for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
             ui.horizontal(|ui| {
-                let a = ui.add(egui::Slider::new(&mut lo[axis], 0.0..=1.0).text(name));
-                let b = ui.add(egui::Slider::new(&mut hi[axis], 0.0..=1.0));
-                if a.changed() || b.changed() {
-                    // Never empty: the box keeps a hundredth of the grid at least.
-                    if a.changed() {
-                        lo[axis] = lo[axis].min(hi[axis] - 0.01).max(0.0);
-                    } else {
-                        hi[axis] = hi[axis].max(lo[axis] + 0.01).min(1.0);
-                    }
-                    s.dirty = true;
+                if ui.add(egui::Slider::new(&mut lo[axis], 0.0..=1.0).text(name)).changed() {
+                    s.set_crop_face(axis, false, lo[axis]);
+                }
+                if ui.add(egui::Slider::new(&mut hi[axis], 0.0..=1.0)).changed() {
+                    s.set_crop_face(axis, true, hi[axis]);
                 }
             });
         }
@@ -336,10 +352,18 @@ fn keys(ui: &egui::Ui, s: &mut State) {
         }
     }
     if pressed(Key::C) {
-        s.toggle_plane();
+        if ui.input(|i| i.modifiers.shift) {
+            s.remove_plane(usize::MAX);
+        } else {
+            s.add_plane();
+        }
     }
     if pressed(Key::B) {
         s.toggle_crop();
+    }
+    if pressed(Key::G) {
+        s.handles_shown = !s.handles_shown;
+        s.dirty = true;
     }
     if pressed(Key::H) {
         s.home();

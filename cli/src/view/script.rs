@@ -8,14 +8,15 @@
 //! drag-tf I X Y       drag the editor's point I to (X, Y): fractions of its width and height
 //! add-tf X Y          double-click the editor there: a new point
 //! delete-tf I         right-click the editor's point I
-//! key K               press and release key K (a letter, comma, period)
+//! key K               press and release key K (a letter, comma, period; shift+K with shift)
 //! pick X Y            click at (X, Y), fractions of the view; print the value under it and
 //!                     the slices' crosshair
 //! slice A X Y         click the slice pane across axis A (x, y or z) at (X, Y), fractions of
 //!                     it from its top left; print the crosshair
 //! grip G DX DY        drag the clipping's grip G (x+, x-, y+, y-, z+, z-: the crop box's
-//!                     faces; plane) by (DX, DY) points
-//! state               print the clipping (crop box, plane offset) and the handles' pixels
+//!                     faces; plane or plane1 to plane6: the clip planes) by (DX, DY) points
+//! state               print the clipping (crop box as fractions, each plane's offset beyond the
+//!                     centre) and the handles' pixels
 //! label V on|off      show or hide label V, as its checkbox in the panel does
 //! channel I on|off    draw channel I (0 the first) or not, as its checkbox does
 //! wait N              N frames
@@ -39,7 +40,7 @@ enum Line {
     DragTf(usize, Pos2),
     AddTf(Pos2),
     DeleteTf(usize),
-    Key(Key),
+    Key(Key, bool),
     Pick(Pos2),
     Slice(usize, Pos2),
     Grip(super::handles::Grip, egui::Vec2),
@@ -96,12 +97,13 @@ fn parse_line(n: usize, text: &str) -> Result<Option<Line>> {
         "delete-tf" => Line::DeleteTf(index(0)?),
         "key" => {
             let name = rest.first().ok_or_else(|| bad("expected a key"))?;
-            let key = match *name {
+            let (shift, name) = name.strip_prefix("shift+").map_or((false, *name), |k| (true, k));
+            let key = match name {
                 "," | "comma" => Some(Key::Comma),
                 "." | "period" => Some(Key::Period),
                 k => Key::from_name(&k.to_uppercase()),
             };
-            Line::Key(key.ok_or_else(|| bad("unknown key"))?)
+            Line::Key(key.ok_or_else(|| bad("unknown key"))?, shift)
         }
         "pick" => Line::Pick(pos(0)?),
         "slice" => {
@@ -111,7 +113,7 @@ fn parse_line(n: usize, text: &str) -> Result<Option<Line>> {
         "grip" => {
             let grip = rest.first().and_then(|g| super::handles::Grip::parse(g));
             Line::Grip(
-                grip.ok_or_else(|| bad("expected a grip: x+, x-, y+, y-, z+, z- or plane"))?,
+                grip.ok_or_else(|| bad("expected a grip: x+, x-, y+, y-, z+, z-, plane or plane2 to plane6"))?,
                 pos(1)? - Pos2::ZERO,
             )
         }
@@ -231,10 +233,11 @@ fn expand(n: usize, line: Line, s: &mut State) -> Result<Vec<Step>> {
                 },
             ]
         }
-        Line::Key(key) => {
-            let k =
-                |pressed| Event::Key { key, physical_key: None, pressed, repeat: false, modifiers: Modifiers::NONE };
-            vec![Step { events: vec![k(true)], after: None }, Step { events: vec![k(false)], after: None }]
+        Line::Key(key, shift) => {
+            let modifiers = if shift { Modifiers::SHIFT } else { Modifiers::NONE };
+            let k = |pressed| Event::Key { key, physical_key: None, pressed, repeat: false, modifiers };
+            let (down, up) = (Event::ModifiersChanged(modifiers), Event::ModifiersChanged(Modifiers::NONE));
+            vec![Step { events: vec![down, k(true)], after: None }, Step { events: vec![k(false), up], after: None }]
         }
         Line::Pick(f) => {
             let rect = s.view_rect.ok_or_else(|| missing("no view laid out"))?;
@@ -264,7 +267,7 @@ fn expand(n: usize, line: Line, s: &mut State) -> Result<Vec<Step>> {
                 }
                 _ => None,
             };
-            let a = at.ok_or_else(|| missing(&format!("no grip {grip:?} in view (c: the plane, b: the crop box)")))?;
+            let a = at.ok_or_else(|| missing(&format!("no grip {grip:?} in view (c: a plane, b: the crop box)")))?;
             drag(a, a + by)
         }
         Line::Label(value, on) => {
@@ -314,8 +317,9 @@ impl Step {
                 println!("slice: crosshair {:?}", s.slices.as_ref().map(|c| c.voxel));
             }
             Some(Line::State) => {
-                let plane = s.clip_plane.map(|p| p.1);
-                println!("state: crop {:?}; plane offset {plane:?}; handle pixels {}", s.crop, s.handle_pixels);
+                let offsets: Vec<f32> = (0..s.clip_planes.len()).filter_map(|i| s.plane_offset(i)).collect();
+                let crop = s.crop_fractions();
+                println!("state: crop {crop:?}; plane offsets {offsets:?}; handle pixels {}", s.handle_pixels);
             }
             Some(Line::Shot(path)) => s.shot_now = Some(path),
             Some(Line::View(path)) => super::save_png(&path, size, view()?)?,

@@ -43,10 +43,13 @@ pub struct State {
     pub clicked: bool,
     pub slices: Option<slices::Slices>,
     pub grid: Option<voxsplat::Grid>,
-    /// A clip plane through the grid's centre (its normal, the offset along it) keeping what lies
-    /// beyond it, and a crop box as fractions of the grid along each axis.
-    pub clip_plane: Option<(Vec3, f32)>,
-    pub crop: Option<[[f32; 3]; 2]>,
+    /// Clip planes in world space (a unit normal N and D: what lies where N . p + D < 0 is cut),
+    /// as `render --clip` takes them, and a crop box's world corners, as `render --crop`: a session
+    /// saves them as they are, so `render --session` cuts the same voxels.
+    pub clip_planes: Vec<Vec4>,
+    pub crop: Option<[Vec3; 2]>,
+    /// Whether the clipping's handles show (and take drags).
+    pub handles_shown: bool,
     /// The clipping's handle a drag moves, and the pixels the last still frame's handles covered.
     pub grip: Option<handles::Grip>,
     pub handle_pixels: usize,
@@ -82,6 +85,66 @@ pub enum TfIo {
 }
 
 impl State {
+    /// The panel at `panel_width` points, drawing with `options` and the order, compositing,
+    /// raster and kernel `names`, clipped by `clipping` (world planes, a crop box).
+    pub fn new(
+        panel_width: f32,
+        options: RenderOptions,
+        (order, composite, raster, kernel): (String, String, String, String),
+        (clip_planes, crop): (Vec<Vec4>, Option<[Vec3; 2]>),
+    ) -> Self {
+        State {
+            title: String::new(),
+            panel_width,
+            base: None,
+            radius: 1.0,
+            orbit: Orbit::HOME,
+            options,
+            order,
+            composite,
+            raster,
+            kernel,
+            tf: None,
+            histogram: None,
+            tf_editor: Default::default(),
+            tf_file: "view-tf.toml".into(),
+            tf_io: None,
+            light: None,
+            shading_on: false,
+            series: None,
+            parts: None,
+            reclassify: false,
+            pointer: None,
+            hover: None,
+            hover_voxel: None,
+            picked_at: None,
+            clicked: false,
+            slices: None,
+            grid: None,
+            clip_planes,
+            crop,
+            handles_shown: true,
+            grip: None,
+            handle_pixels: 0,
+            view_rect: None,
+            pixels_per_point: 1.0,
+            last_ms: 0.0,
+            stats: String::new(),
+            message: String::new(),
+            coarse: super::DRAG_COARSE_START,
+            overhead_ms: 0.0,
+            dragging: false,
+            help: false,
+            help_pressed: false,
+            dirty: true,
+            tf_changed: false,
+            time_to: None,
+            save_now: false,
+            shot_now: None,
+            quit: false,
+        }
+    }
+
     /// A mode, with the iso value it needs.
     pub fn set_mode(&mut self, mode: Mode) {
         self.options.mode = mode;
@@ -118,14 +181,7 @@ impl State {
         o.composite = self.composite.parse()?;
         o.raster = self.raster.parse()?;
         o.kernel = self.kernel.parse()?;
-        if let Some(g) = &self.grid {
-            let planes: Vec<Vec4> = self
-                .clip_plane
-                .map(|(n, offset)| Vec4::new(n.x, n.y, n.z, -n.dot(g.center()) - offset))
-                .into_iter()
-                .collect();
-            o.clip = voxsplat::Clip::new(&planes, self.crop_world(g))?;
-        }
+        o.clip = voxsplat::Clip::new(&self.clip_planes, self.crop)?;
         if o.mode != Mode::Composite {
             // As `render`: a projection draws in no visibility order and at full detail.
             (o.order, o.lod) = (voxsplat::OrderKind::Pbtf, voxsplat::Lod::Off);
@@ -134,67 +190,110 @@ impl State {
         Ok(o)
     }
 
-    /// The crop box in world space: the world box of its fractions of the grid.
-    fn crop_world(&self, g: &voxsplat::Grid) -> Option<[Vec3; 2]> {
-        let last = Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32));
-        self.crop.map(|[lo, hi]| g.world_box(Vec3::from(lo) * last, Vec3::from(hi) * last))
+    /// The grid's world box: the crop box's whole extent.
+    fn bounds(&self) -> Option<[Vec3; 2]> {
+        let g = self.grid.as_ref()?;
+        Some(g.world_box(Vec3::ZERO, Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32))))
     }
 
-    /// The clipping's handles, when a plane or a box clips.
+    /// The clipping's handles, when a plane or a box clips and they are shown.
     pub fn handle_shapes(&self) -> Option<handles::Shapes> {
-        let g = self.grid.as_ref()?;
-        if self.clip_plane.is_none() && self.crop.is_none() {
+        let bounds = self.bounds()?;
+        if !self.handles_shown || (self.clip_planes.is_empty() && self.crop.is_none()) {
             return None;
         }
-        let bounds = g.world_box(Vec3::ZERO, Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32)));
-        let plane = self.clip_plane.map(|(n, offset)| (n, g.center() + n * offset));
-        Some(handles::Shapes::of(bounds, self.crop_world(g), plane))
+        let c = (bounds[0] + bounds[1]) * 0.5;
+        // Each plane's point nearest the box's centre.
+        let planes: Vec<(Vec3, Vec3)> =
+            self.clip_planes.iter().map(|p| (p.truncate(), c - p.truncate() * (p.truncate().dot(c) + p.w))).collect();
+        Some(handles::Shapes::of(bounds, self.crop, &planes))
     }
 
-    /// A clip plane through the centre facing the view, or none.
-    pub fn toggle_plane(&mut self) {
-        self.clip_plane = if self.clip_plane.is_none() { self.view_direction().map(|n| (n, 0.0)) } else { None };
+    /// A clip plane through the grid's centre facing the view (it keeps what lies beyond the
+    /// centre), up to the library's limit.
+    pub fn add_plane(&mut self) {
+        let (Some(n), Some([lo, hi])) = (self.view_direction(), self.bounds()) else { return };
+        if self.clip_planes.len() >= voxsplat::options::MAX_CLIP_PLANES {
+            self.message = format!("at most {} clip planes", voxsplat::options::MAX_CLIP_PLANES);
+            return;
+        }
+        let n = n.normalize();
+        self.clip_planes.push(n.extend(-n.dot((lo + hi) * 0.5)));
         self.dirty = true;
+    }
+
+    /// Remove clip plane `i` (the last one when `i` is past the end).
+    pub fn remove_plane(&mut self, i: usize) {
+        if !self.clip_planes.is_empty() {
+            self.clip_planes.remove(i.min(self.clip_planes.len() - 1));
+            self.dirty = true;
+        }
+    }
+
+    /// How far plane `i` lies beyond the grid's centre, along its normal (world units).
+    pub fn plane_offset(&self, i: usize) -> Option<f32> {
+        let (p, [lo, hi]) = (self.clip_planes.get(i)?, self.bounds()?);
+        Some(-(p.truncate().dot((lo + hi) * 0.5) + p.w))
+    }
+
+    /// Move plane `i` to `offset` beyond the grid's centre, within the view's radius of it.
+    pub fn set_plane_offset(&mut self, i: usize, offset: f32) {
+        let Some([lo, hi]) = self.bounds() else { return };
+        let radius = self.radius;
+        if let Some(p) = self.clip_planes.get_mut(i) {
+            p.w = -(p.truncate().dot((lo + hi) * 0.5) + offset.clamp(-radius, radius));
+            self.dirty = true;
+        }
     }
 
     /// The crop box around the whole grid, or none.
     pub fn toggle_crop(&mut self) {
-        self.crop = if self.crop.is_none() { Some([[0.0; 3], [1.0; 3]]) } else { None };
+        self.crop = if self.crop.is_none() { self.bounds() } else { None };
+        self.dirty = true;
+    }
+
+    /// The crop box as fractions of the grid's world box along each axis.
+    pub fn crop_fractions(&self) -> Option<[[f32; 3]; 2]> {
+        let ([lo, hi], [b0, b1]) = (self.crop?, self.bounds()?);
+        let f = |w: Vec3| ((w - b0) / (b1 - b0).max(Vec3::splat(f32::MIN_POSITIVE))).to_array();
+        Some([f(lo), f(hi)])
+    }
+
+    /// Move the crop box's face across `axis` (its high or low one) to `fraction` of the grid's
+    /// box. The box keeps a hundredth of the grid at least.
+    pub fn set_crop_face(&mut self, axis: usize, high: bool, fraction: f32) {
+        let Some([b0, b1]) = self.bounds() else { return };
+        let Some([lo, hi]) = &mut self.crop else { return };
+        let (extent, keep) = ((b1 - b0)[axis], 0.01 * (b1 - b0)[axis]);
+        let at = b0[axis] + fraction * extent;
+        if high {
+            hi[axis] = at.clamp(lo[axis] + keep, b1[axis]);
+        } else {
+            lo[axis] = at.clamp(b0[axis], hi[axis] - keep);
+        }
         self.dirty = true;
     }
 
     /// Move `grip` by `amount` world units along its direction.
     pub fn move_grip(&mut self, grip: handles::Grip, amount: f32) {
-        let Some(g) = &self.grid else { return };
         match grip {
-            handles::Grip::Plane => {
-                if let Some((_, offset)) = &mut self.clip_plane {
-                    *offset = (*offset + amount).clamp(-self.radius, self.radius);
+            handles::Grip::Plane(i) => {
+                if let Some(offset) = self.plane_offset(i) {
+                    self.set_plane_offset(i, offset + amount);
                 }
             }
             handles::Grip::Face { axis, high } => {
-                let last = Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32));
-                let [lo, hi] = g.world_box(Vec3::ZERO, last);
-                let extent = (hi - lo)[axis].max(f32::MIN_POSITIVE);
-                if let Some([lo, hi]) = &mut self.crop {
-                    // As the sliders: the box keeps a hundredth of the grid at least.
-                    if high {
-                        hi[axis] = (hi[axis] + amount / extent).clamp(lo[axis] + 0.01, 1.0);
-                    } else {
-                        lo[axis] = (lo[axis] + amount / extent).clamp(0.0, hi[axis] - 0.01);
-                    }
-                }
+                let (Some([b0, b1]), Some([lo, hi])) = (self.bounds(), self.crop) else { return };
+                let extent = (b1 - b0)[axis].max(f32::MIN_POSITIVE);
+                let at = if high { hi[axis] } else { lo[axis] };
+                self.set_crop_face(axis, high, (at + amount - b0[axis]) / extent);
             }
         }
-        self.dirty = true;
     }
 
     /// The session of the frame drawn through `cam`: what `render --session` draws again.
     pub fn session(&self, cam: &Camera) -> Result<Session> {
         let tf = self.tf.clone().ok_or_else(|| Error::InvalidArgument("a session needs a --volume file".into()))?;
-        if self.clip_plane.is_some() || self.crop.is_some() {
-            return Err(Error::InvalidArgument("a session holds no clipping: turn the plane and box off first".into()));
-        }
         let o = &self.options;
         let projection = o.mode != Mode::Composite;
         Ok(Session {
@@ -208,6 +307,8 @@ impl State {
             background: o.background.unwrap_or([0.0; 4]),
             camera: Session::view_of(cam),
             light: Session::light_of(self.shading()),
+            clip: self.clip_planes.iter().map(|p| p.to_array()).collect(),
+            crop: self.crop.map(|[lo, hi]| [lo.to_array(), hi.to_array()]),
             tf,
         })
     }
@@ -218,5 +319,65 @@ impl State {
         } else {
             None
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state() -> State {
+        let names = ["pbtf", "splat", "auto", "crawfis-max"].map(String::from);
+        let mut s = State::new(300.0, RenderOptions::default(), names.into(), (Vec::new(), None));
+        let grid = voxsplat::Grid::centered([33, 17, 9], [1.0, 2.0, 3.0]).unwrap();
+        s.base = Some(Camera::framing(&grid, 64, 64));
+        (s.grid, s.radius) = (Some(grid), 0.5 * grid.diagonal());
+        s.tf = Some(TransferFunction::preset("ct").unwrap());
+        s
+    }
+
+    /// Planes face the view through the centre, up to the library's limit; each moves along its
+    /// normal by its offset, within the view's radius; the crop box's faces keep a hundredth of
+    /// the grid between them; the options and the session carry the same world clipping.
+    #[test]
+    fn planes_add_up_to_the_limit_and_move_and_the_session_keeps_them() {
+        let mut s = state();
+        for _ in 0..voxsplat::options::MAX_CLIP_PLANES + 1 {
+            s.add_plane();
+        }
+        assert_eq!(s.clip_planes.len(), voxsplat::options::MAX_CLIP_PLANES);
+        assert!(s.message.contains("at most"), "{}", s.message);
+        let forward = s.view_direction().unwrap();
+        assert!(s.clip_planes[0].truncate().distance(forward) < 1e-6);
+        assert!(s.plane_offset(0).unwrap().abs() < 1e-4);
+        s.set_plane_offset(1, 2.5);
+        assert!((s.plane_offset(1).unwrap() - 2.5).abs() < 1e-4);
+        s.move_grip(handles::Grip::Plane(1), 1e9);
+        assert!((s.plane_offset(1).unwrap() - s.radius).abs() < 1e-3, "held within the radius");
+        s.remove_plane(0);
+        s.remove_plane(usize::MAX);
+        assert_eq!(s.clip_planes.len(), voxsplat::options::MAX_CLIP_PLANES - 2);
+        assert!((s.plane_offset(0).unwrap() - s.radius).abs() < 1e-3, "the first removed, the second first now");
+
+        s.toggle_crop();
+        assert_eq!(s.crop_fractions(), Some([[0.0; 3], [1.0; 3]]));
+        s.set_crop_face(2, true, 0.3);
+        s.set_crop_face(2, false, 0.9);
+        let [lo, hi] = s.crop_fractions().unwrap();
+        assert!((hi[2] - 0.3).abs() < 1e-5 && (hi[2] - lo[2] - 0.01).abs() < 1e-5, "{lo:?} {hi:?}");
+        s.move_grip(handles::Grip::Face { axis: 0, high: true }, -1e9);
+        let [lo, hi] = s.crop_fractions().unwrap();
+        assert!((hi[0] - lo[0] - 0.01).abs() < 1e-5, "{lo:?} {hi:?}");
+
+        let cam = s.view_camera().unwrap_or_else(|| Camera::framing(s.grid.as_ref().unwrap(), 64, 64));
+        let session = s.session(&cam).unwrap();
+        assert_eq!(session.clipping(), (s.clip_planes.clone(), s.crop));
+        assert_eq!(session.clip().unwrap(), s.render_options().unwrap().clip);
+        let shapes = s.handle_shapes().unwrap();
+        // A grip on each plane that cuts the grid's box: not on the first, pushed to the radius.
+        let grips: Vec<_> = shapes.grips.iter().filter(|g| matches!(g.0, handles::Grip::Plane(_))).collect();
+        assert_eq!(grips.iter().map(|g| g.0).collect::<Vec<_>>(), (1..4).map(handles::Grip::Plane).collect::<Vec<_>>());
+        s.handles_shown = false;
+        assert!(s.handle_shapes().is_none(), "hidden handles take no drags");
     }
 }

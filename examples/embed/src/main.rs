@@ -47,7 +47,7 @@ fn main() -> Result<(), voxsplat::Error> {
     // The same field as a bricked store, classified on the device every frame: a new transfer
     // function is a table write, not a re-extraction.
     let mut options = RendererOptions::default();
-    options.gpu_budget_bytes = 64 << 20;
+    options.gpu_budget_bytes = Some(64 << 20);
     let mut bricked = Renderer::new(&options)?;
     bricked.set_volume(&volume, &TransferFunction::preset("ramp")?, None)?;
     let store = &bricked.volume().expect("set above").store;
