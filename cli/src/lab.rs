@@ -504,13 +504,8 @@ fn matrix(a: MatrixArgs) -> Result<()> {
         s
     };
     if let Some(path) = &a.results {
-        let commit = std::process::Command::new("git")
-            .args(["rev-parse", "--short", "HEAD"])
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-            .unwrap_or_else(|| "unknown".into());
+        // The commit this binary was built from (cli/build.rs), not the checkout's HEAD now.
+        let commit = env!("VOXSPLAT_COMMIT").to_string();
         let base = path.parent().unwrap_or(std::path::Path::new("."));
         let chart_dir = pathdiff(&a.out_dir, base);
         let notes_path = base.join("results-notes.md");
