@@ -214,9 +214,7 @@ impl DeviceChoices {
     pub(crate) fn raster(&self) -> crate::raster::Device {
         crate::raster::Device { cpu: self.cpu, point_size_max: self.point_size_max, graphics: self.graphics_raster }
     }
-}
 
-impl DeviceChoices {
     /// The raster variant `options.raster` resolves to for `set` seen from `camera` on this device
     /// (`Raster::Auto`'s rule, or the checks on an explicit choice).
     pub fn choose_raster(

@@ -125,7 +125,7 @@ pub struct Report {
     pub quick: bool,
     /// Validation was on: the times are not a measurement.
     pub validation: bool,
-    /// Untimed and timed frames a case.
+    /// Untimed frames a case, before the timed ones.
     pub warmup: usize,
     /// Timed frames a case.
     pub frames: usize,

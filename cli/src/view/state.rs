@@ -196,13 +196,18 @@ impl State {
         Some(g.world_box(Vec3::ZERO, Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32))))
     }
 
+    /// The grid's world box's centre, which the clip planes' offsets count from.
+    fn centre(&self) -> Option<Vec3> {
+        self.bounds().map(|[lo, hi]| (lo + hi) * 0.5)
+    }
+
     /// The clipping's handles, when a plane or a box clips and they are shown.
     pub fn handle_shapes(&self) -> Option<handles::Shapes> {
         let bounds = self.bounds()?;
         if !self.handles_shown || (self.clip_planes.is_empty() && self.crop.is_none()) {
             return None;
         }
-        let c = (bounds[0] + bounds[1]) * 0.5;
+        let c = self.centre()?;
         // Each plane's point nearest the box's centre.
         let planes: Vec<(Vec3, Vec3)> =
             self.clip_planes.iter().map(|p| (p.truncate(), c - p.truncate() * (p.truncate().dot(c) + p.w))).collect();
@@ -212,13 +217,13 @@ impl State {
     /// A clip plane through the grid's centre facing the view (it keeps what lies beyond the
     /// centre), up to the library's limit.
     pub fn add_plane(&mut self) {
-        let (Some(n), Some([lo, hi])) = (self.view_direction(), self.bounds()) else { return };
+        let (Some(n), Some(c)) = (self.view_direction(), self.centre()) else { return };
         if self.clip_planes.len() >= voxsplat::options::MAX_CLIP_PLANES {
             self.message = format!("at most {} clip planes", voxsplat::options::MAX_CLIP_PLANES);
             return;
         }
         let n = n.normalize();
-        self.clip_planes.push(n.extend(-n.dot((lo + hi) * 0.5)));
+        self.clip_planes.push(n.extend(-n.dot(c)));
         self.dirty = true;
     }
 
@@ -232,16 +237,16 @@ impl State {
 
     /// How far plane `i` lies beyond the grid's centre, along its normal (world units).
     pub fn plane_offset(&self, i: usize) -> Option<f32> {
-        let (p, [lo, hi]) = (self.clip_planes.get(i)?, self.bounds()?);
-        Some(-(p.truncate().dot((lo + hi) * 0.5) + p.w))
+        let (p, c) = (self.clip_planes.get(i)?, self.centre()?);
+        Some(-(p.truncate().dot(c) + p.w))
     }
 
     /// Move plane `i` to `offset` beyond the grid's centre, within the view's radius of it.
     pub fn set_plane_offset(&mut self, i: usize, offset: f32) {
-        let Some([lo, hi]) = self.bounds() else { return };
+        let Some(c) = self.centre() else { return };
         let radius = self.radius;
         if let Some(p) = self.clip_planes.get_mut(i) {
-            p.w = -(p.truncate().dot((lo + hi) * 0.5) + offset.clamp(-radius, radius));
+            p.w = -(p.truncate().dot(c) + offset.clamp(-radius, radius));
             self.dirty = true;
         }
     }
