@@ -21,6 +21,7 @@ use winit::window::{Window, WindowId};
 mod handles;
 mod load;
 mod orbit;
+mod pace;
 mod panel;
 mod script;
 mod slices;
@@ -35,9 +36,6 @@ pub const ORDERS: &[&str] = &["pbtf", "wbtf", "btf", "pbtf-octant", "sorted"];
 pub const COMPOSITES: &[&str] = &["splat", "sheet", "slab"];
 pub const RASTERS: &[&str] = &["auto", "compute", "graphics", "points"];
 pub const KERNELS: &[&str] = &["crawfis-max", "gaussian", "cubic", "narrow"];
-/// A drag frame's coarseness at the first drag, and at most (`State::coarse`).
-const DRAG_COARSE_START: f32 = 2.0;
-const DRAG_COARSE_MAX: f32 = 8.0;
 /// A drag frame's bound on a coarse level's error (`RenderOptions::lod_error`): none that matters.
 const DRAG_LOD_ERROR: f32 = 1e6;
 /// The isosurface's first value (normalised).
@@ -100,9 +98,8 @@ struct App {
     drawn: Option<(Viewport, Camera, RenderOptions)>,
     /// Whether the view's image holds the clipping's handles (drawn under a still frame).
     view_has_handles: bool,
-    /// Each frame drawn: milliseconds drawing the volume, whether a drag drew it (at what
-    /// scale), and milliseconds for the whole window frame.
-    times: Vec<(f64, Option<f32>, f64)>,
+    /// Each frame drawn (`pace::FrameTime`).
+    times: Vec<pace::FrameTime>,
     /// From the command's start to the first frame presented.
     started: Instant,
     first_frame: Option<f64>,
@@ -249,6 +246,10 @@ impl App {
         let base = s.base.expect("started");
         let cam = s.orbit.camera(&base, s.radius, (viewport.width, viewport.height));
         let mut options = s.render_options()?;
+        if s.dragging && !s.coarse_measured {
+            // The first drag frame: as coarse as the last full frame's time says.
+            s.coarse = pace::next_coarse(1.0, s.last_ms + s.overhead_ms, self.args.drag_ms as f64);
+        }
         if s.dragging {
             // A drag frame: fewer pixels and fewer splats. The splats set the cost, and they come
             // in levels (each a quarter of the last), so the pixel bound moves with the scale.
@@ -331,10 +332,8 @@ impl App {
             if s.dragging {
                 // Hold the target: coarser when over it, finer when well under.
                 // The window's own share (the panel, the overlay, the present) counts too.
-                let ratio = ((ms + s.overhead_ms) / self.args.drag_ms as f64).sqrt() as f32;
-                if !(0.7..=1.0).contains(&ratio) {
-                    s.coarse = (s.coarse * ratio).clamp(1.0, DRAG_COARSE_MAX);
-                }
+                s.coarse = pace::next_coarse(s.coarse, ms + s.overhead_ms, self.args.drag_ms as f64);
+                s.coarse_measured = true;
             }
             self.drawn = Some((viewport, cam, options.clone()));
         }
@@ -593,21 +592,8 @@ pub fn view(args: ViewArgs) -> Result<()> {
     if let Some(first) = app.first_frame {
         println!("first frame {first:.2} s after the start (the file read, the device made, the frame drawn)");
     }
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    for (what, dragged) in [("still", false), ("while dragging", true)] {
-        let t: Vec<_> = app.times.iter().filter(|t| t.1.is_some() == dragged).collect();
-        if !t.is_empty() {
-            let volume = median(t.iter().map(|t| t.0).collect());
-            let window = median(t.iter().map(|t| t.2).collect());
-            let scale = median(t.iter().map(|t| t.1.unwrap_or(1.0) as f64).collect());
-            println!(
-                "{} frames drawn {what}: median {volume:.1} ms the volume, {window:.1} ms the window frame, scale {scale:.2}",
-                t.len()
-            );
-        }
+    for line in pace::summary(&app.times, app.args.drag_ms as f64) {
+        println!("{line}");
     }
     if let Some((n, messages)) = validation.filter(|v| v.0 > 0) {
         for m in messages {

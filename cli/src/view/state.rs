@@ -62,6 +62,9 @@ pub struct State {
     /// 1 / coarse of the render scale (a quarter at least) with levels of detail `coarse` times
     /// the pixel bound, the error bound set aside.
     pub coarse: f32,
+    /// Whether a drag frame has set `coarse` (until then the first drag starts from the still
+    /// frame's time).
+    pub coarse_measured: bool,
     /// The last window frame's time beyond drawing the volume.
     pub overhead_ms: f64,
     pub dragging: bool,
@@ -131,7 +134,8 @@ impl State {
             last_ms: 0.0,
             stats: String::new(),
             message: String::new(),
-            coarse: super::DRAG_COARSE_START,
+            coarse: 1.0,
+            coarse_measured: false,
             overhead_ms: 0.0,
             dragging: false,
             help: false,
