@@ -218,7 +218,8 @@ impl std::str::FromStr for BlurProfile {
     }
 }
 
-/// Per-frame choices. `Default` gives PBTF, per-splat back-to-front compositing, the Gaussian.
+/// Per-frame choices. `Default` gives what `voxsplat render` draws with no flags: PBTF, per-splat
+/// back-to-front compositing, the Crawfis-Max kernel, levels of detail on.
 ///
 /// ```
 /// use voxsplat::{Composite, Kernel, Lod, RenderOptions};
@@ -339,7 +340,7 @@ impl Default for RenderOptions {
             depth: None,
             order: OrderKind::Pbtf,
             composite: Composite::Splat,
-            kernel: Kernel::Gaussian,
+            kernel: Kernel::CrawfisMax,
             antialias: Antialias::None,
             motion: None,
             clip: Clip::default(),

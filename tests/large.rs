@@ -125,6 +125,8 @@ fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
     let mut g = gpu();
     g.set_scene(sheet).unwrap();
     let mut o = RenderOptions::default();
+    // rate_camera sizes the footprint by the Gaussian's radius: 300 px, past the budget.
+    o.kernel = Kernel::Gaussian;
     o.composite = Composite::Sheet;
     o.raster = Raster::Compute;
     let m = too_large(g.render(&cam, &o));

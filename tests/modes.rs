@@ -62,6 +62,8 @@ fn scaled_column_camera(dims: [u32; 3], pad: u32, ppv: u32) -> Camera {
 
 fn options(mode: Mode, raster: Raster) -> RenderOptions {
     let mut o = RenderOptions::default();
+    // The host projection below and the pixel-exact sprite sizes are the Gaussian's.
+    o.kernel = Kernel::Gaussian;
     o.mode = mode;
     o.raster = raster;
     o

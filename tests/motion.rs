@@ -29,6 +29,8 @@ fn ortho() -> Camera {
 /// sprites, which cannot blur), so they compare bit for bit.
 fn sheet_with(motion: Option<Motion>) -> RenderOptions {
     let mut o = RenderOptions::default();
+    // The areas below are computed with the Gaussian's G and radius.
+    o.kernel = Kernel::Gaussian;
     o.composite = Composite::Sheet;
     o.motion = motion;
     o.raster = Raster::Graphics;

@@ -258,7 +258,7 @@ fn compute_raster_is_bit_identical_run_to_run() {
 #[test]
 fn points_in_perspective_are_as_close_to_the_truth_as_the_quads() {
     use voxsplat::metrics::compare;
-    use voxsplat::truth::{volumetric_summation, TruthOptions};
+    use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
     let mut gpu = common::gpu();
     let set = scene::build("cube40").unwrap();
     gpu.set_scene(set.clone()).unwrap();
@@ -266,7 +266,9 @@ fn points_in_perspective_are_as_close_to_the_truth_as_the_quads() {
         // The 35-degree framing's eye: at 20 degrees the cube overflows the view, at 60 it is small.
         let mut cam = Camera::framing(set.grid(), 128, 128);
         cam.projection = Projection::Perspective { fov_y_deg: fov };
-        let truth = volumetric_summation(&set, &cam, &TruthOptions::default()).unwrap();
+        // The truth reconstructs with the frames' kernel (the default).
+        let reconstruction = Reconstruction::Kernel(RenderOptions::default().kernel);
+        let truth = volumetric_summation(&set, &cam, &TruthOptions { reconstruction, ..Default::default() }).unwrap();
         let quads = gpu.render(&cam, &opts(Composite::Splat, Raster::Graphics)).unwrap().image;
         let points = gpu.render(&cam, &opts(Composite::Splat, Raster::Points)).unwrap().image;
         let (q, p) = (compare(&quads, &truth).unwrap().rmse, compare(&points, &truth).unwrap().rmse);

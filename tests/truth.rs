@@ -183,7 +183,7 @@ fn empty_space_skipping_changes_no_pixel() {
     common::assert_clean(&gpu);
 }
 
-/// The narrow kernel's trade-off, measured: flat sheets ripple where the default Gaussian's
+/// The narrow kernel's trade-off, measured: flat sheets ripple where the Gaussian's
 /// footprints sum to a constant (the values docs/MODEL.md quotes).
 #[test]
 fn sheet_ripple_of_each_kernel() {

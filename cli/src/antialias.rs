@@ -7,7 +7,7 @@ use crate::bricked::frame_ms;
 use std::fmt::Write as _;
 use voxsplat::image::Downsample;
 use voxsplat::truth::{supersampled_with, TruthOptions};
-use voxsplat::{Antialias, Camera, ImageF32, Projection, RenderOptions, Renderer, RendererOptions, Result};
+use voxsplat::{Antialias, Camera, ImageF32, Projection, Renderer, RendererOptions, Result};
 
 /// One mode on one figure's view.
 pub struct AaSceneRow {
@@ -62,7 +62,7 @@ pub fn study(size: Option<u32>, factor: u32, dolly: usize, frames: usize) -> Res
         r.set_scene(set)?;
         let modes = [Antialias::None, Antialias::Swan, Antialias::Ewa];
         let options = |mode| {
-            let mut o = RenderOptions::default();
+            let mut o = crate::lab_options();
             o.antialias = mode;
             o
         };

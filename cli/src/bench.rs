@@ -7,7 +7,7 @@ use std::time::Instant;
 use voxsplat::camera::Camera;
 use voxsplat::image::ImageF32;
 use voxsplat::metrics::{compare, ImageMetrics};
-use voxsplat::options::{Antialias, Composite, RenderOptions, Rendered};
+use voxsplat::options::{Antialias, Composite, Rendered};
 use voxsplat::order::{count_violations, visibility_order};
 use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use voxsplat::volume::{Grid, SplatSet};
@@ -275,7 +275,7 @@ fn render_method_at(r: &mut Renderer, m: &Method, camera: &Camera, render_scale:
     match m {
         Method::Splat { order, composite, kernel, aa, raster } => {
             let o = {
-                let mut o = RenderOptions::default();
+                let mut o = crate::lab_options();
                 o.order = *order;
                 o.composite = *composite;
                 o.kernel = *kernel;
@@ -290,7 +290,7 @@ fn render_method_at(r: &mut Renderer, m: &Method, camera: &Camera, render_scale:
             r.raycast(camera, &RaycastOptions { step: *step, render_scale, ..Default::default() })
         }
         Method::Bricked { lod } => {
-            let mut o = RenderOptions::default();
+            let mut o = crate::lab_options();
             (o.raster, o.render_scale, o.lod) = (Raster::Compute, render_scale, voxsplat::Lod::Off);
             if let Some((pixels, error)) = *lod {
                 (o.lod, o.lod_pixels, o.lod_error) = (voxsplat::Lod::Auto, pixels, error);

@@ -49,7 +49,7 @@ fn renderer() -> Result<Renderer> {
 }
 
 fn opts(early_termination: f32) -> RenderOptions {
-    let mut o = RenderOptions::default();
+    let mut o = crate::lab_options();
     (o.raster, o.direction, o.early_termination) = (Raster::Compute, Some(Direction::FrontToBack), early_termination);
     // Full detail unless a variant asks for levels of detail.
     o.lod = voxsplat::Lod::Off;
@@ -355,7 +355,7 @@ pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, arc: Arc) -> R
     let steps = arc.check()?;
     let tf = TransferFunction::preset(tf)?;
     let (mut r, cam) = framed(load(path, &tf)?.scene, size, budget_bytes)?;
-    let opts = RenderOptions::default();
+    let opts = crate::lab_options();
     let mut out = String::from(
         "| frame | degrees | ms | splats | record MiB uploaded | record MiB held | uploaded / held |\n|---:|---:|---:|---:|---:|---:|---:|\n",
     );
@@ -401,7 +401,7 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     let mut bricked = renderer()?;
     bricked.set_bricks(BrickScene::new(BrickStore::build(&vol)?, tf, None)?)?;
     drop(vol);
-    let mut o = RenderOptions::default();
+    let mut o = crate::lab_options();
     (o.raster, o.lod) = (Raster::Compute, voxsplat::Lod::Off);
     let mut variants: Vec<(String, bool, RenderOptions)> =
         vec![("dense classified splats".into(), true, o.clone()), ("bricked, full detail".into(), false, o.clone())];
@@ -519,7 +519,7 @@ pub fn zarr_orbit(
         let hits = cache.as_ref().map_or(0, |c| c.stats().hits - before.hits);
         read_total += read;
         let t = Instant::now();
-        let st = r.render(&c, &RenderOptions::default())?.stats;
+        let st = r.render(&c, &crate::lab_options())?.stats;
         frames.push(ms(t));
         let (load_ms, frame_ms) = (loads[i as usize], frames[i as usize]);
         out += &format!(

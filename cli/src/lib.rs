@@ -25,3 +25,13 @@ pub mod suite;
 pub mod uneven;
 pub mod view;
 pub mod volumes;
+
+/// The options the labs measure with: the library's defaults with the Gaussian kernel, the
+/// dissertation's. Their figures in docs/RESULTS.md and the tests' ceilings were measured with it
+/// (it was `RenderOptions::default()`'s kernel until Crawfis-Max, `render`'s default, became the
+/// library's too).
+pub fn lab_options() -> voxsplat::RenderOptions {
+    let mut o = voxsplat::RenderOptions::default();
+    o.kernel = voxsplat::Kernel::Gaussian;
+    o
+}

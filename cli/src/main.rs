@@ -534,9 +534,9 @@ fn animate(a: Box<AnimateArgs>) -> Result<()> {
                 flag.1
             )));
         }
-        // As `render` draws a volume (its --kernel default), so that frame t is `render --time t`'s.
+        // As `render` draws a volume (the library's defaults), so that frame t is `render --time t`'s.
         let mut opts = RenderOptions::default();
-        (opts.composite, opts.kernel) = (composite, Kernel::CrawfisMax);
+        opts.composite = composite;
         let mut gif = out(&a.out_dir)?;
         let report = voxsplat_cli::series::play(&a.scene, &opts, |t, img| write(t, img, &mut gif))?;
         gif.finish()?;

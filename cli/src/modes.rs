@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::{Camera, Mode, RaycastOptions, RenderOptions, Renderer, RendererOptions, Result};
+use voxsplat::{Camera, Mode, RaycastOptions, Renderer, RendererOptions, Result};
 
 /// A volume of the study: its name, file, transfer-function preset and isosurface value (in the
 /// file's units).
@@ -61,7 +61,7 @@ pub fn study(volumes: &[ModeVolume], size: u32, rounds: usize) -> Result<(Vec<Mo
         drop(vol);
         bricked.set_bricks(BrickScene::new(store, tf, None)?)?;
         let options = |mode: Mode| {
-            let mut o = RenderOptions::default();
+            let mut o = crate::lab_options();
             o.mode = mode;
             o.iso = (mode == Mode::Iso).then_some(iso);
             o

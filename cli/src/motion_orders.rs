@@ -67,7 +67,7 @@ fn blur_methods() -> Vec<(String, Blur)> {
 }
 
 fn options(order: OrderKind) -> RenderOptions {
-    let mut o = RenderOptions::default();
+    let mut o = crate::lab_options();
     o.order = order;
     o
 }

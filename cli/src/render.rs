@@ -526,3 +526,36 @@ fn distributed_frames(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Parser)]
+    struct Cmd {
+        #[command(flatten)]
+        render: RenderArgs,
+    }
+
+    /// `render` with no flags draws what `RenderOptions::default()` draws, so an embedder's
+    /// default frame is the command's (the library's kernel was the Gaussian while the command's
+    /// was Crawfis-Max).
+    #[test]
+    fn render_s_defaults_are_the_library_s() {
+        let a = Cmd::try_parse_from(["render", "--out", "frame.png"]).unwrap().render;
+        let d = RenderOptions::default();
+        assert_eq!(a.mode.parse::<voxsplat::Mode>().unwrap(), d.mode);
+        assert_eq!(a.scene.order.parse::<OrderKind>().unwrap(), d.order);
+        assert_eq!(a.composite.parse::<Composite>().unwrap(), d.composite);
+        assert_eq!(a.kernel.parse::<Kernel>().unwrap(), d.kernel);
+        assert_eq!(a.aa.parse::<voxsplat::Antialias>().unwrap(), d.antialias);
+        assert_eq!(a.raster.parse::<voxsplat::Raster>().unwrap(), d.raster);
+        assert_eq!(a.lod.as_deref().unwrap_or("auto").parse::<voxsplat::Lod>().unwrap(), d.lod);
+        assert_eq!((a.lod_pixels, a.lod_error, a.lod_band), (d.lod_pixels, d.lod_error, d.lod_band));
+        assert_eq!((a.early_termination, a.render_scale), (d.early_termination, d.render_scale));
+        assert_eq!(mib_bytes(a.sheet_budget_mib, "").unwrap(), d.sheet_budget_bytes);
+        assert_eq!((a.direction.is_none(), d.direction.is_none()), (true, true));
+        assert_eq!(a.background, d.background);
+        assert_eq!((a.every_voxel, !a.keep_hidden_bricks), (d.every_voxel, d.cull_hidden_bricks));
+    }
+}

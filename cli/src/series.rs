@@ -202,8 +202,7 @@ pub fn study(a: &SceneArgs) -> Result<String> {
     let series = Series::open(a)?;
     let (mut played, cam) = series.first(a)?;
     let mut fresh = renderer_of(a)?;
-    let mut opts = RenderOptions::default();
-    opts.kernel = voxsplat::Kernel::CrawfisMax;
+    let opts = RenderOptions::default();
     fresh.set_bricks(series.scene(a, 0)?)?;
     played.render(&cam, &opts)?;
     fresh.render(&cam, &opts)?;

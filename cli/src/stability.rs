@@ -67,7 +67,7 @@ impl Variant {
 
     pub fn render(&self, r: &mut Renderer, camera: &Camera) -> Result<Rendered> {
         let mut o = {
-            let mut o = RenderOptions::default();
+            let mut o = crate::lab_options();
             o.raster = Raster::Graphics;
             o
         };
@@ -360,7 +360,7 @@ pub fn overlap_study(r: &mut Renderer, size: u32, frames: usize) -> Result<Vec<O
             let mut cam = base;
             let off = cam.eye - cam.target;
             cam.eye = cam.target + Quat::from_rotation_y((f as f32 * 3.0).to_radians()) * off;
-            let mut o = RenderOptions::default();
+            let mut o = crate::lab_options();
             let pbtf = r.render(&cam, &o)?.image;
             o.order = OrderKind::Sorted;
             let sorted = r.render(&cam, &o)?.image;
@@ -401,7 +401,7 @@ pub fn visibility_study(r: &mut Renderer, size: u32) -> Result<Vec<VisibilityRow
         let set = scene::build(name)?;
         let cam = if name == "rmnp" { Camera::flyover(set.grid(), size, size) } else { close_view(set.grid(), size) };
         let mut o = {
-            let mut o = RenderOptions::default();
+            let mut o = crate::lab_options();
             o.order = OrderKind::Sorted;
             o
         };
@@ -608,7 +608,7 @@ pub fn early_termination_study(r: &mut Renderer, size: u32, frames: usize) -> Re
         r.set_scene(set)?;
         for composite in [Composite::Sheet, Composite::Slab] {
             let mut o = {
-                let mut o = RenderOptions::default();
+                let mut o = crate::lab_options();
                 o.composite = composite;
                 o
             };

@@ -5,7 +5,7 @@ use crate::scene_args::SceneArgs;
 use clap::Parser;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use voxsplat::{Error, Kernel, Mode, RenderOptions, Renderer, Result};
+use voxsplat::{Error, Mode, RenderOptions, Renderer, Result};
 
 mod report;
 pub use report::*;
@@ -206,17 +206,15 @@ fn io_error(path: &Path, source: std::io::Error) -> Error {
     Error::Io { path: path.display().to_string(), source }
 }
 
-/// `render`'s default options for a case's mode (its kernel default too).
-fn case_options(case: &Case) -> Result<RenderOptions> {
+/// `render`'s default options (the library's) for a case's mode.
+fn case_options(case: &Case) -> RenderOptions {
     let mut o = RenderOptions::default();
-    o.kernel = "crawfis-max".parse::<Kernel>()?;
-    o.lod = voxsplat::Lod::Auto;
     o.mode = match case.mode {
         CaseMode::Default => Mode::Composite,
         CaseMode::Mip => Mode::Mip,
         CaseMode::Iso(_) => Mode::Iso,
     };
-    Ok(o)
+    o
 }
 
 /// Clear the process's peak resident memory (Linux: `clear_refs` 5), so each case reports its own.
@@ -239,10 +237,14 @@ struct Loaded {
 
 fn load(case: &Case, opts: &SuiteOptions) -> Result<Loaded> {
     let flags = case_flags(case, opts)?;
-    let scene = Flags::try_parse_from(std::iter::once("bench".to_string()).chain(flags))
-        .map_err(|e| Error::InvalidArgument(format!("case {}: {e}", case.name)))?
-        .scene;
-    let mut o = case_options(case)?;
+    // SceneArgs holds no Clone: the truth's copy is parsed anew from the same flags.
+    let parse = || {
+        Flags::try_parse_from(std::iter::once("bench".to_string()).chain(flags.iter().cloned()))
+            .map(|f| f.scene)
+            .map_err(|e| Error::InvalidArgument(format!("case {}: {e}", case.name)))
+    };
+    let scene = parse()?;
+    let mut o = case_options(case);
     if let Source::Animation(name) = case.source {
         use voxsplat::animate::{render_frame_timed, Animation, Blur};
         let anim = Animation::builtin(name)?;
@@ -283,7 +285,7 @@ fn load(case: &Case, opts: &SuiteOptions) -> Result<Loaded> {
             }))
         }
         Source::File { .. } if case.truth => {
-            let (mode, scene) = (o.mode, scene_clone(&scene)?);
+            let (mode, scene) = (o.mode, parse()?);
             Some(Box::new(move || {
                 // The ray caster reads the host's splats, on a renderer of its own.
                 let (_, set, _) = open(&scene, true)?;
@@ -301,25 +303,6 @@ fn load(case: &Case, opts: &SuiteOptions) -> Result<Loaded> {
     }
     let draw = move |r: &mut Renderer, _: u32| r.render(&cam, &o);
     Ok(Loaded { renderer: r, draw: Box::new(draw), splats_stored: stored, truth })
-}
-
-/// The same scene flags again (SceneArgs holds no Clone: parsed anew from its case).
-fn scene_clone(a: &SceneArgs) -> Result<SceneArgs> {
-    let mut f = vec!["bench".to_string()];
-    if let Some(v) = &a.volume {
-        f.extend(["--volume".into(), v.to_string_lossy().into_owned()]);
-    }
-    if let Some(tf) = &a.tf {
-        f.extend(["--tf".into(), tf.clone()]);
-    }
-    f.extend(["--size".into(), format!("{}x{}", a.size.0, a.size.1)]);
-    if a.validation {
-        f.push("--validation".into());
-    }
-    if a.cpu {
-        f.push("--cpu".into());
-    }
-    Flags::try_parse_from(f).map(|f| f.scene).map_err(|e| Error::InvalidArgument(e.to_string()))
 }
 
 /// The case's truth, from the cache or made now (and cached as EXR).

@@ -23,9 +23,9 @@ pub fn motion_study(r: &mut Renderer, size: u32, frame: u32, frames: usize) -> R
     let set = scene::build(&anim.scene)?;
     let grid = *set.grid();
     r.set_scene(set)?;
-    let splat = RenderOptions::default();
+    let splat = crate::lab_options();
     let sheet = {
-        let mut o = RenderOptions::default();
+        let mut o = crate::lab_options();
         o.composite = Composite::Sheet;
         o
     };
