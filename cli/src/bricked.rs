@@ -288,8 +288,11 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     let rss_loaded = peak_rss_mib().unwrap_or(0.0);
     let (stored, bytes) = (l.scene.store.len(), l.scene.store.bytes());
     let (mut r, cam) = framed(l.scene, size, budget_bytes)?;
-    // Full detail and levels of detail (1 px), alternating frame by frame after a warm-up each.
-    let full = opts(0.0);
+    // Full detail and levels of detail (1 px), alternating frame by frame after a warm-up each: what
+    // `render --raster compute --direction ftb` draws (its kernel, early termination), the frames
+    // docs/RESULTS.md sets beside VTK's.
+    let mut full = RenderOptions::default();
+    (full.raster, full.direction, full.lod) = (Raster::Compute, Some(Direction::FrontToBack), voxsplat::Lod::Off);
     let mut lod = full.clone();
     (lod.lod, lod.lod_pixels) = (voxsplat::Lod::Auto, 1.0);
     let reference = r.render(&cam, &full)?.image;
@@ -355,7 +358,7 @@ pub fn orbit(path: &Path, size: u32, budget_bytes: u64, tf: &str, arc: Arc) -> R
     let steps = arc.check()?;
     let tf = TransferFunction::preset(tf)?;
     let (mut r, cam) = framed(load(path, &tf)?.scene, size, budget_bytes)?;
-    let opts = crate::lab_options();
+    let opts = RenderOptions::default();
     let mut out = String::from(
         "| frame | degrees | ms | splats | record MiB uploaded | record MiB held | uploaded / held |\n|---:|---:|---:|---:|---:|---:|---:|\n",
     );
@@ -519,7 +522,7 @@ pub fn zarr_orbit(
         let hits = cache.as_ref().map_or(0, |c| c.stats().hits - before.hits);
         read_total += read;
         let t = Instant::now();
-        let st = r.render(&c, &crate::lab_options())?.stats;
+        let st = r.render(&c, &RenderOptions::default())?.stats;
         frames.push(ms(t));
         let (load_ms, frame_ms) = (loads[i as usize], frames[i as usize]);
         out += &format!(
