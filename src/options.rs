@@ -340,7 +340,8 @@ impl Default for RenderOptions {
             depth: None,
             order: OrderKind::Pbtf,
             composite: Composite::Splat,
-            kernel: Kernel::CrawfisMax,
+            // The kernel's own default (Crawfis-Max): two literals had drifted apart.
+            kernel: Kernel::default(),
             antialias: Antialias::None,
             motion: None,
             clip: Clip::default(),

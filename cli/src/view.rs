@@ -120,7 +120,8 @@ impl App {
         let mut options = RenderOptions::default();
         // Opaque black behind the volume: the window shows no transparency.
         options.background = Some([0.0, 0.0, 0.0, 1.0]);
-        let mut names = (scene.order.clone(), "splat".to_string(), "auto".to_string(), "crawfis-max".to_string());
+        let kernel = options.kernel.name().to_string();
+        let mut names = (scene.order.clone(), "splat".to_string(), "auto".to_string(), kernel);
         let (mut clip_planes, mut crop) = (Vec::new(), None);
         if let Some(path) = &session {
             if scene.volume.is_none() {
