@@ -8,7 +8,9 @@
 // and averaged across it, so a coarse cell covers, seen along each axis, what its children cover.
 // Its splat is 2^l times wider and carries the optical depth through the cell. Each cell's error is how far its children
 // depart from it (Laur-Hanrahan): the largest over its children of their own error plus the
-// difference of opacity per voxel length, or of colour weighted by the child's opacity. Writes
+// difference of opacity per voxel length, or of colour weighted by the child's opacity; and at
+// least how far its face neighbours depart from it (edge_errors: a coarse splat reaches past its
+// cell, so it blurs the edges the fine level keeps). Writes
 // the pyramid cells and each brick's summary (brick.glsl). A streamed store (STREAMED_STORE)
 // builds the pyramids of one batch's bricks from its records, a workgroup per entry of
 // brick_list from pc.first, into the entries' slots or, when the pyramid is resident, the bricks'
@@ -35,6 +37,11 @@ shared float axis_l[3u * LOD_CELLS];
 shared float stored_l[LOD_CELLS];
 // Drawn voxels per level-1 cell.
 shared uint drawn_1[64];
+// The voxel layer just outside each of the brick's 6 faces (face 2 axis + high side, 8 x 8 voxels
+// each, the other two axes in order): 1 where nothing is drawn there (outside the grid, an empty
+// brick or one the TF leaves empty, a voxel the store does not hold), 0 where a voxel may draw
+// (read from resident words only, so a streamed store's build needs no neighbour's records).
+shared uint empty_out[6u * 64u];
 // The brick's occupancy mask and the stored voxels below each of its words.
 shared uint mask_w[MASK_WORDS];
 shared uint below_w[MASK_WORDS];
@@ -45,6 +52,61 @@ uint child(uint l, uvec3 c, uint n, uint d) {
     uint m = 2u * n;
     uint i = k.x + m * (k.y + m * k.z);
     return l == 1u ? i : level_offset(l - 1u) + i;
+}
+
+// Whether the voxel at v (grid coordinates, possibly outside) draws nothing, from resident words.
+uint empty_voxel(ivec3 v) {
+    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(frame.dims.xyz)))) return 1u;
+    uvec3 c = uvec3(v);
+    uint h = header_of(c);
+    if (h == 0xffffffffu) return 1u;
+    uint w = headers[h].w;
+    if (tf_empty(w & 0xffffu, w >> 16u)) return 1u;
+    uvec3 lc = c % BRICK_SIDE;
+    uint l = lc.x + BRICK_SIDE * (lc.y + BRICK_SIDE * lc.z);
+    return ((masks[h * MASK_STRIDE + l / 32u] >> (l % 32u)) & 1u) == 0u ? 1u : 0u;
+}
+
+// Level l's cells against their 6 face neighbours (a coarse splat reaches past its cell: where a
+// neighbour differs, the coarse picture blurs an edge the fine one keeps sharp, the halo of
+// coarse cells on silhouettes): each cell's error becomes at least the largest departure of a
+// neighbour from it, measured as a child's (child_error). A neighbour outside the brick is the
+// voxel layer past that face: its empty voxels draw nothing, the others are taken to be the
+// cell's own (their values are not resident in a streamed store: edges between two materials
+// at brick faces are not seen). Mirror: cpu::brick_pyramid::edge_errors.
+void edge_errors(uint l, uint lane) {
+    uint n = BRICK_SIDE >> l;
+    uint side = 1u << l;
+    float voxels = float(1u << (3u * l));
+    for (uint c = lane; c < n * n * n; c += BRICK_LANES) {
+        uvec3 cc = uvec3(c % n, (c / n) % n, c / (n * n));
+        uint i = level_offset(l) + c;
+        float t = tau_l[i];
+        float a = 1.0 - exp(-t / voxels);
+        vec3 straight = t > 0.0 ? col_l[i] / t : vec3(0.0);
+        float err = err_l[i];
+        for (uint f = 0u; f < 6u; ++f) {
+            uint ax = f / 2u;
+            bool high = (f & 1u) != 0u;
+            if (high ? cc[ax] + 1u < n : cc[ax] > 0u) {
+                uvec3 nc = cc;
+                nc[ax] = high ? cc[ax] + 1u : cc[ax] - 1u;
+                uint k = level_offset(l) + nc.x + n * (nc.y + n * nc.z);
+                err = max(err, child_error(a, straight, tau_l[k], col_l[k], 0.0, voxels));
+            } else {
+                // The face's outside layer under this cell: the fraction of it that draws nothing.
+                uint u0 = cc[(ax + 1u) % 3u] * side;
+                uint w0 = cc[(ax + 2u) % 3u] * side;
+                uint empty = 0u;
+                for (uint w = w0; w < w0 + side; ++w) {
+                    for (uint u = u0; u < u0 + side; ++u) empty += empty_out[f * 64u + u + 8u * w];
+                }
+                float kept = 1.0 - float(empty) / float(side * side);
+                err = max(err, child_error(a, straight, t * kept, col_l[i] * kept, 0.0, voxels));
+            }
+        }
+        err_l[i] = err;
+    }
 }
 
 // Cell i: its sums (t, col, g), error and axis opacities (for the level above), and its pyramid
@@ -107,6 +169,15 @@ void main() {
         return;
     }
     if (lane < MASK_WORDS) mask_w[lane] = masks[h * MASK_STRIDE + lane];
+    for (uint i = lane; i < 6u * 64u; i += BRICK_LANES) {
+        uint f = i / 64u;
+        uint ax = f / 2u;
+        ivec3 v = ivec3(b * BRICK_SIDE);
+        v[ax] += (f & 1u) != 0u ? int(BRICK_SIDE) : -1;
+        v[(ax + 1u) % 3u] += int(i % 8u);
+        v[(ax + 2u) % 3u] += int((i / 8u) % 8u);
+        empty_out[i] = empty_voxel(v);
+    }
     barrier();
     if (lane == 0u) {
         uint below = 0u;
@@ -164,6 +235,8 @@ void main() {
         drawn_1[c] = drawn;
     }
     barrier();
+    edge_errors(1u, lane);
+    barrier();
     // Levels 2 and 3 from the level below.
     for (uint l = 2u; l <= 3u; ++l) {
         uint n = BRICK_SIDE >> l;
@@ -194,6 +267,8 @@ void main() {
             }
             put_cell(slot, h, level_offset(l) + c, t, col, g, err, axes);
         }
+        barrier();
+        edge_errors(l, lane);
         barrier();
     }
     if (lane == 0u) {

@@ -49,7 +49,7 @@ for spec in "../shared/data/bonsai/bonsai.nii.gz|bonsai" "$LARGE/bonsai512.nrrd|
   if [ "$stored" -le 268435456 ] && [ "$name" != procedural1024.nrrd ]; then
     [ -f "$ref" ] || $vs render --volume "$f" --tf "$tf" --size 512x512 --raycast 0.25 --raycast-stop 1e-4 --cpu \
       --supersample 4 --out "$ref" >/dev/null 2>&1
-    p() { $vs compare "$1" "$ref" | awk '/psnr/ {print $2}'; }
+    p() { $vs compare "$1" "$ref" | awk '/^psnr:/ {print $2}'; }
     psnr="$(p "$WORK/cost-$name.exr"), $(p "$WORK/cost-prev-$name.exr")"
   fi
   echo "| $name ($tf) | $stored | $vtk_ms | $ms | $ratio | $prev_ms | $psnr |"

@@ -25,7 +25,7 @@ heptane|$DATA/heptane/heptane.nii.gz|ramp
 stent|$DATA/stent/stent.nrrd|ct
 procedural|$WORK/procedural256.nrrd|ramp
 head-phantom|$WORK/head256.nrrd|mri"}
-psnr() { $vs compare "$1" "$2" | awk '/psnr/ {print $2}'; }
+psnr() { $vs compare "$1" "$2" | awk '/^psnr:/ {print $2}'; }
 truth() { # name file tf k step -> path
   local t="$WORK/truth-$1-k$4-s$5.exr"
   [ -f "$t" ] || $vs render --volume "$2" --tf "$3" --size 512x512 --raycast "$5" --raycast-stop 1e-4 --cpu \

@@ -16,6 +16,22 @@ pub struct ImageMetrics {
     pub ssim_luma: f64,
     /// Structural similarity of the alpha channel.
     pub ssim_alpha: f64,
+    /// RMSE over the covered pixels only: those where either image's alpha exceeds
+    /// `COVERED_ALPHA` (the empty background both agree on is not counted as right). 0 when no
+    /// pixel is covered.
+    pub covered_rmse: f64,
+    /// 20 log10(1 / covered_rmse) in dB: the figure to quote (infinite when identical or empty).
+    pub covered_psnr: f64,
+    /// How many pixels are covered.
+    pub covered_pixels: usize,
+}
+
+/// A pixel is covered when either image's alpha exceeds this: one 8-bit step.
+pub const COVERED_ALPHA: f32 = 1.0 / 255.0;
+
+/// Whether pixel `i` is covered in either image (`COVERED_ALPHA`).
+pub fn is_covered(img: &ImageF32, truth: &ImageF32, i: usize) -> bool {
+    img.pixels[i][3] > COVERED_ALPHA || truth.pixels[i][3] > COVERED_ALPHA
 }
 
 fn clamp01(v: f32) -> f64 {
@@ -40,14 +56,19 @@ pub fn compare(img: &ImageF32, truth: &ImageF32) -> Result<ImageMetrics> {
     }
     let n = (img.pixels.len() * 4).max(1) as f64;
     let rmse = (se / n).sqrt();
-    let psnr = if rmse > 0.0 { 20.0 * (1.0 / rmse).log10() } else { f64::INFINITY };
+    let whole = psnr(rmse);
+    let covered_pixels = (0..img.pixels.len()).filter(|&i| is_covered(img, truth, i)).count();
+    let covered_rmse = rmse_masked(img, truth, |i| is_covered(img, truth, i)).unwrap_or(0.0);
     let luma = |p: &[f32; 4]| 0.2126 * clamp01(p[0]) + 0.7152 * clamp01(p[1]) + 0.0722 * clamp01(p[2]);
     Ok(ImageMetrics {
         rmse,
-        psnr,
+        psnr: whole,
         max_abs,
         ssim_luma: ssim_banded(img, truth, luma),
         ssim_alpha: ssim_banded(img, truth, |p| clamp01(p[3])),
+        covered_rmse,
+        covered_psnr: psnr(covered_rmse),
+        covered_pixels,
     })
 }
 

@@ -137,7 +137,9 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Print error metrics of image A against reference B (PNG or EXR).
+    /// Print error metrics of image A against reference B (PNG or EXR): PSNR and RMSE over the
+    /// covered pixels (either image's alpha above 1/255; the figure to quote) and over the whole
+    /// frame, the largest difference and SSIM.
     Compare {
         /// The image to score.
         a: PathBuf,
@@ -456,8 +458,14 @@ fn run(cli: Cli) -> Result<()> {
         Command::Compare { a, b } => {
             let (x, y) = (voxsplat::output::read_image(&a)?, voxsplat::output::read_image(&b)?);
             let m = voxsplat::metrics::compare(&x, &y)?;
-            println!("rmse:       {:.6}", m.rmse);
-            println!("psnr:       {:.2} dB", m.psnr);
+            // Covered first: the figure to quote. The whole frame counts the empty background
+            // both images agree on as right, which flatters a small object.
+            let n = x.pixels.len();
+            println!("covered:    {} of {} pixels (alpha above 1/255 in either image)", m.covered_pixels, n);
+            println!("psnr:       {:.2} dB over the covered pixels", m.covered_psnr);
+            println!("rmse:       {:.6} over the covered pixels", m.covered_rmse);
+            println!("psnr_frame: {:.2} dB over the whole frame", m.psnr);
+            println!("rmse_frame: {:.6} over the whole frame", m.rmse);
             println!("max_abs:    {:.6}", m.max_abs);
             println!("ssim_luma:  {:.5}", m.ssim_luma);
             println!("ssim_alpha: {:.5}", m.ssim_alpha);

@@ -66,6 +66,7 @@ pub fn brick_pyramid(
             let a = 1.0 - (-t).exp();
             fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0, axes: [a; 3] };
         }
+        let empty_out = outside_layer(inputs, b);
         let mut cells = [Sums::default(); LOD_CELLS];
         let mut stored = [0f32; LOD_CELLS];
         for l in 1..=LOD_LEVELS {
@@ -116,6 +117,7 @@ pub fn brick_pyramid(
                     summary[h * SUMMARY_WORDS + SUMMARY_WORDS - 1] = t.to_bits();
                 }
             }
+            edge_errors(&mut cells, &empty_out, l);
         }
         let mut s = [fine.iter().filter(|f| f.tau > 0.0).count() as u32 * (1 << 16), 0, 0, 0];
         for l in 1..=LOD_LEVELS {
@@ -130,6 +132,77 @@ pub fn brick_pyramid(
         if let Some(slots) = slots.as_deref_mut() {
             slots[h] = slot as u32;
         }
+    }
+}
+
+/// Mirror of the outside layer `brick_pyramid.comp` fills (`empty_out`): per face (2 axis + high
+/// side) of brick `b`, 8 x 8 voxels just past it, true where nothing is drawn there.
+fn outside_layer(inputs: &BrickInputs<'_>, b: [u32; 3]) -> [bool; 6 * 64] {
+    let store = inputs.store;
+    std::array::from_fn(|i| {
+        let f = i / 64;
+        let ax = f / 2;
+        let mut v = b.map(|c| (c * BRICK) as i64);
+        v[ax] += if f & 1 != 0 { BRICK as i64 } else { -1 };
+        v[(ax + 1) % 3] += (i % 8) as i64;
+        v[(ax + 2) % 3] += (i / 8 % 8) as i64;
+        // Mirror of `empty_voxel`.
+        if (0..3).any(|a| v[a] < 0 || v[a] >= store.dims[a] as i64) {
+            return true;
+        }
+        let c = v.map(|x| x as u32);
+        let h = store.header_of(c);
+        if h == u32::MAX {
+            return true;
+        }
+        let range = store.headers[h as usize].range;
+        if inputs.tf_empty(range & 0xffff, range >> 16) {
+            return true;
+        }
+        let l = (c[0] % BRICK + BRICK * (c[1] % BRICK + BRICK * (c[2] % BRICK))) as usize;
+        store.masks[h as usize][l / 64] >> (l % 64) & 1 == 0
+    })
+}
+
+/// Mirror of `edge_errors`: level `l`'s cells' errors raised to their face neighbours' departure
+/// from them (inside the brick, the neighbour cell; past its faces, the outside layer's drawn
+/// fraction of the cell's own sums).
+fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32) {
+    let n = BRICK >> l;
+    let side = 1u32 << l;
+    let voxels = (1u32 << (3 * l)) as f32;
+    let at = |c: [u32; 3]| level_offset(l) as usize + (c[0] + n * (c[1] + n * c[2])) as usize;
+    let errs: Vec<f32> = (0..n * n * n)
+        .map(|c| {
+            let cc = [c % n, (c / n) % n, c / (n * n)];
+            let me = cells[at(cc)];
+            let a = 1.0 - (-me.tau / voxels).exp();
+            let straight = if me.tau > 0.0 { me.col / me.tau } else { Vec3::ZERO };
+            let mut err = me.err;
+            for f in 0..6 {
+                let (ax, high) = (f / 2, f & 1 != 0);
+                if if high { cc[ax] + 1 < n } else { cc[ax] > 0 } {
+                    let mut nc = cc;
+                    nc[ax] = if high { cc[ax] + 1 } else { cc[ax] - 1 };
+                    let k = cells[at(nc)];
+                    err = err.max(child_error(a, straight, k.tau, k.col, 0.0, voxels));
+                } else {
+                    let (u0, w0) = (cc[(ax + 1) % 3] * side, cc[(ax + 2) % 3] * side);
+                    let mut empty = 0u32;
+                    for w in w0..w0 + side {
+                        for u in u0..u0 + side {
+                            empty += u32::from(empty_out[f * 64 + (u + 8 * w) as usize]);
+                        }
+                    }
+                    let kept = 1.0 - empty as f32 / (side * side) as f32;
+                    err = err.max(child_error(a, straight, me.tau * kept, me.col * kept, 0.0, voxels));
+                }
+            }
+            err
+        })
+        .collect();
+    for (c, e) in errs.into_iter().enumerate() {
+        cells[level_offset(l) as usize + c].err = e;
     }
 }
 

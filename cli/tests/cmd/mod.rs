@@ -23,14 +23,14 @@ pub fn refused(args: &[&str]) -> String {
     text
 }
 
-/// `voxsplat compare A B`'s PSNR in dB (infinite for equal images).
+/// `voxsplat compare A B`'s PSNR in dB over the covered pixels (infinite for equal images).
 pub fn psnr(a: &std::path::Path, b: &std::path::Path) -> f64 {
     let out = voxsplat(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(out.status.success(), "compare: {}", String::from_utf8_lossy(&out.stderr));
     text.lines()
         .find_map(|l| l.strip_prefix("psnr:"))
-        .map(|s| s.trim().trim_end_matches(" dB").parse().unwrap_or(f64::INFINITY))
+        .map(|s| s.split_whitespace().next().unwrap_or("").parse().unwrap_or(f64::INFINITY))
         .unwrap_or_else(|| panic!("no psnr in {text}"))
 }
 
