@@ -74,10 +74,11 @@ void main() {
         col += ck[d];
         grad += aligned(unpack_normal(words.y >> 16u) * tc, grad);
     }
-    float a = 1.0 - exp(-t / voxels);
+    float len = float(1u << (3u + k));
+    float a = 1.0 - exp(-t / voxels * len);
     vec3 straight = t > 0.0 ? col / t : vec3(0.0);
     float err = 0.0;
-    for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], ek[d], voxels / 8.0));
+    for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], ek[d], voxels / 8.0, len));
     uint codes[3];
     for (uint x = 0u; x < 3u; ++x) codes[x] = tau_code(-log(1.0 - min(axis_opacity(ak[x], x), 0.9999999)));
     uint w = node_word(k, n, 0u);

@@ -78,11 +78,12 @@ void edge_errors(uint l, uint lane) {
     uint n = BRICK_SIDE >> l;
     uint side = 1u << l;
     float voxels = float(1u << (3u * l));
+    float len = float(side);
     for (uint c = lane; c < n * n * n; c += BRICK_LANES) {
         uvec3 cc = uvec3(c % n, (c / n) % n, c / (n * n));
         uint i = level_offset(l) + c;
         float t = tau_l[i];
-        float a = 1.0 - exp(-t / voxels);
+        float a = 1.0 - exp(-t / voxels * len);
         vec3 straight = t > 0.0 ? col_l[i] / t : vec3(0.0);
         float err = err_l[i];
         for (uint f = 0u; f < 6u; ++f) {
@@ -92,7 +93,7 @@ void edge_errors(uint l, uint lane) {
                 uvec3 nc = cc;
                 nc[ax] = high ? cc[ax] + 1u : cc[ax] - 1u;
                 uint k = level_offset(l) + nc.x + n * (nc.y + n * nc.z);
-                err = max(err, child_error(a, straight, tau_l[k], col_l[k], 0.0, voxels));
+                err = max(err, child_error(a, straight, tau_l[k], col_l[k], 0.0, voxels, len));
             } else {
                 // The face's outside layer under this cell: the fraction of it that draws nothing.
                 uint u0 = cc[(ax + 1u) % 3u] * side;
@@ -102,7 +103,7 @@ void edge_errors(uint l, uint lane) {
                     for (uint u = u0; u < u0 + side; ++u) empty += empty_out[f * 64u + u + 8u * w];
                 }
                 float kept = 1.0 - float(empty) / float(side * side);
-                err = max(err, child_error(a, straight, t * kept, col_l[i] * kept, 0.0, voxels));
+                err = max(err, child_error(a, straight, t * kept, col_l[i] * kept, 0.0, voxels, len));
             }
         }
         err_l[i] = err;
@@ -226,10 +227,10 @@ void main() {
             t += tk[d];
             col += ck[d];
         }
-        float a = 1.0 - exp(-t / 8.0);
+        float a = 1.0 - exp(-t / 8.0 * 2.0);
         vec3 straight = t > 0.0 ? col / t : vec3(0.0);
         float err = 0.0;
-        for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0));
+        for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0, 2.0));
         vec3 axes = vec3(axis_opacity(ak, 0u), axis_opacity(ak, 1u), axis_opacity(ak, 2u));
         put_cell(slot, h, c, t, col, g, err, axes);
         drawn_1[c] = drawn;
@@ -252,12 +253,13 @@ void main() {
                 col += col_l[k];
                 g += aligned(grad_l[k], g);
             }
-            float a = 1.0 - exp(-t / voxels);
+            float len = float(1u << l);
+            float a = 1.0 - exp(-t / voxels * len);
             vec3 straight = t > 0.0 ? col / t : vec3(0.0);
             float err = 0.0;
             for (uint d = 0u; d < 8u; ++d) {
                 uint k = child(l, cc, n, d);
-                err = max(err, child_error(a, straight, tau_l[k], col_l[k], err_l[k], voxels / 8.0));
+                err = max(err, child_error(a, straight, tau_l[k], col_l[k], err_l[k], voxels / 8.0, len));
             }
             vec3 axes;
             for (uint x = 0u; x < 3u; ++x) {

@@ -376,6 +376,14 @@ pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 /// 0.16x), one run each.
 pub const DEFAULT_LOD_ERROR: f32 = 0.1;
 
+/// Largest `RenderOptions::lod_pixels`: a coarse level's cell (at most 8 voxels) projecting to
+/// more pixels than this draws as a blur, not a level of detail.
+pub const MAX_LOD_PIXELS: f32 = 64.0;
+
+/// Largest `RenderOptions::lod_error`, and no bound at all: a cell's error sums at most one
+/// departure (each at most 1) per level, over three levels.
+pub const MAX_LOD_ERROR: f32 = 3.0;
+
 /// Default transmittance threshold of front-to-back early termination: a quarter of an 8-bit step.
 pub const DEFAULT_EARLY_TERMINATION: f32 = 1.0 / 1024.0;
 
@@ -460,15 +468,17 @@ impl RenderOptions {
                 self.early_termination
             )));
         }
-        if !(self.lod_pixels.is_finite() && self.lod_pixels > 0.0) {
+        if !(self.lod_pixels > 0.0 && self.lod_pixels <= MAX_LOD_PIXELS) {
             return Err(Error::InvalidArgument(format!(
-                "the level-of-detail pixel size {} must be positive and finite",
+                "the level-of-detail pixel size {} must be above 0 and at most {MAX_LOD_PIXELS} (the cell a coarse \
+                 level may project to, in pixels; --lod off draws full detail)",
                 self.lod_pixels
             )));
         }
-        if !(self.lod_error.is_finite() && self.lod_error >= 0.0) {
+        if !(0.0..=MAX_LOD_ERROR).contains(&self.lod_error) {
             return Err(Error::InvalidArgument(format!(
-                "the level-of-detail error {} must be finite and at least 0",
+                "the level-of-detail error {} must be in [0, {MAX_LOD_ERROR}] (0: only cells equal to their children \
+                 and neighbours coarsen; {MAX_LOD_ERROR}: no bound)",
                 self.lod_error
             )));
         }

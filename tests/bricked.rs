@@ -591,7 +591,7 @@ fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
         // Levels of detail (the error bound lifted) keep the far bricks coarse: their cells need
         // no records, and the near bricks' fit the cache.
         let mut o = compute(Direction::FrontToBack);
-        (o.lod_pixels, o.lod_error) = (1.0, 100.0);
+        (o.lod_pixels, o.lod_error) = (1.0, voxsplat::options::MAX_LOD_ERROR);
         let first = streamed.render(&cam, &o).unwrap();
         let again = streamed.render(&cam, &o).unwrap();
         let want = resident.render(&cam, &o).unwrap().image;

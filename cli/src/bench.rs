@@ -80,7 +80,7 @@ impl Method {
             Method::Raycast { step } => format!("raycast {step}"),
             Method::Bricked { lod: None } => "bricked compute".into(),
             Method::Bricked { lod: Some((px, e)) } if *px >= LOD_UNBOUNDED => format!("{LOD_CURVE} {e} compute"),
-            Method::Bricked { lod: Some((px, e)) } if *e >= LOD_UNBOUNDED => format!("bricked lod {px}px compute"),
+            Method::Bricked { lod: Some((px, e)) } if *e >= LOD_ANY_ERROR => format!("bricked lod {px}px compute"),
             Method::Bricked { lod: Some((px, e)) } => format!("bricked lod {px}px error {e} compute"),
             Method::Scaled { method, scale } => format!("{} scale {scale}", method.label()),
         }
@@ -107,7 +107,9 @@ impl Method {
 
 /// `lod_pixels` that lets every level pass the pixel test: levels chosen by their error alone
 /// (Laur and Hanrahan's cut).
-pub const LOD_UNBOUNDED: f32 = 1e6;
+pub const LOD_UNBOUNDED: f32 = voxsplat::options::MAX_LOD_PIXELS;
+/// `lod_error` that lets every level pass the error test: levels chosen by their size alone.
+pub const LOD_ANY_ERROR: f32 = voxsplat::options::MAX_LOD_ERROR;
 /// Label prefix of the levels-of-detail curve (error swept, pixels unbounded) on the charts.
 pub const LOD_CURVE: &str = "bricked lod error";
 
@@ -118,7 +120,7 @@ pub fn bricked_methods(errors: &[f32]) -> Vec<Method> {
     let mut m = vec![
         Method::Bricked { lod: None },
         Method::Bricked { lod: Some((1.0, voxsplat::options::DEFAULT_LOD_ERROR)) },
-        Method::Bricked { lod: Some((1.0, LOD_UNBOUNDED)) },
+        Method::Bricked { lod: Some((1.0, LOD_ANY_ERROR)) },
     ];
     m.extend(errors.iter().map(|&e| Method::Bricked { lod: Some((LOD_UNBOUNDED, e)) }));
     m

@@ -409,12 +409,13 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     let mut variants: Vec<(String, bool, RenderOptions)> =
         vec![("dense classified splats".into(), true, o.clone()), ("bricked, full detail".into(), false, o.clone())];
     let unbounded = crate::bench::LOD_UNBOUNDED;
-    let mut lods = vec![(1.0, 0.25), (1.0, 1e6), (1.5, 0.25), (2.0, 0.25), (4.0, 0.25)];
+    let any = crate::bench::LOD_ANY_ERROR;
+    let mut lods = vec![(1.0, 0.25), (1.0, any), (1.5, 0.25), (2.0, 0.25), (4.0, 0.25)];
     lods.extend(LOD_CURVE_ERRORS.iter().map(|&e| (unbounded, e)));
     for (pixels, error) in lods {
         let mut x = o.clone();
         (x.lod, x.lod_pixels, x.lod_error) = (voxsplat::Lod::Auto, pixels, error);
-        let e = if error >= 1e6 { "unbounded".to_string() } else { format!("{error}") };
+        let e = if error >= any { "unbounded".to_string() } else { format!("{error}") };
         let name = if pixels >= unbounded {
             format!("{} {error}", crate::bench::LOD_CURVE)
         } else {

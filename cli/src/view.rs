@@ -37,7 +37,7 @@ pub const COMPOSITES: &[&str] = &["splat", "sheet", "slab"];
 pub const RASTERS: &[&str] = &["auto", "compute", "graphics", "points"];
 pub const KERNELS: &[&str] = &["crawfis-max", "gaussian", "cubic", "narrow"];
 /// A drag frame's bound on a coarse level's error (`RenderOptions::lod_error`): none that matters.
-const DRAG_LOD_ERROR: f32 = 1e6;
+const DRAG_LOD_ERROR: f32 = voxsplat::options::MAX_LOD_ERROR;
 /// The isosurface's first value (normalised).
 const ISO_START: f32 = 0.3;
 /// The window's least height in pixels: the panel's controls and editor fit.
@@ -255,7 +255,7 @@ impl App {
             // A drag frame: fewer pixels and fewer splats. The splats set the cost, and they come
             // in levels (each a quarter of the last), so the pixel bound moves with the scale.
             options.render_scale = (options.render_scale / s.coarse).max(0.25);
-            options.lod_pixels *= s.coarse;
+            options.lod_pixels = (options.lod_pixels * s.coarse).min(voxsplat::options::MAX_LOD_PIXELS);
             options.lod_error = options.lod_error.max(DRAG_LOD_ERROR);
         }
         let changed = s.dirty || self.drawn.as_ref().is_none_or(|d| d.0 != viewport || d.1 != cam || d.2 != options);

@@ -520,10 +520,12 @@ uint unorm10(float v) {
     return uint(floor(clamp(v, 0.0, 1.0) * 1023.0 + 0.5));
 }
 
-// The error of a cell of mean opacity a and colour straight against a child (sums tk, ck; error
-// ek) of `voxels` voxels.
-float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float voxels) {
-    float ak = 1.0 - exp(-tk / voxels);
+// The error of a cell of opacity a (over `len` voxel lengths: the cell's side) and colour
+// straight against a child (sums tk, ck; error ek) of `voxels` voxels, its opacity taken over the
+// same length: opacity a ray crossing the cell sees, so what piles up through a cell counts, not
+// one voxel's share of it.
+float child_error(float a, vec3 straight, float tk, vec3 ck, float ek, float voxels, float len) {
+    float ak = 1.0 - exp(-tk / voxels * len);
     vec3 sk = tk > 0.0 ? ck / tk : vec3(0.0);
     vec3 dc = abs(sk - straight);
     return ek + max(abs(ak - a), ak * max(dc.x, max(dc.y, dc.z)));

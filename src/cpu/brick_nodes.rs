@@ -163,11 +163,12 @@ pub fn brick_nodes(inputs: &BrickInputs<'_>, push: &BrickPush, summary: &mut [u3
             col += ck[d];
             grad += aligned(unpack_normal(words[1] >> 16) * tc, grad);
         }
-        let a = 1.0 - (-t / voxels).exp();
+        let len = (1u32 << (3 + k)) as f32;
+        let a = 1.0 - (-t / voxels * len).exp();
         let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
         let mut err = 0.0f32;
         for d in 0..8 {
-            err = err.max(child_error(a, straight, tk[d], ck[d], ek[d], voxels / 8.0));
+            err = err.max(child_error(a, straight, tk[d], ck[d], ek[d], voxels / 8.0, len));
         }
         let codes = [0, 1, 2].map(|x| tau_code(-(1.0 - axis_opacity(ak[x], x).min(0.999_999_9)).ln()));
         let w = inputs.node_at(k, n);

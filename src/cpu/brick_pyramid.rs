@@ -89,11 +89,12 @@ pub fn brick_pyramid(
                 for k in &children {
                     (t, col, g) = (t + k.tau, col + k.col, g + aligned(k.grad, g));
                 }
-                let a = 1.0 - (-t / voxels).exp();
+                let len = (1u32 << l) as f32;
+                let a = 1.0 - (-t / voxels * len).exp();
                 let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
                 let mut err = 0.0f32;
                 for k in &children {
-                    err = err.max(child_error(a, straight, k.tau, k.col, k.err, voxels / 8.0));
+                    err = err.max(child_error(a, straight, k.tau, k.col, k.err, voxels / 8.0, len));
                 }
                 let axes = [0, 1, 2].map(|x| axis_opacity(children.map(|k| k.axes[x]), x));
                 let i = level_offset(l) as usize + c as usize;
@@ -171,12 +172,13 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
     let n = BRICK >> l;
     let side = 1u32 << l;
     let voxels = (1u32 << (3 * l)) as f32;
+    let len = side as f32;
     let at = |c: [u32; 3]| level_offset(l) as usize + (c[0] + n * (c[1] + n * c[2])) as usize;
     let errs: Vec<f32> = (0..n * n * n)
         .map(|c| {
             let cc = [c % n, (c / n) % n, c / (n * n)];
             let me = cells[at(cc)];
-            let a = 1.0 - (-me.tau / voxels).exp();
+            let a = 1.0 - (-me.tau / voxels * len).exp();
             let straight = if me.tau > 0.0 { me.col / me.tau } else { Vec3::ZERO };
             let mut err = me.err;
             for f in 0..6 {
@@ -185,7 +187,7 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
                     let mut nc = cc;
                     nc[ax] = if high { cc[ax] + 1 } else { cc[ax] - 1 };
                     let k = cells[at(nc)];
-                    err = err.max(child_error(a, straight, k.tau, k.col, 0.0, voxels));
+                    err = err.max(child_error(a, straight, k.tau, k.col, 0.0, voxels, len));
                 } else {
                     let (u0, w0) = (cc[(ax + 1) % 3] * side, cc[(ax + 2) % 3] * side);
                     let mut empty = 0u32;
@@ -195,7 +197,7 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
                         }
                     }
                     let kept = 1.0 - empty as f32 / (side * side) as f32;
-                    err = err.max(child_error(a, straight, me.tau * kept, me.col * kept, 0.0, voxels));
+                    err = err.max(child_error(a, straight, me.tau * kept, me.col * kept, 0.0, voxels, len));
                 }
             }
             err

@@ -201,8 +201,8 @@ pub(crate) fn axis_opacity(a: [f32; 8], axis: usize) -> f32 {
 
 /// Mirror of `child_error`: the error of a cell of mean opacity `a` and colour `straight` against
 /// a child (sums `tk`, `ck`; error `ek`) of `voxels` voxels.
-pub(crate) fn child_error(a: f32, straight: Vec3, tk: f32, ck: Vec3, ek: f32, voxels: f32) -> f32 {
-    let ak = 1.0 - (-tk / voxels).exp();
+pub(crate) fn child_error(a: f32, straight: Vec3, tk: f32, ck: Vec3, ek: f32, voxels: f32, len: f32) -> f32 {
+    let ak = 1.0 - (-tk / voxels * len).exp();
     let sk = if tk > 0.0 { ck / tk } else { Vec3::ZERO };
     let dc = (sk - straight).abs();
     ek + (ak - a).abs().max(ak * dc.x.max(dc.y.max(dc.z)))

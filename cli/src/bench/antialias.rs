@@ -50,7 +50,7 @@ pub fn antialias_study(
     // Levels of detail: the prefiltered cells (issue 24), from the plane as bricks.
     methods.extend(bricked_methods(&AA_LOD_ERRORS));
     // Coarser than a pixel: the isotropic cells trade shimmer for blur along the unforeshortened axis.
-    methods.extend(AA_LOD_PIXELS.iter().map(|&px| Method::Bricked { lod: Some((px, LOD_UNBOUNDED)) }));
+    methods.extend(AA_LOD_PIXELS.iter().map(|&px| Method::Bricked { lod: Some((px, LOD_ANY_ERROR)) }));
     let mut rows = Vec::new();
     let mut bricked = false;
     for m in methods {
