@@ -78,7 +78,7 @@ void edge_errors(uint l, uint lane) {
     uint n = BRICK_SIDE >> l;
     uint side = 1u << l;
     float voxels = float(1u << (3u * l));
-    float len = float(side);
+    float len = float(BRICK_SIDE);
     for (uint c = lane; c < n * n * n; c += BRICK_LANES) {
         uvec3 cc = uvec3(c % n, (c / n) % n, c / (n * n));
         uint i = level_offset(l) + c;
@@ -227,10 +227,10 @@ void main() {
             t += tk[d];
             col += ck[d];
         }
-        float a = 1.0 - exp(-t / 8.0 * 2.0);
+        float a = 1.0 - exp(-t / 8.0 * float(BRICK_SIDE));
         vec3 straight = t > 0.0 ? col / t : vec3(0.0);
         float err = 0.0;
-        for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0, 2.0));
+        for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0, float(BRICK_SIDE)));
         vec3 axes = vec3(axis_opacity(ak, 0u), axis_opacity(ak, 1u), axis_opacity(ak, 2u));
         put_cell(slot, h, c, t, col, g, err, axes);
         drawn_1[c] = drawn;
@@ -253,7 +253,7 @@ void main() {
                 col += col_l[k];
                 g += aligned(grad_l[k], g);
             }
-            float len = float(1u << l);
+            float len = float(BRICK_SIDE);
             float a = 1.0 - exp(-t / voxels * len);
             vec3 straight = t > 0.0 ? col / t : vec3(0.0);
             float err = 0.0;

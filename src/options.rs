@@ -301,8 +301,10 @@ pub struct RenderOptions {
     pub lod: Lod,
     /// Largest projected cell spacing, in pixels, of a coarse level (at the brick's nearest point).
     pub lod_pixels: f32,
-    /// Largest error of a coarse level: how far, in opacity per voxel length (or colour weighted
-    /// by it), any voxel departs from the cell that stands for it, summed down the levels.
+    /// Largest error of a coarse level: how far a cell's children or its face neighbours depart
+    /// from it in the opacity a ray crossing a brick (8 voxels) sees, or in colour weighted by it,
+    /// summed down the levels; weighted by the cell's projected size up to a pixel. 0 to
+    /// `MAX_LOD_ERROR` (no bound); 0 coarsens only cells equal to their children and neighbours.
     pub lod_error: f32,
     /// Levels of detail: over the last `lod_band` octaves (0 to 1) before a brick's next level
     /// takes over, its splats move and widen toward that level's cells (geomorphing), so a level
@@ -370,11 +372,12 @@ impl Default for RenderOptions {
 /// 50.3 and 50.8; their splats widen over the morph band, up to 1.2x the time; docs/RESULTS.md).
 pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 
-/// Default `RenderOptions::lod_error`: the bound that keeps levels of detail at 1 px above 40 dB on
-/// the 512³ bonsai (45.2 dB against the ray-cast truth, 0.58x full detail's frame; 0.25 gave 39.3 dB
-/// at 0.42x) and the 1024³ procedural field (41.4 dB against full detail at 0.18x; 0.25: 37.5 dB at
-/// 0.16x), one run each.
-pub const DEFAULT_LOD_ERROR: f32 = 0.1;
+/// Default `RenderOptions::lod_error`: chosen on crops of the shared scans (scripts/family.py
+/// --small) and checked on the whole family at 512² (docs/RESULTS.md, "Volumes nobody tuned
+/// for"): the translucent heptane upsampled trilinearly, where opacity piles up along the rays,
+/// sets it (0.1: 1.2 dB below full detail; 0.07: 0.7 dB, at about 0.6x full detail's frame; the
+/// 512³ bonsai at 0.6-0.7x either way).
+pub const DEFAULT_LOD_ERROR: f32 = 0.07;
 
 /// Largest `RenderOptions::lod_pixels`: a coarse level's cell (at most 8 voxels) projecting to
 /// more pixels than this draws as a blur, not a level of detail.

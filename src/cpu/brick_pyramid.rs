@@ -89,7 +89,7 @@ pub fn brick_pyramid(
                 for k in &children {
                     (t, col, g) = (t + k.tau, col + k.col, g + aligned(k.grad, g));
                 }
-                let len = (1u32 << l) as f32;
+                let len = BRICK as f32;
                 let a = 1.0 - (-t / voxels * len).exp();
                 let straight = if t > 0.0 { col / t } else { Vec3::ZERO };
                 let mut err = 0.0f32;
@@ -172,7 +172,7 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
     let n = BRICK >> l;
     let side = 1u32 << l;
     let voxels = (1u32 << (3 * l)) as f32;
-    let len = side as f32;
+    let len = BRICK as f32;
     let at = |c: [u32; 3]| level_offset(l) as usize + (c[0] + n * (c[1] + n * c[2])) as usize;
     let errs: Vec<f32> = (0..n * n * n)
         .map(|c| {
