@@ -84,7 +84,7 @@ pub fn study(size: Option<u32>, factor: u32, dolly: usize, frames: usize) -> Res
                 figure,
                 size: (camera.width, camera.height),
                 mode,
-                psnr: voxsplat::metrics::compare(&image, &truth)?.psnr,
+                psnr: voxsplat::metrics::compare(&image, &truth)?.covered_psnr,
                 aliasing: voxsplat::metrics::aliasing_energy(&image, &truth, |_| true).unwrap_or(f64::NAN),
                 shimmer: voxsplat::metrics::shimmer(&moved, |_, _| true).unwrap_or(f64::NAN),
                 median_ms,
@@ -104,7 +104,7 @@ pub fn markdown(rows: &[AaSceneRow], factor: u32, dolly: usize) -> String {
          per-splat PBTF, Gaussian; error against the truth supersampled {factor}×{factor} and brought down by a \
          Lanczos-3 low-pass; aliasing energy over the frame (`metrics::aliasing_energy`); shimmer = mean frame-to-frame \
          RMSE along a {dolly}-frame move of half a voxel per frame (forward in the fly-over, sideways in the orthographic \
-         view); median of the timed frames, the modes alternating frame by frame.\n\n| figure | image | splats beyond k | mode | PSNR dB | \
+         view); median of the timed frames, the modes alternating frame by frame. PSNR over the covered pixels.\n\n| figure | image | splats beyond k | mode | PSNR dB | \
          aliasing energy | shimmer | median ms |\n|---|---|---:|---|---:|---:|---:|---:|"
     );
     for r in rows {

@@ -208,7 +208,8 @@ pub fn study(
         // distance from full detail.
         let full_small = bricked.render(&cam, &o)?.image;
         let full_big = big.render(&lcam, &o)?.image;
-        let psnr = |a: &voxsplat::ImageF32, b: &voxsplat::ImageF32| voxsplat::metrics::compare(a, b).map(|m| m.psnr);
+        let psnr =
+            |a: &voxsplat::ImageF32, b: &voxsplat::ImageF32| voxsplat::metrics::compare(a, b).map(|m| m.covered_psnr);
         let p_small = psnr(&full_small, &bricked.render(&cam, &lod1)?.image)?;
         let mut p_big = Vec::new();
         for (_, _, x) in &big_lods {
@@ -233,7 +234,7 @@ pub fn study(
         let _ = writeln!(
             s,
             "\n| frame, same view | median ms | over the 256³ full-detail frame | over the 256³ frame, same options \
-             | PSNR dB against its full detail |"
+             | PSNR dB against its full detail (covered pixels) |"
         );
         let _ = writeln!(s, "|---|---|---|---|---|");
         let _ = writeln!(s, "| bonsai 256³ bricked | {sm:.0} | 1.00 | 1.00 | |");
@@ -296,7 +297,7 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     let mut lod = full.clone();
     (lod.lod, lod.lod_pixels) = (voxsplat::Lod::Auto, 1.0);
     let reference = r.render(&cam, &full)?.image;
-    let psnr = voxsplat::metrics::compare(&r.render(&cam, &lod)?.image, &reference)?.psnr;
+    let psnr = voxsplat::metrics::compare(&r.render(&cam, &lod)?.image, &reference)?.covered_psnr;
     let (mut times, mut lod_times) = (Vec::new(), Vec::new());
     for _ in 0..frames.max(1) {
         times.push(frame_ms(&mut r, &cam, &full)?);
@@ -441,14 +442,14 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
          compositor; PSNR against the peers' truth (scalar ray integration, step 0.25 voxel); every variant alternates \
          frame by frame, {frames} rounds after a warm-up; medians.\n"
     );
-    let _ = writeln!(s, "| variant | median ms | over bricked full detail | PSNR dB against the truth |");
+    let _ = writeln!(s, "| variant | median ms | over bricked full detail | PSNR dB against the truth (covered pixels) |");
     let _ = writeln!(s, "|---|---:|---:|---:|");
     let medians: Vec<f64> = times.iter_mut().map(|t| median(t)).collect();
     let mut points = Vec::new();
     for (((name, _, _), image), ms) in variants.iter().zip(&images).zip(&medians) {
         let m = voxsplat::metrics::compare(image, &truth)?;
-        let _ = writeln!(s, "| {name} | {ms:.0} | {:.2} | {:.2} |", ms / medians[1], m.psnr);
-        points.push((name.clone(), *ms, m.psnr));
+        let _ = writeln!(s, "| {name} | {ms:.0} | {:.2} | {:.2} |", ms / medians[1], m.covered_psnr);
+        points.push((name.clone(), *ms, m.covered_psnr));
     }
     if let Some(path) = chart {
         let title = format!("peer{n}, {size}²: frame time against PSNR (higher is better)");

@@ -38,7 +38,8 @@ pub struct CaseResult {
     pub device_mib: f64,
     /// The process's peak resident host memory while the case ran (MiB).
     pub host_peak_mib: f64,
-    /// PSNR of the last frame against the case's truth (dB; `None` without one).
+    /// PSNR of the last frame against the case's truth over the covered pixels (either image's
+    /// alpha above 1/255; dB; `None` without one).
     pub psnr_db: Option<f64>,
     /// Seconds to load the case (read, classify, upload), not in the frame times.
     pub load_s: f64,
