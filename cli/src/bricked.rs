@@ -442,7 +442,8 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
          compositor; PSNR against the peers' truth (scalar ray integration, step 0.25 voxel); every variant alternates \
          frame by frame, {frames} rounds after a warm-up; medians.\n"
     );
-    let _ = writeln!(s, "| variant | median ms | over bricked full detail | PSNR dB against the truth (covered pixels) |");
+    let _ =
+        writeln!(s, "| variant | median ms | over bricked full detail | PSNR dB against the truth (covered pixels) |");
     let _ = writeln!(s, "|---|---:|---:|---:|");
     let medians: Vec<f64> = times.iter_mut().map(|t| median(t)).collect();
     let mut points = Vec::new();

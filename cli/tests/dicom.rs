@@ -302,9 +302,10 @@ fn an_uneven_series_is_resampled_or_drawn_at_its_slices_positions() {
     let near = cmd::psnr(&a, &c);
     let apart = cmd::psnr(&b, &c);
     eprintln!("resampled against the ball on 23 slices: {near:.1} dB; the images at their mean gap: {apart:.1} dB");
-    // Measured: 25.0 dB against 19.3 dB. The ball's edge (a step from 280 to 0 at r = 9) lies between
+    // Measured over the covered pixels: 20.6 dB against 15.9 dB (over the whole frame, where this
+    // bound was 22 dB: 25.0 against 19.3). The ball's edge (a step from 280 to 0 at r = 9) lies between
     // images 4 mm apart, where no series of these images can know it: the blend draws a chord.
-    assert!(near > 22.0 && near > apart + 4.0, "resampled {near} dB, evenly spaced {apart} dB");
+    assert!(near > 18.0 && near > apart + 4.0, "resampled {near} dB, evenly spaced {apart} dB");
     let _ = std::fs::remove_dir_all(&dense);
     let _ = std::fs::remove_dir_all(&uneven);
     let _ = std::fs::remove_dir_all(&even);
