@@ -366,10 +366,11 @@ impl Default for RenderOptions {
 }
 
 /// Default `RenderOptions::lod_pixels`: against the supersampled reference (docs/MODEL.md), at
-/// 512² from the default view, the 512³ bonsai's frame costs 0.43x the 1-px cut's at 44.35 dB
+/// 512² from the default view, the 512³ bonsai's frame cost 0.43x the 1-px cut's at 44.35 dB
 /// (1 px: 44.56 dB; its level-1 cells project to 0.8-1.5 px, so at 1 px almost none coarsens), and
-/// the 256³ gallery files stay at or above 42.2 dB (heptane and the procedural field lose 1.8 dB, to
-/// 50.3 and 50.8; their splats widen over the morph band, up to 1.2x the time; docs/RESULTS.md).
+/// the 256³ gallery files stayed at or above 42.2 dB (2026-11-28, PSNR over the whole frame, before
+/// the cut counted edges; over the covered pixels the gallery's default frames score 33.5-43.4 dB:
+/// docs/RESULTS.md).
 pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 
 /// Default `RenderOptions::lod_error`: chosen on crops of the shared scans (scripts/family.py
