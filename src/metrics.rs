@@ -294,3 +294,33 @@ pub fn temporal_of(changes: &[f64]) -> Temporal {
     };
     Temporal { mean_change, max_change, popping }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn covered_figures_leave_out_the_background_both_agree_on() {
+        // A 10 x 10 frame, 4 covered pixels: one of them off by 0.1 in every channel.
+        let (mut a, mut b) = (ImageF32::new(10, 10), ImageF32::new(10, 10));
+        for i in 0..4 {
+            (a.pixels[i], b.pixels[i]) = ([0.5; 4], [0.5; 4]);
+        }
+        a.pixels[0] = [0.6; 4];
+        let m = compare(&a, &b).unwrap();
+        assert_eq!(m.covered_pixels, 4);
+        assert!((m.covered_rmse - (0.01f64 / 4.0).sqrt()).abs() < 1e-6, "{m:?}");
+        assert!((m.rmse - (0.01f64 / 100.0).sqrt()).abs() < 1e-6, "{m:?}");
+        // 10 log10(100 / 4) = 14 dB higher over the whole frame: the 96 empty pixels counted right.
+        assert!((m.psnr - m.covered_psnr - 10.0 * 25f64.log10()).abs() < 1e-3, "{m:?}");
+        // A pixel only one image covers counts; alpha at 1/255 or below in both does not.
+        b.pixels[50] = [0.0, 0.0, 0.0, 2.0 / 255.0];
+        a.pixels[60] = [0.0, 0.0, 0.0, 0.5 / 255.0];
+        assert_eq!(compare(&a, &b).unwrap().covered_pixels, 5);
+        // Nothing covered: no error, infinitely far from one.
+        let empty = ImageF32::new(4, 4);
+        let m = compare(&empty, &empty).unwrap();
+        assert_eq!((m.covered_pixels, m.covered_rmse), (0, 0.0));
+        assert!(m.covered_psnr.is_infinite());
+    }
+}
