@@ -753,3 +753,60 @@ fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
     assert_clean(&a);
     assert_clean(&b);
 }
+
+/// A ball of 20 voxels' radius on a 24³ grid, each voxel repeated 2x2x2 (48³): every aligned
+/// level-1 cell is constant, so only its neighbours tell a silhouette from the inside.
+fn blocky_ball() -> ScalarVolume {
+    let mut values = vec![0.0; 48 * 48 * 48];
+    for (i, v) in values.iter_mut().enumerate() {
+        let c = [i % 48, i / 48 % 48, i / 2304].map(|x| (x / 2) as f32 - 11.5);
+        if c.iter().map(|x| x * x).sum::<f32>() < 10.0 * 10.0 {
+            *v = 1.0;
+        }
+    }
+    ScalarVolume { dims: [48; 3], spacing: [1.0; 3], values }
+}
+
+#[test]
+fn the_cut_sees_a_blocky_silhouette_and_its_errors_are_the_mirror_s() {
+    let vol = blocky_ball();
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let cam = Camera::framing(&grid, 40, 40);
+    let (mut g, mut c) = (common::gpu(), common::cpu());
+    for r in [&mut g, &mut c] {
+        r.set_volume(&vol, &tf(), None).unwrap();
+    }
+    let o = RenderOptions::default();
+    let summaries: Vec<Vec<u32>> = [&mut g, &mut c]
+        .map(|r| r.probe(&cam, &o, StageId::BrickPyramid, &[Res::LodSummary]).unwrap().remove(0))
+        .into();
+    let words = voxsplat::low_level::plan::SUMMARY_WORDS;
+    // One summary per stored brick (the empty ones have no header).
+    let bricks = summaries[1].len() / words;
+    let (mut edges, mut inside) = (0, 0);
+    for h in 0..bricks {
+        let [gs, cs] = [&summaries[0], &summaries[1]].map(|s| &s[h * words..h * words + 4]);
+        assert_eq!(gs[0], cs[0], "brick {h}: drawn cells");
+        for l in 1..4 {
+            let (a, b) = (f32::from_bits(gs[l]), f32::from_bits(cs[l]));
+            assert!(
+                (a - b).abs() <= 1e-4 * b.abs().max(1e-2),
+                "brick {h} level {l}: error {a} on the device, {b} mirror"
+            );
+        }
+        let level1 = f32::from_bits(cs[1]);
+        if cs[0] & 0xff == 64 {
+            // Every level-1 cell drawn: the brick lies inside the ball (the children agree).
+            inside += usize::from(level1 < 1e-6);
+        } else if cs[0] & 0xff > 0 {
+            // A brick the silhouette crosses: an opaque cell beside an empty one.
+            edges += usize::from(level1 > 0.5);
+        }
+    }
+    assert!(inside > 0 && edges > 20, "bricks inside with no error {inside}, on the silhouette with one {edges}");
+    // The frames the default cut draws are the mirror's.
+    assert_eq!(drawn_cells(&mut g, &cam, &o), drawn_cells(&mut c, &cam, &o));
+    let (a, b) = (g.render(&cam, &o).unwrap().image, c.render(&cam, &o).unwrap().image);
+    assert!(diff(&a, &b).0 <= 2e-3, "device against mirror {}", diff(&a, &b).0);
+    assert_clean(&g);
+}
