@@ -301,10 +301,9 @@ pub struct RenderOptions {
     pub lod: Lod,
     /// Largest projected cell spacing, in pixels, of a coarse level (at the brick's nearest point).
     pub lod_pixels: f32,
-    /// Largest error of a coarse level: how far a cell's children or its face neighbours depart
-    /// from it in the opacity a ray crossing a brick (8 voxels) sees, or in colour weighted by it,
-    /// summed down the levels; weighted by the cell's projected size up to a pixel. 0 to
-    /// `MAX_LOD_ERROR` (no bound); 0 coarsens only cells equal to their children and neighbours.
+    /// Largest error of a coarse level: how far a cell's children or face neighbours depart from
+    /// it in the opacity a ray through a brick (8 voxels) sees, or in colour weighted by it, summed
+    /// down the levels, times the cell's size in pixels up to one. 0 to `MAX_LOD_ERROR`.
     pub lod_error: f32,
     /// Levels of detail: over the last `lod_band` octaves (0 to 1) before a brick's next level
     /// takes over, its splats move and widen toward that level's cells (geomorphing), so a level
@@ -368,24 +367,18 @@ impl Default for RenderOptions {
 /// Default `RenderOptions::lod_pixels`: against the supersampled reference (docs/MODEL.md), at
 /// 512² from the default view, the 512³ bonsai's frame cost 0.43x the 1-px cut's at 44.35 dB
 /// (1 px: 44.56 dB; its level-1 cells project to 0.8-1.5 px, so at 1 px almost none coarsens), and
-/// the 256³ gallery files stayed at or above 42.2 dB (2026-11-28, PSNR over the whole frame, before
-/// the cut counted edges; over the covered pixels the gallery's default frames score 33.5-43.4 dB:
-/// docs/RESULTS.md).
+/// the 256³ gallery files stayed at or above 42.2 dB (2026-11-28, over the whole frame; over the
+/// covered pixels the gallery's default frames score 33.5-43.4 dB: docs/RESULTS.md).
 pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 
-/// Default `RenderOptions::lod_error`: chosen on crops of the shared scans (scripts/family.py
-/// --small) and checked on the whole family at 512² (docs/RESULTS.md, "Volumes nobody tuned
-/// for"): the translucent heptane upsampled trilinearly, where opacity piles up along the rays,
-/// sets it (0.1: 1.2 dB below full detail; 0.07: 0.7 dB, at about 0.6x full detail's frame; the
-/// 512³ bonsai at 0.6-0.7x either way).
+/// Default `RenderOptions::lod_error`, set by the trilinear heptane 2x of `scripts/family.py`
+/// (0.1: 1.2 dB below full detail, 0.07: 0.7 dB at 0.6x its frame; docs/RESULTS.md).
 pub const DEFAULT_LOD_ERROR: f32 = 0.07;
 
-/// Largest `RenderOptions::lod_pixels`: a coarse level's cell (at most 8 voxels) projecting to
-/// more pixels than this draws as a blur, not a level of detail.
+/// Largest `RenderOptions::lod_pixels`: a wider coarse cell is a blur, not a level of detail.
 pub const MAX_LOD_PIXELS: f32 = 64.0;
 
-/// Largest `RenderOptions::lod_error`, and no bound at all: a cell's error sums at most one
-/// departure (each at most 1) per level, over three levels.
+/// Largest `RenderOptions::lod_error`: no bound (an error sums a departure of at most 1 a level).
 pub const MAX_LOD_ERROR: f32 = 3.0;
 
 /// Default transmittance threshold of front-to-back early termination: a quarter of an 8-bit step.
@@ -474,15 +467,13 @@ impl RenderOptions {
         }
         if !(self.lod_pixels > 0.0 && self.lod_pixels <= MAX_LOD_PIXELS) {
             return Err(Error::InvalidArgument(format!(
-                "the level-of-detail pixel size {} must be above 0 and at most {MAX_LOD_PIXELS} (the cell a coarse \
-                 level may project to, in pixels; --lod off draws full detail)",
+                "the level-of-detail pixel size {} must be above 0 and at most {MAX_LOD_PIXELS} (--lod off: full detail)",
                 self.lod_pixels
             )));
         }
         if !(0.0..=MAX_LOD_ERROR).contains(&self.lod_error) {
             return Err(Error::InvalidArgument(format!(
-                "the level-of-detail error {} must be in [0, {MAX_LOD_ERROR}] (0: only cells equal to their children \
-                 and neighbours coarsen; {MAX_LOD_ERROR}: no bound)",
+                "the level-of-detail error {} must be in [0, {MAX_LOD_ERROR}] (0: exact cells only; 3: no bound)",
                 self.lod_error
             )));
         }
