@@ -218,8 +218,9 @@ impl App {
         let frame_start = Instant::now();
         let input = self.input.as_mut().expect("made with the window");
         let mut raw = input.take_egui_input(&window);
+        let shown = self.first_frame.is_some();
         let step = match &mut self.script {
-            Some(script) => Some(script.step(&mut self.state, &mut raw)?),
+            Some(script) => Some(script.step(&mut self.state, &mut raw, shown)?),
             None => None,
         };
         let state = &mut self.state;

@@ -48,24 +48,28 @@ pub fn ui(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
     keys(ui, s);
 }
 
+/// `text` in exactly `n` rows, each cut to the panel's width (the whole row shows on hover), so
+/// that the controls below stay where they are as the text changes.
+fn rows(ui: &mut egui::Ui, n: usize, text: &str) {
+    let mut lines = text.lines();
+    for _ in 0..n {
+        ui.add(egui::Label::new(lines.next().unwrap_or(" ")).truncate());
+    }
+}
+
 fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
     ui.heading("voxsplat");
     ui.label(&s.title);
-    ui.label(format!(
-        "{:.1} ms a frame ({:.1} fps){}",
-        s.last_ms,
-        1e3 / s.last_ms.max(1e-3),
-        if s.dragging { format!(", a drag frame {:.1}x coarser", s.coarse) } else { String::new() }
-    ));
-    if !s.stats.is_empty() {
-        ui.label(&s.stats);
-    }
-    match &s.hover {
-        Some(text) => ui.label(text),
-        None => ui.label("(point at the volume for its value)"),
-    };
-    if !s.message.is_empty() {
-        ui.colored_label(egui::Color32::LIGHT_YELLOW, &s.message);
+    // The rows above the transfer-function editor keep their number whatever they show: a row
+    // that came and went would move the editor under a dragged point.
+    let drag = if s.dragging { format!(", a drag frame {:.1}x coarser", s.coarse) } else { String::new() };
+    rows(ui, 1, &format!("{:.1} ms a frame ({:.1} fps){drag}", s.last_ms, 1e3 / s.last_ms.max(1e-3)));
+    rows(ui, 2, if s.stats.is_empty() { "(drawing the first frame)" } else { &s.stats });
+    rows(ui, 2, s.hover.as_deref().unwrap_or("(point at the volume for its value)"));
+    if s.message.is_empty() {
+        rows(ui, 1, " ");
+    } else {
+        ui.add(egui::Label::new(egui::RichText::new(&s.message).color(egui::Color32::LIGHT_YELLOW)).truncate());
     }
     ui.separator();
     let mut mode = s.options.mode;

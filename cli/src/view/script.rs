@@ -1,6 +1,7 @@
 //! `view --script FILE`: synthetic pointer and key events, one line a frame, fed to the panel as
-//! the window's own events would be. Positions are resolved when a line runs, against the last
-//! frame's layout (the editor's points move as they are dragged).
+//! the window's own events would be. The lines start once the first frame is shown. Positions are
+//! resolved when a line runs, against the last frame's layout (the editor's points move as they
+//! are dragged).
 //!
 //! ```text
 //! move X Y            pointer to (X, Y) points from the window's top left
@@ -176,9 +177,12 @@ impl Script {
     }
 
     /// This frame's events, added to `raw`; the step to finish once the frame is drawn.
-    pub fn step(&mut self, s: &mut State, raw: &mut RawInput) -> Result<Step> {
+    /// `shown`: a frame of the volume has reached the window. The lines wait for it, and then one
+    /// frame more, so that they are resolved against the panel's settled layout (its statistics
+    /// line appears with the first frame; a slow machine shows it later).
+    pub fn step(&mut self, s: &mut State, raw: &mut RawInput, shown: bool) -> Result<Step> {
         if !self.started {
-            self.started = true;
+            self.started = shown;
             return Ok(Step::default());
         }
         if self.pending.is_empty() {
