@@ -7,7 +7,7 @@ pub use parts::Parts;
 use voxsplat::orient::Orientation;
 use voxsplat::{scene, Backend, Camera, Error, Projection, Renderer, RendererOptions, Result};
 
-pub use crate::parse::*;
+pub use crate::parse::{parse_background, parse_dims, parse_finite, parse_floats, parse_level, parse_size, parse_vec3};
 pub use crate::scene_args::SceneArgs;
 
 /// What a camera frames beyond the grid: the file's placement in patient space, and the box of
