@@ -371,9 +371,9 @@ impl Default for RenderOptions {
 /// covered pixels the gallery's default frames score 33.5-43.4 dB: docs/RESULTS.md).
 pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 
-/// Default `RenderOptions::lod_error`, set by the trilinear heptane 2x of `scripts/family.py`
-/// (0.1: 1.2 dB below full detail, 0.07: 0.7 dB at 0.6x its frame; docs/RESULTS.md).
-pub const DEFAULT_LOD_ERROR: f32 = 0.07;
+/// Default `RenderOptions::lod_error`: `scripts/family.py`'s thumbnails lay 1.3-1.6 dB below full
+/// detail at 0.07, within 0.9 dB at 0.03 (docs/RESULTS.md).
+pub const DEFAULT_LOD_ERROR: f32 = 0.03;
 
 /// Largest `RenderOptions::lod_pixels`: a wider coarse cell is a blur, not a level of detail.
 pub const MAX_LOD_PIXELS: f32 = 64.0;

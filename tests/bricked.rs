@@ -743,9 +743,10 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
     weighted.gradient_weight = 0.5;
     let mut fine = compute(Direction::FrontToBack);
     fine.lod = Lod::Off;
-    // Cells up to 4 px: the far bricks drawn coarser, from the pyramid.
+    // Cells up to 4 px and no error bound: the far bricks drawn coarser, from the pyramid
+    // (gradients are what this compares, not the cut).
     let mut coarse = compute(Direction::FrontToBack);
-    coarse.lod_pixels = 4.0;
+    (coarse.lod_pixels, coarse.lod_error) = (4.0, voxsplat::options::MAX_LOD_ERROR);
     let made = |r: &voxsplat::Rendered| r.timings.iter().any(|t| t.stage == "gradients");
     for (tf, what) in [(tf(), "shaded"), (weighted, "weighted")] {
         let mut frames = Vec::new();
