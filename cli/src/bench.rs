@@ -418,9 +418,13 @@ mod charts;
 mod motion;
 mod report;
 mod roofline;
-pub use antialias::*;
-pub use bricks_chart::*;
-pub use charts::*;
-pub use motion::*;
-pub use report::*;
-pub use roofline::*;
+pub use antialias::{antialias_markdown, antialias_rows, antialias_study, AaRow};
+pub use bricks_chart::{bricks_panel, read_scaling_csv, scaling_chart};
+pub use charts::{chart_svg, pareto_front, scatter_svg, scatter_svg_higher, write_csv};
+pub(crate) use charts::{io_err, plot_err};
+pub use motion::{motion_markdown, motion_rows, motion_study, write_motion_images, MotionRow};
+pub use report::{link, matrix_markdown, results_markdown, Detail, Report};
+pub use roofline::{
+    footprint_fragments, roofline, scaling, scaling_svg, synthetic_cube, write_scaling_csv, CompositeRoofline,
+    RooflinePoint, ScalePoint, SCALING_RASTERS,
+};

@@ -8,7 +8,7 @@ use std::time::Instant;
 use voxsplat::{Error, Mode, RenderOptions, Renderer, Result};
 
 mod report;
-pub use report::*;
+pub use report::{compare, score, CaseResult, Platform, Report};
 
 /// The suite's version: it changes whenever a case, its view, its options or the score's definition
 /// does, and reports of different versions are not compared.
