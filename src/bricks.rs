@@ -231,17 +231,20 @@ impl BrickStore {
     pub fn value_at(&self, i: i64, j: i64, k: i64) -> f32 {
         let [x, y, z] = [i, j, k].map(|c| c.max(0) as u32);
         let [x, y, z] = [x.min(self.dims[0] - 1), y.min(self.dims[1] - 1), z.min(self.dims[2] - 1)];
-        let h = self.header_of([x, y, z]);
-        if h == u32::MAX {
-            return 0.0;
-        }
-        let mask = &self.masks[h as usize];
-        let l = (x % BRICK + BRICK * (y % BRICK) + BRICK * BRICK * (z % BRICK)) as usize;
-        if mask[l / 64] >> (l % 64) & 1 == 0 {
-            return 0.0;
-        }
+        let Some((h, l)) = self.stored([x, y, z]) else { return 0.0 };
         let rec = record_at(&self.records, self.headers[h as usize].first + self.stored_below(h, l));
         (rec >> 16) as f32 / Q
+    }
+
+    /// Where voxel `v` (inside the grid) is stored: its brick's header and its local index there,
+    /// or None where its brick is empty or its occupancy bit is unset.
+    pub fn stored(&self, v: [u32; 3]) -> Option<(u32, usize)> {
+        let h = self.header_of(v);
+        if h == u32::MAX {
+            return None;
+        }
+        let l = (v[0] % BRICK + BRICK * (v[1] % BRICK) + BRICK * BRICK * (v[2] % BRICK)) as usize;
+        (self.masks[h as usize][l / 64] >> (l % 64) & 1 != 0).then_some((h, l))
     }
 
     /// The rank of local voxel `l`'s record among header `h`'s: the brick's stored voxels below it

@@ -57,8 +57,9 @@ pub fn compare(img: &ImageF32, truth: &ImageF32) -> Result<ImageMetrics> {
     let n = (img.pixels.len() * 4).max(1) as f64;
     let rmse = (se / n).sqrt();
     let whole = psnr(rmse);
-    let covered_pixels = (0..img.pixels.len()).filter(|&i| is_covered(img, truth, i)).count();
-    let covered_rmse = rmse_masked(img, truth, |i| is_covered(img, truth, i)).unwrap_or(0.0);
+    let covered: Vec<bool> = (0..img.pixels.len()).map(|i| is_covered(img, truth, i)).collect();
+    let covered_pixels = covered.iter().filter(|&&c| c).count();
+    let covered_rmse = rmse_masked(img, truth, |i| covered[i]).unwrap_or(0.0);
     let luma = |p: &[f32; 4]| 0.2126 * clamp01(p[0]) + 0.7152 * clamp01(p[1]) + 0.0722 * clamp01(p[2]);
     Ok(ImageMetrics {
         rmse,

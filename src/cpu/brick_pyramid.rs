@@ -151,17 +151,10 @@ fn outside_layer(inputs: &BrickInputs<'_>, b: [u32; 3]) -> [bool; 6 * 64] {
         if (0..3).any(|a| v[a] < 0 || v[a] >= store.dims[a] as i64) {
             return true;
         }
-        let c = v.map(|x| x as u32);
-        let h = store.header_of(c);
-        if h == u32::MAX {
-            return true;
-        }
+        // An empty brick, or one the TF leaves empty, or a voxel not stored (the mask).
+        let Some((h, _)) = store.stored(v.map(|x| x as u32)) else { return true };
         let range = store.headers[h as usize].range;
-        if inputs.tf_empty(range & 0xffff, range >> 16) {
-            return true;
-        }
-        let l = (c[0] % BRICK + BRICK * (c[1] % BRICK + BRICK * (c[2] % BRICK))) as usize;
-        store.masks[h as usize][l / 64] >> (l % 64) & 1 == 0
+        inputs.tf_empty(range & 0xffff, range >> 16)
     })
 }
 
