@@ -8,9 +8,9 @@
 // and averaged across it, so a coarse cell covers, seen along each axis, what its children cover.
 // Its splat is 2^l times wider and carries the optical depth through the cell. Each cell's error is how far its children
 // depart from it (Laur-Hanrahan): the largest over its children of their own error plus the
-// difference of opacity per voxel length, or of colour weighted by the child's opacity; and at
-// least how far its face neighbours depart from it (edge_errors: a coarse splat reaches past its
-// cell, so it blurs the edges the fine level keeps). Writes
+// difference of opacity over a brick's side, or of colour weighted by the child's opacity; and at
+// least how far its face neighbours depart from what the coarse level predicts there (edge_errors:
+// a coarse splat reaches past its cell, so it blurs the edges the fine level keeps). Writes
 // the pyramid cells and each brick's summary (brick.glsl). A streamed store (STREAMED_STORE)
 // builds the pyramids of one batch's bricks from its records, a workgroup per entry of
 // brick_list from pc.first, into the entries' slots or, when the pyramid is resident, the bricks'
@@ -67,13 +67,17 @@ uint empty_voxel(ivec3 v) {
     return ((masks[h * MASK_STRIDE + l / 32u] >> (l % 32u)) & 1u) == 0u ? 1u : 0u;
 }
 
-// Level l's cells against their 6 face neighbours (a coarse splat reaches past its cell: where a
+// Level l's cells against their face neighbours (a coarse splat reaches past its cell: where a
 // neighbour differs, the coarse picture blurs an edge the fine one keeps sharp, the halo of
-// coarse cells on silhouettes): each cell's error becomes at least the largest departure of a
-// neighbour from it, measured as a child's (child_error). A neighbour outside the brick is the
-// voxel layer past that face: its empty voxels draw nothing, the others are taken to be the
-// cell's own (their values are not resident in a streamed store: edges between two materials
-// at brick faces are not seen). Mirror: cpu::brick_pyramid::edge_errors.
+// coarse cells on silhouettes), measured as a child's (child_error) but against what the coarse
+// level predicts there: the cell's sums carried on linearly from the opposite neighbour (2 c - o,
+// at least 0), or the cell's own where that one is outside the brick. Neighbouring coarse splats
+// interpolate a linear ramp, so a ramp departs by nothing and an edge, a kink or a thin wall by
+// its step. A neighbour inside the brick whose opposite one is outside is left to the
+// neighbour's own comparisons and the level below's (no slope is known there). A neighbour
+// outside the brick is the voxel layer past that face: its empty voxels draw nothing, the others
+// are taken to be the prediction (their values are not resident in a streamed store: edges
+// between two materials at brick faces are not seen). Mirror: cpu::brick_pyramid::edge_errors.
 void edge_errors(uint l, uint lane) {
     uint n = BRICK_SIDE >> l;
     uint side = 1u << l;
@@ -83,13 +87,26 @@ void edge_errors(uint l, uint lane) {
         uvec3 cc = uvec3(c % n, (c / n) % n, c / (n * n));
         uint i = level_offset(l) + c;
         float t = tau_l[i];
-        float a = 1.0 - exp(-t / voxels * len);
-        vec3 straight = t > 0.0 ? col_l[i] / t : vec3(0.0);
         float err = err_l[i];
         for (uint f = 0u; f < 6u; ++f) {
             uint ax = f / 2u;
             bool high = (f & 1u) != 0u;
-            if (high ? cc[ax] + 1u < n : cc[ax] > 0u) {
+            bool inside = high ? cc[ax] + 1u < n : cc[ax] > 0u;
+            bool opposite = high ? cc[ax] > 0u : cc[ax] + 1u < n;
+            // The prediction on this side: linear from the opposite neighbour, or the cell's own.
+            float pt = t;
+            vec3 pc = col_l[i];
+            if (opposite) {
+                uvec3 oc = cc;
+                oc[ax] = high ? cc[ax] - 1u : cc[ax] + 1u;
+                uint o = level_offset(l) + oc.x + n * (oc.y + n * oc.z);
+                pt = max(2.0 * t - tau_l[o], 0.0);
+                pc = max(2.0 * col_l[i] - col_l[o], vec3(0.0));
+            }
+            float a = 1.0 - exp(-pt / voxels * len);
+            vec3 straight = pt > 0.0 ? pc / pt : vec3(0.0);
+            if (inside) {
+                if (!opposite) continue;
                 uvec3 nc = cc;
                 nc[ax] = high ? cc[ax] + 1u : cc[ax] - 1u;
                 uint k = level_offset(l) + nc.x + n * (nc.y + n * nc.z);
@@ -103,7 +120,7 @@ void edge_errors(uint l, uint lane) {
                     for (uint u = u0; u < u0 + side; ++u) empty += empty_out[f * 64u + u + 8u * w];
                 }
                 float kept = 1.0 - float(empty) / float(side * side);
-                err = max(err, child_error(a, straight, t * kept, col_l[i] * kept, 0.0, voxels, len));
+                err = max(err, child_error(a, straight, pt * kept, pc * kept, 0.0, voxels, len));
             }
         }
         err_l[i] = err;

@@ -159,8 +159,10 @@ fn outside_layer(inputs: &BrickInputs<'_>, b: [u32; 3]) -> [bool; 6 * 64] {
 }
 
 /// Mirror of `edge_errors`: level `l`'s cells' errors raised to their face neighbours' departure
-/// from them (inside the brick, the neighbour cell; past its faces, the outside layer's drawn
-/// fraction of the cell's own sums).
+/// from what the coarse level predicts there (the cell carried on linearly from the opposite
+/// neighbour, or the cell's own where that one is outside the brick; a neighbour inside whose
+/// opposite is outside is skipped; past the faces, the outside layer's drawn fraction of the
+/// prediction).
 fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32) {
     let n = BRICK >> l;
     let side = 1u32 << l;
@@ -171,12 +173,25 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
         .map(|c| {
             let cc = [c % n, (c / n) % n, c / (n * n)];
             let me = cells[at(cc)];
-            let a = 1.0 - (-me.tau / voxels * len).exp();
-            let straight = if me.tau > 0.0 { me.col / me.tau } else { Vec3::ZERO };
             let mut err = me.err;
             for f in 0..6 {
                 let (ax, high) = (f / 2, f & 1 != 0);
-                if if high { cc[ax] + 1 < n } else { cc[ax] > 0 } {
+                let inside = if high { cc[ax] + 1 < n } else { cc[ax] > 0 };
+                let opposite = if high { cc[ax] > 0 } else { cc[ax] + 1 < n };
+                let (mut pt, mut pc) = (me.tau, me.col);
+                if opposite {
+                    let mut oc = cc;
+                    oc[ax] = if high { cc[ax] - 1 } else { cc[ax] + 1 };
+                    let o = cells[at(oc)];
+                    pt = (2.0 * me.tau - o.tau).max(0.0);
+                    pc = (2.0 * me.col - o.col).max(Vec3::ZERO);
+                }
+                let a = 1.0 - (-pt / voxels * len).exp();
+                let straight = if pt > 0.0 { pc / pt } else { Vec3::ZERO };
+                if inside {
+                    if !opposite {
+                        continue;
+                    }
                     let mut nc = cc;
                     nc[ax] = if high { cc[ax] + 1 } else { cc[ax] - 1 };
                     let k = cells[at(nc)];
@@ -190,7 +205,7 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
                         }
                     }
                     let kept = 1.0 - empty as f32 / (side * side) as f32;
-                    err = err.max(child_error(a, straight, me.tau * kept, me.col * kept, 0.0, voxels, len));
+                    err = err.max(child_error(a, straight, pt * kept, pc * kept, 0.0, voxels, len));
                 }
             }
             err
