@@ -301,9 +301,9 @@ pub struct RenderOptions {
     pub lod: Lod,
     /// Largest projected cell spacing, in pixels, of a coarse level (at the brick's nearest point).
     pub lod_pixels: f32,
-    /// Largest error of a coarse level: how far a cell's children or face neighbours depart from
-    /// it in the opacity a ray through a brick (8 voxels) sees, or in colour weighted by it, summed
-    /// down the levels, times the cell's size in pixels up to one. 0 to `MAX_LOD_ERROR`.
+    /// Largest error of a coarse level: how far a cell's children depart from it, or its face
+    /// neighbours from its linear continuation, in the opacity a ray through a brick (8 voxels) sees
+    /// or colour weighted by it, summed down the levels, times the cell's size in pixels up to one.
     pub lod_error: f32,
     /// Levels of detail: over the last `lod_band` octaves (0 to 1) before a brick's next level
     /// takes over, its splats move and widen toward that level's cells (geomorphing), so a level
@@ -371,8 +371,8 @@ impl Default for RenderOptions {
 /// covered pixels the gallery's default frames score 33.5-43.4 dB: docs/RESULTS.md).
 pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 
-/// Default `RenderOptions::lod_error`: `scripts/family.py`'s thumbnails lay 1.3-1.6 dB below full
-/// detail at 0.07, within 0.9 dB at 0.03 (docs/RESULTS.md).
+/// Default `RenderOptions::lod_error` (0 to `MAX_LOD_ERROR`): `scripts/family.py`'s thumbnails lay
+/// 1.3-1.6 dB below full detail at 0.07, within 1 dB at 0.03 (docs/RESULTS.md).
 pub const DEFAULT_LOD_ERROR: f32 = 0.03;
 
 /// Largest `RenderOptions::lod_pixels`: a wider coarse cell is a blur, not a level of detail.

@@ -810,3 +810,65 @@ fn the_cut_sees_a_blocky_silhouette_and_its_errors_are_the_mirror_s() {
     assert!(diff(&a, &b).0 <= 2e-3, "device against mirror {}", diff(&a, &b).0);
     assert_clean(&g);
 }
+
+/// 48³ along x: a ramp in value (the TF faint, so optical depth rises nearly linearly) or a step
+/// at x = 20 (inside a brick, on a level-1 and a level-2 cell face); one corner voxel at the
+/// minimum, so the store keeps every other voxel.
+fn along_x(step: bool) -> (ScalarVolume, TransferFunction) {
+    let n = 48;
+    let mut values: Vec<f32> = (0..n * n * n)
+        .map(|i| {
+            let x = (i % n) as f32;
+            if step { if x < 20.0 { 0.2 } else { 1.0 } } else { 0.2 + 0.8 * x / (n - 1) as f32 }
+        })
+        .collect();
+    values[0] = 0.0;
+    let tf = TransferFunction {
+        points: vec![(0.0, [0.8, 0.8, 0.8, 0.0]), (1.0, [0.8, 0.8, 0.8, 0.04])],
+        gradient_weight: 0.0,
+        range: Some((0.0, 1.0)),
+        threshold: 0.0,
+    };
+    (ScalarVolume { dims: [n as u32; 3], spacing: [1.0; 3], values }, tf)
+}
+
+#[test]
+fn a_ramp_is_not_an_edge_and_a_step_is() {
+    // Opacity over a brick's side (8 voxels) of optical depth tau per voxel: the error's measure.
+    let seen = |value: f32| 1.0 - (-8.0 * -(1.0 - 0.04 * value).ln()).exp();
+    let mut most = [0.0f32; 2];
+    let mut least = [f32::MAX; 2];
+    for (k, step) in [false, true].into_iter().enumerate() {
+        let (vol, tf) = along_x(step);
+        let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+        let cam = Camera::framing(&grid, 40, 40);
+        let (mut g, mut c) = (common::gpu(), common::cpu());
+        for r in [&mut g, &mut c] {
+            r.set_volume(&vol, &tf, None).unwrap();
+        }
+        let o = RenderOptions::default();
+        let summaries: Vec<Vec<u32>> = [&mut g, &mut c]
+            .map(|r| r.probe(&cam, &o, StageId::BrickPyramid, &[Res::LodSummary]).unwrap().remove(0))
+            .into();
+        let words = voxsplat::low_level::plan::SUMMARY_WORDS;
+        for h in 0..summaries[1].len() / words {
+            let [gs, cs] = [&summaries[0], &summaries[1]].map(|s| &s[h * words..h * words + 4]);
+            for l in 1..4 {
+                let (a, b) = (f32::from_bits(gs[l]), f32::from_bits(cs[l]));
+                assert!((a - b).abs() <= 1e-4 * b.abs().max(1e-2), "brick {h} level {l}: {a} device, {b} mirror");
+            }
+            let level1 = f32::from_bits(cs[1]);
+            (most[k], least[k]) = (most[k].max(level1), least[k].min(level1));
+        }
+        assert_clean(&g);
+    }
+    // Two voxels apart along the ramp (a level-1 cell's neighbour), mid-volume.
+    let neighbour = seen(0.2 + 0.8 * 25.0 / 47.0) - seen(0.2 + 0.8 * 23.0 / 47.0);
+    // Inside the volume a ramp brick's level 1 departs only inside its cells (half a voxel's
+    // rise, over a brick's side); compared with the cell itself, each neighbour departed by two.
+    assert!(least[0] > 0.0 && least[0] < 0.5 * neighbour, "ramp: level-1 error {} against a neighbour's {neighbour}", least[0]);
+    // The step's bricks: its whole rise.
+    let rise = seen(1.0) - seen(0.2);
+    eprintln!("level-1 errors: ramp {} (a neighbour {neighbour}), step {} (its rise {rise})", least[0], most[1]);
+    assert!(most[1] >= 0.9 * rise, "step: level-1 error {} against its rise {rise}", most[1]);
+}

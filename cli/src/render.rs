@@ -74,9 +74,10 @@ pub(crate) struct RenderArgs {
     /// Largest projected cell spacing of a coarse level, in pixels (above 0, at most 64).
     #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
     lod_pixels: f32,
-    /// Largest error of a coarse level, 0 to 3: how far a cell's children or neighbours depart from
-    /// it, in the opacity a ray crossing a brick (8 voxels) sees (summed down the levels; 3: no
-    /// bound, 0: only cells equal to their children and neighbours coarsen).
+    /// Largest error of a coarse level, 0 to 3: how far a cell's children depart from it, or its
+    /// neighbours from its linear continuation, in the opacity a ray crossing a brick (8 voxels)
+    /// sees (summed down the levels). On translucent volumes about the largest change of a pixel
+    /// (0.03: about 8 steps of 8 bits). 3: no bound; 0: only cells equal to their children coarsen.
     #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
     lod_error: f32,
     /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level

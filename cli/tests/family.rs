@@ -207,7 +207,7 @@ fn level_of_detail_bounds_out_of_range_are_refused_with_the_range() {
         let text = refused(&args);
         assert!(text.contains(says), "{flag} {value}: {text}");
     }
-    // 0 has a meaning: only cells equal to their children and neighbours coarsen.
+    // 0 has a meaning: only cells equal to their children, with neighbours on a line, coarsen.
     let args = ["render", "--volume", stent, "--size", "32x32", "--lod-error", "0", "--out", out.to_str().unwrap()];
     assert!(voxsplat(&args).status.success());
 }
