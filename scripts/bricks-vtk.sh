@@ -59,7 +59,7 @@ for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/pro
     for lod in off auto; do
       ./target/release/voxsplat render --volume "$f" --tf $tf --size 512x512 --raster compute --direction ftb \
         --lod $lod --lod-pixels 1 --out "target/frame-$lod.exr" >/dev/null
-      psnr+=("$(./target/release/voxsplat compare "target/frame-$lod.exr" "$t" | sed -nE 's/^psnr: *([0-9.]+) dB/\1/p')")
+      psnr+=("$(./target/release/voxsplat compare "target/frame-$lod.exr" "$t" | sed -nE 's/^psnr: *([0-9.]+) dB.*/\1/p')")
     done
     truth="${psnr[0]}, ${psnr[1]}"
   fi
