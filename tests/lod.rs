@@ -819,7 +819,15 @@ fn along_x(step: bool) -> (ScalarVolume, TransferFunction) {
     let mut values: Vec<f32> = (0..n * n * n)
         .map(|i| {
             let x = (i % n) as f32;
-            if step { if x < 20.0 { 0.2 } else { 1.0 } } else { 0.2 + 0.8 * x / (n - 1) as f32 }
+            if step {
+                if x < 20.0 {
+                    0.2
+                } else {
+                    1.0
+                }
+            } else {
+                0.2 + 0.8 * x / (n - 1) as f32
+            }
         })
         .collect();
     values[0] = 0.0;
@@ -866,7 +874,11 @@ fn a_ramp_is_not_an_edge_and_a_step_is() {
     let neighbour = seen(0.2 + 0.8 * 25.0 / 47.0) - seen(0.2 + 0.8 * 23.0 / 47.0);
     // Inside the volume a ramp brick's level 1 departs only inside its cells (half a voxel's
     // rise, over a brick's side); compared with the cell itself, each neighbour departed by two.
-    assert!(least[0] > 0.0 && least[0] < 0.5 * neighbour, "ramp: level-1 error {} against a neighbour's {neighbour}", least[0]);
+    assert!(
+        least[0] > 0.0 && least[0] < 0.5 * neighbour,
+        "ramp: level-1 error {} against a neighbour's {neighbour}",
+        least[0]
+    );
     // The step's bricks: its whole rise.
     let rise = seen(1.0) - seen(0.2);
     eprintln!("level-1 errors: ramp {} (a neighbour {neighbour}), step {} (its rise {rise})", least[0], most[1]);
