@@ -93,6 +93,8 @@ void edge_errors(uint l, uint lane) {
             bool high = (f & 1u) != 0u;
             bool inside = high ? cc[ax] + 1u < n : cc[ax] > 0u;
             bool opposite = high ? cc[ax] > 0u : cc[ax] + 1u < n;
+            // No slope is known here: left to the neighbour's own comparisons.
+            if (inside && !opposite) continue;
             // The prediction on this side: linear from the opposite neighbour, or the cell's own.
             float pt = t;
             vec3 pc = col_l[i];
@@ -106,7 +108,6 @@ void edge_errors(uint l, uint lane) {
             float a = 1.0 - exp(-pt / voxels * len);
             vec3 straight = pt > 0.0 ? pc / pt : vec3(0.0);
             if (inside) {
-                if (!opposite) continue;
                 uvec3 nc = cc;
                 nc[ax] = high ? cc[ax] + 1u : cc[ax] - 1u;
                 uint k = level_offset(l) + nc.x + n * (nc.y + n * nc.z);

@@ -754,6 +754,29 @@ fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
     assert_clean(&b);
 }
 
+/// Each stored brick's summary (drawn cells, then levels 1-3's errors) from the mirror, after
+/// checking the device's against it: the drawn cells exactly, the errors to 1e-4.
+fn summaries_match_the_mirror(g: &mut Renderer, c: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 4]> {
+    let summaries: Vec<Vec<u32>> =
+        [g, c].map(|r| r.probe(cam, o, StageId::BrickPyramid, &[Res::LodSummary]).unwrap().remove(0)).into();
+    let words = voxsplat::low_level::plan::SUMMARY_WORDS;
+    // One summary per stored brick (the empty ones have no header).
+    (0..summaries[1].len() / words)
+        .map(|h| {
+            let [gs, cs] = [&summaries[0], &summaries[1]].map(|s| &s[h * words..h * words + 4]);
+            assert_eq!(gs[0], cs[0], "brick {h}: drawn cells");
+            for l in 1..4 {
+                let (a, b) = (f32::from_bits(gs[l]), f32::from_bits(cs[l]));
+                assert!(
+                    (a - b).abs() <= 1e-4 * b.abs().max(1e-2),
+                    "brick {h} level {l}: error {a} on the device, {b} mirror"
+                );
+            }
+            [cs[0], cs[1], cs[2], cs[3]]
+        })
+        .collect()
+}
+
 /// A ball of 20 voxels' radius on a 24³ grid, each voxel repeated 2x2x2 (48³): every aligned
 /// level-1 cell is constant, so only its neighbours tell a silhouette from the inside.
 fn blocky_ball() -> ScalarVolume {
@@ -777,23 +800,8 @@ fn the_cut_sees_a_blocky_silhouette_and_its_errors_are_the_mirror_s() {
         r.set_volume(&vol, &tf(), None).unwrap();
     }
     let o = RenderOptions::default();
-    let summaries: Vec<Vec<u32>> = [&mut g, &mut c]
-        .map(|r| r.probe(&cam, &o, StageId::BrickPyramid, &[Res::LodSummary]).unwrap().remove(0))
-        .into();
-    let words = voxsplat::low_level::plan::SUMMARY_WORDS;
-    // One summary per stored brick (the empty ones have no header).
-    let bricks = summaries[1].len() / words;
     let (mut edges, mut inside) = (0, 0);
-    for h in 0..bricks {
-        let [gs, cs] = [&summaries[0], &summaries[1]].map(|s| &s[h * words..h * words + 4]);
-        assert_eq!(gs[0], cs[0], "brick {h}: drawn cells");
-        for l in 1..4 {
-            let (a, b) = (f32::from_bits(gs[l]), f32::from_bits(cs[l]));
-            assert!(
-                (a - b).abs() <= 1e-4 * b.abs().max(1e-2),
-                "brick {h} level {l}: error {a} on the device, {b} mirror"
-            );
-        }
+    for cs in summaries_match_the_mirror(&mut g, &mut c, &cam, &o) {
         let level1 = f32::from_bits(cs[1]);
         if cs[0] & 0xff == 64 {
             // Every level-1 cell drawn: the brick lies inside the ball (the children agree).
@@ -854,17 +862,7 @@ fn a_ramp_is_not_an_edge_and_a_step_is() {
         for r in [&mut g, &mut c] {
             r.set_volume(&vol, &tf, None).unwrap();
         }
-        let o = RenderOptions::default();
-        let summaries: Vec<Vec<u32>> = [&mut g, &mut c]
-            .map(|r| r.probe(&cam, &o, StageId::BrickPyramid, &[Res::LodSummary]).unwrap().remove(0))
-            .into();
-        let words = voxsplat::low_level::plan::SUMMARY_WORDS;
-        for h in 0..summaries[1].len() / words {
-            let [gs, cs] = [&summaries[0], &summaries[1]].map(|s| &s[h * words..h * words + 4]);
-            for l in 1..4 {
-                let (a, b) = (f32::from_bits(gs[l]), f32::from_bits(cs[l]));
-                assert!((a - b).abs() <= 1e-4 * b.abs().max(1e-2), "brick {h} level {l}: {a} device, {b} mirror");
-            }
+        for cs in summaries_match_the_mirror(&mut g, &mut c, &cam, &RenderOptions::default()) {
             let level1 = f32::from_bits(cs[1]);
             (most[k], least[k]) = (most[k].max(level1), least[k].min(level1));
         }

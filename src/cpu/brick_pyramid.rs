@@ -178,6 +178,10 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
                 let (ax, high) = (f / 2, f & 1 != 0);
                 let inside = if high { cc[ax] + 1 < n } else { cc[ax] > 0 };
                 let opposite = if high { cc[ax] > 0 } else { cc[ax] + 1 < n };
+                // No slope is known here: left to the neighbour's own comparisons.
+                if inside && !opposite {
+                    continue;
+                }
                 let (mut pt, mut pc) = (me.tau, me.col);
                 if opposite {
                     let mut oc = cc;
@@ -189,9 +193,6 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
                 let a = 1.0 - (-pt / voxels * len).exp();
                 let straight = if pt > 0.0 { pc / pt } else { Vec3::ZERO };
                 if inside {
-                    if !opposite {
-                        continue;
-                    }
                     let mut nc = cc;
                     nc[ax] = if high { cc[ax] + 1 } else { cc[ax] - 1 };
                     let k = cells[at(nc)];
