@@ -54,6 +54,12 @@ uint child(uint l, uvec3 c, uint n, uint d) {
     return l == 1u ? i : level_offset(l - 1u) + i;
 }
 
+// Cell c (side BRICK_SIDE >> l) of level l, as an index into the sums.
+uint cell_at(uint l, uvec3 c) {
+    uint n = BRICK_SIDE >> l;
+    return level_offset(l) + c.x + n * (c.y + n * c.z);
+}
+
 // Whether the voxel at v (grid coordinates, possibly outside) draws nothing, from resident words.
 uint empty_voxel(ivec3 v) {
     if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(frame.dims.xyz)))) return 1u;
@@ -101,7 +107,7 @@ void edge_errors(uint l, uint lane) {
             if (opposite) {
                 uvec3 oc = cc;
                 oc[ax] = high ? cc[ax] - 1u : cc[ax] + 1u;
-                uint o = level_offset(l) + oc.x + n * (oc.y + n * oc.z);
+                uint o = cell_at(l, oc);
                 pt = max(2.0 * t - tau_l[o], 0.0);
                 pc = max(2.0 * col_l[i] - col_l[o], vec3(0.0));
             }
@@ -110,7 +116,7 @@ void edge_errors(uint l, uint lane) {
             if (inside) {
                 uvec3 nc = cc;
                 nc[ax] = high ? cc[ax] + 1u : cc[ax] - 1u;
-                uint k = level_offset(l) + nc.x + n * (nc.y + n * nc.z);
+                uint k = cell_at(l, nc);
                 err = max(err, child_error(a, straight, tau_l[k], col_l[k], 0.0, voxels, len));
             } else {
                 // The face's outside layer under this cell: the fraction of it that draws nothing.
