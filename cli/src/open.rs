@@ -118,11 +118,14 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
         cam.projection = Projection::Orthographic { height: hgt };
     }
     // Fit near/far to the scene's bounding sphere seen from this eye unless given, widened by the
-    // splats' cull margin (`Camera::cull_margin`; what anti-aliasing widens is never culled).
+    // splats' cull margin (`Camera::cull_margin`; what anti-aliasing widens is never culled). The
+    // near plane from the sphere's depth along the view, not its distance: a --target away from
+    // the scene puts it off the axis, nearer in depth than in distance (it was clipped away).
     let d = (grid.center() - cam.eye).length();
+    let depth = (grid.center() - cam.eye).dot(cam.forward());
     let r = 0.5 * grid.diagonal() + (4.0 * grid.kernel_spacing()).max(Camera::cull_margin(grid.kernel_spacing()));
     // Margins relative to the scene, not in units: spacings in metres (1e-4 and below) are common.
-    let fit_near = if cam.is_perspective() { (d - r).max(1e-3 * d) } else { d - 1.5 * r };
+    let fit_near = if cam.is_perspective() { (depth - r).max(1e-3 * d) } else { depth - 1.5 * r };
     cam.near = a.near.unwrap_or(if grazing { cam.near } else { fit_near });
     cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + 1.5 * r });
     cam.validate()?;

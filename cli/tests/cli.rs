@@ -43,6 +43,34 @@ fn render_writes_png_and_exr() {
     }
 }
 
+/// A --target away from the scene puts it off the view's axis: its depth along the view is less
+/// than its distance, and the fitted near plane must follow the depth (it followed the distance and
+/// clipped this cube away whole: an empty frame, no error).
+#[test]
+fn a_scene_off_the_axis_is_not_clipped() {
+    let path = tmp("off-axis.png");
+    // 20 degrees off the axis, 1000 away: 1 - cos 20° of the distance (60) passes the cube's radius.
+    let out = voxsplat(&[
+        "render",
+        "--scene",
+        "cube40",
+        "--eye",
+        "0,0,1000",
+        "--target",
+        "364,0,0",
+        "--size",
+        "96x64",
+        "--cpu",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&path).unwrap().to_rgba8();
+    let drawn: Vec<u32> = img.enumerate_pixels().filter(|(_, _, px)| px[3] > 200).map(|(x, _, _)| x).collect();
+    assert!(!drawn.is_empty(), "the cube is drawn");
+    assert!(drawn.iter().all(|&x| x < 32), "on the left, where the view's axis turned from it: {drawn:?}");
+}
+
 #[test]
 fn order_dump_and_check() {
     let path = tmp("order.csv");
