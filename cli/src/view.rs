@@ -246,7 +246,7 @@ impl App {
         }
         let s = &mut self.state;
         let base = s.base.expect("started");
-        let cam = s.orbit.camera(&base, s.radius, (viewport.width, viewport.height));
+        let cam = s.orbit.camera(&base, s.centre().unwrap_or(base.target), s.radius, (viewport.width, viewport.height));
         let mut options = s.render_options()?;
         if s.dragging && !s.coarse_measured {
             // The first drag frame: as coarse as the last full frame's time says.
@@ -417,7 +417,8 @@ impl App {
             if s.shading_on && s.light.is_none() {
                 // A headlight along the current view.
                 if let Some(base) = &s.base {
-                    let cam = s.orbit.camera(base, s.radius, (base.width, base.height));
+                    let cam =
+                        s.orbit.camera(base, s.centre().unwrap_or(base.target), s.radius, (base.width, base.height));
                     s.light = Some(Shading::headlight(cam.target - cam.eye));
                 }
             }

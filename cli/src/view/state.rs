@@ -163,13 +163,13 @@ impl State {
             (rect.width() * self.pixels_per_point).round() as u32,
             (rect.height() * self.pixels_per_point).round() as u32,
         );
-        Some(self.orbit.camera(base, self.radius, size))
+        Some(self.orbit.camera(base, self.centre().unwrap_or(base.target), self.radius, size))
     }
 
     /// The direction the current view looks along.
     pub fn view_direction(&self) -> Option<Vec3> {
         let base = self.base.as_ref()?;
-        let cam = self.orbit.camera(base, self.radius, (base.width, base.height));
+        let cam = self.orbit.camera(base, self.centre().unwrap_or(base.target), self.radius, (base.width, base.height));
         Some(cam.forward())
     }
 
@@ -200,8 +200,8 @@ impl State {
         Some(g.world_box(Vec3::ZERO, Vec3::from(g.dims.map(|d| d.saturating_sub(1) as f32))))
     }
 
-    /// The grid's world box's centre, which the clip planes' offsets count from.
-    fn centre(&self) -> Option<Vec3> {
+    /// The grid's world box's centre, which the clip planes' offsets and the view's near plane count from.
+    pub fn centre(&self) -> Option<Vec3> {
         self.bounds().map(|[lo, hi]| (lo + hi) * 0.5)
     }
 
