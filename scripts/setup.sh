@@ -35,4 +35,7 @@ python3 -c "import nrrd" 2>/dev/null || python3 -m pip install --quiet "pynrrd==
 # The OME-Zarr tests write their images with the ome-zarr package (cli/tests/zarr.rs); 0.18 writes
 # OME-NGFF 0.4 and 0.5 through zarr-python 3.
 python3 -c "import ome_zarr, zarr; assert zarr.__version__ >= '3'" 2>/dev/null || python3 -m pip install --quiet "ome-zarr==0.18.0"
+# scripts/sparse-truth.py (the sparse 1024^3 member's reference, and its test in cli/tests/family.rs)
+# reads and writes EXR frames with OpenEXR and finds the volume's clumps with scipy.
+python3 -c "import OpenEXR, scipy" 2>/dev/null || python3 -m pip install --quiet "OpenEXR==3.5.3" scipy
 command -v cargo >/dev/null || { echo "setup: cargo not found; install Rust first (https://rustup.rs)" >&2; exit 1; }

@@ -1,0 +1,241 @@
+#!/usr/bin/env python3
+"""The supersampled ray-cast reference of a sparse volume too large for the ray casters, by crops.
+
+    python3 scripts/sparse-truth.py VOLUME.nrrd OUT.exr --tf TF [--vs BIN] -- RENDER_FLAGS...
+    python3 scripts/sparse-truth.py VOLUME.nrrd --camera --tf TF -- --size WxH --view NAME
+
+The second form prints the explicit camera flags of a view of the whole volume (from `render
+--plan`), for the frames to be scored against the reference to be drawn with the same camera.
+
+The ray casters hold at most 2^28 voxels (a dense field of 16 bytes a voxel), so a sparse 1024^3
+field (scripts/family.py's `sparse1024`) has no reference of its own. Where its non-empty voxels lie
+in separate clumps, the reference is exact without the whole grid: each clump is cut out with a
+margin of empty voxels (wider than the trilinear support, so every sample inside reads what the
+whole grid holds there), placed where it lies in patient space (its NRRD space origin), ray cast
+on its own with the same camera, and the clumps' premultiplied frames are composited front to back
+in the order of their bounding spheres' power distances from the eye (a visibility order for
+disjoint spheres). Crops whose boxes meet are merged into one, so no voxel is drawn twice.
+
+RENDER_FLAGS must fix the camera explicitly (--eye, --target, --up, --fov or --ortho, and --size;
+not a --view, which frames each crop on its own voxels) and carry the ray caster's flags
+(--raycast 0.25 --raycast-stop 1e-4 --cpu --supersample K). TF is a preset or a TOML file; a preset
+is written out with the whole volume's value range (a crop's range is its own). Needs numpy, scipy
+and OpenEXR (pip install OpenEXR). Works only on raw uint8 NRRDs with axis-aligned unit directions
+(what scripts/family.py writes); anything else is refused.
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import OpenEXR
+import scipy.ndimage
+
+MARGIN = 3  # empty voxels kept around a clump: the trilinear support and the occupancy's one voxel
+BRICK = 4  # clumps are found on bricks of this side (26-connected), then cut to their voxels
+
+PRESETS = {"ramp": "points = [[0.1, [0, 0, 0, 0]], [1.0, [1, 1, 1, 0.6]]]"}  # src/classify.rs
+
+
+def header(path):
+    with open(path, "rb") as f:
+        raw = f.read(1 << 16)
+    end = raw.find(b"\n\n")
+    if not raw.startswith(b"NRRD") or end < 0:
+        sys.exit(f"{path}: not a NRRD with an attached header")
+    head = raw[:end].decode()
+    fields = dict(
+        (k.strip(), v.strip()) for k, v in (line.split(":", 1) for line in head.splitlines()[1:] if ":" in line)
+    )
+    if fields.get("type") not in ("uint8", "uchar", "unsigned char") or fields.get("encoding") != "raw":
+        sys.exit(f"{path}: only raw uint8 NRRDs are supported")
+    dims = [int(v) for v in fields["sizes"].split()]
+    dirs = re.findall(r"\(([^)]*)\)", fields.get("space directions", ""))
+    vec = [[float(c) for c in d.split(",")] for d in dirs]
+    if len(dims) != 3 or len(vec) != 3 or any(vec[a][b] != (1.0 if a == b else 0.0) for a in range(3) for b in range(3)):
+        sys.exit(f"{path}: only unit, axis-aligned space directions are supported")
+    origin = [float(c) for c in re.findall(r"[-0-9.e+]+", fields.get("space origin", "(0,0,0)"))]
+    return dims, fields.get("space", ""), origin, end + 2
+
+
+def clumps(vol):
+    """Voxel boxes [lo, hi) (x, y, z) of the non-empty clumps, merged until no two boxes meet."""
+    nz, ny, nx = vol.shape
+    b = BRICK
+    occ = np.zeros(((nz + b - 1) // b, (ny + b - 1) // b, (nx + b - 1) // b), bool)
+    for z0 in range(0, nz, b):
+        slab = np.asarray(vol[z0 : z0 + b])
+        pad = np.zeros((b, occ.shape[1] * b, occ.shape[2] * b), np.uint8)
+        pad[: slab.shape[0], :ny, :nx] = slab
+        occ[z0 // b] = pad.reshape(b, occ.shape[1], b, occ.shape[2], b).max(axis=(0, 2, 4)) > 0
+    labels, count = scipy.ndimage.label(occ, structure=np.ones((3, 3, 3)))
+    boxes = []
+    for sl in scipy.ndimage.find_objects(labels):
+        # The clump's bricks, cut to its voxels, then widened by the margin (kept inside the grid).
+        sub = np.asarray(vol[sl[0].start * b : sl[0].stop * b, sl[1].start * b : sl[1].stop * b, sl[2].start * b : sl[2].stop * b])
+        nzs = np.nonzero(sub)
+        lo = [int(nzs[2].min()) + sl[2].start * b, int(nzs[1].min()) + sl[1].start * b, int(nzs[0].min()) + sl[0].start * b]
+        hi = [int(nzs[2].max()) + sl[2].start * b + 1, int(nzs[1].max()) + sl[1].start * b + 1, int(nzs[0].max()) + sl[0].start * b + 1]
+        boxes.append([[max(0, v - MARGIN) for v in lo], [min(n, v + MARGIN) for v, n in zip(hi, (nx, ny, nz))]])
+    merged = True
+    while merged:
+        merged = False
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                a, c = boxes[i], boxes[j]
+                if all(a[0][k] < c[1][k] and c[0][k] < a[1][k] for k in range(3)):
+                    boxes[i] = [[min(a[0][k], c[0][k]) for k in range(3)], [max(a[1][k], c[1][k]) for k in range(3)]]
+                    del boxes[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return boxes
+
+
+def write_crop(path, vol, box, space, origin):
+    (x0, y0, z0), (x1, y1, z1) = box
+    crop = np.ascontiguousarray(vol[z0:z1, y0:y1, x0:x1])
+    o = [origin[0] + x0, origin[1] + y0, origin[2] + z0]
+    with open(path, "wb") as f:
+        f.write(
+            (
+                f"NRRD0004\ntype: uint8\ndimension: 3\nsizes: {x1 - x0} {y1 - y0} {z1 - z0}\n"
+                f"space: {space}\nspace origin: ({o[0]},{o[1]},{o[2]})\n"
+                "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n\n"
+            ).encode()
+        )
+        f.write(crop.tobytes())
+    return int(crop.sum(dtype=np.int64))
+
+
+def read_exr(path):
+    with OpenEXR.File(path) as f:
+        ch = f.channels()
+        if "RGBA" in ch:
+            return np.asarray(ch["RGBA"].pixels, np.float64)
+        return np.stack([np.asarray(ch[c].pixels, np.float64) for c in "RGBA"], axis=-1)
+
+
+def write_exr(path, img):
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    channels = {c: np.ascontiguousarray(img[..., i], np.float32) for i, c in enumerate("RGBA")}
+    with OpenEXR.File(header, channels) as f:
+        f.write(path)
+
+
+def flag(flags, name):
+    """A flag's comma-separated numbers, given as `NAME V` or `NAME=V` (negative values need =)."""
+    for i, f in enumerate(flags):
+        if f == name and i + 1 < len(flags):
+            return [float(v) for v in flags[i + 1].split(",")]
+        if f.startswith(name + "="):
+            return [float(v) for v in f[len(name) + 1 :].split(",")]
+    return None
+
+
+def camera(a, flags, dims, sign, origin):
+    """The view's camera, as `render --plan` prints it in the grid's centred frame, as flags in
+    patient coordinates (RAS: the file's LPS axes with x and y turned)."""
+    plan = subprocess.run([a.vs, "render", "--volume", a.volume, "--tf", a.tf, *flags, "--plan"], check=True,
+                          capture_output=True, text=True)
+    plan = plan.stdout + plan.stderr
+    m = re.search(r"camera \(grid frame\): eye (\S+) target (\S+) up (\S+) fov (\S+)", plan)
+    if not m:
+        sys.exit(f"no perspective camera in the plan:\n{plan}")
+    centre = [origin[k] + (dims[k] - 1) / 2 for k in range(3)]
+    point = lambda v: ",".join(f"{sign[k] * (float(c) + centre[k]):.4f}" for k, c in enumerate(v.split(",")))
+    up = ",".join(f"{sign[k] * float(c):.4f}" for k, c in enumerate(m.group(3).split(",")))
+    size = [f for i, f in enumerate(flags) if f.startswith("--size") or (i > 0 and flags[i - 1] == "--size")]
+    return [f"--eye={point(m.group(1))}", f"--target={point(m.group(2))}", f"--up={up}", "--fov", m.group(4), *size]
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("volume")
+    p.add_argument("out", nargs="?")
+    p.add_argument("--camera", action="store_true", help="print the explicit camera flags of the view and stop")
+    p.add_argument("--tf", required=True)
+    p.add_argument("--vs", default=os.path.join(os.path.dirname(__file__), "..", "target", "release", "voxsplat"))
+    p.add_argument("--work", help="where the crops go (default: a temporary folder)")
+    argv = sys.argv[1:]
+    if "--" not in argv:
+        p.error("give the render flags after --")
+    cut = argv.index("--")
+    a = p.parse_args(argv[:cut])
+    flags = argv[cut + 1 :]
+    dims, space, origin, offset = header(a.volume)
+    sign = [-1.0, -1.0, 1.0] if space.startswith("left-posterior") else [1.0, 1.0, 1.0]
+    if a.camera:
+        print(" ".join(camera(a, flags, dims, sign, origin)))
+        return 0
+    if a.out is None:
+        p.error("give OUT.exr, or --camera")
+    if any(f == "--view" or f.startswith("--view=") for f in flags) or flag(flags, "--eye") is None or flag(flags, "--target") is None:
+        sys.exit("give the camera explicitly (--eye, --target, --up, --fov): a --view frames each crop on its own")
+    vol = np.memmap(a.volume, np.uint8, "r", offset=offset, shape=(dims[2], dims[1], dims[0]))
+    boxes = clumps(vol)
+    work = a.work or tempfile.mkdtemp(prefix="sparse-truth-")
+    os.makedirs(work, exist_ok=True)
+    tf = a.tf
+    if tf in PRESETS:
+        # The preset over the whole volume's value range, not each crop's.
+        lo, hi = 255, 0
+        for z0 in range(0, dims[2], 64):
+            s = np.asarray(vol[z0 : z0 + 64])
+            lo, hi = min(lo, int(s.min())), max(hi, int(s.max()))
+        tf = os.path.join(work, "tf.toml")
+        with open(tf, "w") as f:
+            f.write(f"{PRESETS[a.tf]}\nrange = [{float(lo)}, {float(hi)}]\n")
+    elif not os.path.exists(tf):
+        sys.exit(f"--tf {tf}: a preset this script knows ({', '.join(PRESETS)}) or a TOML file")
+    # Every non-empty voxel lies in exactly one crop.
+    total = sum(int(np.asarray(vol[z0 : z0 + 64]).sum(dtype=np.int64)) for z0 in range(0, dims[2], 64))
+    # The eye in the grid's index space: patient (RAS) coordinates back through the LPS/RAS frame.
+    eye = flag(flags, "--eye")
+    eye_ijk = np.array([eye[k] * sign[k] - origin[k] for k in range(3)])
+    order, summed = [], 0
+    for n, box in enumerate(boxes):
+        path = os.path.join(work, f"crop{n}.nrrd")
+        summed += write_crop(path, vol, box, space, origin)
+        lo, hi = np.array(box[0], float), np.array(box[1], float)
+        c, r = (lo + hi - 1) / 2, np.linalg.norm(hi - lo) / 2
+        order.append((float(np.dot(c - eye_ijk, c - eye_ijk) - r * r), n, path))
+    if summed != total:
+        sys.exit(f"the crops hold {summed} of the volume's value sum {total}: a clump was missed")
+    order.sort()
+    # K x K rays a pixel: each crop cast K times larger with one ray a pixel, composited ray by ray,
+    # then K x K averaged (what --supersample K does inside one cast). Compositing the crops' pixel
+    # means instead would be wrong where two clumps share a pixel: each covers a part of it.
+    k = int(flag(flags, "--supersample")[0]) if flag(flags, "--supersample") else 1
+    size = flag([f.replace("x", ",") for f in flags], "--size")
+    if size is None:
+        sys.exit("give --size WxH")
+    w, h = int(size[0]), int(size[1])
+    fine = [f for f in flags]
+    for name, value in (("--supersample", "1"), ("--size", f"{w * k}x{h * k}")):
+        for i, f in enumerate(fine):
+            if f == name:
+                fine[i + 1] = value
+            elif f.startswith(name + "="):
+                fine[i] = f"{name}={value}"
+    acc = None
+    for _, n, path in order:
+        exr = os.path.join(work, f"crop{n}.exr")
+        subprocess.run([a.vs, "render", "--volume", path, "--tf", tf, *fine, "--out", exr], check=True,
+                       stdout=subprocess.DEVNULL)
+        img = read_exr(exr)
+        if acc is None:
+            acc = img
+        else:
+            acc = acc + (1.0 - acc[..., 3:4]) * img
+    acc = acc.reshape(h, k, w, k, 4).mean(axis=(1, 3))
+    write_exr(a.out, acc)
+    print(f"{len(boxes)} crops composited into {a.out}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
