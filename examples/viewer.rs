@@ -587,7 +587,10 @@ impl Viewer {
 
     fn camera(&self) -> Option<Camera> {
         let sc = self.swapchain.as_ref()?;
-        Some(self.view.camera(self.base.as_ref()?, self.radius, (sc.extent.width, sc.extent.height)))
+        let base = self.base.as_ref()?;
+        // The near plane follows the scene's depth, which a pan or a --target moves off the axis.
+        let centre = self.grid.as_ref().map_or(base.target, |g| g.center());
+        Some(self.view.camera(base, centre, self.radius, (sc.extent.width, sc.extent.height)))
     }
 
     /// One frame: acquire, render_to the swapchain image, (screenshot,) present.
