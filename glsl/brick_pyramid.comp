@@ -33,6 +33,8 @@ shared vec3 col_l[LOD_CELLS];
 shared vec3 grad_l[LOD_CELLS];
 shared float err_l[LOD_CELLS];
 shared float axis_l[3u * LOD_CELLS];
+// Each cell's tau-weighted sum of its voxels' value codes (its value: the sum over tau_l).
+shared float code_l[LOD_CELLS];
 // The optical depth per cell length each cell stores along x (drawn when > 0).
 shared float stored_l[LOD_CELLS];
 // Drawn voxels per level-1 cell.
@@ -42,6 +44,9 @@ shared uint drawn_1[64];
 // brick or one the TF leaves empty, a voxel the store does not hold), 0 where a voxel may draw
 // (read from resident words only, so a streamed store's build needs no neighbour's records).
 shared uint empty_out[6u * 64u];
+// The value range (low | high << 16, its header's) of the brick past each face, whose voxels the
+// outside layer's drawn ones are: resident too.
+shared uint range_out[6];
 // The brick's occupancy mask and the stored voxels below each of its words.
 shared uint mask_w[MASK_WORDS];
 shared uint below_w[MASK_WORDS];
@@ -73,6 +78,14 @@ uint empty_voxel(ivec3 v) {
     return ((masks[h * MASK_STRIDE + l / 32u] >> (l % 32u)) & 1u) == 0u ? 1u : 0u;
 }
 
+// The value range of the brick holding voxel v (outside the grid or an empty brick: none drawn,
+// the layer's voxels all empty; 0).
+uint neighbour_range(ivec3 v) {
+    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(frame.dims.xyz)))) return 0u;
+    uint h = header_of(uvec3(v));
+    return h == 0xffffffffu ? 0u : headers[h].w;
+}
+
 // Level l's cells against their face neighbours (a coarse splat reaches past its cell: where a
 // neighbour differs, the coarse picture blurs an edge the fine one keeps sharp, the halo of
 // coarse cells on silhouettes), measured as a child's (child_error) but against what the coarse
@@ -82,8 +95,12 @@ uint empty_voxel(ivec3 v) {
 // its step. A neighbour inside the brick whose opposite one is outside is left to the
 // neighbour's own comparisons and the level below's (no slope is known there). A neighbour
 // outside the brick is the voxel layer past that face: its empty voxels draw nothing, the others
-// are taken to be the prediction (their values are not resident in a streamed store: edges
-// between two materials at brick faces are not seen). Mirror: cpu::brick_pyramid::edge_errors.
+// are taken to be the prediction, unless the predicted value (the cell's, carried on likewise)
+// lies outside the value range of the brick they are in (its header's, resident where its voxels
+// are not): then they are at least as far as that range's nearest end, classified (an edge between
+// two materials at a brick face; not with gradient-weighted opacity, which the range does not
+// bound). Mirror:
+// cpu::brick_pyramid::edge_errors.
 void edge_errors(uint l, uint lane) {
     uint n = BRICK_SIDE >> l;
     uint side = 1u << l;
@@ -104,12 +121,16 @@ void edge_errors(uint l, uint lane) {
             // The prediction on this side: linear from the opposite neighbour, or the cell's own.
             float pt = t;
             vec3 pc = col_l[i];
+            // The cell's value (its voxels' codes, tau-weighted), carried on likewise.
+            float q = t > 0.0 ? code_l[i] / t : 0.0;
+            float pq = q;
             if (opposite) {
                 uvec3 oc = cc;
                 oc[ax] = high ? cc[ax] - 1u : cc[ax] + 1u;
                 uint o = cell_at(l, oc);
                 pt = max(2.0 * t - tau_l[o], 0.0);
                 pc = max(2.0 * col_l[i] - col_l[o], vec3(0.0));
+                if (tau_l[o] > 0.0) pq = 2.0 * q - code_l[o] / tau_l[o];
             }
             float a = 1.0 - exp(-pt / voxels * len);
             vec3 straight = pt > 0.0 ? pc / pt : vec3(0.0);
@@ -128,6 +149,16 @@ void edge_errors(uint l, uint lane) {
                 }
                 float kept = 1.0 - float(empty) / float(side * side);
                 err = max(err, child_error(a, straight, pt * kept, pc * kept, 0.0, voxels, len));
+                // The predicted value against the range of the brick past the face, with half a
+                // code's margin so that rounding never decides it (a ramp carries on into it).
+                uint r = range_out[f];
+                float lo = float(r & 0xffffu);
+                float hi = float(r >> 16u);
+                if (kept > 0.0 && t > 0.0 && bf.tf.w <= 0.0 && (pq < lo - 0.5 || pq > hi + 0.5)) {
+                    vec4 cl = tf_color[pq < lo ? r & 0xffffu : r >> 16u];
+                    float to = optical_depth(cl.a) * voxels * kept;
+                    err = max(err, child_error(a, straight, to, cl.rgb * to, 0.0, voxels, len));
+                }
             }
         }
         err_l[i] = err;
@@ -202,6 +233,8 @@ void main() {
         v[(ax + 1u) % 3u] += int(i % 8u);
         v[(ax + 2u) % 3u] += int((i / 8u) % 8u);
         empty_out[i] = empty_voxel(v);
+        // The brick past face f holds its whole outside layer.
+        if (i % 64u == 0u) range_out[f] = neighbour_range(v);
     }
     barrier();
     if (lane == 0u) {
@@ -223,6 +256,7 @@ void main() {
         vec3 col = vec3(0.0);
         vec3 g = vec3(0.0);
         uint drawn = 0u;
+        float code = 0.0;
         for (uint d = 0u; d < 8u; ++d) {
             uvec3 k = 2u * cc + (uvec3(d, d >> 1u, d >> 2u) & 1u);
             uint l = k.x + BRICK_SIDE * (k.y + BRICK_SIDE * k.z);
@@ -237,6 +271,7 @@ void main() {
                     vec4 cl = classify_voxel(v, q, false);
                     tk[d] = optical_depth(cl.a);
                     ck[d] = cl.rgb * tk[d];
+                    code += tk[d] * float(q);
 #ifdef GRADIENTS
                     // Each voxel's differences, made once (BrickStore::gradient_words): half the
                     // shaded pyramid's time read its neighbours through the store.
@@ -257,6 +292,7 @@ void main() {
         for (uint d = 0u; d < 8u; ++d) err = max(err, child_error(a, straight, tk[d], ck[d], 0.0, 1.0, float(BRICK_SIDE)));
         vec3 axes = vec3(axis_opacity(ak, 0u), axis_opacity(ak, 1u), axis_opacity(ak, 2u));
         put_cell(slot, h, c, t, col, g, err, axes);
+        code_l[c] = code;
         drawn_1[c] = drawn;
     }
     barrier();
@@ -271,10 +307,12 @@ void main() {
             float t = 0.0;
             vec3 col = vec3(0.0);
             vec3 g = vec3(0.0);
+            float code = 0.0;
             for (uint d = 0u; d < 8u; ++d) {
                 uint k = child(l, cc, n, d);
                 t += tau_l[k];
                 col += col_l[k];
+                code += code_l[k];
                 g += aligned(grad_l[k], g);
             }
             float len = float(BRICK_SIDE);
@@ -292,6 +330,7 @@ void main() {
                 axes[x] = axis_opacity(ak, x);
             }
             put_cell(slot, h, level_offset(l) + c, t, col, g, err, axes);
+            code_l[level_offset(l) + c] = code;
         }
         barrier();
         edge_errors(l, lane);

@@ -608,7 +608,7 @@ float cull_reach(float depth, float cell) {
 
 // A coarse cell's error as the picture sees it, the cell projecting to `size` pixels: its
 // departure from its children is detail at half its size, which the pixel's filter averages away
-// as the cell shrinks below a pixel (weighted by the square of its size there).
+// as the cell shrinks below a pixel (times its size there, up to 1).
 float seen_error(float err, float size) {
     float s = min(size, 1.0);
     return err * s;

@@ -172,9 +172,14 @@ impl BrickInputs<'_> {
         }
     }
 
+    /// Mirror of `tf_color[q]`: the transfer function's straight colour and opacity at code `q`.
+    pub(crate) fn tf_color(&self, q: u32) -> [f32; 4] {
+        [0, 1, 2, 3].map(|i| f32::from_bits(self.tf[4 * q as usize + i]))
+    }
+
     /// Mirror of `classify_voxel`.
     pub(crate) fn classify_voxel(&self, v: [i64; 3], q: u32, shaded: bool) -> [f32; 4] {
-        let mut c = [0, 1, 2, 3].map(|i| f32::from_bits(self.tf[4 * q as usize + i]));
+        let mut c = self.tf_color(q);
         let weighted = self.bf.tf[3] > 0.0;
         if weighted || shaded {
             let g = match self.gradients {

@@ -11,7 +11,8 @@ use crate::plan::{CELL_WORDS, LOD_CELLS, LOD_LEVELS, SLOT_CELLS};
 use glam::Vec3;
 
 /// Per-level sums of a brick's cells: optical depth, tau-weighted colour and gradient
-/// (sign-aligned), error, and its opacity along x, y and z (a voxel's: its opacity).
+/// (sign-aligned), error, its opacity along x, y and z (a voxel's: its opacity), and its
+/// tau-weighted sum of value codes.
 #[derive(Clone, Copy, Default)]
 struct Sums {
     tau: f32,
@@ -19,6 +20,7 @@ struct Sums {
     grad: Vec3,
     err: f32,
     axes: [f32; 3],
+    code: f32,
 }
 
 /// Mirror of `brick_pyramid.comp`: the non-empty bricks' pyramid cells and summaries of the
@@ -64,9 +66,11 @@ pub fn brick_pyramid(
             let t = optical_depth(c[3]);
             let grad = if shaded { inputs.voxel_gradient(v, h as u32, rank as u32) * t } else { Vec3::ZERO };
             let a = 1.0 - (-t).exp();
-            fine[l as usize] = Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0, axes: [a; 3] };
+            let code = t * (rec >> 16) as f32;
+            fine[l as usize] =
+                Sums { tau: t, col: Vec3::new(c[0], c[1], c[2]) * t, grad, err: 0.0, axes: [a; 3], code };
         }
-        let empty_out = outside_layer(inputs, b);
+        let (empty_out, range_out) = outside_layer(inputs, b);
         let mut cells = [Sums::default(); LOD_CELLS];
         let mut stored = [0f32; LOD_CELLS];
         for l in 1..=LOD_LEVELS {
@@ -85,9 +89,9 @@ pub fn brick_pyramid(
                         cells[level_offset(l - 1) as usize + i]
                     }
                 });
-                let (mut t, mut col, mut g) = (0.0f32, Vec3::ZERO, Vec3::ZERO);
+                let (mut t, mut col, mut g, mut code) = (0.0f32, Vec3::ZERO, Vec3::ZERO, 0.0f32);
                 for k in &children {
-                    (t, col, g) = (t + k.tau, col + k.col, g + aligned(k.grad, g));
+                    (t, col, g, code) = (t + k.tau, col + k.col, g + aligned(k.grad, g), code + k.code);
                 }
                 let len = BRICK as f32;
                 let a = 1.0 - (-t / voxels * len).exp();
@@ -98,7 +102,7 @@ pub fn brick_pyramid(
                 }
                 let axes = [0, 1, 2].map(|x| axis_opacity(children.map(|k| k.axes[x]), x));
                 let i = level_offset(l) as usize + c as usize;
-                cells[i] = Sums { tau: t, col, grad: g, err, axes };
+                cells[i] = Sums { tau: t, col, grad: g, err, axes, code };
                 // Mirror of `put_cell`.
                 let codes = axes.map(|a| tau_code(-(1.0 - a.min(0.999_999_9)).ln()));
                 stored[i] = tau_decode(codes[0]);
@@ -118,7 +122,7 @@ pub fn brick_pyramid(
                     summary[h * SUMMARY_WORDS + SUMMARY_WORDS - 1] = t.to_bits();
                 }
             }
-            edge_errors(&mut cells, &empty_out, l);
+            edge_errors(inputs, &mut cells, &empty_out, &range_out, l);
         }
         let mut s = [fine.iter().filter(|f| f.tau > 0.0).count() as u32 * (1 << 16), 0, 0, 0];
         for l in 1..=LOD_LEVELS {
@@ -136,34 +140,54 @@ pub fn brick_pyramid(
     }
 }
 
-/// Mirror of the outside layer `brick_pyramid.comp` fills (`empty_out`): per face (2 axis + high
-/// side) of brick `b`, 8 x 8 voxels just past it, true where nothing is drawn there.
-fn outside_layer(inputs: &BrickInputs<'_>, b: [u32; 3]) -> [bool; 6 * 64] {
+/// Mirror of the outside layer `brick_pyramid.comp` fills (`empty_out`, `range_out`): per face (2
+/// axis + high side) of brick `b`, 8 x 8 voxels just past it, true where nothing is drawn there;
+/// and the value range of the brick past each face (`neighbour_range`; 0 for none).
+fn outside_layer(inputs: &BrickInputs<'_>, b: [u32; 3]) -> ([bool; 6 * 64], [u32; 6]) {
     let store = inputs.store;
-    std::array::from_fn(|i| {
+    let voxel = |i: usize| {
         let f = i / 64;
         let ax = f / 2;
         let mut v = b.map(|c| (c * BRICK) as i64);
         v[ax] += if f & 1 != 0 { BRICK as i64 } else { -1 };
         v[(ax + 1) % 3] += (i % 8) as i64;
         v[(ax + 2) % 3] += (i / 8 % 8) as i64;
-        // Mirror of `empty_voxel`.
-        if (0..3).any(|a| v[a] < 0 || v[a] >= store.dims[a] as i64) {
-            return true;
-        }
-        // An empty brick, or one the TF leaves empty, or a voxel not stored (the mask).
-        let Some((h, _)) = store.stored(v.map(|x| x as u32)) else { return true };
+        let inside = (0..3).all(|a| v[a] >= 0 && v[a] < store.dims[a] as i64);
+        inside.then(|| v.map(|x| x as u32))
+    };
+    let empty = std::array::from_fn(|i| {
+        // Mirror of `empty_voxel`: outside the grid, an empty brick, or one the TF leaves empty,
+        // or a voxel not stored (the mask).
+        let Some(v) = voxel(i) else { return true };
+        let Some((h, _)) = store.stored(v) else { return true };
         let range = store.headers[h as usize].range;
         inputs.tf_empty(range & 0xffff, range >> 16)
-    })
+    });
+    let ranges = std::array::from_fn(|f| {
+        let Some(v) = voxel(f * 64) else { return 0 };
+        let h = store.header_of(v);
+        if h == u32::MAX {
+            0
+        } else {
+            store.headers[h as usize].range
+        }
+    });
+    (empty, ranges)
 }
 
 /// Mirror of `edge_errors`: level `l`'s cells' errors raised to their face neighbours' departure
 /// from what the coarse level predicts there (the cell carried on linearly from the opposite
 /// neighbour, or the cell's own where that one is outside the brick; a neighbour inside whose
 /// opposite is outside is skipped; past the faces, the outside layer's drawn fraction of the
-/// prediction).
-fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32) {
+/// prediction, and where the predicted value lies outside the value range of the brick past the
+/// face, that range's nearest end, classified).
+fn edge_errors(
+    inputs: &BrickInputs<'_>,
+    cells: &mut [Sums; LOD_CELLS],
+    empty_out: &[bool; 6 * 64],
+    range_out: &[u32; 6],
+    l: u32,
+) {
     let n = BRICK >> l;
     let side = 1u32 << l;
     let voxels = (1u32 << (3 * l)) as f32;
@@ -183,12 +207,18 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
                     continue;
                 }
                 let (mut pt, mut pc) = (me.tau, me.col);
+                // The cell's value (its voxels' codes, tau-weighted), carried on likewise.
+                let q = if me.tau > 0.0 { me.code / me.tau } else { 0.0 };
+                let mut pq = q;
                 if opposite {
                     let mut oc = cc;
                     oc[ax] = if high { cc[ax] - 1 } else { cc[ax] + 1 };
                     let o = cells[at(oc)];
                     pt = (2.0 * me.tau - o.tau).max(0.0);
                     pc = (2.0 * me.col - o.col).max(Vec3::ZERO);
+                    if o.tau > 0.0 {
+                        pq = 2.0 * q - o.code / o.tau;
+                    }
                 }
                 let a = 1.0 - (-pt / voxels * len).exp();
                 let straight = if pt > 0.0 { pc / pt } else { Vec3::ZERO };
@@ -207,6 +237,16 @@ fn edge_errors(cells: &mut [Sums; LOD_CELLS], empty_out: &[bool; 6 * 64], l: u32
                     }
                     let kept = 1.0 - empty as f32 / (side * side) as f32;
                     err = err.max(child_error(a, straight, pt * kept, pc * kept, 0.0, voxels, len));
+                    // The predicted value against the range of the brick past the face.
+                    let r = range_out[f];
+                    let (lo, hi) = ((r & 0xffff) as f32, (r >> 16) as f32);
+                    let weighted = inputs.bf.tf[3] > 0.0;
+                    if kept > 0.0 && me.tau > 0.0 && !weighted && (pq < lo - 0.5 || pq > hi + 0.5) {
+                        let c = inputs.tf_color(if pq < lo { r & 0xffff } else { r >> 16 });
+                        let to = optical_depth(c[3]) * voxels * kept;
+                        let col = Vec3::new(c[0], c[1], c[2]) * to;
+                        err = err.max(child_error(a, straight, to, col, 0.0, voxels, len));
+                    }
                 }
             }
             err
