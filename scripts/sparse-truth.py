@@ -20,8 +20,8 @@ RENDER_FLAGS must fix the camera explicitly (--eye, --target, --up, --fov or --o
 not a --view, which frames each crop on its own voxels) and carry the ray caster's flags
 (--raycast 0.25 --raycast-stop 1e-4 --cpu --supersample K). TF is a preset or a TOML file; a preset
 is written out with the whole volume's value range (a crop's range is its own). Needs numpy, scipy
-and OpenEXR (pip install OpenEXR). Works only on raw uint8 NRRDs with axis-aligned unit directions
-(what scripts/family.py writes); anything else is refused.
+and OpenEXR (pip install OpenEXR). Works only on raw uint8 NRRDs with axis-aligned unit directions,
+in LPS or RAS patient space (what scripts/family.py writes); anything else is refused.
 """
 import argparse
 import os
@@ -57,8 +57,15 @@ def header(path):
     vec = [[float(c) for c in d.split(",")] for d in dirs]
     if len(dims) != 3 or len(vec) != 3 or any(vec[a][b] != (1.0 if a == b else 0.0) for a in range(3) for b in range(3)):
         sys.exit(f"{path}: only unit, axis-aligned space directions are supported")
+    space = fields.get("space", "")
+    if space not in ("left-posterior-superior", "right-anterior-superior"):
+        # The crops are placed by their space origin, and --eye is in patient coordinates only for
+        # a file placed in patient space.
+        sys.exit(f"{path}: only NRRDs in LPS or RAS patient space (a space field) are supported")
     origin = [float(c) for c in re.findall(r"[-0-9.e+]+", fields.get("space origin", "(0,0,0)"))]
-    return dims, fields.get("space", ""), origin, end + 2
+    if len(origin) != 3:
+        sys.exit(f"{path}: a space origin of three numbers is needed")
+    return dims, space, origin, end + 2
 
 
 def clumps(vol):

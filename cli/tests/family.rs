@@ -275,7 +275,7 @@ fn degenerate_volumes_draw_right_frames_with_the_defaults() {
 /// casters hold at most 2^28 voxels). On a field the ray caster takes whole, the clumps' composite
 /// must be the whole cast: balls that share pixels seen from the side (their sub-pixel parts
 /// composited ray by ray, not as pixel means), one cut by the grid's face, at thumbnail and frame
-/// sizes. Checked to fail with the pixel means composited (about 48 dB on such a field).
+/// sizes. Checked to fail with the pixel means composited (54 dB on this field).
 #[test]
 fn the_reference_cast_clump_by_clump_is_the_whole_cast() {
     let dir = tmp_in("family-sparse-truth", "");
