@@ -111,6 +111,8 @@ void edge_errors(uint l, uint lane) {
         uint i = level_offset(l) + c;
         float t = tau_l[i];
         float err = err_l[i];
+        // The cell's value (its voxels' codes, tau-weighted).
+        float q = t > 0.0 ? code_l[i] / t : 0.0;
         for (uint f = 0u; f < 6u; ++f) {
             uint ax = f / 2u;
             bool high = (f & 1u) != 0u;
@@ -121,8 +123,7 @@ void edge_errors(uint l, uint lane) {
             // The prediction on this side: linear from the opposite neighbour, or the cell's own.
             float pt = t;
             vec3 pc = col_l[i];
-            // The cell's value (its voxels' codes, tau-weighted), carried on likewise.
-            float q = t > 0.0 ? code_l[i] / t : 0.0;
+            // The cell's value, carried on likewise.
             float pq = q;
             if (opposite) {
                 uvec3 oc = cc;

@@ -187,20 +187,19 @@ def main():
     boxes = clumps(vol)
     work = a.work or tempfile.mkdtemp(prefix="sparse-truth-")
     os.makedirs(work, exist_ok=True)
+    # One pass over the volume: its value range (a preset's, not each crop's) and its value sum.
+    lo, hi, total = 255, 0, 0
+    for z0 in range(0, dims[2], 64):
+        s = np.asarray(vol[z0 : z0 + 64])
+        lo, hi, total = min(lo, int(s.min())), max(hi, int(s.max())), total + int(s.sum(dtype=np.int64))
     tf = a.tf
     if tf in PRESETS:
-        # The preset over the whole volume's value range, not each crop's.
-        lo, hi = 255, 0
-        for z0 in range(0, dims[2], 64):
-            s = np.asarray(vol[z0 : z0 + 64])
-            lo, hi = min(lo, int(s.min())), max(hi, int(s.max()))
         tf = os.path.join(work, "tf.toml")
         with open(tf, "w") as f:
             f.write(f"{PRESETS[a.tf]}\nrange = [{float(lo)}, {float(hi)}]\n")
     elif not os.path.exists(tf):
         sys.exit(f"--tf {tf}: a preset this script knows ({', '.join(PRESETS)}) or a TOML file")
-    # Every non-empty voxel lies in exactly one crop.
-    total = sum(int(np.asarray(vol[z0 : z0 + 64]).sum(dtype=np.int64)) for z0 in range(0, dims[2], 64))
+    # Every non-empty voxel lies in exactly one crop (the sums agree below).
     # The eye in the grid's index space: patient (RAS) coordinates back through the LPS/RAS frame.
     eye = flag(flags, "--eye")
     eye_ijk = np.array([eye[k] * sign[k] - origin[k] for k in range(3)])
@@ -222,7 +221,7 @@ def main():
     if size is None:
         sys.exit("give --size WxH")
     w, h = int(size[0]), int(size[1])
-    fine = [f for f in flags]
+    fine = list(flags)
     for name, value in (("--supersample", "1"), ("--size", f"{w * k}x{h * k}")):
         for i, f in enumerate(fine):
             if f == name:

@@ -193,11 +193,15 @@ fn edge_errors(
     let voxels = (1u32 << (3 * l)) as f32;
     let len = BRICK as f32;
     let at = |c: [u32; 3]| level_offset(l) as usize + (c[0] + n * (c[1] + n * c[2])) as usize;
+    // Gradient-weighted opacity: the neighbour's value range does not bound it.
+    let weighted = inputs.bf.tf[3] > 0.0;
     let errs: Vec<f32> = (0..n * n * n)
         .map(|c| {
             let cc = [c % n, (c / n) % n, c / (n * n)];
             let me = cells[at(cc)];
             let mut err = me.err;
+            // The cell's value (its voxels' codes, tau-weighted).
+            let q = if me.tau > 0.0 { me.code / me.tau } else { 0.0 };
             for f in 0..6 {
                 let (ax, high) = (f / 2, f & 1 != 0);
                 let inside = if high { cc[ax] + 1 < n } else { cc[ax] > 0 };
@@ -207,8 +211,7 @@ fn edge_errors(
                     continue;
                 }
                 let (mut pt, mut pc) = (me.tau, me.col);
-                // The cell's value (its voxels' codes, tau-weighted), carried on likewise.
-                let q = if me.tau > 0.0 { me.code / me.tau } else { 0.0 };
+                // The cell's value, carried on likewise.
                 let mut pq = q;
                 if opposite {
                     let mut oc = cc;
@@ -240,7 +243,6 @@ fn edge_errors(
                     // The predicted value against the range of the brick past the face.
                     let r = range_out[f];
                     let (lo, hi) = ((r & 0xffff) as f32, (r >> 16) as f32);
-                    let weighted = inputs.bf.tf[3] > 0.0;
                     if kept > 0.0 && me.tau > 0.0 && !weighted && (pq < lo - 0.5 || pq > hi + 0.5) {
                         let c = inputs.tf_color(if pq < lo { r & 0xffff } else { r >> 16 });
                         let to = optical_depth(c[3]) * voxels * kept;
