@@ -88,7 +88,10 @@ void main() {
         uint bs = rc.image.z;
         ivec3 nb = (dims + int(bs) - 1) / max(int(bs), 1);
         for (uint s = 0u; s < n; ++s) {
-            vec3 x = a + dir * (t0 + (float(s) + 0.5) * step);
+            // The last sample covers only what is left of the ray (a clip plane or a crop's face
+            // cuts it there; a cast of tiles would count the rest twice).
+            float seg_t = clamp(t1 - t0 - float(s) * step, 0.0, step);
+            vec3 x = a + dir * (t0 + float(s) * step + 0.5 * seg_t);
             vec3 u = to_index(x - rc.origin.xyz);
             if (bs > 0u) {
                 ivec3 b = clamp(ivec3(floor(u / float(bs))), ivec3(0), nb - 1);
@@ -101,7 +104,7 @@ void main() {
             // The isosurface (value rc.inv_shear.w): the first sample at or above it, the crossing
             // refined linearly from the sample before, shaded by its cell's trilinear gradient.
             if (mode == PROJECT_ISO) {
-                float t = t0 + (float(s) + 0.5) * step;
+                float t = t0 + float(s) * step + 0.5 * seg_t;
                 if (v.r < rc.inv_shear.w || hit < 0.0) {
                     // A ray that starts inside (an iso value at or below the outside's 0) meets
                     // no crossing.
@@ -130,7 +133,7 @@ void main() {
                 break;
             }
             if (v.a <= 0.0) continue;
-            float seg = rc.origin.w * step;  // the step in voxel lengths
+            float seg = rc.origin.w * seg_t;  // the step in voxel lengths
             if (mode == PROJECT_MIP) {
                 acc = max(acc, v.rg);
             } else if (mode == PROJECT_MINIP) {
@@ -141,7 +144,7 @@ void main() {
                 acc.x += v.a * seg;
             }
             if (mode != PROJECT_NONE) continue;
-            float alpha = 1.0 - exp(-v.a * rc.origin.w * step);
+            float alpha = 1.0 - exp(-v.a * seg);
             col += trans * alpha * (v.rgb / v.a);
             trans *= 1.0 - alpha;
             if (trans < rc.box_max.w) break;

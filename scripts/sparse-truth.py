@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The supersampled ray-cast reference of a sparse volume too large for the ray casters, by crops.
+"""The supersampled ray-cast reference of a volume too large for the ray casters, by crops.
 
     python3 scripts/sparse-truth.py VOLUME.nrrd OUT.exr --tf TF [--vs BIN] -- RENDER_FLAGS...
     python3 scripts/sparse-truth.py VOLUME.nrrd --camera --tf TF -- --size WxH --view NAME
@@ -15,6 +15,15 @@ whole grid holds there), placed where it lies in patient space (its NRRD space o
 on its own with the same camera, and the clumps' premultiplied frames are composited front to back
 in the order of their bounding spheres' power distances from the eye (a visibility order for
 disjoint spheres). Crops whose boxes meet are merged into one, so no voxel is drawn twice.
+
+A clump of more than --tile voxels (default 2^27; the procedural 1024^3 field is one clump) is cut
+into tiles, each cut out with two voxels more past its inner faces (the trilinear support) and cast
+with --clip planes at those faces, so its rays sample only its own cells. The tiles are composited
+in a visibility order of the grid of tiles (per axis, tiles nearer the eye's slab first, axis after
+axis: a ray from the eye moves away from it on every axis). On the 256^3 procedural field cut into
+8 and in 64 tiles the composite lies 84-88 dB from the whole cast (128^2, three views). The ray
+caster cuts a ray's last sample to what is left of it before the plane (it counted up to a step
+past it, twice over in two tiles: 67-76 dB before).
 
 RENDER_FLAGS must fix the camera explicitly (--eye, --target, --up, --fov or --ortho, and --size;
 not a --view, which frames each crop on its own voxels) and carry the ray caster's flags
@@ -35,6 +44,7 @@ import OpenEXR
 import scipy.ndimage
 
 MARGIN = 3  # empty voxels kept around a clump: the trilinear support and the occupancy's one voxel
+TILE = 1 << 27  # voxels a crop may hold (the ray caster's dense field takes 16 bytes each, up to 2^28)
 BRICK = 4  # clumps are found on bricks of this side (26-connected), then cut to their voxels
 
 PRESETS = {"ramp": "points = [[0.1, [0, 0, 0, 0]], [1.0, [1, 1, 1, 0.6]]]"}  # src/classify.rs
@@ -61,7 +71,9 @@ def header(path):
     if space not in ("left-posterior-superior", "right-anterior-superior"):
         # The crops are placed by their space origin, and --eye is in patient coordinates only for
         # a file placed in patient space.
-        sys.exit(f"{path}: only NRRDs in LPS or RAS patient space (a space field) are supported")
+        sys.exit(f"{path}: only NRRDs in LPS or RAS patient space (a space field) are supported; for a file "
+                 "without one, draw and score a copy whose header adds `space: left-posterior-superior`, "
+                 "`space origin: (0,0,0)` and unit `space directions`")
     origin = [float(c) for c in re.findall(r"[-0-9.e+]+", fields.get("space origin", "(0,0,0)"))]
     if len(origin) != 3:
         sys.exit(f"{path}: a space origin of three numbers is needed")
@@ -83,9 +95,12 @@ def clumps(vol):
     for sl in scipy.ndimage.find_objects(labels):
         # The clump's bricks, cut to its voxels, then widened by the margin (kept inside the grid).
         sub = np.asarray(vol[sl[0].start * b : sl[0].stop * b, sl[1].start * b : sl[1].stop * b, sl[2].start * b : sl[2].stop * b])
-        nzs = np.nonzero(sub)
-        lo = [int(nzs[2].min()) + sl[2].start * b, int(nzs[1].min()) + sl[1].start * b, int(nzs[0].min()) + sl[0].start * b]
-        hi = [int(nzs[2].max()) + sl[2].start * b + 1, int(nzs[1].max()) + sl[1].start * b + 1, int(nzs[0].max()) + sl[0].start * b + 1]
+        # Its voxels' bounds from each axis's projection (not np.nonzero: a dense clump holds 10^8).
+        lo, hi = [], []
+        for ax, keep in ((2, (0, 1)), (1, (0, 2)), (0, (1, 2))):
+            hit = np.flatnonzero(sub.any(axis=keep))
+            lo.append(int(hit[0]) + sl[ax].start * b)
+            hi.append(int(hit[-1]) + sl[ax].start * b + 1)
         boxes.append([[max(0, v - MARGIN) for v in lo], [min(n, v + MARGIN) for v, n in zip(hi, (nx, ny, nz))]])
     merged = True
     while merged:
@@ -101,6 +116,29 @@ def clumps(vol):
             if merged:
                 break
     return boxes
+
+
+def tiles(box, eye, most):
+    """A clump's box cut into tiles of at most `most` voxels (halving its longest side), each as its
+    own cells [lo, hi) and a sort key that orders them front to back from `eye` (index space): per
+    axis, how many tiles lie between a tile and the eye's slab, compared axis after axis. A ray
+    from the eye moves away from it on every axis, so it meets tiles in that order (PBTF, chapter 2)."""
+    lo, hi = list(box[0]), list(box[1])
+    cuts = [1, 1, 1]
+    while np.prod([(hi[k] - lo[k] + cuts[k] - 1) // cuts[k] + 4 for k in range(3)]) > most:
+        k = max(range(3), key=lambda a: (hi[a] - lo[a]) / cuts[a])
+        cuts[k] *= 2
+    edges = [[lo[k] + (hi[k] - lo[k]) * i // cuts[k] for i in range(cuts[k] + 1)] for k in range(3)]
+    # The tile whose cells (index i covers [i - 0.5, i + 0.5)) hold the eye's coordinate, or the end one nearest it.
+    at = [min(max(int(np.searchsorted(edges[k], eye[k] + 0.5, side="right")) - 1, 0), cuts[k] - 1) for k in range(3)]
+    out = []
+    for i in range(cuts[0]):
+        for j in range(cuts[1]):
+            for m in range(cuts[2]):
+                idx = (i, j, m)
+                own = [[edges[k][idx[k]] for k in range(3)], [edges[k][idx[k] + 1] for k in range(3)]]
+                out.append((own, tuple(abs(idx[k] - at[k]) for k in range(3))))
+    return out
 
 
 def write_crop(path, vol, box, space, origin):
@@ -168,6 +206,7 @@ def main():
     p.add_argument("--tf", required=True)
     p.add_argument("--vs", default=os.path.join(os.path.dirname(__file__), "..", "target", "release", "voxsplat"))
     p.add_argument("--work", help="where the crops go (default: a temporary folder)")
+    p.add_argument("--tile", type=int, default=TILE, help=f"most voxels a crop holds; larger clumps are cut into tiles (default {TILE})")
     argv = sys.argv[1:]
     if "--" not in argv:
         p.error("give the render flags after --")
@@ -199,17 +238,34 @@ def main():
             f.write(f"{PRESETS[a.tf]}\nrange = [{float(lo)}, {float(hi)}]\n")
     elif not os.path.exists(tf):
         sys.exit(f"--tf {tf}: a preset this script knows ({', '.join(PRESETS)}) or a TOML file")
-    # Every non-empty voxel lies in exactly one crop (the sums agree below).
     # The eye in the grid's index space: patient (RAS) coordinates back through the LPS/RAS frame.
     eye = flag(flags, "--eye")
     eye_ijk = np.array([eye[k] * sign[k] - origin[k] for k in range(3)])
     order, summed = [], 0
     for n, box in enumerate(boxes):
-        path = os.path.join(work, f"crop{n}.nrrd")
-        summed += write_crop(path, vol, box, space, origin)
         lo, hi = np.array(box[0], float), np.array(box[1], float)
         c, r = (lo + hi - 1) / 2, np.linalg.norm(hi - lo) / 2
-        order.append((float(np.dot(c - eye_ijk, c - eye_ijk) - r * r), n, path))
+        crops = []
+        for t, (own, key) in enumerate(tiles(box, eye_ijk, a.tile)):
+            path = os.path.join(work, f"crop{n}-{t}.nrrd")
+            # The tile's voxels and two more past each inner face (the trilinear support of the
+            # samples up to that face), its rays clipped to its own half-open cells there.
+            cut = [[max(box[0][k], own[0][k] - 2) for k in range(3)], [min(box[1][k], own[1][k] + 2) for k in range(3)]]
+            write_crop(path, vol, cut, space, origin)
+            summed += int(np.asarray(vol[own[0][2] : own[1][2], own[0][1] : own[1][1], own[0][0] : own[1][0]]).sum(dtype=np.int64))
+            # --clip takes the crop's grid frame: index less the crop's first voxel and its centre.
+            centre = [cut[0][k] + (cut[1][k] - cut[0][k] - 1) / 2 for k in range(3)]
+            clips = []
+            for k in range(3):
+                unit = lambda v: ",".join(str(v if j == k else 0.0) for j in range(3))
+                if own[0][k] > box[0][k]:  # keep index >= lo - 0.5
+                    clips.append(f"--clip={unit(1.0)},{centre[k] - (own[0][k] - 0.5)}")
+                if own[1][k] < box[1][k]:  # keep index <= hi - 0.5
+                    clips.append(f"--clip={unit(-1.0)},{own[1][k] - 0.5 - centre[k]}")
+            crops.append((key, path, clips))
+        crops.sort()
+        order.append((float(np.dot(c - eye_ijk, c - eye_ijk) - r * r), n, crops))
+    # Every non-empty voxel lies in exactly one crop's own cells (the sums agree).
     if summed != total:
         sys.exit(f"the crops hold {summed} of the volume's value sum {total}: a clump was missed")
     order.sort()
@@ -229,15 +285,13 @@ def main():
             elif f.startswith(name + "="):
                 fine[i] = f"{name}={value}"
     acc = None
-    for _, n, path in order:
-        exr = os.path.join(work, f"crop{n}.exr")
-        subprocess.run([a.vs, "render", "--volume", path, "--tf", tf, *fine, "--out", exr], check=True,
-                       stdout=subprocess.DEVNULL)
-        img = read_exr(exr)
-        if acc is None:
-            acc = img
-        else:
-            acc = acc + (1.0 - acc[..., 3:4]) * img
+    for _, n, crops in order:
+        for _, path, clips in crops:
+            exr = path[:-5] + ".exr"
+            subprocess.run([a.vs, "render", "--volume", path, "--tf", tf, *fine, *clips, "--out", exr], check=True,
+                           stdout=subprocess.DEVNULL)
+            img = read_exr(exr)
+            acc = img if acc is None else acc + (1.0 - acc[..., 3:4]) * img
     acc = acc.reshape(h, k, w, k, 4).mean(axis=(1, 3))
     write_exr(a.out, acc)
     print(f"{len(boxes)} crops composited into {a.out}", file=sys.stderr)

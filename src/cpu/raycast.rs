@@ -153,7 +153,10 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                 let nb = [0, 1, 2].map(|ax| (rc.dims[ax] as i32 + bs as i32 - 1) / (bs as i32).max(1));
                 let mut s = 0u32;
                 while s < n {
-                    let u = to_index(rc, a + dir * (t0 + (s as f32 + offset) * step) - origin);
+                    // The last sample covers only what is left of the ray (a clip plane or a
+                    // crop's face cuts it there; a cast of tiles would count the rest twice).
+                    let seg = if jitter.is_none() { step.min(t1 - t0 - s as f32 * step).max(0.0) } else { step };
+                    let u = to_index(rc, a + dir * (t0 + s as f32 * step + offset * seg) - origin);
                     if bs > 0 {
                         let b = [0, 1, 2].map(|ax| ((u[ax] / bs as f32).floor() as i32).clamp(0, nb[ax] - 1));
                         if bricks[((b[2] * nb[1] + b[1]) * nb[0] + b[0]) as usize] == 0 {
@@ -165,7 +168,7 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                     let v = trilinear(field, u);
                     if mode == crate::options::Mode::Iso.code() {
                         let iso = rc.inv_shear[3];
-                        let t = t0 + ((s - 1) as f32 + offset) * step;
+                        let t = t0 + (s - 1) as f32 * step + offset * seg;
                         if v[0] < iso || hit < 0.0 {
                             hit = if v[0] < iso { 0.0 } else { -1.0 };
                             prev = (t, v[0]);
@@ -194,7 +197,7 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                     if v[3] <= 0.0 {
                         continue;
                     }
-                    let length = rc.origin[3] * step;
+                    let length = rc.origin[3] * seg;
                     match mode {
                         1 => acc = [acc[0].max(v[0]), acc[1].max(v[1])],
                         2 => acc = [acc[0].max(v[1] - v[0]), acc[1].max(v[1])],
@@ -205,7 +208,7 @@ pub fn raycast(rc: &RaycastParams, field: &DenseField, bricks: &[u32], jitter: O
                     if mode != 0 {
                         continue;
                     }
-                    let alpha = 1.0 - (-v[3] * rc.origin[3] * step).exp();
+                    let alpha = 1.0 - (-v[3] * length).exp();
                     for c in 0..3 {
                         col[c] += trans * alpha * (v[c] / v[3]);
                     }
