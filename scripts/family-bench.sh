@@ -2,11 +2,12 @@
 # The defaults on volumes nobody tuned them for (issue 75): each member of scripts/family.py's
 # family, at each size and view, drawn with the defaults and with --lod off, both scored against
 # the supersampled CPU ray caster (`render --raycast 0.25 --raycast-stop 1e-4 --cpu --supersample
-# K`, K x K rays a pixel: $K, or by default 512 / size and at least 2, so that a 512^3 volume's
-# thumbnail still has a ray for about every voxel across) by PSNR over the covered pixels (`voxsplat compare`'s first figure), with the median frame
+# K`, K x K rays a pixel: $K, or by default 512 / size and at least 2, times side / 512 past 512
+# voxels a side, so that a volume's thumbnail still has a ray for about every voxel across) by PSNR over the covered pixels (`voxsplat compare`'s first figure), with the median frame
 # time of $FRAMES frames (stage times summed). Prints a markdown table; a row whose default lies
 # more than 1 dB below --lod off's PSNR and under 50 dB is marked MISS; past the ray casters' 2^28
-# voxels the reference is cast clump by clump (scripts/sparse-truth.py; needs python's OpenEXR), or,
+# voxels the reference is cast clump by clump, a clump past 2^27 voxels tile by tile
+# (scripts/sparse-truth.py; needs python's OpenEXR), or,
 # where that cannot be done, the default is scored against --lod off's frame (no reference).
 #   SMALL=1 WORK=target/family-small SIZES="32 128 512" VIEWS="auto anterior grazing" ONLY=bonsai-nn2,shell scripts/family-bench.sh
 set -euo pipefail
@@ -23,7 +24,7 @@ vs=${VS:-./target/release/voxsplat}
 args=()
 [ -n "${ONLY:-}" ] && args+=(--only "$ONLY")
 [ -n "${SMALL:-}" ] && args+=(--small)
-members=$(python3 scripts/family.py "$WORK" "${args[@]}")
+members=$(python3 scripts/family.py "$WORK" --vs "$vs" "${args[@]}")
 psnr() { $vs compare "$1" "$2" | awk '/^psnr:/ {print $2}'; }
 # The grazing view: from the patient's right, nearly along the x axis (10 degrees up, 6 across),
 # so the faces along x are seen edge-on; the family's files are in LPS patient space (RAS here).
@@ -55,7 +56,10 @@ while IFS='|' read -r name file tf; do
     for view in $VIEWS; do
       # shellcheck disable=SC2046
       common=(--volume "$file" --tf "$tf" --size "${size}x${size}" $(view_flags "$view" "$file"))
-      k=${K:-$((512 / size > 2 ? 512 / size : 2))}
+      # Past 512 voxels a side, proportionally more (the 1024^3 field at 512^2: 2 x 2 rays lie
+      # 54 dB from 4 x 4, where its voxels are a quarter of a pixel).
+      side=$(head -c 1024 "$file" | awk '/^sizes:/ { m = 0; for (i = 2; i <= NF; i++) if ($i > m) m = $i; print m; exit }')
+      k=${K:-$(( (512 / size > 2 ? 512 / size : 2) * (side > 512 ? side / 512 : 1) ))}
       ref="$WORK/truth-$name-$size-$view-k$k.exr"
       # The ray casters hold at most 2^28 voxels. Past that (the sparse 1024^3 field) the reference
       # is cast clump by clump (scripts/sparse-truth.py: each clump of voxels cut out and cast on

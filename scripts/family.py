@@ -7,14 +7,18 @@ From each shared file (bonsai, heptane, stent): 2x nearest-neighbour (`-nn2`: bl
 resampled scan or mask looks like), 2x trilinear (`-lin2`), a thresholded binary mask (`-mask`)
 and that mask 2x nearest-neighbour (`-mask2`). Beside them: a label volume of a few regions
 (`labels`), a spherical shell one voxel thick (`shell`), white noise (`noise`) and the same noise
-smoothed (`noise-smooth`), a field with spacing (1, 1, 4) (`aniso`) and a sparse 1024^3 field
-(`sparse1024`, 1 GiB). `--small` makes the CI subset instead: the same kinds from crops and at
-small sides, a few MiB in all. Never commit what it writes. Prints one line per volume: name,
-file, the transfer function it is drawn with.
+smoothed (`noise-smooth`), a field with spacing (1, 1, 4) (`aniso`), a sparse 1024^3 field
+(`sparse1024`, 1 GiB) and the procedural 1024^3 field whose frame time issue 75's targets name
+(`field1024`, 1 GiB: `voxsplat make-volume --procedural 1024`, a gyroid's thin shell in a ball,
+placed in patient space as the others are; made with --vs, default target/release/voxsplat).
+`--small` makes the CI subset instead: the same kinds from crops and at small sides, a few MiB in
+all. Never commit what it writes. Prints one line per volume: name, file, the transfer function it
+is drawn with.
 """
 import argparse
 import gzip
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -149,11 +153,31 @@ def sparse(n, path):
             f.write(sl.tobytes())
 
 
+def procedural(n, path, vs):
+    """voxsplat's procedural field of side n, its header rewritten to place it in patient space."""
+    tmp = path[: -len(".nrrd")] + "-part.nrrd"
+    subprocess.run([vs, "make-volume", "--procedural", str(n), "--out", tmp], check=True, stdout=subprocess.DEVNULL)
+    with open(tmp, "rb") as f, open(path, "wb") as g:
+        head = f.read(4096)
+        f.seek(head.index(b"\n\n") + 2)
+        g.write(
+            (
+                f"NRRD0004\ntype: uint8\ndimension: 3\nsizes: {n} {n} {n}\n{SPACE}"
+                "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n\n"
+            ).encode()
+        )
+        while chunk := f.read(1 << 26):
+            g.write(chunk)
+    os.remove(tmp)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("dir")
     p.add_argument("--small", action="store_true", help="the CI subset: crops and small sides")
     p.add_argument("--only", help="comma-separated names to make")
+    p.add_argument("--vs", default=os.path.join(os.path.dirname(__file__), "..", "target", "release", "voxsplat"),
+                   help="the voxsplat that makes the procedural field")
     a = p.parse_args()
     os.makedirs(a.dir, exist_ok=True)
     only = set(a.only.split(",")) if a.only else None
@@ -204,6 +228,11 @@ def main():
             sparse(1024, path)
         if only is None or "sparse1024" in only:
             out.append(("sparse1024", path, "ramp"))
+        path = os.path.join(a.dir, "field1024.nrrd")
+        if only is None or "field1024" in only:
+            if not os.path.exists(path):
+                procedural(1024, path, a.vs)
+            out.append(("field1024", path, "ramp"))
     for name, path, tf in out:
         print(f"{name}|{path}|{tf}")
 
