@@ -30,19 +30,22 @@ DATA = os.environ.get("VOXSPLAT_DATA", os.path.join(os.path.dirname(__file__), "
 SPACE = "space: left-posterior-superior\nspace origin: (0,0,0)\n"
 
 
+def nrrd_header(x, y, z, spacing=(1.0, 1.0, 1.0)):
+    """The attached header of a raw uint8 NRRD of x * y * z voxels in patient space."""
+    return (
+        "NRRD0004\ntype: uint8\ndimension: 3\n"
+        f"sizes: {x} {y} {z}\n{SPACE}"
+        f"space directions: ({spacing[0]},0,0) (0,{spacing[1]},0) (0,0,{spacing[2]})\n"
+        "encoding: raw\n\n"
+    ).encode()
+
+
 def write_nrrd(path, vol, spacing=(1.0, 1.0, 1.0)):
     """vol is indexed [z, y, x] (x fastest on disk), uint8."""
     vol = np.ascontiguousarray(vol, dtype=np.uint8)
     z, y, x = vol.shape
     with open(path, "wb") as f:
-        f.write(
-            (
-                "NRRD0004\ntype: uint8\ndimension: 3\n"
-                f"sizes: {x} {y} {z}\n{SPACE}"
-                f"space directions: ({spacing[0]},0,0) (0,{spacing[1]},0) (0,0,{spacing[2]})\n"
-                "encoding: raw\n\n"
-            ).encode()
-        )
+        f.write(nrrd_header(x, y, z, spacing))
         f.write(vol.tobytes())
 
 
@@ -136,12 +139,7 @@ def sparse(n, path):
     rng = np.random.default_rng(3)
     balls = [(rng.uniform(0.1, 0.9, 3) * n, rng.uniform(0.01, 0.04) * n) for _ in range(24)]
     with open(path, "wb") as f:
-        f.write(
-            (
-                f"NRRD0004\ntype: uint8\ndimension: 3\nsizes: {n} {n} {n}\n{SPACE}"
-                "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n\n"
-            ).encode()
-        )
+        f.write(nrrd_header(n, n, n))
         yy, xx = np.mgrid[0:n, 0:n].astype(np.float32) + 0.5
         for k in range(n):
             sl = np.zeros((n, n), np.uint8)
@@ -160,12 +158,7 @@ def procedural(n, path, vs):
     with open(tmp, "rb") as f, open(path, "wb") as g:
         head = f.read(4096)
         f.seek(head.index(b"\n\n") + 2)
-        g.write(
-            (
-                f"NRRD0004\ntype: uint8\ndimension: 3\nsizes: {n} {n} {n}\n{SPACE}"
-                "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n\n"
-            ).encode()
-        )
+        g.write(nrrd_header(n, n, n))
         while chunk := f.read(1 << 26):
             g.write(chunk)
     os.remove(tmp)

@@ -141,7 +141,9 @@ def tiles(box, eye, most):
     return out
 
 
-def write_crop(path, vol, box, space, origin):
+def write_crop(path, vol, box, own, space, origin):
+    """Writes voxels `box` of `vol` as a NRRD placed where they lie; returns the value sum of its
+    part `own` (the cells the crop stands for: the voxels past them are only trilinear support)."""
     (x0, y0, z0), (x1, y1, z1) = box
     crop = np.ascontiguousarray(vol[z0:z1, y0:y1, x0:x1])
     o = [origin[0] + x0, origin[1] + y0, origin[2] + z0]
@@ -154,7 +156,8 @@ def write_crop(path, vol, box, space, origin):
             ).encode()
         )
         f.write(crop.tobytes())
-    return int(crop.sum(dtype=np.int64))
+    (a0, b0, c0), (a1, b1, c1) = own
+    return int(crop[c0 - z0 : c1 - z0, b0 - y0 : b1 - y0, a0 - x0 : a1 - x0].sum(dtype=np.int64))
 
 
 def read_exr(path):
@@ -251,8 +254,7 @@ def main():
             # The tile's voxels and two more past each inner face (the trilinear support of the
             # samples up to that face), its rays clipped to its own half-open cells there.
             cut = [[max(box[0][k], own[0][k] - 2) for k in range(3)], [min(box[1][k], own[1][k] + 2) for k in range(3)]]
-            write_crop(path, vol, cut, space, origin)
-            summed += int(np.asarray(vol[own[0][2] : own[1][2], own[0][1] : own[1][1], own[0][0] : own[1][0]]).sum(dtype=np.int64))
+            summed += write_crop(path, vol, cut, own, space, origin)
             # --clip takes the crop's grid frame: index less the crop's first voxel and its centre.
             centre = [cut[0][k] + (cut[1][k] - cut[0][k] - 1) / 2 for k in range(3)]
             clips = []
