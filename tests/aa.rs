@@ -1,5 +1,5 @@
 //! Chapter 3: Swan's anti-aliasing in the per-splat stage, and EWA beside it.
-mod common;
+use crate::common;
 use glam::Vec3;
 use voxsplat::low_level::plan::Prepared;
 use voxsplat::truth::{supersampled, TruthOptions};

@@ -2,7 +2,7 @@
 //! CPU mirrors (or the reverse), everything the first engine wrote handed to the second. Where the
 //! stages before the switch give both engines the same words, the split frame is the other
 //! backend's frame bit for bit; elsewhere it lies within the mirror tolerance.
-mod common;
+use crate::common;
 use common::assert_clean;
 use voxsplat::low_level::stages::StageId;
 use voxsplat::output::diff_rgba8;

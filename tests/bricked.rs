@@ -2,7 +2,7 @@
 //! against their CPU mirrors, the order they write (bricks by the k-d tree, voxels by PBTF) against `order::tree_bricked`
 //! over a random view battery, streaming through a small budget, transfer-function changes, and
 //! bad budgets. Validation on: any message fails.
-mod common;
+use crate::common;
 use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, splat_stage, Rng, ViewKind};
 use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
 use voxsplat::classify::{classify, Shading, TransferFunction};

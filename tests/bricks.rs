@@ -1,7 +1,7 @@
 //! The bricked store (issue 23, host side): every value comes back through it (up to its 16-bit
 //! quantisation), it takes at most 8 bytes per stored voxel on the real volumes, and classifying
 //! through it (values and gradients by neighbour lookups) gives the dense classification.
-mod common;
+use crate::common;
 use common::Rng;
 use voxsplat::bricks::{BrickStore, BRICK};
 use voxsplat::classify::{classify, Shading, TransferFunction};

@@ -1,6 +1,6 @@
 //! Clipping planes and the crop box (issue 27 item 2): every splat mode and the ray caster, dense
 //! and bricked, GPU against the CPU mirrors; what they keep and drop; refused planes.
-mod common;
+use crate::common;
 use common::{assert_clean, blob, blob_tf as tf, diff};
 use glam::{Vec3, Vec4};
 use voxsplat::classify::classify;

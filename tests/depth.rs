@@ -1,7 +1,7 @@
 //! The host's depth buffer (`RenderOptions::depth`): a plane of host geometry through a volume
 //! hides exactly what lies behind it (the same frame as a clipping plane there), on the device and
 //! the mirrors, in every raster; what it refuses.
-mod common;
+use crate::common;
 use common::{assert_clean, assert_mirrors, cpu, gpu};
 use glam::{Mat4, Vec4};
 use std::sync::Arc;

@@ -1,7 +1,7 @@
 //! Every device-dependent choice, run against recorded device profiles (lavapipe's, and a discrete
 //! NVIDIA one from its public limits) so the hardware branch runs in CI too, and the record of
 //! lavapipe checked against the device at hand.
-mod common;
+use crate::common;
 use voxsplat::device::{DeviceKind, DeviceProfile, Timing};
 use voxsplat::{scene, Camera, Composite, Error, Raster, RenderOptions};
 

@@ -1,7 +1,7 @@
 //! Sort-last rendering without a transport (issue 28): a volume cut into k-d boxes, each box's
 //! store read by offset and drawn alone, the images composited in the boxes' visibility order,
 //! equals the whole volume drawn in one piece.
-mod common;
+use crate::common;
 use common::gpu;
 use glam::Vec3;
 use voxsplat::bricks::{BrickScene, BrickStore};

@@ -1,6 +1,6 @@
 //! GPU stages against their CPU mirrors, on lavapipe with validation (and synchronization
 //! validation) on: any validation message fails the test.
-mod common;
+use crate::common;
 use common::{assert_clean, random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
 use voxsplat::output::diff_rgba8;

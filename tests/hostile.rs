@@ -1,6 +1,6 @@
 //! Issue 25: input a hostile user would try, each a typed error or a right picture, never a hang,
 //! a wrap-around or a silently wrong frame (the CLI's side: cli/tests/hostile.rs).
-mod common;
+use crate::common;
 use common::{assert_clean, cpu, gpu};
 use std::path::{Path, PathBuf};
 use voxsplat::bricks::{BrickScene, BrickStore};

@@ -1,7 +1,7 @@
 //! Isosurface splats (`--mode iso`): against the ray caster's first crossing (depth and
 //! coverage), the GPU against the CPU mirrors, a bricked volume against its dense set, a new value
 //! per frame without a new upload, and what they refuse.
-mod common;
+use crate::common;
 use common::{assert_clean, assert_mirrors, cpu, gpu};
 use glam::Vec3;
 use voxsplat::low_level::stages::{Res, StageId};

@@ -1,6 +1,6 @@
 //! Label volumes and channels: labels never interpolated into one another, hidden labels draw
 //! nothing, missing labels are counted; channels combined per voxel; and what each refuses.
-mod common;
+use crate::common;
 use common::{assert_clean, assert_mirrors, cpu, gpu};
 use voxsplat::classify::{classify_channels, TransferFunction};
 use voxsplat::labels::{classify_labels, LabelTable};

@@ -1,7 +1,7 @@
 //! Scenes past a device limit: per-splat arrays longer than one storage binding may be (lavapipe's
 //! maxStorageBufferRange is 2^27 bytes, 1.68 M of the 80-byte records) are bound as two pages, and
 //! splat frames of scenes past two pages get a typed error (a ray cast takes them).
-mod common;
+use crate::common;
 use common::{assert_clean, cpu, gpu};
 use voxsplat::low_level::constants::{MAX_GPU_SPLATS, SPLAT_PAGE};
 use voxsplat::{Antialias, Camera, Composite, Error, Grid, Kernel, Raster, RenderOptions, SplatSet};

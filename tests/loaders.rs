@@ -1,6 +1,6 @@
 //! Loaders, classification and terrain (chapter 5): round trips, malformed input in seeded loops,
 //! hole filling, fly-over visibility, and the real-data presets on GPU and CPU.
-mod common;
+use crate::common;
 use common::Rng;
 use std::io::Write;
 use voxsplat::loaders::{nifti_from_bytes, npy_from_bytes, nrrd_from_bytes, raw_from_bytes, tiff_heights, DType};

@@ -2,7 +2,7 @@
 //! of the brick stages against their CPU mirrors, the mixed-level sequence against the cell
 //! validator over a random view battery, and the pyramid rebuilt when the classification
 //! changes. Validation on: any message fails.
-mod common;
+use crate::common;
 use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, splat_stage, Rng, ViewKind};
 use voxsplat::classify::{Shading, TransferFunction};
 use voxsplat::low_level::plan::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};

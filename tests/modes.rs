@@ -1,7 +1,7 @@
 //! The projection modes (`--mode mip|minip|average|xray`): against the host's projections of the
 //! classified volume with the same kernel, the GPU against the CPU mirrors in every raster, and
 //! what they refuse.
-mod common;
+use crate::common;
 use common::{assert_clean, assert_mirrors, cpu, gpu, Rng};
 use glam::Vec3;
 use voxsplat::classify::{classify, TransferFunction};

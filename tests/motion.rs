@@ -1,5 +1,5 @@
 //! Chapter 4: motion-blurred splats against the accumulation buffer.
-mod common;
+use crate::common;
 use common::assert_clean;
 use glam::{Mat4, Vec3};
 use voxsplat::animate::{render_frame, Animation, Blur};

@@ -1,7 +1,7 @@
 //! Visibility orders on the CPU: PBTF is free of violations everywhere; BTF and WBTF fail on the
 //! close perspective view of Figs 2.25-2.26; the CPU mirror of the GPU order stages equals the
 //! pure-Rust PBTF.
-mod common;
+use crate::common;
 use common::{random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
 use voxsplat::order::{count_violations, pbtf, pbtf_split, visibility_order};

@@ -1,7 +1,7 @@
 //! Placement in patient space (issue 29): NIfTI sform/qform and NRRD space put every voxel where
 //! the file says, whichever way its axes run, and a rotated (oblique) or sheared grid renders as
 //! the truth integrated in world space through the file's own affine.
-mod common;
+use crate::common;
 use common::{nifti, object, samples, DIMS};
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec3};
 use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};

@@ -1,6 +1,6 @@
 //! Picking: the first hit on a ball of known centre and radius, the voxel of a MIP's maximum, and
 //! what picking refuses.
-mod common;
+use crate::common;
 use common::{cpu, Rng};
 use glam::Vec3;
 use voxsplat::classify::{classify, TransferFunction};

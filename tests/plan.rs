@@ -1,6 +1,6 @@
 //! The frame's plan and the stages' named builds, checked without a device: what `plan::frame`
 //! decides for each mode, and what `Dispatch::new` refuses.
-mod common;
+use crate::common;
 use voxsplat::low_level::builds::{
     Build, CompositeLayers, Footprint, Only, Pages, Records, SheetMode, SheetTiles, TileComposite, TileOrder, TABLES,
 };

@@ -2,7 +2,7 @@
 //! mirror of `present.comp` and of the blit says, in every swapchain format, over a background or
 //! transparent, in the modes whose final images differ (accumulation, raster target, two slots);
 //! semaphores order frames; bad targets are refused.
-mod common;
+use crate::common;
 use common::assert_clean;
 use voxsplat::low_level::cpu::present::{decode, encode, host_texel, present_pixel};
 use voxsplat::low_level::plan::{over_bits, present_push};

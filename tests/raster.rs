@@ -2,7 +2,7 @@
 //! compositing, fixed-point sheet sums) against each other and their mirrors; the tile lists'
 //! order; early termination; footprints larger than a tile; typed errors and the auto rule.
 //! On lavapipe with validation: any validation message fails a test.
-mod common;
+use crate::common;
 use common::{assert_clean, random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
 use voxsplat::output::diff_rgba8;

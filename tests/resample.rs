@@ -1,7 +1,7 @@
 //! Reduced-resolution rendering (`RenderOptions::render_scale`, src/resample.rs): the coarse frame
 //! is the backend's own frame of `scaled_camera`, resampled; close to the full-size frame where
 //! voxels cover several pixels; bad scales are typed errors.
-mod common;
+use crate::common;
 use voxsplat::low_level::resample::{scaled_camera, upsample};
 use voxsplat::scene::peer;
 use voxsplat::ImageF32;

@@ -2,7 +2,7 @@
 //! (`BrickStore::patch`, `Renderer::update_volume`) draws what the same store set afresh draws,
 //! on the device and on the CPU mirrors, while the device rewrites only the bricks that changed;
 //! 4-D NIfTI files read one time point at a time. Validation on: any message fails.
-mod common;
+use crate::common;
 use common::{assert_clean, assert_mirrors, blob, blob_tf as tf};
 use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
 use voxsplat::classify::Shading;

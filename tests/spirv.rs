@@ -39,6 +39,6 @@ fn shipped_spirv_equals_a_fresh_compile() {
     assert!(
         stale.is_empty() && missing.is_empty() && differ.is_empty(),
         "glsl/spirv/ is out of date (stale {stale:?}, missing {missing:?}, different {differ:?}): run \
-         VOXSPLAT_BLESS_SPIRV=1 cargo test --release --test spirv"
+         VOXSPLAT_BLESS_SPIRV=1 cargo test --release --test engine spirv"
     );
 }

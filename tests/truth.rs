@@ -1,6 +1,6 @@
 //! The references and metrics: analytic values, the ray caster's convergence, GPU ray caster
 //! against its mirror, metrics on known pairs.
-mod common;
+use crate::common;
 use common::assert_clean;
 use glam::Vec3;
 use voxsplat::low_level::cpu::raycast::raycast;

@@ -1,5 +1,5 @@
 //! Kernels, cameras, scenes and the sheet plan.
-mod common;
+use crate::common;
 use glam::Vec3;
 use voxsplat::low_level::constants::{FOOTPRINT_TABLE_SIZE, MAX_GROUPS_X, WORKGROUP_SIZE};
 use voxsplat::low_level::plan::{groups_1d, sheet_plan, Prepared};

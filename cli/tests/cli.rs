@@ -1,8 +1,7 @@
 //! The command-line contract: listed scenes, rendered files, order dumps, and clear errors (never
 //! a panic) for bad input.
-mod cmd;
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::cmd;
+use crate::common;
 use cmd::voxsplat;
 
 fn tmp(name: &str) -> std::path::PathBuf {

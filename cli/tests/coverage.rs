@@ -18,7 +18,7 @@
 //! Run through the library (classified sets and bricked stores, spacings from 1e-4 to 1e3, the CPU
 //! mirrors and the GPU under validation) and through the binary (built-in scenes and a volume file).
 //! A fixed seed and a bounded case count in CI; `PROPTEST_CASES=N` for a longer hunt.
-mod cmd;
+use crate::cmd;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use std::sync::atomic::{AtomicU32, Ordering::Relaxed};

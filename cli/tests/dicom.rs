@@ -2,7 +2,7 @@
 //! (pip-installed by scripts/setup.sh), read as a folder, a file of it or one series of several,
 //! beside `dcm2niix`'s NIfTI conversion of the same series; and what a folder that is not one
 //! series is refused for.
-mod cmd;
+use crate::cmd;
 use cmd::{refused, voxsplat};
 use std::path::{Path, PathBuf};
 use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};

@@ -4,9 +4,8 @@
 //! exit with the same error, not hang; the sheet modes and scenes without a file are refused on
 //! every rank.
 #![cfg(feature = "mpi")]
-mod cmd;
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::cmd;
+use crate::common;
 use cmd::voxsplat;
 use std::process::{Command, Output};
 

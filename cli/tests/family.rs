@@ -5,7 +5,7 @@
 //! against the supersampled ray caster, over the covered pixels (or at 50 dB or more). The whole
 //! family at full size is `scripts/family-bench.sh`; its figures are in docs/RESULTS.md.
 //! Validation on: any message fails.
-mod cmd;
+use crate::cmd;
 use cmd::{refused, tmp_in, voxsplat};
 use std::path::{Path, PathBuf};
 

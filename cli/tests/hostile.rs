@@ -1,8 +1,7 @@
 //! Issue 25 through the command line: what a hostile user tried, each now a clear error (exit 2,
 //! a message that names the problem) or the right output. The library's side: tests/hostile.rs.
-mod cmd;
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::cmd;
+use crate::common;
 use cmd::voxsplat;
 
 fn tmp(name: &str) -> std::path::PathBuf {

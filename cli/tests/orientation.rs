@@ -1,8 +1,7 @@
 //! Named anatomical views from the file's placement (issue 29): superior up whichever way the file
 //! stores its slices, a clear error for views of data without a frame, and the orientation code.
-mod cmd;
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::cmd;
+use crate::common;
 use cmd::voxsplat;
 use common::{nifti, DIMS};
 use glam::{DMat4, DVec3, DVec4};

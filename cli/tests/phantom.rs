@@ -1,8 +1,7 @@
 //! The MRI head phantom (`make-volume --phantom`) and the `mri` preset tuned on it (issue 29):
 //! ../shared/data holds no brain MRI, so the preset is checked on a made T1 head.
-mod cmd;
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::cmd;
+use crate::common;
 use cmd::voxsplat;
 use voxsplat::classify::TransferFunction;
 use voxsplat::glam::Vec3;

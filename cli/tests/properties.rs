@@ -1,7 +1,7 @@
 //! Property tests through the whole command-line render path (issue 25): random scenes, cameras,
 //! sizes and modes give either a frame of the asked size or a typed error (exit 2), never a panic
 //! and never a validation message.
-mod cmd;
+use crate::cmd;
 use proptest::prelude::*;
 
 fn pick(options: &'static [&'static str]) -> impl Strategy<Value = &'static str> {

@@ -3,7 +3,7 @@
 //! where the data lives), and each must succeed and write what it names. The set-up and test
 //! commands (`./scripts/setup.sh`, `cargo test`) are what CI itself runs, so they are listed, not
 //! run. The README's Rust example is a doc test of the core crate (`src/lib.rs`).
-mod cmd;
+use crate::cmd;
 use std::path::Path;
 use std::process::Command;
 

@@ -1,6 +1,5 @@
 //! Long runs do not leak, renderers are Send and deterministic.
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::common;
 use voxsplat::{scene, Camera, Composite, RenderOptions};
 
 /// GPU allocations must not drift (host memory: the next test, in a child process).

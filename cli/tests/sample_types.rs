@@ -1,7 +1,7 @@
 //! Sample types others write (issue 47): NIfTI from nibabel and NRRD from pynrrd in signed 8-bit,
 //! signed 32-bit and 64-bit float samples (nibabel's default for float arrays) read value for
 //! value, whole and streamed into the bricked store; a double past f32's range is refused.
-mod cmd;
+use crate::cmd;
 use std::path::Path;
 use voxsplat::loaders::{load_volume, VolumeHints};
 

@@ -3,7 +3,7 @@
 //! (tests/data/write_series.py). `animate
 //! --volume` plays every time point, each frame the one `render --time T` draws from the same
 //! view, while the device is sent only what changed; flags that cannot apply are refused.
-mod cmd;
+use crate::cmd;
 use cmd::{refused, voxsplat};
 use std::path::{Path, PathBuf};
 

@@ -1,7 +1,6 @@
 //! Issue 8: the failures of section 1.2.2.3 reproduced as qualitative facts, and the image-aligned
 //! sheet buffer (slabs) that avoids them. Figures go to the bench (docs/RESULTS.md).
-#[path = "../../tests/common/mod.rs"]
-mod common;
+use crate::common;
 use glam::Vec3;
 use voxsplat::output::diff_rgba8;
 use voxsplat::ImageF32;

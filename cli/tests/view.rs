@@ -7,7 +7,7 @@
 //! picked voxel (nibabel reads it). The crop box's handles draw under the volume with their depth,
 //! a grip dragged moves its face or plane, the session keeps two clip planes and the crop box (so
 //! `render --session` cuts the same), and a click in a slice pane moves the crosshair.
-mod cmd;
+use crate::cmd;
 use cmd::{tmp_in, voxsplat};
 use std::path::Path;
 use std::process::Command;

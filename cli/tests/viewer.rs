@@ -2,7 +2,7 @@
 //! under Xvfb on lavapipe with the validation layer, owning its device and swapchain, for a scripted
 //! orbit and transfer-function edit; the frame it reads back from the swapchain image must match
 //! `voxsplat render` with the same camera and transfer function within 1/255.
-mod cmd;
+use crate::cmd;
 use cmd::{tmp_in, voxsplat};
 use std::path::{Path, PathBuf};
 use std::process::Command;

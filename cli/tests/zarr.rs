@@ -2,7 +2,7 @@
 //! from the shared bonsai (0.4 on Zarr v2 with zstd, 0.5 on Zarr v3 sharded), and a series of time
 //! points and channels compressed with blosc, each level checked against what zarr-python reads
 //! back; then files broken one way each, refused by name.
-mod cmd;
+use crate::cmd;
 use cmd::{refused, voxsplat};
 use std::path::{Path, PathBuf};
 use voxsplat::loaders::{load_channels, load_volume, npy_from_bytes, OmeZarr, VolumeHints};

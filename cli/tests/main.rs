@@ -1,0 +1,23 @@
+//! The CLI's integration tests, one binary: each file is a module (`cargo test --test commands
+//! family::` runs one). They share the core's helpers (`tests/common`) and `cmd`.
+mod cli;
+mod cmd;
+#[path = "../../tests/common/mod.rs"]
+mod common;
+mod coverage;
+mod dicom;
+mod distributed;
+mod family;
+mod hostile;
+mod orientation;
+mod peer;
+mod phantom;
+mod properties;
+mod readme;
+mod reliability;
+mod sample_types;
+mod series;
+mod stability;
+mod view;
+mod viewer;
+mod zarr;

@@ -1,0 +1,35 @@
+//! The core's integration tests, one binary: each file is a module (`cargo test --test engine
+//! lod::` runs one, `cargo test --test engine the_pyramid` one test). As thirty-one binaries, each
+//! linked the whole engine.
+mod aa;
+mod bisect;
+mod bricked;
+mod bricks;
+mod clip;
+mod common;
+mod depth;
+mod device;
+mod distributed;
+mod fuzz_corpus;
+mod gpu;
+mod hostile;
+mod iso;
+mod labels;
+mod large;
+mod layout;
+mod loaders;
+mod lod;
+mod modes;
+mod motion;
+mod order;
+mod orient;
+mod pick;
+mod plan;
+mod present;
+mod raster;
+mod resample;
+mod series;
+mod spirv;
+mod stacks;
+mod truth;
+mod units;
