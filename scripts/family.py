@@ -27,14 +27,12 @@ DATA = os.environ.get("VOXSPLAT_DATA", os.path.join(os.path.dirname(__file__), "
 
 
 # In patient space (x left, y posterior, z superior), so the anatomical views (--view anterior) apply.
-SPACE = "space: left-posterior-superior\nspace origin: (0,0,0)\n"
-
-
-def nrrd_header(x, y, z, spacing=(1.0, 1.0, 1.0)):
-    """The attached header of a raw uint8 NRRD of x * y * z voxels in patient space."""
+def nrrd_header(x, y, z, spacing=(1.0, 1.0, 1.0), origin=0):
+    """The attached header of a raw uint8 NRRD of x * y * z voxels in patient space, the first
+    voxel's centre at (origin, origin, origin)."""
     return (
         "NRRD0004\ntype: uint8\ndimension: 3\n"
-        f"sizes: {x} {y} {z}\n{SPACE}"
+        f"sizes: {x} {y} {z}\nspace: left-posterior-superior\nspace origin: ({origin},{origin},{origin})\n"
         f"space directions: ({spacing[0]},0,0) (0,{spacing[1]},0) (0,0,{spacing[2]})\n"
         "encoding: raw\n\n"
     ).encode()
@@ -151,14 +149,15 @@ def sparse(n, path):
             f.write(sl.tobytes())
 
 
-def procedural(n, path, vs):
-    """voxsplat's procedural field of side n, its header rewritten to place it in patient space."""
+def procedural(n, path, vs, spacing=1, origin=0):
+    """voxsplat's procedural field of side n, its header rewritten to place it in patient space
+    (voxels `spacing` apart, the first voxel's centre at `origin` on each axis)."""
     tmp = path[: -len(".nrrd")] + "-part.nrrd"
     subprocess.run([vs, "make-volume", "--procedural", str(n), "--out", tmp], check=True, stdout=subprocess.DEVNULL)
     with open(tmp, "rb") as f, open(path, "wb") as g:
         head = f.read(4096)
         f.seek(head.index(b"\n\n") + 2)
-        g.write(nrrd_header(n, n, n))
+        g.write(nrrd_header(n, n, n, (spacing,) * 3, origin))
         while chunk := f.read(1 << 26):
             g.write(chunk)
     os.remove(tmp)

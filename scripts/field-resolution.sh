@@ -26,29 +26,18 @@ vs=${VS:-./target/release/voxsplat}
 mkdir -p "$WORK"
 # shellcheck disable=SC2207
 cam=($(python3 scripts/sparse-truth.py "$field" --camera --tf ramp --vs "$vs" -- --size 512x512))
-for n in 512 256; do
-  [ -f "$WORK/field$n.nrrd" ] || "$vs" make-volume --procedural "$n" --out "$WORK/raw$n.nrrd" >/dev/null
-done
-python3 - "$WORK" <<'EOF'
+python3 - "$WORK" "$vs" <<'EOF'
 import os, sys
-work = sys.argv[1]
+sys.path.insert(0, "scripts")
+from family import procedural
+
+work, vs = sys.argv[1], sys.argv[2]
 for n in (512, 256):
     k = 1024 // n
     out = os.path.join(work, f"field{n}.nrrd")
+    # Voxel i of n covers the 1024³ field's voxels k i .. k i + k - 1: its centre lies at k i + (k - 1) / 2.
     if not os.path.exists(out):
-        src = os.path.join(work, f"raw{n}.nrrd")
-        data = open(src, "rb").read()
-        raw = data[data.index(b"\n\n") + 2:]
-        assert len(raw) == n ** 3, src
-        # Voxel i of N covers the 1024³ field's voxels k i .. k i + k - 1: its centre lies at k i + (k - 1) / 2.
-        o = (k - 1) / 2
-        header = (f"NRRD0004\ntype: uint8\ndimension: 3\nsizes: {n} {n} {n}\n"
-                  "space: left-posterior-superior\n"
-                  f"space origin: ({o},{o},{o})\n"
-                  f"space directions: ({k},0,0) (0,{k},0) (0,0,{k})\nencoding: raw\n\n")
-        with open(out, "wb") as f:
-            f.write(header.encode() + raw)
-        os.remove(src)
+        procedural(n, out, vs, k, (k - 1) / 2)
 # The ramp preset (grey and opacity rising linearly from a tenth of the range to 0.6), with the
 # opacity of a voxel k times as long, in 37 points.
 for k in (1, 2, 4):
