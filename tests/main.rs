@@ -1,6 +1,7 @@
 //! The core's integration tests, one binary: each file is a module (`cargo test --test engine
 //! lod::` runs one, `cargo test --test engine the_pyramid` one test). As thirty-one binaries, each
-//! linked the whole engine.
+//! linked the whole engine. `fuzz_corpus.rs` stays a binary of its own: the fuzz bodies set the
+//! process's host budget (`set_host_budget`), which the other tests must not share.
 mod aa;
 mod bisect;
 mod bricked;
@@ -10,7 +11,6 @@ mod common;
 mod depth;
 mod device;
 mod distributed;
-mod fuzz_corpus;
 mod gpu;
 mod hostile;
 mod iso;
