@@ -934,3 +934,56 @@ fn an_edge_between_materials_at_a_brick_face_is_seen() {
     eprintln!("the plane at a brick face {:.2} dB from full detail, inside a brick {:.2} dB", psnr[0], psnr[1]);
     assert!(psnr[0] >= psnr[1] - 1.0, "at a brick face {} dB, inside a brick {} dB", psnr[0], psnr[1]);
 }
+
+#[test]
+fn a_view_along_a_grid_axis_counts_a_row_of_departures() {
+    use voxsplat::low_level::cpu::lod::{view_coherence, MAX_COHERENCE};
+    // Along an axis a ray stays in one column of children through every cell: the most. Half a
+    // cell's drift per cell (tan 0.5) or more: once. Between, the cells a ray stays in a column.
+    assert_eq!(view_coherence(glam::Vec3::new(0.0, 0.0, -3.0)), MAX_COHERENCE);
+    assert_eq!(view_coherence(glam::Vec3::new(1.0, 1.0, 0.2)), 1.0);
+    assert_eq!(view_coherence(glam::Vec3::new(0.5, -0.1, 1.0)), 1.0);
+    assert!((view_coherence(glam::Vec3::new(0.15, 0.2, -1.0)) - 2.0).abs() < 1e-5);
+    assert_eq!(view_coherence(glam::Vec3::ZERO), 1.0);
+
+    // Orthographic, a voxel over a pixel (no share of a pixel discounts an error) and no pixel
+    // bound: a brick takes level 1 exactly where its level-1 error, times the view's coherence,
+    // passes the bound. Half the bricks with an error pass it seen obliquely, fewer along z.
+    let vol = blob([48, 48, 48]);
+    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let (mut g, mut c) = (common::gpu(), common::cpu());
+    for r in [&mut g, &mut c] {
+        r.set_volume(&vol, &tf(), None).unwrap();
+    }
+    let view = |dir: glam::Vec3| {
+        let mut cam = Camera::framing(&grid, 96, 96);
+        cam.target = grid.center();
+        cam.eye = grid.center() + 150.0 * dir.normalize();
+        cam.projection = voxsplat::camera::Projection::Orthographic { height: 80.0 };
+        (cam.near, cam.far) = (1.0, 1000.0);
+        cam
+    };
+    let (along, oblique) = (view(glam::Vec3::Z), view(glam::Vec3::new(1.0, 0.0, 1.0)));
+    let mut o = lod(Raster::Compute, Direction::BackToFront, voxsplat::options::MAX_LOD_PIXELS);
+    let errors: Vec<f32> = summaries_match_the_mirror(&mut g, &mut c, &along, &o)
+        .iter()
+        .filter(|s| s[0] & 0xff > 0)
+        .map(|s| f32::from_bits(s[1]))
+        .collect();
+    let mut nonzero: Vec<f32> = errors.iter().copied().filter(|&e| e > 0.0).collect();
+    nonzero.sort_by(f32::total_cmp);
+    assert!(nonzero.len() > 20, "bricks with a level-1 error: {}", nonzero.len());
+    o.lod_error = nonzero[nonzero.len() / 2];
+    let coarse_bricks = |r: &mut Renderer, cam: &Camera| {
+        let cells = drawn_cells(r, cam, &o);
+        let bricks: std::collections::BTreeSet<[u32; 3]> =
+            cells.iter().filter(|c| c[3] > 1).map(|c| [c[0] / 8, c[1] / 8, c[2] / 8]).collect();
+        bricks.len()
+    };
+    for (cam, coherence, what) in [(&oblique, 1.0, "oblique"), (&along, MAX_COHERENCE, "along z")] {
+        let expected = errors.iter().filter(|&&e| e * coherence <= o.lod_error).count();
+        assert_eq!(coarse_bricks(&mut g, cam), expected, "{what}: bricks at level 1 or coarser");
+        assert_eq!(drawn_cells(&mut g, cam, &o), drawn_cells(&mut c, cam, &o), "{what}: GPU vs mirror cells");
+    }
+    assert_clean(&g);
+}

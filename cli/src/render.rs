@@ -75,14 +75,16 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
     lod_pixels: f32,
     /// Largest error of a coarse level, 0 to 3: how far a cell's children depart from it, or its
-    /// neighbours from its linear continuation, in the opacity a ray crossing a brick (8 voxels)
-    /// sees (summed down the levels). On translucent volumes about the largest change of a pixel
-    /// (0.03: about 8 steps of 8 bits). 3: no bound; 0: only cells equal to their children coarsen.
+    /// neighbours from its linear continuation, in the opacity a ray crossing a brick (8 voxels) sees
+    /// (summed down the levels), times the share of a pixel a cell smaller than one covers, and up to
+    /// 4 times more where the view runs along a grid axis. On translucent volumes about the largest
+    /// change of a pixel (0.04: about 10 steps of 8 bits). 3: no bound; 0: only cells equal to their
+    /// children coarsen.
     #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
     lod_error: f32,
     /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
     /// before it takes over (0: abrupt level changes).
-    #[arg(long, value_parser = parse_finite, default_value = "0.75")]
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_BAND)]
     lod_band: f32,
     /// Levels of detail above the brick too: a block of bricks seen within a pixel drawn as one
     /// prefiltered splat (fewer splats for a large volume seen small; off by default: on this

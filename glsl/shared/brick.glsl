@@ -606,12 +606,33 @@ float cull_reach(float depth, float cell) {
     return CULL_RADII * cell * frame.spacing.w * footprint_scale(max(depth, 1e-6), cell);
 }
 
-// A coarse cell's error as the picture sees it, the cell projecting to `size` pixels: its
-// departure from its children is detail at half its size, which the pixel's filter averages away
-// as the cell shrinks below a pixel (times its size there, up to 1).
+// A coarse cell's error as the picture sees it, the cell projecting to `size` pixels: the error
+// already counts a brick's depth of the departure along a ray, and a cell smaller than a pixel
+// covers size² of the pixel's area, which the pixel's filter averages its departure over (times
+// that share, up to 1; along the grid's axes view_coherence counts more).
 float seen_error(float err, float size) {
     float s = min(size, 1.0);
-    return err * s;
+    return err * s * s;
+}
+
+// How many cells' departures a ray adds up seen along `view` (index space): the error counts a
+// brick's side (8 voxels), but a ray near a grid axis stays in one column of a coarse cell's
+// children for about COHERENT_DRIFT / tan(its angle to the axis) cells, through row after row of
+// bricks, so their departures keep one sign along it; an oblique ray crosses to other columns
+// and mixes them. 1 from about 27 degrees off every axis, up to MAX_COHERENCE along one.
+// Mirror: cpu::lod::view_coherence.
+const float COHERENT_DRIFT = 0.5;
+const float MAX_COHERENCE = 4.0;
+float view_coherence(vec3 view) {
+    vec3 g = abs(view);
+    float m = max(g.x, max(g.y, g.z));
+    float across = sqrt(max(dot(g, g) - m * m, 0.0));
+    return clamp(COHERENT_DRIFT * m / max(across, 1e-30), 1.0, MAX_COHERENCE);
+}
+
+// The direction a brick (world box lo..hi) is seen along, in index space.
+vec3 seen_along(vec3 lo, vec3 hi) {
+    return grid_direction(frame.eye.w > 0.5 ? 0.5 * (lo + hi) - frame.eye.xyz : frame.forward.xyz);
 }
 
 // Brick b's (header h) level this frame: the coarsest whose cell spacing projects to at most
@@ -628,9 +649,11 @@ uint brick_level(uint h, uvec3 b, out float morph) {
     vec2 depths = box_depths(lo, hi);
     float px = voxel_pixels(depths.x);
     uvec4 s = lod_summary(h);
+    float coh = view_coherence(seen_along(lo, hi));
     uint level = 0u;
     for (uint l = 1u; l <= 3u; ++l) {
-        if (px * float(1u << l) > bf.grad.y || seen_error(uintBitsToFloat(s[l]), px * float(1u << l)) > bf.grad.z) break;
+        if (px * float(1u << l) > bf.grad.y || seen_error(uintBitsToFloat(s[l]) * coh, px * float(1u << l)) > bf.grad.z)
+            break;
         // Splats within CULL_RADII radii of the near or far plane are dropped (params_at): no level
         // whose wider splats (morphed: up to twice) would be dropped where the brick reaches a plane.
         float cell = float(1u << l);
@@ -641,7 +664,7 @@ uint brick_level(uint h, uvec3 b, out float morph) {
     }
     // Its splats grow (splat_growth) only within the band, which its farthest reaches first.
     float octaves = level_octaves(depths.y, level);
-    float next = seen_error(uintBitsToFloat(s[min(level + 1u, 3u)]), px * float(2u << level));
+    float next = seen_error(uintBitsToFloat(s[min(level + 1u, 3u)]) * coh, px * float(2u << level));
     if (level < 3u && bf.grad.w > 0.0 && next <= bf.grad.z && octaves > 1.0 - bf.grad.w)
         morph = 1.0;
     return level;
@@ -696,7 +719,7 @@ uint node_level(uvec3 b, float px) {
         voxel_box(b, k, lo, hi);
         vec2 depths = box_depths(lo, hi);
         float size = voxel_pixels(depths.x) * cell;
-        if (size > bound || seen_error(err, size) > bf.grad.z) continue;
+        if (size > bound || seen_error(err * view_coherence(seen_along(lo, hi)), size) > bf.grad.z) continue;
         float near_reach = 2.0 * cull_reach(depths.x, cell);
         float far_reach = 2.0 * cull_reach(depths.y, cell);
         if (depths.x < frame.forward.w + near_reach || depths.y > frame.right.w - far_reach) continue;

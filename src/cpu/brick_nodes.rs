@@ -5,7 +5,7 @@ use super::bindings::Bindings;
 use super::brick::{inputs, BrickInputs};
 use super::lod::{
     aligned, axis_opacity, cell_seen, child_error, pack_normal, seen_error, tau_code, tau_decode, unorm10,
-    unpack_normal,
+    unpack_normal, view_coherence,
 };
 use crate::bricks::BRICK;
 use crate::dispatch::{Args, Res, Variant};
@@ -102,7 +102,7 @@ impl BrickInputs<'_> {
             let (lo, hi) = self.voxel_box(b, k);
             let (near, far) = self.box_depths(lo, hi);
             let size = self.voxel_pixels(near) * cell;
-            if size > bound || seen_error(err, size) > bf.grad[2] {
+            if size > bound || seen_error(err * view_coherence(self.seen_along(lo, hi)), size) > bf.grad[2] {
                 continue;
             }
             if near < f.forward[3] + 2.0 * self.cull_reach(near, cell)

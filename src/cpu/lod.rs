@@ -103,10 +103,25 @@ impl BrickInputs<'_> {
 }
 
 /// Mirror of `seen_error`: a coarse cell's error as the picture sees it, the cell projecting to
-/// `size` pixels (its detail is averaged away by the pixel's filter below a pixel).
+/// `size` pixels (below a pixel, times the share of the pixel's area it covers).
 pub fn seen_error(err: f32, size: f32) -> f32 {
     let s = size.min(1.0);
-    err * s
+    err * s * s
+}
+
+/// Mirror of `COHERENT_DRIFT`: the share of a cell a ray may drift across and stay in one column
+/// of its children.
+pub const COHERENT_DRIFT: f32 = 0.5;
+/// Mirror of `MAX_COHERENCE`: the most cells' departures `view_coherence` counts along a ray.
+pub const MAX_COHERENCE: f32 = 4.0;
+
+/// Mirror of `view_coherence`: how many cells' departures a ray seen along `view` (index space)
+/// adds up, 1 for an oblique view up to `MAX_COHERENCE` along a grid axis.
+pub fn view_coherence(view: Vec3) -> f32 {
+    let g = view.abs();
+    let m = g.max_element();
+    let across = (g.dot(g) - m * m).max(0.0).sqrt();
+    (COHERENT_DRIFT * m / across.max(1e-30)).clamp(1.0, MAX_COHERENCE)
 }
 
 /// Mirror of `level_split`: the eye's PBTF split of level `l`'s cells inside brick `b`.
@@ -144,6 +159,18 @@ impl BrickInputs<'_> {
         1.0 + ((octaves - (1.0 - bf.grad[3])) / bf.grad[3]).clamp(0.0, 1.0)
     }
 
+    /// Mirror of `seen_along`: the direction the world box `lo`..`hi` is seen along, in index
+    /// space (`grid_direction`, in f32 as the shader has it).
+    pub(crate) fn seen_along(&self, lo: Vec3, hi: Vec3) -> Vec3 {
+        let f = self.frame;
+        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        let d = if f.eye[3] > 0.5 { 0.5 * (lo + hi) - v3(f.eye) } else { v3(f.forward) };
+        let (s, h) = (v3(f.spacing), v3(f.shear));
+        let z = d.z / s.z;
+        let y = (d.y - h.z * z) / s.y;
+        Vec3::new((d.x - h.x * y - h.y * z) / s.x, y, z)
+    }
+
     /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame, and 1 when
     /// its splats may morph toward the next.
     pub fn brick_level(&self, h: u32, b: [u32; 3]) -> (u32, f32) {
@@ -156,10 +183,11 @@ impl BrickInputs<'_> {
         let px = self.voxel_pixels(near);
         let at = h as usize * SUMMARY_WORDS;
         let s = &self.summary[at..at + 4];
+        let coh = view_coherence(self.seen_along(lo, hi));
         let mut level = 0;
         for l in 1..=LOD_LEVELS {
             let size = px * (1u32 << l) as f32;
-            if size > bf.grad[1] || seen_error(f32::from_bits(s[l as usize]), size) > bf.grad[2] {
+            if size > bf.grad[1] || seen_error(f32::from_bits(s[l as usize]) * coh, size) > bf.grad[2] {
                 break;
             }
             let cell = (1u32 << l) as f32;
@@ -173,7 +201,7 @@ impl BrickInputs<'_> {
         let octaves = self.level_octaves(far, level);
         let morph = level < 3
             && bf.grad[3] > 0.0
-            && seen_error(f32::from_bits(s[level as usize + 1]), px * (2u32 << level) as f32) <= bf.grad[2]
+            && seen_error(f32::from_bits(s[level as usize + 1]) * coh, px * (2u32 << level) as f32) <= bf.grad[2]
             && octaves > 1.0 - bf.grad[3];
         (level, if morph { 1.0 } else { 0.0 })
     }

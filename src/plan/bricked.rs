@@ -333,7 +333,9 @@ pub fn plan(
     bf.split[3] = side;
     let available = available - texel_bytes(w, h, side);
     if lod {
-        (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, opts.lod_error, opts.lod_band);
+        // The largest bound is none, however many times a view counts an error (view_coherence).
+        let error = if opts.lod_error >= crate::options::MAX_LOD_ERROR { f32::INFINITY } else { opts.lod_error };
+        (bf.grad[1], bf.grad[2], bf.grad[3]) = (opts.lod_pixels, error, opts.lod_band);
         bf.hi[3] = node_levels;
     }
     let compute = opts.raster == Raster::Compute;
