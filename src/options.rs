@@ -303,9 +303,7 @@ pub struct RenderOptions {
     pub lod_pixels: f32,
     /// Largest error of a coarse level: how far a cell's children depart from it, or its face
     /// neighbours from its linear continuation, in the opacity a ray through a brick (8 voxels) sees
-    /// or colour weighted by it, summed down the levels, times the share of a pixel's area the cell
-    /// covers (up to one) and up to `MAX_COHERENCE` times where the view runs along a grid axis
-    /// (docs/MODEL.md). `MAX_LOD_ERROR`: no bound.
+    /// or colour weighted by it, down the levels, times the cell's share of a pixel and up to 4 near an axis.
     pub lod_error: f32,
     /// Levels of detail: over the last `lod_band` octaves (0 to 1) before a brick's next level
     /// takes over, its splats move and widen toward that level's cells (geomorphing), so a level
@@ -359,7 +357,7 @@ impl Default for RenderOptions {
             lod: Lod::Auto,
             lod_pixels: DEFAULT_LOD_PIXELS,
             lod_error: DEFAULT_LOD_ERROR,
-            lod_band: DEFAULT_LOD_BAND,
+            lod_band: 0.75,
             lod_nodes: false,
             background: None,
         }
@@ -373,15 +371,9 @@ impl Default for RenderOptions {
 /// covered pixels the gallery's default frames score 33.5-43.4 dB: docs/RESULTS.md).
 pub const DEFAULT_LOD_PIXELS: f32 = 1.5;
 
-/// Default `RenderOptions::lod_error` (0 to `MAX_LOD_ERROR`): with a cell's error seen times its
-/// share of a pixel's area and counted again where the view runs along the grid's rows
-/// (`seen_error`, `view_coherence` in glsl/shared/brick.glsl), every member of
-/// `scripts/family.py`'s family lies within 1 dB of full detail at 0.04, and the 1024³ field
-/// draws in about 0.6x full detail's time (docs/RESULTS.md).
+/// Default `RenderOptions::lod_error` (0 to `MAX_LOD_ERROR`): `scripts/family.py`'s family lies
+/// within 1 dB of full detail at 0.04, the 1024³ field drawn in 0.64x its time (docs/RESULTS.md).
 pub const DEFAULT_LOD_ERROR: f32 = 0.04;
-
-/// Default `RenderOptions::lod_band`: three quarters of an octave.
-pub const DEFAULT_LOD_BAND: f32 = 0.75;
 
 /// Largest `RenderOptions::lod_pixels`: a wider coarse cell is a blur, not a level of detail.
 pub const MAX_LOD_PIXELS: f32 = 64.0;

@@ -84,7 +84,7 @@ pub(crate) struct RenderArgs {
     lod_error: f32,
     /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
     /// before it takes over (0: abrupt level changes).
-    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_BAND)]
+    #[arg(long, value_parser = parse_finite, default_value = "0.75")]
     lod_band: f32,
     /// Levels of detail above the brick too: a block of bricks seen within a pixel drawn as one
     /// prefiltered splat (fewer splats for a large volume seen small; off by default: on this
