@@ -160,15 +160,12 @@ impl BrickInputs<'_> {
     }
 
     /// Mirror of `seen_along`: the direction the world box `lo`..`hi` is seen along, in index
-    /// space (`grid_direction`, in f32 as the shader has it).
+    /// space (`grid_direction` is the frame's grid's `index_dir`).
     pub(crate) fn seen_along(&self, lo: Vec3, hi: Vec3) -> Vec3 {
         let f = self.frame;
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         let d = if f.eye[3] > 0.5 { 0.5 * (lo + hi) - v3(f.eye) } else { v3(f.forward) };
-        let (s, h) = (v3(f.spacing), v3(f.shear));
-        let z = d.z / s.z;
-        let y = (d.y - h.z * z) / s.y;
-        Vec3::new((d.x - h.x * y - h.y * z) / s.x, y, z)
+        super::splat_params::frame_grid(f).index_dir(d.as_dvec3()).as_vec3()
     }
 
     /// Mirror of `brick_level`: brick `b`'s (header `h`) level of detail this frame, and 1 when
