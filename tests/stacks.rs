@@ -119,3 +119,28 @@ fn a_folder_that_is_not_a_stack_is_refused_naming_the_file() {
         let _ = std::fs::remove_dir_all(d);
     }
 }
+
+#[test]
+fn names_that_are_not_utf8_order_by_their_numbers() {
+    // A byte that is not UTF-8 reads as U+FFFD (three bytes) in a lossy name: the number's start
+    // was a byte offset inside it, which panicked in `info`, `render` and `slice`.
+    use std::os::unix::ffi::OsStrExt;
+    let dir = folder("latin1");
+    let raw = |z: u32| {
+        let mut b = b"scan_\xff".to_vec();
+        b.extend_from_slice(z.to_string().as_bytes());
+        b.extend_from_slice(b".png");
+        std::ffi::OsString::from(std::ffi::OsStr::from_bytes(&b))
+    };
+    for z in [2u32, 10, 9] {
+        image::GrayImage::from_pixel(4, 3, image::Luma([z as u8])).save(dir.join(raw(z))).unwrap();
+    }
+    let v = load_volume(&dir, &VolumeHints::default()).unwrap();
+    assert_eq!(v.dims, [4, 3, 3]);
+    assert_eq!([v.values[0], v.values[12], v.values[24]], [2.0, 9.0, 10.0], "ordered by number");
+    // The same files as a pattern of time points.
+    let pattern = dir.join("scan_*.png");
+    let files = voxsplat::loaders::series_files(&pattern).unwrap();
+    assert_eq!(files, [2, 9, 10].map(|z| dir.join(raw(z))));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -231,8 +231,9 @@ fn samples(image: DecodingResult, w: u32, h: u32, what: &str) -> Result<Vec<f32>
 /// The number in a file name's stem (its last run of digits), which orders a folder's slices.
 pub(super) fn slice_number(path: &Path) -> Option<u64> {
     let stem = path.file_stem()?.to_string_lossy().into_owned();
+    // Byte offsets only at ASCII digits: a name that is not UTF-8 reads with U+FFFD, three bytes.
     let end = stem.rfind(|c: char| c.is_ascii_digit())? + 1;
-    let start = stem[..end].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
+    let start = stem[..end].trim_end_matches(|c: char| c.is_ascii_digit()).len();
     stem[start..end].parse().ok()
 }
 

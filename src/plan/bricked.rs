@@ -156,11 +156,37 @@ pub struct BrickedSheets {
     pub pass: SheetPass,
 }
 
-/// A projection's texels a pixel side (`project_texels`): PROJECT_TEXEL_SIDE, fewer where the
-/// image is large (at most PROJECT_TEXELS_MAX of them), `None` past that.
-pub fn texel_side(w: u32, h: u32) -> Option<u32> {
+/// A projection's texels a pixel side (`project_texels`): PROJECT_TEXEL_SIDE, more where the view
+/// projects a voxel spacing to less than three texels (`voxel_px` pixels: a texel spans at most
+/// PROJECT_TEXEL_VOXELS of it), fewer where the image is large; at most PROJECT_TEXELS_MAX of
+/// them, and `None` where that cannot hold texels that fine. The winner of a texel stands for the
+/// others only where their footprints nearly coincide: texels of a third of a pixel over voxels of
+/// a tenth dropped two thirds of the bonsai's MIP coverage at 64x64.
+pub fn texel_side(w: u32, h: u32, voxel_px: f32) -> Option<u32> {
     let pixels = w as u64 * h as u64;
-    (1..=PROJECT_TEXEL_SIDE).rev().find(|&s| pixels * (s * s) as u64 <= PROJECT_TEXELS_MAX)
+    let need = (1.0 / (PROJECT_TEXEL_VOXELS * voxel_px)).ceil();
+    if !(need.is_finite() && need < 65536.0) {
+        return None;
+    }
+    let need = (need as u32).max(1);
+    (need..=need.max(PROJECT_TEXEL_SIDE)).rev().find(|&s| pixels * (s as u64 * s as u64) <= PROJECT_TEXELS_MAX)
+}
+
+/// The fewest pixels a voxel spacing (the grid's smallest) spans anywhere in `camera`'s view of
+/// `grid`: at the box's farthest corner in a perspective view.
+pub fn least_voxel_pixels(grid: &crate::Grid, camera: &Camera) -> f32 {
+    let spacing = grid.spacing.into_iter().fold(f32::INFINITY, f32::min);
+    let per_unit = camera.pixels_per_unit();
+    if !camera.is_perspective() {
+        return spacing * per_unit;
+    }
+    let [lo, hi] = grid.world_box(glam::Vec3::ZERO, glam::Vec3::from(grid.dims.map(|d| d.max(1) as f32 - 1.0)));
+    let forward = camera.forward();
+    let far = (0..8)
+        .map(|c| glam::Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo))
+        .map(|p| (p - camera.eye).dot(forward))
+        .fold(camera.near, f32::max);
+    spacing * per_unit / far
 }
 
 /// Whether every value the TF table extracts draws (an optical depth above 0 in f32: a tiny
@@ -183,6 +209,8 @@ pub fn texel_bytes(w: u32, h: u32, side: u32) -> u64 {
 /// MIP's and MinIP's texels a pixel side: a voxel within a third of a pixel of a brighter one adds
 /// next to nothing (docs/results-notes.md, "Projection modes").
 pub const PROJECT_TEXEL_SIDE: u32 = 3;
+/// The widest a texel is, in the smallest voxel spacing the view projects (`texel_side`).
+pub const PROJECT_TEXEL_VOXELS: f32 = 0.5;
 /// The most texels a frame holds (64 MiB of claims).
 const PROJECT_TEXELS_MAX: u64 = 1 << 24;
 
@@ -326,7 +354,9 @@ pub fn plan(
         && opts.motion.is_none()
         && !sheets
     {
-        texel_side(w, h).filter(|&s| texel_bytes(w, h, s) * 2 <= available).unwrap_or(0)
+        texel_side(w, h, least_voxel_pixels(prep.set.grid(), camera))
+            .filter(|&s| texel_bytes(w, h, s) * 2 <= available)
+            .unwrap_or(0)
     } else {
         0
     };
