@@ -199,6 +199,10 @@ struct AnimateArgs {
     /// --cpu and --validation apply).
     #[command(flatten)]
     scene: SceneArgs,
+    /// The scene flags given on the command line, a default's value included (an animation
+    /// refuses them: `refuse_scene_flags`).
+    #[arg(skip)]
+    given: Vec<String>,
 }
 
 #[derive(Args)]
@@ -551,7 +555,7 @@ fn animate(a: Box<AnimateArgs>) -> Result<()> {
         eprintln!("{report}\nframes -> {}", a.out_dir.display());
         return Ok(());
     }
-    refuse_scene_flags(&a.scene)?;
+    refuse_scene_flags(&a.scene, &a.given)?;
     let anim = a.anim.as_deref().unwrap_or("rotating-box");
     let anim = if anim.ends_with(".toml") {
         let text = voxsplat::loaders::read_text(std::path::Path::new(anim), anim)?;
@@ -584,16 +588,17 @@ fn animate(a: Box<AnimateArgs>) -> Result<()> {
 
 /// An animation sets its own scene and camera: the scene flags (other than --order, --cpu and
 /// --validation) would be ignored.
-fn refuse_scene_flags(s: &SceneArgs) -> Result<()> {
+fn refuse_scene_flags(s: &SceneArgs, given: &[String]) -> Result<()> {
+    let named = |id: &str| given.iter().any(|g| g == id);
     let given = [
-        (s.scene != "cube60", "--scene"),
+        (named("scene"), "--scene"),
         (s.eye.is_some() || s.target.is_some() || s.up.is_some(), "--eye, --target and --up"),
         (s.fov.is_some() || s.ortho.is_some() || s.near.is_some() || s.far.is_some(), "the projection flags"),
-        (s.size != (512, 512), "--size"),
-        (s.view != "auto", "--view"),
+        (named("size"), "--size"),
+        (named("view"), "--view"),
         (s.tf.is_some() || s.shade || s.no_shade, "--tf and shading"),
         (s.labels.is_some() || !s.channels.is_empty() || !s.channel_tfs.is_empty(), "--labels and --channel"),
-        (s.terrain.is_some() || s.color.is_some() || s.vscale != 1.0 || s.cell != 0.0, "the terrain flags"),
+        (s.terrain.is_some() || s.color.is_some() || named("vscale") || named("cell"), "the terrain flags"),
         (s.series.is_some() || s.level.is_some() || s.time.is_some(), "--series, --level and --time"),
         (s.dense || s.bisect.is_some() || s.gpu_budget_mib.is_some(), "--dense, --bisect and --gpu-budget-mib"),
     ];
@@ -606,7 +611,18 @@ fn refuse_scene_flags(s: &SceneArgs) -> Result<()> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = <Cli as clap::CommandFactory>::command().get_matches();
+    let mut cli = match <Cli as clap::FromArgMatches>::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    if let (Command::Animate(a), Some(("animate", m))) = (&mut cli.command, matches.subcommand()) {
+        a.given = m
+            .ids()
+            .filter(|id| m.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
+            .map(|id| id.to_string())
+            .collect();
+    }
     if let Some(mib) = cli.host_budget_mib {
         voxsplat::set_host_budget(Some(mib.saturating_mul(1 << 20)));
     }

@@ -99,8 +99,9 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value = "crawfis-max", value_parser = ["gaussian", "cubic", "narrow", "crawfis-max"])]
     kernel: String,
     /// Anti-aliasing of distant splats (chapter 3): none, Swan's d/k scaling, or an EWA low-pass.
-    #[arg(long, default_value = "none", value_parser = ["none", "swan", "ewa"])]
-    aa: String,
+    /// [default: none]
+    #[arg(long, value_parser = ["none", "swan", "ewa"])]
+    aa: Option<String>,
     /// Draw the line where the first splat each pixel meets lies at eye distance k (Figs 3.6, 3.7).
     #[arg(long)]
     k_line: bool,
@@ -108,9 +109,10 @@ pub(crate) struct RenderArgs {
     /// front (the default where per-splat footprints go through the graphics or point pipelines).
     #[arg(long, value_parser = ["ftb", "btf"])]
     direction: Option<String>,
-    /// Memory budget for one batch of sheet summation layers, in MiB.
-    #[arg(long, default_value_t = 256)]
-    sheet_budget_mib: u64,
+    /// Memory budget for one batch of sheet summation layers (--composite sheet or slab), in MiB
+    /// [default: 256].
+    #[arg(long)]
+    sheet_budget_mib: Option<u64>,
     /// Render with the ray caster at this step (in voxel spacings) instead of splatting.
     #[arg(long, value_parser = parse_finite, conflicts_with = "truth")]
     raycast: Option<f32>,
@@ -130,11 +132,12 @@ pub(crate) struct RenderArgs {
     timings: bool,
     /// Under mpirun (a build with `--features mpi`): how the ranks' frames are composited,
     /// direct-send, binary-swap (a power of two ranks) or auto (binary-swap from 4 ranks).
-    #[arg(long, default_value = "auto")]
-    compositing: String,
+    #[arg(long)]
+    compositing: Option<String>,
     /// Render the frame this many times and report each stage's median (the first frames pay
     /// one-off costs: allocation, shader compilation on some drivers).
-    #[arg(long, default_value_t = 1, conflicts_with_all = ["raycast", "truth"])]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..),
+        conflicts_with_all = ["raycast", "truth"])]
     repeat: u32,
     /// Print what the frame would draw and how (the raster, the order, the sheet batches, a
     /// volume's memory split and levels of detail) instead of rendering it.
@@ -228,10 +231,25 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     opts.order = order;
     opts.composite = composite;
     opts.kernel = a.kernel.parse::<Kernel>()?;
-    opts.antialias = a.aa.parse::<voxsplat::Antialias>()?;
+    opts.antialias = a.aa.as_deref().unwrap_or("none").parse::<voxsplat::Antialias>()?;
+    if a.aa.is_some() && a.raycast.is_some() {
+        return Err(Error::InvalidArgument(
+            "--aa filters splats' footprints; the ray caster samples along each pixel's rays (--supersample K \
+             averages K x K of them)"
+                .into(),
+        ));
+    }
     opts.direction =
         a.direction.as_deref().map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
-    opts.sheet_budget_bytes = mib_bytes(a.sheet_budget_mib, "--sheet-budget-mib")?;
+    if let Some(mib) = a.sheet_budget_mib {
+        if composite == Composite::Splat || a.raycast.is_some() || a.truth {
+            return Err(Error::InvalidArgument(
+                "--sheet-budget-mib bounds the summation layers of --composite sheet or slab; this frame draws none"
+                    .into(),
+            ));
+        }
+        opts.sheet_budget_bytes = mib_bytes(mib, "--sheet-budget-mib")?;
+    }
     if let Some(t) = a.slab_thickness {
         if composite != Composite::Slab {
             return Err(Error::InvalidArgument(
@@ -263,7 +281,20 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     }
     opts.lod_nodes = a.lod_nodes;
     opts.validate()?;
-    a.compositing.parse::<voxsplat::distributed::Scheme>()?;
+    if let Some(c) = &a.compositing {
+        c.parse::<voxsplat::distributed::Scheme>()?;
+        #[cfg(feature = "mpi")]
+        let launched = voxsplat::distributed::mpi::launched();
+        #[cfg(not(feature = "mpi"))]
+        let launched = false;
+        if !launched {
+            return Err(Error::InvalidArgument(
+                "--compositing picks how the ranks' frames are composited under mpirun (a build with --features \
+                 mpi); this run is one renderer"
+                    .into(),
+            ));
+        }
+    }
     #[cfg(feature = "mpi")]
     if voxsplat::distributed::mpi::launched() {
         if a.plan {
@@ -288,6 +319,13 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
             "{flag}: levels of detail are drawn per splat (--composite splat) from a volume's bricked store; \
              this scene is a classified splat set (a built-in scene, --dense, another order, --truth, --raycast)"
         )));
+    }
+    if a.keep_hidden_bricks && (bricked.is_none() || a.raycast.is_some() || a.truth) {
+        return Err(Error::InvalidArgument(
+            "--keep-hidden-bricks draws a volume's bricked store whole; this frame draws no bricks (a built-in scene, \
+             --dense, another order, --truth or --raycast)"
+                .into(),
+        ));
     }
     let cam = camera_of(&a.scene, set.grid(), &content)?;
     if let voxsplat::Projection::Perspective { fov_y_deg } = cam.projection {
@@ -348,7 +386,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
                 }
                 r.raycast(&cam, &o)?
             }
-            None => median_timings((0..a.repeat.max(1)).map(|_| {
+            None => median_timings((0..a.repeat).map(|_| {
                 let t = std::time::Instant::now();
                 let f = r.render(&cam, &opts);
                 wall.push(t.elapsed().as_secs_f64() * 1e3);
@@ -488,7 +526,7 @@ fn distributed_frames(
         camera_of(&a.scene, &grid, &voxsplat_cli::open::Content { orientation, bounds: None })?;
         let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
         let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing, orientation);
-        let scheme: voxsplat::distributed::Scheme = a.compositing.parse()?;
+        let scheme: voxsplat::distributed::Scheme = a.compositing.as_deref().unwrap_or("auto").parse()?;
         Ok((path, hints, grid, orientation, tf, shading, scheme, renderer_of(&a.scene)?))
     })();
     let (path, hints, grid, orientation, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
@@ -497,7 +535,7 @@ fn distributed_frames(
     let cam = d.agree(camera_of(&a.scene, &grid, &content))?;
     let stored = d.stored_per_rank();
     let mut frames = Vec::new();
-    for _ in 0..a.repeat.max(1) {
+    for _ in 0..a.repeat {
         frames.push(d.render(&cam, opts)?);
     }
     d.agree(report_validation(d.renderer()))?;
@@ -553,12 +591,13 @@ mod tests {
         assert_eq!(a.scene.order.parse::<OrderKind>().unwrap(), d.order);
         assert_eq!(a.composite.parse::<Composite>().unwrap(), d.composite);
         assert_eq!(a.kernel.parse::<Kernel>().unwrap(), d.kernel);
-        assert_eq!(a.aa.parse::<voxsplat::Antialias>().unwrap(), d.antialias);
+        assert_eq!(a.aa, None);
+        assert_eq!(voxsplat::Antialias::None, d.antialias);
         assert_eq!(a.raster.parse::<voxsplat::Raster>().unwrap(), d.raster);
         assert_eq!(a.lod.as_deref().unwrap_or("auto").parse::<voxsplat::Lod>().unwrap(), d.lod);
         assert_eq!((a.lod_pixels, a.lod_error, a.lod_band), (d.lod_pixels, d.lod_error, d.lod_band));
         assert_eq!((a.early_termination, a.render_scale), (d.early_termination, d.render_scale));
-        assert_eq!(mib_bytes(a.sheet_budget_mib, "").unwrap(), d.sheet_budget_bytes);
+        assert_eq!((a.sheet_budget_mib, mib_bytes(256, "").unwrap()), (None, d.sheet_budget_bytes));
         assert_eq!((a.direction.is_none(), d.direction.is_none()), (true, true));
         assert_eq!(a.background, d.background);
         assert_eq!((a.every_voxel, !a.keep_hidden_bricks), (d.every_voxel, d.cull_hidden_bricks));

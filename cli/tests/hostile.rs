@@ -32,7 +32,7 @@ fn bad_values_are_refused_with_a_reason() {
     fails_with(&["render", "--size", "32x32", "--raycast", "0.000001", "--cpu", "--out", out], "max_steps");
     fails_with(&["render", "--size", "32x32", "--ortho", "1e-7", "--out", out], "f32 cannot resolve");
     fails_with(&["render", "--size", "32x32", "--eye", "0,0,1e30", "--out", out], "within 1e15");
-    fails_with(&["render", "--sheet-budget-mib", "17592186044416", "--out", out], "overflows");
+    fails_with(&["render", "--composite", "sheet", "--sheet-budget-mib", "17592186044416", "--out", out], "overflows");
     fails_with(&["render", "--gpu-budget-mib", "0", "--out", out], "must be positive");
     let dem = data("rmnp/rmnp-dem.tif");
     fails_with(&["render", "--terrain", &dem, "--vscale", "1e30", "--out", out], "lower --vscale");
@@ -220,6 +220,81 @@ fn metre_scale_spacing_frames_the_object_as_any_other() {
 /// Issue 44: flags that cannot apply are refused, not silently ignored: what describes a --volume
 /// file given with a built-in scene or a terrain, --slab-thickness without slabs, and make-volume
 /// writing NRRD bytes under another extension.
+#[test]
+fn flags_that_were_silently_ignored_are_refused() {
+    // Issue 76's hostile run: each of these drew (exit 0) as if the flag were not there.
+    let out = tmp("ignored.png");
+    let o = out.to_str().unwrap();
+    let stent = data("stent/stent.nrrd");
+    for (args, needle) in [
+        (vec!["render", "--repeat", "0"], "--repeat"),
+        (vec!["render", "--sheet-budget-mib", "64"], "--sheet-budget-mib bounds the summation layers"),
+        (vec!["render", "--volume", &stent, "--raycast", "0.5", "--aa", "swan"], "--aa filters splats"),
+        (vec!["render", "--volume", &stent, "--raycast", "0.5", "--aa", "none"], "--aa filters splats"),
+        (vec!["render", "--volume", &stent, "--dense", "--keep-hidden-bricks"], "--keep-hidden-bricks draws"),
+        (vec!["render", "--compositing", "direct-send"], "--compositing picks how the ranks"),
+    ] {
+        fails_with(&[&args[..], &["--size", "32x32", "--out", o]].concat(), needle);
+    }
+    // A flag given at its default's value is still given: an animation sets its own scene and view.
+    let dir = tmp("anim-flags");
+    for flag in [["--scene", "cube60"], ["--size", "512x512"], ["--view", "auto"]] {
+        let args = [&["animate", "--anim", "rotating-box", "--out-dir", dir.to_str().unwrap()][..], &flag[..]].concat();
+        fails_with(&args, flag[0]);
+    }
+    assert!(!dir.join("frame0000.png").exists(), "refused before a frame");
+    // What does apply still runs.
+    for args in [
+        vec!["render", "--composite", "sheet", "--sheet-budget-mib", "64"],
+        vec!["render", "--volume", &stent, "--keep-hidden-bricks", "--aa", "swan"],
+        vec!["render", "--repeat", "2"],
+    ] {
+        let run = voxsplat(&[&args[..], &["--size", "32x32", "--out", o]].concat());
+        assert!(run.status.success(), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
+    }
+}
+
+#[test]
+fn bench_compare_refuses_reports_that_cannot_be_compared() {
+    let report = |cases: &str| {
+        format!(
+            r#"{{"suite": 1, "quick": false, "validation": false, "warmup": 1, "frames": 3, "score": 1.0,
+            "score_noise": 0.01, "skipped": [], "platform": {{"voxsplat": "0", "commit": "x", "device": "d",
+            "kind": "cpu", "driver": "v", "api": "1.3", "host_cpus": 2}},
+            "cases": [{cases}]}}"#
+        )
+    };
+    let case = |name: &str, fps: f64| {
+        format!(
+            r#"{{"name": "{name}", "size": [64, 64], "frames": 3, "median_ms": 10.0, "min_ms": 9.0, "max_ms": 11.0,
+            "spread": 0.05, "stages_ms": 9.0, "fps": {fps}, "splats": 10, "nodes": 0, "msplats_per_s": 1.0,
+            "device_mib": 1.0, "host_peak_mib": 1.0, "psnr_db": null, "load_s": 0.0, "raster": "compute"}}"#
+        )
+    };
+    let write = |name: &str, text: String| {
+        let p = tmp(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let good = write("good.json", report(&case("cube60", 100.0)));
+    let run = voxsplat(&["bench", "--compare", &good, &good]);
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success() && text.contains("B/A 1.000x"),
+        "the fixture is a report: {text}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for (name, text, needle) in [
+        ("negative.json", report(&case("cube60", -3.7)), "fps is -3.7"),
+        ("zero.json", report(&case("cube60", 0.0)), "fps is 0"),
+        ("twice.json", report(&[case("cube60", 100.0), case("cube60", 50.0)].join(",")), "appears twice"),
+        ("other.json", report(&case("motion", 100.0)), "share no case"),
+    ] {
+        let bad = write(name, text);
+        fails_with(&["bench", "--compare", &good, &bad], needle);
+    }
+}
+
 #[test]
 fn flags_that_cannot_apply_are_refused() {
     let out = tmp("flags.png");

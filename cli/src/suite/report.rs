@@ -217,8 +217,30 @@ impl Report {
     /// Read a report written by `write_json`.
     pub fn read_json(path: &Path) -> Result<Self> {
         let text = voxsplat::loaders::read_text(path, "a benchmark report")?;
-        serde_json::from_str(&text)
-            .map_err(|e| Error::InvalidArgument(format!("{}: not a voxsplat bench report: {e}", path.display())))
+        let report: Self = serde_json::from_str(&text)
+            .map_err(|e| Error::InvalidArgument(format!("{}: not a voxsplat bench report: {e}", path.display())))?;
+        report.check().map_err(|why| Error::InvalidArgument(format!("{}: {why}", path.display())))?;
+        Ok(report)
+    }
+
+    /// What a report `voxsplat bench` wrote holds: each case once, its frame rate and times
+    /// positive and finite, its spread finite and not negative (a ratio of such reports is one).
+    fn check(&self) -> std::result::Result<(), String> {
+        for (i, c) in self.cases.iter().enumerate() {
+            let case = format!("case {} ({}x{})", c.name, c.size[0], c.size[1]);
+            for (field, v) in [("fps", c.fps), ("median_ms", c.median_ms)] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(format!("{case}: {field} is {v}; a measured case has a positive, finite {field}"));
+                }
+            }
+            if !(c.spread.is_finite() && c.spread >= 0.0) {
+                return Err(format!("{case}: spread is {}; a spread is finite and not negative", c.spread));
+            }
+            if self.cases[..i].iter().any(|d| d.name == c.name && d.size == c.size) {
+                return Err(format!("{case} appears twice; a report holds each case once"));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -263,6 +285,11 @@ pub fn compare(a: &Report, b: &Report) -> Result<String> {
     }
     for cb in b.cases.iter().filter(|c| !a.cases.iter().any(|x| x.name == c.name && x.size == c.size)) {
         let _ = writeln!(s, "{:<11} only in B", cb.name);
+    }
+    if common.is_empty() {
+        return Err(Error::InvalidArgument(
+            "the two reports share no case (name and size): nothing to compare; run the same suite on both".into(),
+        ));
     }
     let (sa, na) = score(&common.iter().map(|c| c.0.clone()).collect::<Vec<_>>());
     let (sb, nb) = score(&common.iter().map(|c| c.1.clone()).collect::<Vec<_>>());
