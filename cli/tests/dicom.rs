@@ -618,3 +618,21 @@ fn a_deflated_data_set_reads_as_pydicom_reads_it() {
     assert!(e.contains("a.dcm") && e.contains("deflated data set"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A Rescale Slope of 0 (pydicom writes it) maps every stored value to the intercept: it drew a
+/// constant volume and an empty frame; now refused naming the file and the field.
+#[test]
+fn a_rescale_slope_of_0_is_refused_by_name() {
+    let ct = pydicom_tests().join("98892001/CT5N");
+    let copy = tmp("ct-slope0");
+    let _ = std::fs::remove_dir_all(&copy);
+    std::fs::create_dir_all(&copy).unwrap();
+    python(
+        "import pydicom, pathlib\nfor f in sorted(pathlib.Path('{}').iterdir()):\n    d = pydicom.dcmread(f)\n    \
+         d.RescaleSlope = 0\n    d.save_as(pathlib.Path('{}') / f.name)",
+        &[&ct, &copy],
+    );
+    let e = load_volume(&copy, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("Rescale Slope is 0") && e.contains(copy.to_str().unwrap()), "{e}");
+    let _ = std::fs::remove_dir_all(&copy);
+}

@@ -8,6 +8,7 @@ mod coverage;
 mod dicom;
 mod distributed;
 mod family;
+mod foreign;
 mod hostile;
 mod orientation;
 mod peer;

@@ -143,10 +143,14 @@ fn plane(
         }
     };
     // RT Dose stores its values scaled: Dose Grid Scaling, where no Rescale Slope is given.
-    let slope = match slope.element_opt(tags::RESCALE_SLOPE).ok().flatten() {
-        Some(_) => scalar(slope, tags::RESCALE_SLOPE, 1.0, "Rescale Slope")?,
-        None => scalar(slope, tags::DOSE_GRID_SCALING, 1.0, "Dose Grid Scaling")?,
+    let (slope, name) = match slope.element_opt(tags::RESCALE_SLOPE).ok().flatten() {
+        Some(_) => (scalar(slope, tags::RESCALE_SLOPE, 1.0, "Rescale Slope")?, "Rescale Slope"),
+        None => (scalar(slope, tags::DOSE_GRID_SCALING, 1.0, "Dose Grid Scaling")?, "Dose Grid Scaling"),
     };
+    // A slope of 0 maps every stored value to the intercept: a constant volume, an empty frame.
+    if slope == 0.0 {
+        return Err(bad(what, format!("{name} is 0: every stored value would read as one value (a slope is not 0)")));
+    }
     Ok(Image {
         path: PathBuf::new(),
         position: DVec3::ZERO,

@@ -191,9 +191,34 @@ pub(super) fn nrrd_header(bytes: &[u8], what: &str, limit: u64) -> Result<NrrdHe
             }
         }
     }
-    for (i, t) in spacings.iter().take(3).enumerate() {
-        if let Ok(s) = t.parse::<f32>() {
-            spacing[i] = s;
+    // Plain numbers, one per axis: a unit ('2mm') or a comma ('2,3,4') read as spacing 1 before.
+    if !spacings.is_empty() {
+        let line = spacings.join(" ");
+        if spacings.len() != sizes.len() {
+            return Err(bad(
+                what,
+                format!(
+                    "spacings '{line}' holds {} values for {} axes (numbers apart by spaces)",
+                    spacings.len(),
+                    sizes.len()
+                ),
+            ));
+        }
+        for (i, t) in spacings.iter().enumerate() {
+            spacing[i] = t.parse::<f32>().map_err(|_| {
+                bad(what, format!("spacings '{line}': '{t}' is not a number (units belong in 'space units')"))
+            })?;
+        }
+    }
+    // `space dimension` with `space directions` and no named space: no anatomical frame, but the
+    // directions' lengths are the spacing (it was left at 1).
+    if let (None, Some(d)) = (&space, &directions) {
+        let vectors: Vec<&str> = d.split_whitespace().filter(|t| *t != "none").collect();
+        if vectors.len() != sizes.len() {
+            return Err(bad(what, format!("space directions '{d}': {} vectors expected", sizes.len())));
+        }
+        for (i, v) in vectors.iter().enumerate() {
+            spacing[i] = nrrd_vector(v, what)?.length() as f32;
         }
     }
     let mut d3 = [1u64; 3];
