@@ -57,3 +57,44 @@ fn nrrd_spacing_is_read_from_space_directions_and_malformed_spacings_are_refused
         assert!(e.contains(says) && e.contains(p.to_str().unwrap()), "{name}: {e}");
     }
 }
+
+#[test]
+fn tiff_stacks_keep_their_units_and_refuse_packed_bits_and_mixed_sample_types() {
+    // tifffile's OME-TIFF with x and y in mm and z in nm: z was drawn 10^6 times too long.
+    let ome = tmp("units.ome.tif");
+    python(
+        "import tifffile, numpy as np\ntifffile.imwrite('{}', np.full((3, 4, 5), 9, np.uint8), metadata={'axes': 'ZYX', \
+         'PhysicalSizeX': 0.5, 'PhysicalSizeXUnit': 'mm', 'PhysicalSizeY': 0.25, 'PhysicalSizeYUnit': 'mm', \
+         'PhysicalSizeZ': 2000, 'PhysicalSizeZUnit': 'nm'})",
+        &[&ome],
+    );
+    let v = load_volume(&ome, &VolumeHints::default()).unwrap();
+    assert_eq!(v.dims, [5, 4, 3]);
+    let want = [0.5, 0.25, 0.002];
+    assert!(v.spacing.iter().zip(want).all(|(s, w)| (s - w).abs() < 1e-6 * w), "{:?}", v.spacing);
+    // No unit named: OME's µm for each, as before.
+    let plain = tmp("plain.ome.tif");
+    python(
+        "import tifffile, numpy as np\ntifffile.imwrite('{}', np.full((3, 4, 5), 9, np.uint8), metadata={'axes': 'ZYX', \
+         'PhysicalSizeX': 0.5, 'PhysicalSizeY': 0.25, 'PhysicalSizeZ': 2.0})",
+        &[&plain],
+    );
+    assert_eq!(load_volume(&plain, &VolumeHints::default()).unwrap().spacing, [0.5, 0.25, 2.0]);
+    // A 1-bit mask (tifffile writes bool as bilevel): read a byte a sample past the strip before.
+    let mask = tmp("mask.tif");
+    python("import tifffile, numpy as np\ntifffile.imwrite('{}', np.indices((3, 32, 32)).sum(0) % 2 == 0)", &[&mask]);
+    let e = load_volume(&mask, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("1-bit samples") && e.contains(mask.to_str().unwrap()), "{e}");
+    // A folder of 8- and 16-bit slices: the 8-bit ones sat at 0.4 % of the range before.
+    let dir = tmp("mixed");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    python(
+        "import tifffile, numpy as np\nfor i in range(3):\n    \
+         tifffile.imwrite('{}/s%d.tif' % i, np.full((4, 5), 200, np.uint8 if i == 1 else np.uint16))",
+        &[&dir],
+    );
+    let e = load_volume(&dir, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("s1.tif") && e.contains("8-bit samples") && e.contains("16-bit"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

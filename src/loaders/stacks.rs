@@ -18,7 +18,8 @@ enum Slices {
     /// A multipage TIFF and the decoder at its current page (opened again to go back).
     Pages { path: PathBuf, at: Option<(Decoder<BufReader<std::fs::File>>, u32)> },
     /// One image a slice, in order.
-    Files(Vec<PathBuf>),
+    /// The files, and the first one's sample type (`read_image`), which every slice shares.
+    Files(Vec<PathBuf>, &'static str),
     /// A DICOM series, its images in order along their normal.
     Dicom(super::dicom::Series),
 }
@@ -142,7 +143,12 @@ fn decoder(path: &Path, what: &str) -> Result<Decoder<BufReader<std::fs::File>>>
 fn page_size(dec: &mut Decoder<BufReader<std::fs::File>>, page: u32, what: &str) -> Result<(u32, u32)> {
     let size = dec.dimensions().map_err(|e| bad(what, format!("tiff page {page}: {e}")))?;
     match dec.colortype().map_err(|e| bad(what, format!("tiff page {page}: {e}")))? {
-        tiff::ColorType::Gray(_) => Ok(size),
+        tiff::ColorType::Gray(8 | 16 | 32 | 64) => Ok(size),
+        // The tiff crate reads packed samples a byte each, past the strip: garbage before.
+        tiff::ColorType::Gray(bits) => Err(bad(
+            what,
+            format!("tiff page {page} holds {bits}-bit samples: 8, 16, 32 and 64-bit samples are read (save the mask as 8-bit)"),
+        )),
         other => Err(bad(what, format!("tiff page {page} is {other:?}: a volume's slices are single-channel images"))),
     }
 }
@@ -175,7 +181,7 @@ fn one_volume(dec: &mut Decoder<BufReader<std::fs::File>>, what: &str) -> Result
 
 /// Spacing from a TIFF's description: ImageJ's `spacing=` (z; x and y from the resolution tags,
 /// pixels per unit) or OME-TIFF's `PhysicalSizeX/Y/Z`.
-fn tiff_spacing(dec: &mut Decoder<BufReader<std::fs::File>>) -> [f32; 3] {
+fn tiff_spacing(dec: &mut Decoder<BufReader<std::fs::File>>) -> std::result::Result<[f32; 3], String> {
     let mut s = [1.0f32; 3];
     let description = dec.get_tag_ascii_string(Tag::ImageDescription).unwrap_or_default();
     let number = |key: &str| -> Option<f32> {
@@ -197,13 +203,40 @@ fn tiff_spacing(dec: &mut Decoder<BufReader<std::fs::File>>) -> [f32; 3] {
             }
         }
     } else if description.contains("<OME") {
-        for (axis, key) in ["PhysicalSizeX=", "PhysicalSizeY=", "PhysicalSizeZ="].iter().enumerate() {
-            if let Some(v) = number(key) {
-                s[axis] = v;
+        // Each size in its own unit (µm when none is named), turned into X's: a z in nm beside an
+        // x in mm drew 10^6 times too long.
+        let unit = |key: &str| -> std::result::Result<f64, String> {
+            let Some(at) = description.find(key) else { return Ok(1e-6) };
+            let rest = description[at + key.len()..].trim_start_matches('"');
+            let name = &rest[..rest.find('"').unwrap_or(rest.len())];
+            metres(name).ok_or_else(|| {
+                format!("{}{name}: the units read are m, cm, mm, µm, nm, pm and Å", &key[..key.len() - 1])
+            })
+        };
+        let mut first = None;
+        for (axis, key) in ["PhysicalSizeX", "PhysicalSizeY", "PhysicalSizeZ"].iter().enumerate() {
+            if let Some(v) = number(&format!("{key}=")) {
+                let u = unit(&format!("{key}Unit="))?;
+                let base = *first.get_or_insert(u);
+                s[axis] = (v as f64 * u / base) as f32;
             }
         }
     }
-    s
+    Ok(s)
+}
+
+/// Metres in one of OME's length units.
+fn metres(unit: &str) -> Option<f64> {
+    Some(match unit {
+        "m" => 1.0,
+        "cm" => 1e-2,
+        "mm" => 1e-3,
+        "\u{b5}m" | "\u{3bc}m" | "um" => 1e-6,
+        "nm" => 1e-9,
+        "pm" => 1e-12,
+        "Å" | "A" => 1e-10,
+        _ => return None,
+    })
 }
 
 /// A decoded image's samples as f32, refused unless it is one channel of `w` x `h`.
@@ -257,7 +290,7 @@ impl Stack {
         let mut dec = decoder(path, &what)?;
         let (w, h) = page_size(&mut dec, 0, &what)?;
         one_volume(&mut dec, &what)?;
-        let spacing = tiff_spacing(&mut dec);
+        let spacing = tiff_spacing(&mut dec).map_err(|why| bad(&what, why))?;
         let mut pages = 1u32;
         while dec.more_images() {
             if pages == MAX_PAGES {
@@ -302,7 +335,7 @@ impl Stack {
         let first = read_image(&files[0])?;
         let (w, h) = (first.1, first.2);
         let depth = u32::try_from(files.len()).map_err(|_| bad(&what, "too many slices"))?;
-        Self::sized(Slices::Files(files), [w, h, depth], [1.0; 3], what)
+        Self::sized(Slices::Files(files, first.3), [w, h, depth], [1.0; 3], what)
     }
 
     /// A DICOM series: a folder of one (or `pick`: its index or UID), or one file of its series,
@@ -345,13 +378,21 @@ impl Stack {
                     samples(image, w, h, &format!("{} page {z}", self.what))?
                 }
                 Slices::Dicom(series) => series.slice(z)?,
-                Slices::Files(files) => {
-                    let (values, fw, fh) = read_image(&files[z as usize])?;
+                Slices::Files(files, kind) => {
+                    let (values, fw, fh, k) = read_image(&files[z as usize])?;
+                    let first = files[0].display();
                     if (fw, fh) != (w, h) {
-                        let first = files[0].display();
                         return Err(bad(
                             &files[z as usize].display().to_string(),
                             format!("{fw} x {fh}, {first} {w} x {h}"),
+                        ));
+                    }
+                    // 8-bit slices beside 16-bit ones sat at 0.4 % of the range: one volume's
+                    // slices share a sample type.
+                    if k != *kind {
+                        return Err(bad(
+                            &files[z as usize].display().to_string(),
+                            format!("{k} samples, {first} {kind}: a folder's slices share one sample type"),
                         ));
                     }
                     values
@@ -363,15 +404,27 @@ impl Stack {
     }
 }
 
-/// One single-channel 2-D image (PNG, or a TIFF's first page): its samples and size.
-fn read_image(path: &Path) -> Result<(Vec<f32>, u32, u32)> {
+/// One single-channel 2-D image (PNG, or a TIFF's first page): its samples, size and sample type.
+fn read_image(path: &Path) -> Result<(Vec<f32>, u32, u32, &'static str)> {
     let what = path.display().to_string();
     let name = super::lower_name(path);
     if name.ends_with(".tif") || name.ends_with(".tiff") {
         let mut dec = decoder(path, &what)?;
         let (w, h) = page_size(&mut dec, 0, &what)?;
         let image = dec.read_image().map_err(|e| bad(&what, format!("tiff: {e}")))?;
-        return Ok((samples(image, w, h, &what)?, w, h));
+        use DecodingResult as D;
+        let kind = match &image {
+            D::U8(_) => "8-bit",
+            D::U16(_) => "16-bit",
+            D::I8(_) => "signed 8-bit",
+            D::I16(_) => "signed 16-bit",
+            D::U32(_) => "32-bit",
+            D::I32(_) => "signed 32-bit",
+            D::F32(_) => "float32",
+            D::F64(_) => "float64",
+            _ => "64-bit integer",
+        };
+        return Ok((samples(image, w, h, &what)?, w, h, kind));
     }
     let mut reader = image::ImageReader::open(path).map_err(io(path))?.with_guessed_format().map_err(io(path))?;
     let mut limits = image::Limits::default();
@@ -379,14 +432,14 @@ fn read_image(path: &Path) -> Result<(Vec<f32>, u32, u32)> {
     reader.limits(limits);
     let img = reader.decode().map_err(|e| bad(&what, e))?;
     let (w, h) = (img.width(), img.height());
-    let values: Vec<f32> = match img {
-        image::DynamicImage::ImageLuma8(i) => i.pixels().map(|p| p[0] as f32).collect(),
-        image::DynamicImage::ImageLuma16(i) => i.pixels().map(|p| p[0] as f32).collect(),
+    let (values, kind): (Vec<f32>, _) = match img {
+        image::DynamicImage::ImageLuma8(i) => (i.pixels().map(|p| p[0] as f32).collect(), "8-bit"),
+        image::DynamicImage::ImageLuma16(i) => (i.pixels().map(|p| p[0] as f32).collect(), "16-bit"),
         other => {
             return Err(bad(&what, format!("{:?}: a volume's slices are single-channel (grey) images", other.color())))
         }
     };
-    Ok((values, w, h))
+    Ok((values, w, h, kind))
 }
 
 /// The first image of a TIFF as heights (u8, u16, i16, u32, f32), within `MAX_VOXELS`.
