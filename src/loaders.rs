@@ -277,8 +277,8 @@ pub fn nifti_from_bytes(bytes: &[u8], what: &str) -> Result<ScalarVolume> {
 /// The error for a series of several time points read as one volume.
 pub(crate) fn several_times(what: &str, times: u32) -> Error {
     Error::InvalidArgument(format!(
-        "{what} holds {times} time points: pick one with --time N (VolumeHints::time), or play them all with \
-         voxsplat animate"
+        "{what} holds {times} time points: pick one with --time N, or play them all with \
+         voxsplat animate --volume"
     ))
 }
 
@@ -296,8 +296,8 @@ pub(crate) fn time_point(what: &str, times: u32, time: Option<u32>) -> Result<u3
 /// The error for a file of several channels read as one volume.
 pub(crate) fn several_channels(what: &str, channels: u32) -> Error {
     Error::InvalidArgument(format!(
-        "{what} holds {channels} channels: read them with loaders::load_channels (voxsplat render --channel-tf for \
-         each channel after the first)"
+        "{what} holds {channels} channels: draw them together with voxsplat render and one --channel-tf for \
+         each channel after the first (the library: load_channels)"
     ))
 }
 

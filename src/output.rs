@@ -183,6 +183,9 @@ pub fn read_image(path: &Path) -> Result<ImageF32> {
     let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     match ext.as_deref() {
         Some("png") => {
+            // The decoded image (up to 8 bytes a pixel) and its floats, within the host budget.
+            let (w, h) = image::image_dimensions(path).map_err(|e| bad(e.to_string()))?;
+            crate::error::check_host_memory(w as u64 * h as u64 * 24, &format!("reading {name} ({w}x{h})"))?;
             let img = decode(path)?;
             let (width, height) = (img.width(), img.height());
             let premultiplied = |p: [f32; 4]| [p[0] * p[3], p[1] * p[3], p[2] * p[3], p[3]];
@@ -205,6 +208,10 @@ pub fn read_image(path: &Path) -> Result<ImageF32> {
             if size.0 as u64 * size.1 as u64 > MAX_PIXELS {
                 return Err(bad(format!("{}x{} exceeds the pixel limit", size.0, size.1)));
             }
+            crate::error::check_host_memory(
+                size.0 as u64 * size.1 as u64 * 16,
+                &format!("reading {name} ({}x{})", size.0, size.1),
+            )?;
             let image = exr::prelude::read_first_rgba_layer_from_file(
                 path,
                 |res, _| ImageF32::new(res.width() as u32, res.height() as u32),

@@ -18,6 +18,7 @@ fn fails_with(args: &[&str], needle: &str) -> String {
     let err = String::from_utf8_lossy(&out.stderr).to_string();
     assert_eq!(out.status.code(), Some(2), "{args:?} should fail: {err}");
     assert!(err.contains(needle) && !err.contains("panicked"), "{args:?}: {err}");
+    cmd::assert_user_words(&err);
     err
 }
 
@@ -334,8 +335,16 @@ fn the_host_budget_refuses_before_allocating() {
     // The bricked store costs what the volume holds (bonsai's records: 13 MiB), checked as it grows.
     fails_with(
         &["render", "--volume", &bonsai, "--size", "32x32", "--out", o, "--host-budget-mib", "8"],
-        "for its records, past the host budget of 8 MiB",
+        "for its records and the next slab, past the host budget of 8 MiB",
     );
+    // Two frames compared: each image's decoded bytes and floats are checked from its header (two
+    // 8000x8000 PNGs took 2.3 GB within a budget of 10 MiB).
+    let big = tmp("big.png");
+    image::RgbaImage::new(3000, 3000).save(&big).unwrap();
+    let big = big.to_str().unwrap();
+    fails_with(&["compare", big, big, "--host-budget-mib", "10"], "reading");
+    let run = voxsplat(&["compare", big, big, "--host-budget-mib", "400"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     for (args, needle) in [
         (vec!["render", "--scene", "cube40", "--size", "8192x8192", "--out", o], "a 8192x8192 frame may need"),
         (

@@ -233,8 +233,9 @@ impl BrickStore {
             let records = store.records.len() as u64 * 4;
             if let Some(b) = crate::error::host_budget().filter(|&b| fixed + records + slab_voxels * 4 > b) {
                 return Err(Error::TooLarge(format!(
-                    "{what} needs more than {} MiB of host memory for its records, past the host budget of {} MiB",
-                    (fixed + records) >> 20,
+                    "{what} needs more than {} MiB of host memory for its records and the next slab, past the host \
+                     budget of {} MiB",
+                    (fixed + records + slab_voxels * 4).div_ceil(1 << 20),
                     b >> 20
                 )));
             }

@@ -496,8 +496,9 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
                 bad(
                     what,
                     format!(
-                        "{gap}: resampled at its smallest gap it would take over {} slices per image; read it as \
-                         a rectilinear grid (VolumeHints::rectilinear and loaders::file_positions; voxsplat render does)",
+                        "{gap}: resampled at its smallest gap it would take over {} slices per image; draw it as \
+                         a rectilinear grid at its slices' positions, as voxsplat render does (the library: the \
+                         rectilinear volume hint)",
                         resample::MAX_GROWTH
                     ),
                 )

@@ -20,7 +20,14 @@ pub fn refused(args: &[&str]) -> String {
     let text = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(!out.status.success() && text.starts_with("error:"), "voxsplat {args:?} should fail: {text}");
     assert!(!text.contains("panicked"), "{text}");
+    assert_user_words(&text);
     text
+}
+
+/// A message a command prints names no Rust path (`loaders::load_channels`, `VolumeHints::time`):
+/// the user's words, flags and files only.
+pub fn assert_user_words(text: &str) {
+    assert!(!text.contains("::"), "a Rust path in a message: {text}");
 }
 
 /// `voxsplat compare A B`'s PSNR in dB over the covered pixels (infinite for equal images).
