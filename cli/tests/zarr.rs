@@ -220,7 +220,27 @@ fn broken_images_are_refused_by_file_and_field() {
     let l1 = load_volume(&dir, &level(1)).unwrap();
     assert_eq!((l1.dims, l1.spacing), ([6, 5, 4], [2.0; 3]));
     type Break = fn(&Path);
-    let cases: [(&str, Break, &str); 11] = [
+    let cases: [(&str, Break, &str); 12] = [
+        (
+            // Issue 76: a 24 KB image declaring 2048^3 with no chunk ran for minutes in `info`.
+            "no chunk stored",
+            |d| {
+                std::fs::remove_dir_all(d.join("0")).unwrap();
+                std::fs::create_dir_all(d.join("0")).unwrap();
+                let zarray = r#"{"zarr_format": 2, "shape": [2048, 2048, 2048], "chunks": [64, 64, 64],
+                    "dtype": "<u2", "compressor": null, "fill_value": 0, "order": "C", "filters": null,
+                    "dimension_separator": "/"}"#;
+                std::fs::write(d.join("0/.zarray"), zarray).unwrap();
+                std::fs::remove_dir_all(d.join("1")).unwrap();
+                edit(
+                    &d.join(".zattrs"),
+                    r#",
+            {"path": "1", "coordinateTransformations": [{"type": "scale", "scale": [2, 2, 2]}]}"#,
+                    "",
+                );
+            },
+            "stores no chunk: every voxel is the array's fill value",
+        ),
         (
             "truncated chunk",
             |d| std::fs::write(d.join("0/1/1/2"), [0u8; 17]).unwrap(),
