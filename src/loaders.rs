@@ -635,7 +635,13 @@ pub(crate) fn check_finite(values: &[f32], what: &str) -> Result<()> {
 /// as `check_finite` requires of volumes).
 pub fn load_heights(path: &Path) -> Result<HeightGrid> {
     let grid = load_height_file(path)?;
-    check_finite(&grid.heights, &path.display().to_string())?;
+    // NaN is a GeoTIFF's no-data cell (a hole in the terrain); infinities are refused.
+    if let Some(v) = grid.heights.iter().find(|v| v.is_infinite()) {
+        return Err(bad(&path.display().to_string(), format!("a height of {v}: heights are finite")));
+    }
+    if grid.heights.iter().all(|v| v.is_nan()) {
+        return Err(bad(&path.display().to_string(), "no cell has a height (every one is no-data or NaN)"));
+    }
     Ok(grid)
 }
 

@@ -10,6 +10,8 @@ const SPLAT_HOST_BYTES: u64 = 2 * std::mem::size_of::<crate::gpu_types::Splat>()
 
 /// Most height levels a terrain may span.
 pub const MAX_LEVELS: u32 = 4096;
+/// The level of a cell without a height (a hole: no column).
+const HOLE: u32 = u32::MAX;
 
 #[derive(Clone, Debug)]
 /// How a height grid becomes voxel columns.
@@ -77,12 +79,16 @@ pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet>
             opts.vscale
         )));
     }
+    // A cell without a height (NaN: a GeoTIFF's no-data value) is a hole: no column.
     let level_of = |v: f32| -> u32 {
-        let v = if v.is_finite() { v } else { hmin };
-        ((v - hmin) / cell * opts.vscale).round().max(0.0) as u32
+        if v.is_finite() {
+            ((v - hmin) / cell * opts.vscale).round().max(0.0) as u32
+        } else {
+            HOLE
+        }
     };
     let levels: Vec<u32> = h.heights.iter().map(|&v| level_of(v)).collect();
-    let nz = levels.iter().max().copied().unwrap_or(0) + 1;
+    let nz = levels.iter().filter(|&&l| l != HOLE).max().copied().unwrap_or(0) + 1;
     if nz > MAX_LEVELS {
         return Err(Error::TooLarge(format!("{nz} height levels exceed {MAX_LEVELS}: lower --vscale")));
     }
@@ -92,9 +98,17 @@ pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet>
     };
     // Column (x, r)'s lowest and highest level: its top, down to one above its lowest neighbour
     // when gaps are filled.
+    // A hole's column is empty (bottom above top); a hole beside a column does not lower it.
     let column = |x: i64, r: i64| -> (u32, u32) {
         let top = at(x, r);
-        let lowest = [at(x - 1, r), at(x + 1, r), at(x, r - 1), at(x, r + 1)].into_iter().min().unwrap_or(top);
+        if top == HOLE {
+            return (1, 0);
+        }
+        let lowest = [at(x - 1, r), at(x + 1, r), at(x, r - 1), at(x, r + 1)]
+            .into_iter()
+            .filter(|&l| l != HOLE)
+            .min()
+            .unwrap_or(top);
         (if opts.fill_gaps { top.min(lowest + 1) } else { top }, top)
     };
     let height = |x: i64, r: i64| -> f32 {
@@ -112,7 +126,7 @@ pub fn terrain_splats(h: &HeightGrid, opts: &TerrainOptions) -> Result<SplatSet>
         .flat_map(|r| (0..w as i64).map(move |x| (x, r)))
         .map(|(x, r)| {
             let (bottom, top) = column(x, r);
-            (top - bottom + 1) as u64
+            (top + 1).saturating_sub(bottom) as u64
         })
         .sum();
     if voxels > MAX_SPLATS as u64 {

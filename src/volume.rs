@@ -473,7 +473,8 @@ pub struct ScalarVolume {
     pub values: Vec<f32>,
 }
 
-/// A height grid: `width` × `rows` heights, row 0 first (north for the DEMs here).
+/// A height grid: `width` × `rows` heights, row 0 first (north for the DEMs here); a NaN height
+/// is a cell without one (a GeoTIFF no-data cell), drawn as a hole.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeightGrid {
     /// Heights across.

@@ -98,3 +98,42 @@ fn tiff_stacks_keep_their_units_and_refuse_packed_bits_and_mixed_sample_types() 
     assert!(e.contains("s1.tif") && e.contains("8-bit samples") && e.contains("16-bit"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn geotiff_no_data_cells_are_holes_not_heights() {
+    // A hill of 0..90 m in a 40 x 30 grid whose border is GDAL's no-data -9999 (tifffile writes the
+    // tag as GDAL does): the border was drawn at -9999, the hill a flat slab 10^4 m above it.
+    let dem = tmp("hill.tif");
+    python(
+        "import tifffile, numpy as np\ny, x = np.mgrid[:30, :40]\nh = (90 * np.exp(-((x - 20) ** 2 + (y - 15) ** 2) / 60))\
+         .astype(np.float32)\nh[:3, :] = -9999\nh[:, :2] = -9999\ntifffile.imwrite('{}', h, \
+         extratags=[(42113, 's', 0, '-9999', True)])",
+        &[&dem],
+    );
+    let h = voxsplat::loaders::load_heights(&dem).unwrap();
+    let holes = h.heights.iter().filter(|v| v.is_nan()).count();
+    assert_eq!(holes, 3 * 40 + 27 * 2, "the no-data cells");
+    let fine = h.heights.iter().filter(|v| v.is_finite()).fold(f32::MAX, |a, &b| a.min(b));
+    assert!(fine >= 0.0, "the lowest height is the hill's: {fine}");
+    let opts = voxsplat::terrain::TerrainOptions { cell: 1.0, ..Default::default() };
+    let set = voxsplat::terrain::terrain_splats(&h, &opts).unwrap();
+    // The hill's relief, not 10^4 levels; no column where there is no height.
+    assert!(set.grid().dims[2] <= 92, "{:?}", set.grid().dims);
+    let rows = set.grid().dims[1];
+    for s in set.splats() {
+        let [i, j] = [s.ijk[0], rows - 1 - s.ijk[1]];
+        assert!(j >= 3 && i >= 2, "a column at the no-data cell ({i}, {j})");
+    }
+    // Drawn: the hill covers pixels.
+    let out = tmp("hill.png");
+    let run = cmd::voxsplat(&[
+        "render",
+        "--terrain",
+        dem.to_str().unwrap(),
+        "--size",
+        "64x48",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+}

@@ -452,6 +452,15 @@ pub fn tiff_heights(bytes: &[u8], what: &str) -> Result<super::HeightGrid> {
         .with_limits(limits);
     let (w, h) = dec.dimensions().map_err(|e| bad(what, format!("tiff: {e}")))?;
     super::voxel_count(&[w as u64, h as u64], what)?;
+    // GDAL's no-data value (tag 42113, text): those cells have no height (holes), where they were
+    // drawn at it (-9999 flattened a hill into a slab).
+    let no_data = match dec.get_tag_ascii_string(Tag::GdalNodata) {
+        Ok(text) => {
+            let t = text.trim_end_matches('\0').trim();
+            Some(t.parse::<f64>().map_err(|_| bad(what, format!("GDAL_NODATA '{t}' is not a number")))?)
+        }
+        Err(_) => None,
+    };
     use tiff::decoder::DecodingResult as D;
     const READ: &str = "uint8, uint16, int16, uint32, float32 and float64 single-channel heights are read";
     let heights: Vec<f32> = match dec.read_image().map_err(|e| bad(what, format!("tiff: {e} ({READ})")))? {
@@ -474,6 +483,11 @@ pub fn tiff_heights(bytes: &[u8], what: &str) -> Result<super::HeightGrid> {
     };
     if heights.len() as u64 != w as u64 * h as u64 {
         return Err(bad(what, "TIFF is not a single-channel height grid"));
+    }
+    let mut heights = heights;
+    if let Some(nd) = no_data {
+        // Compared as the samples are held (f32): -9999 is exact, 3.4e38 rounds alike.
+        heights.iter_mut().filter(|v| **v == nd as f32 || nd.is_nan() && v.is_nan()).for_each(|v| *v = f32::NAN);
     }
     Ok(super::HeightGrid { width: w, rows: h, heights })
 }
