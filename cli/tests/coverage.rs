@@ -164,6 +164,8 @@ struct Mode {
     order: OrderKind,
     early_termination: f32,
     lod: Lod,
+    /// MIP or MinIP (issue 76: a thumbnail's MIP drew empty), else compositing.
+    project: Option<voxsplat::Mode>,
 }
 
 fn mode() -> impl Strategy<Value = Mode> {
@@ -175,8 +177,9 @@ fn mode() -> impl Strategy<Value = Mode> {
         prop::sample::select(vec![OrderKind::Pbtf, OrderKind::Btf, OrderKind::Wbtf, OrderKind::Sorted]),
         prop::sample::select(vec![0.0f32, 0.004, 0.05]),
         prop::sample::select(vec![Lod::Auto, Lod::Off]),
+        prop::sample::select(vec![None, None, Some(voxsplat::Mode::Mip), Some(voxsplat::Mode::Minip)]),
     )
-        .prop_map(|(composite, raster, kernel, antialias, order, early_termination, lod)| Mode {
+        .prop_map(|(composite, raster, kernel, antialias, order, early_termination, lod, project)| Mode {
             composite,
             raster,
             kernel,
@@ -184,6 +187,7 @@ fn mode() -> impl Strategy<Value = Mode> {
             order,
             early_termination,
             lod,
+            project,
         })
 }
 
@@ -211,6 +215,7 @@ fn the_library_covers_what_the_ray_cast_covers_or_refuses() {
     );
     // Cases that compared a covered ray cast with a frame, and cases refused.
     let (compared, refused) = (AtomicU32::new(0), AtomicU32::new(0));
+    let projected = AtomicU32::new(0);
     let mut runner = runner(48);
     let cases = runner.config().cases;
     runner
@@ -223,7 +228,9 @@ fn the_library_covers_what_the_ray_cast_covers_or_refuses() {
             let supersample = if summed { SUPERSAMPLE } else { 1 };
             let ray = with_renderer(Backend::Cpu, |r| {
                 r.set_scene(scene.set()).unwrap();
-                r.raycast(&cam, &RaycastOptions { step: 0.25, supersample, ..Default::default() }).map(|f| f.image)
+                let mode = mode.project.unwrap_or_default();
+                r.raycast(&cam, &RaycastOptions { step: 0.25, supersample, mode, ..Default::default() })
+                    .map(|f| f.image)
             });
             let ray = match ray {
                 Ok(image) => image,
@@ -233,6 +240,11 @@ fn the_library_covers_what_the_ray_cast_covers_or_refuses() {
             let mut o = RenderOptions::default();
             (o.composite, o.raster, o.kernel, o.antialias) = (mode.composite, mode.raster, mode.kernel, mode.antialias);
             (o.order, o.early_termination, o.lod) = (mode.order, mode.early_termination, mode.lod);
+            if let Some(p) = mode.project {
+                // A projection draws in no order, every voxel's value (no early termination or
+                // coarse cells): those choices are the compositing's.
+                (o.mode, o.order, o.early_termination, o.lod) = (p, OrderKind::Pbtf, 0.0, Lod::Off);
+            }
             let backend = if gpu { Backend::Gpu } else { Backend::Cpu };
             let frame = with_renderer(backend, |r| {
                 match &scene {
@@ -256,6 +268,7 @@ fn the_library_covers_what_the_ray_cast_covers_or_refuses() {
             let (ray, splat) = coverage(&ray, &splat, summed);
             if ray > 0.0 {
                 compared.fetch_add(1, Relaxed);
+                projected.fetch_add(mode.project.is_some() as u32, Relaxed);
             }
             prop_assert!(
                 splat * COVERAGE_FACTOR >= ray,
@@ -268,6 +281,9 @@ fn the_library_covers_what_the_ray_cast_covers_or_refuses() {
         })
         .unwrap();
     not_vacuous(&compared, &refused, cases);
+    let projected = projected.load(Relaxed);
+    eprintln!("{projected} of them MIP or MinIP");
+    assert!(projected * 8 >= cases, "only {projected} of {cases} cases compared a projection's coverage");
 }
 
 /// A small volume file for the binary: a hollow ball, 24 x 20 x 16 bytes, in a raw NRRD.
