@@ -137,3 +137,30 @@ fn geotiff_no_data_cells_are_holes_not_heights() {
     ]);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
 }
+
+#[test]
+fn refusals_blame_the_field_at_fault() {
+    // nibabel's NIfTI with dim[1] set to 0: the parser blamed "dim[0] = 3".
+    let nii = tmp("dim1.nii");
+    python(
+        "import nibabel, numpy as np, struct\nnibabel.save(nibabel.Nifti1Image(np.zeros((4, 4, 4), np.uint8), np.eye(4)), \
+         '{}')\nb = bytearray(open('{}', 'rb').read())\nstruct.pack_into('<h', b, 42, 0)\nopen('{}', 'wb').write(b)",
+        &[&nii, &nii, &nii],
+    );
+    let e = load_volume(&nii, &VolumeHints::default()).unwrap_err().to_string();
+    assert!(e.contains("dim[1] = 0"), "{e}");
+    // zarr-python's OME-Zarr whose .zattrs is cut short: it was taken for a folder of slices.
+    let zarr = tmp("cut.zarr");
+    let _ = std::fs::remove_dir_all(&zarr);
+    python(
+        "import zarr\nroot = zarr.open_group('{}', mode='w', zarr_format=2)\nroot.create_array('0', shape=(4, 4, 4), \
+         dtype='u1')\nroot.attrs['multiscales'] = [{'version': '0.4', 'axes': [{'name': a, 'type': 'space'} for a in \
+         'zyx'], 'datasets': [{'path': '0', 'coordinateTransformations': [{'type': 'scale', 'scale': [1, 1, 1]}]}]}]",
+        &[&zarr],
+    );
+    let attrs = zarr.join(".zattrs");
+    let text = std::fs::read_to_string(&attrs).unwrap();
+    std::fs::write(&attrs, &text[..text.len() / 2]).unwrap();
+    let e = cmd::refused(&["info", zarr.to_str().unwrap()]);
+    assert!(e.contains(".zattrs") && e.contains("JSON"), "{e}");
+}

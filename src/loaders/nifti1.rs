@@ -6,6 +6,15 @@ use crate::error::{Error, Result};
 /// A NIfTI header's `dim[1..=dim[0]]` as the signed values the format stores (the parser reads
 /// them unsigned, so -256 would read as 65280), each checked to be positive.
 pub(super) fn nifti_dims(header: &nifti::NiftiHeader, what: &str) -> Result<Vec<u64>> {
+    // The parser blames dim[0] for a zero or negative axis after it (dim[1] = 0 read as "dim[0]
+    // = 3 must be positive"): the axes are checked here first.
+    let n = header.dim[0] as i16;
+    if (1..=7).contains(&n) {
+        if let Some(i) = (1..=n as usize).find(|&i| header.dim[i] as i16 <= 0) {
+            let d = header.dim[i] as i16;
+            return Err(bad(what, format!("NIfTI dim[{i}] = {d}: dimensions must be positive")));
+        }
+    }
     let dim = header.dim().map_err(|e| bad(what, format!("NIfTI dim: {e}")))?;
     dim.iter()
         .enumerate()

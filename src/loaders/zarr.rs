@@ -82,9 +82,10 @@ pub struct OmeZarr {
 }
 
 /// Whether `path` is a folder holding an OME-Zarr image (multiscales in its `.zattrs` or in its
-/// `zarr.json`'s `ome` attributes).
+/// `zarr.json`'s `ome` attributes), or metadata that does not parse (read as an image, its
+/// reader names the fault; it was taken for a folder of slices).
 pub fn is_ome_zarr(path: &Path) -> bool {
-    path.is_dir() && root_multiscales(path).is_ok_and(|m| m.is_some())
+    path.is_dir() && !matches!(root_multiscales(path), Ok(None))
 }
 
 /// The group's metadata JSON, when the folder has one: `zarr.json` (v3) or `.zattrs` (v2).
