@@ -230,8 +230,19 @@ pub(crate) fn check_spacing(s: [f32; 3], what: &str) -> Result<()> {
     if s.iter().any(|&v| v > MAX_SPACING) {
         return Err(bad(what, format!("spacing {s:?} is past {MAX_SPACING:e} units a voxel: the grid would pass the 1e15 units a camera resolves")));
     }
+    // Below it the camera's distances square to nothing in f32 ("eye and target coincide").
+    if s.iter().any(|&v| v < MIN_SPACING) {
+        return Err(bad(
+            what,
+            format!("spacing {s:?} is below {MIN_SPACING:e} units a voxel, closer than a camera resolves: give it in larger units"),
+        ));
+    }
     Ok(())
 }
+
+/// The smallest voxel spacing a file or `--spacing` may give (1e-20 drew; 1e-30 was "eye and
+/// target coincide").
+const MIN_SPACING: f32 = 1e-15;
 
 /// The largest voxel spacing a file may give: 2^16 voxels of it span 1e15 units, the most a camera
 /// resolves.

@@ -35,6 +35,12 @@ fn bad_values_are_refused_with_a_reason() {
     fails_with(&["render", "--size", "32x32", "--eye", "0,0,1e30", "--out", out], "within 1e15");
     fails_with(&["render", "--composite", "sheet", "--sheet-budget-mib", "17592186044416", "--out", out], "overflows");
     fails_with(&["render", "--gpu-budget-mib", "0", "--out", out], "must be positive");
+    // A spacing the camera cannot resolve is a spacing error (it was "eye and target coincide").
+    let stent = data("stent/stent.nrrd");
+    fails_with(
+        &["render", "--volume", &stent, "--spacing", "1e-30,1e-30,1e-30", "--out", out],
+        "below 1e-15 units a voxel",
+    );
     let dem = data("rmnp/rmnp-dem.tif");
     fails_with(&["render", "--terrain", &dem, "--vscale", "1e30", "--out", out], "lower --vscale");
     // A bad extension is found before anything is drawn.
