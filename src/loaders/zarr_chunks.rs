@@ -248,6 +248,42 @@ pub(super) fn copy_part(out: &mut [f32], to: Block, block: Block, values: &Sampl
     }
 }
 
+/// Refuses a level that stores no chunk (`holds_a_chunk`): missing chunks read as the fill value,
+/// so the array is one value throughout, and reading it (a 24 KB file declaring 2048^3) ran for
+/// minutes before drawing nothing.
+pub(super) fn some_chunk_stored(dir: &std::path::Path, level: u32, path: &str, what: &str) -> Result<()> {
+    if holds_a_chunk(dir) {
+        return Ok(());
+    }
+    Err(super::bad(
+        what,
+        format!("level {level} ({path}) stores no chunk: every voxel is the array's fill value, nothing to draw"),
+    ))
+}
+
+/// Whether an array's folder holds a file besides its metadata: a stored chunk (v2 `0.0.0` or
+/// `0/0/0`, v3 `c/0/0/0`, or a shard). Stops at the first.
+fn holds_a_chunk(dir: &std::path::Path) -> bool {
+    let mut folders = vec![dir.to_path_buf()];
+    while let Some(d) = folders.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else { continue };
+        for e in entries.flatten() {
+            let name = e.file_name();
+            match e.file_type() {
+                Ok(t) if t.is_dir() => folders.push(e.path()),
+                Ok(_)
+                    if ![".zarray", ".zattrs", ".zgroup", ".zmetadata", "zarr.json"]
+                        .contains(&&*name.to_string_lossy()) =>
+                {
+                    return true
+                }
+                _ => {}
+            }
+        }
+    }
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
