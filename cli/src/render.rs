@@ -281,12 +281,12 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     }
     opts.lod_nodes = a.lod_nodes;
     opts.validate()?;
+    #[cfg(feature = "mpi")]
+    let launched = voxsplat::distributed::mpi::launched();
+    #[cfg(not(feature = "mpi"))]
+    let launched = false;
     if let Some(c) = &a.compositing {
         c.parse::<voxsplat::distributed::Scheme>()?;
-        #[cfg(feature = "mpi")]
-        let launched = voxsplat::distributed::mpi::launched();
-        #[cfg(not(feature = "mpi"))]
-        let launched = false;
         if !launched {
             return Err(Error::InvalidArgument(
                 "--compositing picks how the ranks' frames are composited under mpirun (a build with --features \
@@ -296,7 +296,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         }
     }
     #[cfg(feature = "mpi")]
-    if voxsplat::distributed::mpi::launched() {
+    if launched {
         if a.plan {
             return Err(Error::InvalidArgument("--plan prints one renderer's plan: run it without mpirun".into()));
         }
