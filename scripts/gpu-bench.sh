@@ -5,7 +5,8 @@
 #                                (both git-excluded), to carry to the GPU machine
 #   scripts/gpu-bench.sh run     there, from the repository root: unpack the loaders, describe the
 #                                device, run the quick suite once with validation (a first pass:
-#                                any message fails it), then the full suite for timings; reports in
+#                                any message fails it), once under best practices and once under
+#                                GPU-assisted validation, then the full suite for timings; reports in
 #                                .gpubench/out (or $OUT when set)
 # With the device tool: run `scripts/gpu-bench.sh stage` here, then
 #   run(command="bash scripts/gpu-bench.sh run", carry=[".gpubench", ".gl"])
@@ -47,6 +48,15 @@ run)
   # Validation first: every case drawn once with the Khronos layer; a message fails the case.
   $b bench --quick --validation --warmup 0 --frames 1 --cache "$cache" --json "$out/validation.json" \
     2>&1 | tee "$out/validation.txt"
+  # The layer's extra checks (docs/RELIABILITY.md, "The validation layer's extra checks"): best
+  # practices with NVIDIA's own, and GPU-assisted validation with the buffer bounds lavapipe
+  # cannot build. A finding is recorded, and the times still run.
+  sed 's/gpuav_buffer_oob = false/gpuav_buffer_oob = true/' tests/validation/gpu-assisted.txt >"$out/gpu-assisted.txt"
+  for s in "$PWD/tests/validation/best-practices.txt" "$(cd "$out" && pwd)/gpu-assisted.txt"; do
+    n=$(basename "$s" .txt)
+    VK_LAYER_SETTINGS_PATH=$s $b bench --quick --validation --warmup 0 --frames 1 --cache "$cache" \
+      --json "$out/layers-$n.json" 2>&1 | tee "$out/layers-$n.txt" || echo "layers $n: findings above"
+  done
   # Then the times: the whole suite, its made volumes kept in the cache between calls.
   $b bench --cache "$cache" --json "$out/full.json" ${BENCH_ARGS:-} 2>&1 | tee "$out/full.txt"
   ;;

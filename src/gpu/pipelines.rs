@@ -63,6 +63,17 @@ fn has(ctx: &Context, feature: Feature) -> bool {
     }
 }
 
+/// A driver's refusal of a stage's pipeline names the stage: a driver, or a layer instrumenting the
+/// shader, can refuse one shader of many with nothing more than `VK_ERROR_UNKNOWN`.
+fn refused_stage(e: Error, stage: &str) -> Error {
+    match e {
+        Error::Vulkan { call, result } => {
+            Error::Unsupported(format!("the driver refused the pipeline of stage {stage} ({call}: {result})"))
+        }
+        e => e,
+    }
+}
+
 fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Result<StagePipelines> {
     let slots: Vec<Slot> = desc.bindings.iter().map(|&r| slot(r)).collect();
     let flags = match desc.kind {
@@ -77,7 +88,8 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Resu
         let defines = defines.join("+");
         let pipe = match (desc.kind, v.draw, desc.shaders) {
             (Kind::Compute, _, Shaders::Compute(comp)) => {
-                Pipeline::compute_specialized(ctx, &layout, spirv_build(comp, &defines, desc.name)?, v.spec)?
+                Pipeline::compute_specialized(ctx, &layout, spirv_build(comp, &defines, desc.name)?, v.spec)
+                    .map_err(|e| refused_stage(e, desc.name))?
             }
             (Kind::Draw, Some(state), Shaders::Draw(vert, frag)) => {
                 let vert = spirv_build(vert, &defines, desc.name)?;
@@ -94,7 +106,8 @@ fn build(ctx: &Arc<Context>, desc: &StageDesc, passes: [&RenderPass; 3]) -> Resu
                     Pass::Sheet => passes[1],
                     Pass::Slots => passes[2],
                 };
-                Pipeline::graphics(ctx, &layout, pass, vert, frag, blend, primitive, v.spec)?
+                Pipeline::graphics(ctx, &layout, pass, vert, frag, blend, primitive, v.spec)
+                    .map_err(|e| refused_stage(e, desc.name))?
             }
             (Kind::Draw, None, _) => {
                 return Err(Error::Unsupported(format!("{}: a draw variant without raster state", desc.name)))

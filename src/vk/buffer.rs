@@ -116,12 +116,14 @@ impl Buffer {
 
 impl Drop for Buffer {
     fn drop(&mut self) {
+        // The buffer goes before its memory: freeing memory still bound to a live buffer is legal
+        // but leaves a dangling binding, which best-practices validation reports.
+        // SAFETY: the owner waits for the GPU before dropping resources (Renderer waits idle).
+        unsafe { self.ctx.device.destroy_buffer(self.raw, None) };
         if let Some(a) = self.allocation.take() {
             if let Ok(mut alloc) = self.ctx.allocator.lock() {
                 let _ = alloc.free(a);
             }
         }
-        // SAFETY: the owner waits for the GPU before dropping resources (Renderer waits idle).
-        unsafe { self.ctx.device.destroy_buffer(self.raw, None) };
     }
 }

@@ -1,6 +1,7 @@
 //! A host's image as a frame's destination (`Renderer::render_to`): the image, its layouts and the
 //! semaphores that order the frame with the host's work; an image voxsplat owns for hosts (and
 //! tests) without one; semaphores; and reading any of them back.
+use super::submit::layout_access;
 use super::{Buffer, Context, Image, Memory, Recorder};
 use crate::error::{Error, Result};
 use crate::image::TargetFormat;
@@ -379,7 +380,7 @@ pub(super) fn color_range() -> vk::ImageSubresourceRange {
 }
 
 /// A layout change of a host's image; the semaphore waits and the submission's own barriers order
-/// everything else, so every stage on both sides.
+/// everything else, so every stage this submission records on both sides.
 fn host_barrier(rec: &Recorder<'_>, image: vk::Image, layouts: (vk::ImageLayout, vk::ImageLayout)) {
     barrier_on(rec, image, layouts, color_range());
 }
@@ -391,12 +392,12 @@ fn barrier_on(
     layouts: (vk::ImageLayout, vk::ImageLayout),
     range: vk::ImageSubresourceRange,
 ) {
-    let all = vk::PipelineStageFlags::ALL_COMMANDS;
+    let all = super::submit::ENGINE_STAGES;
     let b = [vk::ImageMemoryBarrier::default()
         .old_layout(layouts.0)
         .new_layout(layouts.1)
-        .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
-        .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+        .src_access_mask(layout_access(layouts.0, all, vk::AccessFlags::MEMORY_WRITE))
+        .dst_access_mask(layout_access(layouts.1, all, vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE))
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)

@@ -403,6 +403,8 @@ pub struct RenderPass {
     pub(crate) raw: vk::RenderPass,
     /// Colour attachments (at most `MAX_ATTACHMENTS`).
     pub(crate) attachments: u32,
+    /// Whether it clears them (else it loads them, and takes no clear values).
+    pub(crate) clears: bool,
 }
 
 /// Most colour attachments a render pass here takes (`begin_pass` clears this many).
@@ -480,7 +482,7 @@ impl RenderPass {
             .dependencies(&dependencies);
         // SAFETY: valid create info.
         let raw = unsafe { ctx.device.create_render_pass(&info, None) }.map_err(Error::vk("vkCreateRenderPass"))?;
-        Ok(Self { ctx: ctx.clone(), raw, attachments: count })
+        Ok(Self { ctx: ctx.clone(), raw, attachments: count, clears: !load })
     }
 }
 

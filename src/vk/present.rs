@@ -3,6 +3,7 @@
 //! triangles over it and presents. What `voxsplat view` draws with; a host with its own device
 //! embeds voxsplat through `Context::from_host` and `Renderer::render_to` instead.
 use super::host::color_range;
+use super::submit::layout_access;
 use super::{target_format, Buffer, Context, ContextOptions, HostTarget, Memory, Semaphore, TargetImage};
 use crate::error::{Error, Result};
 use ash::vk;
@@ -652,16 +653,16 @@ fn color_layers() -> vk::ImageSubresourceLayers {
 
 /// A layout change of a swapchain image that orders all earlier work before all later work.
 fn layout(ctx: &Context, cmd: vk::CommandBuffer, image: vk::Image, from: vk::ImageLayout, to: vk::ImageLayout) {
+    let all = super::submit::ENGINE_STAGES;
     let barrier = [vk::ImageMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
-        .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+        .src_access_mask(layout_access(from, all, vk::AccessFlags::MEMORY_WRITE))
+        .dst_access_mask(layout_access(to, all, vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE))
         .old_layout(from)
         .new_layout(to)
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)
         .subresource_range(color_range())];
-    let all = vk::PipelineStageFlags::ALL_COMMANDS;
     // SAFETY: recording on a command buffer of this device.
     unsafe { ctx.device.cmd_pipeline_barrier(cmd, all, all, vk::DependencyFlags::empty(), &[], &[], &barrier) };
 }

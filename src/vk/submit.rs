@@ -22,9 +22,21 @@ pub enum Stage {
     Graphics,
     /// Host reads and writes.
     Host,
-    /// Every command.
+    /// Every stage the engine records: compute, transfer, vertex input, shaders and attachments.
+    /// Named one by one rather than ALL_COMMANDS, which drains stages (ray tracing, mesh,
+    /// acceleration builds) the engine never uses, and which best-practices validation flags.
     All,
 }
+
+/// The stages [`Stage::All`] orders: everything the engine's command buffers record.
+pub(crate) const ENGINE_STAGES: vk::PipelineStageFlags = vk::PipelineStageFlags::from_raw(
+    vk::PipelineStageFlags::COMPUTE_SHADER.as_raw()
+        | vk::PipelineStageFlags::TRANSFER.as_raw()
+        | vk::PipelineStageFlags::VERTEX_INPUT.as_raw()
+        | vk::PipelineStageFlags::VERTEX_SHADER.as_raw()
+        | vk::PipelineStageFlags::FRAGMENT_SHADER.as_raw()
+        | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT.as_raw(),
+);
 
 impl Stage {
     fn flags(self) -> (vk::PipelineStageFlags, vk::AccessFlags, vk::AccessFlags) {
@@ -39,8 +51,26 @@ impl Stage {
                 A::SHADER_READ | A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
             ),
             Stage::Host => (P::HOST, A::HOST_WRITE, A::HOST_READ),
-            Stage::All => (P::ALL_COMMANDS, A::MEMORY_WRITE, A::MEMORY_READ | A::MEMORY_WRITE),
+            Stage::All => (ENGINE_STAGES, A::MEMORY_WRITE, A::MEMORY_READ | A::MEMORY_WRITE),
         }
+    }
+}
+
+/// The access an image in `layout` takes at `stages`: one kind where the layout admits one
+/// (a transfer's source or destination, a shader's read-only), `otherwise` elsewhere. Naming
+/// accesses a layout cannot take is meaningless, and best-practices validation says so.
+pub(crate) fn layout_access(
+    layout: vk::ImageLayout,
+    stages: vk::PipelineStageFlags,
+    otherwise: vk::AccessFlags,
+) -> vk::AccessFlags {
+    use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as P};
+    let shaders = P::COMPUTE_SHADER | P::VERTEX_SHADER | P::FRAGMENT_SHADER;
+    match layout {
+        L::TRANSFER_DST_OPTIMAL if stages.contains(P::TRANSFER) => A::TRANSFER_WRITE,
+        L::TRANSFER_SRC_OPTIMAL if stages.contains(P::TRANSFER) => A::TRANSFER_READ,
+        L::SHADER_READ_ONLY_OPTIMAL if stages.intersects(shaders) => A::SHADER_READ,
+        _ => otherwise,
     }
 }
 
@@ -58,6 +88,7 @@ impl Recorder<'_> {
     pub fn transition(&self, image: &Image, from: vk::ImageLayout, to: vk::ImageLayout, src: Stage, dst: Stage) {
         let (s, sa, _) = src.flags();
         let (d, _, da) = dst.flags();
+        let (sa, da) = (layout_access(from, s, sa), layout_access(to, d, da));
         let b = [vk::ImageMemoryBarrier::default()
             .old_layout(from)
             .new_layout(to)
@@ -203,7 +234,7 @@ impl Recorder<'_> {
             .render_pass(pass.raw)
             .framebuffer(fb.raw)
             .render_area(area)
-            .clear_values(&clear[..pass.attachments as usize]);
+            .clear_values(&clear[..if pass.clears { pass.attachments as usize } else { 0 }]);
         let viewport = [vk::Viewport {
             x: 0.0,
             y: 0.0,
@@ -334,12 +365,18 @@ impl Context {
             .map_err(Error::vk("vkCreateFence"))?;
         let cmds = [cmd];
         let (wait, signal) = target.map(|t| (&t.wait[..], &t.signal[..])).unwrap_or((&[], &[]));
-        let stages = vec![vk::PipelineStageFlags::ALL_COMMANDS; wait.len()];
-        let submit = [vk::SubmitInfo::default()
-            .command_buffers(&cmds)
-            .wait_semaphores(wait)
-            .wait_dst_stage_mask(&stages)
-            .signal_semaphores(signal)];
+        // The host's semaphores hold back every stage of this submission.
+        let stages = vec![ENGINE_STAGES; wait.len()];
+        // Empty lists stay null pointers: a dangling pointer with a count of 0 is legal, but
+        // best-practices validation reports it.
+        let mut info = vk::SubmitInfo::default().command_buffers(&cmds);
+        if !wait.is_empty() {
+            info = info.wait_semaphores(wait).wait_dst_stage_mask(&stages);
+        }
+        if !signal.is_empty() {
+            info = info.signal_semaphores(signal);
+        }
+        let submit = [info];
         let submitted = {
             let queue = self.queue.lock().map_err(|_| Error::Unsupported("queue lock poisoned".into()))?;
             // SAFETY: the queue is externally synchronised by the mutex.
