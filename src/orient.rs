@@ -50,6 +50,22 @@ impl Orientation {
         if !affine.is_finite() || cols.iter().any(|c| c.length() <= 0.0) {
             return Err(Error::InvalidArgument(format!("index-to-world affine {affine:?} is singular or not finite")));
         }
+        // Past these the camera cannot frame the grid ("eye, target and up must be finite").
+        let far = crate::camera::MAX_WORLD as f64;
+        if let Some(c) = cols.iter().find(|c| c.length() * dims.into_iter().max().unwrap_or(1) as f64 > far) {
+            return Err(Error::InvalidArgument(format!(
+                "index-to-world affine: a voxel step of {:.3e} units spans past the 1e15 units a camera resolves",
+                c.length()
+            )));
+        }
+        let origin = affine.w_axis.truncate();
+        if origin.length() > far {
+            return Err(Error::InvalidArgument(format!(
+                "index-to-world affine: the grid's origin [{:.3e}, {:.3e}, {:.3e}] lies past the 1e15 units a camera \
+                 resolves",
+                origin.x, origin.y, origin.z
+            )));
+        }
         let dirs = cols.map(|c| c.normalize());
         let mut sheared = false;
         for (a, b) in [(0, 1), (0, 2), (1, 2)] {

@@ -402,6 +402,7 @@ fn run(cli: Cli) -> Result<()> {
                     time: time.or((times > 1).then_some(0)),
                     ..Default::default()
                 };
+                voxsplat_cli::uneven::say_left_out(&file, &hints)?;
                 match voxsplat::loaders::load_orientation(&file, &hints)? {
                     Some(o) => {
                         let [ij, ik, jk] = o.angles();
@@ -419,6 +420,17 @@ fn run(cli: Cli) -> Result<()> {
                         )
                     }
                     None => println!("orientation: none (no anatomical frame: --view framing)"),
+                }
+                // A file of several channels: each described (render draws them with --channel-tf).
+                let channels = voxsplat::loaders::SliceReader::channels(&file)?;
+                if channels > 1 {
+                    println!("{channels} channels: render draws them with --channel-tf for each after the first");
+                    for (k, v) in voxsplat::loaders::load_channels(&file, &hints)?.iter().enumerate() {
+                        let (lo, hi) =
+                            v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+                        println!("channel {k}: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
+                    }
+                    return Ok(());
                 }
                 // Past the dense loader (a file read slice by slice, of more than MAX_VOXELS): the store only.
                 if let Some(reader) = voxsplat::loaders::SliceReader::open(&file, &hints)? {

@@ -125,7 +125,16 @@ pub fn camera_of(a: &SceneArgs, grid: &voxsplat::Grid, content: &Content) -> Res
     let depth = (grid.center() - cam.eye).dot(cam.forward());
     let r = 0.5 * grid.diagonal() + (4.0 * grid.kernel_spacing()).max(Camera::cull_margin(grid.kernel_spacing()));
     // Margins relative to the scene, not in units: spacings in metres (1e-4 and below) are common.
-    let fit_near = if cam.is_perspective() { (depth - r).max(1e-3 * d) } else { depth - 1.5 * r };
+    // An eye at what the view looks at has no view: say which flag to add.
+    if a.eye.is_some() && a.target.is_none() && (cam.eye - cam.target).length() <= 1e-6 * r {
+        let e = a.eye.unwrap_or_default();
+        return Err(Error::InvalidArgument(format!(
+            "--eye {},{},{} is the point the view looks at (the centre of what it frames): give --target too",
+            e.x, e.y, e.z
+        )));
+    }
+    // An eye inside the scene sees from a near plane a small share of the scene's size ahead.
+    let fit_near = if cam.is_perspective() { (depth - r).max(1e-3 * d).max(1e-4 * r) } else { depth - 1.5 * r };
     cam.near = a.near.unwrap_or(if grazing { cam.near } else { fit_near });
     cam.far = a.far.unwrap_or(if grazing { cam.far } else { d + 1.5 * r });
     cam.validate()?;
@@ -474,6 +483,9 @@ pub fn open(
     }
     // An unevenly spaced DICOM series is resampled evenly (said here), or when its gaps are too far
     // apart, drawn as a rectilinear grid: host splats.
+    if let Some(path) = &a.volume {
+        crate::uneven::say_left_out(path, &volume_hints_at(a, None)?)?;
+    }
     let uneven = match &a.volume {
         Some(path) if file_places(a) => crate::uneven::report(path, &volume_hints_at(a, None)?)?,
         _ => false,

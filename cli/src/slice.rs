@@ -45,6 +45,7 @@ pub(crate) fn slice(a: SliceArgs) -> Result<()> {
         _ => 2,
     };
     let hints = voxsplat::loaders::VolumeHints { series: a.series, time: a.time, level: a.level, ..Default::default() };
+    voxsplat_cli::uneven::say_left_out(&a.file, &hints)?;
     let (dims, index, plane) = read_plane(&a.file, &hints, axis, a.index, &a.axis)?;
     let [lo, hi] = a.window.unwrap_or_else(|| {
         let finite = plane.values.iter().filter(|v| v.is_finite());

@@ -1,7 +1,7 @@
 //! A DICOM --volume whose slice gaps are uneven: resampled onto even slices (the loaders' default,
 //! said on stderr), or, when its gaps are too far apart for that, drawn as a rectilinear grid of
 //! host splats at the slices' own positions.
-use voxsplat::loaders::{even_slices, file_positions, slice_offsets, VolumeHints};
+use voxsplat::loaders::{even_slices, file_positions, left_out, slice_offsets, VolumeHints};
 use voxsplat::Result;
 
 /// The series whose offsets were found last (path, its modification time, --series, --time) and
@@ -52,4 +52,13 @@ pub fn positions(path: &std::path::Path, hints: &VolumeHints, grid: &voxsplat::G
          (host splats)"
     );
     Ok(coords)
+}
+
+/// Says on stderr what reading `path`, a DICOM series, left out (a localizer, a slice far from the
+/// rest); nothing for any other file.
+pub fn say_left_out(path: &std::path::Path, hints: &VolumeHints) -> Result<()> {
+    for line in left_out(path, hints)? {
+        eprintln!("note: {line}");
+    }
+    Ok(())
 }

@@ -111,11 +111,7 @@ fn a_folder_of_several_series_lists_them_and_reads_the_one_picked() {
 fn a_folder_that_is_not_one_even_series_is_refused_by_name() {
     let tests = pydicom_tests();
     let hints = VolumeHints::default();
-    for (dir, says) in [
-        ("98892003/MR700", "mixed orientations"),
-        ("98892001/CT2N", "mixed orientations"),
-        ("77654033/CT2", "uneven slice gaps"),
-    ] {
+    for (dir, says) in [("98892003/MR700", "mixed orientations"), ("98892001/CT2N", "mixed orientations")] {
         let e = load_volume(&tests.join(dir), &hints).unwrap_err().to_string();
         assert!(e.contains(says), "{dir}: {e}");
     }
@@ -202,26 +198,20 @@ fn a_tilted_gantry_s_series_is_placed_as_a_sheared_grid() {
 fn an_uneven_series_is_resampled_or_drawn_at_its_slices_positions() {
     use voxsplat::loaders::{file_positions, slice_offsets};
     let rect = VolumeHints { rectilinear: true, ..Default::default() };
-    // CT2's positions along its normal, as pydicom reads them.
-    let ct2 = pydicom_tests().join("77654033/CT2");
-    let script = format!(
-        "import glob, pydicom\nz = sorted(float(pydicom.dcmread(f).ImagePositionPatient[2]) for f in glob.glob('{}/*'))\n\
-         print(' '.join(str(v - z[0]) for v in z))",
-        ct2.display()
-    );
-    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
-    let want: Vec<f64> = String::from_utf8_lossy(&out.stdout).split_whitespace().map(|v| v.parse().unwrap()).collect();
-    assert_eq!(want.len(), 4);
-    let got = slice_offsets(&ct2, &rect).unwrap().expect("CT2's gaps are uneven");
-    assert!(got.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-3), "{got:?} against pydicom's {want:?}");
-    assert_eq!(load_volume(&ct2, &rect).unwrap().dims, [16, 16, 4]);
-    let e = load_volume(&ct2, &VolumeHints::default()).unwrap_err().to_string();
+    // Images 37 mm apart in the middle of a series, too far to resample, are drawn as they lie.
+    let gappy = tmp("gappy");
+    let zs_gappy = [0, 1, 2, 3, 40, 41, 42, 43];
+    ball_series(&gappy, &zs_gappy);
+    let got = slice_offsets(&gappy, &rect).unwrap().expect("the gaps are uneven");
+    assert!(got.iter().zip(zs_gappy).all(|(a, b)| (a - b as f64).abs() < 1e-3), "{got:?}");
+    assert_eq!(load_volume(&gappy, &rect).unwrap().dims, [24, 20, 8]);
+    let e = load_volume(&gappy, &VolumeHints::default()).unwrap_err().to_string();
     assert!(e.contains("uneven slice gaps") && e.contains("rectilinear"), "{e}");
-    let shot = tmp("ct2.png");
+    let shot = tmp("gappy.png");
     let said = ok(&[
         "render",
         "--volume",
-        ct2.to_str().unwrap(),
+        gappy.to_str().unwrap(),
         "--size",
         "64x64",
         "--validation",
@@ -229,36 +219,12 @@ fn an_uneven_series_is_resampled_or_drawn_at_its_slices_positions() {
         shot.to_str().unwrap(),
     ]);
     assert!(said.contains("drawn as a rectilinear grid"), "{said}");
+    let _ = std::fs::remove_dir_all(&gappy);
     // A ball written at uneven slice positions.
     let zs = [0, 2, 4, 8, 10, 13, 15, 16, 18, 22];
-    let write = |dir: &Path, zs: &[i32]| {
-        let _ = std::fs::remove_dir_all(dir);
-        std::fs::create_dir_all(dir).unwrap();
-        let script = format!(
-            "import numpy as np, pydicom\n\
-             from pydicom.dataset import Dataset, FileMetaDataset\n\
-             from pydicom.uid import ExplicitVRLittleEndian\n\
-             x, y = np.meshgrid(np.arange(24), np.arange(20))\n\
-             for k, z in enumerate({zs:?}):\n\
-             \x20   m = FileMetaDataset(); m.MediaStorageSOPClassUID = '1.2.840.10008.5.1.4.1.1.2'\n\
-             \x20   m.MediaStorageSOPInstanceUID = '1.2.3.%d' % (k + 10); m.TransferSyntaxUID = ExplicitVRLittleEndian\n\
-             \x20   d = Dataset(); d.file_meta = m; d.SOPClassUID = m.MediaStorageSOPClassUID\n\
-             \x20   d.SOPInstanceUID = m.MediaStorageSOPInstanceUID; d.Modality = 'CT'; d.SeriesInstanceUID = '1.2.3.1'\n\
-             \x20   d.InstanceNumber = k + 1; d.Rows, d.Columns = 20, 24\n\
-             \x20   d.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]; d.ImagePositionPatient = [0, 0, z]\n\
-             \x20   d.PixelSpacing = [1, 1]; d.SamplesPerPixel = 1; d.PhotometricInterpretation = 'MONOCHROME2'\n\
-             \x20   d.BitsAllocated, d.BitsStored, d.HighBit, d.PixelRepresentation = 16, 16, 15, 0\n\
-             \x20   r = np.sqrt((x - 12) ** 2 + (y - 10) ** 2 + (z - 11) ** 2)\n\
-             \x20   d.PixelData = np.where(r < 9, 1000 - 80 * r, 0).astype(np.uint16).tobytes()\n\
-             \x20   pydicom.dcmwrite('{}/s%d' % k, d, enforce_file_format=True)\n",
-            dir.display()
-        );
-        let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    };
     let (uneven, even) = (tmp("uneven"), tmp("even"));
-    write(&uneven, &zs);
-    write(&even, &[0, 2, 4, 6, 8, 10, 12, 14, 16, 18]);
+    ball_series(&uneven, &zs);
+    ball_series(&even, &[0, 2, 4, 6, 8, 10, 12, 14, 16, 18]);
     let grid = voxsplat::Grid::centered([24, 20, 10], [1.0, 1.0, 22.0 / 9.0]).unwrap();
     let [x, y, z] = file_positions(&uneven, &rect, &grid).unwrap().expect("uneven");
     // x and y the grid's own; z the slices' positions, centred as the grid is (22 mm long).
@@ -288,7 +254,7 @@ fn an_uneven_series_is_resampled_or_drawn_at_its_slices_positions() {
     // Drawn as a bricked store, near the same ball written on those 23 slices, and another picture
     // than the images spaced evenly at their mean gap.
     let dense = tmp("dense");
-    write(&dense, &(0..23).collect::<Vec<_>>());
+    ball_series(&dense, &(0..23).collect::<Vec<_>>());
     let (a, b, c) = (tmp("uneven.png"), tmp("even.png"), tmp("dense.png"));
     // One transfer function over the files' values: each picture classifies them alike.
     let tf = tmp("ball-tf.toml");
@@ -445,6 +411,11 @@ fn an_enhanced_image_is_placed_by_its_functional_groups_as_dcm2niix_places_it() 
     assert!(e.contains("one volume"), "{e}");
     let listed = ok(&["info", times.to_str().unwrap()]);
     assert!(listed.contains("[24, 20, 12] (columns, rows, images), 3 time points"), "{listed}");
+    // animate --volume plays them (issue 76: it was refused, telling the user to run animate).
+    let played = dir.join("played");
+    let said =
+        ok(&["animate", "--volume", times.to_str().unwrap(), "--size", "32x32", "--out-dir", played.to_str().unwrap()]);
+    assert!(said.contains("3 time points") && played.join("frame0002.png").exists(), "{said}");
     // Refused: per-frame items that are not one per frame.
     let bad = dir.join("items");
     std::fs::create_dir_all(&bad).unwrap();
@@ -635,4 +606,51 @@ fn a_rescale_slope_of_0_is_refused_by_name() {
     let e = load_volume(&copy, &VolumeHints::default()).unwrap_err().to_string();
     assert!(e.contains("Rescale Slope is 0") && e.contains(copy.to_str().unwrap()), "{e}");
     let _ = std::fs::remove_dir_all(&copy);
+}
+
+/// Issue 76: a localizer filed in the series, or a slice far from the rest (pydicom's own CT2:
+/// one slice 202 mm from three 1.25 mm apart), is left out with a note, as a clinical viewer
+/// does, and the rest draws as it would alone. Before, CT2 was refused, and a far slice drew
+/// a rectilinear grid whose footprints spanned its gap: an empty frame.
+#[test]
+fn a_localizer_or_a_far_slice_is_left_out_with_a_note() {
+    let ct2 = pydicom_tests().join("77654033/CT2");
+    let said = ok(&["info", ct2.to_str().unwrap()]);
+    assert!(said.contains("volume: [16, 16, 3]"), "{said}");
+    assert!(said.contains("note: left out") && said.contains("17106") && said.contains("202.5000 mm"), "{said}");
+    let hints = VolumeHints::default();
+    assert_eq!(load_volume(&ct2, &hints).unwrap().dims, [16, 16, 3]);
+    // A ball's even series, then the same with a slice 5 m away and with a localizer beside it.
+    let zs: Vec<i32> = (0..10).map(|k| 2 * k).collect();
+    let (even, far, scout) = (tmp("left-even"), tmp("left-far"), tmp("left-scout"));
+    ball_series(&even, &zs);
+    ball_series(&far, &[&zs[..], &[5000]].concat());
+    ball_series(&scout, &zs);
+    let script = "import pydicom\n\
+                  d = pydicom.dcmread('{}/s0')\n\
+                  d.ImageOrientationPatient = [0, 1, 0, 0, 0, -1]\n\
+                  d.SOPInstanceUID = d.file_meta.MediaStorageSOPInstanceUID = '1.2.3.99'\n\
+                  d.Rows = 24; d.Columns = 20\n\
+                  pydicom.dcmwrite('{}/scout', d, enforce_file_format=True)\n";
+    python(script, &[&scout, &scout]);
+    let want = load_volume(&even, &hints).unwrap();
+    for (dir, says) in [(&far, "lies 4982.0000 mm from the next slice"), (&scout, "a localizer")] {
+        let left = voxsplat::loaders::left_out(dir, &hints).unwrap();
+        assert!(left.len() == 1 && left[0].contains(says), "{}: {left:?}", dir.display());
+        let got = load_volume(dir, &hints).unwrap();
+        assert_eq!((got.dims, &got.values), (want.dims, &want.values), "{}", dir.display());
+    }
+    // Drawn, the series with a far slice is the series without it, and says what it left out.
+    let tf = tmp("left-tf.toml");
+    let tf = cmd::tf_file(&tf, 0.0, 1000.0).to_str().unwrap();
+    let (a, b) = (tmp("left-even.png"), tmp("left-far.png"));
+    let view = ["--size", "48x48", "--tf", tf, "--validation", "--out"];
+    ok(&[&["render", "--volume", even.to_str().unwrap()][..], &view, &[a.to_str().unwrap()]].concat());
+    let said = ok(&[&["render", "--volume", far.to_str().unwrap()][..], &view, &[b.to_str().unwrap()]].concat());
+    assert!(said.contains("note: left out") && said.contains("s10"), "{said}");
+    let psnr = cmd::psnr(&b, &a);
+    assert!(psnr > 60.0, "the series with its far slice left out against the series alone: {psnr} dB");
+    for d in [&even, &far, &scout] {
+        let _ = std::fs::remove_dir_all(d);
+    }
 }

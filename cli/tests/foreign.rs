@@ -163,4 +163,22 @@ fn refusals_blame_the_field_at_fault() {
     std::fs::write(&attrs, &text[..text.len() / 2]).unwrap();
     let e = cmd::refused(&["info", zarr.to_str().unwrap()]);
     assert!(e.contains(".zattrs") && e.contains("JSON"), "{e}");
+    // nibabel's NIfTI with a pixdim, an sform step or an sform origin of 1e30: each drew nothing
+    // or blamed the camera ("eye, target and up must be finite").
+    let d = "import nibabel as nib, numpy as np\nd = np.zeros((8, 8, 8), np.uint8); d[2:6, 2:6, 2:6] = 200\n";
+    for (name, make, says) in [
+        (
+            "pixdim.nii",
+            "i = nib.Nifti1Image(d, None); i.header['pixdim'][1:4] = [1e30, 1, 1]; i.set_sform(None, 0)\n\
+             i.set_qform(None, 0)\n",
+            "spacing [1e30",
+        ),
+        ("sform.nii", "a = np.diag([1e30, 1, 1, 1]); i = nib.Nifti1Image(d, a); i.set_qform(None, 0)\n", "voxel step"),
+        ("origin.nii", "a = np.eye(4); a[0, 3] = 1e30; i = nib.Nifti1Image(d, a)\n", "origin"),
+    ] {
+        let nii = tmp(name);
+        python(&format!("{d}{make}nib.save(i, '{{}}')"), &[&nii]);
+        let e = cmd::refused(&["render", "--volume", nii.to_str().unwrap(), "--size", "16x16", "--out", "x.png"]);
+        assert!(e.contains(says) && !e.contains("camera"), "{name}: {e}");
+    }
 }

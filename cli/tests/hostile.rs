@@ -33,6 +33,11 @@ fn bad_values_are_refused_with_a_reason() {
     fails_with(&["render", "--size", "32x32", "--raycast", "0.000001", "--cpu", "--out", out], "max_steps");
     fails_with(&["render", "--size", "32x32", "--ortho", "1e-7", "--out", out], "f32 cannot resolve");
     fails_with(&["render", "--size", "32x32", "--eye", "0,0,1e30", "--out", out], "within 1e15");
+    // An eye at the view's target names the flag to add; inside the scene with a target it sees
+    // from a fitted near plane (both were camera errors).
+    fails_with(&["render", "--size", "32x32", "--eye", "0,0,0", "--out", out], "give --target too");
+    let inside = voxsplat(&["render", "--size", "32x32", "--eye", "0,0,0", "--target", "0,0,-10", "--out", out]);
+    assert!(inside.status.success(), "{}", String::from_utf8_lossy(&inside.stderr));
     fails_with(&["render", "--composite", "sheet", "--sheet-budget-mib", "17592186044416", "--out", out], "overflows");
     fails_with(&["render", "--gpu-budget-mib", "0", "--out", out], "must be positive");
     // A spacing the camera cannot resolve is a spacing error (it was "eye and target coincide").

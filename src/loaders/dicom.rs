@@ -31,6 +31,7 @@ pub fn is_dicom(path: &Path) -> bool {
     std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut head)).is_ok() && &head[128..] == b"DICM"
 }
 
+mod apart;
 mod jpegls;
 mod resample;
 use resample::Gaps;
@@ -371,6 +372,8 @@ pub struct Series {
     /// The last image a resampled read decoded, and its index: the next read of the slices
     /// after it starts from it.
     kept: Option<(u32, Vec<f32>)>,
+    /// The images of the series left out (a localizer, a slice far from the rest), a line each.
+    pub left_out: Vec<String>,
 }
 
 /// The series `path` names: a folder holding one series (or `pick`, its index in `voxsplat info`'s
@@ -432,7 +435,6 @@ fn chosen(path: &Path, pick: Option<&str>) -> Result<SeriesInfo> {
 
 /// Checks a series' images agree and orders them along their normal.
 fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
-    let first = &s.images[0];
     // A file, or a frame of a multi-frame file.
     let name = |i: &Image| match s.images.iter().filter(|j| j.path == i.path).count() {
         1 => i.path.display().to_string(),
@@ -441,32 +443,15 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     if s.images.len() > MAX_FILES {
         return Err(bad(what, format!("{} slices: a series holds at most {MAX_FILES}", s.images.len())));
     }
-    for i in &s.images {
-        if i.size != first.size {
-            return Err(bad(
-                what,
-                format!("mixed sizes: {} is {:?}, {} {:?}", name(i), i.size, name(first), first.size),
-            ));
-        }
-        if (i.row - first.row).length() > 1e-4 || (i.column - first.column).length() > 1e-4 {
-            return Err(bad(
-                what,
-                format!("mixed orientations (a localizer?): {} and {} lie in different planes", name(first), name(i)),
-            ));
-        }
-        if i.rescale != first.rescale {
-            return Err(bad(
-                what,
-                format!("mixed rescale: {} {:?}, {} {:?}", name(first), first.rescale, name(i), i.rescale),
-            ));
-        }
-        if (i.spacing[0] - first.spacing[0]).abs() > 1e-6 || (i.spacing[1] - first.spacing[1]).abs() > 1e-6 {
-            return Err(bad(what, format!("mixed pixel spacing: {} and {}", name(first), name(i))));
-        }
-    }
+    let (images, mut notes) = apart::localizers(s.images.clone(), &name).unwrap_or((s.images.clone(), Vec::new()));
+    apart::agree(&images, what, &name)?;
+    let first = &images[0];
     let normal = first.row.cross(first.column);
-    let mut images = s.images.clone();
+    let mut images = images;
     images.sort_by(|a, b| a.position.dot(normal).total_cmp(&b.position.dot(normal)));
+    let (images, far) = apart::far_slices(images, normal, &name);
+    notes.extend(far);
+    let first = &images[0].clone();
     let steps: Vec<f64> = images.windows(2).map(|w| (w[1].position - w[0].position).dot(normal)).collect();
     let least = first.spacing[0].min(first.spacing[1]) * 1e-3;
     if let Some(k) = steps.iter().position(|&d| d.abs() < least) {
@@ -524,7 +509,7 @@ fn build(s: &SeriesInfo, what: &str, rectilinear: bool) -> Result<Series> {
     let affine = DMat4::from_diagonal(DVec4::new(-1.0, -1.0, 1.0, 1.0)) * lps;
     let dims = [first.size[0], first.size[1], slices as u32];
     let orientation = crate::orient::Orientation::from_affine(affine, dims).map_err(|e| bad(what, e))?;
-    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, gaps, kept: None })
+    Ok(Series { images, frames: None, dims, orientation, rescale: first.rescale, gaps, kept: None, left_out: notes })
 }
 
 impl Series {

@@ -114,6 +114,7 @@ pub(crate) fn nifti_layout(head: &[u8], limit: u64, what: &str) -> Result<NiftiL
     }
     let orientation = nrrd::nifti_orientation(&header, d3.map(|d| d as u32), what)?;
     let spacing = orientation.map(|o| o.spacing()).unwrap_or(spacing);
+    super::check_spacing(spacing, what)?;
     Ok(NiftiLayout {
         orientation,
         dims: d3.map(|d| d as u32),

@@ -174,6 +174,18 @@ impl SliceReader {
         Ok((nrrd_header(&head, &path.display().to_string(), MAX_STREAMED_VOXELS)?, file))
     }
 
+    /// The channels a NIfTI or an NRRD holds (`load_channels` reads them); 1 for any other file.
+    pub fn channels(path: &Path) -> Result<u32> {
+        let name = super::lower_name(path);
+        if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+            return Self::nifti_channels(path);
+        }
+        if name.ends_with(".nrrd") || name.ends_with(".nhdr") {
+            return Ok(Self::nrrd_head(path)?.0.channels);
+        }
+        Ok(1)
+    }
+
     /// The time points an NRRD holds (1 unless it is a 4-D series).
     pub fn nrrd_times(path: &Path) -> Result<u32> {
         Ok(Self::nrrd_head(path)?.0.times)
