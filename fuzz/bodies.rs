@@ -199,3 +199,29 @@ pub fn zarr(data: &[u8]) {
         }
     }
 }
+
+/// File names and a pattern (issue 76: names that are not UTF-8 panicked, and a pattern of many
+/// `*` hung): the first line is a pattern, each later one (at most 16) names an empty file made in
+/// a fresh folder; the pattern's series and the folder as slices are then read.
+pub fn names(data: &[u8]) {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = std::env::temp_dir().join(format!("voxsplat-fuzz-names-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    if std::fs::create_dir_all(&dir).is_err() {
+        return;
+    }
+    let usable = |n: &[u8]| !n.is_empty() && n.len() <= 255 && !n.contains(&b'/') && !n.contains(&0) && n != b"." && n != b"..";
+    let mut lines = data.split(|&b| b == b'\n');
+    let pattern = lines.next().unwrap_or_default();
+    for name in lines.take(16).filter(|n| usable(n)) {
+        let _ = std::fs::write(dir.join(std::ffi::OsStr::from_bytes(name)), b"");
+    }
+    if usable(pattern) {
+        let path = dir.join(std::ffi::OsStr::from_bytes(pattern));
+        let _ = voxsplat::loaders::series_files(&path);
+        let _ = voxsplat::loaders::time_points(&path);
+    }
+    let _ = voxsplat::loaders::is_stack(&dir);
+    let _ = voxsplat::loaders::load_volume(&dir, &Default::default());
+    let _ = std::fs::remove_dir_all(&dir);
+}

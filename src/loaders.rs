@@ -459,11 +459,21 @@ pub struct VolumeHints {
 /// The positions of an unevenly spaced DICOM series' slices along their normal, from the first
 /// (mm); `None` for evenly spaced slices and any other file.
 pub fn slice_offsets(path: &Path, hints: &VolumeHints) -> Result<Option<Vec<f64>>> {
+    Ok(series_of(path, hints)?.and_then(|s| s.offsets().map(<[f64]>::to_vec)))
+}
+
+/// What reading DICOM series `path` leaves out (a localizer, a far slice), a line each; else none.
+pub fn left_out(path: &Path, hints: &VolumeHints) -> Result<Vec<String>> {
+    Ok(series_of(path, hints)?.map(|s| s.left_out).unwrap_or_default())
+}
+
+fn series_of(path: &Path, hints: &VolumeHints) -> Result<Option<dicom::Series>> {
     let dir = path.is_dir() && !is_ome_zarr(path);
     if !(dir && dicom::holds_dicom(path) || !path.is_dir() && is_dicom(path)) {
         return Ok(None);
     }
-    Ok(dicom::open(path, hints.series.as_deref(), true, hints.time)?.offsets().map(<[f64]>::to_vec))
+    // A series' time points share their slices' placement: the first stands for all.
+    dicom::open(path, hints.series.as_deref(), true, hints.time.or(Some(0))).map(Some)
 }
 
 /// The voxel positions of a file whose slices are not evenly spaced (a DICOM series with uneven
@@ -540,20 +550,21 @@ pub fn load_orientation(path: &Path, hints: &VolumeHints) -> Result<Option<crate
         check_raw_hints(path, hints)?;
         return crate::orient::respaced(SliceReader::nifti_channel(path, 0)?.orientation, hints.spacing);
     }
-    // An OME-Zarr image has no anatomical frame (NGFF 0.4 and 0.5 give none).
     if is_ome_zarr(path) {
+        // No anatomical frame: NGFF 0.4 and 0.5 give none.
         OmeZarr::open(path)?;
         return Ok(None);
     }
-    let o = match SliceReader::open(path, hints)? {
+    let nrrd = name.ends_with(".nrrd") || name.ends_with(".nhdr");
+    let o = match if nrrd { None } else { SliceReader::open(path, hints)? } {
         Some(reader) => reader.orientation,
-        // Not streamed: an .npy (no frame), or an NRRD in another encoding (its header alone).
-        None if path.to_string_lossy().to_ascii_lowercase().ends_with(".npy") => None,
+        None if name.ends_with(".npy") => None,
+        // An NRRD: its header places all its channels and time points, however it is read.
         None => {
             let mut head = Vec::new();
             let file = std::fs::File::open(path).map_err(|e| Error::Io { path: what.clone(), source: e })?;
             file.take(1 << 20).read_to_end(&mut head).map_err(|e| Error::Io { path: what.clone(), source: e })?;
-            nrrd_header(&head, &what, MAX_VOXELS)?.orientation
+            nrrd_header(&head, &what, MAX_STREAMED_VOXELS)?.orientation
         }
     };
     crate::orient::respaced(o, hints.spacing)

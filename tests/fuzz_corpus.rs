@@ -23,6 +23,7 @@ const TARGETS: &[(&str, Body)] = &[
     ("stacks", stacks),
     ("dicom", dicom),
     ("zarr", zarr),
+    ("names", names),
 ];
 
 /// The seeds of `target` (which must exist), then its corpus.

@@ -1,0 +1,3 @@
+#![no_main]
+include!("../cli_bodies.rs");
+libfuzzer_sys::fuzz_target!(|data: &[u8]| session(data));
