@@ -472,8 +472,7 @@ fn series_of(path: &Path, hints: &VolumeHints) -> Result<Option<dicom::Series>> 
     if !(dir && dicom::holds_dicom(path) || !path.is_dir() && is_dicom(path)) {
         return Ok(None);
     }
-    // A series' time points share their slices' placement: the first stands for all.
-    dicom::open(path, hints.series.as_deref(), true, hints.time.or(Some(0))).map(Some)
+    dicom::open_placed(path, hints.series.as_deref(), hints.time).map(Some)
 }
 
 /// The voxel positions of a file whose slices are not evenly spaced (a DICOM series with uneven

@@ -654,3 +654,31 @@ fn a_localizer_or_a_far_slice_is_left_out_with_a_note() {
         let _ = std::fs::remove_dir_all(d);
     }
 }
+
+/// A series of a ball (24 x 20 pixels, 1 mm, centred at z = 11 mm) with its slices at `zs` mm,
+/// written by pydicom into `dir`.
+fn ball_series(dir: &Path, zs: &[i32]) {
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).unwrap();
+    let script = format!(
+        "import numpy as np, pydicom\n\
+         from pydicom.dataset import Dataset, FileMetaDataset\n\
+         from pydicom.uid import ExplicitVRLittleEndian\n\
+         x, y = np.meshgrid(np.arange(24), np.arange(20))\n\
+         for k, z in enumerate({zs:?}):\n\
+         \x20   m = FileMetaDataset(); m.MediaStorageSOPClassUID = '1.2.840.10008.5.1.4.1.1.2'\n\
+         \x20   m.MediaStorageSOPInstanceUID = '1.2.3.%d' % (k + 10); m.TransferSyntaxUID = ExplicitVRLittleEndian\n\
+         \x20   d = Dataset(); d.file_meta = m; d.SOPClassUID = m.MediaStorageSOPClassUID\n\
+         \x20   d.SOPInstanceUID = m.MediaStorageSOPInstanceUID; d.Modality = 'CT'; d.SeriesInstanceUID = '1.2.3.1'\n\
+         \x20   d.InstanceNumber = k + 1; d.Rows, d.Columns = 20, 24\n\
+         \x20   d.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]; d.ImagePositionPatient = [0, 0, z]\n\
+         \x20   d.PixelSpacing = [1, 1]; d.SamplesPerPixel = 1; d.PhotometricInterpretation = 'MONOCHROME2'\n\
+         \x20   d.BitsAllocated, d.BitsStored, d.HighBit, d.PixelRepresentation = 16, 16, 15, 0\n\
+         \x20   r = np.sqrt((x - 12) ** 2 + (y - 10) ** 2 + (z - 11) ** 2)\n\
+         \x20   d.PixelData = np.where(r < 9, 1000 - 80 * r, 0).astype(np.uint16).tobytes()\n\
+         \x20   pydicom.dcmwrite('{}/s%d' % k, d, enforce_file_format=True)\n",
+        dir.display()
+    );
+    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}

@@ -383,9 +383,21 @@ pub struct Series {
 /// more than `resample::MAX_GROWTH` slices per image), or with `rectilinear` read as they lie (the
 /// caller places the slices at `Series::offsets`).
 pub fn open(path: &Path, pick: Option<&str>, rectilinear: bool, time: Option<u32>) -> Result<Series> {
+    open_at(path, pick, rectilinear, |times| super::time_point(&path.display().to_string(), times, time))
+}
+
+/// `open` at time point `time`, or the first when none is given: the placement all time points
+/// share (their slices' gaps, the images left out).
+pub fn open_placed(path: &Path, pick: Option<&str>, time: Option<u32>) -> Result<Series> {
+    open_at(path, pick, true, |times| {
+        super::time_point(&path.display().to_string(), times, time.or((times > 1).then_some(0)))
+    })
+}
+
+fn open_at(path: &Path, pick: Option<&str>, rectilinear: bool, at: impl Fn(u32) -> Result<u32>) -> Result<Series> {
     let what = path.display().to_string();
     let chosen = chosen(path, pick)?;
-    let t = super::time_point(&what, chosen.times, time)?;
+    let t = at(chosen.times)?;
     let at = chosen.temporal_positions()[t as usize];
     let images = chosen.images.iter().filter(|i| i.time == at).cloned().collect();
     build(&SeriesInfo { images, ..chosen }, &what, rectilinear)
