@@ -21,6 +21,7 @@ mod sequence;
 mod slices;
 mod stacks;
 mod zarr;
+mod zarr_axes;
 mod zarr_chunks;
 use bounded::read_bounded;
 pub use bounded::{read_text, MAX_TEXT_BYTES};

@@ -182,3 +182,81 @@ fn refusals_blame_the_field_at_fault() {
         assert!(e.contains(says) && !e.contains("invalid camera"), "{name}: {e}");
     }
 }
+
+/// zarr-python's OME-Zarr images (issue 76): a z axis in nanometres beside x and y in micrometres
+/// is scaled into micrometres (it drew z a thousand times too long), and spatial axes named x, y,
+/// z in array order x, y, z are refused (they were scaled as z, y, x).
+#[test]
+fn ome_zarr_axes_keep_their_units_and_their_names() {
+    let write = |name: &str, axes: &str, scale: &str| {
+        let dir = tmp(name);
+        let _ = std::fs::remove_dir_all(&dir);
+        let script = format!(
+            "import zarr, numpy as np\nroot = zarr.open_group('{{}}', mode='w', zarr_format=2)\n\
+             a = root.create_array('0', shape=(4, 5, 6), dtype='u1')\na[:] = np.arange(120).reshape(4, 5, 6)\n\
+             root.attrs['multiscales'] = [{{'version': '0.4', 'axes': {axes}, 'datasets': [{{'path': '0', \
+             'coordinateTransformations': [{{'type': 'scale', 'scale': {scale}}}]}}]}}]"
+        );
+        python(&script, &[&dir]);
+        dir
+    };
+    let units = write(
+        "units.zarr",
+        "[{'name': 'z', 'type': 'space', 'unit': 'nanometer'}, {'name': 'y', 'type': 'space', 'unit': 'micrometer'}, \
+         {'name': 'x', 'type': 'space', 'unit': 'micrometer'}]",
+        "[2000.0, 0.5, 0.25]",
+    );
+    let v = load_volume(&units, &VolumeHints::default()).unwrap();
+    assert_eq!(v.dims, [6, 5, 4]);
+    let want = [0.25, 0.5, 2.0];
+    assert!(v.spacing.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6), "{:?} against {want:?}", v.spacing);
+    let swapped = write(
+        "xyz.zarr",
+        "[{'name': 'x', 'type': 'space'}, {'name': 'y', 'type': 'space'}, {'name': 'z', 'type': 'space'}]",
+        "[1.0, 1.0, 3.0]",
+    );
+    let e = cmd::refused(&["info", swapped.to_str().unwrap()]);
+    assert!(e.contains("[\"x\", \"y\", \"z\"]") && e.contains("z, y, x"), "{e}");
+    let seconds = write(
+        "seconds.zarr",
+        "[{'name': 'z', 'type': 'space', 'unit': 'second'}, {'name': 'y', 'type': 'space'}, {'name': 'x', 'type': 'space'}]",
+        "[1.0, 1.0, 1.0]",
+    );
+    let e = cmd::refused(&["info", seconds.to_str().unwrap()]);
+    assert!(e.contains("axis z has unit \"second\""), "{e}");
+}
+
+/// pynrrd's NRRD of 2 channels and nibabel's NIfTI of 3 (issue 76): `info` describes each channel
+/// and `render --channel-tf` draws them (the NRRD was refused by both, "holds 2 channels").
+#[test]
+fn files_of_channels_are_described_and_drawn() {
+    let (nrrd, nii) = (tmp("two.nrrd"), tmp("three.nii"));
+    python(
+        "import nrrd, nibabel, numpy as np\nd = np.zeros((2, 16, 16, 16), np.uint8)\nd[0, 4:12, 4:12, 4:12] = 200\n\
+         d[1, 2:8, 2:8, 2:8] = 150\nnrrd.write('{}', d, {'kinds': ['vector', 'domain', 'domain', 'domain']}, \
+         index_order='F')\nv = np.zeros((16, 16, 16, 1, 3), np.uint8)\nv[4:12, 4:12, 4:12, 0, :] = [200, 150, 100]\n\
+         nibabel.save(nibabel.Nifti1Image(v, np.eye(4)), '{}')",
+        &[&nrrd, &nii],
+    );
+    for (file, n, tfs) in
+        [(&nrrd, 2, vec!["--channel-tf", "bonsai"]), (&nii, 3, vec!["--channel-tf", "bonsai", "--channel-tf", "ct"])]
+    {
+        let out = cmd::voxsplat(&["info", file.to_str().unwrap()]);
+        let said = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success() && said.contains(&format!("{n} channels")),
+            "{said}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(said.contains(&format!("channel {}: [16, 16, 16] voxels", n - 1)), "{said}");
+        let png = tmp("channels.png");
+        let args = [
+            &["render", "--volume", file.to_str().unwrap()][..],
+            &tfs,
+            &["--size", "32x32", "--out", png.to_str().unwrap()],
+        ]
+        .concat();
+        let out = cmd::voxsplat(&args);
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+}

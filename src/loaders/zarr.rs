@@ -315,16 +315,7 @@ impl OmeZarr {
             })
             .collect();
         let n = axes.len();
-        let space: Vec<usize> = (0..n).filter(|&i| axes[i].kind == "space").collect();
-        if space.len() != 3 || space != [n - 3, n - 2, n - 1] {
-            return Err(bad(
-                &what,
-                format!(
-                    "axes {:?}: a volume has three spatial axes, last (z, y, x)",
-                    axes.iter().map(|a| a.name.as_str()).collect::<Vec<_>>()
-                ),
-            ));
-        }
+        let units = super::zarr_axes::spatial(&axes, &what)?;
         let find = |kind: &str| (0..n - 3).find(|&i| axes[i].kind == kind);
         let (time_axis, channel_axis) = (find("time"), find("channel"));
         if (0..n - 3).any(|i| Some(i) != time_axis && Some(i) != channel_axis) {
@@ -346,8 +337,10 @@ impl OmeZarr {
             }
             let meta = array_meta(&dir.join(path), zarr_v3, n)?;
             let (s, t) = transforms(&d["coordinateTransformations"], n, &what)?;
-            let scale: Vec<f64> = (0..n).map(|a| s[a] * global_scale[a]).collect();
-            let shift: Vec<f64> = (0..n).map(|a| t[a] * global_scale[a] + global_shift[a]).collect();
+            // Each spatial axis in the unit of x.
+            let unit = |a: usize| if a + 3 >= n { units[a + 3 - n] } else { 1.0 };
+            let scale: Vec<f64> = (0..n).map(|a| s[a] * global_scale[a] * unit(a)).collect();
+            let shift: Vec<f64> = (0..n).map(|a| (t[a] * global_scale[a] + global_shift[a]) * unit(a)).collect();
             // Array order (z, y, x) to the grid's (x, y, z).
             let xyz = |a: usize| n - 1 - a;
             if meta.shape.iter().any(|&d| d > u32::MAX as u64) {
