@@ -10,6 +10,9 @@ use glam::DVec3;
 /// lies apart from the series.
 pub const FAR_GAPS: f64 = 10.0;
 
+/// Most planes and sizes a series with localizers holds (more is a mixed folder).
+const MAX_PLANES: usize = 8;
+
 /// The images that share the plane and size of most of them, and a note for each left out; `None`
 /// when no plane and size holds a strict majority of at least two (a mixed series, refused by
 /// the caller as before). `name` names an image in notes.
@@ -17,9 +20,17 @@ pub(super) fn localizers(images: Vec<Image>, name: &dyn Fn(&Image) -> String) ->
     let same = |a: &Image, b: &Image| {
         a.size == b.size && (a.row - b.row).length() <= 1e-4 && (a.column - b.column).length() <= 1e-4
     };
-    let count = |i: &Image| images.iter().filter(|j| same(i, j)).count();
-    let most = images.iter().max_by_key(|i| count(i))?.clone();
-    let kept = count(&most);
+    // Each plane and size once, with its count: a series of more than a few is mixed, not a
+    // series with its localizers (and counting stays linear in the images).
+    let mut groups: Vec<(&Image, usize)> = Vec::new();
+    for i in &images {
+        match groups.iter().position(|(g, _)| same(g, i)) {
+            Some(k) => groups[k].1 += 1,
+            None if groups.len() < MAX_PLANES => groups.push((i, 1)),
+            None => return None,
+        }
+    }
+    let (most, kept) = groups.iter().max_by_key(|(_, n)| *n).map(|(g, n)| ((*g).clone(), *n))?;
     if kept == images.len() {
         return Some((images, Vec::new()));
     }
@@ -45,33 +56,40 @@ pub(super) fn localizers(images: Vec<Image>, name: &dyn Fn(&Image) -> String) ->
 /// `images`, sorted along `normal`, less the slices at either end that lie apart (a gap over
 /// `FAR_GAPS` times the median), with a note for each. Three slices or more are kept.
 pub(super) fn far_slices(
-    mut images: Vec<Image>,
+    images: Vec<Image>,
     normal: DVec3,
     name: &dyn Fn(&Image) -> String,
 ) -> (Vec<Image>, Vec<String>) {
+    let step = |k: usize| (images[k + 1].position - images[k].position).dot(normal).abs();
+    // The median of the whole series' gaps, once: a far slice or two barely moves it.
+    let mut sorted: Vec<f64> = (0..images.len().saturating_sub(1)).map(step).collect();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len().saturating_sub(1) / 2).copied().unwrap_or(0.0);
+    let far = |gap: f64| median > 0.0 && gap > FAR_GAPS * median;
+    // Kept: images[lo..hi].
+    let (mut lo, mut hi) = (0, images.len());
     let mut notes = Vec::new();
-    while images.len() > 3 {
-        let steps: Vec<f64> = images.windows(2).map(|w| (w[1].position - w[0].position).dot(normal).abs()).collect();
-        let mut sorted = steps.clone();
-        sorted.sort_by(f64::total_cmp);
-        let median = sorted[(sorted.len() - 1) / 2];
-        let (first, last) = (steps[0], steps[steps.len() - 1]);
-        let far = |gap: f64| median > 0.0 && gap > FAR_GAPS * median;
+    while hi - lo > 3 {
+        let (first, last) = (step(lo), step(hi - 2));
         let (at, gap) = match (far(first), far(last)) {
             (false, false) => break,
-            (true, false) => (0, first),
-            (false, true) => (images.len() - 1, last),
-            (true, true) if first >= last => (0, first),
-            (true, true) => (images.len() - 1, last),
+            (true, false) => (lo, first),
+            (false, true) => (hi - 1, last),
+            (true, true) if first >= last => (lo, first),
+            (true, true) => (hi - 1, last),
         };
-        let image = images.remove(at);
+        if at == lo {
+            lo += 1;
+        } else {
+            hi -= 1;
+        }
         notes.push(format!(
             "left out {}: it lies {gap:.4} mm from the next slice, over {FAR_GAPS} times the median gap of \
              {median:.4} mm (a stray slice or a localizer)",
-            name(&image)
+            name(&images[at])
         ));
     }
-    (images, notes)
+    (images.into_iter().skip(lo).take(hi - lo).collect(), notes)
 }
 
 /// Refuses `images` (those kept) unless they share one size, plane, rescale and pixel spacing.
