@@ -4,6 +4,7 @@
 //! read and checked as JSON before zarrs opens it (a decoded chunk against `MAX_CHUNK_BYTES`, the
 //! level read against `MAX_STREAMED_VOXELS`, the pyramid's levels against each other), so nothing is sized by
 //! a header that has not been checked.
+use super::zarr_axes::AxisText;
 use super::zarr_chunks::{copy_part, may_see_block, spatial, ChunkKey, Samples};
 use super::{bad, MAX_STREAMED_VOXELS};
 use crate::error::{Error, Result};
@@ -315,7 +316,9 @@ impl OmeZarr {
             })
             .collect();
         let n = axes.len();
-        let units = super::zarr_axes::spatial(&axes, &what)?;
+        let text: Vec<_> =
+            axes.iter().map(|a| AxisText { name: &a.name, kind: &a.kind, unit: a.unit.as_deref() }).collect();
+        let units = super::zarr_axes::spatial(&text, &what)?;
         let find = |kind: &str| (0..n - 3).find(|&i| axes[i].kind == kind);
         let (time_axis, channel_axis) = (find("time"), find("channel"));
         if (0..n - 3).any(|i| Some(i) != time_axis && Some(i) != channel_axis) {

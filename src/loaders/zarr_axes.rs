@@ -4,7 +4,6 @@
 //! scale into the unit of x (they were ignored: a z in nanometres beside an x in micrometres drew
 //! z a thousand times too long).
 use super::bad;
-use super::zarr::Axis;
 use crate::error::Result;
 
 /// The metres in one of OME-NGFF's length units.
@@ -44,18 +43,25 @@ fn metres(unit: &str) -> Option<f64> {
     }
 }
 
+/// One axis as the metadata gives it: its name, its type and its unit.
+pub(super) struct AxisText<'a> {
+    pub name: &'a str,
+    pub kind: &'a str,
+    pub unit: Option<&'a str>,
+}
+
 /// Checks that `axes` end in three spatial ones, in order z, y, x where they are so named, and
 /// gives the factor that takes each one's scale (array order) into the unit of x: 1 where no
 /// unit is given.
-pub(super) fn spatial(axes: &[Axis], what: &str) -> Result<[f64; 3]> {
+pub(super) fn spatial(axes: &[AxisText<'_>], what: &str) -> Result<[f64; 3]> {
     let n = axes.len();
-    let names = || axes.iter().map(|a| a.name.as_str()).collect::<Vec<_>>();
+    let names = || axes.iter().map(|a| a.name).collect::<Vec<_>>();
     let space: Vec<usize> = (0..n).filter(|&i| axes[i].kind == "space").collect();
     if n < 3 || space != [n - 3, n - 2, n - 1] {
         return Err(bad(what, format!("axes {:?}: a volume has three spatial axes, last (z, y, x)", names())));
     }
     let last = &axes[n - 3..];
-    let named: Vec<&str> = last.iter().map(|a| a.name.as_str()).collect();
+    let named: Vec<&str> = last.iter().map(|a| a.name).collect();
     let mut sorted = named.clone();
     sorted.sort_unstable();
     if sorted == ["x", "y", "z"] && named != ["z", "y", "x"] {
@@ -64,7 +70,7 @@ pub(super) fn spatial(axes: &[Axis], what: &str) -> Result<[f64; 3]> {
             format!("spatial axes {named:?}: they are read in array order z, y, x (OME-NGFF's), not by name"),
         ));
     }
-    let unit = |a: &Axis| match &a.unit {
+    let unit = |a: &AxisText<'_>| match a.unit {
         None => Ok(None),
         Some(u) => metres(u).map(Some).ok_or_else(|| {
             bad(
