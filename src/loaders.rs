@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 mod bounded;
 mod dicom;
+mod held;
 mod nifti1;
 mod npy;
 mod nrrd;
@@ -133,6 +134,15 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
     }
     crate::error::check_host_memory(n * 4, &format!("{what}'s {n} samples"))?;
     let b = &bytes[..need as usize];
+    // Four bytes as a u32 in the file's byte order.
+    let word = |c: &[u8]| {
+        let a = [c[0], c[1], c[2], c[3]];
+        if big_endian {
+            u32::from_be_bytes(a)
+        } else {
+            u32::from_le_bytes(a)
+        }
+    };
     let v = match dtype {
         DType::U8 => b.iter().map(|&x| x as f32).collect(),
         DType::I8 => b.iter().map(|&x| x as i8 as f32).collect(),
@@ -148,38 +158,17 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
                 |c| if big_endian { i16::from_be_bytes([c[0], c[1]]) } else { i16::from_le_bytes([c[0], c[1]]) } as f32,
             )
             .collect(),
-        DType::U32 => b
-            .chunks_exact(4)
-            .map(|c| {
-                let a = [c[0], c[1], c[2], c[3]];
-                (if big_endian { u32::from_be_bytes(a) } else { u32::from_le_bytes(a) }) as f32
-            })
-            .collect(),
-        DType::I32 => b
-            .chunks_exact(4)
-            .map(|c| {
-                let a = [c[0], c[1], c[2], c[3]];
-                (if big_endian { i32::from_be_bytes(a) } else { i32::from_le_bytes(a) }) as f32
-            })
-            .collect(),
-        DType::F64 => b
-            .chunks_exact(8)
-            .map(|c| {
-                let a = [c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]];
-                (if big_endian { f64::from_be_bytes(a) } else { f64::from_le_bytes(a) }) as f32
-            })
-            .collect(),
-        DType::F32 => b
-            .chunks_exact(4)
-            .map(|c| {
-                let a = [c[0], c[1], c[2], c[3]];
-                if big_endian {
-                    f32::from_be_bytes(a)
-                } else {
-                    f32::from_le_bytes(a)
-                }
-            })
-            .collect(),
+        // Wider than f32 holds exactly: rounded toward zero, refused where f32 would flatten them.
+        DType::U32 => held::held(b.chunks_exact(4).map(|c| word(c) as f64), what)?,
+        DType::I32 => held::held(b.chunks_exact(4).map(|c| word(c) as i32 as f64), what)?,
+        DType::F64 => held::held(
+            b.chunks_exact(8).map(|c| {
+                let (high, low) = if big_endian { (&c[..4], &c[4..]) } else { (&c[4..], &c[..4]) };
+                f64::from_bits((word(high) as u64) << 32 | word(low) as u64)
+            }),
+            what,
+        )?,
+        DType::F32 => b.chunks_exact(4).map(|c| f32::from_bits(word(c))).collect(),
     };
     Ok(v)
 }

@@ -426,9 +426,12 @@ fn run(cli: Cli) -> Result<()> {
                 if channels > 1 {
                     println!("{channels} channels: render draws them with --channel-tf for each after the first");
                     for (k, v) in voxsplat::loaders::load_channels(&file, &hints)?.iter().enumerate() {
-                        let (lo, hi) =
-                            v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
-                        println!("channel {k}: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
+                        println!(
+                            "channel {k}: {:?} voxels, spacing {:?}, values {}",
+                            v.dims,
+                            v.spacing,
+                            span(&v.values)
+                        );
                     }
                     return Ok(());
                 }
@@ -443,7 +446,10 @@ fn run(cli: Cli) -> Result<()> {
                         bar.finish_and_clear();
                         println!(
                             "volume: {:?} voxels, spacing {:?}, values {} .. {}",
-                            store.dims, store.spacing, store.range.0, store.range.1
+                            store.dims,
+                            store.spacing,
+                            held(store.range.0),
+                            held(store.range.1)
                         );
                         print_store(&store);
                         histogram.map(|bins| print_histogram(&store, bins)).transpose()?;
@@ -455,9 +461,7 @@ fn run(cli: Cli) -> Result<()> {
                     }
                 }
                 let v = voxsplat::loaders::load_volume(&file, &hints)?;
-                let (lo, hi) =
-                    v.values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
-                println!("volume: {:?} voxels, spacing {:?}, values {lo} .. {hi}", v.dims, v.spacing);
+                println!("volume: {:?} voxels, spacing {:?}, values {}", v.dims, v.spacing, span(&v.values));
                 let store = voxsplat::bricks::BrickStore::build(&v)?;
                 print_store(&store);
                 histogram.map(|bins| print_histogram(&store, bins)).transpose()?;
@@ -647,5 +651,21 @@ fn main() -> ExitCode {
             let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
             ExitCode::from(2)
         }
+    }
+}
+
+/// The least and greatest of `values` as `info` prints them (`held`).
+fn span(values: &[f32]) -> String {
+    let (lo, hi) = values.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+    format!("{} .. {}", held(lo), held(hi))
+}
+
+/// A value as the engine holds it: past f32's 2^24 whole numbers, every digit of the f32 (its
+/// shortest form, "4294967000", would name a value it does not hold).
+fn held(v: f32) -> String {
+    if (16777216.0..1e15).contains(&v.abs()) {
+        format!("{}", v as f64)
+    } else {
+        format!("{v}")
     }
 }

@@ -260,3 +260,50 @@ fn files_of_channels_are_described_and_drawn() {
         assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
     }
 }
+
+#[test]
+fn wide_values_stay_in_range_and_values_f32_would_flatten_are_refused() {
+    // nibabel's uint32 and int32 at their types' limits, a float64 ball on an offset of 1e10 and an
+    // int32 ball on 2e9 (both drew flat: f32 steps of 1024 and 128 there), numpy's float64 the same.
+    let [u32n, i32n, f64n, i32b, npy] = ["u32.nii", "i32.nii", "f64.nii", "i32-ball.nii", "f64.npy"].map(|n| tmp(n));
+    python(
+        "import nibabel, numpy as np\n\
+         def save(a, p): nibabel.save(nibabel.Nifti1Image(a, np.eye(4)), p)\n\
+         z, y, x = np.mgrid[:16, :16, :16]\nball = ((x - 8) ** 2 + (y - 8) ** 2 + (z - 8) ** 2 < 25)\n\
+         u = np.zeros((16, 16, 16), np.uint32)\nu[ball] = 4294967295\nsave(u, '{}')\n\
+         i = np.full((16, 16, 16), -2147483648, np.int32)\ni[ball] = 2147483647\nsave(i, '{}')\n\
+         save(1e10 + ball.astype(np.float64), '{}')\nsave((2000000000 + 100 * ball).astype(np.int32), '{}')\n\
+         np.save('{}', 1e10 + ball.astype(np.float64))",
+        &[&u32n, &i32n, &f64n, &i32b, &npy],
+    );
+    for (file, lo, hi) in [(&u32n, 0.0, u32::MAX as f64), (&i32n, i32::MIN as f64, i32::MAX as f64)] {
+        let out = cmd::voxsplat(&["info", file.to_str().unwrap()]);
+        let said = String::from_utf8_lossy(&out.stdout);
+        let values = said.lines().find_map(|l| l.split_once("values ")).map(|(_, v)| v.to_string());
+        let values = values.unwrap_or_else(|| panic!("{said}{}", String::from_utf8_lossy(&out.stderr)));
+        let (a, b) = values.split_once(" .. ").unwrap();
+        let (a, b) = (a.parse::<f64>().unwrap(), b.parse::<f64>().unwrap());
+        // Within the type's range and within one f32 step (512 near 2^32) of its ends.
+        assert!(a >= lo && b <= hi && a - lo < 512.0 && hi - b < 512.0, "{}: {values}", file.display());
+        let png = tmp("wide.png");
+        let out = cmd::voxsplat(&[
+            "render",
+            "--volume",
+            file.to_str().unwrap(),
+            "--size",
+            "32x32",
+            "--out",
+            png.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    for file in [&f64n, &i32b, &npy] {
+        for args in [
+            vec!["info", file.to_str().unwrap()],
+            vec!["render", "--volume", file.to_str().unwrap(), "--size", "16x16", "--out", "x.png"],
+        ] {
+            let e = cmd::refused(&args);
+            assert!(e.contains(file.to_str().unwrap()) && e.contains("Subtract their offset"), "{args:?}: {e}");
+        }
+    }
+}

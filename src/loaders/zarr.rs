@@ -621,16 +621,19 @@ impl ZarrReader {
             Kind::I8 => Samples::I8(a.retrieve_array_subset(subset).map_err(err)?),
             Kind::U16 => Samples::U16(a.retrieve_array_subset(subset).map_err(err)?),
             Kind::I16 => Samples::I16(a.retrieve_array_subset(subset).map_err(err)?),
-            Kind::U32 => {
-                f32s(a.retrieve_array_subset::<Vec<u32>>(subset).map_err(err)?.iter().map(|&v| v as f32).collect())?
-            }
-            Kind::I32 => {
-                f32s(a.retrieve_array_subset::<Vec<i32>>(subset).map_err(err)?.iter().map(|&v| v as f32).collect())?
-            }
+            Kind::U32 => f32s(super::held::held(
+                a.retrieve_array_subset::<Vec<u32>>(subset).map_err(err)?.into_iter().map(f64::from),
+                &self.what,
+            )?)?,
+            Kind::I32 => f32s(super::held::held(
+                a.retrieve_array_subset::<Vec<i32>>(subset).map_err(err)?.into_iter().map(f64::from),
+                &self.what,
+            )?)?,
             Kind::F32 => f32s(a.retrieve_array_subset(subset).map_err(err)?)?,
-            Kind::F64 => {
-                f32s(a.retrieve_array_subset::<Vec<f64>>(subset).map_err(err)?.iter().map(|&v| v as f32).collect())?
-            }
+            Kind::F64 => f32s(super::held::held(
+                a.retrieve_array_subset::<Vec<f64>>(subset).map_err(err)?.into_iter(),
+                &self.what,
+            )?)?,
         };
         if values.len() as u64 != n {
             return Err(bad(&self.what, format!("slices {z0}..{}: {} samples for {n}", z0 + count, values.len())));
