@@ -200,6 +200,29 @@ pub fn zarr(data: &[u8]) {
     }
 }
 
+/// OME-Zarr metadata alone (issue 76: the `zarr` target reads chunks at about 50 a second and
+/// stopped short of 1 M): the image as `zarr_image` unpacks it, its multiscales, axes and every
+/// level's array metadata opened and checked, and the pyramid asked which level and region a view
+/// and a crop need. No chunk is decoded.
+pub fn zarr_meta(data: &[u8]) {
+    voxsplat::set_host_budget(Some(256 << 20));
+    let Some(dir) = zarr_image(data) else { return };
+    let Ok(image) = voxsplat::loaders::OmeZarr::open(&dir) else { return };
+    for level in 0..image.levels.len().min(4) as u32 {
+        // Opened to be read slice by slice (each level's array, its chunk grid and codecs).
+        let hints = voxsplat::loaders::VolumeHints { level: Some(level), ..Default::default() };
+        let _ = voxsplat::loaders::SliceReader::open(&dir, &hints);
+        let _ = image.region(level, [[-2.0, -1.0, -3.0], [3.0, 2.0, 1.0]]);
+    }
+    let _ = image.default_level();
+    if let Ok(grid) = voxsplat::Grid::centered([8; 3], [1.0; 3]) {
+        let camera = voxsplat::Camera::framing(&grid, 16, 16);
+        let _ = image.default_level_within(Some([[-2.0, -1.0, -3.0], [3.0, 2.0, 1.0]]), Some(&camera));
+        let level = image.level_for(&camera, 1.0);
+        let _ = image.voxel_pixels(&camera, level);
+    }
+}
+
 /// File names and a pattern (issue 76: names that are not UTF-8 panicked, and a pattern of many
 /// `*` hung): the first line is a pattern, each later one (at most 16) names an empty file made in
 /// a fresh folder; the pattern's series and the folder as slices are then read.

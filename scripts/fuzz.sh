@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every cargo-fuzz target (fuzz/fuzz_targets: one per loader, the streamed store, image stacks,
-# DICOM series, OME-Zarr images, file names and patterns, terrain
+# DICOM series, OME-Zarr images and their metadata alone, file names and patterns, terrain
 # heights, and the transfer-function, animation, positions and sidecar TOML files) for a fixed
 # number of executions (default 1,000,000 each) from its committed seeds and corpus
 # (fuzz/seeds/TARGET, fuzz/corpus/TARGET),
@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 runs="${1:-1000000}"
 export RUSTC_BOOTSTRAP=1
-all="nrrd nifti npy tiff raw slices heights tf animation positions sidecar stacks dicom zarr names"
+all="nrrd nifti npy tiff raw slices heights tf animation positions sidecar stacks dicom zarr zarr_meta names"
 for t in ${FUZZ_TARGETS:-$all}; do
   log="/tmp/fuzz-$t.log"
   mkdir -p "fuzz/corpus/$t"

@@ -23,6 +23,7 @@ const TARGETS: &[(&str, Body)] = &[
     ("stacks", stacks),
     ("dicom", dicom),
     ("zarr", zarr),
+    ("zarr_meta", zarr_meta),
     ("names", names),
 ];
 
