@@ -682,3 +682,35 @@ fn ball_series(dir: &Path, zs: &[i32]) {
     let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// A deflate bomb (issue 76): pydicom's deflated image with 1.1 GiB of zeros deflated after its
+/// data set (1 MiB on disk; each 64 MiB flushed whole, so one block serves for all) took 1 GB of memory before its refusal at 1 GiB. Its length is
+/// now learnt inflating into nothing: refused naming the file within 512 MiB of address space.
+#[test]
+fn a_deflate_bomb_is_refused_before_it_is_held() {
+    let dir = tmp("bomb");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bomb.dcm");
+    python(
+        "import struct, zlib\n\
+         b = open('{}', 'rb').read()\n\
+         start = 144 + struct.unpack('<I', b[140:144])[0]\n\
+         data = zlib.decompress(b[start:], -15)\n\
+         c = zlib.compressobj(6, zlib.DEFLATED, -15)\n\
+         out = [b[:start], c.compress(data) + c.flush(zlib.Z_FULL_FLUSH)]\n\
+         zeros = c.compress(bytes(64 << 20)) + c.flush(zlib.Z_FULL_FLUSH)\n\
+         out += [zeros] * 18 + [c.flush()]\n\
+         open('{}', 'wb').write(b''.join(out))",
+        &[&pydicom_tests().join("../image_dfl.dcm"), &file],
+    );
+    assert!(std::fs::metadata(&file).unwrap().len() < 2 << 20);
+    let out = std::process::Command::new("bash")
+        .args(["-c", &format!("ulimit -v 524288; exec '{}' info '{}'", env!("CARGO_BIN_EXE_voxsplat"), file.display())])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && e.starts_with("error:"), "{:?}: {e}", out.status);
+    assert!(e.contains("bomb.dcm") && e.contains("inflates past 1024 MiB"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -229,13 +229,17 @@ fn inflated(bytes: &[u8], data: usize, what: &str) -> Result<Vec<u8>> {
     out.extend_from_slice(&(meta.len() as u32).to_le_bytes());
     out.extend_from_slice(&meta);
     let room = MAX_FILE_BYTES.saturating_sub(out.len() as u64);
-    flate2::read::DeflateDecoder::new(&bytes[data..])
-        .take(room + 1)
-        .read_to_end(&mut out)
-        .map_err(|e| bad(what, format!("DICOM: the deflated data set does not inflate: {e}")))?;
-    if out.len() as u64 > MAX_FILE_BYTES {
+    let fails = |e: std::io::Error| bad(what, format!("DICOM: the deflated data set does not inflate: {e}"));
+    // Inflated once into nothing to learn its length: a bomb is refused before its bytes are held.
+    let len =
+        std::io::copy(&mut flate2::read::DeflateDecoder::new(&bytes[data..]).take(room + 1), &mut std::io::sink())
+            .map_err(fails)?;
+    if len > room {
         return Err(bad(what, format!("DICOM: the deflated data set inflates past {} MiB", MAX_FILE_BYTES >> 20)));
     }
+    crate::error::check_host_memory(out.len() as u64 + len, &format!("{what}'s inflated data set"))?;
+    out.reserve_exact(len as usize);
+    flate2::read::DeflateDecoder::new(&bytes[data..]).take(len).read_to_end(&mut out).map_err(fails)?;
     Ok(out)
 }
 
