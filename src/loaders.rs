@@ -26,7 +26,7 @@ mod zarr_axes;
 mod zarr_chunks;
 use bounded::read_bounded;
 pub use bounded::{read_text, MAX_TEXT_BYTES};
-pub use dicom::{even_slices, is_dicom, series_in as dicom_series, SeriesInfo};
+pub use dicom::{even_slices, is_dicom, series_in as dicom_series, Scan as DicomScan, SeriesInfo};
 use nifti1::nifti_size;
 pub(crate) use nifti1::{nifti_layout, NiftiLayout};
 use npy::read_npy;

@@ -348,7 +348,8 @@ fn run(cli: Cli) -> Result<()> {
             }
             // A folder of DICOM series: each listed, and the one picked (or the only one) described.
             if file.is_dir() && !voxsplat::loaders::is_ome_zarr(&file) {
-                let all = voxsplat::loaders::dicom_series(&file)?;
+                let scan = voxsplat::loaders::dicom_series(&file)?;
+                let all = &scan.series;
                 for (i, s) in all.iter().enumerate() {
                     let times =
                         if s.times > 1 { format!(", {} time points (--time N)", s.times) } else { String::new() };
@@ -358,6 +359,10 @@ fn run(cli: Cli) -> Result<()> {
                     );
                 }
                 if all.len() > 1 && series.is_none() {
+                    // (A series described says so itself, with the images it leaves out.)
+                    if let Some(note) = scan.note() {
+                        eprintln!("note: {note}");
+                    }
                     println!("{} series: describe one with --series N or UID", all.len());
                     return Ok(());
                 }

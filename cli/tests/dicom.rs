@@ -714,3 +714,50 @@ fn a_deflate_bomb_is_refused_before_it_is_held() {
     assert!(e.contains("bomb.dcm") && e.contains("inflates past 1024 MiB"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 76: one DICOM file cut short hid every series of its folder (`info`, `render` and
+/// `slice` refused the folder for it). Now it is left out with a note naming it: the folder's
+/// series are listed, and another series (its UID is found in the file's bytes) is described and
+/// drawn. Its own series, the file itself, and a folder of nothing else are refused for its fault.
+#[test]
+fn a_file_that_does_not_read_leaves_its_folders_other_series_readable() {
+    let dir = tmp("one-bad");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (series, prefix) in [("98892001/CT5N", "a"), ("77654033/CT2", "b")] {
+        for f in std::fs::read_dir(pydicom_tests().join(series)).unwrap() {
+            let f = f.unwrap().path();
+            std::fs::copy(&f, dir.join(format!("{prefix}{}", f.file_name().unwrap().to_string_lossy()))).unwrap();
+        }
+    }
+    let mut names: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    names.sort();
+    let cut = names.last().unwrap().clone();
+    let bytes = std::fs::read(&cut).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() - 100]).unwrap();
+    let d = dir.to_str().unwrap();
+    let said = ok(&["info", d]);
+    assert!(said.contains("series 0:") && said.contains("series 1:") && said.contains("2 series"), "{said}");
+    assert!(
+        said.contains("note: 1 DICOM file(s) of the folder left out") && said.contains(cut.to_str().unwrap()),
+        "{said}"
+    );
+    cmd::assert_user_words(&said);
+    let said = ok(&["info", d, "--series", "0"]);
+    assert!(said.contains("volume: [16, 16, 5]") && said.contains(cut.to_str().unwrap()), "{said}");
+    let e = refused(&["info", d, "--series", "1"]);
+    assert!(e.contains(cut.to_str().unwrap()), "{e}");
+    let png = tmp("one-bad.png");
+    let said = ok(&["render", "--volume", d, "--series", "0", "--size", "32x32", "--out", png.to_str().unwrap()]);
+    assert!(said.contains("left out") && said.contains(cut.to_str().unwrap()), "{said}");
+    assert!(voxsplat::output::read_image(&png).unwrap().pixels.iter().any(|p| p[3] > 0.0));
+    // The file itself, and a folder holding it alone.
+    let e = refused(&["info", cut.to_str().unwrap()]);
+    assert!(e.contains(cut.to_str().unwrap()), "{e}");
+    let alone = dir.join("alone");
+    std::fs::create_dir_all(&alone).unwrap();
+    std::fs::copy(&cut, alone.join("x.dcm")).unwrap();
+    let e = refused(&["info", alone.to_str().unwrap()]);
+    assert!(e.contains("x.dcm"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

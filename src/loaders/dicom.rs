@@ -14,7 +14,6 @@ use crate::error::{Error, Result};
 use dicom_dictionary_std::tags;
 use dicom_object::file::ReadPreamble;
 use dicom_object::OpenFileOptions;
-use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder, VoiLutOption};
 use glam::{DMat4, DVec3, DVec4};
 use std::path::{Path, PathBuf};
 
@@ -33,6 +32,8 @@ pub fn is_dicom(path: &Path) -> bool {
 
 mod apart;
 mod jpegls;
+mod pixels;
+use pixels::decode;
 mod resample;
 use resample::Gaps;
 mod walk;
@@ -304,7 +305,10 @@ fn header(path: &Path) -> Result<Option<Header>> {
 
 /// The series of the DICOM images in folder `dir` (its files, not its subfolders), in order of
 /// their UIDs; files that are not DICOM, and DICOM objects that are not images, are left alone.
-pub fn series_in(dir: &Path) -> Result<Vec<SeriesInfo>> {
+/// A DICOM file whose header does not read (cut short, malformed) is left out too, so that one
+/// bad file does not hide the folder's other series (`Scan::unread` names each); with no series
+/// left, the first such file's error is the folder's.
+pub fn series_in(dir: &Path) -> Result<Scan> {
     let what = dir.display().to_string();
     let io = |e| Error::Io { path: what.clone(), source: e };
     let mut files: Vec<PathBuf> =
@@ -314,8 +318,16 @@ pub fn series_in(dir: &Path) -> Result<Vec<SeriesInfo>> {
     }
     files.sort();
     let mut series: Vec<SeriesInfo> = Vec::new();
+    let mut unread = Vec::new();
     for path in files.into_iter().filter(|p| is_dicom(p)) {
-        let Some((uid, description, modality, images)) = header(&path)? else { continue };
+        let (uid, description, modality, images) = match header(&path) {
+            Ok(Some(h)) => h,
+            Ok(None) => continue,
+            Err(e) => {
+                unread.push((path, e));
+                continue;
+            }
+        };
         match series.iter_mut().find(|s| s.uid == uid) {
             Some(s) => s.images.extend(images),
             None => series.push(SeriesInfo { uid, description, modality, dims: [0; 3], times: 1, images }),
@@ -327,7 +339,34 @@ pub fn series_in(dir: &Path) -> Result<Vec<SeriesInfo>> {
         s.times = times as u32;
         s.dims = [s.images[0].size[0], s.images[0].size[1], (s.images.len() / times) as u32];
     }
-    Ok(series)
+    if series.is_empty() && !unread.is_empty() {
+        return Err(unread.swap_remove(0).1);
+    }
+    Ok(Scan { series, unread })
+}
+
+/// A folder's DICOM series (`series_in`) and the DICOM files whose headers did not read.
+pub struct Scan {
+    /// Its series, in order of their UIDs.
+    pub series: Vec<SeriesInfo>,
+    /// Each file left out, and why.
+    pub unread: Vec<(PathBuf, Error)>,
+}
+
+impl Scan {
+    /// A note on the files left out (the first three named), or `None` when every file read.
+    pub fn note(&self) -> Option<String> {
+        let (first, n) = (self.unread.iter().take(3), self.unread.len());
+        let said = |e: &Error| match e {
+            Error::InvalidArgument(m) => m.clone(),
+            e => e.to_string(),
+        };
+        let named: Vec<String> = first.map(|(_, why)| said(why)).collect();
+        let more = if n > 3 { format!("; and {} more", n - 3) } else { String::new() };
+        (n > 0).then(|| {
+            format!("{n} DICOM file(s) of the folder left out, their headers unread: {}{more}", named.join("; "))
+        })
+    }
 }
 
 impl SeriesInfo {
@@ -340,20 +379,6 @@ impl SeriesInfo {
 /// Whether folder `dir` holds a DICOM file (read as a series rather than a stack of images).
 pub fn holds_dicom(dir: &Path) -> bool {
     std::fs::read_dir(dir).is_ok_and(|d| d.filter_map(|e| e.ok()).take(MAX_FILES).any(|e| is_dicom(&e.path())))
-}
-
-/// Why pixel data in transfer syntax `uid` is not decoded, naming it, or `None` when it is (or is
-/// unknown, and the decoder's own error says more).
-fn undecoded(uid: &str) -> Option<String> {
-    use dicom_encoding::TransferSyntaxIndex;
-    let ts = dicom_transfer_syntax_registry::TransferSyntaxRegistry.get(uid)?;
-    (!ts.can_decode_all()).then(|| {
-        format!(
-            "pixel data in {} ({uid}) is not decoded: dicom-rs has no decoder for it \
-             (uncompressed, RLE, JPEG, JPEG-LS and JPEG 2000 are)",
-            ts.name()
-        )
-    })
 }
 
 /// A series read a slice at a time.
@@ -396,28 +421,35 @@ pub fn open_placed(path: &Path, pick: Option<&str>, time: Option<u32>) -> Result
 
 fn open_at(path: &Path, pick: Option<&str>, rectilinear: bool, at: impl Fn(u32) -> Result<u32>) -> Result<Series> {
     let what = path.display().to_string();
-    let chosen = chosen(path, pick)?;
+    let (chosen, unread) = chosen(path, pick)?;
     let t = at(chosen.times)?;
     let at = chosen.temporal_positions()[t as usize];
     let images = chosen.images.iter().filter(|i| i.time == at).cloned().collect();
-    build(&SeriesInfo { images, ..chosen }, &what, rectilinear)
+    let mut series = build(&SeriesInfo { images, ..chosen }, &what, rectilinear)?;
+    series.left_out.extend(unread);
+    Ok(series)
 }
 
 /// The temporal positions of the series `path` names (`open`'s), 1 when it names none alone (a
 /// folder of several series without `pick`).
 pub fn time_points(path: &Path, pick: Option<&str>) -> Result<u32> {
-    Ok(chosen(path, pick).map_or(1, |s| s.times))
+    Ok(chosen(path, pick).map_or(1, |(s, _)| s.times))
 }
 
-/// The series `path` and `pick` name (`open`).
-fn chosen(path: &Path, pick: Option<&str>) -> Result<SeriesInfo> {
+/// The series `path` and `pick` name (`open`), and a note on the folder's files left out.
+fn chosen(path: &Path, pick: Option<&str>) -> Result<(SeriesInfo, Option<String>)> {
     let what = path.display().to_string();
     let (dir, own) = if path.is_dir() {
         (path.to_path_buf(), None)
     } else {
         (path.parent().unwrap_or(Path::new(".")).to_path_buf(), Some(path))
     };
-    let all = series_in(&dir)?;
+    let mut scan = series_in(&dir)?;
+    // A file named itself whose header does not read is refused for its own reason.
+    if let Some(i) = own.and_then(|f| scan.unread.iter().position(|(p, _)| p == f)) {
+        return Err(scan.unread.swap_remove(i).1);
+    }
+    let all = &scan.series;
     let list = || {
         all.iter()
             .enumerate()
@@ -442,7 +474,12 @@ fn chosen(path: &Path, pick: Option<&str>) -> Result<SeriesInfo> {
             n => return Err(bad(&what, format!("holds {n} series: pick one with --series N or UID ({})", list()))),
         },
     };
-    Ok(chosen.clone())
+    // A file left out may be an image of this series: refused unless its Series Instance UID,
+    // found in its bytes, names another one.
+    if let Some(i) = scan.unread.iter().position(|(p, _)| walk::series_uid(p).is_none_or(|u| u == chosen.uid)) {
+        return Err(scan.unread.swap_remove(i).1);
+    }
+    Ok((chosen.clone(), scan.note()))
 }
 
 /// Checks a series' images agree and orders them along their normal.
@@ -639,55 +676,4 @@ fn frames_of(image: &Image) -> Result<Vec<Vec<f64>>> {
         .map_err(|e| bad(&what, format!("DICOM: {e}")))?;
     let syntax = obj.meta().transfer_syntax().trim_end_matches('\0').to_string();
     decode(&obj, &syntax, image.size, image.frames, &what)
-}
-
-/// Every frame's raw samples of `obj`, a file of `frames` frames of `size` (Columns, Rows) in
-/// transfer syntax `syntax`.
-fn decode(
-    obj: &dicom_object::FileDicomObject<dicom_object::InMemDicomObject>,
-    syntax: &str,
-    size: [u32; 2],
-    frames: u32,
-    what: &str,
-) -> Result<Vec<Vec<f64>>> {
-    if jpegls::is_jpegls(syntax) {
-        return jpegls::frames(obj, size, frames, what);
-    }
-    let failed = |e: &dyn std::fmt::Display| bad(what, format!("pixel data (transfer syntax {syntax}): {e}"));
-    if syntax.starts_with("1.2.840.10008.1.2.4.9") || syntax.starts_with("1.2.840.10008.1.2.4.20") {
-        let pixel_data = obj.element(tags::PIXEL_DATA).map_err(|e| failed(&e))?;
-        let fragments = pixel_data.value().fragments().unwrap_or_default();
-        walk::check_j2k(fragments, size, frames, what)?;
-    }
-    let pixels = obj.decode_pixel_data().map_err(|e| match undecoded(syntax) {
-        Some(refusal) => Error::Unsupported(format!("{what}: {refusal}")),
-        None => failed(&e),
-    })?;
-    let options = ConvertOptions::new().with_modality_lut(ModalityLutOption::None).with_voi_lut(VoiLutOption::Identity);
-    let frame = |f: u32| -> Result<Vec<f64>> {
-        if pixels.bits_allocated() != 32 || pixels.samples_per_pixel() != 1 {
-            return pixels.to_vec_frame_with_options(f, &options).map_err(|e| failed(&e));
-        }
-        // 32-bit samples (RT Dose), which dicom-pixeldata's conversion does not take: the
-        // decoded frame's words. dicom-rs reads big-endian pixel data (OW) as 16-bit
-        // little-endian words, so a big-endian file's sample is its high word first.
-        let signed = pixels.pixel_representation() == dicom_pixeldata::PixelRepresentation::Signed;
-        let big = syntax == "1.2.840.10008.1.2.2";
-        let words = pixels.frame_data(f).map_err(|e| failed(&e))?.chunks_exact(4);
-        Ok(words
-            .map(|b| {
-                let u = if big {
-                    (u16::from_le_bytes([b[0], b[1]]) as u32) << 16 | u16::from_le_bytes([b[2], b[3]]) as u32
-                } else {
-                    u32::from_le_bytes([b[0], b[1], b[2], b[3]])
-                };
-                if signed {
-                    u as i32 as f64
-                } else {
-                    u as f64
-                }
-            })
-            .collect())
-    };
-    (0..frames).map(frame).collect()
 }

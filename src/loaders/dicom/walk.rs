@@ -290,3 +290,21 @@ pub(super) fn check_j2k(fragments: &[Vec<u8>], size: [u32; 2], frames: u32, what
     }
     Ok(())
 }
+
+/// The Series Instance UID (0020,000E) found in the first 64 KiB of a file whose header does not
+/// read (cut short, malformed), in explicit or implicit VR little endian, or `None`.
+pub(super) fn series_uid(path: &Path) -> Option<String> {
+    use std::io::Read;
+    let mut head = Vec::new();
+    std::fs::File::open(path).ok()?.take(64 << 10).read_to_end(&mut head).ok()?;
+    let at = head.windows(4).position(|w| w == [0x20, 0x00, 0x0e, 0x00])?;
+    let h = head.get(at..at + 8)?;
+    let len = if &h[4..6] == b"UI" {
+        u16::from_le_bytes([h[6], h[7]]) as usize
+    } else {
+        u32::from_le_bytes([h[4], h[5], h[6], h[7]]) as usize
+    };
+    let value = head.get(at + 8..at + 8 + len.min(64))?;
+    let uid = std::str::from_utf8(value).ok()?.trim_end_matches(['\0', ' ']);
+    (!uid.is_empty() && uid.bytes().all(|b| b.is_ascii_digit() || b == b'.')).then(|| uid.to_string())
+}
