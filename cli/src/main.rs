@@ -126,6 +126,9 @@ enum Command {
         /// ...by this factor per axis.
         #[arg(long, default_value_t = 2)]
         factor: u32,
+        /// The channel of --from to upsample, from 0, when it holds several.
+        #[arg(long, requires = "from")]
+        channel: Option<u32>,
         /// Or make the procedural field of this side.
         #[arg(long, conflicts_with = "phantom")]
         procedural: Option<u32>,
@@ -297,7 +300,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Slice(a) => slice::slice(*a),
         Command::View(a) => voxsplat_cli::view::view(*a),
         Command::Animate(a) => animate(a),
-        Command::MakeVolume { from, factor, procedural, phantom, out } => {
+        Command::MakeVolume { from, factor, channel, procedural, phantom, out } => {
             // It writes NRRD (raw data, attached): a name that says otherwise would mislead.
             if !out.to_string_lossy().to_ascii_lowercase().ends_with(".nrrd") {
                 return Err(Error::InvalidArgument(format!(
@@ -313,7 +316,17 @@ fn run(cli: Cli) -> Result<()> {
                     voxsplat_cli::volumes::head_phantom(n, &out, |z| bar.set_position(z as u64))?
                 }
                 (Some(file), None) => {
-                    let vol = voxsplat::loaders::load_volume(&file, &Default::default())?;
+                    if voxsplat_cli::uneven::at_positions(&file, &Default::default())? {
+                        return Err(Error::InvalidArgument(format!(
+                            "{}: its slice gaps are too uneven to resample evenly, and make-volume writes an evenly \
+                             spaced NRRD; render draws it at its slices' positions",
+                            file.display()
+                        )));
+                    }
+                    let vol = match slice::picked_channel(&file, &Default::default(), channel)? {
+                        Some(v) => v,
+                        None => voxsplat::loaders::load_volume(&file, &Default::default())?,
+                    };
                     let placement = voxsplat::loaders::load_orientation(&file, &Default::default())?;
                     bar.set_length(vol.dims[2] as u64 * factor as u64);
                     voxsplat_cli::volumes::upsample(&vol, factor, placement.as_ref(), &out, |z| {

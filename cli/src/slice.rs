@@ -26,6 +26,9 @@ pub(crate) struct SliceArgs {
     /// An OME-Zarr image's pyramid level [default: as `render` picks it].
     #[arg(long)]
     level: Option<u32>,
+    /// The channel to cut, from 0, of a file of several (a NIfTI's or NRRD's vector axis).
+    #[arg(long)]
+    channel: Option<u32>,
     /// The PNG to write (8-bit grey, the plane's row 0 at the top).
     #[arg(long)]
     out: PathBuf,
@@ -44,9 +47,15 @@ pub(crate) fn slice(a: SliceArgs) -> Result<()> {
         "y" => 1,
         _ => 2,
     };
-    let hints = voxsplat::loaders::VolumeHints { series: a.series, time: a.time, level: a.level, ..Default::default() };
+    let mut hints =
+        voxsplat::loaders::VolumeHints { series: a.series, time: a.time, level: a.level, ..Default::default() };
     voxsplat_cli::uneven::say_left_out(&a.file, &hints)?;
-    let (dims, index, plane) = read_plane(&a.file, &hints, axis, a.index, &a.axis)?;
+    // A series too unevenly spaced to resample is cut as it is stored: one plane per image.
+    if voxsplat_cli::uneven::at_positions(&a.file, &hints)? {
+        hints.rectilinear = true;
+        eprintln!("note: uneven slice gaps, too far apart to resample evenly: cut as stored, one plane per image");
+    }
+    let (dims, index, plane) = read_plane(&a.file, &hints, axis, a.index, &a.axis, a.channel)?;
     let [lo, hi] = a.window.unwrap_or_else(|| {
         let finite = plane.values.iter().filter(|v| v.is_finite());
         finite.fold([f32::INFINITY, f32::NEG_INFINITY], |[l, h], &v| [l.min(v), h.max(v)])
@@ -76,10 +85,14 @@ fn read_plane(
     axis: usize,
     index: Option<u32>,
     name: &str,
+    channel: Option<u32>,
 ) -> Result<([u32; 3], u32, voxsplat::bricks::Plane)> {
-    let whole = match voxsplat::loaders::SliceReader::open(path, hints)? {
-        Some(reader) => Err(reader),
-        None => Ok(voxsplat::loaders::load_volume(path, hints)?),
+    let whole = match picked_channel(path, hints, channel)? {
+        Some(v) => Ok(v),
+        None => match voxsplat::loaders::SliceReader::open(path, hints)? {
+            Some(reader) => Err(reader),
+            None => Ok(voxsplat::loaders::load_volume(path, hints)?),
+        },
     };
     let dims = match &whole {
         Ok(v) => v.dims,
@@ -127,4 +140,29 @@ fn read_plane(
     }
     let (width, height) = [(ny, nz), (nx, nz), (nx, ny)][axis];
     Ok((dims, index, voxsplat::bricks::Plane { width, height, values }))
+}
+
+/// Channel `channel` of `path`, read whole, when the file holds several (refused without
+/// `--channel`), or `None` for a file of one (refused with `--channel` past 0).
+pub(crate) fn picked_channel(
+    path: &std::path::Path,
+    hints: &voxsplat::loaders::VolumeHints,
+    channel: Option<u32>,
+) -> Result<Option<voxsplat::loaders::ScalarVolume>> {
+    let n = voxsplat::loaders::SliceReader::channels(path)?;
+    match channel {
+        None if n > 1 => Err(Error::InvalidArgument(format!(
+            "{} holds {n} channels: pick one with --channel N (0 to {})",
+            path.display(),
+            n - 1
+        ))),
+        Some(c) if c >= n => Err(Error::InvalidArgument(format!(
+            "--channel {c}: {} holds {n} channel{} (0 to {})",
+            path.display(),
+            if n == 1 { "" } else { "s" },
+            n - 1
+        ))),
+        Some(c) if n > 1 => Ok(Some(voxsplat::loaders::load_channels(path, hints)?.swap_remove(c as usize))),
+        _ => Ok(None),
+    }
 }

@@ -219,6 +219,13 @@ fn an_uneven_series_is_resampled_or_drawn_at_its_slices_positions() {
         shot.to_str().unwrap(),
     ]);
     assert!(said.contains("drawn as a rectilinear grid"), "{said}");
+    // `slice` cuts it as stored, one plane per image (refused before issue 76); `make-volume`,
+    // which writes an evenly spaced NRRD, refuses it for that reason.
+    let plane = tmp("gappy-x.png");
+    let said = ok(&["slice", gappy.to_str().unwrap(), "--axis", "x", "--out", plane.to_str().unwrap()]);
+    assert!(said.contains("[24, 20, 8] grid, 20 x 8 voxels") && said.contains("cut as stored"), "{said}");
+    let e = refused(&["make-volume", "--from", gappy.to_str().unwrap(), "--out", tmp("gappy.nrrd").to_str().unwrap()]);
+    assert!(e.contains("too uneven to resample") && e.contains("evenly spaced NRRD"), "{e}");
     let _ = std::fs::remove_dir_all(&gappy);
     // A ball written at uneven slice positions.
     let zs = [0, 2, 4, 8, 10, 13, 15, 16, 18, 22];

@@ -258,6 +258,21 @@ fn files_of_channels_are_described_and_drawn() {
         .concat();
         let out = cmd::voxsplat(&args);
         assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        // `slice` and `make-volume --from` take one channel (refused outright before).
+        let f = file.to_str().unwrap();
+        let e = cmd::refused(&["slice", f, "--out", png.to_str().unwrap()]);
+        assert!(e.contains(&format!("holds {n} channels: pick one with --channel N")), "{e}");
+        let last = (n - 1).to_string();
+        let out = cmd::voxsplat(&["slice", f, "--channel", &last, "--index", "4", "--out", png.to_str().unwrap()]);
+        let said = String::from_utf8_lossy(&out.stdout);
+        // The last channel's value inside its cube (through plane 4): 150 (NRRD) or 100 (NIfTI).
+        let top = if n == 2 { "values 0 .. 150" } else { "values 0 .. 100" };
+        assert!(out.status.success() && said.contains(top), "{said}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(cmd::refused(&["slice", f, "--channel", &n.to_string(), "--out", "x.png"]).contains("(0 to"));
+        let up = tmp("channel.nrrd");
+        let out = cmd::voxsplat(&["make-volume", "--from", f, "--channel", "0", "--out", up.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(load_volume(&up, &VolumeHints::default()).unwrap().dims, [32, 32, 32]);
     }
 }
 
@@ -265,7 +280,7 @@ fn files_of_channels_are_described_and_drawn() {
 fn wide_values_stay_in_range_and_values_f32_would_flatten_are_refused() {
     // nibabel's uint32 and int32 at their types' limits, a float64 ball on an offset of 1e10 and an
     // int32 ball on 2e9 (both drew flat: f32 steps of 1024 and 128 there), numpy's float64 the same.
-    let [u32n, i32n, f64n, i32b, npy] = ["u32.nii", "i32.nii", "f64.nii", "i32-ball.nii", "f64.npy"].map(|n| tmp(n));
+    let [u32n, i32n, f64n, i32b, npy] = ["u32.nii", "i32.nii", "f64.nii", "i32-ball.nii", "f64.npy"].map(tmp);
     python(
         "import nibabel, numpy as np\n\
          def save(a, p): nibabel.save(nibabel.Nifti1Image(a, np.eye(4)), p)\n\
