@@ -158,14 +158,15 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
                 |c| if big_endian { i16::from_be_bytes([c[0], c[1]]) } else { i16::from_le_bytes([c[0], c[1]]) } as f32,
             )
             .collect(),
-        // Wider than f32 holds exactly: rounded toward zero, refused where f32 would flatten them.
-        DType::U32 => held::held(b.chunks_exact(4).map(|c| word(c) as f64), what)?,
-        DType::I32 => held::held(b.chunks_exact(4).map(|c| word(c) as i32 as f64), what)?,
+        // Wider than f32 holds exactly: kept within their type, refused where f32 would flatten them.
+        DType::U32 => held::held(b.chunks_exact(4).map(|c| word(c) as f64), held::U32, what)?,
+        DType::I32 => held::held(b.chunks_exact(4).map(|c| word(c) as i32 as f64), held::I32, what)?,
         DType::F64 => held::held(
             b.chunks_exact(8).map(|c| {
                 let (high, low) = if big_endian { (&c[..4], &c[4..]) } else { (&c[4..], &c[..4]) };
                 f64::from_bits((word(high) as u64) << 32 | word(low) as u64)
             }),
+            None,
             what,
         )?,
         DType::F32 => b.chunks_exact(4).map(|c| f32::from_bits(word(c))).collect(),

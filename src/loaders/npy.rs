@@ -34,9 +34,11 @@ pub fn npy_from_bytes(bytes: &[u8], what: &str) -> Result<(Vec<u64>, Vec<f32>)> 
         (npyz::TypeChar::Uint, 1) => read_all::<u8>(npy, what)?.into_iter().map(f32::from).collect(),
         (npyz::TypeChar::Uint, 2) => read_all::<u16>(npy, what)?.into_iter().map(f32::from).collect(),
         (npyz::TypeChar::Int, 2) => read_all::<i16>(npy, what)?.into_iter().map(f32::from).collect(),
-        (npyz::TypeChar::Uint, 4) => super::held::held(read_all::<u32>(npy, what)?.into_iter().map(f64::from), what)?,
+        (npyz::TypeChar::Uint, 4) => {
+            super::held::held(read_all::<u32>(npy, what)?.into_iter().map(f64::from), super::held::U32, what)?
+        }
         (npyz::TypeChar::Float, 4) => read_all::<f32>(npy, what)?,
-        (npyz::TypeChar::Float, 8) => super::held::held(read_all::<f64>(npy, what)?.into_iter(), what)?,
+        (npyz::TypeChar::Float, 8) => super::held::held(read_all::<f64>(npy, what)?.into_iter(), None, what)?,
         (c, s) => {
             let kind = match c {
                 npyz::TypeChar::Uint => "uint",

@@ -247,10 +247,10 @@ fn samples(image: DecodingResult, w: u32, h: u32, what: &str) -> Result<Vec<f32>
         D::U16(v) => v.into_iter().map(f32::from).collect(),
         D::I16(v) => v.into_iter().map(f32::from).collect(),
         D::I8(v) => v.into_iter().map(f32::from).collect(),
-        D::U32(v) => super::held::held(v.into_iter().map(f64::from), what)?,
-        D::I32(v) => super::held::held(v.into_iter().map(f64::from), what)?,
+        D::U32(v) => super::held::held(v.into_iter().map(f64::from), super::held::U32, what)?,
+        D::I32(v) => super::held::held(v.into_iter().map(f64::from), super::held::I32, what)?,
         D::F32(v) => v,
-        D::F64(v) => super::held::held(v.into_iter(), what)?,
+        D::F64(v) => super::held::held(v.into_iter(), None, what)?,
         _ => {
             return Err(bad(what, "64-bit integer samples are not read (8, 16 and 32-bit integers, float32, float64)"))
         }
@@ -467,9 +467,9 @@ pub fn tiff_heights(bytes: &[u8], what: &str) -> Result<super::HeightGrid> {
         D::U8(v) => v.into_iter().map(f32::from).collect(),
         D::U16(v) => v.into_iter().map(f32::from).collect(),
         D::I16(v) => v.into_iter().map(f32::from).collect(),
-        D::U32(v) => super::held::held(v.into_iter().map(f64::from), what)?,
+        D::U32(v) => super::held::held(v.into_iter().map(f64::from), super::held::U32, what)?,
         D::F32(v) => v,
-        D::F64(v) => super::held::held(v.into_iter(), what)?,
+        D::F64(v) => super::held::held(v.into_iter(), None, what)?,
         other => {
             let kind = match other {
                 D::I8(_) => "int8",

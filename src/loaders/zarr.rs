@@ -623,15 +623,18 @@ impl ZarrReader {
             Kind::I16 => Samples::I16(a.retrieve_array_subset(subset).map_err(err)?),
             Kind::U32 => f32s(super::held::held(
                 a.retrieve_array_subset::<Vec<u32>>(subset).map_err(err)?.into_iter().map(f64::from),
+                super::held::U32,
                 &self.what,
             )?)?,
             Kind::I32 => f32s(super::held::held(
                 a.retrieve_array_subset::<Vec<i32>>(subset).map_err(err)?.into_iter().map(f64::from),
+                super::held::I32,
                 &self.what,
             )?)?,
             Kind::F32 => f32s(a.retrieve_array_subset(subset).map_err(err)?)?,
             Kind::F64 => f32s(super::held::held(
                 a.retrieve_array_subset::<Vec<f64>>(subset).map_err(err)?.into_iter(),
+                None,
                 &self.what,
             )?)?,
         };
