@@ -24,15 +24,20 @@ float cell_extent(uint a, uint i) {
     return (i == 0u || i == n - 1u) ? hi - lo : 0.5 * (hi - lo);
 }
 
-// A rectilinear grid's splat: at its coordinates, sized for the widest gap (frame.spacing.w),
-// its optical depth weighted by its cell's volume over the widest gap's cube, so a ray crossing
-// denser cells meets as much material as one crossing the widest (mirror:
+// A rectilinear grid's splat: at its coordinates, as wide as its own cell's widest extent (the
+// mean of its neighbouring gaps; at most the widest gap, frame.spacing.w, which bounds every
+// footprint), its optical depth weighted so that it deposits its cell's volume over the length
+// opacities are per (frame.shear.w): a ray crossing denser cells meets as much material as one
+// crossing wider ones, and one far slice widens only its neighbours (mirror:
 // cpu::splat_params::params_rect).
 SplatParams params_rect(uvec3 ijk, vec4 color) {
     vec3 center = vec3(coords[ijk.x], coords[frame.dims.x + ijk.y], coords[frame.dims.x + frame.dims.y + ijk.z]);
     float ks = frame.spacing.w / frame.origin.w;
-    float weight = cell_extent(0u, ijk.x) / ks * (cell_extent(1u, ijk.y) / ks) * (cell_extent(2u, ijk.z) / ks);
-    return params_world(center, 1.0, 1.0, color.rgb, optical_depth(color.a) * weight);
+    vec3 e = vec3(cell_extent(0u, ijk.x), cell_extent(1u, ijk.y), cell_extent(2u, ijk.z));
+    float cell = min(max(e.x, max(e.y, e.z)) / ks, 1.0);
+    float r = cell * ks;
+    float weight = e.x * e.y * e.z / (frame.shear.w * r * r);
+    return params_world(center, cell, 1.0, color.rgb, optical_depth(color.a) * weight);
 }
 
 void main() {

@@ -64,7 +64,8 @@ pub struct Frame {
     pub origin: [f32; 4],
     /// The grid's spacing; w: the kernel's world radius.
     pub spacing: [f32; 4],
-    /// The cell matrix above its diagonal (`Grid::shear`); w: unused.
+    /// The cell matrix above its diagonal (`Grid::shear`); w: the length a splat's opacity is per
+    /// (`SplatSet::opacity_length`).
     pub shear: [f32; 4],
     /// The grid's dims; w: splats.
     pub dims: [u32; 4],

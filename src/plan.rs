@@ -172,7 +172,7 @@ pub fn make_frame(
         up: v4(u, camera.pixels_per_unit()),
         origin: [g.origin[0], g.origin[1], g.origin[2], radius_vox],
         spacing: [g.spacing[0], g.spacing[1], g.spacing[2], radius_vox * set.kernel_spacing()],
-        shear: [g.shear[0], g.shear[1], g.shear[2], 0.0],
+        shear: [g.shear[0], g.shear[1], g.shear[2], set.opacity_length()],
         dims: [g.dims[0], g.dims[1], g.dims[2], set.len() as u32],
         split: [split[0], split[1], split[2], back_to_front as u32],
         aa: [antialias.code(), kernel.footprint_sigma() as f32, EWA_LOWPASS_PX, 0.0],

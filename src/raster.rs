@@ -54,20 +54,28 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
     let (mut near, mut far, mut sum) = (f32::INFINITY, f32::NEG_INFINITY, 0.0);
     for c in 0..8u32 {
         let ijk = [0, 1, 2].map(|a| if c >> a & 1 == 1 { g.dims[a].saturating_sub(1) } else { 0 });
-        let d = (g.position(ijk) - eye).dot(forward);
+        let d = (set.position(ijk) - eye).dot(forward);
         near = near.min(d);
         far = far.max(d);
         sum += d;
     }
     let centre = sum / 8.0;
-    let diameter = |depth: f32| {
+    // A rectilinear grid's splats are as wide as their own cells: the widest gap bounds them, and
+    // the widest gap that is not an outlier is their typical size (one far position must not
+    // turn a frame of small footprints into one of huge ones).
+    let widest = frame.spacing[3];
+    let typical = widest * (set.opacity_length() / set.kernel_spacing()).min(1.0);
+    let diameter = |depth: f32, radius: f32| {
         let depth = depth.max(camera.near);
-        let scale = crate::plan::footprint_scale(&frame, depth);
-        let radius = frame.spacing[3] * scale;
+        let radius = radius * crate::plan::footprint_scale(&frame, depth);
         let ppu = frame.up[3];
         2.0 * if camera.is_perspective() { radius * ppu / depth } else { radius * ppu }
     };
-    FootprintSize { typical_px: diameter(centre), max_px: diameter(near), min_px: diameter(far) }
+    FootprintSize {
+        typical_px: diameter(centre, typical),
+        max_px: diameter(near, widest),
+        min_px: diameter(far, typical),
+    }
 }
 
 /// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device: the tile

@@ -247,7 +247,8 @@ impl SplatSet {
     /// coordinate of index `i` along axis `a`, one per voxel, finite and strictly increasing.
     /// PBTF needs only the eye's cell, so the orders and validators of `crate::order` run on
     /// such grids through [`SplatSet::index_of`]; the per-splat stage places each splat at its
-    /// coordinates, sized for the widest gap and weighted by its cell's volume. The grid's origin
+    /// coordinates, as wide as its own cell and weighted by its cell's volume (docs/MODEL.md,
+    /// "PBTF on rectilinear grids"). The grid's origin
     /// and spacing become the coordinates' first values and mean gaps. The ray casters and the
     /// truths, which sample a uniform grid, refuse such sets.
     pub fn with_coordinates(mut self, coords: [Vec<f32>; 3]) -> Result<Self> {
@@ -309,7 +310,8 @@ impl SplatSet {
         }
     }
 
-    /// The spacing footprints are scaled by: the grid's, or a rectilinear grid's widest gap.
+    /// The spacing footprints are scaled by: the grid's, or a rectilinear grid's widest gap (which
+    /// bounds its splats; each is as wide as its own cell).
     pub fn kernel_spacing(&self) -> f32 {
         match &self.coords {
             Some(c) => {
@@ -321,6 +323,27 @@ impl SplatSet {
                 }
             }
             None => self.grid.kernel_spacing(),
+        }
+    }
+
+    /// The length a splat's opacity is per: the kernel spacing, or on a rectilinear grid the widest
+    /// gap that is not an outlier (at most ten times its axis's median gap). One far slice or
+    /// position leaves the rest of the volume as opaque as it would be alone.
+    pub fn opacity_length(&self) -> f32 {
+        let Some(c) = &self.coords else { return self.grid.kernel_spacing() };
+        let widest = c
+            .iter()
+            .filter_map(|v| {
+                let mut gaps: Vec<f32> = v.windows(2).map(|w| w[1] - w[0]).collect();
+                gaps.sort_by(f32::total_cmp);
+                let median = *gaps.get(gaps.len() / 2)?;
+                gaps.into_iter().filter(|&g| g <= 10.0 * median).reduce(f32::max)
+            })
+            .fold(0.0, f32::max);
+        if widest > 0.0 {
+            widest
+        } else {
+            self.kernel_spacing()
         }
     }
 

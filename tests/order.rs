@@ -396,6 +396,73 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
     assert!(voxsplat::truth::volumetric_summation(&rect, &cam, &Default::default()).is_err());
 }
 
+/// Issue 76: one gap 37 times the others in the middle of a rectilinear grid (a `--positions`
+/// sidecar with one far position) drew every footprint as wide as that gap, and every opacity
+/// per that gap: the ball on its near side came out 37 times wider and fainter. Now each splat is
+/// as wide as its own cell and opacities are per the widest gap that is not an outlier, so the
+/// ball, clear of the gap's neighbours, draws as it does on the uniform grid of its slices alone;
+/// the GPU equals its mirror.
+#[test]
+fn a_far_position_widens_only_its_neighbours() {
+    use voxsplat::{Grid, RenderOptions};
+    let ball = |p: Vec3| (p - Vec3::new(0.0, 0.0, -1.0)).length() < 5.0;
+    let color = |p: Vec3| ball(p).then_some([0.9, 0.7, 0.4, 0.35]);
+    // Slices z = -8..=7 one apart, then 8 more beyond a gap of 37: empty, as are the two slices
+    // either side of the gap.
+    let mut z: Vec<f32> = (-8..=7).map(|k| k as f32).collect();
+    z.extend((0..8).map(|k| 7.0 + 37.0 + k as f32));
+    let xy: Vec<f32> = (-8..=8).map(|i| i as f32).collect();
+    let g = Grid::centered([17, 17, z.len() as u32], [1.0; 3]).unwrap();
+    let at = |i: u32, j: u32, k: u32| Vec3::new(xy[i as usize], xy[j as usize], z[k as usize]);
+    let rect = SplatSet::from_fn(g, |i, j, k| if k < 14 { color(at(i, j, k)) } else { None })
+        .unwrap()
+        .with_coordinates([xy.clone(), xy.clone(), z.clone()])
+        .unwrap();
+    // The slices before the gap alone, as a uniform grid.
+    let near = Grid::centered([17, 17, 16], [1.0; 3]).unwrap();
+    let shift = Vec3::new(0.0, 0.0, -8.0 - near.position([0, 0, 0]).z);
+    let alone = SplatSet::from_fn(near, |i, j, k| color(near.position([i, j, k]) + shift)).unwrap();
+    let cam = |at: Vec3| Camera {
+        eye: at + Vec3::new(30.0, 14.0, 18.0),
+        target: at,
+        up: Vec3::Z,
+        projection: Projection::Perspective { fov_y_deg: 35.0 },
+        near: 5.0,
+        far: 200.0,
+        width: 96,
+        height: 96,
+    };
+    let o = RenderOptions::default();
+    let mut gpu = common::gpu();
+    gpu.set_scene(rect.clone()).unwrap();
+    let drawn = gpu.render(&cam(Vec3::new(0.0, 0.0, -1.0)), &o).unwrap().image;
+    gpu.set_scene(alone).unwrap();
+    let truth = gpu.render(&cam(Vec3::new(0.0, 0.0, -1.0) - shift), &o).unwrap().image;
+    let m = voxsplat::metrics::compare(&drawn, &truth).unwrap();
+    eprintln!(
+        "a far position: {:.2} dB over {} covered pixels against the slices alone ({} px drawn, {} px alone)",
+        m.covered_psnr,
+        m.covered_pixels,
+        common::covered(&drawn),
+        common::covered(&truth)
+    );
+    assert!(common::covered(&truth) > 1000);
+    assert!(m.covered_psnr > 40.0, "{:.2} dB", m.covered_psnr);
+    common::assert_clean(&gpu);
+    // Like for like: on this scene auto picks quads on the device and point sprites on the CPU,
+    // whose widest sprite is wider.
+    let mut quads = RenderOptions::default();
+    quads.raster = voxsplat::Raster::Graphics;
+    let at = cam(Vec3::new(0.0, 0.0, -1.0));
+    gpu.set_scene(rect.clone()).unwrap();
+    let g = gpu.render(&at, &quads).unwrap().image;
+    let mut cpu = common::cpu();
+    cpu.set_scene(rect).unwrap();
+    let c = cpu.render(&at, &quads).unwrap().image;
+    common::assert_mirrors(&g, &c, "a far position");
+    common::assert_clean(&gpu);
+}
+
 /// A k-d leaf's bricks as an octree of aligned blocks (`octree_pbtf`, what the device's brick
 /// slots use inside a leaf): over random boxes (aligned or not) and eye splits (inside, on block
 /// planes, outside), the positions are a permutation of the box's bricks, every aligned block

@@ -144,16 +144,18 @@ fn cell_extent(frame: &Frame, coords: &[f32], a: usize, i: u32) -> f32 {
     }
 }
 
-/// Mirror of `params_rect`: a rectilinear grid's splat at its coordinates, its optical depth
-/// weighted by its cell's volume over the widest gap's cube.
+/// Mirror of `params_rect`: a rectilinear grid's splat at its coordinates, as wide as its own
+/// cell's widest extent (at most the widest gap), its optical depth weighted so that it deposits
+/// its cell's volume over the length opacities are per (`SplatSet::opacity_length`).
 pub fn params_rect(frame: &Frame, coords: &[f32], ijk: [u32; 3], color: [f32; 4]) -> SplatParams {
     let (nx, ny) = (frame.dims[0] as usize, frame.dims[1] as usize);
     let center = Vec3::new(coords[ijk[0] as usize], coords[nx + ijk[1] as usize], coords[nx + ny + ijk[2] as usize]);
     let ks = frame.spacing[3] / frame.origin[3];
-    let weight = cell_extent(frame, coords, 0, ijk[0]) / ks
-        * (cell_extent(frame, coords, 1, ijk[1]) / ks)
-        * (cell_extent(frame, coords, 2, ijk[2]) / ks);
-    params_world(frame, center, 1.0, 1.0, [color[0], color[1], color[2]], optical_depth(color[3]) * weight)
+    let e = [0, 1, 2].map(|a| cell_extent(frame, coords, a, ijk[a]));
+    let cell = (e[0].max(e[1].max(e[2])) / ks).min(1.0);
+    let r = cell * ks;
+    let weight = e[0] * e[1] * e[2] / (frame.shear[3] * r * r);
+    params_world(frame, center, cell, 1.0, [color[0], color[1], color[2]], optical_depth(color[3]) * weight)
 }
 
 /// Mirror of `project_emit` in `glsl/splat_params.comp`: a projection's emit, the key its blend
