@@ -138,9 +138,7 @@ impl BrickStore {
             let z1 = ((z0 / BRICK + 1) * BRICK).min(r1[2]);
             read(z0, z1 - z0, &mut slab)?;
             report((z1 - r0[2]) as u64);
-            for &v in slab.iter().filter(|v| v.is_finite()) {
-                (lo, hi) = (lo.min(v), hi.max(v));
-            }
+            (lo, hi) = finite_span(&slab, (lo, hi));
             if keep {
                 kept.extend_from_slice(&slab);
             }
@@ -241,8 +239,22 @@ impl BrickStore {
             }
             crate::error::check_host_memory(slab_voxels * 4 + (slab_voxels * 4).min(records), &what)?;
             read(z0, ((bz + 1) * BRICK).min(r1[2]) - z0, &mut slab)?;
+            let z1 = ((bz + 1) * BRICK).min(r1[2]);
             for by in blo[1]..bhi[1] {
                 for bx in blo[0]..bhi[0] {
+                    // A brick with nothing to keep, found row by row (most of a sparse volume).
+                    let [x0, x1] = [bx * BRICK, (bx + 1) * BRICK].map(|x| x.clamp(r0[0], r1[0]) - r0[0]);
+                    let [y0, y1] = [by * BRICK, (by + 1) * BRICK].map(|y| y.clamp(r0[1], r1[1]) - r0[1]);
+                    let row = |z: u32, y: u32| (z - z0) as usize * plane + y as usize * w;
+                    let rows = (z0..z1).flat_map(|z| (y0..y1).map(move |y| (z, y)));
+                    if !rows.into_iter().any(|(z, y)| {
+                        // Without a short cut per value, so the row's test vectorises.
+                        slab[row(z, y) + x0 as usize..row(z, y) + x1 as usize]
+                            .iter()
+                            .fold(false, |k, &v| k | keeps(v, range))
+                    }) {
+                        continue;
+                    }
                     let first = store.records.len() as u32;
                     let mut mask = [0u64; BRICK_VOXELS / 64];
                     let (mut qmin, mut qmax) = (u32::MAX, 0u32);
@@ -298,6 +310,22 @@ pub fn store_range(lo: f32, hi: f32) -> (f32, f32) {
     } else {
         (0.0, 0.0)
     }
+}
+
+/// The smallest and largest finite values of `values` and `(lo, hi)`: eight lanes of compares
+/// and selects, which vectorise (a 1024^3 range pass took seconds one value at a time).
+fn finite_span(values: &[f32], (lo, hi): (f32, f32)) -> (f32, f32) {
+    let (mut l8, mut h8) = ([lo; 8], [hi; 8]);
+    let mut lanes = values.chunks_exact(8);
+    for c in &mut lanes {
+        for i in 0..8 {
+            let (v, f) = (c[i], c[i].is_finite());
+            l8[i] = if f && v < l8[i] { v } else { l8[i] };
+            h8[i] = if f && v > h8[i] { v } else { h8[i] };
+        }
+    }
+    let finite = lanes.remainder().iter().chain(&l8).chain(&h8).filter(|v| v.is_finite());
+    finite.fold((lo, hi), |(l, h), &v| (l.min(v), h.max(v)))
 }
 
 /// Whether a store normalised by `range` keeps value `v`: finite and above the minimum, or any
