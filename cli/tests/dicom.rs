@@ -3,7 +3,7 @@
 //! beside `dcm2niix`'s NIfTI conversion of the same series; and what a folder that is not one
 //! series is refused for.
 use crate::cmd;
-use cmd::{refused, voxsplat};
+use cmd::{python, refused, voxsplat};
 use std::path::{Path, PathBuf};
 use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};
 
@@ -452,13 +452,6 @@ fn jpeg_2000_images_read_as_their_uncompressed_originals() {
     for name in ["MR_small_jp2klossless", "MR_small_RLE"] {
         assert_eq!(read(name).unwrap().values, plain.values, "{name}");
     }
-}
-
-/// Runs `script` with python3 (pydicom, numpy, pyjpegls), its `{}` replaced by `args` in turn.
-fn python(script: &str, args: &[&Path]) {
-    let script = args.iter().fold(script.to_string(), |s, a| s.replacen("{}", &a.display().to_string(), 1));
-    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
 /// JPEG-LS (issue 47 item 1), which dicom-rs decodes only through the C++ CharLS, decoded by the

@@ -2,18 +2,12 @@
 //! spacing of 1, a constant volume) and now read right or are refused naming the file, the field
 //! and the value. Each file is written by the tool its users have: pynrrd, pydicom, tifffile.
 use crate::cmd;
-use std::path::{Path, PathBuf};
+use cmd::python;
+use std::path::PathBuf;
 use voxsplat::loaders::{load_volume, VolumeHints};
 
 fn tmp(name: &str) -> PathBuf {
     cmd::tmp_in("foreign", name)
-}
-
-/// Runs a Python script with `{}` replaced by `args` in turn.
-fn python(script: &str, args: &[&Path]) {
-    let script = args.iter().fold(script.to_string(), |s, a| s.replacen("{}", &a.display().to_string(), 1));
-    let out = std::process::Command::new("python3").args(["-c", &script]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
 /// A 4 x 5 x 6 NRRD of `u8` with the header lines `fields` (written here: pynrrd writes only

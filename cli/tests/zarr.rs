@@ -567,9 +567,10 @@ fn an_image_of_few_chunks_reads_only_those_and_the_fill_value_elsewhere() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("sparse.zarr");
+    let npy_path = dir.join("sparse.npy");
     let script = r#"
-import sys, numpy as np, zarr
-path, npy = sys.argv[1], sys.argv[2]
+import numpy as np, zarr
+path, npy = "{}", "{}"
 root = zarr.open_group(path, mode="w", zarr_format=2)
 a = root.create_array("0", shape=(40, 36, 44), chunks=(8, 8, 8), dtype="u2", fill_value=7)
 z, y, x = np.mgrid[0:12, 0:14, 0:10]
@@ -579,12 +580,7 @@ root.attrs["multiscales"] = [{"version": "0.4", "axes": [{"name": n, "type": "sp
     "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [1, 1, 1]}]}]}]
 np.save(npy, a[:])
 "#;
-    let npy_path = dir.join("sparse.npy");
-    let out = std::process::Command::new("python3")
-        .args(["-c", script, path.to_str().unwrap(), npy_path.to_str().unwrap()])
-        .output()
-        .expect("python3");
-    assert!(out.status.success(), "zarr-python: {}", String::from_utf8_lossy(&out.stderr));
+    cmd::python(script, &[&path, &npy_path]);
     let stored = chunk_files(&path.join("0"));
     // 2 x 3 x 2 chunks for the ball's box (along z, y, x), 1 for the corner.
     assert_eq!(stored, 13, "chunks zarr-python stored");

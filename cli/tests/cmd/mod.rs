@@ -48,3 +48,11 @@ pub fn tf_file(path: &std::path::Path, lo: f32, hi: f32) -> &std::path::Path {
     std::fs::write(path, format!("{points}\nrange = [{lo:?}, {hi:?}]\n")).unwrap();
     path
 }
+
+/// Runs a Python script (python3: pydicom, nibabel, zarr-python, numpy...) with each `{}` replaced
+/// by `args` in turn.
+pub fn python(script: &str, args: &[&std::path::Path]) {
+    let script = args.iter().fold(script.to_string(), |s, a| s.replacen("{}", &a.display().to_string(), 1));
+    let out = std::process::Command::new("python3").args(["-c", &script]).output().expect("python3");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
