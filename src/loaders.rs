@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 mod bounded;
 mod dicom;
+mod endian;
 mod held;
 mod nifti1;
 mod npy;
@@ -134,42 +135,20 @@ pub fn decode(bytes: &[u8], n: u64, dtype: DType, big_endian: bool, what: &str) 
     }
     crate::error::check_host_memory(n * 4, &format!("{what}'s {n} samples"))?;
     let b = &bytes[..need as usize];
-    // Four bytes as a u32 in the file's byte order.
-    let word = |c: &[u8]| {
-        let a = [c[0], c[1], c[2], c[3]];
-        if big_endian {
-            u32::from_be_bytes(a)
-        } else {
-            u32::from_le_bytes(a)
-        }
-    };
+    let w2 = |c: &[u8]| endian::word::<2>(c, big_endian) as u16;
+    let w4 = |c: &[u8]| endian::word::<4>(c, big_endian) as u32;
     let v = match dtype {
         DType::U8 => b.iter().map(|&x| x as f32).collect(),
         DType::I8 => b.iter().map(|&x| x as i8 as f32).collect(),
-        DType::U16 => b
-            .chunks_exact(2)
-            .map(
-                |c| if big_endian { u16::from_be_bytes([c[0], c[1]]) } else { u16::from_le_bytes([c[0], c[1]]) } as f32,
-            )
-            .collect(),
-        DType::I16 => b
-            .chunks_exact(2)
-            .map(
-                |c| if big_endian { i16::from_be_bytes([c[0], c[1]]) } else { i16::from_le_bytes([c[0], c[1]]) } as f32,
-            )
-            .collect(),
+        DType::U16 => b.chunks_exact(2).map(|c| w2(c) as f32).collect(),
+        DType::I16 => b.chunks_exact(2).map(|c| w2(c) as i16 as f32).collect(),
         // Wider than f32 holds exactly: kept within their type, refused where f32 would flatten them.
-        DType::U32 => held::held(b.chunks_exact(4).map(|c| word(c) as f64), held::U32, what)?,
-        DType::I32 => held::held(b.chunks_exact(4).map(|c| word(c) as i32 as f64), held::I32, what)?,
-        DType::F64 => held::held(
-            b.chunks_exact(8).map(|c| {
-                let (high, low) = if big_endian { (&c[..4], &c[4..]) } else { (&c[4..], &c[..4]) };
-                f64::from_bits((word(high) as u64) << 32 | word(low) as u64)
-            }),
-            None,
-            what,
-        )?,
-        DType::F32 => b.chunks_exact(4).map(|c| f32::from_bits(word(c))).collect(),
+        DType::U32 => held::held(b.chunks_exact(4).map(|c| w4(c) as f64), held::U32, what)?,
+        DType::I32 => held::held(b.chunks_exact(4).map(|c| w4(c) as i32 as f64), held::I32, what)?,
+        DType::F64 => {
+            held::held(b.chunks_exact(8).map(|c| f64::from_bits(endian::word::<8>(c, big_endian))), None, what)?
+        }
+        DType::F32 => b.chunks_exact(4).map(|c| f32::from_bits(w4(c))).collect(),
     };
     Ok(v)
 }

@@ -68,24 +68,9 @@ fn check_ifds(path: &Path, what: &str) -> Result<()> {
         b"MM" => true,
         _ => return Err(bad(what, "not a TIFF file (no II or MM byte order)")),
     };
-    let u16_at =
-        |b: &[u8]| if big_endian { u16::from_be_bytes([b[0], b[1]]) } else { u16::from_le_bytes([b[0], b[1]]) };
-    let u32_at = |b: &[u8]| {
-        let a = [b[0], b[1], b[2], b[3]];
-        if big_endian {
-            u32::from_be_bytes(a)
-        } else {
-            u32::from_le_bytes(a)
-        }
-    };
-    let u64_at = |b: &[u8]| {
-        let a: [u8; 8] = b[..8].try_into().expect("8 bytes");
-        if big_endian {
-            u64::from_be_bytes(a)
-        } else {
-            u64::from_le_bytes(a)
-        }
-    };
+    let u16_at = |b: &[u8]| super::endian::word::<2>(b, big_endian) as u16;
+    let u32_at = |b: &[u8]| super::endian::word::<4>(b, big_endian) as u32;
+    let u64_at = |b: &[u8]| super::endian::word::<8>(b, big_endian);
     let bigtiff = match u16_at(&head[2..]) {
         42 => false,
         43 if n >= 16 => true,
