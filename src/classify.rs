@@ -313,12 +313,7 @@ fn voxel_classifier<'a>(
         return Err(Error::InvalidArgument(format!("a {:?} grid for a {:?} volume", grid.dims, vol.dims)));
     }
     let [nx, ny, nz] = vol.dims;
-    let (lo, hi) = tf.range.unwrap_or_else(|| {
-        vol.values
-            .iter()
-            .filter(|v| v.is_finite())
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)))
-    });
+    let (lo, hi) = tf.range.unwrap_or_else(|| crate::volume::value_span(&vol.values));
     // In f64: the span of an f32 range may pass f32's largest value.
     let span = if hi > lo { hi as f64 - lo as f64 } else { 1.0 };
     let at = move |i: i64, j: i64, k: i64| -> f32 {

@@ -155,6 +155,23 @@ impl Grid {
     }
 }
 
+/// The smallest and largest finite values of `values` ((inf, -inf) when none is finite). Eight
+/// lanes of compares and selects, which vectorise: a 1024^3 store's range pass took seconds one
+/// value at a time.
+pub fn value_span(values: &[f32]) -> (f32, f32) {
+    let (mut l8, mut h8) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
+    let mut lanes = values.chunks_exact(8);
+    for c in &mut lanes {
+        for i in 0..8 {
+            let (v, f) = (c[i], c[i].is_finite());
+            l8[i] = if f && v < l8[i] { v } else { l8[i] };
+            h8[i] = if f && v > h8[i] { v } else { h8[i] };
+        }
+    }
+    let finite = lanes.remainder().iter().chain(&l8).chain(&h8).filter(|v| v.is_finite());
+    finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)))
+}
+
 /// The extracted voxels of a grid as rows along i: row (j, k) holds its voxels sorted by i.
 ///
 /// ```
@@ -619,4 +636,32 @@ pub const MAX_OPACITY: f32 = 0.999;
 /// tau = -ln(1 - alpha) of one voxel-length of material, alpha clamped to `MAX_OPACITY`.
 pub fn optical_depth(opacity: f32) -> f32 {
     -(1.0 - opacity.clamp(0.0, MAX_OPACITY)).ln()
+}
+
+#[cfg(test)]
+mod tests {
+    /// The eight-lane span equals a plain fold over the finite values, whatever the length and
+    /// wherever NaN and infinities fall.
+    #[test]
+    fn value_span_is_the_finite_values_span() {
+        let mut seed = 7u64;
+        for n in 0..70usize {
+            let values: Vec<f32> = (0..n)
+                .map(|_| {
+                    seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                    match seed >> 60 {
+                        0 => f32::NAN,
+                        1 => f32::INFINITY,
+                        2 => f32::NEG_INFINITY,
+                        _ => (seed >> 32) as u32 as f32 / 1e6 - 2000.0,
+                    }
+                })
+                .collect();
+            let plain = values
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+            assert_eq!(super::value_span(&values), plain, "{values:?}");
+        }
+    }
 }

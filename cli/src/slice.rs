@@ -56,10 +56,7 @@ pub(crate) fn slice(a: SliceArgs) -> Result<()> {
         eprintln!("note: uneven slice gaps, too far apart to resample evenly: cut as stored, one plane per image");
     }
     let (dims, index, plane) = read_plane(&a.file, &hints, axis, a.index, &a.axis, a.channel)?;
-    let [lo, hi] = a.window.unwrap_or_else(|| {
-        let finite = plane.values.iter().filter(|v| v.is_finite());
-        finite.fold([f32::INFINITY, f32::NEG_INFINITY], |[l, h], &v| [l.min(v), h.max(v)])
-    });
+    let [lo, hi] = a.window.unwrap_or_else(|| voxsplat::volume::value_span(&plane.values).into());
     let span = if hi > lo { hi - lo } else { 1.0 };
     let grey: Vec<u8> =
         plane.values.iter().map(|&v| ((v - lo) / span * 255.0).round().clamp(0.0, 255.0) as u8).collect();

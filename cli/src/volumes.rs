@@ -96,11 +96,7 @@ pub fn upsample(
     }
     let [nx, ny, nz] = vol.dims;
     let dims = vol.dims.map(|d| d.saturating_mul(factor));
-    let (lo, hi) = vol
-        .values
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (lo, hi) = voxsplat::volume::value_span(&vol.values);
     let span = if hi > lo { hi - lo } else { 1.0 };
     let at = |i: usize, j: usize, k: usize| {
         let v = vol.values[i + nx as usize * (j + ny as usize * k)];

@@ -138,7 +138,8 @@ impl BrickStore {
             let z1 = ((z0 / BRICK + 1) * BRICK).min(r1[2]);
             read(z0, z1 - z0, &mut slab)?;
             report((z1 - r0[2]) as u64);
-            (lo, hi) = finite_span(&slab, (lo, hi));
+            let (l, h) = crate::volume::value_span(&slab);
+            (lo, hi) = (lo.min(l), hi.max(h));
             if keep {
                 kept.extend_from_slice(&slab);
             }
@@ -310,22 +311,6 @@ pub fn store_range(lo: f32, hi: f32) -> (f32, f32) {
     } else {
         (0.0, 0.0)
     }
-}
-
-/// The smallest and largest finite values of `values` and `(lo, hi)`: eight lanes of compares
-/// and selects, which vectorise (a 1024^3 range pass took seconds one value at a time).
-fn finite_span(values: &[f32], (lo, hi): (f32, f32)) -> (f32, f32) {
-    let (mut l8, mut h8) = ([lo; 8], [hi; 8]);
-    let mut lanes = values.chunks_exact(8);
-    for c in &mut lanes {
-        for i in 0..8 {
-            let (v, f) = (c[i], c[i].is_finite());
-            l8[i] = if f && v < l8[i] { v } else { l8[i] };
-            h8[i] = if f && v > h8[i] { v } else { h8[i] };
-        }
-    }
-    let finite = lanes.remainder().iter().chain(&l8).chain(&h8).filter(|v| v.is_finite());
-    finite.fold((lo, hi), |(l, h), &v| (l.min(v), h.max(v)))
 }
 
 /// Whether a store normalised by `range` keeps value `v`: finite and above the minimum, or any

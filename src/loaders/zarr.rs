@@ -5,7 +5,7 @@
 //! level read against `MAX_STREAMED_VOXELS`, the pyramid's levels against each other), so nothing is sized by
 //! a header that has not been checked.
 use super::zarr_axes::AxisText;
-use super::zarr_chunks::{copy_part, may_see_block, spatial, ChunkKey, Samples};
+use super::zarr_chunks::{copy_part, may_see_block, spatial, ChunkKey, Kind, Samples};
 use super::{bad, MAX_STREAMED_VOXELS};
 use crate::error::{Error, Result};
 use serde_json::Value;
@@ -156,46 +156,6 @@ fn transforms(v: &Value, n: usize, what: &str) -> Result<(Vec<f64>, Vec<f64>)> {
         }
     }
     Ok((scale, shift))
-}
-
-/// The sample types read, by their Zarr v3 and v2 names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    U8,
-    I8,
-    U16,
-    I16,
-    U32,
-    I32,
-    F32,
-    F64,
-}
-
-impl Kind {
-    fn parse(name: &str) -> Option<Kind> {
-        // Zarr v2 names carry a byte order first (`<u2`, `|u1`); zarrs reads either order.
-        let bare = name.trim_start_matches(['<', '>', '|', '=']);
-        Some(match bare {
-            "uint8" | "u1" => Kind::U8,
-            "int8" | "i1" => Kind::I8,
-            "uint16" | "u2" => Kind::U16,
-            "int16" | "i2" => Kind::I16,
-            "uint32" | "u4" => Kind::U32,
-            "int32" | "i4" => Kind::I32,
-            "float32" | "f4" => Kind::F32,
-            "float64" | "f8" => Kind::F64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> u64 {
-        match self {
-            Kind::U8 | Kind::I8 => 1,
-            Kind::U16 | Kind::I16 => 2,
-            Kind::U32 | Kind::I32 | Kind::F32 => 4,
-            Kind::F64 => 8,
-        }
-    }
 }
 
 /// A level's array metadata as the file states it, checked: shape, decoded chunk, sample type and
