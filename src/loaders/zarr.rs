@@ -5,8 +5,8 @@
 //! level read against `MAX_STREAMED_VOXELS`, the pyramid's levels against each other), so nothing is sized by
 //! a header that has not been checked.
 use super::zarr_axes::AxisText;
-use super::zarr_chunks::{copy_part, may_see_block, spatial, ChunkKey, Kind, Samples};
-use super::{bad, MAX_STREAMED_VOXELS};
+use super::zarr_chunks::{copy_part, may_see_block, spatial, ChunkKey, Samples};
+use super::{bad, DType, MAX_STREAMED_VOXELS};
 use crate::error::{Error, Result};
 use serde_json::Value;
 use std::path::Path;
@@ -158,6 +158,22 @@ fn transforms(v: &Value, n: usize, what: &str) -> Result<(Vec<f64>, Vec<f64>)> {
     Ok((scale, shift))
 }
 
+/// The sample type of a Zarr v3 or v2 name (v2 names carry a byte order first, `<u2`, `|u1`;
+/// zarrs reads either order).
+fn zarr_dtype(name: &str) -> Option<DType> {
+    Some(match name.trim_start_matches(['<', '>', '|', '=']) {
+        "uint8" | "u1" => DType::U8,
+        "int8" | "i1" => DType::I8,
+        "uint16" | "u2" => DType::U16,
+        "int16" | "i2" => DType::I16,
+        "uint32" | "u4" => DType::U32,
+        "int32" | "i4" => DType::I32,
+        "float32" | "f4" => DType::F32,
+        "float64" | "f8" => DType::F64,
+        _ => return None,
+    })
+}
+
 /// A level's array metadata as the file states it, checked: shape, decoded chunk, sample type and
 /// codec names.
 struct ArrayMeta {
@@ -203,7 +219,7 @@ fn array_meta(dir: &Path, v3: bool, n: usize) -> Result<ArrayMeta> {
         }
         (chunk, dtype, codecs)
     };
-    let kind = Kind::parse(&dtype).ok_or_else(|| {
+    let kind = zarr_dtype(&dtype).ok_or_else(|| {
         bad(
             &what,
             format!("sample type {dtype:?} is not read (uint8, int8, uint16, int16, uint32, int32, float32, float64)"),
@@ -224,7 +240,7 @@ fn array_meta(dir: &Path, v3: bool, n: usize) -> Result<ArrayMeta> {
         }
         chunk = inner;
     }
-    let bytes = chunk.iter().try_fold(kind.size(), |a, &c| a.checked_mul(c));
+    let bytes = chunk.iter().try_fold(kind.size() as u64, |a, &c| a.checked_mul(c));
     if bytes.is_none_or(|b| b > MAX_CHUNK_BYTES) {
         return Err(Error::TooLarge(format!(
             "{what}: a chunk of {chunk:?} decodes to more than {MAX_CHUNK_BYTES} bytes"
@@ -385,7 +401,7 @@ fn check_pyramid(levels: &[Level], what: &str) -> Result<()> {
 /// One level of an image read a slab at a time.
 pub struct ZarrReader {
     array: Array<FilesystemStore>,
-    kind: Kind,
+    kind: DType,
     /// Voxels along x, y, z.
     pub dims: [u32; 3],
     /// Voxel spacing.
@@ -433,17 +449,17 @@ impl ZarrReader {
         if array.shape()[n - 3..] != shape[..] {
             return Err(bad(&what, format!("level {level}: zarrs reads shape {:?}", array.shape())));
         }
-        let kind = Kind::parse(&l.dtype).expect("checked by OmeZarr::open");
+        let kind = zarr_dtype(&l.dtype).expect("checked by OmeZarr::open");
         let dtype = array.data_type();
         let agrees = match kind {
-            Kind::U8 => dtype.is::<dt::UInt8DataType>(),
-            Kind::I8 => dtype.is::<dt::Int8DataType>(),
-            Kind::U16 => dtype.is::<dt::UInt16DataType>(),
-            Kind::I16 => dtype.is::<dt::Int16DataType>(),
-            Kind::U32 => dtype.is::<dt::UInt32DataType>(),
-            Kind::I32 => dtype.is::<dt::Int32DataType>(),
-            Kind::F32 => dtype.is::<dt::Float32DataType>(),
-            Kind::F64 => dtype.is::<dt::Float64DataType>(),
+            DType::U8 => dtype.is::<dt::UInt8DataType>(),
+            DType::I8 => dtype.is::<dt::Int8DataType>(),
+            DType::U16 => dtype.is::<dt::UInt16DataType>(),
+            DType::I16 => dtype.is::<dt::Int16DataType>(),
+            DType::U32 => dtype.is::<dt::UInt32DataType>(),
+            DType::I32 => dtype.is::<dt::Int32DataType>(),
+            DType::F32 => dtype.is::<dt::Float32DataType>(),
+            DType::F64 => dtype.is::<dt::Float64DataType>(),
         };
         if !agrees {
             return Err(bad(&what, format!("level {level}: zarrs reads another sample type than {}", l.dtype)));
@@ -497,7 +513,8 @@ impl ZarrReader {
     fn failing_chunk(&self, subset: &ArraySubset) -> Option<(String, zarrs::array::ArrayError)> {
         let chunks = self.array.chunks_in_array_subset(subset).ok()??;
         for idx in &chunks.indices() {
-            let bytes = self.array.chunk_shape(&idx).ok()?.iter().map(|c| c.get()).product::<u64>() * self.kind.size();
+            let bytes =
+                self.array.chunk_shape(&idx).ok()?.iter().map(|c| c.get()).product::<u64>() * self.kind.size() as u64;
             if bytes > MAX_CHUNK_BYTES {
                 return None;
             }
@@ -518,20 +535,23 @@ impl ZarrReader {
     fn samples(&self, z0: u32, count: u32, [x0, y0, x1, y1]: [u32; 4]) -> Result<Vec<f32>> {
         let subset = self.at_lead([z0..z0 + count, y0..y1, x0..x1].map(|r| r.start as u64..r.end as u64));
         let n = subset.num_elements();
-        crate::error::check_host_memory(n * (4 + self.kind.size()), &format!("{}'s slices", self.what))?;
+        crate::error::check_host_memory(n * (4 + self.kind.size() as u64), &format!("{}'s slices", self.what))?;
         let chunks = self.array.chunks_in_array_subset(&subset).map_err(|e| bad(&self.what, e))?;
-        let whole = self.seen.is_none() && self.cache.is_none();
+        let direct = self.seen.is_none() && self.cache.is_none();
         // Chunks a sparse image does not store read as its fill value without a decode each (one
         // chunk of a 1024^3 array took 18 s); the fill as a stored chunk would read it.
-        let stored = |idx: &[u64]| self.key.image.join(self.array.chunk_key(idx).as_str()).exists();
-        let missing = chunks.iter().flat_map(|c| c.indices().into_iter()).find(|idx| whole && !stored(idx));
-        if whole && missing.is_none() {
+        // Each chunk with whether it is decoded: those stored, or every one for a view or a cache
+        // (which test each in the loop below).
+        let stored = |idx: &[u64]| !direct || self.key.image.join(self.array.chunk_key(idx).as_str()).exists();
+        let indices: Vec<_> = chunks.iter().flat_map(|c| c.indices().into_iter()).map(|i| (stored(&i), i)).collect();
+        let missing = indices.iter().find(|(read, _)| !read).map(|(_, idx)| idx);
+        if direct && missing.is_none() {
             CHUNKS_READ.fetch_add(chunks.map_or(0, |c| c.num_elements()), std::sync::atomic::Ordering::Relaxed);
             return Ok(self.decoded(&subset, n, z0, count)?.into_f32());
         }
         let fill = match missing {
             Some(idx) => {
-                let at = self.array.chunk_origin(&idx).map_err(|e| bad(&self.what, e))?;
+                let at = self.array.chunk_origin(idx).map_err(|e| bad(&self.what, e))?;
                 let one =
                     ArraySubset::new_with_start_shape(at.clone(), vec![1; at.len()]).map_err(|e| bad(&self.what, e))?;
                 self.decoded(&one, 1, z0, count)?.into_f32()[0]
@@ -544,15 +564,15 @@ impl ZarrReader {
         let grid = crate::Grid::centered(self.dims, self.spacing)?;
         let to = ([z0, y0, x0].map(u64::from), [count, y1 - y0, x1 - x0].map(u64::from));
         let spatial = |s: &ArraySubset| spatial(s, lead);
-        for idx in chunks.iter().flat_map(|c| c.indices().into_iter()) {
+        for (_, idx) in indices.iter().filter(|(read, _)| *read) {
             let part =
-                self.array.chunk_subset(&idx).and_then(|c| Ok(c.overlap(&subset)?)).map_err(|e| bad(&self.what, e))?;
+                self.array.chunk_subset(idx).and_then(|c| Ok(c.overlap(&subset)?)).map_err(|e| bad(&self.what, e))?;
             let (start, shape) = spatial(&part);
-            if !may_see_block(self.seen.as_ref(), &grid, (start, shape)) || (whole && !stored(&idx)) {
+            if !may_see_block(self.seen.as_ref(), &grid, (start, shape)) {
                 continue;
             }
             // The chunk's samples at this time point and channel, within the array.
-            let whole = self.array.chunk_subset_bounded(&idx).map_err(|e| bad(&self.what, e))?;
+            let whole = self.array.chunk_subset_bounded(idx).map_err(|e| bad(&self.what, e))?;
             let block = spatial(&whole);
             let bytes = block.1.iter().product::<u64>() * 4;
             match &self.cache {
@@ -589,22 +609,22 @@ impl ZarrReader {
             Ok(Samples::F32(v))
         };
         let values = match self.kind {
-            Kind::U8 => Samples::U8(a.retrieve_array_subset(subset).map_err(err)?),
-            Kind::I8 => Samples::I8(a.retrieve_array_subset(subset).map_err(err)?),
-            Kind::U16 => Samples::U16(a.retrieve_array_subset(subset).map_err(err)?),
-            Kind::I16 => Samples::I16(a.retrieve_array_subset(subset).map_err(err)?),
-            Kind::U32 => f32s(super::held::held(
+            DType::U8 => Samples::U8(a.retrieve_array_subset(subset).map_err(err)?),
+            DType::I8 => Samples::I8(a.retrieve_array_subset(subset).map_err(err)?),
+            DType::U16 => Samples::U16(a.retrieve_array_subset(subset).map_err(err)?),
+            DType::I16 => Samples::I16(a.retrieve_array_subset(subset).map_err(err)?),
+            DType::U32 => f32s(super::held::held(
                 a.retrieve_array_subset::<Vec<u32>>(subset).map_err(err)?.into_iter().map(f64::from),
                 super::held::U32,
                 &self.what,
             )?)?,
-            Kind::I32 => f32s(super::held::held(
+            DType::I32 => f32s(super::held::held(
                 a.retrieve_array_subset::<Vec<i32>>(subset).map_err(err)?.into_iter().map(f64::from),
                 super::held::I32,
                 &self.what,
             )?)?,
-            Kind::F32 => f32s(a.retrieve_array_subset(subset).map_err(err)?)?,
-            Kind::F64 => f32s(super::held::held(
+            DType::F32 => f32s(a.retrieve_array_subset(subset).map_err(err)?)?,
+            DType::F64 => f32s(super::held::held(
                 a.retrieve_array_subset::<Vec<f64>>(subset).map_err(err)?.into_iter(),
                 None,
                 &self.what,

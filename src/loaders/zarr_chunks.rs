@@ -248,46 +248,6 @@ pub(super) fn copy_part(out: &mut [f32], to: Block, block: Block, values: &Sampl
     }
 }
 
-/// The sample types read, by their Zarr v3 and v2 names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Kind {
-    U8,
-    I8,
-    U16,
-    I16,
-    U32,
-    I32,
-    F32,
-    F64,
-}
-
-impl Kind {
-    pub(super) fn parse(name: &str) -> Option<Kind> {
-        // Zarr v2 names carry a byte order first (`<u2`, `|u1`); zarrs reads either order.
-        let bare = name.trim_start_matches(['<', '>', '|', '=']);
-        Some(match bare {
-            "uint8" | "u1" => Kind::U8,
-            "int8" | "i1" => Kind::I8,
-            "uint16" | "u2" => Kind::U16,
-            "int16" | "i2" => Kind::I16,
-            "uint32" | "u4" => Kind::U32,
-            "int32" | "i4" => Kind::I32,
-            "float32" | "f4" => Kind::F32,
-            "float64" | "f8" => Kind::F64,
-            _ => return None,
-        })
-    }
-
-    pub(super) fn size(self) -> u64 {
-        match self {
-            Kind::U8 | Kind::I8 => 1,
-            Kind::U16 | Kind::I16 => 2,
-            Kind::U32 | Kind::I32 | Kind::F32 => 4,
-            Kind::F64 => 8,
-        }
-    }
-}
-
 /// Refuses a level that stores no chunk (`holds_a_chunk`): missing chunks read as the fill value,
 /// so the array is one value throughout, and reading it (a 24 KB file declaring 2048^3) ran for
 /// minutes before drawing nothing.
