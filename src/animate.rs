@@ -221,6 +221,7 @@ impl Animation {
         let dist = (Vec3::from(c.target) - eye).length();
         let ortho = matches!(projection, Projection::Orthographic { .. });
         let camera = Camera {
+            window: None,
             eye,
             target: Vec3::from(c.target),
             up: Vec3::from(c.up),

@@ -62,6 +62,23 @@ pub struct Camera {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
+    /// `Some`: this camera draws only a window of a larger frame, `width` x `height` pixels of it
+    /// at the window's corner (a band of a frame drawn in parts). `None`: the whole frame.
+    pub window: Option<Window>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Where a camera's image lies in the whole frame it is part of: the frame's size and the image's
+/// top-left pixel in it. The projection, the pixel size and the culling are the whole frame's.
+pub struct Window {
+    /// Column of the image's left edge in the frame.
+    pub x: u32,
+    /// Row of the image's top edge in the frame.
+    pub y: u32,
+    /// The whole frame's width in pixels.
+    pub frame_width: u32,
+    /// The whole frame's height in pixels.
+    pub frame_height: u32,
 }
 
 impl Camera {
@@ -101,6 +118,7 @@ impl Camera {
             far: (dist + radius * 1.5).max(dist + radius + reach),
             width,
             height,
+            window: None,
         }
     }
 
@@ -118,6 +136,21 @@ impl Camera {
         }
         if self.width as u64 * self.height as u64 > MAX_PIXELS {
             return Err(Error::InvalidCamera(format!("image has more than {MAX_PIXELS} pixels")));
+        }
+        if let Some(w) = self.window {
+            let (fw, fh) = (w.frame_width, w.frame_height);
+            if fw > MAX_IMAGE_SIDE || fh > MAX_IMAGE_SIDE || fw as u64 * fh as u64 > MAX_PIXELS {
+                return Err(Error::InvalidCamera(format!(
+                    "the whole frame of a window ({fw}x{fh}) must have sides of at most {MAX_IMAGE_SIDE} and at most \
+                     {MAX_PIXELS} pixels"
+                )));
+            }
+            if w.x as u64 + self.width as u64 > fw as u64 || w.y as u64 + self.height as u64 > fh as u64 {
+                return Err(Error::InvalidCamera(format!(
+                    "a {}x{} window at ({}, {}) does not fit in its {fw}x{fh} frame",
+                    self.width, self.height, w.x, w.y
+                )));
+            }
         }
         if self.eye.abs().max_element() > MAX_WORLD || self.target.abs().max_element() > MAX_WORLD {
             return Err(Error::InvalidCamera(format!(
@@ -171,7 +204,30 @@ impl Camera {
             }
             Projection::Orthographic { height } => height,
         };
-        height / self.height as f32
+        height / self.frame_size().1 as f32
+    }
+
+    /// The whole frame's width and height: the image's own, or its window's frame's.
+    pub fn frame_size(&self) -> (u32, u32) {
+        self.window.map_or((self.width, self.height), |w| (w.frame_width, w.frame_height))
+    }
+
+    /// The same view on a pixel grid `k` times finer on each axis (its window's too).
+    pub fn supersampled(&self, k: u32) -> Self {
+        let window = self.window.map(|w| Window {
+            x: w.x * k,
+            y: w.y * k,
+            frame_width: w.frame_width * k,
+            frame_height: w.frame_height * k,
+        });
+        Self { width: self.width * k, height: self.height * k, window, ..*self }
+    }
+
+    /// The same view drawing only `width` x `height` pixels at column `x`, row `y` of its frame.
+    pub fn windowed(&self, x: u32, y: u32, width: u32, height: u32) -> Self {
+        let (frame_width, frame_height) = self.frame_size();
+        let (ox, oy) = self.window.map_or((0, 0), |w| (w.x, w.y));
+        Self { width, height, window: Some(Window { x: ox + x, y: oy + y, frame_width, frame_height }), ..*self }
     }
 
     /// Whether the projection is a perspective one.
@@ -194,9 +250,10 @@ impl Camera {
         self.right().cross(self.forward())
     }
 
-    /// Width over height.
+    /// Width over height, of the whole frame.
     pub fn aspect(&self) -> f32 {
-        self.width as f32 / self.height as f32
+        let (w, h) = self.frame_size();
+        w as f32 / h as f32
     }
 
     /// World to eye space (right-handed, looking down -z).
@@ -216,7 +273,26 @@ impl Camera {
             }
         };
         p.y_axis = Vec4::new(p.y_axis.x, -p.y_axis.y, p.y_axis.z, p.y_axis.w);
-        p
+        match self.window {
+            None => p,
+            // The window's pixels stretched over [-1, 1]: ndc' = ndc * F / n + (F - 2 o) / n - 1
+            // per axis, for a frame of F pixels and a window of n at o.
+            Some(w) => {
+                let axis = |frame: u32, at: u32, n: u32| {
+                    let (f, o, n) = (frame as f32, at as f32, n as f32);
+                    (f / n, (f - 2.0 * o) / n - 1.0)
+                };
+                let (sx, ox) = axis(w.frame_width, w.x, self.width);
+                let (sy, oy) = axis(w.frame_height, w.y, self.height);
+                let t = Mat4::from_cols(
+                    Vec4::new(sx, 0.0, 0.0, 0.0),
+                    Vec4::new(0.0, sy, 0.0, 0.0),
+                    Vec4::Z,
+                    Vec4::new(ox, oy, 0.0, 1.0),
+                );
+                t * p
+            }
+        }
     }
 
     /// World to clip space (Vulkan depth range, y down).
@@ -228,8 +304,10 @@ impl Camera {
     /// world unit at unit depth. Orthographic: pixels per world unit everywhere.
     pub fn pixels_per_unit(&self) -> f32 {
         match self.projection {
-            Projection::Perspective { fov_y_deg } => 0.5 * self.height as f32 / (0.5 * fov_y_deg.to_radians()).tan(),
-            Projection::Orthographic { height } => self.height as f32 / height,
+            Projection::Perspective { fov_y_deg } => {
+                0.5 * self.frame_size().1 as f32 / (0.5 * fov_y_deg.to_radians()).tan()
+            }
+            Projection::Orthographic { height } => self.frame_size().1 as f32 / height,
         }
     }
 
@@ -258,6 +336,7 @@ impl Camera {
             far: 4.0 * (half_y + 100.0),
             width,
             height,
+            window: None,
         }
     }
 
@@ -286,6 +365,7 @@ impl Camera {
             far: 4.0 * (d + ext.length()),
             width,
             height,
+            window: None,
         }
     }
 
@@ -298,7 +378,8 @@ impl Camera {
 
     /// Eye to perspective space, Eqs 3.3-3.5 with D = near, F = far and h = half the view-plane
     /// height at the near plane: x_p, y_p in [-1, 1] across the view (x scaled by the aspect),
-    /// z_p in [0, 1] from near to far (Vulkan depth). Orthographic views map linearly.
+    /// z_p in [0, 1] from near to far (Vulkan depth). Orthographic views map linearly. The whole
+    /// frame's, whatever the window.
     pub fn eye_to_perspective(&self, e: Vec3) -> Vec3 {
         let (d, f) = (self.near, self.far);
         match self.projection {
@@ -334,10 +415,12 @@ impl Camera {
     }
 
     /// Half the view's width and height, `margin` pixels past the image's edges: at unit depth
-    /// (perspective) or in world units (orthographic).
+    /// (perspective) or in world units (orthographic). A window culls as its whole frame does, so
+    /// that every part of a frame makes the same decisions.
     fn half_view(&self, margin: f32) -> (f32, f32) {
         let per = self.pixels_per_unit();
-        ((0.5 * self.width as f32 + margin) / per, (0.5 * self.height as f32 + margin) / per)
+        let (w, h) = self.frame_size();
+        ((0.5 * w as f32 + margin) / per, (0.5 * h as f32 + margin) / per)
     }
 
     /// The bounds of the part of box `lo..hi` this view can see, `margin` pixels past the image's

@@ -19,6 +19,7 @@
 #[cfg(feature = "lab")]
 pub mod aa;
 pub mod animate;
+pub mod bands;
 mod bisect;
 pub mod bricks;
 mod builds;
@@ -73,9 +74,10 @@ pub mod vk;
 pub mod volume;
 
 pub use bisect::Bisect;
-pub use camera::{Camera, Projection};
+pub use camera::{Camera, Projection, Window};
 pub use error::{host_budget, set_host_budget, Error, Result};
 pub use glam;
+pub use gpu_types::gpu_bytes_per_splat;
 pub use image::ImageF32;
 pub use image::TargetFormat;
 pub use kernel::Kernel;
@@ -87,6 +89,8 @@ pub use order::{Direction, OrderKind};
 pub use pick::{Pick, PICK_OPACITY};
 pub use raster::{Raster, RasterChoice};
 pub use series::VolumeUpdate;
+#[doc(hidden)]
+pub use shaders::spirv_builds;
 pub use volume::{Grid, SplatSet, Volume};
 
 use cpu_engine::CpuEngine;
@@ -316,33 +320,75 @@ impl Renderer {
         scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
     }
 
-    /// Draw a frame.
+    /// Draw a frame (in bands past [`bands::BAND_BYTES`], put together: see `render_bands`).
     pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
         options.validate()?;
         camera.validate()?;
-        check_frame_memory(camera)?;
+        bands::check_memory(camera, true)?;
         if options.render_scale != 1.0 {
             let full = RenderOptions { render_scale: 1.0, ..options.clone() };
             return resample::render_scaled(camera, options.render_scale, |low| self.render(low, &full));
         }
         let (opts, choice) = self.choose(camera, options)?;
+        if bands::bands(camera).len() > 1 {
+            return bands::assemble(camera, |band| {
+                let r = self.record(band, &opts)?;
+                Ok(Rendered { image: r.image, timings: r.timings, raster: Some(choice.clone()), stats: r.stats })
+            });
+        }
+        let recorded = self.record(camera, &opts)?;
+        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats: recorded.stats })
+    }
+
+    /// Draw a frame in full-width bands of at most [`bands::BAND_BYTES`], top to bottom, handing
+    /// each to `sink` with its first row: a frame of any size in the memory of one band. Each band
+    /// is a window of the camera (`Camera::windowed`) culled, ordered and rastered as the whole
+    /// frame, so bands meet without seams; stats are the busiest band's. Full size only.
+    pub fn render_bands(
+        &mut self,
+        camera: &Camera,
+        options: &RenderOptions,
+        sink: &mut dyn FnMut(u32, &ImageF32) -> Result<()>,
+    ) -> Result<Delivered> {
+        options.validate()?;
+        camera.validate()?;
+        bands::check_memory(camera, false)?;
+        if options.render_scale != 1.0 {
+            return Err(Error::Unsupported(
+                "a frame drawn in bands is drawn at full size: a render scale below 1 needs the whole frame".into(),
+            ));
+        }
+        let (opts, raster) = self.choose(camera, options)?;
+        let (timings, stats) = bands::each(
+            camera,
+            |band| {
+                let r = self.record(band, &opts)?;
+                Ok((r.image, r.timings, r.stats))
+            },
+            sink,
+        )?;
+        Ok(Delivered { timings, raster, stats })
+    }
+
+    /// One frame (or band) recorded on the backend, or on a bisect split of it.
+    fn record(&mut self, camera: &Camera, opts: &RenderOptions) -> Result<recording::Recorded> {
         let bisect = self.bisect;
         let prep = Self::prepared_in(&self.scene)?;
         let mut cpu = CpuEngine::new(prep).with_budget(self.budget_bytes);
-        let recorded = match (&mut self.gpu, bisect) {
-            (Some(g), None) => record_frame(&mut g.engine(prep), prep, camera, &opts)?,
+        let mut recorded = match (&mut self.gpu, bisect) {
+            (Some(g), None) => record_frame(&mut g.engine(prep), prep, camera, opts)?,
             (Some(g), Some(b)) => {
                 let mut gpu = g.engine(prep);
                 let mut split = match b {
                     Bisect::GpuUntil(at) => bisect::Split::new(&mut gpu, &mut cpu, at),
                     Bisect::CpuUntil(at) => bisect::Split::new(&mut cpu, &mut gpu, at),
                 };
-                record_frame(&mut split, prep, camera, &opts)?
+                record_frame(&mut split, prep, camera, opts)?
             }
-            (None, _) => record_frame(&mut cpu, prep, camera, &opts)?,
+            (None, _) => record_frame(&mut cpu, prep, camera, opts)?,
         };
-        let stats = options::FrameStats { unlabelled: prep.set.unlabelled(), ..recorded.stats };
-        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats })
+        recorded.stats.unlabelled = prep.set.unlabelled();
+        Ok(recorded)
     }
 
     /// The frame's plan: every decision `render` would make for this frame before it touches the
@@ -559,7 +605,7 @@ impl Renderer {
     /// The ray caster: `raycast.comp` on the GPU, or its CPU mirror.
     pub fn raycast(&mut self, camera: &Camera, options: &RaycastOptions) -> Result<Rendered> {
         camera.validate()?;
-        check_frame_memory(camera)?;
+        bands::check_memory(camera, true)?;
         if !(options.step.is_finite() && options.step > 0.0) {
             return Err(Error::InvalidArgument("ray caster step must be positive".into()));
         }
@@ -582,10 +628,13 @@ impl Renderer {
                 "a supersampled ray cast is the full-size reference: drop the render scale".into(),
             ));
         }
+        if options.render_scale == 1.0 && bands::bands(camera).len() > 1 {
+            return bands::assemble(camera, |band| self.raycast(band, options));
+        }
         if k > 1 {
             // k x k rays per pixel: the view cast on a grid k times finer, each pixel the mean of
             // its k x k rays (the finer grid's pixel centres sit on a regular grid inside it).
-            let fine = Camera { width: camera.width * k, height: camera.height * k, ..*camera };
+            let fine = camera.supersampled(k);
             fine.validate()?;
             let one = RaycastOptions { supersample: 1, ..options.clone() };
             let mut out = self.raycast(&fine, &one)?;
@@ -648,36 +697,4 @@ impl Renderer {
     pub fn context(&self) -> Option<&Arc<vk::Context>> {
         self.gpu.as_ref().map(|g| g.context())
     }
-}
-
-/// GPU memory a scene costs per splat: the splat (32 B), its parameters (80 B), its order entry and
-/// its three slice-list entries (16 B), plus the per-row tables spread over the splats.
-pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
-    let n = set.len().max(1) as f64;
-    let rows = (set.row_start().len() - 1) as f64;
-    let dims = set.grid().dims;
-    let per_splat =
-        (std::mem::size_of::<gpu_types::Splat>() + std::mem::size_of::<gpu_types::SplatParams>() + 16) as f64;
-    per_splat + (rows * (4.0 + 4.0 + 8.0) + (dims[0] + dims[1] + dims[2]) as f64 * 4.0) / n
-}
-
-/// Every SPIR-V build the pipelines use, by name: compiled from `glsl/` with the `shaderc`
-/// feature, else the copies shipped in `glsl/spirv/` (tests/spirv.rs keeps the two equal).
-#[doc(hidden)]
-pub fn spirv_builds() -> &'static [(&'static str, &'static [u8])] {
-    shaders::SPIRV
-}
-
-/// Host bytes a frame takes per pixel at most: the image (f32 RGBA), its read-back copy, the CPU
-/// engine's accumulators and the 8-bit copy an output format writes (an 8192² frame took 4.4 GB).
-const FRAME_HOST_BYTES_PER_PIXEL: u64 = 72;
-
-/// Refuse a frame whose host memory would pass the host budget or what the host has available,
-/// before anything of it is allocated.
-fn check_frame_memory(camera: &Camera) -> Result<()> {
-    let pixels = camera.width as u64 * camera.height as u64;
-    error::check_host_memory(
-        pixels * FRAME_HOST_BYTES_PER_PIXEL,
-        &format!("a {}x{} frame", camera.width, camera.height),
-    )
 }

@@ -479,6 +479,10 @@ pub fn count_pixel_inversions(
     let (right, up) = (camera.right().as_dvec3(), camera.true_up().as_dvec3());
     let scale = camera.pixels_per_unit() as f64;
     let persp = camera.is_perspective();
+    // The whole frame's centre in this image's pixels (a window's frame may be larger).
+    let (fw, fh) = camera.frame_size();
+    let (ox, oy) = camera.window.map_or((0, 0), |v| (v.x, v.y));
+    let centre = (fw as f64 * 0.5 - ox as f64, fh as f64 * 0.5 - oy as f64);
     let mut depths: Vec<Vec<f64>> = vec![Vec::new(); w * h];
     for &s in order {
         let ijk = set.splats()[s as usize].ijk;
@@ -488,7 +492,7 @@ pub fn count_pixel_inversions(
             continue;
         }
         let k = if persp { scale / z } else { scale };
-        let (cx, cy) = (w as f64 * 0.5 + p.dot(right) * k, h as f64 * 0.5 - p.dot(up) * k);
+        let (cx, cy) = (centre.0 + p.dot(right) * k, centre.1 - p.dot(up) * k);
         let r = world * k;
         let (x0, x1) = ((cx - r).floor().max(0.0) as usize, ((cx + r).ceil() as usize).min(w));
         let (y0, y1) = ((cy - r).floor().max(0.0) as usize, ((cy + r).ceil() as usize).min(h));

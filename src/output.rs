@@ -2,21 +2,84 @@
 //! premultiplied alpha (EXR's own convention). Values are written as computed: no sRGB curve.
 use crate::error::{Error, Result};
 use crate::image::ImageF32;
-use image::ImageEncoder as _;
 use std::fs::File;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 
 /// Straight-alpha RGBA8 pixels of a premultiplied float image.
 pub fn to_rgba8(img: &ImageF32) -> Vec<u8> {
-    let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
     let mut out = Vec::with_capacity(img.pixels.len() * 4);
-    for p in &img.pixels {
+    rgba8_into(&img.pixels, &mut out);
+    out
+}
+
+/// `pixels` (premultiplied float) appended to `out` as straight-alpha RGBA8.
+fn rgba8_into(pixels: &[[f32; 4]], out: &mut Vec<u8>) {
+    let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    for p in pixels {
         let a = p[3].clamp(0.0, 1.0);
         let s = if a > 0.0 { 1.0 / a } else { 0.0 };
         out.extend_from_slice(&[q(p[0] * s), q(p[1] * s), q(p[2] * s), q(a)]);
     }
-    out
+}
+
+/// A PNG (RGBA8, straight alpha) written in bands of rows as they come, so a large frame is never
+/// held whole: `Renderer::render_bands` hands its bands to `push`; `finish` checks that every row
+/// came and that the last flush succeeded.
+pub struct PngRows {
+    path: std::path::PathBuf,
+    writer: png::StreamWriter<'static, SharedWriter>,
+    file: std::sync::Arc<std::sync::Mutex<BufWriter<File>>>,
+    rows_left: u32,
+    width: u32,
+    row: Vec<u8>,
+}
+
+impl PngRows {
+    /// Create `path` for a `width` x `height` PNG.
+    pub fn create(path: &Path, width: u32, height: u32) -> Result<Self> {
+        let name = path.display().to_string();
+        let file = File::create(path).map_err(|source| Error::Io { path: name.clone(), source })?;
+        let file = std::sync::Arc::new(std::sync::Mutex::new(BufWriter::new(file)));
+        let mut encoder = png::Encoder::new(SharedWriter(file.clone()), width, height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        let encoding = |e: png::EncodingError| Error::Image { path: name.clone(), message: e.to_string() };
+        let writer = encoder.write_header().map_err(encoding)?.into_stream_writer().map_err(encoding)?;
+        let row = Vec::with_capacity(width as usize * 4);
+        Ok(Self { path: path.to_path_buf(), writer, file, rows_left: height, width, row })
+    }
+
+    /// Append `band`'s rows (as wide as the image).
+    pub fn push(&mut self, band: &ImageF32) -> Result<()> {
+        if band.width != self.width || band.height > self.rows_left {
+            return Err(Error::InvalidArgument(format!(
+                "a {}x{} band does not fit the {} rows left of a PNG {} wide",
+                band.width, band.height, self.rows_left, self.width
+            )));
+        }
+        let name = self.path.display().to_string();
+        for line in band.pixels.chunks_exact(self.width as usize) {
+            self.row.clear();
+            rgba8_into(line, &mut self.row);
+            std::io::Write::write_all(&mut self.writer, &self.row)
+                .map_err(|source| Error::Io { path: name.clone(), source })?;
+        }
+        self.rows_left -= band.height;
+        Ok(())
+    }
+
+    /// Write the trailer and flush the file.
+    pub fn finish(self) -> Result<()> {
+        let name = self.path.display().to_string();
+        if self.rows_left > 0 {
+            return Err(Error::InvalidArgument(format!("{name}: {} rows were never written", self.rows_left)));
+        }
+        let encoding = |e: png::EncodingError| Error::Image { path: name.clone(), message: e.to_string() };
+        self.writer.finish().map_err(encoding)?;
+        let io = |source| Error::Io { path: name.clone(), source };
+        self.file.lock().map_err(|_| io(std::io::Error::other("PNG writer poisoned")))?.flush().map_err(io)
+    }
 }
 
 /// The formats `write_image` writes, by extension.
@@ -62,11 +125,19 @@ fn write_file(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()
 pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
     let format = ImageFormat::of(path)?;
     let encoding = |message: String| Error::Image { path: path.display().to_string(), message };
-    write_file(path, |w| match format {
-        ImageFormat::Png => image::codecs::png::PngEncoder::new(w)
-            .write_image(&to_rgba8(img), img.width, img.height, image::ExtendedColorType::Rgba8)
-            .map_err(|e| encoding(e.to_string())),
-        ImageFormat::Exr => {
+    write_file_as(path, format, img, encoding)
+}
+
+/// `write_image`'s body by format.
+fn write_file_as(path: &Path, format: ImageFormat, img: &ImageF32, encoding: impl Fn(String) -> Error) -> Result<()> {
+    match format {
+        ImageFormat::Png => {
+            // Row by row: an 8-bit copy of a large frame would add a quarter of its size.
+            let mut png = PngRows::create(path, img.width, img.height)?;
+            png.push(img)?;
+            png.finish()
+        }
+        ImageFormat::Exr => write_file(path, |w| {
             use exr::prelude::WritableImage as _;
             let width = img.width as usize;
             let channels =
@@ -78,8 +149,8 @@ pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
                 .write()
                 .to_buffered(w)
                 .map_err(|e| encoding(e.to_string()))
-        }
-    })
+        }),
+    }
 }
 
 /// An animated GIF written frame by frame over a dark background (`delay_ms` per frame), so a
@@ -91,16 +162,16 @@ pub struct GifWriter {
     delay_ms: u32,
 }
 
-/// The GIF encoder's handle on the file: the encoder writes its trailer when dropped, and the
-/// file is flushed after that, through the other handle.
+/// An encoder's handle on the file (GIF's, PNG's): the encoder writes its trailer when finished or
+/// dropped, and the file is flushed after that, through the other handle, its error checked.
 struct SharedWriter(std::sync::Arc<std::sync::Mutex<BufWriter<File>>>);
 
 impl std::io::Write for SharedWriter {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0.lock().map_err(|_| std::io::Error::other("GIF writer poisoned"))?.write(buf)
+        self.0.lock().map_err(|_| std::io::Error::other("image writer poisoned"))?.write(buf)
     }
     fn flush(&mut self) -> std::io::Result<()> {
-        self.0.lock().map_err(|_| std::io::Error::other("GIF writer poisoned"))?.flush()
+        self.0.lock().map_err(|_| std::io::Error::other("image writer poisoned"))?.flush()
     }
 }
 

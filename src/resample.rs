@@ -21,6 +21,12 @@ pub use crate::options::{check_scale, MIN_RENDER_SCALE};
 /// pixels of the full one on both axes (`upsample` relies on that).
 pub fn scaled_camera(camera: &Camera, scale: f32) -> Result<Camera> {
     check_scale(scale)?;
+    if scale != 1.0 && camera.window.is_some() {
+        return Err(Error::Unsupported(
+            "a render scale below 1 draws the whole frame: a window of it (a camera's `window`) cannot be drawn coarser"
+                .into(),
+        ));
+    }
     let rows = ((camera.height as f64 * scale as f64).round() as u32).max(1);
     let cols = ((camera.width as f64 * rows as f64 / camera.height as f64).ceil() as u32).max(1);
     Ok(Camera { width: cols, height: rows, ..*camera })
@@ -85,6 +91,7 @@ mod tests {
 
     fn camera(w: u32, h: u32) -> Camera {
         Camera {
+            window: None,
             eye: Vec3::new(0.0, 0.0, 10.0),
             target: Vec3::ZERO,
             up: Vec3::Y,

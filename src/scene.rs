@@ -111,6 +111,7 @@ pub fn build(name: &str) -> Result<SplatSet> {
 pub fn close_view(grid: &Grid, size: u32) -> Camera {
     let c = grid.center();
     Camera {
+        window: None,
         eye: c + Vec3::new(12.0, 20.0, 75.0),
         target: c,
         up: Vec3::Y,
@@ -141,6 +142,7 @@ pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
     let side = (extent * ppv).ceil() as u32;
     let c = grid.center();
     Ok(Camera {
+        window: None,
         eye: c + Vec3::new(0.0, 0.0, 50.0),
         target: c,
         up: Vec3::Y,

@@ -30,3 +30,10 @@ pub fn spirv_build(
 }
 
 include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+
+/// Every SPIR-V build the pipelines use, by name: compiled from `glsl/` with the `shaderc`
+/// feature, else the copies shipped in `glsl/spirv/` (tests/spirv.rs keeps the two equal).
+#[doc(hidden)]
+pub fn spirv_builds() -> &'static [(&'static str, &'static [u8])] {
+    SPIRV
+}

@@ -67,7 +67,7 @@ pub fn supersampled_with(
     if factor == 0 || factor > 16 {
         return Err(Error::InvalidArgument("supersampling factor must be in 1..=16".into()));
     }
-    let big = Camera { width: camera.width * factor, height: camera.height * factor, ..*camera };
+    let big = camera.supersampled(factor);
     let img = volumetric_summation(set, &big, opts)?;
     Ok(crate::image::downsample(&img, factor as usize, filter))
 }

@@ -32,6 +32,7 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
     let mut gpu = common::gpu();
     let mut cpu = common::cpu();
     let plane_ortho = |g: &voxsplat::Grid| Camera {
+        window: None,
         eye: g.center() + Vec3::new(60.0, 200.0, 300.0),
         target: g.center(),
         up: Vec3::Y,
@@ -42,6 +43,7 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
         height: 160,
     };
     let plane_grazing = |g: &voxsplat::Grid| Camera {
+        window: None,
         eye: g.center() + Vec3::new(0.0, -230.0, 40.0),
         target: g.center() + Vec3::new(0.0, 60.0, 0.0),
         up: Vec3::Z,

@@ -222,6 +222,7 @@ fn terrain_columns_have_no_holes_from_a_grazing_view() {
         // A low view along the ridges' faces, from well outside the grid.
         let c = set.grid().center();
         let cam = Camera {
+            window: None,
             eye: c + glam::Vec3::new(-70.0, -60.0, 10.0),
             target: c,
             up: glam::Vec3::Z,

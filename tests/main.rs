@@ -3,6 +3,7 @@
 //! linked the whole engine. `fuzz_corpus.rs` stays a binary of its own: the fuzz bodies set the
 //! process's host budget (`set_host_budget`), which the other tests must not share.
 mod aa;
+mod bands;
 mod bisect;
 mod bricked;
 mod bricks;

@@ -14,6 +14,7 @@ fn one_voxel() -> SplatSet {
 /// Orthographic, 4 pixels per voxel, looking down -z.
 fn ortho() -> Camera {
     Camera {
+        window: None,
         eye: Vec3::new(0.13, 0.07, 50.0),
         target: Vec3::new(0.13, 0.07, 0.0),
         up: Vec3::Y,

@@ -127,6 +127,7 @@ fn pbtf_is_correct_in_every_case_of_table_2_3() {
                 let target = if (g.center() - eye).length() > 1e-3 { g.center() } else { g.center() + Vec3::X };
                 let up = if (target - eye).normalize().cross(Vec3::Y).length() > 0.1 { Vec3::Y } else { Vec3::Z };
                 let cam = Camera {
+                    window: None,
                     eye,
                     target,
                     up,
@@ -210,6 +211,7 @@ fn the_image_space_validator_tells_wbtf_from_btf() {
     let grid = voxsplat::Grid::centered([1, 1, 8], [1.0; 3]).unwrap();
     let pair = SplatSet::from_fn(grid, |_, _, k| (k == 0 || k == 7).then_some([1.0, 1.0, 1.0, 0.5])).unwrap();
     let cam = Camera {
+        window: None,
         eye: glam::Vec3::new(0.0, 0.0, 30.0),
         target: glam::Vec3::ZERO,
         up: glam::Vec3::Y,
@@ -293,6 +295,7 @@ fn pbtf_orders_rectilinear_grids_from_the_eyes_cell() {
     let rect = solid.clone().with_coordinates([x.clone(), y.clone(), z.clone()]).unwrap();
     // An eye inside the grid, in z between slices 4 and 5 (world 4.0 and 7.0), past their midpoint.
     let cam = Camera {
+        window: None,
         eye: glam::Vec3::new(6.0, 3.9, 5.8),
         target: glam::Vec3::new(6.0, 20.0, 5.8),
         up: glam::Vec3::Z,
@@ -357,6 +360,7 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
     let rect = samples.clone().with_coordinates([xy.clone(), xy.clone(), z.clone()]).unwrap();
     assert_eq!(rect.grid().spacing, [0.5, 0.5, (z[18] - z[0]) / 18.0]);
     let cam = Camera {
+        window: None,
         eye: Vec3::new(20.0, 6.0, 9.0),
         target: Vec3::ZERO,
         up: Vec3::Z,
@@ -423,6 +427,7 @@ fn a_far_position_widens_only_its_neighbours() {
     let shift = Vec3::new(0.0, 0.0, -8.0 - near.position([0, 0, 0]).z);
     let alone = SplatSet::from_fn(near, |i, j, k| color(near.position([i, j, k]) + shift)).unwrap();
     let cam = |at: Vec3| Camera {
+        window: None,
         eye: at + Vec3::new(30.0, 14.0, 18.0),
         target: at,
         up: Vec3::Z,

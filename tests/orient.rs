@@ -284,6 +284,7 @@ fn validator_cameras(a: DMat4) -> Vec<(f32, Camera)> {
         .map(|(dist, dir): (f32, Vec3)| {
             let up = if dir.cross(Vec3::Z).length() < 1e-3 { Vec3::Y } else { Vec3::Z };
             let cam = Camera {
+                window: None,
                 eye: c + dir.normalize() * dist,
                 target: c,
                 up,
@@ -353,6 +354,7 @@ fn world_camera(a: DMat4) -> Camera {
     let (dir, up) = View::Oblique.directions();
     let c = a.transform_point3(DVec3::new(5.5, 4.5, 7.5)).as_vec3();
     Camera {
+        window: None,
         eye: c + dir * 40.0,
         target: c,
         up,
@@ -515,6 +517,7 @@ fn sheets_on_a_sheared_grid_face_the_view() {
     let aligned = Grid::centered(DIMS, [1.0; 3]).unwrap();
     let f = Vec3::new(0.0, 0.8, 0.6);
     let cam = Camera {
+        window: None,
         eye: -f * 40.0,
         target: Vec3::ZERO,
         up: Vec3::X,

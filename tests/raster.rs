@@ -30,6 +30,7 @@ fn close_up() -> (SplatSet, Camera) {
     })
     .unwrap();
     let cam = Camera {
+        window: None,
         eye: Vec3::new(0.37, -0.21, 7.3),
         target: Vec3::new(0.11, 0.07, 0.0),
         up: Vec3::Y,

@@ -13,6 +13,7 @@ use voxsplat::{scene, Camera, Grid, Kernel, Projection, SplatSet};
 
 fn ortho_down_z(center: Vec3, size: u32) -> Camera {
     Camera {
+        window: None,
         eye: center + Vec3::new(0.0, 0.0, 50.0),
         target: center,
         up: Vec3::Y,

@@ -386,6 +386,16 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
                 }
                 r.raycast(&cam, &o)?
             }
+            // A frame past one band goes to its PNG band by band, never whole (`render_bands`).
+            None if streams(&a, &cam, &out)? => {
+                let mut png = voxsplat::output::PngRows::create(&out, cam.width, cam.height)?;
+                let t = std::time::Instant::now();
+                let d = r.render_bands(&cam, &opts, &mut |_, band| png.push(band))?;
+                png.finish()?;
+                wall.push(t.elapsed().as_secs_f64() * 1e3);
+                let image = voxsplat::ImageF32::new(0, 0);
+                voxsplat::Rendered { image, timings: d.timings, raster: Some(d.raster), stats: d.stats }
+            }
             None => median_timings((0..a.repeat).map(|_| {
                 let t = std::time::Instant::now();
                 let f = r.render(&cam, &opts);
@@ -410,7 +420,9 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         }
         voxsplat::aa::draw_k_line(&mut image, &regions);
     }
-    voxsplat::output::write_image(&image, &out)?;
+    if image.width > 0 {
+        voxsplat::output::write_image(&image, &out)?;
+    }
     let what = if r_bricked { "stored voxels" } else { "splats" };
     eprintln!("{splats} {what} -> {}", out.display());
     if let Some(v) = a.iso {
@@ -458,6 +470,13 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
 
 /// The last of `frames` with each stage's median time over all of them, keeping one image at a
 /// time (`--repeat` would otherwise hold every frame).
+/// Whether `render` writes its frame band by band: a PNG of more than one band
+/// (`voxsplat::bands`) drawn once, with nothing to add to the whole frame after it.
+fn streams(a: &RenderArgs, cam: &voxsplat::Camera, out: &std::path::Path) -> Result<bool> {
+    let png = voxsplat::output::ImageFormat::of(out)? == voxsplat::output::ImageFormat::Png;
+    Ok(png && a.repeat == 1 && !a.k_line && voxsplat::bands::bands(cam).len() > 1)
+}
+
 fn median_timings(frames: impl Iterator<Item = Result<voxsplat::Rendered>>) -> Result<voxsplat::Rendered> {
     let mut earlier: Vec<Vec<voxsplat::StageTime>> = Vec::new();
     let mut last: Option<voxsplat::Rendered> = None;

@@ -51,6 +51,7 @@ fn a_single_splat_sliced_into_slabs_equals_the_whole_footprint() {
     let mut r = common::gpu();
     r.set_scene(one_voxel()).unwrap();
     let cam = Camera {
+        window: None,
         eye: Vec3::new(0.4, 0.3, 6.0),
         target: Vec3::ZERO,
         up: Vec3::Y,

@@ -468,6 +468,7 @@ fn a_moving_view_reads_through_a_chunk_cache(path: &Path) {
     let view = |deg: f32| {
         let a = deg.to_radians();
         voxsplat::Camera {
+            window: None,
             eye: Vec3::new(a.cos(), a.sin(), 0.0) * 300.0,
             target: Vec3::ZERO,
             up: Vec3::Z,

@@ -31,3 +31,23 @@ pub struct FrameStats {
     /// (`labels::classify_labels`).
     pub unlabelled: u64,
 }
+
+impl FrameStats {
+    /// Field by field, the larger of the two: a frame drawn in bands (`bands`) reports its
+    /// busiest band's counts, since a brick or splat two bands draw would be counted twice.
+    pub fn busiest(&self, o: &Self) -> Self {
+        Self {
+            bricks: self.bricks.max(o.bricks),
+            bricks_visible: self.bricks_visible.max(o.bricks_visible),
+            bricks_coarse: self.bricks_coarse.max(o.bricks_coarse),
+            nodes: self.nodes.max(o.nodes),
+            bricks_hidden: self.bricks_hidden.max(o.bricks_hidden),
+            splats: self.splats.max(o.splats),
+            splats_outshone: self.splats_outshone.max(o.splats_outshone),
+            waves: self.waves.max(o.waves),
+            bytes_uploaded: self.bytes_uploaded.max(o.bytes_uploaded),
+            records_resident: self.records_resident.max(o.records_resident),
+            unlabelled: self.unlabelled.max(o.unlabelled),
+        }
+    }
+}

@@ -116,6 +116,7 @@ pub fn random_camera(rng: &mut Rng, grid: &Grid, kind: ViewKind) -> Camera {
     };
     let d = (c - eye).length();
     Camera {
+        window: None,
         eye,
         target,
         up,

@@ -68,6 +68,7 @@ mod tests {
     #[test]
     fn an_off_axis_scene_stays_past_the_near_plane() {
         let base = Camera {
+            window: None,
             eye: Vec3::new(0.0, 0.0, 1000.0),
             target: Vec3::new(364.0, 0.0, 0.0),
             up: Vec3::Y,

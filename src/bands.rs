@@ -1,0 +1,73 @@
+//! Large frames drawn in bands: a frame of more than `BAND_BYTES` of RGBA32F is drawn as
+//! full-width windows of its camera (`Camera::windowed`), one after another. The device's images,
+//! their read-back copies and the CPU engine's accumulators then hold one band, not the frame:
+//! an 8192² frame drawn whole took 4.4 times its own 1 GiB. Every band culls, orders and picks its
+//! raster as the whole frame does, so the bands meet without seams.
+use crate::camera::Camera;
+use crate::error::{check_host_memory, Result};
+use crate::image::ImageF32;
+use crate::options::{add_time, FrameStats, Rendered, StageTime};
+
+/// Most bytes of RGBA32F one band holds: 64 MiB, so frames up to 2048² are drawn whole.
+pub const BAND_BYTES: u64 = 64 << 20;
+
+/// Host bytes a drawn band takes per pixel at most: the image (f32 RGBA), its read-back copy, the
+/// CPU engine's accumulators and an 8-bit copy (an 8192² frame drawn whole took 4.4 GB).
+pub const BAND_HOST_BYTES_PER_PIXEL: u64 = 72;
+
+/// The bands of `camera`'s image: (first row, rows), full width, all as tall but the last.
+pub fn bands(camera: &Camera) -> Vec<(u32, u32)> {
+    let most = (BAND_BYTES / (camera.width as u64 * 16)).clamp(1, camera.height.max(1) as u64) as u32;
+    let n = camera.height.div_ceil(most).max(1);
+    let rows = camera.height.div_ceil(n);
+    (0..n).map(|i| i * rows).take_while(|&y| y < camera.height).map(|y| (y, rows.min(camera.height - y))).collect()
+}
+
+/// Refuse a frame whose host memory would pass the host budget or what the host has available,
+/// before anything of it is allocated: one band's drawing, and the whole frame's image when
+/// `assembled` (`Renderer::render` returns it; `render_bands` hands the bands on).
+pub fn check_memory(camera: &Camera, assembled: bool) -> Result<()> {
+    let band = bands(camera).first().map_or(0, |&(_, rows)| rows as u64) * camera.width as u64;
+    let whole = camera.width as u64 * camera.height as u64;
+    let bytes = band * BAND_HOST_BYTES_PER_PIXEL + if assembled && band < whole { whole * 16 } else { 0 };
+    check_host_memory(bytes, &format!("a {}x{} frame", camera.width, camera.height))
+}
+
+/// Draw `camera`'s bands with `draw`, handing each to `sink` with its first row; the bands' stage
+/// times summed and their stats merged (`FrameStats::busiest`).
+pub fn each(
+    camera: &Camera,
+    mut draw: impl FnMut(&Camera) -> Result<(ImageF32, Vec<StageTime>, FrameStats)>,
+    sink: &mut dyn FnMut(u32, &ImageF32) -> Result<()>,
+) -> Result<(Vec<StageTime>, FrameStats)> {
+    let (mut timings, mut stats) = (Vec::new(), FrameStats::default());
+    for (y, rows) in bands(camera) {
+        let (image, t, s) = draw(&camera.windowed(0, y, camera.width, rows))?;
+        sink(y, &image)?;
+        for st in t {
+            add_time(&mut timings, st.stage, st.ms);
+        }
+        stats = stats.busiest(&s);
+    }
+    Ok((timings, stats))
+}
+
+/// `draw`'s bands of `camera` put together into one frame.
+pub fn assemble(camera: &Camera, mut draw: impl FnMut(&Camera) -> Result<Rendered>) -> Result<Rendered> {
+    let mut frame = ImageF32::new(camera.width, camera.height);
+    let mut raster = None;
+    let (timings, stats) = each(
+        camera,
+        |band| {
+            let r = draw(band)?;
+            raster = r.raster.or(raster.take());
+            Ok((r.image, r.timings, r.stats))
+        },
+        &mut |y, band| {
+            let at = y as usize * camera.width as usize;
+            frame.pixels[at..at + band.pixels.len()].copy_from_slice(&band.pixels);
+            Ok(())
+        },
+    )?;
+    Ok(Rendered { image: frame, timings, raster, stats })
+}
