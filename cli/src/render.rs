@@ -468,8 +468,6 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     Ok(())
 }
 
-/// The last of `frames` with each stage's median time over all of them, keeping one image at a
-/// time (`--repeat` would otherwise hold every frame).
 /// Whether `render` writes its frame band by band: a PNG of more than one band
 /// (`voxsplat::bands`) drawn once, with nothing to add to the whole frame after it.
 fn streams(a: &RenderArgs, cam: &voxsplat::Camera, out: &std::path::Path) -> Result<bool> {
@@ -477,6 +475,8 @@ fn streams(a: &RenderArgs, cam: &voxsplat::Camera, out: &std::path::Path) -> Res
     Ok(png && a.repeat == 1 && !a.k_line && voxsplat::bands::bands(cam).len() > 1)
 }
 
+/// The last of `frames` with each stage's median time over all of them, keeping one image at a
+/// time (`--repeat` would otherwise hold every frame).
 fn median_timings(frames: impl Iterator<Item = Result<voxsplat::Rendered>>) -> Result<voxsplat::Rendered> {
     let mut earlier: Vec<Vec<voxsplat::StageTime>> = Vec::new();
     let mut last: Option<voxsplat::Rendered> = None;

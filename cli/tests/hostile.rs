@@ -166,6 +166,24 @@ fn repeated_frames_are_not_all_kept() {
     assert!(many < one + 40.0, "30 frames peak at {many} MiB against {one} MiB for 2");
 }
 
+/// Issue 76: a large frame is drawn in bands (`voxsplat::bands`) and takes at most 1.5 times its own
+/// RGBA32F size above a small frame's peak: a PNG streamed band by band (4096²: measured 264 MiB
+/// above, 1.03x), an EXR put together whole (8192²: 1,222 MiB above, 1.19x). Drawn whole, 8192²
+/// took 4.5 GB and 4096² 733 MB.
+#[test]
+fn a_large_frame_takes_at_most_half_again_its_own_size() {
+    let run = |size: &str, name: &str| {
+        let out = tmp(name);
+        peak_mib(&["render", "--scene", "cube40", "--size", size, "--timings", "--out", out.to_str().unwrap()])
+    };
+    let base = run("256x256", "band-base.png");
+    for (side, name) in [(4096u64, "band-4096.png"), (8192, "band-8192.exr")] {
+        let own = (side * side * 16) as f64 / 1048576.0;
+        let peak = run(&format!("{side}x{side}"), name);
+        assert!(peak - base <= 1.5 * own, "{side}²: {peak} MiB peak against {base} MiB for 256², own {own} MiB");
+    }
+}
+
 /// Pixels with any coverage in an image the CLI wrote.
 fn covered(path: &std::path::Path) -> usize {
     voxsplat::output::read_image(path).unwrap().pixels.iter().filter(|p| p[3] > 0.0).count()
