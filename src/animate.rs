@@ -221,7 +221,6 @@ impl Animation {
         let dist = (Vec3::from(c.target) - eye).length();
         let ortho = matches!(projection, Projection::Orthographic { .. });
         let camera = Camera {
-            window: None,
             eye,
             target: Vec3::from(c.target),
             up: Vec3::from(c.up),
@@ -230,6 +229,7 @@ impl Animation {
             far: c.far.unwrap_or(4.0 * dist.max(1.0)),
             width: f.size[0],
             height: f.size[1],
+            window: None,
         };
         camera.validate()?;
         let anim = Self { scene: f.scene, frames: f.frames, shutter: f.shutter, camera, keyframes };

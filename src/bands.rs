@@ -3,6 +3,17 @@
 //! their read-back copies and the CPU engine's accumulators then hold one band, not the frame:
 //! an 8192² frame drawn whole took 4.4 times its own 1 GiB. Every band culls, orders and picks its
 //! raster as the whole frame does, so the bands meet without seams.
+//!
+//! ```no_run
+//! // An 8192² PNG written band by band: no more than one band of it in memory.
+//! let mut renderer = voxsplat::Renderer::new(&Default::default())?;
+//! renderer.set_scene(voxsplat::scene::build("cube60")?)?;
+//! let camera = voxsplat::Camera::framing(renderer.scene().unwrap().grid(), 8192, 8192);
+//! let mut png = voxsplat::output::PngRows::create("big.png".as_ref(), 8192, 8192)?;
+//! renderer.render_bands(&camera, &Default::default(), &mut |_first_row, band| png.push(band))?;
+//! png.finish()?;
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::camera::Camera;
 use crate::error::{check_host_memory, Result};
 use crate::image::ImageF32;

@@ -91,7 +91,6 @@ mod tests {
 
     fn camera(w: u32, h: u32) -> Camera {
         Camera {
-            window: None,
             eye: Vec3::new(0.0, 0.0, 10.0),
             target: Vec3::ZERO,
             up: Vec3::Y,
@@ -100,6 +99,7 @@ mod tests {
             far: 20.0,
             width: w,
             height: h,
+            window: None,
         }
     }
 

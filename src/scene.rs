@@ -111,7 +111,6 @@ pub fn build(name: &str) -> Result<SplatSet> {
 pub fn close_view(grid: &Grid, size: u32) -> Camera {
     let c = grid.center();
     Camera {
-        window: None,
         eye: c + Vec3::new(12.0, 20.0, 75.0),
         target: c,
         up: Vec3::Y,
@@ -120,6 +119,7 @@ pub fn close_view(grid: &Grid, size: u32) -> Camera {
         far: 300.0,
         width: size,
         height: size,
+        window: None,
     }
 }
 
@@ -142,7 +142,6 @@ pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
     let side = (extent * ppv).ceil() as u32;
     let c = grid.center();
     Ok(Camera {
-        window: None,
         eye: c + Vec3::new(0.0, 0.0, 50.0),
         target: c,
         up: Vec3::Y,
@@ -151,5 +150,6 @@ pub fn rate_camera(grid: &Grid, size_px: f32) -> Result<Camera> {
         far: 100.0,
         width: side,
         height: side,
+        window: None,
     })
 }

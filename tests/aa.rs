@@ -12,7 +12,6 @@ fn one_voxel(opacity: f32) -> SplatSet {
 
 fn looking_at(p: Vec3, distance: f32, size: u32) -> Camera {
     Camera {
-        window: None,
         eye: p + Vec3::new(0.31, 0.17, distance),
         target: p + Vec3::new(0.31, 0.17, 0.0),
         up: Vec3::Y,
@@ -21,6 +20,7 @@ fn looking_at(p: Vec3, distance: f32, size: u32) -> Camera {
         far: 4.0 * distance,
         width: size,
         height: size,
+        window: None,
     }
 }
 

@@ -32,7 +32,6 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
     let mut gpu = common::gpu();
     let mut cpu = common::cpu();
     let plane_ortho = |g: &voxsplat::Grid| Camera {
-        window: None,
         eye: g.center() + Vec3::new(60.0, 200.0, 300.0),
         target: g.center(),
         up: Vec3::Y,
@@ -41,9 +40,9 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
         far: 800.0,
         width: 192,
         height: 160,
+        window: None,
     };
     let plane_grazing = |g: &voxsplat::Grid| Camera {
-        window: None,
         eye: g.center() + Vec3::new(0.0, -230.0, 40.0),
         target: g.center() + Vec3::new(0.0, 60.0, 0.0),
         up: Vec3::Z,
@@ -52,6 +51,7 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
         far: 800.0,
         width: 192,
         height: 160,
+        window: None,
     };
     let framing = |g: &voxsplat::Grid| Camera::framing(g, 192, 160);
     type CameraFor<'a> = &'a dyn Fn(&voxsplat::Grid) -> Camera;

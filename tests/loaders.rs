@@ -222,7 +222,6 @@ fn terrain_columns_have_no_holes_from_a_grazing_view() {
         // A low view along the ridges' faces, from well outside the grid.
         let c = set.grid().center();
         let cam = Camera {
-            window: None,
             eye: c + glam::Vec3::new(-70.0, -60.0, 10.0),
             target: c,
             up: glam::Vec3::Z,
@@ -231,6 +230,7 @@ fn terrain_columns_have_no_holes_from_a_grazing_view() {
             far: 400.0,
             width: 96,
             height: 72,
+            window: None,
         };
         r.set_scene(set).unwrap();
         let img = r.render(&cam, &voxsplat::RenderOptions::default()).unwrap().image;

@@ -49,7 +49,6 @@ fn column_camera(dims: [u32; 3], pad: u32) -> Camera {
 fn scaled_column_camera(dims: [u32; 3], pad: u32, ppv: u32) -> Camera {
     let (w, h) = (dims[0] + 2 * pad, dims[1] + 2 * pad);
     Camera {
-        window: None,
         eye: Vec3::new(0.0, 0.0, 100.0),
         target: Vec3::ZERO,
         up: Vec3::Y,
@@ -58,6 +57,7 @@ fn scaled_column_camera(dims: [u32; 3], pad: u32, ppv: u32) -> Camera {
         far: 200.0,
         width: w * ppv,
         height: h * ppv,
+        window: None,
     }
 }
 
@@ -463,7 +463,6 @@ fn mip_and_minip_of_a_store_keep_what_the_ray_caster_covers_at_every_size() {
     let mut g = gpu();
     for side in [2u32, 4, 8, 16, 32, 64, 128, 256, 512] {
         let cam = Camera {
-            window: None,
             eye: Vec3::new(70.0, 52.0, 95.0),
             target: Vec3::new(4.0, -3.0, 0.0),
             up: Vec3::Y,
@@ -472,6 +471,7 @@ fn mip_and_minip_of_a_store_keep_what_the_ray_caster_covers_at_every_size() {
             far: 400.0,
             width: side,
             height: side,
+            window: None,
         };
         for mode in [Mode::Mip, Mode::Minip] {
             g.set_scene(set.clone()).unwrap();

@@ -14,7 +14,6 @@ fn one_voxel() -> SplatSet {
 /// Orthographic, 4 pixels per voxel, looking down -z.
 fn ortho() -> Camera {
     Camera {
-        window: None,
         eye: Vec3::new(0.13, 0.07, 50.0),
         target: Vec3::new(0.13, 0.07, 0.0),
         up: Vec3::Y,
@@ -23,6 +22,7 @@ fn ortho() -> Camera {
         far: 100.0,
         width: 128,
         height: 128,
+        window: None,
     }
 }
 

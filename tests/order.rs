@@ -127,7 +127,6 @@ fn pbtf_is_correct_in_every_case_of_table_2_3() {
                 let target = if (g.center() - eye).length() > 1e-3 { g.center() } else { g.center() + Vec3::X };
                 let up = if (target - eye).normalize().cross(Vec3::Y).length() > 0.1 { Vec3::Y } else { Vec3::Z };
                 let cam = Camera {
-                    window: None,
                     eye,
                     target,
                     up,
@@ -136,6 +135,7 @@ fn pbtf_is_correct_in_every_case_of_table_2_3() {
                     far: 100.0,
                     width: 8,
                     height: 8,
+                    window: None,
                 };
                 for dir in [Direction::FrontToBack, Direction::BackToFront] {
                     let o = visibility_order(&set, &cam, OrderKind::Pbtf, dir);
@@ -211,7 +211,6 @@ fn the_image_space_validator_tells_wbtf_from_btf() {
     let grid = voxsplat::Grid::centered([1, 1, 8], [1.0; 3]).unwrap();
     let pair = SplatSet::from_fn(grid, |_, _, k| (k == 0 || k == 7).then_some([1.0, 1.0, 1.0, 0.5])).unwrap();
     let cam = Camera {
-        window: None,
         eye: glam::Vec3::new(0.0, 0.0, 30.0),
         target: glam::Vec3::ZERO,
         up: glam::Vec3::Y,
@@ -220,6 +219,7 @@ fn the_image_space_validator_tells_wbtf_from_btf() {
         far: 60.0,
         width: 32,
         height: 32,
+        window: None,
     };
     // Back to front is the far splat (k = 0, at z = -3.5) first.
     let right = count_pixel_inversions(&pair, &cam, &[0, 1], Direction::BackToFront, 2.0).unwrap();
@@ -295,7 +295,6 @@ fn pbtf_orders_rectilinear_grids_from_the_eyes_cell() {
     let rect = solid.clone().with_coordinates([x.clone(), y.clone(), z.clone()]).unwrap();
     // An eye inside the grid, in z between slices 4 and 5 (world 4.0 and 7.0), past their midpoint.
     let cam = Camera {
-        window: None,
         eye: glam::Vec3::new(6.0, 3.9, 5.8),
         target: glam::Vec3::new(6.0, 20.0, 5.8),
         up: glam::Vec3::Z,
@@ -304,6 +303,7 @@ fn pbtf_orders_rectilinear_grids_from_the_eyes_cell() {
         far: 100.0,
         width: 64,
         height: 64,
+        window: None,
     };
     let split = pbtf_split(&rect, &cam);
     // z 5.8 lies in slice 5's cell (from 5.5, the midpoint of slices 4 and 5 at 4.0 and 7.0): slices
@@ -360,7 +360,6 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
     let rect = samples.clone().with_coordinates([xy.clone(), xy.clone(), z.clone()]).unwrap();
     assert_eq!(rect.grid().spacing, [0.5, 0.5, (z[18] - z[0]) / 18.0]);
     let cam = Camera {
-        window: None,
         eye: Vec3::new(20.0, 6.0, 9.0),
         target: Vec3::ZERO,
         up: Vec3::Z,
@@ -369,6 +368,7 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
         far: 100.0,
         width: 96,
         height: 96,
+        window: None,
     };
     let o = RenderOptions::default();
     let mut gpu = common::gpu();
@@ -427,7 +427,6 @@ fn a_far_position_widens_only_its_neighbours() {
     let shift = Vec3::new(0.0, 0.0, -8.0 - near.position([0, 0, 0]).z);
     let alone = SplatSet::from_fn(near, |i, j, k| color(near.position([i, j, k]) + shift)).unwrap();
     let cam = |at: Vec3| Camera {
-        window: None,
         eye: at + Vec3::new(30.0, 14.0, 18.0),
         target: at,
         up: Vec3::Z,
@@ -436,6 +435,7 @@ fn a_far_position_widens_only_its_neighbours() {
         far: 200.0,
         width: 96,
         height: 96,
+        window: None,
     };
     let o = RenderOptions::default();
     let mut gpu = common::gpu();

@@ -284,7 +284,6 @@ fn validator_cameras(a: DMat4) -> Vec<(f32, Camera)> {
         .map(|(dist, dir): (f32, Vec3)| {
             let up = if dir.cross(Vec3::Z).length() < 1e-3 { Vec3::Y } else { Vec3::Z };
             let cam = Camera {
-                window: None,
                 eye: c + dir.normalize() * dist,
                 target: c,
                 up,
@@ -293,6 +292,7 @@ fn validator_cameras(a: DMat4) -> Vec<(f32, Camera)> {
                 far: 80.0,
                 width: 64,
                 height: 64,
+                window: None,
             };
             (dist, cam)
         })
@@ -354,7 +354,6 @@ fn world_camera(a: DMat4) -> Camera {
     let (dir, up) = View::Oblique.directions();
     let c = a.transform_point3(DVec3::new(5.5, 4.5, 7.5)).as_vec3();
     Camera {
-        window: None,
         eye: c + dir * 40.0,
         target: c,
         up,
@@ -363,6 +362,7 @@ fn world_camera(a: DMat4) -> Camera {
         far: 60.0,
         width: 96,
         height: 96,
+        window: None,
     }
 }
 
@@ -517,7 +517,6 @@ fn sheets_on_a_sheared_grid_face_the_view() {
     let aligned = Grid::centered(DIMS, [1.0; 3]).unwrap();
     let f = Vec3::new(0.0, 0.8, 0.6);
     let cam = Camera {
-        window: None,
         eye: -f * 40.0,
         target: Vec3::ZERO,
         up: Vec3::X,
@@ -526,6 +525,7 @@ fn sheets_on_a_sheared_grid_face_the_view() {
         far: 60.0,
         width: 96,
         height: 96,
+        window: None,
     };
     assert_eq!(sheet_axis(&aligned, &cam), 1, "the axis-aligned grid: j planes face the view");
     assert_eq!(sheet_axis(&sheared, &cam), 2, "the sheared grid: its j planes are nearly edge-on");

@@ -47,7 +47,6 @@ fn a_picked_point_lies_within_a_voxel_of_the_analytic_first_hit() {
     for view in 0..10 {
         let eye = rng.dir() * 60.0;
         let cam = Camera {
-            window: None,
             eye,
             target: Vec3::ZERO,
             up: if eye.normalize().dot(Vec3::Y).abs() < 0.9 { Vec3::Y } else { Vec3::X },
@@ -60,6 +59,7 @@ fn a_picked_point_lies_within_a_voxel_of_the_analytic_first_hit() {
             far: 200.0,
             width: 96,
             height: 96,
+            window: None,
         };
         let o = RenderOptions::default();
         let mut here = 0;

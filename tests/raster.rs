@@ -30,7 +30,6 @@ fn close_up() -> (SplatSet, Camera) {
     })
     .unwrap();
     let cam = Camera {
-        window: None,
         eye: Vec3::new(0.37, -0.21, 7.3),
         target: Vec3::new(0.11, 0.07, 0.0),
         up: Vec3::Y,
@@ -39,6 +38,7 @@ fn close_up() -> (SplatSet, Camera) {
         far: 40.0,
         width: 157,
         height: 131,
+        window: None,
     };
     (set, cam)
 }

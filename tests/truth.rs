@@ -13,7 +13,6 @@ use voxsplat::{scene, Camera, Grid, Kernel, Projection, SplatSet};
 
 fn ortho_down_z(center: Vec3, size: u32) -> Camera {
     Camera {
-        window: None,
         eye: center + Vec3::new(0.0, 0.0, 50.0),
         target: center,
         up: Vec3::Y,
@@ -22,6 +21,7 @@ fn ortho_down_z(center: Vec3, size: u32) -> Camera {
         far: 100.0,
         width: size,
         height: size,
+        window: None,
     }
 }
 

@@ -112,7 +112,7 @@ impl Session {
             _ => return Err(Error::InvalidArgument("a session's camera has a fov or a height, one of them".into())),
         };
         let (eye, target, up) = (Vec3::from(c.eye), Vec3::from(c.target), Vec3::from(c.up));
-        let cam = Camera { window: None, eye, target, up, projection, near: c.near, far: c.far, width, height };
+        let cam = Camera { eye, target, up, projection, near: c.near, far: c.far, width, height, window: None };
         cam.validate()?;
         Ok(cam)
     }

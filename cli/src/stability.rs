@@ -142,7 +142,6 @@ pub fn axis_switch_cameras(grid: &Grid, size: u32, frames: usize) -> (Vec<Camera
             let azimuth = (45.0 + (i as f32 - (frames as f32 - 1.0) / 2.0)).to_radians();
             let dir = Quat::from_rotation_y(azimuth) * Quat::from_rotation_x(-20f32.to_radians()) * Vec3::Z;
             Camera {
-                window: None,
                 eye: c + dir * dist,
                 target: c,
                 up: Vec3::Y,
@@ -151,6 +150,7 @@ pub fn axis_switch_cameras(grid: &Grid, size: u32, frames: usize) -> (Vec<Camera
                 far: dist + grid.diagonal(),
                 width: size,
                 height: size,
+                window: None,
             }
         })
         .collect();
@@ -292,7 +292,6 @@ pub fn brightening_camera(grid: &Grid, size: u32) -> Camera {
     let c = grid.center();
     let s = grid.diagonal() / 3f32.sqrt();
     Camera {
-        window: None,
         eye: c + Vec3::new(0.1 * s, -0.75 * s, 1.05 * s),
         target: c + Vec3::new(0.0, -0.2 * s, 0.0),
         up: Vec3::Y,
@@ -301,6 +300,7 @@ pub fn brightening_camera(grid: &Grid, size: u32) -> Camera {
         far: 4.0 * s,
         width: size,
         height: size,
+        window: None,
     }
 }
 

@@ -152,7 +152,7 @@ fn camera(grid: &Grid, dir: Vec3, span: f32, fov: Option<f32>, (w, h): (u32, u32
     let eye = target + dir.normalize() * d;
     let up = if dir.normalize().cross(Vec3::Y).length() > 0.1 { Vec3::Y } else { Vec3::Z };
     let near = (d - r - margin * 1.01).max(d * 1e-4);
-    Camera { window: None, eye, target, up, projection, near, far: d + r + margin * 1.01, width: w, height: h }
+    Camera { eye, target, up, projection, near, far: d + r + margin * 1.01, width: w, height: h, window: None }
 }
 
 #[derive(Clone, Debug)]

@@ -30,7 +30,6 @@ fn the_mri_preset_shows_the_phantom_brain_through_a_faint_scalp() {
     let set = voxsplat::classify::classify_on(grid, &vol, &tf, None).unwrap();
     // From the front, 400 mm away, superior up (patient coordinates).
     let world = Camera {
-        window: None,
         eye: Vec3::new(0.0, 400.0, 0.0),
         target: Vec3::ZERO,
         up: Vec3::Z,
@@ -39,6 +38,7 @@ fn the_mri_preset_shows_the_phantom_brain_through_a_faint_scalp() {
         far: 600.0,
         width: 96,
         height: 96,
+        window: None,
     };
     let cam = placement.camera_to_grid(&world);
     let (mut gpu, mut cpu) = (common::gpu(), common::cpu());

@@ -51,7 +51,6 @@ fn a_single_splat_sliced_into_slabs_equals_the_whole_footprint() {
     let mut r = common::gpu();
     r.set_scene(one_voxel()).unwrap();
     let cam = Camera {
-        window: None,
         eye: Vec3::new(0.4, 0.3, 6.0),
         target: Vec3::ZERO,
         up: Vec3::Y,
@@ -60,6 +59,7 @@ fn a_single_splat_sliced_into_slabs_equals_the_whole_footprint() {
         far: 20.0,
         width: 64,
         height: 64,
+        window: None,
     };
     let whole = r.render(&cam, &RenderOptions::default()).unwrap().image;
     assert!(common::covered(&whole) > 20, "the splat is drawn ({} px)", common::covered(&whole));

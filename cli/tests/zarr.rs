@@ -468,7 +468,6 @@ fn a_moving_view_reads_through_a_chunk_cache(path: &Path) {
     let view = |deg: f32| {
         let a = deg.to_radians();
         voxsplat::Camera {
-            window: None,
             eye: Vec3::new(a.cos(), a.sin(), 0.0) * 300.0,
             target: Vec3::ZERO,
             up: Vec3::Z,
@@ -477,6 +476,7 @@ fn a_moving_view_reads_through_a_chunk_cache(path: &Path) {
             far: 1000.0,
             width: 48,
             height: 48,
+            window: None,
         }
     };
     let half = Vec3::new(128.0, 128.0, 192.0);

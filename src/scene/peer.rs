@@ -75,7 +75,6 @@ pub fn camera(n: u32, size: u32) -> Camera {
     let dist = eye.length();
     let radius = 0.5 * 3f32.sqrt() * n;
     Camera {
-        window: None,
         eye,
         target: Vec3::ZERO,
         up: Vec3::Y,
@@ -84,6 +83,7 @@ pub fn camera(n: u32, size: u32) -> Camera {
         far: dist + radius * 1.1,
         width: size,
         height: size,
+        window: None,
     }
 }
 

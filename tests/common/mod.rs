@@ -116,7 +116,6 @@ pub fn random_camera(rng: &mut Rng, grid: &Grid, kind: ViewKind) -> Camera {
     };
     let d = (c - eye).length();
     Camera {
-        window: None,
         eye,
         target,
         up,
@@ -125,6 +124,7 @@ pub fn random_camera(rng: &mut Rng, grid: &Grid, kind: ViewKind) -> Camera {
         far: d + 4.0 * r,
         width: 64,
         height: 64,
+        window: None,
     }
 }
 

@@ -68,7 +68,6 @@ mod tests {
     #[test]
     fn an_off_axis_scene_stays_past_the_near_plane() {
         let base = Camera {
-            window: None,
             eye: Vec3::new(0.0, 0.0, 1000.0),
             target: Vec3::new(364.0, 0.0, 0.0),
             up: Vec3::Y,
@@ -77,6 +76,7 @@ mod tests {
             far: 2000.0,
             width: 96,
             height: 64,
+            window: None,
         };
         let orbit = Orbit { yaw: 0.01, ..Orbit::HOME };
         let (centre, radius) = (Vec3::ZERO, 40.0);
