@@ -27,7 +27,7 @@ pub const BAND_BYTES: u64 = 64 << 20;
 pub const BAND_HOST_BYTES_PER_PIXEL: u64 = 72;
 
 /// The bands of `camera`'s image: (first row, rows), full width, all as tall but the last.
-pub fn bands(camera: &Camera) -> Vec<(u32, u32)> {
+pub fn frame_bands(camera: &Camera) -> Vec<(u32, u32)> {
     let most = (BAND_BYTES / (camera.width as u64 * 16)).clamp(1, camera.height.max(1) as u64) as u32;
     let n = camera.height.div_ceil(most).max(1);
     let rows = camera.height.div_ceil(n);
@@ -38,7 +38,7 @@ pub fn bands(camera: &Camera) -> Vec<(u32, u32)> {
 /// before anything of it is allocated: one band's drawing, and the whole frame's image when
 /// `assembled` (`Renderer::render` returns it; `render_bands` hands the bands on).
 pub fn check_memory(camera: &Camera, assembled: bool) -> Result<()> {
-    let band = bands(camera).first().map_or(0, |&(_, rows)| rows as u64) * camera.width as u64;
+    let band = frame_bands(camera).first().map_or(0, |&(_, rows)| rows as u64) * camera.width as u64;
     let whole = camera.width as u64 * camera.height as u64;
     let bytes = band * BAND_HOST_BYTES_PER_PIXEL + if assembled && band < whole { whole * 16 } else { 0 };
     check_host_memory(bytes, &format!("a {}x{} frame", camera.width, camera.height))
@@ -52,7 +52,7 @@ pub fn each(
     sink: &mut dyn FnMut(u32, &ImageF32) -> Result<()>,
 ) -> Result<(Vec<StageTime>, FrameStats)> {
     let (mut timings, mut stats) = (Vec::new(), FrameStats::default());
-    for (y, rows) in bands(camera) {
+    for (y, rows) in frame_bands(camera) {
         let (image, t, s) = draw(&camera.windowed(0, y, camera.width, rows))?;
         sink(y, &image)?;
         for st in t {

@@ -19,7 +19,7 @@
 #[cfg(feature = "lab")]
 pub mod aa;
 pub mod animate;
-pub mod bands;
+mod bands;
 mod bisect;
 pub mod bricks;
 mod builds;
@@ -73,11 +73,11 @@ pub mod truth;
 pub mod vk;
 pub mod volume;
 
+pub use bands::{frame_bands, BAND_BYTES};
 pub use bisect::Bisect;
 pub use camera::{Camera, Projection, Window};
 pub use error::{host_budget, set_host_budget, Error, Result};
 pub use glam;
-pub use gpu_types::gpu_bytes_per_splat;
 pub use image::ImageF32;
 pub use image::TargetFormat;
 pub use kernel::Kernel;
@@ -91,7 +91,7 @@ pub use raster::{Raster, RasterChoice};
 pub use series::VolumeUpdate;
 #[doc(hidden)]
 pub use shaders::spirv_builds;
-pub use volume::{Grid, SplatSet, Volume};
+pub use volume::{gpu_bytes_per_splat, Grid, SplatSet, Volume};
 
 use cpu_engine::CpuEngine;
 use plan::Prepared;
@@ -320,7 +320,7 @@ impl Renderer {
         scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
     }
 
-    /// Draw a frame (in bands past [`bands::BAND_BYTES`], put together: see `render_bands`).
+    /// Draw a frame (in bands past [`BAND_BYTES`], put together: see `render_bands`).
     pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
         options.validate()?;
         camera.validate()?;
@@ -330,7 +330,7 @@ impl Renderer {
             return resample::render_scaled(camera, options.render_scale, |low| self.render(low, &full));
         }
         let (opts, choice) = self.choose(camera, options)?;
-        if bands::bands(camera).len() > 1 {
+        if bands::frame_bands(camera).len() > 1 {
             return bands::assemble(camera, |band| {
                 let r = self.record(band, &opts)?;
                 Ok(Rendered { image: r.image, timings: r.timings, raster: Some(choice.clone()), stats: r.stats })
@@ -340,7 +340,7 @@ impl Renderer {
         Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats: recorded.stats })
     }
 
-    /// Draw a frame in full-width bands of at most [`bands::BAND_BYTES`], top to bottom, handing
+    /// Draw a frame in full-width bands of at most [`BAND_BYTES`], top to bottom, handing
     /// each to `sink` with its first row: a frame of any size in the memory of one band. Each band
     /// is a window of the camera (`Camera::windowed`) culled, ordered and rastered as the whole
     /// frame, so bands meet without seams; stats are the busiest band's. Full size only.
@@ -628,7 +628,7 @@ impl Renderer {
                 "a supersampled ray cast is the full-size reference: drop the render scale".into(),
             ));
         }
-        if options.render_scale == 1.0 && bands::bands(camera).len() > 1 {
+        if options.render_scale == 1.0 && bands::frame_bands(camera).len() > 1 {
             return bands::assemble(camera, |band| self.raycast(band, options));
         }
         if k > 1 {

@@ -1,6 +1,6 @@
 //! Frames drawn in parts: a camera's window (`Camera::windowed`) draws exactly its pixels of the
 //! whole frame, on both backends, over the paths a frame takes; `render` draws a frame past one
-//! band (`voxsplat::bands`) in bands and `render_bands` hands them on in order.
+//! band (`voxsplat::frame_bands`) in bands and `render_bands` hands them on in order.
 use crate::common;
 use common::{assert_clean, cpu, gpu};
 use glam::Mat4;
@@ -116,14 +116,14 @@ fn a_window_draws_exactly_its_pixels_of_the_whole_frame() {
 fn bands_cover_every_row_once_within_the_band_size() {
     for (w, h) in [(1, 1), (2048, 2048), (2049, 2048), (8192, 8192), (16384, 4096), (16384, 300), (3000, 1)] {
         let cam = Camera::framing(&voxsplat::Grid::centered([4; 3], [1.0; 3]).unwrap(), w, h);
-        let bands = voxsplat::bands::bands(&cam);
+        let bands = voxsplat::frame_bands(&cam);
         let whole = w as u64 * h as u64 * 16;
-        let least = whole.div_ceil(voxsplat::bands::BAND_BYTES) as usize;
+        let least = whole.div_ceil(voxsplat::BAND_BYTES) as usize;
         assert!(bands.len() == least || bands.len() == least + 1, "{w}x{h}: {} bands, at least {least}", bands.len());
         let mut next = 0;
         for &(y, rows) in &bands {
             assert_eq!(y, next, "{w}x{h}: bands in order, none left out");
-            assert!(rows > 0 && w as u64 * rows as u64 * 16 <= voxsplat::bands::BAND_BYTES.max(w as u64 * 16));
+            assert!(rows > 0 && w as u64 * rows as u64 * 16 <= voxsplat::BAND_BYTES.max(w as u64 * 16));
             next += rows;
         }
         assert_eq!(next, h, "{w}x{h}: every row");

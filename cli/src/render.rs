@@ -469,10 +469,10 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
 }
 
 /// Whether `render` writes its frame band by band: a PNG of more than one band
-/// (`voxsplat::bands`) drawn once, with nothing to add to the whole frame after it.
+/// (`voxsplat::frame_bands`) drawn once, with nothing to add to the whole frame after it.
 fn streams(a: &RenderArgs, cam: &voxsplat::Camera, out: &std::path::Path) -> Result<bool> {
     let png = voxsplat::output::ImageFormat::of(out)? == voxsplat::output::ImageFormat::Png;
-    Ok(png && a.repeat == 1 && !a.k_line && voxsplat::bands::bands(cam).len() > 1)
+    Ok(png && a.repeat == 1 && !a.k_line && voxsplat::frame_bands(cam).len() > 1)
 }
 
 /// The last of `frames` with each stage's median time over all of them, keeping one image at a

@@ -33,7 +33,7 @@ pub struct FrameStats {
 }
 
 impl FrameStats {
-    /// Field by field, the larger of the two: a frame drawn in bands (`bands`) reports its
+    /// Field by field, the larger of the two: a frame drawn in bands (`frame_bands`) reports its
     /// busiest band's counts, since a brick or splat two bands draw would be counted twice.
     pub fn busiest(&self, o: &Self) -> Self {
         Self {
