@@ -69,7 +69,8 @@ pub struct Camera {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 /// Where a camera's image lies in the whole frame it is part of: the frame's size and the image's
-/// top-left pixel in it. The projection, the pixel size and the culling are the whole frame's.
+/// top-left pixel in it. The projection and the pixel size are the whole frame's, the window's
+/// pixels stretched over the image.
 pub struct Window {
     /// Column of the image's left edge in the frame.
     pub x: u32,
@@ -415,8 +416,8 @@ impl Camera {
     }
 
     /// Half the view's width and height, `margin` pixels past the image's edges: at unit depth
-    /// (perspective) or in world units (orthographic). A window culls as its whole frame does, so
-    /// that every part of a frame makes the same decisions.
+    /// (perspective) or in world units (orthographic). A window's are its whole frame's: a reader
+    /// reads what the frame shows (the engine culls each window by its own projection).
     fn half_view(&self, margin: f32) -> (f32, f32) {
         let per = self.pixels_per_unit();
         let (w, h) = self.frame_size();

@@ -342,8 +342,8 @@ impl Renderer {
 
     /// Draw a frame in full-width bands of at most [`BAND_BYTES`], top to bottom, handing
     /// each to `sink` with its first row: a frame of any size in the memory of one band. Each band
-    /// is a window of the camera (`Camera::windowed`) culled, ordered and rastered as the whole
-    /// frame, so bands meet without seams; stats are the busiest band's. Full size only.
+    /// is a window of the camera (`Camera::windowed`) drawn with the whole frame's projection and
+    /// raster, so bands meet without seams; stats are the busiest band's. Full size only.
     pub fn render_bands(
         &mut self,
         camera: &Camera,

@@ -638,6 +638,18 @@ pub fn optical_depth(opacity: f32) -> f32 {
     -(1.0 - opacity.clamp(0.0, MAX_OPACITY)).ln()
 }
 
+/// GPU memory a scene costs per splat: the splat (32 B), its parameters (80 B), its order entry and
+/// its three slice-list entries (16 B), plus the per-row tables spread over the splats.
+pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
+    let n = set.len().max(1) as f64;
+    let rows = (set.row_start().len() - 1) as f64;
+    let dims = set.grid().dims;
+    let per_splat = (std::mem::size_of::<crate::gpu_types::Splat>()
+        + std::mem::size_of::<crate::gpu_types::SplatParams>()
+        + 16) as f64;
+    per_splat + (rows * (4.0 + 4.0 + 8.0) + (dims[0] + dims[1] + dims[2]) as f64 * 4.0) / n
+}
+
 #[cfg(test)]
 mod tests {
     /// The eight-lane span equals a plain fold over the finite values, whatever the length and
@@ -664,16 +676,4 @@ mod tests {
             assert_eq!(super::value_span(&values), plain, "{values:?}");
         }
     }
-}
-
-/// GPU memory a scene costs per splat: the splat (32 B), its parameters (80 B), its order entry and
-/// its three slice-list entries (16 B), plus the per-row tables spread over the splats.
-pub fn gpu_bytes_per_splat(set: &SplatSet) -> f64 {
-    let n = set.len().max(1) as f64;
-    let rows = (set.row_start().len() - 1) as f64;
-    let dims = set.grid().dims;
-    let per_splat = (std::mem::size_of::<crate::gpu_types::Splat>()
-        + std::mem::size_of::<crate::gpu_types::SplatParams>()
-        + 16) as f64;
-    per_splat + (rows * (4.0 + 4.0 + 8.0) + (dims[0] + dims[1] + dims[2]) as f64 * 4.0) / n
 }

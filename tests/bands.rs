@@ -64,7 +64,7 @@ fn cases(grid: &voxsplat::Grid) -> Vec<(&'static str, RenderOptions, Camera)> {
         ("sheets", with(&|o| o.composite = Composite::Sheet), persp),
         ("mip", with(&|o| o.mode = Mode::Mip), persp),
         ("ewa", with(&|o| o.antialias = Antialias::Ewa), persp),
-        ("motion blur", with(&|o| o.motion = Some(motion.clone())), ortho),
+        ("motion blur", with(&|o| o.motion = Some(motion)), ortho),
     ]
 }
 
@@ -79,7 +79,7 @@ fn a_window_draws_exactly_its_pixels_of_the_whole_frame() {
                 r.volume().unwrap().store.grid().unwrap()
             } else {
                 r.set_scene(set.clone()).unwrap();
-                set.grid().clone()
+                *set.grid()
             };
             for (name, o, cam) in cases(&grid) {
                 let whole = r.render(&cam, &o).unwrap().image;
@@ -101,8 +101,7 @@ fn a_window_draws_exactly_its_pixels_of_the_whole_frame() {
         // The ray caster, two rays a pixel side (measured at most 9.5e-6 off).
         r.set_scene(set.clone()).unwrap();
         let cam = Camera::framing(set.grid(), 90, 70);
-        let mut o = voxsplat::RaycastOptions::default();
-        o.supersample = 2;
+        let o = voxsplat::RaycastOptions { supersample: 2, ..Default::default() };
         let whole = r.raycast(&cam, &o).unwrap().image;
         let parts = in_windows(&cam, 17, 31, |c| r.raycast(c, &o).unwrap().image);
         let (max, covered) = compare(&whole, &parts);
