@@ -224,7 +224,8 @@ impl Camera {
         Self { width: self.width * k, height: self.height * k, window, ..*self }
     }
 
-    /// The same view drawing only `width` x `height` pixels at column `x`, row `y` of its frame.
+    /// The same view drawing only `width` x `height` pixels at column `x`, row `y` of this camera's
+    /// image (of its window, for a window: the result is a window of the same frame).
     pub fn windowed(&self, x: u32, y: u32, width: u32, height: u32) -> Self {
         let (frame_width, frame_height) = self.frame_size();
         let (ox, oy) = self.window.map_or((0, 0), |w| (w.x, w.y));
