@@ -64,6 +64,25 @@ pub fn each(
     Ok((timings, stats))
 }
 
+/// `low`, drawn on `resample::scaled_camera(camera, ..)`'s grid, resampled to `camera`'s size band
+/// by band into `sink` (`Renderer::render_bands` under a render scale); `raster` is what the coarse
+/// frame was drawn with.
+pub fn upsampled(
+    camera: &Camera,
+    low: Rendered,
+    raster: crate::RasterChoice,
+    sink: &mut dyn FnMut(u32, &ImageF32) -> Result<()>,
+) -> Result<crate::Delivered> {
+    let mut timings = low.timings;
+    for (y, rows) in frame_bands(camera) {
+        let t = std::time::Instant::now();
+        let band = crate::resample::upsample_rows(&low.image, camera.width, camera.height, y, rows)?;
+        add_time(&mut timings, "upsample", t.elapsed().as_secs_f64() * 1e3);
+        sink(y, &band)?;
+    }
+    Ok(crate::Delivered { timings, raster, stats: low.stats })
+}
+
 /// `draw`'s bands of `camera` put together into one frame.
 pub fn assemble(camera: &Camera, mut draw: impl FnMut(&Camera) -> Result<Rendered>) -> Result<Rendered> {
     let mut frame = ImageF32::new(camera.width, camera.height);

@@ -331,19 +331,16 @@ impl Renderer {
         }
         let (opts, choice) = self.choose(camera, options)?;
         if bands::frame_bands(camera).len() > 1 {
-            return bands::assemble(camera, |band| {
-                let r = self.record(band, &opts)?;
-                Ok(Rendered { image: r.image, timings: r.timings, raster: Some(choice.clone()), stats: r.stats })
-            });
+            return bands::assemble(camera, |band| Ok(self.record(band, &opts)?.rendered(Some(choice.clone()))));
         }
-        let recorded = self.record(camera, &opts)?;
-        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: Some(choice), stats: recorded.stats })
+        Ok(self.record(camera, &opts)?.rendered(Some(choice)))
     }
 
     /// Draw a frame in full-width bands of at most [`BAND_BYTES`], top to bottom, handing
     /// each to `sink` with its first row: a frame of any size in the memory of one band. Each band
     /// is a window of the camera (`Camera::windowed`) drawn with the whole frame's projection and
-    /// raster, so bands meet without seams; stats are the busiest band's. Full size only.
+    /// raster, so bands meet without seams; stats are the busiest band's. Under a render scale the
+    /// coarse frame is drawn whole and resampled band by band.
     pub fn render_bands(
         &mut self,
         camera: &Camera,
@@ -354,9 +351,11 @@ impl Renderer {
         camera.validate()?;
         bands::check_memory(camera, false)?;
         if options.render_scale != 1.0 {
-            return Err(Error::Unsupported(
-                "a frame drawn in bands is drawn at full size: a render scale below 1 needs the whole frame".into(),
-            ));
+            // The coarse frame whole (a fraction of this one), resampled band by band.
+            let full = RenderOptions { render_scale: 1.0, ..options.clone() };
+            let low = resample::scaled_camera(camera, options.render_scale)?;
+            let (_, raster) = self.choose(&low, &full)?;
+            return bands::upsampled(camera, self.render(&low, &full)?, raster, sink);
         }
         let (opts, raster) = self.choose(camera, options)?;
         let (timings, stats) = bands::each(
@@ -660,7 +659,7 @@ impl Renderer {
             Some(g) => recording::record_raycast(&mut g.engine(prep), prep, camera, options)?,
             None => recording::record_raycast(&mut CpuEngine::new(prep), prep, camera, options)?,
         };
-        Ok(Rendered { image: recorded.image, timings: recorded.timings, raster: None, stats: recorded.stats })
+        Ok(recorded.rendered(None))
     }
 
     /// Validation messages counted so far (always 0 without validation or on the CPU).

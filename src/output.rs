@@ -125,11 +125,6 @@ fn write_file(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()
 pub fn write_image(img: &ImageF32, path: &Path) -> Result<()> {
     let format = ImageFormat::of(path)?;
     let encoding = |message: String| Error::Image { path: path.display().to_string(), message };
-    write_file_as(path, format, img, encoding)
-}
-
-/// `write_image`'s body by format.
-fn write_file_as(path: &Path, format: ImageFormat, img: &ImageF32, encoding: impl Fn(String) -> Error) -> Result<()> {
     match format {
         ImageFormat::Png => {
             // Row by row: an 8-bit copy of a large frame would add a quarter of its size.

@@ -54,6 +54,13 @@ pub struct Recorded {
     pub stats: crate::options::FrameStats,
 }
 
+impl Recorded {
+    /// The frame as `Renderer` returns it, with the raster `Raster::Auto` picked (none for a ray cast).
+    pub fn rendered(self, raster: Option<crate::RasterChoice>) -> crate::Rendered {
+        crate::Rendered { image: self.image, timings: self.timings, raster, stats: self.stats }
+    }
+}
+
 /// THE recording of a frame: `prep` drawn from `camera` with `opts` (whose raster is already
 /// chosen), on `e`: its plan (`plan::frame`), then the plan recorded.
 pub fn record_frame(e: &mut dyn Engine, prep: &Prepared, camera: &Camera, opts: &RenderOptions) -> Result<Recorded> {

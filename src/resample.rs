@@ -51,8 +51,20 @@ pub fn render_scaled(camera: &Camera, scale: f32, draw: impl FnOnce(&Camera) -> 
 /// nearest coarse pixels are interpolated (clamped at the border). Premultiplied colour, so alpha
 /// and colour interpolate alike.
 pub fn upsample(low: &ImageF32, width: u32, height: u32) -> Result<ImageF32> {
-    if low.width == 0 || low.height == 0 || width == 0 || height == 0 {
+    upsample_rows(low, width, height, 0, height)
+}
+
+/// Rows `first .. first + rows` of `upsample(low, width, height)`, alone: a frame resampled band
+/// by band (`Renderer::render_bands` under a render scale) never holds the whole of it.
+pub fn upsample_rows(low: &ImageF32, width: u32, height: u32, first: u32, rows: u32) -> Result<ImageF32> {
+    if low.width == 0 || low.height == 0 || width == 0 || height == 0 || rows == 0 {
         return Err(Error::InvalidArgument("cannot resample an empty image".into()));
+    }
+    if first.checked_add(rows).is_none_or(|end| end > height) {
+        return Err(Error::InvalidArgument(format!(
+            "rows {first}..{} lie outside a frame of {height} rows",
+            first as u64 + rows as u64
+        )));
     }
     if low.pixels.len() != low.width as usize * low.height as usize {
         return Err(Error::InvalidArgument("image size does not match its pixels".into()));
@@ -68,9 +80,9 @@ pub fn upsample(low: &ImageF32, width: u32, height: u32) -> Result<ImageF32> {
     };
     let xs: Vec<_> = (0..width).map(|x| axis(x, cx, lx, low.width)).collect();
     let w = low.width as usize;
-    let mut out = ImageF32::new(width, height);
+    let mut out = ImageF32::new(width, rows);
     out.pixels.par_chunks_mut(width as usize).enumerate().for_each(|(y, row)| {
-        let (y0, y1, fy) = axis(y as u32, cy, ly, low.height);
+        let (y0, y1, fy) = axis(first + y as u32, cy, ly, low.height);
         let (top, bottom) = (&low.pixels[y0 * w..][..w], &low.pixels[y1 * w..][..w]);
         for (p, &(x0, x1, fx)) in row.iter_mut().zip(&xs) {
             for c in 0..4 {
@@ -111,6 +123,25 @@ mod tests {
         assert_eq!(scaled_camera(&camera(512, 512), 1.0).unwrap(), camera(512, 512));
         for bad in [0.0, -0.5, 1.5, f32::NAN, f32::INFINITY, MIN_RENDER_SCALE * 0.5] {
             assert!(scaled_camera(&camera(64, 64), bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn upsample_rows_are_the_rows_of_the_whole_upsample() {
+        let mut low = ImageF32::new(7, 5);
+        for (i, p) in low.pixels.iter_mut().enumerate() {
+            *p = [i as f32, (i * i % 11) as f32, 1.0, 0.5];
+        }
+        let whole = upsample(&low, 23, 17).unwrap();
+        let mut joined = Vec::new();
+        for (first, rows) in [(0, 6), (6, 1), (7, 10)] {
+            let band = upsample_rows(&low, 23, 17, first, rows).unwrap();
+            assert_eq!((band.width, band.height), (23, rows));
+            joined.extend_from_slice(&band.pixels);
+        }
+        assert!(joined == whole.pixels);
+        for (first, rows) in [(10, 8), (0, 0), (u32::MAX, 2)] {
+            assert!(upsample_rows(&low, 23, 17, first, rows).is_err(), "{first} {rows}");
         }
     }
 

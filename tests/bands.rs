@@ -156,9 +156,22 @@ fn a_frame_past_one_band_is_drawn_in_bands_that_render_bands_hands_on_in_order()
     let small = r.render(&Camera { width: 1638, height: 30, ..cam }, &o).unwrap().image;
     let ratio = common::covered(&whole.image) as f64 / (100.0 * common::covered(&small) as f64);
     assert!((0.9..1.1).contains(&ratio), "coverage against the small frame's: {ratio}");
-    // A render scale below 1 needs the whole frame.
+    // Under a render scale the coarse frame is drawn whole and resampled band by band: the same
+    // pixels as `render` at that scale (`voxsplat render --render-scale` refused such frames).
     let mut scaled = o.clone();
     scaled.render_scale = 0.5;
-    assert!(matches!(r.render_bands(&cam, &scaled, &mut |_, _| Ok(())), Err(voxsplat::Error::Unsupported(_))));
+    let low = r.render(&cam, &scaled).unwrap();
+    let (mut seen, mut pixels) = (Vec::new(), Vec::new());
+    let delivered = r
+        .render_bands(&cam, &scaled, &mut |y, band| {
+            seen.push((y, band.width, band.height));
+            pixels.extend_from_slice(&band.pixels);
+            Ok(())
+        })
+        .unwrap();
+    assert_eq!(seen, vec![(0, 16384, 150), (150, 16384, 150)]);
+    assert!(pixels == low.image.pixels, "render_bands at a render scale hands on render's frame");
+    assert_eq!(Some(delivered.raster), low.raster);
+    assert!(delivered.timings.iter().any(|t| t.stage == "upsample"));
     assert_clean(&r);
 }

@@ -349,6 +349,8 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         return report_validation(&r);
     }
     let mut wall = Vec::new();
+    // Whether the frame went to its file band by band as it was drawn.
+    let mut written = false;
     let frame = if a.truth {
         let t = std::time::Instant::now();
         let opts = voxsplat::truth::TruthOptions {
@@ -393,6 +395,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
                 let d = r.render_bands(&cam, &opts, &mut |_, band| png.push(band))?;
                 png.finish()?;
                 wall.push(t.elapsed().as_secs_f64() * 1e3);
+                written = true;
                 let image = voxsplat::ImageF32::new(0, 0);
                 voxsplat::Rendered { image, timings: d.timings, raster: Some(d.raster), stats: d.stats }
             }
@@ -420,7 +423,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         }
         voxsplat::aa::draw_k_line(&mut image, &regions);
     }
-    if image.width > 0 {
+    if !written {
         voxsplat::output::write_image(&image, &out)?;
     }
     let what = if r_bricked { "stored voxels" } else { "splats" };
