@@ -4,7 +4,7 @@
 use crate::common;
 use common::{assert_clean, cpu, gpu};
 use glam::Mat4;
-use voxsplat::{Antialias, Camera, Composite, Mode, Motion, Projection, Raster, RenderOptions};
+use voxsplat::{Antialias, Camera, Composite, Delivered, Mode, Motion, Projection, Raster, RenderOptions, Renderer};
 
 /// The whole frame put together from windows of it: bands of `rows` rows, each cut into columns
 /// `cols` wide.
@@ -129,6 +129,20 @@ fn bands_cover_every_row_once_within_the_band_size() {
     }
 }
 
+/// What `render_bands` hands on: each band's (first row, width, height), the bands' pixels in
+/// order, and what it returns.
+fn banded(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> (Vec<(u32, u32, u32)>, Vec<[f32; 4]>, Delivered) {
+    let (mut seen, mut pixels) = (Vec::new(), Vec::new());
+    let delivered = r
+        .render_bands(cam, o, &mut |y, band| {
+            seen.push((y, band.width, band.height));
+            pixels.extend_from_slice(&band.pixels);
+            Ok(())
+        })
+        .unwrap();
+    (seen, pixels, delivered)
+}
+
 #[test]
 fn a_frame_past_one_band_is_drawn_in_bands_that_render_bands_hands_on_in_order() {
     let set = common::random_sparse(5, [24, 20, 16], 0.4);
@@ -139,15 +153,7 @@ fn a_frame_past_one_band_is_drawn_in_bands_that_render_bands_hands_on_in_order()
     let o = RenderOptions::default();
     let whole = r.render(&cam, &o).unwrap();
     assert_eq!((whole.image.width, whole.image.height), (16384, 300));
-    let mut seen = Vec::new();
-    let mut pixels = Vec::new();
-    let delivered = r
-        .render_bands(&cam, &o, &mut |y, band| {
-            seen.push((y, band.width, band.height));
-            pixels.extend_from_slice(&band.pixels);
-            Ok(())
-        })
-        .unwrap();
+    let (seen, pixels, delivered) = banded(&mut r, &cam, &o);
     assert_eq!(seen, vec![(0, 16384, 150), (150, 16384, 150)]);
     assert!(pixels == whole.image.pixels, "render puts together the bands render_bands hands on");
     assert!(common::covered(&whole.image) > 10_000, "something drawn");
@@ -161,14 +167,7 @@ fn a_frame_past_one_band_is_drawn_in_bands_that_render_bands_hands_on_in_order()
     let mut scaled = o.clone();
     scaled.render_scale = 0.5;
     let low = r.render(&cam, &scaled).unwrap();
-    let (mut seen, mut pixels) = (Vec::new(), Vec::new());
-    let delivered = r
-        .render_bands(&cam, &scaled, &mut |y, band| {
-            seen.push((y, band.width, band.height));
-            pixels.extend_from_slice(&band.pixels);
-            Ok(())
-        })
-        .unwrap();
+    let (seen, pixels, delivered) = banded(&mut r, &cam, &scaled);
     assert_eq!(seen, vec![(0, 16384, 150), (150, 16384, 150)]);
     assert!(pixels == low.image.pixels, "render_bands at a render scale hands on render's frame");
     assert_eq!(Some(delivered.raster), low.raster);
