@@ -1,6 +1,6 @@
 //! Criterion wall-time benchmark of whole frames through the library's public API, one per raster
 //! variant and compositing mode on the 60³ cube. The full matrix with errors, roofline and scaling
-//! is `voxsplat lab matrix` (cli/src/bench.rs), and cli/benches/render.rs times its quick matrix.
+//! is `voxsplat-lab matrix` (cli/src/bench.rs), and cli/benches/render.rs times its quick matrix.
 use criterion::{criterion_group, criterion_main, Criterion};
 use voxsplat::{scene, Camera, Composite, Raster, RenderOptions, Renderer, RendererOptions};
 

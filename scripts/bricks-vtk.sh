@@ -3,7 +3,7 @@
 # bonsai, its 2x upsampling (512³) and the procedural 1024³ field (scripts/large-volumes.sh), the
 # same transfer-function preset and view (scripts/vtk_file.py copies voxsplat's framing camera),
 # 512x512, alternating the two tools file by file in one run. Each voxsplat run is its own process
-# (`voxsplat lab bricks --volume`: load, store, median frame at full detail and with levels of detail,
+# (`voxsplat-lab bricks --volume`: load, store, median frame at full detail and with levels of detail,
 # peak RSS). Prints a markdown table and
 # draws docs/bench/bricks-scaling.svg (frame time against voxels, both tools); its CSV,
 # docs/bench/bricks-scaling.csv, is the third panel of the bench's scaling.svg.
@@ -24,7 +24,7 @@ cat <<'TEXT'
 
 `scripts/bricks-vtk.sh`, one run, the two tools alternating file by file: VTK's fixed-point CPU ray
 caster (`scripts/vtk_file.py`: the same preset mapped over the data's range, opacity per voxel
-length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat lab bricks --volume`, its
+length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat-lab bricks --volume`, its
 own process per file), 512², 5 frames after a warm-up, medians. voxsplat alternates full detail
 with levels of detail (`--lod auto`, 1 px; PSNR against its own full detail): the fifth column is
 the levels of detail's moonshot, LOD frame time against VTK's. The last column holds both frames' PSNR against a
@@ -41,7 +41,7 @@ for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/pro
   tf=bonsai; [[ $f == *procedural* ]] && tf=ramp
   vtk=$( { /usr/bin/time -f "rss=%M" "$VENV/bin/python" scripts/vtk_file.py --file "$f" --tf $tf --frames "$FRAMES" \
     --out "target/vtk-$(basename "$f").png"; } 2>&1 | grep -E "median=|rss=" | tr '\n' ' ')
-  vs=$(./target/release/voxsplat lab bricks --volume "$f" --tf $tf --frames "$FRAMES")
+  vs=$(./target/release/voxsplat-lab bricks --volume "$f" --tf $tf --frames "$FRAMES")
   vtk_ms=$(sed -E 's/.*median=([0-9.]+)s.*/\1/' <<< "$vtk" | awk '{print $1 * 1000}')
   vtk_load=$(sed -E 's/.*load=([0-9.]+)s.*/\1/' <<< "$vtk")
   vtk_rss=$(sed -E 's/.*rss=([0-9]+).*/\1/' <<< "$vtk" | awk '{printf "%.0f", $1 / 1024}')
@@ -66,6 +66,6 @@ for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/pro
   echo "| $(basename "$f") ($tf) | $vtk_load, $vtk_ms, $vtk_rss | ${vs#*: } | $ratio | $lod_ratio | $truth |"
   echo "$voxels,$vtk_ms,$vs_ms" >> "$csv"
 done
-./target/release/voxsplat lab bricks --chart "$csv" --chart-out docs/bench/bricks-scaling.svg
+./target/release/voxsplat-lab bricks --chart "$csv" --chart-out docs/bench/bricks-scaling.svg
 echo
 echo "![bricked volumes against VTK, frame time against voxels](bench/bricks-scaling.svg)"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # DICOM loading throughput (issue 47's target): a CT series of SLICES 512 x 512 16-bit images
 # (default 256, 128 MiB of pixel data) written by pydicom from the procedural field, read by
-# `voxsplat lab load` (the dense volume and the bricked store) beside dcm2niix converting it to an
+# `voxsplat-lab load` (the dense volume and the bricked store) beside dcm2niix converting it to an
 # uncompressed NIfTI; medians of 5 alternating rounds, in MB/s of pixel data. With `jpegls` each
 # image is compressed as JPEG-LS lossless (CharLS, through pydicom and pyjpegls), and the peer is
 # pydicom decoding the series into one array with CharLS (pyjpegls): Debian's dcm2niix is built
@@ -52,7 +52,7 @@ mb=$(python3 -c "print(512 * 512 * 2 * $slices / 1e6)")
 cat "$dir"/series/* > /dev/null
 rows=()
 for _ in 1 2 3 4 5; do
-  out=$(./target/release/voxsplat lab load "$dir/series" --repeat 1)
+  out=$(./target/release/voxsplat-lab load "$dir/series" --repeat 1)
   dense=$(echo "$out" | grep "dense volume" | awk -F'|' '{print $3}' | tr -d ' s')
   bricked=$(echo "$out" | grep "bricked store" | awk -F'|' '{print $3}' | tr -d ' s')
   rm -f "$dir"/out/*

@@ -2,13 +2,17 @@
 # Renders a fixed matrix of 123 frames through the CLI (every order, compositing mode, raster
 # variant and kernel on both backends, AA, early termination, budgets, render scale, the ray caster,
 # the truth, four motion-blurred animations, and eight bricked volumes from ../shared/data) and
-# prints a hash of each frame's exact RGBA32F pixels (cli/examples/pixel_hash.rs). Run it with the binaries before and after a refactor and diff
+# prints a hash of each frame's exact RGBA32F pixels (lab/examples/pixel_hash.rs). Run it with the binaries before and after a refactor and diff
 # the outputs: a change that changes no image changes no hash. (Issue 22 ran it at every commit.)
-# Usage: scripts/image-hashes.sh [VOXSPLAT_BINARY] > hashes.txt
+# The matrix uses the research switches, so it renders with `voxsplat-lab render`, and animates
+# with `voxsplat animate` (before issue 77 one binary did both: give it twice).
+# Usage: scripts/image-hashes.sh [RENDER_BINARY [ANIMATE_BINARY]] > hashes.txt
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --quiet -p voxsplat-cli --example pixel_hash
-bin=${1:-target/release/voxsplat}
+cargo build --release --quiet -p voxsplat-lab --bin voxsplat-lab --example pixel_hash
+cargo build --release --quiet -p voxsplat-cli --bin voxsplat
+bin=${1:-target/release/voxsplat-lab}
+animate=${2:-target/release/voxsplat}
 hash=target/release/examples/pixel_hash
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
@@ -68,7 +72,7 @@ fi
 for blur in splat accum:3; do
   for comp in splat sheet; do
     d="$out/anim-$blur-$comp"
-    "$bin" animate --anim rotating-box --blur $blur --composite $comp --format exr --out-dir "$d" >/dev/null 2>&1 \
+    "$animate" animate --anim rotating-box --blur $blur --composite $comp --format exr --out-dir "$d" >/dev/null 2>&1 \
       || { echo "anim-$blur-$comp FAILED"; continue; }
     echo "anim-$blur-$comp $($hash "$d"/*.exr | sha256sum | cut -c1-16)"
   done

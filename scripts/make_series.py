@@ -1,5 +1,5 @@
 """Writes a time series from the shared bonsai as a 4-D NIfTI (nibabel; its fourth axis in
-seconds) for `voxsplat lab series` and `voxsplat animate --volume` (not committed: 16 MiB a time
+seconds) for `voxsplat-lab series` and `voxsplat animate --volume` (not committed: 16 MiB a time
 point).
 
     python3 scripts/make_series.py ball OUT.nii [T]    # a bright ball crosses the still bonsai

@@ -6,7 +6,7 @@
 # and 256^3, 512x512. Every image is scored against one truth: voxsplat's ray integration of the
 # interpolated scalar at a 0.1-voxel step, first checked against VTK's ray casters at the same small
 # sample distance (GPU: float; fixed point: drifts as the distance shrinks, docs/MODEL.md). Writes docs/bench/peers.md (table) and docs/bench/peers-*.png (strips);
-# `voxsplat lab matrix --results` includes peers.md in docs/RESULTS.md.
+# `voxsplat-lab matrix --results` includes peers.md in docs/RESULTS.md.
 # Installs VTK (PyPI) in a virtual environment when missing: ~/.cache/peers/venv, as the peers do.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,7 +32,7 @@ for n in $SIZES; do
   for m in gpu fixed; do
     $VTK --mapper $m --n "$n" --size 512 --frames 1 --warmup 0 --sample 0.1 --out "$OUT/vtk-$m-fine-$n.png" >/dev/null 2>&1
   done
-  ./target/release/voxsplat lab peer --n "$n" --frames 5 --warmup 0 --out-dir "$OUT" --truth-step 0.1 >/dev/null
+  ./target/release/voxsplat-lab peer --n "$n" --frames 5 --warmup 0 --out-dir "$OUT" --truth-step 0.1 >/dev/null
   for r in $(seq "$ROUNDS"); do
     for m in fixed gpu; do
       ms=$(vtk_ms $VTK --mapper $m --n "$n" --size 512 --frames 5 --warmup 2 --out "$OUT/vtk-$m-$n.png")
@@ -43,7 +43,7 @@ for n in $SIZES; do
         --mapper fixed --n "$n" --size 512 --frames 5 --warmup 2 --out "$OUT/vtk-fixed-isd-$d-$n.png")
       echo "$n,$r,vtk fixed isd $d,$ms" >> "$OUT/times.csv"
     done
-    ./target/release/voxsplat lab peer --n "$n" --frames 5 --warmup 2 --out-dir "$OUT" | tail -n +2 \
+    ./target/release/voxsplat-lab peer --n "$n" --frames 5 --warmup 2 --out-dir "$OUT" | tail -n +2 \
       | sed "s/^/$n,$r,voxsplat /" >> "$OUT/times.csv"
   done
 done

@@ -167,7 +167,7 @@ for n in sizes:
     md.append("")
 open(os.path.join(docs, "peers.md"), "w").write("\n".join(md) + "\n")
 
-# Splice the section into docs/RESULTS.md (replacing an earlier one); `voxsplat lab matrix --results`
+# Splice the section into docs/RESULTS.md (replacing an earlier one); `voxsplat-lab matrix --results`
 # includes docs/bench/peers.md the same way when it regenerates the page.
 results = os.path.join(os.path.dirname(os.path.abspath(docs)), "RESULTS.md")
 if os.path.exists(results):

@@ -10,10 +10,10 @@ cd "$(dirname "$0")/.."
 # The bricked-volume study first (its section is included by the bench's report): the 512³ bonsai
 # is made, never committed.
 ./scripts/large-volumes.sh target/large
-cargo run --release --quiet -- lab bricks --large target/large/bonsai512.nrrd --lod-chart docs/bench/lod-peer256.svg > docs/bench/bricks.md
+cargo run --release --quiet -p voxsplat-lab -- bricks --large target/large/bonsai512.nrrd --lod-chart docs/bench/lod-peer256.svg > docs/bench/bricks.md
 ./scripts/bricks-vtk.sh >> docs/bench/bricks.md
-cargo run --release --quiet -- lab kernels --chart docs/bench/kernels.svg > docs/bench/kernels.md
-cargo run --release --quiet -- lab antialias > docs/bench/antialias.md
-cargo run --release --quiet -- lab motion-orders > docs/bench/motion-orders.md
+cargo run --release --quiet -p voxsplat-lab -- kernels --chart docs/bench/kernels.svg > docs/bench/kernels.md
+cargo run --release --quiet -p voxsplat-lab -- antialias > docs/bench/antialias.md
+cargo run --release --quiet -p voxsplat-lab -- motion-orders > docs/bench/motion-orders.md
 ./scripts/modes.sh > docs/bench/modes.md
-cargo run --release --quiet -- lab matrix --out-dir docs/bench --results docs/RESULTS.md "$@"
+cargo run --release --quiet -p voxsplat-lab -- matrix --out-dir docs/bench --results docs/RESULTS.md "$@"

@@ -11,6 +11,6 @@ frames="${1:-1000}"
 cargo build --release --quiet
 export MALLOC_ARENA_MAX=1 MALLOC_MMAP_THRESHOLD_=131072
 echo "== without validation"
-./target/release/voxsplat lab soak --frames "$frames"
+./target/release/voxsplat-lab soak --frames "$frames"
 echo "== with validation"
-./target/release/voxsplat lab soak --frames "$frames" --validation
+./target/release/voxsplat-lab soak --frames "$frames" --validation

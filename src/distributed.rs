@@ -181,9 +181,7 @@ impl std::str::FromStr for Scheme {
             "direct-send" | "direct" => Ok(Scheme::DirectSend),
             "binary-swap" => Ok(Scheme::BinarySwap),
             "auto" => Ok(Scheme::Auto),
-            _ => Err(Error::InvalidArgument(format!(
-                "unknown compositing scheme {s:?}: direct-send, binary-swap or auto"
-            ))),
+            _ => Err(Error::InvalidArgument(format!("unknown exchange {s:?}: direct-send, binary-swap or auto"))),
         }
     }
 }

@@ -80,7 +80,7 @@ pub fn footprint_size(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> 
 
 /// Typical footprint diameters (px) up to which `auto` uses compute on a CPU device: the tile
 /// compositor for per-splat compositing, the fixed-point sums for sheet modes. Measured on lavapipe
-/// (`voxsplat lab rates`, docs/RESULTS.md, two full runs) since the compositor deals each box's pixels
+/// (`voxsplat-lab rates`, docs/RESULTS.md, two full runs) since the compositor deals each box's pixels
 /// to its lanes: 5.4-6.3x, 3.8-4.2x, 2.7x the quads at 3, 5, 7 px and 2.1-2.4x, 1.7-1.9x at 11 and
 /// 15 px, ahead of the point sprites at every size (2.1-2.7x, 2.2-2.3x, 1.8-2.0x, 1.6-1.7x, 1.5x),
 /// and level with them on the peers' 128^3 scene (~14 px in perspective: 306 and 228 ms against

@@ -129,9 +129,12 @@ fn bands_cover_every_row_once_within_the_band_size() {
     }
 }
 
-/// What `render_bands` hands on: each band's (first row, width, height), the bands' pixels in
-/// order, and what it returns.
-fn banded(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> (Vec<(u32, u32, u32)>, Vec<[f32; 4]>, Delivered) {
+/// Each band's (first row, width, height), the bands' pixels in order, and what `render_bands`
+/// returns.
+type Banded = (Vec<(u32, u32, u32)>, Vec<[f32; 4]>, Delivered);
+
+/// What `render_bands` hands on.
+fn banded(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Banded {
     let (mut seen, mut pixels) = (Vec::new(), Vec::new());
     let delivered = r
         .render_bands(cam, o, &mut |y, band| {

@@ -67,8 +67,8 @@ fn the_maths_reaches_into_no_executor() {
 }
 
 #[test]
-fn no_source_file_of_the_core_or_the_cli_passes_700_lines() {
-    for dir in ["src", "cli/src"] {
+fn no_source_file_of_the_core_the_cli_or_the_lab_passes_700_lines() {
+    for dir in ["src", "cli/src", "lab/src"] {
         for p in rust_files(&Path::new(env!("CARGO_MANIFEST_DIR")).join(dir)) {
             let lines = std::fs::read_to_string(&p).unwrap().lines().count();
             assert!(lines <= 700, "{} has {lines} lines", p.display());
@@ -277,14 +277,27 @@ fn file_loops(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
 fn no_file_imports_a_file_that_imports_it_back() {
     let core = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), None);
     let cli = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("cli/src"), Some("voxsplat_cli"));
-    assert!(core.len() > 60 && cli.len() > 10, "files found: {} and {}", core.len(), cli.len());
+    let lab = file_graph(&Path::new(env!("CARGO_MANIFEST_DIR")).join("lab/src"), Some("voxsplat_lab"));
+    assert!(
+        core.len() > 60 && cli.len() > 10 && lab.len() > 10,
+        "files found: {} {} {}",
+        core.len(),
+        cli.len(),
+        lab.len()
+    );
     let show = |g: &BTreeMap<String, BTreeSet<String>>, on: &[String]| -> String {
         on.iter()
             .map(|f| format!("\n  {f} -> {:?}", g[f].iter().filter(|t| on.contains(t)).collect::<Vec<_>>()))
             .collect()
     };
-    let (a, b) = (file_loops(&core), file_loops(&cli));
-    assert!(a.is_empty() && b.is_empty(), "files on an import loop:{}{}", show(&core, &a), show(&cli, &b));
+    let (a, b, c) = (file_loops(&core), file_loops(&cli), file_loops(&lab));
+    assert!(
+        a.is_empty() && b.is_empty() && c.is_empty(),
+        "files on an import loop:{}{}{}",
+        show(&core, &a),
+        show(&cli, &b),
+        show(&lab, &c)
+    );
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! The SPIR-V shipped in `glsl/spirv/` (what a dependent crate builds with, no shaderc needed) is a
-//! fresh compile of `glsl/`, byte for byte. Runs with the `shaderc` feature, which the workspace's
-//! CLI turns on (so `cargo test` at the top level runs it); `VOXSPLAT_BLESS_SPIRV=1` rewrites the
-//! shipped copies after a shader changes.
+//! fresh compile of `glsl/`, byte for byte. Runs with the `shaderc` feature, which the core's tests
+//! turn on (its dev-dependency on itself, so `cargo test` at the top level runs it);
+//! `VOXSPLAT_BLESS_SPIRV=1` rewrites the shipped copies after a shader changes.
 #![cfg(feature = "shaderc")]
 use std::collections::BTreeMap;
 use std::path::Path;

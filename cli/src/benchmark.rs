@@ -2,6 +2,7 @@
 //! writes JSON, compares two reports.
 use super::*;
 use voxsplat_cli::suite::{self, Report, SuiteOptions};
+use voxsplat_cli::{print, println};
 
 #[derive(Args)]
 pub(crate) struct BenchArgs {
@@ -124,7 +125,7 @@ pub(crate) fn bench(a: BenchArgs) -> Result<()> {
 /// The device the cases will use, and this build.
 fn platform(opts: &SuiteOptions) -> Result<suite::Platform> {
     let host_cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let (voxsplat, commit) = (env!("CARGO_PKG_VERSION").to_string(), env!("VOXSPLAT_COMMIT").to_string());
+    let (voxsplat, commit) = (env!("CARGO_PKG_VERSION").to_string(), voxsplat_cli::measure::COMMIT.to_string());
     if opts.cpu {
         let kind = "cpu mirrors".to_string();
         return Ok(suite::Platform {

@@ -1,48 +1,18 @@
 //! The voxsplat command line: list scenes, render a frame, dump or check a visibility order.
 use clap::{Args, Parser, Subcommand};
-use glam::Vec3;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use voxsplat::{
-    order, scene, Backend, Composite, Direction, Error, Kernel, OrderKind, RenderOptions, Renderer, RendererOptions,
-    Result,
+    order, scene, Backend, Composite, Direction, Error, OrderKind, RenderOptions, Renderer, RendererOptions, Result,
 };
 use voxsplat_cli::open::*;
 
-/// `print!` and `println!` that end the process quietly when stdout is a closed pipe
-/// (`voxsplat info F | head`): the standard ones panic there.
-macro_rules! print {
-    ($($arg:tt)*) => {
-        stdout_or_exit(write!(std::io::stdout(), $($arg)*))
-    };
-}
-macro_rules! println {
-    ($($arg:tt)*) => {
-        stdout_or_exit(writeln!(std::io::stdout(), $($arg)*))
-    };
-}
-
-/// A write to stdout's outcome: a closed pipe ends the process with success (the reader has what
-/// it wanted), another error with a message and failure.
-fn stdout_or_exit(written: std::io::Result<()>) {
-    match written {
-        Ok(()) => {}
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
-        Err(e) => {
-            eprintln!("error: writing to stdout: {e}");
-            std::process::exit(1)
-        }
-    }
-}
-
-// After the macros above, which the studies' printing uses too.
 mod benchmark;
-mod lab;
 mod pick;
-mod render;
 mod slice;
-use render::RenderArgs;
+use voxsplat_cli::render::{self, RenderArgs};
+use voxsplat_cli::{print, println};
 
 #[derive(Parser)]
 #[command(
@@ -162,13 +132,6 @@ enum Command {
         /// Print the profile as TOML (what tests/data/devices records), nothing else.
         #[arg(long)]
         toml: bool,
-    },
-    /// Studies that measure the renderer (for its developers): the timing matrix and the results
-    /// page, anti-aliasing, orders under motion, kernels, bricked volumes, the peers' scene,
-    /// raster rates, long runs. `voxsplat lab --help` lists them.
-    Lab {
-        #[command(subcommand)]
-        study: lab::Study,
     },
 }
 
@@ -486,7 +449,7 @@ fn run(cli: Cli) -> Result<()> {
                 voxsplat::classify::classify(&v, &tf, None)?
             };
             println!("splats: {}", set.len());
-            println!("bytes per splat (--dense): {:.0}", voxsplat::gpu_bytes_per_splat(&set));
+            println!("bytes per splat (classified on the host, voxsplat-lab render --dense): {:.0}", voxsplat::gpu_bytes_per_splat(&set));
             let most = voxsplat::low_level::constants::MAX_GPU_SPLATS as usize;
             if set.len() > most {
                 println!("over the dense GPU path's {most} splats: render it bricked (the default for volumes)");
@@ -509,7 +472,6 @@ fn run(cli: Cli) -> Result<()> {
             println!("ssim_alpha: {:.5}", m.ssim_alpha);
             Ok(())
         }
-        Command::Lab { study } => lab::run(study),
         Command::Bench(a) => benchmark::bench(*a),
         Command::Device { name, toml } => {
             let ctx =
@@ -634,7 +596,7 @@ fn refuse_scene_flags(s: &SceneArgs, given: &[String]) -> Result<()> {
         (s.labels.is_some() || !s.channels.is_empty() || !s.channel_tfs.is_empty(), "--labels and --channel"),
         (s.terrain.is_some() || s.color.is_some() || named("vscale") || named("cell"), "the terrain flags"),
         (s.series.is_some() || s.level.is_some() || s.time.is_some(), "--series, --level and --time"),
-        (s.dense || s.bisect.is_some() || s.gpu_budget_mib.is_some(), "--dense, --bisect and --gpu-budget-mib"),
+        (s.gpu_budget_mib.is_some(), "--gpu-budget-mib"),
     ];
     match given.iter().find(|g| g.0) {
         Some((_, flags)) => Err(Error::InvalidArgument(format!(

@@ -421,7 +421,7 @@ pub fn renderer_of(a: &SceneArgs) -> Result<Renderer> {
     opts.validation = a.validation;
     opts.gpu_budget_bytes = a.gpu_budget_mib.map(|m| mib_bytes(m, "--gpu-budget-mib")).transpose()?;
     let mut r = Renderer::new(&opts)?;
-    r.set_bisect(a.bisect)?;
+    r.set_bisect(a.research.bisect)?;
     Ok(r)
 }
 
@@ -474,7 +474,7 @@ pub fn open(
     host_splats: bool,
 ) -> Result<(Option<voxsplat::bricks::BrickScene>, voxsplat::SplatSet, Content)> {
     let peer = voxsplat::scene::peer::side_of(&a.scene).filter(|_| a.volume.is_none() && a.terrain.is_none());
-    if a.dense && a.volume.is_none() && peer.is_none() {
+    if a.research.dense && a.volume.is_none() && peer.is_none() {
         return Err(Error::InvalidArgument(
             "--dense classifies a --volume or the peers' scene (--scene peer128, peer256) on the host; this scene is \
              already a classified splat set"
@@ -493,7 +493,7 @@ pub fn open(
     let (bricked, orientation) = match (&a.volume, peer) {
         (Some(path), _)
             if !host_splats
-                && !a.dense
+                && !a.research.dense
                 && !uneven
                 && file_places(a)
                 && a.channels.is_empty()
@@ -502,7 +502,7 @@ pub fn open(
             let orientation = orientation_of(a)?;
             (load_bricked(a, path, orientation)?, orientation)
         }
-        (None, Some(n)) if !host_splats && !a.dense => {
+        (None, Some(n)) if !host_splats && !a.research.dense => {
             refuse_volume_flags(a)?;
             let store = voxsplat::bricks::BrickStore::build(&voxsplat::scene::peer::volume(n)?)?;
             eprintln!("{} stored voxels in {} bricks", store.len(), store.headers.len());

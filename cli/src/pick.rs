@@ -1,5 +1,6 @@
 //! `voxsplat pick`: what one pixel of a view shows (the point, its voxel, value and depth).
 use super::*;
+use voxsplat_cli::println;
 
 #[derive(Args)]
 pub(crate) struct PickArgs {

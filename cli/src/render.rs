@@ -1,167 +1,183 @@
 //! `voxsplat render`: one frame of a built-in scene, a volume file or a terrain, to PNG or EXR;
 //! under mpirun (feature `mpi`), one box of the volume per rank.
-use super::*;
+use crate::open::*;
+use crate::{print, println};
+use clap::Args;
+use glam::Vec3;
+use std::path::PathBuf;
+use voxsplat::{scene, Composite, Direction, Error, Kernel, OrderKind, RenderOptions, Result};
+
+/// The switches of `voxsplat-lab render` that measure the renderer rather than set up a picture: the
+/// reference and the k line, the engine's paths and budgets kept apart from the defaults.
+#[derive(Args, Clone, Debug, Default)]
+#[command(next_help_heading = "Research")]
+pub struct Research {
+    /// Bricked volumes: also draw the bricks that nearer ones already hide (slower; pixels move by
+    /// at most --early-termination; for measuring what dropping them saves).
+    #[arg(long)]
+    pub keep_hidden_bricks: bool,
+    /// --mode mip or minip: draw every voxel, where by default each third of a pixel draws only
+    /// the brightest voxel there (slower; the others add next to nothing).
+    #[arg(long)]
+    pub every_voxel: bool,
+    /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25) [default: 1].
+    #[arg(long, value_parser = parse_finite)]
+    pub slab_thickness: Option<f32>,
+    /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
+    /// before it takes over (0: abrupt level changes) [default: 0.75].
+    #[arg(long, value_parser = parse_finite)]
+    pub lod_band: Option<f32>,
+    /// Levels of detail above the brick too: a block of bricks seen within a pixel drawn as one
+    /// prefiltered splat (fewer splats for a large volume seen small; off by default: on this
+    /// machine kind it pays only at thumbnail sizes).
+    #[arg(long)]
+    pub lod_nodes: bool,
+    /// Draw the line where the first splat each pixel meets lies at eye distance k (Figs 3.6, 3.7).
+    #[arg(long)]
+    pub k_line: bool,
+    /// Order of drawing: front to back (the default, which lets early termination stop), or back to
+    /// front (the default where per-splat footprints go through the graphics or point pipelines).
+    #[arg(long, value_parser = ["ftb", "btf"])]
+    pub direction: Option<String>,
+    /// Memory budget for one batch of sheet summation layers (--composite sheet or slab), in MiB
+    /// [default: 256].
+    #[arg(long)]
+    pub sheet_budget_mib: Option<u64>,
+    /// Render the volumetric-summation truth (CPU, f64) with --kernel's reconstruction.
+    #[arg(long)]
+    pub truth: bool,
+}
 
 #[derive(Args)]
-pub(crate) struct RenderArgs {
+pub struct RenderArgs {
+    /// The research switches (`voxsplat-lab render`); their defaults under `voxsplat render`.
+    #[arg(skip)]
+    pub research: Research,
     #[command(flatten)]
-    scene: SceneArgs,
+    pub scene: SceneArgs,
     /// A clipping plane NX,NY,NZ,D in world space: what lies where NX x + NY y + NZ z + D < 0 is
     /// not drawn (splat centres; the ray caster cuts its rays). Up to 6.
-    #[arg(long = "clip", value_parser = parse_floats::<4>, allow_hyphen_values = true)]
-    clip: Vec<[f32; 4]>,
+    #[arg(help_heading = "View", long = "clip", value_parser = parse_floats::<4>, allow_hyphen_values = true)]
+    pub clip: Vec<[f32; 4]>,
     /// A crop box X0,Y0,Z0,X1,Y1,Z1 in world space: only what lies inside is drawn. An OME-Zarr
     /// image reads only the chunks the box needs, from the finest level whose part fits the host's
     /// memory, its values normalised by their own range.
-    #[arg(long, value_parser = parse_floats::<6>, allow_hyphen_values = true)]
-    crop: Option<[f32; 6]>,
+    #[arg(help_heading = "View", long, value_parser = parse_floats::<6>, allow_hyphen_values = true)]
+    pub crop: Option<[f32; 6]>,
     /// Composite the frame over this colour R,G,B[,A] (each in [0, 1]; A defaults to 1, opaque), as
     /// a window shows it; without it the PNG is transparent where nothing was drawn.
-    #[arg(long, value_parser = parse_background)]
-    background: Option<[f32; 4]>,
+    #[arg(help_heading = "Transfer function and mode", long, value_parser = parse_background)]
+    pub background: Option<[f32; 4]>,
     /// What each pixel shows of its ray: emission and absorption composited in order (the default);
     /// the largest value (mip) or the smallest (minip), each mapped through --colormap; the mean
     /// value (average); an X-ray (the extinction summed along the ray, a radiograph); or the
     /// surface where the values cross --iso (iso: shaded discs on the surface, whatever --tf
     /// draws). The projections need no visibility order and read every voxel (no levels of detail
     /// or early termination); --raycast casts in the same mode.
-    #[arg(long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray", "iso"])]
-    mode: String,
+    #[arg(help_heading = "Transfer function and mode", long, default_value = "composite", value_parser = ["composite", "mip", "minip", "average", "xray", "iso"])]
+    pub mode: String,
     /// The value of --mode iso's surface, in the volume file's units (a built-in scene's values lie
     /// in 0 to 1). A value the data never crosses draws nothing, and says so.
-    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
-    iso: Option<f32>,
+    #[arg(help_heading = "Transfer function and mode", long, value_parser = parse_finite, allow_hyphen_values = true)]
+    pub iso: Option<f32>,
     /// The colours of --mode mip, minip, average and xray (a transfer function preset or TOML file:
     /// its colours over the values 0 to 1; --tf still picks the voxels drawn) [default: grey]; with
     /// --mode iso, the surface takes the colour at its value [default: bone].
-    #[arg(long)]
-    colormap: Option<String>,
+    #[arg(help_heading = "Transfer function and mode", long)]
+    pub colormap: Option<String>,
     /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
     /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
-    #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
-    composite: String,
+    #[arg(help_heading = "Quality and speed", long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
+    pub composite: String,
     /// Front to back, stop drawing where what is drawn already lets at most this much light
     /// through (0 = off; the default, a quarter of an 8-bit step, changes a value by at most one
     /// step). No pixel changes by more than this.
-    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_EARLY_TERMINATION)]
-    early_termination: f32,
-    /// Bricked volumes: also draw the bricks that nearer ones already hide (slower; pixels move by
-    /// at most --early-termination; for measuring what dropping them saves).
-    #[arg(long)]
-    keep_hidden_bricks: bool,
-    /// --mode mip or minip: draw every voxel, where by default each third of a pixel draws only
-    /// the brightest voxel there (slower; the others add next to nothing).
-    #[arg(long)]
-    every_voxel: bool,
-    /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25) [default: 1].
-    #[arg(long, value_parser = parse_finite)]
-    slab_thickness: Option<f32>,
+    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_EARLY_TERMINATION)]
+    pub early_termination: f32,
     /// How footprints become pixels: instanced quads (graphics), point sprites (points), compute
     /// shaders (tile compositing / fixed-point sheet sums), or auto (on a CPU device: compute for
     /// small footprints, else point sprites where they fit, else graphics; graphics on hardware; it
     /// prints what it picked).
-    #[arg(long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"])]
-    raster: String,
+    #[arg(help_heading = "Quality and speed", long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"])]
+    pub raster: String,
     /// Draw on a grid this fraction of --size and resample it bilinearly to full size (1/16 to 1):
     /// faster where voxels cover several pixels; the added error is in docs/RESULTS.md (peers).
-    #[arg(long, value_parser = parse_finite, default_value = "1")]
-    render_scale: f32,
+    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value = "1")]
+    pub render_scale: f32,
     /// Levels of detail of a volume drawn per splat: auto (the default: where voxels project
     /// smaller than --lod-pixels, groups of them drawn as one prefiltered splat, within
     /// --lod-error; docs/MODEL.md) or off (every voxel a splat).
-    #[arg(long, value_parser = ["off", "auto"])]
-    lod: Option<String>,
+    #[arg(help_heading = "Quality and speed", long, value_parser = ["off", "auto"])]
+    pub lod: Option<String>,
     /// Largest projected cell spacing of a coarse level, in pixels (above 0, at most 64).
-    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
-    lod_pixels: f32,
+    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
+    pub lod_pixels: f32,
     /// Largest error of a coarse level, 0 to 3: how far a cell's children depart from it, or its
     /// neighbours from its linear continuation, in the opacity a ray crossing a brick (8 voxels) sees
     /// (summed down the levels), times the share of a pixel a cell smaller than one covers, and up to
     /// 4 times more where the view runs along a grid axis. On translucent volumes about the largest
     /// change of a pixel (0.04: about 10 steps of 8 bits). 3: no bound; 0: only cells equal to their
     /// children coarsen.
-    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
-    lod_error: f32,
-    /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
-    /// before it takes over (0: abrupt level changes).
-    #[arg(long, value_parser = parse_finite, default_value = "0.75")]
-    lod_band: f32,
-    /// Levels of detail above the brick too: a block of bricks seen within a pixel drawn as one
-    /// prefiltered splat (fewer splats for a large volume seen small; off by default: on this
-    /// machine kind it pays only at thumbnail sizes).
-    #[arg(long)]
-    lod_nodes: bool,
+    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
+    pub lod_error: f32,
     /// Reconstruction kernel: the piecewise cubic fitted by Crawfis and Max's criterion (the
     /// default: radius 1.6, flat sheets stay flat to 0.37 %, closest to the ray-cast picture but for
     /// narrow), Westover's Gaussian (sigma 0.6, radius 2: softer), the Hermite cubic of Crawfis and
     /// Max's support (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: sharpest and
     /// fewest fragments, but flat sheets ripple by 7.6 %).
-    #[arg(long, default_value = "crawfis-max", value_parser = ["gaussian", "cubic", "narrow", "crawfis-max"])]
-    kernel: String,
+    #[arg(help_heading = "Quality and speed", long, default_value = "crawfis-max", value_parser = ["gaussian", "cubic", "narrow", "crawfis-max"])]
+    pub kernel: String,
     /// Anti-aliasing of distant splats (chapter 3): none, Swan's d/k scaling, or an EWA low-pass.
     /// [default: none]
-    #[arg(long, value_parser = ["none", "swan", "ewa"])]
-    aa: Option<String>,
-    /// Draw the line where the first splat each pixel meets lies at eye distance k (Figs 3.6, 3.7).
-    #[arg(long)]
-    k_line: bool,
-    /// Order of drawing: front to back (the default, which lets early termination stop), or back to
-    /// front (the default where per-splat footprints go through the graphics or point pipelines).
-    #[arg(long, value_parser = ["ftb", "btf"])]
-    direction: Option<String>,
-    /// Memory budget for one batch of sheet summation layers (--composite sheet or slab), in MiB
-    /// [default: 256].
-    #[arg(long)]
-    sheet_budget_mib: Option<u64>,
+    #[arg(help_heading = "Quality and speed", long, value_parser = ["none", "swan", "ewa"])]
+    pub aa: Option<String>,
     /// Render with the ray caster at this step (in voxel spacings) instead of splatting.
-    #[arg(long, value_parser = parse_finite, conflicts_with = "truth")]
-    raycast: Option<f32>,
+    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, conflicts_with = "truth")]
+    pub raycast: Option<f32>,
     /// With --raycast: cast K x K rays per pixel and average them (the converged reference that
     /// levels of detail and anti-aliasing are scored against; 4 with --raycast 0.25 is the one
     /// docs/MODEL.md checks).
-    #[arg(long, default_value_t = 1, requires = "raycast")]
-    supersample: u32,
+    #[arg(help_heading = "Quality and speed", long, default_value_t = 1, requires = "raycast")]
+    pub supersample: u32,
     /// With --raycast: transmittance below which a ray stops.
-    #[arg(long, value_parser = parse_finite, requires = "raycast")]
-    raycast_stop: Option<f32>,
-    /// Render the volumetric-summation truth (CPU, f64) with --kernel's reconstruction.
-    #[arg(long)]
-    truth: bool,
+    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, requires = "raycast")]
+    pub raycast_stop: Option<f32>,
     /// Print per-stage times.
-    #[arg(long)]
-    timings: bool,
-    /// Under mpirun (a build with `--features mpi`): how the ranks' frames are composited,
-    /// direct-send, binary-swap (a power of two ranks) or auto (binary-swap from 4 ranks).
-    #[arg(long)]
-    compositing: Option<String>,
+    #[arg(help_heading = "Output", long)]
+    pub timings: bool,
+    /// Under mpirun (a build with `--features mpi`): how the ranks exchange their frames to
+    /// composite them, direct-send, binary-swap (a power of two ranks) or auto (binary-swap from
+    /// 4 ranks).
+    #[arg(help_heading = "Output", long)]
+    pub exchange: Option<String>,
     /// Render the frame this many times and report each stage's median (the first frames pay
     /// one-off costs: allocation, shader compilation on some drivers).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..),
+    #[arg(help_heading = "Output", long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..),
         conflicts_with_all = ["raycast", "truth"])]
-    repeat: u32,
+    pub repeat: u32,
     /// Print what the frame would draw and how (the raster, the order, the sheet batches, a
     /// volume's memory split and levels of detail) instead of rendering it.
-    #[arg(long, conflicts_with_all = ["raycast", "truth", "out", "k_line", "repeat", "timings"])]
-    plan: bool,
+    #[arg(help_heading = "Output", long, conflicts_with_all = ["raycast", "truth", "out", "k_line", "repeat", "timings"])]
+    pub plan: bool,
     /// Draw a session the viewer saved (its camera, transfer function, shading, mode, clipping and
     /// the options its keys change) of the same --volume, at --size.
-    #[arg(long, requires = "volume", conflicts_with_all = ["eye", "target", "up", "fov", "ortho", "near", "far",
+    #[arg(help_heading = "Scene and file", long, requires = "volume", conflicts_with_all = ["eye", "target", "up", "fov", "ortho", "near", "far",
         "view", "tf", "shade", "no_shade", "mode", "iso", "order", "composite", "raster", "lod", "kernel",
         "background", "clip", "crop"])]
-    session: Option<PathBuf>,
+    pub session: Option<PathBuf>,
     /// Output file, .png or .exr.
-    #[arg(long, required_unless_present = "plan")]
-    out: Option<PathBuf>,
+    #[arg(help_heading = "Output", long, required_unless_present = "plan")]
+    pub out: Option<PathBuf>,
 }
 
 /// Runs `voxsplat render`.
-pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
+pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     if let Some(path) = &a.session {
         // (clap's `requires` does not reach the flattened --volume.)
         if a.scene.volume.is_none() {
             return Err(Error::InvalidArgument("--session draws the --volume it was saved from: give it".into()));
         }
-        let s = voxsplat_cli::session::Session::load(path)?;
+        let s = crate::session::Session::load(path)?;
         (a.mode, a.composite, a.raster, a.kernel) =
             (s.mode.clone(), s.composite.clone(), s.raster.clone(), s.kernel.clone());
         a.background = Some(s.background);
@@ -174,7 +190,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     a.scene.crop = a.crop.map(|c| [[c[0], c[1], c[2]], [c[3], c[4], c[5]]]);
     // One frame: an OME-Zarr image need be read only where it is seen.
     if let Some(path) = a.scene.volume.clone().filter(|p| a.crop.is_none() && voxsplat::loaders::is_ome_zarr(p)) {
-        if let Some((seen, camera)) = voxsplat_cli::pyramid::seen_box(&a.scene, &path)? {
+        if let Some((seen, camera)) = crate::pyramid::seen_box(&a.scene, &path)? {
             (a.scene.crop, a.scene.view_read) = (Some(seen), Some(camera));
         }
     }
@@ -187,19 +203,19 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     let mode = a.mode.parse::<voxsplat::Mode>()?;
     if mode.is_projection() {
         let refuse = |flag: &str, why: &str| Err(Error::InvalidArgument(format!("--mode {mode} {flag}: {why}")));
-        if a.truth {
+        if a.research.truth {
             return refuse("--truth", "the truth composites; the projections' reference is --raycast");
         }
-        if a.k_line {
+        if a.research.k_line {
             return refuse("--k-line", "the k line marks where composited splats grow; use --mode composite");
         }
         if a.scene.order != "pbtf" {
             return refuse("--order", "a projection draws in no order");
         }
-        if a.early_termination != voxsplat::options::DEFAULT_EARLY_TERMINATION || a.keep_hidden_bricks {
+        if a.early_termination != voxsplat::options::DEFAULT_EARLY_TERMINATION || a.research.keep_hidden_bricks {
             return refuse("early termination", "a projection reads every splat along the ray");
         }
-        if a.lod.as_deref() == Some("auto") || a.lod_nodes {
+        if a.lod.as_deref() == Some("auto") || a.research.lod_nodes {
             return refuse("levels of detail", "a projection reads each voxel's value, which coarse cells do not keep");
         }
     } else if a.colormap.is_some() {
@@ -222,7 +238,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     // A volume is a bricked store classified on the device unless a mode needs host splats (the
     // ray caster reads a bricked store's isosurface).
     let cast_splats = a.raycast.is_some() && mode != voxsplat::Mode::Iso;
-    let host_splats = order != OrderKind::Pbtf || a.truth || cast_splats || a.k_line;
+    let host_splats = order != OrderKind::Pbtf || a.research.truth || cast_splats || a.research.k_line;
     let mut opts = RenderOptions::default();
     opts.mode = mode;
     // In the file's units until the scene is open (then its store's normalisation).
@@ -240,9 +256,12 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         ));
     }
     opts.direction =
-        a.direction.as_deref().map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
-    if let Some(mib) = a.sheet_budget_mib {
-        if composite == Composite::Splat || a.raycast.is_some() || a.truth {
+        a.research
+            .direction
+            .as_deref()
+            .map(|d| if d == "ftb" { Direction::FrontToBack } else { Direction::BackToFront });
+    if let Some(mib) = a.research.sheet_budget_mib {
+        if composite == Composite::Splat || a.raycast.is_some() || a.research.truth {
             return Err(Error::InvalidArgument(
                 "--sheet-budget-mib bounds the summation layers of --composite sheet or slab; this frame draws none"
                     .into(),
@@ -250,7 +269,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         }
         opts.sheet_budget_bytes = mib_bytes(mib, "--sheet-budget-mib")?;
     }
-    if let Some(t) = a.slab_thickness {
+    if let Some(t) = a.research.slab_thickness {
         if composite != Composite::Slab {
             return Err(Error::InvalidArgument(
                 "--slab-thickness sets the slabs of --composite slab; this frame draws no slabs".into(),
@@ -259,8 +278,8 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         opts.slab_thickness = t;
     }
     opts.early_termination = a.early_termination;
-    opts.cull_hidden_bricks = !a.keep_hidden_bricks;
-    opts.every_voxel = a.every_voxel;
+    opts.cull_hidden_bricks = !a.research.keep_hidden_bricks;
+    opts.every_voxel = a.research.every_voxel;
     opts.raster = a.raster.parse::<voxsplat::Raster>()?;
     opts.render_scale = a.render_scale;
     opts.lod = a.lod.as_deref().unwrap_or("auto").parse()?;
@@ -272,24 +291,27 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         opts.clip = s.clip()?;
     }
     opts.background = a.background;
-    (opts.lod_pixels, opts.lod_error, opts.lod_band) = (a.lod_pixels, a.lod_error, a.lod_band);
-    if a.lod_nodes && opts.lod == voxsplat::Lod::Off {
+    (opts.lod_pixels, opts.lod_error) = (a.lod_pixels, a.lod_error);
+    if let Some(band) = a.research.lod_band {
+        opts.lod_band = band;
+    }
+    if a.research.lod_nodes && opts.lod == voxsplat::Lod::Off {
         return Err(Error::InvalidArgument(
             "--lod-nodes draws levels of detail above the brick: it needs --lod auto (the default), not --lod off"
                 .into(),
         ));
     }
-    opts.lod_nodes = a.lod_nodes;
+    opts.lod_nodes = a.research.lod_nodes;
     opts.validate()?;
     #[cfg(feature = "mpi")]
     let launched = voxsplat::distributed::mpi::launched();
     #[cfg(not(feature = "mpi"))]
     let launched = false;
-    if let Some(c) = &a.compositing {
+    if let Some(c) = &a.exchange {
         c.parse::<voxsplat::distributed::Scheme>()?;
         if !launched {
             return Err(Error::InvalidArgument(
-                "--compositing picks how the ranks' frames are composited under mpirun (a build with --features \
+                "--exchange picks how the ranks exchange their frames under mpirun (a build with --features \
                  mpi); this run is one renderer"
                     .into(),
             ));
@@ -312,15 +334,18 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         Some(v) => Some(v),
         None => normalised_iso(bricked.as_ref(), &a.scene, a.iso)?,
     };
-    let asked =
-        if a.lod_nodes { Some("--lod-nodes") } else { a.lod.as_deref().filter(|l| *l == "auto").map(|_| "--lod auto") };
+    let asked = if a.research.lod_nodes {
+        Some("--lod-nodes")
+    } else {
+        a.lod.as_deref().filter(|l| *l == "auto").map(|_| "--lod auto")
+    };
     if let Some(flag) = asked.filter(|_| bricked.is_none() || composite != Composite::Splat) {
         return Err(Error::InvalidArgument(format!(
             "{flag}: levels of detail are drawn per splat (--composite splat) from a volume's bricked store; \
              this scene is a classified splat set (a built-in scene, --dense, another order, --truth, --raycast)"
         )));
     }
-    if a.keep_hidden_bricks && (bricked.is_none() || a.raycast.is_some() || a.truth) {
+    if a.research.keep_hidden_bricks && (bricked.is_none() || a.raycast.is_some() || a.research.truth) {
         return Err(Error::InvalidArgument(
             "--keep-hidden-bricks draws a volume's bricked store whole; this frame draws no bricks (a built-in scene, \
              --dense, another order, --truth or --raycast)"
@@ -335,8 +360,8 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     }
     let splats = bricked.as_ref().map(|b| b.store.len()).unwrap_or(set.len());
     let r_bricked = bricked.is_some();
-    let set_for_k = if a.k_line { set.clone() } else { scene::build("empty")? };
-    if a.truth && a.render_scale != 1.0 {
+    let set_for_k = if a.research.k_line { set.clone() } else { scene::build("empty")? };
+    if a.research.truth && a.render_scale != 1.0 {
         return Err(Error::InvalidArgument("--truth is the full-size reference: drop --render-scale".into()));
     }
     if a.plan {
@@ -351,7 +376,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     let mut wall = Vec::new();
     // Whether the frame went to its file band by band as it was drawn.
     let mut written = false;
-    let frame = if a.truth {
+    let frame = if a.research.truth {
         let t = std::time::Instant::now();
         let opts = voxsplat::truth::TruthOptions {
             reconstruction: voxsplat::truth::Reconstruction::Kernel(opts.kernel),
@@ -411,12 +436,12 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
     };
     let empty = frame.image.pixels.iter().all(|p| p[3] == 0.0);
     let mut image = frame.image;
-    if let (Some(bg), true) = (a.background, a.truth || a.raycast.is_some()) {
+    if let (Some(bg), true) = (a.background, a.research.truth || a.raycast.is_some()) {
         // The reference renderers have no present stage: its mirror, on the host.
         let push = voxsplat::low_level::plan::present_push(Some(bg), 1, false, cam.width, cam.height);
         voxsplat::low_level::cpu::present::present(&push, &mut image, &voxsplat::ImageF32::new(0, 0), &[]);
     }
-    if a.k_line {
+    if a.research.k_line {
         let regions = voxsplat::aa::k_regions(&set_for_k, &cam);
         if regions.iter().all(|&r| r == 0) {
             return Err(Error::InvalidArgument("--k-line needs a scene in view".into()));
@@ -462,9 +487,9 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
         if !wall.is_empty() {
             let n = wall.len();
             // Not a stage line: scripts sum those.
-            println!("frame, wall:   {:>9.3} ms (median of {n})", voxsplat_cli::bench::median(&mut wall));
+            println!("frame, wall:   {:>9.3} ms (median of {n})", crate::measure::median(&mut wall));
         }
-        if let Some(mib) = voxsplat_cli::bricked::peak_rss_mib() {
+        if let Some(mib) = crate::measure::peak_rss_mib() {
             println!("host memory, peak: {mib:.0} MiB resident");
         }
     }
@@ -475,7 +500,7 @@ pub(crate) fn render(mut a: Box<RenderArgs>) -> Result<()> {
 /// (`voxsplat::frame_bands`) drawn once, with nothing to add to the whole frame after it.
 fn streams(a: &RenderArgs, cam: &voxsplat::Camera, out: &std::path::Path) -> Result<bool> {
     let png = voxsplat::output::ImageFormat::of(out)? == voxsplat::output::ImageFormat::Png;
-    Ok(png && a.repeat == 1 && !a.k_line && voxsplat::frame_bands(cam).len() > 1)
+    Ok(png && a.repeat == 1 && !a.research.k_line && voxsplat::frame_bands(cam).len() > 1)
 }
 
 /// The last of `frames` with each stage's median time over all of them, keeping one image at a
@@ -494,7 +519,7 @@ fn median_timings(frames: impl Iterator<Item = Result<voxsplat::Rendered>>) -> R
         let mut v: Vec<f64> =
             earlier.iter().flat_map(|ts| ts.iter().filter(|s| s.stage == t.stage).map(|s| s.ms)).collect();
         v.push(t.ms);
-        t.ms = voxsplat_cli::bench::median(&mut v);
+        t.ms = crate::measure::median(&mut v);
     }
     Ok(last)
 }
@@ -539,21 +564,21 @@ fn distributed_frames(
                     .into(),
             ));
         };
-        let hints = voxsplat_cli::open::volume_hints(&a.scene)?;
+        let hints = crate::open::volume_hints(&a.scene)?;
         let reader = voxsplat::distributed::open(path, &hints)?;
-        let orientation = voxsplat_cli::open::orientation_of(&a.scene)?;
+        let orientation = crate::open::orientation_of(&a.scene)?;
         let spacing = hints.spacing.unwrap_or(reader.spacing);
         let grid = voxsplat::orient::placed_grid(reader.dims, spacing, orientation.as_ref())?;
         // Checked here; framed on the visible voxels once the ranks hold them.
-        camera_of(&a.scene, &grid, &voxsplat_cli::open::Content { orientation, bounds: None })?;
-        let tf = voxsplat_cli::open::transfer_function(&a.scene)?;
-        let shading = voxsplat_cli::open::headlight(&a.scene, grid.dims, grid.spacing, orientation);
-        let scheme: voxsplat::distributed::Scheme = a.compositing.as_deref().unwrap_or("auto").parse()?;
+        camera_of(&a.scene, &grid, &crate::open::Content { orientation, bounds: None })?;
+        let tf = crate::open::transfer_function(&a.scene)?;
+        let shading = crate::open::headlight(&a.scene, grid.dims, grid.spacing, orientation);
+        let scheme: voxsplat::distributed::Scheme = a.exchange.as_deref().unwrap_or("auto").parse()?;
         Ok((path, hints, grid, orientation, tf, shading, scheme, renderer_of(&a.scene)?))
     })();
     let (path, hints, grid, orientation, tf, shading, scheme, r) = voxsplat::distributed::mpi::agree(&world, setup)?;
     let mut d = Distributed::load(world, r, path, &hints, tf, shading, scheme)?;
-    let content = voxsplat_cli::open::Content { orientation, bounds: d.visible_bounds() };
+    let content = crate::open::Content { orientation, bounds: d.visible_bounds() };
     let cam = d.agree(camera_of(&a.scene, &grid, &content))?;
     let stored = d.stored_per_rank();
     let mut frames = Vec::new();
@@ -595,6 +620,7 @@ fn distributed_frames(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::Parser;
 
     #[derive(Parser)]
     struct Cmd {
@@ -617,11 +643,11 @@ mod tests {
         assert_eq!(voxsplat::Antialias::None, d.antialias);
         assert_eq!(a.raster.parse::<voxsplat::Raster>().unwrap(), d.raster);
         assert_eq!(a.lod.as_deref().unwrap_or("auto").parse::<voxsplat::Lod>().unwrap(), d.lod);
-        assert_eq!((a.lod_pixels, a.lod_error, a.lod_band), (d.lod_pixels, d.lod_error, d.lod_band));
+        assert_eq!((a.lod_pixels, a.lod_error, a.research.lod_band), (d.lod_pixels, d.lod_error, None));
         assert_eq!((a.early_termination, a.render_scale), (d.early_termination, d.render_scale));
-        assert_eq!((a.sheet_budget_mib, mib_bytes(256, "").unwrap()), (None, d.sheet_budget_bytes));
-        assert_eq!((a.direction.is_none(), d.direction.is_none()), (true, true));
+        assert_eq!((a.research.sheet_budget_mib, mib_bytes(256, "").unwrap()), (None, d.sheet_budget_bytes));
+        assert_eq!((a.research.direction.is_none(), d.direction.is_none()), (true, true));
         assert_eq!(a.background, d.background);
-        assert_eq!((a.every_voxel, !a.keep_hidden_bricks), (d.every_voxel, d.cull_hidden_bricks));
+        assert_eq!((a.research.every_voxel, !a.research.keep_hidden_bricks), (d.every_voxel, d.cull_hidden_bricks));
     }
 }

@@ -11,6 +11,9 @@ pub struct SceneArgs {
     /// the flags that would give them.
     #[arg(skip)]
     pub session: Option<crate::session::Session>,
+    /// The research switches (`voxsplat-lab`); off under `voxsplat`.
+    #[arg(skip)]
+    pub research: SceneResearch,
     /// What `render` draws of the volume (lo, hi): --crop's box, or the part of an OME-Zarr image
     /// its one view sees; an OME-Zarr image reads only what it needs there.
     #[arg(skip)]
@@ -23,32 +26,32 @@ pub struct SceneArgs {
     #[arg(skip)]
     pub progress: Option<voxsplat::loaders::Progress>,
     /// Built-in scene name (see `voxsplat scenes`).
-    #[arg(long, default_value = "cube60", conflicts_with_all = ["volume", "terrain", "labels"])]
+    #[arg(help_heading = "Scene and file", long, default_value = "cube60", conflicts_with_all = ["volume", "terrain", "labels"])]
     pub scene: String,
     /// Eye position (default: the --view's; patient RAS coordinates for a file with an anatomical
     /// frame, the grid's centred frame otherwise).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(help_heading = "View", long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
     /// Look-at point (default: the centre of what the view frames; coordinates as --eye's).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(help_heading = "View", long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub target: Option<Vec3>,
     /// Up vector (default: +y; superior for data with an anatomical frame).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(help_heading = "View", long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees (perspective).
-    #[arg(long, value_parser = parse_finite, conflicts_with = "ortho", allow_hyphen_values = true)]
+    #[arg(help_heading = "View", long, value_parser = parse_finite, conflicts_with = "ortho", allow_hyphen_values = true)]
     pub fov: Option<f32>,
     /// Orthographic projection with this view height (world units).
-    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    #[arg(help_heading = "View", long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub ortho: Option<f32>,
     /// Near plane distance (default: fitted to the scene).
-    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    #[arg(help_heading = "View", long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub near: Option<f32>,
     /// Far plane distance (default: fitted to the scene).
-    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true)]
+    #[arg(help_heading = "View", long, value_parser = parse_finite, allow_hyphen_values = true)]
     pub far: Option<f32>,
     /// Image size.
-    #[arg(long, value_parser = parse_size, default_value = "512x512")]
+    #[arg(help_heading = "View", long, value_parser = parse_size, default_value = "512x512")]
     pub size: (u32, u32),
     /// Preset view: auto (fly-over for terrain, VTK's camera for the peer scenes, the oblique
     /// anatomical view for data with an anatomical frame, framing otherwise), a three-quarter
@@ -57,98 +60,109 @@ pub struct SceneArgs {
     /// places it in patient space (NIfTI sform/qform, NRRD space), superior up: anterior,
     /// posterior, left, right, superior and inferior (anterior up), oblique (anterior, a little
     /// right and above). Volumes are framed on the voxels the transfer function shows.
-    #[arg(long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover", "peer",
+    #[arg(help_heading = "View", long, default_value = "auto", value_parser = ["auto", "framing", "grazing", "flyover", "peer",
         "anterior", "posterior", "left", "right", "superior", "inferior", "oblique"])]
     pub view: String,
     /// Render a volume file (.nrrd/.nhdr, .nii/.nii.gz, .npy, a multipage .tif, a DICOM series (its
     /// folder or a file of it), an OME-Zarr image's folder, a folder of numbered PNG or TIFF slices,
     /// or raw with --dims and --dtype); a series of numbered files as a quoted pattern
     /// ('scan_*.nii.gz', one time point each).
-    #[arg(long, conflicts_with = "terrain")]
+    #[arg(help_heading = "Scene and file", long, conflicts_with = "terrain")]
     pub volume: Option<PathBuf>,
     /// Raw volume dimensions.
-    #[arg(long, value_parser = parse_dims, requires = "volume")]
+    #[arg(help_heading = "Scene and file", long, value_parser = parse_dims, requires = "volume")]
     pub dims: Option<[u32; 3]>,
     /// Raw sample type.
-    #[arg(long, value_parser = ["u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"], requires = "volume")]
+    #[arg(help_heading = "Scene and file", long, value_parser = ["u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"], requires = "volume")]
     pub dtype: Option<String>,
     /// Raw data is big-endian.
-    #[arg(long, requires = "volume")]
+    #[arg(help_heading = "Scene and file", long, requires = "volume")]
     pub big_endian: bool,
     /// Voxel spacing (overrides the file's).
-    #[arg(long, value_parser = parse_vec3, requires = "volume")]
+    #[arg(help_heading = "Scene and file", long, value_parser = parse_vec3, requires = "volume")]
     pub spacing: Option<Vec3>,
     /// A folder of several DICOM series: the one to read (its number in `voxsplat info DIR`'s
     /// list, or its Series Instance UID).
-    #[arg(long)]
+    #[arg(help_heading = "Scene and file", long)]
     pub series: Option<String>,
     /// An OME-Zarr image's pyramid level to draw (`voxsplat info` lists them), or `auto`: the
     /// coarsest whose voxels span at most 0.75 px in this view, which reads only that level's
     /// chunks but averages thin structures away (a preview). By default the finest the host's
     /// memory holds.
-    #[arg(long, value_parser = parse_level, requires = "volume")]
+    #[arg(help_heading = "Scene and file", long, value_parser = parse_level, requires = "volume")]
     pub level: Option<String>,
     /// The time point of a series to draw: a 4-D NIfTI or NRRD, an OME-Zarr image, a DICOM series
     /// of several temporal positions, a pattern of numbered files (needed when it holds several;
     /// `voxsplat animate --volume` plays them all).
-    #[arg(long, requires = "volume")]
+    #[arg(help_heading = "Scene and file", long, requires = "volume")]
     pub time: Option<u32>,
     /// A rectilinear grid's voxel positions: a TOML file whose x, y, z arrays give every voxel's
     /// world coordinate along that axis (e.g. irregular CT slices; an axis left out keeps the even
     /// spacing). Draws the volume as host splats.
-    #[arg(long, requires = "volume")]
+    #[arg(help_heading = "Scene and file", long, requires = "volume")]
     pub positions: Option<PathBuf>,
     /// Transfer function for --volume: a preset (ramp, ct, bonsai, mri) or a TOML file [default:
     /// ramp].
-    #[arg(long)]
+    #[arg(help_heading = "Transfer function and mode", long)]
     pub tf: Option<String>,
     /// Phong shading with a headlight, applied to the voxels before splatting (on by default for
     /// the presets it measurably helps: bonsai).
-    #[arg(long, conflicts_with = "no_shade")]
+    #[arg(help_heading = "Transfer function and mode", long, conflicts_with = "no_shade")]
     pub shade: bool,
     /// No shading, even for a preset shaded by default.
-    #[arg(long)]
+    #[arg(help_heading = "Transfer function and mode", long)]
     pub no_shade: bool,
     /// A label volume (a segmentation: one whole number per voxel, u8, u16 or u32) coloured by
     /// --label-table, drawn alone or over the --volume on the same grid (the two added per voxel).
     /// Label 0 is the background; voxels whose label the table lacks are hidden and counted.
-    #[arg(long, requires = "label_table", conflicts_with_all = ["terrain", "channels", "positions"])]
+    #[arg(help_heading = "Scene and file", long, requires = "label_table", conflicts_with_all = ["terrain", "channels", "positions"])]
     pub labels: Option<PathBuf>,
     /// The label table, TOML: one [[label]] per label with value, color = [r, g, b], opacity and
     /// optionally visible = false (docs/guide/cli.md).
-    #[arg(long, requires = "labels")]
+    #[arg(help_heading = "Scene and file", long, requires = "labels")]
     pub label_table: Option<PathBuf>,
     /// Another channel of the --volume (a scalar volume on its grid; up to 4 channels in all, a
     /// 4-D NIfTI --volume's own included), classified by its own --channel-tf and added per
     /// voxel: emission and extinction summed.
-    #[arg(long = "channel", requires = "volume", conflicts_with = "positions")]
+    #[arg(help_heading = "Scene and file", long = "channel", requires = "volume", conflicts_with = "positions")]
     pub channels: Vec<PathBuf>,
     /// The transfer function of each channel after the first (--tf's): a 4-D NIfTI --volume's
     /// further channels, then each --channel, in order (a preset or a TOML file).
-    #[arg(long = "channel-tf", requires = "volume")]
+    #[arg(help_heading = "Scene and file", long = "channel-tf", requires = "volume")]
     pub channel_tfs: Vec<String>,
     /// Render a height grid (16-bit PNG, GeoTIFF, or 2D .npy) as voxel columns.
-    #[arg(long)]
+    #[arg(help_heading = "Scene and file", long)]
     pub terrain: Option<PathBuf>,
     /// Colour image for --terrain (default: hypsometric ramp with hillshade).
-    #[arg(long, requires = "terrain")]
+    #[arg(help_heading = "Scene and file", long, requires = "terrain")]
     pub color: Option<PathBuf>,
     /// Vertical exaggeration for --terrain.
-    #[arg(long, value_parser = parse_finite, default_value = "1")]
+    #[arg(help_heading = "Scene and file", long, value_parser = parse_finite, default_value = "1")]
     pub vscale: f32,
     /// Horizontal cell size of --terrain, in height units (0: relief a sixth of the width).
-    #[arg(long, value_parser = parse_finite, default_value = "0")]
+    #[arg(help_heading = "Scene and file", long, value_parser = parse_finite, default_value = "0")]
     pub cell: f32,
     /// Visibility order.
-    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
+    #[arg(help_heading = "Quality and speed", long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
     pub order: String,
     /// Render on the CPU instead of the Vulkan device: every GPU step has a CPU twin that computes
     /// the same picture to within rounding (slower; for checking a device).
-    #[arg(long)]
+    #[arg(help_heading = "Quality and speed", long)]
     pub cpu: bool,
     /// Enable the Khronos validation layer and report its messages.
-    #[arg(long)]
+    #[arg(help_heading = "Output", long)]
     pub validation: bool,
+    /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
+    /// batches [default: 1024 on a CPU device such as lavapipe, half the GPU's memory on a GPU].
+    #[arg(help_heading = "Quality and speed", long)]
+    pub gpu_budget_mib: Option<u64>,
+}
+
+/// The scene switches of `voxsplat-lab render` that pick the engine's path rather than the picture:
+/// the split between the device and the mirrors, and the host's classification.
+#[derive(Args, Clone, Debug, Default)]
+#[command(next_help_heading = "Research")]
+pub struct SceneResearch {
     /// Split each frame between Vulkan and the CPU mirrors at a stage, to find the stage that
     /// departs from its mirror: gpu-until:STAGE (the device runs the stages before STAGE, the
     /// mirrors the rest) or cpu-until:STAGE. Stages: see src/stages.rs.
@@ -160,8 +174,4 @@ pub struct SceneArgs {
     /// detail need it).
     #[arg(long)]
     pub dense: bool,
-    /// Device memory a frame may hold, in MiB: a bricked volume's splats stream through it in
-    /// batches [default: 1024 on a CPU device such as lavapipe, half the GPU's memory on a GPU].
-    #[arg(long)]
-    pub gpu_budget_mib: Option<u64>,
 }

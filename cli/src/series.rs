@@ -1,4 +1,4 @@
-//! A volume's time points played as frames (`voxsplat animate --volume`, `voxsplat lab series`):
+//! A volume's time points played as frames (`voxsplat animate --volume`, `voxsplat-lab series`):
 //! the series' value range read once, then each time point built as a store normalised by it and
 //! swapped into the renderer (`Renderer::update_volume`), which rewrites only the bricks that
 //! changed on the device.
@@ -41,7 +41,6 @@ impl Series {
         let refused = [
             (a.time.is_some(), "--time", "it draws one time point (voxsplat render --time N); animate plays them all"),
             (a.level.as_deref() == Some("auto"), "--level auto", "it picks a level for one view: give --level N"),
-            (a.dense, "--dense", "a series plays from its bricked store"),
             (a.positions.is_some(), "--positions", "a series plays from its bricked store, on a uniform grid"),
             (a.labels.is_some(), "--labels", "a series plays one scalar volume"),
             (!a.channels.is_empty() || !a.channel_tfs.is_empty(), "--channel", "a series plays one scalar volume"),
@@ -192,7 +191,7 @@ pub fn play(
     ))
 }
 
-/// `voxsplat lab series`: per time point after the first, swapping it into a renderer that holds
+/// `voxsplat-lab series`: per time point after the first, swapping it into a renderer that holds
 /// the last (`update_volume`) against setting it afresh on another (`set_bricks`, as a program
 /// without `update_volume` would), each followed by two frames (the first derives what the new
 /// values need: levels of detail, gradients); alternated time point by time point so drift falls

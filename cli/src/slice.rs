@@ -1,6 +1,7 @@
 //! `voxsplat slice`: one plane of a volume's voxels as a grey PNG, windowed (the views of the data
 //! that a viewer shows beside the frame).
 use super::*;
+use voxsplat_cli::println;
 
 #[derive(Args)]
 pub(crate) struct SliceArgs {

@@ -1088,3 +1088,56 @@ fn bench_runs_named_cases_and_compares_reports() {
         cmd::refused(&["bench", "--case", "bonsai", "--data", "/nonexistent", "--cache", cache.to_str().unwrap()]);
     assert!(text.contains("no case ran"), "{text}");
 }
+
+/// `voxsplat render --help` lists the options a user sets, each under a heading (scene and file,
+/// view, transfer function and mode, quality and speed, output), and none of the research
+/// switches; `voxsplat-lab render --help` lists those too, under their own heading, and the user's
+/// binary refuses them by name.
+#[test]
+fn render_s_help_is_the_user_s_and_the_lab_s_adds_the_research_switches() {
+    let help = |args: &[&str]| {
+        let out = voxsplat(args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    // (heading, the long options under it)
+    let sections = |text: &str| -> Vec<(String, Vec<String>)> {
+        let mut s: Vec<(String, Vec<String>)> = Vec::new();
+        for line in text.lines() {
+            if !line.starts_with(' ') && line.ends_with(':') {
+                s.push((line.trim_end_matches(':').to_string(), Vec::new()));
+            } else if let Some(flag) = line.trim_start().strip_prefix("--").filter(|_| line.starts_with("  ")) {
+                let name = flag.split([' ', ',']).next().unwrap().to_string();
+                if line.len() - line.trim_start().len() <= 6 {
+                    s.last_mut().expect("an option before any heading").1.push(name);
+                }
+            }
+        }
+        s
+    };
+    let user = sections(&help(&["render", "--help"]));
+    let headings: Vec<&str> = user.iter().map(|(h, _)| h.as_str()).collect();
+    assert_eq!(
+        headings,
+        ["Options", "Scene and file", "View", "Transfer function and mode", "Quality and speed", "Output"],
+        "{user:?}"
+    );
+    // Under "Options" only what every command takes (and `-h, --help`).
+    assert_eq!(user[0].1, ["host-budget-mib"], "options without a heading");
+    let all: Vec<&String> = user.iter().flat_map(|(_, o)| o).collect();
+    for switch in cmd::RESEARCH {
+        assert!(!all.iter().any(|o| format!("--{o}") == switch), "{switch} in voxsplat render --help");
+        let out = cmd::user_binary(&["render", "--scene", "cube40", switch, "--out", "x.png"]);
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.code() == Some(2) && e.starts_with("error:") && e.contains(switch), "{e}");
+    }
+    let lab = sections(&help(&["lab", "render", "--help"]));
+    let research = &lab.iter().find(|(h, _)| h == "Research").expect("a Research heading").1;
+    let mut want: Vec<String> = cmd::RESEARCH.iter().map(|s| s.trim_start_matches("--").to_string()).collect();
+    let mut got = research.clone();
+    want.sort();
+    got.sort();
+    assert_eq!(got, want);
+    let lab_all: Vec<&String> = lab.iter().flat_map(|(_, o)| o).collect();
+    assert_eq!(lab_all.len(), all.len() + cmd::RESEARCH.len(), "the lab's render takes every user option");
+}

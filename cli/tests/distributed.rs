@@ -79,7 +79,7 @@ fn one_two_and_four_ranks_draw_the_single_process_frame() {
         for (ranks, scheme) in [(1, "auto"), (2, "auto"), (4, "binary-swap"), (4, "direct-send")] {
             let out = tmp(&format!("{view}-{ranks}-{scheme}.exr"));
             let mut a = args.clone();
-            a.extend(["--compositing", scheme, "--out", out.to_str().unwrap()]);
+            a.extend(["--exchange", scheme, "--out", out.to_str().unwrap()]);
             let run = mpirun(ranks, &a);
             ok(&run, &format!("{view}, {ranks} ranks, {scheme}"));
             let err = String::from_utf8_lossy(&run.stderr);
@@ -93,14 +93,14 @@ fn one_two_and_four_ranks_draw_the_single_process_frame() {
 #[test]
 fn every_per_splat_mode_draws_the_single_process_frame_on_four_ranks() {
     // The compute tile raster, point sprites, levels of detail, shading (gradients across the
-    // boxes' faces read the voxel layer each rank holds around its box), back to front, a
-    // background laid under the composite at rank 0.
+    // boxes' faces read the voxel layer each rank holds around its box), quads back to front (the
+    // graphics raster's order), a background laid under the composite at rank 0.
     let modes: [&[&str]; 6] = [
         &["--raster", "compute"],
         &["--raster", "points", "--kernel", "narrow"],
         &["--lod", "auto"],
         &["--shade"],
-        &["--direction", "btf", "--raster", "graphics"],
+        &["--raster", "graphics"],
         &["--background", "0.1,0.2,0.3"],
     ];
     for (i, mode) in modes.iter().enumerate() {

@@ -271,7 +271,7 @@ fn flags_that_were_silently_ignored_are_refused() {
         (vec!["render", "--volume", &stent, "--raycast", "0.5", "--aa", "swan"], "--aa filters splats"),
         (vec!["render", "--volume", &stent, "--raycast", "0.5", "--aa", "none"], "--aa filters splats"),
         (vec!["render", "--volume", &stent, "--dense", "--keep-hidden-bricks"], "--keep-hidden-bricks draws"),
-        (vec!["render", "--compositing", "direct-send"], "--compositing picks how the ranks"),
+        (vec!["render", "--exchange", "direct-send"], "--exchange picks how the ranks"),
     ] {
         fails_with(&[&args[..], &["--size", "32x32", "--out", o]].concat(), needle);
     }

@@ -20,7 +20,6 @@ mod readme;
 mod reliability;
 mod sample_types;
 mod series;
-mod stability;
 mod view;
 mod viewer;
 mod zarr;

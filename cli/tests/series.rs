@@ -103,7 +103,6 @@ fn flags_that_cannot_apply_to_a_series_are_refused() {
         ("--anim", "rotating-box", "time points are the frames"),
         ("--blur", "none", "time points are the frames"),
         ("--order", "btf", "PBTF order"),
-        ("--dense", "", "bricked store"),
     ] {
         let mut args = vec!["animate", "--volume", nii, "--out-dir", out, flag];
         if !value.is_empty() {

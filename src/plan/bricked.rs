@@ -389,7 +389,8 @@ pub fn plan(
         let Some(left) = available.checked_sub(layer_bytes).filter(|&a| a >= brick_bytes) else {
             return Err(Error::TooLarge(format!(
                 "the {} MiB GPU budget cannot hold this volume's store, {layers} summation layers of {w}x{h} and one \
-                 brick of splats: raise it by {} MiB or lower --sheet-budget-mib",
+                 brick of splats: raise it (--gpu-budget-mib) by {} MiB, or lower the sheet budget \
+                 (voxsplat-lab render --sheet-budget-mib)",
                 limits.budget_bytes >> 20,
                 (layer_bytes + brick_bytes).saturating_sub(available).div_ceil(1 << 20)
             )));

@@ -90,7 +90,7 @@ impl CaseResult {
             nodes,
             msplats_per_s: splats as f64 / median_ms / 1e3,
             device_mib: device_bytes as f64 / 1048576.0,
-            host_peak_mib: crate::bricked::peak_rss_mib().unwrap_or(f64::NAN),
+            host_peak_mib: crate::measure::peak_rss_mib().unwrap_or(f64::NAN),
             psnr_db: psnr_db.map(|p| if p.is_finite() { p } else { 99.0 }),
             load_s,
             raster: last.raster.as_ref().map(|c| format!("{} ({})", c.raster, c.reason)).unwrap_or_default(),

@@ -2,9 +2,48 @@
 #![allow(dead_code)]
 use std::process::{Command, Output};
 
-/// `voxsplat ARGS`, waited for.
+/// The research switches of `render`, which only `voxsplat-lab render` takes.
+pub const RESEARCH: [&str; 11] = [
+    "--truth",
+    "--k-line",
+    "--bisect",
+    "--dense",
+    "--every-voxel",
+    "--lod-band",
+    "--lod-nodes",
+    "--sheet-budget-mib",
+    "--direction",
+    "--keep-hidden-bricks",
+    "--slab-thickness",
+];
+
+/// `voxsplat ARGS`, waited for. Two kinds run the lab's binary: `["lab", STUDY, ...]` runs
+/// `voxsplat-lab STUDY ...`, and a `render` with a research switch (`RESEARCH`) runs as
+/// `voxsplat-lab render` (the same command with those switches).
 pub fn voxsplat(args: &[&str]) -> Output {
+    let (bin, args) = match args {
+        ["lab", rest @ ..] => (lab_binary(), rest),
+        ["render", ..] if args.iter().any(|a| RESEARCH.contains(a)) => (lab_binary(), args),
+        _ => (std::path::PathBuf::from(env!("CARGO_BIN_EXE_voxsplat")), args),
+    };
+    Command::new(&bin).args(args).output().unwrap_or_else(|e| panic!("run {}: {e}", bin.display()))
+}
+
+/// `voxsplat ARGS` itself, whatever they are (`voxsplat` routes some to the lab).
+pub fn user_binary(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_voxsplat")).args(args).output().expect("run voxsplat")
+}
+
+/// `voxsplat-lab`, beside `voxsplat` in the target directory: a package of its own (`lab/`), which
+/// the top level's `cargo test` builds with its tests.
+pub fn lab_binary() -> std::path::PathBuf {
+    let lab = std::path::Path::new(env!("CARGO_BIN_EXE_voxsplat")).with_file_name("voxsplat-lab");
+    assert!(
+        lab.exists(),
+        "{} is not built: run `cargo test` at the top level, or `cargo build -p voxsplat-lab`",
+        lab.display()
+    );
+    lab
 }
 
 /// A path in this test process's own temporary directory (`tag` names the test file).

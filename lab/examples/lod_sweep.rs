@@ -3,7 +3,7 @@
 //! (e.g. `voxsplat render --volume F --raycast 0.25 --cpu`), then median frame times of three rounds
 //! with the variants alternating in one process.
 //!
-//! `cargo run --release -p voxsplat-cli --example lod_sweep -- FILE TF TRUTH.exr 1,0.1 2,1e30 ...`
+//! `cargo run --release -p voxsplat-lab --example lod_sweep -- FILE TF TRUTH.exr 1,0.1 2,1e30 ...`
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
 use voxsplat::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
@@ -35,8 +35,8 @@ fn main() -> voxsplat::Result<()> {
     for v in &variants {
         psnr.push(voxsplat::metrics::compare(&r.render(&cam, &options(v))?.image, &truth)?.psnr);
     }
-    let times = voxsplat_cli::bench::alternating_medians(variants.len(), 0, 3, |v| {
-        voxsplat_cli::bricked::frame_ms(&mut r, &cam, &options(&variants[v]))
+    let times = voxsplat_lab::bench::alternating_medians(variants.len(), 0, 3, |v| {
+        voxsplat_lab::bricked::frame_ms(&mut r, &cam, &options(&variants[v]))
     })?;
     println!("| cut (pixels, error) | PSNR dB | median ms | × full detail |\n|---|---:|---:|---:|");
     for ((v, p), t) in variants.iter().zip(&psnr).zip(&times) {

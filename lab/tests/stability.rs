@@ -5,7 +5,7 @@ use glam::Vec3;
 use voxsplat::output::diff_rgba8;
 use voxsplat::ImageF32;
 use voxsplat::{Camera, Composite, Direction, Grid, Kernel, OrderKind, Projection, RenderOptions, SplatSet};
-use voxsplat_cli::stability::{self, Variant};
+use voxsplat_lab::stability::{self, Variant};
 
 #[test]
 fn slice_table_starts_at_zero_rises_and_ends_at_the_footprint() {

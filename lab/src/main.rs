@@ -1,11 +1,49 @@
-//! `voxsplat lab`: the studies that measure the renderer, apart from the user's commands. Each
+//! `voxsplat-lab`: the studies that measure the renderer, apart from the user's commands. Each
 //! prints a markdown section or CSV that `scripts/results.sh` gathers into docs/RESULTS.md; none of
-//! them is needed to render. docs/guide/lab.md says why they are a subcommand and not a binary.
-use super::*;
+//! them is needed to render. `voxsplat-lab render` is `voxsplat render` with the research switches
+//! (the truth, the k line, the engine's paths and budgets). docs/guide/lab.md says why they are a
+//! binary of their own.
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use voxsplat::{Error, Renderer, RendererOptions, Result};
+use voxsplat_cli::open::*;
+use voxsplat_cli::render::{RenderArgs, Research};
+use voxsplat_cli::scene_args::SceneResearch;
+use voxsplat_cli::{print, println};
+
+#[derive(Parser)]
+#[command(
+    name = "voxsplat-lab",
+    version,
+    about = "Studies that measure the voxsplat renderer (for its developers), and render with the research switches"
+)]
+struct Lab {
+    #[command(subcommand)]
+    study: Study,
+    /// Host memory, in MiB, that what a file's header or a flag sizes may take (as `voxsplat`'s)
+    /// [default: three quarters of physical memory].
+    #[arg(long, global = true)]
+    host_budget_mib: Option<u64>,
+}
+
+/// `voxsplat render`'s flags and the research switches.
+#[derive(Args)]
+struct LabRender {
+    #[command(flatten)]
+    render: RenderArgs,
+    #[command(flatten)]
+    research: Research,
+    #[command(flatten)]
+    scene_research: SceneResearch,
+}
 
 /// A study of the renderer.
 #[derive(Subcommand)]
-pub(crate) enum Study {
+enum Study {
+    /// `voxsplat render` with the research switches: the volumetric-summation truth, the k line,
+    /// the engine's paths (--dense, --bisect, --direction, ...) and budgets.
+    Render(Box<LabRender>),
     /// Render many frames with changing scenes, cameras and modes; report host memory and GPU
     /// allocations per cycle (they must stay flat after warm-up).
     Soak {
@@ -195,7 +233,7 @@ pub(crate) enum Study {
 }
 
 #[derive(Args)]
-pub(crate) struct MatrixArgs {
+struct MatrixArgs {
     /// A small matrix (two scenes at 128x128) that CI can afford.
     #[arg(long)]
     quick: bool,
@@ -215,8 +253,13 @@ pub(crate) struct MatrixArgs {
 }
 
 /// Runs one study.
-pub(crate) fn run(study: Study) -> Result<()> {
+fn run(study: Study) -> Result<()> {
     match study {
+        Study::Render(a) => {
+            let LabRender { mut render, research, scene_research } = *a;
+            (render.research, render.scene.research) = (research, scene_research);
+            voxsplat_cli::render::render(Box::new(render))
+        }
         Study::Series(a) => {
             print!("{}", voxsplat_cli::series::study(&a)?);
             Ok(())
@@ -256,8 +299,8 @@ pub(crate) fn run(study: Study) -> Result<()> {
             }
             let mut r = Renderer::new(&RendererOptions::default())?;
             eprintln!("device: {}", r.device_name());
-            let pts = voxsplat_cli::rates::raster_rates(&mut r, n, &sizes, frames, |m| eprintln!("{m}"))?;
-            print!("{}", voxsplat_cli::rates::rates_csv(&pts));
+            let pts = voxsplat_lab::rates::raster_rates(&mut r, n, &sizes, frames, |m| eprintln!("{m}"))?;
+            print!("{}", voxsplat_lab::rates::rates_csv(&pts));
             Ok(())
         }
         Study::Peer { n, size, warmup, frames, out_dir, truth_step } => {
@@ -288,7 +331,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
             }
             let mut r = Renderer::new(&RendererOptions::default())?;
             println!("label,median_ms");
-            for run in voxsplat_cli::peer::time_variants(&mut r, n, size, warmup, frames)? {
+            for run in voxsplat_lab::peer::time_variants(&mut r, n, size, warmup, frames)? {
                 println!("{},{:.2}", run.label, run.median_ms);
                 let file = format!("voxsplat-{}-{n}.png", run.label.replace(' ', "-"));
                 voxsplat::output::write_image(&run.image, &out_dir.join(file))?;
@@ -303,7 +346,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
             ro.validation = validation;
             let mut r = Renderer::new(&ro)?;
             let bar = indicatif::ProgressBar::new(frames as u64);
-            let rep = voxsplat_cli::soak::soak(&mut r, frames, size, |_| bar.inc(1))?;
+            let rep = voxsplat_lab::soak::soak(&mut r, frames, size, |_| bar.inc(1))?;
             bar.finish_and_clear();
             println!("frames: {}", rep.frames);
             println!("cycle,rss_mib,gpu_allocations,gpu_bytes");
@@ -315,7 +358,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
             let step = rep.rss_median_step() as f64 / (1u64 << 20) as f64;
             println!(
                 "rss median step per cycle after warm-up: {step:.2} MiB ({} frames per cycle)",
-                voxsplat_cli::soak::CYCLE
+                voxsplat_lab::soak::CYCLE
             );
             println!("validation messages: {}", rep.validation_messages);
             Ok(())
@@ -331,8 +374,8 @@ pub(crate) fn run(study: Study) -> Result<()> {
                     "--size in 16..=2048, --factor in 1..=16, --dolly at least 2, --frames at least 1".into(),
                 ));
             }
-            let rows = voxsplat_cli::antialias::study(size, factor, dolly, frames)?;
-            print!("{}", voxsplat_cli::antialias::markdown(&rows, factor, dolly));
+            let rows = voxsplat_lab::antialias::study(size, factor, dolly, frames)?;
+            print!("{}", voxsplat_lab::antialias::markdown(&rows, factor, dolly));
             Ok(())
         }
         Study::MotionOrders { first, frames, rounds } => {
@@ -341,26 +384,26 @@ pub(crate) fn run(study: Study) -> Result<()> {
                     "--frames at least 1, --first + --frames at most 24, --rounds at least 1".into(),
                 ));
             }
-            let (orders, blurs) = voxsplat_cli::motion_orders::study(first, frames, rounds)?;
-            print!("{}", voxsplat_cli::motion_orders::markdown(&orders, &blurs, first, frames));
+            let (orders, blurs) = voxsplat_lab::motion_orders::study(first, frames, rounds)?;
+            print!("{}", voxsplat_lab::motion_orders::markdown(&orders, &blurs, first, frames));
             Ok(())
         }
         Study::Kernels { n, size, frames, chart } => {
             if !(16..=512).contains(&n) || !(16..=4096).contains(&size) || frames == 0 {
                 return Err(Error::InvalidArgument("--n in 16..=512, --size in 16..=4096, --frames at least 1".into()));
             }
-            let rows = voxsplat_cli::kernels::study(n, size, frames)?;
+            let rows = voxsplat_lab::kernels::study(n, size, frames)?;
             if let Some(c) = &chart {
-                voxsplat_cli::kernels::chart(&rows, c)?;
+                voxsplat_lab::kernels::chart(&rows, c)?;
             }
-            print!("{}", voxsplat_cli::kernels::markdown(&rows, n, size, chart.as_deref()));
+            print!("{}", voxsplat_lab::kernels::markdown(&rows, n, size, chart.as_deref()));
             Ok(())
         }
         Study::Modes { size, frames, charts, data } => {
             if !(16..=4096).contains(&size) || frames == 0 {
                 return Err(Error::InvalidArgument("--size in 16..=4096, --frames at least 1".into()));
             }
-            let volume = |name: &str, file: &str, tf: &str, iso: f32| voxsplat_cli::modes::ModeVolume {
+            let volume = |name: &str, file: &str, tf: &str, iso: f32| voxsplat_lab::modes::ModeVolume {
                 name: name.into(),
                 path: data.join(file),
                 tf: tf.into(),
@@ -370,12 +413,12 @@ pub(crate) fn run(study: Study) -> Result<()> {
                 volume("bonsai", "bonsai/bonsai.nii.gz", "bonsai", 60.0),
                 volume("stent", "stent/stent.nrrd", "ct", 1000.0),
             ];
-            let (rows, device) = voxsplat_cli::modes::study(&volumes, size, frames)?;
-            let written = voxsplat_cli::modes::charts(&rows, &charts)?;
-            print!("{}", voxsplat_cli::modes::markdown(&rows, &device, size, frames, &written));
+            let (rows, device) = voxsplat_lab::modes::study(&volumes, size, frames)?;
+            let written = voxsplat_lab::modes::charts(&rows, &charts)?;
+            print!("{}", voxsplat_lab::modes::markdown(&rows, &device, size, frames, &written));
             Ok(())
         }
-        Study::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => voxsplat_cli::bench::scaling_chart(&csv, &svg),
+        Study::Bricks { chart: Some(csv), chart_out: Some(svg), .. } => voxsplat_lab::bench::scaling_chart(&csv, &svg),
         Study::Bricks {
             bonsai,
             large,
@@ -396,7 +439,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
             }
             if let (Some(v), Some(steps)) = (&volume, orbit) {
                 let budget = mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?;
-                let arc = voxsplat_cli::bricked::Arc { steps, degrees: arc };
+                let arc = voxsplat_lab::bricked::Arc { steps, degrees: arc };
                 if let Some(fov) = fov {
                     if !voxsplat::loaders::is_ome_zarr(v) {
                         return Err(Error::InvalidArgument(format!(
@@ -408,16 +451,16 @@ pub(crate) fn run(study: Study) -> Result<()> {
                         0 => 0,
                         m => mib_bytes(m, "--chunk-cache-mib")?,
                     };
-                    print!("{}", voxsplat_cli::bricked::zarr_orbit(v, size, budget, &tf, arc, fov, cache)?);
+                    print!("{}", voxsplat_lab::bricked::zarr_orbit(v, size, budget, &tf, arc, fov, cache)?);
                     return Ok(());
                 }
-                print!("{}", voxsplat_cli::bricked::orbit(v, size, budget, &tf, arc)?);
+                print!("{}", voxsplat_lab::bricked::orbit(v, size, budget, &tf, arc)?);
                 return Ok(());
             }
             match volume {
                 Some(v) => println!(
                     "{}",
-                    voxsplat_cli::bricked::one_volume(
+                    voxsplat_lab::bricked::one_volume(
                         &v,
                         size,
                         mib_bytes(gpu_budget_mib, "--gpu-budget-mib")?,
@@ -427,7 +470,7 @@ pub(crate) fn run(study: Study) -> Result<()> {
                 ),
                 None => print!(
                     "{}",
-                    voxsplat_cli::bricked::study(&bonsai, large.as_deref(), size, frames, lod_chart.as_deref())?
+                    voxsplat_lab::bricked::study(&bonsai, large.as_deref(), size, frames, lod_chart.as_deref())?
                 ),
             }
             Ok(())
@@ -435,9 +478,9 @@ pub(crate) fn run(study: Study) -> Result<()> {
     }
 }
 
-/// `voxsplat lab matrix`.
+/// `voxsplat-lab matrix`.
 fn matrix(a: MatrixArgs) -> Result<()> {
-    use voxsplat_cli::bench::*;
+    use voxsplat_lab::bench::*;
     let mut m = if a.quick { MatrixOptions::quick() } else { MatrixOptions::full() };
     if let Some(f) = a.frames {
         if f < 5 {
@@ -471,8 +514,8 @@ fn matrix(a: MatrixArgs) -> Result<()> {
     let mb = motion_study(&mut r, mb_size, mb_frame, m.frames)?;
     rows.extend(motion_rows(&mb, mb_size));
     let mb_images = write_motion_images(&mb, &a.out_dir)?;
-    let stab = voxsplat_cli::stability::run(&mut r, a.quick, |msg| eprintln!("{msg}"))?;
-    voxsplat_cli::stability::write_outputs(&stab, &a.out_dir)?;
+    let stab = voxsplat_lab::stability::run(&mut r, a.quick, |msg| eprintln!("{msg}"))?;
+    voxsplat_lab::stability::write_outputs(&stab, &a.out_dir)?;
     write_csv(&rows, &a.out_dir.join("matrix.csv"))?;
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -487,9 +530,9 @@ fn matrix(a: MatrixArgs) -> Result<()> {
     let (rate_n, rate_sizes): (u32, &[f32]) =
         if a.quick { (48, &[3.0, 7.0]) } else { (256, &[3.0, 5.0, 7.0, 11.0, 15.0]) };
     let rates =
-        voxsplat_cli::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames.clamp(3, 5), |msg| eprintln!("{msg}"))?;
-    voxsplat_cli::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
-    voxsplat_cli::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
+        voxsplat_lab::rates::raster_rates(&mut r, rate_n, rate_sizes, m.frames.clamp(3, 5), |msg| eprintln!("{msg}"))?;
+    voxsplat_lab::rates::write_rates_csv(&rates, &a.out_dir.join("rates.csv"))?;
+    voxsplat_lab::rates::rates_svg(&rates, &a.out_dir.join("rates.svg"))?;
     let scale = if a.no_scaling {
         Vec::new()
     } else {
@@ -499,13 +542,13 @@ fn matrix(a: MatrixArgs) -> Result<()> {
         write_scaling_csv(&s, &a.out_dir.join("scaling.csv"))?;
         // The bricked volumes' series (scripts/bricks-vtk.sh, run first by scripts/results.sh).
         let bricks = a.out_dir.join("bricks-scaling.csv");
-        let bricks = bricks.exists().then(|| voxsplat_cli::bench::read_scaling_csv(&bricks)).transpose()?;
+        let bricks = bricks.exists().then(|| voxsplat_lab::bench::read_scaling_csv(&bricks)).transpose()?;
         scaling_svg(&s, bricks.as_deref(), &a.out_dir.join("scaling.svg"))?;
         s
     };
     if let Some(path) = &a.results {
         // The commit this binary was built from (cli/build.rs), not the checkout's HEAD now.
-        let commit = env!("VOXSPLAT_COMMIT").to_string();
+        let commit = voxsplat_cli::measure::COMMIT.to_string();
         let base = path.parent().unwrap_or(std::path::Path::new("."));
         let chart_dir = pathdiff(&a.out_dir, base);
         let notes_path = base.join("results-notes.md");
@@ -534,11 +577,11 @@ fn matrix(a: MatrixArgs) -> Result<()> {
             ("matrix.md", matrix_markdown(&report)?),
             (
                 "raster.md",
-                voxsplat_cli::rates::rates_markdown(&rates, &roof_rates, &voxsplat_cli::bench::link("", "rates.svg")),
+                voxsplat_lab::rates::rates_markdown(&rates, &roof_rates, &voxsplat_lab::bench::link("", "rates.svg")),
             ),
             ("antialias-plane.md", antialias_markdown(&aa, aa_size, aa_factor, aa_dolly)),
             ("motion.md", motion_markdown(&mb, mb_size, mb_frame, &mb_images, "")),
-            ("stability.md", voxsplat_cli::stability::markdown(&stab, "")),
+            ("stability.md", voxsplat_lab::stability::markdown(&stab, "")),
         ];
         for (file, md) in &written {
             let p = a.out_dir.join(file);
@@ -627,4 +670,20 @@ fn relink(md: &str, dir: &str) -> String {
     }
     out.push_str(rest);
     out
+}
+
+fn main() -> ExitCode {
+    let lab = Lab::parse();
+    if let Some(mib) = lab.host_budget_mib {
+        voxsplat::set_host_budget(Some(mib.saturating_mul(1 << 20)));
+    }
+    match run(lab.study) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One write for the whole line: under mpirun the ranks share one stderr.
+            let line = format!("error: {e}\n");
+            let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
+            ExitCode::from(2)
+        }
+    }
 }

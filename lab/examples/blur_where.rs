@@ -2,7 +2,7 @@
 //! rotating box and of the orthographic terrain, WBTF through graphics quads, each method against
 //! 64 sub-frames, its squared error split by the truth's alpha (background below 0.01, edges,
 //! inside above 0.99), and the mean alpha difference (coverage).
-//! `cargo run --release -p voxsplat-cli --example blur_where`
+//! `cargo run --release -p voxsplat-lab --example blur_where`
 use voxsplat::animate::{render_frame, Animation, Blur};
 use voxsplat::{OrderKind, Raster, RenderOptions, Renderer, RendererOptions};
 fn main() -> voxsplat::Result<()> {

@@ -159,7 +159,7 @@ pub fn markdown(rows: &[ModeRow], device: &str, size: u32, rounds: usize, charts
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# Rendering modes\n\n`voxsplat lab modes` ({device}): each mode's default frame (the bricked store; MIP and \
+        "# Rendering modes\n\n`voxsplat-lab modes` ({device}): each mode's default frame (the bricked store; MIP and \
          MinIP draw each texel's brightest voxel, *mip, every voxel* all of them: `--every-voxel`) at {size}², the framing camera, no shading, `--raster auto`, the median of {rounds} frames \
          alternating mode by mode after a warm-up; beside it the ray caster in the same mode at step {RAY_STEP} \
          (median of {rounds}). Both are scored by PSNR against a ray cast at step {FINE_STEP} in that mode \

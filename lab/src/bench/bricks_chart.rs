@@ -1,5 +1,5 @@
 //! The bricked volumes' scaling beside VTK (`scripts/bricks-vtk.sh`'s CSV): its own chart
-//! (`voxsplat lab bricks --chart`) and a panel of the matrix's scaling chart.
+//! (`voxsplat-lab bricks --chart`) and a panel of the matrix's scaling chart.
 use super::*;
 
 /// Rows `voxels,vtk_ms,voxsplat_ms` of the bricked-volume scaling CSV (`scripts/bricks-vtk.sh`),
@@ -60,7 +60,7 @@ pub fn bricks_panel(
     Ok(())
 }
 
-/// The bricked-volume scaling chart (`voxsplat lab bricks --chart`) from `read_scaling_csv`'s file.
+/// The bricked-volume scaling chart (`voxsplat-lab bricks --chart`) from `read_scaling_csv`'s file.
 pub fn scaling_chart(csv: &Path, out: &Path) -> Result<()> {
     use plotters::prelude::*;
     let rows = read_scaling_csv(csv)?;

@@ -151,7 +151,7 @@ pub fn markdown(orders: &[OrderRow], blurs: &[BlurRow], first: u32, frames: u32)
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "## Orders under motion, blur shapes (chapters 4 and 5)\n\n`voxsplat lab motion-orders`: still frames {first} to {} \
+        "## Orders under motion, blur shapes (chapters 4 and 5)\n\n`voxsplat-lab motion-orders`: still frames {first} to {} \
          of each built-in animation; static error = mean PSNR against the exactly sorted order's frames; temporal error = \
          mean RMSE of each frame-to-frame change against the sorted order's change (what the order adds to the motion).\n\n\
          | animation | order | static PSNR dB | temporal RMSE |\n|---|---|---:|---:|",

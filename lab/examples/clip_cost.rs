@@ -3,7 +3,7 @@
 //! a plane through its middle; median frame times of five rounds with the variants alternating in
 //! one process, and the covered pixels of each.
 //!
-//! `cargo run --release -p voxsplat-cli --example clip_cost [-- FILE [TF]]`
+//! `cargo run --release -p voxsplat-lab --example clip_cost [-- FILE [TF]]`
 use glam::Vec4;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
@@ -29,8 +29,8 @@ fn main() -> voxsplat::Result<()> {
         (o.raster, o.direction, o.clip) = (Raster::Compute, Some(Direction::FrontToBack), clip);
         o
     };
-    let times = voxsplat_cli::bench::alternating_medians(variants.len(), 1, 5, |v| {
-        voxsplat_cli::bricked::frame_ms(&mut r, &cam, &options(variants[v].1))
+    let times = voxsplat_lab::bench::alternating_medians(variants.len(), 1, 5, |v| {
+        voxsplat_lab::bricked::frame_ms(&mut r, &cam, &options(variants[v].1))
     })?;
     println!("| clip | covered px | median ms | vs whole |\n|---|---:|---:|---:|");
     for ((name, clip), ms) in variants.iter().zip(&times) {

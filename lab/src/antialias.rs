@@ -100,7 +100,7 @@ pub fn markdown(rows: &[AaSceneRow], factor: u32, dolly: usize) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "## Anti-aliasing on the terrain and orthographic figures (Figs 3.7, 3.8, 5.3)\n\n`voxsplat lab antialias`: \
+        "## Anti-aliasing on the terrain and orthographic figures (Figs 3.7, 3.8, 5.3)\n\n`voxsplat-lab antialias`: \
          per-splat PBTF, Gaussian; error against the truth supersampled {factor}×{factor} and brought down by a \
          Lanczos-3 low-pass; aliasing energy over the frame (`metrics::aliasing_energy`); shimmer = mean frame-to-frame \
          RMSE along a {dolly}-frame move of half a voxel per frame (forward in the fly-over, sideways in the orthographic \

@@ -58,7 +58,7 @@ pub fn markdown(rows: &[KernelRow], n: u32, size: u32, chart: Option<&Path>) -> 
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "## Reconstruction kernels (section 1.2.3)\n\n`voxsplat lab kernels`: ripple = peak to peak of a flat unit-spaced \
+        "## Reconstruction kernels (section 1.2.3)\n\n`voxsplat-lab kernels`: ripple = peak to peak of a flat unit-spaced \
          sheet's summed footprints seen head-on, over their mean; lattice RMS = their RMS deviation (Crawfis and Max's \
          criterion, which `crawfis-max` is fitted to minimise with their support); error on the peers' {n}³ scene at \
          {size}², tile compositor, against the scalar ray integration (step 0.25), a truth no kernel shapes; median of \

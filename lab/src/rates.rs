@@ -1,4 +1,4 @@
-//! The raster-rate sweep of `voxsplat lab matrix`: splats per second of every raster variant
+//! The raster-rate sweep of `voxsplat-lab matrix`: splats per second of every raster variant
 //! against footprint size, each with its error against the truth, beside the raster roofline.
 //!
 //! Scene: one sheet of n x n voxels (a checkerboard at opacity 0.3) seen head-on through an

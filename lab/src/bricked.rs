@@ -1,5 +1,5 @@
 //! The bricked-volume study: what a volume costs as a bricked store and what a frame
-//! costs from it, alternating the variants frame by frame in one process (`voxsplat lab bricks`).
+//! costs from it, alternating the variants frame by frame in one process (`voxsplat-lab bricks`).
 //! Prints a markdown section for docs/RESULTS.md.
 use crate::bench::median;
 use std::fmt::Write as _;
@@ -9,13 +9,7 @@ use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::{classify, TransferFunction};
 use voxsplat::{Camera, Direction, Error, Raster, RenderOptions, Renderer, RendererOptions, Result};
 
-/// The process's peak resident set (VmHWM) in MiB, where /proc says (Linux).
-pub fn peak_rss_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb / 1024.0)
-}
+pub use voxsplat_cli::measure::peak_rss_mib;
 
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
@@ -73,7 +67,7 @@ pub fn study(
     let _ = writeln!(s, "## Bricked volumes\n");
     let _ = writeln!(
         s,
-        "`voxsplat lab bricks`, one process, {size}², the framing view, tile compositor front to back; every \
+        "`voxsplat-lab bricks`, one process, {size}², the framing view, tile compositor front to back; every \
          variant of a pair alternates frame by frame, {frames} rounds after a warm-up frame; medians.\n"
     );
     let _ = writeln!(s, "| volume | voxels | stored | bricks | GPU bytes / stored voxel | load + bricks ms |");

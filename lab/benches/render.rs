@@ -1,8 +1,8 @@
 //! Criterion wall-time benchmark of whole frames for the methods of the quick matrix; the full
-//! matrix with errors, roofline and scaling is `voxsplat lab matrix` (bodies in `voxsplat::bench`).
+//! matrix with errors, roofline and scaling is `voxsplat-lab matrix` (bodies in `voxsplat::bench`).
 use criterion::{criterion_group, criterion_main, Criterion};
 use voxsplat::{Renderer, RendererOptions};
-use voxsplat_cli::bench::{bench_camera, time_method, MatrixOptions};
+use voxsplat_lab::bench::{bench_camera, time_method, MatrixOptions};
 
 fn frames(c: &mut Criterion) {
     let mut renderer = Renderer::new(&RendererOptions::default()).expect("Vulkan device (run scripts/setup.sh)");

@@ -1,4 +1,4 @@
-//! Benchmark bodies shared by `benches/render.rs` and `voxsplat lab matrix`: the method matrix (time
+//! Benchmark bodies shared by `benches/render.rs` and `voxsplat-lab matrix`: the method matrix (time
 //! from GPU timestamps, error against the truth), the roofline, and scaling; CSV, SVG charts and
 //! docs/RESULTS.md. Medians over frames after warm-up.
 use std::fmt::Write as _;
@@ -233,15 +233,7 @@ pub struct Row {
     pub violations: Option<u64>,
 }
 
-/// The middle value (upper median); NaN when empty.
-pub fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[v.len() / 2]
-    }
-}
+pub use voxsplat_cli::measure::median;
 
 /// Medians of `rounds` timings per variant, the `variants` alternating frame by frame after
 /// `warmup` untimed rounds (times on these shared machines drift; alternating keeps the ratios

@@ -4,7 +4,7 @@
 //! bonsai at 512², the default options over a black background; median wall time per frame of
 //! seven rounds, the variants alternating in one process, and the present stage's own time.
 //!
-//! `cargo run --release -p voxsplat-cli --example render_to_cost`
+//! `cargo run --release -p voxsplat-lab --example render_to_cost`
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
 use voxsplat::vk::ImageLayout as IL;
@@ -29,7 +29,7 @@ fn main() -> voxsplat::Result<()> {
         };
         let image = r.target_image(TargetFormat::Bgra8Srgb, 512, 512)?;
         let target = image.target(IL::UNDEFINED, IL::SHADER_READ_ONLY_OPTIMAL)?;
-        let times = voxsplat_cli::bench::alternating_medians(2, 1, 7, |v| {
+        let times = voxsplat_lab::bench::alternating_medians(2, 1, 7, |v| {
             let t = std::time::Instant::now();
             if v == 0 {
                 r.render(&cam, &options)?;
