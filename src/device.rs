@@ -208,21 +208,3 @@ impl DeviceProfile {
         format!("{}.{}.{}", self.api_version[0], self.api_version[1], self.api_version[2])
     }
 }
-
-impl DeviceChoices {
-    /// What `--raster auto` weighs.
-    pub(crate) fn raster(&self) -> crate::raster::Device {
-        crate::raster::Device { cpu: self.cpu, point_size_max: self.point_size_max, graphics: self.graphics_raster }
-    }
-
-    /// The raster variant `options.raster` resolves to for `set` seen from `camera` on this device
-    /// (`Raster::Auto`'s rule, or the checks on an explicit choice).
-    pub fn choose_raster(
-        &self,
-        set: &crate::SplatSet,
-        camera: &crate::Camera,
-        options: &crate::RenderOptions,
-    ) -> crate::Result<crate::RasterChoice> {
-        crate::raster::choose(set, camera, options, self.raster())
-    }
-}

@@ -449,7 +449,7 @@ impl Renderer {
     ) -> Result<Delivered> {
         options.validate()?;
         camera.validate()?;
-        target.check_frame(camera, options)?;
+        plan::check_host_frame(target, camera, options)?;
         if self.bisect.is_some() {
             return Err(Error::Unsupported("render_to with a bisect split: use render()".into()));
         }
@@ -495,7 +495,7 @@ impl Renderer {
         let device = match &self.gpu {
             Some(g) => {
                 gpu::resources::Resources::check_splat_cap(prep)?;
-                g.context().choices().raster()
+                raster::Device::of(g.context().choices())
             }
             None => raster::Device { cpu: true, point_size_max: f32::INFINITY, graphics: true },
         };

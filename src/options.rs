@@ -694,7 +694,7 @@ pub struct Delivered {
     /// Per-stage times, as `Rendered::timings`.
     pub timings: Vec<StageTime>,
     /// What `Raster::Auto` picked.
-    pub raster: crate::RasterChoice,
+    pub raster: RasterChoice,
     /// What a bricked volume's frame drew and culled, as `Rendered::stats`.
     pub stats: FrameStats,
 }

@@ -4,7 +4,7 @@
 use crate::bricks::{BrickScene, BRICK};
 use crate::camera::Camera;
 use crate::constants::{COMPOSITE_TILE, MAX_GROUPS_X, WORKGROUP_SIZE};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu_types::{
     BrickFrame, CompositePush, FootprintPush, Frame, RaycastParams, SHEET_MODE_AXIS, SHEET_MODE_BINNED,
 };
@@ -430,4 +430,25 @@ pub fn brick_frame(scene: &BrickScene, split: [u32; 3]) -> BrickFrame {
         lo: [part[0][0], part[0][1], part[0][2], scene.tree().len() as u32],
         hi: [part[1][0], part[1][1], part[1][2], 0],
     }
+}
+
+/// Refuse a frame `target` cannot take: a camera of another size; a render scale below 1 (the frame
+/// is then drawn on a coarser grid and the blit stretches it) with the host's depth or colour,
+/// which are read pixel for pixel; a background over the host's image.
+pub(crate) fn check_host_frame(target: &crate::vk::HostTarget, camera: &Camera, options: &RenderOptions) -> Result<()> {
+    let (width, height) = target.size();
+    if (camera.width, camera.height) != (width, height) {
+        return Err(Error::InvalidArgument(format!(
+            "the camera's {} x {} frame does not fit the {width} x {height} target",
+            camera.width, camera.height
+        )));
+    }
+    let refuse = |m: &str| Err(Error::InvalidArgument(m.into()));
+    if options.render_scale != 1.0 && (target.depth().is_some() || target.is_over()) {
+        return refuse("the host's depth and colour images are read pixel for pixel: draw at render scale 1");
+    }
+    if target.is_over() && options.background.is_some() {
+        return refuse("a frame drawn over the host's image has that image for its background: give no background");
+    }
+    Ok(())
 }

@@ -33,6 +33,13 @@ pub struct Device {
     pub graphics: bool,
 }
 
+impl Device {
+    /// What `Raster::Auto` weighs of a device's choices.
+    pub fn of(choices: &crate::device::DeviceChoices) -> Self {
+        Device { cpu: choices.cpu, point_size_max: choices.point_size_max, graphics: choices.graphics_raster }
+    }
+}
+
 /// Footprint diameters in pixels, estimated from the grid's bounds (O(1), no pass over splats).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FootprintSize {

@@ -3,6 +3,7 @@
 //! lavapipe checked against the device at hand.
 use crate::common;
 use voxsplat::device::{DeviceKind, DeviceProfile, Timing};
+use voxsplat::low_level::raster::{choose, Device};
 use voxsplat::{scene, Camera, Composite, Error, Raster, RenderOptions};
 
 fn profile(name: &str) -> DeviceProfile {
@@ -16,7 +17,7 @@ fn auto(p: &DeviceProfile, scene_name: &str, size: u32, composite: Composite) ->
     let cam = Camera::framing(set.grid(), size, size);
     let mut o = RenderOptions::default();
     o.composite = composite;
-    p.choices().choose_raster(&set, &cam, &o).map(|c| c.raster)
+    choose(&set, &cam, &o, Device::of(&p.choices())).map(|c| c.raster)
 }
 
 #[test]
@@ -80,13 +81,13 @@ fn each_missing_feature_takes_its_fallback() {
     let cam = Camera::framing(set.grid(), 512, 512);
     let mut o = RenderOptions::default();
     o.raster = Raster::Points;
-    assert!(matches!(p.choices().choose_raster(&set, &cam, &o), Err(Error::InvalidArgument(_))));
+    assert!(matches!(choose(&set, &cam, &o, Device::of(&p.choices())), Err(Error::InvalidArgument(_))));
     // RGBA32F targets that do not blend: auto draws by compute, an explicit graphics raster is refused.
     let p = with(&|p| p.rgba32f_blend = false);
     assert_eq!(auto(&p, "cube60", 512, Composite::Splat).unwrap(), Raster::Compute);
     assert_eq!(auto(&p, "cube60", 512, Composite::Sheet).unwrap(), Raster::Compute);
     o.raster = Raster::Graphics;
-    assert!(matches!(p.choices().choose_raster(&set, &cam, &o), Err(Error::Unsupported(_))));
+    assert!(matches!(choose(&set, &cam, &o, Device::of(&p.choices())), Err(Error::Unsupported(_))));
     // What voxsplat cannot run on at all.
     assert!(with(&|p| p.api_version = [1, 1, 0]).choices().unusable.unwrap().contains("1.2"));
     assert!(with(&|p| p.shader_output_layer = false).choices().unusable.unwrap().contains("shaderOutputLayer"));

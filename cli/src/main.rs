@@ -449,7 +449,10 @@ fn run(cli: Cli) -> Result<()> {
                 voxsplat::classify::classify(&v, &tf, None)?
             };
             println!("splats: {}", set.len());
-            println!("bytes per splat (classified on the host, voxsplat-lab render --dense): {:.0}", voxsplat::gpu_bytes_per_splat(&set));
+            println!(
+                "bytes per splat (classified on the host, voxsplat-lab render --dense): {:.0}",
+                voxsplat::gpu_bytes_per_splat(&set)
+            );
             let most = voxsplat::low_level::constants::MAX_GPU_SPLATS as usize;
             if set.len() > most {
                 println!("over the dense GPU path's {most} splats: render it bricked (the default for volumes)");

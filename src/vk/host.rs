@@ -178,26 +178,6 @@ impl HostTarget {
         Ok(self)
     }
 
-    /// Refuse a frame this target cannot take: a camera of another size; a render scale below 1
-    /// (the frame is then drawn on a coarser grid and the blit stretches it) with the host's
-    /// depth or colour, which are read pixel for pixel; a background over the host's image.
-    pub(crate) fn check_frame(&self, camera: &crate::Camera, options: &crate::RenderOptions) -> Result<()> {
-        if (camera.width, camera.height) != self.size() {
-            return Err(Error::InvalidArgument(format!(
-                "the camera's {} x {} frame does not fit the {} x {} target",
-                camera.width, camera.height, self.width, self.height
-            )));
-        }
-        let refuse = |m: &str| Err(Error::InvalidArgument(m.into()));
-        if options.render_scale != 1.0 && (self.depth.is_some() || self.over) {
-            return refuse("the host's depth and colour images are read pixel for pixel: draw at render scale 1");
-        }
-        if self.over && options.background.is_some() {
-            return refuse("a frame drawn over the host's image has that image for its background: give no background");
-        }
-        Ok(())
-    }
-
     /// Whether the frame is composited over the image's contents (`over`).
     pub fn is_over(&self) -> bool {
         self.over
