@@ -625,16 +625,7 @@ fn main() -> ExitCode {
     if let Some(mib) = cli.host_budget_mib {
         voxsplat::set_host_budget(Some(mib.saturating_mul(1 << 20)));
     }
-    match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            // One write for the whole line: under mpirun the ranks share one stderr, and a line
-            // written in pieces interleaves with the other ranks'.
-            let line = format!("error: {e}\n");
-            let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
-            ExitCode::from(2)
-        }
-    }
+    voxsplat_cli::stdout::exit_code(run(cli))
 }
 
 /// The least and greatest of `values` as `info` prints them (`held`).
@@ -650,5 +641,15 @@ fn held(v: f32) -> String {
         format!("{}", v as f64)
     } else {
         format!("{v}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// clap's own checks of the command line (ids that conflicts and requirements name exist,
+    /// headings, ...), which it runs only in debug builds.
+    #[test]
+    fn the_command_line_passes_clap_s_checks() {
+        <super::Cli as clap::CommandFactory>::command().debug_assert();
     }
 }

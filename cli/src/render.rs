@@ -33,7 +33,7 @@ pub struct Research {
     #[arg(long)]
     pub lod_nodes: bool,
     /// Draw the line where the first splat each pixel meets lies at eye distance k (Figs 3.6, 3.7).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "plan")]
     pub k_line: bool,
     /// Order of drawing: front to back (the default, which lets early termination stop), or back to
     /// front (the default where per-splat footprints go through the graphics or point pipelines).
@@ -44,7 +44,8 @@ pub struct Research {
     #[arg(long)]
     pub sheet_budget_mib: Option<u64>,
     /// Render the volumetric-summation truth (CPU, f64) with --kernel's reconstruction.
-    #[arg(long)]
+    // (The conflicts are declared here: `voxsplat render` has no --truth for its flags to name.)
+    #[arg(long, conflicts_with_all = ["raycast", "repeat", "plan"])]
     pub truth: bool,
 }
 
@@ -132,7 +133,7 @@ pub struct RenderArgs {
     #[arg(help_heading = "Quality and speed", long, value_parser = ["none", "swan", "ewa"])]
     pub aa: Option<String>,
     /// Render with the ray caster at this step (in voxel spacings) instead of splatting.
-    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, conflicts_with = "truth")]
+    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite)]
     pub raycast: Option<f32>,
     /// With --raycast: cast K x K rays per pixel and average them (the converged reference that
     /// levels of detail and anti-aliasing are scored against; 4 with --raycast 0.25 is the one
@@ -153,11 +154,11 @@ pub struct RenderArgs {
     /// Render the frame this many times and report each stage's median (the first frames pay
     /// one-off costs: allocation, shader compilation on some drivers).
     #[arg(help_heading = "Output", long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..),
-        conflicts_with_all = ["raycast", "truth"])]
+        conflicts_with = "raycast")]
     pub repeat: u32,
     /// Print what the frame would draw and how (the raster, the order, the sheet batches, a
     /// volume's memory split and levels of detail) instead of rendering it.
-    #[arg(help_heading = "Output", long, conflicts_with_all = ["raycast", "truth", "out", "k_line", "repeat", "timings"])]
+    #[arg(help_heading = "Output", long, conflicts_with_all = ["raycast", "out", "repeat", "timings"])]
     pub plan: bool,
     /// Draw a session the viewer saved (its camera, transfer function, shading, mode, clipping and
     /// the options its keys change) of the same --volume, at --size.

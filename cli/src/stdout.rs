@@ -1,7 +1,7 @@
-//! Printing to stdout that ends the process quietly when stdout is a closed pipe
-//! (`voxsplat info F | head`): the standard `print!` panics there. The commands of both binaries
-//! (`voxsplat`, `voxsplat-lab`) print through [`print!`](crate::print) and
-//! [`println!`](crate::println).
+//! How both binaries (`voxsplat`, `voxsplat-lab`) end and print: printing to stdout that ends the
+//! process quietly when stdout is a closed pipe (`voxsplat info F | head`; the standard `print!`
+//! panics there), through [`print!`](crate::print) and [`println!`](crate::println), and a failed
+//! command's one line on stderr ([`exit_code`]).
 
 /// A write to stdout's outcome: a closed pipe ends the process with success (the reader has what
 /// it wanted), another error with a message and failure.
@@ -33,4 +33,19 @@ macro_rules! println {
             format_args!("{}\n", format_args!($($arg)*)),
         ))
     };
+}
+
+/// A command's outcome as the process's exit status: success, or `error: ...` on stderr and
+/// status 2 (as clap's own refusals).
+pub fn exit_code(result: voxsplat::Result<()>) -> std::process::ExitCode {
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            // One write for the whole line: under mpirun the ranks share one stderr, and a line
+            // written in pieces interleaves with the other ranks'.
+            let line = format!("error: {e}\n");
+            let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
+            std::process::ExitCode::from(2)
+        }
+    }
 }

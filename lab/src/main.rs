@@ -677,13 +677,15 @@ fn main() -> ExitCode {
     if let Some(mib) = lab.host_budget_mib {
         voxsplat::set_host_budget(Some(mib.saturating_mul(1 << 20)));
     }
-    match run(lab.study) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            // One write for the whole line: under mpirun the ranks share one stderr.
-            let line = format!("error: {e}\n");
-            let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
-            ExitCode::from(2)
-        }
+    voxsplat_cli::stdout::exit_code(run(lab.study))
+}
+
+#[cfg(test)]
+mod tests {
+    /// clap's own checks of the command line (ids that conflicts and requirements name exist,
+    /// headings, ...), which it runs only in debug builds.
+    #[test]
+    fn the_command_line_passes_clap_s_checks() {
+        <super::Lab as clap::CommandFactory>::command().debug_assert();
     }
 }
