@@ -64,7 +64,7 @@ fn shader_modules(dir: &Path, built: &[String]) -> String {
             _ => "super::Shaders::Other".to_string(),
         };
         s += &format!(
-            "    /// The handle the stage table names.\n    pub const SHADERS: super::Shaders = {handle};\n}}\n"
+            "    /// The handle the stage table names (the roofline's, none).\n    #[allow(dead_code)]\n    pub const SHADERS: super::Shaders = {handle};\n}}\n"
         );
     }
     flat += "];\n";

@@ -2,7 +2,7 @@
 //! variant and compositing mode on the 60³ cube. The full matrix with errors, roofline and scaling
 //! is `voxsplat-lab matrix` (cli/src/bench.rs), and cli/benches/render.rs times its quick matrix.
 use criterion::{criterion_group, criterion_main, Criterion};
-use voxsplat::{scene, Camera, Composite, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{options::Composite, options::Raster, scene, Camera, RenderOptions, Renderer, RendererOptions};
 
 fn frames(c: &mut Criterion) {
     let mut renderer = Renderer::new(&RendererOptions::default()).expect("Vulkan device (run scripts/setup.sh)");

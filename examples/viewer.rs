@@ -30,7 +30,10 @@ use std::time::Instant;
 use voxsplat::glam::{Vec3, Vec4};
 use voxsplat::vk::ash::{self, vk};
 use voxsplat::vk::{Context, HostHandles, HostTarget, Semaphore};
-use voxsplat::{Camera, Clip, Composite, Error, Lod, OrderKind, Raster, RenderOptions, Renderer, Result};
+use voxsplat::{
+    options::Clip, options::Composite, options::Lod, options::Raster, order::OrderKind, Camera, Error, RenderOptions,
+    Renderer, Result,
+};
 use voxsplat_cli::open::{camera_of, open, parse_background, SceneArgs};
 use voxsplat_cli::view::{Orbit, COMPOSITES, ORDERS, RASTERS};
 use winit::application::ApplicationHandler;
@@ -408,7 +411,7 @@ impl Viewer {
         options.order = args.scene.order.parse::<OrderKind>()?;
         options.render_scale = args.render_scale;
         options.kernel = args.kernel.parse()?;
-        voxsplat::low_level::resample::check_scale(args.interactive_scale)?;
+        voxsplat::low_level::check_scale(args.interactive_scale)?;
         options.validate()?;
         let indices = [
             ORDERS.iter().position(|o| *o == args.scene.order).unwrap_or(0),
@@ -729,7 +732,7 @@ impl Viewer {
         );
         let mode = match o.iso {
             Some(v) => format!(", iso {v:.2}"),
-            None if o.mode != voxsplat::Mode::Composite => format!(", {}", o.mode),
+            None if o.mode != voxsplat::options::Mode::Composite => format!(", {}", o.mode),
             None => String::new(),
         };
         let time = match &self.series {
@@ -775,10 +778,10 @@ impl Viewer {
             }
             "l" => self.options.lod = if self.options.lod == Lod::Off { Lod::Auto } else { Lod::Off },
             "m" => {
-                let modes = voxsplat::Mode::ALL;
+                let modes = voxsplat::options::Mode::ALL;
                 let at = modes.iter().position(|&m| m == self.options.mode).unwrap_or(0);
                 self.options.mode = modes[(at + 1) % modes.len()];
-                self.options.iso = (self.options.mode == voxsplat::Mode::Iso).then_some(ISO_START);
+                self.options.iso = (self.options.mode == voxsplat::options::Mode::Iso).then_some(ISO_START);
             }
             "," | "." => match self.options.iso {
                 Some(v) => {

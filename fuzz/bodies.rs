@@ -36,7 +36,7 @@ pub fn raw(data: &[u8]) {
 /// rest is the file. The host budget bounds what a header may make them allocate.
 pub fn slices(data: &[u8]) {
     let Some((&kind, rest)) = data.split_first() else { return };
-    voxsplat::set_host_budget(Some(256 << 20));
+    voxsplat::options::set_host_budget(Some(256 << 20));
     let ext = ["nrrd", "nii", "nii.gz"][kind as usize % 3];
     let path = std::env::temp_dir().join(format!("voxsplat-fuzz-slices-{}.{ext}", std::process::id()));
     if std::fs::write(&path, rest).is_ok() {
@@ -57,7 +57,7 @@ pub fn slices(data: &[u8]) {
 /// the file.
 pub fn heights(data: &[u8]) {
     let Some((&kind, rest)) = data.split_first() else { return };
-    voxsplat::set_host_budget(Some(256 << 20));
+    voxsplat::options::set_host_budget(Some(256 << 20));
     let ext = ["png", "tif", "npy"][kind as usize % 3];
     let path = std::env::temp_dir().join(format!("voxsplat-fuzz-heights-{}.{ext}", std::process::id()));
     if std::fs::write(&path, rest).is_ok() {
@@ -110,7 +110,7 @@ pub fn sidecar(data: &[u8]) {
 /// Image stacks read as volumes (a multipage TIFF through `load_volume` and the streamed store),
 /// through a file.
 pub fn stacks(data: &[u8]) {
-    voxsplat::set_host_budget(Some(256 << 20));
+    voxsplat::options::set_host_budget(Some(256 << 20));
     let path = std::env::temp_dir().join(format!("voxsplat-fuzz-stacks-{}.tif", std::process::id()));
     if std::fs::write(&path, data).is_ok() {
         let hints = voxsplat::loaders::VolumeHints::default();
@@ -129,7 +129,7 @@ pub fn stacks(data: &[u8]) {
 /// DICOM series: the bytes as the one file of a folder read as a series (`load_volume` and the
 /// streamed store).
 pub fn dicom(data: &[u8]) {
-    voxsplat::set_host_budget(Some(256 << 20));
+    voxsplat::options::set_host_budget(Some(256 << 20));
     let dir = std::env::temp_dir().join(format!("voxsplat-fuzz-dicom-{}", std::process::id()));
     if std::fs::create_dir_all(&dir).is_ok() && std::fs::write(dir.join("image.dcm"), data).is_ok() {
         let hints = voxsplat::loaders::VolumeHints::default();
@@ -168,7 +168,7 @@ pub fn zarr_image(data: &[u8]) -> Option<std::path::PathBuf> {
 /// level and channel, and a part of one read as `render --crop` and a narrow view read it, with
 /// and without a chunk cache.
 pub fn zarr(data: &[u8]) {
-    voxsplat::set_host_budget(Some(256 << 20));
+    voxsplat::options::set_host_budget(Some(256 << 20));
     if let Some(dir) = zarr_image(data) {
         for level in [None, Some(1)] {
             let hints = voxsplat::loaders::VolumeHints { level, ..Default::default() };
@@ -179,7 +179,7 @@ pub fn zarr(data: &[u8]) {
         // A part of it (`VolumeHints::crop`), and of that only the chunks a narrow view may see.
         if let Ok(grid) = voxsplat::Grid::centered([8; 3], [1.0; 3]) {
             let camera = voxsplat::Camera {
-                projection: voxsplat::Projection::Perspective { fov_y_deg: 10.0 },
+                projection: voxsplat::camera::Projection::Perspective { fov_y_deg: 10.0 },
                 ..voxsplat::Camera::framing(&grid, 16, 16)
             };
             // Without a chunk cache, then twice through one (the second finds the chunks held).
@@ -205,7 +205,7 @@ pub fn zarr(data: &[u8]) {
 /// level's array metadata opened and checked, and the pyramid asked which level and region a view
 /// and a crop need. No chunk is decoded.
 pub fn zarr_meta(data: &[u8]) {
-    voxsplat::set_host_budget(Some(256 << 20));
+    voxsplat::options::set_host_budget(Some(256 << 20));
     let Some(dir) = zarr_image(data) else { return };
     let Ok(image) = voxsplat::loaders::OmeZarr::open(&dir) else { return };
     for level in 0..image.levels.len().min(4) as u32 {

@@ -1,4 +1,14 @@
 //! Chapter 3 helpers: where k falls on a single-sheet scene, and the k line overlay.
+//!
+//! ```
+//! use voxsplat::{aa::k_regions, scene, Camera};
+//! // Where a frame crosses k, the distance beyond which a voxel is smaller than a pixel (§3.4).
+//! let set = scene::build("cube40")?;
+//! let camera = Camera::framing(set.grid(), 32, 32);
+//! let regions = k_regions(&set, &camera);
+//! assert_eq!(regions.len(), 32 * 32);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::camera::Camera;
 use crate::image::ImageF32;
 use crate::truth::pixel_ray;

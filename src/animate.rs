@@ -1,6 +1,15 @@
 //! Animations (chapter 4): a scene, a camera, and object-transform keyframes, from a small TOML
 //! file or built in; frames rendered still, with motion-blurred splats, or with an accumulation
 //! buffer of N sub-frames over the shutter interval.
+//!
+//! ```
+//! use voxsplat::animate::Animation;
+//! // A built-in animation (`voxsplat animate --list` names them): its camera half way through.
+//! let a = Animation::builtin("rotating-box")?;
+//! let camera = a.camera_at(0.5);
+//! assert!(camera.width > 0);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result};
 use crate::image::ImageF32;

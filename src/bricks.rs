@@ -12,18 +12,30 @@
 //! stored voxel on bonsai and 4.76 on the stent (4.26 and 4.54 without the counts; tests/bricks.rs).
 //! On the device the store is resident and `BrickScene` draws it: the brick stages
 //! (`glsl/brick_*.comp`) cull bricks, classify voxels and order them in two-level PBTF each frame.
+//!
+//! ```
+//! use voxsplat::{bricks::BrickStore, classify::TransferFunction, loaders::ScalarVolume};
+//! // A volume kept as 8^3 bricks (empty ones dropped), classified through a transfer function.
+//! let dims = [16, 16, 16];
+//! let values = (0..16 * 16 * 16).map(|i| (i % 16) as f32 / 15.0).collect();
+//! let store = BrickStore::build(&ScalarVolume { dims, spacing: [1.0; 3], values })?;
+//! let set = store.classify(&TransferFunction::preset("ramp")?, None)?;
+//! assert!(set.len() > 0);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::classify::{classify_field, Shading, TransferFunction};
 use crate::error::{Error, Result};
 use crate::volume::{Grid, ScalarVolume, SplatSet};
-use bytemuck::{Pod, Zeroable};
 
 mod build;
 mod gradients;
+mod header;
 mod histogram;
 mod planes;
 mod series;
 pub use build::{keeps, record_at, store_range, UNIFORM_RECORDS};
 pub use gradients::{pack_differences, unpack_differences};
+pub use header::BrickHeader;
 pub use histogram::{Histogram, MAX_BINS};
 pub use planes::Plane;
 pub use series::Patch;
@@ -34,31 +46,8 @@ const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
 /// Largest value of a quantised scalar.
 const Q: f32 = 65535.0;
 
-/// A non-empty brick. Keep in step with the GPU side when it arrives (16 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
-pub struct BrickHeader {
-    /// Brick coordinates, 10 bits each: x | y << 10 | z << 20.
-    pub brick: u32,
-    /// Its first record.
-    pub first: u32,
-    /// Its records (at most `BRICK`³).
-    pub count: u32,
-    /// Its smallest and largest quantised value: min | max << 16.
-    pub range: u32,
-}
-
-const _: () = assert!(std::mem::size_of::<BrickHeader>() == 16);
-
 /// Words of a brick's mask on the device (`mask_words`): 16 of bits, 8 of counts.
 const MASK_DEVICE_WORDS: usize = BRICK_VOXELS / 32 * 3 / 2;
-
-impl BrickHeader {
-    /// The brick's coordinates in the brick grid.
-    pub fn coords(&self) -> [u32; 3] {
-        [self.brick & 1023, (self.brick >> 10) & 1023, self.brick >> 20]
-    }
-}
 
 /// A scalar volume as bricks of compact records.
 ///

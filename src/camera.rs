@@ -1,6 +1,16 @@
 //! Perspective and orthographic cameras. World space is right-handed; eye space is the rigid
 //! transform looking down -z (section 3.3.1); clip space follows Vulkan (y down, depth 0..1), so
 //! image row 0 is the top of the picture.
+//!
+//! ```
+//! use voxsplat::{camera::Projection, Camera, Grid};
+//! // A camera that frames a 64^3 grid in a 256 x 256 image, then made orthographic.
+//! let grid = Grid::centered([64; 3], [1.0; 3])?;
+//! let mut camera = Camera::framing(&grid, 256, 256);
+//! camera.projection = Projection::Orthographic { height: grid.diagonal() };
+//! camera.validate()?;
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
 use crate::volume::Grid;
 use glam::{Mat4, Vec3, Vec4};

@@ -2,6 +2,16 @@
 //! optionally its gradient magnitude) to colour and opacity; voxels with zero opacity are not
 //! extracted. Optional Phong shading with a headlight is applied to the voxels before splatting,
 //! as in the seed (docs/MODEL.md).
+//!
+//! ```
+//! use voxsplat::{classify::{classify, TransferFunction}, loaders::ScalarVolume};
+//! // Scalars through a preset transfer function: one splat per voxel it does not make transparent.
+//! let values = (0..8 * 8 * 8).map(|i| i as f32 / 511.0).collect();
+//! let volume = ScalarVolume { dims: [8; 3], spacing: [1.0; 3], values };
+//! let set = classify(&volume, &TransferFunction::preset("ct")?, None)?;
+//! assert!(set.len() <= 512);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
 use crate::volume::ScalarVolume;
 use crate::volume::{Grid, SplatSet};

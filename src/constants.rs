@@ -89,6 +89,7 @@ pub const ISO_SEGMENT: u32 = 32;
 pub const COLOR_MAP_SIZE: u32 = 256;
 
 /// Macros injected into GLSL (name, value).
+#[allow(dead_code)] // build.rs reads it (the shaders' macros), the library does not
 pub const GLSL_DEFINES: &[(&str, u32)] = &[
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
     ("SCAN_WORKGROUP_SIZE", SCAN_WORKGROUP_SIZE),

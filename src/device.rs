@@ -8,6 +8,16 @@
 //! plain functions of the profile, so tests run them against recorded profiles
 //! (`tests/data/devices/`: lavapipe's and a discrete NVIDIA one from its public limits) as well as
 //! against the device at hand.
+//!
+//! ```
+//! use voxsplat::{Backend, Renderer, RendererOptions};
+//! // What voxsplat chose on the device it opened (`voxsplat info` prints it); none on the CPU.
+//! let mut o = RendererOptions::default();
+//! o.backend = Backend::Cpu;
+//! let mut r = Renderer::new(&o)?;
+//! assert!(r.context().is_none());
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::constants::{DEFAULT_GPU_BUDGET, RASTER_LANES};
 use serde::{Deserialize, Serialize};
 

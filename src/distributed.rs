@@ -5,6 +5,16 @@
 //! volume's range and non-empty bricks; the region a rank reads (its box and the layer of voxels
 //! its faces' gradients need); and the `over` of premultiplied images and the pixel pieces the
 //! compositing schemes exchange. The MPI side (feature `mpi`) is `distributed::mpi`.
+//!
+//! ```
+//! use voxsplat::distributed::over_into;
+//! // Sort-last compositing: a front rank's premultiplied pixels over a back rank's.
+//! let front = [0.5, 0.0, 0.0, 0.5];
+//! let mut back = [0.0, 0.0, 1.0, 1.0];
+//! over_into(&front, &mut back);
+//! assert_eq!(back, [0.5, 0.0, 0.5, 1.0]);
+//!
+//! ```
 use crate::bricks::BRICK;
 use crate::camera::Camera;
 use crate::error::{Error, Result};

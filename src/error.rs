@@ -101,6 +101,14 @@ pub(crate) fn clip_message(message: impl std::fmt::Display) -> String {
 }
 
 /// The crate's result type.
+///
+/// ```
+/// fn frame_size() -> voxsplat::Result<u32> {
+///     let grid = voxsplat::Grid::centered([0, 4, 4], [1.0; 3])?; // refused: an empty side
+///     Ok(grid.dims[0])
+/// }
+/// assert!(frame_size().is_err());
+/// ```
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {

@@ -1,9 +1,19 @@
 //! The output image, and the formats of a host's image it can be drawn into.
+//!
+//! ```
+//! use voxsplat::image::{downsample, Downsample, ImageF32};
+//! // Frames are linear, premultiplied RGBA in f32; a 2 x 2 box filter halves one.
+//! let mut img = ImageF32::new(4, 4);
+//! img.pixels[0] = [1.0, 0.0, 0.0, 1.0];
+//! let half = downsample(&img, 2, Downsample::Box);
+//! assert_eq!((half.width, half.pixels[0][3]), (2, 0.25));
+//!
+//! ```
 
 /// An RGBA32F image, row 0 at the top. Colour is premultiplied by alpha.
 ///
 /// ```
-/// use voxsplat::ImageF32;
+/// use voxsplat::image::ImageF32;
 /// // Premultiplied RGBA per pixel, row by row.
 /// let mut image = ImageF32::new(4, 2);
 /// image.pixels[0] = [0.5, 0.0, 0.0, 0.5];

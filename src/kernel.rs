@@ -5,6 +5,15 @@
 //! the footprint f(rho) = integral of h(sqrt(rho^2 + z^2)) dz, normalised so that the table's own
 //! discrete integral is exactly 1 voxel^2. A sheet of unit-spaced splats therefore sums to ~1, and
 //! a voxel of optical depth tau contributes tau * f to the pixels its footprint covers.
+//!
+//! ```
+//! use voxsplat::{kernel::Kernel, RenderOptions};
+//! // The reconstruction kernel each splat's footprint integrates; Gaussian by default.
+//! let mut options = RenderOptions::default();
+//! options.kernel = "cubic".parse::<Kernel>()?;
+//! assert!(options.kernel.radius() > 1.0);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::constants::FOOTPRINT_TABLE_SIZE;
 use crate::error::{Error, Result};
 use std::sync::OnceLock;

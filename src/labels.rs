@@ -2,6 +2,15 @@
 //! opacity and visibility per label. A voxel takes its own label's entry (the nearest label), so
 //! no label is ever interpolated into another; a label volume is drawn alone or over a scalar
 //! volume on the same grid, the two combined per voxel (`classify::combine`).
+//!
+//! ```
+//! use voxsplat::labels::LabelTable;
+//! // A segmentation's labels: each value's colour, opacity and whether it is drawn.
+//! let mut table = LabelTable::from_toml("[[label]]\nvalue = 1\ncolor = [0.8, 0.3, 0.2]\nopacity = 1.0\n")?;
+//! table.set_visible(1, false)?;
+//! assert!(!table.get(1).unwrap().visible);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::classify::{combine, Shading, TransferFunction};
 use crate::error::{Error, Result};
 use crate::volume::{Grid, ScalarVolume, SplatSet};

@@ -15,6 +15,10 @@
 //! ```
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
+// Some internals only the tests use (a mirror's helpers, the stage tables' lists): dead in the
+// library's own build. The test build (`mod tests`), which clippy and CI check, still reports
+// anything that nothing uses.
+#![cfg_attr(not(test), allow(dead_code, unused_imports))]
 
 #[cfg(feature = "lab")]
 pub mod aa;
@@ -67,31 +71,46 @@ mod shaders;
 mod stages;
 #[cfg(feature = "io")]
 pub mod terrain;
+// The engine's tests (tests/main.rs, each file a module) are compiled into the library's test
+// build, so that they use its internals from inside the crate rather than through a public door.
+#[cfg(test)]
+#[allow(unsafe_code)]
+#[path = "../tests/main.rs"]
+mod tests;
 #[cfg(feature = "lab")]
 pub mod truth;
 #[allow(unsafe_code)]
 pub mod vk;
 pub mod volume;
 
-pub use bands::{frame_bands, BAND_BYTES};
-pub use bisect::Bisect;
-pub use camera::{Camera, Projection, Window};
-pub use error::{host_budget, set_host_budget, Error, Result};
+// The facade: what an embedder names at the top. Everything else has one path, in its module
+// (`options::Mode`, `order::Direction`, ...); tests/layout.rs counts these names (at most 40).
+pub use camera::Camera;
+pub use error::{Error, Result};
+/// The vector and matrix types of the API (`Camera`'s eye, a clip plane, an affine).
+///
+/// ```
+/// use voxsplat::glam::Vec3;
+/// let mut camera = voxsplat::Camera::framing(&voxsplat::Grid::centered([8; 3], [1.0; 3])?, 64, 64);
+/// camera.up = Vec3::Z;
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 pub use glam;
-pub use image::ImageF32;
-pub use image::TargetFormat;
-pub use kernel::Kernel;
-pub use options::{
-    Antialias, BlurProfile, Clip, Composite, Delivered, DepthBuffer, DepthFormat, FrameStats, Lod, Mode, Motion,
-    RaycastOptions, RenderOptions, Rendered, StageTime,
-};
-pub use order::{Direction, OrderKind};
-pub use pick::{Pick, PICK_OPACITY};
-pub use raster::{Raster, RasterChoice};
+pub use options::{RenderOptions, Rendered};
+pub use pick::Pick;
 pub use series::VolumeUpdate;
-#[doc(hidden)]
-pub use shaders::spirv_builds;
-pub use volume::{gpu_bytes_per_splat, Grid, SplatSet, Volume};
+pub use volume::{Grid, SplatSet, Volume};
+
+// Short paths inside the crate (and for its tests), not public.
+use bisect::Bisect;
+use camera::Projection;
+use image::{ImageF32, TargetFormat};
+use kernel::Kernel;
+use options::{
+    Antialias, BlurProfile, Clip, Composite, Delivered, DepthBuffer, DepthFormat, FrameStats, Lod, Mode, Motion,
+    Raster, RasterChoice, RaycastOptions, StageTime,
+};
+use order::{Direction, OrderKind};
 
 use cpu_engine::CpuEngine;
 use plan::Prepared;
@@ -100,6 +119,16 @@ use stages::{Engine, Res, StageId};
 use std::sync::Arc;
 
 /// Where the frame is computed.
+///
+/// ```
+/// use voxsplat::{Backend, Renderer, RendererOptions};
+/// // The CPU mirrors: the same frame without a Vulkan device.
+/// let mut o = RendererOptions::default();
+/// o.backend = Backend::Cpu;
+/// let r = Renderer::new(&o)?;
+/// assert_eq!(r.backend(), Backend::Cpu);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Backend {
     /// Vulkan.
@@ -506,9 +535,8 @@ impl Renderer {
     }
 
     /// Run this frame's recording through stage `after` (the backend's engine) and read `what`
-    /// back, whole: a probe for tests and inspection.
-    #[doc(hidden)]
-    pub fn probe(
+    /// back, whole: a probe for tests and the single-stage probes of `low_level`.
+    fn probe(
         &mut self,
         camera: &Camera,
         options: &RenderOptions,
@@ -530,55 +558,9 @@ impl Renderer {
         }
     }
 
-    /// The compute tile compositor's binning for this frame (GPU stages or their CPU mirrors):
-    /// each screen tile's first entry plus the total, and the entries (splat indices, each tile's
-    /// run in draw-list order).
-    #[doc(hidden)]
-    pub fn tile_lists(&mut self, camera: &Camera, options: &RenderOptions) -> Result<(Vec<u32>, Vec<u32>)> {
-        let mut opts = options.clone();
-        opts.raster = Raster::Compute;
-        opts.composite = Composite::Splat;
-        let got = self.probe(camera, &opts, StageId::TileScatter, &[Res::TileStart, Res::TileEntries])?;
-        let frame = plan::frame_for(&self.prepared()?.set, camera, &opts);
-        let (tx, ty) = plan::tile_grid(&frame);
-        let tiles = tx as usize * ty as usize;
-        let starts = got[0][..tiles + 1].to_vec();
-        let entries = got[1][..starts[tiles] as usize].to_vec();
-        Ok((starts, entries))
-    }
-
-    /// The sheet modes' per-tile sheet ranges of this frame, as the backend computes them (the GPU
-    /// `sheet_tiles` stage, or its CPU mirror), of the grid actually drawn (the coarse one under a
-    /// render scale): for each composite tile, the lowest sheet (global rank; slab mode: slab)
-    /// whose footprints reach it (`u32::MAX`: none), then for each tile the highest + 1; every
-    /// tile `plan::ALL_SHEETS` where the pass would not pay (`plan::sheet_tiles_pay`).
-    #[doc(hidden)]
-    pub fn sheet_tiles(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Vec<u32>> {
-        if options.composite == Composite::Splat {
-            return Err(Error::InvalidArgument("sheet ranges exist only in the sheet and slab modes".into()));
-        }
-        options.validate()?;
-        let camera =
-            if options.render_scale != 1.0 { resample::scaled_camera(camera, options.render_scale)? } else { *camera };
-        let opts = RenderOptions { render_scale: 1.0, ..options.clone() };
-        let got = self.probe(&camera, &opts, StageId::SheetTiles, &[Res::SheetTiles])?;
-        let c = constants::COMPOSITE_TILE;
-        let tiles = camera.width.div_ceil(c) as usize * camera.height.div_ceil(c) as usize;
-        Ok(got[0][..2 * tiles].to_vec())
-    }
-
-    /// The PBTF draw sequence as the backend computes it (the GPU order stages, or their mirrors).
-    #[doc(hidden)]
-    pub fn pbtf_order(&mut self, camera: &Camera, direction: Direction) -> Result<Vec<u32>> {
-        let opts = RenderOptions { raster: Raster::Graphics, direction: Some(direction), ..Default::default() };
-        let n = self.prepared()?.set.len();
-        let got = self.probe(camera, &opts, StageId::OrderScatter, &[Res::Order])?;
-        Ok(got[0][..n].to_vec())
-    }
-
     /// What pixel position (`x`, `y`) of `camera` shows (pixels from the top left corner; a
     /// pixel's centre at + 0.5): the first point along its ray where the accumulated opacity
-    /// passes [`PICK_OPACITY`], in MIP and MinIP the point of the extreme value, or in `Mode::Iso`
+    /// passes one half, in MIP and MinIP the point of the extreme value, or in `Mode::Iso`
     /// the ray's first crossing of the iso value (the ray caster's surface), with the voxel
     /// nearest it, its value and depth; `None` where the ray meets nothing. Computed on the host
     /// over the ray caster's trilinear field with `options`' mode and clipping, so it needs no
@@ -670,26 +652,6 @@ impl Renderer {
     /// The validation messages counted so far (empty without validation or on the CPU).
     pub fn validation_messages(&self) -> Vec<String> {
         self.gpu.as_ref().map(|g| g.context().validation_messages()).unwrap_or_default()
-    }
-
-    /// GPU roofline of the raster pass: milliseconds for `instances` additive `size`-pixel quads
-    /// (a bench probe).
-    #[doc(hidden)]
-    pub fn roofline_quads(&mut self, width: u32, height: u32, size: u32, instances: u32) -> Result<f64> {
-        match &mut self.gpu {
-            Some(g) => g.roofline_quads(width, height, size.max(1), instances),
-            None => Err(Error::Unsupported("the roofline needs a GPU backend".into())),
-        }
-    }
-
-    /// GPU roofline of the compositing pass: (roofline ms, composite.comp ms) over `layers` layers
-    /// (a bench probe).
-    #[doc(hidden)]
-    pub fn roofline_composite(&mut self, width: u32, height: u32, layers: u32) -> Result<(f64, f64)> {
-        match &mut self.gpu {
-            Some(g) => g.roofline_composite(width, height, layers.max(1)),
-            None => Err(Error::Unsupported("the roofline needs a GPU backend".into())),
-        }
     }
 
     /// The Vulkan context, for hosts that share it or tests that probe it.

@@ -4,6 +4,14 @@
 //! gives typed errors (`Error::InvalidArgument` with the file's name, `Error::TooLarge`), never a
 //! panic. One rule for values in every format: samples must be finite (NaN, infinities, and a
 //! NIfTI `scl_slope` that overflows are errors), spacings finite and non-zero.
+//!
+//! ```,no_run
+//! use voxsplat::loaders::{load_volume, VolumeHints};
+//! // Any format by its name: raw (with hints), NRRD, NIfTI, npy, TIFF stacks, DICOM, OME-Zarr.
+//! let volume = load_volume("head.nii.gz".as_ref(), &VolumeHints::default())?;
+//! println!("{:?} voxels", volume.dims);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
 pub use crate::volume::{HeightGrid, ScalarVolume};
 use std::io::Read;

@@ -1,5 +1,15 @@
 //! Image and animation error metrics, used by tests, the bench and `voxsplat compare`. All work on
 //! premultiplied RGBA with values clamped to [0, 1].
+//!
+//! ```
+//! use voxsplat::{image::ImageF32, metrics::compare};
+//! // A frame against a reference, over the pixels either covers.
+//! let mut a = ImageF32::new(8, 8);
+//! a.pixels[0] = [1.0, 1.0, 1.0, 1.0];
+//! let m = compare(&a, &a.clone())?;
+//! assert!(m.rmse == 0.0);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
 use crate::image::ImageF32;
 

@@ -1,6 +1,19 @@
 //! Per-frame choices (`RenderOptions` and its enums) and what a frame returns.
+//!
+//! ```
+//! use voxsplat::options::{Antialias, Composite, Mode};
+//! use voxsplat::RenderOptions;
+//! // A frame's options: sheet compositing with EWA anti-aliasing.
+//! let mut options = RenderOptions::default();
+//! options.composite = Composite::Sheet;
+//! options.antialias = Antialias::Ewa;
+//! options.validate()?;
+//! // What cannot apply is refused, never ignored: maximum intensity needs no sheets.
+//! options.mode = Mode::Mip;
+//! assert!(options.validate().is_err());
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
-use crate::image::ImageF32;
 use crate::kernel::Kernel;
 use crate::order::{Direction, OrderKind};
 
@@ -9,7 +22,7 @@ mod mode;
 mod stats;
 pub use depth::{DepthBuffer, DepthFormat};
 pub use mode::Mode;
-pub use stats::FrameStats;
+pub use stats::{add_time, FrameStats, Rendered, StageTime};
 
 /// How splats become pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -78,6 +91,7 @@ impl std::str::FromStr for Antialias {
 }
 
 pub use crate::constants::{CLIP_SLOTS, MAX_CLIP_PLANES};
+pub use crate::error::{host_budget, set_host_budget};
 
 /// Clipping in world space: up to `MAX_CLIP_PLANES` half-spaces `n · x + d >= 0` and a box crop.
 /// Splats whose centres lie outside any are not drawn (every splat mode, dense and bricked); the
@@ -222,7 +236,7 @@ impl std::str::FromStr for BlurProfile {
 /// back-to-front compositing, the Crawfis-Max kernel, levels of detail on.
 ///
 /// ```
-/// use voxsplat::{Composite, Kernel, Lod, RenderOptions};
+/// use voxsplat::{options::Composite, kernel::Kernel, options::Lod, RenderOptions};
 /// // Westover's sheet buffer with the Gaussian kernel, over a dark background, no levels of detail.
 /// let mut options = RenderOptions::default();
 /// options.composite = Composite::Sheet;
@@ -513,23 +527,6 @@ impl RenderOptions {
     }
 }
 
-/// One named stage's time in milliseconds (GPU timestamps, or wall time on the CPU path).
-#[derive(Clone, Debug, PartialEq)]
-pub struct StageTime {
-    /// The stage's name (`order`, `splat_params`, `footprint`, ...).
-    pub stage: &'static str,
-    /// Milliseconds.
-    pub ms: f64,
-}
-
-/// Add `ms` to the stage named `stage` (first-seen order).
-pub fn add_time(timings: &mut Vec<StageTime>, stage: &'static str, ms: f64) {
-    match timings.iter_mut().find(|t| t.stage == stage) {
-        Some(t) => t.ms += ms,
-        None => timings.push(StageTime { stage, ms }),
-    }
-}
-
 /// Ray caster settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RaycastOptions {
@@ -596,19 +593,6 @@ impl Default for RaycastOptions {
             supersample: 1,
         }
     }
-}
-
-/// A rendered frame: premultiplied RGBA32F, row 0 at the top.
-#[derive(Clone, Debug)]
-pub struct Rendered {
-    /// The frame.
-    pub image: ImageF32,
-    /// Per-stage times, in the order the stages ran.
-    pub timings: Vec<StageTime>,
-    /// The footprint stage's raster variant and why (`None` for the ray caster and the truth).
-    pub raster: Option<RasterChoice>,
-    /// What the frame drew and culled (a bricked volume's; zero elsewhere).
-    pub stats: FrameStats,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

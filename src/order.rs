@@ -3,6 +3,17 @@
 //!
 //! Orders are computed front to back and reversed for back to front. All of them return indices
 //! into [`SplatSet::splats`].
+//!
+//! ```
+//! use voxsplat::order::{visibility_order, Direction, OrderKind};
+//! use voxsplat::{scene, Camera};
+//! // The PBTF order on the host: each splat once, back to front for this camera.
+//! let set = scene::build("cube40")?;
+//! let camera = Camera::framing(set.grid(), 64, 64);
+//! let order = visibility_order(&set, &camera, OrderKind::Pbtf, Direction::BackToFront);
+//! assert_eq!(order.len(), set.len());
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::volume::SplatSet;

@@ -12,6 +12,16 @@
 //! (oblique) affine, such as a CT's tilted gantry gives, is split as rotation times an upper
 //! triangular cell matrix (QR): the rotation moves the camera, the cell matrix places the voxels
 //! (`Orientation::grid`, `Grid::shear`).
+//!
+//! ```
+//! use voxsplat::orient::Orientation;
+//! use voxsplat::glam::DMat4;
+//! // A file's affine places its grid in patient space; a singular one is refused.
+//! let placed = Orientation::from_affine(DMat4::from_scale([0.5, 0.5, 2.0].into()), [64, 64, 32])?;
+//! assert!(Orientation::from_affine(DMat4::ZERO, [64, 64, 32]).is_err());
+//! # let _ = placed;
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use glam::{DMat3, DMat4, DVec3, Vec3};

@@ -1,5 +1,13 @@
 //! Writing frames: RGBA8 PNG with straight (un-premultiplied) alpha, and RGBA32F EXR with
 //! premultiplied alpha (EXR's own convention). Values are written as computed: no sRGB curve.
+//!
+//! ```,no_run
+//! use voxsplat::{image::ImageF32, output::write_image};
+//! // PNG (8-bit sRGB), EXR (linear float) or GIF, by the file's extension.
+//! let frame = ImageF32::new(64, 64);
+//! write_image(&frame, "frame.png".as_ref())?;
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
 use crate::image::ImageF32;
 use std::fs::File;
@@ -116,7 +124,7 @@ fn write_file(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()
 /// Write `img` as PNG or EXR, chosen by the extension.
 ///
 /// ```no_run
-/// use voxsplat::{output::write_image, ImageF32};
+/// use voxsplat::{output::write_image, image::ImageF32};
 /// let frame = ImageF32::new(64, 64);
 /// write_image(&frame, "frame.png".as_ref())?; // 8-bit sRGB
 /// write_image(&frame, "frame.exr".as_ref())?; // linear float

@@ -16,7 +16,20 @@ pub const PICK_OPACITY: f32 = 0.5;
 const PICK_STEPS_PER_VOXEL: f32 = 8.0;
 
 /// What a pixel shows: its ray's first point where the accumulated opacity passes
-/// [`PICK_OPACITY`] (in MIP and MinIP, the point of the extreme value).
+/// one half (in MIP and MinIP, the point of the extreme value). `Renderer::pick` finds it.
+///
+/// ```
+/// use voxsplat::{scene, Backend, Camera, RenderOptions, Renderer, RendererOptions};
+/// let mut o = RendererOptions::default();
+/// o.backend = Backend::Cpu;
+/// let mut r = Renderer::new(&o)?;
+/// let set = scene::build("cube40")?;
+/// let camera = Camera::framing(set.grid(), 64, 64);
+/// r.set_scene(set)?;
+/// let corner = r.pick(&camera, &RenderOptions::default(), 0.5, 0.5)?;
+/// assert!(corner.is_none(), "the corner pixel's ray misses the cube");
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pick {
     /// The point, in world coordinates.

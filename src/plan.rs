@@ -22,15 +22,14 @@ pub mod slab;
 pub use bricked::{
     bricked_min_budget, bricked_resident_bytes, texel_bytes, BrickedPlan, BrickedSheets, BATCH_BYTES_PER_SPLAT,
 };
-pub use frame::{color_map, frame, mode_color_map, DepthSource, Draw, FramePlan, OrderSource, Projection, SplatRaster};
+pub use frame::{frame, mode_color_map, DepthSource, Draw, FramePlan, OrderSource, Projection, SplatRaster};
 pub(crate) use layout::NO_NORMAL;
 pub use layout::{
     cell_footprint_scale, footprint_scale, node_and_cut_words, node_grid, node_levels, node_words, occlusion_len,
-    over_bits, present_push, pyramid_bytes, tile_counts, tile_grid, AA_EWA, AA_NONE, AA_SWAN, CELL_WORDS, LOD_BUFFERS,
-    LOD_CELLS, LOD_LEVELS, NODE_BYTES_FLOOR, NODE_LEVELS, NODE_PIXELS, NODE_WORDS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS,
-    SLOT_CELLS, STREAMED_LOD_BUFFERS, SUMMARY_BYTES, SUMMARY_WORDS,
+    over_bits, present_push, pyramid_bytes, tile_counts, tile_grid, CELL_WORDS, LOD_BUFFERS, LOD_CELLS, LOD_LEVELS,
+    NODE_PIXELS, NODE_WORDS, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, SLOT_CELLS, STREAMED_LOD_BUFFERS, SUMMARY_WORDS,
 };
-pub use pass::{sheet_layers, sheet_pass, SheetPass, TileRule};
+pub use pass::{SheetPass, TileRule};
 
 /// A scene ready to draw: the splat rows plus, per axis, the splats grouped by slice and each
 /// slice's rank among non-empty slices (what the sheet batches index).
@@ -202,12 +201,6 @@ pub fn frame_for(set: &SplatSet, camera: &Camera, opts: &RenderOptions) -> Frame
     let mut frame = make_frame(set, camera, opts.kernel, opts.antialias, opts.motion.as_ref(), split, btf);
     (frame.clip, frame.rect[1]) = opts.clip.uniforms();
     frame
-}
-
-/// The uniforms the order stage alone needs (no anti-aliasing or motion).
-pub fn order_frame(set: &SplatSet, camera: &Camera, direction: Direction) -> Frame {
-    let split = order::pbtf_split(set, camera);
-    make_frame(set, camera, Kernel::Gaussian, Antialias::None, None, split, direction == Direction::BackToFront)
 }
 
 /// One batch of sheets drawn into summation layers and composited together.

@@ -17,7 +17,6 @@ use crate::options::RaycastOptions;
 use crate::options::{RenderOptions, StageTime};
 use crate::plan::{self, groups_1d, Draw, FramePlan, OrderSource, Prepared, SheetPass, SplatRaster, TileRule};
 use crate::stages::{Dispatch, Engine, List, Res, StageId, Workgroup};
-pub use bricked::{HIDDEN_BATCHES, HIDDEN_BATCH_MIN};
 use std::time::Instant;
 
 /// Bits of the status word (binding 17): a binning invocation, or a footprint-sum invocation, made

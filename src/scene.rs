@@ -1,4 +1,13 @@
 //! Built-in scenes reproducing the dissertation's test objects, listed by name.
+//!
+//! ```
+//! use voxsplat::scene;
+//! // The built-in scenes (`voxsplat render --list`): here the hollow 40^3 cube, one voxel thick.
+//! let set = scene::build("cube40")?;
+//! assert_eq!(set.len(), 40 * 40 * 40 - 38 * 38 * 38);
+//! assert!(scene::build("no-such-scene").is_err());
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;

@@ -6,6 +6,21 @@ use crate::plan::Prepared;
 use crate::Renderer;
 
 /// What `Renderer::update_volume` changed.
+///
+/// ```
+/// use voxsplat::{bricks::BrickStore, classify::TransferFunction, loaders::ScalarVolume};
+/// use voxsplat::{Backend, Renderer, RendererOptions};
+/// let mut o = RendererOptions::default();
+/// o.backend = Backend::Cpu;
+/// let mut r = Renderer::new(&o)?;
+/// let values = (0..16 * 16 * 16).map(|i| (i % 16) as f32 / 15.0).collect();
+/// let volume = ScalarVolume { dims: [16; 3], spacing: [1.0; 3], values };
+/// r.set_volume(&volume, &TransferFunction::preset("ramp")?, None)?;
+/// // The same voxels again: no brick changed.
+/// let update = r.update_volume(BrickStore::build(&volume)?)?;
+/// assert_eq!(update.changed, 0);
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct VolumeUpdate {
     /// Bricks whose voxels changed, appeared or went empty.

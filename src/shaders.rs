@@ -33,7 +33,6 @@ include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 
 /// Every SPIR-V build the pipelines use, by name: compiled from `glsl/` with the `shaderc`
 /// feature, else the copies shipped in `glsl/spirv/` (tests/spirv.rs keeps the two equal).
-#[doc(hidden)]
 pub fn spirv_builds() -> &'static [(&'static str, &'static [u8])] {
     SPIRV
 }

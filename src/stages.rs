@@ -16,7 +16,7 @@ use crate::gpu_types::{
     BrickPush, CompositePush, DepthPush, FootprintPush, IsoPush, PresentPush, ProjectPush, SlabPush,
 };
 
-pub use crate::dispatch::{Args, Blend, DrawState, Feature, Kind, Limits, List, Pass, Res, Variant, Workgroup};
+pub use crate::dispatch::{Args, Feature, Kind, Limits, List, Pass, Res, Variant, Workgroup};
 use crate::gpu_types::Frame;
 use crate::kernel::Kernel;
 use crate::options::StageTime;
@@ -535,7 +535,8 @@ impl StageId {
 pub struct Dispatch {
     /// The stage.
     pub stage: StageId,
-    /// The build.
+    /// The build (in a recording's Debug log).
+    #[allow(dead_code)]
     pub build: Build,
     /// Where `build` sits in the stage's table (its pipeline, its mirror's variant).
     pub variant: usize,

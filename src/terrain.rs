@@ -1,6 +1,15 @@
 //! Terrain as voxel columns (chapter 5): one splat at each height cell's surface, plus splats
 //! filling the vertical gap down to the lowest 4-neighbour so the surface has no holes from a
 //! grazing view.
+//!
+//! ```
+//! use voxsplat::{loaders::HeightGrid, terrain::{terrain_splats, TerrainOptions}};
+//! // A height field as voxel columns (chapter 5): each cell a column of splats up to its height.
+//! let heights = HeightGrid { width: 4, rows: 4, heights: vec![2.0; 16] };
+//! let set = terrain_splats(&heights, &TerrainOptions::default())?;
+//! assert!(set.len() >= 16);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
 use crate::volume::HeightGrid;
 use crate::volume::{Grid, SplatSet, MAX_SPLATS};

@@ -5,6 +5,16 @@
 //! (optical depth and emission both), and every pixel's column is integrated front to back with
 //! the emission–absorption model at a depth step of at most a quarter voxel, in f64. It does not
 //! store the m×m×n buffer: each column is integrated as it is reconstructed.
+//!
+//! ```
+//! use voxsplat::{scene, truth::{volumetric_summation, TruthOptions}, Camera};
+//! // The volumetric-summation truth the splatted frames are measured against (chapter 4).
+//! let set = scene::build("cube40")?;
+//! let camera = Camera::framing(set.grid(), 16, 16);
+//! let truth = volumetric_summation(&set, &camera, &TruthOptions::default())?;
+//! assert!(truth.pixels.iter().any(|p| p[3] > 0.0));
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::image::{Downsample, ImageF32};

@@ -1,5 +1,14 @@
 //! Volume rasters and their sparse extraction into splat rows (section 1.2.5): only non-empty
 //! voxels are stored, each keeping its grid index.
+//!
+//! ```
+//! use voxsplat::{Grid, SplatSet};
+//! // A splat set made voxel by voxel: premultiplied RGBA, `None` where nothing is drawn.
+//! let grid = Grid::centered([4, 4, 4], [1.0, 1.0, 2.0])?;
+//! let set = SplatSet::from_fn(grid, |i, _, _| (i % 2 == 0).then_some([0.5, 0.5, 0.5, 0.5]))?;
+//! assert_eq!(set.len(), 32);
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 use crate::error::{Error, Result};
 use crate::gpu_types::Splat;
 use glam::{DVec3, Vec3};
@@ -460,6 +469,15 @@ impl SplatSet {
 
 /// A dense volume raster: density and RGBA per voxel. Loaders produce these; rendering uses the
 /// sparse [`SplatSet`] extracted from it.
+///
+/// ```
+/// use voxsplat::{Grid, Volume};
+/// let grid = Grid::centered([2, 2, 2], [1.0; 3])?;
+/// let volume = Volume::new(grid, vec![1.0; 8], vec![[0.5, 0.5, 0.5, 0.5]; 8])?;
+/// # let _ = volume;
+/// assert!(Volume::new(grid, vec![1.0; 7], vec![[0.0; 4]; 8]).is_err(), "one density per voxel");
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct Volume {
     /// The grid.

@@ -1,9 +1,9 @@
 //! Chapter 3: Swan's anti-aliasing in the per-splat stage, and EWA beside it.
-use crate::common;
+use super::common;
+use crate::plan::Prepared;
+use crate::truth::{supersampled, TruthOptions};
+use crate::{scene, Antialias, Camera, Composite, Grid, Kernel, Projection, RenderOptions, SplatSet};
 use glam::Vec3;
-use voxsplat::low_level::plan::Prepared;
-use voxsplat::truth::{supersampled, TruthOptions};
-use voxsplat::{scene, Antialias, Camera, Composite, Grid, Kernel, Projection, RenderOptions, SplatSet};
 
 fn one_voxel(opacity: f32) -> SplatSet {
     let grid = Grid::centered([1, 1, 1], [1.0; 3]).unwrap();
@@ -27,7 +27,7 @@ fn looking_at(p: Vec3, distance: f32, size: u32) -> Camera {
 #[test]
 fn a_splat_beyond_k_keeps_its_footprint_energy() {
     let set = one_voxel(0.01);
-    let tau = voxsplat::low_level::cpu::splat_params::optical_depth(0.01) as f64;
+    let tau = crate::cpu::splat_params::optical_depth(0.01) as f64;
     let mut r = common::cpu();
     r.set_scene(set.clone()).unwrap();
     let probe = looking_at(set.grid().center(), 1.0, 64);
@@ -58,8 +58,8 @@ fn radius_scale_is_max_of_one_and_d_over_k_and_nothing_changes_before_k() {
     let k = cam.k(set.grid().kernel_spacing()).unwrap();
     let mut r = common::cpu();
     r.set_scene(set).unwrap();
-    let none = r.splat_params(&cam, Kernel::Gaussian, Antialias::None).unwrap();
-    let swan = r.splat_params(&cam, Kernel::Gaussian, Antialias::Swan).unwrap();
+    let none = crate::low_level::splat_params(&mut r, &cam, Kernel::Gaussian, Antialias::None).unwrap();
+    let swan = crate::low_level::splat_params(&mut r, &cam, Kernel::Gaussian, Antialias::Swan).unwrap();
     let (mut before, mut beyond) = (0, 0);
     for (a, b) in none.iter().zip(&swan) {
         let d = b.screen[0];
@@ -86,7 +86,7 @@ fn swan_lowers_the_error_beyond_k_on_the_plane() {
     let set = scene::build("plane").unwrap();
     let cam = Camera::grazing(set.grid(), 96, 96);
     let truth = supersampled(&set, &cam, 8, &TruthOptions::default()).unwrap();
-    let regions = voxsplat::aa::k_regions(&set, &cam);
+    let regions = crate::aa::k_regions(&set, &cam);
     assert!(regions.iter().filter(|&&x| x == 2).count() > 200);
     let mut r = common::gpu();
     r.set_scene(set).unwrap();
@@ -94,7 +94,7 @@ fn swan_lowers_the_error_beyond_k_on_the_plane() {
         let mut o = RenderOptions::default();
         o.antialias = aa;
         let img = r.render(&cam, &o).unwrap().image;
-        voxsplat::metrics::rmse_masked(&img, &truth, |i| regions[i] == 2).unwrap()
+        crate::metrics::rmse_masked(&img, &truth, |i| regions[i] == 2).unwrap()
     };
     let (none, swan) = (err(Antialias::None), err(Antialias::Swan));
     eprintln!("beyond k: none {none:.4}, swan {swan:.4}");
@@ -114,14 +114,14 @@ fn orthographic_dense_volume_lies_wholly_beyond_k() {
     assert!(set.grid().kernel_spacing() * cam.pixels_per_unit() < 1.0);
     let mut r = common::cpu();
     r.set_scene(set).unwrap();
-    let p = r.splat_params(&cam, Kernel::Gaussian, Antialias::Swan).unwrap();
+    let p = crate::low_level::splat_params(&mut r, &cam, Kernel::Gaussian, Antialias::Swan).unwrap();
     let want = 1.0 / (cam.pixels_per_unit());
     assert!(p.iter().all(|q| (q.screen[3] - want).abs() < 1e-4 * want));
 }
 
 /// A `w` x `h` image of luma `f(x, y)`, opaque.
-fn luma_image(w: u32, h: u32, f: impl Fn(f32, f32) -> f32) -> voxsplat::ImageF32 {
-    let mut img = voxsplat::ImageF32::new(w, h);
+fn luma_image(w: u32, h: u32, f: impl Fn(f32, f32) -> f32) -> crate::ImageF32 {
+    let mut img = crate::ImageF32::new(w, h);
     for (i, p) in img.pixels.iter_mut().enumerate() {
         let v = f((i % w as usize) as f32, (i / w as usize) as f32);
         *p = [v, v, v, 1.0];
@@ -131,12 +131,12 @@ fn luma_image(w: u32, h: u32, f: impl Fn(f32, f32) -> f32) -> voxsplat::ImageF32
 
 #[test]
 fn lanczos_keeps_what_the_pixels_can_hold_and_drops_what_they_cannot() {
-    use voxsplat::image::{downsample, Downsample};
+    use crate::image::{downsample, Downsample};
     let f = 8usize;
     let sine = |period: f32| {
         luma_image(64 * f as u32, 8 * f as u32, move |x, _| 0.5 + 0.4 * (x * std::f32::consts::TAU / period).sin())
     };
-    let amplitude = |img: &voxsplat::ImageF32| {
+    let amplitude = |img: &crate::ImageF32| {
         let row: Vec<f32> = (8..56).map(|x| img.pixels[4 * 64 + x][0]).collect();
         (row.iter().cloned().fold(0.0f32, f32::max) - row.iter().cloned().fold(1.0f32, f32::min)) / 2.0
     };
@@ -155,7 +155,7 @@ fn lanczos_keeps_what_the_pixels_can_hold_and_drops_what_they_cannot() {
 
 #[test]
 fn aliasing_energy_counts_added_patterns_not_blur() {
-    use voxsplat::metrics::aliasing_energy;
+    use crate::metrics::aliasing_energy;
     let scene = |x: f32, y: f32| 0.5 + 0.3 * (x * 0.2).sin() * (y * 0.15).cos();
     let reference = luma_image(64, 48, scene);
     let all = |_: usize| true;
@@ -175,7 +175,7 @@ fn the_k_line_falls_across_the_terrain_fly_over() {
     // Fig. 3.7's view at its size: the near terrain (lower rows) before k, the far terrain beyond.
     let set = scene::build("rmnp").unwrap();
     let cam = Camera::flyover(set.grid(), 260, 179);
-    let regions = voxsplat::aa::k_regions(&set, &cam);
+    let regions = crate::aa::k_regions(&set, &cam);
     let rows = |class: u8| {
         let ys: Vec<usize> = (0..regions.len()).filter(|&i| regions[i] == class).map(|i| i / 260).collect();
         (ys.len(), ys.iter().sum::<usize>() as f64 / ys.len().max(1) as f64)
@@ -186,8 +186,8 @@ fn the_k_line_falls_across_the_terrain_fly_over() {
     // The image's first row is its top (Vulkan's y points down): the far terrain lies above.
     assert!(y_beyond < y_before);
     // A voxel raster the rays miss has no regions.
-    let empty = voxsplat::SplatSet::from_fn(*set.grid(), |_, _, _| None).unwrap();
-    assert!(voxsplat::aa::k_regions(&empty, &cam).iter().all(|&r| r == 0));
+    let empty = crate::SplatSet::from_fn(*set.grid(), |_, _, _| None).unwrap();
+    assert!(crate::aa::k_regions(&empty, &cam).iter().all(|&r| r == 0));
 }
 
 /// Issue 44: in a frame of a few pixels, or near the near plane, anti-aliasing's widening no longer
@@ -210,7 +210,7 @@ fn anti_aliasing_never_culls_the_splat_it_widens() {
         let mut none_o = RenderOptions::default();
         none_o.kernel = Kernel::Gaussian;
         let none = c.render(&cam, &none_o).unwrap().image;
-        let sum = |img: &voxsplat::ImageF32| img.pixels.iter().map(|p| p[3]).sum::<f32>();
+        let sum = |img: &crate::ImageF32| img.pixels.iter().map(|p| p[3]).sum::<f32>();
         assert!(sum(&none) > 0.05, "{size}: nothing drawn without anti-aliasing ({})", sum(&none));
         for aa in [Antialias::Swan, Antialias::Ewa] {
             let mut o = none_o.clone();
@@ -236,7 +236,7 @@ fn slab_mode_keeps_an_anti_aliased_splat_s_energy() {
     g.set_scene(set.clone()).unwrap();
     let probe = looking_at(set.grid().center(), 1.0, 64);
     let k = probe.k(1.0).unwrap();
-    let sum = |img: &voxsplat::ImageF32| img.pixels.iter().map(|p| p[3]).sum::<f32>();
+    let sum = |img: &crate::ImageF32| img.pixels.iter().map(|p| p[3]).sum::<f32>();
     for (d_over_k, aa) in
         [(4.0f32, Antialias::Swan), (12.0, Antialias::Swan), (4.0, Antialias::Ewa), (12.0, Antialias::Ewa)]
     {

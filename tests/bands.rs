@@ -1,20 +1,15 @@
 //! Frames drawn in parts: a camera's window (`Camera::windowed`) draws exactly its pixels of the
 //! whole frame, on both backends, over the paths a frame takes; `render` draws a frame past one
-//! band (`voxsplat::frame_bands`) in bands and `render_bands` hands them on in order.
-use crate::common;
+//! band (`crate::bands::frame_bands`) in bands and `render_bands` hands them on in order.
+use super::common;
+use crate::{Antialias, Camera, Composite, Delivered, Mode, Motion, Projection, Raster, RenderOptions, Renderer};
 use common::{assert_clean, cpu, gpu};
 use glam::Mat4;
-use voxsplat::{Antialias, Camera, Composite, Delivered, Mode, Motion, Projection, Raster, RenderOptions, Renderer};
 
 /// The whole frame put together from windows of it: bands of `rows` rows, each cut into columns
 /// `cols` wide.
-fn in_windows(
-    cam: &Camera,
-    rows: u32,
-    cols: u32,
-    mut draw: impl FnMut(&Camera) -> voxsplat::ImageF32,
-) -> voxsplat::ImageF32 {
-    let mut out = voxsplat::ImageF32::new(cam.width, cam.height);
+fn in_windows(cam: &Camera, rows: u32, cols: u32, mut draw: impl FnMut(&Camera) -> crate::ImageF32) -> crate::ImageF32 {
+    let mut out = crate::ImageF32::new(cam.width, cam.height);
     for y in (0..cam.height).step_by(rows as usize) {
         for x in (0..cam.width).step_by(cols as usize) {
             let (w, h) = (cols.min(cam.width - x), rows.min(cam.height - y));
@@ -31,17 +26,17 @@ fn in_windows(
 }
 
 /// Pixels where a channel differs by more than 1e-3 (a quarter of an 8-bit step).
-fn off_pixels(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> usize {
+fn off_pixels(a: &crate::ImageF32, b: &crate::ImageF32) -> usize {
     a.pixels.iter().zip(&b.pixels).filter(|(p, q)| (0..4).any(|k| (p[k] - q[k]).abs() > 1e-3)).count()
 }
 
 /// Largest channel difference and the number of covered pixels of `whole`.
-fn compare(whole: &voxsplat::ImageF32, parts: &voxsplat::ImageF32) -> (f32, usize) {
+fn compare(whole: &crate::ImageF32, parts: &crate::ImageF32) -> (f32, usize) {
     (common::diff(whole, parts).0, common::covered(whole))
 }
 
 /// The cases: a name, options and a camera, over splat sets and a bricked volume.
-fn cases(grid: &voxsplat::Grid) -> Vec<(&'static str, RenderOptions, Camera)> {
+fn cases(grid: &crate::Grid) -> Vec<(&'static str, RenderOptions, Camera)> {
     let persp = Camera::framing(grid, 90, 70);
     let ortho = Camera { projection: Projection::Orthographic { height: 1.1 * grid.diagonal() }, ..persp };
     let with = |f: &dyn Fn(&mut RenderOptions)| {
@@ -53,7 +48,7 @@ fn cases(grid: &voxsplat::Grid) -> Vec<(&'static str, RenderOptions, Camera)> {
         previous: Mat4::from_rotation_z(0.08),
         middle: None,
         delta_px: 0.5,
-        profile: voxsplat::BlurProfile::default(),
+        profile: crate::BlurProfile::default(),
     };
     vec![
         ("default", RenderOptions::default(), persp),
@@ -101,7 +96,7 @@ fn a_window_draws_exactly_its_pixels_of_the_whole_frame() {
         // The ray caster, two rays a pixel side (measured at most 9.5e-6 off).
         r.set_scene(set.clone()).unwrap();
         let cam = Camera::framing(set.grid(), 90, 70);
-        let o = voxsplat::RaycastOptions { supersample: 2, ..Default::default() };
+        let o = crate::RaycastOptions { supersample: 2, ..Default::default() };
         let whole = r.raycast(&cam, &o).unwrap().image;
         let parts = in_windows(&cam, 17, 31, |c| r.raycast(c, &o).unwrap().image);
         let (max, covered) = compare(&whole, &parts);
@@ -114,15 +109,15 @@ fn a_window_draws_exactly_its_pixels_of_the_whole_frame() {
 #[test]
 fn bands_cover_every_row_once_within_the_band_size() {
     for (w, h) in [(1, 1), (2048, 2048), (2049, 2048), (8192, 8192), (16384, 4096), (16384, 300), (3000, 1)] {
-        let cam = Camera::framing(&voxsplat::Grid::centered([4; 3], [1.0; 3]).unwrap(), w, h);
-        let bands = voxsplat::frame_bands(&cam);
+        let cam = Camera::framing(&crate::Grid::centered([4; 3], [1.0; 3]).unwrap(), w, h);
+        let bands = crate::bands::frame_bands(&cam);
         let whole = w as u64 * h as u64 * 16;
-        let least = whole.div_ceil(voxsplat::BAND_BYTES) as usize;
+        let least = whole.div_ceil(crate::bands::BAND_BYTES) as usize;
         assert!(bands.len() == least || bands.len() == least + 1, "{w}x{h}: {} bands, at least {least}", bands.len());
         let mut next = 0;
         for &(y, rows) in &bands {
             assert_eq!(y, next, "{w}x{h}: bands in order, none left out");
-            assert!(rows > 0 && w as u64 * rows as u64 * 16 <= voxsplat::BAND_BYTES.max(w as u64 * 16));
+            assert!(rows > 0 && w as u64 * rows as u64 * 16 <= crate::bands::BAND_BYTES.max(w as u64 * 16));
             next += rows;
         }
         assert_eq!(next, h, "{w}x{h}: every row");

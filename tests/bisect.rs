@@ -2,11 +2,11 @@
 //! CPU mirrors (or the reverse), everything the first engine wrote handed to the second. Where the
 //! stages before the switch give both engines the same words, the split frame is the other
 //! backend's frame bit for bit; elsewhere it lies within the mirror tolerance.
-use crate::common;
+use super::common;
+use crate::output::diff_rgba8;
+use crate::stages::StageId;
+use crate::{scene, Bisect, Camera, Composite, Error, ImageF32, Lod, Raster, RenderOptions, Renderer};
 use common::assert_clean;
-use voxsplat::low_level::stages::StageId;
-use voxsplat::output::diff_rgba8;
-use voxsplat::{scene, Bisect, Camera, Composite, Error, ImageF32, Lod, Raster, RenderOptions, Renderer};
 
 fn options(composite: Composite, raster: Raster) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -111,9 +111,9 @@ fn bisect_names_are_parsed_and_checked() {
 #[test]
 fn bricked_volumes_split_at_the_brick_stages() {
     let stent = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/stent/stent.nrrd");
-    let vol = voxsplat::loaders::load_volume(stent.as_ref(), &Default::default()).unwrap();
-    let tf = voxsplat::classify::TransferFunction::preset("ct").unwrap();
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
+    let vol = crate::loaders::load_volume(stent.as_ref(), &Default::default()).unwrap();
+    let tf = crate::classify::TransferFunction::preset("ct").unwrap();
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
     let (mut gpu, mut cpu) = (common::gpu(), common::cpu());
     gpu.set_volume(&vol, &tf, None).unwrap();
     cpu.set_volume(&vol, &tf, None).unwrap();

@@ -2,13 +2,14 @@
 //! against their CPU mirrors, the order they write (bricks by the k-d tree, voxels by PBTF) against `order::tree_bricked`
 //! over a random view battery, streaming through a small budget, transfer-function changes, and
 //! bad budgets. Validation on: any message fails.
-use crate::common;
-use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, splat_stage, Rng, ViewKind};
-use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
-use voxsplat::classify::{classify, Shading, TransferFunction};
-use voxsplat::low_level::stages::{Res, StageId};
-use voxsplat::volume::ScalarVolume;
-use voxsplat::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
+use super::common;
+use super::probes::splat_stage;
+use crate::bricks::{BrickScene, BrickStore, BRICK};
+use crate::classify::{classify, Shading, TransferFunction};
+use crate::stages::{Res, StageId};
+use crate::volume::ScalarVolume;
+use crate::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
+use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 
 fn renderer(gpu: bool, budget: Option<u64>) -> Renderer {
     let mut r = if gpu { common::gpu() } else { common::cpu() };
@@ -31,7 +32,7 @@ fn compute(direction: Direction) -> RenderOptions {
 #[test]
 fn gpu_frames_match_the_cpu_mirrors_and_the_dense_classification() {
     let vol = blob([37, 29, 23]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 80);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 80);
     let shading = Some(Shading::headlight(cam.forward()));
     let mut weighted = tf();
     weighted.gradient_weight = 0.5;
@@ -67,11 +68,7 @@ fn gpu_frames_match_the_cpu_mirrors_and_the_dense_classification() {
 fn drawn_sequence(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 3]> {
     let got = r.probe(cam, o, splat_stage(o), &[Res::BrickSlots, Res::BrickVoxels]).unwrap();
     let total: u32 = got[0].iter().map(|w| w & 1023).sum();
-    got[1]
-        .chunks_exact(2)
-        .take(total as usize)
-        .map(|v| voxsplat::low_level::cpu::brick::voxel_ijk([v[0], v[1]]))
-        .collect()
+    got[1].chunks_exact(2).take(total as usize).map(|v| crate::cpu::brick::voxel_ijk([v[0], v[1]])).collect()
 }
 
 #[test]
@@ -81,7 +78,7 @@ fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
     let set = store.classify(&tf(), None).unwrap();
     let grid = *set.grid();
     let nb = store.dims.map(|d| d.div_ceil(BRICK));
-    let tree = voxsplat::low_level::kdtree::build(nb, 1, |id| store.index[id] != u32::MAX);
+    let tree = crate::kdtree::build(nb, 1, |id| store.index[id] != u32::MAX);
     assert!(tree.len() >= 3, "the tree cuts the bricks: {tree:?}");
     let (mut g, mut c) = (renderer(true, None), renderer(false, None));
     g.set_volume(&vol, &tf(), None).unwrap();
@@ -106,7 +103,7 @@ fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
                 o.lod = Lod::Off;
                 let got = drawn_sequence(&mut g, &cam, &o);
                 assert_eq!(got, drawn_sequence(&mut c, &cam, &o), "{kind:?} {v}: GPU vs mirror sequence");
-                let mut want: Vec<[u32; 3]> = voxsplat::order::tree_bricked(&set, &cam, BRICK, &tree)
+                let mut want: Vec<[u32; 3]> = crate::order::tree_bricked(&set, &cam, BRICK, &tree)
                     .unwrap()
                     .iter()
                     .map(|&s| {
@@ -123,12 +120,11 @@ fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
                 assert_eq!(got.len(), want.len(), "{kind:?} {v}: drawn voxels are the classified ones");
                 assert_eq!(got, want, "{kind:?} {v} {direction:?}: tree order, then PBTF");
                 // And the order validator on what is drawn: no 6-neighbour pair against its plane.
-                let drawn = voxsplat::SplatSet::from_fn(grid, |i, j, k| {
-                    kept.contains(&[i, j, k]).then_some([1.0, 1.0, 1.0, 0.5])
-                })
-                .unwrap();
+                let drawn =
+                    crate::SplatSet::from_fn(grid, |i, j, k| kept.contains(&[i, j, k]).then_some([1.0, 1.0, 1.0, 0.5]))
+                        .unwrap();
                 let seq: Vec<u32> = got.iter().map(|v| drawn.find(v[0], v[1], v[2]).unwrap() as u32).collect();
-                let bad = voxsplat::order::count_violations(&drawn, &cam, &seq, direction).unwrap();
+                let bad = crate::order::count_violations(&drawn, &cam, &seq, direction).unwrap();
                 assert_eq!(bad, 0, "{kind:?} {v} {direction:?}: validator violations");
                 views += 1;
             }
@@ -145,15 +141,15 @@ fn bricks_in_k_d_tree_order_then_voxels_in_pbtf_on_both_engines() {
 #[test]
 fn streaming_through_a_small_budget_draws_the_same_frame() {
     let vol = blob([61, 53, 47]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
     for gpu in [true, false] {
         let mut whole = renderer(gpu, None);
         whole.set_volume(&vol, &tf(), None).unwrap();
         let scene = whole.volume().unwrap();
         // Room for about a fifth of the splats in each batch.
-        let least = voxsplat::low_level::plan::bricked_min_budget(scene, u64::MAX, 80, 80);
+        let least = crate::plan::bricked_min_budget(scene, u64::MAX, 80, 80);
         let splats = scene.store.len() as u64;
-        let budget = least + splats / 5 * voxsplat::low_level::plan::BATCH_BYTES_PER_SPLAT;
+        let budget = least + splats / 5 * crate::plan::BATCH_BYTES_PER_SPLAT;
         assert!(!scene.streams(budget), "the store stays resident");
         let mut streamed = renderer(gpu, Some(budget));
         streamed.set_volume(&vol, &tf(), None).unwrap();
@@ -191,7 +187,7 @@ fn streaming_through_a_small_budget_draws_the_same_frame() {
 #[test]
 fn a_transfer_function_change_is_the_new_classification_and_empty_is_an_empty_frame() {
     let vol = blob([37, 29, 23]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 64);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 64);
     let o = compute(Direction::FrontToBack);
     let mut other = tf();
     other.points = vec![(0.0, [0.2, 0.8, 0.3, 0.0]), (0.5, [0.2, 0.8, 0.3, 0.5]), (0.6, [0.0; 4])];
@@ -220,7 +216,7 @@ fn a_transfer_function_change_is_the_new_classification_and_empty_is_an_empty_fr
     assert_clean(&changed);
     // Not a bricked scene: a typed error.
     let mut dense = renderer(false, None);
-    dense.set_scene(voxsplat::scene::build("cube40").unwrap()).unwrap();
+    dense.set_scene(crate::scene::build("cube40").unwrap()).unwrap();
     assert!(matches!(dense.set_transfer_function(&other, None), Err(Error::InvalidArgument(_))));
     let _ = BrickScene::new; // the scene type embedders build themselves
     let _ = RendererOptions::default().gpu_budget_bytes;
@@ -233,7 +229,7 @@ fn a_transfer_function_change_is_the_new_classification_and_empty_is_an_empty_fr
 #[test]
 fn waves_front_to_back_draw_bricks_in_shells_around_the_eye() {
     let vol = blob([61, 47, 39]);
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let store = BrickStore::build(&vol).unwrap();
     let (mut g, mut c) = (renderer(true, None), renderer(false, None));
     g.set_volume(&vol, &tf(), None).unwrap();
@@ -259,17 +255,16 @@ fn waves_front_to_back_draw_bricks_in_shells_around_the_eye() {
             let got = drawn_sequence(&mut g, &cam, &o);
             assert_eq!(got, drawn_sequence(&mut c, &cam, &o), "{kind:?} {v}: GPU vs mirror sequence");
             assert!(!got.is_empty(), "{kind:?} {v}");
-            let split = voxsplat::order::brick_split(&set, &cam, BRICK);
-            let shells: Vec<u32> =
-                got.iter().map(|v| voxsplat::order::brick_shell(v.map(|c| c / BRICK), split)).collect();
+            let split = crate::order::brick_split(&set, &cam, BRICK);
+            let shells: Vec<u32> = got.iter().map(|v| crate::order::brick_shell(v.map(|c| c / BRICK), split)).collect();
             assert!(shells.windows(2).all(|w| w[0] <= w[1]), "{kind:?} {v}: shells out of order");
             shells_seen += usize::from(shells[0] < *shells.last().unwrap());
             let kept: std::collections::HashSet<[u32; 3]> = got.iter().copied().collect();
             let drawn =
-                voxsplat::SplatSet::from_fn(grid, |i, j, k| kept.contains(&[i, j, k]).then_some([1.0, 1.0, 1.0, 0.5]))
+                crate::SplatSet::from_fn(grid, |i, j, k| kept.contains(&[i, j, k]).then_some([1.0, 1.0, 1.0, 0.5]))
                     .unwrap();
             let seq: Vec<u32> = got.iter().map(|v| drawn.find(v[0], v[1], v[2]).unwrap() as u32).collect();
-            let bad = voxsplat::order::count_violations(&drawn, &cam, &seq, Direction::FrontToBack).unwrap();
+            let bad = crate::order::count_violations(&drawn, &cam, &seq, Direction::FrontToBack).unwrap();
             assert_eq!(bad, 0, "{kind:?} {v}: validator violations");
             views += 1;
         }
@@ -281,7 +276,7 @@ fn waves_front_to_back_draw_bricks_in_shells_around_the_eye() {
 #[test]
 fn dropping_hidden_bricks_front_to_back_changes_nothing_and_drops_some() {
     let vol = blob([120, 100, 90]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
     // Opaque material: most bricks lie behind the front ones.
     let opaque = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.95])], ..tf() };
     // At full detail, and with levels of detail (the default; at 192², since at 96² most bricks
@@ -323,7 +318,7 @@ fn dropping_hidden_bricks_front_to_back_changes_nothing_and_drops_some() {
 #[test]
 fn waves_stop_where_nothing_is_hidden() {
     let vol = blob([120, 100, 90]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
     let faint = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.02])], ..tf() };
     for gpu in [true, false] {
         let mut r = renderer(gpu, None);
@@ -352,7 +347,7 @@ fn waves_stop_where_nothing_is_hidden() {
 fn a_store_of_more_than_one_record_page_reads_every_page() {
     let dims = [340u32, 340, 300];
     let n = dims.iter().map(|&d| d as usize).product::<usize>();
-    assert!(n > voxsplat::low_level::constants::RECORD_PAGE as usize);
+    assert!(n > crate::constants::RECORD_PAGE as usize);
     let mut values = vec![200.0f32; n];
     values[0] = 0.0;
     for (i, v) in values.iter_mut().enumerate() {
@@ -361,7 +356,7 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
         }
     }
     let vol = ScalarVolume { dims, spacing: [1.0; 3], values };
-    let grid = voxsplat::Grid::centered(dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(dims, vol.spacing).unwrap();
     let store = BrickStore::build(&vol).unwrap();
     drop(vol);
     let scene = BrickScene::new(store, tf(), None).unwrap();
@@ -371,7 +366,7 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
     // Full detail: this far, levels of detail would draw the bricks from their pyramids, which
     // read no records.
     let mut o = compute(Direction::FrontToBack);
-    o.lod = voxsplat::Lod::Off;
+    o.lod = crate::Lod::Off;
     let what = [Res::BrickSlots, Res::BrickVoxels];
     let (mut g, mut c) = (renderer(true, None), renderer(false, None));
     g.set_bricks(scene.clone()).unwrap();
@@ -382,10 +377,10 @@ fn a_store_of_more_than_one_record_page_reads_every_page() {
     let count = a[0].iter().zip(&b[0]).filter(|(x, y)| x != y).count();
     assert_eq!(count, 0, "brick_cull's counts differ at {count} slots, first {differ:?}");
     // The first batch's splats: the bricks in slot order up to the batch capacity.
-    let budget = voxsplat::low_level::constants::DEFAULT_GPU_BUDGET;
-    let resident = voxsplat::low_level::plan::bricked_resident_bytes(g.volume().unwrap(), budget, 48, 48);
-    let capacity = ((budget - resident) / voxsplat::low_level::plan::BATCH_BYTES_PER_SPLAT)
-        .min(voxsplat::low_level::constants::MAX_GPU_SPLATS as u64) as u32;
+    let budget = crate::constants::DEFAULT_GPU_BUDGET;
+    let resident = crate::plan::bricked_resident_bytes(g.volume().unwrap(), budget, 48, 48);
+    let capacity =
+        ((budget - resident) / crate::plan::BATCH_BYTES_PER_SPLAT).min(crate::constants::MAX_GPU_SPLATS as u64) as u32;
     let mut first = 0;
     for w in a[0].iter().filter(|&&w| w != 0) {
         if first + (w & 1023) > capacity {
@@ -412,7 +407,7 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
     let vol = blob([61, 53, 47]);
     // 64², so the images leave the streamed store's resident part (headers, masks with their
     // counts, index) and a brick of splats room under twice its records.
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 64);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 64);
     for gpu in [true, false] {
         let mut resident = renderer(gpu, None);
         resident.set_volume(&vol, &tf(), None).unwrap();
@@ -421,7 +416,7 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
         // Under twice the records, the store streams; above the streamed minimum, it draws.
         let budget = 2 * records - 1;
         assert!(scene.streams(budget));
-        let least = voxsplat::low_level::plan::bricked_min_budget(scene, budget, 64, 64);
+        let least = crate::plan::bricked_min_budget(scene, budget, 64, 64);
         assert!(least < budget, "{least} < {budget}");
         let mut streamed = renderer(gpu, Some(budget));
         streamed.set_volume(&vol, &tf(), None).unwrap();
@@ -447,7 +442,7 @@ fn a_store_larger_than_the_budget_allows_streams_batch_by_batch() {
         // A projection does not shade: the shaded store streams in MIP, as the unshaded one draws
         // (every voxel: a streamed store would upload its records twice for MIP's texels).
         let mut mip = RenderOptions::default();
-        (mip.mode, mip.raster, mip.every_voxel) = (voxsplat::Mode::Mip, Raster::Compute, true);
+        (mip.mode, mip.raster, mip.every_voxel) = (crate::Mode::Mip, Raster::Compute, true);
         resident.set_transfer_function(&tf(), None).unwrap();
         let plain = resident.render(&cam, &mip).unwrap().image;
         assert!(plain.pixels == streamed.render(&cam, &mip).unwrap().image.pixels, "gpu {gpu}: MIP, streamed, shaded");
@@ -468,9 +463,9 @@ const SHEET_RASTERS: [(Raster, Direction); 4] = [
 
 #[test]
 fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classification() {
-    use voxsplat::Composite;
+    use crate::Composite;
     let vol = blob([37, 29, 23]);
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let mut rng = Rng(23);
     // Outside, and inside the volume (the sheets split at the eye's plane).
     let cams = [Camera::framing(&grid, 96, 80), random_camera(&mut rng, &grid, ViewKind::Inside)];
@@ -516,9 +511,9 @@ fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classificat
     for gpu in [true, false] {
         let mut whole = renderer(gpu, None);
         whole.set_volume(&vol, &tf(), None).unwrap();
-        let least = voxsplat::low_level::plan::bricked_min_budget(whole.volume().unwrap(), u64::MAX, 96, 80);
+        let least = crate::plan::bricked_min_budget(whole.volume().unwrap(), u64::MAX, 96, 80);
         let splats = whole.volume().unwrap().store.len() as u64;
-        let budget = least + 2 * sheet_budget + splats / 6 * voxsplat::low_level::plan::BATCH_BYTES_PER_SPLAT;
+        let budget = least + 2 * sheet_budget + splats / 6 * crate::plan::BATCH_BYTES_PER_SPLAT;
         let mut small = renderer(gpu, Some(budget));
         small.set_volume(&vol, &tf(), None).unwrap();
         for composite in [Composite::Sheet, Composite::Slab] {
@@ -555,7 +550,7 @@ fn sheet_and_slab_modes_draw_a_bricked_volume_as_they_draw_its_dense_classificat
 fn a_built_in_scene_as_a_palette_volume_classifies_back_to_its_splats() {
     // The plane fills its grid (no empty voxel to be the store's minimum); the cubes are hollow.
     for name in ["plane", "cube40", "cube40-attenuated"] {
-        let set = voxsplat::scene::build(name).unwrap();
+        let set = crate::scene::build(name).unwrap();
         let scene = BrickScene::from_palette(&set).unwrap();
         let back = scene.store.classify(scene.transfer_function(), None).unwrap();
         assert_eq!(back.len(), set.len(), "{name}: splats");
@@ -564,10 +559,10 @@ fn a_built_in_scene_as_a_palette_volume_classifies_back_to_its_splats() {
             assert!(a.color.iter().zip(&b.color).all(|(x, y)| (x - y).abs() < 1e-6), "{name}: {a:?} vs {b:?}");
         }
     }
-    let grid = voxsplat::Grid::centered([70, 1, 1], [1.0; 3]).unwrap();
-    let many = voxsplat::SplatSet::from_fn(grid, |i, _, _| Some([i as f32 / 70.0, 0.5, 0.5, 0.5])).unwrap();
+    let grid = crate::Grid::centered([70, 1, 1], [1.0; 3]).unwrap();
+    let many = crate::SplatSet::from_fn(grid, |i, _, _| Some([i as f32 / 70.0, 0.5, 0.5, 0.5])).unwrap();
     let err = BrickScene::from_palette(&many).unwrap_err();
-    assert!(matches!(err, voxsplat::Error::InvalidArgument(_)), "{err}");
+    assert!(matches!(err, crate::Error::InvalidArgument(_)), "{err}");
     assert!(err.to_string().contains("more than 64 colours"), "{err}");
 }
 
@@ -577,7 +572,7 @@ fn a_built_in_scene_as_a_palette_volume_classifies_back_to_its_splats() {
 #[test]
 fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
     let vol = blob([120, 110, 100]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
     let mut turned = cam;
     turned.eye = cam.target + glam::Quat::from_rotation_y(0.35) * (cam.eye - cam.target);
     for gpu in [true, false] {
@@ -591,7 +586,7 @@ fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
         // Levels of detail (the error bound lifted) keep the far bricks coarse: their cells need
         // no records, and the near bricks' fit the cache.
         let mut o = compute(Direction::FrontToBack);
-        (o.lod_pixels, o.lod_error) = (1.0, voxsplat::options::MAX_LOD_ERROR);
+        (o.lod_pixels, o.lod_error) = (1.0, crate::options::MAX_LOD_ERROR);
         let first = streamed.render(&cam, &o).unwrap();
         let again = streamed.render(&cam, &o).unwrap();
         let want = resident.render(&cam, &o).unwrap().image;
@@ -605,7 +600,7 @@ fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
             assert!(st.bricks_visible > st.bricks_coarse, "some bricks draw their voxels: {st:?}");
             assert_eq!(st.bytes_uploaded, 0, "the same view again uploads nothing ({st:?})");
             // Every fine brick's records, were none cached.
-            let fine = |s: &voxsplat::FrameStats| (s.bricks_visible - s.bricks_coarse) as u64;
+            let fine = |s: &crate::FrameStats| (s.bricks_visible - s.bricks_coarse) as u64;
             assert!(
                 t.stats.bytes_uploaded * 2 < fine(&t.stats) * st.records_resident / fine(&st),
                 "a 20-degree turn re-uploads {} bytes ({:?})",
@@ -623,20 +618,20 @@ fn a_streamed_store_uploads_only_the_records_its_cache_lacks() {
 /// that leave partial tiles at the edges, boxes small and large, inside and across the border.
 #[test]
 fn the_occlusion_map_answers_a_box_as_its_pixels_do() {
-    use voxsplat::low_level::cpu::tile_occlusion::{box_hidden, tile_occlusion};
-    use voxsplat::low_level::plan::occlusion_len;
+    use crate::cpu::tile_occlusion::{box_hidden, tile_occlusion};
+    use crate::plan::occlusion_len;
     let threshold = 1.0 / 1024.0;
     let mut rng = Rng(0x6f63_636c);
     let (mut hidden, mut open) = (0, 0);
     for (w, h, closed) in [(64, 48, 0.9), (37, 29, 0.97), (100, 70, 0.995), (9, 17, 0.5)] {
-        let mut accum = voxsplat::image::ImageF32::new(w, h);
+        let mut accum = crate::image::ImageF32::new(w, h);
         for p in accum.pixels.iter_mut() {
             // Closed: opaque or within the threshold; open: just past it, or clear.
             p[3] = if rng.f32() < closed { 1.0 - threshold * rng.f32() } else { 1.0 - threshold * (1.5 + rng.f32()) };
         }
         let mut map = vec![0u32; occlusion_len(w, h) as usize];
         tile_occlusion(&accum, threshold, &mut map);
-        let mut frame: voxsplat::low_level::gpu_types::Frame = bytemuck::Zeroable::zeroed();
+        let mut frame: crate::gpu_types::Frame = bytemuck::Zeroable::zeroed();
         (frame.blur[2], frame.blur[3]) = (w as f32, h as f32);
         for _ in 0..4000 {
             let x0 = (rng.f32() * (w + 8) as f32) as i32 - 4;
@@ -661,7 +656,7 @@ fn the_occlusion_map_answers_a_box_as_its_pixels_do() {
 #[test]
 fn motion_blurred_frames_drop_no_hidden_brick() {
     let vol = blob([120, 100, 90]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 96);
     let opaque = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.95])], ..tf() };
     for gpu in [true, false] {
         let mut r = renderer(gpu, None);
@@ -670,7 +665,7 @@ fn motion_blurred_frames_drop_no_hidden_brick() {
         (o.early_termination, o.lod) = (1.0 / 1024.0, Lod::Off);
         // Without blur the same frame drops bricks (the test above): the guard is what keeps them.
         assert!(r.render(&cam, &o).unwrap().stats.bricks_hidden > 10, "gpu {gpu}");
-        o.motion = Some(voxsplat::Motion::straight(glam::Mat4::from_translation(glam::Vec3::new(40.0, 0.0, 0.0)), 0.5));
+        o.motion = Some(crate::Motion::straight(glam::Mat4::from_translation(glam::Vec3::new(40.0, 0.0, 0.0)), 0.5));
         let blurred = r.render(&cam, &o).unwrap();
         assert_eq!(blurred.stats.bricks_hidden, 0, "gpu {gpu}: {:?}", blurred.stats);
         assert!(blurred.stats.waves > 1, "gpu {gpu}: {:?}", blurred.stats);
@@ -695,7 +690,7 @@ fn uniform_bricks_draw_as_their_voxels_do() {
         range: None,
         threshold: 0.0,
     };
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let cam = Camera::framing(&grid, 72, 64);
     let mut dense = renderer(true, None);
     dense.set_scene(classify(&vol, &tf, None).unwrap()).unwrap();
@@ -703,7 +698,7 @@ fn uniform_bricks_draw_as_their_voxels_do() {
     whole.set_volume(&vol, &tf, None).unwrap();
     let scene = whole.volume().unwrap();
     assert!(scene.store.headers.iter().filter(|h| h.is_uniform()).count() >= 12);
-    let least = voxsplat::low_level::plan::bricked_min_budget(scene, u64::MAX, 72, 64);
+    let least = crate::plan::bricked_min_budget(scene, u64::MAX, 72, 64);
     let most = scene.store.records.len() as u64 * 8; // streams below twice the records
     assert!(least < most, "{least} {most}");
     let budget = (least + most) / 2;
@@ -737,7 +732,7 @@ fn uniform_bricks_draw_as_their_voxels_do() {
 #[test]
 fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
     let vol = blob([61, 53, 47]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
     let shading = Some(Shading::headlight(cam.forward()));
     let mut weighted = tf();
     weighted.gradient_weight = 0.5;
@@ -746,8 +741,8 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
     // Cells up to 4 px and no error bound: the far bricks drawn coarser, from the pyramid
     // (gradients are what this compares, not the cut).
     let mut coarse = compute(Direction::FrontToBack);
-    (coarse.lod_pixels, coarse.lod_error) = (4.0, voxsplat::options::MAX_LOD_ERROR);
-    let made = |r: &voxsplat::Rendered| r.timings.iter().any(|t| t.stage == "gradients");
+    (coarse.lod_pixels, coarse.lod_error) = (4.0, crate::options::MAX_LOD_ERROR);
+    let made = |r: &crate::Rendered| r.timings.iter().any(|t| t.stage == "gradients");
     for (tf, what) in [(tf(), "shaded"), (weighted, "weighted")] {
         let mut frames = Vec::new();
         for gpu in [true, false] {
@@ -757,11 +752,8 @@ fn shaded_frames_read_the_same_gradients_precomputed_or_through_the_store() {
             // Just under four times one buffer's bytes left by the store (and the pyramid, with
             // levels of detail): they do not fit.
             let bytes = scene.store.gradient_len() * 4;
-            let pyramid = voxsplat::low_level::plan::pyramid_bytes(
-                voxsplat::low_level::plan::LOD_BUFFERS,
-                scene.store.headers.len(),
-            );
-            let resident = voxsplat::low_level::plan::bricked_resident_bytes(scene, u64::MAX, 80, 80);
+            let pyramid = crate::plan::pyramid_bytes(crate::plan::LOD_BUFFERS, scene.store.headers.len());
+            let resident = crate::plan::bricked_resident_bytes(scene, u64::MAX, 80, 80);
             assert!(!scene.streams(resident + 4 * bytes), "the store stays resident");
             for (o, which, held) in [(&fine, "full detail", 0), (&coarse, "coarse cells", pyramid)] {
                 let budget = resident + held + 4 * bytes - 4;

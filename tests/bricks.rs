@@ -1,11 +1,11 @@
 //! The bricked store (issue 23, host side): every value comes back through it (up to its 16-bit
 //! quantisation), it takes at most 8 bytes per stored voxel on the real volumes, and classifying
 //! through it (values and gradients by neighbour lookups) gives the dense classification.
-use crate::common;
+use super::common;
+use crate::bricks::{BrickStore, BRICK};
+use crate::classify::{classify, Shading, TransferFunction};
+use crate::volume::ScalarVolume;
 use common::Rng;
-use voxsplat::bricks::{BrickStore, BRICK};
-use voxsplat::classify::{classify, Shading, TransferFunction};
-use voxsplat::volume::ScalarVolume;
 
 #[test]
 fn every_value_comes_back_through_the_store() {
@@ -94,10 +94,10 @@ fn the_device_masks_count_the_stored_voxels_before_each_word() {
 
 #[test]
 fn real_volumes_take_under_8_bytes_a_voxel_and_classify_alike_through_the_store() {
-    let data = voxsplat::loaders::data_dir();
+    let data = crate::loaders::data_dir();
     assert!(data.join("bonsai/bonsai.nii.gz").exists(), "../shared/data is needed (see README)");
     for (file, tf) in [("bonsai/bonsai.nii.gz", "bonsai"), ("stent/stent.nrrd", "ct")] {
-        let vol = voxsplat::loaders::load_volume(&data.join(file), &Default::default()).unwrap();
+        let vol = crate::loaders::load_volume(&data.join(file), &Default::default()).unwrap();
         let store = BrickStore::build(&vol).unwrap();
         let per_voxel = store.bytes() as f64 / store.len() as f64;
         eprintln!("{file}: {} stored voxels in {} bricks, {per_voxel:.2} bytes each", store.len(), store.headers.len());
@@ -107,7 +107,7 @@ fn real_volumes_take_under_8_bytes_a_voxel_and_classify_alike_through_the_store(
         let dense = classify(&vol, &tf, shading).unwrap();
         let bricked = store.classify(&tf, shading).unwrap();
         // Quantisation may move a voxel across a transfer-function edge: count those, compare the rest.
-        let key = |s: &voxsplat::low_level::gpu_types::Splat| (s.ijk[2], s.ijk[1], s.ijk[0]);
+        let key = |s: &crate::gpu_types::Splat| (s.ijk[2], s.ijk[1], s.ijk[0]);
         let (a, b) = (dense.splats(), bricked.splats());
         let (mut ia, mut ib, mut common, mut worst) = (0, 0, 0usize, 0f32);
         while ia < a.len() && ib < b.len() {
@@ -152,9 +152,9 @@ fn a_raw_nrrd_streams_into_the_same_store() {
         path
     };
     let path = write("small.nrrd", "21 18 11", &data);
-    let whole = BrickStore::build(&voxsplat::loaders::load_volume(&path, &Default::default()).unwrap()).unwrap();
+    let whole = BrickStore::build(&crate::loaders::load_volume(&path, &Default::default()).unwrap()).unwrap();
     let streamed = BrickStore::load(&path, &Default::default()).unwrap();
-    assert!(voxsplat::loaders::SliceReader::nrrd(&path).unwrap().is_some());
+    assert!(crate::loaders::SliceReader::nrrd(&path).unwrap().is_some());
     assert_eq!(streamed.range, whole.range);
     assert_eq!(streamed.spacing, [1.0, 0.5, 2.0]);
     assert_eq!(streamed.headers, whole.headers);
@@ -162,11 +162,11 @@ fn a_raw_nrrd_streams_into_the_same_store() {
     assert_eq!(streamed.records, whole.records);
     let truncated = write("truncated.nrrd", "21 18 11", &data[..n - 1]);
     assert!(
-        matches!(BrickStore::load(&truncated, &Default::default()), Err(voxsplat::Error::InvalidArgument(m)) if m.contains("truncated"))
+        matches!(BrickStore::load(&truncated, &Default::default()), Err(crate::Error::InvalidArgument(m)) if m.contains("truncated"))
     );
     // 2^35 voxels: past what streaming takes, refused from the header alone.
     let huge = write("huge.nrrd", "32768 32768 32", &data);
-    assert!(matches!(BrickStore::load(&huge, &Default::default()), Err(voxsplat::Error::TooLarge(_))));
+    assert!(matches!(BrickStore::load(&huge, &Default::default()), Err(crate::Error::TooLarge(_))));
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -206,10 +206,10 @@ fn nifti_and_raw_files_stream_into_the_same_store() {
     std::fs::create_dir_all(&dir).unwrap();
     let gz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bonsai/bonsai.nii.gz");
     let packed = std::fs::read(&gz).unwrap();
-    let plain = voxsplat::loaders::gunzip(&packed, 1 << 26, "bonsai").unwrap();
+    let plain = crate::loaders::gunzip(&packed, 1 << 26, "bonsai").unwrap();
     let nii = dir.join("bonsai.nii");
     std::fs::write(&nii, &plain).unwrap();
-    let whole = BrickStore::build(&voxsplat::loaders::load_volume(&gz, &Default::default()).unwrap()).unwrap();
+    let whole = BrickStore::build(&crate::loaders::load_volume(&gz, &Default::default()).unwrap()).unwrap();
     assert!(whole.len() > 1_000_000, "{} stored voxels", whole.len());
     let same = |s: &BrickStore, what: &str| {
         assert_eq!((s.dims, s.spacing, s.range), (whole.dims, whole.spacing, whole.range), "{what}");
@@ -221,15 +221,15 @@ fn nifti_and_raw_files_stream_into_the_same_store() {
     let offset = plain.len() - whole.dims.iter().product::<u32>() as usize;
     let raw = dir.join("bonsai.raw");
     std::fs::write(&raw, &plain[offset..]).unwrap();
-    let hints = voxsplat::loaders::VolumeHints {
+    let hints = crate::loaders::VolumeHints {
         dims: Some(whole.dims),
-        dtype: Some(voxsplat::loaders::DType::U8),
+        dtype: Some(crate::loaders::DType::U8),
         spacing: Some(whole.spacing),
         ..Default::default()
     };
     same(&BrickStore::load(&raw, &hints).unwrap(), "raw");
     // Truncated: the plain file and the raw one before reading, the gzip stream while it inflates.
-    let cut = |path: &std::path::Path, bytes: &[u8], at: usize, h: &voxsplat::loaders::VolumeHints| {
+    let cut = |path: &std::path::Path, bytes: &[u8], at: usize, h: &crate::loaders::VolumeHints| {
         std::fs::write(path, &bytes[..at]).unwrap();
         BrickStore::load(path, h)
     };
@@ -237,11 +237,11 @@ fn nifti_and_raw_files_stream_into_the_same_store() {
         let at = |n: usize| (n as f64 * frac) as usize;
         let err = cut(&nii, &plain, at(plain.len()), &Default::default()).unwrap_err();
         assert!(
-            matches!(err, voxsplat::Error::InvalidArgument(ref m) if m.contains("truncated") || m.contains("NIfTI")),
+            matches!(err, crate::Error::InvalidArgument(ref m) if m.contains("truncated") || m.contains("NIfTI")),
             "{err}"
         );
         let err = cut(&dir.join("t.nii.gz"), &packed, at(packed.len()).max(400), &Default::default()).unwrap_err();
-        assert!(matches!(err, voxsplat::Error::InvalidArgument(_)), "{err}");
+        assert!(matches!(err, crate::Error::InvalidArgument(_)), "{err}");
         assert!(cut(&raw, &plain[offset..], at(plain.len() - offset), &hints).is_err());
     }
     std::fs::remove_dir_all(&dir).ok();
@@ -252,8 +252,8 @@ fn nifti_and_raw_files_stream_into_the_same_store() {
 #[test]
 fn a_gzip_nrrd_streams_into_the_same_store() {
     let stent = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/stent/stent.nrrd");
-    let whole = BrickStore::build(&voxsplat::loaders::load_volume(&stent, &Default::default()).unwrap()).unwrap();
-    assert!(voxsplat::loaders::SliceReader::nrrd(&stent).unwrap().is_some(), "gzip data streams");
+    let whole = BrickStore::build(&crate::loaders::load_volume(&stent, &Default::default()).unwrap()).unwrap();
+    assert!(crate::loaders::SliceReader::nrrd(&stent).unwrap().is_some(), "gzip data streams");
     let s = BrickStore::load(&stent, &Default::default()).unwrap();
     assert_eq!((s.dims, s.spacing, s.range), (whole.dims, whole.spacing, whole.range));
     assert!(s.headers == whole.headers && s.masks == whole.masks && s.records == whole.records);
@@ -264,7 +264,7 @@ fn a_gzip_nrrd_streams_into_the_same_store() {
     for frac in [0.2, 0.6, 0.99] {
         std::fs::write(&cut, &bytes[..(bytes.len() as f64 * frac) as usize]).unwrap();
         let err = BrickStore::load(&cut, &Default::default()).unwrap_err();
-        assert!(matches!(err, voxsplat::Error::InvalidArgument(_)), "{err}");
+        assert!(matches!(err, crate::Error::InvalidArgument(_)), "{err}");
     }
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -294,9 +294,9 @@ fn uniform_bricks_store_no_records_and_every_value_comes_back() {
     assert_eq!(store.records.len(), stored - uniform.len() * 512, "a uniform brick stores no record");
     // What the scene frames and draws, taken from uniform bricks' values, is what classifying
     // the store voxel by voxel gives.
-    for tf in [common::blob_tf(), voxsplat::classify::TransferFunction::preset("ramp").unwrap()] {
+    for tf in [common::blob_tf(), crate::classify::TransferFunction::preset("ramp").unwrap()] {
         let set = store.classify(&tf, None).unwrap();
-        let scene = voxsplat::bricks::BrickScene::new(store.clone(), tf, None).unwrap();
+        let scene = crate::bricks::BrickScene::new(store.clone(), tf, None).unwrap();
         assert_eq!(scene.visible_bounds(), set.bounds());
         assert_eq!(scene.drawn_counts().iter().sum::<u32>() as usize, set.len());
     }
@@ -314,9 +314,9 @@ fn uniform_bricks_store_no_records_and_every_value_comes_back() {
         assert_eq!((store.len(), store.records.len()), (n, records), "{dims:?}");
         assert_eq!(store.value_at(5, 5, 5), 0.0);
         // Seen through a TF range that makes the value visible, every voxel is framed and drawn.
-        let mut tf = voxsplat::classify::TransferFunction::preset("ramp").unwrap();
+        let mut tf = crate::classify::TransferFunction::preset("ramp").unwrap();
         tf.range = Some((0.0, 6.0));
-        let scene = voxsplat::bricks::BrickScene::new(store, tf, None).unwrap();
+        let scene = crate::bricks::BrickScene::new(store, tf, None).unwrap();
         assert_eq!(scene.visible_bounds(), Some([[0; 3], dims.map(|d| d - 1)]), "{dims:?}");
         assert_eq!(scene.drawn_counts().iter().sum::<u32>() as usize, n, "{dims:?}");
     }
@@ -328,7 +328,7 @@ fn uniform_bricks_store_no_records_and_every_value_comes_back() {
 /// two words as `brick_params` does: the header's first word plus the records before it.
 #[test]
 fn every_stored_voxel_keeps_the_stores_central_differences() {
-    use voxsplat::bricks::unpack_differences;
+    use crate::bricks::unpack_differences;
     let mut rng = Rng(41);
     let noisy = {
         let dims = [21, 17, 11];
@@ -398,8 +398,8 @@ fn a_stream_that_fits_is_read_once() {
 /// run from 0 to 1; a bin count outside 1 to `MAX_BINS` is refused.
 #[test]
 fn the_histogram_counts_each_stored_voxel_in_the_bin_of_its_file_value() {
-    let data = voxsplat::loaders::data_dir();
-    let vol = voxsplat::loaders::load_volume(&data.join("bonsai/bonsai.nii.gz"), &Default::default()).unwrap();
+    let data = crate::loaders::data_dir();
+    let vol = crate::loaders::load_volume(&data.join("bonsai/bonsai.nii.gz"), &Default::default()).unwrap();
     let store = BrickStore::build(&vol).unwrap();
     let (lo, hi) = store.range;
     assert!(vol.values.iter().all(|v| v.fract() == 0.0) && hi > lo, "integer samples");
@@ -449,7 +449,7 @@ fn the_histogram_counts_each_stored_voxel_in_the_bin_of_its_file_value() {
     let at = ((50.0 - store.range.0) / (store.range.1 - store.range.0) * 8.0) as usize;
     assert!(h.counts[at] >= block, "{} in the block's bin, {block} in the block", h.counts[at]);
     assert_eq!(h.counts.iter().sum::<u64>() + h.empty, vol.values.len() as u64);
-    for bins in [0, voxsplat::bricks::MAX_BINS + 1] {
+    for bins in [0, crate::bricks::MAX_BINS + 1] {
         let e = store.histogram(bins).unwrap_err().to_string();
         assert!(e.contains("1 to 65536 bins"), "{e}");
     }
@@ -460,11 +460,11 @@ fn the_histogram_counts_each_stored_voxel_in_the_bin_of_its_file_value() {
 /// without it.
 #[test]
 fn a_streamed_load_tells_its_progress() {
-    let path = voxsplat::loaders::data_dir().join("bonsai/bonsai.nii.gz");
+    let path = crate::loaders::data_dir().join("bonsai/bonsai.nii.gz");
     let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
     let log = seen.clone();
-    let progress = voxsplat::loaders::Progress::new(move |read, of| log.lock().unwrap().push((read, of)));
-    let hints = voxsplat::loaders::VolumeHints { progress: Some(progress), ..Default::default() };
+    let progress = crate::loaders::Progress::new(move |read, of| log.lock().unwrap().push((read, of)));
+    let hints = crate::loaders::VolumeHints { progress: Some(progress), ..Default::default() };
     let store = BrickStore::load(&path, &hints).unwrap();
     let seen = seen.lock().unwrap().clone();
     // The bonsai's 256 slices fit the kept samples: one pass over the file, 32 slabs.
@@ -480,8 +480,8 @@ fn a_streamed_load_tells_its_progress() {
 /// planes outside the grid are refused.
 #[test]
 fn a_plane_through_the_store_reads_the_files_values() {
-    let path = voxsplat::loaders::data_dir().join("stent/stent.nrrd");
-    let vol = voxsplat::loaders::load_volume(&path, &Default::default()).unwrap();
+    let path = crate::loaders::data_dir().join("stent/stent.nrrd");
+    let vol = crate::loaders::load_volume(&path, &Default::default()).unwrap();
     let store = BrickStore::build(&vol).unwrap();
     let [nx, ny, nz] = vol.dims;
     let at = |i: u32, j: u32, k: u32| vol.values[(i + nx * (j + ny * k)) as usize];

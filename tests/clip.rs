@@ -1,11 +1,11 @@
 //! Clipping planes and the crop box (issue 27 item 2): every splat mode and the ray caster, dense
 //! and bricked, GPU against the CPU mirrors; what they keep and drop; refused planes.
-use crate::common;
+use super::common;
+use crate::classify::classify;
+use crate::RaycastOptions;
+use crate::{scene, Camera, Clip, Composite, Raster, RenderOptions};
 use common::{assert_clean, blob, blob_tf as tf, diff};
 use glam::{Vec3, Vec4};
-use voxsplat::classify::classify;
-use voxsplat::RaycastOptions;
-use voxsplat::{scene, Camera, Clip, Composite, Raster, RenderOptions};
 
 fn with(clip: Clip, composite: Composite, raster: Raster) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -13,7 +13,7 @@ fn with(clip: Clip, composite: Composite, raster: Raster) -> RenderOptions {
     o
 }
 
-fn covered(img: &voxsplat::ImageF32) -> usize {
+fn covered(img: &crate::ImageF32) -> usize {
     common::covered(img)
 }
 
@@ -65,7 +65,7 @@ fn clipping_drops_what_lies_outside_in_every_mode_and_the_gpu_equals_its_mirror(
 #[test]
 fn a_clipped_bricked_volume_draws_the_clipped_dense_splats() {
     let vol = blob([37, 29, 23]);
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let cam = Camera::framing(&grid, 96, 80);
     // Through the middle, and a crop that leaves whole bricks out (the brick test culls them).
     let clip =
@@ -91,7 +91,7 @@ fn a_clipped_bricked_volume_draws_the_clipped_dense_splats() {
 #[test]
 fn degenerate_planes_and_boxes_are_refused() {
     let p = Vec4::new(1.0, 0.0, 0.0, 0.0);
-    let e = |r: voxsplat::Result<Clip>| r.unwrap_err().to_string();
+    let e = |r: crate::Result<Clip>| r.unwrap_err().to_string();
     assert!(e(Clip::new(&[p; 7], None)).contains("at most 6"));
     assert!(e(Clip::new(&[Vec4::new(0.0, 0.0, 0.0, 1.0)], None)).contains("non-zero"));
     assert!(e(Clip::new(&[Vec4::new(f32::NAN, 1.0, 0.0, 1.0)], None)).contains("finite"));
@@ -121,7 +121,7 @@ fn the_two_halves_of_a_clipped_ray_cast_composite_to_the_whole() {
     // The eye's side of the plane is in front.
     let front = if cam.eye.x > 0.3 { 1.0 } else { -1.0 };
     for (engine, name) in [(&mut c, "cpu"), (&mut g, "gpu")] {
-        let cast = |e: &mut voxsplat::Renderer, clip| e.raycast(&cam, &RaycastOptions { clip, ..Default::default() });
+        let cast = |e: &mut crate::Renderer, clip| e.raycast(&cam, &RaycastOptions { clip, ..Default::default() });
         let whole = cast(engine, Clip::default()).unwrap().image;
         let near = cast(engine, keep(front)).unwrap().image;
         let far = cast(engine, keep(-front)).unwrap().image;

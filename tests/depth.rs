@@ -1,12 +1,12 @@
 //! The host's depth buffer (`RenderOptions::depth`): a plane of host geometry through a volume
 //! hides exactly what lies behind it (the same frame as a clipping plane there), on the device and
 //! the mirrors, in every raster; what it refuses.
-use crate::common;
+use super::common;
+use crate::classify::classify;
+use crate::{Camera, Clip, DepthBuffer, DepthFormat, Projection, Raster, RenderOptions, Renderer};
 use common::{assert_clean, assert_mirrors, cpu, gpu};
 use glam::{Mat4, Vec4};
 use std::sync::Arc;
-use voxsplat::classify::classify;
-use voxsplat::{Camera, Clip, DepthBuffer, DepthFormat, Projection, Raster, RenderOptions, Renderer};
 
 /// A host depth buffer of a plane facing the camera at eye depth `d`, drawn with the camera's
 /// own projection.
@@ -33,7 +33,7 @@ fn clip_at(cam: &Camera, d: f32) -> Clip {
     Clip::new(&[(-f).extend(f.dot(cam.eye) + d)], None).unwrap()
 }
 
-fn cameras(set: &voxsplat::SplatSet) -> Vec<Camera> {
+fn cameras(set: &crate::SplatSet) -> Vec<Camera> {
     let mut cam = Camera::framing(set.grid(), 72, 64);
     let mut ortho = cam;
     let r = set.grid().diagonal() * 0.5;
@@ -50,22 +50,22 @@ fn target_with_depth(
     cam: &Camera,
     d: f32,
     format: DepthFormat,
-) -> (voxsplat::vk::TargetImage, voxsplat::vk::DepthImage, voxsplat::vk::HostTarget) {
-    use voxsplat::vk::ImageLayout as IL;
+) -> (crate::vk::TargetImage, crate::vk::DepthImage, crate::vk::HostTarget) {
+    use crate::vk::ImageLayout as IL;
     let proj = cam.proj();
     let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
     let depth = g.depth_image(format, cam.width, cam.height, c.z / c.w).unwrap();
-    let image = g.target_image(voxsplat::TargetFormat::Rgba16Float, cam.width, cam.height).unwrap();
+    let image = g.target_image(crate::TargetFormat::Rgba16Float, cam.width, cam.height).unwrap();
     let target = depth.attach(image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(), proj).unwrap();
     (image, depth, target)
 }
 
 /// The largest difference of a half-float target's texels from `frame` presented as the blit
 /// delivers it (linear values, no background).
-fn target_against(g: &Renderer, target: &voxsplat::vk::HostTarget, frame: &voxsplat::ImageF32) -> f32 {
-    use voxsplat::low_level::cpu::present::{decode, present_pixel};
-    let got = decode(voxsplat::TargetFormat::Rgba16Float, &g.read_target(target).unwrap()).unwrap();
-    let push = voxsplat::low_level::plan::present_push(None, 1, true, frame.width, frame.height);
+fn target_against(g: &Renderer, target: &crate::vk::HostTarget, frame: &crate::ImageF32) -> f32 {
+    use crate::cpu::present::{decode, present_pixel};
+    let got = decode(crate::TargetFormat::Rgba16Float, &g.read_target(target).unwrap()).unwrap();
+    let push = crate::plan::present_push(None, 1, true, frame.width, frame.height);
     got.iter()
         .zip(&frame.pixels)
         .map(|(a, &b)| {
@@ -75,7 +75,7 @@ fn target_against(g: &Renderer, target: &voxsplat::vk::HostTarget, frame: &voxsp
         .fold(0.0f32, f32::max)
 }
 
-fn depth_of_centre(cam: &Camera, set: &voxsplat::SplatSet) -> f32 {
+fn depth_of_centre(cam: &Camera, set: &crate::SplatSet) -> f32 {
     (set.grid().center() - cam.eye).dot(cam.forward())
 }
 
@@ -116,16 +116,16 @@ fn a_d24_depth_buffer_and_a_projection_mode_and_a_bricked_store_take_it_too() {
     let cam = cameras(&set)[0];
     let d = depth_of_centre(&cam, &set) + 0.137;
     let depth = Some(Arc::new(plane_depth(&cam, d, DepthFormat::D24S8)));
-    let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
-    let scene = voxsplat::bricks::BrickScene::new(store, common::blob_tf(), None).unwrap();
+    let store = crate::bricks::BrickStore::build(&vol).unwrap();
+    let scene = crate::bricks::BrickScene::new(store, common::blob_tf(), None).unwrap();
     let mut g = gpu();
     let mut c = cpu();
     let mut o = RenderOptions::default();
     o.depth = depth;
     for (what, mode, bricked) in [
-        ("dense", voxsplat::Mode::Composite, false),
-        ("mip", voxsplat::Mode::Mip, false),
-        ("bricked", voxsplat::Mode::Composite, true),
+        ("dense", crate::Mode::Composite, false),
+        ("mip", crate::Mode::Mip, false),
+        ("bricked", crate::Mode::Composite, true),
     ] {
         o.mode = mode;
         let set_up = |r: &mut Renderer| {
@@ -168,7 +168,7 @@ fn a_depth_buffer_that_does_not_fit_is_refused() {
     }
     let mut o = RenderOptions::default();
     o.depth = Some(Arc::new(good));
-    o.composite = voxsplat::Composite::Sheet;
+    o.composite = crate::Composite::Sheet;
     assert!(r.render(&cam, &o).unwrap_err().to_string().contains("--composite splat"));
 }
 

@@ -1,10 +1,10 @@
 //! Every device-dependent choice, run against recorded device profiles (lavapipe's, and a discrete
 //! NVIDIA one from its public limits) so the hardware branch runs in CI too, and the record of
 //! lavapipe checked against the device at hand.
-use crate::common;
-use voxsplat::device::{DeviceKind, DeviceProfile, Timing};
-use voxsplat::low_level::raster::{choose, Device};
-use voxsplat::{scene, Camera, Composite, Error, Raster, RenderOptions};
+use super::common;
+use crate::device::{DeviceKind, DeviceProfile, Timing};
+use crate::raster::{choose, Device};
+use crate::{scene, Camera, Composite, Error, Raster, RenderOptions};
 
 fn profile(name: &str) -> DeviceProfile {
     let path = format!("{}/tests/data/devices/{name}.toml", env!("CARGO_MANIFEST_DIR"));
@@ -12,7 +12,7 @@ fn profile(name: &str) -> DeviceProfile {
 }
 
 /// The raster `auto` picks for `scene` framed at `size`² with `composite`.
-fn auto(p: &DeviceProfile, scene_name: &str, size: u32, composite: Composite) -> voxsplat::Result<Raster> {
+fn auto(p: &DeviceProfile, scene_name: &str, size: u32, composite: Composite) -> crate::Result<Raster> {
     let set = scene::build(scene_name).unwrap();
     let cam = Camera::framing(set.grid(), size, size);
     let mut o = RenderOptions::default();

@@ -1,13 +1,13 @@
 //! Sort-last rendering without a transport (issue 28): a volume cut into k-d boxes, each box's
 //! store read by offset and drawn alone, the images composited in the boxes' visibility order,
 //! equals the whole volume drawn in one piece.
-use crate::common;
+use super::common;
+use crate::bricks::{BrickScene, BrickStore};
+use crate::classify::TransferFunction;
+use crate::distributed::{self, Partition};
+use crate::{Camera, Grid, ImageF32, RenderOptions, Renderer};
 use common::gpu;
 use glam::Vec3;
-use voxsplat::bricks::{BrickScene, BrickStore};
-use voxsplat::classify::TransferFunction;
-use voxsplat::distributed::{self, Partition};
-use voxsplat::{Camera, Grid, ImageF32, RenderOptions, Renderer};
 
 const STENT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/stent/stent.nrrd");
 
@@ -20,10 +20,10 @@ fn parts(
     ranks: u32,
     cam: &Camera,
     o: &RenderOptions,
-) -> (ImageF32, Vec<voxsplat::low_level::kdtree::Node>) {
+) -> (ImageF32, Vec<crate::kdtree::Node>) {
     let hints = Default::default();
     let mut reader = distributed::open(path.as_ref(), &hints).unwrap();
-    let nb = reader.dims.map(|d| d.div_ceil(voxsplat::bricks::BRICK));
+    let nb = reader.dims.map(|d| d.div_ceil(crate::bricks::BRICK));
     let mut scan = distributed::scan(&mut reader, distributed::scan_layers(nb, ranks, 0)).unwrap();
     for s in 1..ranks {
         scan.merge(&distributed::scan(&mut reader, distributed::scan_layers(nb, ranks, s)).unwrap());
@@ -115,7 +115,7 @@ fn the_partition_is_the_top_of_the_brick_tree_balanced_by_non_empty_bricks() {
         assert!(counts.iter().all(|&c| (c as f64 - share).abs() <= 16.0), "{ranks}: balanced {counts:?}");
         if ranks.is_power_of_two() {
             assert!(counts.iter().all(|&c| c == 128 / ranks), "{ranks}: balanced {counts:?}");
-            let one = voxsplat::low_level::kdtree::build(grid, 1, |id| occupied[id]);
+            let one = crate::kdtree::build(grid, 1, |id| occupied[id]);
             assert_eq!(p.tree, one, "{ranks}: the one-process tree");
         }
         // Every eye: a back-to-front order of all ranks.

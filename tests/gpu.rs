@@ -1,10 +1,10 @@
 //! GPU stages against their CPU mirrors, on lavapipe with validation (and synchronization
 //! validation) on: any validation message fails the test.
-use crate::common;
+use super::common;
+use crate::output::diff_rgba8;
+use crate::{scene, Antialias, Camera, Composite, Direction, Kernel, OrderKind, Raster, RenderOptions};
 use common::{assert_clean, random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
-use voxsplat::output::diff_rgba8;
-use voxsplat::{scene, Antialias, Camera, Composite, Direction, Kernel, OrderKind, Raster, RenderOptions};
 
 fn options(composite: Composite, kernel: Kernel) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -14,15 +14,17 @@ fn options(composite: Composite, kernel: Kernel) -> RenderOptions {
 }
 
 /// On a mismatch, write the GPU image, the CPU image and their difference for inspection.
-fn save_failure(tag: &str, gpu: &voxsplat::ImageF32, cpu: &voxsplat::ImageF32) {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("mirror-failures");
+fn save_failure(tag: &str, gpu: &crate::ImageF32, cpu: &crate::ImageF32) {
+    // Beside the test binary (target/<profile>/deps/..): kept with the build, not in the sources.
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().and_then(|d| d.parent()).unwrap_or(std::path::Path::new(".")).join("mirror-failures");
     std::fs::create_dir_all(&dir).unwrap();
     let mut diff = gpu.clone();
     for (d, c) in diff.pixels.iter_mut().zip(&cpu.pixels) {
         *d = [0, 1, 2, 3].map(|i| if i == 3 { 1.0 } else { ((d[i] - c[i]).abs() * 8.0).min(1.0) });
     }
     for (suffix, img) in [("gpu", gpu), ("cpu", cpu), ("diff", &diff)] {
-        voxsplat::output::write_image(img, &dir.join(format!("{tag}-{suffix}.png"))).unwrap();
+        crate::output::write_image(img, &dir.join(format!("{tag}-{suffix}.png"))).unwrap();
     }
     eprintln!("wrote {}/{tag}-*.png", dir.display());
 }
@@ -31,30 +33,30 @@ fn save_failure(tag: &str, gpu: &voxsplat::ImageF32, cpu: &voxsplat::ImageF32) {
 fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
     let mut gpu = common::gpu();
     let mut cpu = common::cpu();
-    let plane_ortho = |g: &voxsplat::Grid| Camera {
+    let plane_ortho = |g: &crate::Grid| Camera {
         eye: g.center() + Vec3::new(60.0, 200.0, 300.0),
         target: g.center(),
         up: Vec3::Y,
-        projection: voxsplat::Projection::Orthographic { height: 420.0 },
+        projection: crate::Projection::Orthographic { height: 420.0 },
         near: 1.0,
         far: 800.0,
         width: 192,
         height: 160,
         window: None,
     };
-    let plane_grazing = |g: &voxsplat::Grid| Camera {
+    let plane_grazing = |g: &crate::Grid| Camera {
         eye: g.center() + Vec3::new(0.0, -230.0, 40.0),
         target: g.center() + Vec3::new(0.0, 60.0, 0.0),
         up: Vec3::Z,
-        projection: voxsplat::Projection::Perspective { fov_y_deg: 50.0 },
+        projection: crate::Projection::Perspective { fov_y_deg: 50.0 },
         near: 1.0,
         far: 800.0,
         width: 192,
         height: 160,
         window: None,
     };
-    let framing = |g: &voxsplat::Grid| Camera::framing(g, 192, 160);
-    type CameraFor<'a> = &'a dyn Fn(&voxsplat::Grid) -> Camera;
+    let framing = |g: &crate::Grid| Camera::framing(g, 192, 160);
+    type CameraFor<'a> = &'a dyn Fn(&crate::Grid) -> Camera;
     let cases: [(&str, CameraFor); 4] =
         [("cube60", &framing), ("cube40-attenuated", &framing), ("plane", &plane_ortho), ("plane", &plane_grazing)];
     let (mut combo, mut fitted_combo) = (0usize, 1usize);
@@ -65,7 +67,7 @@ fn gpu_matches_cpu_mirror_for_every_compositing_mode_and_kernel() {
         gpu.set_scene(set.clone()).unwrap();
         cpu.set_scene(set).unwrap();
         for composite in [Composite::Splat, Composite::Sheet, Composite::Slab] {
-            for kernel in voxsplat::kernel::KERNELS {
+            for kernel in crate::kernel::KERNELS {
                 for direction in [Direction::BackToFront, Direction::FrontToBack] {
                     let mut o = options(composite, kernel);
                     o.direction = Some(direction);
@@ -120,8 +122,8 @@ fn gpu_pbtf_sequence_equals_cpu() {
             let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
             let cam = random_camera(&mut rng, set.grid(), kind);
             for dir in [Direction::FrontToBack, Direction::BackToFront] {
-                let got = gpu.pbtf_order(&cam, dir).unwrap();
-                let want = voxsplat::order::visibility_order(&set, &cam, OrderKind::Pbtf, dir);
+                let got = crate::low_level::pbtf_order(&mut gpu, &cam, dir).unwrap();
+                let want = crate::order::visibility_order(&set, &cam, OrderKind::Pbtf, dir);
                 assert_eq!(got, want, "set {si} view {v} {kind:?} {dir:?}");
             }
         }
@@ -184,8 +186,8 @@ fn renderer_on_an_adopted_host_device_matches_an_owning_one() {
         // The "host" here is the owning renderer's context; the adopted one must not destroy it.
         let host = owner.context().unwrap().handles();
         // SAFETY: the owning renderer's handles stay alive until the adopting renderer is dropped.
-        let ctx = unsafe { voxsplat::vk::Context::from_host(host) }.unwrap();
-        let mut guest = voxsplat::Renderer::with_context(ctx).unwrap();
+        let ctx = unsafe { crate::vk::Context::from_host(host) }.unwrap();
+        let mut guest = crate::Renderer::with_context(ctx).unwrap();
         guest.set_scene(set).unwrap();
         let got = guest.render(&cam, &opts).unwrap();
         assert_eq!(got.raster.map(|c| c.raster), owned.raster.map(|c| c.raster));
@@ -210,8 +212,7 @@ fn sheet_sums_without_64_bit_atomics_match_the_64_bit_build() {
     let mut host = owner.context().unwrap().handles();
     host.int64_atomics = false;
     // SAFETY: the owning renderer's handles stay alive until the adopting renderer is dropped.
-    let mut guest =
-        voxsplat::Renderer::with_context(unsafe { voxsplat::vk::Context::from_host(host) }.unwrap()).unwrap();
+    let mut guest = crate::Renderer::with_context(unsafe { crate::vk::Context::from_host(host) }.unwrap()).unwrap();
     guest.set_scene(set).unwrap();
     for composite in [Composite::Sheet, Composite::Slab] {
         let mut o = RenderOptions::default();
@@ -237,8 +238,8 @@ fn splat_params_stage_matches_its_mirror() {
         for (kernel, aa) in
             [(Kernel::Gaussian, Antialias::None), (Kernel::Cubic, Antialias::Swan), (Kernel::Gaussian, Antialias::Ewa)]
         {
-            let g = gpu.splat_params(&cam, kernel, aa).unwrap();
-            let c = cpu.splat_params(&cam, kernel, aa).unwrap();
+            let g = crate::low_level::splat_params(&mut gpu, &cam, kernel, aa).unwrap();
+            let c = crate::low_level::splat_params(&mut cpu, &cam, kernel, aa).unwrap();
             assert_eq!(g.len(), set.len());
             let mut culled = 0;
             for (a, b) in g.iter().zip(&c) {

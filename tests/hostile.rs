@@ -1,14 +1,14 @@
 //! Issue 25: input a hostile user would try, each a typed error or a right picture, never a hang,
 //! a wrap-around or a silently wrong frame (the CLI's side: cli/tests/hostile.rs).
-use crate::common;
+use super::common;
+use crate::bricks::{BrickScene, BrickStore};
+use crate::classify::TransferFunction;
+use crate::loaders::{load_volume, npy_from_bytes, DType, VolumeHints};
+use crate::volume::ScalarVolume;
+use crate::RaycastOptions;
+use crate::{Camera, Error, Grid, ImageF32, Projection, Raster, RenderOptions};
 use common::{assert_clean, cpu, gpu};
 use std::path::{Path, PathBuf};
-use voxsplat::bricks::{BrickScene, BrickStore};
-use voxsplat::classify::TransferFunction;
-use voxsplat::loaders::{load_volume, npy_from_bytes, DType, VolumeHints};
-use voxsplat::volume::ScalarVolume;
-use voxsplat::RaycastOptions;
-use voxsplat::{Camera, Error, Grid, ImageF32, Projection, Raster, RenderOptions};
 
 fn dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("voxsplat-hostile-{}", std::process::id()));
@@ -106,15 +106,15 @@ fn full_disks_fail_writes_instead_of_leaving_short_files() {
         let link = dir().join(name);
         let _ = std::fs::remove_file(&link);
         std::os::unix::fs::symlink("/dev/full", &link).unwrap();
-        let e = voxsplat::output::write_image(&img, &link).unwrap_err();
+        let e = crate::output::write_image(&img, &link).unwrap_err();
         assert!(e.to_string().contains("No space left"), "{name}: {e}");
     }
-    let mut gif = voxsplat::output::GifWriter::create(Path::new("/dev/full"), 80).unwrap();
+    let mut gif = crate::output::GifWriter::create(Path::new("/dev/full"), 80).unwrap();
     let pushed = gif.push(&img).and_then(|_| gif.push(&img));
     assert!(pushed.is_err() || gif.finish().is_err(), "a GIF on a full disk must fail");
     // A good GIF streams and reads back with its frames.
     let path = dir().join("ok.gif");
-    let mut gif = voxsplat::output::GifWriter::create(&path, 80).unwrap();
+    let mut gif = crate::output::GifWriter::create(&path, 80).unwrap();
     for _ in 0..3 {
         gif.push(&img).unwrap();
     }
@@ -138,7 +138,7 @@ fn a_one_voxel_volume_is_drawn_by_every_path() {
     .unwrap();
     let cam = Camera::framing(&Grid::centered(vol.dims, vol.spacing).unwrap(), 64, 48);
     let mut reference = cpu();
-    let splats = voxsplat::classify::classify(&vol, &tf, None).unwrap();
+    let splats = crate::classify::classify(&vol, &tf, None).unwrap();
     reference.set_scene(splats.clone()).unwrap();
     let truth = covered(&reference.raycast(&cam, &RaycastOptions::default()).unwrap().image);
     assert!(truth > 500, "the ray caster covers {truth} px");
@@ -164,7 +164,7 @@ fn the_ray_casters_refuse_rays_max_steps_would_cut() {
     // The mirror stopped at max_steps and drew an almost transparent picture; the GPU names its
     // own loop budget first.
     for (mut r, says) in [(cpu(), "max_steps"), (gpu(), "the GPU ray caster takes at most")] {
-        let set = voxsplat::scene::build("cube60").unwrap();
+        let set = crate::scene::build("cube60").unwrap();
         let cam = Camera::framing(set.grid(), 32, 32);
         r.set_scene(set).unwrap();
         let e = r.raycast(&cam, &RaycastOptions { step: 1e-6, ..Default::default() }).unwrap_err();
@@ -206,17 +206,17 @@ frame = 8
 eye = [0.0, 0.0, -100.0]
 target = [0.0, 0.0, 0.0]
 "#;
-    let anim = voxsplat::animate::Animation::from_toml(text).unwrap();
-    let grid = *voxsplat::scene::build("cube40").unwrap().grid();
-    let e = anim.check_path(&grid, voxsplat::animate::Blur::None).unwrap_err();
+    let anim = crate::animate::Animation::from_toml(text).unwrap();
+    let grid = *crate::scene::build("cube40").unwrap().grid();
+    let e = anim.check_path(&grid, crate::animate::Blur::None).unwrap_err();
     assert!(matches!(e, Error::InvalidCamera(_)) && e.to_string().contains("frame 4"), "{e}");
 }
 
 #[test]
 fn terrain_levels_and_messages_do_not_wrap() {
-    let h = voxsplat::volume::HeightGrid { width: 4, rows: 4, heights: (0..16).map(|i| i as f32).collect() };
-    let opts = voxsplat::terrain::TerrainOptions { vscale: 1e30, ..Default::default() };
-    let e = voxsplat::terrain::terrain_splats(&h, &opts).unwrap_err();
+    let h = crate::volume::HeightGrid { width: 4, rows: 4, heights: (0..16).map(|i| i as f32).collect() };
+    let opts = crate::terrain::TerrainOptions { vscale: 1e30, ..Default::default() };
+    let e = crate::terrain::terrain_splats(&h, &opts).unwrap_err();
     assert!(matches!(e, Error::TooLarge(_)), "{e}");
     // A corrupt TIFF's decoder message is cut to a readable length.
     let mut tiff = std::io::Cursor::new(Vec::new());
@@ -230,7 +230,7 @@ fn terrain_levels_and_messages_do_not_wrap() {
         for bit in 0..8 {
             let mut b = good.clone();
             b[i] ^= 1 << bit;
-            if let Err(e) = voxsplat::loaders::tiff_heights(&b, "flip.tif") {
+            if let Err(e) = crate::loaders::tiff_heights(&b, "flip.tif") {
                 longest = longest.max(e.to_string().len());
             }
         }
@@ -239,7 +239,7 @@ fn terrain_levels_and_messages_do_not_wrap() {
     // Reading a missing or broken image says so (it said "cannot write image").
     let bad = dir().join("broken.png");
     std::fs::write(&bad, b"\x89PNG\r\n\x1a\nnot really").unwrap();
-    let e = voxsplat::output::read_image(&bad).unwrap_err();
+    let e = crate::output::read_image(&bad).unwrap_err();
     assert!(e.to_string().starts_with("cannot read image"), "{e}");
 }
 
@@ -253,9 +253,9 @@ fn banded_ssim_is_the_whole_image_ssim() {
         pixels: (0..w * h).map(|_| [rng.f32(), rng.f32(), rng.f32(), rng.f32()]).collect(),
     };
     let (a, b) = (img(&mut rng), img(&mut rng));
-    let m = voxsplat::metrics::compare(&a, &b).unwrap();
+    let m = crate::metrics::compare(&a, &b).unwrap();
     let alpha = |im: &ImageF32| im.pixels.iter().map(|p| p[3].clamp(0.0, 1.0) as f64).collect::<Vec<_>>();
-    let whole = voxsplat::metrics::ssim(&alpha(&a), &alpha(&b), w, h);
+    let whole = crate::metrics::ssim(&alpha(&a), &alpha(&b), w, h);
     assert!((m.ssim_alpha - whole).abs() < 1e-12, "{} against {whole}", m.ssim_alpha);
 }
 
@@ -283,7 +283,7 @@ fn transfer_function_points_take_no_extra_components() {
 /// length, before a byte of it is parsed (a 2 M-point file took 3.2 GB and 10 s to be refused).
 #[test]
 fn text_files_are_refused_past_their_size_cap() {
-    use voxsplat::loaders::{read_text, MAX_TEXT_BYTES};
+    use crate::loaders::{read_text, MAX_TEXT_BYTES};
     let big = dir().join("big-tf.toml");
     let f = std::fs::File::create(&big).unwrap();
     f.set_len(MAX_TEXT_BYTES + 1).unwrap();
@@ -334,7 +334,7 @@ fn nrrd_skips_lists_and_odd_endians_are_refused_by_name() {
         std::fs::write(&p, body(extra)).unwrap();
         let e = load_volume(&p, &VolumeHints::default()).unwrap_err();
         assert!(e.to_string().contains(needle), "{extra}: {e}");
-        let e = voxsplat::loaders::SliceReader::open(&p, &VolumeHints::default()).map(|_| ()).unwrap_err();
+        let e = crate::loaders::SliceReader::open(&p, &VolumeHints::default()).map(|_| ()).unwrap_err();
         assert!(e.to_string().contains(needle), "{extra} (streamed): {e}");
     }
     // A zero skip is the default, and read as such.
@@ -355,7 +355,7 @@ fn ranges_wider_than_f32_normalise_in_f64() {
     let tf = TransferFunction::from_toml("points = [[0.0, [0, 0, 0, 0]], [0.9, [0, 0, 0, 0]], [1.0, [1, 1, 1, 1]]]")
         .unwrap();
     let cam = Camera::framing(&Grid::centered(vol.dims, vol.spacing).unwrap(), 48, 48);
-    let splats = voxsplat::classify::classify(&vol, &tf, None).unwrap();
+    let splats = crate::classify::classify(&vol, &tf, None).unwrap();
     assert_eq!(splats.len(), 1, "the hot voxel, classified");
     for mut r in [gpu(), cpu()] {
         r.set_scene(splats.clone()).unwrap();
@@ -369,7 +369,7 @@ fn ranges_wider_than_f32_normalise_in_f64() {
     // A TF range of [-3e38, 3e38] over ordinary values: they sit at its middle, drawn.
     let ordinary = ScalarVolume { dims: [3, 3, 3], spacing: [1.0; 3], values: vec![5.0; 27] };
     let wide = TransferFunction::from_toml("points = [[0.0, [0, 0, 0, 0]], [0.4, [0, 0, 0, 0]], [0.5, [1, 1, 1, 1]], [1.0, [1, 1, 1, 1]]]\nrange = [-3e38, 3e38]").unwrap();
-    let set = voxsplat::classify::classify(&ordinary, &wide, None).unwrap();
+    let set = crate::classify::classify(&ordinary, &wide, None).unwrap();
     assert_eq!(set.len(), 27);
     let mut r = cpu();
     r.set_bricks(BrickScene::new(BrickStore::build(&ordinary).unwrap(), wide, None).unwrap()).unwrap();
@@ -385,9 +385,9 @@ fn a_huge_rotation_axis_keeps_its_direction() {
             "scene = \"cube40\"\nframes = 9\n[camera]\neye = [0.0, 0.0, 100.0]\ntarget = [0.0, 0.0, 0.0]\n\
              [[keyframe]]\nframe = 0\nrotate = [{axis}, 0.0]\n[[keyframe]]\nframe = 8\nrotate = [{axis}, 90.0]\n"
         );
-        voxsplat::animate::Animation::from_toml(&text).unwrap()
+        crate::animate::Animation::from_toml(&text).unwrap()
     };
-    let grid = *voxsplat::scene::build("cube40").unwrap().grid();
+    let grid = *crate::scene::build("cube40").unwrap().grid();
     let (huge, unit) = (anim("1e30, 0.0, 0.0"), anim("1.0, 0.0, 0.0"));
     for t in [0.0, 2.0, 4.0, 8.0] {
         let (a, b) = (huge.model(&grid, t), unit.model(&grid, t));
@@ -419,7 +419,7 @@ fn refusals_name_the_real_cause() {
     std::fs::write(&p, &long).unwrap();
     let e = load_volume(&p, &VolumeHints::default()).unwrap_err();
     assert!(e.to_string().contains("longer than 1 MiB"), "{e}");
-    let e = voxsplat::loaders::SliceReader::open(&p, &VolumeHints::default()).map(|_| ()).unwrap_err();
+    let e = crate::loaders::SliceReader::open(&p, &VolumeHints::default()).map(|_| ()).unwrap_err();
     assert!(e.to_string().contains("longer than 1 MiB"), "streamed: {e}");
     let p = dir().join("huge-spacing.nrrd");
     let mut b = b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 1e30 1 1\nencoding: raw\n\n".to_vec();
@@ -427,15 +427,15 @@ fn refusals_name_the_real_cause() {
     std::fs::write(&p, &b).unwrap();
     let e = load_volume(&p, &VolumeHints::default()).unwrap_err();
     assert!(e.to_string().contains("past 1e10 units a voxel"), "{e}");
-    voxsplat::Clip::new(&[glam::Vec4::new(1e30, 0.0, 0.0, 0.0)], None).unwrap();
-    assert!(voxsplat::Clip::new(&[glam::Vec4::new(0.0, 0.0, 0.0, 1.0)], None).is_err());
+    crate::Clip::new(&[glam::Vec4::new(1e30, 0.0, 0.0, 0.0)], None).unwrap();
+    assert!(crate::Clip::new(&[glam::Vec4::new(0.0, 0.0, 0.0, 1.0)], None).is_err());
 }
 
 /// Issue 44: a splat blur takes one path and one profile; `splat:arc+slotted+tapered+teardrop`
 /// kept the last profile silently.
 #[test]
 fn a_blur_takes_one_path_and_one_profile() {
-    use voxsplat::animate::Blur;
+    use crate::animate::Blur;
     for bad in ["splat:arc+slotted+tapered+teardrop", "splat:tapered+teardrop", "splat:arc+line"] {
         let e = bad.parse::<Blur>().unwrap_err();
         assert!(e.to_string().contains("both given"), "{bad}: {e}");
@@ -450,9 +450,9 @@ fn a_blur_takes_one_path_and_one_profile() {
 #[test]
 fn a_set_past_the_splat_cap_is_still_ray_cast() {
     let n = 150; // 3,375,000 voxels, past MAX_GPU_SPLATS
-    assert!(n * n * n > voxsplat::low_level::constants::MAX_GPU_SPLATS);
+    assert!(n * n * n > crate::constants::MAX_GPU_SPLATS);
     let grid = Grid::centered([n; 3], [1.0; 3]).unwrap();
-    let set = voxsplat::SplatSet::from_fn(grid, |_, _, _| Some([0.8, 0.6, 0.4, 0.02])).unwrap();
+    let set = crate::SplatSet::from_fn(grid, |_, _, _| Some([0.8, 0.6, 0.4, 0.02])).unwrap();
     let cam = Camera::framing(&grid, 24, 24);
     let mut g = gpu();
     g.set_scene(set).unwrap();
@@ -473,9 +473,9 @@ fn the_host_budget_defaults_to_a_share_of_physical_memory() {
         line.split_whitespace().nth(1).unwrap().parse().unwrap()
     };
     let total = kb("MemTotal:") * 1024;
-    assert_eq!(voxsplat::host_budget(), Some(total / 4 * 3));
+    assert_eq!(crate::options::host_budget(), Some(total / 4 * 3));
     // A gzip stream allowed to inflate to 90 % of physical memory: refused before a byte is read.
-    let e = voxsplat::loaders::gunzip(&[], total / 10 * 9, "a test's stream").unwrap_err();
+    let e = crate::loaders::gunzip(&[], total / 10 * 9, "a test's stream").unwrap_err();
     assert!(e.to_string().contains("past the host budget") && e.to_string().contains("three quarters"), "{e}");
 }
 
@@ -517,7 +517,7 @@ fn an_npy_header_that_is_not_numpy_s_dict_is_refused_before_it_is_parsed() {
         // Read from a file (a volume, or terrain heights), the whole header is checked too.
         let path = dir().join("odd.npy");
         std::fs::write(&path, &bytes).unwrap();
-        let e = voxsplat::loaders::load_heights(&path).unwrap_err();
+        let e = crate::loaders::load_heights(&path).unwrap_err();
         assert!(e.to_string().contains(needle), "{header:?}: {e}");
         let e = load_volume(&path, &VolumeHints::default()).unwrap_err();
         assert!(e.to_string().contains(needle), "{header:?}: {e}");

@@ -1,14 +1,12 @@
 //! Isosurface splats (`--mode iso`): against the ray caster's first crossing (depth and
 //! coverage), the GPU against the CPU mirrors, a bricked volume against its dense set, a new value
 //! per frame without a new upload, and what they refuse.
-use crate::common;
+use super::common;
+use crate::stages::{Res, StageId};
+use crate::volume::ScalarVolume;
+use crate::{Camera, Error, Grid, ImageF32, Kernel, Mode, Raster, RaycastOptions, RenderOptions, Renderer, SplatSet};
 use common::{assert_clean, assert_mirrors, cpu, gpu};
 use glam::Vec3;
-use voxsplat::low_level::stages::{Res, StageId};
-use voxsplat::volume::ScalarVolume;
-use voxsplat::{
-    Camera, Error, Grid, ImageF32, Kernel, Mode, Raster, RaycastOptions, RenderOptions, Renderer, SplatSet,
-};
 
 /// A ball's values: 1 at its centre falling linearly to 0 at `radius` voxels, on an n³ grid:
 /// its isosurface at v is the sphere of radius (1 - v) radius.
@@ -50,10 +48,10 @@ fn opaque(img: &ImageF32) -> Vec<bool> {
 /// orthographic ones from opposite octants.
 fn views(grid: &Grid, size: u32) -> Vec<(&'static str, Camera)> {
     let framing = Camera::framing(grid, size, size);
-    let close = voxsplat::scene::close_view(grid, size);
+    let close = crate::scene::close_view(grid, size);
     let mut ortho = Camera::framing(grid, size, size);
     ortho.eye = Vec3::new(70.0, 45.0, 90.0);
-    ortho.projection = voxsplat::Projection::Orthographic { height: grid.dims[1] as f32 * 1.3 };
+    ortho.projection = crate::Projection::Orthographic { height: grid.dims[1] as f32 * 1.3 };
     // From the opposite octant: the grid's low faces.
     let mut back = ortho;
     back.eye = Vec3::new(-80.0, -40.0, -70.0);
@@ -155,13 +153,13 @@ fn the_hosts_depth_hides_the_surface_behind_it() {
     let z = c.probe(&cam, &iso(0.5), StageId::TileComposite, &[Res::Accum]).unwrap().remove(0);
     // A plane facing the camera through the front of the sphere (radius 14), 11 voxels before its
     // centre: it hides the rim and leaves the middle.
-    let d = (voxsplat::glam::Vec3::ZERO - cam.eye).dot(cam.forward()) - 11.0;
+    let d = (crate::glam::Vec3::ZERO - cam.eye).dot(cam.forward()) - 11.0;
     let proj = cam.proj();
-    let clip = proj * voxsplat::glam::Vec4::new(0.0, 0.0, -d, 1.0);
-    let depth = voxsplat::DepthBuffer {
+    let clip = proj * crate::glam::Vec4::new(0.0, 0.0, -d, 1.0);
+    let depth = crate::DepthBuffer {
         width: cam.width,
         height: cam.height,
-        format: voxsplat::DepthFormat::D32,
+        format: crate::DepthFormat::D32,
         texels: vec![(clip.z / clip.w).to_bits(); (cam.width * cam.height) as usize],
         projection: proj,
     };
@@ -194,7 +192,7 @@ fn a_new_iso_value_needs_no_new_upload() {
     let mut g = gpu();
     g.set_scene(set.clone()).unwrap();
     let cam = Camera::framing(set.grid(), 64, 64);
-    let uploads = |r: &voxsplat::Rendered| r.timings.iter().filter(|t| t.stage == "iso_field").count();
+    let uploads = |r: &crate::Rendered| r.timings.iter().filter(|t| t.stage == "iso_field").count();
     let first = g.render(&cam, &iso(0.4)).unwrap();
     let second = g.render(&cam, &iso(0.6)).unwrap();
     assert_eq!((uploads(&first), uploads(&second)), (1, 0), "the field goes up once per scene");
@@ -282,7 +280,7 @@ fn refusals() {
     o.raster = Raster::Graphics;
     refused(&mut r, &o, "compute tile compositor");
     o = iso(0.5);
-    o.composite = voxsplat::Composite::Sheet;
+    o.composite = crate::Composite::Sheet;
     refused(&mut r, &o, "sheets and slabs");
     let mut c = cast(0.5);
     c.iso = None;

@@ -1,11 +1,11 @@
 //! Label volumes and channels: labels never interpolated into one another, hidden labels draw
 //! nothing, missing labels are counted; channels combined per voxel; and what each refuses.
-use crate::common;
+use super::common;
+use crate::classify::{classify_channels, TransferFunction};
+use crate::labels::{classify_labels, LabelTable};
+use crate::volume::ScalarVolume;
+use crate::{Camera, Grid, Raster, RenderOptions};
 use common::{assert_clean, assert_mirrors, cpu, gpu};
-use voxsplat::classify::{classify_channels, TransferFunction};
-use voxsplat::labels::{classify_labels, LabelTable};
-use voxsplat::volume::ScalarVolume;
-use voxsplat::{Camera, Grid, Raster, RenderOptions};
 
 const DIMS: [u32; 3] = [24, 20, 16];
 
@@ -105,7 +105,7 @@ fn a_label_volume_over_a_scalar_volume_adds_their_emission_and_extinction() {
     let scalar = common::blob(DIMS);
     let tf = common::blob_tf();
     let both = classify_labels(grid, &seg, &table(true), Some((&scalar, &tf, None))).unwrap().set;
-    let alone = voxsplat::classify::classify_on(grid, &scalar, &tf, None).unwrap();
+    let alone = crate::classify::classify_on(grid, &scalar, &tf, None).unwrap();
     let tau = |a: f32| -(1.0 - a).ln();
     let mut checked = 0;
     for sp in both.splats() {
@@ -149,7 +149,7 @@ fn channels_combine_per_voxel_and_must_share_a_grid() {
     let red = TransferFunction::from_toml("points = [[0.1, [1, 0, 0, 0]], [1.0, [1, 0, 0, 0.5]]]").unwrap();
     let green = TransferFunction::from_toml("points = [[0.1, [0, 1, 0, 0]], [1.0, [0, 1, 0, 0.5]]]").unwrap();
     let set = classify_channels(grid, &[(&a, &red), (&b, &green)], None).unwrap();
-    let only_a = voxsplat::classify::classify_on(grid, &a, &red, None).unwrap();
+    let only_a = crate::classify::classify_on(grid, &a, &red, None).unwrap();
     let (mut mixed, mut alone) = (0, 0);
     for sp in set.splats() {
         let [i, j, k, _] = sp.ijk;
@@ -228,14 +228,14 @@ fn a_four_d_nifti_reads_as_its_channels() {
     for (five, name) in [(false, "c.nii"), (true, "c5.nii")] {
         let path = dir.join(name);
         std::fs::write(&path, nifti_channels(dims, &data, 3, five)).unwrap();
-        let vols = voxsplat::loaders::load_channels(&path, &Default::default()).unwrap();
+        let vols = crate::loaders::load_channels(&path, &Default::default()).unwrap();
         assert_eq!(vols.len(), 3, "{name}");
         for (k, v) in vols.iter().enumerate() {
             assert_eq!(v.dims, dims);
             let want: Vec<f32> = data[k * n..(k + 1) * n].iter().map(|&b| b as f32).collect();
             assert_eq!(v.values, want, "{name}: channel {k}");
         }
-        let e = voxsplat::loaders::load_volume(&path, &Default::default()).unwrap_err().to_string();
+        let e = crate::loaders::load_volume(&path, &Default::default()).unwrap_err().to_string();
         assert!(e.contains("holds 3 channels"), "{e}");
     }
     // Too many channels (a 5-D file's vector axis), and a file too short for its channels. A 4-D
@@ -243,19 +243,19 @@ fn a_four_d_nifti_reads_as_its_channels() {
     // tests/series.rs reads them).
     let many = dir.join("many.nii");
     std::fs::write(&many, nifti_channels(dims, &vec![0; 7 * n], 7, true)).unwrap();
-    let e = voxsplat::loaders::load_channels(&many, &Default::default()).unwrap_err().to_string();
+    let e = crate::loaders::load_channels(&many, &Default::default()).unwrap_err().to_string();
     assert!(e.contains("2 to 4 channels"), "{e}");
     std::fs::write(&many, nifti_channels(dims, &vec![0; 7 * n], 7, false)).unwrap();
-    let e = voxsplat::loaders::load_channels(&many, &Default::default()).unwrap_err().to_string();
+    let e = crate::loaders::load_channels(&many, &Default::default()).unwrap_err().to_string();
     assert!(e.contains("holds 7 time points"), "{e}");
     let short = dir.join("short.nii");
     std::fs::write(&short, nifti_channels(dims, &data[..2 * n], 3, false)).unwrap();
-    let e = voxsplat::loaders::load_channels(&short, &Default::default()).unwrap_err().to_string();
+    let e = crate::loaders::load_channels(&short, &Default::default()).unwrap_err().to_string();
     assert!(e.contains("truncated"), "{e}");
     // A 3-D file is one channel.
     let one = dir.join("one.nii");
     std::fs::write(&one, common::nifti(dims, &data[..n], None, None)).unwrap();
-    assert_eq!(voxsplat::loaders::load_channels(&one, &Default::default()).unwrap().len(), 1);
+    assert_eq!(crate::loaders::load_channels(&one, &Default::default()).unwrap().len(), 1);
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -284,7 +284,7 @@ fn a_four_d_nrrd_reads_as_its_channels() {
     for (name, bytes) in cases {
         let path = dir.join(name);
         std::fs::write(&path, bytes).unwrap();
-        let vols = voxsplat::loaders::load_channels(&path, &Default::default()).unwrap();
+        let vols = crate::loaders::load_channels(&path, &Default::default()).unwrap();
         assert_eq!(vols.len(), 3, "{name}");
         for (k, v) in vols.iter().enumerate() {
             assert_eq!(v.dims, dims.map(|d| d as u32), "{name}");
@@ -294,7 +294,7 @@ fn a_four_d_nrrd_reads_as_its_channels() {
         if name == "first.nrrd" {
             assert_eq!(vols[0].spacing, [1.0, 2.0, 3.0], "the channel axis's spacing is dropped");
         }
-        let e = voxsplat::loaders::load_volume(&path, &Default::default()).unwrap_err().to_string();
+        let e = crate::loaders::load_volume(&path, &Default::default()).unwrap_err().to_string();
         assert!(e.contains("holds 3 channels"), "{name}: {e}");
     }
     // Five channels; a channel axis in the middle; four spatial-looking axes of which none is marked.
@@ -305,7 +305,7 @@ fn a_four_d_nrrd_reads_as_its_channels() {
     ] {
         let path = dir.join(name);
         std::fs::write(&path, bytes).unwrap();
-        let e = voxsplat::loaders::load_channels(&path, &Default::default()).unwrap_err().to_string();
+        let e = crate::loaders::load_channels(&path, &Default::default()).unwrap_err().to_string();
         assert!(e.contains(says), "{name}: {e}");
     }
     std::fs::remove_dir_all(&dir).ok();

@@ -1,10 +1,10 @@
 //! Scenes past a device limit: per-splat arrays longer than one storage binding may be (lavapipe's
 //! maxStorageBufferRange is 2^27 bytes, 1.68 M of the 80-byte records) are bound as two pages, and
 //! splat frames of scenes past two pages get a typed error (a ray cast takes them).
-use crate::common;
+use super::common;
+use crate::constants::{MAX_GPU_SPLATS, SPLAT_PAGE};
+use crate::{Antialias, Camera, Composite, Error, Grid, Kernel, Raster, RenderOptions, SplatSet};
 use common::{assert_clean, cpu, gpu};
-use voxsplat::low_level::constants::{MAX_GPU_SPLATS, SPLAT_PAGE};
-use voxsplat::{Antialias, Camera, Composite, Error, Grid, Kernel, Raster, RenderOptions, SplatSet};
 
 /// `nx` x 100 x 100 translucent splats with a colour ramp, so neighbouring records differ.
 fn block(nx: u32) -> SplatSet {
@@ -13,7 +13,7 @@ fn block(nx: u32) -> SplatSet {
 }
 
 /// The message of a `TooLarge` error; anything else fails the test.
-fn too_large<T>(r: voxsplat::Result<T>) -> String {
+fn too_large<T>(r: crate::Result<T>) -> String {
     match r {
         Err(Error::TooLarge(m)) => m,
         Err(e) => panic!("expected TooLarge, got {e}"),
@@ -21,7 +21,7 @@ fn too_large<T>(r: voxsplat::Result<T>) -> String {
     }
 }
 
-fn max_diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> f32 {
+fn max_diff(a: &crate::ImageF32, b: &crate::ImageF32) -> f32 {
     a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs())).fold(0.0, f32::max)
 }
 
@@ -33,8 +33,8 @@ fn per_splat_records_past_one_binding_range_are_paged() {
     g.set_scene(set.clone()).unwrap();
     c.set_scene(set.clone()).unwrap();
     let cam = Camera::framing(set.grid(), 40, 32);
-    let gp = g.splat_params(&cam, Kernel::Gaussian, Antialias::None).unwrap();
-    let cp = c.splat_params(&cam, Kernel::Gaussian, Antialias::None).unwrap();
+    let gp = crate::low_level::splat_params(&mut g, &cam, Kernel::Gaussian, Antialias::None).unwrap();
+    let cp = crate::low_level::splat_params(&mut c, &cam, Kernel::Gaussian, Antialias::None).unwrap();
     // The second page holds the last splats; unpaged, a binding clipped to the device's range lost them.
     let page = SPLAT_PAGE as usize;
     for (i, (a, b)) in gp.iter().zip(&cp).enumerate().skip(page - 2) {
@@ -79,16 +79,16 @@ fn scenes_past_two_pages_are_refused_with_a_typed_error() {
 /// in shorter chunks. Both match the mirror, which has no such budget.
 #[test]
 fn work_past_llvmpipes_loop_budget_is_split_not_cut_short() {
-    use voxsplat::low_level::constants::TILE_SEGMENT;
-    use voxsplat::Direction;
+    use crate::constants::TILE_SEGMENT;
+    use crate::Direction;
     let (mut g, mut c) = (gpu(), cpu());
-    let set = voxsplat::scene::build("stripes128").unwrap();
+    let set = crate::scene::build("stripes128").unwrap();
     g.set_scene(set.clone()).unwrap();
     c.set_scene(set.clone()).unwrap();
     let cam = Camera::framing(set.grid(), 32, 32);
     let mut o = RenderOptions::default();
     o.raster = Raster::Compute;
-    let (starts, _) = g.tile_lists(&cam, &o).unwrap();
+    let (starts, _) = super::probes::tile_lists(&mut g, &cam, &o).unwrap();
     let longest = starts.windows(2).map(|w| w[1] - w[0]).max().unwrap();
     assert!(longest > 8 * TILE_SEGMENT, "longest list {longest}");
     for (direction, stop) in
@@ -101,14 +101,14 @@ fn work_past_llvmpipes_loop_budget_is_split_not_cut_short() {
     }
 
     // 1024 footprints 100 px wide: one binning chunk would visit ~190 000 tiles.
-    let sheet = voxsplat::scene::rate_scene(32).unwrap();
-    let cam = voxsplat::scene::rate_camera(sheet.grid(), 100.0).unwrap();
+    let sheet = crate::scene::rate_scene(32).unwrap();
+    let cam = crate::scene::rate_camera(sheet.grid(), 100.0).unwrap();
     g.set_scene(sheet.clone()).unwrap();
     c.set_scene(sheet).unwrap();
     o.direction = None;
     o.early_termination = 0.0;
-    let (gs, ge) = g.tile_lists(&cam, &o).unwrap();
-    let (cs, ce) = c.tile_lists(&cam, &o).unwrap();
+    let (gs, ge) = super::probes::tile_lists(&mut g, &cam, &o).unwrap();
+    let (cs, ce) = super::probes::tile_lists(&mut c, &cam, &o).unwrap();
     assert_eq!((gs.len(), ge.len()), (cs.len(), ce.len()), "tile lists");
     assert!(gs == cs && ge == ce, "the GPU's tile lists are the mirror's");
     let d = max_diff(&g.render(&cam, &o).unwrap().image, &c.render(&cam, &o).unwrap().image);
@@ -120,8 +120,8 @@ fn work_past_llvmpipes_loop_budget_is_split_not_cut_short() {
 /// 300 x 300 pixels) is a typed error naming the raster modes that draw it, not a cut footprint.
 #[test]
 fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
-    let sheet = voxsplat::scene::rate_scene(4).unwrap();
-    let cam = voxsplat::scene::rate_camera(sheet.grid(), 300.0).unwrap();
+    let sheet = crate::scene::rate_scene(4).unwrap();
+    let cam = crate::scene::rate_camera(sheet.grid(), 300.0).unwrap();
     let mut g = gpu();
     g.set_scene(sheet).unwrap();
     let mut o = RenderOptions::default();
@@ -142,13 +142,13 @@ fn sheet_sums_refuse_a_footprint_past_the_loop_budget() {
 /// `max_steps`, on both engines (issue 25: the mirror stopped there silently); under both it draws.
 #[test]
 fn gpu_rays_past_the_loop_budget_are_refused() {
-    use voxsplat::low_level::constants::MAX_GPU_RAY_STEPS;
-    let set = voxsplat::scene::build("cube40").unwrap();
+    use crate::constants::MAX_GPU_RAY_STEPS;
+    let set = crate::scene::build("cube40").unwrap();
     let cam = Camera::framing(set.grid(), 24, 24);
     let mut g = gpu();
     g.set_scene(set).unwrap();
     // A ~70-voxel diagonal at a 0.001-voxel step: 70 000 samples.
-    let mut o = voxsplat::RaycastOptions { step: 0.001, ..Default::default() };
+    let mut o = crate::RaycastOptions { step: 0.001, ..Default::default() };
     let m = too_large(g.raycast(&cam, &o));
     assert!(m.contains(&MAX_GPU_RAY_STEPS.to_string()), "{m}");
     o.step = 0.002;
@@ -163,7 +163,7 @@ fn gpu_rays_past_the_loop_budget_are_refused() {
 /// batch is cut to fit; the frame matches the sheets drawn as quads.
 #[test]
 fn fixed_point_sheet_batches_fit_one_binding() {
-    let set = voxsplat::scene::build("cube60").unwrap();
+    let set = crate::scene::build("cube60").unwrap();
     let cam = Camera::framing(set.grid(), 512, 512);
     let mut g = gpu();
     g.set_scene(set).unwrap();

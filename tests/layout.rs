@@ -356,8 +356,8 @@ fn the_maths_imports_no_gpu_layout() {
 fn every_stage_has_its_shader_and_a_mirror_file_of_its_name() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let table = std::fs::read_to_string(root.join("src/stages.rs")).unwrap();
-    assert!(voxsplat::low_level::stages::STAGES.len() >= 26);
-    for desc in voxsplat::low_level::stages::STAGES {
+    assert!(crate::stages::STAGES.len() >= 26);
+    for desc in crate::stages::STAGES {
         let name = desc.name;
         let comp = root.join(format!("glsl/{name}.comp")).exists();
         let draw = root.join(format!("glsl/{name}.vert")).exists() && root.join(format!("glsl/{name}.frag")).exists();
@@ -435,17 +435,108 @@ fn the_top_level_holds_the_embedders_modules() {
         public.push(name);
     }
     assert!(public.len() >= 15 && public.len() <= embedder.len() + lab.len(), "{public:?}");
-    // What low_level re-exports is private at the top, so it has one path; and it is named, item by
-    // item, so that the public face is what the list says, not whatever a module makes public.
+    // low_level names its items one by one (no glob, no module), at most 30: what the CLI and the
+    // lab reach below the facade, not the engine; the engine's tests use the internals from inside
+    // the crate. Its re-exports come from modules private at the top, so each has one path.
     let low = std::fs::read_to_string(root.join("low_level.rs")).unwrap();
     assert!(!low.contains("::*"), "low_level re-exports a module whole: name its items");
-    let mut reexported = 0;
-    for l in low.lines() {
-        let Some(m) = l.trim().strip_prefix("pub use crate::").and_then(|r| r.split("::").next()) else { continue };
+    assert!(!low.contains("pub mod "), "low_level holds a module: name the items the lab needs");
+    let mut items = Vec::new();
+    let code: String = low.lines().filter(|l| !l.trim_start().starts_with("//")).collect::<Vec<_>>().join("\n");
+    for (i, _) in code.match_indices("pub use crate::") {
+        let m = code[i + 15..].split("::").next().unwrap();
         assert!(lines.contains(&format!("mod {m};").as_str()), "{m}: low_level's module is private at the top");
-        reexported += 1;
+        let rest = &code[i + 15..code[i..].find(';').unwrap() + i];
+        let names = rest.rsplit("::").next().unwrap().trim_matches(|c| c == '{' || c == '}');
+        items.extend(names.split(',').map(|n| n.trim().to_string()).filter(|n| !n.is_empty()));
     }
-    assert!(reexported >= 12, "{reexported} modules under low_level");
+    for l in code.lines() {
+        for kind in ["pub fn ", "pub struct ", "pub enum ", "pub const ", "pub trait "] {
+            if let Some(r) = l.strip_prefix(kind) {
+                items.push(r.split(|c: char| !c.is_alphanumeric() && c != '_').next().unwrap().to_string());
+            }
+        }
+    }
+    assert!((8..=30).contains(&items.len()), "low_level lists {} items: {items:?}", items.len());
+    // Test probes are not methods of Renderer: no hidden public method on it.
+    for f in ["lib.rs", "series.rs", "animate.rs"] {
+        let code = std::fs::read_to_string(root.join(f)).unwrap();
+        assert!(
+            !code.contains("#[doc(hidden)]\n    pub fn"),
+            "{f}: a hidden Renderer method (a probe goes in low_level)"
+        );
+    }
+}
+
+/// The facade an embedder reads in one sitting: at most 40 public names at the top (modules,
+/// types, functions), each with a doc example; all else has one path, in its module.
+#[test]
+fn the_facade_has_at_most_forty_names_each_with_an_example() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap_or_default();
+    let lib = read(&src.join("lib.rs"));
+    let lines: Vec<&str> = lib.lines().collect();
+    // The doc lines (and attributes) right above line `i` of `lines` hold an example: a code block,
+    // in the comment or in the file an attribute includes.
+    let example_above = |lines: &[&str], i: usize, dir: &Path| {
+        let mut j = i;
+        while j > 0 && (lines[j - 1].trim_start().starts_with("///") || lines[j - 1].trim_start().starts_with("#[")) {
+            j -= 1;
+            let l = lines[j];
+            if l.contains("```") {
+                return true;
+            }
+            if let Some(f) = l.split("include_str!(\"").nth(1).and_then(|r| r.split('"').next()) {
+                if read(&dir.join(f)).contains("```") {
+                    return true;
+                }
+            }
+        }
+        false
+    };
+    let defined_with_example = |module: &str, name: &str| {
+        // The module's file, or one of its submodules' (`options::Rendered` is in options/stats.rs).
+        let mut files = vec![src.join(format!("{module}.rs"))];
+        files.extend(std::fs::read_dir(src.join(module)).into_iter().flatten().flatten().map(|e| e.path()));
+        files.iter().any(|f| {
+            let text = read(f);
+            let lines: Vec<&str> = text.lines().collect();
+            lines.iter().enumerate().any(|(i, l)| {
+                ["pub struct ", "pub enum ", "pub type ", "pub fn ", "pub trait "].iter().any(|k| {
+                    l.strip_prefix(k).is_some_and(|r| {
+                        r.starts_with(name) && !r[name.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+                    })
+                }) && example_above(&lines, i, &src)
+            })
+        })
+    };
+    let mut names: Vec<(String, bool)> = Vec::new();
+    for (i, l) in lines.iter().enumerate() {
+        if let Some(r) = l.strip_prefix("pub mod ") {
+            let name = r.split(|c: char| !c.is_alphanumeric() && c != '_').next().unwrap();
+            let file = [src.join(format!("{name}.rs")), src.join(name).join("mod.rs")].into_iter().find(|p| p.exists());
+            let header: String =
+                file.map(|f| read(&f)).unwrap_or_default().lines().take_while(|l| l.starts_with("//!")).collect();
+            names.push((name.to_string(), header.contains("```") || example_above(&lines, i, &src)));
+        } else if let Some(r) = l.strip_prefix("pub use ") {
+            let r = r.trim_end_matches(';');
+            let (module, list) = r.split_once("::").unwrap_or(("", r));
+            for n in list.trim_matches(|c| c == '{' || c == '}').split(',').map(str::trim).filter(|n| !n.is_empty()) {
+                names.push((n.to_string(), example_above(&lines, i, &src) || defined_with_example(module, n)));
+            }
+        } else {
+            for k in ["pub struct ", "pub enum ", "pub fn ", "pub type ", "pub trait ", "pub const "] {
+                if let Some(r) = l.strip_prefix(k) {
+                    let n = r.split(|c: char| !c.is_alphanumeric() && c != '_').next().unwrap();
+                    names.push((n.to_string(), example_above(&lines, i, &src)));
+                }
+            }
+        }
+    }
+    let all: Vec<&str> = names.iter().map(|(n, _)| n.as_str()).collect();
+    assert!((10..=40).contains(&names.len()), "{} names at the top: {all:?}", names.len());
+    let bare: Vec<&str> = names.iter().filter(|(_, e)| !e).map(|(n, _)| n.as_str()).collect();
+    assert!(bare.is_empty(), "top-level names without a doc example: {bare:?}");
 }
 
 /// The crates the core's modules will move to (docs/DEVELOPING.md, "The crates to come"), each

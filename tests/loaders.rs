@@ -1,13 +1,13 @@
 //! Loaders, classification and terrain (chapter 5): round trips, malformed input in seeded loops,
 //! hole filling, fly-over visibility, and the real-data presets on GPU and CPU.
-use crate::common;
+use super::common;
+use crate::loaders::{nifti_from_bytes, npy_from_bytes, nrrd_from_bytes, raw_from_bytes, tiff_heights, DType};
+use crate::order::{count_violations, visibility_order};
+use crate::terrain::{terrain_splats, TerrainOptions};
+use crate::RaycastOptions;
+use crate::{Camera, Direction, OrderKind};
 use common::Rng;
 use std::io::Write;
-use voxsplat::loaders::{nifti_from_bytes, npy_from_bytes, nrrd_from_bytes, raw_from_bytes, tiff_heights, DType};
-use voxsplat::order::{count_violations, visibility_order};
-use voxsplat::terrain::{terrain_splats, TerrainOptions};
-use voxsplat::RaycastOptions;
-use voxsplat::{Camera, Direction, OrderKind};
 
 const DIMS: [u32; 3] = [7, 5, 4];
 
@@ -93,13 +93,13 @@ fn every_format_round_trips() {
         "dims = [7, 5, 4]\ndtype = \"u16\"\nendian = \"big\"\nspacing = [1.0, 2.0, 0.5]\n",
     )
     .unwrap();
-    let r = voxsplat::loaders::load_volume(&dir.join("vol.raw"), &Default::default()).unwrap();
+    let r = crate::loaders::load_volume(&dir.join("vol.raw"), &Default::default()).unwrap();
     assert_eq!((r.dims, r.spacing, r.values.clone()), (DIMS, [1.0, 2.0, 0.5], v.clone()));
     // 16-bit PNG heights.
     let png =
         image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(7, 5, |x, y| image::Luma([(x * 1000 + y) as u16]));
     png.save(dir.join("h.png")).unwrap();
-    let hp = voxsplat::loaders::load_heights(&dir.join("h.png")).unwrap();
+    let hp = crate::loaders::load_heights(&dir.join("h.png")).unwrap();
     assert_eq!((hp.width, hp.rows, hp.heights[8]), (7, 5, 1001.0));
     let hv: Vec<u16> = (0..35).map(|i| (i * 100) as u16).collect();
     let t = tiff_heights(&tiff_u16(7, 5, &hv), "tif").unwrap();
@@ -151,21 +151,21 @@ fn malformed_input_returns_errors() {
     }
 }
 
-fn steep_heights() -> voxsplat::loaders::HeightGrid {
+fn steep_heights() -> crate::loaders::HeightGrid {
     // Ridges with 12-level cliffs between neighbouring cells.
     let (w, rows) = (40u32, 40u32);
     let heights = (0..rows * w).map(|i| if (i % w / 5) % 2 == 0 { 0.0 } else { 12.0 } + (i / w) as f32 * 0.3).collect();
-    voxsplat::loaders::HeightGrid { width: w, rows, heights }
+    crate::loaders::HeightGrid { width: w, rows, heights }
 }
 
 /// Pixels inside the silhouette of the voxels of `set` (ray-traced, eroded by 2 pixels) whose alpha
 /// in `img` is below 0.95.
-fn coverage_holes(img: &voxsplat::ImageF32, set: &voxsplat::SplatSet, cam: &Camera) -> usize {
+fn coverage_holes(img: &crate::ImageF32, set: &crate::SplatSet, cam: &Camera) -> usize {
     let g = set.grid();
     let inv = cam.view_proj().as_dmat4().inverse();
     let (w, h) = (img.width, img.height);
     let solid = |x: u32, y: u32| -> bool {
-        let (o, d, len) = voxsplat::truth::pixel_ray(&inv, x, y, w, h);
+        let (o, d, len) = crate::truth::pixel_ray(&inv, x, y, w, h);
         let mut t = 0.0;
         while t < len {
             let p = o + d * t;
@@ -225,7 +225,7 @@ fn terrain_columns_have_no_holes_from_a_grazing_view() {
             eye: c + glam::Vec3::new(-70.0, -60.0, 10.0),
             target: c,
             up: glam::Vec3::Z,
-            projection: voxsplat::Projection::Perspective { fov_y_deg: 40.0 },
+            projection: crate::Projection::Perspective { fov_y_deg: 40.0 },
             near: 1.0,
             far: 400.0,
             width: 96,
@@ -233,7 +233,7 @@ fn terrain_columns_have_no_holes_from_a_grazing_view() {
             window: None,
         };
         r.set_scene(set).unwrap();
-        let img = r.render(&cam, &voxsplat::RenderOptions::default()).unwrap().image;
+        let img = r.render(&cam, &crate::RenderOptions::default()).unwrap().image;
         holes.push(coverage_holes(&img, &filled, &cam));
     }
     eprintln!("holes with filling {}, without {}", holes[0], holes[1]);
@@ -242,13 +242,13 @@ fn terrain_columns_have_no_holes_from_a_grazing_view() {
 }
 
 fn data_present() -> bool {
-    voxsplat::loaders::data_dir().join("rmnp/rmnp-dem.tif").exists()
+    crate::loaders::data_dir().join("rmnp/rmnp-dem.tif").exists()
 }
 
 #[test]
 fn flyover_breaks_btf_but_not_pbtf() {
     assert!(data_present(), "../shared/data is needed (see README)");
-    let set = voxsplat::scene::build("rmnp").unwrap();
+    let set = crate::scene::build("rmnp").unwrap();
     let mut rng = Rng(77);
     for _ in 0..6 {
         let mut cam = Camera::flyover(set.grid(), 128, 96);
@@ -269,12 +269,12 @@ fn real_presets_render_the_same_on_gpu_and_cpu() {
     let mut gpu = common::gpu();
     let mut cpu = common::cpu();
     for name in ["rmnp", "stent", "bonsai"] {
-        let set = voxsplat::scene::build(name).unwrap();
+        let set = crate::scene::build(name).unwrap();
         let cam =
             if name == "rmnp" { Camera::flyover(set.grid(), 96, 72) } else { Camera::framing(set.grid(), 96, 72) };
         gpu.set_scene(set.clone()).unwrap();
         cpu.set_scene(set.clone()).unwrap();
-        let o = voxsplat::RenderOptions::default();
+        let o = crate::RenderOptions::default();
         let g = gpu.render(&cam, &o).unwrap().image;
         let c = cpu.render(&cam, &o).unwrap().image;
         let (max, mean) = common::assert_mirrors(&g, &c, name);
@@ -286,7 +286,7 @@ fn real_presets_render_the_same_on_gpu_and_cpu() {
 
 #[test]
 fn transfer_functions_are_checked() {
-    use voxsplat::classify::TransferFunction;
+    use crate::classify::TransferFunction;
     let tf =
         TransferFunction::from_toml("points = [[0.2, [1.0, 0.0, 0.0, 0.0]], [0.8, [1.0, 1.0, 1.0, 0.5]]]").unwrap();
     assert_eq!(tf.eval(0.5), [1.0, 0.5, 0.5, 0.25]);
@@ -301,12 +301,12 @@ fn transfer_functions_are_checked() {
     }
     assert!(TransferFunction::preset("nope").is_err());
     // The extraction threshold removes voxels the ramp would keep.
-    let vol = voxsplat::loaders::ScalarVolume { dims: [4, 1, 1], spacing: [1.0; 3], values: vec![0.0, 1.0, 2.0, 3.0] };
+    let vol = crate::loaders::ScalarVolume { dims: [4, 1, 1], spacing: [1.0; 3], values: vec![0.0, 1.0, 2.0, 3.0] };
     let ramp =
         TransferFunction::from_toml("points = [[0.0, [1.0, 1.0, 1.0, 0.0]], [1.0, [1.0, 1.0, 1.0, 1.0]]]").unwrap();
-    assert_eq!(voxsplat::classify::classify(&vol, &ramp, None).unwrap().len(), 3);
+    assert_eq!(crate::classify::classify(&vol, &ramp, None).unwrap().len(), 3);
     let cut = TransferFunction { threshold: 0.5, ..ramp };
-    assert_eq!(voxsplat::classify::classify(&vol, &cut, None).unwrap().len(), 2);
+    assert_eq!(crate::classify::classify(&vol, &cut, None).unwrap().len(), 2);
 }
 
 /// An absolute accuracy bound on the real datasets: the default GPU frame against the ray-cast
@@ -319,7 +319,7 @@ fn real_scenes_stay_within_their_error_ceilings() {
     let mut cpu = common::cpu();
     // The bonsai preset as it was when the ceilings were set (issue 29 made the base plate
     // transparent and the trunk and pot opaque): its ceiling keeps guarding the same picture.
-    let before = voxsplat::classify::TransferFunction {
+    let before = crate::classify::TransferFunction {
         points: vec![
             (0.0, [0.0, 0.0, 0.0, 0.0]),
             (0.15, [0.0, 0.0, 0.0, 0.0]),
@@ -332,11 +332,9 @@ fn real_scenes_stay_within_their_error_ceilings() {
         range: None,
         threshold: 0.0,
     };
-    let bonsai = voxsplat::loaders::load_volume(
-        &voxsplat::loaders::data_dir().join("bonsai/bonsai.nii.gz"),
-        &Default::default(),
-    )
-    .unwrap();
+    let bonsai =
+        crate::loaders::load_volume(&crate::loaders::data_dir().join("bonsai/bonsai.nii.gz"), &Default::default())
+            .unwrap();
     let scenes = [
         ("bonsai", CEILING_BONSAI),
         ("bonsai (preset before issue 29)", CEILING_BONSAI_BEFORE),
@@ -345,16 +343,16 @@ fn real_scenes_stay_within_their_error_ceilings() {
     ];
     for (name, ceiling) in scenes {
         let set = match name {
-            "bonsai (preset before issue 29)" => voxsplat::classify::classify(&bonsai, &before, None).unwrap(),
-            _ => voxsplat::scene::build(name).unwrap(),
+            "bonsai (preset before issue 29)" => crate::classify::classify(&bonsai, &before, None).unwrap(),
+            _ => crate::scene::build(name).unwrap(),
         };
         let cam =
             if name == "rmnp" { Camera::flyover(set.grid(), 96, 72) } else { Camera::framing(set.grid(), 96, 72) };
         gpu.set_scene(set.clone()).unwrap();
         cpu.set_scene(set).unwrap();
         let truth = cpu.raycast(&cam, &RaycastOptions { step: 0.25, ..Default::default() }).unwrap().image;
-        let frame = gpu.render(&cam, &voxsplat::RenderOptions::default()).unwrap().image;
-        let rmse = voxsplat::metrics::compare(&frame, &truth).unwrap().rmse;
+        let frame = gpu.render(&cam, &crate::RenderOptions::default()).unwrap().image;
+        let rmse = crate::metrics::compare(&frame, &truth).unwrap().rmse;
         eprintln!("{name}: RMSE {rmse:.6} against the ray-cast truth (ceiling {ceiling})");
         assert!(common::covered(&frame) > 96 * 72 / 20, "{name} is drawn");
         assert!(rmse <= ceiling, "{name}: RMSE {rmse} against the ray-cast truth, ceiling {ceiling}");

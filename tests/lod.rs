@@ -2,31 +2,32 @@
 //! of the brick stages against their CPU mirrors, the mixed-level sequence against the cell
 //! validator over a random view battery, and the pyramid rebuilt when the classification
 //! changes. Validation on: any message fails.
-use crate::common;
-use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, splat_stage, Rng, ViewKind};
-use voxsplat::classify::{Shading, TransferFunction};
-use voxsplat::low_level::plan::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
-use voxsplat::low_level::stages::{Res, StageId};
-use voxsplat::volume::ScalarVolume;
-use voxsplat::{Camera, Direction, Lod, Raster, RenderOptions, Renderer};
+use super::common;
+use super::probes::splat_stage;
+use crate::classify::{Shading, TransferFunction};
+use crate::plan::{pyramid_bytes, PYRAMID_BYTES, SLOTTED_LOD_BUFFERS, STREAMED_LOD_BUFFERS};
+use crate::stages::{Res, StageId};
+use crate::volume::ScalarVolume;
+use crate::{Camera, Direction, Lod, Raster, RenderOptions, Renderer};
+use common::{assert_clean, blob, blob_tf as tf, diff, random_camera, Rng, ViewKind};
 
 fn lod(raster: Raster, direction: Direction, pixels: f32) -> RenderOptions {
     let mut o = RenderOptions::default();
     (o.raster, o.direction, o.lod, o.lod_pixels, o.lod_error) =
-        (raster, Some(direction), Lod::Auto, pixels, voxsplat::options::MAX_LOD_ERROR);
+        (raster, Some(direction), Lod::Auto, pixels, crate::options::MAX_LOD_ERROR);
     o
 }
 
 /// The frame's cells in draw order, (i, j, k, side), read back once the splats are made.
 fn drawn_cells(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 4]> {
     let got = r.probe(cam, o, splat_stage(o), &[Res::BrickSlots, Res::BrickVoxels]).unwrap();
-    let total: u32 = got[0].iter().filter(|&&w| w != 0).map(|&w| voxsplat::bricks::slot_entry(w).2).sum();
+    let total: u32 = got[0].iter().filter(|&&w| w != 0).map(|&w| crate::bricks::slot_entry(w).2).sum();
     got[1]
         .chunks_exact(2)
         .take(total as usize)
         .map(|v| {
-            let [i, j, k] = voxsplat::low_level::cpu::brick::voxel_ijk([v[0], v[1]]);
-            [i, j, k, 1 << voxsplat::low_level::cpu::brick::voxel_level([v[0], v[1]])]
+            let [i, j, k] = crate::cpu::brick::voxel_ijk([v[0], v[1]]);
+            [i, j, k, 1 << crate::cpu::brick::voxel_level([v[0], v[1]])]
         })
         .collect()
 }
@@ -34,7 +35,7 @@ fn drawn_cells(r: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 4
 #[test]
 fn coarse_levels_match_the_cpu_mirrors_on_every_raster() {
     let vol = blob([45, 37, 29]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 80);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 96, 80);
     let shading = Some(Shading::headlight(cam.forward()));
     let mut weighted = tf();
     weighted.gradient_weight = 0.5;
@@ -95,7 +96,7 @@ fn coarse_levels_match_the_cpu_mirrors_on_every_raster() {
 #[test]
 fn mixed_level_sequences_pass_the_cell_validator_on_both_engines() {
     let vol = blob([45, 37, 29]);
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let (mut g, mut c) = (common::gpu(), common::cpu());
     g.set_volume(&vol, &tf(), None).unwrap();
     c.set_volume(&vol, &tf(), None).unwrap();
@@ -118,7 +119,7 @@ fn mixed_level_sequences_pass_the_cell_validator_on_both_engines() {
                 let o = lod(Raster::Graphics, direction, pixels);
                 let cells = drawn_cells(&mut g, &cam, &o);
                 assert_eq!(cells, drawn_cells(&mut c, &cam, &o), "{kind:?} {v}: GPU vs mirror sequence");
-                let bad = voxsplat::order::count_cell_violations(&grid, &cam, &cells, direction).unwrap();
+                let bad = crate::order::count_cell_violations(&grid, &cam, &cells, direction).unwrap();
                 assert_eq!(bad, 0, "{kind:?} {v} {direction:?}: validator violations");
                 let sides: std::collections::BTreeSet<u32> = cells.iter().map(|c| c[3]).collect();
                 mixed += usize::from(sides.len() >= 2);
@@ -133,14 +134,14 @@ fn mixed_level_sequences_pass_the_cell_validator_on_both_engines() {
     let mut cells = drawn_cells(&mut g, &cam, &o);
     let n = cells.len();
     cells.swap(0, n - 1);
-    assert!(voxsplat::order::count_cell_violations(&grid, &cam, &cells, Direction::FrontToBack).unwrap() > 0);
+    assert!(crate::order::count_cell_violations(&grid, &cam, &cells, Direction::FrontToBack).unwrap() > 0);
     assert_clean(&g);
 }
 
 #[test]
 fn the_pyramid_follows_the_classification() {
     let vol = blob([45, 37, 29]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 64);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 64);
     let o = lod(Raster::Compute, Direction::FrontToBack, 6.0);
     let mut other = tf();
     other.points[1].1 = [0.2, 0.8, 0.3, 0.6];
@@ -160,7 +161,7 @@ fn the_pyramid_follows_the_classification() {
     // Back to the first classification: the first frame again.
     assert_eq!(diff(&g.render(&cam, &o).unwrap().image, &first).0, 0.0);
     // A pyramid build is timed once per classification, not per frame.
-    let stages = |r: &voxsplat::Rendered| r.timings.iter().filter(|t| t.stage == "lod").count();
+    let stages = |r: &crate::Rendered| r.timings.iter().filter(|t| t.stage == "lod").count();
     assert_eq!(stages(&g.render(&cam, &o).unwrap()), 0);
     assert_clean(&g);
 }
@@ -182,8 +183,8 @@ fn constant_cube(n: u32) -> (ScalarVolume, TransferFunction) {
 /// the mean of its two neighbours (either way). A level switching abruptly makes one change jump
 /// or dip against the changes around it; the dolly alone changes them smoothly. (The global score,
 /// the largest change over the median, also follows the image's blur as levels coarsen.)
-fn local_popping(frames: &[voxsplat::ImageF32]) -> f64 {
-    let c = voxsplat::metrics::frame_changes(frames).unwrap();
+fn local_popping(frames: &[crate::ImageF32]) -> f64 {
+    let c = crate::metrics::frame_changes(frames).unwrap();
     c.windows(3)
         .map(|w| {
             let around = 0.5 * (w[0] + w[2]);
@@ -197,12 +198,12 @@ fn a_dolly_across_level_boundaries_changes_smoothly_with_morphing() {
     let vol = blob([40, 40, 40]);
     let mut g = common::gpu();
     g.set_volume(&vol, &tf(), None).unwrap();
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let mut dolly = |band: f32, lod: Lod| -> f64 {
         let mut frames = Vec::new();
         let mut o = RenderOptions::default();
         (o.raster, o.lod, o.lod_pixels, o.lod_error, o.lod_band) =
-            (Raster::Compute, lod, 4.0, voxsplat::options::MAX_LOD_ERROR, band);
+            (Raster::Compute, lod, 4.0, crate::options::MAX_LOD_ERROR, band);
         for f in 0..24 {
             let mut cam = Camera::framing(&grid, 96, 96);
             cam.target = glam::Vec3::ZERO;
@@ -234,7 +235,7 @@ fn level_boundaries_keep_the_brightness_of_a_constant_slab_and_cube() {
         vol.dims = dims;
         vol.values = vec![1.0; (dims[0] * dims[1] * dims[2]) as usize];
         vol.values[0] = 0.0;
-        let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+        let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
         let mut cam = Camera::framing(&grid, 128, 128);
         (cam.eye, cam.target, cam.near, cam.far) = (eye, glam::Vec3::ZERO, 1.0, 200.0);
         let mut g = common::gpu();
@@ -259,7 +260,7 @@ fn level_boundaries_keep_the_brightness_of_a_constant_slab_and_cube() {
             for band in [0.0, RenderOptions::default().lod_band] {
                 let mut o = full.clone();
                 (o.lod, o.lod_pixels, o.lod_error, o.lod_band) =
-                    (Lod::Auto, pixels, voxsplat::options::MAX_LOD_ERROR, band);
+                    (Lod::Auto, pixels, crate::options::MAX_LOD_ERROR, band);
                 let cells = drawn_cells(&mut g, &cam, &o);
                 let sides: std::collections::BTreeSet<u32> = cells.iter().map(|c| c[3]).collect();
                 boundaries += usize::from(sides.len() >= 2);
@@ -273,7 +274,7 @@ fn level_boundaries_keep_the_brightness_of_a_constant_slab_and_cube() {
                         let tile: Vec<usize> =
                             (0..16).map(|k| (ty + k / 4) * 128 + tx + k % 4).filter(|&i| inside(i)).collect();
                         if tile.len() == 16 {
-                            let sum = |img: &voxsplat::ImageF32| tile.iter().map(|&i| img.pixels[i][3]).sum::<f32>();
+                            let sum = |img: &crate::ImageF32| tile.iter().map(|&i| img.pixels[i][3]).sum::<f32>();
                             ratios.push(sum(&b) / sum(&a));
                         }
                     }
@@ -299,7 +300,7 @@ fn level_boundaries_keep_the_brightness_of_a_constant_slab_and_cube() {
 }
 
 /// The alpha-weighted mean row of an image.
-fn mean_row(img: &voxsplat::ImageF32) -> f64 {
+fn mean_row(img: &crate::ImageF32) -> f64 {
     let w = img.width as usize;
     let (mut sum, mut weight) = (0.0f64, 0.0f64);
     for (i, p) in img.pixels.iter().enumerate() {
@@ -311,14 +312,14 @@ fn mean_row(img: &voxsplat::ImageF32) -> f64 {
 
 /// A one-voxel 64 x 64 plate of constant colour and opacity, its transfer function and grid (a
 /// store keeps the voxels above its minimum: one corner voxel is the empty value).
-fn plate() -> (ScalarVolume, TransferFunction, voxsplat::Grid) {
+fn plate() -> (ScalarVolume, TransferFunction, crate::Grid) {
     let mut values = vec![1.0; 64 * 64];
     values[0] = 0.0;
     let vol = ScalarVolume { dims: [64, 64, 1], spacing: [1.0; 3], values };
     let mut plate = tf();
     plate.points = vec![(0.0, [0.9, 0.8, 0.7, 0.6]), (1.0, [0.9, 0.8, 0.7, 0.6])];
     plate.threshold = 0.0;
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     (vol, plate, grid)
 }
 
@@ -330,12 +331,12 @@ fn a_coarse_cell_the_grid_end_cuts_sits_on_the_voxels_it_holds() {
     let (vol, plate, grid) = plate();
     let mut cam = Camera::framing(&grid, 96, 96);
     cam.eye = grid.center() + glam::Vec3::new(0.0, -110.0, 34.0);
-    cam.projection = voxsplat::camera::Projection::Orthographic { height: 80.0 };
+    cam.projection = crate::camera::Projection::Orthographic { height: 80.0 };
     // Planes well clear of the plate: splats within 1.5 radii of one are dropped.
     (cam.near, cam.far) = (1.0, 1000.0);
     for mut r in [common::gpu(), common::cpu()] {
         r.set_volume(&vol, &plate, None).unwrap();
-        let fine = lod(Raster::Compute, Direction::BackToFront, voxsplat::options::MAX_LOD_PIXELS);
+        let fine = lod(Raster::Compute, Direction::BackToFront, crate::options::MAX_LOD_PIXELS);
         let mut full = fine.clone();
         full.lod = Lod::Off;
         let cells = drawn_cells(&mut r, &cam, &fine);
@@ -353,7 +354,7 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
     // A small image: its frame buffers leave the pyramid room under a budget the store streams in.
     const SIDE: u32 = 32;
     let vol = blob([80, 72, 64]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), SIDE, SIDE);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), SIDE, SIDE);
     let mut other = tf();
     other.points[1].1[3] *= 0.5;
     let mut frames = Vec::new();
@@ -366,18 +367,17 @@ fn a_streamed_store_draws_the_levels_a_resident_one_draws() {
         // summaries, each batch building its coarse bricks' pyramids.
         let scene = resident.volume().unwrap();
         let headers = scene.store.headers.len();
-        let per_batch = voxsplat::low_level::plan::bricked_min_budget(scene, records, SIDE, SIDE)
+        let per_batch = crate::plan::bricked_min_budget(scene, records, SIDE, SIDE)
             + pyramid_bytes(STREAMED_LOD_BUFFERS, headers)
             + 64 * PYRAMID_BYTES;
         // The resident pyramid built in one batch, and in several (room for it and under all
         // the records).
         let slotted = pyramid_bytes(SLOTTED_LOD_BUFFERS, headers);
-        let several =
-            voxsplat::low_level::plan::bricked_resident_bytes(scene, 2 * records - 1, SIDE, SIDE) + 2 * slotted;
+        let several = crate::plan::bricked_resident_bytes(scene, 2 * records - 1, SIDE, SIDE) + 2 * slotted;
         assert!(slotted < records, "the pyramid and a batch leave less room than the records take");
         let budgets = [2 * records - 1, several, per_batch];
         for (k, &budget) in budgets.iter().enumerate() {
-            let room = budget - voxsplat::low_level::plan::bricked_resident_bytes(scene, budget, SIDE, SIDE);
+            let room = budget - crate::plan::bricked_resident_bytes(scene, budget, SIDE, SIDE);
             assert!(scene.streams(budget));
             assert_eq!(slotted <= room / 2, k < 2, "{budget}");
         }
@@ -444,10 +444,10 @@ fn no_level_is_taken_whose_splats_the_near_plane_would_drop() {
     let mut cam = Camera::framing(&grid, 64, 64);
     cam.eye = grid.center() + glam::Vec3::new(0.0, 0.0, 20.0);
     (cam.near, cam.far) = (1.0, 1000.0);
-    let coverage = |img: &voxsplat::ImageF32| img.pixels.iter().map(|p| p[3] as f64).sum::<f64>();
+    let coverage = |img: &crate::ImageF32| img.pixels.iter().map(|p| p[3] as f64).sum::<f64>();
     for mut r in [common::gpu(), common::cpu()] {
         r.set_volume(&vol, &plate, None).unwrap();
-        let coarse = lod(Raster::Compute, Direction::BackToFront, voxsplat::options::MAX_LOD_PIXELS);
+        let coarse = lod(Raster::Compute, Direction::BackToFront, crate::options::MAX_LOD_PIXELS);
         let mut full = coarse.clone();
         full.lod = Lod::Off;
         let (a, b) = (r.render(&cam, &full).unwrap().image, r.render(&cam, &coarse).unwrap().image);
@@ -464,7 +464,7 @@ fn no_level_is_taken_whose_splats_the_near_plane_would_drop() {
 }
 
 /// Opaque one-voxel rods along z on a 4-voxel lattice in x and y (every 16th column), 32³.
-fn rods() -> (ScalarVolume, TransferFunction, voxsplat::Grid) {
+fn rods() -> (ScalarVolume, TransferFunction, crate::Grid) {
     let n = 32u32;
     let mut values = Vec::new();
     for _k in 0..n {
@@ -477,7 +477,7 @@ fn rods() -> (ScalarVolume, TransferFunction, voxsplat::Grid) {
     let vol = ScalarVolume { dims: [n; 3], spacing: [1.0; 3], values };
     let mut rod = tf();
     rod.points = vec![(0.0, [0.0; 4]), (0.5, [0.0; 4]), (0.6, [0.8, 0.7, 0.6, 0.999]), (1.0, [0.8, 0.7, 0.6, 0.999])];
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     (vol, rod, grid)
 }
 
@@ -490,7 +490,7 @@ fn coarse_cells_cover_what_their_voxels_cover_along_each_axis() {
     // covers more than its share there.)
     let (vol, rod, grid) = rods();
     let cam = Camera::framing(&grid, 64, 64);
-    let o = lod(Raster::Compute, Direction::FrontToBack, voxsplat::options::MAX_LOD_PIXELS);
+    let o = lod(Raster::Compute, Direction::FrontToBack, crate::options::MAX_LOD_PIXELS);
     let (mut g, mut c) = (common::gpu(), common::cpu());
     let mut cells = Vec::new();
     for r in [&mut g, &mut c] {
@@ -498,9 +498,9 @@ fn coarse_cells_cover_what_their_voxels_cover_along_each_axis() {
         cells.push(r.probe(&cam, &o, StageId::BrickPyramid, &[Res::Pyramid]).unwrap().remove(0));
     }
     // 64 bricks, all holding rods.
-    let words = 64 * voxsplat::low_level::plan::SLOT_CELLS * voxsplat::low_level::plan::CELL_WORDS;
+    let words = 64 * crate::plan::SLOT_CELLS * crate::plan::CELL_WORDS;
     assert!(cells[0][..words] == cells[1][..words], "GPU vs mirror pyramid");
-    let alpha = |code: u32| 1.0 - (-voxsplat::low_level::cpu::lod::tau_decode(code)).exp();
+    let alpha = |code: u32| 1.0 - (-crate::cpu::lod::tau_decode(code)).exp();
     let pyramid = &cells[0];
     let a0 = 1.0 - (1.0f32 - 0.999).powi(2);
     // Level 1 of brick 0: cell (0, 0, z) holds voxel column (1, 1) of its 2x2 (i, j).
@@ -521,7 +521,7 @@ fn coarse_cells_cover_what_their_voxels_cover_along_each_axis() {
 #[test]
 fn hidden_bricks_dropped_over_mixed_levels_change_no_pixel_eye_inside_too() {
     let vol = blob([96, 80, 72]);
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let opaque = TransferFunction { points: vec![(0.05, [0.0; 4]), (0.1, [0.8, 0.5, 0.3, 0.95])], ..tf() };
     let mut rng = Rng(4343);
     for gpu in [true, false] {
@@ -574,7 +574,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
     let mut cube = tf();
     cube.points = vec![(0.0, [0.9, 0.6, 0.3, 0.05]), (1.0, [0.9, 0.6, 0.3, 0.05])];
     cube.threshold = 0.0;
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let (mut g, mut c) = (common::gpu(), common::cpu());
     for r in [&mut g, &mut c] {
         r.set_volume(&vol, &cube, None).unwrap();
@@ -583,7 +583,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
     // Sizes alone choose: this tests the nodes' machinery (mirror, statistics, order). With the
     // error test on, the cube's faces (a full cell beside the empty outside) keep every node from
     // standing in for it at these sizes: its one footprint would blur the cube's silhouette.
-    (o.lod, o.lod_nodes, o.lod_error) = (Lod::Auto, true, voxsplat::options::MAX_LOD_ERROR);
+    (o.lod, o.lod_nodes, o.lod_error) = (Lod::Auto, true, crate::options::MAX_LOD_ERROR);
     let mut full = o.clone();
     (full.lod, full.lod_nodes) = (Lod::Off, false);
     let mut drawn = 0;
@@ -597,8 +597,8 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
             .into();
         // The nodes, after the bricks' summaries (whose float sums differ from the mirror's in the
         // last bits: exp and log): packed fields within a step, sums within 1e-4, the brick exact.
-        let at = 512 * voxsplat::low_level::plan::SUMMARY_WORDS;
-        let words = voxsplat::low_level::plan::NODE_WORDS;
+        let at = 512 * crate::plan::SUMMARY_WORDS;
+        let words = crate::plan::NODE_WORDS;
         let fields = |w: u32, i: usize| match i {
             0 | 1 => vec![w & 0xffff, w >> 16],
             2 => vec![w & 1023, w >> 10 & 1023, w >> 20 & 1023],
@@ -610,7 +610,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
             _ => fields(a, i).iter().zip(fields(b, i)).all(|(x, y)| x.abs_diff(y) <= 1),
         };
         // 4³ + 2³ + 1 nodes over the 8³ bricks.
-        let n = voxsplat::low_level::plan::node_words([8; 3], 3) as usize;
+        let n = crate::plan::node_words([8; 3], 3) as usize;
         assert_eq!(n, 73 * words);
         for (i, (x, y)) in nodes[0][at..at + n].iter().zip(&nodes[1][at..at + n]).enumerate() {
             assert!(
@@ -628,7 +628,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
         // What the nodes cover against full detail is measured, not bounded, here: at 3-8 pixels
         // the footprints' anti-aliasing dominates (docs/log/2026-11-28-thumbnails-and-nodes.md).
         let f = g.render(&cam, &full).unwrap().image;
-        let coverage = |i: &voxsplat::ImageF32| i.pixels.iter().map(|p| p[3] as f64).sum::<f64>();
+        let coverage = |i: &crate::ImageF32| i.pixels.iter().map(|p| p[3] as f64).sum::<f64>();
         eprintln!("{size}: coverage {:.3} of full detail's ({st:?})", coverage(&a.image) / coverage(&f));
         // Each node draws at its first drawing brick's place in the brick order: the cell
         // validator checks that order against every face two drawn cells share.
@@ -636,7 +636,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
             let mut o = o.clone();
             o.direction = Some(direction);
             let cells = drawn_cells(&mut g, &cam, &o);
-            let bad = voxsplat::order::count_cell_violations(&grid, &cam, &cells, direction).unwrap();
+            let bad = crate::order::count_cell_violations(&grid, &cam, &cells, direction).unwrap();
             assert_eq!(bad, 0, "{size} {direction:?}: validator violations over nodes");
         }
         drawn += usize::from(st.nodes > 0 && st.splats < st.bricks as u64 / 4);
@@ -653,7 +653,7 @@ fn nodes_above_the_brick_draw_a_volume_seen_small() {
 #[test]
 fn nodes_above_the_brick_keep_a_visibility_order() {
     let vol = blob([128, 112, 96]);
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let (mut g, mut c) = (common::gpu(), common::cpu());
     g.set_volume(&vol, &tf(), None).unwrap();
     c.set_volume(&vol, &tf(), None).unwrap();
@@ -673,7 +673,7 @@ fn nodes_above_the_brick_keep_a_visibility_order() {
                 o.lod_nodes = true;
                 let cells = drawn_cells(&mut g, &cam, &o);
                 assert_eq!(cells, drawn_cells(&mut c, &cam, &o), "{kind:?} {v}: GPU vs mirror sequence");
-                let bad = voxsplat::order::count_cell_violations(&grid, &cam, &cells, direction).unwrap();
+                let bad = crate::order::count_cell_violations(&grid, &cam, &cells, direction).unwrap();
                 assert_eq!(bad, 0, "{kind:?} {v} {direction:?}: validator violations");
                 with_nodes += usize::from(cells.iter().any(|c| c[3] > 8));
                 views += 1;
@@ -689,19 +689,19 @@ fn nodes_above_the_brick_keep_a_visibility_order() {
 /// error from the hook stops the frame (the next builds it all); the frame is `render_to`'s.
 #[test]
 fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
-    use voxsplat::vk::ImageLayout as IL;
+    use crate::vk::ImageLayout as IL;
     let gz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/bonsai/bonsai.nii.gz");
-    let store = voxsplat::bricks::BrickStore::load(&gz, &Default::default()).unwrap();
+    let store = crate::bricks::BrickStore::load(&gz, &Default::default()).unwrap();
     let tf = TransferFunction::preset("bonsai").unwrap();
     let (mut a, mut b) = (common::gpu(), common::gpu());
-    a.set_bricks(voxsplat::bricks::BrickScene::new(store.clone(), tf.clone(), None).unwrap()).unwrap();
-    b.set_bricks(voxsplat::bricks::BrickScene::new(store, tf, None).unwrap()).unwrap();
+    a.set_bricks(crate::bricks::BrickScene::new(store.clone(), tf.clone(), None).unwrap()).unwrap();
+    b.set_bricks(crate::bricks::BrickScene::new(store, tf, None).unwrap()).unwrap();
     let bricks = a.volume().unwrap().store.headers.len() as u64;
     assert!(bricks > 2 * 4096, "several parts: {bricks} bricks");
     let cam = Camera::framing(&a.volume().unwrap().store.grid().unwrap(), 40, 40);
     let o = RenderOptions::default();
     assert_eq!(o.lod, Lod::Auto);
-    let format = voxsplat::TargetFormat::Rgba16Float;
+    let format = crate::TargetFormat::Rgba16Float;
     let (ia, ib) = (a.target_image(format, 40, 40).unwrap(), b.target_image(format, 40, 40).unwrap());
     let (ta, tb) = (
         ia.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap(),
@@ -722,7 +722,7 @@ fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
     let mut parts = 0;
     let stop = b.render_to_with_progress(&cam, &o, &tb, &mut |_, _| {
         parts += 1;
-        Err(voxsplat::Error::InvalidArgument("stop".into()))
+        Err(crate::Error::InvalidArgument("stop".into()))
     });
     assert!(parts == 1 && stop.is_err_and(|e| e.to_string().contains("stop")));
     b.render_to(&cam, &o, &tb).unwrap();
@@ -731,7 +731,7 @@ fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
     // (one word each of what levels it draws, then its levels' errors).
     let mut c = common::cpu();
     c.set_bricks(
-        voxsplat::bricks::BrickScene::new(
+        crate::bricks::BrickScene::new(
             b.volume().unwrap().store.clone(),
             TransferFunction::preset("bonsai").unwrap(),
             None,
@@ -744,7 +744,7 @@ fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
         b.probe(&cam, &o, StageId::BrickPyramid, &what).unwrap(),
         c.probe(&cam, &o, StageId::BrickPyramid, &what).unwrap(),
     );
-    let words = voxsplat::low_level::plan::SUMMARY_WORDS;
+    let words = crate::plan::SUMMARY_WORDS;
     let differ = (0..bricks as usize).filter(|&h| gpu[0][h * words] != cpu[0][h * words]).count();
     let built = (0..bricks as usize).filter(|&h| cpu[0][h * words] != 0).count();
     let later = (2 * 4096..bricks as usize).filter(|&h| cpu[0][h * words] != 0).count();
@@ -759,7 +759,7 @@ fn the_pyramid_builds_in_parts_and_says_how_far_it_has_got() {
 fn summaries_match_the_mirror(g: &mut Renderer, c: &mut Renderer, cam: &Camera, o: &RenderOptions) -> Vec<[u32; 4]> {
     let summaries: Vec<Vec<u32>> =
         [g, c].map(|r| r.probe(cam, o, StageId::BrickPyramid, &[Res::LodSummary]).unwrap().remove(0)).into();
-    let words = voxsplat::low_level::plan::SUMMARY_WORDS;
+    let words = crate::plan::SUMMARY_WORDS;
     // One summary per stored brick (the empty ones have no header).
     (0..summaries[1].len() / words)
         .map(|h| {
@@ -793,7 +793,7 @@ fn blocky_ball() -> ScalarVolume {
 #[test]
 fn the_cut_sees_a_blocky_silhouette_and_its_errors_are_the_mirror_s() {
     let vol = blocky_ball();
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let cam = Camera::framing(&grid, 40, 40);
     let (mut g, mut c) = (common::gpu(), common::cpu());
     for r in [&mut g, &mut c] {
@@ -856,7 +856,7 @@ fn a_ramp_is_not_an_edge_and_a_step_is() {
     let mut least = [f32::MAX; 2];
     for (k, step) in [false, true].into_iter().enumerate() {
         let (vol, tf) = along_x(step);
-        let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+        let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
         let cam = Camera::framing(&grid, 40, 40);
         let (mut g, mut c) = (common::gpu(), common::cpu());
         for r in [&mut g, &mut c] {
@@ -913,7 +913,7 @@ fn an_edge_between_materials_at_a_brick_face_is_seen() {
     let mut psnr = Vec::new();
     for plane in [64, 66] {
         let vol = two_materials(plane);
-        let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+        let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
         let [lo, hi] = grid.world_box(glam::Vec3::ZERO, glam::Vec3::splat(127.0));
         let cam = Camera::framing_box(lo, hi, 1.0, glam::Vec3::Y, glam::Vec3::Z, 64, 64);
         let (mut g, mut c) = (common::gpu(), common::cpu());
@@ -924,7 +924,7 @@ fn an_edge_between_materials_at_a_brick_face_is_seen() {
         let mut full = RenderOptions::default();
         full.lod = Lod::Off;
         let (a, b) = (g.render(&cam, &o).unwrap().image, g.render(&cam, &full).unwrap().image);
-        let m = voxsplat::metrics::compare(&a, &b).unwrap();
+        let m = crate::metrics::compare(&a, &b).unwrap();
         let mirror = c.render(&cam, &o).unwrap().image;
         assert!(diff(&a, &mirror).0 <= 2e-3, "plane {plane}: device against mirror {}", diff(&a, &mirror).0);
         assert!(drawn_cells(&mut g, &cam, &o).iter().any(|s| s[3] > 1), "plane {plane}: levels engage");
@@ -937,7 +937,7 @@ fn an_edge_between_materials_at_a_brick_face_is_seen() {
 
 #[test]
 fn a_view_along_a_grid_axis_counts_a_row_of_departures() {
-    use voxsplat::low_level::cpu::lod::{view_coherence, MAX_COHERENCE};
+    use crate::cpu::lod::{view_coherence, MAX_COHERENCE};
     // Along an axis a ray stays in one column of children through every cell: the most. Half a
     // cell's drift per cell (tan 0.5) or more: once. Between, the cells a ray stays in a column.
     assert_eq!(view_coherence(glam::Vec3::new(0.0, 0.0, -3.0)), MAX_COHERENCE);
@@ -950,7 +950,7 @@ fn a_view_along_a_grid_axis_counts_a_row_of_departures() {
     // bound: a brick takes level 1 exactly where its level-1 error, times the view's coherence,
     // passes the bound. Half the bricks with an error pass it seen obliquely, fewer along z.
     let vol = blob([48, 48, 48]);
-    let grid = voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap();
+    let grid = crate::Grid::centered(vol.dims, vol.spacing).unwrap();
     let (mut g, mut c) = (common::gpu(), common::cpu());
     for r in [&mut g, &mut c] {
         r.set_volume(&vol, &tf(), None).unwrap();
@@ -959,12 +959,12 @@ fn a_view_along_a_grid_axis_counts_a_row_of_departures() {
         let mut cam = Camera::framing(&grid, 96, 96);
         cam.target = grid.center();
         cam.eye = grid.center() + 150.0 * dir.normalize();
-        cam.projection = voxsplat::camera::Projection::Orthographic { height: 80.0 };
+        cam.projection = crate::camera::Projection::Orthographic { height: 80.0 };
         (cam.near, cam.far) = (1.0, 1000.0);
         cam
     };
     let (along, oblique) = (view(glam::Vec3::Z), view(glam::Vec3::new(1.0, 0.0, 1.0)));
-    let mut o = lod(Raster::Compute, Direction::BackToFront, voxsplat::options::MAX_LOD_PIXELS);
+    let mut o = lod(Raster::Compute, Direction::BackToFront, crate::options::MAX_LOD_PIXELS);
     let errors: Vec<f32> = summaries_match_the_mirror(&mut g, &mut c, &along, &o)
         .iter()
         .filter(|s| s[0] & 0xff > 0)

@@ -1,7 +1,12 @@
-//! The core's integration tests, one binary: each file is a module (`cargo test --test engine
-//! lod::` runs one, `cargo test --test engine the_pyramid` one test). As thirty-one binaries, each
-//! linked the whole engine. `fuzz_corpus.rs` stays a binary of its own: the fuzz bodies set the
-//! process's host budget (`set_host_budget`), which the other tests must not share.
+//! The engine's tests, compiled into the library's test build (`mod tests` in src/lib.rs), so they
+//! reach the internals from inside the crate: `cargo test --release --lib -- tests::lod::` runs one
+//! file, `cargo test --release --lib the_pyramid` one test. `fuzz_corpus.rs` is a binary of its own:
+//! the fuzz bodies set the process's host budget (`set_host_budget`), which the other tests must
+//! not share.
+// The tests set options one field at a time, as a program outside the crate must (the option
+// structs are non_exhaustive): clippy, inside the crate, would have struct literals.
+#![allow(clippy::field_reassign_with_default)]
+use crate as vs;
 mod aa;
 mod bands;
 mod bisect;
@@ -27,7 +32,9 @@ mod orient;
 mod pick;
 mod plan;
 mod present;
+mod probes;
 mod raster;
+mod reliability;
 mod resample;
 mod series;
 mod spirv;

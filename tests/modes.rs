@@ -1,15 +1,15 @@
 //! The projection modes (`--mode mip|minip|average|xray`): against the host's projections of the
 //! classified volume with the same kernel, the GPU against the CPU mirrors in every raster, and
 //! what they refuse.
-use crate::common;
+use super::common;
+use crate::classify::{classify, TransferFunction};
+use crate::cpu::footprint::PROJECT_FULL;
+use crate::cpu::splat_params::PROJECT_SHRINK;
+use crate::kernel::sample_radial;
+use crate::volume::ScalarVolume;
+use crate::{Camera, Composite, Kernel, Mode, Projection, Raster, RenderOptions, SplatSet};
 use common::{assert_clean, assert_mirrors, cpu, gpu, Rng};
 use glam::Vec3;
-use voxsplat::classify::{classify, TransferFunction};
-use voxsplat::kernel::sample_radial;
-use voxsplat::low_level::cpu::footprint::PROJECT_FULL;
-use voxsplat::low_level::cpu::splat_params::PROJECT_SHRINK;
-use voxsplat::volume::ScalarVolume;
-use voxsplat::{Camera, Composite, Kernel, Mode, Projection, Raster, RenderOptions, SplatSet};
 
 const PROJECTIONS: [Mode; 4] = [Mode::Mip, Mode::Minip, Mode::Average, Mode::Xray];
 
@@ -234,7 +234,7 @@ fn a_projection_runs_no_order_stage_and_says_so_in_its_plan() {
 #[test]
 fn the_mip_colour_map_colours_the_largest_value() {
     // Two voxels along one ray: the MIP pixel takes the larger value's colour, whatever the order.
-    let grid = voxsplat::Grid::centered([1, 1, 2], [1.0; 3]).unwrap();
+    let grid = crate::Grid::centered([1, 1, 2], [1.0; 3]).unwrap();
     let set = SplatSet::from_fn_valued(grid, |_, _, k| Some(([0.5; 4], if k == 0 { 0.25 } else { 0.75 }))).unwrap();
     let mut r = cpu();
     r.set_scene(set).unwrap();
@@ -262,7 +262,7 @@ fn a_projection_refuses_what_cannot_apply() {
     let mut r = cpu();
     r.set_scene(set.clone()).unwrap();
     let cam = Camera::framing(set.grid(), 32, 32);
-    let refused = |o: RenderOptions, r: &mut voxsplat::Renderer| {
+    let refused = |o: RenderOptions, r: &mut crate::Renderer| {
         let e = r.render(&cam, &o).unwrap_err().to_string();
         assert!(e.contains("--mode mip"), "{e}");
     };
@@ -270,18 +270,18 @@ fn a_projection_refuses_what_cannot_apply() {
     o.composite = Composite::Sheet;
     refused(o, &mut r);
     let mut o = options(Mode::Mip, Raster::Auto);
-    o.order = voxsplat::OrderKind::Sorted;
+    o.order = crate::OrderKind::Sorted;
     refused(o, &mut r);
     let mut o = options(Mode::Mip, Raster::Auto);
-    o.direction = Some(voxsplat::Direction::FrontToBack);
+    o.direction = Some(crate::Direction::FrontToBack);
     refused(o, &mut r);
     let mut o = options(Mode::Mip, Raster::Auto);
-    o.motion = Some(voxsplat::Motion::straight(glam::Mat4::IDENTITY, 1.0));
+    o.motion = Some(crate::Motion::straight(glam::Mat4::IDENTITY, 1.0));
     refused(o, &mut r);
     // A bricked volume takes no levels-of-detail flag it cannot apply: the plan draws every voxel.
     let mut b = cpu();
-    let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
-    b.set_bricks(voxsplat::bricks::BrickScene::new(store, tf(), None).unwrap()).unwrap();
+    let store = crate::bricks::BrickStore::build(&vol).unwrap();
+    b.set_bricks(crate::bricks::BrickScene::new(store, tf(), None).unwrap()).unwrap();
     let plan = b.plan(&cam, &options(Mode::Mip, Raster::Auto)).unwrap().to_string();
     assert!(plan.contains("mip projection") && plan.contains("lod        off"), "{plan}");
     assert!(plan.contains("texels     3x3 a pixel"), "{plan}");
@@ -294,7 +294,7 @@ fn a_projection_refuses_what_cannot_apply() {
     let e = r.render(&cam, &o).unwrap_err().to_string();
     assert!(e.contains("--every-voxel") && e.contains("--mode average"), "{e}");
     // Values outside [0, 1] are refused where a set is made.
-    let grid = voxsplat::Grid::centered([2, 2, 2], [1.0; 3]).unwrap();
+    let grid = crate::Grid::centered([2, 2, 2], [1.0; 3]).unwrap();
     let e = SplatSet::from_fn_valued(grid, |_, _, _| Some(([1.0; 4], 1.5))).unwrap_err().to_string();
     assert!(e.contains("value 1.5"), "{e}");
     assert!("maximum".parse::<Mode>().unwrap_err().to_string().contains("mip, minip"));
@@ -310,7 +310,7 @@ fn the_ray_caster_projects_in_every_mode_and_mirrors_on_the_cpu() {
     c.set_scene(set).unwrap();
     let cam = column_camera(vol.dims, 4);
     for mode in PROJECTIONS {
-        let o = voxsplat::RaycastOptions { mode, step: 0.25, ..Default::default() };
+        let o = crate::RaycastOptions { mode, step: 0.25, ..Default::default() };
         let (gi, ci) = (g.raycast(&cam, &o).unwrap().image, c.raycast(&cam, &o).unwrap().image);
         assert_mirrors(&gi, &ci, &format!("ray-cast {mode}"));
         // Against the splats' projection of the same view: other reconstructions (trilinear
@@ -323,7 +323,7 @@ fn the_ray_caster_projects_in_every_mode_and_mirrors_on_the_cpu() {
         assert!(mean < 0.05, "{mode}: the ray caster and the splats differ by {mean} on average");
     }
     // Compositing is unchanged by the projection field: the two fields live apart.
-    let o = voxsplat::RaycastOptions::default();
+    let o = crate::RaycastOptions::default();
     let (gi, ci) = (g.raycast(&cam, &o).unwrap().image, c.raycast(&cam, &o).unwrap().image);
     assert_mirrors(&gi, &ci, "ray-cast composite after the projections");
     assert_clean(&g);
@@ -333,8 +333,8 @@ fn the_ray_caster_projects_in_every_mode_and_mirrors_on_the_cpu() {
 fn a_bricked_volume_projects_as_its_dense_splats_do() {
     let vol = ball([30, 26, 20]);
     let set = classify(&vol, &tf(), None).unwrap();
-    let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
-    let scene = voxsplat::bricks::BrickScene::new(store, tf(), None).unwrap();
+    let store = crate::bricks::BrickStore::build(&vol).unwrap();
+    let scene = crate::bricks::BrickScene::new(store, tf(), None).unwrap();
     let mut g = gpu();
     let mut c = cpu();
     let mut rng = Rng(4601);
@@ -379,9 +379,9 @@ fn a_bricked_volume_projects_as_its_dense_splats_do() {
 }
 
 /// A bricked ball for the texel tests.
-fn bricked_ball(dims: [u32; 3]) -> voxsplat::bricks::BrickScene {
-    let store = voxsplat::bricks::BrickStore::build(&ball(dims)).unwrap();
-    voxsplat::bricks::BrickScene::new(store, tf(), None).unwrap()
+fn bricked_ball(dims: [u32; 3]) -> crate::bricks::BrickScene {
+    let store = crate::bricks::BrickStore::build(&ball(dims)).unwrap();
+    crate::bricks::BrickScene::new(store, tf(), None).unwrap()
 }
 
 #[test]
@@ -427,12 +427,12 @@ fn a_projection_s_texels_keep_the_clipping_planes_and_the_image_s_edges() {
     g.set_bricks(scene.clone()).unwrap();
     let mut c = cpu();
     c.set_bricks(scene).unwrap();
-    let mut cam = Camera::framing(&voxsplat::Grid::centered(dims, [1.0; 3]).unwrap(), 56, 48);
+    let mut cam = Camera::framing(&crate::Grid::centered(dims, [1.0; 3]).unwrap(), 56, 48);
     cam.eye = cam.target + (cam.eye - cam.target) * 0.8;
     cam.near = (cam.eye - cam.target).length() - 14.0;
     for mode in [Mode::Mip, Mode::Minip] {
         let mut o = options(mode, Raster::Compute);
-        o.clip = voxsplat::Clip::new(&[glam::Vec4::new(0.6, -0.3, 0.74, 1.5)], None).unwrap();
+        o.clip = crate::Clip::new(&[glam::Vec4::new(0.6, -0.3, 0.74, 1.5)], None).unwrap();
         let mut every = o.clone();
         every.every_voxel = true;
         let texels = g.render(&cam, &o).unwrap();
@@ -475,7 +475,7 @@ fn mip_and_minip_of_a_store_keep_what_the_ray_caster_covers_at_every_size() {
         };
         for mode in [Mode::Mip, Mode::Minip] {
             g.set_scene(set.clone()).unwrap();
-            let ray = g.raycast(&cam, &voxsplat::RaycastOptions { mode, step: 0.25, ..Default::default() }).unwrap();
+            let ray = g.raycast(&cam, &crate::RaycastOptions { mode, step: 0.25, ..Default::default() }).unwrap();
             g.set_bricks(scene.clone()).unwrap();
             let drawn = g.render(&cam, &options(mode, Raster::Compute)).unwrap();
             let mut every = options(mode, Raster::Compute);

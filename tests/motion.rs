@@ -1,10 +1,10 @@
 //! Chapter 4: motion-blurred splats against the accumulation buffer.
-use crate::common;
+use super::common;
+use crate::animate::{render_frame, Animation, Blur};
+use crate::Motion;
+use crate::{Antialias, Camera, Composite, Grid, Kernel, Projection, Raster, RenderOptions, SplatSet};
 use common::assert_clean;
 use glam::{Mat4, Vec3};
-use voxsplat::animate::{render_frame, Animation, Blur};
-use voxsplat::Motion;
-use voxsplat::{Antialias, Camera, Composite, Grid, Kernel, Projection, Raster, RenderOptions, SplatSet};
 
 fn one_voxel() -> SplatSet {
     let grid = Grid::centered([1, 1, 1], [1.0; 3]).unwrap();
@@ -39,7 +39,7 @@ fn sheet_with(motion: Option<Motion>) -> RenderOptions {
 }
 
 /// Per-pixel optical depth T of a single splat drawn into a sheet (alpha = 1 - e^-T).
-fn optical_depths(r: &mut voxsplat::Renderer, cam: &Camera, o: &RenderOptions) -> Vec<f64> {
+fn optical_depths(r: &mut crate::Renderer, cam: &Camera, o: &RenderOptions) -> Vec<f64> {
     r.render(cam, o).unwrap().image.pixels.iter().map(|p| -(1.0 - p[3] as f64).ln()).collect()
 }
 
@@ -93,7 +93,7 @@ fn no_blur_below_delta_or_along_the_eye_axis() {
 #[test]
 fn accumulation_with_one_subframe_is_the_still_frame() {
     let anim = Animation::builtin("rotating-box").unwrap();
-    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let set = crate::scene::build(&anim.scene).unwrap();
     let grid = *set.grid();
     let mut anim = anim;
     anim.camera.width = 64;
@@ -122,7 +122,7 @@ fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
     let mut anim = Animation::builtin("rotating-box").unwrap();
     anim.camera.width = 128;
     anim.camera.height = 128;
-    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let set = crate::scene::build(&anim.scene).unwrap();
     let grid = *set.grid();
     let mut spin = Animation::builtin("spinning-box").unwrap();
     (spin.camera.width, spin.camera.height) = (128, 128);
@@ -151,8 +151,8 @@ fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
             }
             o.raster = if blur == "splat:arc" { Raster::Auto } else { Raster::Graphics };
             let blur: Blur = blur.parse().unwrap();
-            gpu.set_scene(voxsplat::scene::build(&spin.scene).unwrap()).unwrap();
-            cpu.set_scene(voxsplat::scene::build(&spin.scene).unwrap()).unwrap();
+            gpu.set_scene(crate::scene::build(&spin.scene).unwrap()).unwrap();
+            cpu.set_scene(crate::scene::build(&spin.scene).unwrap()).unwrap();
             let g = render_frame(&mut gpu, &spin, &grid, 9, blur, &o).unwrap();
             let c = render_frame(&mut cpu, &spin, &grid, 9, blur, &o).unwrap();
             let tag = format!("{composite:?} {} {blur:?}", o.raster);
@@ -168,8 +168,8 @@ fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
         // Blurred splats are closer to a 16-sub-frame accumulation than the still frame is.
         let truth = render_frame(&mut gpu, &anim, &grid, 9, Blur::Accum(16), &o).unwrap();
         let still = render_frame(&mut gpu, &anim, &grid, 9, Blur::None, &o).unwrap();
-        let e_blur = voxsplat::metrics::compare(&g, &truth).unwrap().rmse;
-        let e_still = voxsplat::metrics::compare(&still, &truth).unwrap().rmse;
+        let e_blur = crate::metrics::compare(&g, &truth).unwrap().rmse;
+        let e_still = crate::metrics::compare(&still, &truth).unwrap().rmse;
         eprintln!("{composite:?}: rmse to accum:16: blurred {e_blur:.4}, still {e_still:.4}");
         assert!(e_blur < e_still);
     }
@@ -181,7 +181,7 @@ fn the_rotating_terrain_animation_blurs_the_real_dem() {
     let mut anim = Animation::builtin("rotating-terrain").unwrap();
     anim.camera.width = 96;
     anim.camera.height = 72;
-    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let set = crate::scene::build(&anim.scene).unwrap();
     let grid = *set.grid();
     let mut r = common::cpu();
     r.set_scene(set).unwrap();
@@ -209,7 +209,7 @@ fn animation_files_are_checked() {
         translate = [5.0, 0.0, 0.0]
     "#;
     let a = Animation::from_toml(good).unwrap();
-    let grid = *voxsplat::scene::build("cube40").unwrap().grid();
+    let grid = *crate::scene::build("cube40").unwrap().grid();
     // Halfway: 45 degrees about x and half the translation.
     let m = a.model(&grid, 5.0);
     let p = m.transform_point3(grid.center() + Vec3::Y);
@@ -234,7 +234,7 @@ fn animation_files_are_checked() {
     let a = Animation::from_toml(&path).unwrap();
     assert!((a.camera_at(5.0).eye.z - 90.0).abs() < 1e-4);
     // A camera dolly along the view axis alone projects to no motion: nothing blurs.
-    let still_grid = *voxsplat::scene::build("cube40").unwrap().grid();
+    let still_grid = *crate::scene::build("cube40").unwrap().grid();
     let m = a.motion(&still_grid, 4.0, 5.0);
     let o = a.object_camera(&still_grid, 5.0);
     assert!(m.is_finite() && o.validate().is_ok());
@@ -256,7 +256,7 @@ fn turned(cam: &Camera, deg: f32) -> Camera {
 
 /// The frame at t_i of a voxel turning `deg` a frame about z, blurred with `profile` on an arc or
 /// straight path, and the accumulation of `n` sub-frames over the same shutter.
-fn spun(r: &mut voxsplat::Renderer, deg: f32, arc: bool, profile: voxsplat::BlurProfile) -> voxsplat::ImageF32 {
+fn spun(r: &mut crate::Renderer, deg: f32, arc: bool, profile: crate::BlurProfile) -> crate::ImageF32 {
     let mut o = RenderOptions::default();
     o.raster = Raster::Graphics;
     o.motion = Some(Motion {
@@ -268,10 +268,10 @@ fn spun(r: &mut voxsplat::Renderer, deg: f32, arc: bool, profile: voxsplat::Blur
     r.render(&ortho(), &o).unwrap().image
 }
 
-fn accumulated(r: &mut voxsplat::Renderer, deg: f32, n: u32) -> voxsplat::ImageF32 {
+fn accumulated(r: &mut crate::Renderer, deg: f32, n: u32) -> crate::ImageF32 {
     let mut o = RenderOptions::default();
     o.raster = Raster::Graphics;
-    let mut acc = voxsplat::ImageF32::new(128, 128);
+    let mut acc = crate::ImageF32::new(128, 128);
     for k in 0..n {
         // Sub-frame k at the middle of its slice of the shutter, turned back from t_i.
         let back = deg * (1.0 - (k as f32 + 0.5) / n as f32);
@@ -287,12 +287,12 @@ fn accumulated(r: &mut voxsplat::Renderer, deg: f32, n: u32) -> voxsplat::ImageF
 
 #[test]
 fn tapered_arcs_follow_a_turning_splat_as_the_accumulation_buffer_does() {
-    use voxsplat::BlurProfile::{Tapered, Teardrop, Uniform};
+    use crate::BlurProfile::{Tapered, Teardrop, Uniform};
     let mut r = common::gpu();
     r.set_scene(off_centre_voxel()).unwrap();
     // 60 degrees a frame at 6 voxels: a path of 25 px whose chord misses the arc by 3.2 px.
     let truth = accumulated(&mut r, 60.0, 256);
-    let err = |img: &voxsplat::ImageF32| voxsplat::metrics::compare(img, &truth).unwrap().rmse;
+    let err = |img: &crate::ImageF32| crate::metrics::compare(img, &truth).unwrap().rmse;
     let seed = err(&spun(&mut r, 60.0, false, Uniform));
     let tapered = err(&spun(&mut r, 60.0, false, Tapered));
     let arc = err(&spun(&mut r, 60.0, true, Uniform));
@@ -302,7 +302,7 @@ fn tapered_arcs_follow_a_turning_splat_as_the_accumulation_buffer_does() {
     assert!(tapered < seed, "the taper alone weighs the path as time does");
     assert!(arc_tapered * 4.0 < seed && arc_tapered * 2.0 < tapered && arc_tapered < arc);
     // A teardrop's weight leans towards t_i: its centroid lies nearer the voxel's place now.
-    let centroid_angle = |img: &voxsplat::ImageF32| {
+    let centroid_angle = |img: &crate::ImageF32| {
         let (mut x, mut y) = (0.0f64, 0.0f64);
         for (i, p) in img.pixels.iter().enumerate() {
             let (px, py) = ((i % 128) as f64 - 63.5 - 0.52, (i / 128) as f64 - 63.5 - 0.28);
@@ -325,7 +325,7 @@ fn a_tapered_splat_keeps_its_energy() {
     r.set_scene(one_voxel()).unwrap();
     let cam = ortho();
     let e1: f64 = optical_depths(&mut r, &cam, &sheet_with(None)).iter().sum();
-    for profile in [voxsplat::BlurProfile::Tapered, voxsplat::BlurProfile::Teardrop] {
+    for profile in [crate::BlurProfile::Tapered, crate::BlurProfile::Teardrop] {
         for l_vox in [2.0f32, 5.0, 9.0] {
             let mut m = Motion::straight(Mat4::from_translation(Vec3::new(-l_vox, 0.0, 0.0)), 0.5);
             m.profile = profile;
@@ -337,8 +337,8 @@ fn a_tapered_splat_keeps_its_energy() {
 
 #[test]
 fn blur_shapes_parse_and_bad_ones_are_refused() {
-    use voxsplat::animate::SplatBlur;
-    use voxsplat::BlurProfile;
+    use crate::animate::SplatBlur;
+    use crate::BlurProfile;
     let shape = |s: &str| match s.parse::<Blur>().unwrap() {
         Blur::Splat(b) => b,
         other => panic!("{s}: {other:?}"),
@@ -361,17 +361,17 @@ fn blur_shapes_parse_and_bad_ones_are_refused() {
 fn slotted_blur_follows_the_accumulation_buffer_on_the_turning_box() {
     let mut anim = Animation::builtin("rotating-box").unwrap();
     (anim.camera.width, anim.camera.height) = (128, 128);
-    let set = voxsplat::scene::build(&anim.scene).unwrap();
+    let set = crate::scene::build(&anim.scene).unwrap();
     let grid = *set.grid();
     let mut r = common::gpu();
     r.set_scene(set).unwrap();
     let mut o = RenderOptions::default();
-    o.order = voxsplat::OrderKind::Wbtf;
+    o.order = crate::OrderKind::Wbtf;
     o.raster = Raster::Graphics;
     let truth = render_frame(&mut r, &anim, &grid, 12, Blur::Accum(64), &o).unwrap();
     let mut err = |b: &str| {
         let img = render_frame(&mut r, &anim, &grid, 12, b.parse().unwrap(), &o).unwrap();
-        voxsplat::metrics::compare(&img, &truth).unwrap().rmse
+        crate::metrics::compare(&img, &truth).unwrap().rmse
     };
     let (seed, tapered, slotted, accum5) = (err("splat"), err("splat:tapered"), err("splat:slotted"), err("accum:5"));
     eprintln!("rmse to accum:64: seed {seed:.5}, tapered {tapered:.5}, slotted {slotted:.5}, accum:5 {accum5:.5}");

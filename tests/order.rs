@@ -1,11 +1,11 @@
 //! Visibility orders on the CPU: PBTF is free of violations everywhere; BTF and WBTF fail on the
 //! close perspective view of Figs 2.25-2.26; the CPU mirror of the GPU order stages equals the
 //! pure-Rust PBTF.
-use crate::common;
+use super::common;
+use crate::order::{count_violations, pbtf, pbtf_split, visibility_order};
+use crate::{scene, Camera, Direction, OrderKind, Projection, SplatSet};
 use common::{random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
-use voxsplat::order::{count_violations, pbtf, pbtf_split, visibility_order};
-use voxsplat::{scene, Camera, Direction, OrderKind, Projection, SplatSet};
 
 fn is_permutation(order: &[u32], n: usize) -> bool {
     let mut seen = vec![false; n];
@@ -43,7 +43,7 @@ fn pbtf_has_no_violations_on_1000_random_viewpoints() {
 
 /// The close, off-axis perspective view of Figs 2.25-2.27 (shared with the stability study).
 fn close_view(set: &SplatSet) -> Camera {
-    voxsplat::scene::close_view(set.grid(), 256)
+    crate::scene::close_view(set.grid(), 256)
 }
 
 #[test]
@@ -82,9 +82,9 @@ fn cpu_mirror_of_gpu_order_equals_pure_rust_pbtf() {
             let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
             let cam = random_camera(&mut rng, set.grid(), kind);
             let want = pbtf(set, pbtf_split(set, &cam));
-            let got = r.pbtf_order(&cam, Direction::FrontToBack).unwrap();
+            let got = crate::low_level::pbtf_order(&mut r, &cam, Direction::FrontToBack).unwrap();
             assert_eq!(got, want, "set {si} {kind:?}");
-            let mut back = r.pbtf_order(&cam, Direction::BackToFront).unwrap();
+            let mut back = crate::low_level::pbtf_order(&mut r, &cam, Direction::BackToFront).unwrap();
             back.reverse();
             assert_eq!(back, want);
         }
@@ -175,7 +175,7 @@ fn two_level_pbtf_has_no_violations_on_random_and_brick_plane_viewpoints() {
                 continue;
             }
         }
-        let ftb = voxsplat::order::pbtf_bricked(set, &cam, brick).unwrap();
+        let ftb = crate::order::pbtf_bricked(set, &cam, brick).unwrap();
         assert!(is_permutation(&ftb, set.len()));
         let n = count_violations(set, &cam, &ftb, Direction::FrontToBack).unwrap();
         assert_eq!(n, 0, "two-level PBTF (brick {brick}) violations {n} for {cam:?}");
@@ -195,10 +195,10 @@ fn two_level_pbtf_is_pbtf_for_voxel_bricks_and_one_brick() {
         let kind = [ViewKind::Outside, ViewKind::Inside, ViewKind::OnGridPlane, ViewKind::Orthographic][v % 4];
         let cam = random_camera(&mut rng, set.grid(), kind);
         let one = pbtf(&set, pbtf_split(&set, &cam));
-        assert_eq!(voxsplat::order::pbtf_bricked(&set, &cam, 1).unwrap(), one, "{kind:?}");
-        assert_eq!(voxsplat::order::pbtf_bricked(&set, &cam, 16).unwrap(), one, "{kind:?}");
+        assert_eq!(crate::order::pbtf_bricked(&set, &cam, 1).unwrap(), one, "{kind:?}");
+        assert_eq!(crate::order::pbtf_bricked(&set, &cam, 16).unwrap(), one, "{kind:?}");
     }
-    assert!(voxsplat::order::pbtf_bricked(&set, &Camera::framing(set.grid(), 8, 8), 0).is_err());
+    assert!(crate::order::pbtf_bricked(&set, &Camera::framing(set.grid(), 8, 8), 0).is_err());
 }
 
 /// Issue 26: the image-space validator counts, per pixel, splats drawn against their depth along
@@ -207,14 +207,14 @@ fn two_level_pbtf_is_pbtf_for_voxel_bricks_and_one_brick() {
 /// 2.25/2.26 both have 6,136 neighbour violations, but not the same picture.
 #[test]
 fn the_image_space_validator_tells_wbtf_from_btf() {
-    use voxsplat::order::count_pixel_inversions;
-    let grid = voxsplat::Grid::centered([1, 1, 8], [1.0; 3]).unwrap();
+    use crate::order::count_pixel_inversions;
+    let grid = crate::Grid::centered([1, 1, 8], [1.0; 3]).unwrap();
     let pair = SplatSet::from_fn(grid, |_, _, k| (k == 0 || k == 7).then_some([1.0, 1.0, 1.0, 0.5])).unwrap();
     let cam = Camera {
         eye: glam::Vec3::new(0.0, 0.0, 30.0),
         target: glam::Vec3::ZERO,
         up: glam::Vec3::Y,
-        projection: voxsplat::Projection::Orthographic { height: 8.0 },
+        projection: crate::Projection::Orthographic { height: 8.0 },
         near: 1.0,
         far: 60.0,
         width: 32,
@@ -234,7 +234,7 @@ fn the_image_space_validator_tells_wbtf_from_btf() {
     let view = |eye: glam::Vec3, target: glam::Vec3| Camera {
         eye,
         target,
-        projection: voxsplat::Projection::Perspective { fov_y_deg: 75.0 },
+        projection: crate::Projection::Perspective { fov_y_deg: 75.0 },
         width: 128,
         height: 128,
         ..Camera::framing(set.grid(), 128, 128)
@@ -256,7 +256,7 @@ fn the_image_space_validator_tells_wbtf_from_btf() {
 /// with k, j, i is `pbtf`, and any other nesting is a visibility order too (0 violations).
 #[test]
 fn pbtf_nesting_inside_octants_is_free() {
-    use voxsplat::order::pbtf_nested;
+    use crate::order::pbtf_nested;
     let mut rng = Rng(26);
     for seed in 0..4 {
         let set = random_sparse(seed, [13, 9, 11], 0.3);
@@ -264,7 +264,7 @@ fn pbtf_nesting_inside_octants_is_free() {
             let cam = random_camera(&mut rng, set.grid(), ViewKind::Inside);
             let split = pbtf_split(&set, &cam);
             assert_eq!(pbtf_nested(&set, split, |_| [2, 1, 0]), pbtf(&set, split));
-            for axes in [[0, 1, 2], [1, 2, 0], voxsplat::order::wbtf_axes(&cam)] {
+            for axes in [[0, 1, 2], [1, 2, 0], crate::order::wbtf_axes(&cam)] {
                 let seq = pbtf_nested(&set, split, |_| axes);
                 assert_eq!(count_violations(&set, &cam, &seq, Direction::FrontToBack).unwrap(), 0, "{axes:?}");
             }
@@ -285,9 +285,9 @@ fn pbtf_nesting_inside_octants_is_free() {
 /// axis). The eye's cell comes from the per-axis coordinates; everything else is index space.
 #[test]
 fn pbtf_orders_rectilinear_grids_from_the_eyes_cell() {
-    use voxsplat::order::{count_pixel_inversions, count_violations, pbtf, pbtf_split, Direction};
-    let grid = voxsplat::Grid::centered([10, 9, 12], [1.0; 3]).unwrap();
-    let solid = voxsplat::SplatSet::from_fn(grid, |_, _, _| Some([1.0, 1.0, 1.0, 0.2])).unwrap();
+    use crate::order::{count_pixel_inversions, count_violations, pbtf, pbtf_split, Direction};
+    let grid = crate::Grid::centered([10, 9, 12], [1.0; 3]).unwrap();
+    let solid = crate::SplatSet::from_fn(grid, |_, _, _| Some([1.0, 1.0, 1.0, 0.2])).unwrap();
     // CT-like slices: z gaps from 0.25 to 3, x and y gently irregular.
     let x: Vec<f32> = (0..10).map(|i| i as f32 * 1.2 + 0.1 * (i * i) as f32).collect();
     let y: Vec<f32> = (0..9).map(|j| j as f32 + 0.3 * (j % 2) as f32).collect();
@@ -298,7 +298,7 @@ fn pbtf_orders_rectilinear_grids_from_the_eyes_cell() {
         eye: glam::Vec3::new(6.0, 3.9, 5.8),
         target: glam::Vec3::new(6.0, 20.0, 5.8),
         up: glam::Vec3::Z,
-        projection: voxsplat::Projection::Perspective { fov_y_deg: 90.0 },
+        projection: crate::Projection::Perspective { fov_y_deg: 90.0 },
         near: 0.01,
         far: 100.0,
         width: 64,
@@ -339,7 +339,7 @@ fn pbtf_orders_rectilinear_grids_from_the_eyes_cell() {
 /// the same samples drawn as if the slices were evenly spaced, and the GPU equals its mirror.
 #[test]
 fn a_rectilinear_grid_renders_at_its_coordinates() {
-    use voxsplat::{Grid, RenderOptions, SplatSet};
+    use crate::{Grid, RenderOptions, SplatSet};
     let ball = |p: Vec3| p.length() < 6.0;
     let (a, tau) = (0.3f32, -(1.0f32 - 0.3).ln());
     // Uniform reference, spacing 0.5: a voxel-length is 0.5 there, half the rectilinear grid's
@@ -384,7 +384,7 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
     let drawn = render(rect.clone());
     let as_if_even = render(samples);
     let widest = render(coarse.unwrap());
-    let psnr = |img: &voxsplat::ImageF32| voxsplat::metrics::compare(img, &truth).unwrap().psnr;
+    let psnr = |img: &crate::ImageF32| crate::metrics::compare(img, &truth).unwrap().psnr;
     let (near, far, wide) = (psnr(&drawn), psnr(&as_if_even), psnr(&widest));
     eprintln!(
         "against the ball on the 0.5 grid: rectilinear {near:.2} dB; the same samples evenly spaced {far:.2} dB; \
@@ -397,7 +397,7 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
     let c = cpu.render(&cam, &o).unwrap().image;
     common::assert_mirrors(&drawn, &c, "rectilinear");
     // What samples a uniform grid refuses the set.
-    assert!(voxsplat::truth::volumetric_summation(&rect, &cam, &Default::default()).is_err());
+    assert!(crate::truth::volumetric_summation(&rect, &cam, &Default::default()).is_err());
 }
 
 /// Issue 76: one gap 37 times the others in the middle of a rectilinear grid (a `--positions`
@@ -408,7 +408,7 @@ fn a_rectilinear_grid_renders_at_its_coordinates() {
 /// the GPU equals its mirror.
 #[test]
 fn a_far_position_widens_only_its_neighbours() {
-    use voxsplat::{Grid, RenderOptions};
+    use crate::{Grid, RenderOptions};
     let ball = |p: Vec3| (p - Vec3::new(0.0, 0.0, -1.0)).length() < 5.0;
     let color = |p: Vec3| ball(p).then_some([0.9, 0.7, 0.4, 0.35]);
     // Slices z = -8..=7 one apart, then 8 more beyond a gap of 37: empty, as are the two slices
@@ -443,7 +443,7 @@ fn a_far_position_widens_only_its_neighbours() {
     let drawn = gpu.render(&cam(Vec3::new(0.0, 0.0, -1.0)), &o).unwrap().image;
     gpu.set_scene(alone).unwrap();
     let truth = gpu.render(&cam(Vec3::new(0.0, 0.0, -1.0) - shift), &o).unwrap().image;
-    let m = voxsplat::metrics::compare(&drawn, &truth).unwrap();
+    let m = crate::metrics::compare(&drawn, &truth).unwrap();
     eprintln!(
         "a far position: {:.2} dB over {} covered pixels against the slices alone ({} px drawn, {} px alone)",
         m.covered_psnr,
@@ -457,7 +457,7 @@ fn a_far_position_widens_only_its_neighbours() {
     // Like for like: on this scene auto picks quads on the device and point sprites on the CPU,
     // whose widest sprite is wider.
     let mut quads = RenderOptions::default();
-    quads.raster = voxsplat::Raster::Graphics;
+    quads.raster = crate::Raster::Graphics;
     let at = cam(Vec3::new(0.0, 0.0, -1.0));
     gpu.set_scene(rect.clone()).unwrap();
     let g = gpu.render(&at, &quads).unwrap().image;
@@ -476,7 +476,7 @@ fn a_far_position_widens_only_its_neighbours() {
 /// side first, or the low-side one first where the split runs between them.
 #[test]
 fn octree_order_in_a_leaf_is_a_visibility_order_with_consecutive_blocks() {
-    use voxsplat::low_level::cpu::brick::octree_pbtf;
+    use crate::cpu::brick::octree_pbtf;
     let mut rng = Rng(777);
     let mut below = |n: u32| (rng.next_u64() % n as u64) as u32;
     for _ in 0..200 {

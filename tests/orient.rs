@@ -1,12 +1,12 @@
 //! Placement in patient space (issue 29): NIfTI sform/qform and NRRD space put every voxel where
 //! the file says, whichever way its axes run, and a rotated (oblique) or sheared grid renders as
 //! the truth integrated in world space through the file's own affine.
-use crate::common;
+use super::common;
+use crate::loaders::{load_orientation, load_volume, VolumeHints};
+use crate::orient::{Orientation, View};
+use crate::{Camera, Error, Grid, Projection, RenderOptions};
 use common::{nifti, object, samples, DIMS};
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec3};
-use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};
-use voxsplat::orient::{Orientation, View};
-use voxsplat::{Camera, Error, Grid, Projection, RenderOptions};
 
 fn write(name: &str, bytes: &[u8]) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("voxsplat-orient-{}", std::process::id()));
@@ -138,9 +138,9 @@ fn world_truth(
     v: &[u8],
     dims: [u32; 3],
     affine: DMat4,
-    tf: &voxsplat::classify::TransferFunction,
+    tf: &crate::classify::TransferFunction,
     camera: &Camera,
-) -> voxsplat::ImageF32 {
+) -> crate::ImageF32 {
     let inv_affine = affine.inverse();
     let at = |i: i64, j: i64, k: i64| -> f64 {
         if i < 0 || j < 0 || k < 0 || i >= dims[0] as i64 || j >= dims[1] as i64 || k >= dims[2] as i64 {
@@ -170,11 +170,11 @@ fn world_truth(
     };
     let inv = camera.view_proj().as_dmat4().inverse();
     let (w, h) = (camera.width, camera.height);
-    let mut img = voxsplat::ImageF32::new(w, h);
+    let mut img = crate::ImageF32::new(w, h);
     let dt = 0.1;
     for y in 0..h {
         for x in 0..w {
-            let (o, d, len) = voxsplat::truth::pixel_ray(&inv, x, y, w, h);
+            let (o, d, len) = crate::truth::pixel_ray(&inv, x, y, w, h);
             let (mut c, mut trans, mut t) = (DVec3::ZERO, 1.0f64, 0.5 * dt);
             while t < len {
                 if let Some(s) = sample(inv_affine.transform_point3(o + d * t)) {
@@ -192,7 +192,7 @@ fn world_truth(
 }
 
 /// Mean absolute channel difference over the pixels either image covers.
-fn covered_error(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> f64 {
+fn covered_error(a: &crate::ImageF32, b: &crate::ImageF32) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
     for (p, q) in a.pixels.iter().zip(&b.pixels) {
         if p[3] > 1e-3 || q[3] > 1e-3 {
@@ -206,8 +206,8 @@ fn covered_error(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> f64 {
 
 /// One colour, opacity rising from 0.3 of the object's value range (0..200): the comparisons turn
 /// on shape and opacity, not on where classification happens.
-fn one_colour() -> voxsplat::classify::TransferFunction {
-    voxsplat::classify::TransferFunction {
+fn one_colour() -> crate::classify::TransferFunction {
+    crate::classify::TransferFunction {
         points: vec![(0.3, [0.9, 0.6, 0.3, 0.0]), (1.0, [0.9, 0.6, 0.3, 0.6])],
         gradient_weight: 0.0,
         range: Some((0.0, 200.0)),
@@ -238,7 +238,7 @@ fn an_oblique_grid_renders_as_the_world_space_truth() {
         let hints = VolumeHints::default();
         let vol = load_volume(&path, &hints).unwrap();
         let o = load_orientation(&path, &hints).unwrap().unwrap();
-        let set = voxsplat::classify::classify(&vol, &tf, None).unwrap();
+        let set = crate::classify::classify(&vol, &tf, None).unwrap();
         r.set_scene(set).unwrap();
         let cam = world_camera(a);
         let frame = r.render(&o.camera_to_grid(&cam), &RenderOptions::default()).unwrap().image;
@@ -264,7 +264,7 @@ fn an_oblique_grid_renders_as_the_world_space_truth() {
 
 #[test]
 fn views_put_superior_up_and_face_their_side() {
-    for v in voxsplat::orient::VIEWS {
+    for v in crate::orient::VIEWS {
         let view: View = v.parse().unwrap();
         let (dir, up) = view.directions();
         assert!((dir.length() - 1.0).abs() < 1e-5 && dir.dot(up).abs() < 0.5, "{v}");
@@ -301,7 +301,7 @@ fn validator_cameras(a: DMat4) -> Vec<(f32, Camera)> {
 
 #[test]
 fn the_validator_runs_on_oblique_grids() {
-    use voxsplat::order::{count_violations, visibility_order, Direction, OrderKind};
+    use crate::order::{count_violations, visibility_order, Direction, OrderKind};
     let tf = one_colour();
     let v = samples(DIMS, |b| b);
     let m = DMat3::from_quat(DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.6));
@@ -310,7 +310,7 @@ fn the_validator_runs_on_oblique_grids() {
         let path = write(&format!("validator-{name}.nii"), &nifti(DIMS, &v, Some(a), None));
         let vol = load_volume(&path, &VolumeHints::default()).unwrap();
         let o = load_orientation(&path, &VolumeHints::default()).unwrap().unwrap();
-        let set = voxsplat::classify::classify(&vol, &tf, None).unwrap();
+        let set = crate::classify::classify(&vol, &tf, None).unwrap();
         for (dist, cam) in validator_cameras(a) {
             let eye = cam.eye;
             let grid_cam = o.camera_to_grid(&cam);
@@ -380,16 +380,13 @@ fn sheared_affines() -> [(&'static str, DMat4); 2] {
 }
 
 /// A sheared file's splats, on its placed grid (what the CLI draws) or with the shear dropped.
-fn sheared_scene(
-    path: &std::path::Path,
-    placed: bool,
-) -> (voxsplat::SplatSet, Orientation, voxsplat::volume::ScalarVolume) {
+fn sheared_scene(path: &std::path::Path, placed: bool) -> (crate::SplatSet, Orientation, crate::volume::ScalarVolume) {
     let hints = VolumeHints::default();
     let vol = load_volume(path, &hints).unwrap();
     let o = load_orientation(path, &hints).unwrap().unwrap();
-    let grid = voxsplat::orient::placed_grid(vol.dims, vol.spacing, Some(&o)).unwrap();
+    let grid = crate::orient::placed_grid(vol.dims, vol.spacing, Some(&o)).unwrap();
     let grid = if placed { grid } else { Grid::centered(vol.dims, grid.spacing).unwrap() };
-    (voxsplat::classify::classify_on(grid, &vol, &one_colour(), None).unwrap(), o, vol)
+    (crate::classify::classify_on(grid, &vol, &one_colour(), None).unwrap(), o, vol)
 }
 
 #[test]
@@ -404,7 +401,7 @@ fn a_sheared_grid_renders_as_the_world_space_truth() {
         (o.camera_to_grid(&world_camera(aligned)), world_truth(&v, DIMS, aligned, &tf, &world_camera(aligned)));
     g.set_scene(set).unwrap();
     let base = covered_error(&g.render(&cam, &RenderOptions::default()).unwrap().image, &truth);
-    let raycast = voxsplat::RaycastOptions { step: 0.25, ..Default::default() };
+    let raycast = crate::RaycastOptions { step: 0.25, ..Default::default() };
     let base_rc = covered_error(&g.raycast(&cam, &raycast).unwrap().image, &truth);
     eprintln!("axis-aligned: splats {base:.4}, ray cast {base_rc:.4}");
     for (name, a) in sheared_affines() {
@@ -423,10 +420,10 @@ fn a_sheared_grid_renders_as_the_world_space_truth() {
         common::assert_mirrors(&rc, &c.raycast(&cam, &raycast).unwrap().image, &format!("{name} ray cast"));
         let e_rc = covered_error(&rc, &truth);
         // A bricked store on the same grid draws the dense classification's frame.
-        let mut store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
+        let mut store = crate::bricks::BrickStore::build(&vol).unwrap();
         store.place(&o).unwrap();
         let mut b = common::gpu();
-        b.set_bricks(voxsplat::bricks::BrickScene::new(store, tf.clone(), None).unwrap()).unwrap();
+        b.set_bricks(crate::bricks::BrickScene::new(store, tf.clone(), None).unwrap()).unwrap();
         let (most, mean) = common::diff(&b.render(&cam, &RenderOptions::default()).unwrap().image, &frame);
         common::assert_clean(&b);
         // The same voxels drawn without the shear.
@@ -449,7 +446,7 @@ fn a_sheared_grid_renders_as_the_world_space_truth() {
 /// Face pairs drawn against the eye, found in the world from the file's own affine: of two
 /// 6-neighbour splats, the one on the eye's side of the plane between them (through their cells'
 /// shared face, spanned by the other two affine columns) must be drawn later, back to front.
-fn world_face_violations(set: &voxsplat::SplatSet, order: &[u32], a: DMat4, flip_x: bool, eye: DVec3) -> u64 {
+fn world_face_violations(set: &crate::SplatSet, order: &[u32], a: DMat4, flip_x: bool, eye: DVec3) -> u64 {
     let dims = set.grid().dims;
     let mut rank = std::collections::HashMap::new();
     for (r, &s) in order.iter().enumerate() {
@@ -480,7 +477,7 @@ fn world_face_violations(set: &voxsplat::SplatSet, order: &[u32], a: DMat4, flip
 
 #[test]
 fn the_validator_runs_on_sheared_grids() {
-    use voxsplat::order::{count_violations, visibility_order, Direction, OrderKind};
+    use crate::order::{count_violations, visibility_order, Direction, OrderKind};
     let v = samples(DIMS, |b| b);
     for (name, a) in sheared_affines() {
         let (set, o, _) =
@@ -511,7 +508,7 @@ fn the_validator_runs_on_sheared_grids() {
 /// largest component.
 #[test]
 fn sheets_on_a_sheared_grid_face_the_view() {
-    use voxsplat::low_level::plan::sheet_axis;
+    use crate::plan::sheet_axis;
     let tilt = 60f64.to_radians().tan() as f32;
     let sheared = Grid::centered_sheared(DIMS, [1.0; 3], [0.0, 0.0, tilt]).unwrap();
     let aligned = Grid::centered(DIMS, [1.0; 3]).unwrap();
@@ -537,19 +534,19 @@ fn sheets_on_a_sheared_grid_face_the_view() {
     assert_eq!(*placed.grid(), sheared);
     let world = o.camera_to_world(&cam);
     // Two colours (the stub red, ball and bar blue): the order of sheets shows.
-    let tf = voxsplat::classify::TransferFunction {
+    let tf = crate::classify::TransferFunction {
         points: vec![(0.3, [0.9, 0.2, 0.1, 0.0]), (0.6, [0.9, 0.2, 0.1, 0.6]), (1.0, [0.1, 0.3, 0.9, 0.6])],
         gradient_weight: 0.0,
         range: Some((0.0, 200.0)),
         threshold: 0.0,
     };
-    let set = voxsplat::classify::classify_on(sheared, &vol, &tf, None).unwrap();
+    let set = crate::classify::classify_on(sheared, &vol, &tf, None).unwrap();
     let truth = world_truth(&v, DIMS, a, &tf, &world);
     let (mut g, mut c) = (common::gpu(), common::cpu());
     g.set_scene(set.clone()).unwrap();
     c.set_scene(set).unwrap();
     let mut sheets = RenderOptions::default();
-    sheets.composite = voxsplat::Composite::Sheet;
+    sheets.composite = crate::Composite::Sheet;
     let frame = g.render(&cam, &sheets).unwrap().image;
     common::assert_mirrors(&frame, &c.render(&cam, &sheets).unwrap().image, "sheets on a sheared grid");
     let e = covered_error(&frame, &truth);

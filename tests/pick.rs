@@ -1,11 +1,11 @@
 //! Picking: the first hit on a ball of known centre and radius, the voxel of a MIP's maximum, and
 //! what picking refuses.
-use crate::common;
+use super::common;
+use crate::classify::{classify, TransferFunction};
+use crate::volume::ScalarVolume;
+use crate::{Camera, Mode, Projection, RenderOptions};
 use common::{cpu, Rng};
 use glam::Vec3;
-use voxsplat::classify::{classify, TransferFunction};
-use voxsplat::volume::ScalarVolume;
-use voxsplat::{Camera, Mode, Projection, RenderOptions};
 
 const N: u32 = 40;
 const RADIUS: f32 = 12.0;
@@ -144,8 +144,8 @@ fn a_bricked_store_picks_what_its_dense_splats_pick() {
     let mut dense = cpu();
     dense.set_scene(set.clone()).unwrap();
     let mut bricked = cpu();
-    let store = voxsplat::bricks::BrickStore::build(&vol).unwrap();
-    bricked.set_bricks(voxsplat::bricks::BrickScene::new(store, opaque(), None).unwrap()).unwrap();
+    let store = crate::bricks::BrickStore::build(&vol).unwrap();
+    bricked.set_bricks(crate::bricks::BrickScene::new(store, opaque(), None).unwrap()).unwrap();
     let cam = Camera::framing(set.grid(), 64, 64);
     let mut rng = Rng(4605);
     let mut hits = 0;

@@ -1,15 +1,15 @@
 //! The frame's plan and the stages' named builds, checked without a device: what `plan::frame`
 //! decides for each mode, and what `Dispatch::new` refuses.
-use crate::common;
-use voxsplat::low_level::builds::{
+use super::common;
+use crate::builds::{
     Build, CompositeLayers, Footprint, Only, Pages, Records, SheetMode, SheetTiles, TileComposite, TileOrder, TABLES,
 };
-use voxsplat::low_level::dispatch::{Blend, Limits, List};
-use voxsplat::low_level::gpu_types::BrickPush;
-use voxsplat::low_level::plan::{Draw, OrderSource, Prepared, SplatRaster};
-use voxsplat::low_level::stages::{Dispatch, Kind, StageId};
-use voxsplat::options::{BlurProfile, Composite, Motion};
-use voxsplat::{scene, Camera, Direction, Error, OrderKind, Raster, RenderOptions};
+use crate::dispatch::{Blend, Limits, List};
+use crate::gpu_types::BrickPush;
+use crate::options::{BlurProfile, Composite, Motion};
+use crate::plan::{Draw, OrderSource, Prepared, SplatRaster};
+use crate::stages::{Dispatch, Kind, StageId};
+use crate::{scene, Camera, Direction, Error, OrderKind, Raster, RenderOptions};
 
 const LIMITS: Limits =
     Limits { max_layers: 2048, max_storage_range: 1 << 31, budget_bytes: 1 << 30, target_depth: None };
@@ -98,7 +98,7 @@ fn a_dense_frame_plans_its_order_and_raster() {
     let cam = Camera::framing(set.grid(), 96, 80);
     let prep = Prepared::new(set);
     let splats = prep.set.len() as u32;
-    let plan_of = |o: &RenderOptions| voxsplat::low_level::plan::frame(&prep, &cam, o, &LIMITS).unwrap();
+    let plan_of = |o: &RenderOptions| crate::plan::frame(&prep, &cam, o, &LIMITS).unwrap();
 
     let p = plan_of(&options(Raster::Compute, Direction::FrontToBack));
     let Draw::Splats { splats: n, order, raster: SplatRaster::Tiles(rule), .. } = p.draw else { panic!("{p}") };
@@ -156,7 +156,7 @@ fn sheet_batches_stay_within_the_layer_limit_and_cover_the_list() {
         let limits = Limits { max_layers, ..LIMITS };
         let mut o = options(raster, direction);
         o.composite = Composite::Sheet;
-        let p = voxsplat::low_level::plan::frame(&prep, &cam, &o, &limits).unwrap();
+        let p = crate::plan::frame(&prep, &cam, &o, &limits).unwrap();
         let Draw::Sheets { pass, axis, .. } = &p.draw else { panic!("{p}") };
         assert_eq!(pass.list, List::Slices(*axis as u8));
         assert!(pass.layers <= max_layers, "{} layers", pass.layers);
@@ -172,7 +172,7 @@ fn sheet_batches_stay_within_the_layer_limit_and_cover_the_list() {
     // Slabs: the geometry now, the batches once the binning's counts are back.
     let mut o = options(Raster::Graphics, Direction::FrontToBack);
     o.composite = Composite::Slab;
-    let p = voxsplat::low_level::plan::frame(&prep, &cam, &o, &LIMITS).unwrap();
+    let p = crate::plan::frame(&prep, &cam, &o, &LIMITS).unwrap();
     let Draw::Slabs { geometry, pass, .. } = &p.draw else { panic!("{p}") };
     assert!(geometry.slabs > 1 && pass.batches.is_empty() && pass.list == List::SlabPairs);
     assert!(p.to_string().contains("cut after the binning"));
@@ -181,20 +181,20 @@ fn sheet_batches_stay_within_the_layer_limit_and_cover_the_list() {
 #[test]
 fn a_bricked_plan_streams_only_under_a_short_budget() {
     let vol = common::blob([96, 96, 96]);
-    let cam = Camera::framing(&voxsplat::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
+    let cam = Camera::framing(&crate::Grid::centered(vol.dims, vol.spacing).unwrap(), 80, 80);
     let mut r = common::cpu();
     r.set_volume(&vol, &common::blob_tf(), None).unwrap();
     let scene = r.volume().unwrap().clone();
-    let least = voxsplat::low_level::plan::bricked_min_budget(&scene, u64::MAX, 80, 80);
+    let least = crate::plan::bricked_min_budget(&scene, u64::MAX, 80, 80);
     let records = scene.store.records.len() as u64 * 4;
     let o = options(Raster::Compute, Direction::FrontToBack);
-    for lod in [voxsplat::Lod::Auto, voxsplat::Lod::Off] {
+    for lod in [crate::Lod::Auto, crate::Lod::Off] {
         let mut o = o.clone();
         o.lod = lod;
         // Plenty: resident, one page of records.
         let p = r.plan(&cam, &o).unwrap();
         let Draw::Bricked(b) = &p.draw else { panic!("{p}") };
-        assert!(!b.streamed && b.build == Records::OnePage && b.lod == (lod == voxsplat::Lod::Auto), "{p}");
+        assert!(!b.streamed && b.build == Records::OnePage && b.lod == (lod == crate::Lod::Auto), "{p}");
         assert!(b.terminating && b.cull_hidden && b.sheets.is_none());
         // Below the least budget (the images alone take more): refused with the minimum named.
         assert!(least > 1 << 16);
@@ -205,11 +205,11 @@ fn a_bricked_plan_streams_only_under_a_short_budget() {
     }
     // A budget under twice the records streams them (levels of detail off: no pyramid to hold).
     let budget = 2 * records - 1;
-    let streamed_least = voxsplat::low_level::plan::bricked_min_budget(&scene, budget, 80, 80);
+    let streamed_least = crate::plan::bricked_min_budget(&scene, budget, 80, 80);
     assert!(scene.streams(budget) && budget >= streamed_least, "{budget} {streamed_least}");
     r.set_gpu_budget(budget).unwrap();
     let mut o = o.clone();
-    o.lod = voxsplat::Lod::Off;
+    o.lod = crate::Lod::Off;
     let p = r.plan(&cam, &o).unwrap();
     let Draw::Bricked(b) = &p.draw else { panic!("{p}") };
     assert!(b.streamed && b.build == Records::Streamed && b.cache_slots > 0, "{p}");

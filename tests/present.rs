@@ -2,12 +2,12 @@
 //! mirror of `present.comp` and of the blit says, in every swapchain format, over a background or
 //! transparent, in the modes whose final images differ (accumulation, raster target, two slots);
 //! semaphores order frames; bad targets are refused.
-use crate::common;
+use super::common;
+use crate::cpu::present::{decode, encode, host_texel, present_pixel};
+use crate::plan::{over_bits, present_push};
+use crate::vk::ImageLayout as IL;
+use crate::{scene, Camera, Composite, Motion, Raster, RenderOptions, TargetFormat};
 use common::assert_clean;
-use voxsplat::low_level::cpu::present::{decode, encode, host_texel, present_pixel};
-use voxsplat::low_level::plan::{over_bits, present_push};
-use voxsplat::vk::ImageLayout as IL;
-use voxsplat::{scene, Camera, Composite, Motion, Raster, RenderOptions, TargetFormat};
 
 fn options(composite: Composite, raster: Raster, background: Option<[f32; 4]>) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -22,11 +22,7 @@ fn most(format: TargetFormat, a: &[u8], b: &[u8]) -> f32 {
     // Compare in the stored encoding: an sRGB byte step is not a fixed linear step.
     let stored = |p: [f32; 4]| {
         if matches!(format, TargetFormat::Bgra8Srgb | TargetFormat::Rgba8Srgb) {
-            [0, 1, 2]
-                .map(|c| voxsplat::low_level::cpu::present::to_srgb(p[c]))
-                .into_iter()
-                .chain([p[3]])
-                .collect::<Vec<_>>()
+            [0, 1, 2].map(|c| crate::cpu::present::to_srgb(p[c])).into_iter().chain([p[3]]).collect::<Vec<_>>()
         } else {
             p.to_vec()
         }
@@ -46,7 +42,7 @@ fn render_to_writes_what_the_mirror_says_in_every_format_and_mode() {
     let slotted = {
         let mut o = options(Composite::Splat, Raster::Graphics, Some([0.1, 0.2, 0.3, 1.0]));
         let mut m = Motion::straight(glam::Mat4::from_translation(glam::Vec3::new(6.0, 0.0, 0.0)), 0.5);
-        m.profile = voxsplat::BlurProfile::Slotted;
+        m.profile = crate::BlurProfile::Slotted;
         o.motion = Some(m);
         o
     };
@@ -103,7 +99,7 @@ fn a_background_goes_through_present_on_both_engines_and_keeps_the_png_bytes() {
     }
     // The sRGB target gets the PNG's bytes back: render_to into B8G8R8A8_SRGB, decoded by hand.
     let o = options(Composite::Splat, Raster::Graphics, Some([0.0, 0.0, 0.0, 1.0]));
-    let png = voxsplat::output::to_rgba8(&g.render(&cam, &o).unwrap().image);
+    let png = crate::output::to_rgba8(&g.render(&cam, &o).unwrap().image);
     let image = g.target_image(TargetFormat::Bgra8Srgb, cam.width, cam.height).unwrap();
     let target = image.target(IL::UNDEFINED, IL::TRANSFER_SRC_OPTIMAL).unwrap();
     g.render_to(&cam, &o, &target).unwrap();
@@ -200,15 +196,15 @@ fn render_to_over_the_hosts_image_composites_the_frame_over_what_it_held() {
 
 /// A 64 x 64 RGBA8 target of voxsplat's `image`, with raw semaphores, as a host would pass them.
 fn rgba8_target(
-    image: &voxsplat::vk::TargetImage,
+    image: &crate::vk::TargetImage,
     layouts: (IL, IL),
-    wait: &[voxsplat::vk::ash::vk::Semaphore],
-    signal: &[voxsplat::vk::ash::vk::Semaphore],
-) -> voxsplat::vk::HostTarget {
-    let format = voxsplat::vk::vk_format(TargetFormat::Rgba8Unorm);
+    wait: &[crate::vk::ash::vk::Semaphore],
+    signal: &[crate::vk::ash::vk::Semaphore],
+) -> crate::vk::HostTarget {
+    let format = crate::vk::vk_format(TargetFormat::Rgba8Unorm);
     // SAFETY: the image and semaphores are voxsplat's and outlive every frame that uses them; each
     // wait semaphore was signalled by the frame before.
-    unsafe { voxsplat::vk::HostTarget::new(image.raw(), format, (64, 64), layouts, wait, signal) }.unwrap()
+    unsafe { crate::vk::HostTarget::new(image.raw(), format, (64, 64), layouts, wait, signal) }.unwrap()
 }
 
 #[test]
@@ -218,7 +214,7 @@ fn semaphores_order_frames_into_one_image() {
     let mut g = common::gpu();
     g.set_scene(set).unwrap();
     let ctx = g.context().unwrap().clone();
-    let (a, b) = (voxsplat::vk::Semaphore::new(&ctx).unwrap(), voxsplat::vk::Semaphore::new(&ctx).unwrap());
+    let (a, b) = (crate::vk::Semaphore::new(&ctx).unwrap(), crate::vk::Semaphore::new(&ctx).unwrap());
     let image = g.target_image(TargetFormat::Rgba8Unorm, 64, 64).unwrap();
     let o = options(Composite::Splat, Raster::Graphics, Some([0.0, 0.0, 0.0, 1.0]));
     let mut last = Vec::new();
@@ -249,7 +245,7 @@ fn bad_targets_are_refused_with_typed_errors() {
     let target = image.target(IL::UNDEFINED, IL::GENERAL).unwrap();
     let e = g.render_to(&cam, &RenderOptions::default(), &target).unwrap_err();
     assert!(e.to_string().contains("does not fit"), "{e}");
-    let wrong = voxsplat::vk::target_format(voxsplat::vk::Format::R8_UNORM).unwrap_err();
+    let wrong = crate::vk::target_format(crate::vk::Format::R8_UNORM).unwrap_err();
     assert!(wrong.to_string().contains("R16G16B16A16_SFLOAT"), "{wrong}");
     assert!(image.target(IL::UNDEFINED, IL::UNDEFINED).is_err(), "a target left undefined");
     let image = g.target_image(TargetFormat::Rgba8Unorm, 64, 48).unwrap();

@@ -2,12 +2,12 @@
 //! compositing, fixed-point sheet sums) against each other and their mirrors; the tile lists'
 //! order; early termination; footprints larger than a tile; typed errors and the auto rule.
 //! On lavapipe with validation: any validation message fails a test.
-use crate::common;
+use super::common;
+use crate::output::diff_rgba8;
+use crate::ImageF32;
+use crate::{scene, Camera, Composite, Direction, Error, Grid, Projection, Raster, RenderOptions, SplatSet};
 use common::{assert_clean, random_camera, random_sparse, Rng, ViewKind};
 use glam::Vec3;
-use voxsplat::output::diff_rgba8;
-use voxsplat::ImageF32;
-use voxsplat::{scene, Camera, Composite, Direction, Error, Grid, Projection, Raster, RenderOptions, SplatSet};
 
 fn opts(composite: Composite, raster: Raster) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -78,8 +78,7 @@ fn raster_variants_agree_with_the_graphics_path() {
 /// The validator: every tile's list is the subsequence of the draw order made of exactly the splats
 /// whose footprint box overlaps the tile.
 fn check_tile_lists(order: &[u32], boxes: &[Option<[i32; 4]>], tiles_x: u32, start: &[u32], entries: &[u32]) {
-    let (tw, th) =
-        (voxsplat::low_level::constants::RASTER_TILE_W as i32, voxsplat::low_level::constants::RASTER_TILE_H as i32);
+    let (tw, th) = (crate::constants::RASTER_TILE_W as i32, crate::constants::RASTER_TILE_H as i32);
     let mut pos = vec![u32::MAX; boxes.len()];
     for (i, &s) in order.iter().enumerate() {
         pos[s as usize] = i as u32;
@@ -117,17 +116,21 @@ fn tile_lists_keep_the_pbtf_order_and_hold_exactly_the_overlapping_splats() {
             for direction in [Direction::FrontToBack, Direction::BackToFront] {
                 let mut o = opts(Composite::Splat, Raster::Compute);
                 o.direction = Some(direction);
-                let (start, entries) = gpu.tile_lists(&cam, &o).unwrap();
-                assert_eq!((start.clone(), entries.clone()), cpu.tile_lists(&cam, &o).unwrap(), "GPU = mirror");
-                let order = gpu.pbtf_order(&cam, direction).unwrap();
-                let frame = voxsplat::low_level::plan::frame_for(&set, &cam, &o);
+                let (start, entries) = super::probes::tile_lists(&mut gpu, &cam, &o).unwrap();
+                assert_eq!(
+                    (start.clone(), entries.clone()),
+                    super::probes::tile_lists(&mut cpu, &cam, &o).unwrap(),
+                    "GPU = mirror"
+                );
+                let order = crate::low_level::pbtf_order(&mut gpu, &cam, direction).unwrap();
+                let frame = crate::plan::frame_for(&set, &cam, &o);
                 let mut params = vec![Default::default(); set.len()];
-                voxsplat::low_level::cpu::splat_params(&frame, set.splats(), &[], &mut params);
+                crate::cpu::splat_params::splat_params(&frame, set.splats(), &[], &mut params);
                 let boxes: Vec<_> = params
                     .iter()
-                    .map(|p| voxsplat::low_level::cpu::footprint::screen_quad(&frame, p).map(|(_, b)| b.to_array()))
+                    .map(|p| crate::cpu::footprint::screen_quad(&frame, p).map(|(_, b)| b.to_array()))
                     .collect();
-                let tiles_x = voxsplat::low_level::plan::tile_grid(&frame).0;
+                let tiles_x = crate::plan::tile_grid(&frame).0;
                 check_tile_lists(&order, &boxes, tiles_x, &start, &entries);
                 assert!(!entries.is_empty() || boxes.iter().all(Option::is_none), "{kind:?}: something binned");
             }
@@ -162,8 +165,8 @@ fn early_termination_in_the_tile_compositor_changes_no_pixel_beyond_the_threshol
     assert_clean(&gpu);
 }
 
-fn check_early_termination(gpu: &mut voxsplat::Renderer, cpu: &mut voxsplat::Renderer, cam: &Camera, full: &ImageF32) {
-    for threshold in [voxsplat::options::DEFAULT_EARLY_TERMINATION, 0.3] {
+fn check_early_termination(gpu: &mut crate::Renderer, cpu: &mut crate::Renderer, cam: &Camera, full: &ImageF32) {
+    for threshold in [crate::options::DEFAULT_EARLY_TERMINATION, 0.3] {
         let mut o = opts(Composite::Splat, Raster::Compute);
         o.early_termination = threshold;
         let g = gpu.render(cam, &o).unwrap().image;
@@ -213,9 +216,9 @@ fn tile_compositor_without_subgroup_shuffles_matches_the_shuffled_build() {
     let mut owner = common::gpu();
     assert!(owner.context().unwrap().subgroup_shuffle(), "lavapipe has compute subgroup shuffles");
     // SAFETY: the owning renderer's handles stay alive until the adopting renderer is dropped.
-    let ctx = unsafe { voxsplat::vk::Context::from_host(owner.context().unwrap().handles()) }.unwrap();
+    let ctx = unsafe { crate::vk::Context::from_host(owner.context().unwrap().handles()) }.unwrap();
     ctx.disable_subgroup_shuffle();
-    let mut guest = voxsplat::Renderer::with_context(ctx).unwrap();
+    let mut guest = crate::Renderer::with_context(ctx).unwrap();
     let cube = scene::build("cube40-attenuated").unwrap();
     let solid = scene::build("solid40").unwrap();
     let (near, near_cam) = close_up();
@@ -258,8 +261,8 @@ fn compute_raster_is_bit_identical_run_to_run() {
 /// (their difference from the quads is 3-8x below either one's error here).
 #[test]
 fn points_in_perspective_are_as_close_to_the_truth_as_the_quads() {
-    use voxsplat::metrics::compare;
-    use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
+    use crate::metrics::compare;
+    use crate::truth::{volumetric_summation, Reconstruction, TruthOptions};
     let mut gpu = common::gpu();
     let set = scene::build("cube40").unwrap();
     gpu.set_scene(set.clone()).unwrap();
@@ -288,7 +291,7 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
     let cam = Camera::framing(set.grid(), 64, 48);
     gpu.set_scene(set).unwrap();
     let mut o = opts(Composite::Splat, Raster::Points);
-    o.motion = Some(voxsplat::Motion::straight(glam::Mat4::IDENTITY, 1.0));
+    o.motion = Some(crate::Motion::straight(glam::Mat4::IDENTITY, 1.0));
     assert!(matches!(gpu.render(&cam, &o), Err(Error::InvalidArgument(m)) if m.contains("motion")));
     // A voxel a hair in front of the eye: its footprint is thousands of pixels wide.
     let (set, mut close) = close_up();
@@ -304,14 +307,14 @@ fn points_refuse_motion_blur_and_footprints_wider_than_the_device_draws() {
 
 #[test]
 fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphics_and_says_so() {
-    use voxsplat::low_level::raster::{choose, Device};
+    use crate::raster::{choose, Device};
     let set = scene::build("cube40").unwrap();
     let small = Camera::framing(set.grid(), 96, 80);
     let cpu = Device { cpu: true, point_size_max: 64.0, graphics: true };
     let wide_points = Device { cpu: true, point_size_max: 256.0, graphics: true };
     let pick = |set: &SplatSet, cam: &Camera, o: &RenderOptions, d: Device| choose(set, cam, o, d).unwrap();
     let mut blurred = opts(Composite::Splat, Raster::Auto);
-    blurred.motion = Some(voxsplat::Motion::straight(glam::Mat4::IDENTITY, 1.0));
+    blurred.motion = Some(crate::Motion::straight(glam::Mat4::IDENTITY, 1.0));
 
     // Small footprints: the tile compositor (ahead of the sprites up to 15 px, docs/RESULTS.md).
     let c = pick(&set, &small, &opts(Composite::Splat, Raster::Auto), cpu);
@@ -359,24 +362,18 @@ fn auto_rule_compute_for_small_footprints_else_points_where_they_fit_else_graphi
 /// sheet (so the composite, which reads only those layers, misses nothing), for quads and points:
 /// all entries drawn at once into one layer per global sheet by the footprint mirror.
 fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tiles: &[u32]) -> usize {
-    use voxsplat::low_level::cpu::footprint::{footprint, Blend, FootprintInputs};
-    use voxsplat::low_level::plan::{frame_for, sheet_plan, sheet_tiles_push, Prepared};
+    use crate::cpu::footprint::{footprint, Blend, FootprintInputs};
+    use crate::plan::{frame_for, sheet_plan, sheet_tiles_push, Prepared};
     let prep = Prepared::new(set.clone());
     let frame = frame_for(set, cam, o);
     let mut params = vec![Default::default(); set.len()];
-    voxsplat::low_level::cpu::splat_params(&frame, set.splats(), &[], &mut params);
+    crate::cpu::splat_params::splat_params(&frame, set.splats(), &[], &mut params);
     let (draw, batches) = if o.composite == Composite::Sheet {
         let (axis, batches) = sheet_plan(&prep, cam, o.direction(), 1 << 16);
         (prep.slices[axis].1.clone(), batches)
     } else {
-        let pc = voxsplat::low_level::plan::slab::slab_geometry(
-            &frame,
-            set.grid(),
-            set.len(),
-            o.slab_thickness,
-            o.direction(),
-        )
-        .unwrap();
+        let pc =
+            crate::plan::slab::slab_geometry(&frame, set.grid(), set.len(), o.slab_thickness, o.direction()).unwrap();
         slab_bins(&pc, &params)
     };
     let push = sheet_tiles_push(&batches, &batches[0]);
@@ -396,7 +393,7 @@ fn check_sheet_tiles_cover(set: &SplatSet, cam: &Camera, o: &RenderOptions, tile
     let mut layers = vec![ImageF32::new(cam.width, cam.height); sheets];
     let points = o.raster == Raster::Points;
     footprint(&inputs, &push, Blend::Add, points, false, 0, push.count, &mut layers);
-    let tile = voxsplat::low_level::constants::COMPOSITE_TILE;
+    let tile = crate::constants::COMPOSITE_TILE;
     let (tiles_x, n) = (cam.width.div_ceil(tile), tiles.len() / 2);
     let mut written = 0;
     for (s, layer) in layers.iter().enumerate() {
@@ -435,11 +432,15 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
         for composite in [Composite::Sheet, Composite::Slab] {
             for raster in [Raster::Graphics, Raster::Points, Raster::Compute] {
                 let o = opts(composite, raster);
-                let tiles = match gpu.sheet_tiles(cam, &o) {
+                let tiles = match super::probes::sheet_tiles(&mut gpu, cam, &o) {
                     Err(Error::InvalidArgument(_)) if raster == Raster::Points => continue, // wider than a point
                     t => t.unwrap(),
                 };
-                assert_eq!(tiles, cpu.sheet_tiles(cam, &o).unwrap(), "{composite:?} {raster:?}: GPU = mirror");
+                assert_eq!(
+                    tiles,
+                    super::probes::sheet_tiles(&mut cpu, cam, &o).unwrap(),
+                    "{composite:?} {raster:?}: GPU = mirror"
+                );
                 let written = check_sheet_tiles_cover(set, cam, &o, &tiles);
                 assert!(written > 0, "{composite:?} {raster:?}: something drawn");
                 // The share of (tile, sheet) pairs the composite no longer visits.
@@ -452,12 +453,12 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
     }
     // A single sheet seen head-on: too few layer pixels per splat for the pass to pay; every tile
     // then lets the composite read every layer.
-    let sheet = voxsplat::scene::rate_scene(64).unwrap();
-    let cam = voxsplat::scene::rate_camera(sheet.grid(), 5.0).unwrap();
+    let sheet = crate::scene::rate_scene(64).unwrap();
+    let cam = crate::scene::rate_camera(sheet.grid(), 5.0).unwrap();
     gpu.set_scene(sheet).unwrap();
-    let tiles = gpu.sheet_tiles(&cam, &opts(Composite::Sheet, Raster::Compute)).unwrap();
+    let tiles = super::probes::sheet_tiles(&mut gpu, &cam, &opts(Composite::Sheet, Raster::Compute)).unwrap();
     let n = tiles.len() / 2;
-    let [lo, hi] = voxsplat::low_level::plan::ALL_SHEETS;
+    let [lo, hi] = crate::plan::ALL_SHEETS;
     assert!(tiles[..n].iter().all(|&t| t == lo) && tiles[n..].iter().all(|&t| t == hi), "single sheet: all layers");
     // Not a bound on speed: that the ranges skip anything at all on these sparse scenes.
     let mean = skipped_share.iter().sum::<f64>() / skipped_share.len() as f64;
@@ -468,15 +469,15 @@ fn sheet_tiles_match_the_mirror_and_cover_every_footprint() {
 /// The slab binning on the CPU mirrors, straight (the oracle beside the recording's): the pairs
 /// and the batches.
 fn slab_bins(
-    pc: &voxsplat::low_level::gpu_types::SlabPush,
-    params: &[voxsplat::low_level::gpu_types::SplatParams],
-) -> (Vec<u32>, Vec<voxsplat::low_level::plan::Batch>) {
+    pc: &crate::gpu_types::SlabPush,
+    params: &[crate::gpu_types::SplatParams],
+) -> (Vec<u32>, Vec<crate::plan::Batch>) {
     let mut counts = vec![0u32; (pc.slabs * pc.chunks) as usize];
     let mut start = vec![0u32; pc.slabs as usize + 1];
-    voxsplat::low_level::cpu::slab_count(pc, params, None, &mut counts);
-    voxsplat::low_level::cpu::slab_scan(pc, &mut counts, &mut start);
-    let batches = voxsplat::low_level::plan::slab::slab_batches(pc, &start, 1 << 16).unwrap();
+    crate::cpu::slab_count::slab_count(pc, params, None, &mut counts);
+    crate::cpu::slab_scan::slab_scan(pc, &mut counts, &mut start);
+    let batches = crate::plan::slab::slab_batches(pc, &start, 1 << 16).unwrap();
     let mut pairs = vec![0u32; 2 * start[pc.slabs as usize] as usize];
-    voxsplat::low_level::cpu::slab_scatter(pc, params, None, &mut counts, &mut pairs);
+    crate::cpu::slab_scatter::slab_scatter(pc, params, None, &mut counts, &mut pairs);
     (pairs, batches)
 }

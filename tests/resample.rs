@@ -1,12 +1,12 @@
 //! Reduced-resolution rendering (`RenderOptions::render_scale`, src/resample.rs): the coarse frame
 //! is the backend's own frame of `scaled_camera`, resampled; close to the full-size frame where
 //! voxels cover several pixels; bad scales are typed errors.
-use crate::common;
-use voxsplat::low_level::resample::{scaled_camera, upsample};
-use voxsplat::scene::peer;
-use voxsplat::ImageF32;
-use voxsplat::RaycastOptions;
-use voxsplat::{classify, scene, Camera, Error, Kernel, Raster, RenderOptions, Renderer};
+use super::common;
+use crate::resample::{scaled_camera, upsample};
+use crate::scene::peer;
+use crate::ImageF32;
+use crate::RaycastOptions;
+use crate::{classify, scene, Camera, Error, Kernel, Raster, RenderOptions, Renderer};
 
 fn opts(raster: Raster, kernel: Kernel, scale: f32) -> RenderOptions {
     let mut o = RenderOptions::default();
@@ -74,7 +74,7 @@ fn a_scaled_frame_is_the_coarse_frame_resampled() {
     // Analytically: a linear ramp survives the resampling. A full-size pixel centre X lies at
     // 0.5 X - 0.25 on the half-size grid (clamped at its edges), where the ramp is linear.
     let ramp = |x: f64, y: f64| 0.01 * x + 0.02 * y;
-    let coarse = voxsplat::ImageF32 {
+    let coarse = crate::ImageF32 {
         width: 8,
         height: 6,
         pixels: (0..48).map(|i| [ramp((i % 8) as f64, (i / 8) as f64) as f32, 0.0, 0.0, 1.0]).collect(),
@@ -125,8 +125,6 @@ fn bad_render_scales_are_typed_errors() {
     }
     // The smallest scale still draws at least one row and column.
     let tiny = Camera { width: 3, height: 2, ..cam };
-    let img = c
-        .render(&tiny, &opts(Raster::Graphics, Kernel::Gaussian, voxsplat::low_level::resample::MIN_RENDER_SCALE))
-        .unwrap();
+    let img = c.render(&tiny, &opts(Raster::Graphics, Kernel::Gaussian, crate::resample::MIN_RENDER_SCALE)).unwrap();
     assert_eq!((img.image.width, img.image.height), (3, 2));
 }

@@ -2,12 +2,12 @@
 //! (`BrickStore::patch`, `Renderer::update_volume`) draws what the same store set afresh draws,
 //! on the device and on the CPU mirrors, while the device rewrites only the bricks that changed;
 //! 4-D NIfTI files read one time point at a time. Validation on: any message fails.
-use crate::common;
+use super::common;
+use crate::bricks::{BrickScene, BrickStore, BRICK};
+use crate::classify::Shading;
+use crate::volume::ScalarVolume;
+use crate::{Camera, Error, Mode, RenderOptions};
 use common::{assert_clean, assert_mirrors, blob, blob_tf as tf};
-use voxsplat::bricks::{BrickScene, BrickStore, BRICK};
-use voxsplat::classify::Shading;
-use voxsplat::volume::ScalarVolume;
-use voxsplat::{Camera, Error, Mode, RenderOptions};
 
 const DIMS: [u32; 3] = [61, 53, 47];
 
@@ -115,7 +115,7 @@ fn a_patched_store_reads_back_every_value_and_keeps_what_did_not_change() {
     assert!(!compacted, "the ball's holes stay below the blob's records");
     // The same store again changes nothing.
     let again = store_in(&times[11], range);
-    assert_eq!(store.patch(again).unwrap(), voxsplat::bricks::Patch::default());
+    assert_eq!(store.patch(again).unwrap(), crate::bricks::Patch::default());
     // The ball alone: its moves leave holes that pass its records, which are then laid out afresh.
     let empty = ScalarVolume { values: vec![0.0; times[0].values.len()], ..times[0].clone() };
     let mut store = store_in(&ball(0, empty.clone()), range);
@@ -149,7 +149,7 @@ fn a_time_point_of_another_grid_or_range_is_refused_and_the_scene_kept() {
     let err = r.update_volume(store_in(&small, range)).unwrap_err();
     assert!(matches!(err, Error::InvalidArgument(ref m) if m.contains("keeps its grid")), "{err}");
     // Still the first time point.
-    let cam = Camera::framing(&voxsplat::Grid::centered(DIMS, a.spacing).unwrap(), 48, 48);
+    let cam = Camera::framing(&crate::Grid::centered(DIMS, a.spacing).unwrap(), 48, 48);
     let mut fresh = common::cpu();
     fresh.set_bricks(BrickScene::new(store_in(&a, range), tf(), None).unwrap()).unwrap();
     let o = RenderOptions::default();
@@ -164,10 +164,10 @@ fn play(
     shading: Option<Shading>,
     o: &RenderOptions,
     series: fn(u32) -> ScalarVolume,
-) -> (Vec<voxsplat::ImageF32>, Vec<(voxsplat::VolumeUpdate, u64)>) {
+) -> (Vec<crate::ImageF32>, Vec<(crate::VolumeUpdate, u64)>) {
     let times: Vec<ScalarVolume> = (0..6).map(series).collect();
     let range = range(&times);
-    let cam = Camera::framing(&voxsplat::Grid::centered(times[0].dims, times[0].spacing).unwrap(), 80, 72);
+    let cam = Camera::framing(&crate::Grid::centered(times[0].dims, times[0].spacing).unwrap(), 80, 72);
     let renderer = || {
         let mut r = if gpu { common::gpu() } else { common::cpu() };
         if let Some(b) = budget {
@@ -210,7 +210,7 @@ fn play(
 
 #[test]
 fn a_played_series_draws_what_each_time_point_draws_set_afresh() {
-    let cam = Camera::framing(&voxsplat::Grid::centered(DIMS, [1.0, 1.2, 0.9]).unwrap(), 80, 72);
+    let cam = Camera::framing(&crate::Grid::centered(DIMS, [1.0, 1.2, 0.9]).unwrap(), 80, 72);
     let shading = Some(Shading::headlight(cam.forward()));
     let mut mip = RenderOptions::default();
     mip.mode = Mode::Mip;
@@ -243,7 +243,7 @@ fn a_series_streamed_through_a_small_budget_plays_the_same_frames() {
     let budget = store.records.len() as u64 * 8 - 1;
     let scene = BrickScene::new(store, tf(), None).unwrap();
     assert!(scene.streams(budget));
-    assert!(voxsplat::low_level::plan::bricked_min_budget(&scene, budget, 80, 72) < budget);
+    assert!(crate::plan::bricked_min_budget(&scene, budget, 80, 72) < budget);
     let o = RenderOptions::default();
     let (resident, _) = play(true, None, None, &o, large_at);
     let (streamed, updates) = play(true, Some(budget), None, &o, large_at);
@@ -269,7 +269,7 @@ fn nifti4(dims: [u32; 3], frames: u32, units: u8, v: &[u8]) -> Vec<u8> {
 
 #[test]
 fn a_4d_nifti_is_read_one_time_point_at_a_time() {
-    use voxsplat::loaders::{load_channels, load_volume, time_points, VolumeHints};
+    use crate::loaders::{load_channels, load_volume, time_points, VolumeHints};
     let dims = [9, 8, 7];
     let n = (dims[0] * dims[1] * dims[2]) as usize;
     let dir = std::env::temp_dir().join(format!("voxsplat-series-{}", std::process::id()));
@@ -322,7 +322,7 @@ fn a_4d_nifti_is_read_one_time_point_at_a_time() {
 
 #[test]
 fn a_4d_nrrd_with_a_time_axis_is_read_one_time_point_at_a_time() {
-    use voxsplat::loaders::{load_channels, load_volume, time_points, VolumeHints};
+    use crate::loaders::{load_channels, load_volume, time_points, VolumeHints};
     let dir = std::env::temp_dir().join(format!("voxsplat-series-nrrd-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let n = 5 * 4 * 3;
@@ -362,7 +362,7 @@ fn a_4d_nrrd_with_a_time_axis_is_read_one_time_point_at_a_time() {
 
 #[test]
 fn a_pattern_names_a_series_of_files_ordered_by_number() {
-    use voxsplat::loaders::{is_pattern, load_volume, series_files, time_points, VolumeHints};
+    use crate::loaders::{is_pattern, load_volume, series_files, time_points, VolumeHints};
     let dir = std::env::temp_dir().join(format!("voxsplat-series-files-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let dims = [6, 5, 4];
@@ -401,7 +401,7 @@ fn a_pattern_names_a_series_of_files_ordered_by_number() {
 /// dynamic programming, here).
 #[test]
 fn a_pattern_matches_as_the_shell_does_in_bounded_time() {
-    use voxsplat::loaders::series_files;
+    use crate::loaders::series_files;
     let dir = std::env::temp_dir().join(format!("voxsplat-series-glob-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();

@@ -9,7 +9,7 @@ use std::path::Path;
 #[test]
 fn shipped_spirv_equals_a_fresh_compile() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl/spirv");
-    let fresh: BTreeMap<&str, &[u8]> = voxsplat::spirv_builds().iter().copied().collect();
+    let fresh: BTreeMap<&str, &[u8]> = crate::shaders::spirv_builds().iter().copied().collect();
     assert!(fresh.len() > 20, "every stage and variant is built ({})", fresh.len());
     if std::env::var_os("VOXSPLAT_BLESS_SPIRV").is_some() {
         std::fs::create_dir_all(&dir).unwrap();
@@ -39,6 +39,6 @@ fn shipped_spirv_equals_a_fresh_compile() {
     assert!(
         stale.is_empty() && missing.is_empty() && differ.is_empty(),
         "glsl/spirv/ is out of date (stale {stale:?}, missing {missing:?}, different {differ:?}): run \
-         VOXSPLAT_BLESS_SPIRV=1 cargo test --release --test engine spirv"
+         VOXSPLAT_BLESS_SPIRV=1 cargo test --release -p voxsplat --lib tests::spirv"
     );
 }

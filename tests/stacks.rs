@@ -1,9 +1,9 @@
 //! Image stacks read as volumes (issue 47): multipage TIFFs written by tifffile (the fuzz seeds,
 //! fuzz/seeds/make.py) with ImageJ's and OME-TIFF's spacing, folders of numbered PNG slices, the
 //! streamed store built from them, and what they refuse.
+use crate::bricks::BrickStore;
+use crate::loaders::{is_stack, load_volume, SliceReader, VolumeHints};
 use std::path::{Path, PathBuf};
-use voxsplat::bricks::BrickStore;
-use voxsplat::loaders::{is_stack, load_volume, SliceReader, VolumeHints};
 
 fn seed(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/stacks").join(name)
@@ -140,7 +140,7 @@ fn names_that_are_not_utf8_order_by_their_numbers() {
     assert_eq!([v.values[0], v.values[12], v.values[24]], [2.0, 9.0, 10.0], "ordered by number");
     // The same files as a pattern of time points.
     let pattern = dir.join("scan_*.png");
-    let files = voxsplat::loaders::series_files(&pattern).unwrap();
+    let files = crate::loaders::series_files(&pattern).unwrap();
     assert_eq!(files, [2, 9, 10].map(|z| dir.join(raw(z))));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,15 +1,15 @@
 //! The references and metrics: analytic values, the ray caster's convergence, GPU ray caster
 //! against its mirror, metrics on known pairs.
-use crate::common;
+use super::common;
+use crate::cpu::raycast::raycast;
+use crate::metrics::{compare, temporal};
+use crate::plan::raycast_params;
+use crate::truth::{volumetric_summation, DenseField, Reconstruction, TruthOptions};
+use crate::ImageF32;
+use crate::RaycastOptions;
+use crate::{scene, Camera, Grid, Kernel, Projection, SplatSet};
 use common::assert_clean;
 use glam::Vec3;
-use voxsplat::low_level::cpu::raycast::raycast;
-use voxsplat::low_level::plan::raycast_params;
-use voxsplat::metrics::{compare, temporal};
-use voxsplat::truth::{volumetric_summation, DenseField, Reconstruction, TruthOptions};
-use voxsplat::ImageF32;
-use voxsplat::RaycastOptions;
-use voxsplat::{scene, Camera, Grid, Kernel, Projection, SplatSet};
 
 fn ortho_down_z(center: Vec3, size: u32) -> Camera {
     Camera {
@@ -40,7 +40,7 @@ fn single_cubic_voxel_matches_its_analytic_line_integral() {
     };
     let img = volumetric_summation(&set, &cam, &opts).unwrap();
     let r = Kernel::Cubic.radius() as f64;
-    let tau = voxsplat::low_level::cpu::splat_params::optical_depth(opacity) as f64;
+    let tau = crate::cpu::splat_params::optical_depth(opacity) as f64;
     let alpha = 1.0 - (-tau * 15.0 / (4.0 * std::f64::consts::PI * r * r)).exp();
     let got = img.pixels[0];
     assert!((got[3] as f64 - alpha).abs() < 1e-6, "alpha {} vs {alpha}", got[3]);
@@ -59,7 +59,7 @@ fn homogeneous_slab_transmittance_is_exp_minus_tau_m() {
     let cam = ortho_down_z(grid.center(), 1);
     let opts = TruthOptions { reconstruction: Reconstruction::Trilinear, oversampling: 4, min_transmittance: 0.0 };
     let img = volumetric_summation(&set, &cam, &opts).unwrap();
-    let tau = voxsplat::low_level::cpu::splat_params::optical_depth(opacity) as f64;
+    let tau = crate::cpu::splat_params::optical_depth(opacity) as f64;
     // Trilinear: full density over m - 1 voxels plus two half-voxel ramps = tau * m.
     let alpha = 1.0 - (-tau * m as f64).exp();
     let got = img.pixels[0];
@@ -151,8 +151,8 @@ fn metrics_on_known_pairs() {
     assert!((t.popping - 10.0).abs() < 1e-3, "{}", t.popping);
     assert!(temporal(&frames[..2]).is_err());
     // Shimmer over kept pixels only: keeping nothing gives None; keeping all gives the mean change.
-    assert!(voxsplat::metrics::shimmer(&frames, |_, _| false).is_none());
-    let mean = voxsplat::metrics::shimmer(&frames, |_, _| true).unwrap();
+    assert!(crate::metrics::shimmer(&frames, |_, _| false).is_none());
+    let mean = crate::metrics::shimmer(&frames, |_, _| true).unwrap();
     assert!((mean - t.mean_change).abs() < 1e-12);
 }
 
@@ -164,7 +164,7 @@ fn empty_space_skipping_changes_no_pixel() {
     let mut gpu = common::gpu();
     let mut cpu = common::cpu();
     let mut rng = common::Rng(21);
-    for set in [voxsplat::scene::build("cube40").unwrap(), common::random_sparse(4, [30, 9, 21], 0.05)] {
+    for set in [crate::scene::build("cube40").unwrap(), common::random_sparse(4, [30, 9, 21], 0.05)] {
         gpu.set_scene(set.clone()).unwrap();
         cpu.set_scene(set.clone()).unwrap();
         for v in 0..4 {
@@ -188,7 +188,7 @@ fn empty_space_skipping_changes_no_pixel() {
 /// footprints sum to a constant (the values docs/MODEL.md quotes).
 #[test]
 fn sheet_ripple_of_each_kernel() {
-    let r: Vec<f64> = voxsplat::kernel::KERNELS.iter().map(|k| k.sheet_ripple()).collect();
+    let r: Vec<f64> = crate::kernel::KERNELS.iter().map(|k| k.sheet_ripple()).collect();
     eprintln!("sheet ripple: gaussian {:.4} cubic {:.4} narrow {:.4} crawfis-max {:.4}", r[0], r[1], r[2], r[3]);
     // Pinned at the measured values (docs/MODEL.md quotes them): 0.43 %, 3.0 %, 7.6 %, 0.37 %.
     let measured = [0.0043, 0.0300, 0.0757, 0.0037];
@@ -228,7 +228,7 @@ fn the_supersampled_reference_averages_k_by_k_rays_per_pixel() {
         let (d12, d24) = (compare(&one, &two).unwrap().rmse, compare(&two, &four).unwrap().rmse);
         assert!(d24 < d12 && d12 > 0.0, "1 vs 2 rays per axis {d12}, 2 vs 4 {d24}");
         for bad in [0, 17] {
-            assert!(matches!(r.raycast(&cam, &o(bad)), Err(voxsplat::Error::InvalidArgument(_))), "{bad}");
+            assert!(matches!(r.raycast(&cam, &o(bad)), Err(crate::Error::InvalidArgument(_))), "{bad}");
         }
         let mut scaled = o(2);
         scaled.render_scale = 0.5;

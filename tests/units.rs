@@ -1,14 +1,14 @@
 //! Kernels, cameras, scenes and the sheet plan.
-use crate::common;
+use super::common;
+use crate::constants::{FOOTPRINT_TABLE_SIZE, MAX_GROUPS_X, WORKGROUP_SIZE};
+use crate::order::Direction;
+use crate::plan::{groups_1d, sheet_plan, Prepared};
+use crate::{scene, Camera, Error, Grid, Kernel, Projection, SplatSet, Volume};
 use glam::Vec3;
-use voxsplat::low_level::constants::{FOOTPRINT_TABLE_SIZE, MAX_GROUPS_X, WORKGROUP_SIZE};
-use voxsplat::low_level::plan::{groups_1d, sheet_plan, Prepared};
-use voxsplat::order::Direction;
-use voxsplat::{scene, Camera, Error, Grid, Kernel, Projection, SplatSet, Volume};
 
 #[test]
 fn footprint_tables_integrate_to_one_and_vanish_at_the_radius() {
-    for k in voxsplat::kernel::KERNELS {
+    for k in crate::kernel::KERNELS {
         let t = k.footprint_table();
         let n = FOOTPRINT_TABLE_SIZE as usize;
         let texel = (2.0 * k.radius() as f64 / n as f64).powi(2);
@@ -27,7 +27,7 @@ fn footprint_tables_integrate_to_one_and_vanish_at_the_radius() {
             for dy in -3..=3 {
                 let (u, v) = ((0.3 + dx as f64) / r, (0.2 + dy as f64) / r);
                 if u.abs() <= 1.0 && v.abs() <= 1.0 {
-                    sum += voxsplat::low_level::cpu::sample_table(&t, u as f32, v as f32) as f64;
+                    sum += crate::cpu::footprint::sample_table(&t, u as f32, v as f32) as f64;
                 }
             }
         }
@@ -36,7 +36,7 @@ fn footprint_tables_integrate_to_one_and_vanish_at_the_radius() {
         assert!((sum - 1.0).abs() <= k.sheet_ripple() + 2e-3, "{k:?} sheet sum {sum}, ripple {}", k.sheet_ripple());
     }
     // Gaussian pre-integration matches the closed form 1/(2 pi s^2) exp(-rho^2 / 2 s^2).
-    let s = voxsplat::kernel::GAUSSIAN_SIGMA;
+    let s = crate::kernel::GAUSSIAN_SIGMA;
     let g = Kernel::Gaussian;
     let ratio = g.integrated(0.8) / g.integrated(0.0);
     assert!((ratio - (-(0.64) / (2.0 * s * s)).exp()).abs() < 2e-3, "{ratio}");
@@ -152,8 +152,8 @@ fn built_in_scenes_match_the_dissertation() {
 #[test]
 fn renderer_is_send() {
     fn send<T: Send>() {}
-    send::<voxsplat::Renderer>();
-    send::<voxsplat::SplatSet>();
+    send::<crate::Renderer>();
+    send::<crate::SplatSet>();
 }
 
 #[test]
@@ -199,7 +199,7 @@ fn eye_and_perspective_spaces_agree_with_the_clip_transform() {
 /// and the wider Gaussian at their own criterion.
 #[test]
 fn the_crawfis_max_kernel_is_the_least_variance_cubic() {
-    use voxsplat::kernel::{fit_crawfis_max, lattice_rms, RadialSpline, CRAWFIS_MAX, CRAWFIS_MAX_RADIUS};
+    use crate::kernel::{fit_crawfis_max, lattice_rms, RadialSpline, CRAWFIS_MAX, CRAWFIS_MAX_RADIUS};
     let fit = fit_crawfis_max();
     let rms = |s: &RadialSpline| lattice_rms(|r| s.eval(r / CRAWFIS_MAX_RADIUS), CRAWFIS_MAX_RADIUS);
     let baked = rms(&CRAWFIS_MAX);

@@ -4,7 +4,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use voxsplat::{
-    order, scene, Backend, Composite, Direction, Error, OrderKind, RenderOptions, Renderer, RendererOptions, Result,
+    options::Composite, order, order::Direction, order::OrderKind, scene, Backend, Error, RenderOptions, Renderer,
+    RendererOptions, Result,
 };
 use voxsplat_cli::open::*;
 
@@ -235,7 +236,7 @@ fn print_histogram(store: &voxsplat::bricks::BrickStore, bins: u32) -> Result<()
 
 fn print_store(store: &voxsplat::bricks::BrickStore) {
     let per_voxel = |bytes: u64| bytes as f64 / store.len().max(1) as f64;
-    let pyramid = voxsplat::low_level::plan::pyramid_bytes(voxsplat::low_level::plan::LOD_BUFFERS, store.headers.len());
+    let pyramid = voxsplat::low_level::pyramid_bytes(store.headers.len());
     println!(
         "bricked store: {} stored voxels in {} bricks of {}^3, {} bytes on the GPU, {:.2} bytes per stored voxel \
          ({:.2} with the levels-of-detail pyramid of --lod auto; shaded or gradient-weighted frames add {:.2} for \
@@ -451,9 +452,9 @@ fn run(cli: Cli) -> Result<()> {
             println!("splats: {}", set.len());
             println!(
                 "bytes per splat (classified on the host, voxsplat-lab render --dense): {:.0}",
-                voxsplat::gpu_bytes_per_splat(&set)
+                voxsplat::volume::gpu_bytes_per_splat(&set)
             );
-            let most = voxsplat::low_level::constants::MAX_GPU_SPLATS as usize;
+            let most = voxsplat::low_level::MAX_GPU_SPLATS as usize;
             if set.len() > most {
                 println!("over the dense GPU path's {most} splats: render it bricked (the default for volumes)");
             }
@@ -493,7 +494,7 @@ fn run(cli: Cli) -> Result<()> {
             let seq = if kind == OrderKind::Pbtf && !a.scene.cpu {
                 let mut r = renderer_of(&a.scene)?;
                 r.set_scene(set.clone())?;
-                let s = r.pbtf_order(&cam, Direction::BackToFront)?;
+                let s = voxsplat::low_level::pbtf_order(&mut r, &cam, Direction::BackToFront)?;
                 report_validation(&r)?;
                 s
             } else {
@@ -511,7 +512,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             println!("splats: {}", seq.len());
             if a.check {
-                let radius = voxsplat::Kernel::default().radius();
+                let radius = voxsplat::kernel::Kernel::default().radius();
                 let p = order::count_pixel_inversions(&set, &cam, &seq, Direction::BackToFront, radius)?;
                 println!(
                     "pixel inversions: {} in {} of {} covered pixels, {} of them between kernels apart along the ray",
@@ -534,7 +535,7 @@ fn animate(a: Box<AnimateArgs>) -> Result<()> {
         // Frames go to the GIF as they are drawn: one frame held at a time.
         voxsplat::output::GifWriter::create(&dir.join("anim.gif"), 1000 / 12)
     };
-    let write = |i: u32, img: &voxsplat::ImageF32, gif: &mut voxsplat::output::GifWriter| {
+    let write = |i: u32, img: &voxsplat::image::ImageF32, gif: &mut voxsplat::output::GifWriter| {
         voxsplat::output::write_image(img, &a.out_dir.join(format!("frame{i:04}.{}", a.format)))?;
         gif.push(img)
     };
@@ -623,7 +624,7 @@ fn main() -> ExitCode {
             .collect();
     }
     if let Some(mib) = cli.host_budget_mib {
-        voxsplat::set_host_budget(Some(mib.saturating_mul(1 << 20)));
+        voxsplat::options::set_host_budget(Some(mib.saturating_mul(1 << 20)));
     }
     voxsplat_cli::stdout::exit_code(run(cli))
 }

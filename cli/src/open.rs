@@ -5,7 +5,7 @@ mod parts;
 use glam::Vec3;
 pub use parts::Parts;
 use voxsplat::orient::Orientation;
-use voxsplat::{scene, Backend, Camera, Error, Projection, Renderer, RendererOptions, Result};
+use voxsplat::{camera::Projection, scene, Backend, Camera, Error, Renderer, RendererOptions, Result};
 
 pub use crate::parse::{parse_background, parse_dims, parse_finite, parse_floats, parse_level, parse_size, parse_vec3};
 pub use crate::scene_args::SceneArgs;
@@ -395,7 +395,7 @@ pub fn load_scene_parts(a: &SceneArgs) -> Result<(voxsplat::SplatSet, Content, O
     eprintln!(
         "{} splats, {:.0} bytes per splat on the GPU ({} x {} x {} grid)",
         set.len(),
-        voxsplat::gpu_bytes_per_splat(&set),
+        voxsplat::volume::gpu_bytes_per_splat(&set),
         set.grid().dims[0],
         set.grid().dims[1],
         set.grid().dims[2]

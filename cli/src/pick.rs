@@ -47,8 +47,11 @@ pub(crate) fn pick(a: PickArgs) -> Result<()> {
             println!("pixel      {x},{y}");
             println!("point      {:.4} {:.4} {:.4} (the grid's world frame)", p.world.x, p.world.y, p.world.z);
             println!("voxel      {} {} {}", p.voxel[0], p.voxel[1], p.voxel[2]);
-            let over =
-                if opts.mode == voxsplat::Mode::Iso { "the volume's values" } else { "the transfer function's range" };
+            let over = if opts.mode == voxsplat::options::Mode::Iso {
+                "the volume's values"
+            } else {
+                "the transfer function's range"
+            };
             println!("value      {:.6} (0 to 1 over {over})", p.value);
             println!("depth      {:.4} (along the view, from the eye)", p.depth);
         }

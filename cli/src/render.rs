@@ -5,7 +5,9 @@ use crate::{print, println};
 use clap::Args;
 use glam::Vec3;
 use std::path::PathBuf;
-use voxsplat::{scene, Composite, Direction, Error, Kernel, OrderKind, RenderOptions, Result};
+use voxsplat::{
+    kernel::Kernel, options::Composite, order::Direction, order::OrderKind, scene, Error, RenderOptions, Result,
+};
 
 /// The switches of `voxsplat-lab render` that measure the renderer rather than set up a picture: the
 /// reference and the k line, the engine's paths and budgets kept apart from the defaults.
@@ -201,7 +203,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     }
     let order = a.scene.order.parse::<OrderKind>()?;
     let composite = a.composite.parse::<Composite>()?;
-    let mode = a.mode.parse::<voxsplat::Mode>()?;
+    let mode = a.mode.parse::<voxsplat::options::Mode>()?;
     if mode.is_projection() {
         let refuse = |flag: &str, why: &str| Err(Error::InvalidArgument(format!("--mode {mode} {flag}: {why}")));
         if a.research.truth {
@@ -228,17 +230,17 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     }
     let session_iso = a.scene.session.as_ref().and_then(|s| s.iso);
     match (mode, a.iso.or(session_iso)) {
-        (voxsplat::Mode::Iso, None) => {
+        (voxsplat::options::Mode::Iso, None) => {
             return Err(Error::InvalidArgument("--mode iso needs the surface's value: --iso VALUE".into()))
         }
-        (m, Some(_)) if m != voxsplat::Mode::Iso => {
+        (m, Some(_)) if m != voxsplat::options::Mode::Iso => {
             return Err(Error::InvalidArgument(format!("--iso sets --mode iso's surface, not --mode {m}'s")))
         }
         _ => {}
     }
     // A volume is a bricked store classified on the device unless a mode needs host splats (the
     // ray caster reads a bricked store's isosurface).
-    let cast_splats = a.raycast.is_some() && mode != voxsplat::Mode::Iso;
+    let cast_splats = a.raycast.is_some() && mode != voxsplat::options::Mode::Iso;
     let host_splats = order != OrderKind::Pbtf || a.research.truth || cast_splats || a.research.k_line;
     let mut opts = RenderOptions::default();
     opts.mode = mode;
@@ -248,7 +250,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     opts.order = order;
     opts.composite = composite;
     opts.kernel = a.kernel.parse::<Kernel>()?;
-    opts.antialias = a.aa.as_deref().unwrap_or("none").parse::<voxsplat::Antialias>()?;
+    opts.antialias = a.aa.as_deref().unwrap_or("none").parse::<voxsplat::options::Antialias>()?;
     if a.aa.is_some() && a.raycast.is_some() {
         return Err(Error::InvalidArgument(
             "--aa filters splats' footprints; the ray caster samples along each pixel's rays (--supersample K \
@@ -281,12 +283,12 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     opts.early_termination = a.early_termination;
     opts.cull_hidden_bricks = !a.research.keep_hidden_bricks;
     opts.every_voxel = a.research.every_voxel;
-    opts.raster = a.raster.parse::<voxsplat::Raster>()?;
+    opts.raster = a.raster.parse::<voxsplat::options::Raster>()?;
     opts.render_scale = a.render_scale;
     opts.lod = a.lod.as_deref().unwrap_or("auto").parse()?;
     let planes: Vec<voxsplat::glam::Vec4> = a.clip.iter().map(|p| voxsplat::glam::Vec4::from(*p)).collect();
     let crop = a.crop.map(|c| [Vec3::new(c[0], c[1], c[2]), Vec3::new(c[3], c[4], c[5])]);
-    opts.clip = voxsplat::Clip::new(&planes, crop)?;
+    opts.clip = voxsplat::options::Clip::new(&planes, crop)?;
     // A session's clipping cuts the whole volume, as the viewer did (--crop would read a part).
     if let Some(s) = &a.scene.session {
         opts.clip = s.clip()?;
@@ -296,7 +298,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     if let Some(band) = a.research.lod_band {
         opts.lod_band = band;
     }
-    if a.research.lod_nodes && opts.lod == voxsplat::Lod::Off {
+    if a.research.lod_nodes && opts.lod == voxsplat::options::Lod::Off {
         return Err(Error::InvalidArgument(
             "--lod-nodes draws levels of detail above the brick: it needs --lod auto (the default), not --lod off"
                 .into(),
@@ -323,7 +325,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
         if a.plan {
             return Err(Error::InvalidArgument("--plan prints one renderer's plan: run it without mpirun".into()));
         }
-        if mode == voxsplat::Mode::Iso {
+        if mode == voxsplat::options::Mode::Iso {
             return Err(Error::Unsupported("--mode iso draws on one renderer: run it without mpirun".into()));
         }
         return render_distributed(&a, &opts, host_splats);
@@ -354,7 +356,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
         ));
     }
     let cam = camera_of(&a.scene, set.grid(), &content)?;
-    if let voxsplat::Projection::Perspective { fov_y_deg } = cam.projection {
+    if let voxsplat::camera::Projection::Perspective { fov_y_deg } = cam.projection {
         // Other renderers (scripts/vtk_file.py) take the same view from this line.
         let v = |v: Vec3| format!("{:.4},{:.4},{:.4}", v.x, v.y, v.z);
         eprintln!("camera (grid frame): eye {} target {} up {} fov {fov_y_deg}", v(cam.eye), v(cam.target), v(cam.up));
@@ -387,7 +389,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
         let ms = t.elapsed().as_secs_f64() * 1e3;
         voxsplat::Rendered {
             image,
-            timings: vec![voxsplat::StageTime { stage: "truth", ms }],
+            timings: vec![voxsplat::options::StageTime { stage: "truth", ms }],
             raster: None,
             stats: Default::default(),
         }
@@ -399,7 +401,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
         }
         let f = match a.raycast {
             Some(step) => {
-                let mut o = voxsplat::RaycastOptions {
+                let mut o = voxsplat::options::RaycastOptions {
                     mode,
                     colormap: opts.colormap.clone(),
                     iso: opts.iso,
@@ -422,7 +424,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
                 png.finish()?;
                 wall.push(t.elapsed().as_secs_f64() * 1e3);
                 written = true;
-                let image = voxsplat::ImageF32::new(0, 0);
+                let image = voxsplat::image::ImageF32::new(0, 0);
                 voxsplat::Rendered { image, timings: d.timings, raster: Some(d.raster), stats: d.stats }
             }
             None => median_timings((0..a.repeat).map(|_| {
@@ -439,8 +441,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     let mut image = frame.image;
     if let (Some(bg), true) = (a.background, a.research.truth || a.raycast.is_some()) {
         // The reference renderers have no present stage: its mirror, on the host.
-        let push = voxsplat::low_level::plan::present_push(Some(bg), 1, false, cam.width, cam.height);
-        voxsplat::low_level::cpu::present::present(&push, &mut image, &voxsplat::ImageF32::new(0, 0), &[]);
+        voxsplat::low_level::present_over(&mut image, bg);
     }
     if a.research.k_line {
         let regions = voxsplat::aa::k_regions(&set_for_k, &cam);
@@ -498,16 +499,16 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
 }
 
 /// Whether `render` writes its frame band by band: a PNG of more than one band
-/// (`voxsplat::frame_bands`) drawn once, with nothing to add to the whole frame after it.
+/// (`voxsplat::low_level::frame_bands`) drawn once, with nothing to add to the whole frame after it.
 fn streams(a: &RenderArgs, cam: &voxsplat::Camera, out: &std::path::Path) -> Result<bool> {
     let png = voxsplat::output::ImageFormat::of(out)? == voxsplat::output::ImageFormat::Png;
-    Ok(png && a.repeat == 1 && !a.research.k_line && voxsplat::frame_bands(cam).len() > 1)
+    Ok(png && a.repeat == 1 && !a.research.k_line && voxsplat::low_level::frame_bands(cam).len() > 1)
 }
 
 /// The last of `frames` with each stage's median time over all of them, keeping one image at a
 /// time (`--repeat` would otherwise hold every frame).
 fn median_timings(frames: impl Iterator<Item = Result<voxsplat::Rendered>>) -> Result<voxsplat::Rendered> {
-    let mut earlier: Vec<Vec<voxsplat::StageTime>> = Vec::new();
+    let mut earlier: Vec<Vec<voxsplat::options::StageTime>> = Vec::new();
     let mut last: Option<voxsplat::Rendered> = None;
     for f in frames {
         let f = f?;
@@ -636,14 +637,14 @@ mod tests {
     fn render_s_defaults_are_the_library_s() {
         let a = Cmd::try_parse_from(["render", "--out", "frame.png"]).unwrap().render;
         let d = RenderOptions::default();
-        assert_eq!(a.mode.parse::<voxsplat::Mode>().unwrap(), d.mode);
+        assert_eq!(a.mode.parse::<voxsplat::options::Mode>().unwrap(), d.mode);
         assert_eq!(a.scene.order.parse::<OrderKind>().unwrap(), d.order);
         assert_eq!(a.composite.parse::<Composite>().unwrap(), d.composite);
         assert_eq!(a.kernel.parse::<Kernel>().unwrap(), d.kernel);
         assert_eq!(a.aa, None);
-        assert_eq!(voxsplat::Antialias::None, d.antialias);
-        assert_eq!(a.raster.parse::<voxsplat::Raster>().unwrap(), d.raster);
-        assert_eq!(a.lod.as_deref().unwrap_or("auto").parse::<voxsplat::Lod>().unwrap(), d.lod);
+        assert_eq!(voxsplat::options::Antialias::None, d.antialias);
+        assert_eq!(a.raster.parse::<voxsplat::options::Raster>().unwrap(), d.raster);
+        assert_eq!(a.lod.as_deref().unwrap_or("auto").parse::<voxsplat::options::Lod>().unwrap(), d.lod);
         assert_eq!((a.lod_pixels, a.lod_error, a.research.lod_band), (d.lod_pixels, d.lod_error, None));
         assert_eq!((a.early_termination, a.render_scale), (d.early_termination, d.render_scale));
         assert_eq!((a.research.sheet_budget_mib, mib_bytes(256, "").unwrap()), (None, d.sheet_budget_bytes));

@@ -167,7 +167,7 @@ pub struct SceneResearch {
     /// departs from its mirror: gpu-until:STAGE (the device runs the stages before STAGE, the
     /// mirrors the rest) or cpu-until:STAGE. Stages: see src/stages.rs.
     #[arg(long, conflicts_with = "cpu")]
-    pub bisect: Option<voxsplat::Bisect>,
+    pub bisect: Option<voxsplat::low_level::Bisect>,
     /// Classify a --volume, or the peers' scene (--scene peer128, peer256), on the host into a
     /// splat set: needed by the other orders, --truth, --raycast and --k-line, which pick it
     /// themselves. Without it a volume is a bricked store classified on the device (levels of

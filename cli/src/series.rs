@@ -134,7 +134,7 @@ impl Series {
 pub fn play(
     a: &SceneArgs,
     opts: &RenderOptions,
-    mut frame: impl FnMut(u32, &voxsplat::ImageF32) -> Result<()>,
+    mut frame: impl FnMut(u32, &voxsplat::image::ImageF32) -> Result<()>,
 ) -> Result<String> {
     let series = Series::open(a)?;
     let chunks = voxsplat::loaders::zarr_chunks_read();

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use voxsplat::classify::{Shading, TransferFunction};
 use voxsplat::glam::{Vec3, Vec4};
-use voxsplat::{Camera, Error, Projection, Result};
+use voxsplat::{camera::Projection, Camera, Error, Result};
 
 /// The view, in the grid's frame (the one `render` prints as "camera (grid frame)").
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
@@ -133,9 +133,10 @@ impl Session {
     }
 
     /// The clipping as the renderer takes it.
-    pub fn clip(&self) -> Result<voxsplat::Clip> {
+    pub fn clip(&self) -> Result<voxsplat::options::Clip> {
         let (planes, crop) = self.clipping();
-        voxsplat::Clip::new(&planes, crop).map_err(|e| Error::InvalidArgument(format!("a session's clipping: {e}")))
+        voxsplat::options::Clip::new(&planes, crop)
+            .map_err(|e| Error::InvalidArgument(format!("a session's clipping: {e}")))
     }
 
     /// The shading, if any.

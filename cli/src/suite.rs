@@ -5,7 +5,7 @@ use crate::scene_args::SceneArgs;
 use clap::Parser;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use voxsplat::{Error, Mode, RenderOptions, Renderer, Result};
+use voxsplat::{options::Mode, Error, RenderOptions, Renderer, Result};
 
 mod report;
 pub use report::{compare, score, CaseResult, Platform, Report};
@@ -225,7 +225,7 @@ fn reset_peak_rss() {
 /// Draws a case's frame `i`.
 type Draw = Box<dyn FnMut(&mut Renderer, u32) -> Result<voxsplat::Rendered>>;
 /// Makes a case's truth.
-type Truth = Box<dyn FnOnce() -> Result<voxsplat::ImageF32>>;
+type Truth = Box<dyn FnOnce() -> Result<voxsplat::image::ImageF32>>;
 
 /// A case, loaded and ready to draw.
 struct Loaded {
@@ -258,7 +258,7 @@ fn load(case: &Case, opts: &SuiteOptions) -> Result<Loaded> {
         // Frames 1.. of the animation, round again past its last: each a blurred view of its own.
         let draw = move |r: &mut Renderer, i: u32| {
             let (image, gpu) = render_frame_timed(r, &anim, &grid, 1 + i % (anim.frames - 1).max(1), blur, &o)?;
-            let timings = vec![voxsplat::StageTime { stage: "frame", ms: gpu }];
+            let timings = vec![voxsplat::options::StageTime { stage: "frame", ms: gpu }];
             Ok(voxsplat::Rendered { image, timings, raster: None, stats: Default::default() })
         };
         return Ok(Loaded { renderer: r, draw: Box::new(draw), splats_stored: stored, truth: None });
@@ -292,7 +292,7 @@ fn load(case: &Case, opts: &SuiteOptions) -> Result<Loaded> {
                 let mut t = renderer_of(&scene)?;
                 t.set_scene(set)?;
                 let step = 0.25;
-                Ok(t.raycast(&cam, &voxsplat::RaycastOptions { mode, step, ..Default::default() })?.image)
+                Ok(t.raycast(&cam, &voxsplat::options::RaycastOptions { mode, step, ..Default::default() })?.image)
             }))
         }
         _ => None,
@@ -306,7 +306,7 @@ fn load(case: &Case, opts: &SuiteOptions) -> Result<Loaded> {
 }
 
 /// The case's truth, from the cache or made now (and cached as EXR).
-fn truth_image(case: &Case, opts: &SuiteOptions, l: &mut Loaded) -> Result<Option<voxsplat::ImageF32>> {
+fn truth_image(case: &Case, opts: &SuiteOptions, l: &mut Loaded) -> Result<Option<voxsplat::image::ImageF32>> {
     let Some(make) = l.truth.take() else { return Ok(None) };
     let path = opts.cache.join(format!("truth-v{SUITE_VERSION}-{}-{}x{}.exr", case.name, case.size[0], case.size[1]));
     if let Ok(img) = voxsplat::output::read_image(&path) {

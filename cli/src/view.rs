@@ -12,7 +12,7 @@ use std::time::Instant;
 use voxsplat::bricks::Histogram;
 use voxsplat::classify::Shading;
 use voxsplat::vk::{OverlayFrame, PresentOptions, Presenter, Viewport};
-use voxsplat::{Camera, Error, Mode, RenderOptions, Renderer, Result};
+use voxsplat::{options::Mode, Camera, Error, RenderOptions, Renderer, Result};
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -176,7 +176,7 @@ impl App {
         };
         let presenter = Presenter::new(window.clone(), (size.width, size.height), &options)?;
         self.renderer = Some(Renderer::with_context(presenter.context().clone())?);
-        self.loading = Some(load::Loading::start(a, self.state.options.order != voxsplat::OrderKind::Pbtf));
+        self.loading = Some(load::Loading::start(a, self.state.options.order != voxsplat::order::OrderKind::Pbtf));
         let input = egui_winit::State::new(
             self.egui.clone(),
             egui::ViewportId::ROOT,
@@ -265,7 +265,7 @@ impl App {
         // render scale (a drag frame's) and no sheets or slabs, which get them over the volume.
         let depth_path = handles.is_some()
             && options.render_scale == 1.0
-            && options.composite == voxsplat::Composite::Splat
+            && options.composite == voxsplat::options::Composite::Splat
             && matches!(options.mode, Mode::Composite | Mode::Iso);
         let mut frame_options = options.clone();
         if let (true, true, Some(shapes)) = (changed, depth_path, &handles) {
@@ -494,7 +494,7 @@ fn busy_frame(
 }
 
 /// The stages that took the most of the frame (ms), and what a bricked volume's frame drew.
-fn frame_summary(d: &voxsplat::Delivered) -> String {
+fn frame_summary(d: &voxsplat::options::Delivered) -> String {
     let mut t: Vec<_> = d.timings.iter().filter(|s| s.ms > 0.0).collect();
     t.sort_by(|a, b| b.ms.total_cmp(&a.ms));
     let stages = t.iter().take(4).map(|s| format!("{} {:.1}", s.stage, s.ms)).collect::<Vec<_>>().join(", ");
@@ -526,7 +526,7 @@ fn display_bytes(c: [f32; 4]) -> [u8; 4] {
     let a = c[3].clamp(0.0, 1.0);
     let encode = |v: f32| {
         let l = if a > 0.0 { (v / a).clamp(0.0, 1.0) } else { 0.0 };
-        (voxsplat::low_level::cpu::present::to_srgb(l) * a * 255.0).round() as u8
+        (voxsplat::low_level::to_srgb(l) * a * 255.0).round() as u8
     };
     [encode(c[0]), encode(c[1]), encode(c[2]), (a * 255.0).round() as u8]
 }

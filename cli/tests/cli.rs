@@ -321,7 +321,7 @@ fn compare_prints_metrics_and_rejects_bad_files() {
     assert!(String::from_utf8_lossy(&same.stdout).contains("rmse:       0.000000"));
     // Known values: red off by 0.25 everywhere, the other channels equal: RMSE sqrt(0.25^2 / 4).
     let flat = |r: f32, path: &std::path::Path| {
-        let img = voxsplat::ImageF32 { width: 20, height: 10, pixels: vec![[r, 0.5, 0.5, 1.0]; 200] };
+        let img = voxsplat::image::ImageF32 { width: 20, height: 10, pixels: vec![[r, 0.5, 0.5, 1.0]; 200] };
         voxsplat::output::write_image(&img, path).unwrap();
     };
     let (x, y) = (tmp("known-x.exr"), tmp("known-y.exr"));

@@ -26,12 +26,13 @@ use std::sync::Mutex;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
 use voxsplat::glam::Vec3;
+use voxsplat::options::RaycastOptions;
 use voxsplat::options::{Antialias, Composite, Lod};
 use voxsplat::order::OrderKind;
 use voxsplat::volume::ScalarVolume;
-use voxsplat::RaycastOptions;
 use voxsplat::{
-    Backend, Camera, Grid, ImageF32, Kernel, Projection, Raster, RenderOptions, Renderer, RendererOptions, SplatSet,
+    camera::Projection, image::ImageF32, kernel::Kernel, options::Raster, Backend, Camera, Grid, RenderOptions,
+    Renderer, RendererOptions, SplatSet,
 };
 
 const RAY_ALPHA: f32 = 0.05;
@@ -165,7 +166,7 @@ struct Mode {
     early_termination: f32,
     lod: Lod,
     /// MIP or MinIP (issue 76: a thumbnail's MIP drew empty), else compositing.
-    project: Option<voxsplat::Mode>,
+    project: Option<voxsplat::options::Mode>,
 }
 
 fn mode() -> impl Strategy<Value = Mode> {
@@ -177,7 +178,12 @@ fn mode() -> impl Strategy<Value = Mode> {
         prop::sample::select(vec![OrderKind::Pbtf, OrderKind::Btf, OrderKind::Wbtf, OrderKind::Sorted]),
         prop::sample::select(vec![0.0f32, 0.004, 0.05]),
         prop::sample::select(vec![Lod::Auto, Lod::Off]),
-        prop::sample::select(vec![None, None, Some(voxsplat::Mode::Mip), Some(voxsplat::Mode::Minip)]),
+        prop::sample::select(vec![
+            None,
+            None,
+            Some(voxsplat::options::Mode::Mip),
+            Some(voxsplat::options::Mode::Minip),
+        ]),
     )
         .prop_map(|(composite, raster, kernel, antialias, order, early_termination, lod, project)| Mode {
             composite,

@@ -220,7 +220,7 @@ fn far_small_and_tiny_scenes_are_drawn() {
         }
         // The smallest terrain a height grid may be: 2 x 2 cells.
         voxsplat::output::write_image(
-            &voxsplat::ImageF32 {
+            &voxsplat::image::ImageF32 {
                 width: 2,
                 height: 2,
                 pixels: vec![[0.1, 0.1, 0.1, 1.0], [0.2; 4], [0.3; 4], [0.4; 4]],

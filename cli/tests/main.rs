@@ -4,6 +4,7 @@ mod cli;
 mod cmd;
 #[path = "../../tests/common/mod.rs"]
 mod common;
+use voxsplat as vs;
 mod coverage;
 mod dicom;
 mod distributed;
@@ -17,7 +18,6 @@ mod peer;
 mod phantom;
 mod properties;
 mod readme;
-mod reliability;
 mod sample_types;
 mod series;
 mod view;

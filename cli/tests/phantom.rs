@@ -6,8 +6,8 @@ use cmd::voxsplat;
 use voxsplat::classify::TransferFunction;
 use voxsplat::glam::Vec3;
 use voxsplat::loaders::{load_orientation, load_volume, VolumeHints};
-use voxsplat::RaycastOptions;
-use voxsplat::{Camera, Projection};
+use voxsplat::options::RaycastOptions;
+use voxsplat::{camera::Projection, Camera};
 
 /// 1.2x the measured RMSE of the `mri` preset's splats on the 64³ phantom against the CPU
 /// ray-cast truth, anterior view at 96² (measured 0.034727, 2026-11-25).

@@ -471,7 +471,7 @@ fn a_moving_view_reads_through_a_chunk_cache(path: &Path) {
             eye: Vec3::new(a.cos(), a.sin(), 0.0) * 300.0,
             target: Vec3::ZERO,
             up: Vec3::Z,
-            projection: voxsplat::Projection::Perspective { fov_y_deg: 10.0 },
+            projection: voxsplat::camera::Projection::Perspective { fov_y_deg: 10.0 },
             near: 1.0,
             far: 1000.0,
             width: 48,

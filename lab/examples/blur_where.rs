@@ -4,7 +4,7 @@
 //! inside above 0.99), and the mean alpha difference (coverage).
 //! `cargo run --release -p voxsplat-lab --example blur_where`
 use voxsplat::animate::{render_frame, Animation, Blur};
-use voxsplat::{OrderKind, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{options::Raster, order::OrderKind, RenderOptions, Renderer, RendererOptions};
 fn main() -> voxsplat::Result<()> {
     let mut r = Renderer::new(&RendererOptions::default())?;
     for name in ["rotating-box", "rotating-terrain-ortho"] {

@@ -7,7 +7,7 @@
 use glam::Vec4;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::{Camera, Clip, Direction, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{options::Clip, options::Raster, order::Direction, Camera, RenderOptions, Renderer, RendererOptions};
 
 fn main() -> voxsplat::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -6,7 +6,9 @@
 //! `cargo run --release -p voxsplat-lab --example lod_sweep -- FILE TF TRUTH.exr 1,0.1 2,1e30 ...`
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::{Camera, Direction, Error, Lod, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{
+    options::Lod, options::Raster, order::Direction, Camera, Error, RenderOptions, Renderer, RendererOptions,
+};
 
 fn main() -> voxsplat::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -2,7 +2,7 @@
 //! Westover's per-view choice (`order::wbtf_axes`), both visibility orders (the seed's "or
 //! duals"), scored by the image-space validator on the README's views and the rmnp fly-over, 256².
 use voxsplat::order::{count_pixel_inversions, pbtf_nested, pbtf_split, wbtf_axes};
-use voxsplat::{Camera, Direction, Projection};
+use voxsplat::{camera::Projection, order::Direction, Camera};
 
 /// A nesting per octant.
 type Nesting<'a> = &'a dyn Fn(u32) -> [usize; 3];

@@ -8,7 +8,7 @@
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
 use voxsplat::vk::ImageLayout as IL;
-use voxsplat::{scene, Camera, RenderOptions, Renderer, RendererOptions, TargetFormat};
+use voxsplat::{image::TargetFormat, scene, Camera, RenderOptions, Renderer, RendererOptions};
 
 fn main() -> voxsplat::Result<()> {
     let mut options = RenderOptions::default();
@@ -38,7 +38,8 @@ fn main() -> voxsplat::Result<()> {
             }
             Ok(t.elapsed().as_secs_f64() * 1e3)
         })?;
-        let present = |t: &[voxsplat::StageTime]| t.iter().filter(|s| s.stage == "present").map(|s| s.ms).sum::<f64>();
+        let present =
+            |t: &[voxsplat::options::StageTime]| t.iter().filter(|s| s.stage == "present").map(|s| s.ms).sum::<f64>();
         let (a, b) = (r.render(&cam, &options)?.timings, r.render_to(&cam, &options, &target)?.timings);
         println!(
             "| {name} | {:.1} | {:.1} | {:.2}× | present stage {:.1} / {:.1} ms |",

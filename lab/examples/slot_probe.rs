@@ -3,7 +3,9 @@
 //! quads), against 64 sub-frames, as a multiple of accum:5's error. `splat:slotted` is the
 //! two-slot case in one geometry pass.
 use voxsplat::animate::{render_frame, Animation, Blur};
-use voxsplat::{BlurProfile, Motion, OrderKind, Raster, RenderOptions, Renderer, RendererOptions};
+use voxsplat::{
+    options::BlurProfile, options::Motion, options::Raster, order::OrderKind, RenderOptions, Renderer, RendererOptions,
+};
 fn main() -> voxsplat::Result<()> {
     let mut r = Renderer::new(&RendererOptions::default())?;
     for name in ["rotating-box", "spinning-box", "rotating-terrain-ortho"] {
@@ -19,7 +21,7 @@ fn main() -> voxsplat::Result<()> {
         let e5 = voxsplat::metrics::compare(&a5, &truth)?.rmse;
         for m in [1u32, 2, 3, 4] {
             let t = 20.0f32;
-            let mut acc = voxsplat::ImageF32::new(truth.width, truth.height);
+            let mut acc = voxsplat::image::ImageF32::new(truth.width, truth.height);
             for k in 0..m {
                 let t1 = t - anim.shutter + (k + 1) as f32 / m as f32 * anim.shutter;
                 let t0 = t1 - anim.shutter / m as f32;

@@ -7,7 +7,7 @@ use crate::bricked::frame_ms;
 use std::fmt::Write as _;
 use voxsplat::image::Downsample;
 use voxsplat::truth::{supersampled_with, TruthOptions};
-use voxsplat::{Antialias, Camera, ImageF32, Projection, Renderer, RendererOptions, Result};
+use voxsplat::{camera::Projection, image::ImageF32, options::Antialias, Camera, Renderer, RendererOptions, Result};
 
 /// One mode on one figure's view.
 pub struct AaSceneRow {

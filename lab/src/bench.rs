@@ -7,13 +7,13 @@ use std::time::Instant;
 use voxsplat::camera::Camera;
 use voxsplat::image::ImageF32;
 use voxsplat::metrics::{compare, ImageMetrics};
+use voxsplat::options::Raster;
+use voxsplat::options::RaycastOptions;
 use voxsplat::options::{Antialias, Composite, Rendered};
 use voxsplat::order::{count_violations, visibility_order};
 use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use voxsplat::volume::{Grid, SplatSet};
-use voxsplat::Raster;
-use voxsplat::RaycastOptions;
-use voxsplat::{scene, Direction, Kernel, OrderKind, Renderer};
+use voxsplat::{kernel::Kernel, order::Direction, order::OrderKind, scene, Renderer};
 use voxsplat::{Error, Result};
 
 /// One rendering method of the matrix.
@@ -285,9 +285,9 @@ fn render_method_at(r: &mut Renderer, m: &Method, camera: &Camera, render_scale:
         }
         Method::Bricked { lod } => {
             let mut o = crate::lab_options();
-            (o.raster, o.render_scale, o.lod) = (Raster::Compute, render_scale, voxsplat::Lod::Off);
+            (o.raster, o.render_scale, o.lod) = (Raster::Compute, render_scale, voxsplat::options::Lod::Off);
             if let Some((pixels, error)) = *lod {
-                (o.lod, o.lod_pixels, o.lod_error) = (voxsplat::Lod::Auto, pixels, error);
+                (o.lod, o.lod_pixels, o.lod_error) = (voxsplat::options::Lod::Auto, pixels, error);
             }
             r.render(camera, &o)
         }

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::{classify, TransferFunction};
-use voxsplat::{Camera, Direction, Error, Raster, RenderOptions, Renderer, RendererOptions, Result};
+use voxsplat::{options::Raster, order::Direction, Camera, Error, RenderOptions, Renderer, RendererOptions, Result};
 
 pub use voxsplat_cli::measure::peak_rss_mib;
 
@@ -46,7 +46,7 @@ fn opts(early_termination: f32) -> RenderOptions {
     let mut o = crate::lab_options();
     (o.raster, o.direction, o.early_termination) = (Raster::Compute, Some(Direction::FrontToBack), early_termination);
     // Full detail unless a variant asks for levels of detail.
-    o.lod = voxsplat::Lod::Off;
+    o.lod = voxsplat::options::Lod::Off;
     o
 }
 
@@ -104,7 +104,7 @@ pub fn study(
     let m = voxsplat::metrics::compare(&a, &b)?;
     frame_ms(&mut bricked, &cam, &o)?;
     let mut with_lod = o.clone();
-    (with_lod.lod, with_lod.lod_pixels) = (voxsplat::Lod::Auto, 1.0);
+    (with_lod.lod, with_lod.lod_pixels) = (voxsplat::options::Lod::Auto, 1.0);
     frame_ms(&mut bricked, &cam, &with_lod)?;
     let (mut t_dense, mut t_bricked, mut t_tf) = (Vec::new(), Vec::new(), Vec::new());
     let (mut t_lod, mut t_tf_lod) = (Vec::new(), Vec::new());
@@ -168,7 +168,7 @@ pub fn study(
     // The sheet modes over the bricks against the same modes over dense splats.
     let _ = writeln!(s, "\n| bonsai 256³, compute raster | dense ms | bricked ms | bricked / dense | PSNR dB |");
     let _ = writeln!(s, "|---|---|---|---|---|");
-    for composite in [voxsplat::Composite::Sheet, voxsplat::Composite::Slab] {
+    for composite in [voxsplat::options::Composite::Sheet, voxsplat::options::Composite::Slab] {
         let mut so = o.clone();
         so.composite = composite;
         let a = dense.render(&cam, &so)?.image;
@@ -190,7 +190,7 @@ pub fn study(
         big.set_bricks(l.scene)?;
         let lod = |pixels: f32, error: f32| {
             let mut x = o.clone();
-            (x.lod, x.lod_pixels, x.lod_error) = (voxsplat::Lod::Auto, pixels, error);
+            (x.lod, x.lod_pixels, x.lod_error) = (voxsplat::options::Lod::Auto, pixels, error);
             x
         };
         let default_error = voxsplat::options::DEFAULT_LOD_ERROR;
@@ -202,8 +202,9 @@ pub fn study(
         // distance from full detail.
         let full_small = bricked.render(&cam, &o)?.image;
         let full_big = big.render(&lcam, &o)?.image;
-        let psnr =
-            |a: &voxsplat::ImageF32, b: &voxsplat::ImageF32| voxsplat::metrics::compare(a, b).map(|m| m.covered_psnr);
+        let psnr = |a: &voxsplat::image::ImageF32, b: &voxsplat::image::ImageF32| {
+            voxsplat::metrics::compare(a, b).map(|m| m.covered_psnr)
+        };
         let p_small = psnr(&full_small, &bricked.render(&cam, &lod1)?.image)?;
         let mut p_big = Vec::new();
         for (_, _, x) in &big_lods {
@@ -221,7 +222,7 @@ pub fn study(
         }
         // The sheets at 512³ stream (the visible voxels pass one batch): once, after the others.
         let mut so = o.clone();
-        so.composite = voxsplat::Composite::Sheet;
+        so.composite = voxsplat::options::Composite::Sheet;
         let sheet = frame_ms(&mut big, &lcam, &so)?;
         let m: Vec<f64> = t.iter_mut().map(|v| median(v)).collect();
         let (sm, sl, bg, be) = (m[0], m[1], m[2], m[3]);
@@ -287,9 +288,10 @@ pub fn one_volume(path: &Path, size: u32, budget_bytes: u64, tf: &str, frames: u
     // `render --raster compute --direction ftb` draws (its kernel, early termination), the frames
     // docs/RESULTS.md sets beside VTK's.
     let mut full = RenderOptions::default();
-    (full.raster, full.direction, full.lod) = (Raster::Compute, Some(Direction::FrontToBack), voxsplat::Lod::Off);
+    (full.raster, full.direction, full.lod) =
+        (Raster::Compute, Some(Direction::FrontToBack), voxsplat::options::Lod::Off);
     let mut lod = full.clone();
-    (lod.lod, lod.lod_pixels) = (voxsplat::Lod::Auto, 1.0);
+    (lod.lod, lod.lod_pixels) = (voxsplat::options::Lod::Auto, 1.0);
     let reference = r.render(&cam, &full)?.image;
     let psnr = voxsplat::metrics::compare(&r.render(&cam, &lod)?.image, &reference)?.covered_psnr;
     let (mut times, mut lod_times) = (Vec::new(), Vec::new());
@@ -400,7 +402,7 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     bricked.set_bricks(BrickScene::new(BrickStore::build(&vol)?, tf, None)?)?;
     drop(vol);
     let mut o = crate::lab_options();
-    (o.raster, o.lod) = (Raster::Compute, voxsplat::Lod::Off);
+    (o.raster, o.lod) = (Raster::Compute, voxsplat::options::Lod::Off);
     let mut variants: Vec<(String, bool, RenderOptions)> =
         vec![("dense classified splats".into(), true, o.clone()), ("bricked, full detail".into(), false, o.clone())];
     let unbounded = crate::bench::LOD_UNBOUNDED;
@@ -409,7 +411,7 @@ pub fn lod_peer(n: u32, size: u32, frames: usize, chart: Option<&Path>) -> Resul
     lods.extend(LOD_CURVE_ERRORS.iter().map(|&e| (unbounded, e)));
     for (pixels, error) in lods {
         let mut x = o.clone();
-        (x.lod, x.lod_pixels, x.lod_error) = (voxsplat::Lod::Auto, pixels, error);
+        (x.lod, x.lod_pixels, x.lod_error) = (voxsplat::options::Lod::Auto, pixels, error);
         let e = if error >= any { "unbounded".to_string() } else { format!("{error}") };
         let name = if pixels >= unbounded {
             format!("{} {error}", crate::bench::LOD_CURVE)
@@ -482,7 +484,7 @@ pub fn zarr_orbit(
     let grid = voxsplat::Grid::centered(l.dims, l.spacing)?;
     let half = voxsplat::glam::Vec3::from(l.dims.map(|d| d as f32)) * voxsplat::glam::Vec3::from(l.spacing) * 0.5;
     let mut cam = Camera::framing(&grid, size, size);
-    cam.projection = voxsplat::Projection::Perspective { fov_y_deg: fov };
+    cam.projection = voxsplat::camera::Projection::Perspective { fov_y_deg: fov };
     let cache = (cache_bytes > 0).then(|| ChunkCache::new(cache_bytes)).transpose()?;
     let mut o = RendererOptions::default();
     o.gpu_budget_bytes = Some(budget_bytes);

@@ -5,7 +5,7 @@ use crate::bricked::frame_ms;
 use std::fmt::Write as _;
 use std::path::Path;
 use voxsplat::kernel::{lattice_rms, KERNELS};
-use voxsplat::{Error, Kernel, Raster, RenderOptions, Renderer, RendererOptions, Result};
+use voxsplat::{kernel::Kernel, options::Raster, Error, RenderOptions, Renderer, RendererOptions, Result};
 
 /// One kernel's row.
 pub struct KernelRow {

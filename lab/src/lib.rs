@@ -22,6 +22,6 @@ pub mod stability;
 /// library's too).
 pub fn lab_options() -> voxsplat::RenderOptions {
     let mut o = voxsplat::RenderOptions::default();
-    o.kernel = voxsplat::Kernel::Gaussian;
+    o.kernel = voxsplat::kernel::Kernel::Gaussian;
     o
 }

@@ -675,7 +675,7 @@ fn relink(md: &str, dir: &str) -> String {
 fn main() -> ExitCode {
     let lab = Lab::parse();
     if let Some(mib) = lab.host_budget_mib {
-        voxsplat::set_host_budget(Some(mib.saturating_mul(1 << 20)));
+        voxsplat::options::set_host_budget(Some(mib.saturating_mul(1 << 20)));
     }
     voxsplat_cli::stdout::exit_code(run(lab.study))
 }

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use voxsplat::bricks::{BrickScene, BrickStore};
 use voxsplat::classify::TransferFunction;
-use voxsplat::{Camera, Mode, RaycastOptions, Renderer, RendererOptions, Result};
+use voxsplat::{options::Mode, options::RaycastOptions, Camera, Renderer, RendererOptions, Result};
 
 /// A volume of the study: its name, file, transfer-function preset and isosurface value (in the
 /// file's units).

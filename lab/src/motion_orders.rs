@@ -6,7 +6,10 @@
 //! on the orthographic terrain drawn with WBTF, blurred splats against the accumulation buffer.
 use std::fmt::Write as _;
 use voxsplat::animate::{render_frame_timed, Animation, Blur, SplatBlur};
-use voxsplat::{BlurProfile, ImageF32, OrderKind, Raster, RenderOptions, Renderer, RendererOptions, Result};
+use voxsplat::{
+    image::ImageF32, options::BlurProfile, options::Raster, order::OrderKind, RenderOptions, Renderer, RendererOptions,
+    Result,
+};
 
 /// The turn of `rotating-box` seen in perspective by an eye level with the box (inside its y
 /// slab): PBTF splits at the eye's plane there, so its seams cross the moving faces, the case the
@@ -22,7 +25,7 @@ fn seams() -> Result<Animation> {
     a.camera = voxsplat::Camera {
         eye,
         target,
-        projection: voxsplat::Projection::Perspective { fov_y_deg: 75.0 },
+        projection: voxsplat::camera::Projection::Perspective { fov_y_deg: 75.0 },
         near: 0.05 * dist,
         far: 4.0 * dist.max(1.0),
         ..a.camera

@@ -9,7 +9,7 @@ pub struct PeerRun {
     pub label: String,
     /// Median wall time of a whole frame (render call to image on the host), ms.
     pub median_ms: f64,
-    pub image: voxsplat::ImageF32,
+    pub image: voxsplat::image::ImageF32,
 }
 
 /// The configurations compared with the peers on an `n`³ volume. Image-aligned slabs draw each of
@@ -17,19 +17,19 @@ pub struct PeerRun {
 /// they are timed at 128³ only.
 pub fn variants(n: u32) -> Vec<crate::stability::Variant> {
     use crate::stability::Variant;
-    use voxsplat::{Composite, Raster};
+    use voxsplat::{options::Composite, options::Raster};
     let mut v = vec![
-        Variant::Splat(voxsplat::OrderKind::Pbtf),
+        Variant::Splat(voxsplat::order::OrderKind::Pbtf),
         Variant::Rastered(Composite::Splat, Raster::Points),
         Variant::Rastered(Composite::Splat, Raster::Compute),
-        Variant::Kernel(voxsplat::Kernel::Narrow, Raster::Points),
+        Variant::Kernel(voxsplat::kernel::Kernel::Narrow, Raster::Points),
         // Drawn on a coarser grid and resampled (`RenderOptions::render_scale`): at 128³ a voxel
         // covers ~3.5 px, so the kernel is far wider than a pixel. Two scales of the compositor
         // trace its speed-accuracy curve beside VTK's image sample distances (scripts/peers.sh).
-        Variant::Scaled(voxsplat::Kernel::Gaussian, Raster::Compute, 0.5),
-        Variant::Scaled(voxsplat::Kernel::Narrow, Raster::Compute, 0.4),
-        Variant::Scaled(voxsplat::Kernel::Narrow, Raster::Compute, 0.25),
-        Variant::Scaled(voxsplat::Kernel::Narrow, Raster::Points, 0.4),
+        Variant::Scaled(voxsplat::kernel::Kernel::Gaussian, Raster::Compute, 0.5),
+        Variant::Scaled(voxsplat::kernel::Kernel::Narrow, Raster::Compute, 0.4),
+        Variant::Scaled(voxsplat::kernel::Kernel::Narrow, Raster::Compute, 0.25),
+        Variant::Scaled(voxsplat::kernel::Kernel::Narrow, Raster::Points, 0.4),
         Variant::Sheet,
         Variant::Rastered(Composite::Sheet, Raster::Compute),
     ];

@@ -11,11 +11,11 @@ use std::path::Path;
 use voxsplat::image::ImageF32;
 use voxsplat::metrics::compare;
 use voxsplat::options::Composite;
+use voxsplat::options::Raster;
 use voxsplat::scene::{rate_camera, rate_scene};
 use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
-use voxsplat::Raster;
+use voxsplat::{kernel::Kernel, Renderer};
 use voxsplat::{Error, Result};
-use voxsplat::{Kernel, Renderer};
 
 /// The variants the sweep times: per-splat compositing and the sheet buffer, each through quads,
 /// point sprites and compute.

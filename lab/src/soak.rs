@@ -5,7 +5,7 @@ use voxsplat::camera::Camera;
 use voxsplat::kernel::KERNELS;
 use voxsplat::options::{Antialias, Composite, RenderOptions};
 use voxsplat::Result;
-use voxsplat::{scene, OrderKind, Renderer};
+use voxsplat::{order::OrderKind, scene, Renderer};
 
 /// Frames per repetition of the sequence.
 pub const CYCLE: usize = 12;

@@ -7,15 +7,15 @@ use crate::bench::median;
 use glam::{Quat, Vec3};
 use voxsplat::camera::{Camera, Projection};
 use voxsplat::image::ImageF32;
-use voxsplat::low_level::plan::sheet_axis;
+use voxsplat::low_level::sheet_axis;
 use voxsplat::metrics::{compare, frame_changes, temporal_of};
+use voxsplat::options::Raster;
+use voxsplat::options::RaycastOptions;
 use voxsplat::options::{Composite, RenderOptions, Rendered};
 use voxsplat::order::{count_violations, visibility_order, Direction, OrderKind};
 use voxsplat::scene::close_view;
 use voxsplat::truth::{volumetric_summation, Reconstruction, TruthOptions};
 use voxsplat::volume::{Grid, SplatSet};
-use voxsplat::Raster;
-use voxsplat::RaycastOptions;
 use voxsplat::Result;
 use voxsplat::{scene, Renderer};
 
@@ -34,9 +34,9 @@ pub enum Variant {
     /// variant (the others draw instanced quads through the graphics pipeline).
     Rastered(Composite, Raster),
     /// PBTF per-splat compositing with another reconstruction kernel, through a raster variant.
-    Kernel(voxsplat::Kernel, Raster),
+    Kernel(voxsplat::kernel::Kernel, Raster),
     /// `Kernel` drawn at a render scale (`RenderOptions::render_scale`) and resampled to full size.
-    Scaled(voxsplat::Kernel, Raster, f32),
+    Scaled(voxsplat::kernel::Kernel, Raster, f32),
 }
 
 impl Variant {
@@ -61,7 +61,7 @@ impl Variant {
         match self {
             Variant::Raycast(_) => Reconstruction::Trilinear,
             Variant::Kernel(k, _) | Variant::Scaled(k, _, _) => Reconstruction::Kernel(*k),
-            _ => Reconstruction::Kernel(voxsplat::Kernel::Gaussian),
+            _ => Reconstruction::Kernel(voxsplat::kernel::Kernel::Gaussian),
         }
     }
 

@@ -2,5 +2,6 @@
 //! (`tests/common`).
 #[path = "../../tests/common/mod.rs"]
 mod common;
+use voxsplat as vs;
 mod soak;
 mod stability;

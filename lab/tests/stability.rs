@@ -2,14 +2,17 @@
 //! sheet buffer (slabs) that avoids them. Figures go to the bench (docs/RESULTS.md).
 use crate::common;
 use glam::Vec3;
+use voxsplat::image::ImageF32;
 use voxsplat::output::diff_rgba8;
-use voxsplat::ImageF32;
-use voxsplat::{Camera, Composite, Direction, Grid, Kernel, OrderKind, Projection, RenderOptions, SplatSet};
+use voxsplat::{
+    camera::Projection, kernel::Kernel, options::Composite, order::Direction, order::OrderKind, Camera, Grid,
+    RenderOptions, SplatSet,
+};
 use voxsplat_lab::stability::{self, Variant};
 
 #[test]
 fn slice_table_starts_at_zero_rises_and_ends_at_the_footprint() {
-    let n = voxsplat::low_level::constants::FOOTPRINT_TABLE_SIZE as usize;
+    let n = voxsplat::low_level::FOOTPRINT_TABLE_SIZE as usize;
     for kernel in [Kernel::Gaussian, Kernel::Cubic] {
         let t = kernel.slice_table();
         let rr = kernel.radius() as f64;
@@ -32,7 +35,7 @@ fn slice_table_starts_at_zero_rises_and_ends_at_the_footprint() {
 
 /// The footprint table's normaliser: its texel value over the unnormalised line integral there.
 fn norm(kernel: Kernel) -> f64 {
-    let n = voxsplat::low_level::constants::FOOTPRINT_TABLE_SIZE as usize;
+    let n = voxsplat::low_level::FOOTPRINT_TABLE_SIZE as usize;
     let rr = kernel.radius() as f64;
     let c = n / 2;
     let u = ((c as f64 + 0.5) / n as f64 * 2.0 - 1.0) * rr;
@@ -247,9 +250,9 @@ fn gpu_slab_binning_equals_the_mirror_and_is_stable() {
             o.composite = Composite::Slab;
             o.slab_thickness = [1.0, 0.5, 2.5][v % 3];
             o.direction = Some([Direction::FrontToBack, Direction::BackToFront][v % 2]);
-            o.antialias = [voxsplat::Antialias::None, voxsplat::Antialias::Swan][v % 2];
-            let g = gpu.slab_pairs(&cam, &o).unwrap();
-            let c = cpu.slab_pairs(&cam, &o).unwrap();
+            o.antialias = [voxsplat::options::Antialias::None, voxsplat::options::Antialias::Swan][v % 2];
+            let g = voxsplat::low_level::slab_pairs(&mut gpu, &cam, &o).unwrap();
+            let c = voxsplat::low_level::slab_pairs(&mut cpu, &cam, &o).unwrap();
             assert_eq!(g, c, "set {si} view {v} {kind:?}");
             eprintln!("set {si} view {v} {kind:?}: {} pairs", g.len() / 2);
             if kind == common::ViewKind::Outside {

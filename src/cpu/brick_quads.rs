@@ -9,7 +9,7 @@ use crate::gpu_types::{BrickPush, ScreenQuad, SplatParams};
 /// Each voxel's splat of the batch (`brick_params`) as its footprint in screen space.
 pub fn brick_quads(inputs: &BrickInputs<'_>, push: &BrickPush, voxels: &[[u32; 2]], quads: &mut [ScreenQuad]) {
     let mut params = vec![SplatParams::default(); push.splats as usize];
-    super::brick_params(inputs, push, voxels, &mut params);
+    super::brick_params::brick_params(inputs, push, voxels, &mut params);
     for (s, v) in voxels.iter().enumerate().take(push.splats as usize) {
         if voxel_level(*v) == 0 {
             quads[s] = screen_record(inputs.frame, &params[s]);

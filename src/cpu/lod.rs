@@ -3,7 +3,7 @@
 //! (`level_split`, `brick_level`, `cell_color`; the word codecs the brick mirrors share are in
 //! brick_words.rs).
 use super::brick::BrickInputs;
-pub use super::brick_words::{level_count, tau_code, tau_decode};
+pub use super::brick_words::{tau_code, tau_decode};
 use crate::bricks::BRICK;
 use crate::gpu_types::BrickPush;
 use crate::plan::NO_NORMAL;

@@ -8,7 +8,6 @@ use crate::plan::cell_footprint_scale;
 use glam::{Mat4, Vec2, Vec3};
 
 pub use crate::constants::CULL_RADII;
-pub use crate::volume::MAX_OPACITY;
 
 pub use crate::volume::optical_depth;
 

@@ -1,4 +1,52 @@
-//! What a frame drew (`Rendered::stats`).
+//! A rendered frame: its image, each stage's time, and what it drew (`Rendered::stats`).
+
+use super::RasterChoice;
+use crate::image::ImageF32;
+
+/// A rendered frame: premultiplied RGBA32F, row 0 at the top.
+///
+/// ```
+/// use voxsplat::{scene, Backend, Camera, RenderOptions, Renderer, RendererOptions};
+/// let mut o = RendererOptions::default();
+/// o.backend = Backend::Cpu;
+/// let mut r = Renderer::new(&o)?;
+/// let set = scene::build("cube40")?;
+/// let camera = Camera::framing(set.grid(), 64, 48);
+/// r.set_scene(set)?;
+/// let frame = r.render(&camera, &RenderOptions::default())?;
+/// assert_eq!((frame.image.width, frame.image.height), (64, 48));
+/// let ms: f64 = frame.timings.iter().map(|t| t.ms).sum(); // each stage's time
+/// # let _ = ms;
+/// # Ok::<(), voxsplat::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The frame.
+    pub image: ImageF32,
+    /// Per-stage times, in the order the stages ran.
+    pub timings: Vec<StageTime>,
+    /// The footprint stage's raster variant and why (`None` for the ray caster and the truth).
+    pub raster: Option<RasterChoice>,
+    /// What the frame drew and culled (a bricked volume's; zero elsewhere).
+    pub stats: FrameStats,
+}
+
+/// One named stage's time in milliseconds (GPU timestamps, or wall time on the CPU path).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageTime {
+    /// The stage's name (`order`, `splat_params`, `footprint`, ...).
+    pub stage: &'static str,
+    /// Milliseconds.
+    pub ms: f64,
+}
+
+/// Add `ms` to the stage named `stage` (first-seen order).
+pub fn add_time(timings: &mut Vec<StageTime>, stage: &'static str, ms: f64) {
+    match timings.iter_mut().find(|t| t.stage == stage) {
+        Some(t) => t.ms += ms,
+        None => timings.push(StageTime { stage, ms }),
+    }
+}
 
 /// What a frame drew and what it left out, and why (`Rendered::stats`): a bricked volume's bricks and
 /// splats, an isosurface's discs, a label volume's unlabelled voxels.

@@ -29,11 +29,9 @@ pub fn over_bits(format: crate::image::TargetFormat) -> u32 {
     PRESENT_OVER | layout
 }
 
-/// `Frame::aa[0]`: no anti-aliasing, Swan's, or the EWA low-pass (`params.glsl`).
-pub const AA_NONE: f32 = 0.0;
-/// See `AA_NONE`.
+/// `Frame::aa[0]`: 0 for no anti-aliasing, Swan's, or the EWA low-pass (`params.glsl`).
 pub const AA_SWAN: f32 = 1.0;
-/// See `AA_NONE`.
+/// See `AA_SWAN`.
 pub const AA_EWA: f32 = 2.0;
 
 /// The anti-aliasing radius scale at eye-space `depth` (1 before k; Eq. 3.9 or the EWA low-pass).

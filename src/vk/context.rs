@@ -380,8 +380,7 @@ impl Context {
 
     /// Test hook: renderers created on this context afterwards use the tile compositor's build
     /// without subgroup shuffles, as on a device that lacks them.
-    #[doc(hidden)]
-    pub fn disable_subgroup_shuffle(&self) {
+    pub(crate) fn disable_subgroup_shuffle(&self) {
         self.subgroup_shuffle.store(false, Ordering::Relaxed);
     }
 
@@ -434,15 +433,13 @@ impl Context {
     /// Test-only: the next submission completes on the device but reports `result` (for example
     /// `ERROR_DEVICE_LOST`, which a CPU device cannot be made to produce), so tests can follow the
     /// error path from the queue up to the caller and through Drop.
-    #[doc(hidden)]
-    pub fn inject_submit_fault(&self, result: vk::Result) {
+    pub(crate) fn inject_submit_fault(&self, result: vk::Result) {
         self.injected.store(result.as_raw(), Ordering::Release);
     }
 
     /// Test-only: makes an invalid call (a zero-sized buffer) so tests can prove the validation
     /// counter is live. Returns whether the call itself failed.
-    #[doc(hidden)]
-    pub fn provoke_validation_error(&self) -> bool {
+    pub(crate) fn provoke_validation_error(&self) -> bool {
         let info = vk::BufferCreateInfo::default()
             .size(0)
             .usage(vk::BufferUsageFlags::STORAGE_BUFFER)

@@ -1,4 +1,12 @@
 //! The thin ash layer: the only place with `unsafe`. One file per Vulkan concern.
+//!
+//! ```,no_run
+//! use voxsplat::vk::{Context, ContextOptions};
+//! // voxsplat's own Vulkan device; a host that has one passes its handles (`HostHandles`) instead.
+//! let ctx = Context::new(&ContextOptions::default())?;
+//! println!("{}", ctx.device_name());
+//! # Ok::<(), voxsplat::Error>(())
+//! ```
 mod buffer;
 mod context;
 mod debug;

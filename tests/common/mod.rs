@@ -1,6 +1,10 @@
+//! Helpers both the engine's tests and the CLI's share: renderers, random scenes and cameras, file
+//! writers, image checks. Public API only (`vs` is the crate for the one, `voxsplat` for the other).
 #![allow(dead_code)]
+use super::vs;
 use glam::Vec3;
-use voxsplat::{Backend, Camera, Grid, Projection, RenderOptions, Renderer, RendererOptions, SplatSet};
+use vs::camera::Projection;
+use vs::{Backend, Camera, Grid, RenderOptions, Renderer, RendererOptions, SplatSet};
 
 /// A GPU renderer with validation on (every GPU test asks for it).
 pub fn gpu() -> Renderer {
@@ -148,7 +152,7 @@ pub fn npy(shape: &[u64], descr: &str, data: &[u8]) -> Vec<u8> {
 
 /// A lumpy blob with empty space around it and a hollow, on a grid whose sides are not multiples
 /// of the brick side.
-pub fn blob(dims: [u32; 3]) -> voxsplat::volume::ScalarVolume {
+pub fn blob(dims: [u32; 3]) -> vs::volume::ScalarVolume {
     let c = dims.map(|d| d as f32 / 2.0);
     let mut values = Vec::new();
     for k in 0..dims[2] {
@@ -161,11 +165,11 @@ pub fn blob(dims: [u32; 3]) -> voxsplat::volume::ScalarVolume {
             }
         }
     }
-    voxsplat::volume::ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
+    vs::volume::ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
 }
 
 /// A volume with flat regions: empty space (its minimum), a block at one value, and noise.
-pub fn flat_blocks(dims: [u32; 3]) -> voxsplat::volume::ScalarVolume {
+pub fn flat_blocks(dims: [u32; 3]) -> vs::volume::ScalarVolume {
     let mut rng = Rng(44);
     let mut values = Vec::new();
     for k in 0..dims[2] {
@@ -184,12 +188,12 @@ pub fn flat_blocks(dims: [u32; 3]) -> voxsplat::volume::ScalarVolume {
             }
         }
     }
-    voxsplat::volume::ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
+    vs::volume::ScalarVolume { dims, spacing: [1.0, 1.2, 0.9], values }
 }
 
 /// The bricked tests' transfer function for `blob`.
-pub fn blob_tf() -> voxsplat::classify::TransferFunction {
-    voxsplat::classify::TransferFunction {
+pub fn blob_tf() -> vs::classify::TransferFunction {
+    vs::classify::TransferFunction {
         points: vec![(0.1, [0.0, 0.0, 0.0, 0.0]), (0.3, [0.9, 0.4, 0.2, 0.3]), (1.0, [0.9, 0.9, 1.0, 0.8])],
         gradient_weight: 0.0,
         range: None,
@@ -198,14 +202,14 @@ pub fn blob_tf() -> voxsplat::classify::TransferFunction {
 }
 
 /// Largest and mean absolute channel difference.
-pub fn diff(a: &voxsplat::ImageF32, b: &voxsplat::ImageF32) -> (f32, f32) {
+pub fn diff(a: &vs::image::ImageF32, b: &vs::image::ImageF32) -> (f32, f32) {
     let d: Vec<f32> =
         a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs())).collect();
     (d.iter().copied().fold(0.0, f32::max), d.iter().sum::<f32>() / d.len() as f32)
 }
 
 /// Pixels with any opacity.
-pub fn covered(img: &voxsplat::ImageF32) -> usize {
+pub fn covered(img: &vs::image::ImageF32) -> usize {
     img.pixels.iter().filter(|p| p[3] > 0.0).count()
 }
 
@@ -213,7 +217,7 @@ pub fn covered(img: &voxsplat::ImageF32) -> usize {
 /// at most 2e-5, 7e-4 with point sprites), the mean of each covered pixel's largest difference at
 /// most 2e-4, and something covered (a mean over every byte, background included, let a bug
 /// confined to a few pixels pass). Returns (max, mean) for the log.
-pub fn assert_mirrors(g: &voxsplat::ImageF32, c: &voxsplat::ImageF32, tag: &str) -> (f32, f64) {
+pub fn assert_mirrors(g: &vs::image::ImageF32, c: &vs::image::ImageF32, tag: &str) -> (f32, f64) {
     assert_eq!((g.width, g.height), (c.width, c.height), "{tag}: sizes");
     let (mut max, mut sum, mut n) = (0.0f32, 0.0f64, 0usize);
     for (p, q) in g.pixels.iter().zip(&c.pixels) {
@@ -308,15 +312,4 @@ pub fn nifti(
     h[344..348].copy_from_slice(b"n+1\0");
     h.extend_from_slice(v);
     h
-}
-
-/// The stage that makes a bricked batch's splats under `o` (a probe reads its outputs): the compute
-/// tiles take them as screen quads (`brick_quads`), the other rasters as parameters.
-pub fn splat_stage(o: &RenderOptions) -> voxsplat::low_level::stages::StageId {
-    use voxsplat::low_level::stages::StageId;
-    if o.raster == voxsplat::Raster::Compute {
-        StageId::BrickQuads
-    } else {
-        StageId::BrickParams
-    }
 }

@@ -6,7 +6,7 @@
 //! take) gets them over the volume as the panel's lines. Dragging a grip moves its face or the
 //! plane.
 use voxsplat::glam::{Mat4, Vec2, Vec3, Vec3Swizzles, Vec4Swizzles};
-use voxsplat::{Camera, DepthBuffer, DepthFormat};
+use voxsplat::{options::DepthBuffer, options::DepthFormat, Camera};
 
 /// What a grip moves.
 #[derive(Clone, Copy, Debug, PartialEq)]

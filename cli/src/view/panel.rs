@@ -8,7 +8,7 @@ use voxsplat::bricks::BrickStore;
 
 /// Labels listed in the panel, at most.
 const LABELS_SHOWN: usize = 64;
-use voxsplat::{Lod, Mode};
+use voxsplat::{options::Lod, options::Mode};
 
 /// The key help the panel shows (and `?` opens).
 pub const KEYS: &[(&str, &str)] = &[

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use voxsplat::bricks::Histogram;
 use voxsplat::classify::{Shading, TransferFunction};
 use voxsplat::glam::{Vec3, Vec4};
-use voxsplat::{Camera, Error, Mode, RenderOptions, Result};
+use voxsplat::{options::Mode, Camera, Error, RenderOptions, Result};
 
 /// What the panel shows and edits; the window loop applies it.
 pub struct State {
@@ -185,10 +185,10 @@ impl State {
         o.composite = self.composite.parse()?;
         o.raster = self.raster.parse()?;
         o.kernel = self.kernel.parse()?;
-        o.clip = voxsplat::Clip::new(&self.clip_planes, self.crop)?;
+        o.clip = voxsplat::options::Clip::new(&self.clip_planes, self.crop)?;
         if o.mode != Mode::Composite {
             // As `render`: a projection draws in no visibility order and at full detail.
-            (o.order, o.lod) = (voxsplat::OrderKind::Pbtf, voxsplat::Lod::Off);
+            (o.order, o.lod) = (voxsplat::order::OrderKind::Pbtf, voxsplat::options::Lod::Off);
         }
         o.validate()?;
         Ok(o)
@@ -311,7 +311,7 @@ impl State {
             order: if projection { "pbtf".into() } else { self.order.clone() },
             composite: self.composite.clone(),
             raster: self.raster.clone(),
-            lod: if projection || o.lod == voxsplat::Lod::Off { "off".into() } else { "auto".into() },
+            lod: if projection || o.lod == voxsplat::options::Lod::Off { "off".into() } else { "auto".into() },
             kernel: self.kernel.clone(),
             background: o.background.unwrap_or([0.0; 4]),
             camera: Session::view_of(cam),

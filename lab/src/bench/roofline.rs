@@ -33,9 +33,10 @@ pub fn roofline(
     let mut pts = Vec::new();
     for &size in sizes {
         let quads = (fragments / (size as u64 * size as u64)).max(1) as u32;
-        let _ = r.roofline_quads(width, height, size, quads)?;
-        let mut t: Vec<f64> =
-            (0..frames.max(1)).map(|_| r.roofline_quads(width, height, size, quads)).collect::<Result<_>>()?;
+        let _ = voxsplat::low_level::roofline_quads(r, width, height, size, quads)?;
+        let mut t: Vec<f64> = (0..frames.max(1))
+            .map(|_| voxsplat::low_level::roofline_quads(r, width, height, size, quads))
+            .collect::<Result<_>>()?;
         let ms = median(&mut t);
         let frags = quads as f64 * (size * size) as f64;
         pts.push(RooflinePoint {
@@ -47,11 +48,11 @@ pub fn roofline(
         });
     }
     let layers = 32;
-    let _ = r.roofline_composite(width, height, layers)?;
+    let _ = voxsplat::low_level::roofline_composite(r, width, height, layers)?;
     let mut a = Vec::new();
     let mut b = Vec::new();
     for _ in 0..frames.max(1) {
-        let (x, y) = r.roofline_composite(width, height, layers)?;
+        let (x, y) = voxsplat::low_level::roofline_composite(r, width, height, layers)?;
         a.push(x);
         b.push(y);
     }
@@ -71,7 +72,7 @@ pub fn footprint_fragments(set: &SplatSet, camera: &Camera, kernel: Kernel) -> R
         o
     })?;
     r.set_scene(set.clone())?;
-    let params = r.splat_params(camera, kernel, voxsplat::Antialias::None)?;
+    let params = voxsplat::low_level::splat_params(&mut r, camera, kernel, voxsplat::options::Antialias::None)?;
     let cap = camera.width as f64 * camera.height as f64;
     let mut total = 0.0;
     let mut sizes = Vec::new();

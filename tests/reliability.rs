@@ -1,13 +1,13 @@
 //! Renderers are Send and deterministic; device loss and out-of-memory are errors (the long runs
 //! that must not leak: the lab's tests, lab/tests/soak.rs).
-use crate::common;
-use voxsplat::{scene, Camera, Composite, RenderOptions};
+use super::common;
+use crate::{options::Composite, scene, Camera, RenderOptions};
 
 #[test]
 fn two_renderers_in_two_threads_render_identical_images() {
     let set = scene::build("cube40").unwrap();
     let cam = Camera::framing(set.grid(), 80, 64);
-    let run = move |set: voxsplat::SplatSet| {
+    let run = move |set: crate::SplatSet| {
         std::thread::spawn(move || {
             let mut r = common::gpu();
             r.set_scene(set).unwrap();
@@ -60,16 +60,16 @@ fn device_loss_is_an_error_that_sticks_and_the_renderer_drops_cleanly() {
     r.render(&cam, &RenderOptions::default()).unwrap();
     let ctx = r.context().expect("gpu").clone();
     assert!(!ctx.is_lost());
-    ctx.inject_submit_fault(voxsplat::vk::ash::vk::Result::ERROR_DEVICE_LOST);
+    ctx.inject_submit_fault(crate::vk::ash::vk::Result::ERROR_DEVICE_LOST);
     let err = r.render(&cam, &RenderOptions::default()).unwrap_err();
-    assert!(matches!(err, voxsplat::Error::DeviceLost(_)), "{err}");
+    assert!(matches!(err, crate::Error::DeviceLost(_)), "{err}");
     assert!(err.to_string().contains("create a new one"), "{err}");
     assert!(ctx.is_lost());
     let mut sheet = RenderOptions::default();
     sheet.composite = Composite::Sheet;
-    assert!(matches!(r.render(&cam, &sheet), Err(voxsplat::Error::DeviceLost(_))));
-    let rc = voxsplat::RaycastOptions::default();
-    assert!(matches!(r.raycast(&cam, &rc), Err(voxsplat::Error::DeviceLost(_))));
+    assert!(matches!(r.render(&cam, &sheet), Err(crate::Error::DeviceLost(_))));
+    let rc = crate::options::RaycastOptions::default();
+    assert!(matches!(r.raycast(&cam, &rc), Err(crate::Error::DeviceLost(_))));
     common::assert_clean(&r);
     drop(ctx);
     drop(r);
@@ -83,9 +83,9 @@ fn out_of_memory_at_submit_is_an_error_and_the_next_frame_renders() {
     r.set_scene(scene::build("cube40").unwrap()).unwrap();
     let cam = Camera::framing(r.scene().unwrap().grid(), 48, 48);
     let before = r.render(&cam, &RenderOptions::default()).unwrap().image;
-    r.context().unwrap().inject_submit_fault(voxsplat::vk::ash::vk::Result::ERROR_OUT_OF_DEVICE_MEMORY);
+    r.context().unwrap().inject_submit_fault(crate::vk::ash::vk::Result::ERROR_OUT_OF_DEVICE_MEMORY);
     let err = r.render(&cam, &RenderOptions::default()).unwrap_err();
-    assert!(matches!(err, voxsplat::Error::OutOfMemory(_)), "{err}");
+    assert!(matches!(err, crate::Error::OutOfMemory(_)), "{err}");
     let after = r.render(&cam, &RenderOptions::default()).unwrap().image;
     assert_eq!(before.pixels, after.pixels);
     common::assert_clean(&r);
