@@ -349,7 +349,7 @@ impl Renderer {
         scene.as_ref().ok_or_else(|| Error::InvalidArgument("no scene: call set_scene first".into()))
     }
 
-    /// Draw a frame (in bands past [`BAND_BYTES`], put together: see `render_bands`).
+    /// Draw a frame (in bands past [`BAND_BYTES`](low_level::BAND_BYTES), put together: see `render_bands`).
     pub fn render(&mut self, camera: &Camera, options: &RenderOptions) -> Result<Rendered> {
         options.validate()?;
         camera.validate()?;
@@ -365,7 +365,7 @@ impl Renderer {
         Ok(self.record(camera, &opts)?.rendered(Some(choice)))
     }
 
-    /// Draw a frame in full-width bands of at most [`BAND_BYTES`], top to bottom, handing
+    /// Draw a frame in full-width bands of at most [`BAND_BYTES`](low_level::BAND_BYTES), top to bottom, handing
     /// each to `sink` with its first row: a frame of any size in the memory of one band. Each band
     /// is a window of the camera (`Camera::windowed`) drawn with the whole frame's projection and
     /// raster, so bands meet without seams; stats are the busiest band's. Under a render scale the
