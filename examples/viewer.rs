@@ -85,7 +85,7 @@ struct Args {
     /// Levels of detail (as `render --lod`; `l` toggles them).
     #[arg(long, default_value = "auto", value_parser = ["off", "auto"])]
     lod: String,
-    /// The reconstruction kernel (as `render --kernel`).
+    /// The reconstruction kernel (as `voxsplat-lab render --kernel`).
     #[arg(long, default_value = "crawfis-max")]
     kernel: String,
     /// Draw on a grid this fraction of the window's size, stretched by the device's blit.
@@ -408,13 +408,13 @@ impl Viewer {
         options.composite = args.composite.parse::<Composite>()?;
         options.raster = args.raster.parse::<Raster>()?;
         options.lod = args.lod.parse::<Lod>()?;
-        options.order = args.scene.order.parse::<OrderKind>()?;
+        options.order = args.scene.research.order.parse::<OrderKind>()?;
         options.render_scale = args.render_scale;
         options.kernel = args.kernel.parse()?;
         voxsplat::low_level::check_scale(args.interactive_scale)?;
         options.validate()?;
         let indices = [
-            ORDERS.iter().position(|o| *o == args.scene.order).unwrap_or(0),
+            ORDERS.iter().position(|o| *o == args.scene.research.order).unwrap_or(0),
             COMPOSITES.iter().position(|c| *c == args.composite).unwrap_or(0),
             RASTERS.iter().position(|r| *r == args.raster).unwrap_or(0),
         ];

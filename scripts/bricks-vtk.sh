@@ -17,7 +17,7 @@ if [ ! -x "$VENV/bin/python" ] || ! "$VENV/bin/python" -c "import vtk" 2>/dev/nu
   python3 -m venv "$VENV" && "$VENV/bin/pip" install -q vtk numpy pillow
 fi
 [ -f "$LARGE/procedural1024.nrrd" ] || ./scripts/large-volumes.sh "$LARGE" >&2
-cargo build --release --quiet
+cargo build --release --quiet -p voxsplat-cli -p voxsplat-lab
 export VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow
 cat <<'TEXT'
 ### Beside VTK on the same files
@@ -53,11 +53,11 @@ for f in ../shared/data/bonsai/bonsai.nii.gz "$LARGE/bonsai512.nrrd" "$LARGE/pro
   truth="-"
   if [ "$voxels" -le 268435456 ]; then
     t=target/truth-$(basename "$f").exr
-    ./target/release/voxsplat render --volume "$f" --tf $tf --size 512x512 --raycast 0.25 --supersample 4 \
+    ./target/release/voxsplat-lab render --volume "$f" --tf $tf --size 512x512 --raycast 0.25 --supersample 4 \
       --raycast-stop 1e-4 --cpu --out "$t" >/dev/null
     psnr=()
     for lod in off auto; do
-      ./target/release/voxsplat render --volume "$f" --tf $tf --size 512x512 --raster compute --direction ftb \
+      ./target/release/voxsplat-lab render --volume "$f" --tf $tf --size 512x512 --raster compute --direction ftb \
         --lod $lod --lod-pixels 1 --out "target/frame-$lod.exr" >/dev/null
       psnr+=("$(./target/release/voxsplat compare "target/frame-$lod.exr" "$t" | sed -nE 's/^psnr: *([0-9.]+) dB.*/\1/p')")
     done

@@ -19,10 +19,12 @@ if [ ! -x "$VENV/bin/python" ] || ! "$VENV/bin/python" -c "import vtk" 2>/dev/nu
 fi
 [ -f "$LARGE/procedural1024.nrrd" ] || ./scripts/large-volumes.sh "$LARGE" >&2
 [ -f "$LARGE/procedural256.nrrd" ] || ./target/release/voxsplat make-volume --procedural 256 --out "$LARGE/procedural256.nrrd" >&2
-cargo build --release --quiet
+cargo build --release --quiet -p voxsplat-cli -p voxsplat-lab
 mkdir -p "$WORK"
 export VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow
 vs=./target/release/voxsplat
+# `render` with the research switches (--repeat, the engine's paths, the reference's settings).
+lab=./target/release/voxsplat-lab
 PREVIOUS="--kernel gaussian --early-termination 0 --lod off"
 stages=()
 wall() { sed -nE 's/^frame, wall: +([0-9.]+) ms.*/\1/p' <<< "$1"; }
@@ -33,21 +35,21 @@ for spec in "../shared/data/bonsai/bonsai.nii.gz|bonsai" "$LARGE/bonsai512.nrrd|
   name=$(basename "$f")
   shade=(); $vs info "$f" >/dev/null
   [ "$tf" = bonsai ] && shade=(--shade)
-  log=$($vs render --volume "$f" --tf "$tf" --size 512x512 --repeat $((FRAMES + 1)) --timings --out "$WORK/cost-$name.exr" 2>&1)
+  log=$($lab render --volume "$f" --tf "$tf" --size 512x512 --repeat $((FRAMES + 1)) --timings --out "$WORK/cost-$name.exr" 2>&1)
   cam=$(grep "camera (grid frame)" <<< "$log")
   stored=$(sed -nE 's/^([0-9]+) stored voxels in.*/\1/p' <<< "$log" | head -1)
   vtk=$("$VENV/bin/python" scripts/vtk_file.py --file "$f" --tf "$tf" --frames "$FRAMES" --camera "$cam" "${shade[@]}" \
     --out "$WORK/vtk-$name.png" 2>&1 | grep -E "median=")
   vtk_ms=$(sed -E 's/.*median=([0-9.]+)s.*/\1/' <<< "$vtk" | awk '{print $1 * 1000}')
   # shellcheck disable=SC2086
-  prev=$($vs render --volume "$f" --tf "$tf" --size 512x512 --repeat $((FRAMES + 1)) --timings $PREVIOUS \
+  prev=$($lab render --volume "$f" --tf "$tf" --size 512x512 --repeat $((FRAMES + 1)) --timings $PREVIOUS \
     --out "$WORK/cost-prev-$name.exr" 2>&1)
   ms=$(wall "$log"); prev_ms=$(wall "$prev")
   ratio=$(awk -v a="$vtk_ms" -v b="$ms" 'BEGIN {printf "%.3f", a / b}')
   psnr="-"
   ref="$WORK/truth-$name-k4-s0.25.exr"
   if [ "$stored" -le 268435456 ] && [ "$name" != procedural1024.nrrd ]; then
-    [ -f "$ref" ] || $vs render --volume "$f" --tf "$tf" --size 512x512 --raycast 0.25 --raycast-stop 1e-4 --cpu \
+    [ -f "$ref" ] || $lab render --volume "$f" --tf "$tf" --size 512x512 --raycast 0.25 --raycast-stop 1e-4 --cpu \
       --supersample 4 --out "$ref" >/dev/null 2>&1
     p() { $vs compare "$1" "$ref" | awk '/^psnr:/ {print $2}'; }
     psnr="$(p "$WORK/cost-$name.exr"), $(p "$WORK/cost-prev-$name.exr")"

@@ -18,8 +18,10 @@ SIZES=${SIZES:-"32 128 512"}
 VIEWS=${VIEWS:-"auto anterior grazing"}
 EXTRA=${EXTRA:-}
 # VS: another build of voxsplat to draw the frames with (the references are cached in $WORK).
-if [ -z "${VS:-}" ]; then cargo build --release --quiet; fi
+if [ -z "${VS:-}" ]; then cargo build --release --quiet -p voxsplat-cli -p voxsplat-lab; fi
 vs=${VS:-./target/release/voxsplat}
+# `render` with the research switches (--repeat, the reference's settings): the lab beside it.
+lab=$(dirname "$vs")/voxsplat-lab
 # SMALL=1: the small family (crops; what the CI test draws).
 args=()
 [ -n "${ONLY:-}" ] && args+=(--only "$ONLY")
@@ -47,7 +49,7 @@ PY
 frame() { # out flags... -> median ms
   local out=$1; shift
   # shellcheck disable=SC2068
-  $vs render "$@" --repeat "$FRAMES" --timings --out "$out" 2>&1 | awk '/ ms$/ {s += $2} END {printf "%.0f", s}'
+  $lab render "$@" --repeat "$FRAMES" --timings --out "$out" 2>&1 | awk '/ ms$/ {s += $2} END {printf "%.0f", s}'
 }
 echo "| volume | size | view | default dB | --lod off dB | default ms | --lod off ms | ratio | |"
 echo "|---|---:|---|---:|---:|---:|---:|---:|---|"
@@ -69,17 +71,17 @@ while IFS='|' read -r name file tf; do
       against=""
       crops="$WORK/truth-$name-$size-$view-k$k-crops.exr"
       if [ -f "$crops" ] || { [ ! -f "$ref" ] &&
-        ! $vs render "${common[@]}" --raycast 0.25 --raycast-stop 1e-4 --cpu --supersample "$k" \
+        ! $lab render "${common[@]}" --raycast 0.25 --raycast-stop 1e-4 --cpu --supersample "$k" \
           --out "$ref" >/dev/null 2>"$WORK/err.txt"; }; then
         if [ ! -f "$crops" ]; then
           grep -q "too large" "$WORK/err.txt" || { echo "| $name | $size | $view | refused: $(head -c 120 "$WORK/err.txt" | tr '\n|' '  ') | | | | | |"; continue; }
         fi
         # shellcheck disable=SC2046
-        if cam=$(python3 scripts/sparse-truth.py "$file" --camera --tf "$tf" --vs "$vs" -- --size "${size}x${size}" $(view_flags "$view" "$file") 2>"$WORK/err.txt"); then
+        if cam=$(python3 scripts/sparse-truth.py "$file" --camera --tf "$tf" --vs "$lab" -- --size "${size}x${size}" $(view_flags "$view" "$file") 2>"$WORK/err.txt"); then
           # shellcheck disable=SC2206
           common=(--volume "$file" --tf "$tf" $cam)
           ref=$crops
-          [ -f "$ref" ] || python3 scripts/sparse-truth.py "$file" "$ref" --tf "$tf" --vs "$vs" --work "$WORK/crops" -- \
+          [ -f "$ref" ] || python3 scripts/sparse-truth.py "$file" "$ref" --tf "$tf" --vs "$lab" --work "$WORK/crops" -- \
             "${common[@]:4}" --raycast 0.25 --raycast-stop 1e-4 --cpu --supersample "$k" 2>>"$WORK/err.txt" || ref=""
         else
           ref=""

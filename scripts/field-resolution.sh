@@ -21,8 +21,10 @@ ref="$FAMILY/truth-field1024-512-auto-k4-crops.exr"
 for f in "$field" "$ref"; do
   [ -f "$f" ] || { echo "field-resolution: $f is missing; make it with: ONLY=field1024 SIZES=512 VIEWS=auto scripts/family-bench.sh" >&2; exit 1; }
 done
-if [ -z "${VS:-}" ]; then cargo build --release --quiet; fi
+if [ -z "${VS:-}" ]; then cargo build --release --quiet -p voxsplat-cli -p voxsplat-lab; fi
 vs=${VS:-./target/release/voxsplat}
+# `render` with the research switches (--repeat, the reference's settings): the lab beside it.
+lab=$(dirname "$vs")/voxsplat-lab
 mkdir -p "$WORK"
 # shellcheck disable=SC2207
 cam=($(python3 scripts/sparse-truth.py "$field" --camera --tf ramp --vs "$vs" -- --size 512x512))
@@ -54,7 +56,7 @@ echo "| volume | splats | ms | dB against the 1024³ reference |"
 echo "|---|---:|---:|---:|"
 for row in "1024:$field:1" "512:$WORK/field512.nrrd:2" "256:$WORK/field256.nrrd:4"; do
   IFS=: read -r n file k <<<"$row"
-  "$vs" render --volume "$file" --tf "$WORK/ramp$k.toml" "${cam[@]}" --lod off --repeat "$FRAMES" --timings \
+  "$lab" render --volume "$file" --tf "$WORK/ramp$k.toml" "${cam[@]}" --lod off --repeat "$FRAMES" --timings \
     --out "$WORK/frame$n.exr" >"$WORK/frame$n.log" 2>&1
   splats=$(grep -o "drawn: [0-9]* splats" "$WORK/frame$n.log" | awk '{printf "%.1f M", $2 / 1e6}')
   ms=$(awk '/ ms$/ {s += $2} END {printf "%.0f", s}' "$WORK/frame$n.log")

@@ -18,7 +18,7 @@ FRAMES=${FRAMES:-5}
 if [ ! -x "$VENV/bin/python" ] || ! "$VENV/bin/python" -c "import vtk, PIL, numpy" 2>/dev/null; then
   python3 -m venv "$VENV" && "$VENV/bin/pip" install -q vtk numpy pillow
 fi
-cargo build --release --quiet
+cargo build --release --quiet -p voxsplat-cli -p voxsplat-lab
 export VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow
 work=target/gallery
 out=docs/img/gallery
@@ -27,12 +27,14 @@ mkdir -p "$work" "$out"
 # No brain MRI in ../shared/data: the mri preset is shown on the T1 head phantom.
 [ -f "$work/head256.nrrd" ] || ./target/release/voxsplat make-volume --phantom 256 --out "$work/head256.nrrd" >&2
 vs=./target/release/voxsplat
+# `render` with the research switches (--repeat, the engine's paths, the reference's settings).
+lab=./target/release/voxsplat-lab
 echo "| data | preset, view | voxsplat ms | VTK GPU ray cast ms | VTK / voxsplat | PSNR over the object, dB | contrast |"
 echo "|---|---|---|---|---|---|---|"
 while IFS='|' read -r name file tf shade; do
-  flags=(--no-shade)
+  flags=(--shade off)
   [ "$shade" = shade ] && flags=(--shade)
-  log=$("$vs" render --volume "$file" --tf "$tf" "${flags[@]}" --size 512x512 --repeat "$FRAMES" --timings \
+  log=$("$lab" render --volume "$file" --tf "$tf" "${flags[@]}" --size 512x512 --repeat "$FRAMES" --timings \
     --out "$work/$name-voxsplat.png" 2>&1)
   cam=$(grep "camera (grid frame)" <<< "$log")
   if "$vs" info "$file" | grep "^orientation: none" >/dev/null; then view=framing; else view=oblique; fi
@@ -64,7 +66,7 @@ ROWS
 # (scripts/vtk_terrain.py), voxsplat's default fly-over.
 dem=$DATA/rmnp/rmnp-dem.tif
 rgb=$DATA/rmnp/rmnp-rgb.png
-log=$("$vs" render --terrain "$dem" --color "$rgb" --size 512x512 --repeat "$FRAMES" --timings \
+log=$("$lab" render --terrain "$dem" --color "$rgb" --size 512x512 --repeat "$FRAMES" --timings \
   --out "$work/rmnp-voxsplat.png" 2>&1)
 t=$(grep -E "^[a-z_]+ +[0-9.]+ ms" <<< "$log" | awk '{s += $2} END {printf "%.1f", s}')
 vtk=$("$VENV/bin/python" scripts/vtk_terrain.py --dem "$dem" --color "$rgb" --camera "$(grep "camera (grid frame)" <<< "$log")" \

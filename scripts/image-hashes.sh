@@ -36,13 +36,13 @@ for be in gpu cpu; do
     run $be-$scene-splat-compute-et "${s[@]}" --raster compute --early-termination 0.01
     run $be-$scene-splat-auto "${s[@]}"
     for r in graphics points compute; do
-      run $be-$scene-sheet-$r "${s[@]}" --composite sheet --raster $r
-      run $be-$scene-slab-$r "${s[@]}" --composite slab --raster $r
+      run $be-$scene-sheet-$r "${s[@]}" --accumulate sheet --raster $r
+      run $be-$scene-slab-$r "${s[@]}" --accumulate slab --raster $r
     done
-    run $be-$scene-sheet-btf "${s[@]}" --composite sheet --direction btf --raster graphics
-    run $be-$scene-sheet-et "${s[@]}" --composite sheet --early-termination 0.01 --raster graphics
-    run $be-$scene-sheet-budget "${s[@]}" --composite sheet --sheet-budget-mib 1 --raster graphics
-    run $be-$scene-slab-thick "${s[@]}" --composite slab --slab-thickness 2.5 --raster compute
+    run $be-$scene-sheet-btf "${s[@]}" --accumulate sheet --direction btf --raster graphics
+    run $be-$scene-sheet-et "${s[@]}" --accumulate sheet --early-termination 0.01 --raster graphics
+    run $be-$scene-sheet-budget "${s[@]}" --accumulate sheet --sheet-budget-mib 1 --raster graphics
+    run $be-$scene-slab-thick "${s[@]}" --accumulate slab --slab-thickness 2.5 --raster compute
     run $be-$scene-cubic-swan "${s[@]}" --kernel cubic --aa swan --raster graphics
     run $be-$scene-narrow-ewa "${s[@]}" --kernel narrow --aa ewa --raster compute
     run $be-$scene-scaled "${s[@]}" --render-scale 0.5 --raster compute
@@ -51,7 +51,7 @@ for be in gpu cpu; do
   done
   run $be-plane-grazing-swan --scene plane --view grazing --aa swan --size 128x96 "${cpu[@]}" --raster graphics
   run $be-plane-grazing-compute --scene plane --view grazing --size 128x96 "${cpu[@]}" --raster compute
-  run $be-plane-grazing-sheet --scene plane --view grazing --size 128x96 "${cpu[@]}" --composite sheet --raster compute
+  run $be-plane-grazing-sheet --scene plane --view grazing --size 128x96 "${cpu[@]}" --accumulate sheet --raster compute
 done
 run truth-cube40 --scene cube40 --size 64x48 --truth
 # Bricked volumes from ../shared/data (or $VOXSPLAT_DATA): levels of detail with their nodes, waves
@@ -63,7 +63,7 @@ if [ -d "$data/bonsai" ]; then
   run bricked-bonsai "${b[@]}" --size 128x128
   run bricked-bonsai-lod-off "${b[@]}" --size 128x128 --lod off
   run bricked-bonsai-nodes "${b[@]}" --lod-nodes --size 48x48
-  run bricked-bonsai-flat "${b[@]}" --size 128x128 --no-shade --early-termination 0
+  run bricked-bonsai-flat "${b[@]}" --size 128x128 --shade off --early-termination 0
   run bricked-stent "${st[@]}" --size 128x128
   run bricked-stent-streamed "${st[@]}" --size 128x128 --gpu-budget-mib 4
   run bricked-stent-cpu "${st[@]}" --size 64x64 --cpu
@@ -72,7 +72,7 @@ fi
 for blur in splat accum:3; do
   for comp in splat sheet; do
     d="$out/anim-$blur-$comp"
-    "$animate" animate --anim rotating-box --blur $blur --composite $comp --format exr --out-dir "$d" >/dev/null 2>&1 \
+    "$animate" animate --anim rotating-box --blur $blur --accumulate $comp --format exr --out-dir "$d" >/dev/null 2>&1 \
       || { echo "anim-$blur-$comp FAILED"; continue; }
     echo "anim-$blur-$comp $($hash "$d"/*.exr | sha256sum | cut -c1-16)"
   done

@@ -16,8 +16,10 @@ LARGE=${LARGE:-target/large}
 # One variant a line: a label, '|', then render flags ('' : the defaults).
 VARIANTS=${VARIANTS:-"defaults|"}
 mkdir -p "$WORK"
-cargo build --release --quiet
+cargo build --release --quiet -p voxsplat-cli -p voxsplat-lab
 vs=./target/release/voxsplat
+# `render` with the research switches (--repeat, the engine's paths, the reference's settings).
+lab=./target/release/voxsplat-lab
 [ -f "$WORK/procedural256.nrrd" ] || $vs make-volume --procedural 256 --out "$WORK/procedural256.nrrd" >&2
 [ -f "$WORK/head256.nrrd" ] || $vs make-volume --phantom 256 --out "$WORK/head256.nrrd" >&2
 FILES=${FILES:-"bonsai|$DATA/bonsai/bonsai.nii.gz|bonsai
@@ -28,7 +30,7 @@ head-phantom|$WORK/head256.nrrd|mri"}
 psnr() { $vs compare "$1" "$2" | awk '/^psnr:/ {print $2}'; }
 truth() { # name file tf k step -> path
   local t="$WORK/truth-$1-k$4-s$5.exr"
-  [ -f "$t" ] || $vs render --volume "$2" --tf "$3" --size 512x512 --raycast "$5" --raycast-stop 1e-4 --cpu \
+  [ -f "$t" ] || $lab render --volume "$2" --tf "$3" --size 512x512 --raycast "$5" --raycast-stop 1e-4 --cpu \
     --supersample "$4" --out "$t" >/dev/null
   echo "$t"
 }
@@ -39,7 +41,7 @@ while IFS='|' read -r name file tf; do
   conv="$(psnr "$(truth "$name" "$file" "$tf" $((K / 2)) 0.25)" "$ref") / $(psnr "$(truth "$name" "$file" "$tf" $((2 * K)) 0.25)" "$ref") / $(psnr "$(truth "$name" "$file" "$tf" "$K" 0.125)" "$ref")"
   while IFS='|' read -r label flags; do
     # shellcheck disable=SC2086
-    ms=$($vs render --volume "$file" --tf "$tf" --size 512x512 --repeat "$FRAMES" --timings $flags \
+    ms=$($lab render --volume "$file" --tf "$tf" --size 512x512 --repeat "$FRAMES" --timings $flags \
       --out "$WORK/frame.exr" 2>&1 | awk '/ ms$/ {s += $2} END {printf "%.0f", s}')
     echo "| $name | $tf | $conv | $label | $ms | $(psnr "$WORK/frame.exr" "$ref") |"
     conv=""

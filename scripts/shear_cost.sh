@@ -8,7 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROUNDS=${1:-5}
-cargo build --release --quiet
+cargo build --release --quiet -p voxsplat-cli -p voxsplat-lab
 work=target/shear
 mkdir -p "$work"
 python3 - "../shared/data/bonsai/bonsai.nii.gz" "$work" <<'PY'
@@ -25,6 +25,8 @@ for name, tilt in [("aligned", 0.0), ("tilted", math.tan(math.radians(30)))]:
         f.write(d)
 PY
 vs=./target/release/voxsplat
+# `render` with the research switches (--repeat, the engine's paths, the reference's settings).
+lab=./target/release/voxsplat-lab
 # One camera for both: 700 mm anterior of each grid's centre (RAS), looking posterior, superior up
 # (the default framing would fit each file's own box, and the tilted box is larger).
 declare -A centre=([aligned]="127.5,127.5,127.5" [tilted]="127.5,201.1,127.5")
@@ -32,7 +34,7 @@ declare -A eye=([aligned]="127.5,827.5,127.5" [tilted]="127.5,901.1,127.5")
 time_of() {  # name, extra flags...
   local f=$work/bonsai-$1.nii.gz
   local name=$1; shift
-  "$vs" render --volume "$f" --tf bonsai --no-shade --eye "${eye[$name]}" --target "${centre[$name]}" --up 0,0,1 \
+  "$lab" render --volume "$f" --tf bonsai --shade off --eye "${eye[$name]}" --target "${centre[$name]}" --up 0,0,1 \
     --size 512x512 --timings \
     --out "$work/$name-$mode.png" "$@" 2>&1 | grep -E "^[a-z_]+ +[0-9.]+ ms" | awk '{s += $2} END {printf "%.1f", s}'
 }

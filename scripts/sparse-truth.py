@@ -207,7 +207,7 @@ def main():
     p.add_argument("out", nargs="?")
     p.add_argument("--camera", action="store_true", help="print the explicit camera flags of the view and stop")
     p.add_argument("--tf", required=True)
-    p.add_argument("--vs", default=os.path.join(os.path.dirname(__file__), "..", "target", "release", "voxsplat"))
+    p.add_argument("--vs", default=os.path.join(os.path.dirname(__file__), "..", "target", "release", "voxsplat-lab"))
     p.add_argument("--work", help="where the crops go (default: a temporary folder)")
     p.add_argument("--tile", type=int, default=TILE, help=f"most voxels a crop holds; larger clumps are cut into tiles (default {TILE})")
     argv = sys.argv[1:]

@@ -426,7 +426,7 @@ impl RenderOptions {
         if self.mode.is_projection() {
             let refuse = |what: &str| {
                 Err(Error::InvalidArgument(format!(
-                    "--mode {}: {what}; the projection modes are order-independent splats (--composite splat, \
+                    "--mode {}: {what}; the projection modes are order-independent splats (--accumulate splat, \
                      no order, direction or motion blur)",
                     self.mode
                 )))
@@ -465,12 +465,12 @@ impl RenderOptions {
         }
         if self.depth.is_some() && self.composite != Composite::Splat {
             return Err(Error::InvalidArgument(
-                "the host's depth buffer hides splats per pixel as they are composited: use --composite splat".into(),
+                "the host's depth buffer hides splats per pixel as they are composited: use --accumulate splat".into(),
             ));
         }
         if self.slotted() && self.composite != Composite::Splat {
             return Err(Error::InvalidArgument(
-                "the slotted blur composites each half of the shutter per splat: use --composite splat".into(),
+                "the slotted blur composites each half of the shutter per splat: use --accumulate splat".into(),
             ));
         }
         if !(0.0..1.0).contains(&self.early_termination) {

@@ -169,7 +169,7 @@ fn a_depth_buffer_that_does_not_fit_is_refused() {
     let mut o = RenderOptions::default();
     o.depth = Some(Arc::new(good));
     o.composite = crate::Composite::Sheet;
-    assert!(r.render(&cam, &o).unwrap_err().to_string().contains("--composite splat"));
+    assert!(r.render(&cam, &o).unwrap_err().to_string().contains("--accumulate splat"));
 }
 
 #[test]

@@ -146,7 +146,7 @@ fn blurred_frames_match_the_cpu_mirror_and_approach_the_accumulation_buffer() {
         for blur in ["splat:arc+tapered", "splat:arc+teardrop", "splat:arc", "splat:tapered", "splat:arc+slotted"] {
             if blur.ends_with("slotted") && composite != Composite::Splat {
                 let e = render_frame(&mut gpu, &spin, &grid, 9, blur.parse().unwrap(), &o).unwrap_err();
-                assert!(e.to_string().contains("--composite splat"), "{e}");
+                assert!(e.to_string().contains("--accumulate splat"), "{e}");
                 continue;
             }
             o.raster = if blur == "splat:arc" { Raster::Auto } else { Raster::Graphics };

@@ -1,11 +1,9 @@
 //! The voxsplat command line: list scenes, render a frame, dump or check a visibility order.
 use clap::{Args, Parser, Subcommand};
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use voxsplat::{
-    options::Composite, order, order::Direction, order::OrderKind, scene, Backend, Error, RenderOptions, Renderer,
-    RendererOptions, Result,
+    options::Composite, order::OrderKind, scene, Backend, Error, RenderOptions, Renderer, RendererOptions, Result,
 };
 use voxsplat_cli::open::*;
 
@@ -46,8 +44,6 @@ enum Command {
     /// Open a window with the volume and a panel: modes, shading, the transfer function over the
     /// data's histogram, the value under the pointer, sessions and screenshots.
     View(Box<voxsplat_cli::view::ViewArgs>),
-    /// Write or check a visibility order (back to front).
-    Order(Box<OrderArgs>),
     /// Describe a volume or height file: dims, spacing, value range, splats at the default
     /// classification and GPU bytes per splat.
     Info {
@@ -150,9 +146,10 @@ struct AnimateArgs {
     /// --volume.
     #[arg(long)]
     blur: Option<String>,
-    /// Per-splat compositing or sheet summation.
+    /// How footprints accumulate: composited per splat, or summed into Westover's axis-aligned
+    /// sheets (`--mode composite`, the picture, is another idea).
     #[arg(long, default_value = "splat", value_parser = ["splat", "sheet"])]
-    composite: String,
+    accumulate: String,
     /// Frame files: png or exr.
     #[arg(long, default_value = "png", value_parser = ["png", "exr"])]
     format: String,
@@ -162,8 +159,8 @@ struct AnimateArgs {
     /// With --volume (a 4-D NIfTI, or an OME-Zarr image with a time axis): one frame per time
     /// point, from the view the scene flags describe, the whole series classified by one
     /// transfer function over its value range; an OME-Zarr image that --eye and --target see in
-    /// part is read only there. Without it, the animation's own scene and camera (only --order,
-    /// --cpu and --validation apply).
+    /// part is read only there. Without it, the animation's own scene and camera (only --cpu
+    /// and --validation apply).
     #[command(flatten)]
     scene: SceneArgs,
     /// The scene flags given on the command line, a default's value included (an animation
@@ -172,21 +169,6 @@ struct AnimateArgs {
     given: Vec<String>,
 }
 
-#[derive(Args)]
-struct OrderArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    /// Write the back-to-front sequence as `i,j,k,x,y,z` lines.
-    #[arg(long)]
-    dump: Option<PathBuf>,
-    /// Count pairs drawn in the wrong order: in image space (splats covering a pixel drawn against
-    /// their depth along its ray, the default kernel's footprints; `pixel inversions: N`), then
-    /// 6-neighbours (prints `violations: N` last).
-    #[arg(long)]
-    check: bool,
-}
-
-/// `info`'s line about the bricked store.
 /// An OME-Zarr image's axes and pyramid, one line per level.
 fn print_ome_zarr(image: &voxsplat::loaders::OmeZarr) {
     let axes: Vec<String> = image
@@ -487,49 +469,13 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Order(a) => {
-            let (set, content) = load_scene(&a.scene)?;
-            let cam = camera_of(&a.scene, set.grid(), &content)?;
-            let kind = a.scene.order.parse::<OrderKind>()?;
-            let seq = if kind == OrderKind::Pbtf && !a.scene.cpu {
-                let mut r = renderer_of(&a.scene)?;
-                r.set_scene(set.clone())?;
-                let s = voxsplat::low_level::pbtf_order(&mut r, &cam, Direction::BackToFront)?;
-                report_validation(&r)?;
-                s
-            } else {
-                order::visibility_order(&set, &cam, kind, Direction::BackToFront)
-            };
-            if let Some(path) = &a.dump {
-                let io = |e| Error::Io { path: path.display().to_string(), source: e };
-                let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-                for &s in &seq {
-                    let ijk = set.splats()[s as usize].ijk;
-                    let p = set.grid().position([ijk[0], ijk[1], ijk[2]]);
-                    writeln!(f, "{},{},{},{},{},{}", ijk[0], ijk[1], ijk[2], p.x, p.y, p.z).map_err(io)?;
-                }
-                f.flush().map_err(io)?;
-            }
-            println!("splats: {}", seq.len());
-            if a.check {
-                let radius = voxsplat::kernel::Kernel::default().radius();
-                let p = order::count_pixel_inversions(&set, &cam, &seq, Direction::BackToFront, radius)?;
-                println!(
-                    "pixel inversions: {} in {} of {} covered pixels, {} of them between kernels apart along the ray",
-                    p.inversions, p.pixels, p.covered, p.separated
-                );
-                let v = order::count_violations(&set, &cam, &seq, Direction::BackToFront)?;
-                println!("violations: {v}");
-            }
-            Ok(())
-        }
     }
 }
 
 fn animate(a: Box<AnimateArgs>) -> Result<()> {
     use voxsplat::animate::{render_frame, Animation, Blur};
     voxsplat::output::ImageFormat::of(std::path::Path::new(&format!("frame.{}", a.format)))?;
-    let composite = a.composite.parse::<Composite>()?;
+    let composite = a.accumulate.parse::<Composite>()?;
     let out = |dir: &std::path::Path| {
         std::fs::create_dir_all(dir).map_err(|e| Error::Io { path: dir.display().to_string(), source: e })?;
         // Frames go to the GIF as they are drawn: one frame held at a time.
@@ -569,7 +515,7 @@ fn animate(a: Box<AnimateArgs>) -> Result<()> {
     anim.check_path(&grid, blur)?;
     let mut opts = RenderOptions::default();
     opts.composite = composite;
-    opts.order = a.scene.order.parse::<OrderKind>()?;
+    opts.order = a.scene.research.order.parse::<OrderKind>()?;
     let mut r = renderer_of(&a.scene)?;
     r.set_scene(set)?;
     let mut gif = out(&a.out_dir)?;
@@ -586,8 +532,8 @@ fn animate(a: Box<AnimateArgs>) -> Result<()> {
     Ok(())
 }
 
-/// An animation sets its own scene and camera: the scene flags (other than --order, --cpu and
-/// --validation) would be ignored.
+/// An animation sets its own scene and camera: the scene flags (other than --cpu and --validation)
+/// would be ignored.
 fn refuse_scene_flags(s: &SceneArgs, given: &[String]) -> Result<()> {
     let named = |id: &str| given.iter().any(|g| g == id);
     let given = [
@@ -596,7 +542,7 @@ fn refuse_scene_flags(s: &SceneArgs, given: &[String]) -> Result<()> {
         (s.fov.is_some() || s.ortho.is_some() || s.near.is_some() || s.far.is_some(), "the projection flags"),
         (named("size"), "--size"),
         (named("view"), "--view"),
-        (s.tf.is_some() || s.shade || s.no_shade, "--tf and shading"),
+        (s.tf.is_some() || s.shade.is_some(), "--tf and --shade"),
         (s.labels.is_some() || !s.channels.is_empty() || !s.channel_tfs.is_empty(), "--labels and --channel"),
         (s.terrain.is_some() || s.color.is_some() || named("vscale") || named("cell"), "the terrain flags"),
         (s.series.is_some() || s.level.is_some() || s.time.is_some(), "--series, --level and --time"),

@@ -211,7 +211,7 @@ pub fn headlight(
         return s.shading();
     }
     let by_default = voxsplat::classify::SHADED_PRESETS.contains(&tf_spec(a));
-    (a.shade || by_default && !a.no_shade).then(|| {
+    a.shading().unwrap_or(by_default).then(|| {
         let g = voxsplat::Grid::centered(dims, spacing).ok();
         let content = Content { orientation, bounds: None };
         let forward = g.and_then(|g| camera_of(a, &g, &content).ok()).map(|c| c.forward()).unwrap_or(Vec3::NEG_Z);

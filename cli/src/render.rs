@@ -11,7 +11,7 @@ use voxsplat::{
 
 /// The switches of `voxsplat-lab render` that measure the renderer rather than set up a picture: the
 /// reference and the k line, the engine's paths and budgets kept apart from the defaults.
-#[derive(Args, Clone, Debug, Default)]
+#[derive(Args, Clone, Debug)]
 #[command(next_help_heading = "Research")]
 pub struct Research {
     /// Bricked volumes: also draw the bricks that nearer ones already hide (slower; pixels move by
@@ -22,7 +22,7 @@ pub struct Research {
     /// the brightest voxel there (slower; the others add next to nothing).
     #[arg(long)]
     pub every_voxel: bool,
-    /// Slab thickness in voxel spacings for `--composite slab` (at least 0.25) [default: 1].
+    /// Slab thickness in voxel spacings for `--accumulate slab` (at least 0.25) [default: 1].
     #[arg(long, value_parser = parse_finite)]
     pub slab_thickness: Option<f32>,
     /// Octaves of projected size (0 to 1) over which a brick's splats morph toward its next level
@@ -41,14 +41,88 @@ pub struct Research {
     /// front (the default where per-splat footprints go through the graphics or point pipelines).
     #[arg(long, value_parser = ["ftb", "btf"])]
     pub direction: Option<String>,
-    /// Memory budget for one batch of sheet summation layers (--composite sheet or slab), in MiB
+    /// Memory budget for one batch of sheet summation layers (--accumulate sheet or slab), in MiB
     /// [default: 256].
     #[arg(long)]
     pub sheet_budget_mib: Option<u64>,
     /// Render the volumetric-summation truth (CPU, f64) with --kernel's reconstruction.
-    // (The conflicts are declared here: `voxsplat render` has no --truth for its flags to name.)
+    // (The conflicts are declared here: `voxsplat render` has none of these flags for its own to
+    // name; clap checks that every name exists.)
     #[arg(long, conflicts_with_all = ["raycast", "repeat", "plan"])]
     pub truth: bool,
+    /// How footprints accumulate: composited per splat (the default), summed into Westover's
+    /// axis-aligned sheet buffer, or into image-aligned sheets (slabs parallel to the image plane,
+    /// Mueller & Crawfis 1998). (`--mode composite` is what a pixel shows; this is how.)
+    #[arg(long, default_value = "splat", value_parser = ["splat", "sheet", "slab"], conflicts_with = "session")]
+    pub accumulate: String,
+    /// Front to back, stop drawing where what is drawn already lets at most this much light
+    /// through (0 = off; the default, a quarter of an 8-bit step, changes a value by at most one
+    /// step). No pixel changes by more than this.
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_EARLY_TERMINATION)]
+    pub early_termination: f32,
+    /// How footprints become pixels: instanced quads (graphics), point sprites (points), compute
+    /// shaders (tile compositing / fixed-point sheet sums), or auto (on a CPU device: compute for
+    /// small footprints, else point sprites where they fit, else graphics; graphics on hardware; it
+    /// prints what it picked).
+    #[arg(long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"], conflicts_with = "session")]
+    pub raster: String,
+    /// Largest projected cell spacing of a coarse level, in pixels (above 0, at most 64).
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
+    pub lod_pixels: f32,
+    /// Largest error of a coarse level, 0 to 3: how far a cell's children depart from it, or its
+    /// neighbours from its linear continuation, in the opacity a ray crossing a brick (8 voxels) sees
+    /// (summed down the levels), times the share of a pixel a cell smaller than one covers, and up to
+    /// 4 times more where the view runs along a grid axis. On translucent volumes about the largest
+    /// change of a pixel (0.04: about 10 steps of 8 bits). 3: no bound; 0: only cells equal to their
+    /// children coarsen.
+    #[arg(long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
+    pub lod_error: f32,
+    /// Reconstruction kernel: the piecewise cubic fitted by Crawfis and Max's criterion (the
+    /// default: radius 1.6, flat sheets stay flat to 0.37 %, closest to the ray-cast picture but for
+    /// narrow), Westover's Gaussian (sigma 0.6, radius 2: softer), the Hermite cubic of Crawfis and
+    /// Max's support (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: sharpest and
+    /// fewest fragments, but flat sheets ripple by 7.6 %).
+    #[arg(long, default_value = "crawfis-max", value_parser = ["gaussian", "cubic", "narrow", "crawfis-max"], conflicts_with = "session")]
+    pub kernel: String,
+    /// With --raycast: cast K x K rays per pixel and average them (the converged reference that
+    /// levels of detail and anti-aliasing are scored against; 4 with --raycast 0.25 is the one
+    /// docs/MODEL.md checks).
+    #[arg(long, default_value_t = 1, requires = "raycast")]
+    pub supersample: u32,
+    /// With --raycast: transmittance below which a ray stops.
+    #[arg(long, value_parser = parse_finite, requires = "raycast")]
+    pub raycast_stop: Option<f32>,
+    /// Render the frame this many times and report each stage's median (the first frames pay
+    /// one-off costs: allocation, shader compilation on some drivers).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..),
+        conflicts_with_all = ["raycast", "plan"])]
+    pub repeat: u32,
+}
+
+impl Default for Research {
+    /// What `voxsplat render` draws with: each switch's default.
+    fn default() -> Self {
+        Self {
+            keep_hidden_bricks: false,
+            every_voxel: false,
+            slab_thickness: None,
+            lod_band: None,
+            lod_nodes: false,
+            k_line: false,
+            direction: None,
+            sheet_budget_mib: None,
+            truth: false,
+            accumulate: "splat".into(),
+            early_termination: voxsplat::options::DEFAULT_EARLY_TERMINATION,
+            raster: "auto".into(),
+            lod_pixels: voxsplat::options::DEFAULT_LOD_PIXELS,
+            lod_error: voxsplat::options::DEFAULT_LOD_ERROR,
+            kernel: "crawfis-max".into(),
+            supersample: 1,
+            raycast_stop: None,
+            repeat: 1,
+        }
+    }
 }
 
 #[derive(Args)]
@@ -88,21 +162,6 @@ pub struct RenderArgs {
     /// --mode iso, the surface takes the colour at its value [default: bone].
     #[arg(help_heading = "Transfer function and mode", long)]
     pub colormap: Option<String>,
-    /// Per-splat compositing, Westover's axis-aligned sheet summation buffer, or image-aligned sheets
-    /// (slabs parallel to the image plane, Mueller & Crawfis 1998).
-    #[arg(help_heading = "Quality and speed", long, default_value = "splat", value_parser = ["splat", "sheet", "slab"])]
-    pub composite: String,
-    /// Front to back, stop drawing where what is drawn already lets at most this much light
-    /// through (0 = off; the default, a quarter of an 8-bit step, changes a value by at most one
-    /// step). No pixel changes by more than this.
-    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_EARLY_TERMINATION)]
-    pub early_termination: f32,
-    /// How footprints become pixels: instanced quads (graphics), point sprites (points), compute
-    /// shaders (tile compositing / fixed-point sheet sums), or auto (on a CPU device: compute for
-    /// small footprints, else point sprites where they fit, else graphics; graphics on hardware; it
-    /// prints what it picked).
-    #[arg(help_heading = "Quality and speed", long, default_value = "auto", value_parser = ["graphics", "points", "compute", "auto"])]
-    pub raster: String,
     /// Draw on a grid this fraction of --size and resample it bilinearly to full size (1/16 to 1):
     /// faster where voxels cover several pixels; the added error is in docs/RESULTS.md (peers).
     #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value = "1")]
@@ -112,24 +171,6 @@ pub struct RenderArgs {
     /// --lod-error; docs/MODEL.md) or off (every voxel a splat).
     #[arg(help_heading = "Quality and speed", long, value_parser = ["off", "auto"])]
     pub lod: Option<String>,
-    /// Largest projected cell spacing of a coarse level, in pixels (above 0, at most 64).
-    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_PIXELS)]
-    pub lod_pixels: f32,
-    /// Largest error of a coarse level, 0 to 3: how far a cell's children depart from it, or its
-    /// neighbours from its linear continuation, in the opacity a ray crossing a brick (8 voxels) sees
-    /// (summed down the levels), times the share of a pixel a cell smaller than one covers, and up to
-    /// 4 times more where the view runs along a grid axis. On translucent volumes about the largest
-    /// change of a pixel (0.04: about 10 steps of 8 bits). 3: no bound; 0: only cells equal to their
-    /// children coarsen.
-    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, default_value_t = voxsplat::options::DEFAULT_LOD_ERROR)]
-    pub lod_error: f32,
-    /// Reconstruction kernel: the piecewise cubic fitted by Crawfis and Max's criterion (the
-    /// default: radius 1.6, flat sheets stay flat to 0.37 %, closest to the ray-cast picture but for
-    /// narrow), Westover's Gaussian (sigma 0.6, radius 2: softer), the Hermite cubic of Crawfis and
-    /// Max's support (radius 1.6), or a narrow Gaussian (sigma 0.5, radius 1.5: sharpest and
-    /// fewest fragments, but flat sheets ripple by 7.6 %).
-    #[arg(help_heading = "Quality and speed", long, default_value = "crawfis-max", value_parser = ["gaussian", "cubic", "narrow", "crawfis-max"])]
-    pub kernel: String,
     /// Anti-aliasing of distant splats (chapter 3): none, Swan's d/k scaling, or an EWA low-pass.
     /// [default: none]
     #[arg(help_heading = "Quality and speed", long, value_parser = ["none", "swan", "ewa"])]
@@ -137,14 +178,6 @@ pub struct RenderArgs {
     /// Render with the ray caster at this step (in voxel spacings) instead of splatting.
     #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite)]
     pub raycast: Option<f32>,
-    /// With --raycast: cast K x K rays per pixel and average them (the converged reference that
-    /// levels of detail and anti-aliasing are scored against; 4 with --raycast 0.25 is the one
-    /// docs/MODEL.md checks).
-    #[arg(help_heading = "Quality and speed", long, default_value_t = 1, requires = "raycast")]
-    pub supersample: u32,
-    /// With --raycast: transmittance below which a ray stops.
-    #[arg(help_heading = "Quality and speed", long, value_parser = parse_finite, requires = "raycast")]
-    pub raycast_stop: Option<f32>,
     /// Print per-stage times.
     #[arg(help_heading = "Output", long)]
     pub timings: bool,
@@ -153,20 +186,14 @@ pub struct RenderArgs {
     /// 4 ranks).
     #[arg(help_heading = "Output", long)]
     pub exchange: Option<String>,
-    /// Render the frame this many times and report each stage's median (the first frames pay
-    /// one-off costs: allocation, shader compilation on some drivers).
-    #[arg(help_heading = "Output", long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..),
-        conflicts_with = "raycast")]
-    pub repeat: u32,
     /// Print what the frame would draw and how (the raster, the order, the sheet batches, a
     /// volume's memory split and levels of detail) instead of rendering it.
-    #[arg(help_heading = "Output", long, conflicts_with_all = ["raycast", "out", "repeat", "timings"])]
+    #[arg(help_heading = "Output", long, conflicts_with_all = ["raycast", "out", "timings"])]
     pub plan: bool,
     /// Draw a session the viewer saved (its camera, transfer function, shading, mode, clipping and
     /// the options its keys change) of the same --volume, at --size.
     #[arg(help_heading = "Scene and file", long, requires = "volume", conflicts_with_all = ["eye", "target", "up", "fov", "ortho", "near", "far",
-        "view", "tf", "shade", "no_shade", "mode", "iso", "order", "composite", "raster", "lod", "kernel",
-        "background", "clip", "crop"])]
+        "view", "tf", "shade", "mode", "iso", "lod", "background", "clip", "crop"])]
     pub session: Option<PathBuf>,
     /// Output file, .png or .exr.
     #[arg(help_heading = "Output", long, required_unless_present = "plan")]
@@ -180,13 +207,18 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
         if a.scene.volume.is_none() {
             return Err(Error::InvalidArgument("--session draws the --volume it was saved from: give it".into()));
         }
+        // (clap's conflicts cannot name --order: it is `SceneResearch`'s, which `voxsplat-lab order`
+        // also takes, without --session.)
+        if a.scene.research.order != "pbtf" {
+            return Err(Error::InvalidArgument("--order with --session: the session sets the order".into()));
+        }
         let s = crate::session::Session::load(path)?;
-        (a.mode, a.composite, a.raster, a.kernel) =
+        (a.mode, a.research.accumulate, a.research.raster, a.research.kernel) =
             (s.mode.clone(), s.composite.clone(), s.raster.clone(), s.kernel.clone());
         a.background = Some(s.background);
         // A projection draws in no order and without levels of detail, whatever the viewer had set.
         if s.mode == "composite" {
-            (a.scene.order, a.lod) = (s.order.clone(), Some(s.lod.clone()));
+            (a.scene.research.order, a.lod) = (s.order.clone(), Some(s.lod.clone()));
         }
         a.scene.session = Some(s);
     }
@@ -201,8 +233,8 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     if !a.plan {
         voxsplat::output::ImageFormat::of(&out)?;
     }
-    let order = a.scene.order.parse::<OrderKind>()?;
-    let composite = a.composite.parse::<Composite>()?;
+    let order = a.scene.research.order.parse::<OrderKind>()?;
+    let composite = a.research.accumulate.parse::<Composite>()?;
     let mode = a.mode.parse::<voxsplat::options::Mode>()?;
     if mode.is_projection() {
         let refuse = |flag: &str, why: &str| Err(Error::InvalidArgument(format!("--mode {mode} {flag}: {why}")));
@@ -212,10 +244,11 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
         if a.research.k_line {
             return refuse("--k-line", "the k line marks where composited splats grow; use --mode composite");
         }
-        if a.scene.order != "pbtf" {
+        if a.scene.research.order != "pbtf" {
             return refuse("--order", "a projection draws in no order");
         }
-        if a.early_termination != voxsplat::options::DEFAULT_EARLY_TERMINATION || a.research.keep_hidden_bricks {
+        if a.research.early_termination != voxsplat::options::DEFAULT_EARLY_TERMINATION || a.research.keep_hidden_bricks
+        {
             return refuse("early termination", "a projection reads every splat along the ray");
         }
         if a.lod.as_deref() == Some("auto") || a.research.lod_nodes {
@@ -249,7 +282,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     opts.colormap = a.colormap.as_deref().map(load_tf).transpose()?;
     opts.order = order;
     opts.composite = composite;
-    opts.kernel = a.kernel.parse::<Kernel>()?;
+    opts.kernel = a.research.kernel.parse::<Kernel>()?;
     opts.antialias = a.aa.as_deref().unwrap_or("none").parse::<voxsplat::options::Antialias>()?;
     if a.aa.is_some() && a.raycast.is_some() {
         return Err(Error::InvalidArgument(
@@ -266,7 +299,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     if let Some(mib) = a.research.sheet_budget_mib {
         if composite == Composite::Splat || a.raycast.is_some() || a.research.truth {
             return Err(Error::InvalidArgument(
-                "--sheet-budget-mib bounds the summation layers of --composite sheet or slab; this frame draws none"
+                "--sheet-budget-mib bounds the summation layers of --accumulate sheet or slab; this frame draws none"
                     .into(),
             ));
         }
@@ -275,15 +308,15 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     if let Some(t) = a.research.slab_thickness {
         if composite != Composite::Slab {
             return Err(Error::InvalidArgument(
-                "--slab-thickness sets the slabs of --composite slab; this frame draws no slabs".into(),
+                "--slab-thickness sets the slabs of --accumulate slab; this frame draws no slabs".into(),
             ));
         }
         opts.slab_thickness = t;
     }
-    opts.early_termination = a.early_termination;
+    opts.early_termination = a.research.early_termination;
     opts.cull_hidden_bricks = !a.research.keep_hidden_bricks;
     opts.every_voxel = a.research.every_voxel;
-    opts.raster = a.raster.parse::<voxsplat::options::Raster>()?;
+    opts.raster = a.research.raster.parse::<voxsplat::options::Raster>()?;
     opts.render_scale = a.render_scale;
     opts.lod = a.lod.as_deref().unwrap_or("auto").parse()?;
     let planes: Vec<voxsplat::glam::Vec4> = a.clip.iter().map(|p| voxsplat::glam::Vec4::from(*p)).collect();
@@ -294,7 +327,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
         opts.clip = s.clip()?;
     }
     opts.background = a.background;
-    (opts.lod_pixels, opts.lod_error) = (a.lod_pixels, a.lod_error);
+    (opts.lod_pixels, opts.lod_error) = (a.research.lod_pixels, a.research.lod_error);
     if let Some(band) = a.research.lod_band {
         opts.lod_band = band;
     }
@@ -344,7 +377,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
     };
     if let Some(flag) = asked.filter(|_| bricked.is_none() || composite != Composite::Splat) {
         return Err(Error::InvalidArgument(format!(
-            "{flag}: levels of detail are drawn per splat (--composite splat) from a volume's bricked store; \
+            "{flag}: levels of detail are drawn per splat (--accumulate splat) from a volume's bricked store; \
              this scene is a classified splat set (a built-in scene, --dense, another order, --truth, --raycast)"
         )));
     }
@@ -408,10 +441,10 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
                     step,
                     render_scale: a.render_scale,
                     clip: opts.clip,
-                    supersample: a.supersample,
+                    supersample: a.research.supersample,
                     ..Default::default()
                 };
-                if let Some(stop) = a.raycast_stop {
+                if let Some(stop) = a.research.raycast_stop {
                     o.min_transmittance = stop;
                 }
                 r.raycast(&cam, &o)?
@@ -427,7 +460,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
                 let image = voxsplat::image::ImageF32::new(0, 0);
                 voxsplat::Rendered { image, timings: d.timings, raster: Some(d.raster), stats: d.stats }
             }
-            None => median_timings((0..a.repeat).map(|_| {
+            None => median_timings((0..a.research.repeat).map(|_| {
                 let t = std::time::Instant::now();
                 let f = r.render(&cam, &opts);
                 wall.push(t.elapsed().as_secs_f64() * 1e3);
@@ -502,7 +535,7 @@ pub fn render(mut a: Box<RenderArgs>) -> Result<()> {
 /// (`voxsplat::low_level::frame_bands`) drawn once, with nothing to add to the whole frame after it.
 fn streams(a: &RenderArgs, cam: &voxsplat::Camera, out: &std::path::Path) -> Result<bool> {
     let png = voxsplat::output::ImageFormat::of(out)? == voxsplat::output::ImageFormat::Png;
-    Ok(png && a.repeat == 1 && !a.research.k_line && voxsplat::low_level::frame_bands(cam).len() > 1)
+    Ok(png && a.research.repeat == 1 && !a.research.k_line && voxsplat::low_level::frame_bands(cam).len() > 1)
 }
 
 /// The last of `frames` with each stage's median time over all of them, keeping one image at a
@@ -584,7 +617,7 @@ fn distributed_frames(
     let cam = d.agree(camera_of(&a.scene, &grid, &content))?;
     let stored = d.stored_per_rank();
     let mut frames = Vec::new();
-    for _ in 0..a.repeat {
+    for _ in 0..a.research.repeat {
         frames.push(d.render(&cam, opts)?);
     }
     d.agree(report_validation(d.renderer()))?;
@@ -638,15 +671,18 @@ mod tests {
         let a = Cmd::try_parse_from(["render", "--out", "frame.png"]).unwrap().render;
         let d = RenderOptions::default();
         assert_eq!(a.mode.parse::<voxsplat::options::Mode>().unwrap(), d.mode);
-        assert_eq!(a.scene.order.parse::<OrderKind>().unwrap(), d.order);
-        assert_eq!(a.composite.parse::<Composite>().unwrap(), d.composite);
-        assert_eq!(a.kernel.parse::<Kernel>().unwrap(), d.kernel);
+        assert_eq!(a.scene.research.order.parse::<OrderKind>().unwrap(), d.order);
+        assert_eq!(a.research.accumulate.parse::<Composite>().unwrap(), d.composite);
+        assert_eq!(a.research.kernel.parse::<Kernel>().unwrap(), d.kernel);
         assert_eq!(a.aa, None);
         assert_eq!(voxsplat::options::Antialias::None, d.antialias);
-        assert_eq!(a.raster.parse::<voxsplat::options::Raster>().unwrap(), d.raster);
+        assert_eq!(a.research.raster.parse::<voxsplat::options::Raster>().unwrap(), d.raster);
         assert_eq!(a.lod.as_deref().unwrap_or("auto").parse::<voxsplat::options::Lod>().unwrap(), d.lod);
-        assert_eq!((a.lod_pixels, a.lod_error, a.research.lod_band), (d.lod_pixels, d.lod_error, None));
-        assert_eq!((a.early_termination, a.render_scale), (d.early_termination, d.render_scale));
+        assert_eq!(
+            (a.research.lod_pixels, a.research.lod_error, a.research.lod_band),
+            (d.lod_pixels, d.lod_error, None)
+        );
+        assert_eq!((a.research.early_termination, a.render_scale), (d.early_termination, d.render_scale));
         assert_eq!((a.research.sheet_budget_mib, mib_bytes(256, "").unwrap()), (None, d.sheet_budget_bytes));
         assert_eq!((a.research.direction.is_none(), d.direction.is_none()), (true, true));
         assert_eq!(a.background, d.background);

@@ -105,13 +105,12 @@ pub struct SceneArgs {
     /// ramp].
     #[arg(help_heading = "Transfer function and mode", long)]
     pub tf: Option<String>,
-    /// Phong shading with a headlight, applied to the voxels before splatting (on by default for
-    /// the presets it measurably helps: bonsai).
-    #[arg(help_heading = "Transfer function and mode", long, conflicts_with = "no_shade")]
-    pub shade: bool,
-    /// No shading, even for a preset shaded by default.
-    #[arg(help_heading = "Transfer function and mode", long)]
-    pub no_shade: bool,
+    /// Phong shading with a headlight, applied to the voxels before splatting: `--shade` (or
+    /// `--shade on`) lights the volume, `--shade off` leaves it unlit [default: on for the presets
+    /// it measurably helps (bonsai), off otherwise].
+    #[arg(help_heading = "Transfer function and mode", long, num_args = 0..=1, default_missing_value = "on",
+        value_parser = ["on", "off"])]
+    pub shade: Option<String>,
     /// A label volume (a segmentation: one whole number per voxel, u8, u16 or u32) coloured by
     /// --label-table, drawn alone or over the --volume on the same grid (the two added per voxel).
     /// Label 0 is the background; voxels whose label the table lacks are hidden and counted.
@@ -142,11 +141,9 @@ pub struct SceneArgs {
     /// Horizontal cell size of --terrain, in height units (0: relief a sixth of the width).
     #[arg(help_heading = "Scene and file", long, value_parser = parse_finite, default_value = "0")]
     pub cell: f32,
-    /// Visibility order.
-    #[arg(help_heading = "Quality and speed", long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
-    pub order: String,
     /// Render on the CPU instead of the Vulkan device: every GPU step has a CPU twin that computes
-    /// the same picture to within rounding (slower; for checking a device).
+    /// the same picture to within rounding (slower; for a machine without Vulkan, or checking a
+    /// device).
     #[arg(help_heading = "Quality and speed", long)]
     pub cpu: bool,
     /// Enable the Khronos validation layer and report its messages.
@@ -158,9 +155,10 @@ pub struct SceneArgs {
     pub gpu_budget_mib: Option<u64>,
 }
 
-/// The scene switches of `voxsplat-lab render` that pick the engine's path rather than the picture:
-/// the split between the device and the mirrors, and the host's classification.
-#[derive(Args, Clone, Debug, Default)]
+/// The scene switches of `voxsplat-lab render` and `order` that pick the engine's path rather than
+/// the picture: the split between the device and the mirrors, the host's classification and the
+/// visibility order.
+#[derive(Args, Clone, Debug)]
 #[command(next_help_heading = "Research")]
 pub struct SceneResearch {
     /// Split each frame between Vulkan and the CPU mirrors at a stage, to find the stage that
@@ -174,4 +172,22 @@ pub struct SceneResearch {
     /// detail need it).
     #[arg(long)]
     pub dense: bool,
+    /// Visibility order: PBTF (the default; the device orders a bricked volume), or one of the
+    /// host's orders over a splat set: back to front, weighted BTF, sorted by depth, PBTF by octant.
+    #[arg(long, default_value = "pbtf", value_parser = ["btf", "wbtf", "pbtf", "sorted", "pbtf-octant"])]
+    pub order: String,
+}
+
+impl SceneArgs {
+    /// `--shade`'s answer: lit, unlit, or the preset's default (`None`).
+    pub fn shading(&self) -> Option<bool> {
+        self.shade.as_deref().map(|s| s == "on")
+    }
+}
+
+impl Default for SceneResearch {
+    /// What `voxsplat` draws with: each switch's default.
+    fn default() -> Self {
+        Self { bisect: None, dense: false, order: "pbtf".into() }
+    }
 }

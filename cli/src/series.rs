@@ -44,7 +44,6 @@ impl Series {
             (a.positions.is_some(), "--positions", "a series plays from its bricked store, on a uniform grid"),
             (a.labels.is_some(), "--labels", "a series plays one scalar volume"),
             (!a.channels.is_empty() || !a.channel_tfs.is_empty(), "--channel", "a series plays one scalar volume"),
-            (a.order != "pbtf", "--order", "a series plays from its bricked store, in PBTF order"),
         ];
         if let Some((_, flag, why)) = refused.iter().find(|r| r.0) {
             return Err(Error::InvalidArgument(format!("{flag} with a series: {why}")));

@@ -40,7 +40,7 @@ pub struct Session {
     pub mode: String,
     /// --mode iso's value, normalised to 0..1 over the store's range (`RenderOptions::iso`).
     pub iso: Option<f32>,
-    /// As `render --order`, `--composite`, `--raster`, `--lod` and `--kernel`.
+    /// As `render --lod`, and `voxsplat-lab render`'s `--order`, `--accumulate`, `--raster` and `--kernel`.
     pub order: String,
     pub composite: String,
     pub raster: String,

@@ -66,7 +66,7 @@ pub struct ViewArgs {
     /// Open a saved session (`s`, or a script's `session`) of the same --volume: its camera,
     /// transfer function, shading, mode and options.
     #[arg(long, requires = "volume", conflicts_with_all = ["eye", "target", "up", "fov", "ortho", "near", "far",
-        "view", "tf", "shade", "no_shade", "order"])]
+        "view", "tf", "shade"])]
     pub session: Option<PathBuf>,
     /// Run a script of synthetic pointer and key events, one line a frame, then exit (tests;
     /// docs/guide/cli.md lists its commands).
@@ -121,7 +121,7 @@ impl App {
         // Opaque black behind the volume: the window shows no transparency.
         options.background = Some([0.0, 0.0, 0.0, 1.0]);
         let kernel = options.kernel.name().to_string();
-        let mut names = (scene.order.clone(), "splat".to_string(), "auto".to_string(), kernel);
+        let mut names = (scene.research.order.clone(), "splat".to_string(), "auto".to_string(), kernel);
         let (mut clip_planes, mut crop) = (Vec::new(), None);
         if let Some(path) = &session {
             if scene.volume.is_none() {

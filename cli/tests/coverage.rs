@@ -386,7 +386,7 @@ fn the_binary_covers_what_its_ray_cast_covers_or_refuses() {
                 let mut extra = vec![
                     "--aa",
                     aa,
-                    "--composite",
+                    "--accumulate",
                     composite,
                     "--raster",
                     raster,

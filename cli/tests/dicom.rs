@@ -386,7 +386,7 @@ fn an_enhanced_image_is_placed_by_its_functional_groups_as_dcm2niix_places_it() 
             "render",
             "--volume",
             s,
-            "--composite",
+            "--accumulate",
             "sheet",
             "--size",
             "64x64",

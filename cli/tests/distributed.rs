@@ -171,7 +171,7 @@ fn what_cannot_be_split_is_refused_on_every_rank() {
     let out = tmp("refused.png");
     let o = out.to_str().unwrap();
     let cases: [(&[&str], &str); 2] = [
-        (&["render", "--volume", STENT, "--composite", "sheet", "--size", "64x64", "--out", o], "SCALE.md"),
+        (&["render", "--volume", STENT, "--accumulate", "sheet", "--size", "64x64", "--out", o], "SCALE.md"),
         (&["render", "--scene", "cube40", "--size", "64x64", "--out", o], "--volume file"),
     ];
     for (args, why) in cases {

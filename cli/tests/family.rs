@@ -297,7 +297,9 @@ fn the_reference_cast_clump_by_clump_is_the_whole_cast() {
     });
     let file = vol.write(&dir.join("sparse.nrrd")).to_str().unwrap().to_string();
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/sparse-truth.py");
-    let vs = env!("CARGO_BIN_EXE_voxsplat");
+    // The reference's settings (--raycast-stop, --supersample, --cpu) are the lab's render's.
+    let vs = cmd::lab_binary();
+    let vs = vs.to_str().unwrap();
     let python = |args: &[&str]| {
         let out = std::process::Command::new("python3").arg(script).args(args).output().expect("python3");
         assert!(out.status.success(), "sparse-truth.py {args:?}: {}", String::from_utf8_lossy(&out.stderr));

@@ -38,7 +38,7 @@ fn bad_values_are_refused_with_a_reason() {
     fails_with(&["render", "--size", "32x32", "--eye", "0,0,0", "--out", out], "give --target too");
     let inside = voxsplat(&["render", "--size", "32x32", "--eye", "0,0,0", "--target", "0,0,-10", "--out", out]);
     assert!(inside.status.success(), "{}", String::from_utf8_lossy(&inside.stderr));
-    fails_with(&["render", "--composite", "sheet", "--sheet-budget-mib", "17592186044416", "--out", out], "overflows");
+    fails_with(&["render", "--accumulate", "sheet", "--sheet-budget-mib", "17592186044416", "--out", out], "overflows");
     fails_with(&["render", "--gpu-budget-mib", "0", "--out", out], "must be positive");
     // A spacing the camera cannot resolve is a spacing error (it was "eye and target coincide").
     let stent = data("stent/stent.nrrd");
@@ -284,7 +284,7 @@ fn flags_that_were_silently_ignored_are_refused() {
     assert!(!dir.join("frame0000.png").exists(), "refused before a frame");
     // What does apply still runs.
     for args in [
-        vec!["render", "--composite", "sheet", "--sheet-budget-mib", "64"],
+        vec!["render", "--accumulate", "sheet", "--sheet-budget-mib", "64"],
         vec!["render", "--volume", &stent, "--keep-hidden-bricks", "--aa", "swan"],
         vec!["render", "--repeat", "2"],
     ] {
@@ -354,7 +354,7 @@ fn flags_that_cannot_apply_are_refused() {
     // What does apply still runs.
     for args in [
         vec!["render", "--volume", &stent, "--tf", "ct"],
-        vec!["render", "--scene", "cube60", "--composite", "slab", "--slab-thickness", "2"],
+        vec!["render", "--scene", "cube60", "--accumulate", "slab", "--slab-thickness", "2"],
     ] {
         let run = voxsplat(&[&args[..], &["--size", "32x32", "--out", o]].concat());
         assert!(run.status.success(), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));

@@ -29,7 +29,8 @@ fn settings(name: &str, log: &Path) -> PathBuf {
 /// `voxsplat render --validation ARGS` under the layer settings `path`: its exit and its output.
 fn render(path: &Path, args: &[&str]) -> (bool, String) {
     let out = tmp("layers.png");
-    let o = Command::new(env!("CARGO_BIN_EXE_voxsplat"))
+    // `voxsplat-lab render`: the user's render with the switches that pick a path (--raster).
+    let o = Command::new(crate::cmd::lab_binary())
         .env("VK_LAYER_SETTINGS_PATH", path)
         .args(["render", "--validation", "--size", "48x48", "--out", out.to_str().unwrap()])
         .args(args)

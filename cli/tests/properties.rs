@@ -31,7 +31,7 @@ proptest! {
     ) {
         let out = std::env::temp_dir().join(format!("voxsplat-prop-{}.{}", std::process::id(), if exr { "exr" } else { "png" }));
         let size = format!("{w}x{h}");
-        let mut args: Vec<String> = ["render", "--scene", scene, "--size", &size, "--composite", composite, "--raster", raster,
+        let mut args: Vec<String> = ["render", "--scene", scene, "--size", &size, "--accumulate", composite, "--raster", raster,
             "--kernel", kernel, "--aa", aa, "--order", order, "--out", out.to_str().unwrap()]
             .iter().map(|s| s.to_string()).collect();
         if let Some((x, y, z)) = eye {

@@ -347,7 +347,7 @@ fn a_cropped_image_reads_only_the_chunks_its_box_needs() {
     let tf = dir.join("tf.toml");
     cmd::tf_file(&tf, 0.0, 255.0);
     let view =
-        ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--composite", "sheet", "--tf", tf.to_str().unwrap()];
+        ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--accumulate", "sheet", "--tf", tf.to_str().unwrap()];
     let draw = |args: &[&str], out: &str| -> (u32, String) {
         let base = ["render", "--volume", path.to_str().unwrap(), "--size", "48x48", "--validation", "--out"];
         let o = voxsplat(&[&base[..], &[dir.join(out).to_str().unwrap()], args].concat());
@@ -644,7 +644,7 @@ fn a_series_seen_in_part_reads_only_that_part_at_each_time_point() {
     cmd::tf_file(&tf, 0.0, 255.0);
     let (p, t) = (path.to_str().unwrap(), tf.to_str().unwrap());
     let view =
-        ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--tf", t, "--size", "48x48", "--composite", "sheet"];
+        ["--eye", "300,0,0", "--target", "0,0,0", "--fov", "10", "--tf", t, "--size", "48x48", "--accumulate", "sheet"];
     let frames = dir.join("frames");
     let o = voxsplat(
         &[&["animate", "--volume", p, "--validation", "--out-dir", frames.to_str().unwrap()], &view[..]].concat(),

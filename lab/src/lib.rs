@@ -2,7 +2,7 @@
 //! charts (`bench`), anti-aliasing on the seed's terrain and orthographic figures (`antialias`),
 //! where methods fail (`stability`), the raster-rate sweep (`rates`), the peers' comparison
 //! (`peer`), the reconstruction kernels (`kernels`), the rendering modes (`modes`), orders under
-//! motion (`motion_orders`), bricked volumes (`bricked`) and long runs (`soak`). The
+//! motion (`motion_orders`), a view's visibility order (`order`), bricked volumes (`bricked`) and long runs (`soak`). The
 //! `voxsplat-lab` binary runs them; it builds on the user's command line (`voxsplat_cli`), and
 //! neither the `voxsplat` binary nor the library needs any of this.
 pub mod antialias;
@@ -11,6 +11,7 @@ pub mod bricked;
 pub mod kernels;
 pub mod modes;
 pub mod motion_orders;
+pub mod order;
 pub mod peer;
 pub mod rates;
 pub mod soak;

@@ -44,6 +44,9 @@ enum Study {
     /// `voxsplat render` with the research switches: the volumetric-summation truth, the k line,
     /// the engine's paths (--dense, --bisect, --direction, ...) and budgets.
     Render(Box<LabRender>),
+    /// Write or check a visibility order (back to front): the device's PBTF order or the host's
+    /// (--order).
+    Order(Box<voxsplat_lab::order::OrderArgs>),
     /// Render many frames with changing scenes, cameras and modes; report host memory and GPU
     /// allocations per cycle (they must stay flat after warm-up).
     Soak {
@@ -260,6 +263,7 @@ fn run(study: Study) -> Result<()> {
             (render.research, render.scene.research) = (research, scene_research);
             voxsplat_cli::render::render(Box::new(render))
         }
+        Study::Order(a) => voxsplat_lab::order::run(*a),
         Study::Series(a) => {
             print!("{}", voxsplat_cli::series::study(&a)?);
             Ok(())

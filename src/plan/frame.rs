@@ -189,7 +189,7 @@ pub fn frame(prep: &Prepared, camera: &Camera, opts: &RenderOptions, limits: &Li
     if depth.is_some() {
         if opts.composite != Composite::Splat {
             return Err(Error::InvalidArgument(
-                "the host's depth hides splats per pixel as they are composited: use --composite splat".into(),
+                "the host's depth hides splats per pixel as they are composited: use --accumulate splat".into(),
             ));
         }
         if opts.motion.is_some() && opts.raster == Raster::Compute {

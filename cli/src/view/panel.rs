@@ -118,7 +118,7 @@ fn controls(ui: &mut egui::Ui, s: &mut State, store: Option<&BrickStore>) {
         }
     }
     choice(ui, "order", ORDERS, &mut s.order, &mut s.dirty);
-    choice(ui, "compositing", COMPOSITES, &mut s.composite, &mut s.dirty);
+    choice(ui, "accumulate", COMPOSITES, &mut s.composite, &mut s.dirty);
     choice(ui, "raster", RASTERS, &mut s.raster, &mut s.dirty);
     choice(ui, "kernel", KERNELS, &mut s.kernel, &mut s.dirty);
     ui.horizontal(|ui| {

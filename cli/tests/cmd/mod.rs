@@ -3,7 +3,7 @@
 use std::process::{Command, Output};
 
 /// The research switches of `render`, which only `voxsplat-lab render` takes.
-pub const RESEARCH: [&str; 11] = [
+pub const RESEARCH: [&str; 21] = [
     "--truth",
     "--k-line",
     "--bisect",
@@ -15,15 +15,29 @@ pub const RESEARCH: [&str; 11] = [
     "--direction",
     "--keep-hidden-bricks",
     "--slab-thickness",
+    "--accumulate",
+    "--early-termination",
+    "--raster",
+    "--lod-pixels",
+    "--lod-error",
+    "--kernel",
+    "--supersample",
+    "--raycast-stop",
+    "--repeat",
+    "--order",
 ];
 
-/// `voxsplat ARGS`, waited for. Two kinds run the lab's binary: `["lab", STUDY, ...]` runs
-/// `voxsplat-lab STUDY ...`, and a `render` with a research switch (`RESEARCH`) runs as
-/// `voxsplat-lab render` (the same command with those switches).
+/// `voxsplat ARGS`, waited for. Three kinds run the lab's binary: `["lab", STUDY, ...]` runs
+/// `voxsplat-lab STUDY ...`, a `render` with a research switch (`RESEARCH`) runs as
+/// `voxsplat-lab render` (the same command with those switches), and `order` (a study since
+/// issue 77) as `voxsplat-lab order`.
 pub fn voxsplat(args: &[&str]) -> Output {
     let (bin, args) = match args {
         ["lab", rest @ ..] => (lab_binary(), rest),
-        ["render", ..] if args.iter().any(|a| RESEARCH.contains(a)) => (lab_binary(), args),
+        ["render", ..] if args.iter().any(|a| RESEARCH.contains(&a.split('=').next().unwrap_or(a))) => {
+            (lab_binary(), args)
+        }
+        ["order", ..] => (lab_binary(), args),
         _ => (std::path::PathBuf::from(env!("CARGO_BIN_EXE_voxsplat")), args),
     };
     Command::new(&bin).args(args).output().unwrap_or_else(|e| panic!("run {}: {e}", bin.display()))
