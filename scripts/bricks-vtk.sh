@@ -28,7 +28,7 @@ length, voxsplat's framing camera) and voxsplat's bricked GPU path (`voxsplat-la
 own process per file), 512², 5 frames after a warm-up, medians. voxsplat alternates full detail
 with levels of detail (`--lod auto`, 1 px; PSNR against its own full detail): the fifth column is
 the levels of detail's moonshot, LOD frame time against VTK's. The last column holds both frames' PSNR against a
-converged truth, the supersampled reference (`render --raycast 0.25 --supersample 4 --raycast-stop
+converged truth, the supersampled reference (`voxsplat-lab render --raycast 0.25 --supersample 4 --raycast-stop
 1e-4 --cpu`: 4 x 4 rays per pixel, trilinear scalars through the same transfer function;
 docs/MODEL.md), for the files the dense loaders take (at most 2²⁸ voxels; not the 1024³).
 

@@ -5,7 +5,7 @@
 # defaults, at the previous defaults (Gaussian kernel, no early termination, no levels of detail),
 # and VTK's fixed-point CPU ray caster (scripts/vtk_file.py: same camera, shading as voxsplat's
 # preset has it), alternating the tools file by file in one run. Frame times are wall-clock medians
-# of $FRAMES frames after a warm-up (voxsplat: `render --repeat`, the first frame dropped by taking
+# of $FRAMES frames after a warm-up (voxsplat: `voxsplat-lab render --repeat`, the first frame dropped by taking
 # the median). PSNR against the supersampled reference (scripts/reference.sh; files the dense
 # loaders take). Prints markdown tables.
 set -euo pipefail

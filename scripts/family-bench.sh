@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The defaults on volumes nobody tuned them for (issue 75): each member of scripts/family.py's
 # family, at each size and view, drawn with the defaults and with --lod off, both scored against
-# the supersampled CPU ray caster (`render --raycast 0.25 --raycast-stop 1e-4 --cpu --supersample
+# the supersampled CPU ray caster (`voxsplat-lab render --raycast 0.25 --raycast-stop 1e-4 --cpu --supersample
 # K`, K x K rays a pixel: $K, or by default 512 / size and at least 2, times side / 512 past 512
 # voxels a side, so that a volume's thumbnail still has a ray for about every voxel across) by PSNR over the covered pixels (`voxsplat compare`'s first figure), with the median frame
 # time of $FRAMES frames (stage times summed). Prints a markdown table; a row whose default lies

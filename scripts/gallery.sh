@@ -3,7 +3,7 @@
 # the T1 head phantom (make-volume --phantom; no brain MRI in ../shared/data)
 # at 512², voxsplat beside VTK's GPU ray caster (vtkGPUVolumeRayCastMapper on llvmpipe through EGL),
 # the same file, preset and view (voxsplat's default camera, handed to VTK: scripts/vtk_file.py
-# --camera), in one run, the two tools alternating file by file. voxsplat: `render --repeat 5
+# --camera), in one run, the two tools alternating file by file. voxsplat: `voxsplat-lab render --repeat 5
 # --timings` (default path, median of each stage, summed); VTK: median of 5 frames after a warm-up.
 # PSNR over the object (scripts/gallery.py), and the luminance contrast over the object of each
 # voxsplat frame (std / mean; the shaded rows against the unshaded decide `SHADED_PRESETS`).

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The honest reference and what scores against it (docs/MODEL.md, "The reference"): per gallery
 # file at 512² and its default view, the CPU ray caster at 0.25-voxel steps with K x K rays per
-# pixel averaged (`render --raycast 0.25 --supersample K --raycast-stop 1e-4 --cpu`), its
+# pixel averaged (`voxsplat-lab render --raycast 0.25 --supersample K --raycast-stop 1e-4 --cpu`), its
 # convergence (K/2 and 2K rays per axis, and half the step, against it), then voxsplat's frames
 # (the defaults, and each FLAGS set of $VARIANTS) scored against it: median frame time over
 # $FRAMES frames (stage times summed) and PSNR. Truths are cached in $WORK (target/reference).
