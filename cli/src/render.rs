@@ -688,4 +688,23 @@ mod tests {
         assert_eq!(a.background, d.background);
         assert_eq!((a.research.every_voxel, !a.research.keep_hidden_bricks), (d.every_voxel, d.cull_hidden_bricks));
     }
+
+    /// `voxsplat render` takes the research switches' `Default`s, `voxsplat-lab render` their clap
+    /// defaults: the two agree, so the lab's render with no switches is the user's.
+    #[test]
+    fn the_research_switches_default_alike_in_both_binaries() {
+        #[derive(Parser)]
+        struct Lab {
+            #[command(flatten)]
+            render: RenderArgs,
+            #[command(flatten)]
+            research: Research,
+            #[command(flatten)]
+            scene: crate::scene_args::SceneResearch,
+        }
+        let lab = Lab::try_parse_from(["render", "--out", "frame.png"]).unwrap();
+        assert_eq!(format!("{:?}", lab.research), format!("{:?}", Research::default()));
+        assert_eq!(format!("{:?}", lab.scene), format!("{:?}", crate::scene_args::SceneResearch::default()));
+        let _ = lab.render;
+    }
 }

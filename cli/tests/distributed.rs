@@ -15,11 +15,12 @@ fn tmp(name: &str) -> std::path::PathBuf {
     cmd::tmp_in("distributed", name)
 }
 
-/// `mpirun -n RANKS voxsplat ARGS`, killed after two minutes (a hang fails the test).
+/// `mpirun -n RANKS voxsplat ARGS` (`voxsplat-lab` for a render with research switches: both take
+/// the `mpi` feature), killed after two minutes (a hang fails the test).
 fn mpirun(ranks: u32, args: &[&str]) -> Output {
     let mut c = Command::new("timeout");
     c.args(["120", "mpirun", "--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string()]);
-    c.arg(env!("CARGO_BIN_EXE_voxsplat")).args(args);
+    c.arg(cmd::binary_for(args)).args(args);
     c.output().expect("run mpirun (scripts/setup.sh --mpi installs OpenMPI)")
 }
 

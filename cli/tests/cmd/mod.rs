@@ -32,15 +32,20 @@ pub const RESEARCH: [&str; 21] = [
 /// `voxsplat-lab render` (the same command with those switches), and `order` (a study since
 /// issue 77) as `voxsplat-lab order`.
 pub fn voxsplat(args: &[&str]) -> Output {
-    let (bin, args) = match args {
-        ["lab", rest @ ..] => (lab_binary(), rest),
-        ["render", ..] if args.iter().any(|a| RESEARCH.contains(&a.split('=').next().unwrap_or(a))) => {
-            (lab_binary(), args)
-        }
-        ["order", ..] => (lab_binary(), args),
-        _ => (std::path::PathBuf::from(env!("CARGO_BIN_EXE_voxsplat")), args),
-    };
+    let bin = binary_for(args);
+    let args = if args.first() == Some(&"lab") { &args[1..] } else { args };
     Command::new(&bin).args(args).output().unwrap_or_else(|e| panic!("run {}: {e}", bin.display()))
+}
+
+/// The binary that runs `voxsplat ARGS` (`voxsplat` itself or `voxsplat-lab`, as `voxsplat`
+/// says); with `["lab", ...]` the lab's, which takes the rest.
+pub fn binary_for(args: &[&str]) -> std::path::PathBuf {
+    let research = |a: &&str| RESEARCH.contains(&a.split('=').next().unwrap_or(a));
+    match args {
+        ["lab", ..] | ["order", ..] => lab_binary(),
+        ["render", ..] if args.iter().any(research) => lab_binary(),
+        _ => std::path::PathBuf::from(env!("CARGO_BIN_EXE_voxsplat")),
+    }
 }
 
 /// `voxsplat ARGS` itself, whatever they are (`voxsplat` routes some to the lab).
